@@ -1,0 +1,47 @@
+# The two commands in the README work on a fresh machine with Python 3.11, git and make.
+PYTHON ?= python3.11
+VENV   := .venv
+BIN    := $(VENV)/bin
+# Stamp files make each install step run only when pyproject.toml changes.
+STAMP_RUN := $(VENV)/.installed-run
+STAMP_DEV := $(VENV)/.installed-dev
+OUT ?= out
+
+.PHONY: demo test test-slow test-browser lint format bench clean
+
+$(BIN)/python:
+	@command -v $(PYTHON) >/dev/null 2>&1 || { echo "error: $(PYTHON) not found; set PYTHON=/path/to/python3.11" >&2; exit 1; }
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+
+$(STAMP_RUN): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e .
+	@touch $@
+
+$(STAMP_DEV): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e ".[dev]"
+	@touch $@ $(STAMP_RUN)
+
+# Until the end-to-end DAA demo lands, the demo is the ch2 simulator experiment.
+demo: $(STAMP_RUN)
+	$(BIN)/skyradar experiment ch2 --out $(OUT)/ch2
+
+test: $(STAMP_DEV)
+	$(BIN)/python -m pytest -q -m "not slow and not browser"
+
+test-slow: $(STAMP_DEV)
+	$(BIN)/python -m pytest -q -m "slow"
+
+lint: $(STAMP_DEV)
+	$(BIN)/ruff check src tests
+	$(BIN)/ruff format --check src tests
+
+format: $(STAMP_DEV)
+	$(BIN)/ruff format src tests
+	$(BIN)/ruff check --fix src tests
+
+bench: $(STAMP_RUN)
+	$(BIN)/skyradar bench sim --json
+
+clean:
+	rm -rf $(VENV) $(OUT) build *.egg-info src/*.egg-info

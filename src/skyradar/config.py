@@ -1,0 +1,334 @@
+"""Radar hardware description and every quantity derived from it.
+
+The default is the seed prototype of seed-brief.md: a 9.425 GHz sawtooth FMCW radar sweeping
+10 MHz per chirp at 4921 chirps/s, sampled at 10 MHz, 250 chirps per frame, four receive
+antennas in a coplanar 2x2 square, processed to 5 km.
+
+Axis conventions (shared by the image-domain simulator and the raw FFT chain, so their frames
+are interchangeable): range bin ``k`` is centred at ``k * dR`` (the FFT bin of beat frequency
+``k * PRF``), Doppler bin ``j`` at ``(j - nV/2) * dV`` after the FFT shift. Radial velocity is
+positive for a receding target; a velocity outside ``[-VLim, VLim)`` wraps around.
+
+Frames: antenna frame has boresight +x, y right, z down. The :class:`Mount` rotates it into
+the aircraft body frame (forward, right, down).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+
+from skyradar.antenna import AntennaPattern, GainCut
+from skyradar.errors import InputError
+
+__all__ = ["SPEED_OF_LIGHT", "BOLTZMANN", "Mount", "RadarConfig"]
+
+SPEED_OF_LIGHT = 299_792_458.0  # m/s
+BOLTZMANN = 1.380649e-23  # J/K
+
+_MOUNT_PRESETS: dict[str, dict[str, Any]] = {
+    "forward": {"position_m": (2.0, 0.0, 0.0), "yaw_deg": 0.0, "pitch_deg": 0.0, "roll_deg": 0.0},
+    "forward-down": {"position_m": (2.0, 0.0, 0.3), "yaw_deg": 0.0, "pitch_deg": -30.0, "roll_deg": 0.0},
+    "side-right": {"position_m": (0.0, 5.0, 0.0), "yaw_deg": 90.0, "pitch_deg": -30.0, "roll_deg": 0.0},
+    "side-left": {"position_m": (0.0, -5.0, 0.0), "yaw_deg": -90.0, "pitch_deg": -30.0, "roll_deg": 0.0},
+    "sky": {"position_m": (0.0, 0.0, 0.0), "yaw_deg": 0.0, "pitch_deg": 0.0, "roll_deg": 0.0},
+}
+
+
+@dataclass(frozen=True)
+class Mount:
+    """Where the antenna sits on the aircraft and how it is turned.
+
+    Parameters
+    ----------
+    position_m : tuple of float
+        Antenna phase centre in the body frame (forward, right, down), metres.
+    yaw_deg, pitch_deg, roll_deg : float
+        Antenna frame relative to the body frame (ZYX Euler angles, degrees); pitch is
+        positive nose-up, so a forward-down radar has negative pitch.
+
+    Examples
+    --------
+    >>> Mount.preset("forward-down").pitch_deg
+    -30.0
+    """
+
+    position_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    yaw_deg: float = 0.0
+    pitch_deg: float = 0.0
+    roll_deg: float = 0.0
+
+    def __post_init__(self) -> None:
+        pos = tuple(float(v) for v in self.position_m)
+        if len(pos) != 3 or not all(np.isfinite(pos)):
+            raise InputError(f"mount.position_m must be 3 finite numbers, got {self.position_m!r}")
+        object.__setattr__(self, "position_m", pos)
+        for name in ("yaw_deg", "pitch_deg", "roll_deg"):
+            if not np.isfinite(getattr(self, name)):
+                raise InputError(f"mount.{name} must be finite, got {getattr(self, name)!r}")
+
+    @classmethod
+    def preset(cls, name: str) -> Mount:
+        """``forward``, ``forward-down``, ``side-right``, ``side-left`` (wingtips) or ``sky``."""
+        if name not in _MOUNT_PRESETS:
+            raise InputError(f"mount preset {name!r} unknown; choose from {sorted(_MOUNT_PRESETS)}")
+        return cls(**_MOUNT_PRESETS[name])
+
+    @property
+    def rotation(self) -> np.ndarray:
+        """3x3 matrix taking antenna-frame vectors to body-frame vectors."""
+        from skyradar.geo import rotation_matrix
+
+        return rotation_matrix(np.radians(self.yaw_deg), np.radians(self.pitch_deg), np.radians(self.roll_deg))
+
+
+def _square_array(wavelength_m: float) -> np.ndarray:
+    # 2x2 square in the antenna's y-z plane, half-wavelength spacing: unambiguous phase
+    # differences over the whole hemisphere.
+    q = wavelength_m / 4.0
+    return np.array([[0.0, -q, -q], [0.0, q, -q], [0.0, -q, q], [0.0, q, q]])
+
+
+@dataclass(frozen=True)
+class RadarConfig:
+    """FMCW radar hardware parameters and derived axes (SI units throughout).
+
+    Parameters
+    ----------
+    fc_hz : float
+        Carrier frequency, Hz.
+    fs_hz : float
+        ADC sampling frequency (complex), Hz.
+    prf_hz : float
+        Chirp repetition frequency, Hz; one sawtooth chirp fills the repetition interval.
+    pe_dbm : float
+        Emitted power, dBm.
+    bandwidth_hz : float
+        Sweep bandwidth per chirp, Hz.
+    n_doppler : int
+        Chirps per frame (= Doppler bins).
+    range_limit_m : float
+        Processed range (RLim), m.
+    rx_positions_m : ndarray, shape (n_rx, 3)
+        Receive antenna phase centres in the antenna frame, m. Default: 2x2 square,
+        half-wavelength spacing.
+    tx_position_m : ndarray, shape (3,)
+        Transmit antenna phase centre in the antenna frame, m.
+    noise_figure_db : float
+        Receiver noise figure, dB.
+    temperature_k : float
+        Reference noise temperature, K.
+    antenna : AntennaPattern
+        One-way gain pattern (the same for transmit and receive).
+    mount : Mount
+        Antenna placement on the aircraft.
+    rx_calibration : ndarray, shape (n_rx,), complex
+        Per-channel complex gain the measured signal is divided by (1 = uncalibrated).
+
+    Examples
+    --------
+    >>> cfg = RadarConfig.seed_prototype()
+    >>> round(cfg.range_resolution_m, 2), round(cfg.v_lim_mps, 2), cfg.n_range, cfg.n_doppler
+    (14.99, 39.16, 333, 250)
+    """
+
+    fc_hz: float = 9.425e9
+    fs_hz: float = 10e6
+    prf_hz: float = 4921.0
+    pe_dbm: float = 40.0
+    bandwidth_hz: float = 10e6
+    n_doppler: int = 250
+    range_limit_m: float = 5000.0
+    rx_positions_m: np.ndarray | None = None
+    tx_position_m: np.ndarray | None = None
+    noise_figure_db: float = 6.0
+    temperature_k: float = 290.0
+    antenna: AntennaPattern = field(default_factory=AntennaPattern.default)
+    mount: Mount = field(default_factory=Mount)
+    rx_calibration: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("fc_hz", "fs_hz", "prf_hz", "bandwidth_hz", "range_limit_m", "temperature_k"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value > 0):
+                raise InputError(f"radar.{name} must be a positive number, got {value!r}")
+        if int(self.n_doppler) != self.n_doppler or self.n_doppler < 2:
+            raise InputError(f"radar.n_doppler must be an integer >= 2, got {self.n_doppler!r}")
+        if self.prf_hz >= self.fs_hz:
+            raise InputError(f"radar.prf_hz ({self.prf_hz}) must be below fs_hz ({self.fs_hz})")
+        rx = _square_array(self.wavelength_m) if self.rx_positions_m is None else self.rx_positions_m
+        rx = np.array(rx, dtype=float)
+        if rx.ndim != 2 or rx.shape[1] != 3 or rx.shape[0] < 1 or not np.all(np.isfinite(rx)):
+            raise InputError(f"radar.rx_positions_m must be an (n_rx, 3) array of finite metres, got shape {rx.shape}")
+        if rx.shape[0] > 1 and np.ptp(rx, axis=0).max() < 1e-6:
+            raise InputError("radar.rx_positions_m: all receive antennas are at one point; no baseline for DoA")
+        tx = np.zeros(3) if self.tx_position_m is None else np.array(self.tx_position_m, dtype=float)
+        if tx.shape != (3,) or not np.all(np.isfinite(tx)):
+            raise InputError(f"radar.tx_position_m must be 3 finite metres, got {self.tx_position_m!r}")
+        cal = np.ones(rx.shape[0], complex) if self.rx_calibration is None else np.array(self.rx_calibration, complex)
+        if cal.shape != (rx.shape[0],) or not np.all(np.isfinite(cal)) or np.any(cal == 0):
+            raise InputError(f"radar.rx_calibration must be {rx.shape[0]} finite non-zero complex gains")
+        rx.setflags(write=False)
+        tx.setflags(write=False)
+        cal.setflags(write=False)
+        object.__setattr__(self, "rx_positions_m", rx)
+        object.__setattr__(self, "tx_position_m", tx)
+        object.__setattr__(self, "rx_calibration", cal)
+        object.__setattr__(self, "n_doppler", int(self.n_doppler))
+        if self.range_limit_m > self.rmax_m:
+            raise InputError(f"radar.range_limit_m {self.range_limit_m} exceeds the unambiguous range {self.rmax_m:.0f} m")
+
+    @classmethod
+    def seed_prototype(cls, **changes: Any) -> RadarConfig:
+        """The thesis prototype (seed-brief.md), with optional field overrides."""
+        return cls(**changes)
+
+    def replace(self, **changes: Any) -> RadarConfig:
+        """A copy with some fields changed (dataclasses.replace)."""
+        return replace(self, **changes)
+
+    # ---- derived quantities -------------------------------------------------------------
+    @property
+    def wavelength_m(self) -> float:
+        return SPEED_OF_LIGHT / self.fc_hz
+
+    @property
+    def n_rx(self) -> int:
+        return int(self.rx_positions_m.shape[0])
+
+    @property
+    def rmax_m(self) -> float:
+        """Unambiguous range c*Fs / (2*B*PRF), m."""
+        return SPEED_OF_LIGHT * self.fs_hz / (2.0 * self.bandwidth_hz * self.prf_hz)
+
+    @property
+    def range_resolution_m(self) -> float:
+        """dR = c / (2B), m."""
+        return SPEED_OF_LIGHT / (2.0 * self.bandwidth_hz)
+
+    @property
+    def v_lim_mps(self) -> float:
+        """Nyquist radial velocity PRF * lambda / 4, m/s."""
+        return self.prf_hz * self.wavelength_m / 4.0
+
+    @property
+    def doppler_resolution_mps(self) -> float:
+        """dV = 2 VLim / nV, m/s."""
+        return 2.0 * self.v_lim_mps / self.n_doppler
+
+    @property
+    def samples_per_chirp(self) -> int:
+        """ADC samples in one chirp, Fs / PRF (rounded down)."""
+        return int(self.fs_hz // self.prf_hz)
+
+    @property
+    def chirp_slope_hz_per_s(self) -> float:
+        return self.bandwidth_hz * self.prf_hz
+
+    @property
+    def n_range(self) -> int:
+        """Range bins from 0 up to RLim."""
+        return int(self.range_limit_m // self.range_resolution_m)
+
+    @property
+    def frame_duration_s(self) -> float:
+        """Coherent integration time of one frame, nV / PRF, s."""
+        return self.n_doppler / self.prf_hz
+
+    @property
+    def range_doppler_coupling_s(self) -> float:
+        """Apparent range shift per unit radial velocity, fc / (B * PRF), s (m per m/s).
+
+        A sawtooth chirp adds the Doppler shift 2v/lambda to the beat frequency, so the target
+        appears ``v * fc / (B * PRF)`` further away (0.19 m per m/s for the prototype).
+        """
+        return self.fc_hz / self.chirp_slope_hz_per_s
+
+    @cached_property
+    def range_axis_m(self) -> np.ndarray:
+        """Range bin centres k * dR, m."""
+        return np.arange(self.n_range) * self.range_resolution_m
+
+    @cached_property
+    def doppler_axis_mps(self) -> np.ndarray:
+        """Doppler bin centres (j - nV/2) * dV, m/s (FFT-shifted order)."""
+        return (np.arange(self.n_doppler) - self.n_doppler // 2) * self.doppler_resolution_mps
+
+    @property
+    def pe_w(self) -> float:
+        return 10.0 ** ((self.pe_dbm - 30.0) / 10.0)
+
+    @property
+    def noise_bandwidth_hz(self) -> float:
+        """Noise bandwidth of one range-Doppler pixel after coherent integration: PRF / nV."""
+        return self.prf_hz / self.n_doppler
+
+    @property
+    def noise_power_w(self) -> float:
+        """Thermal noise power per pixel, k T B_n F, W (pixel units: received power in W)."""
+        return BOLTZMANN * self.temperature_k * self.noise_bandwidth_hz * 10 ** (self.noise_figure_db / 10.0)
+
+    # ---- serialisation --------------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-able description, round-trips through :meth:`from_dict`."""
+        ant = self.antenna
+        return {
+            "fc_hz": self.fc_hz,
+            "fs_hz": self.fs_hz,
+            "prf_hz": self.prf_hz,
+            "pe_dbm": self.pe_dbm,
+            "bandwidth_hz": self.bandwidth_hz,
+            "n_doppler": self.n_doppler,
+            "range_limit_m": self.range_limit_m,
+            "rx_positions_m": self.rx_positions_m.tolist(),
+            "tx_position_m": self.tx_position_m.tolist(),
+            "noise_figure_db": self.noise_figure_db,
+            "temperature_k": self.temperature_k,
+            "antenna": {
+                "combine": ant.combine,
+                "azimuth": [ant.azimuth.angle_deg.tolist(), ant.azimuth.gain_db.tolist()],
+                "elevation": [ant.elevation.angle_deg.tolist(), ant.elevation.gain_db.tolist()],
+            },
+            "mount": {
+                "position_m": list(self.mount.position_m),
+                "yaw_deg": self.mount.yaw_deg,
+                "pitch_deg": self.mount.pitch_deg,
+                "roll_deg": self.mount.roll_deg,
+            },
+            "rx_calibration": [[c.real, c.imag] for c in self.rx_calibration],
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> RadarConfig:
+        """Inverse of :meth:`to_dict`."""
+        data = dict(data)
+        ant = data.pop("antenna", None)
+        if ant is not None:
+            data["antenna"] = AntennaPattern(GainCut(*ant["azimuth"]), GainCut(*ant["elevation"]), ant["combine"])
+        mount = data.pop("mount", None)
+        if mount is not None:
+            data["mount"] = Mount(**mount)
+        cal = data.pop("rx_calibration", None)
+        if cal is not None:
+            data["rx_calibration"] = np.array([complex(re, im) for re, im in cal])
+        unknown = set(data) - {f for f in cls.__dataclass_fields__}
+        if unknown:
+            raise InputError(f"radar: unknown field(s) {sorted(unknown)}")
+        return cls(**data)
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict())
+
+    @classmethod
+    def from_json(cls, text: str) -> RadarConfig:
+        return cls.from_dict(json.loads(text))
+
+    def __hash__(self) -> int:
+        return hash(self.to_json())
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, RadarConfig) and self.to_json() == other.to_json()

@@ -1,0 +1,1 @@
+"""Detect and avoid: conflict detection, alert levels and resolution advice."""

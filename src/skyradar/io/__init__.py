@@ -1,0 +1,1 @@
+"""Reading and writing frames (xarray/Zarr) and tables (Parquet)."""

@@ -1,0 +1,238 @@
+"""Frames as labelled xarray Datasets, and their Zarr store.
+
+A run is one Dataset with dims ``(time, range, doppler, rx)`` holding complex64 ``iq`` (pixel
+units: |iq|^2 is received power in W, thermal noise power per pixel is
+``RadarConfig.noise_power_w``), coordinates in SI units, the RadarConfig as a JSON attribute,
+and, when simulated, own-ship truth on ``time`` and intruder truth on ``(time, target)``.
+
+Writers never leave a half-written run under the final name: :class:`FrameStoreWriter` writes
+into ``NAME.partial`` chunk by chunk along time, marks each finished chunk, and renames the
+store when the last chunk is in. Re-running with the same fingerprint resumes: finished chunks
+are skipped.
+"""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from skyradar.config import RadarConfig
+from skyradar.errors import InputError
+
+__all__ = [
+    "OWNSHIP_VARS",
+    "TARGET_VARS",
+    "frames_dataset",
+    "radar_config_of",
+    "open_frames",
+    "FrameStoreWriter",
+]
+
+# Truth variables written by the simulator: name -> (units, description).
+OWNSHIP_VARS: dict[str, tuple[str, str]] = {
+    "own_north_m": ("m", "own-ship (radar reference point) north in the scenario NED frame"),
+    "own_east_m": ("m", "own-ship east in the scenario NED frame"),
+    "own_down_m": ("m", "own-ship down in the scenario NED frame"),
+    "own_vn_mps": ("m/s", "own-ship velocity north"),
+    "own_ve_mps": ("m/s", "own-ship velocity east"),
+    "own_vd_mps": ("m/s", "own-ship velocity down"),
+    "own_lat_deg": ("degree", "own-ship WGS84 latitude"),
+    "own_lon_deg": ("degree", "own-ship WGS84 longitude"),
+    "own_alt_m": ("m", "own-ship altitude above the WGS84 ellipsoid"),
+    "own_yaw_rad": ("rad", "own-ship heading (yaw) from north"),
+    "own_pitch_rad": ("rad", "own-ship pitch, positive nose-up"),
+    "own_roll_rad": ("rad", "own-ship roll (bank), positive right wing down"),
+    "own_height_agl_m": ("m", "own-ship height above the terrain directly below"),
+}
+TARGET_VARS: dict[str, tuple[str, str]] = {
+    "tgt_north_m": ("m", "intruder north in the scenario NED frame"),
+    "tgt_east_m": ("m", "intruder east"),
+    "tgt_down_m": ("m", "intruder down"),
+    "tgt_vn_mps": ("m/s", "intruder velocity north"),
+    "tgt_ve_mps": ("m/s", "intruder velocity east"),
+    "tgt_vd_mps": ("m/s", "intruder velocity down"),
+    "tgt_lat_deg": ("degree", "intruder WGS84 latitude"),
+    "tgt_lon_deg": ("degree", "intruder WGS84 longitude"),
+    "tgt_alt_m": ("m", "intruder altitude above the WGS84 ellipsoid"),
+    "tgt_range_m": ("m", "range from the radar"),
+    "tgt_radial_velocity_mps": ("m/s", "true radial velocity (not aliased), positive receding"),
+    "tgt_azimuth_rad": ("rad", "azimuth in the antenna frame, positive right"),
+    "tgt_elevation_rad": ("rad", "elevation in the antenna frame, positive up"),
+    "tgt_rcs_m2": ("m^2", "radar cross-section"),
+    "tgt_snr_db": ("dB", "expected single-pixel SNR from the radar equation"),
+    "tgt_visible": ("1", "inside range, field of view and line of sight"),
+}
+
+
+def _axis_coords(config: RadarConfig, times_s: np.ndarray) -> dict[str, Any]:
+    return {
+        "time": ("time", np.asarray(times_s, float), {"units": "s", "long_name": "frame time from scenario start"}),
+        "range": ("range", config.range_axis_m, {"units": "m", "long_name": "range bin centre"}),
+        "doppler": (
+            "doppler",
+            config.doppler_axis_mps,
+            {"units": "m/s", "long_name": "radial velocity bin centre, positive receding"},
+        ),
+        "rx": ("rx", np.arange(config.n_rx), {"long_name": "receive antenna index"}),
+    }
+
+
+def frames_dataset(
+    iq: Any,
+    times_s: np.ndarray,
+    config: RadarConfig,
+    ownship: Mapping[str, np.ndarray] | None = None,
+    targets: Mapping[str, np.ndarray] | None = None,
+    target_names: list[str] | None = None,
+    attrs: Mapping[str, Any] | None = None,
+) -> xr.Dataset:
+    """Wrap a (time, range, doppler, rx) cube and truth arrays into the frames Dataset.
+
+    Parameters
+    ----------
+    iq : array_like, shape (n_time, n_range, n_doppler, n_rx)
+        Complex pixels (numpy or dask).
+    times_s : ndarray, shape (n_time,)
+        Frame times, s.
+    config : RadarConfig
+        Stored as the ``radar_config`` attribute.
+    ownship, targets : mapping, optional
+        Truth arrays keyed by the names in ``OWNSHIP_VARS`` / ``TARGET_VARS``.
+    target_names : list of str, optional
+        One name per intruder (the ``target`` coordinate).
+
+    Examples
+    --------
+    >>> cfg = RadarConfig.seed_prototype()
+    >>> cube = np.zeros((2, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
+    >>> frames_dataset(cube, np.array([0.0, 0.1]), cfg).iq.dims
+    ('time', 'range', 'doppler', 'rx')
+    """
+    expected = (len(times_s), config.n_range, config.n_doppler, config.n_rx)
+    if tuple(iq.shape) != expected:
+        raise InputError(f"frames: iq has shape {tuple(iq.shape)}, expected (time, range, doppler, rx) = {expected}")
+    data_vars: dict[str, Any] = {
+        "iq": (("time", "range", "doppler", "rx"), iq, {"long_name": "complex pixel, |iq|^2 in W"}),
+    }
+    for name, values in (ownship or {}).items():
+        units, desc = OWNSHIP_VARS[name]
+        data_vars[name] = ("time", np.asarray(values), {"units": units, "long_name": desc})
+    coords = _axis_coords(config, times_s)
+    if targets:
+        for name, values in targets.items():
+            units, desc = TARGET_VARS[name]
+            data_vars[name] = (("time", "target"), np.asarray(values), {"units": units, "long_name": desc})
+        n_targets = np.asarray(next(iter(targets.values()))).shape[1]
+        coords["target"] = ("target", np.array(target_names or [f"T{i}" for i in range(n_targets)], dtype=str))
+    all_attrs = {"radar_config": config.to_json(), "skyradar_format": "frames/1"}
+    all_attrs.update(attrs or {})
+    return xr.Dataset(data_vars, coords=coords, attrs=all_attrs)
+
+
+def radar_config_of(ds: xr.Dataset, source: str = "frames") -> RadarConfig:
+    """The RadarConfig stored with a frames Dataset."""
+    text = ds.attrs.get("radar_config")
+    if text is None:
+        raise InputError(f"{source}: no 'radar_config' attribute; not a skyradar frames store")
+    return RadarConfig.from_json(text)
+
+
+def open_frames(path: str | Path) -> xr.Dataset:
+    """Open a frames store (Zarr directory or NetCDF file) and check it is usable.
+
+    Raises :class:`InputError` naming the file when it is missing, unfinished, empty or
+    inconsistent with its own RadarConfig.
+    """
+    path = Path(path)
+    if not path.exists():
+        partial = path.with_name(path.name + ".partial")
+        hint = f" (an unfinished run is at {partial}; rerun to resume)" if partial.exists() else ""
+        raise InputError(f"{path}: no such run{hint}")
+    try:
+        if path.is_dir():
+            ds = xr.open_zarr(path, consolidated=None)
+        else:
+            ds = xr.open_dataset(path)
+    except Exception as exc:  # noqa: BLE001 - any reader failure becomes one clear line
+        raise InputError(f"{path}: cannot open as a frames store ({type(exc).__name__}: {exc})") from exc
+    if "iq" not in ds:
+        raise InputError(f"{path}: missing variable 'iq'")
+    config = radar_config_of(ds, str(path))
+    if ds.sizes.get("time", 0) == 0:
+        raise InputError(f"{path}: empty run (0 frames)")
+    if ds.sizes.get("rx") != config.n_rx:
+        raise InputError(f"{path}: field 'rx' has {ds.sizes.get('rx')} antennas, radar_config has {config.n_rx}")
+    for dim, n in (("range", config.n_range), ("doppler", config.n_doppler)):
+        if ds.sizes.get(dim) != n:
+            raise InputError(f"{path}: dimension '{dim}' is {ds.sizes.get(dim)}, radar_config needs {n}")
+    return ds
+
+
+class FrameStoreWriter:
+    """Write a frames Dataset to Zarr chunk by chunk along time, resumably and atomically.
+
+    Parameters
+    ----------
+    path : path
+        Final store name; work happens in ``path + ".partial"`` until :meth:`close`.
+    template : xr.Dataset
+        The full Dataset with ``iq`` as a lazy (dask) array; every other variable is written
+        at creation.
+    chunk_frames : int
+        Frames per chunk along time.
+    fingerprint : str
+        Identifies the job (e.g. a hash of the scenario); a partial store with another
+        fingerprint is discarded rather than resumed.
+    """
+
+    def __init__(self, path: str | Path, template: xr.Dataset, chunk_frames: int, fingerprint: str) -> None:
+        self.path = Path(path)
+        self.partial = self.path.with_name(self.path.name + ".partial")
+        self.chunk_frames = int(chunk_frames)
+        self.n_frames = template.sizes["time"]
+        self.n_chunks = -(-self.n_frames // self.chunk_frames)
+        self._marks = self.partial / "_skyradar_done"
+        if self.partial.exists() and self._fingerprint_on_disk() != fingerprint:
+            shutil.rmtree(self.partial)
+        if not self.partial.exists():
+            template = template.assign_attrs(skyradar_fingerprint=fingerprint)
+            encoding = {"iq": {"chunks": (self.chunk_frames, *template.iq.shape[1:])}}
+            template.to_zarr(self.partial, compute=False, encoding=encoding, mode="w", consolidated=False)
+            self._marks.mkdir()
+
+    def _fingerprint_on_disk(self) -> str | None:
+        try:
+            return xr.open_zarr(self.partial, consolidated=False).attrs.get("skyradar_fingerprint")
+        except Exception:  # noqa: BLE001 - an unreadable partial store is simply redone
+            return None
+
+    def chunk_slice(self, index: int) -> slice:
+        return slice(index * self.chunk_frames, min((index + 1) * self.chunk_frames, self.n_frames))
+
+    def pending_chunks(self) -> list[int]:
+        """Chunk indices not yet written (all of them on a fresh store)."""
+        return [i for i in range(self.n_chunks) if not (self._marks / str(i)).exists()]
+
+    def write_chunk(self, index: int, iq: np.ndarray) -> None:
+        """Write frames of chunk ``index`` (shape (n, range, doppler, rx)) and mark it done."""
+        sl = self.chunk_slice(index)
+        piece = xr.Dataset({"iq": (("time", "range", "doppler", "rx"), iq.astype(np.complex64, copy=False))})
+        piece.to_zarr(self.partial, region={"time": sl, "range": slice(None), "doppler": slice(None), "rx": slice(None)})
+        (self._marks / str(index)).touch()
+
+    def close(self) -> Path:
+        """Rename the finished store to its final name (replacing an older run of that name)."""
+        missing = self.pending_chunks()
+        if missing:
+            raise RuntimeError(f"{self.partial}: chunks {missing[:5]} not written; cannot finalise")
+        shutil.rmtree(self._marks)
+        if self.path.exists():
+            shutil.rmtree(self.path) if self.path.is_dir() else self.path.unlink()
+        self.partial.rename(self.path)
+        return self.path
+

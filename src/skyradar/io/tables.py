@@ -1,0 +1,67 @@
+"""Tables (detections, tracks, states, poses, alerts) as pandas DataFrames in Parquet.
+
+Writers go through a temporary name and rename, so an interrupted job never leaves a
+half-written file under the final name. Readers check required columns and say which are
+missing.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from skyradar.errors import InputError
+
+__all__ = ["write_table", "read_table", "write_json_atomic"]
+
+
+def write_table(df: pd.DataFrame, path: str | Path, metadata: dict[str, Any] | None = None) -> Path:
+    """Write ``df`` to Parquet atomically; ``metadata`` goes into ``df.attrs`` (kept by pyarrow)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    if metadata:
+        df = df.copy()
+        df.attrs.update(metadata)
+    df.to_parquet(tmp, index=False)
+    tmp.replace(path)
+    return path
+
+
+def read_table(path: str | Path, required: Iterable[str] = (), sort_by: str | None = None) -> pd.DataFrame:
+    """Read a Parquet (or CSV) table and check that ``required`` columns are present.
+
+    With ``sort_by`` the column must be non-decreasing; a clear error names the first row
+    where it goes backwards.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise InputError(f"{path}: no such file")
+    try:
+        df = pd.read_csv(path) if path.suffix.lower() == ".csv" else pd.read_parquet(path)
+    except Exception as exc:  # noqa: BLE001 - reader failure becomes one clear line
+        raise InputError(f"{path}: cannot read table ({type(exc).__name__}: {exc})") from exc
+    missing = [c for c in required if c not in df.columns]
+    if missing:
+        raise InputError(f"{path}: missing column(s) {missing} (have {list(df.columns)})")
+    if sort_by is not None and len(df) > 1:
+        values = df[sort_by].to_numpy()
+        back = (values[1:] < values[:-1]).nonzero()[0]
+        if back.size:
+            i = int(back[0]) + 1
+            raise InputError(f"{path}: field '{sort_by}' goes backwards at row {i} ({values[i - 1]} -> {values[i]})")
+    return df
+
+
+def write_json_atomic(path: str | Path, payload: Any) -> Path:
+    """Write JSON to ``path`` through a temporary name and rename."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(payload, indent=2, default=float))
+    tmp.replace(path)
+    return path

@@ -1,0 +1,1 @@
+"""Own-ship navigation from radar: flight state over the terrain, GPS check against the map."""

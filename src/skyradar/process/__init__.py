@@ -1,0 +1,1 @@
+"""Frame processing: range-Doppler, spur maps, detection, direction of arrival, ground filter."""

@@ -1,0 +1,1 @@
+"""Radar simulators: image domain (fast) and chirp-level raw ADC, plus hardware impairments."""

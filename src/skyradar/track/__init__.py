@@ -1,0 +1,1 @@
+"""Multi-target tracking in range-Doppler and 3-D, with swappable parts, and track metrics."""

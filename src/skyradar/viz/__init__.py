@@ -1,0 +1,1 @@
+"""Matplotlib figures (headless Agg backend)."""

@@ -1,0 +1,1 @@
+"""Live traffic display (FastAPI + WebSocket + static page)."""

@@ -10,6 +10,7 @@ import sys
 
 import click
 
+import skyradar.cli.commands_daa  # noqa: F401  (registers commands)
 from skyradar.cli import commands_sim  # noqa: F401  (registers commands)
 from skyradar.cli.app import app
 from skyradar.errors import InputError

@@ -1,0 +1,308 @@
+"""Resolution advice: conflict bands on heading and vertical speed, and one preferred manoeuvre.
+
+Bands follow DAIDALUS' instantaneous bands: for every candidate own-ship heading (same ground
+speed and vertical speed) or vertical speed (same horizontal velocity), the straight-line
+encounter with each intruder is checked for a loss of well clear within the lookahead; a
+candidate is in a conflict band when any intruder (or, for vertical speed, the terrain) conflicts.
+The preferred manoeuvre is BlueSky's Modified Voltage Potential (MVP): each conflicting intruder
+pushes the own-ship velocity away from the intruder's position at closest approach by the
+intrusion divided by the time to closest approach; the pushes add up over intruders. The MVP
+heading and vertical speed are then moved to the nearest conflict-free candidate when they fall
+inside a band.
+
+Terrain: with the own-ship height above ground ``h`` and a minimum height ``h_min``, a vertical
+speed ``vs`` (positive up) conflicts when ``h + vs * T_terrain < h_min``, i.e. it would take the
+aircraft (or keep it) below the minimum at the end of the terrain lookahead. Heading bands do not
+use terrain (the height above ground is all the flight-state estimate gives).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from skyradar.daa.conflict import WellClearVolume, cpa, loss_of_well_clear_interval
+
+__all__ = ["heading_bands", "vertical_speed_bands", "band_intervals", "mvp_velocity", "resolution_advice"]
+
+
+def _conflicts(
+    own_vel: np.ndarray, s: np.ndarray, v_int: np.ndarray, volume, lookahead_s, dthr, zthr
+) -> np.ndarray:
+    """Any-intruder conflict for candidate own velocities ``own_vel`` (c, 3) -> (c,) bool."""
+    if len(s) == 0:
+        return np.zeros(len(own_vel), bool)
+    rel_v = v_int[None, :, :] - own_vel[:, None, :]
+    rel_s = np.broadcast_to(s[None, :, :], rel_v.shape)
+    t_in, _ = loss_of_well_clear_interval(rel_s, rel_v, volume, lookahead_s, dthr, zthr)
+    return np.isfinite(t_in).any(axis=1)
+
+
+def _prepare(s, v_int, volume, dthr_m, zthr_m):
+    s = np.asarray(s, float).reshape(-1, 3)
+    v_int = np.asarray(v_int, float).reshape(-1, 3)
+    dthr = np.broadcast_to(volume.dthr_m if dthr_m is None else np.asarray(dthr_m, float), (len(s),))
+    zthr = np.broadcast_to(volume.zthr_m if zthr_m is None else np.asarray(zthr_m, float), (len(s),))
+    return s, v_int, dthr, zthr
+
+
+def heading_bands(
+    own_vel_mps: np.ndarray,
+    s: np.ndarray,
+    v_int_mps: np.ndarray,
+    volume: WellClearVolume,
+    lookahead_s: float,
+    step_deg: float = 1.0,
+    dthr_m=None,
+    zthr_m=None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Conflict flag for every own-ship heading at the current ground speed and vertical speed.
+
+    Parameters
+    ----------
+    own_vel_mps : ndarray, shape (3,)
+        Own-ship velocity, NED, m/s.
+    s : ndarray, shape (n, 3)
+        Intruder positions relative to the own-ship, NED, m.
+    v_int_mps : ndarray, shape (n, 3)
+        Intruder velocities (absolute), NED, m/s.
+    volume : WellClearVolume
+    lookahead_s : float
+    step_deg : float
+    dthr_m, zthr_m : array_like, optional
+        Per-intruder (widened) thresholds.
+
+    Returns
+    -------
+    headings_deg : ndarray
+        Candidate headings from north, degrees in [0, 360).
+    conflict : ndarray of bool
+
+    Examples
+    --------
+    >>> h, c = heading_bands(np.array([50.0, 0, 0]), np.array([[3000.0, 0, 0]]),
+    ...                      np.array([[-50.0, 0, 0]]), WellClearVolume(500.0, 100.0), 60.0)
+    >>> bool(c[0]), bool(c[90])
+    (True, False)
+    """
+    s, v_int, dthr, zthr = _prepare(s, v_int_mps, volume, dthr_m, zthr_m)
+    own = np.asarray(own_vel_mps, float)
+    headings = np.arange(0.0, 360.0, step_deg)
+    gs = np.hypot(own[0], own[1])
+    psi = np.radians(headings)
+    cand = np.stack([gs * np.cos(psi), gs * np.sin(psi), np.full_like(psi, own[2])], axis=-1)
+    return headings, _conflicts(cand, s, v_int, volume, lookahead_s, dthr, zthr)
+
+
+def vertical_speed_bands(
+    own_vel_mps: np.ndarray,
+    s: np.ndarray,
+    v_int_mps: np.ndarray,
+    volume: WellClearVolume,
+    lookahead_s: float,
+    vs_limits_mps: tuple[float, float] = (-10.0, 10.0),
+    step_mps: float = 0.5,
+    height_agl_m: float | None = None,
+    min_height_agl_m: float = 150.0,
+    terrain_lookahead_s: float = 30.0,
+    dthr_m=None,
+    zthr_m=None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Conflict flags for every vertical speed (positive up) at the current horizontal velocity.
+
+    Returns
+    -------
+    vs_mps : ndarray
+        Candidate vertical speeds, m/s, positive up.
+    traffic_conflict, terrain_conflict : ndarray of bool
+
+    Examples
+    --------
+    >>> none = np.zeros((0, 3))
+    >>> vs, traffic, terrain = vertical_speed_bands(np.array([50.0, 0, 0]), none, none,
+    ...                                             WellClearVolume(500.0, 100.0), 60.0, height_agl_m=300.0)
+    >>> float(vs[terrain].max())
+    -5.5
+    """
+    s, v_int, dthr, zthr = _prepare(s, v_int_mps, volume, dthr_m, zthr_m)
+    own = np.asarray(own_vel_mps, float)
+    lo, hi = vs_limits_mps
+    vs = np.arange(lo, hi + step_mps / 2, step_mps)
+    cand = np.stack([np.full_like(vs, own[0]), np.full_like(vs, own[1]), -vs], axis=-1)
+    traffic = _conflicts(cand, s, v_int, volume, lookahead_s, dthr, zthr)
+    terrain = np.zeros_like(traffic)
+    if height_agl_m is not None and np.isfinite(height_agl_m):
+        terrain = height_agl_m + vs * terrain_lookahead_s < min_height_agl_m
+    return vs, traffic, terrain
+
+
+def band_intervals(
+    values: np.ndarray, conflict: np.ndarray, step: float, circular: bool = False
+) -> list[list[float]]:
+    """Merge flagged candidates into ``[lo, hi]`` intervals (each candidate covers +-step/2).
+
+    With ``circular`` (headings) an interval crossing 360 is returned as ``[lo, hi + 360]``.
+
+    Examples
+    --------
+    >>> band_intervals(np.arange(0.0, 360.0, 90.0), np.array([True, False, False, True]), 90.0, circular=True)
+    [[225.0, 405.0]]
+    """
+    conflict = np.asarray(conflict, bool)
+    if not conflict.any():
+        return []
+    if conflict.all():
+        return [[float(values[0] - step / 2), float(values[-1] + step / 2)]]
+    idx = np.flatnonzero(conflict)
+    runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
+    out = [[float(values[r[0]] - step / 2), float(values[r[-1]] + step / 2)] for r in runs]
+    if circular and len(out) > 1 and conflict[0] and conflict[-1]:
+        first = out.pop(0)
+        out[-1][1] = first[1] + 360.0
+    return out
+
+
+def mvp_velocity(
+    own_vel_mps: np.ndarray,
+    s: np.ndarray,
+    v_int_mps: np.ndarray,
+    volume: WellClearVolume,
+    lookahead_s: float,
+    resofac: float = 1.05,
+    dthr_m=None,
+    zthr_m=None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Own-ship velocity after the Modified Voltage Potential resolution (BlueSky's MVP).
+
+    Only intruders with a predicted loss of well clear within ``lookahead_s`` contribute; the
+    own-ship takes the whole manoeuvre (the intruder is not cooperative).
+
+    Returns
+    -------
+    new_vel_mps : ndarray, shape (3,)
+        Resolution velocity, NED, m/s.
+    in_conflict : ndarray of bool, shape (n,)
+
+    Examples
+    --------
+    >>> v, c = mvp_velocity(np.array([50.0, 0, 0]), np.array([[3000.0, 100.0, 0]]),
+    ...                     np.array([[-50.0, 0, 0]]), WellClearVolume(500.0, 100.0), 60.0)
+    >>> bool(c[0]), bool(v[1] < 0)
+    (True, True)
+    """
+    s, v_int, dthr, zthr = _prepare(s, v_int_mps, volume, dthr_m, zthr_m)
+    own = np.asarray(own_vel_mps, float)
+    vrel = v_int - own
+    t_los, _ = loss_of_well_clear_interval(s, vrel, volume, lookahead_s, dthr, zthr)
+    conf = np.isfinite(t_los)
+    if not conf.any():
+        return own.copy(), conf
+    s, vrel, t_los = s[conf], vrel[conf], t_los[conf]
+    pz, hpz = dthr[conf] * resofac, zthr[conf] * resofac
+    tcpa, _, _ = cpa(s, vrel)
+    dist = np.maximum(np.hypot(s[:, 0], s[:, 1]), 1e-6)
+    dcpa = s[:, :2] + vrel[:, :2] * tcpa[:, None]
+    dabs = np.hypot(dcpa[:, 0], dcpa[:, 1])
+    head_on = dabs <= 10.0
+    # Head-on: no miss vector to push along, so push perpendicular to the line of sight.
+    perp = np.stack([-s[:, 1], s[:, 0]], axis=-1) / dist[:, None] * 10.0
+    dcpa = np.where(head_on[:, None], perp, dcpa)
+    dabs = np.where(head_on, 10.0, dabs)
+    tdiv = np.maximum(np.abs(tcpa), 0.5)
+    outside = (pz < dist) & (dabs < dist)
+    erratum = np.cos(np.arcsin(np.minimum(pz / dist, 1.0)) - np.arcsin(np.minimum(dabs / dist, 1.0)))
+    push = np.where(outside, pz / np.where(outside, erratum, 1.0) - dabs, pz - dabs)
+    dv_h = push[:, None] * dcpa / (tdiv * dabs)[:, None]
+    # Vertical (up positive in BlueSky): intrusion over the time to co-altitude, against the
+    # relative vertical rate; with no relative rate, away from the intruder's side.
+    d_up, v_up = -s[:, 2], -vrel[:, 2]
+    moving = np.abs(v_up) > 0
+    tsol = np.where(moving, np.abs(d_up) / np.where(moving, np.abs(v_up), 1.0), t_los)
+    i_v = np.where(moving, hpz, hpz - np.abs(d_up))
+    slow = tsol > lookahead_s
+    tsol = np.maximum(np.where(slow, t_los, tsol), 0.5)
+    i_v = np.where(slow, hpz, i_v)
+    sign = np.where(moving, -np.sign(v_up), np.where(d_up >= 0, 1.0, -1.0))
+    dv_up = i_v / tsol * sign
+    new = own.copy()
+    new[:2] -= dv_h.sum(axis=0)
+    new[2] += dv_up.sum()  # own vs_up -= dv_up, i.e. down += dv_up
+    return new, conf
+
+
+def _nearest_free(values: np.ndarray, conflict: np.ndarray, target: float, circular: bool) -> float:
+    if not conflict.any():
+        return float(target)
+    free = values[~conflict]
+    if free.size == 0:
+        return float("nan")
+    diff = np.abs(free - target)
+    if circular:
+        diff = np.minimum(diff, 360.0 - diff)
+    return float(free[np.argmin(diff)])
+
+
+def resolution_advice(
+    own_vel_mps: np.ndarray,
+    s: np.ndarray,
+    v_int_mps: np.ndarray,
+    volume: WellClearVolume,
+    lookahead_s: float,
+    height_agl_m: float | None = None,
+    min_height_agl_m: float = 150.0,
+    step_deg: float = 1.0,
+    vs_step_mps: float = 0.5,
+    dthr_m=None,
+    zthr_m=None,
+) -> dict:
+    """Bands and the preferred manoeuvre for one own-ship state against several intruders.
+
+    Returns
+    -------
+    dict
+        ``heading_bands_deg`` and ``vs_bands_mps`` (conflict intervals from traffic),
+        ``terrain_vs_bands_mps``, ``mvp_heading_deg``, ``mvp_vs_mps`` (raw MVP),
+        ``preferred_heading_deg``, ``preferred_vs_mps`` (the MVP values moved to the nearest
+        conflict-free candidate; the raw MVP value when every candidate conflicts),
+        ``heading_saturated``, ``vs_saturated`` (every candidate conflicts), ``n_conflicts``.
+
+    Examples
+    --------
+    >>> adv = resolution_advice(np.array([50.0, 0, 0]), np.array([[3000.0, 100.0, 0]]),
+    ...                         np.array([[-50.0, 0, 0]]), WellClearVolume(500.0, 100.0), 60.0)
+    >>> 270 < adv["preferred_heading_deg"] < 360
+    True
+    """
+    own = np.asarray(own_vel_mps, float)
+    kw = {"dthr_m": dthr_m, "zthr_m": zthr_m}
+    headings, h_conf = heading_bands(own, s, v_int_mps, volume, lookahead_s, step_deg, **kw)
+    vs, vs_traffic, vs_terrain = vertical_speed_bands(
+        own, s, v_int_mps, volume, lookahead_s, step_mps=vs_step_mps, height_agl_m=height_agl_m,
+        min_height_agl_m=min_height_agl_m, **kw,
+    )  # fmt: skip
+    new_vel, conf = mvp_velocity(own, s, v_int_mps, volume, lookahead_s, **kw)
+    mvp_heading = float(np.degrees(np.arctan2(new_vel[1], new_vel[0])) % 360.0)
+    mvp_vs = float(-new_vel[2])
+    # Quantise to the candidate grid so "inside a band" is judged on the same grid as the bands.
+    h_idx = int(np.round(mvp_heading / step_deg)) % len(headings)
+    v_idx = int(np.clip(np.round((mvp_vs - vs[0]) / vs_step_mps), 0, len(vs) - 1))
+    vs_conf = vs_traffic | vs_terrain
+    pref_h = (
+        float(headings[h_idx]) if not h_conf[h_idx] else _nearest_free(headings, h_conf, mvp_heading, True)
+    )
+    pref_v = float(vs[v_idx]) if not vs_conf[v_idx] else _nearest_free(vs, vs_conf, mvp_vs, False)
+    if not np.isfinite(pref_h):
+        pref_h = mvp_heading
+    if not np.isfinite(pref_v):
+        pref_v = mvp_vs
+    return {
+        "heading_saturated": bool(h_conf.all()),
+        "vs_saturated": bool(vs_conf.all()),
+        "heading_bands_deg": band_intervals(headings, h_conf, step_deg, circular=True),
+        "vs_bands_mps": band_intervals(vs, vs_traffic, vs_step_mps),
+        "terrain_vs_bands_mps": band_intervals(vs, vs_terrain, vs_step_mps),
+        "mvp_heading_deg": mvp_heading,
+        "mvp_vs_mps": mvp_vs,
+        "preferred_heading_deg": pref_h,
+        "preferred_vs_mps": pref_v,
+        "n_conflicts": int(conf.sum()),
+    }

@@ -1,0 +1,228 @@
+"""Alert levels: DAIDALUS-style thresholds and the stateful persistence/hysteresis filter.
+
+A raw level is the highest level ``k`` whose well-clear volume is predicted to be lost within its
+alerting time. The filter turns the per-frame raw levels of one track into a steady indication:
+level ``k`` is issued when at least ``M`` of the last ``N`` raw levels reach ``k``; a level, once
+issued, is held at least ``persistence_s``, and it is lowered only after the M-of-N level has stayed
+below it for ``hysteresis_s``. The defaults follow DAIDALUS' DO-365B configuration
+(``alerting_m = 2``, ``alerting_n = 4``, ``persistence_time = 4 s``, ``hysteresis_time = 5 s``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from skyradar.daa.conflict import (
+    FT,
+    WellClearVolume,
+    cpa,
+    flarm_alarm_level,
+    loss_of_well_clear_interval,
+    widened_thresholds,
+)
+
+__all__ = [
+    "LEVEL_NAMES",
+    "AlertLevel",
+    "AlertConfig",
+    "raw_alert_levels",
+    "AlertFilter",
+    "filter_alert_levels",
+]
+
+LEVEL_NAMES = ("none", "preventive", "corrective", "warning")
+
+
+@dataclass(frozen=True)
+class AlertLevel:
+    """One alert level: its volume and alerting time (s)."""
+
+    name: str
+    volume: WellClearVolume
+    alerting_time_s: float
+
+
+def _noncoop_levels() -> tuple[AlertLevel, ...]:
+    # DAIDALUS DO-365B "DWC_Non_Coop" alerter (2200 ft / 450 ft, no tau; 55, 55, 25 s). Its preventive
+    # level differs from the corrective one only by guidance region; we give it the 700 ft vertical
+    # threshold of the DO-365 Phase I preventive alert so that it warns earlier for vertical encounters.
+    nc = WellClearVolume.do365_noncoop()
+    return (
+        AlertLevel("preventive", WellClearVolume(nc.dthr_m, 700 * FT), 55.0),
+        AlertLevel("corrective", nc, 55.0),
+        AlertLevel("warning", nc, 25.0),
+    )
+
+
+@dataclass(frozen=True)
+class AlertConfig:
+    """Alerting configuration.
+
+    Parameters
+    ----------
+    levels : tuple of AlertLevel
+        Preventive, corrective, warning (index + 1 is the level number).
+    m, n : int
+        M-of-N persistence on the raw level.
+    persistence_s : float
+        Minimum time an issued level is held, s.
+    hysteresis_s : float
+        Time the M-of-N level must stay below the issued one before it is lowered, s.
+    z_h_pos, z_h_vel, z_v_pos, z_v_vel : float
+        Sensor-uncertainty z-scores (see :func:`skyradar.daa.conflict.widened_thresholds`).
+    collision_volume : WellClearVolume
+        Volume whose entry time is the FLARM "time to impact" (default: NMAC cylinder).
+    flarm_thresholds_s : tuple of float
+        Times to impact of FLARM alarm levels 1, 2, 3, s.
+
+    Examples
+    --------
+    >>> AlertConfig().levels[2].alerting_time_s
+    25.0
+    """
+
+    levels: tuple[AlertLevel, ...] = field(default_factory=_noncoop_levels)
+    m: int = 2
+    n: int = 4
+    persistence_s: float = 4.0
+    hysteresis_s: float = 5.0
+    z_h_pos: float = 1.5
+    z_h_vel: float = 1.0
+    z_v_pos: float = 0.75
+    z_v_vel: float = 1.5
+    collision_volume: WellClearVolume = field(default_factory=WellClearVolume.nmac)
+    flarm_thresholds_s: tuple[float, float, float] = (18.0, 13.0, 8.0)
+
+    def __post_init__(self) -> None:
+        if not 1 <= self.m <= self.n:
+            raise ValueError(f"alert config: need 1 <= m <= n, got m={self.m}, n={self.n}")
+
+    @property
+    def lookahead_s(self) -> float:
+        """The longest alerting time, s."""
+        return max(lv.alerting_time_s for lv in self.levels)
+
+
+def raw_alert_levels(
+    s: np.ndarray,
+    v: np.ndarray,
+    config: AlertConfig | None = None,
+    cov_pos_m2: np.ndarray | None = None,
+    cov_vel_m2ps2: np.ndarray | None = None,
+) -> dict[str, np.ndarray]:
+    """Per-encounter raw alert level and conflict geometry (no persistence).
+
+    Parameters
+    ----------
+    s, v : ndarray, shape (n, 3)
+        Relative position (m) and velocity (m/s), intruder minus own-ship, NED.
+    config : AlertConfig, optional
+    cov_pos_m2, cov_vel_m2ps2 : ndarray, shape (n, 3, 3), optional
+        Relative position / velocity covariance; widens the volumes.
+
+    Returns
+    -------
+    dict of ndarray
+        ``level`` (0..3), ``t_in_s`` (entry time into the highest-level volume lost, or the
+        corrective one; NaN if none), ``tcpa_s``, ``hmd_m``, ``vmd_m``, ``time_to_impact_s``,
+        ``flarm_level``, ``dthr_m``, ``zthr_m`` (widened corrective thresholds).
+
+    Examples
+    --------
+    >>> out = raw_alert_levels(np.array([[3000.0, 0, 0]]), np.array([[-100.0, 0, 0]]))
+    >>> int(out["level"][0])
+    3
+    """
+    config = config or AlertConfig()
+    s = np.atleast_2d(np.asarray(s, float))
+    v = np.atleast_2d(np.asarray(v, float))
+    tcpa, hmd, vmd = cpa(s, v)
+    level = np.zeros(len(s), int)
+    t_in_out = np.full(len(s), np.nan)
+    widened = {}
+    for k, lv in enumerate(config.levels, start=1):
+        t_ref = np.clip(tcpa, 0.0, lv.alerting_time_s)
+        dthr, zthr = widened_thresholds(
+            lv.volume,
+            cov_pos_m2,
+            cov_vel_m2ps2,
+            t_ref,
+            config.z_h_pos,
+            config.z_h_vel,
+            config.z_v_pos,
+            config.z_v_vel,
+        )
+        widened[k] = (dthr, zthr)
+        t_in, _ = loss_of_well_clear_interval(s, v, lv.volume, lv.alerting_time_s, dthr, zthr)
+        hit = np.isfinite(t_in)
+        level = np.where(hit, k, level)
+        t_in_out = np.where(hit, t_in, t_in_out)
+    t_imp, _ = loss_of_well_clear_interval(s, v, config.collision_volume, config.flarm_thresholds_s[0])
+    corrective = widened[min(2, len(config.levels))]
+    return {
+        "level": level,
+        "t_in_s": t_in_out,
+        "tcpa_s": tcpa,
+        "hmd_m": hmd,
+        "vmd_m": vmd,
+        "time_to_impact_s": t_imp,
+        "flarm_level": flarm_alarm_level(t_imp, config.flarm_thresholds_s),
+        "dthr_m": np.broadcast_to(corrective[0], level.shape).copy(),
+        "zthr_m": np.broadcast_to(corrective[1], level.shape).copy(),
+    }
+
+
+class AlertFilter:
+    """M-of-N persistence and hysteresis for the alert level of one track.
+
+    Parameters
+    ----------
+    config : AlertConfig, optional
+
+    Examples
+    --------
+    >>> f = AlertFilter(AlertConfig(m=2, n=3, persistence_s=0.0, hysteresis_s=2.0))
+    >>> [f.update(t, raw) for t, raw in enumerate([3, 0, 3, 0, 0, 0, 0, 0])]
+    [0, 0, 3, 3, 3, 0, 0, 0]
+    """
+
+    def __init__(self, config: AlertConfig | None = None) -> None:
+        self.config = config or AlertConfig()
+        self._raw: list[int] = []
+        self.level = 0
+        self._raised_at = -np.inf
+        self._below_since: float | None = None
+
+    def update(self, time_s: float, raw_level: int) -> int:
+        """Feed the raw level of the frame at ``time_s`` (s); return the issued level."""
+        cfg = self.config
+        self._raw = (self._raw + [int(raw_level)])[-cfg.n :]
+        counts = [sum(r >= k for r in self._raw) for k in range(1, len(cfg.levels) + 1)]
+        candidate = max([k for k, c in enumerate(counts, start=1) if c >= cfg.m], default=0)
+        if candidate > self.level:
+            self.level, self._raised_at, self._below_since = candidate, time_s, None
+        elif candidate == self.level:
+            self._below_since = None
+        else:
+            if self._below_since is None:
+                self._below_since = time_s
+            held = time_s - self._raised_at < cfg.persistence_s
+            if not held and time_s - self._below_since >= cfg.hysteresis_s:
+                self.level, self._below_since = candidate, None
+        return self.level
+
+
+def filter_alert_levels(
+    times_s: np.ndarray, raw_levels: np.ndarray, config: AlertConfig | None = None
+) -> np.ndarray:
+    """Issued levels of one track from its raw levels at increasing ``times_s`` (see :class:`AlertFilter`).
+
+    Examples
+    --------
+    >>> filter_alert_levels(np.arange(4.0), np.array([1, 1, 1, 1])).tolist()
+    [0, 1, 1, 1]
+    """
+    filt = AlertFilter(config)
+    return np.array([filt.update(float(t), int(r)) for t, r in zip(times_s, raw_levels, strict=True)], int)

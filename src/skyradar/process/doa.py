@@ -1,0 +1,344 @@
+"""Direction of arrival from phase differences between receive antennas, and its Cramer-Rao bound.
+
+Phase model (far field, antenna frame): the pixel of receiver k for a scatterer in unit direction
+``u`` is ``A exp(i (phi - (2 pi / lambda) u . r_k))`` with a common phase ``phi`` (two-way path,
+transmitter term shared). Linearly, ``psi_k = -(2 pi / lambda) u . r_k + phi`` for the measured
+phases ``psi_k``, which is least squares in ``u`` with a free intercept ``phi``. The intercept is
+what makes the estimator use all pairs optimally: with independent phase noise of equal variance
+it is the best linear unbiased estimator, and it reaches the Cramer-Rao bound at high SNR.
+
+Layouts:
+
+* non-coplanar arrays (rank 3): all three components by least squares, normalised, then
+  refined by Gauss-Newton in (azimuth, elevation) so that ``|u| = 1`` is part of the fit;
+* coplanar arrays (rank 2): the two in-plane components by least squares and the third from
+  ``|u| = 1`` (the position is ``range * u``), on the side of the array that faces the scene
+  (the side the boresight +x points to);
+* collinear arrays or fewer than three distinct antennas cannot give a direction: InputError.
+
+Ambiguity: a pair of antennas further apart than half a wavelength wraps its phase difference.
+A coarse direction comes first from the pairs at most lambda/2 apart (unambiguous) when they span
+a coplanar array, otherwise from a beamforming grid search over the field of view (non-coplanar
+and sparse arrays; grating lobes outside the field of view are ignored); every phase is then unwrapped
+to the value the coarse direction predicts and the least-squares fit is redone on all antennas.
+
+Cramer-Rao bound: for ``x_k = A exp(i theta_k) + n_k``, ``n_k ~ CN(0, sigma^2)`` and the unknowns
+(A, phi, az, el), the Fisher information of (az, el) after eliminating the nuisance phase is
+``J = 2 SNR sum_k (g_k - mean(g)) (g_k - mean(g))^T`` with ``g_k = -(2 pi / lambda) (du/daz . r_k,
+du/del . r_k)`` and ``SNR = A^2 / sigma^2`` per channel and pixel; ``CRLB = J^-1``.
+
+Examples
+--------
+>>> from skyradar.config import RadarConfig
+>>> cfg = RadarConfig.seed_prototype()
+>>> u = direction_from_angles(np.radians(10.0), np.radians(-5.0))
+>>> pixels = steering_vector(u, cfg)[None, :]
+>>> az, el = angles_from_direction(estimate_directions(pixels, cfg))
+>>> np.round(np.degrees([az[0], el[0]]), 6).tolist()
+[10.0, -5.0]
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from skyradar.config import RadarConfig
+from skyradar.errors import InputError
+
+__all__ = [
+    "ArrayGeometry",
+    "array_geometry",
+    "direction_from_angles",
+    "angles_from_direction",
+    "steering_vector",
+    "estimate_directions",
+    "doa_crlb",
+    "antenna_to_body",
+]
+
+
+@dataclass(frozen=True)
+class ArrayGeometry:
+    """Precomputed least-squares operators of one receive array.
+
+    Attributes
+    ----------
+    basis : ndarray, shape (3, dims)
+        Solved direction components ``a = basis.T @ u`` (the array plane for coplanar arrays).
+    normal : ndarray, shape (3,) or None
+        Unit normal on the facing side (coplanar arrays only).
+    design : ndarray, shape (n_rx, dims)
+        ``-(2 pi / lambda) (r_k - centroid) @ basis``: phase per unit of ``a``.
+    solve : ndarray, shape (dims, n_rx)
+        Pseudo-inverse of ``design``; its rows sum to zero, so a common phase drops out.
+    pairs : ndarray, shape (n_pairs, 2) or None
+        Antenna pairs at most lambda/2 apart, when they span ``dims`` (unambiguous coarse fit).
+    pair_solve : ndarray, shape (dims, n_pairs) or None
+    grid : ndarray, shape (n_grid, dims) or None
+        Coarse search grid in ``a`` over the field of view (within 6 dB of peak gain) when no
+        unambiguous pair set exists.
+    """
+
+    basis: np.ndarray
+    normal: np.ndarray | None
+    design: np.ndarray
+    solve: np.ndarray
+    pairs: np.ndarray | None
+    pair_solve: np.ndarray | None
+    grid: np.ndarray | None
+
+    @property
+    def dims(self) -> int:
+        return int(self.basis.shape[1])
+
+
+def _search_grid(
+    q: np.ndarray,
+    basis: np.ndarray,
+    normal: np.ndarray | None,
+    wavelength_m: float,
+    facing: np.ndarray,
+    half: float,
+) -> np.ndarray:
+    """Coarse grid of ``a`` over the field of view (a cone around ``facing``).
+
+    The step keeps the coarse phase error on the longest baseline below pi/4. Grating lobes of
+    arrays sparser than lambda/2 are only resolved inside the cone: outside it they are real
+    ambiguities of the layout.
+    """
+    step = min(0.05, wavelength_m / (16.0 * float(np.linalg.norm(q, axis=1).max())))
+    if normal is not None:
+        axis = np.arange(-1.0, 1.0 + step, step)
+        a = np.stack(np.meshgrid(axis, axis, indexing="ij"), axis=-1).reshape(-1, 2)
+        a = a[np.sum(a * a, axis=1) <= 1.0]
+        u = a @ basis.T + np.sqrt(1.0 - np.sum(a * a, axis=1))[:, None] * normal
+    else:
+        n = int(4.0 * np.pi / step**2)
+        i = np.arange(n) + 0.5
+        z = 1.0 - 2.0 * i / n  # Fibonacci sphere
+        phi = np.pi * (1.0 + 5**0.5) * i
+        u = np.stack([np.sqrt(1 - z * z) * np.cos(phi), np.sqrt(1 - z * z) * np.sin(phi), z], axis=1)
+        a = u
+    return a[u @ facing >= np.cos(half)]
+
+
+@lru_cache(maxsize=32)
+def _geometry(
+    rx_bytes: bytes, n_rx: int, wavelength_m: float, facing: tuple[float, float, float], half_angle_rad: float
+) -> ArrayGeometry:
+    rx = np.frombuffer(rx_bytes).reshape(n_rx, 3)
+    k = 2.0 * np.pi / wavelength_m
+    scale = max(float(np.ptp(rx, axis=0).max()), 1e-12)
+    distinct = np.unique(np.round(rx / (1e-6 * scale)), axis=0).shape[0]
+    if distinct < 3:
+        raise InputError(f"radar.rx_positions_m: {distinct} distinct antennas; a direction needs at least 3")
+    q = rx - rx.mean(axis=0)
+    _, sv, vt = np.linalg.svd(q)
+    rank = int(np.sum(sv > 1e-6 * sv[0]))
+    if rank < 2:
+        raise InputError(
+            "radar.rx_positions_m: all antennas are on one line; azimuth and elevation are not separable"
+        )
+    normal = None
+    if rank == 2:
+        basis = vt[:2].T
+        normal = np.cross(basis[:, 0], basis[:, 1])
+        face = float(normal @ np.asarray(facing))
+        if abs(face) < 0.1:
+            raise InputError(
+                "radar.rx_positions_m: the array plane contains the boresight; cannot tell the facing side"
+            )
+        normal = normal * np.sign(face)
+    else:
+        basis = np.eye(3)
+    design = -k * q @ basis
+    solve = np.linalg.pinv(design)
+    ii, jj = np.triu_indices(n_rx, 1)
+    short = np.linalg.norm(rx[jj] - rx[ii], axis=1) <= wavelength_m / 2.0 * (1.0 + 1e-9)
+    pairs = pair_solve = grid = None
+    pair_design = -k * (rx[jj[short]] - rx[ii[short]]) @ basis
+    # Non-coplanar arrays always search the grid: a lambda/2 pair along the boresight wraps at
+    # +-pi exactly where targets are, and only the field of view tells front from back.
+    if rank == 2 and short.any() and np.linalg.matrix_rank(pair_design) == 2:
+        pairs = np.stack([ii[short], jj[short]], axis=1)
+        pair_solve = np.linalg.pinv(pair_design)
+    else:
+        grid = _search_grid(q, basis, normal, wavelength_m, np.asarray(facing), half_angle_rad)
+    return ArrayGeometry(basis, normal, design, solve, pairs, pair_solve, grid)
+
+
+def array_geometry(
+    config: RadarConfig, facing: tuple[float, float, float] = (1.0, 0.0, 0.0)
+) -> ArrayGeometry:
+    """Least-squares operators of ``config``'s receive array (cached); InputError for unusable layouts."""
+    rx = np.ascontiguousarray(config.rx_positions_m, dtype=float)
+    facing = tuple(float(f) for f in np.asarray(facing, float) / np.linalg.norm(facing))
+    return _geometry(rx.tobytes(), rx.shape[0], float(config.wavelength_m), facing, _fov_half_angle(config))
+
+
+def _fov_half_angle(config: RadarConfig, max_loss_db: float = 6.0) -> float:
+    """Widest off-boresight angle (rad) at which either principal cut is within ``max_loss_db`` of peak."""
+    angle = np.radians(np.arange(0.0, 90.5, 0.5))
+    ant = config.antenna
+    half = 0.0
+    for cut in (
+        ant.gain_db(angle, 0.0),
+        ant.gain_db(-angle, 0.0),
+        ant.gain_db(0.0, angle),
+        ant.gain_db(0.0, -angle),
+    ):
+        inside = ant.peak_db - cut <= max_loss_db
+        half = max(half, float(angle[np.argmin(inside)] if not inside.all() else angle[-1]))
+    return round(half, 6)
+
+
+def direction_from_angles(azimuth_rad: np.ndarray | float, elevation_rad: np.ndarray | float) -> np.ndarray:
+    """Unit vectors (..., 3) in the antenna frame (x boresight, y right, z down)."""
+    az, el = np.broadcast_arrays(np.asarray(azimuth_rad, float), np.asarray(elevation_rad, float))
+    return np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)], axis=-1)
+
+
+def angles_from_direction(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Azimuth (positive right) and elevation (positive up) of vectors (..., 3), radians."""
+    u = np.asarray(u, float)
+    norm = np.maximum(np.linalg.norm(u, axis=-1), 1e-300)
+    return np.arctan2(u[..., 1], u[..., 0]), np.arcsin(np.clip(-u[..., 2] / norm, -1.0, 1.0))
+
+
+def steering_vector(u: np.ndarray, config: RadarConfig) -> np.ndarray:
+    """Far-field receive phases ``exp(-i (2 pi / lambda) u . r_k)``, shape (..., n_rx)."""
+    return np.exp(
+        -1j * (2.0 * np.pi / config.wavelength_m) * (np.asarray(u, float) @ config.rx_positions_m.T)
+    )
+
+
+def _coarse(z: np.ndarray, geo: ArrayGeometry) -> np.ndarray:
+    if geo.pairs is not None:
+        d = np.angle(z[:, geo.pairs[:, 1]] * np.conj(z[:, geo.pairs[:, 0]]))
+        return d @ geo.pair_solve.T
+    # Beamforming: the grid point whose predicted phases best match the measured ones.
+    steer = np.exp(1j * geo.grid @ geo.design.T)  # (n_grid, n_rx)
+    score = np.abs(z @ np.conj(steer).T)  # (n, n_grid)
+    return geo.grid[np.argmax(score, axis=1)]
+
+
+def _refine_on_sphere(u: np.ndarray, psi: np.ndarray, design: np.ndarray, iterations: int = 3) -> np.ndarray:
+    """Gauss-Newton in (az, el) on the unwrapped phases: least squares with ``|u| = 1`` built in.
+
+    Normalising the unconstrained 3-D solution lets the poorly observed component (small depth
+    aperture) leak into azimuth and elevation; fitting the angles directly reaches the bound.
+    """
+    psi = psi - psi.mean(axis=1, keepdims=True)
+    az, el = angles_from_direction(u)
+    for _ in range(iterations):
+        ca, sa, ce, se = np.cos(az), np.sin(az), np.cos(el), np.sin(el)
+        u = np.stack([ce * ca, ce * sa, -se], axis=1)
+        d_az = np.stack([-ce * sa, ce * ca, np.zeros_like(az)], axis=1)
+        d_el = np.stack([-se * ca, -se * sa, -ce], axis=1)
+        jac = np.stack([d_az @ design.T, d_el @ design.T], axis=2)  # (n, n_rx, 2)
+        resid = psi - u @ design.T
+        step = np.linalg.solve(
+            np.einsum("nki,nkj->nij", jac, jac), np.einsum("nki,nk->ni", jac, resid)[..., None]
+        )
+        az, el = az + step[:, 0, 0], np.clip(el + step[:, 1, 0], -np.pi / 2, np.pi / 2)
+    return direction_from_angles(az, el)
+
+
+def estimate_directions(
+    pixels: np.ndarray,
+    config: RadarConfig,
+    calibrated: bool = False,
+    facing: tuple[float, float, float] = (1.0, 0.0, 0.0),
+) -> np.ndarray:
+    """Unit direction vectors (antenna frame) from complex pixels of all receive channels.
+
+    Parameters
+    ----------
+    pixels : ndarray, shape (n, n_rx), complex
+        Peak pixel of each detection, one column per receive antenna.
+    config : RadarConfig
+        Antenna positions, wavelength and ``rx_calibration`` (divided out unless ``calibrated``).
+    calibrated : bool
+        True when ``pixels`` already had the calibration divided out.
+    facing : (float, float, float)
+        Side a coplanar array looks at (antenna frame); the default is the boresight.
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+        Unit vectors; multiply by the measured range for positions.
+    """
+    z = np.atleast_2d(np.asarray(pixels))
+    if z.ndim != 2 or z.shape[1] != config.n_rx:
+        raise InputError(f"doa: field 'rx' has {z.shape[-1]} channels, radar_config has {config.n_rx}")
+    if not calibrated:
+        z = z / config.rx_calibration
+    geo = array_geometry(config, facing)
+    if z.shape[0] == 0:
+        return np.zeros((0, 3))
+    a0 = _coarse(z, geo)
+    pred = a0 @ geo.design.T
+    resid = np.angle(z * np.conj(z[:, :1])) - pred
+    common = np.angle(np.sum(np.exp(1j * resid), axis=1, keepdims=True))
+    unwrapped = pred + common + np.angle(np.exp(1j * (resid - common)))
+    a = unwrapped @ geo.solve.T
+    if geo.normal is None:
+        u = a / np.maximum(np.linalg.norm(a, axis=1, keepdims=True), 1e-300)
+        return _refine_on_sphere(u, unwrapped, geo.design)
+    norm = np.linalg.norm(a, axis=1, keepdims=True)
+    a = a / np.maximum(norm, 1.0)  # noise can push the in-plane part beyond the unit circle
+    third = np.sqrt(np.maximum(1.0 - np.sum(a * a, axis=1, keepdims=True), 0.0))
+    return a @ geo.basis.T + third * geo.normal
+
+
+def doa_crlb(
+    snr_db: np.ndarray | float,
+    azimuth_rad: np.ndarray | float,
+    elevation_rad: np.ndarray | float,
+    config: RadarConfig,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Cramer-Rao bound on the standard deviation of azimuth and elevation, radians.
+
+    Parameters
+    ----------
+    snr_db : array_like
+        Per-channel, per-pixel SNR ``A^2 / sigma^2`` of the pixel the direction is taken from, dB.
+    azimuth_rad, elevation_rad : array_like
+        True direction in the antenna frame.
+    config : RadarConfig
+        Antenna positions and wavelength.
+
+    Returns
+    -------
+    (sd_az_rad, sd_el_rad) : tuple of ndarray
+        Square roots of the diagonal of the inverse Fisher information (module docstring).
+
+    Examples
+    --------
+    >>> cfg = RadarConfig.seed_prototype()
+    >>> sd_az, sd_el = doa_crlb(30.0, 0.0, 0.0, cfg)
+    >>> round(float(np.degrees(sd_az)), 3) == round(float(np.degrees(sd_el)), 3)  # square array
+    True
+    """
+    snr = 10.0 ** (np.asarray(snr_db, float) / 10.0)
+    az, el = np.broadcast_arrays(np.asarray(azimuth_rad, float), np.asarray(elevation_rad, float))
+    k = 2.0 * np.pi / config.wavelength_m
+    q = config.rx_positions_m - config.rx_positions_m.mean(axis=0)
+    du_daz = np.stack([-np.cos(el) * np.sin(az), np.cos(el) * np.cos(az), np.zeros_like(az)], axis=-1)
+    du_del = np.stack([-np.sin(el) * np.cos(az), -np.sin(el) * np.sin(az), -np.cos(el)], axis=-1)
+    g = -k * np.stack([du_daz @ q.T, du_del @ q.T], axis=-1)  # (..., n_rx, 2), centred by q
+    info = np.einsum("...ki,...kj->...ij", g, g)
+    det = info[..., 0, 0] * info[..., 1, 1] - info[..., 0, 1] ** 2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        var_az = info[..., 1, 1] / det / (2.0 * snr)
+        var_el = info[..., 0, 0] / det / (2.0 * snr)
+    return np.sqrt(var_az), np.sqrt(var_el)
+
+
+def antenna_to_body(points_m: np.ndarray, config: RadarConfig) -> np.ndarray:
+    """Antenna-frame points (..., 3) to the body frame (forward, right, down) via ``config.mount``."""
+    mount = config.mount
+    return np.asarray(points_m, float) @ mount.rotation.T + np.asarray(mount.position_m)

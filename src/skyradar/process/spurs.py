@@ -1,0 +1,232 @@
+"""Spur maps: pixels that light up in most frames whatever the scene does.
+
+Self-interference puts fixed bright spots into every frame. With a static radar looking at a
+static scene every bright spot is a spur (seed-brief.md ch3): run the detector over a series of
+frames, dilate every detected point by one pixel (Doppler wraps), count how often each pixel is
+hit, and call pixels hit in more than a fraction ``threshold`` of the frames spurs (the thesis
+compared 2, 5, 10 and 25 %). Detections whose peak falls inside the map are flagged.
+
+On a moving platform the scene moves through the image while spurs stay put, so
+:class:`OnlineSpurMap` keeps an exponentially weighted hit frequency and flags the pixels that
+stay lit. An object that holds the same range and radial velocity for longer than the time
+constant (e.g. formation flight) would be learned too; keep the time constant short next to
+the time the scene takes to move by a pixel.
+
+Examples
+--------
+>>> from skyradar.config import RadarConfig
+>>> cfg = RadarConfig.seed_prototype()
+>>> hits = np.zeros((10, cfg.n_range, cfg.n_doppler), bool)
+>>> hits[:, 50, 0] = True  # a spur on the Doppler edge, in every frame
+>>> spur_map = SpurMap.from_hits(hits, threshold=0.05)
+>>> spur_map.contains(np.array([50.0, 51.0, 60.0]), np.array([249.4, 1.0, 0.0])).tolist()
+[True, True, False]
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from scipy import ndimage
+
+from skyradar.config import RadarConfig
+from skyradar.errors import InputError
+from skyradar.process.cfar import cfar_2d
+from skyradar.process.detect import detect
+
+__all__ = ["THESIS_THRESHOLDS", "SpurMap", "detection_pixels", "learn_spur_map", "OnlineSpurMap"]
+
+THESIS_THRESHOLDS = (0.02, 0.05, 0.10, 0.25)
+_SQUARE = np.ones((3, 3), bool)
+
+
+def _dilate(hits: np.ndarray) -> np.ndarray:
+    """Grow every hit by one pixel (8-neighbourhood), wrapping in Doppler (last axis)."""
+    padded = np.concatenate([hits[..., -1:], hits, hits[..., :1]], axis=-1)
+    structure = _SQUARE if hits.ndim == 2 else _SQUARE[None]
+    return ndimage.binary_dilation(padded, structure=structure)[..., 1:-1]
+
+
+def detection_pixels(
+    power: np.ndarray, config: RadarConfig, pixels: Literal["peaks", "hits"] = "peaks", **detect_kwargs: Any
+) -> np.ndarray:
+    """Boolean image of one channel-integrated frame's detections.
+
+    ``"peaks"``: the detector's point per object (the thesis' corners). ``"hits"``: every pixel
+    above the CFAR threshold, so extended interference (zero-Doppler line, near-range leakage)
+    is learned whole, not only where its peak happens to be.
+    """
+    if pixels == "hits":
+        return cfar_2d(power, pfa=detect_kwargs.get("pfa", 1e-5), n_integrated=config.n_rx)[0]
+    if pixels != "peaks":
+        raise InputError(f"spur map: field 'pixels' must be 'peaks' or 'hits', got {pixels!r}")
+    det = detect(power, config, **detect_kwargs)
+    hits = np.zeros(power.shape, bool)
+    hits[det.range_index, det.doppler_index] = True
+    return hits
+
+
+@dataclass(frozen=True)
+class SpurMap:
+    """Per-pixel hit frequency over a series of frames and the threshold that makes a spur.
+
+    Attributes
+    ----------
+    frequency : ndarray, shape (n_range, n_doppler), float32
+        Fraction of frames in which the (dilated) detections covered each pixel.
+    threshold : float
+        Pixels with ``frequency > threshold`` are spurs.
+    n_frames : int
+        Frames the map was learned from.
+    """
+
+    frequency: np.ndarray
+    threshold: float = 0.05
+    n_frames: int = 0
+
+    def __post_init__(self) -> None:
+        freq = np.asarray(self.frequency, np.float32)
+        if freq.ndim != 2:
+            raise InputError(f"spur map: field 'frequency' must be 2-D, got shape {freq.shape}")
+        if not 0.0 <= self.threshold < 1.0:
+            raise InputError(f"spur map: field 'threshold' must be in [0, 1), got {self.threshold}")
+        object.__setattr__(self, "frequency", freq)
+
+    @classmethod
+    def from_hits(cls, hits: np.ndarray, threshold: float = 0.05) -> SpurMap:
+        """Map from a (n_frames, n_range, n_doppler) boolean stack of detection pixels."""
+        hits = np.asarray(hits, bool)
+        if hits.ndim != 3 or hits.shape[0] == 0:
+            raise InputError(f"spur map: need a (frames, range, doppler) stack, got shape {hits.shape}")
+        return cls(_dilate(hits).mean(axis=0), threshold, hits.shape[0])
+
+    @property
+    def mask(self) -> np.ndarray:
+        """Boolean spur image."""
+        return self.frequency > self.threshold
+
+    def with_threshold(self, threshold: float) -> SpurMap:
+        return SpurMap(self.frequency, threshold, self.n_frames)
+
+    def contains(self, range_bin: np.ndarray, doppler_bin: np.ndarray) -> np.ndarray:
+        """True for (sub-pixel) positions whose nearest pixel is a spur."""
+        n_r, n_d = self.frequency.shape
+        r = np.clip(np.rint(np.asarray(range_bin, float)).astype(np.int64), 0, n_r - 1)
+        d = np.rint(np.asarray(doppler_bin, float)).astype(np.int64) % n_d
+        return self.mask[r, d]
+
+    def save(self, path: str | Path) -> Path:
+        """Write to ``.npz`` atomically."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(path.name + ".tmp.npz")
+        np.savez_compressed(tmp, frequency=self.frequency, threshold=self.threshold, n_frames=self.n_frames)
+        os.replace(tmp, path)
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path, config: RadarConfig | None = None) -> SpurMap:
+        """Read a map written by :meth:`save`; with ``config`` check it fits the radar's image."""
+        path = Path(path)
+        if not path.exists():
+            raise InputError(f"{path}: no such spur map")
+        try:
+            with np.load(path) as data:
+                spur_map = cls(data["frequency"], float(data["threshold"]), int(data["n_frames"]))
+        except (OSError, KeyError, ValueError) as exc:
+            raise InputError(f"{path}: not a spur map ({type(exc).__name__}: {exc})") from exc
+        if config is not None and spur_map.frequency.shape != (config.n_range, config.n_doppler):
+            raise InputError(
+                f"{path}: field 'frequency' has shape {spur_map.frequency.shape}, radar_config needs "
+                f"{(config.n_range, config.n_doppler)}"
+            )
+        return spur_map
+
+
+def learn_spur_map(
+    powers: Iterable[np.ndarray],
+    config: RadarConfig,
+    threshold: float = 0.05,
+    pixels: Literal["peaks", "hits"] = "peaks",
+    **detect_kwargs: Any,
+) -> SpurMap:
+    """Learn a spur map from channel-integrated frames of a static scene.
+
+    Parameters
+    ----------
+    powers : iterable of ndarray (n_range, n_doppler)
+        Frames from :func:`skyradar.process.detect.integrate_channels`.
+    threshold : float
+        Hit frequency above which a pixel is a spur.
+    pixels : {"peaks", "hits"}
+        Learn detector points (thesis) or every CFAR hit pixel (:func:`detection_pixels`).
+    **detect_kwargs
+        Passed to :func:`skyradar.process.detect.detect`; default Shi-Tomasi corners as in the thesis.
+    """
+    detect_kwargs.setdefault("method", "shi-tomasi")
+    counts = None
+    n = 0
+    for power in powers:
+        hits = _dilate(detection_pixels(power, config, pixels, **detect_kwargs))
+        counts = hits.astype(np.int32) if counts is None else counts + hits
+        n += 1
+    if n == 0:
+        raise InputError("spur map: no frames to learn from")
+    return SpurMap(counts / np.float32(n), threshold, n)
+
+
+class OnlineSpurMap:
+    """Running spur map for a moving platform: pixels that stay lit while the scene moves.
+
+    Parameters
+    ----------
+    shape : (int, int)
+        Image shape (n_range, n_doppler).
+    time_constant_frames : float
+        Memory of the exponentially weighted hit frequency, frames.
+    threshold : float
+        Frequency above which a pixel is a spur.
+    min_frames : int
+        Frames to see before anything is called a spur.
+    """
+
+    def __init__(
+        self,
+        shape: tuple[int, int],
+        time_constant_frames: float = 50.0,
+        threshold: float = 0.5,
+        min_frames: int = 10,
+    ) -> None:
+        if time_constant_frames < 1:
+            raise InputError(
+                f"spur map: field 'time_constant_frames' must be >= 1, got {time_constant_frames}"
+            )
+        self.frequency = np.zeros(shape, np.float32)
+        self.alpha = np.float32(1.0 / time_constant_frames)
+        self.threshold = float(threshold)
+        self.min_frames = int(min_frames)
+        self.n_frames = 0
+
+    def update(self, hits: np.ndarray) -> np.ndarray:
+        """Add one frame's detection pixels (boolean image); returns the current spur mask."""
+        hits = _dilate(np.asarray(hits, bool))
+        # Bias-corrected average: equal weights until the time constant is reached.
+        alpha = max(self.alpha, np.float32(1.0 / (self.n_frames + 1)))
+        self.frequency += alpha * (hits - self.frequency)
+        self.n_frames += 1
+        return self.mask
+
+    @property
+    def mask(self) -> np.ndarray:
+        if self.n_frames < self.min_frames:
+            return np.zeros(self.frequency.shape, bool)
+        return self.frequency > self.threshold
+
+    def snapshot(self) -> SpurMap:
+        """The current state as a :class:`SpurMap`."""
+        return SpurMap(self.frequency.copy(), self.threshold, self.n_frames)

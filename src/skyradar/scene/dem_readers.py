@@ -1,0 +1,289 @@
+"""DEM readers: SRTM ``.hgt``, GeoTIFF, ``.npz``; void filling.
+
+Every reader returns a :class:`~skyradar.scene.terrain.Terrain` with finite elevations. Voids
+(SRTM's -32768, a GeoTIFF's nodata value, NaN) and infinities are filled from the surrounding
+valid samples when they are at most ``max_void_fraction`` of the grid, and rejected with an
+:class:`~skyradar.errors.InputError` otherwise.
+"""
+
+from __future__ import annotations
+
+import logging
+import re
+from collections.abc import Mapping
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+from scipy import sparse
+from scipy.sparse.linalg import spsolve
+
+from skyradar.errors import InputError
+from skyradar.geo import geodetic_to_ned
+from skyradar.scene.terrain import Terrain
+
+__all__ = ["read_dem", "read_hgt", "read_geotiff", "read_npz", "jacksboro", "fill_voids", "SRTM_VOID"]
+
+SRTM_VOID = -32768
+_HGT_NAME = re.compile(r"^([NS])(\d{2})([EW])(\d{3})", re.IGNORECASE)
+_log = logging.getLogger(__name__)
+
+
+def fill_voids(
+    elevation: np.ndarray, voids: np.ndarray, source: str, max_void_fraction: float = 0.01
+) -> np.ndarray:
+    """Fill ``voids`` (bool mask) of ``elevation`` with the harmonic (Laplace) interpolant.
+
+    Each void sample becomes the mean of its 4 in-grid neighbours, the valid ones fixed: one
+    sparse linear solve over the void samples. Planes are reproduced exactly inside the grid;
+    at the grid edge the fill has zero normal slope. Raises :class:`InputError` when the void
+    fraction exceeds ``max_void_fraction``.
+
+    Examples
+    --------
+    >>> z = np.arange(16.0).reshape(4, 4)
+    >>> holes = np.zeros((4, 4), bool); holes[1, 2] = True
+    >>> float(fill_voids(np.where(holes, np.nan, z), holes, "x.npz", 0.1)[1, 2])
+    6.0
+    """
+    z = np.array(elevation, dtype=float)
+    fraction = float(voids.mean())
+    if fraction == 0.0:
+        return z
+    if fraction > max_void_fraction or voids.all():
+        raise InputError(
+            f"{source}: {fraction * 100:.1f}% of samples are voids, above the fill limit "
+            f"{max_void_fraction * 100:g}% (field elevation)"
+        )
+    ny, nx = z.shape
+    rr, cc = np.nonzero(voids)
+    index = np.full(z.shape, -1, np.intp)
+    index[rr, cc] = np.arange(rr.size)
+    diag, rhs = np.zeros(rr.size), np.zeros(rr.size)
+    rows, cols = [], []
+    for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+        qr, qc = rr + dr, cc + dc
+        ok = (qr >= 0) & (qr < ny) & (qc >= 0) & (qc < nx)
+        diag += ok
+        p, qr, qc = np.nonzero(ok)[0], qr[ok], qc[ok]
+        q = index[qr, qc]
+        known = q < 0
+        np.add.at(rhs, p[known], z[qr[known], qc[known]])
+        rows.append(p[~known])
+        cols.append(q[~known])
+    rows, cols = np.concatenate(rows), np.concatenate(cols)
+    m = rr.size
+    lap = sparse.csr_matrix((-np.ones(rows.size), (rows, cols)), shape=(m, m)) + sparse.diags(diag)
+    z[rr, cc] = spsolve(lap.tocsc(), rhs)
+    _log.info("%s: filled %d void samples (%.3f%%)", source, rr.size, fraction * 100)
+    return z
+
+
+def _void_mask(z: np.ndarray, nodata: float | None = None) -> np.ndarray:
+    voids = ~np.isfinite(z) if np.issubdtype(z.dtype, np.floating) else np.zeros(z.shape, bool)
+    if np.issubdtype(z.dtype, np.signedinteger) and z.dtype.itemsize >= 2:
+        voids |= z == SRTM_VOID
+    if nodata is not None and np.isfinite(nodata):
+        voids |= z == nodata
+    return voids
+
+
+def _fill(z: np.ndarray, source: str, max_void_fraction: float, nodata: float | None = None) -> np.ndarray:
+    return fill_voids(z, _void_mask(z, nodata), source, max_void_fraction)
+
+
+def read_hgt(path: str | Path, max_void_fraction: float = 0.01) -> Terrain:
+    """Read an SRTM ``.hgt`` tile (1201x1201 or 3601x3601 big-endian int16).
+
+    The file name gives the south-west corner (``N52E004.hgt``: 52 N, 4 E); row 0 is the
+    north edge at lat + 1. Heights are taken as given (SRTM is relative to the EGM96 geoid).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "N52E004.hgt"
+    >>> np.full((1201, 1201), 7, ">i2").tofile(p)
+    >>> read_hgt(p).bounds
+    Bounds(south_deg=52.0, west_deg=4.0, north_deg=53.0, east_deg=5.0)
+    """
+    path = Path(path)
+    match = _HGT_NAME.match(path.name)
+    if match is None:
+        raise InputError(
+            f"{path.name}: file name '{path.name}' does not give the tile corner (expected like N52E004.hgt)"
+        )
+    ns, lat, ew, lon = match.groups()
+    lat_deg = int(lat) * (1 if ns.upper() == "N" else -1)
+    lon_deg = int(lon) * (1 if ew.upper() == "E" else -1)
+    if not (-90 <= lat_deg <= 89 and -180 <= lon_deg <= 179):
+        raise InputError(
+            f"{path.name}: tile corner lat {lat_deg}, lon {lon_deg} in the file name is out of range"
+        )
+    size = path.stat().st_size
+    n = {1201 * 1201 * 2: 1201, 3601 * 3601 * 2: 3601}.get(size)
+    if n is None:
+        raise InputError(f"{path.name}: size {size} bytes is not a 1201x1201 or 3601x3601 int16 tile")
+    raw = np.fromfile(path, dtype=">i2").reshape(n, n)
+    z = _fill(raw, path.name, max_void_fraction)
+    step = 1.0 / (n - 1)
+    return Terrain.geographic(z, lat_deg + 1.0, float(lon_deg), step, step, source=path.name)
+
+
+def read_geotiff(path: str | Path, max_void_fraction: float = 0.01) -> Terrain:
+    """Read band 1 of a GeoTIFF DEM with rasterio.
+
+    A geographic CRS gives a geographic grid; a projected CRS gives a projected grid anchored
+    at pixel [0, 0] (its centre transformed to WGS84 lat/lon), with the spacing scaled to ground
+    metres and the grid's rotation from true north (meridian convergence) measured at the anchor.
+    The nodata value and NaN are voids.
+    """
+    import rasterio
+    from rasterio.errors import RasterioError
+
+    path = Path(path)
+    try:
+        with rasterio.open(path) as ds:
+            z, nodata, tf, crs = ds.read(1), ds.nodata, ds.transform, ds.crs
+    except RasterioError as exc:
+        raise InputError(f"{path.name}: cannot read GeoTIFF ({exc})") from exc
+    if crs is None:
+        raise InputError(f"{path.name}: field 'crs' is missing; cannot place the grid on the earth")
+    if tf.b != 0 or tf.d != 0:
+        raise InputError(
+            f"{path.name}: field 'transform' is rotated or sheared ({tuple(tf)[:6]}); not supported"
+        )
+    z = _fill(z, path.name, max_void_fraction, nodata)
+    if tf.e > 0:  # rows run south to north
+        z, tf = z[::-1], tf @ rasterio.Affine.translation(0, z.shape[0]) @ rasterio.Affine.scale(1, -1)
+    if tf.a < 0:  # columns run east to west
+        z, tf = z[:, ::-1], tf @ rasterio.Affine.translation(z.shape[1], 0) @ rasterio.Affine.scale(-1, 1)
+    x0, y0 = tf @ (0.5, 0.5)
+    lat0, lon0 = _to_wgs84(crs, [x0], [y0])
+    if crs.is_geographic:
+        return Terrain.geographic(z, lat0[0], lon0[0], -tf.e, tf.a, source=path.name)
+    unit_m = float(crs.linear_units_factor[1])
+    reach = 1000.0 / unit_m  # 1 km along each grid axis, in CRS units
+    lat, lon = _to_wgs84(crs, [x0, x0 + reach], [y0 + reach, y0])
+    ned = geodetic_to_ned(np.array(lat), np.array(lon), 0.0, lat0[0], lon0[0], 0.0)
+    up_m, right_m = np.hypot(ned[0, 0], ned[0, 1]), np.hypot(ned[1, 0], ned[1, 1])
+    rotation = float(np.degrees(np.arctan2(ned[0, 1], ned[0, 0])))
+    dy_m, dx_m = -tf.e * unit_m * up_m / 1000.0, tf.a * unit_m * right_m / 1000.0
+    return Terrain.projected(z, lat0[0], lon0[0], dy_m, dx_m, rotation_deg=rotation, source=path.name)
+
+
+def _to_wgs84(crs, xs: list[float], ys: list[float]) -> tuple[list[float], list[float]]:
+    from rasterio.warp import transform
+
+    lon, lat = transform(crs, "EPSG:4326", xs, ys)
+    return list(lat), list(lon)
+
+
+def _scalar(data: Mapping, key: str, source: str) -> float:
+    try:
+        value = float(np.asarray(data[key]))
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{source}: field '{key}' is not a number ({data[key]!r})") from exc
+    if not np.isfinite(value):
+        raise InputError(f"{source}: field '{key}' is not finite ({value})")
+    return value
+
+
+def terrain_from_arrays(data: Mapping, source: str, max_void_fraction: float = 0.01) -> Terrain:
+    """Build a Terrain from an ``.npz``-style mapping (see :func:`read_npz` for the keys)."""
+    keys = set(data.keys())
+    if "elevation" not in keys:
+        raise InputError(f"{source}: field 'elevation' is missing (have {sorted(keys)})")
+    raw = np.asarray(data["elevation"])
+    if raw.ndim != 2:
+        raise InputError(f"{source}: field 'elevation' must be 2-D (shape {raw.shape})")
+    nodata = _scalar(data, "nodata", source) if "nodata" in keys else None
+    z = _fill(raw, source, max_void_fraction, nodata)
+    if {"dx_m", "dy_m", "lat0_deg", "lon0_deg"} <= keys:
+        rot = _scalar(data, "rotation_deg", source) if "rotation_deg" in keys else 0.0
+        vals = [_scalar(data, k, source) for k in ("lat0_deg", "lon0_deg", "dy_m", "dx_m")]
+        return Terrain.projected(z, *vals, rotation_deg=rot, source=source)
+    if {"dx", "dy", "xmin", "ymax"} <= keys:
+        dx, dy = abs(_scalar(data, "dx", source)), abs(_scalar(data, "dy", source))
+        west, north = _scalar(data, "xmin", source), _scalar(data, "ymax", source)
+        ny, nx = z.shape
+        if "ymin" in keys:  # the two y bounds may be swapped: north is the larger
+            north = max(north, _scalar(data, "ymin", source))
+            if abs(abs(_scalar(data, "ymin", source) - _scalar(data, "ymax", source)) - ny * dy) < 0.01 * dy:
+                north -= dy / 2.0  # bounds are pixel edges (n * d wide): move to the sample centre
+        if "xmax" in keys:
+            west = min(west, _scalar(data, "xmax", source))
+            if abs(abs(_scalar(data, "xmax", source) - _scalar(data, "xmin", source)) - nx * dx) < 0.01 * dx:
+                west += dx / 2.0
+        return Terrain.geographic(z, north, west, dy, dx, source=source)
+    raise InputError(
+        f"{source}: fields for the grid position are missing: need dx, dy, xmin, ymax (degrees) "
+        f"or dx_m, dy_m, lat0_deg, lon0_deg (have {sorted(keys)})"
+    )
+
+
+def read_npz(path: str | Path, max_void_fraction: float = 0.01) -> Terrain:
+    """Read a DEM from ``.npz``.
+
+    Keys: ``elevation`` (2-D, row 0 north) and either ``dx, dy, xmin, ymax`` in degrees
+    (matplotlib's ``jacksboro_fault_dem.npz`` convention; with ``xmax``/``ymin`` also present
+    and spanning n*d, the bounds are pixel edges; the larger of ``ymin``/``ymax`` is north) or
+    ``dx_m, dy_m, lat0_deg, lon0_deg`` (+ optional ``rotation_deg``) for a projected grid
+    anchored at sample [0, 0]. Optional ``nodata``.
+    """
+    path = Path(path)
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            arrays = {k: data[k] for k in data.files}
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{path.name}: cannot read .npz ({exc})") from exc
+    return terrain_from_arrays(arrays, path.name, max_void_fraction)
+
+
+def jacksboro(max_void_fraction: float = 0.01) -> Terrain:
+    """Matplotlib's sample DEM of the Jacksboro fault (Tennessee): 344 x 403, 3 arc-second.
+
+    Examples
+    --------
+    >>> jacksboro().shape
+    (344, 403)
+    """
+    from matplotlib import cbook
+
+    data = cbook.get_sample_data("jacksboro_fault_dem.npz")
+    arrays = {k: data[k] for k in data.files}
+    return terrain_from_arrays(arrays, "jacksboro_fault_dem.npz", max_void_fraction)
+
+
+_READERS = {".hgt": read_hgt, ".tif": read_geotiff, ".tiff": read_geotiff, ".npz": read_npz}
+
+
+def read_dem(path: str | Path, max_void_fraction: float = 0.01, height_offset_m: float = 0.0) -> Terrain:
+    """Read a DEM by suffix: ``.hgt`` (SRTM), ``.tif``/``.tiff`` (GeoTIFF), ``.npz``.
+
+    Voids up to ``max_void_fraction`` of the samples are filled; more raise InputError.
+    ``height_offset_m`` is added to every elevation: Terrain heights are above the WGS84
+    ellipsoid, while SRTM heights are above the EGM96 geoid, so pass the local geoid
+    undulation there (about +45 m in the Netherlands) to match GPS altitudes.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "N52E005.hgt"
+    >>> np.full((1201, 1201), 10, ">i2").tofile(p)
+    >>> float(read_dem(p, height_offset_m=45.0).height_at(52.5, 5.5))
+    55.0
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{path}: no such DEM file")
+    reader = _READERS.get(path.suffix.lower())
+    if reader is None:
+        raise InputError(f"{path.name}: DEM format '{path.suffix}' not supported (use {', '.join(_READERS)})")
+    if not 0.0 <= max_void_fraction <= 1.0:
+        raise InputError(
+            f"{path.name}: field 'max_void_fraction' must be within [0, 1] ({max_void_fraction})"
+        )
+    terrain = reader(path, max_void_fraction)
+    if height_offset_m:
+        terrain = replace(terrain, elevation_m=terrain.elevation_m + np.float32(height_offset_m))
+    return terrain

@@ -1,0 +1,380 @@
+"""Scenario files: one YAML describing radar, mount, terrain, own-ship, intruders and frame times.
+
+:func:`load_scenario` validates a file into a :class:`Scenario` (pydantic models, unknown keys
+rejected); every problem becomes one :class:`~skyradar.errors.InputError` line such as
+``bad.yaml: field 'frame_rate_hz': must be > 0 (got -5)``. :meth:`Scenario.build` turns it into
+a :class:`BuiltScenario`: a :class:`~skyradar.config.RadarConfig` (mount inside), the terrain,
+own-ship and intruder trajectories in the NED frame of the scenario origin, the frame times and
+the simulator options. Paths in the file are relative to the file. Heights are metres above the
+WGS84 ellipsoid (see :mod:`skyradar.scene.trajectories`).
+
+The origin defaults to the own-ship file's first point, else the centre of a DEM terrain (on
+the ground); flat and fractal terrain are centred on the origin at ``height_m`` (default: the
+origin's altitude). Parametric flights start at ``start_s`` and last ``duration_s`` unless told.
+
+Example
+-------
+>>> built = load_scenario(example_scenario("ch2_flat_forward")).build()
+>>> len(built.times_s), built.intruders[0].name, built.sim_options["reflectivity"]
+(94, 'head-on', 'cosine')
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+from pydantic import ValidationError
+
+from skyradar.config import Mount, RadarConfig
+from skyradar.errors import InputError
+from skyradar.scene.scenario_models import (
+    TAGS,
+    AntennaModel,
+    EncounterFlight,
+    FileFlight,
+    FlatTerrainModel,
+    FractalTerrainModel,
+    ScenarioModel,
+)
+from skyradar.scene.trajectories import Trajectory
+
+__all__ = [
+    "Scenario",
+    "BuiltScenario",
+    "Intruder",
+    "load_scenario",
+    "example_scenario",
+    "list_example_scenarios",
+]
+
+_SENSE = {"greater_than": ">", "greater_than_equal": ">=", "less_than": "<", "less_than_equal": "<="}
+_SENSE_KEY = {"greater_than": "gt", "greater_than_equal": "ge", "less_than": "lt", "less_than_equal": "le"}
+
+
+@dataclass(frozen=True)
+class Intruder:
+    """Another aircraft: its trajectory (scenario NED frame) and radar cross-section (m^2)."""
+
+    name: str
+    trajectory: Trajectory
+    rcs_m2: float = 1.0
+
+
+@dataclass(frozen=True, eq=False)
+class BuiltScenario:
+    """Everything the simulator needs, in one NED frame at ``origin``.
+
+    ``times_s`` are the frame times (s). Intruders exist only inside their trajectories' spans
+    (``intruder.trajectory.covers(times_s)``); own-ship covers every frame. ``sim_options`` keys:
+    facet_size_m, reflectivity, occlusion, noise, flat_earth, range_doppler_coupling, seed.
+    """
+
+    name: str
+    origin: tuple[float, float, float]
+    radar: RadarConfig
+    terrain: Any
+    ownship: Trajectory
+    intruders: list[Intruder]
+    times_s: np.ndarray
+    sim_options: dict[str, Any] = field(default_factory=dict)
+    source: Path | None = None
+
+
+def _describe(value: Any) -> str:
+    text = repr(value) if isinstance(value, str) else str(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _format_error(source: str, err: dict[str, Any]) -> str:
+    """One line from a pydantic error: file, dotted field, what is wrong, the value."""
+    loc = [
+        str(p) for p in err["loc"] if not (isinstance(p, str) and (p in TAGS or p.startswith("function-")))
+    ]
+    dotted = ".".join(loc) or "(top level)"
+    kind, ctx, value = err["type"], err.get("ctx", {}), err.get("input")
+    if kind == "extra_forbidden":
+        return f"{source}: unknown key '{dotted}'"
+    if kind == "missing" or (kind in ("model_attributes_type", "dict_type") and value is None):
+        return f"{source}: field '{dotted}': is required"
+    if kind in ("model_attributes_type", "dict_type"):
+        return f"{source}: field '{dotted}': must be a mapping of keys (got {_describe(value)})"
+    if kind in _SENSE:
+        what = f"must be {_SENSE[kind]} {ctx[_SENSE_KEY[kind]]:g}"
+    elif kind == "union_tag_invalid":
+        what = f"'type' must be one of {ctx['expected_tags']}"
+        value = ctx.get("tag")
+    elif kind == "union_tag_not_found":
+        return f"{source}: field '{dotted}': needs a 'type'"
+    elif kind == "literal_error":
+        what = f"must be one of {ctx['expected']}"
+    elif kind in (
+        "float_parsing",
+        "float_type",
+        "int_parsing",
+        "int_type",
+        "int_from_float",
+        "finite_number",
+    ):
+        what = "must be a finite number" if kind != "int_from_float" else "must be a whole number"
+    else:
+        what = str(err["msg"]).removeprefix("Value error, ")
+        what = what[:1].lower() + what[1:]
+    return f"{source}: field '{dotted}': {what} (got {_describe(value)})"
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate a scenario YAML file.
+
+    Raises :class:`InputError` (one line naming the file and the field) on any problem.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{path}: no such scenario file")
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}" if mark is not None else ""
+        problem = getattr(exc, "problem", None) or type(exc).__name__
+        raise InputError(f"{path}: not valid YAML{where} ({problem})") from None
+    if not isinstance(data, dict):
+        raise InputError(
+            f"{path}: must be a mapping of sections (name, radar, ownship, ...), got {type(data).__name__}"
+        )
+    return Scenario.from_dict(data, source=path)
+
+
+class Scenario:
+    """A validated scenario file; :meth:`build` makes the trajectories, terrain and radar."""
+
+    def __init__(self, model: ScenarioModel, source: Path | None = None) -> None:
+        self.model = model
+        self.source = source
+        self.base_dir = source.parent if source is not None else Path.cwd()
+        self._label = str(source) if source is not None else "scenario"
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any], source: str | Path | None = None) -> Scenario:
+        """Validate a parsed scenario mapping; paths are relative to ``source``'s folder."""
+        source = Path(source) if source is not None else None
+        label = str(source) if source is not None else "scenario"
+        try:
+            model = ScenarioModel.model_validate(data)
+        except ValidationError as exc:
+            raise InputError(_format_error(label, exc.errors()[0])) from None
+        return cls(model, source)
+
+    @property
+    def name(self) -> str:
+        return self.model.name
+
+    def _path(self, value: str) -> Path:
+        p = Path(value).expanduser()
+        return p if p.is_absolute() else self.base_dir / p
+
+    def _fail(self, section: str, exc: InputError) -> InputError:
+        msg = str(exc)
+        prefix = "field '"
+        if msg.startswith(prefix):
+            return InputError(f"{self._label}: field '{section}.{msg[len(prefix) :]}")
+        return InputError(f"{self._label}: field '{section}': {msg}")
+
+    # ---- pieces ---------------------------------------------------------------------------
+    def frame_times(self) -> np.ndarray:
+        """Frame times start_s + k / frame_rate_hz inside [start_s, start_s + duration_s), s."""
+        m = self.model
+        n = max(1, int(np.floor(m.duration_s * m.frame_rate_hz + 1e-9)))
+        return m.start_s + np.arange(n) / m.frame_rate_hz
+
+    def _radar(self) -> RadarConfig:
+        m = self.model
+        overrides = m.radar.model_dump(exclude_none=True, exclude={"antenna"})
+        mount = self._mount()
+        try:
+            if m.radar.antenna is not None:
+                overrides["antenna"] = self._antenna(m.radar.antenna)
+            radar = RadarConfig.seed_prototype(mount=mount, **overrides)
+        except InputError as exc:
+            raise self._fail("radar", exc) from None
+        max_rate = 1.0 / radar.frame_duration_s
+        if m.frame_rate_hz > max_rate:
+            raise InputError(
+                f"{self._label}: field 'frame_rate_hz': must be <= {max_rate:.4g} "
+                f"(1 / radar frame duration) (got {m.frame_rate_hz})"
+            )
+        return radar
+
+    def _antenna(self, a: AntennaModel):
+        from skyradar.antenna import AntennaPattern
+
+        if a.azimuth_csv is not None:
+            return AntennaPattern.from_csv(self._path(a.azimuth_csv), self._path(a.elevation_csv), a.combine)
+        return AntennaPattern.default(a.beamwidth_deg if a.beamwidth_deg is not None else 70.0, a.combine)
+
+    def _mount(self) -> Mount:
+        mm = self.model.mount
+        if mm is None:
+            return Mount()
+        try:
+            base = Mount.preset(mm.preset) if mm.preset is not None else Mount()
+        except InputError as exc:
+            raise InputError(f"{self._label}: field 'mount.preset': {exc}") from None
+        changes = mm.model_dump(exclude_none=True, exclude={"preset"})
+        return Mount(**{**base.__dict__, **changes})
+
+    def _terrain(self, origin: tuple[float, float, float] | None):
+        t = self.model.terrain
+        if t is None:
+            return None
+        from skyradar.scene import terrain as terrain_mod
+
+        try:
+            if t.type == "jacksboro":
+                return terrain_mod.jacksboro()
+            if t.type == "file":
+                return terrain_mod.read_dem(self._path(t.path))
+            if origin is None:
+                raise InputError(
+                    f"field 'origin': is required for {t.type} terrain (it is centred on the origin)"
+                )
+            height = origin[2] if t.height_m is None else t.height_m
+            if isinstance(t, FlatTerrainModel):
+                return terrain_mod.flat_terrain(origin[0], origin[1], height, t.size_m, t.spacing_m)
+            assert isinstance(t, FractalTerrainModel)
+            return terrain_mod.fractal_terrain(
+                origin[0], origin[1], t.local_sd_m, size_m=t.size_m, spacing_m=t.spacing_m, seed=t.seed,
+                mean_height_m=height,
+            )  # fmt: skip
+        except InputError as exc:
+            if str(exc).startswith("field 'origin'"):
+                raise InputError(f"{self._label}: {exc}") from None
+            raise self._fail("terrain", exc) from None
+
+    def _flight(self, spec, section: str, origin, ownship: Trajectory | None, name: str) -> Trajectory:
+        m = self.model
+        try:
+            if isinstance(spec, FileFlight):
+                return _read_flight(self._path(spec.path), spec.icao24, origin, spec.time_zero_s)
+            if isinstance(spec, EncounterFlight):
+                params = spec.model_dump(exclude={"type", "name", "rcs_m2", "time_offset_s"})
+                return _encounter(ownship, params, name)
+            from skyradar.scene import flights
+
+            params = spec.model_dump(exclude={"type", "name", "rcs_m2", "time_offset_s"})
+            params["duration_s"] = params["duration_s"] or m.duration_s
+            params["start_time_s"] = m.start_s if params["start_time_s"] is None else params["start_time_s"]
+            return getattr(flights, spec.type)(origin=origin, name=name, **params)
+        except InputError as exc:
+            raise self._fail(section, exc) from None
+
+    def _origin(self) -> tuple[tuple[float, float, float] | None, Trajectory | None, Any]:
+        """(origin, own-ship if read to find it, terrain if built to find it)."""
+        m = self.model
+        if m.origin is not None:
+            return (m.origin.lat_deg, m.origin.lon_deg, m.origin.alt_m), None, None
+        if isinstance(m.ownship, FileFlight):
+            own = self._flight(m.ownship, "ownship", None, None, "ownship")
+            if isinstance(m.terrain, FlatTerrainModel | FractalTerrainModel) and m.terrain.height_m is None:
+                raise InputError(
+                    f"{self._label}: field 'terrain.height_m': is required when the origin comes from "
+                    "the own-ship file (its first point is in the air)"
+                )
+            return own.origin, own, None
+        if m.terrain is not None and m.terrain.type in ("jacksboro", "file"):
+            terrain = self._terrain(None)
+            lat, lon = terrain.center_latlon
+            return (lat, lon, float(terrain.height_at(lat, lon))), None, terrain
+        raise InputError(
+            f"{self._label}: field 'origin': is required when own-ship is parametric and terrain is not a DEM"
+        )
+
+    # ---- all together -------------------------------------------------------------------------
+    def build(self) -> BuiltScenario:
+        """Make the radar, terrain, trajectories and frame times (see :class:`BuiltScenario`)."""
+        m = self.model
+        radar = self._radar()
+        times = self.frame_times()
+        origin, ownship, terrain = self._origin()
+        if terrain is None:
+            terrain = self._terrain(origin)
+        if ownship is None:
+            ownship = self._flight(m.ownship, "ownship", origin, None, "ownship")
+        if not np.all(ownship.covers(times)):
+            raise InputError(
+                f"{self._label}: field 'ownship': '{ownship.name}' covers "
+                f"{ownship.start_s:.6g}..{ownship.end_s:.6g} s but the frames need "
+                f"{times[0]:.6g}..{times[-1]:.6g} s (start_s, duration_s)"
+            )
+        intruders: list[Intruder] = []
+        for i, spec in enumerate(m.intruders):
+            traj = self._flight(spec, f"intruders.{i}", origin, ownship, spec.name or f"intruder{i}")
+            name = spec.name or (traj.name if isinstance(spec, FileFlight) else None) or f"intruder{i}"
+            traj = (
+                traj.shifted(spec.time_offset_s).renamed(name) if spec.time_offset_s else traj.renamed(name)
+            )
+            if not np.any(traj.covers(times)):
+                raise InputError(
+                    f"{self._label}: field 'intruders.{i}.time_offset_s': '{name}' flies "
+                    f"{traj.start_s:.6g}..{traj.end_s:.6g} s, outside every frame "
+                    f"({times[0]:.6g}..{times[-1]:.6g} s) (got {spec.time_offset_s})"
+                )
+            if any(other.name == name for other in intruders):
+                raise InputError(f"{self._label}: field 'intruders.{i}.name': '{name}' is used twice")
+            intruders.append(Intruder(name, traj, float(spec.rcs_m2)))
+        return BuiltScenario(
+            name=m.name,
+            origin=tuple(float(v) for v in origin),
+            radar=radar,
+            terrain=terrain,
+            ownship=ownship,
+            intruders=intruders,
+            times_s=times,
+            sim_options=m.simulation.model_dump(),
+            source=self.source,
+        )
+
+
+def _read_flight(path: Path, icao24: str | None, origin, time_zero_s: float | None) -> Trajectory:
+    from skyradar.scene.adsb import read_trajectories, read_trajectory
+
+    if icao24 is None:
+        return read_trajectory(path, origin=origin, time_zero_s=time_zero_s)
+    tracks = read_trajectories(path, origin=origin, time_zero_s=time_zero_s)
+    if icao24 not in tracks:
+        raise InputError(f"field 'icao24': {icao24!r} is not in {path} (has {sorted(tracks)[:10]})")
+    return tracks[icao24]
+
+
+def _encounter(ownship: Trajectory, params: dict[str, Any], name: str) -> Trajectory:
+    from skyradar.scene.flights import encounter
+
+    return encounter(ownship, name=name, **params)
+
+
+def _scenario_dir():
+    return resources.files("skyradar") / "data" / "scenarios"
+
+
+def list_example_scenarios() -> list[str]:
+    """Names of the example scenarios shipped with skyradar.
+
+    Examples
+    --------
+    >>> "ch2_flat_forward" in list_example_scenarios()
+    True
+    """
+    return sorted(p.name[: -len(".yaml")] for p in _scenario_dir().iterdir() if p.name.endswith(".yaml"))
+
+
+def example_scenario(name: str) -> Path:
+    """Path of a shipped example scenario (see :func:`list_example_scenarios`)."""
+    stem = name[: -len(".yaml")] if name.endswith(".yaml") else name
+    path = _scenario_dir() / f"{stem}.yaml"
+    if not path.is_file():
+        raise InputError(f"example scenario {name!r} unknown; choose from {list_example_scenarios()}")
+    return Path(str(path))

@@ -1,0 +1,285 @@
+"""The pydantic models behind scenario files (see :mod:`skyradar.scene.scenario`).
+
+Every model forbids unknown keys. Flights and terrains are tagged unions on ``type``. Units
+are in the field names: metres, m/s, degrees, seconds, Hz. Positions ``*_ned_m`` are
+(north, east, down) in the NED frame of the origin (down negative above it). The file::
+
+    name: my scenario
+    origin: {lat_deg: 52.0, lon_deg: 4.36, alt_m: 0.0}     # optional (see scenario.py)
+    radar:                                                 # optional RadarConfig overrides
+      range_limit_m: 5000
+      antenna: {beamwidth_deg: 70, combine: L1}            # or azimuth_csv + elevation_csv
+    mount: forward-down                                    # preset, or {preset, position_m,
+                                                           #   yaw_deg, pitch_deg, roll_deg}
+    terrain: {type: fractal, local_sd_m: 20, seed: 1, size_m: 12000, spacing_m: 30, height_m: 0}
+                                                           # or flat | file (path) | jacksboro
+    ownship:                                               # a file path, or:
+      type: circuit                                        # straight | circle | circuit | file
+      runway_heading_deg: 280
+      pattern_altitude_m: 300
+      speed_mps: 45
+    intruders:
+      - {name: A, type: encounter, kind: head-on, t_cpa_s: 30, horizontal_miss_m: 200, rcs_m2: 1}
+      - {name: B, type: file, path: tracks/adsb.csv, icao24: 4840d6, time_offset_s: -20}
+    frame_rate_hz: 9.4
+    duration_s: 60
+    start_s: 0
+    simulation: {facet_size_m: 30, reflectivity: cosine, occlusion: true, noise: true,
+                 flat_earth: false, range_doppler_coupling: true, seed: 0}
+
+Flight parameters are those of :mod:`skyradar.scene.flights` (``straight``, ``circle``,
+``circuit``, ``encounter``); file flights take ``path``, ``icao24`` and ``time_zero_s``.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+
+__all__ = [
+    "TAGS",
+    "AntennaModel",
+    "RadarModel",
+    "MountModel",
+    "OriginModel",
+    "FlatTerrainModel",
+    "FractalTerrainModel",
+    "FileTerrainModel",
+    "JacksboroTerrainModel",
+    "FileFlight",
+    "StraightFlight",
+    "CircleFlight",
+    "CircuitFlight",
+    "EncounterFlight",
+    "SimulationModel",
+    "ScenarioModel",
+]
+
+# Tag values of the unions; pydantic puts them in error locations, the messages leave them out.
+TAGS = frozenset({"flat", "fractal", "file", "jacksboro", "straight", "circle", "circuit", "encounter"})
+
+Vector3 = tuple[float, float, float]
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+
+class OriginModel(_Model):
+    lat_deg: float = Field(ge=-90.0, le=90.0)
+    lon_deg: float = Field(ge=-180.0, le=360.0)
+    alt_m: Finite = 0.0
+
+
+class AntennaModel(_Model):
+    beamwidth_deg: float | None = Field(None, ge=1.0, le=180.0)
+    azimuth_csv: str | None = None
+    elevation_csv: str | None = None
+    combine: Literal["L1", "L2"] = "L1"
+
+    @model_validator(mode="after")
+    def _one_source(self) -> AntennaModel:
+        csvs = (self.azimuth_csv is None, self.elevation_csv is None)
+        if csvs[0] != csvs[1]:
+            raise ValueError("give both azimuth_csv and elevation_csv, or neither")
+        if self.azimuth_csv is not None and self.beamwidth_deg is not None:
+            raise ValueError("give beamwidth_deg or the two CSV cuts, not both")
+        return self
+
+
+class RadarModel(_Model):
+    """Overrides of :class:`skyradar.config.RadarConfig` fields; unset fields keep the seed prototype."""
+
+    fc_hz: Positive | None = None
+    fs_hz: Positive | None = None
+    prf_hz: Positive | None = None
+    pe_dbm: Finite | None = None
+    bandwidth_hz: Positive | None = None
+    n_doppler: int | None = Field(None, ge=2)
+    range_limit_m: Positive | None = None
+    rx_positions_m: list[Vector3] | None = None
+    tx_position_m: Vector3 | None = None
+    noise_figure_db: Finite | None = None
+    temperature_k: Positive | None = None
+    antenna: AntennaModel | None = None
+
+
+def _mount_shorthand(value: Any) -> Any:
+    return {"preset": value} if isinstance(value, str) else value
+
+
+class MountModel(_Model):
+    """A preset name, optionally with fields changed, or an explicit placement."""
+
+    preset: str | None = None
+    position_m: Vector3 | None = None
+    yaw_deg: Finite | None = None
+    pitch_deg: Finite | None = None
+    roll_deg: Finite | None = None
+
+
+class _GridTerrain(_Model):
+    height_m: Finite | None = None
+    size_m: Positive = 12_000.0
+    spacing_m: Positive = 30.0
+
+
+class FlatTerrainModel(_GridTerrain):
+    type: Literal["flat"]
+
+
+class FractalTerrainModel(_GridTerrain):
+    type: Literal["fractal"]
+    local_sd_m: float = Field(ge=0.0, allow_inf_nan=False)
+    seed: int = 0
+
+
+class FileTerrainModel(_Model):
+    type: Literal["file"]
+    path: str
+
+
+class JacksboroTerrainModel(_Model):
+    type: Literal["jacksboro"]
+
+
+Terrain = Annotated[
+    FlatTerrainModel | FractalTerrainModel | FileTerrainModel | JacksboroTerrainModel,
+    Field(discriminator="type"),
+]
+
+
+class _Timed(_Model):
+    duration_s: Positive | None = None  # default: the scenario's duration_s
+    start_time_s: Finite | None = None  # default: the scenario's start_s
+    rate_hz: Positive = 20.0
+
+
+class FileFlight(_Model):
+    type: Literal["file"]
+    path: str
+    icao24: str | None = None
+    # File timestamp (unix s, or time_s value) that becomes scenario time 0; default the file's
+    # first. Give recordings made together the same value to keep them in step.
+    time_zero_s: Finite | None = None
+
+
+class StraightFlight(_Timed):
+    type: Literal["straight"]
+    start_ned_m: Vector3 = (0.0, 0.0, 0.0)
+    heading_deg: Finite = 0.0
+    speed_mps: float = Field(ge=0.0, allow_inf_nan=False)
+    climb_mps: Finite = 0.0
+
+
+class CircleFlight(_Timed):
+    type: Literal["circle"]
+    center_ned_m: Vector3
+    radius_m: Positive
+    speed_mps: Positive
+    clockwise: bool = True
+    start_bearing_deg: Finite = 0.0
+    climb_mps: Finite = 0.0
+
+
+class CircuitFlight(_Timed):
+    type: Literal["circuit"]
+    runway_threshold_ned_m: Vector3 = (0.0, 0.0, 0.0)
+    runway_heading_deg: Finite
+    pattern_altitude_m: Positive
+    speed_mps: Positive
+    upwind_m: Positive = 2000.0
+    width_m: Positive = 1200.0
+    final_m: Positive = 1500.0
+    left_hand: bool = True
+    bank_deg: float = Field(25.0, gt=0.0, lt=80.0)
+    touch_and_go: bool = True
+    climb_angle_deg: float = Field(6.0, gt=0.0, lt=45.0)
+    descent_angle_deg: float = Field(4.0, gt=0.0, lt=45.0)
+    start_leg: Literal["upwind", "crosswind", "downwind", "base", "final"] = "upwind"
+
+
+class EncounterFlight(_Model):
+    type: Literal["encounter"]
+    kind: Literal["head-on", "crossing", "overtaking", "converging"]
+    t_cpa_s: Finite
+    horizontal_miss_m: float = Field(0.0, ge=0.0, allow_inf_nan=False)
+    vertical_miss_m: Finite = 0.0
+    intruder_speed_mps: Positive | None = None
+    crossing_angle_deg: Finite | None = None
+    intruder_climb_mps: Finite | None = None
+    side: Literal["right", "left"] = "right"
+    rate_hz: Positive = 20.0
+
+
+def _flight_shorthand(value: Any) -> Any:
+    if isinstance(value, str):
+        return {"type": "file", "path": value}
+    if isinstance(value, dict) and "type" not in value and "path" in value:
+        return {"type": "file", **value}
+    return value
+
+
+class _IntruderFields(_Model):
+    name: str | None = None
+    rcs_m2: Positive = 1.0
+    time_offset_s: Finite = 0.0
+
+
+class FileIntruder(FileFlight, _IntruderFields):
+    pass
+
+
+class StraightIntruder(StraightFlight, _IntruderFields):
+    pass
+
+
+class CircleIntruder(CircleFlight, _IntruderFields):
+    pass
+
+
+class CircuitIntruder(CircuitFlight, _IntruderFields):
+    pass
+
+
+class EncounterIntruder(EncounterFlight, _IntruderFields):
+    pass
+
+
+Ownship = Annotated[
+    FileFlight | StraightFlight | CircleFlight | CircuitFlight,
+    Field(discriminator="type"),
+    BeforeValidator(_flight_shorthand),
+]
+IntruderSpec = Annotated[
+    FileIntruder | StraightIntruder | CircleIntruder | CircuitIntruder | EncounterIntruder,
+    Field(discriminator="type"),
+    BeforeValidator(_flight_shorthand),
+]
+
+
+class SimulationModel(_Model):
+    facet_size_m: Positive | None = None
+    reflectivity: Literal["cosine", "lambert", "constant"] = "cosine"
+    occlusion: bool = True
+    noise: bool = True
+    flat_earth: bool = False
+    range_doppler_coupling: bool = True
+    seed: int = Field(0, ge=0)
+
+
+class ScenarioModel(_Model):
+    name: str = "scenario"
+    origin: OriginModel | None = None
+    radar: RadarModel = Field(default_factory=RadarModel)
+    mount: Annotated[MountModel | None, BeforeValidator(_mount_shorthand)] = None
+    terrain: Terrain | None = None
+    ownship: Ownship
+    intruders: list[IntruderSpec] = Field(default_factory=list)
+    frame_rate_hz: Positive = 9.4
+    duration_s: Positive
+    start_s: Finite = 0.0
+    simulation: SimulationModel = Field(default_factory=SimulationModel)

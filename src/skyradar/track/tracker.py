@@ -1,0 +1,381 @@
+"""The range-Doppler multi-target tracker, composed from swappable parts.
+
+One frame is: predict every track (one batched Kalman step), gate and assign detections
+(:func:`skyradar.track.association.associate`, Hungarian), update the assigned tracks with the
+model's innovation, de-alias the radial velocity (radar model), start tentative tracks from
+unassigned detections, confirm them M-of-N, and close tracks after misses. The parts are plain
+objects passed in, as in Stone Soup: the motion model (:mod:`skyradar.track.models`), the
+associator function, the initiator (:class:`~skyradar.track.initiation.MOfN`) and the deleter
+(:class:`~skyradar.track.deletion.MissDeleter`).
+
+Tracks live as a struct of arrays (states ``(n, 4)``, covariances ``(n, 4, 4)``, counters), so the
+cost per frame is a fixed number of numpy calls, whatever the number of tracks.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from skyradar.track.association import Association, associate
+from skyradar.track.dealias import dealias_velocity, push_history, range_rate_fit
+from skyradar.track.deletion import MissDeleter
+from skyradar.track.initiation import MOfN
+from skyradar.track.kalman import predict, update
+from skyradar.track.models import MEASUREMENT_MATRIX, MotionModel
+
+__all__ = ["TrackerConfig", "FrameTracks", "RangeDopplerTracker"]
+
+_FIELDS = (
+    "x", "P", "ids", "t_update", "hits", "frames", "misses", "confirmed", "n_updates", "hist_t", "hist_r", "resolved",
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class TrackerConfig:
+    """Tracker settings that are not part of the motion model.
+
+    Parameters
+    ----------
+    gate : float
+        Assignment gate: squared Mahalanobis distance (``metric='mahalanobis'``, 2 degrees of
+        freedom; 16 keeps 99.97 % of true pairs) or l2 innovation in pixels (``metric='l2'``).
+    metric : {'mahalanobis', 'l2'}
+    confirm_m, confirm_n : int
+        M-of-N confirmation.
+    max_misses : int
+        Consecutive missed frames before a track is closed.
+    max_coast_s : float
+        Time without an update before a track is closed, s.
+    history : int
+        Range observations kept per track for the range-rate fit used to de-alias.
+    max_alias : int
+        Largest alias (in image widths) a single-observation track may be off by.
+    confirmed_first : bool
+        Assign detections to confirmed tracks before tentative ones.
+    dealias : {'confident', 'thesis'}
+        How the radar model resolves the alias of ``V_R``. ``'thesis'``: wrap the range innovation
+        of single-observation tracks by ``W dt`` and apply the rounding rule at every update with
+        the range rate fitted to the last ``history`` ranges. ``'confident'`` (default): until the
+        alias is resolved, range follows the range-rate state (which moves with the radial
+        acceleration like ``V_R``); the rounding rule is applied once, when the range-rate standard
+        deviation falls below ``resolve_fraction * W``, and from then on range follows ``V_R``.
+        With 15 m range bins at 10 frames/s the two-observation slope has about 60 m/s standard
+        deviation against ``W/2 = 39`` m/s, which is why the second is the default.
+    resolve_fraction : float
+        Range-rate standard deviation, as a fraction of ``W``, below which the alias is resolved.
+    """
+
+    gate: float = 16.0
+    metric: str = "mahalanobis"
+    confirm_m: int = 4
+    confirm_n: int = 5
+    max_misses: int = 8
+    max_coast_s: float = 1.0
+    history: int = 16
+    max_alias: int = 2
+    confirmed_first: bool = True
+    dealias: str = "confident"
+    resolve_fraction: float = 1.0 / 6.0
+
+
+@dataclass(frozen=True)
+class FrameTracks:
+    """Confirmed tracks after one frame.
+
+    Attributes
+    ----------
+    time_s : float
+    track_id : ndarray of int, shape (k,)
+    state : ndarray, shape (k, 4)
+        (range [m], radial velocity [m/s], range rate [m/s], radial acceleration [m/s^2]).
+    covariance : ndarray, shape (k, 4, 4)
+    n_updates : ndarray of int, shape (k,)
+    detection_index : ndarray of int, shape (k,)
+        Row of the frame's detections assigned to the track, -1 when it coasted.
+    innovation : ndarray, shape (k, 2)
+        Innovation of the assigned detection (range [m], radial velocity [m/s]); NaN when coasting.
+    alive_ids, alive_detection : ndarray of int
+        All live tracks (tentative too) and their assigned detection rows, for the 3-D tracker.
+    """
+
+    time_s: float
+    track_id: np.ndarray
+    state: np.ndarray
+    covariance: np.ndarray
+    n_updates: np.ndarray
+    detection_index: np.ndarray
+    innovation: np.ndarray
+    alive_ids: np.ndarray
+    alive_detection: np.ndarray
+
+
+class RangeDopplerTracker:
+    """Multi-target tracker in the range-Doppler image.
+
+    Parameters
+    ----------
+    model : MotionModel
+        :func:`~skyradar.track.models.radar_model` or :func:`~skyradar.track.models.traditional_model`.
+    config : TrackerConfig, optional
+    pixel_size : (float, float)
+        (dR [m], dV [m/s]) of the image, for the l2 metric.
+    associator : callable, optional
+        Same signature as :func:`~skyradar.track.association.associate` (the default).
+    initiator, deleter : optional
+        Objects with the :class:`MOfN` / :class:`MissDeleter` interface.
+
+    Examples
+    --------
+    >>> from skyradar.track.models import radar_model
+    >>> trk = RangeDopplerTracker(radar_model(78.3))
+    >>> for k in range(5):
+    ...     out = trk.step(0.1 * k, np.array([[1000.0 - 5.0 * k, -50.0 + 78.3]]))
+    >>> out.track_id.tolist(), round(float(out.state[0, 1]), 1)
+    ([0], -50.0)
+    """
+
+    def __init__(
+        self,
+        model: MotionModel,
+        config: TrackerConfig | None = None,
+        pixel_size: tuple[float, float] = (14.99, 0.313),
+        associator: Callable[..., Association] = associate,
+        initiator: MOfN | None = None,
+        deleter: MissDeleter | None = None,
+    ) -> None:
+        self.model = model
+        self.config = config or TrackerConfig()
+        self.pixel_size = pixel_size
+        self.associator = associator
+        self.initiator = initiator or MOfN(self.config.confirm_m, self.config.confirm_n)
+        self.deleter = deleter or MissDeleter(self.config.max_misses, self.config.max_coast_s)
+        self.time_s: float | None = None
+        self._next_id = 0
+        self._range_wrap: np.ndarray | None = None
+        self._cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+        k = self.config.history
+        self.t = {
+            "x": np.zeros((0, 4)),
+            "P": np.zeros((0, 4, 4)),
+            "ids": np.zeros(0, np.int64),
+            "t_update": np.zeros(0),
+            "hits": np.zeros(0, np.int64),
+            "frames": np.zeros(0, np.int64),
+            "misses": np.zeros(0, np.int64),
+            "confirmed": np.zeros(0, bool),
+            "n_updates": np.zeros(0, np.int64),
+            "hist_t": np.zeros((0, k)),
+            "hist_r": np.zeros((0, k)),
+            "resolved": np.zeros(0, bool),
+        }
+        if self.config.dealias not in ("confident", "thesis"):
+            raise ValueError(f"dealias must be 'confident' or 'thesis', got {self.config.dealias!r}")
+        self._hybrid = model.dealias and self.config.dealias == "confident"
+        self._thesis = model.dealias and self.config.dealias == "thesis"
+
+    @property
+    def n_tracks(self) -> int:
+        """Live tracks, tentative and confirmed."""
+        return int(self.t["ids"].size)
+
+    def step(self, time_s: float, z: np.ndarray) -> FrameTracks:
+        """Process one frame of detections ``z`` (m, 2) = (range [m], radial velocity [m/s]).
+
+        ``time_s`` must not decrease between calls.
+        """
+        if self.time_s is not None and time_s < self.time_s:
+            raise ValueError(f"time goes backwards ({self.time_s} -> {time_s})")
+        z = np.asarray(z, float).reshape(-1, 2)
+        t = self.t
+        if self.time_s is not None and t["ids"].size and time_s > self.time_s:
+            dt = time_s - self.time_s
+            F, Q, F_u, Q_u = self._matrices(dt)
+            if self._hybrid:
+                resolved = t["resolved"][:, None, None]
+                F, Q = np.where(resolved, F, F_u), np.where(resolved, Q, Q_u)
+            t["x"], t["P"] = predict(t["x"], t["P"], F, Q)
+        self.time_s = float(time_s)
+        assoc = self._associate(z)
+        assigned = np.full(t["ids"].size, -1)
+        assigned[assoc.track_index] = assoc.detection_index
+        innov = np.full((t["ids"].size, 2), np.nan)
+        innov[assoc.track_index] = assoc.innovation
+        self._update(assoc, z)
+        self._bookkeep(assigned >= 0)
+        alive = self._manage()
+        assigned, innov = assigned[alive], innov[alive]
+        used = np.zeros(len(z), bool)
+        used[assoc.detection_index] = True
+        new_det = np.flatnonzero(~used)
+        self._start(z[new_det])
+        alive_ids = t["ids"]
+        alive_det = np.concatenate([assigned, new_det])
+        out = t["confirmed"][: assigned.size]
+        return FrameTracks(
+            self.time_s,
+            t["ids"][: assigned.size][out],
+            t["x"][: assigned.size][out],
+            t["P"][: assigned.size][out],
+            t["n_updates"][: assigned.size][out],
+            assigned[out],
+            innov[out],
+            alive_ids,
+            alive_det,
+        )
+
+    def _matrices(self, dt: float) -> tuple[np.ndarray, ...]:
+        """F, Q (and their unresolved-alias versions) for a time step, cached by step."""
+        key = round(dt, 9)
+        if key not in self._cache:
+            if len(self._cache) > 64:
+                self._cache.clear()
+            m = self.model
+            self._cache[key] = (
+                m.transition(dt), m.process_noise(dt), m.transition_unresolved(dt), m.process_noise_unresolved(dt)
+            )
+        return self._cache[key]
+
+    def _associate(self, z: np.ndarray) -> Association:
+        t, m = self.t, self.model
+        S = t["P"][:, :2, :2] + m.measurement_noise
+        range_wrap = None
+        if self._thesis:
+            range_wrap = np.where(t["n_updates"] == 1, m.doppler_width_mps * (self.time_s - t["t_update"]), np.nan)
+        self._range_wrap = range_wrap
+        # Confirmed tracks choose first; tentative tracks share what is left. Otherwise the
+        # solver's preference for more pairs lets a new track take a confirmed track's detection
+        # while the confirmed track is handed a clutter point.
+        if self.config.confirmed_first:
+            stages = [np.flatnonzero(t["confirmed"]), np.flatnonzero(~t["confirmed"])]
+        else:
+            stages = [np.arange(t["ids"].size)]
+        free = np.ones(len(z), bool)
+        parts = []
+        for rows in stages:
+            dets = np.flatnonzero(free)
+            if rows.size == 0 or dets.size == 0:
+                continue
+            a = self.associator(
+                t["x"][rows, :2],
+                S[rows],
+                z[dets],
+                self.config.gate,
+                m.doppler_width_mps if m.wrap_doppler else None,
+                None if range_wrap is None else range_wrap[rows],
+                self.config.metric,
+                self.pixel_size,
+                self.config.max_alias,
+            )
+            parts.append(Association(rows[a.track_index], dets[a.detection_index], a.innovation, a.cost))
+            free[dets[a.detection_index]] = False
+        if not parts:
+            return Association(np.zeros(0, int), np.zeros(0, int), np.zeros((0, 2)), np.zeros(0))
+        return Association(*(np.concatenate([getattr(p, f) for p in parts]) for f in Association.__dataclass_fields__))
+
+    def _update(self, assoc: Association, z: np.ndarray) -> None:
+        t, m = self.t, self.model
+        rows = assoc.track_index
+        if rows.size == 0:
+            return
+        if self._range_wrap is not None:
+            self._shift_alias(rows, z[assoc.detection_index, 0], assoc.innovation[:, 0])
+        t["x"][rows], t["P"][rows] = update(
+            t["x"][rows], t["P"][rows], assoc.innovation, MEASUREMENT_MATRIX, m.measurement_noise
+        )
+        if self._hybrid:
+            self._resolve(rows)
+        if self._thesis:
+            push_history(t["hist_t"], rows, np.full(rows.size, self.time_s), t["n_updates"][rows])
+            push_history(t["hist_r"], rows, z[assoc.detection_index, 0], t["n_updates"][rows])
+            rate = range_rate_fit(t["hist_t"][rows], t["hist_r"][rows], t["n_updates"][rows] + 1)
+            ok = np.isfinite(rate)
+            r_ok = rows[ok]
+            t["x"][r_ok, 2] = rate[ok]
+            t["x"][r_ok, 1] = dealias_velocity(t["x"][r_ok, 1], rate[ok], m.doppler_width_mps)
+
+    def _resolve(self, rows: np.ndarray) -> None:
+        """Resolve the alias of tracks whose range rate is now known well enough (confident mode)."""
+        t, width = self.t, self.model.doppler_width_mps
+        sd = np.sqrt(t["P"][rows, 2, 2])
+        now = ~t["resolved"][rows] & (sd < self.config.resolve_fraction * width)
+        r = rows[now]
+        t["x"][r, 1] = dealias_velocity(t["x"][r, 1], t["x"][r, 2], width)
+        t["resolved"][r] = True
+        done = rows[t["resolved"][rows]]
+        # Once resolved, range follows V_R; the range-rate state simply reports it.
+        t["x"][done, 2] = t["x"][done, 1]
+
+    def _shift_alias(self, rows: np.ndarray, range_m: np.ndarray, wrapped_m: np.ndarray) -> None:
+        """Move single-observation tracks to the alias their wrapped range innovation chose.
+
+        The wrapped residual differs from the raw one by ``k * W * dt``; that ``k`` is the thesis'
+        de-aliasing rule with the range rate of the first two observations, so the prediction is
+        shifted by ``k`` image widths (range by ``k W dt``) before the ordinary update.
+        """
+        t, width = self.t, self.model.doppler_width_mps
+        span = self._range_wrap[rows]
+        use = np.isfinite(span) & (span > 0)
+        if not np.any(use):
+            return
+        r = rows[use]
+        k = np.round((range_m[use] - t["x"][r, 0] - wrapped_m[use]) / span[use])
+        t["x"][r, 0] += k * span[use]
+        t["x"][r, 1] += k * width
+
+    def _bookkeep(self, hit: np.ndarray) -> None:
+        t = self.t
+        t["frames"] += 1
+        t["hits"] += hit
+        t["n_updates"] += hit
+        t["misses"] = np.where(hit, 0, t["misses"] + 1)
+        t["t_update"] = np.where(hit, self.time_s, t["t_update"])
+
+    def _manage(self) -> np.ndarray:
+        """Confirm and delete; returns the mask of surviving tracks (in pre-deletion order)."""
+        t = self.t
+        tentative = ~t["confirmed"]
+        confirmed_now, failed = self.initiator.status(t["hits"], t["frames"])
+        t["confirmed"] = t["confirmed"] | (tentative & confirmed_now)
+        dead = (tentative & failed & ~t["confirmed"]) | (
+            t["confirmed"] & self.deleter.delete(t["misses"], self.time_s - t["t_update"])
+        )
+        alive = ~dead
+        if np.any(dead):
+            for name in _FIELDS:
+                t[name] = t[name][alive]
+        return alive
+
+    def _start(self, z_new: np.ndarray) -> None:
+        n = len(z_new)
+        if n == 0:
+            return
+        t, m = self.t, self.model
+        x = np.zeros((n, 4))
+        x[:, :2] = z_new
+        # The radar model's range rate starts at the (possibly aliased) radial velocity.
+        x[:, 2] = z_new[:, 1] if m.coupled else 0.0
+        k = self.config.history
+        hist_t = np.full((n, k), np.nan)
+        hist_r = np.full((n, k), np.nan)
+        hist_t[:, 0] = self.time_s
+        hist_r[:, 0] = z_new[:, 0]
+        new = {
+            "x": x,
+            "P": np.broadcast_to(m.initial_covariance(), (n, 4, 4)),
+            "ids": np.arange(self._next_id, self._next_id + n),
+            "t_update": np.full(n, self.time_s),
+            "hits": np.ones(n, np.int64),
+            "frames": np.ones(n, np.int64),
+            "misses": np.zeros(n, np.int64),
+            "confirmed": np.full(n, self.initiator.m <= 1),
+            "n_updates": np.ones(n, np.int64),
+            "hist_t": hist_t,
+            "hist_r": hist_r,
+            "resolved": np.zeros(n, bool),
+        }
+        self._next_id += n
+        for name in _FIELDS:
+            t[name] = np.concatenate([t[name], new[name]])

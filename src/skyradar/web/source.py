@@ -1,0 +1,226 @@
+"""What the live display replays: a frames run (finished or still being written) and its alerts.
+
+A run still being written is a ``NAME.partial`` Zarr store from
+:class:`skyradar.io.frames.FrameStoreWriter`; only frames of chunks marked done (a leading run of
+chunks) are shown, because an unwritten chunk reads as zeros. When the writer renames the store
+to its final name, :meth:`RunSource.refresh` reopens it there.
+
+Traffic comes from, in order of preference: an alerts table, a tracks table (alerted here), or
+the intruder truth stored in a simulated run (alerted here; labelled ``truth``).
+"""
+
+from __future__ import annotations
+
+import base64
+import threading
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from skyradar.daa.pipeline import alerts_from_tracks, ownship_from_frames, truth_tracks
+from skyradar.errors import InputError
+from skyradar.io.frames import open_frames, radar_config_of
+from skyradar.io.tables import read_table
+
+__all__ = ["RunSource", "range_doppler_png"]
+
+_DONE_MARKS = "_skyradar_done"
+_ADVICE_KEYS = (
+    "heading_bands_deg",
+    "vs_bands_mps",
+    "terrain_vs_bands_mps",
+    "preferred_heading_deg",
+    "preferred_vs_mps",
+)
+
+
+def range_doppler_png(iq_frame: np.ndarray, noise_power_w: float, span_db: float = 40.0) -> bytes:
+    """Colour PNG of one (range, doppler, rx) frame: receiver-summed power, noise floor to +span_db.
+
+    Range grows upwards, radial velocity to the right.
+
+    Examples
+    --------
+    >>> png = range_doppler_png(np.zeros((4, 8, 2), np.complex64), 1e-12)
+    >>> png[:4]
+    b'\\x89PNG'
+    """
+    power = np.sum(np.abs(iq_frame) ** 2, axis=-1)
+    floor_db = 10 * np.log10(iq_frame.shape[-1] * noise_power_w)
+    db = 10 * np.log10(np.maximum(power, 1e-30))
+    img = np.clip((db - floor_db + 3.0) / (span_db + 3.0), 0.0, 1.0)
+    img8 = (img[::-1] * 255).astype(np.uint8)
+    ok, buf = cv2.imencode(".png", cv2.applyColorMap(img8, cv2.COLORMAP_VIRIDIS))
+    if not ok:  # pragma: no cover - OpenCV always encodes a uint8 image
+        raise RuntimeError("PNG encoding failed")
+    return buf.tobytes()
+
+
+class RunSource:
+    """A run and its traffic, re-read as the run grows.
+
+    Parameters
+    ----------
+    run_path : path
+        Final name of the frames store (``RUN.zarr``); ``RUN.zarr.partial`` is used while it exists.
+    tracks_path, alerts_path : path, optional
+        Tracks / alerts Parquet tables.
+    """
+
+    def __init__(
+        self, run_path: str | Path, tracks_path: Path | None = None, alerts_path: Path | None = None
+    ):
+        self.path = Path(run_path)
+        self.partial = self.path.with_name(self.path.name + ".partial")
+        self.tracks_path, self.alerts_path = tracks_path, alerts_path
+        self._lock = threading.Lock()
+        self._opened: Path | None = None
+        self.ds: xr.Dataset | None = None
+        self.n_ready = 0
+        self.alerts = pd.DataFrame()
+        self.traffic_source = "none"
+        self.refresh()
+        if self.ds is None:
+            raise InputError(f"{self.path}: no such run (and no {self.partial.name})")
+
+    @property
+    def growing(self) -> bool:
+        """True while the run is still being written."""
+        return self._opened == self.partial
+
+    def _open(self) -> None:
+        if self.path.exists():
+            target = self.path
+        elif self.partial.exists():
+            target = self.partial
+        else:
+            return
+        if target == self._opened:
+            return
+        if target == self.path:
+            ds = open_frames(target)
+        else:
+            try:
+                ds = xr.open_zarr(target, consolidated=False)
+            except Exception:  # noqa: BLE001 - a store still being created is simply not ready yet
+                return
+            radar_config_of(ds, str(target))
+        self.ds, self._opened = ds, target
+        self.config = radar_config_of(ds, str(target))
+        self.times = np.asarray(ds["time"].values, float)
+        self._compute_alerts()
+
+    def _ready_frames(self) -> int:
+        if not self.growing:
+            return len(self.times)
+        chunk = int(self.ds["iq"].data.chunks[0][0])
+        marks = self.partial / _DONE_MARKS
+        k = 0
+        while (marks / str(k)).exists():
+            k += 1
+        return min(k * chunk, len(self.times))
+
+    def refresh(self) -> int:
+        """Re-check the store (new chunks, rename to the final name); return the ready frame count."""
+        with self._lock:
+            self._open()
+            if self.ds is not None:
+                self.n_ready = self._ready_frames()
+            return self.n_ready
+
+    def _compute_alerts(self) -> None:
+        if self.alerts_path is not None:
+            self.alerts = read_table(self.alerts_path, required=["time_s", "track_id", "level"])
+            self.traffic_source = "alerts"
+            return
+        try:
+            own = ownship_from_frames(self.ds, str(self._opened))
+        except InputError:
+            self.alerts, self.traffic_source = pd.DataFrame(), "none"
+            return
+        if self.tracks_path is not None:
+            tracks, self.traffic_source = read_table(self.tracks_path, sort_by="time_s"), "tracks"
+        else:
+            tracks, self.traffic_source = truth_tracks(self.ds), "truth"
+        self.alerts = alerts_from_tracks(tracks, own, source=str(self.tracks_path or self._opened))
+
+    def info(self) -> dict[str, Any]:
+        """Run summary for the page."""
+        return {
+            "type": "info",
+            "run": self.path.name,
+            "growing": self.growing,
+            "n_ready": self.n_ready,
+            "n_total": len(self.times),
+            "times_s": self.times.tolist(),
+            "traffic_source": self.traffic_source,
+            "range_max_m": float(self.config.range_axis_m[-1]),
+            "v_lim_mps": float(self.config.v_lim_mps),
+        }
+
+    def _ownship(self, i: int) -> dict[str, float] | None:
+        if "own_north_m" not in self.ds:
+            return None
+        row = {k: float(self.ds[k].values[i]) for k in self.ds.data_vars if k.startswith("own_")}
+        yaw = row.get("own_yaw_rad", np.arctan2(row["own_ve_mps"], row["own_vn_mps"]))
+        return {
+            "north_m": row["own_north_m"],
+            "east_m": row["own_east_m"],
+            "alt_m": -row["own_down_m"],
+            "heading_deg": float(np.degrees(yaw) % 360.0),
+            "gs_mps": float(np.hypot(row["own_vn_mps"], row["own_ve_mps"])),
+            "vs_mps": -row["own_vd_mps"],
+            "height_agl_m": row.get("own_height_agl_m"),
+        }
+
+    def _traffic(self, t: float) -> tuple[list[dict[str, Any]], dict[str, Any] | None]:
+        if self.alerts.empty:
+            return [], None
+        dt = np.min(np.diff(self.times)) / 2 if len(self.times) > 1 else 0.5
+        rows = self.alerts[np.abs(self.alerts["time_s"].to_numpy() - t) <= dt]
+        keys = ["track_id", "level", "flarm_level", "sector", "layer", "range_m", "bearing_deg", "tcpa_s",
+                "rel_north_m", "rel_east_m", "rel_alt_m", "climb_rate_mps"]  # fmt: skip
+        traffic = [{k: _plain(r[k]) for k in keys if k in r} for r in rows.to_dict("records")]
+        advice = None
+        if len(rows) and "heading_bands_deg" in rows and rows["level"].max() > 0:
+            r0 = rows.iloc[0]
+            advice = {k: _plain(r0[k]) for k in _ADVICE_KEYS if k in rows}
+        return traffic, advice
+
+    def frame(self, i: int, with_image: bool = True) -> dict[str, Any]:
+        """Everything the page draws for frame ``i`` (must be ready)."""
+        with self._lock:
+            self._open()  # the writer may have renamed the store since the last refresh
+            if not 0 <= i < self.n_ready:
+                raise IndexError(f"frame {i} not ready (0..{self.n_ready - 1})")
+            t = float(self.times[i])
+            traffic, advice = self._traffic(t)
+            payload = {
+                "type": "frame",
+                "index": i,
+                "time_s": t,
+                "n_ready": self.n_ready,
+                "ownship": self._ownship(i),
+                "traffic": traffic,
+                "advice": advice,
+                "max_level": max([int(x["level"]) for x in traffic], default=0),
+            }
+            if with_image:
+                png = range_doppler_png(np.asarray(self.ds["iq"][i].values), self.config.noise_power_w)
+                payload["rd_png"] = "data:image/png;base64," + base64.b64encode(png).decode()
+        return payload
+
+
+def _plain(value: Any) -> Any:
+    """JSON-safe Python value (numpy scalars and arrays, NaN -> None)."""
+    if isinstance(value, np.ndarray | list | tuple):
+        return [_plain(v) for v in value]
+    if hasattr(value, "item"):
+        value = value.item()
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    return value

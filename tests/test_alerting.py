@@ -1,0 +1,172 @@
+"""Alert levels switch at the configured times, with M-of-N persistence and hysteresis."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from skyradar.daa.alerting import AlertConfig, AlertFilter, filter_alert_levels, raw_alert_levels
+from skyradar.daa.conflict import FT
+from skyradar.daa.pipeline import alerts_from_tracks
+from skyradar.errors import InputError
+
+DT = 0.5
+D_NC = 2200 * FT
+
+
+def _head_on(start_m=8000.0, closure_mps=100.0, duration_s=90.0, dt=DT):
+    """Own-ship north at 50 m/s from the origin; intruder on the same line coming south at 50 m/s."""
+    t = np.arange(0.0, duration_s, dt)
+    own = pd.DataFrame(
+        {
+            "time_s": t,
+            "own_north_m": 50.0 * t,
+            "own_east_m": 0.0,
+            "own_down_m": -1000.0,
+            "own_vn_mps": 50.0,
+            "own_ve_mps": 0.0,
+            "own_vd_mps": 0.0,
+            "own_yaw_rad": 0.0,
+        }
+    )
+    v_int = closure_mps - 50.0
+    tracks = pd.DataFrame(
+        {
+            "time_s": t,
+            "track_id": 1,
+            "north_m": start_m - v_int * t,
+            "east_m": 0.0,
+            "down_m": -1000.0,
+            "vn_mps": -v_int,
+            "ve_mps": 0.0,
+            "vd_mps": 0.0,
+        }
+    )
+    return own, tracks
+
+
+def test_raw_levels_switch_at_alerting_times():
+    own, tracks = _head_on()
+    out = alerts_from_tracks(tracks, own, with_advice=False)
+    t = out["time_s"].to_numpy()
+    # Loss of well clear (2200 ft disc) at (8000 - 670.56) / 100 = 73.29 s after start.
+    t_lowc = (8000.0 - D_NC) / 100.0
+    raw = out["raw_level"].to_numpy()
+    assert t[np.argmax(raw >= 2)] == pytest.approx(np.ceil((t_lowc - 55.0) / DT) * DT)
+    assert t[np.argmax(raw >= 3)] == pytest.approx(np.ceil((t_lowc - 25.0) / DT) * DT)
+    # M = 2 of N = 4: the issued level follows one frame after the raw level.
+    lvl = out["level"].to_numpy()
+    assert t[np.argmax(lvl >= 2)] == pytest.approx(t[np.argmax(raw >= 2)] + DT)
+    assert t[np.argmax(lvl >= 3)] == pytest.approx(t[np.argmax(raw >= 3)] + DT)
+    np.testing.assert_allclose(
+        out["t_in_s"].to_numpy()[raw >= 2], np.maximum(t_lowc - t[raw >= 2], 0.0), atol=1e-9
+    )
+
+
+def test_flarm_level_and_sector_in_pipeline():
+    own, tracks = _head_on(start_m=3000.0, duration_s=30.0)
+    out = alerts_from_tracks(tracks, own, with_advice=False)
+    t = out["time_s"].to_numpy()
+    t_imp = (3000.0 - 500 * FT) / 100.0
+    fl = out["flarm_level"].to_numpy()
+    assert t[np.argmax(fl >= 1)] == pytest.approx(np.ceil((t_imp - 18) / DT) * DT)
+    assert t[np.argmax(fl >= 3)] == pytest.approx(np.ceil((t_imp - 8) / DT) * DT)
+    assert (out["sector"] == 0).all()
+    assert out["rel_alt_m"].abs().max() == 0.0
+
+
+def test_hysteresis_lowers_only_after_hysteresis_time():
+    cfg = AlertConfig(m=1, n=1, persistence_s=0.0, hysteresis_s=3.0)
+    t = np.arange(0.0, 10.0, 0.5)
+    raw = np.where(t < 4.0, 3, 0)
+    lvl = filter_alert_levels(t, raw, cfg)
+    assert lvl[t < 4.0].tolist() == [3] * 8
+    # Below from 4.0 s, so held until 4.0 + 3.0 s.
+    assert t[np.argmax(lvl == 0)] == pytest.approx(7.0)
+    # A raw level that comes back before the hysteresis ran out resets the clock.
+    raw2 = np.where((t < 4.0) | (t == 6.0), 3, 0)
+    lvl2 = filter_alert_levels(t, raw2, cfg)
+    assert t[np.argmax(lvl2 == 0)] == pytest.approx(9.5)
+
+
+def test_persistence_holds_a_fresh_alert():
+    cfg = AlertConfig(m=1, n=1, persistence_s=4.0, hysteresis_s=0.0)
+    t = np.arange(0.0, 8.0, 1.0)
+    lvl = filter_alert_levels(t, np.array([0, 2, 0, 0, 0, 0, 0, 0]), cfg)
+    assert lvl.tolist() == [0, 2, 2, 2, 2, 0, 0, 0]
+
+
+def test_m_of_n_ignores_isolated_blips():
+    cfg = AlertConfig(m=2, n=4, persistence_s=0.0, hysteresis_s=0.0)
+    t = np.arange(12.0)
+    blips = np.array([3, 0, 0, 0, 3, 0, 0, 0, 3, 0, 0, 0])
+    assert filter_alert_levels(t, blips, cfg).max() == 0
+    pair = np.array([0, 3, 0, 0, 3, 0, 0, 0, 0, 0, 0, 0])
+    assert filter_alert_levels(t, pair, cfg).tolist() == [0, 0, 0, 0, 3, 0, 0, 0, 0, 0, 0, 0]
+
+
+def _m_of_n_levels(raw, m, n):
+    out = []
+    for k in range(len(raw)):
+        window = raw[max(0, k - n + 1) : k + 1]
+        out.append(max([lv for lv in range(1, 4) if sum(r >= lv for r in window) >= m], default=0))
+    return out
+
+
+@given(st.lists(st.integers(0, 3), min_size=1, max_size=40), st.integers(1, 4), st.integers(0, 3))
+@settings(max_examples=200, deadline=None)
+def test_filter_invariants(raw, n, m_minus):
+    m = max(1, n - m_minus)
+    cfg = AlertConfig(m=m, n=n, persistence_s=2.0, hysteresis_s=3.0)
+    lvl = filter_alert_levels(np.arange(len(raw), dtype=float), np.array(raw), cfg)
+    mofn = _m_of_n_levels(raw, m, n)
+    for k in range(len(raw)):
+        assert lvl[k] >= mofn[k]  # never below what M of N support
+        if k and lvl[k] > lvl[k - 1]:
+            assert lvl[k] == mofn[k]  # rises only to the M-of-N level
+        if k and lvl[k] < lvl[k - 1]:
+            # lowered only after the M-of-N level stayed below for hysteresis_s (4 frames of 1 s)
+            assert k >= 3 and all(mofn[j] < lvl[k - 1] for j in range(k - 3, k + 1))
+
+
+def test_uncertainty_raises_level():
+    s = np.array([[6000.0, 800.0, 0.0]])
+    v = np.array([[-100.0, 0.0, 0.0]])
+    base = raw_alert_levels(s, v)
+    wide = raw_alert_levels(s, v, cov_pos_m2=np.diag([200.0**2, 200.0**2, 50.0**2])[None])
+    assert base["level"][0] == 0
+    assert wide["level"][0] >= 2
+    assert wide["dthr_m"][0] == pytest.approx(D_NC + 1.5 * 200.0)
+
+
+def test_filter_state_is_per_track_and_confirmed_only():
+    own, tracks = _head_on()
+    other = tracks.copy()
+    other["track_id"] = 2
+    other["east_m"] = 5000.0  # far to the side: never alerts
+    both = pd.concat([tracks, other]).sort_values("time_s", kind="stable")
+    both["confirmed"] = both["track_id"] == 1
+    out = alerts_from_tracks(both, own, with_advice=False)
+    assert set(out["track_id"]) == {1}
+    both["confirmed"] = True
+    out = alerts_from_tracks(both, own, with_advice=False)
+    assert out.loc[out.track_id == 2, "level"].max() == 0
+    assert out.loc[out.track_id == 1, "level"].max() == 3
+
+
+def test_pipeline_rejects_bad_input():
+    own, tracks = _head_on()
+    with pytest.raises(InputError, match="missing column"):
+        alerts_from_tracks(tracks.drop(columns="vn_mps"), own, source="t.parquet")
+    late = tracks.copy()
+    late["time_s"] += 500.0
+    with pytest.raises(InputError, match="t.parquet: field 'time_s'"):
+        alerts_from_tracks(late, own, source="t.parquet")
+
+
+def test_filter_rejects_bad_m_of_n():
+    with pytest.raises(ValueError):
+        AlertFilter(AlertConfig(m=5, n=4))

@@ -1,0 +1,194 @@
+"""The live display server: API, WebSocket replay and controls, disconnects, growing runs, path safety."""
+
+from __future__ import annotations
+
+import base64
+import os
+import warnings
+
+import cv2
+import numpy as np
+import pytest
+from fastapi.testclient import TestClient
+
+from skyradar.daa.pipeline import alerts_from_tracks, ownship_from_frames, truth_tracks
+from skyradar.errors import InputError
+from skyradar.io.frames import FrameStoreWriter
+from skyradar.io.tables import write_table
+from skyradar.web.sample import sample_run_dataset, write_sample_run
+from skyradar.web.server import create_app
+
+pytestmark = pytest.mark.filterwarnings("ignore::RuntimeWarning", "ignore::UserWarning")
+
+# Sample run: head-on intruder (target 0) enters radar range (5 km) at 15 s; loss of well clear
+# (2200 ft) at (6500 - 670.56) / 100 = 58.29 s, so the raw warning (25 s) starts at frame 34 and
+# the 2-of-4 issued warning at 35 s.
+WARNING_AT_S = 35.0
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    return write_sample_run(tmp_path_factory.mktemp("web") / "run.zarr")
+
+
+@pytest.fixture(scope="module")
+def client(run):
+    with TestClient(create_app(run, speed=50.0, autoplay=False)) as c:
+        yield c
+
+
+def _frames_until(ws, pred, limit=200):
+    for _ in range(limit):
+        msg = ws.receive_json()
+        if pred(msg):
+            return msg
+    raise AssertionError("expected message not received")
+
+
+def test_page_and_static(client):
+    page = client.get("/")
+    assert page.status_code == 200 and 'id="plan"' in page.text
+    js = client.get("/static/app.js")
+    assert js.status_code == 200 and "WebSocket" in js.text
+
+
+def test_info_and_frame_payload(client):
+    info = client.get("/api/info").json()
+    assert info["n_ready"] == 60 and not info["growing"] and info["traffic_source"] == "truth"
+    early = client.get("/api/frame/10?image=false").json()
+    assert [t["track_id"] for t in early["traffic"]] == [1] and early[
+        "max_level"
+    ] == 0  # head-on not in range
+    f = client.get("/api/frame/40").json()
+    head_on = next(t for t in f["traffic"] if t["track_id"] == 0)
+    assert head_on["level"] == 3 and head_on["sector"] == 0
+    assert head_on["range_m"] == pytest.approx(6500 - 100 * 40)
+    crossing = next(t for t in f["traffic"] if t["track_id"] == 1)
+    assert crossing["level"] == 0 and crossing["rel_alt_m"] == pytest.approx(400.0)
+    assert f["advice"]["preferred_heading_deg"] is not None
+    # The image shows the head-on intruder at its range and closing speed (range grows upwards).
+    png = base64.b64decode(f["rd_png"].split(",", 1)[1])
+    img = cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_GRAYSCALE)
+    ds = sample_run_dataset(n_frames=41)
+    r = round(2500 / ds["range"].values[1])
+    # Closing at 100 m/s aliases once: -100 + 2 VLim = -21.7 m/s.
+    d = int(np.argmin(np.abs(ds["doppler"].values - (-100.0 + 2 * 39.16))))
+    assert img[img.shape[0] - 1 - r, d] == img.max() > img[img.shape[0] - 1 - r, (d + 5) % img.shape[1]]
+    assert client.get("/api/frame/60").status_code == 404
+
+
+def test_websocket_seek_speed_and_play(client):
+    with client.websocket_connect("/ws") as ws:
+        info = ws.receive_json()
+        assert info["type"] == "info" and info["playing"] is False
+        assert ws.receive_json()["index"] == 0
+        ws.send_json({"cmd": "seek", "time_s": WARNING_AT_S - 1})
+        before = ws.receive_json()
+        assert before["index"] == 34 and before["max_level"] == 2
+        ws.send_json({"cmd": "seek", "index": 35})
+        assert ws.receive_json()["max_level"] == 3
+        ws.send_json({"cmd": "speed", "value": 100})
+        ws.send_json({"cmd": "play"})
+        indices = [ws.receive_json()["index"] for _ in range(5)]
+        assert indices == [36, 37, 38, 39, 40]
+        ws.send_json({"cmd": "seek", "index": 57})
+        msg = _frames_until(ws, lambda m: m["type"] == "end")
+        assert msg["index"] == 59
+        ws.send_text("not json")  # ignored
+        ws.send_json({"cmd": "seek", "index": 1})
+        assert ws.receive_json()["index"] == 1
+
+
+def test_client_disconnect_mid_stream(run):
+    app = create_app(run, speed=100.0)
+    with TestClient(app) as c:
+        for _ in range(3):
+            with c.websocket_connect("/ws") as ws:
+                ws.receive_json()
+                ws.receive_json()
+                ws.receive_json()
+            # leaving the block closes the socket while the server is streaming
+        with c.websocket_connect("/ws") as ws:
+            assert ws.receive_json()["type"] == "info"
+            assert ws.receive_json()["type"] == "frame"
+        assert c.get("/api/info").status_code == 200
+
+
+def test_growing_run_is_followed_until_renamed(tmp_path):
+    ds = sample_run_dataset(n_frames=30)
+    template = ds.assign(iq=ds["iq"].chunk({"time": 10}))
+    final = tmp_path / "live.zarr"
+    writer = FrameStoreWriter(final, template, 10, fingerprint="t")
+    writer.write_chunk(0, ds["iq"].values[0:10])
+    app = create_app(final, speed=100.0)
+    with TestClient(app) as c:
+        info = c.get("/api/info").json()
+        assert info["growing"] and info["n_ready"] == 10 and info["n_total"] == 30
+        assert c.get("/api/frame/10").status_code == 404
+        with c.websocket_connect("/ws") as ws:
+            assert ws.receive_json()["growing"] is True
+            seen = [ws.receive_json()["index"] for _ in range(10)]
+            assert seen == list(range(10))
+            writer.write_chunk(1, ds["iq"].values[10:20])
+            assert ws.receive_json()["index"] == 10  # the server polls the done marks
+            writer.write_chunk(2, ds["iq"].values[20:30])
+            writer.close()  # rename .partial -> final while streaming
+            msgs = [ws.receive_json() for _ in range(20)]
+        assert [m["index"] for m in msgs[:19]] == list(range(11, 30))
+        assert msgs[19]["type"] == "end"
+        last = c.get("/api/frame/29").json()
+        assert not c.get("/api/info").json()["growing"]
+        assert last["traffic"][0]["range_m"] == pytest.approx(6500 - 100 * 29)
+        # The last frame has its pixel (read from the renamed store, not zeros).
+        png = base64.b64decode(last["rd_png"].split(",", 1)[1])
+        img = cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_GRAYSCALE)
+        assert img.max() > 3 * np.median(img)  # 20 dB pixel over the empty (floor) background
+
+
+def test_missing_run_is_an_input_error(tmp_path):
+    with pytest.raises(InputError, match="no such run"):
+        create_app(tmp_path / "nothing.zarr")
+
+
+def test_alerts_table_is_displayed(run, tmp_path):
+    import xarray as xr
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = xr.open_zarr(run)
+    alerts = alerts_from_tracks(truth_tracks(ds), ownship_from_frames(ds))
+    alerts = alerts[alerts["track_id"] == 0]
+    path = write_table(alerts, tmp_path / "alerts.parquet")
+    with TestClient(create_app(run, alerts_path=path, autoplay=False)) as c:
+        assert c.get("/api/info").json()["traffic_source"] == "alerts"
+        f = c.get("/api/frame/50?image=false").json()
+        assert [t["track_id"] for t in f["traffic"]] == [0]
+        assert f["advice"]["heading_bands_deg"]
+
+
+def test_rejects_paths_outside_the_run(tmp_path):
+    served = tmp_path / "served"
+    run = write_sample_run(served / "run.zarr", n_frames=3)
+    (served / "report.txt").write_text("inside")
+    secret = tmp_path / "secret.txt"
+    secret.write_text("TOP-SECRET")
+    os.symlink(secret, served / "link.txt")
+    with TestClient(create_app(run)) as c:
+        ok = c.get("/files/report.txt")
+        assert ok.status_code == 200 and ok.text == "inside"
+        attempts = [
+            "/files/..%2Fsecret.txt",
+            "/files/%2e%2e/secret.txt",
+            "/files/..%5Csecret.txt",
+            "/files/%2Fetc%2Fpasswd",
+            "/files//etc/passwd",
+            "/files/link.txt",
+            "/files/run.zarr/..%2F..%2Fsecret.txt",
+            "/static/..%2F..%2Fweb%2Fserver.py",
+            "/static/%2e%2e/server.py",
+            "/files/report.txt%00.png",
+        ]
+        for url in attempts:
+            r = c.get(url)
+            assert r.status_code in (403, 404), url
+            assert "TOP-SECRET" not in r.text and "def create_app" not in r.text and "root:" not in r.text

@@ -32,6 +32,11 @@ test: $(STAMP_DEV)
 test-slow: $(STAMP_DEV)
 	$(BIN)/python -m pytest -q -m "slow"
 
+# Headless Chromium drives the live display; the test installs Debian's chromium and the playwright
+# package itself when missing. The screenshot lands in $(OUT)/browser/display.png.
+test-browser: $(STAMP_DEV)
+	SKYRADAR_SCREENSHOT_DIR=$(OUT)/browser $(BIN)/python -m pytest -q -m browser tests/browser
+
 lint: $(STAMP_DEV)
 	$(BIN)/ruff check src tests
 	$(BIN)/ruff format --check src tests

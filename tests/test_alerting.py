@@ -170,3 +170,42 @@ def test_pipeline_rejects_bad_input():
 def test_filter_rejects_bad_m_of_n():
     with pytest.raises(ValueError):
         AlertFilter(AlertConfig(m=5, n=4))
+
+
+def test_cli_alert_writes_table(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    from typer.testing import CliRunner
+
+    from skyradar.cli import app
+    from skyradar.daa.pipeline import truth_tracks
+    from skyradar.io.tables import read_table, write_table
+    from skyradar.web.sample import sample_run_dataset, write_sample_run
+
+    run = write_sample_run(tmp_path / "run.zarr", n_frames=40)
+    tracks = truth_tracks(sample_run_dataset(n_frames=40))
+    write_table(tracks, tmp_path / "tracks.parquet")
+    out = tmp_path / "alerts.parquet"
+    res = CliRunner().invoke(
+        app, ["alert", str(tmp_path / "tracks.parquet"), "--ownship", str(run), "-o", str(out), "--json"]
+    )
+    assert res.exit_code == 0, res.output
+    summary = json.loads(res.stdout.strip().splitlines()[-1])
+    alerts = read_table(out, required=["time_s", "track_id", "level", "heading_bands_deg"])
+    assert summary["tracks_with_warning"] == 1 and summary["first_warning_s"] == 35.0
+    assert alerts.loc[alerts.track_id == 1, "level"].max() == 0
+    # Bad input: one line naming the file and field, exit code 2 (through the real entry point).
+    bad = tmp_path / "bad.parquet"
+    write_table(tracks.drop(columns="vd_mps"), bad)
+    cmd = [sys.executable, "-c", "from skyradar.cli import main; main()", "alert", str(bad)]
+    proc = subprocess.run(
+        cmd + ["--ownship", str(run), "-o", str(out)], capture_output=True, text=True, timeout=120
+    )
+    assert proc.returncode == 2
+    assert (
+        proc.stderr.strip().startswith("error:")
+        and "vd_mps" in proc.stderr
+        and "Traceback" not in proc.stderr
+    )

@@ -44,7 +44,9 @@ def test_listed_spurs_land_on_their_pixel_with_their_power_and_wrap():
     assert np.array_equal(cube, spur_cube(CFG, spurs, leakage=False, seed=3))  # same every frame
     leaky = spur_cube(CFG, spurs[:1], leakage=True, seed=3)
     assert np.count_nonzero(np.abs(leaky).sum(axis=2)) == 9
-    assert np.allclose(leaky[41, j1] / leaky[40, j1], -0.5) and np.allclose(leaky[41, j1 + 1] / leaky[40, j1], 0.25)
+    assert np.allclose(leaky[41, j1] / leaky[40, j1], -0.5) and np.allclose(
+        leaky[41, j1 + 1] / leaky[40, j1], 0.25
+    )
 
 
 def test_spur_map_pixels_get_the_map_level():
@@ -89,18 +91,26 @@ def test_near_range_leakage_covers_all_velocities_below_the_range():
     assert np.all(power[inside].min(axis=1) > 0) and not np.any(power[~inside])
     # Mean over Doppler at zero range: the set level (exponential statistics, 250 samples).
     assert 10 * np.log10(power[0].mean()) + 30 == pytest.approx(-110.0, abs=1.0)
-    assert 10 * np.log10(power[6].mean()) + 30 == pytest.approx(-110.0 - 30 * CFG.range_axis_m[6] / 100, abs=1.0)
+    assert 10 * np.log10(power[6].mean()) + 30 == pytest.approx(
+        -110.0 - 30 * CFG.range_axis_m[6] / 100, abs=1.0
+    )
 
 
 def test_channel_errors_are_undone_by_calibration():
     errors = channel_errors(4, gain_sd_db=1.0, phase_sd_deg=20.0, seed=7)
-    assert errors[0] == 1.0 and np.allclose(errors, channel_errors(4, gain_sd_db=1.0, phase_sd_deg=20.0, seed=7))
+    assert errors[0] == 1.0 and np.allclose(
+        errors, channel_errors(4, gain_sd_db=1.0, phase_sd_deg=20.0, seed=7)
+    )
     adc = simulate_adc(CFG, [[900.0, 100.0, -50.0]], noise=False)
     clean = range_doppler(adc, CFG)
     measured = apply_channel_errors(adc, errors, layout="adc")
-    assert np.allclose(range_doppler(measured, CFG, calibration=errors), clean, atol=1e-6 * np.abs(clean).max())
+    assert np.allclose(
+        range_doppler(measured, CFG, calibration=errors), clean, atol=1e-6 * np.abs(clean).max()
+    )
     # Same thing done on the image: linear, so identical.
-    assert np.allclose(range_doppler(measured, CFG), apply_channel_errors(clean, errors), atol=1e-6 * np.abs(clean).max())
+    assert np.allclose(
+        range_doppler(measured, CFG), apply_channel_errors(clean, errors), atol=1e-6 * np.abs(clean).max()
+    )
     with pytest.raises(InputError, match="need 4 gains"):
         channel_errors(4, gain_db=[0, 1])
 
@@ -129,6 +139,17 @@ def test_config_from_dict_switches_and_errors():
         ImpairmentConfig.from_dict({"sparks": {}})
 
 
+def test_preset_in_config_with_overrides():
+    imp = ImpairmentConfig.from_dict(
+        {"preset": "thesis_flight_look", "seed": 3, "zero_doppler": {"width_bins": 3}}
+    )
+    preset = thesis_flight_look(seed=3)
+    assert imp.spurs == preset.spurs and imp.seed == 3 and imp.ground_reflectivity_db == -10.0
+    assert imp.zero_doppler.width_bins == 3 and imp.zero_doppler.power_dbm_at_100m == -115.0
+    with pytest.raises(InputError, match="field 'preset'"):
+        ImpairmentConfig.from_dict({"preset": "rainy_day"})
+
+
 def test_spur_map_file(tmp_path):
     spur_map = np.zeros((CFG.n_range, NV), bool)
     spur_map[9, 9] = True
@@ -145,7 +166,8 @@ def test_thesis_preset_gives_the_flight_data_look():
     imp = thesis_flight_look()
     assert imp.ground_reflectivity_db < 0
     frames = [
-        apply_impairments(receiver_noise(CFG, rng=np.random.default_rng(i)), CFG, imp, frame_index=i) for i in range(3)
+        apply_impairments(receiver_noise(CFG, rng=np.random.default_rng(i)), CFG, imp, frame_index=i)
+        for i in range(3)
     ]
     noise_dbm = 10 * np.log10(CFG.noise_power_w) + 30
     for cube in frames:
@@ -171,7 +193,9 @@ def test_adc_impairments_match_image_impairments():
     )
     adc = simulate_adc(CFG, [[1200.0, 0.0, 0.0]], [[-5.0, 0, 0]], noise=False)
     via_adc = range_doppler(apply_impairments_adc(adc, CFG, imp), CFG, "none", "none")
-    via_img = apply_impairments(range_doppler(adc, CFG, "none", "none"), CFG, imp.model_copy(update={"spurs": None}))
+    via_img = apply_impairments(
+        range_doppler(adc, CFG, "none", "none"), CFG, imp.model_copy(update={"spurs": None})
+    )
     # Without windows the ADC spur is exactly the single image pixel; channel errors are linear.
     spur = spur_cube(CFG, [(450, -12, -118)], leakage=False)
     assert np.allclose(via_adc, via_img + spur, rtol=0, atol=1e-3 * np.sqrt(dbm_to_w(-118)))

@@ -176,3 +176,71 @@ def test_writer_rejects_bad_input_and_leaves_nothing(tmp_path):
     with pytest.raises(InputError, match="frame, rx, chirp, sample"):
         write_recording(tmp_path / "w.bin", frames(1)[0], CFG)
     assert list(tmp_path.iterdir()) == []
+
+
+def run_cli(monkeypatch, capsys, *args: str) -> tuple[int, str, str]:
+    cli = pytest.importorskip("skyradar.cli", exc_type=ImportError)
+    monkeypatch.setattr("sys.argv", ["skyradar", *args])
+    code = 0
+    try:
+        cli.main()
+    except SystemExit as exc:
+        code = int(exc.code or 0)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_rd_command_writes_frames_and_resumes(tmp_path, monkeypatch, capsys):
+    from skyradar.io.frames import open_frames
+    from skyradar.process.rangedoppler import range_doppler
+
+    data = frames(3)
+    sidecar = write_recording(tmp_path / "rec.bin", data, CFG, dtype="complex64")
+    out = tmp_path / "run.zarr"
+    code, stdout, err = run_cli(
+        monkeypatch, capsys, "rd", str(sidecar), "-o", str(out), "--chunk-frames", "2", "--json"
+    )
+    assert code == 0, err
+    result = json.loads(stdout.strip().splitlines()[-1])
+    assert result["frames"] == 3 and result["chunks_written"] == 2
+    ds = open_frames(out)
+    assert ds.iq.shape == (3, CFG.n_range, CFG.n_doppler, CFG.n_rx)
+    assert np.allclose(ds.iq.values[2], range_doppler(data[2], CFG), atol=1e-7)
+    assert not (tmp_path / "run.zarr.partial").exists()
+
+
+def test_rd_command_bad_recording_leaves_no_output(tmp_path, monkeypatch, capsys):
+    sidecar = write_recording(tmp_path / "rec.bin", frames(2), CFG)
+    with open(tmp_path / "rec.bin", "r+b") as fh:
+        fh.truncate(1000)
+    out = tmp_path / "run.zarr"
+    code, _, err = run_cli(monkeypatch, capsys, "rd", str(sidecar), "-o", str(out))
+    assert code == 2
+    assert err.startswith("error: ") and "truncated" in err and len(err.strip().splitlines()) == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rec.bin", "rec.json"]
+
+
+def test_rd_command_resumes_after_interruption(tmp_path, monkeypatch, capsys):
+    from skyradar.process.rangedoppler import RangeDopplerProcessor
+
+    sidecar = write_recording(tmp_path / "rec.bin", frames(4), CFG, dtype="complex64")
+    out = tmp_path / "run.zarr"
+    original = RangeDopplerProcessor.__call__
+    calls = []
+
+    def interrupted(self, adc, **kw):
+        calls.append(1)
+        if len(calls) == 3:  # first chunk (2 frames) done, stop inside the second
+            raise KeyboardInterrupt
+        return original(self, adc, **kw)
+
+    monkeypatch.setattr(RangeDopplerProcessor, "__call__", interrupted)
+    run_cli(monkeypatch, capsys, "rd", str(sidecar), "-o", str(out), "--chunk-frames", "2")
+    assert not out.exists() and (tmp_path / "run.zarr.partial").exists()
+    monkeypatch.setattr(RangeDopplerProcessor, "__call__", original)
+    code, stdout, err = run_cli(
+        monkeypatch, capsys, "rd", str(sidecar), "-o", str(out), "--chunk-frames", "2", "--json"
+    )
+    assert code == 0, err
+    result = json.loads(stdout.strip().splitlines()[-1])
+    assert result["chunks_resumed"] == 1 and result["chunks_written"] == 1 and out.exists()

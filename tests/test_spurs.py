@@ -99,3 +99,30 @@ def test_online_map_learns_fixed_spurs_while_the_scene_moves():
     d_moving = round(-20.0 / CFG.doppler_resolution_mps) + CFG.n_doppler // 2
     assert not mask[moving, d_moving]
     assert online.snapshot().mask.sum() == mask.sum()
+
+
+def test_hits_map_masks_zero_doppler_line_and_near_range_leakage_but_not_a_target_beside_them():
+    from skyradar.sim.impairments import near_range_leakage, zero_doppler_line
+
+    rng = np.random.default_rng(4)
+    line = zero_doppler_line(CFG, power_dbm_at_100m=-110.0, falloff_db_per_decade=15.0)
+
+    def frame(targets=()):
+        cube, _ = synthetic_frame(CFG, targets, rng)
+        return integrate_channels(cube + line + near_range_leakage(CFG, -110.0, 100.0, rng))
+
+    spur_map = learn_spur_map((frame() for _ in range(30)), CFG, threshold=0.05, pixels="hits")
+    centre = CFG.n_doppler // 2
+    assert spur_map.mask[50:, centre].all() and spur_map.mask[:6].all()
+    # A 15 dB aircraft three Doppler bins from the line at 2 km.
+    target = [(2000.0, 3 * CFG.doppler_resolution_mps, 0.1, 0.1, 15.0)]
+    found = false_alarms = 0
+    for _ in range(40):
+        det = detect(frame(target), CFG, exclude=spur_map.mask)
+        on_target = (np.abs(det.range_m(CFG) - 2000.0) < 10) & (det.doppler_index == centre + 3)
+        found += int(on_target.sum())
+        false_alarms += int((~on_target).sum())
+    assert found == 40 and false_alarms <= 0
+    # Without the mask the line inflates the CFAR noise estimate beside it and swallows the target.
+    det = detect(frame(target), CFG)
+    assert not np.any((np.abs(det.range_m(CFG) - 2000.0) < 10) & (det.doppler_index == centre + 3))

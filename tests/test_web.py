@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import base64
+import json
 import os
 import warnings
 
@@ -16,7 +17,7 @@ from skyradar.errors import InputError
 from skyradar.io.frames import FrameStoreWriter
 from skyradar.io.tables import write_table
 from skyradar.web.sample import sample_run_dataset, write_sample_run
-from skyradar.web.server import create_app
+from skyradar.web.server import create_app, serve_in_thread
 
 pytestmark = pytest.mark.filterwarnings("ignore::RuntimeWarning", "ignore::UserWarning")
 
@@ -192,3 +193,21 @@ def test_rejects_paths_outside_the_run(tmp_path):
             r = c.get(url)
             assert r.status_code in (403, 404), url
             assert "TOP-SECRET" not in r.text and "def create_app" not in r.text and "root:" not in r.text
+
+
+def test_real_server_survives_abrupt_disconnects(run):
+    """Over real TCP (uvicorn + websockets): clients that vanish mid-stream do not stop the server."""
+    import httpx
+    from websockets.sync.client import connect
+
+    with serve_in_thread(create_app(run, speed=100.0)) as url:
+        ws_url = url.replace("http", "ws") + "/ws"
+        for _ in range(3):
+            ws = connect(ws_url, open_timeout=10)
+            json.loads(ws.recv(timeout=10))
+            json.loads(ws.recv(timeout=10))
+            ws.socket.close()  # drop the TCP connection without a close handshake
+        with connect(ws_url, open_timeout=10) as ws:
+            assert json.loads(ws.recv(timeout=10))["type"] == "info"
+            assert json.loads(ws.recv(timeout=10))["index"] == 0
+        assert httpx.get(url + "/api/info", timeout=10).json()["n_ready"] == 60

@@ -38,6 +38,16 @@ def rotation_matrix(yaw_rad: np.ndarray | float, pitch_rad: np.ndarray | float, 
     >>> np.round(rotation_matrix(np.pi / 2, 0.0, 0.0) @ [1.0, 0.0, 0.0], 6).tolist()
     [0.0, 1.0, 0.0]
     """
+    if np.ndim(yaw_rad) == 0 and np.ndim(pitch_rad) == 0 and np.ndim(roll_rad) == 0:
+        # Closed form for one attitude: called per frame, where scipy's set-up cost dominates.
+        cy, sy = np.cos(yaw_rad), np.sin(yaw_rad)
+        cp, sp = np.cos(pitch_rad), np.sin(pitch_rad)
+        cr, sr = np.cos(roll_rad), np.sin(roll_rad)
+        return np.array([
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ])
     angles = np.stack(np.broadcast_arrays(yaw_rad, pitch_rad, roll_rad), axis=-1)
     return Rotation.from_euler("ZYX", angles).as_matrix()
 

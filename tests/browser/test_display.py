@@ -10,11 +10,8 @@ from __future__ import annotations
 
 import os
 import shutil
-import socket
 import subprocess
 import sys
-import threading
-import time
 from pathlib import Path
 
 import pytest
@@ -55,37 +52,14 @@ def chromium() -> str:
     return CHROMIUM
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 @pytest.fixture()
 def display_url(tmp_path):
-    import uvicorn
-
     from skyradar.web.sample import write_sample_run
-    from skyradar.web.server import create_app
+    from skyradar.web.server import create_app, serve_in_thread
 
     run = write_sample_run(tmp_path / "run.zarr", n_frames=50)
-    app = create_app(run, speed=1.0, autoplay=False)
-    port = _free_port()
-    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
-    thread = threading.Thread(target=server.run, daemon=True)
-    thread.start()
-    deadline = time.monotonic() + 20
-    while not server.started:
-        if time.monotonic() > deadline or not thread.is_alive():
-            server.should_exit = True
-            pytest.fail("display server did not start")
-        time.sleep(0.05)
-    try:
-        yield f"http://127.0.0.1:{port}/"
-    finally:
-        server.should_exit = True
-        thread.join(timeout=10)
-        assert not thread.is_alive(), "display server did not stop"
+    with serve_in_thread(create_app(run, speed=1.0, autoplay=False)) as url:  # 127.0.0.1, stopped on exit
+        yield url + "/"
 
 
 def _count_colour(page, selector: str, rgb: tuple[int, int, int]) -> int:

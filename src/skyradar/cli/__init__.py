@@ -11,6 +11,9 @@ import sys
 import click
 
 import skyradar.cli.commands_daa  # noqa: F401  (registers commands)
+import skyradar.cli.commands_process  # noqa: F401  (registers commands)
+import skyradar.cli.commands_raw  # noqa: F401  (registers commands)
+import skyradar.cli.commands_track  # noqa: F401  (registers commands)
 from skyradar.cli import commands_sim  # noqa: F401  (registers commands)
 from skyradar.cli.app import app
 from skyradar.errors import InputError

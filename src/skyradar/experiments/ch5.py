@@ -30,6 +30,7 @@ from skyradar.experiments.ch5_flight import Flight, terrain_following_flight
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.nav.flight_state import estimate_frame, filter_table, mount_height_offset_m
 from skyradar.nav.kalman_state import KalmanSettings
+from skyradar.nav.ridge import extract_ridge
 from skyradar.nav.terrain_aware import TerrainAwareEstimator
 
 __all__ = ["TERRAINS", "THESIS_TABLE", "run"]
@@ -94,16 +95,18 @@ def _fly(terrain, flight: Flight, config: RadarConfig, facet_size_m: float, seed
     sim = ImageSimulator(config, terrain, origin=(lat0, lon0, 0.0), facet_size_m=facet_size_m, seed=seed)
     aware = TerrainAwareEstimator(config)
     rows: dict[str, list] = {m: [] for m in METHODS}
-    priors: dict[str, Any] = {"thesis": None, "robust": None}
+    prior = None
     for i, (t, state) in enumerate(zip(flight.times_s, flight.states, strict=True)):
         cube = sim.frame(state, frame_index=i)
         offset = mount_height_offset_m(config, *flight.attitude_rad[i, 1:])
+        # One ridge per frame serves all three methods (the thesis one uses bin-centre ranges).
+        ridge = extract_ridge(cube, config, prior_state=prior)
         for method in ("thesis", "robust"):
-            est = estimate_frame(cube, config, method=method, prior_state=priors[method])
-            if est.fit.ok:
-                priors[method] = (est.fit.vx_mps, est.fit.vz_mps, est.fit.h_m)
+            est = estimate_frame(cube, config, method=method, ridge=ridge)
+            if method == "robust" and est.fit.ok:
+                prior = (est.fit.vx_mps, est.fit.vz_mps, est.fit.h_m)
             rows[method].append({"time_s": t, **_raw_row(est.fit, est.quality, est.low_quality, offset)})
-        ta = aware.update(t, cube, flight.attitude_rad[i])
+        ta = aware.update(t, cube, flight.attitude_rad[i], ridge=ridge)
         rows["terrain"].append({"time_s": t, **_raw_row(ta, ta.quality, ta.low_quality, offset)})
     return {m: pd.DataFrame(r) for m, r in rows.items()}
 

@@ -7,7 +7,7 @@ and, when simulated, own-ship truth on ``time`` and intruder truth on ``(time, t
 
 Writers never leave a half-written run under the final name: :class:`FrameStoreWriter` writes
 into ``NAME.partial`` chunk by chunk along time, marks each finished chunk, and renames the
-store when the last chunk is in. Re-running with the same fingerprint resumes: finished chunks
+store when the last chunk is in (done marks sit in ``NAME.partial.done``). Re-running with the same fingerprint resumes: finished chunks
 are skipped.
 """
 
@@ -128,10 +128,15 @@ def frames_dataset(
             units, desc = TARGET_VARS[name]
             data_vars[name] = (("time", "target"), np.asarray(values), {"units": units, "long_name": desc})
         n_targets = np.asarray(next(iter(targets.values()))).shape[1]
-        coords["target"] = ("target", np.array(target_names or [f"T{i}" for i in range(n_targets)], dtype=str))
+        coords["target"] = ("target", np.array(target_names or [f"T{i}" for i in range(n_targets)], dtype=object))
     all_attrs = {"radar_config": config.to_json(), "skyradar_format": "frames/1"}
     all_attrs.update(attrs or {})
     return xr.Dataset(data_vars, coords=coords, attrs=all_attrs)
+
+
+def _open_zarr(path: Path) -> xr.Dataset:
+    # No consolidated metadata: it is not part of Zarr v3, and stores are written chunk by chunk.
+    return xr.open_zarr(path, consolidated=False)
 
 
 def radar_config_of(ds: xr.Dataset, source: str = "frames") -> RadarConfig:
@@ -155,7 +160,7 @@ def open_frames(path: str | Path) -> xr.Dataset:
         raise InputError(f"{path}: no such run{hint}")
     try:
         if path.is_dir():
-            ds = xr.open_zarr(path, consolidated=None)
+            ds = _open_zarr(path)
         else:
             ds = xr.open_dataset(path)
     except Exception as exc:  # noqa: BLE001 - any reader failure becomes one clear line
@@ -196,14 +201,29 @@ class FrameStoreWriter:
         self.chunk_frames = int(chunk_frames)
         self.n_frames = template.sizes["time"]
         self.n_chunks = -(-self.n_frames // self.chunk_frames)
-        self._marks = self.partial / "_skyradar_done"
+        # Done marks live beside the store: zarr must not find foreign files inside it.
+        self._marks = self.partial.with_name(self.partial.name + ".done")
         if self.partial.exists() and self._fingerprint_on_disk() != fingerprint:
             shutil.rmtree(self.partial)
+            shutil.rmtree(self._marks, ignore_errors=True)
         if not self.partial.exists():
+            shutil.rmtree(self._marks, ignore_errors=True)
             template = template.assign_attrs(skyradar_fingerprint=fingerprint)
             encoding = {"iq": {"chunks": (self.chunk_frames, *template.iq.shape[1:])}}
             template.to_zarr(self.partial, compute=False, encoding=encoding, mode="w", consolidated=False)
             self._marks.mkdir()
+        self._marks.mkdir(exist_ok=True)
+
+    @classmethod
+    def attach(cls, partial: str | Path, chunk_frames: int, n_frames: int) -> FrameStoreWriter:
+        """A writer for an existing ``.partial`` store (used by workers that write their own chunks)."""
+        self = cls.__new__(cls)
+        self.partial = Path(partial)
+        self.path = self.partial.with_name(self.partial.name.removesuffix(".partial"))
+        self.chunk_frames, self.n_frames = int(chunk_frames), int(n_frames)
+        self.n_chunks = -(-self.n_frames // self.chunk_frames)
+        self._marks = self.partial.with_name(self.partial.name + ".done")
+        return self
 
     def _fingerprint_on_disk(self) -> str | None:
         try:
@@ -222,7 +242,8 @@ class FrameStoreWriter:
         """Write frames of chunk ``index`` (shape (n, range, doppler, rx)) and mark it done."""
         sl = self.chunk_slice(index)
         piece = xr.Dataset({"iq": (("time", "range", "doppler", "rx"), iq.astype(np.complex64, copy=False))})
-        piece.to_zarr(self.partial, region={"time": sl, "range": slice(None), "doppler": slice(None), "rx": slice(None)})
+        region = {"time": sl, "range": slice(None), "doppler": slice(None), "rx": slice(None)}
+        piece.to_zarr(self.partial, region=region, consolidated=False)
         (self._marks / str(index)).touch()
 
     def close(self) -> Path:

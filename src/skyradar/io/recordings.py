@@ -275,7 +275,7 @@ def read_recording(path: str | Path) -> tuple[AdcFrames, RadarConfig]:
     --------
     >>> import tempfile
     >>> cfg = RadarConfig.seed_prototype(n_doppler=8)
-    >>> adc = np.ones((2, 4, 8, cfg.samples_per_chirp), np.complex64)
+    >>> adc = np.full((2, 4, 8, cfg.samples_per_chirp), 1 + 1j, np.complex64)
     >>> d = Path(tempfile.mkdtemp())
     >>> _ = write_recording(d / "rec.bin", adc, cfg, scale=0.5)
     >>> frames, config = read_recording(d / "rec.json")

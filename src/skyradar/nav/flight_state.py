@@ -63,6 +63,7 @@ def estimate_frame(
     min_points: int = 12,
     min_quality: float = 0.3,
     threshold_db: float = 8.0,
+    ridge: Ridge | None = None,
 ) -> FrameEstimate:
     """Flight state of the antenna over the ground plane from one frame.
 
@@ -78,6 +79,8 @@ def estimate_frame(
         Below either the frame is flagged low quality and its estimates are NaN.
     threshold_db : float
         Noise gate of the ridge extraction.
+    ridge : Ridge, optional
+        Ridge of this frame already extracted (default edge placement); saves the extraction.
 
     Examples
     --------
@@ -88,13 +91,12 @@ def estimate_frame(
     """
     if method not in METHODS:
         raise InputError(f"flight state: field 'method' must be one of {METHODS}, got {method!r}")
-    if method == "thesis":
-        ridge = extract_ridge(frame, config, threshold_db=threshold_db, edge_offset_bins=0.0, prior_state=prior_state)
-        # The thesis paired bin centres with the apparent (coupled) range.
-        r = ridge.range_m + config.range_doppler_coupling_s * ridge.radial_velocity_mps
-        fit = fit_thesis(r, ridge.radial_velocity_mps)
-    else:
+    if ridge is None:
         ridge = extract_ridge(frame, config, threshold_db=threshold_db, prior_state=prior_state)
+    if method == "thesis":
+        # The thesis paired the ridge velocity with the range-bin centre (apparent range).
+        fit = fit_thesis(ridge.range_bin * config.range_resolution_m, ridge.radial_velocity_mps)
+    else:
         fit = fit_robust(ridge.range_m, ridge.radial_velocity_mps)
     n_in = int(fit.inliers.sum())
     quality = float(n_in / max(len(ridge), 1) * min(1.0, n_in / 50.0)) if fit.ok else 0.0

@@ -231,7 +231,13 @@ def fit_ransac(
     return StateFit(fit.vx_mps, fit.vz_mps, fit.h_m, fit.vx_sd_mps, fit.vz_sd_mps, fit.h_sd_m, keep, fit.rms_mps)
 
 
-def _residuals(x: np.ndarray, r: np.ndarray, v: np.ndarray, sigma_v: float, sigma_r: float) -> np.ndarray:
+def _residuals(
+    x: np.ndarray, r: np.ndarray, v: np.ndarray, sigma_v: float, sigma_r: float, prior: np.ndarray | None = None
+) -> np.ndarray:
+    if prior is not None:
+        # Prior rows (x - mean) / sd for the components with a finite prior SD.
+        used = np.isfinite(prior[1])
+        return np.concatenate([_residuals(x, r, v, sigma_v, sigma_r), ((x - prior[0]) / prior[1])[used]])
     vx, vz, h = x
     h = min(h, 0.999 * r.min())
     ground = np.sqrt(np.maximum(r * r - h * h, 1e-6))
@@ -249,6 +255,7 @@ def fit_robust(
     sigma_r_m: float = 4.5,
     f_scale: float = 2.0,
     seed: int = 0,
+    prior: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> StateFit:
     """RANSAC start, then Huber-loss nonlinear least squares on the unsquared ridge model.
 
@@ -260,6 +267,10 @@ def fit_robust(
         Measurement noise of one pair (bin quantisation: dV/sqrt(12), dR/sqrt(12)).
     f_scale : float
         Huber transition, in units of the normalised residual.
+    prior : (mean, sd), optional
+        Gaussian prior on (V_X, V_Z, H), e.g. the filter's prediction; an infinite SD leaves
+        that component free. Over rough terrain the ridge cannot separate H from V_Z well
+        (both bend the ridge near the nadir); a prior on the slowly varying V_Z steadies H.
 
     Examples
     --------
@@ -279,15 +290,18 @@ def fit_robust(
     good = np.isfinite(r) & np.isfinite(v)
     rg, vg = r[good], v[good]
     x0 = np.array([start.vx_mps, start.vz_mps, min(start.h_m, 0.99 * rg.min())])
-    sol = least_squares(
-        _residuals, x0, loss="huber", f_scale=f_scale, args=(rg, vg, sigma_v_mps, sigma_r_m), x_scale=[10, 1, 100]
-    )
+    pri = None if prior is None else np.array([np.asarray(prior[0], float), np.asarray(prior[1], float)])
+    if pri is not None and np.all(np.isfinite(pri[0])):
+        x0 = np.where(np.isfinite(pri[1]), pri[0], x0)
+        x0[2] = min(x0[2], 0.99 * rg.min())
+    args = (rg, vg, sigma_v_mps, sigma_r_m, pri)
+    sol = least_squares(_residuals, x0, loss="huber", f_scale=f_scale, args=args, x_scale=[10, 1, 100])
     vx, vz, h = (float(x) for x in sol.x)
     res = _residuals(sol.x, rg, vg, sigma_v_mps, sigma_r_m)
     inl = np.abs(res) < 3.0 * f_scale
     if inl.sum() < 4 or not (vx > 0 and h > 0):
         return StateFit.failed(r.size)
-    jac = sol.jac[inl]
+    jac = sol.jac[: rg.size][inl]
     # Scale the covariance by the observed residual spread (at least the assumed noise).
     s2 = max(float(np.mean(res[inl] ** 2)), 1.0)
     cov = np.linalg.pinv(jac.T @ jac) * s2

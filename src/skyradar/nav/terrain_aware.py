@@ -29,7 +29,7 @@ from scipy.optimize import least_squares
 
 from skyradar.config import RadarConfig
 from skyradar.geo import rotation_matrix
-from skyradar.nav.ridge import extract_ridge
+from skyradar.nav.ridge import Ridge, extract_ridge
 from skyradar.process.doa import doa_crlb, estimate_directions
 
 __all__ = ["TerrainEstimate", "TerrainAwareEstimator", "level_velocity", "ground_points"]
@@ -160,10 +160,16 @@ class TerrainAwareEstimator:
         while self._points and self._points[0][0] < time_s - self.memory_s:
             self._points.popleft()
 
-    def update(self, time_s: float, cube: np.ndarray, attitude_rad=(0.0, 0.0, 0.0)) -> TerrainEstimate:
-        """Estimate from one (range, doppler, rx) cube and the AHRS attitude (yaw, pitch, roll)."""
+    def update(
+        self, time_s: float, cube: np.ndarray, attitude_rad=(0.0, 0.0, 0.0), ridge: Ridge | None = None
+    ) -> TerrainEstimate:
+        """Estimate from one (range, doppler, rx) cube and the AHRS attitude (yaw, pitch, roll).
+
+        ``ridge`` may be passed when already extracted from this cube.
+        """
         failed = TerrainEstimate(*([float("nan")] * 6), 0.0, True, 0)
-        ridge = extract_ridge(cube, self.config, prior_state=self.prior)
+        if ridge is None:
+            ridge = extract_ridge(cube, self.config, prior_state=self.prior)
         if len(ridge) < self.min_points:
             self._advance(time_s, None)
             return failed

@@ -194,6 +194,8 @@ class RangeDopplerProcessor:
         self.workers = int(workers)
         self.w_range = get_window(range_window, self.n_samples).astype(np.float32)
         self.w_doppler = get_window(doppler_window, config.n_doppler).astype(np.float32)
+        self._w_full = np.zeros(self.n_fft, np.float32)
+        self._w_full[: self.n_samples] = self.w_range
         self.scale = 1.0 / (self.n_samples * config.n_doppler)
         n = np.arange(config.n_doppler)
         shift = np.exp(2j * np.pi * (config.n_doppler // 2) * n / config.n_doppler)
@@ -209,21 +211,31 @@ class RangeDopplerProcessor:
         if method == "pruned":
             self._p, self._q, self._k2 = p, q, k2
             n2 = np.arange(q)
-            self._twiddle = np.exp(-2j * np.pi * np.outer(np.arange(p), n2) / self.n_fft).astype(np.complex64)
+            twiddle = np.exp(-2j * np.pi * np.outer(np.arange(p), n2) / self.n_fft)
+            self._twiddle = twiddle.astype(np.complex64).reshape(p, 1, q)
             self._dft = np.exp(-2j * np.pi * np.outer(n2, np.arange(k2)) / q).astype(np.complex64)
 
     def _range_transform(self, x: np.ndarray) -> np.ndarray:
-        """(C, n_fft) complex64 -> first n_range DFT bins (C, n_range)."""
-        n_range = self.config.n_range
+        """Window and transform (C, n_samples) ADC rows -> first n_range DFT bins (C, n_range)."""
+        c, n_range = x.shape[0], self.config.n_range
+        if self.n_samples < self.n_fft:  # short chirps: zero-pad (window covers the valid part)
+            x = np.concatenate([x, np.zeros((c, self.n_fft - self.n_samples), x.dtype)], axis=1)
         if self.method == "fft":
-            return sfft.fft(x, axis=-1, workers=self.workers, overwrite_x=True)[:, :n_range]
-        c = x.shape[0]
+            xw = np.empty((c, self.n_fft), np.complex64)
+            np.multiply(x, self._w_full, out=xw, casting="unsafe")
+            return sfft.fft(xw, axis=-1, workers=self.workers, overwrite_x=True)[:, :n_range]
         p, q, k2 = self._p, self._q, self._k2
-        y = sfft.fft(x.reshape(c, p, q), axis=1, workers=self.workers, overwrite_x=True)
+        # Write the windowed samples as (n1, chirp, n2) so the length-P FFT runs over the
+        # outer axis, where pocketfft vectorises across the contiguous inner axes.
+        y = np.empty((p, c, q), np.complex64)
+        np.multiply(
+            x.reshape(c, p, q).transpose(1, 0, 2), self._w_full.reshape(p, 1, q), out=y, casting="unsafe"
+        )
+        y = sfft.fft(y, axis=0, workers=self.workers, overwrite_x=True)
         y *= self._twiddle
-        z = (y.reshape(c * p, q) @ self._dft).reshape(c, p, k2)
-        # bin k = k1 + P*k2 lives at z[:, k1, k2]: k2-major order gives increasing k.
-        return z.transpose(0, 2, 1).reshape(c, k2 * p)[:, :n_range]
+        z = (y.reshape(p * c, q) @ self._dft).reshape(p, c, k2)
+        # bin k = k1 + P*k2 lives at z[k1, :, k2]: (chirp, k2, k1) order gives increasing k.
+        return z.transpose(1, 2, 0).reshape(c, k2 * p)[:, :n_range]
 
     def __call__(
         self, adc: np.ndarray, remove_dc: bool = False, calibration: np.ndarray | None = None
@@ -237,13 +249,13 @@ class RangeDopplerProcessor:
         if remove_dc:
             # ADC offset and LO leakage sit at zero beat frequency: remove each chirp's mean.
             x = x - x.mean(axis=-1, keepdims=True, dtype=np.complex64 if np.iscomplexobj(x) else np.float32)
-        c = cfg.n_rx * cfg.n_doppler
-        xw = np.zeros((c, self.n_fft), np.complex64)
-        np.multiply(x.reshape(c, self.n_samples), self.w_range, out=xw[:, : self.n_samples], casting="unsafe")
         gains = cfg.rx_calibration if calibration is None else np.asarray(calibration, complex)
         if gains.shape != (cfg.n_rx,) or not np.all(np.isfinite(gains)) or np.any(gains == 0):
             raise InputError(f"range_doppler: calibration must be {cfg.n_rx} finite non-zero complex gains")
-        rng = self._range_transform(xw).reshape(cfg.n_rx, cfg.n_doppler, cfg.n_range)
+        c = cfg.n_rx * cfg.n_doppler
+        rng = self._range_transform(x.reshape(c, self.n_samples)).reshape(
+            cfg.n_rx, cfg.n_doppler, cfg.n_range
+        )
         # Doppler window, FFT shift (a frequency offset of nV//2 bins), normalisation and
         # calibration are one complex weight per (rx, chirp): one pass over the data.
         weight = (self._doppler_weight[None, :] * (self.scale / gains)[:, None]).astype(np.complex64)

@@ -32,11 +32,10 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from scipy import ndimage
+from scipy import ndimage, stats
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
-from skyradar.process.cfar import cfar_2d
 from skyradar.process.detect import detect
 
 __all__ = ["THESIS_THRESHOLDS", "SpurMap", "detection_pixels", "learn_spur_map", "OnlineSpurMap"]
@@ -58,11 +57,14 @@ def detection_pixels(
     """Boolean image of one channel-integrated frame's detections.
 
     ``"peaks"``: the detector's point per object (the thesis' corners). ``"hits"``: every pixel
-    above the CFAR threshold, so extended interference (zero-Doppler line, near-range leakage)
-    is learned whole, not only where its peak happens to be.
+    above the thermal noise floor at false-alarm probability ``pfa`` (default 1e-5), the floor
+    estimated from the image median, so extended interference (zero-Doppler line, near-range
+    leakage with its range gradient) is learned whole, not only where a CFAR window would fire.
     """
     if pixels == "hits":
-        return cfar_2d(power, pfa=detect_kwargs.get("pfa", 1e-5), n_integrated=config.n_rx)[0]
+        law = stats.gamma(config.n_rx, scale=1.0 / config.n_rx)
+        floor = np.median(power) / law.median()
+        return power > np.float32(law.isf(detect_kwargs.get("pfa", 1e-5)) * floor)
     if pixels != "peaks":
         raise InputError(f"spur map: field 'pixels' must be 'peaks' or 'hits', got {pixels!r}")
     det = detect(power, config, **detect_kwargs)

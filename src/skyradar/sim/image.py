@@ -62,6 +62,8 @@ class AntennaGeometry:
     origin_ned_m: np.ndarray  # antenna phase-centre reference point
     rot_ned_to_ant: np.ndarray  # 3x3, NED vector -> antenna-frame vector
     velocity_ned_mps: np.ndarray
+    lat_deg: float  # platform position (the antenna is metres away: same crop)
+    lon_deg: float
 
 
 class ImageSimulator:
@@ -148,17 +150,15 @@ class ImageSimulator:
         pos = np.asarray(platform.position_ned_m, float)
         yaw, pitch, roll = np.asarray(platform.attitude_rad, float)
         body_to_local = rotation_matrix(yaw, pitch, roll)
+        lat, lon, _ = ned_to_geodetic(pos, *self.origin, flat_earth=self.flat_earth)
         if self.flat_earth:
             body_to_ned = body_to_local
         else:
-            lat, lon, _ = ned_to_geodetic(pos, *self.origin)
             # Attitude is relative to the local vertical at the aircraft, not at the origin.
-            body_to_ned = (
-                ned_rotation_to(self.origin[0], self.origin[1], float(lat), float(lon)).T @ body_to_local
-            )
+            body_to_ned = ned_rotation_to(self.origin[0], self.origin[1], float(lat), float(lon)).T @ body_to_local
         ant_to_ned = body_to_ned @ self.config.mount.rotation
         origin = pos + body_to_ned @ np.asarray(self.config.mount.position_m)
-        return AntennaGeometry(origin, ant_to_ned.T, np.asarray(platform.velocity_ned_mps, float))
+        return AntennaGeometry(origin, ant_to_ned.T, np.asarray(platform.velocity_ned_mps, float), float(lat), float(lon))
 
     # ---- one frame --------------------------------------------------------------------------
     def frame(
@@ -167,24 +167,26 @@ class ImageSimulator:
         """Simulate one frame; returns (n_range, n_doppler, n_rx) complex64."""
         cfg = self.config
         geom = self.geometry(platform)
-        cube = np.zeros((cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex128)
         if self.terrain is not None:
-            cube += self.terrain_cube(geom)
+            cube = self.terrain_cube(geom)
+        else:
+            cube = np.zeros((cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex128)
         if targets:
             _add_targets(cube, cfg, geom, targets, self.coupling_s)
+        frame = cube.astype(np.complex64)
         if self.noise:
             rng = np.random.default_rng([self.seed, int(frame_index)])
-            sigma = np.sqrt(cfg.noise_power_w / 2.0)
-            noise = rng.standard_normal((*cube.shape, 2), dtype=np.float32) * np.float32(sigma)
-            cube += noise.view(np.complex64)[..., 0]
-        return cube.astype(np.complex64)
+            noise = rng.standard_normal((*frame.shape, 2), dtype=np.float32)
+            noise *= np.float32(np.sqrt(cfg.noise_power_w / 2.0))
+            frame += noise.view(np.complex64)[..., 0]
+        return frame
 
     def terrain_cube(self, geom: AntennaGeometry) -> np.ndarray:
         """Terrain returns only, (n_range, n_doppler, n_rx) complex128."""
         cfg = self.config
         n_blocks = get_num_threads()
         out = np.zeros((n_blocks, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex128)
-        crop = self._crop(geom.origin_ned_m)
+        crop = self._crop(geom)
         if crop is None:
             return out[0]
         p_ned = np.ascontiguousarray(self._grid_ned[crop] - geom.origin_ned_m)
@@ -231,13 +233,12 @@ class ImageSimulator:
             n_blocks,
             out,
         )
-        return out.sum(axis=0)
+        return out[0] if n_blocks == 1 else out.sum(axis=0)
 
-    def _crop(self, antenna_ned: np.ndarray) -> tuple[slice, slice] | None:
-        lat, lon, _ = ned_to_geodetic(antenna_ned, *self.origin, flat_earth=self.flat_earth)
-        rows, cols = self.terrain.crop_window(
-            float(lat), float(lon), self.config.range_limit_m + 2 * self._facet_m
-        )
+    def _crop(self, geom: AntennaGeometry) -> tuple[slice, slice] | None:
+        # Crop around the platform; the mount offset (metres) is added to the reach.
+        reach = self.config.range_limit_m + 2 * self._facet_m + float(np.linalg.norm(self.config.mount.position_m))
+        rows, cols = self.terrain.crop_window(geom.lat_deg, geom.lon_deg, reach)
         if rows.stop - rows.start < 2 or cols.stop - cols.start < 2:
             return None
         return rows, cols

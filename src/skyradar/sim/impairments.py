@@ -19,9 +19,10 @@ carried here as ``ground_reflectivity_db`` for the scenario runner.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from skyradar.config import BOLTZMANN, RadarConfig
 from skyradar.errors import InputError
@@ -125,7 +126,9 @@ def spur_cube(
     values = np.sqrt(power)[:, None] * _phasors(np.random.default_rng([seed, 1]), (rows.size, config.n_rx))
     taps = [(0, 0, 1.0)]
     if leakage:
-        taps += [(dk, dj, (-0.5) ** (abs(dk) + abs(dj))) for dk in (-1, 0, 1) for dj in (-1, 0, 1) if dk or dj]
+        taps += [
+            (dk, dj, (-0.5) ** (abs(dk) + abs(dj))) for dk in (-1, 0, 1) for dj in (-1, 0, 1) if dk or dj
+        ]
     for dk, dj, gain in taps:
         k = rows + dk
         ok = (k >= 0) & (k < config.n_range)
@@ -309,9 +312,13 @@ class ImpairmentConfig(BaseModel):
     >>> imp = ImpairmentConfig.from_dict({"zero_doppler": {"power_dbm_at_100m": -120}})
     >>> imp.zero_doppler.power_dbm_at_100m, imp.spurs is None
     (-120.0, True)
+    >>> imp = ImpairmentConfig.from_dict({"preset": "thesis_flight_look", "near_range": {"enabled": False}})
+    >>> len(imp.spurs.spurs), imp.near_range.enabled, imp.ground_reflectivity_db
+    (6, False, -10.0)
     """
 
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    preset: Literal["thesis_flight_look"] | None = None
     spurs: SpursConfig | None = None
     zero_doppler: ZeroDopplerConfig | None = None
     near_range: NearRangeConfig | None = None
@@ -319,6 +326,16 @@ class ImpairmentConfig(BaseModel):
     noise: NoiseConfig | None = None
     ground_reflectivity_db: float = 0.0  # applied by the simulator, not by the cube functions
     seed: int = Field(0, ge=0)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _expand_preset(cls, data: Any) -> Any:
+        # ``preset: thesis_flight_look`` gives the preset's sections; sections written beside it
+        # replace the preset's one by one.
+        if isinstance(data, dict) and data.get("preset") == "thesis_flight_look":
+            base = thesis_flight_look(seed=int(data.get("seed", 0))).model_dump(exclude={"preset"})
+            return {**base, **data}
+        return data
 
     @classmethod
     def from_dict(cls, data: dict | None, source: str = "impairments") -> ImpairmentConfig:

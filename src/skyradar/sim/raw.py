@@ -56,7 +56,7 @@ def received_power_w(config: RadarConfig, positions_m: np.ndarray, rcs_m2: np.nd
     >>> cfg = RadarConfig.seed_prototype()
     >>> p = received_power_w(cfg, np.array([[1000.0, 0, 0]]), 1.0)
     >>> round(float(10 * np.log10(p[0] / cfg.noise_power_w)), 1)  # single-pixel SNR, dB
-    37.5
+    30.6
     """
     p = np.asarray(positions_m, float).reshape(-1, 3)
     rcs = np.broadcast_to(np.asarray(rcs_m2, float), p.shape[:1])

@@ -147,7 +147,13 @@ def associate(
     d_idx = order[lo[t_idx] + offsets]
     rw = None if range_wrap_m is None else np.asarray(range_wrap_m, float)[t_idx]
     y = innovation(z[d_idx], z_pred[t_idx], doppler_width_mps, rw)
-    cost = pair_costs(y, S[t_idx], metric, pixel_size)
+    if metric == "l2":
+        cost = pair_costs(y, S[t_idx], metric, pixel_size)
+    else:
+        # Inverse terms once per track, then gathered per pair (cheaper than S[t_idx]).
+        det = S[:, 0, 0] * S[:, 1, 1] - S[:, 0, 1] ** 2
+        ia, ib, id_ = S[:, 1, 1] / det, -S[:, 0, 1] / det, S[:, 0, 0] / det
+        cost = ia[t_idx] * y[:, 0] ** 2 + 2.0 * ib[t_idx] * y[:, 0] * y[:, 1] + id_[t_idx] * y[:, 1] ** 2
     ok = cost < gate
     t_idx, d_idx, y, cost = t_idx[ok], d_idx[ok], y[ok], cost[ok]
     pick = _solve(t_idx, d_idx, cost)

@@ -62,9 +62,9 @@ class MotionModel:
     dealias: bool
     doppler_width_mps: float
     sigma_range_m: float = 4.5
-    sigma_velocity_mps: float = 0.15
+    sigma_velocity_mps: float = 0.2
     q_range_mps2: float = 6.0
-    q_velocity_mps3: float = 8.0
+    q_velocity_mps3: float = 6.0
     init_sigma_rate_mps: float = 100.0
     init_sigma_accel_mps2: float = 3.0
 

@@ -173,6 +173,8 @@ class RangeDopplerTracker:
         }
         if self.config.dealias not in ("confident", "thesis"):
             raise ValueError(f"dealias must be 'confident' or 'thesis', got {self.config.dealias!r}")
+        self._R = model.measurement_noise
+        self._P0 = model.initial_covariance()
         self._hybrid = model.dealias and self.config.dealias == "confident"
         self._thesis = model.dealias and self.config.dealias == "thesis"
 
@@ -240,7 +242,7 @@ class RangeDopplerTracker:
 
     def _associate(self, z: np.ndarray) -> Association:
         t, m = self.t, self.model
-        S = t["P"][:, :2, :2] + m.measurement_noise
+        S = t["P"][:, :2, :2] + self._R
         range_wrap = None
         if self._thesis:
             range_wrap = np.where(t["n_updates"] == 1, m.doppler_width_mps * (self.time_s - t["t_update"]), np.nan)
@@ -283,7 +285,7 @@ class RangeDopplerTracker:
         if self._range_wrap is not None:
             self._shift_alias(rows, z[assoc.detection_index, 0], assoc.innovation[:, 0])
         t["x"][rows], t["P"][rows] = update(
-            t["x"][rows], t["P"][rows], assoc.innovation, MEASUREMENT_MATRIX, m.measurement_noise
+            t["x"][rows], t["P"][rows], assoc.innovation, MEASUREMENT_MATRIX, self._R
         )
         if self._hybrid:
             self._resolve(rows)
@@ -364,7 +366,7 @@ class RangeDopplerTracker:
         hist_r[:, 0] = z_new[:, 0]
         new = {
             "x": x,
-            "P": np.broadcast_to(m.initial_covariance(), (n, 4, 4)),
+            "P": np.broadcast_to(self._P0, (n, 4, 4)),
             "ids": np.arange(self._next_id, self._next_id + n),
             "t_update": np.full(n, self.time_s),
             "hits": np.ones(n, np.int64),

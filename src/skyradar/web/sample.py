@@ -2,8 +2,8 @@
 
 Own-ship flies north at 50 m/s, 1000 m up. Intruder ``head-on`` comes south at 50 m/s on the same
 line from 6500 m (a collision course); intruder ``crossing`` crosses from the right well clear.
-Each frame holds only the intruders' point responses (one pixel per intruder at its range and
-aliased radial velocity, 20 dB above the noise power, all receivers in phase) on an empty
+Each frame holds only the intruders' point responses (a 3x3 blob per intruder at its range and
+aliased radial velocity, peak 20 dB above the noise power, all receivers in phase) on an empty
 background, so the store compresses to a few kilobytes per frame.
 """
 
@@ -80,8 +80,11 @@ def sample_run_dataset(
                 int(round(tgt["tgt_radial_velocity_mps"][i, k] / dv + config.n_doppler / 2))
                 % config.n_doppler
             )
-            if r_bin < config.n_range:
-                iq[i, r_bin, d_bin, :] = amp
+            # A 3x3 blob (Hann-windowed main lobe: -6 dB on the neighbours), Doppler wrapping around.
+            for dr, dd in np.ndindex(3, 3):
+                rr, jj = r_bin + dr - 1, (d_bin + dd - 1) % config.n_doppler
+                if 0 <= rr < config.n_range:
+                    iq[i, rr, jj, :] = amp * 0.5 ** (abs(dr - 1) + abs(dd - 1))
     return frames_dataset(iq, t, config, ownship=own, targets=tgt, target_names=["head-on", "crossing"])
 
 

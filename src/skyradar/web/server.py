@@ -22,6 +22,9 @@ import asyncio
 import contextlib
 import json
 import logging
+import threading
+import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -31,7 +34,7 @@ from fastapi.responses import FileResponse, JSONResponse
 
 from skyradar.web.source import RunSource
 
-__all__ = ["STATIC_DIR", "create_app", "safe_path"]
+__all__ = ["STATIC_DIR", "create_app", "safe_path", "serve_in_thread"]
 
 STATIC_DIR = Path(__file__).parent / "static"
 _log = logging.getLogger(__name__)
@@ -208,3 +211,33 @@ async def _play(websocket: WebSocket, source: RunSource, queue: asyncio.Queue, p
         else:
             p.ended = True
             await websocket.send_json({"type": "end", "index": p.index})
+
+
+@contextlib.contextmanager
+def serve_in_thread(app: FastAPI, host: str = "127.0.0.1", timeout_s: float = 20.0) -> Iterator[str]:
+    """Run ``app`` with uvicorn on a free port in a background thread; yield its base URL; stop it after.
+
+    Examples
+    --------
+    >>> from fastapi import FastAPI
+    >>> with serve_in_thread(FastAPI()) as url:
+    ...     url.startswith("http://127.0.0.1:")
+    True
+    """
+    import uvicorn
+
+    server = uvicorn.Server(uvicorn.Config(app, host=host, port=0, log_level="warning"))
+    thread = threading.Thread(target=server.run, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + timeout_s
+    while not server.started:
+        if time.monotonic() > deadline or not thread.is_alive():
+            server.should_exit = True
+            raise RuntimeError("display server did not start")
+        time.sleep(0.05)
+    port = server.servers[0].sockets[0].getsockname()[1]
+    try:
+        yield f"http://{host}:{port}"
+    finally:
+        server.should_exit = True
+        thread.join(timeout=timeout_s)

@@ -23,12 +23,11 @@ import xarray as xr
 
 from skyradar.daa.pipeline import alerts_from_tracks, ownship_from_frames, truth_tracks
 from skyradar.errors import InputError
-from skyradar.io.frames import open_frames, radar_config_of
+from skyradar.io.frames import FrameStoreWriter, open_frames, radar_config_of
 from skyradar.io.tables import read_table
 
 __all__ = ["RunSource", "range_doppler_png"]
 
-_DONE_MARKS = "_skyradar_done"
 _ADVICE_KEYS = (
     "heading_bands_deg",
     "vs_bands_mps",
@@ -118,10 +117,10 @@ class RunSource:
         if not self.growing:
             return len(self.times)
         chunk = int(self.ds["iq"].data.chunks[0][0])
-        marks = self.partial / _DONE_MARKS
-        k = 0
-        while (marks / str(k)).exists():
-            k += 1
+        # Ask the writer's own bookkeeping which chunks are done (a leading run of them is shown).
+        writer = FrameStoreWriter.attach(self.partial, chunk, len(self.times))
+        pending = writer.pending_chunks()
+        k = pending[0] if pending else writer.n_chunks
         return min(k * chunk, len(self.times))
 
     def refresh(self) -> int:

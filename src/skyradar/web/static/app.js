@@ -94,9 +94,9 @@ function drawPlan(f) {
   g.clearRect(0, 0, W, H);
   // Range rings and compass ring (heading up).
   g.strokeStyle = "#333"; g.fillStyle = "#777"; g.font = "11px sans-serif"; g.lineWidth = 1;
-  for (const frac of [0.25, 0.5, 1.0]) {
+  for (const frac of [0.2, 0.5, 1.0]) {
     g.beginPath(); g.arc(cx, cy, R * frac, 0, 2 * Math.PI); g.stroke();
-    g.fillText(`${(scaleM * frac / 1000).toFixed(scaleM * frac >= 1000 ? 0 : 2)} km`, cx + 3, cy - R * frac + 12);
+    g.fillText(`${parseFloat((scaleM * frac / 1000).toFixed(1))} km`, cx - 40, cy - R * frac + 12);
   }
   const arcAngle = (deg) => ((deg - hdg - 90) * Math.PI) / 180;
   // Heading bands on the outer ring: green free, red conflicting, marker at the preferred heading.

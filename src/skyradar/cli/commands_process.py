@@ -1,0 +1,146 @@
+"""Frame processing commands: ``process``, ``spur-map``, ``experiment ch3`` and ``bench process``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from skyradar.cli.app import app, bench_app, console, emit_result, experiment_app
+
+__all__ = ["process", "spur_map", "experiment_ch3", "bench_process"]
+
+JsonOption = Annotated[bool, typer.Option("--json", help="Print the result as JSON (last stdout line).")]
+
+
+def _progress(total: int, label: str):
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
+
+    bar = Progress("[progress.description]{task.description}", BarColumn(), MofNCompleteColumn(),
+                   TimeRemainingColumn(), console=console)  # fmt: skip
+    return bar, bar.add_task(label, total=total)
+
+
+@app.command()
+def process(
+    run: Annotated[Path, typer.Argument(help="Frames run (Zarr directory or NetCDF file).")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Detections table to write (Parquet).")],
+    spur_map: Annotated[
+        Path | None, typer.Option("--spur-map", help="Spur map (.npz from `skyradar spur-map`).")
+    ] = None,
+    spur_mode: Annotated[
+        str,
+        typer.Option("--spur-mode", help="'mask' spur pixels before detection or 'flag' detections in them."),
+    ] = "mask",
+    method: Annotated[str, typer.Option("--method", help="Detector: cfar, os-cfar or shi-tomasi.")] = "cfar",
+    pfa: Annotated[float, typer.Option("--pfa", help="CFAR false-alarm probability per pixel.")] = 2e-8,
+    terrain: Annotated[
+        Path | None,
+        typer.Option("--terrain", help="DEM (.hgt/.tif/.npz) for the ground filter's height test."),
+    ] = None,
+    as_json: JsonOption = False,
+) -> None:
+    """Detect objects in every frame and locate them in 3-D: one row per detection per frame.
+
+    Columns: time_s, frame, range_m, radial_velocity_mps, range/doppler_bin, snr_db, power_db,
+    azimuth/elevation_rad (antenna frame), x/y/z_body_m, north/east/down_m, lat/lon/alt, is_ground, spur.
+    """
+    from skyradar.io.frames import open_frames, radar_config_of
+    from skyradar.io.tables import write_table
+    from skyradar.process.pipeline import process_frames
+    from skyradar.process.spurs import SpurMap
+
+    ds = open_frames(run)
+    config = radar_config_of(ds, str(run))
+    spurs = SpurMap.load(spur_map, config) if spur_map is not None else None
+    dem = None
+    if terrain is not None:
+        from skyradar.scene.dem_readers import read_dem
+
+        dem = read_dem(terrain)
+    bar, task = _progress(ds.sizes["time"], "frames")
+    with bar:
+        table = process_frames(
+            ds,
+            spurs,
+            dem,
+            method,
+            spur_mode,
+            progress=lambda n: bar.update(task, completed=n),
+            source=str(run),
+            pfa=pfa,
+        )
+    write_table(table, output, metadata={"radar_config": config.to_json(), "source": str(run)})
+    n = ds.sizes["time"]
+    result = {
+        "frames": n,
+        "detections": len(table),
+        "detections_per_frame": len(table) / n,
+        "ground": int(table["is_ground"].sum()),
+        "spur": int(table["spur"].sum()),
+        "output": str(output),
+    }
+    emit_result(result, as_json, "detections")
+
+
+@app.command("spur-map")
+def spur_map(
+    run: Annotated[Path, typer.Argument(help="Frames of a static scene (Zarr directory or NetCDF file).")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Spur map to write (.npz).")],
+    threshold: Annotated[
+        float, typer.Option("--threshold", help="Hit frequency above which a pixel is a spur.")
+    ] = 0.05,
+    pixels: Annotated[
+        str, typer.Option("--pixels", help="'peaks' (detector points, thesis) or 'hits' (every lit pixel).")
+    ] = "hits",
+    as_json: JsonOption = False,
+) -> None:
+    """Learn a spur map from frames of a static scene (every fixed bright pixel is a spur)."""
+    import numpy as np
+
+    from skyradar.io.frames import open_frames, radar_config_of
+    from skyradar.process.detect import integrate_channels
+    from skyradar.process.spurs import learn_spur_map
+
+    ds = open_frames(run)
+    config = radar_config_of(ds, str(run))
+    frames = (
+        integrate_channels(np.asarray(ds["iq"][i].values), config.rx_calibration)
+        for i in range(ds.sizes["time"])
+    )
+    learned = learn_spur_map(frames, config, threshold, pixels)
+    learned.save(output)
+    result = {"frames": learned.n_frames, "spur_pixels": int(learned.mask.sum()), "threshold": threshold,
+              "output": str(output)}  # fmt: skip
+    emit_result(result, as_json, "spur map")
+
+
+@experiment_app.command("ch3")
+def experiment_ch3(
+    out: Annotated[Path, typer.Option("--out", help="Output directory for figures and tables.")] = Path(
+        "out/ch3"
+    ),
+    frames: Annotated[int, typer.Option("--frames", help="Flyover frames (thesis: 300).")] = 300,
+    path: Annotated[
+        str, typer.Option("--path", help="'circuit' (500-3000 m racetrack) or 'approach' (32 s at 9.4 fps).")
+    ] = "circuit",
+    seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
+    as_json: JsonOption = False,
+) -> None:
+    """ch3: radar on the ground aimed at the sky: spur map, calibration on a building, aircraft flyover."""
+    from skyradar.experiments.ch3 import run as run_ch3
+
+    result = run_ch3(out, n_frames=frames, path=path, seed=seed)
+    emit_result(result, as_json, "ch3: detection and direction of arrival")
+
+
+@bench_app.command("process")
+def bench_process(
+    seconds: Annotated[float, typer.Option("--seconds", help="Minimum timing per implementation, s.")] = 2.0,
+    as_json: JsonOption = False,
+) -> None:
+    """Detection + DoA frames per second on prototype-size cubes (333 x 250 x 4), ours vs a baseline."""
+    from skyradar.benchmarks.process import run as run_bench
+
+    emit_result(run_bench(min_time_s=seconds), as_json, "bench process")

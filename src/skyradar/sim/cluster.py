@@ -1,0 +1,53 @@
+"""Run per-chunk jobs on Dask: an existing cluster (``--scheduler ADDRESS``) or a local one.
+
+Each job writes its own chunk into the shared store and marks it done, so nothing but a frame
+count travels back to the client, and an interrupted run keeps every finished chunk.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from skyradar.errors import InputError
+
+__all__ = ["connect", "map_chunks"]
+
+
+def connect(scheduler: str | None, workers: int | None, timeout_s: float = 10.0):
+    """A ``distributed.Client`` on ``scheduler``, or on a new local cluster of ``workers`` processes."""
+    from distributed import Client, LocalCluster
+
+    if scheduler is not None:
+        try:
+            return Client(scheduler, timeout=timeout_s)
+        except (OSError, TimeoutError) as exc:
+            raise InputError(f"--scheduler {scheduler}: no Dask scheduler answered within {timeout_s:.0f} s ({exc})") from exc
+    cluster = LocalCluster(n_workers=int(workers or 2), threads_per_worker=1, processes=True, dashboard_address=None)
+    return Client(cluster)
+
+
+def map_chunks(
+    job: Callable[..., int],
+    *args: Any,
+    chunks: Sequence[int] = (),
+    scheduler: str | None = None,
+    workers: int | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> None:
+    """Run ``job(*args, index)`` for every chunk index on Dask; ``progress(frames)`` as each finishes."""
+    from distributed import as_completed
+
+    client = connect(scheduler, workers)
+    try:
+        scattered = [client.scatter(a, broadcast=True) if not isinstance(a, str | int | float) else a for a in args]
+        futures = [client.submit(job, *scattered, index, pure=False) for index in chunks]
+        for future in as_completed(futures):
+            frames = future.result()
+            if progress:
+                progress(frames)
+    finally:
+        cluster = getattr(client, "cluster", None)
+        client.close()
+        if scheduler is None and cluster is not None:
+            cluster.close()

@@ -1,0 +1,87 @@
+"""Ground filter: static-surface Doppler with aliasing, height above terrain, and their combination."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from skyradar.config import RadarConfig
+from skyradar.geo import geodetic_to_ned, ned_to_geodetic
+from skyradar.process.ground import (
+    classify_ground,
+    doppler_matches_static,
+    height_above_ground_m,
+    static_radial_velocity_mps,
+)
+from skyradar.scene.terrain import flat_terrain
+
+CFG = RadarConfig.seed_prototype()
+
+
+@given(
+    v=st.lists(st.floats(-80, 80), min_size=3, max_size=3),
+    p=st.lists(st.floats(-3000, 3000), min_size=3, max_size=3),
+)
+def test_static_radial_velocity_is_the_range_rate_of_a_fixed_point(v, p):
+    own_v, point = np.array(v), np.array(p)
+    if np.linalg.norm(point) < 10:
+        return
+    dt = 1e-4
+    rate = (np.linalg.norm(point - own_v * dt) - np.linalg.norm(point)) / dt  # own-ship moves, point fixed
+    u = point / np.linalg.norm(point)
+    assert static_radial_velocity_mps(u[None], own_v)[0] == pytest.approx(rate, abs=1e-2)
+
+
+def test_doppler_match_wraps_at_the_aliasing_width():
+    width = 2 * CFG.v_lim_mps
+    expected = np.array([-60.0, 10.0, 10.0])
+    measured = np.array([-60.0 + width, 10.0 + 0.4, 10.0 + 5.0])
+    assert doppler_matches_static(measured, expected, CFG, 1.0).tolist() == [True, True, False]
+
+
+def test_height_above_terrain_uses_the_dem_under_each_detection():
+    terrain = flat_terrain(52.0, 4.0, height_m=120.0, size_m=4000.0, spacing_m=30.0)
+    lat, lon, alt = ned_to_geodetic(np.array([[500.0, 200.0, -125.0], [-800.0, 0.0, -900.0]]), 52.0, 4.0, 0.0)
+    h = height_above_ground_m(lat, lon, alt, terrain)
+    # NED "down" is along the origin's vertical; the difference at 800 m is millimetres.
+    np.testing.assert_allclose(h, [5.0, 780.0], atol=0.2)
+    assert np.isnan(height_above_ground_m(lat, lon, alt)).all()
+    np.testing.assert_allclose(
+        height_above_ground_m(lat, lon, alt, ground_alt_m=0.0), [125.0, 900.0], atol=0.2
+    )
+
+
+def test_classify_ground_separates_terrain_from_aircraft_for_a_moving_radar():
+    # Own-ship at 1000 m flying north at 40 m/s; ground point 2 km ahead, aircraft at co-altitude.
+    own = np.array([0.0, 0.0, -1000.0])
+    own_v = np.array([40.0, 0.0, 0.0])
+    points = np.array([[1732.0, 0.0, 0.0], [2000.0, 300.0, -1000.0], [1500.0, -400.0, -1000.0]])
+    rel = points - own
+    rng = np.linalg.norm(rel, axis=1)
+    u = rel / rng[:, None]
+    crossing = np.cross(u[2], [0.0, 0.0, 1.0])  # last aircraft flies across the line of sight
+    target_v = np.array([[0.0, 0.0, 0.0], [-50.0, 0.0, 0.0], 40.0 * crossing / np.linalg.norm(crossing)])
+    v_r = np.einsum("ij,ij->i", target_v - own_v, u)
+    v_meas = (v_r + CFG.v_lim_mps) % (2 * CFG.v_lim_mps) - CFG.v_lim_mps  # aliased as measured
+    lat, lon, alt = ned_to_geodetic(points, 52.0, 4.0, 0.0)
+    terrain = flat_terrain(52.0, 4.0, height_m=0.0, size_m=6000.0, spacing_m=30.0)
+    height = height_above_ground_m(lat, lon, alt, terrain)
+    ground = classify_ground(rng, v_meas, u, CFG, own_v, height)
+    assert ground.tolist() == [True, False, False]
+    # Doppler alone cannot save the crossing aircraft (its radial velocity equals the ground's there) ...
+    doppler_only = classify_ground(rng, v_meas, u, CFG, own_v, None)
+    assert doppler_only.tolist() == [True, False, True]
+    # ... and nothing is called ground without any test.
+    assert not classify_ground(rng, v_meas, u, CFG, None, None).any()
+
+
+def test_stationary_radar_without_terrain_calls_nothing_ground():
+    u = np.array([[1.0, 0.0, 0.0]])
+    assert not classify_ground(np.array([500.0]), np.array([0.0]), u, CFG, np.zeros(3), None).any()
+    # With a flat ground altitude a static return at ground level is ground.
+    lat, lon, alt = ned_to_geodetic(np.array([[500.0, 0.0, 0.0]]), 52.0, 4.0, 0.0)
+    h = height_above_ground_m(lat, lon, alt, ground_alt_m=0.0)
+    assert classify_ground(np.array([500.0]), np.array([0.0]), u, CFG, np.zeros(3), h).all()
+    assert geodetic_to_ned(lat, lon, alt, 52.0, 4.0, 0.0).shape == (1, 3)

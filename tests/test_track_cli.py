@@ -1,0 +1,82 @@
+"""`skyradar track` and `skyradar evaluate` end to end, and their bad-input errors."""
+
+import json
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from skyradar.cli import main
+from skyradar.config import RadarConfig
+from skyradar.io.frames import frames_dataset
+from skyradar.track.synthetic import synthetic_detections
+
+
+def _cli(monkeypatch, capsys, *args):
+    monkeypatch.setattr(sys, "argv", ["skyradar", *args])
+    code = 0
+    try:
+        main()
+    except SystemExit as exc:
+        code = exc.code or 0
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def _scene(cfg, n=120, dt=0.106):
+    t = np.arange(n) * dt
+    V = np.column_stack([np.full(n, -50.0), 20.0 + 10.0 * np.sin(t)])
+    R = np.column_stack([550.0 + V[:, 0] * t, 120.0 + np.cumsum(V[:, 1]) * dt])
+    return t, R, V
+
+
+def test_track_then_evaluate_against_run_truth(tmp_path, monkeypatch, capsys):
+    cfg = RadarConfig.seed_prototype(range_limit_m=600.0, n_doppler=16)
+    t, R, V = _scene(cfg)
+    vis = (R > 30) & (R < 590)
+    det = synthetic_detections(t, R, V, vis, cfg, pd_detect=0.95, clutter_per_frame=1, seed=3)
+    det_path = tmp_path / "det.parquet"
+    det.attrs["radar_config"] = cfg.to_json()
+    det.to_parquet(det_path)
+    iq = np.zeros((t.size, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
+    targets = {"tgt_range_m": R, "tgt_radial_velocity_mps": V, "tgt_visible": vis}
+    frames_dataset(iq, t, cfg, targets=targets).to_zarr(tmp_path / "run.zarr")
+    code, out, err = _cli(monkeypatch, capsys, "track", str(det_path), "-o", str(tmp_path / "trk.parquet"), "--json")
+    assert code == 0, err
+    assert json.loads(out.strip().splitlines()[-1])["tracks"] >= 2
+    code, out, err = _cli(monkeypatch, capsys, "evaluate", str(tmp_path / "run.zarr"), str(tmp_path / "trk.parquet"), "--json")
+    assert code == 0, err
+    res = json.loads(out.strip().splitlines()[-1])
+    assert res["truth_tracks"] == 2 and res["tracks"] == 2
+    assert res["id_switches"] == 0 and res["fragmentation"] == 0
+    for key in ("gospa_mean", "innov_mean_px", "innov_p95_px", "completeness"):
+        assert np.isfinite(res[key])
+
+
+def test_track_bad_inputs_give_one_line_errors(tmp_path, monkeypatch, capsys):
+    bad = tmp_path / "bad.parquet"
+    pd.DataFrame({"time_s": [0.0, 0.1], "range_m": [1.0, 2.0]}).to_parquet(bad)
+    code, _, err = _cli(monkeypatch, capsys, "track", str(bad), "-o", str(tmp_path / "x.parquet"))
+    assert code == 2
+    assert err.startswith("error: ") and "radial_velocity_mps" in err and str(bad) in err
+    assert len(err.strip().splitlines()) == 1
+    back = tmp_path / "back.csv"
+    pd.DataFrame({"time_s": [0.0, 0.2, 0.1], "range_m": [1.0] * 3, "radial_velocity_mps": [0.0] * 3}).to_csv(back)
+    code, _, err = _cli(monkeypatch, capsys, "track", str(back), "-o", str(tmp_path / "x.parquet"))
+    assert code == 2 and "'time_s' goes backwards at row 2 (0.2 -> 0.1)" in err
+    code, _, err = _cli(monkeypatch, capsys, "track", str(back), "-o", str(tmp_path / "x.parquet"), "--model", "kf")
+    assert code == 2 and "--model" in err
+    assert not (tmp_path / "x.parquet").exists()
+
+
+@pytest.mark.parametrize("missing", ["tgt_visible"])
+def test_evaluate_without_truth_is_clear_error(tmp_path, monkeypatch, capsys, missing):
+    cfg = RadarConfig.seed_prototype(range_limit_m=300.0, n_doppler=8)
+    iq = np.zeros((3, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
+    frames_dataset(iq, np.arange(3.0), cfg).to_zarr(tmp_path / "run.zarr")
+    trk = tmp_path / "t.parquet"
+    pd.DataFrame({"time_s": [0.0], "track_id": [0], "range_m": [1.0], "radial_velocity_mps": [0.0],
+                  "innovation_range_m": [0.0], "innovation_radial_velocity_mps": [0.0]}).to_parquet(trk)  # fmt: skip
+    code, _, err = _cli(monkeypatch, capsys, "evaluate", str(tmp_path / "run.zarr"), str(trk))
+    assert code == 2 and missing in err and "run.zarr" in err

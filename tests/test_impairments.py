@@ -14,6 +14,7 @@ from skyradar.sim.impairments import (
     apply_channel_errors,
     apply_impairments,
     apply_impairments_adc,
+    apply_impairments_frames,
     channel_errors,
     dbm_to_w,
     near_range_leakage,
@@ -199,3 +200,16 @@ def test_adc_impairments_match_image_impairments():
     # Without windows the ADC spur is exactly the single image pixel; channel errors are linear.
     spur = spur_cube(CFG, [(450, -12, -118)], leakage=False)
     assert np.allclose(via_adc, via_img + spur, rtol=0, atol=1e-3 * np.sqrt(dbm_to_w(-118)))
+
+
+def test_frames_helper_is_chunking_invariant():
+    imp = thesis_flight_look(seed=2)
+    block = np.zeros((4, CFG.n_range, NV, CFG.n_rx), np.complex64)
+    whole = apply_impairments_frames(block, CFG, imp)
+    parts = np.concatenate(
+        [
+            apply_impairments_frames(block[:2], CFG, imp, [0, 1]),
+            apply_impairments_frames(block[2:], CFG, imp, [2, 3]),
+        ]
+    )
+    assert np.array_equal(whole, parts)

@@ -210,3 +210,14 @@ def test_rd_frames_dataset_has_the_frames_form():
     assert (k, j) == (60, NV // 2 - 7)
     with pytest.raises(InputError, match="frame times"):
         rd_frames_dataset(frames, np.array([0.0]), CFG)
+
+
+def test_benchmark_baseline_computes_the_same_cube():
+    from skyradar.benchmarks.chain import baseline_range_doppler
+
+    rng = np.random.default_rng(9)
+    adc = (rng.standard_normal((CFG.n_rx, NV, NS)) + 1j * rng.standard_normal((CFG.n_rx, NV, NS))).astype(
+        np.complex64
+    )
+    ours = range_doppler(adc, CFG, "none", "none")
+    assert np.allclose(baseline_range_doppler(adc, CFG), ours, atol=1e-5 * np.abs(ours).max())

@@ -106,7 +106,8 @@ def _scene(pitch_deg: float, seed: int) -> dict[str, Any]:
 
 
 def _racetrack(n: int = 6000) -> np.ndarray:
-    """Dense circuit in (forward, right, down) from the radar: legs at +-300 m, turns at 500 and 3000 m."""
+    """Dense circuit in (forward, right, down) from the radar: legs at +-300 m, turns reaching 500 and
+    3000 m horizontal distance along boresight, 300 m above the radar."""
     near, far, half, down = 800.0, 2700.0, 300.0, -300.0
     leg = np.linspace(near, far, n)
     turn = np.linspace(0.0, np.pi, n)
@@ -116,7 +117,7 @@ def _racetrack(n: int = 6000) -> np.ndarray:
         np.stack([leg[::-1], np.full(n, -half)], axis=1),  # inbound
         np.stack([near - half * np.sin(turn), -half * np.cos(turn)], axis=1),  # near turn through 500 m
     ]
-    fr = np.concatenate(parts)
+    fr = np.concatenate([part[1:] for part in parts])  # each part starts where the last ended
     return np.column_stack([fr, np.full(len(fr), down)])
 
 

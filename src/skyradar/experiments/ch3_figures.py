@@ -33,7 +33,7 @@ def plot_range_doppler(out_dir: Path, static_frame, cal, spur_map, shown) -> Pat
     fig, axes = plt.subplots(1, 2, figsize=(13, 5.5))
     _rd_panel(axes[0], static_frame, cal, "static scene and learned spur map (red)")
     r, d = np.nonzero(spur_map.mask)
-    axes[0].scatter(cal.doppler_axis_mps[d], cal.range_axis_m[r], s=2, c="red", marker="s", linewidths=0)
+    axes[0].scatter(cal.doppler_axis_mps[d], cal.range_axis_m[r], s=1, c="red", marker="s", lw=0, alpha=0.3)
     if shown is not None:
         cube, out, truth = shown
         _rd_panel(axes[1], cube, cal, "flyover frame: detections (o), aircraft truth (x)")

@@ -102,7 +102,7 @@ def _fly(terrain, flight: Flight, config: RadarConfig, facet_size_m: float, seed
         # One ridge per frame serves all three methods (the thesis one uses bin-centre ranges).
         ridge = extract_ridge(cube, config, prior_state=prior)
         for method in ("thesis", "robust"):
-            est = estimate_frame(cube, config, method=method, ridge=ridge)
+            est = estimate_frame(cube, config, method=method, ridge=ridge, prior_state=prior)
             if method == "robust" and est.fit.ok:
                 prior = (est.fit.vx_mps, est.fit.vz_mps, est.fit.h_m)
             rows[method].append({"time_s": t, **_raw_row(est.fit, est.quality, est.low_quality, offset)})

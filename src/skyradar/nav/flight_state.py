@@ -10,7 +10,8 @@ Per frame: the ground ridge (:mod:`skyradar.nav.ridge`), a flat-plane inversion
     height is given (comparison only).
 ``robust``
     Ridge pairs at the bin edge with the coupling removed, RANSAC + Huber nonlinear least
-    squares, GPS-free innovation gating in the filter.
+    squares started from the previous frame's estimate with a weak prior on V_Z, GPS-free
+    innovation gating in the filter.
 
 Heights refer to the own-ship reference point: the antenna's height (what the radar sees) plus
 the mount offset rotated by pitch and roll when the run carries attitude, else level flight.
@@ -64,6 +65,7 @@ def estimate_frame(
     min_quality: float = 0.3,
     threshold_db: float = 8.0,
     ridge: Ridge | None = None,
+    vz_prior_sd_mps: float = 0.5,
 ) -> FrameEstimate:
     """Flight state of the antenna over the ground plane from one frame.
 
@@ -74,7 +76,9 @@ def estimate_frame(
     config : RadarConfig
     method : {"thesis", "robust"}
     prior_state : (vx_mps, vz_mps, h_m), optional
-        Previous estimate; resolves ground-return aliasing.
+        Previous estimate (antenna height): resolves ground-return aliasing; for ``robust`` it
+        also starts the fit and holds V_Z with SD ``vz_prior_sd_mps`` (frame to frame V_Z
+        changes slowly, while over rough terrain one frame's ridge trades H against V_Z).
     min_points, min_quality : int, float
         Below either the frame is flagged low quality and its estimates are NaN.
     threshold_db : float
@@ -97,7 +101,10 @@ def estimate_frame(
         # The thesis paired the ridge velocity with the range-bin centre (apparent range).
         fit = fit_thesis(ridge.range_bin * config.range_resolution_m, ridge.radial_velocity_mps)
     else:
-        fit = fit_robust(ridge.range_m, ridge.radial_velocity_mps)
+        prior = None
+        if prior_state is not None and np.all(np.isfinite(prior_state)):
+            prior = (np.asarray(prior_state, float), np.array([np.inf, vz_prior_sd_mps, np.inf]))
+        fit = fit_robust(ridge.range_m, ridge.radial_velocity_mps, prior=prior)
     n_in = int(fit.inliers.sum())
     quality = float(n_in / max(len(ridge), 1) * min(1.0, n_in / 50.0)) if fit.ok else 0.0
     low = (not fit.ok) or n_in < min_points or quality < min_quality
@@ -139,10 +146,47 @@ def filter_table(
     return table
 
 
-def _attitude(ds: xr.Dataset, i: int) -> tuple[float, float]:
-    if "own_pitch_rad" in ds and "own_roll_rad" in ds:
-        return float(ds.own_pitch_rad[i]), float(ds.own_roll_rad[i])
-    return 0.0, 0.0
+def _attitude(ds: xr.Dataset, i: int) -> tuple[float, float, float]:
+    names = ("own_yaw_rad", "own_pitch_rad", "own_roll_rad")
+    return tuple(float(ds[n][i]) if n in ds else 0.0 for n in names)  # type: ignore[return-value]
+
+
+def _frame_rows(ds: xr.Dataset, config: RadarConfig, method: str, progress) -> list[dict]:
+    from skyradar.nav.terrain_aware import TerrainAwareEstimator
+
+    times = ds["time"].to_numpy(float)
+    aware = TerrainAwareEstimator(config) if method == "terrain" else None
+    rows, prior = [], None
+    for i in range(times.size):
+        attitude = _attitude(ds, i)
+        frame = np.asarray(ds.iq[i].values)
+        if aware is not None:
+            est = aware.update(times[i], frame, attitude)
+            fit, quality, low, n_ridge, n_in = est, est.quality, est.low_quality, est.n_points, est.n_points
+        else:
+            fe = estimate_frame(frame, config, method=method, prior_state=prior)
+            fit, quality, low, n_ridge, n_in = fe.fit, fe.quality, fe.low_quality, len(fe.ridge), fe.n_inliers
+            if fe.fit.ok:
+                prior = (fit.vx_mps, fit.vz_mps, fit.h_m)
+        rows.append(
+            {
+                "time_s": times[i],
+                "frame": i,
+                "vx_raw_mps": fit.vx_mps,
+                "vz_raw_mps": fit.vz_mps,
+                "h_raw_m": fit.h_m + mount_height_offset_m(config, *attitude[1:]),
+                "vx_raw_sd_mps": fit.vx_sd_mps,
+                "vz_raw_sd_mps": fit.vz_sd_mps,
+                "h_raw_sd_m": fit.h_sd_m,
+                "quality": quality,
+                "low_quality": bool(low),
+                "n_ridge": n_ridge,
+                "n_inliers": n_in,
+            }
+        )
+        if progress is not None:
+            progress(i + 1, times.size)
+    return rows
 
 
 def estimate_run(
@@ -152,46 +196,27 @@ def estimate_run(
     gps_gate: bool = False,
     progress: Callable[[int, int], None] | None = None,
 ) -> pd.DataFrame:
-    """Per-frame raw and filtered flight state of a frames Dataset (see module docstring).
+    """Per-frame raw and filtered flight state of a frames Dataset.
 
-    Returns a DataFrame with ``time_s, frame, vx_raw_mps, vz_raw_mps, h_raw_m`` (+ ``_sd``),
-    filtered ``vx_mps, vz_mps, h_m`` (+ ``_sd``), ``quality, low_quality, n_ridge, n_inliers,
-    used_by_filter``. With ``gps_gate`` the thesis' 150 m gate against ``own_height_agl_m``.
+    ``method`` is ``thesis``, ``robust`` or ``terrain`` (:mod:`skyradar.nav.terrain_aware`,
+    which takes the attitude from the run's ``own_yaw_rad/own_pitch_rad/own_roll_rad``, i.e. an
+    AHRS; level flight heading north when absent). Returns a DataFrame with ``time_s, frame,
+    vx_raw_mps, vz_raw_mps, h_raw_m`` (+ ``_sd``), filtered ``vx_mps, vz_mps, h_m`` (+ ``_sd``),
+    ``quality, low_quality, n_ridge, n_inliers, used_by_filter``. With ``gps_gate`` the
+    thesis' 150 m gate against ``own_height_agl_m`` (comparison only).
     """
     from skyradar.io.frames import radar_config_of
 
+    if method not in (*METHODS, "terrain"):
+        raise InputError(f"flight state: field 'method' must be thesis, robust or terrain, got {method!r}")
     config = radar_config_of(ds)
-    times = ds["time"].to_numpy(float)
-    rows, prior = [], None
-    for i in range(times.size):
-        est = estimate_frame(np.asarray(ds.iq[i].values), config, method=method, prior_state=prior)
-        fit = est.fit
-        h_ref = fit.h_m + mount_height_offset_m(config, *_attitude(ds, i))
-        if fit.ok:
-            prior = (fit.vx_mps, fit.vz_mps, fit.h_m)
-        rows.append(
-            {
-                "time_s": times[i],
-                "frame": i,
-                "vx_raw_mps": fit.vx_mps,
-                "vz_raw_mps": fit.vz_mps,
-                "h_raw_m": h_ref,
-                "vx_raw_sd_mps": fit.vx_sd_mps,
-                "vz_raw_sd_mps": fit.vz_sd_mps,
-                "h_raw_sd_m": fit.h_sd_m,
-                "quality": est.quality,
-                "low_quality": est.low_quality,
-                "n_ridge": len(est.ridge),
-                "n_inliers": est.n_inliers,
-            }
-        )
-        if progress is not None:
-            progress(i + 1, times.size)
-    table = pd.DataFrame(rows)
+    table = pd.DataFrame(_frame_rows(ds, config, method, progress))
+    if settings is None:
+        settings = KalmanSettings(terrain_psd=400.0) if method == "terrain" else KalmanSettings()
     reference = None
     if gps_gate:
         if "own_height_agl_m" not in ds:
             raise InputError("frames: field 'own_height_agl_m' is needed for the GPS gate but missing")
         reference = ds["own_height_agl_m"].to_numpy(float)
-        settings = KalmanSettings(**{**(settings or KalmanSettings()).__dict__, "gps_gate_m": 150.0})
+        settings = KalmanSettings(**{**settings.__dict__, "gps_gate_m": 150.0})
     return filter_table(table, settings, reference)

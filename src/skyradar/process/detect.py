@@ -31,7 +31,6 @@ from typing import Literal
 import cv2
 import numpy as np
 from numba import njit
-from scipy import ndimage
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
@@ -155,37 +154,55 @@ def shi_tomasi(
     return np.stack([xy[inside, 1], xy[inside, 0]], axis=1)
 
 
-def _merge_wrapped(labels: np.ndarray, n: int) -> np.ndarray:
-    """Map label -> root label, joining blobs that touch across the Doppler edge."""
-    parent = np.arange(n + 1)
-    left, right = labels[:, 0], labels[:, -1]
-    pairs = set()
-    for shift in (-1, 0, 1):  # 8-connectivity across the edge
-        r = np.roll(right, shift)
-        if shift == -1:
-            r[-1] = 0
-        elif shift == 1:
-            r[0] = 0
-        both = (left > 0) & (r > 0)
-        pairs.update(zip(left[both].tolist(), r[both].tolist(), strict=True))
+@njit(cache=True)
+def _flood_peaks(mask: np.ndarray, power: np.ndarray, seeds: np.ndarray, use_seeds: bool) -> np.ndarray:
+    """(n, 2) peak pixels of 8-connected blobs; Doppler (axis 1) wraps, range does not."""
+    n_r, n_d = mask.shape
+    seen = np.zeros((n_r, n_d), np.bool_)
+    stack = np.empty((n_r * n_d, 2), np.int64)
+    peaks = np.empty((n_r * n_d // 2 + 1, 2), np.int64)
+    n_peaks = 0
+    for i0 in range(n_r):
+        for j0 in range(n_d):
+            if not mask[i0, j0] or seen[i0, j0]:
+                continue
+            seen[i0, j0] = True
+            top = 0
+            stack[0, 0], stack[0, 1] = i0, j0
+            best, bi, bj, seeded = power[i0, j0], i0, j0, seeds[i0, j0]
+            while top >= 0:
+                i, j = stack[top, 0], stack[top, 1]
+                top -= 1
+                for di in range(-1, 2):
+                    ii = i + di
+                    if ii < 0 or ii >= n_r:
+                        continue
+                    for dj in range(-1, 2):
+                        jj = (j + dj) % n_d
+                        if mask[ii, jj] and not seen[ii, jj]:
+                            seen[ii, jj] = True
+                            top += 1
+                            stack[top, 0], stack[top, 1] = ii, jj
+                            seeded = seeded or seeds[ii, jj]
+                            if power[ii, jj] > best:
+                                best, bi, bj = power[ii, jj], ii, jj
+            if seeded or not use_seeds:
+                peaks[n_peaks, 0], peaks[n_peaks, 1] = bi, bj
+                n_peaks += 1
+    return peaks[:n_peaks]
 
-    def root(a: int) -> int:
-        while parent[a] != a:
-            a = parent[a]
-        return a
 
-    for a, b in pairs:
-        ra, rb = root(a), root(b)
-        if ra != rb:
-            parent[max(ra, rb)] = min(ra, rb)
-    return np.array([root(a) for a in range(n + 1)])
-
-
-def _blob_labels(mask: np.ndarray) -> tuple[np.ndarray, int]:
-    labels, n = ndimage.label(mask, structure=np.ones((3, 3), bool))
-    if n > 1 and labels[:, 0].any() and labels[:, -1].any():
-        labels = _merge_wrapped(labels, n)[labels]
-    return labels, n
+def _snap_to_max(power: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Move each (range, Doppler) point to the brightest pixel of its 3x3 neighbourhood."""
+    if len(points) == 0:
+        return points
+    n_r, n_d = power.shape
+    off = np.array([(a, b) for a in (-1, 0, 1) for b in (-1, 0, 1)])
+    r = np.clip(points[:, None, 0] + off[:, 0], 0, n_r - 1)
+    d = (points[:, None, 1] + off[:, 1]) % n_d
+    best = np.argmax(power[r, d], axis=1)
+    rows = np.arange(len(points))
+    return np.stack([r[rows, best], d[rows, best]], axis=1)
 
 
 def blob_peaks(
@@ -196,22 +213,12 @@ def blob_peaks(
     With ``seeds`` (a boolean image) only blobs containing a seed pixel are kept.
     Returns (range_index, doppler_index), strongest blob first.
     """
-    labels, n = _blob_labels(mask)
-    if n == 0:
-        return np.zeros(0, np.int64), np.zeros(0, np.int64)
-    if seeds is not None:
-        keep = np.zeros(n + 1, bool)
-        keep[labels[seeds]] = True
-        keep[0] = False
-        labels = np.where(keep[labels], labels, 0)
-    flat = np.flatnonzero(labels)
-    lab = labels.ravel()[flat]
-    val = power.ravel()[flat]
-    order = np.lexsort((-val, lab))
-    first = order[np.r_[True, lab[order][1:] != lab[order][:-1]]] if order.size else order
-    first = first[np.argsort(-val[first])]
-    r, d = np.unravel_index(flat[first], mask.shape)
-    return r.astype(np.int64), d.astype(np.int64)
+    mask = np.ascontiguousarray(mask, dtype=np.bool_)
+    use_seeds = seeds is not None
+    seeds = np.ascontiguousarray(seeds, dtype=np.bool_) if use_seeds else mask
+    peaks = _flood_peaks(mask, np.ascontiguousarray(power, dtype=np.float32), seeds, use_seeds)
+    order = np.argsort(-power[peaks[:, 0], peaks[:, 1]], kind="stable")
+    return peaks[order, 0], peaks[order, 1]
 
 
 def refine_peaks(power: np.ndarray, r: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -283,6 +290,7 @@ def detect(
         floor = np.float32(config.noise_power_w * 1e-3)
         image = power if exclude is None else np.where(exclude, np.float32(config.noise_power_w), power)
         corners = shi_tomasi(10.0 * np.log10(np.maximum(image, floor)))
+        corners = _snap_to_max(image, corners)
         noise_all = np.full(len(corners), config.noise_power_w, np.float32)
         strong = power[corners[:, 0], corners[:, 1]] >= noise_all * (1.0 + 10 ** (min_snr_db / 10.0))
         seeds = np.zeros(power.shape, bool)

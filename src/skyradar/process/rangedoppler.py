@@ -18,7 +18,8 @@ of its time in the prime factor 127, yet only the first ``n_range`` (333) of the
 The range transform is therefore split (Cooley-Tukey, ``n = Q*n1 + n2``, ``k = k1 + P*k2`` with
 ``P`` the 5-smooth part of the length): a length-``P`` FFT, a twiddle, and a matrix product with
 the length-``Q`` DFT restricted to the ``k2`` that are kept. It is exact (same numbers as the full
-FFT to float32 rounding) and about twice as fast. ``method='fft'`` forces the plain FFT.
+FFT to float32 rounding) and needs about a third less CPU time than scipy's full FFT (measured by
+``skyradar bench chain``). ``method='fft'`` forces the plain FFT.
 """
 
 from __future__ import annotations

@@ -27,26 +27,14 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from skyradar.config import BOLTZMANN, RadarConfig
 from skyradar.errors import InputError
 
+# fmt: off
 __all__ = [
-    "Spur",
-    "SpursConfig",
-    "ZeroDopplerConfig",
-    "NearRangeConfig",
-    "ChannelErrorsConfig",
-    "NoiseConfig",
-    "ImpairmentConfig",
-    "dbm_to_w",
-    "spur_cube",
-    "spur_adc",
-    "zero_doppler_line",
-    "near_range_leakage",
-    "channel_errors",
-    "apply_channel_errors",
-    "receiver_noise",
-    "apply_impairments",
-    "apply_impairments_adc",
-    "thesis_flight_look",
+    "Spur", "SpursConfig", "ZeroDopplerConfig", "NearRangeConfig", "ChannelErrorsConfig",
+    "NoiseConfig", "ImpairmentConfig", "dbm_to_w", "spur_cube", "spur_adc", "zero_doppler_line",
+    "near_range_leakage", "channel_errors", "apply_channel_errors", "receiver_noise",
+    "apply_impairments", "apply_impairments_frames", "apply_impairments_adc", "thesis_flight_look",
 ]
+# fmt: on
 
 
 def dbm_to_w(power_dbm: float | np.ndarray) -> float | np.ndarray:
@@ -351,6 +339,13 @@ class ImpairmentConfig(BaseModel):
         section = getattr(self, name)
         return section if section is not None and section.enabled else None
 
+    def channel_gains(self, n_rx: int) -> np.ndarray:
+        """The per-antenna complex errors of the ``channel_errors`` section (ones when off)."""
+        ce = self._on("channel_errors")
+        if ce is None:
+            return np.ones(n_rx, complex)
+        return channel_errors(n_rx, ce.gain_db, ce.phase_deg, ce.gain_sd_db, ce.phase_sd_deg, self.seed)
+
     def spur_map(self, config: RadarConfig) -> np.ndarray | None:
         s = self._on("spurs")
         if s is None or s.map_file is None:
@@ -375,11 +370,8 @@ def apply_impairments(
     own fixed channel phases), then receiver noise. Returns a new complex64 cube.
     """
     out = np.array(cube, np.complex64)
-    if (ce := imp._on("channel_errors")) is not None:
-        errors = channel_errors(
-            config.n_rx, ce.gain_db, ce.phase_deg, ce.gain_sd_db, ce.phase_sd_deg, imp.seed
-        )
-        out = apply_channel_errors(out, errors)
+    if imp._on("channel_errors") is not None:
+        out = apply_channel_errors(out, imp.channel_gains(config.n_rx))
     if (s := imp._on("spurs")) is not None:
         out += spur_cube(config, _spur_list(s), imp.spur_map(config), s.map_power_dbm, s.leakage, imp.seed)
     if (z := imp._on("zero_doppler")) is not None:
@@ -390,6 +382,20 @@ def apply_impairments(
     if (n := imp._on("noise")) is not None:
         out += receiver_noise(config, n.noise_figure_db, rng)
     return out
+
+
+def apply_impairments_frames(
+    iq: np.ndarray, config: RadarConfig, imp: ImpairmentConfig, frame_indices: np.ndarray | None = None
+) -> np.ndarray:
+    """:func:`apply_impairments` over a (time, n_range, n_doppler, n_rx) block of frames.
+
+    ``frame_indices`` are the frames' indices in the whole run (default 0..n-1), so a chunked run
+    gives the same bytes as a single pass.
+    """
+    indices = np.arange(len(iq)) if frame_indices is None else np.asarray(frame_indices)
+    return np.stack(
+        [apply_impairments(frame, config, imp, int(i)) for frame, i in zip(iq, indices, strict=True)]
+    )
 
 
 def apply_impairments_adc(
@@ -403,11 +409,8 @@ def apply_impairments_adc(
     from skyradar.sim.raw import adc_noise
 
     out = np.array(adc, np.complex64)
-    if (ce := imp._on("channel_errors")) is not None:
-        errors = channel_errors(
-            config.n_rx, ce.gain_db, ce.phase_deg, ce.gain_sd_db, ce.phase_sd_deg, imp.seed
-        )
-        out = apply_channel_errors(out, errors, layout="adc")
+    if imp._on("channel_errors") is not None:
+        out = apply_channel_errors(out, imp.channel_gains(config.n_rx), layout="adc")
     if (s := imp._on("spurs")) is not None and s.spurs:
         out += spur_adc(config, _spur_list(s), imp.seed)
     if (n := imp._on("noise")) is not None:

@@ -54,6 +54,10 @@ class MotionModel:
         White-jerk noise driving the radial acceleration, m/s^3 (both models).
     init_sigma_rate_mps, init_sigma_accel_mps2 : float
         Prior standard deviations of ``dR/dt`` and ``dV_R/dt`` for a new track.
+    coupling_s : float
+        Range-Doppler coupling of a sawtooth chirp, s (m of apparent range per m/s): the observed
+        range is ``R + coupling_s * V_R``. The radar model knows it (so ``R`` is the true range once
+        ``V_R`` is de-aliased); the image model does not (0).
     """
 
     name: str
@@ -67,6 +71,7 @@ class MotionModel:
     q_velocity_mps3: float = 6.0
     init_sigma_rate_mps: float = 100.0
     init_sigma_accel_mps2: float = 3.0
+    coupling_s: float = 0.0
 
     def transition(self, dt_s: np.ndarray) -> np.ndarray:
         """State transition matrices, shape ``dt_s.shape + (4, 4)``.
@@ -136,6 +141,19 @@ class MotionModel:
         qa = (0.25 * self.q_range_mps2) ** 2
         Q[np.ix_([0, 2], [0, 2])] += qa * np.array([[dt**3 / 3, dt**2 / 2], [dt**2 / 2, dt]])
         return Q
+
+    @property
+    def measurement_matrix(self) -> np.ndarray:
+        """``H``, 2x4: observed (range, radial velocity) = ``(R + c V_R, V_R)``.
+
+        Examples
+        --------
+        >>> radar_model(78.3, coupling_s=0.19).measurement_matrix[0].tolist()
+        [1.0, 0.19, 0.0, 0.0]
+        """
+        H = MEASUREMENT_MATRIX.copy()
+        H[0, 1] = self.coupling_s
+        return H
 
     @property
     def measurement_noise(self) -> np.ndarray:

@@ -25,6 +25,9 @@ _NED = ("north_m", "east_m", "down_m")
 def make_model(name: str, config: RadarConfig, **noise: float) -> MotionModel:
     """``'radar'`` or ``'traditional'`` model for the image width of ``config`` (W = 2 VLim).
 
+    The radar model also gets the range-Doppler coupling of ``config``; its tracks then report the
+    true range ``R``, where the image model reports the apparent range ``R + c V_R``.
+
     Examples
     --------
     >>> make_model("radar", RadarConfig.seed_prototype()).coupled
@@ -32,6 +35,7 @@ def make_model(name: str, config: RadarConfig, **noise: float) -> MotionModel:
     """
     width = 2.0 * config.v_lim_mps
     if name == "radar":
+        noise.setdefault("coupling_s", config.range_doppler_coupling_s)
         return radar_model(width, **noise)
     if name == "traditional":
         return traditional_model(width, **noise)

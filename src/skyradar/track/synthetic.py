@@ -3,7 +3,7 @@
 Used to test and benchmark the tracker independently of the simulator and the detector: each
 visible truth is detected with probability ``pd``, its range gets Gaussian noise, its radial
 velocity gets Gaussian noise and is then wrapped into ``[-VLim, VLim)`` as the Doppler FFT does;
-clutter is uniform over the image. Optional 3-D positions get an angular error.
+clutter is uniform over the image. The range includes the sawtooth range-Doppler coupling. Optional 3-D positions get an angular error.
 """
 
 from __future__ import annotations
@@ -30,6 +30,7 @@ def synthetic_detections(
     positions_ned_m: np.ndarray | None = None,
     sigma_angle_rad: float = 0.04,
     seed: int = 0,
+    coupling: bool = True,
 ) -> pd.DataFrame:
     """Detections table (``time_s, frame, range_m, radial_velocity_mps, target``) from truth.
 
@@ -51,6 +52,9 @@ def synthetic_detections(
     positions_ned_m : ndarray, shape (n_time, n_target, 3), optional
         True positions; adds ``north_m, east_m, down_m`` with isotropic error ``range * sigma_angle``.
     seed : int
+    coupling : bool
+        Add the sawtooth range-Doppler coupling ``config.range_doppler_coupling_s * V`` (true,
+        unaliased ``V``) to the range, as the radar measures it.
 
     Examples
     --------
@@ -71,7 +75,8 @@ def synthetic_detections(
     cols = {
         "time_s": t[fi],
         "frame": fi,
-        "range_m": R[fi, ti] + rng.normal(0.0, sigma_range_m, fi.size),
+        "range_m": R[fi, ti] + (config.range_doppler_coupling_s * V[fi, ti] if coupling else 0.0)
+        + rng.normal(0.0, sigma_range_m, fi.size),
         "radial_velocity_mps": wrap(V[fi, ti] + rng.normal(0.0, sigma_velocity_mps, fi.size), width),
         "target": ti,
     }

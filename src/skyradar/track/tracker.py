@@ -24,7 +24,7 @@ from skyradar.track.dealias import dealias_velocity, push_history, range_rate_fi
 from skyradar.track.deletion import MissDeleter
 from skyradar.track.initiation import MOfN
 from skyradar.track.kalman import predict, update
-from skyradar.track.models import MEASUREMENT_MATRIX, MotionModel
+from skyradar.track.models import MotionModel
 
 __all__ = ["TrackerConfig", "FrameTracks", "RangeDopplerTracker"]
 
@@ -174,6 +174,7 @@ class RangeDopplerTracker:
         if self.config.dealias not in ("confident", "thesis"):
             raise ValueError(f"dealias must be 'confident' or 'thesis', got {self.config.dealias!r}")
         self._R = model.measurement_noise
+        self._H = model.measurement_matrix
         self._P0 = model.initial_covariance()
         self._hybrid = model.dealias and self.config.dealias == "confident"
         self._thesis = model.dealias and self.config.dealias == "thesis"
@@ -242,7 +243,9 @@ class RangeDopplerTracker:
 
     def _associate(self, z: np.ndarray) -> Association:
         t, m = self.t, self.model
-        S = t["P"][:, :2, :2] + self._R
+        H = self._H
+        z_pred = t["x"] @ H.T
+        S = H @ t["P"] @ H.T + self._R
         range_wrap = None
         if self._thesis:
             range_wrap = np.where(t["n_updates"] == 1, m.doppler_width_mps * (self.time_s - t["t_update"]), np.nan)
@@ -261,7 +264,7 @@ class RangeDopplerTracker:
             if rows.size == 0 or dets.size == 0:
                 continue
             a = self.associator(
-                t["x"][rows, :2],
+                z_pred[rows],
                 S[rows],
                 z[dets],
                 self.config.gate,
@@ -285,7 +288,7 @@ class RangeDopplerTracker:
         if self._range_wrap is not None:
             self._shift_alias(rows, z[assoc.detection_index, 0], assoc.innovation[:, 0])
         t["x"][rows], t["P"][rows] = update(
-            t["x"][rows], t["P"][rows], assoc.innovation, MEASUREMENT_MATRIX, self._R
+            t["x"][rows], t["P"][rows], assoc.innovation, self._H, self._R
         )
         if self._hybrid:
             self._resolve(rows)
@@ -296,7 +299,7 @@ class RangeDopplerTracker:
             ok = np.isfinite(rate)
             r_ok = rows[ok]
             t["x"][r_ok, 2] = rate[ok]
-            t["x"][r_ok, 1] = dealias_velocity(t["x"][r_ok, 1], rate[ok], m.doppler_width_mps)
+            self._shift_velocity(r_ok, dealias_velocity(t["x"][r_ok, 1], rate[ok], m.doppler_width_mps) - t["x"][r_ok, 1])
 
     def _resolve(self, rows: np.ndarray) -> None:
         """Resolve the alias of tracks whose range rate is now known well enough (confident mode)."""
@@ -304,11 +307,19 @@ class RangeDopplerTracker:
         sd = np.sqrt(t["P"][rows, 2, 2])
         now = ~t["resolved"][rows] & (sd < self.config.resolve_fraction * width)
         r = rows[now]
-        t["x"][r, 1] = dealias_velocity(t["x"][r, 1], t["x"][r, 2], width)
+        self._shift_velocity(r, dealias_velocity(t["x"][r, 1], t["x"][r, 2], width) - t["x"][r, 1])
         t["resolved"][r] = True
         done = rows[t["resolved"][rows]]
         # Once resolved, range follows V_R; the range-rate state simply reports it.
         t["x"][done, 2] = t["x"][done, 1]
+
+    def _shift_velocity(self, rows: np.ndarray, delta_mps: np.ndarray) -> None:
+        """Move V_R by whole image widths, keeping the predicted observed range unchanged.
+
+        The observed range is ``R + c V_R`` (range-Doppler coupling), so R moves by ``-c dV``.
+        """
+        self.t["x"][rows, 1] += delta_mps
+        self.t["x"][rows, 0] -= self.model.coupling_s * delta_mps
 
     def _shift_alias(self, rows: np.ndarray, range_m: np.ndarray, wrapped_m: np.ndarray) -> None:
         """Move single-observation tracks to the alias their wrapped range innovation chose.
@@ -325,7 +336,7 @@ class RangeDopplerTracker:
         r = rows[use]
         k = np.round((range_m[use] - t["x"][r, 0] - wrapped_m[use]) / span[use])
         t["x"][r, 0] += k * span[use]
-        t["x"][r, 1] += k * width
+        self._shift_velocity(r, k * width)
 
     def _bookkeep(self, hit: np.ndarray) -> None:
         t = self.t
@@ -357,6 +368,7 @@ class RangeDopplerTracker:
         t, m = self.t, self.model
         x = np.zeros((n, 4))
         x[:, :2] = z_new
+        x[:, 0] -= m.coupling_s * z_new[:, 1]
         # The radar model's range rate starts at the (possibly aliased) radial velocity.
         x[:, 2] = z_new[:, 1] if m.coupled else 0.0
         k = self.config.history

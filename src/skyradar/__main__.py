@@ -1,0 +1,5 @@
+"""``python -m skyradar`` runs the command-line interface."""
+
+from skyradar.cli import main
+
+main()

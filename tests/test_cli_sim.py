@@ -1,0 +1,130 @@
+"""The simulate command end to end, and its one-line errors on bad input."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from skyradar.io.frames import FrameStoreWriter, open_frames
+from skyradar.scene.scenario import Scenario, example_scenario
+from skyradar.sim.run import _template, fingerprint, make_simulator, simulate_to_zarr
+
+BASE = {
+    "name": "tiny",
+    "origin": {"lat_deg": 52.0, "lon_deg": 4.36, "alt_m": 0.0},
+    "mount": "forward",
+    "terrain": {"type": "flat", "size_m": 3000, "spacing_m": 60},
+    "ownship": {"type": "straight", "start_ned_m": [0, 0, -500], "heading_deg": 0, "speed_mps": 40},
+    "intruders": [{"name": "A", "type": "encounter", "kind": "head-on", "t_cpa_s": 20, "rcs_m2": 1.0}],
+    "frame_rate_hz": 5.0,
+    "duration_s": 1.0,
+    "simulation": {"facet_size_m": 30.0},
+}
+
+
+def _skyradar(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "skyradar", *args], cwd=cwd, capture_output=True, text=True, timeout=300)
+
+
+def _write(tmp_path: Path, data: dict, name: str = "scenario.yaml") -> Path:
+    path = tmp_path / name
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def _assert_one_line_error(result: subprocess.CompletedProcess, *needles: str) -> None:
+    assert result.returncode == 2, result.stderr
+    lines = [line for line in result.stderr.strip().splitlines() if line.strip()]
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith("error: ")
+    assert "Traceback" not in result.stderr
+    for needle in needles:
+        assert needle in lines[0], lines[0]
+
+
+def test_simulate_writes_frames_and_truth(tmp_path):
+    scenario = _write(tmp_path, BASE)
+    result = _skyradar("simulate", str(scenario), "-o", "run.zarr", "--chunk-frames", "2", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    ds = open_frames(tmp_path / "run.zarr")
+    assert ds.iq.shape == (5, 333, 250, 4)
+    assert np.all(np.isfinite(ds.own_height_agl_m.values))
+    assert ds.own_height_agl_m.values[0] == pytest.approx(500.0, abs=1.0)
+    assert list(ds.target.values) == ["A"]
+    assert not (tmp_path / "run.zarr.partial").exists()
+
+
+def test_resume_skips_finished_chunks(tmp_path):
+    built = Scenario.from_dict(BASE, source=tmp_path / "s.yaml").build()
+    path = tmp_path / "run.zarr"
+    writer = FrameStoreWriter(path, _template(built, 2, make_simulator(built)), 2, fingerprint(built))
+    sentinel = np.full((2, 333, 250, 4), 7 + 7j, np.complex64)
+    writer.write_chunk(0, sentinel)  # as if a run was interrupted after its first chunk
+    simulate_to_zarr(built, path, chunk_frames=2)
+    iq = open_frames(path).iq.values
+    np.testing.assert_array_equal(iq[:2], sentinel)  # finished chunk kept, not recomputed
+    assert not np.any(iq[2:] == 7 + 7j)
+
+
+@pytest.mark.parametrize(
+    ("change", "needles"),
+    [
+        ({"intruderz": []}, ["scenario.yaml", "intruderz"]),
+        ({"frame_rate_hz": -5}, ["scenario.yaml", "frame_rate_hz"]),
+        ({"radar": {"rx_positions_m": [[0, 0, 0]] * 4}}, ["scenario.yaml", "rx_positions_m"]),
+    ],
+)
+def test_bad_scenario_gives_one_line(tmp_path, change, needles):
+    scenario = _write(tmp_path, {**BASE, **change})
+    result = _skyradar("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path)
+    _assert_one_line_error(result, *needles)
+    assert not any(tmp_path.glob("run.zarr*"))
+
+
+def test_dem_with_too_many_voids(tmp_path):
+    elevation = np.full((101, 101), 10.0)
+    elevation[:20, :20] = np.nan  # 4% voids, above the 1% fill limit
+    np.savez(tmp_path / "dem.npz", elevation=elevation, dx=1 / 1200, dy=1 / 1200, xmin=4.3, ymax=52.05)
+    scenario = _write(tmp_path, {**BASE, "terrain": {"type": "file", "path": "dem.npz"}})
+    _assert_one_line_error(_skyradar("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path), "dem.npz", "elevation")
+
+
+def test_wrong_hgt_size(tmp_path):
+    (tmp_path / "N52E004.hgt").write_bytes(b"\x00" * 100)
+    scenario = _write(tmp_path, {**BASE, "terrain": {"type": "file", "path": "N52E004.hgt"}})
+    _assert_one_line_error(_skyradar("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path), "N52E004.hgt", "size")
+
+
+@pytest.mark.parametrize(
+    ("csv", "needles"),
+    [
+        ("timestamp,latitude,longitude,altitude\n0,52.0,4.36,1000\n2,52.001,4.36,1000\n1,52.002,4.36,1000\n",
+         ["track.csv", "timestamp", "backwards"]),
+        ("timestamp,longitude,altitude\n0,4.36,1000\n1,4.36,1000\n", ["track.csv", "latitude"]),
+    ],
+)
+def test_bad_trajectory_file(tmp_path, csv, needles):
+    (tmp_path / "track.csv").write_text(csv)
+    scenario = _write(tmp_path, {**BASE, "ownship": "track.csv"})
+    _assert_one_line_error(_skyradar("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path), *needles)
+
+
+def test_help_on_every_command(tmp_path):
+    result = _skyradar("--help", cwd=tmp_path)
+    assert result.returncode == 0
+    for command in ("simulate", "scenarios", "experiment", "bench"):
+        sub = _skyradar(command, "--help", cwd=tmp_path)
+        assert sub.returncode == 0, sub.stderr
+        assert "Usage" in sub.stdout
+
+
+def test_example_scenarios_listed(tmp_path):
+    result = _skyradar("scenarios", cwd=tmp_path)
+    assert result.returncode == 0
+    assert "ch2_flat_forward" in result.stdout
+    assert Path(example_scenario("ch2_flat_forward")).exists()

@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from skyradar.daa.advice import (
+    _choose,
     band_intervals,
     heading_bands,
     mvp_velocity,
@@ -166,3 +167,19 @@ def test_band_intervals_wraps_headings():
     c = (h <= 20) | (h >= 340) | ((h >= 100) & (h <= 120))
     assert band_intervals(h, c, 10.0, circular=True) == [[95.0, 125.0], [335.0, 385.0]]
     assert band_intervals(h, np.zeros_like(c), 10.0) == []
+
+
+def test_recovery_choice_when_every_candidate_conflicts():
+    vs = np.arange(-10.0, 10.5, 0.5)
+    entry = 20.0 - np.abs(vs - 4.0)  # latest loss of well clear at +4 m/s
+    terrain = vs < 1.5
+    # Nearest free wins when one exists.
+    some_free = np.where(vs == 8.0, np.inf, entry)
+    assert _choose(vs, some_free, ~terrain, -6.0, circular=False) == 8.0
+    # All conflict: the allowed candidate whose conflict comes latest, never into the terrain.
+    assert _choose(vs, entry, ~terrain, -6.0, circular=False) == 4.0
+    assert _choose(vs, np.where(vs < 0, 25.0, entry), ~terrain, -6.0, circular=False) == 4.0
+    # Headings wrap: 350 is 20 deg from 10, nearer than 40.
+    h = np.arange(0.0, 360.0, 10.0)
+    free = np.where((h == 350) | (h == 40), np.inf, 1.0)
+    assert _choose(h, free, np.ones(h.size, bool), 10.0, circular=True) == 350.0

@@ -29,7 +29,8 @@ def test_static_radial_velocity_is_the_range_rate_of_a_fixed_point(v, p):
     if np.linalg.norm(point) < 10:
         return
     dt = 1e-4
-    rate = (np.linalg.norm(point - own_v * dt) - np.linalg.norm(point)) / dt  # own-ship moves, point fixed
+    # Own-ship moves, the point is fixed: central difference of the range.
+    rate = (np.linalg.norm(point - own_v * dt) - np.linalg.norm(point + own_v * dt)) / (2 * dt)
     u = point / np.linalg.norm(point)
     assert static_radial_velocity_mps(u[None], own_v)[0] == pytest.approx(rate, abs=1e-2)
 

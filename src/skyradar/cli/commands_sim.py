@@ -17,7 +17,7 @@ OutDir = Annotated[Path, typer.Option("--out", help="Folder for figures and tabl
 def frame_progress(total: int, label: str) -> Progress:
     """A rich progress bar on stderr for a per-frame job."""
     return Progress(
-        TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(), console=console, transient=False
+        TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(), console=console, transient=True
     )
 
 
@@ -82,3 +82,35 @@ def bench_sim(
     from skyradar.benchmarks.sim import run
 
     emit_result(run(n_frames=frames), json_out, "bench sim")
+
+
+@app.command()
+def sweep(
+    scenario: Annotated[Path, typer.Argument(help="Scenario YAML file.")],
+    param: Annotated[str, typer.Option(help="Dotted path in the scenario, e.g. terrain.local_sd_m, intruders.0.rcs_m2.")],
+    values: Annotated[str, typer.Option(help="Comma-separated values, e.g. 0,19.2,39.9.")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Table of all runs (.csv or .parquet).")],
+    scheduler: Annotated[str | None, typer.Option(help="Address of an existing Dask scheduler.")] = None,
+    workers: Annotated[int | None, typer.Option(help="Run on a local Dask cluster of this many workers.")] = None,
+    json_out: JsonFlag = False,
+) -> None:
+    """Run one scenario over a list of parameter values and collect each run's detectability table."""
+    from skyradar.io.tables import write_table
+    from skyradar.sim.sweep import parse_values
+    from skyradar.sim.sweep import sweep as run_sweep
+
+    value_list = parse_values(values)
+    with frame_progress(len(value_list), f"sweep {param}") as bar:
+        task = bar.add_task("runs", total=len(value_list))
+        table = run_sweep(scenario, param, value_list, scheduler, workers, progress=lambda k: bar.advance(task, k))
+    if output.suffix.lower() == ".csv":
+        tmp = output.with_name(output.name + ".tmp")
+        table.to_csv(tmp, index=False)
+        tmp.replace(output)
+    else:
+        write_table(table, output)
+    console.print(table.to_string(index=False))
+    if json_out:
+        import json
+
+        print(json.dumps({"param": param, "runs": json.loads(table.to_json(orient="records"))}))

@@ -25,16 +25,35 @@ from skyradar.daa.conflict import WellClearVolume, cpa, loss_of_well_clear_inter
 __all__ = ["heading_bands", "vertical_speed_bands", "band_intervals", "mvp_velocity", "resolution_advice"]
 
 
-def _conflicts(
+def _entry_times(
     own_vel: np.ndarray, s: np.ndarray, v_int: np.ndarray, volume, lookahead_s, dthr, zthr
 ) -> np.ndarray:
-    """Any-intruder conflict for candidate own velocities ``own_vel`` (c, 3) -> (c,) bool."""
+    """Earliest loss of well clear (s; inf if none) over intruders for each candidate own velocity (c, 3)."""
     if len(s) == 0:
-        return np.zeros(len(own_vel), bool)
+        return np.full(len(own_vel), np.inf)
     rel_v = v_int[None, :, :] - own_vel[:, None, :]
     rel_s = np.broadcast_to(s[None, :, :], rel_v.shape)
     t_in, _ = loss_of_well_clear_interval(rel_s, rel_v, volume, lookahead_s, dthr, zthr)
-    return np.isfinite(t_in).any(axis=1)
+    return np.where(np.isfinite(t_in), t_in, np.inf).min(axis=1)
+
+
+def _heading_candidates(own: np.ndarray, step_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    headings = np.arange(0.0, 360.0, step_deg)
+    gs, psi = np.hypot(own[0], own[1]), np.radians(headings)
+    return headings, np.stack([gs * np.cos(psi), gs * np.sin(psi), np.full_like(psi, own[2])], axis=-1)
+
+
+def _vs_candidates(
+    own: np.ndarray, limits: tuple[float, float], step: float
+) -> tuple[np.ndarray, np.ndarray]:
+    vs = np.arange(limits[0], limits[1] + step / 2, step)
+    return vs, np.stack([np.full_like(vs, own[0]), np.full_like(vs, own[1]), -vs], axis=-1)
+
+
+def _terrain_conflict(vs, height_agl_m, min_height_agl_m, terrain_lookahead_s) -> np.ndarray:
+    if height_agl_m is None or not np.isfinite(height_agl_m):
+        return np.zeros(vs.shape, bool)
+    return height_agl_m + vs * terrain_lookahead_s < min_height_agl_m
 
 
 def _prepare(s, v_int, volume, dthr_m, zthr_m):
@@ -85,12 +104,8 @@ def heading_bands(
     (True, False)
     """
     s, v_int, dthr, zthr = _prepare(s, v_int_mps, volume, dthr_m, zthr_m)
-    own = np.asarray(own_vel_mps, float)
-    headings = np.arange(0.0, 360.0, step_deg)
-    gs = np.hypot(own[0], own[1])
-    psi = np.radians(headings)
-    cand = np.stack([gs * np.cos(psi), gs * np.sin(psi), np.full_like(psi, own[2])], axis=-1)
-    return headings, _conflicts(cand, s, v_int, volume, lookahead_s, dthr, zthr)
+    headings, cand = _heading_candidates(np.asarray(own_vel_mps, float), step_deg)
+    return headings, np.isfinite(_entry_times(cand, s, v_int, volume, lookahead_s, dthr, zthr))
 
 
 def vertical_speed_bands(
@@ -124,15 +139,9 @@ def vertical_speed_bands(
     -5.5
     """
     s, v_int, dthr, zthr = _prepare(s, v_int_mps, volume, dthr_m, zthr_m)
-    own = np.asarray(own_vel_mps, float)
-    lo, hi = vs_limits_mps
-    vs = np.arange(lo, hi + step_mps / 2, step_mps)
-    cand = np.stack([np.full_like(vs, own[0]), np.full_like(vs, own[1]), -vs], axis=-1)
-    traffic = _conflicts(cand, s, v_int, volume, lookahead_s, dthr, zthr)
-    terrain = np.zeros_like(traffic)
-    if height_agl_m is not None and np.isfinite(height_agl_m):
-        terrain = height_agl_m + vs * terrain_lookahead_s < min_height_agl_m
-    return vs, traffic, terrain
+    vs, cand = _vs_candidates(np.asarray(own_vel_mps, float), vs_limits_mps, step_mps)
+    traffic = np.isfinite(_entry_times(cand, s, v_int, volume, lookahead_s, dthr, zthr))
+    return vs, traffic, _terrain_conflict(vs, height_agl_m, min_height_agl_m, terrain_lookahead_s)
 
 
 def band_intervals(
@@ -229,16 +238,19 @@ def mvp_velocity(
     return new, conf
 
 
-def _nearest_free(values: np.ndarray, conflict: np.ndarray, target: float, circular: bool) -> float:
-    if not conflict.any():
-        return float(target)
-    free = values[~conflict]
-    if free.size == 0:
-        return float("nan")
-    diff = np.abs(free - target)
+def _choose(values, entry_s, allowed, target: float, circular: bool) -> float:
+    """Candidate nearest ``target`` among the conflict-free allowed ones; else the allowed one whose
+    loss of well clear comes latest (recovery); else the one nearest ``target``."""
+    diff = np.abs(values - target)
     if circular:
         diff = np.minimum(diff, 360.0 - diff)
-    return float(free[np.argmin(diff)])
+    free = allowed & ~np.isfinite(entry_s)
+    if free.any():
+        return float(values[free][np.argmin(diff[free])])
+    if allowed.any():
+        latest = allowed & (entry_s == entry_s[allowed].max())
+        return float(values[latest][np.argmin(diff[latest])])
+    return float(values[np.argmin(diff)])
 
 
 def resolution_advice(
@@ -262,7 +274,8 @@ def resolution_advice(
         ``heading_bands_deg`` and ``vs_bands_mps`` (conflict intervals from traffic),
         ``terrain_vs_bands_mps``, ``mvp_heading_deg``, ``mvp_vs_mps`` (raw MVP),
         ``preferred_heading_deg``, ``preferred_vs_mps`` (the MVP values moved to the nearest
-        conflict-free candidate; the raw MVP value when every candidate conflicts),
+        conflict-free candidate; when every candidate conflicts, the one whose loss of well clear
+        comes latest, never one into the terrain if any other exists),
         ``heading_saturated``, ``vs_saturated`` (every candidate conflicts), ``n_conflicts``.
 
     Examples
@@ -273,27 +286,19 @@ def resolution_advice(
     True
     """
     own = np.asarray(own_vel_mps, float)
-    kw = {"dthr_m": dthr_m, "zthr_m": zthr_m}
-    headings, h_conf = heading_bands(own, s, v_int_mps, volume, lookahead_s, step_deg, **kw)
-    vs, vs_traffic, vs_terrain = vertical_speed_bands(
-        own, s, v_int_mps, volume, lookahead_s, step_mps=vs_step_mps, height_agl_m=height_agl_m,
-        min_height_agl_m=min_height_agl_m, **kw,
-    )  # fmt: skip
-    new_vel, conf = mvp_velocity(own, s, v_int_mps, volume, lookahead_s, **kw)
+    s, v_int, dthr, zthr = _prepare(s, v_int_mps, volume, dthr_m, zthr_m)
+    headings, h_cand = _heading_candidates(own, step_deg)
+    h_entry = _entry_times(h_cand, s, v_int, volume, lookahead_s, dthr, zthr)
+    vs, v_cand = _vs_candidates(own, (-10.0, 10.0), vs_step_mps)
+    v_entry = _entry_times(v_cand, s, v_int, volume, lookahead_s, dthr, zthr)
+    vs_terrain = _terrain_conflict(vs, height_agl_m, min_height_agl_m, 30.0)
+    h_conf, vs_traffic = np.isfinite(h_entry), np.isfinite(v_entry)
+    vs_conf = vs_traffic | vs_terrain
+    new_vel, conf = mvp_velocity(own, s, v_int, volume, lookahead_s, dthr_m=dthr, zthr_m=zthr)
     mvp_heading = float(np.degrees(np.arctan2(new_vel[1], new_vel[0])) % 360.0)
     mvp_vs = float(-new_vel[2])
-    # Quantise to the candidate grid so "inside a band" is judged on the same grid as the bands.
-    h_idx = int(np.round(mvp_heading / step_deg)) % len(headings)
-    v_idx = int(np.clip(np.round((mvp_vs - vs[0]) / vs_step_mps), 0, len(vs) - 1))
-    vs_conf = vs_traffic | vs_terrain
-    pref_h = (
-        float(headings[h_idx]) if not h_conf[h_idx] else _nearest_free(headings, h_conf, mvp_heading, True)
-    )
-    pref_v = float(vs[v_idx]) if not vs_conf[v_idx] else _nearest_free(vs, vs_conf, mvp_vs, False)
-    if not np.isfinite(pref_h):
-        pref_h = mvp_heading
-    if not np.isfinite(pref_v):
-        pref_v = mvp_vs
+    pref_h = _choose(headings, h_entry, np.ones(len(headings), bool), mvp_heading, circular=True)
+    pref_v = _choose(vs, v_entry, ~vs_terrain, mvp_vs, circular=False)
     return {
         "heading_saturated": bool(h_conf.all()),
         "vs_saturated": bool(vs_conf.all()),

@@ -120,27 +120,32 @@ def _clean_tracks(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
 def _advice_columns(out: pd.DataFrame, s, v_int, own_vel, height, raw, config: AlertConfig) -> None:
     """Fill the per-frame advice columns for frames where any track has an issued alert."""
     n = len(out)
-    for name in ("heading_bands_deg", "vs_bands_mps", "terrain_vs_bands_mps"):
-        out[name] = [[] for _ in range(n)]
-    out["preferred_heading_deg"] = np.nan
-    out["preferred_vs_mps"] = np.nan
+    names = ("heading_bands_deg", "vs_bands_mps", "terrain_vs_bands_mps")
+    lists: dict[str, list] = {name: [[]] * n for name in names}  # shared empty list; replaced, never mutated
+    pref = {"preferred_heading_deg": np.full(n, np.nan), "preferred_vs_mps": np.full(n, np.nan)}
     corrective = config.levels[min(1, len(config.levels) - 1)]
     times = out["time_s"].to_numpy()
     alerting = out["level"].to_numpy() > 0
-    for t in np.unique(times[alerting]):
-        rows = np.flatnonzero(times == t)
-        r0 = rows[0]
+    # Rows are sorted by time, so each frame is one contiguous block.
+    starts = np.flatnonzero(np.r_[True, times[1:] != times[:-1]])
+    stops = np.r_[starts[1:], n]
+    for a, b in zip(starts, stops, strict=True):
+        if not alerting[a:b].any():
+            continue
         adv = resolution_advice(
-            own_vel[r0], s[rows], v_int[rows], corrective.volume, corrective.alerting_time_s,
-            height_agl_m=None if height is None else float(height[r0]),
-            dthr_m=raw["dthr_m"][rows], zthr_m=raw["zthr_m"][rows],
+            own_vel[a], s[a:b], v_int[a:b], corrective.volume, corrective.alerting_time_s,
+            height_agl_m=None if height is None else float(height[a]),
+            dthr_m=raw["dthr_m"][a:b], zthr_m=raw["zthr_m"][a:b],
         )  # fmt: skip
-        for name in ("heading_bands_deg", "vs_bands_mps", "terrain_vs_bands_mps"):
+        for name in names:
             flat = [float(x) for band in adv[name] for x in band]
-            for r in rows:
-                out.at[r, name] = flat
-        out.loc[rows, "preferred_heading_deg"] = adv["preferred_heading_deg"]
-        out.loc[rows, "preferred_vs_mps"] = adv["preferred_vs_mps"]
+            lists[name][a:b] = [flat] * (b - a)
+        for name in pref:
+            pref[name][a:b] = adv[name]
+    for name in names:
+        out[name] = lists[name]
+    for name, values in pref.items():
+        out[name] = values
 
 
 def alerts_from_tracks(

@@ -239,7 +239,6 @@ def _residuals(
         used = np.isfinite(prior[1])
         return np.concatenate([_residuals(x, r, v, sigma_v, sigma_r), ((x - prior[0]) / prior[1])[used]])
     vx, vz, h = x
-    h = min(h, 0.999 * r.min())
     ground = np.sqrt(np.maximum(r * r - h * h, 1e-6))
     model = -(vx * ground + vz * h) / r
     # Effective variance: a range error moves the ridge along its slope dv/dr.
@@ -287,15 +286,23 @@ def fit_robust(
         start = fit_thesis(r, v)
     if not start.ok:
         return StateFit.failed(r.size)
-    good = np.isfinite(r) & np.isfinite(v)
-    rg, vg = r[good], v[good]
-    x0 = np.array([start.vx_mps, start.vz_mps, min(start.h_m, 0.99 * rg.min())])
     pri = None if prior is None else np.array([np.asarray(prior[0], float), np.asarray(prior[1], float)])
+    x0 = np.array([start.vx_mps, start.vz_mps, start.h_m])
     if pri is not None and np.all(np.isfinite(pri[0])):
         x0 = np.where(np.isfinite(pri[1]), pri[0], x0)
-        x0[2] = min(x0[2], 0.99 * rg.min())
+    # No ground point is nearer than the plane below: H stays below the nearest ridge pair. Over
+    # rough terrain that is the nearest hill, which keeps H from running off with V_Z.
+    good = np.isfinite(r) & np.isfinite(v)
+    if good.sum() < 4:
+        return StateFit.failed(r.size)
+    rg, vg = r[good], v[good]
+    h_max = 0.9999 * rg.min()
+    x0 = np.clip(x0, [1e-3, -np.inf, 1.0], [np.inf, np.inf, 0.999 * h_max])
     args = (rg, vg, sigma_v_mps, sigma_r_m, pri)
-    sol = least_squares(_residuals, x0, loss="huber", f_scale=f_scale, args=args, x_scale=[10, 1, 100])
+    bounds = ([1e-3, -np.inf, 1.0], [np.inf, np.inf, h_max])
+    sol = least_squares(
+        _residuals, x0, loss="huber", f_scale=f_scale, args=args, x_scale=[10, 1, 100], bounds=bounds
+    )
     vx, vz, h = (float(x) for x in sol.x)
     res = _residuals(sol.x, rg, vg, sigma_v_mps, sigma_r_m)
     inl = np.abs(res) < 3.0 * f_scale

@@ -24,8 +24,8 @@ from __future__ import annotations
 from functools import lru_cache
 from typing import Literal
 
-import cv2
 import numpy as np
+from numba import njit
 from scipy import integrate, ndimage, optimize, stats
 
 from skyradar.errors import InputError
@@ -88,11 +88,46 @@ def _pad(image: np.ndarray, pr: int, pd: int) -> np.ndarray:
     return np.pad(image, ((pr, pr), (0, 0)), mode="reflect") if pr else image
 
 
-def _box_sum(padded: np.ndarray, hr: int, hd: int, pr: int, pd: int, shape: tuple[int, int]) -> np.ndarray:
-    s = cv2.boxFilter(
-        padded, cv2.CV_32F, (2 * hd + 1, 2 * hr + 1), normalize=False, borderType=cv2.BORDER_REPLICATE
-    )
-    return s[pr : pr + shape[0], pd : pd + shape[1]]
+@njit(cache=True)
+def _ca_kernel(
+    power: np.ndarray, valid: np.ndarray, gr: int, gd: int, hr: int, hd: int, alpha: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Cell-averaging CFAR from summed-area tables; Doppler wraps, range reflects.
+
+    ``valid`` weights pixels into the training sums (0 for excluded pixels); ``alpha[n]`` is the
+    threshold factor for n training cells.
+    """
+    n_r, n_d = power.shape
+    rows, cols = n_r + 2 * hr, n_d + 2 * hd
+    sp = np.zeros((rows + 1, cols + 1))
+    sv = np.zeros((rows + 1, cols + 1))
+    for a in range(rows):
+        i = a - hr
+        i = -i if i < 0 else (2 * (n_r - 1) - i if i >= n_r else i)
+        acc_p = 0.0
+        acc_v = 0.0
+        for b in range(cols):
+            j = (b - hd) % n_d
+            acc_p += power[i, j] * valid[i, j]
+            acc_v += valid[i, j]
+            sp[a + 1, b + 1] = sp[a, b + 1] + acc_p
+            sv[a + 1, b + 1] = sv[a, b + 1] + acc_v
+    hits = np.zeros((n_r, n_d), np.bool_)
+    noise = np.empty((n_r, n_d), np.float32)
+    n_max = alpha.size - 1
+    for i in range(n_r):
+        for j in range(n_d):
+            r0, r1, c0, c1 = i, i + 2 * hr + 1, j, j + 2 * hd + 1
+            q0, q1, k0, k1 = i + hr - gr, i + hr + gr + 1, j + hd - gd, j + hd + gd + 1
+            tot = sp[r1, c1] - sp[r0, c1] - sp[r1, c0] + sp[r0, c0]
+            tot -= sp[q1, k1] - sp[q0, k1] - sp[q1, k0] + sp[q0, k0]
+            cnt = sv[r1, c1] - sv[r0, c1] - sv[r1, c0] + sv[r0, c0]
+            cnt -= sv[q1, k1] - sv[q0, k1] - sv[q1, k0] + sv[q0, k0]
+            n = min(max(int(cnt + 0.5), 0), n_max)
+            level = max(tot / max(cnt, 1.0), 1e-38)
+            noise[i, j] = level
+            hits[i, j] = n > 0 and valid[i, j] > 0 and power[i, j] > alpha[n] * level
+    return hits, noise
 
 
 def cfar_2d(
@@ -139,24 +174,24 @@ def cfar_2d(
     if min(gr, gd, tr, td) < 0 or hd >= power.shape[1] // 2 or hr >= power.shape[0] // 2:
         raise InputError(f"cfar: guard {guard} / train {train} do not fit an image of shape {power.shape}")
     n_train = (2 * hr + 1) * (2 * hd + 1) - (2 * gr + 1) * (2 * gd + 1)
-    if exclude is not None and kind == "ca":
-        return _masked_ca(power, np.asarray(exclude, bool), (gr, gd), (hr, hd), pfa, n_integrated)
+    if kind == "ca":
+        valid = np.ones(power.shape, np.float32)
+        if exclude is not None:
+            if exclude.shape != power.shape:
+                raise InputError(f"cfar: field 'exclude' has shape {exclude.shape}, image has {power.shape}")
+            valid = (~np.asarray(exclude, bool)).astype(np.float32)
+        table = _ca_factor_table(float(pfa), n_train, int(n_integrated))
+        return _ca_kernel(np.ascontiguousarray(power), valid, gr, gd, hr, hd, table)
     alpha = cfar_factor(pfa, n_train, n_integrated, kind, rank)
     if exclude is not None:
         # OS-CFAR: fill excluded pixels with the image median, a noise-like value.
         power = np.where(exclude, np.median(power), power).astype(np.float32)
     padded = _pad(power, hr, hd)
-    if kind == "ca":
-        outer = _box_sum(padded, hr, hd, hr, hd, power.shape)
-        inner = _box_sum(padded, gr, gd, hr, hd, power.shape)
-        noise = (outer - inner) / np.float32(n_train)
-    else:
-        footprint = np.ones((2 * hr + 1, 2 * hd + 1), bool)
-        footprint[tr : tr + 2 * gr + 1, td : td + 2 * gd + 1] = False
-        k = int(round(0.75 * n_train)) if rank is None else int(rank)
-        full = ndimage.rank_filter(padded, k - 1, footprint=footprint, mode="nearest")
-        noise = full[hr : hr + power.shape[0], hd : hd + power.shape[1]]
-    noise = np.maximum(noise, np.float32(np.finfo(np.float32).tiny))
+    footprint = np.ones((2 * hr + 1, 2 * hd + 1), bool)
+    footprint[tr : tr + 2 * gr + 1, td : td + 2 * gd + 1] = False
+    k = int(round(0.75 * n_train)) if rank is None else int(rank)
+    full = ndimage.rank_filter(padded, k - 1, footprint=footprint, mode="nearest")
+    noise = np.maximum(full[hr : hr + power.shape[0], hd : hd + power.shape[1]], np.float32(1e-38))
     hits = power > np.float32(alpha) * noise
     return (hits & ~exclude if exclude is not None else hits), noise
 
@@ -167,25 +202,3 @@ def _ca_factor_table(pfa: float, n_max: int, n_integrated: int) -> np.ndarray:
     for n in range(1, n_max + 1):
         table[n] = cfar_factor(pfa, n, n_integrated)
     return table
-
-
-def _masked_ca(
-    power: np.ndarray,
-    exclude: np.ndarray,
-    guard: tuple[int, int],
-    half: tuple[int, int],
-    pfa: float,
-    n_integrated: int,
-) -> tuple[np.ndarray, np.ndarray]:
-    if exclude.shape != power.shape:
-        raise InputError(f"cfar: field 'exclude' has shape {exclude.shape}, image has {power.shape}")
-    (gr, gd), (hr, hd) = guard, half
-    valid = (~exclude).astype(np.float32)
-    p_pad, v_pad = _pad(power * valid, hr, hd), _pad(valid, hr, hd)
-    total = _box_sum(p_pad, hr, hd, hr, hd, power.shape) - _box_sum(p_pad, gr, gd, hr, hd, power.shape)
-    count = _box_sum(v_pad, hr, hd, hr, hd, power.shape) - _box_sum(v_pad, gr, gd, hr, hd, power.shape)
-    n_cells = np.rint(count).astype(np.int64)
-    n_max = (2 * hr + 1) * (2 * hd + 1) - (2 * gr + 1) * (2 * gd + 1)
-    alpha = _ca_factor_table(float(pfa), n_max, int(n_integrated))[np.clip(n_cells, 0, n_max)]
-    noise = np.maximum(total / np.maximum(count, np.float32(1.0)), np.float32(np.finfo(np.float32).tiny))
-    return (power > alpha * noise) & ~exclude & (n_cells > 0), noise

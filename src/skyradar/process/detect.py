@@ -92,15 +92,16 @@ class Detections:
 
 
 @njit(cache=True, fastmath=True)
-def _mean_power(cube: np.ndarray, weight: np.ndarray) -> np.ndarray:
-    n_r, n_d, n_k = cube.shape
+def _mean_power(iq: np.ndarray, weight: np.ndarray) -> np.ndarray:
+    # iq: (n_range, n_doppler, 2 n_rx) float32 view of the complex cube (re, im interleaved).
+    n_r, n_d, n_k = iq.shape
     out = np.empty((n_r, n_d), np.float32)
     for i in range(n_r):
         for j in range(n_d):
             acc = np.float32(0.0)
             for k in range(n_k):
-                z = cube[i, j, k]
-                acc += (z.real * z.real + z.imag * z.imag) * weight[k]
+                v = iq[i, j, k]
+                acc += v * v * weight[k]
             out[i, j] = acc
     return out
 
@@ -122,8 +123,8 @@ def integrate_channels(cube: np.ndarray, calibration: np.ndarray | None = None) 
     gain = np.ones(n_rx) if calibration is None else np.asarray(calibration)
     if gain.shape != (n_rx,):
         raise InputError(f"frame: field 'rx' has {n_rx} channels, calibration has {gain.shape[0]}")
-    weight = (1.0 / (np.abs(gain) ** 2 * n_rx)).astype(np.float32)
-    return _mean_power(np.ascontiguousarray(cube, dtype=np.complex64), weight)
+    weight = np.repeat(1.0 / (np.abs(gain) ** 2 * n_rx), 2).astype(np.float32)
+    return _mean_power(np.ascontiguousarray(cube, dtype=np.complex64).view(np.float32), weight)
 
 
 def shi_tomasi(
@@ -140,9 +141,12 @@ def shi_tomasi(
     """
     image = np.asarray(power_db, dtype=np.float32)
     pad = block_size + min_distance
-    # Doppler wraps; range edges reflect so that corners on the first/last bin are found.
+    # Doppler wraps; beyond the range edges lies a flat noise floor, so peaks on the first/last bin
+    # stay corners (reflection would mirror them into ridges).
     padded = np.pad(
-        np.concatenate([image[:, -pad:], image, image[:, :pad]], axis=1), ((pad, pad), (0, 0)), "reflect"
+        np.concatenate([image[:, -pad:], image, image[:, :pad]], axis=1),
+        ((pad, pad), (0, 0)),
+        constant_values=float(np.median(image)),
     )
     corners = cv2.goodFeaturesToTrack(
         np.ascontiguousarray(padded), max_corners, quality, min_distance, blockSize=block_size

@@ -19,12 +19,14 @@ The range transform is therefore split (Cooley-Tukey, ``n = Q*n1 + n2``, ``k = k
 ``P`` the 5-smooth part of the length): a length-``P`` FFT, a twiddle, and a matrix product with
 the length-``Q`` DFT restricted to the ``k2`` that are kept. It is exact (same numbers as the full
 FFT to float32 rounding) and needs about a third less CPU time than scipy's full FFT (measured by
-``skyradar bench chain``). ``method='fft'`` forces the plain FFT.
+``skyradar bench chain``). ``method='fft'`` forces the plain FFT. Chirps are processed in blocks
+that stay in cache, spread over ``workers`` threads, with BLAS held to one thread meanwhile.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from functools import lru_cache
 from typing import Any
 
@@ -170,7 +172,7 @@ class RangeDopplerProcessor:
         Range transform: split DFT that computes only the kept bins, or a full FFT. ``'auto'``
         uses the split form when the chirp length has a prime factor above 5 and few bins are kept.
     workers : int
-        Threads for scipy.fft.
+        Threads: blocks of chirps are range-transformed in parallel, then the Doppler FFTs.
     n_samples : int, optional
         Valid ADC samples per chirp when fewer than ``config.samples_per_chirp`` (the rest is
         zero-padded after windowing, so the range axis keeps its bin spacing).
@@ -216,15 +218,18 @@ class RangeDopplerProcessor:
             self._twiddle = twiddle.astype(np.complex64).reshape(p, 1, q)
             self._dft = np.exp(-2j * np.pi * np.outer(n2, np.arange(k2)) / q).astype(np.complex64)
 
-    def _range_transform(self, x: np.ndarray) -> np.ndarray:
+    def _range_transform(self, x: np.ndarray, remove_dc: bool) -> np.ndarray:
         """Window and transform (C, n_samples) ADC rows -> first n_range DFT bins (C, n_range)."""
         c, n_range = x.shape[0], self.config.n_range
+        if remove_dc:
+            # ADC offset and LO leakage sit at zero beat frequency: remove each chirp's mean.
+            x = x - x.mean(axis=-1, keepdims=True, dtype=np.complex64 if np.iscomplexobj(x) else np.float32)
         if self.n_samples < self.n_fft:  # short chirps: zero-pad (window covers the valid part)
             x = np.concatenate([x, np.zeros((c, self.n_fft - self.n_samples), x.dtype)], axis=1)
         if self.method == "fft":
             xw = np.empty((c, self.n_fft), np.complex64)
             np.multiply(x, self._w_full, out=xw, casting="unsafe")
-            return sfft.fft(xw, axis=-1, workers=self.workers, overwrite_x=True)[:, :n_range]
+            return sfft.fft(xw, axis=-1, workers=1, overwrite_x=True)[:, :n_range]
         p, q, k2 = self._p, self._q, self._k2
         # Write the windowed samples as (n1, chirp, n2) so the length-P FFT runs over the
         # outer axis, where pocketfft vectorises across the contiguous inner axes.
@@ -232,11 +237,29 @@ class RangeDopplerProcessor:
         np.multiply(
             x.reshape(c, p, q).transpose(1, 0, 2), self._w_full.reshape(p, 1, q), out=y, casting="unsafe"
         )
-        y = sfft.fft(y, axis=0, workers=self.workers, overwrite_x=True)
+        y = sfft.fft(y, axis=0, workers=1, overwrite_x=True)
         y *= self._twiddle
         z = (y.reshape(p * c, q) @ self._dft).reshape(p, c, k2)
         # bin k = k1 + P*k2 lives at z[k1, :, k2]: (chirp, k2, k1) order gives increasing k.
         return z.transpose(1, 2, 0).reshape(c, k2 * p)[:, :n_range]
+
+    def _range_stage(self, rows: np.ndarray, remove_dc: bool) -> np.ndarray:
+        """Range transform in cache-sized blocks of chirps spread over ``workers`` threads."""
+        out = np.empty((rows.shape[0], self.config.n_range), np.complex64)
+        blocks = [slice(s, s + _BLOCK_CHIRPS) for s in range(0, rows.shape[0], _BLOCK_CHIRPS)]
+
+        def job(sl: slice) -> None:
+            out[sl] = self._range_transform(rows[sl], remove_dc)
+
+        # BLAS threads spinning beside ours (or beside other processes) cost more than they
+        # give on small machines: one BLAS thread per worker, parallel over blocks instead.
+        with _blas_controller().limit(limits=1, user_api="blas"):
+            if self.workers > 1 and len(blocks) > 1:
+                list(_thread_pool(self.workers).map(job, blocks))
+            else:
+                for sl in blocks:
+                    job(sl)
+        return out
 
     def __call__(
         self, adc: np.ndarray, remove_dc: bool = False, calibration: np.ndarray | None = None
@@ -246,23 +269,32 @@ class RangeDopplerProcessor:
         expected = (cfg.n_rx, cfg.n_doppler, self.n_samples)
         if adc.ndim != 3 or tuple(adc.shape) != expected:
             raise InputError(f"adc: shape {tuple(adc.shape)}, expected (rx, chirp, sample) = {expected}")
-        x = np.asarray(adc)
-        if remove_dc:
-            # ADC offset and LO leakage sit at zero beat frequency: remove each chirp's mean.
-            x = x - x.mean(axis=-1, keepdims=True, dtype=np.complex64 if np.iscomplexobj(x) else np.float32)
         gains = cfg.rx_calibration if calibration is None else np.asarray(calibration, complex)
         if gains.shape != (cfg.n_rx,) or not np.all(np.isfinite(gains)) or np.any(gains == 0):
             raise InputError(f"range_doppler: calibration must be {cfg.n_rx} finite non-zero complex gains")
-        c = cfg.n_rx * cfg.n_doppler
-        rng = self._range_transform(x.reshape(c, self.n_samples)).reshape(
-            cfg.n_rx, cfg.n_doppler, cfg.n_range
-        )
+        rows = np.asarray(adc).reshape(cfg.n_rx * cfg.n_doppler, self.n_samples)
+        rng = self._range_stage(rows, remove_dc).reshape(cfg.n_rx, cfg.n_doppler, cfg.n_range)
         # Doppler window, FFT shift (a frequency offset of nV//2 bins), normalisation and
         # calibration are one complex weight per (rx, chirp): one pass over the data.
         weight = (self._doppler_weight[None, :] * (self.scale / gains)[:, None]).astype(np.complex64)
         rng *= weight[:, :, None]
         rd = sfft.fft(rng, axis=1, workers=self.workers, overwrite_x=True)
         return np.ascontiguousarray(rd.transpose(2, 1, 0))
+
+
+_BLOCK_CHIRPS = 125  # 2 MB of complex64 ADC rows: stays in cache from window to matrix product
+
+
+@lru_cache(maxsize=1)
+def _blas_controller():
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController()
+
+
+@lru_cache(maxsize=4)
+def _thread_pool(workers: int) -> ThreadPoolExecutor:
+    return ThreadPoolExecutor(max_workers=workers, thread_name_prefix="skyradar-rd")
 
 
 @lru_cache(maxsize=8)

@@ -11,7 +11,7 @@ from typing import Any
 
 from skyradar.errors import InputError
 
-__all__ = ["connect", "map_chunks"]
+__all__ = ["connect", "close", "map_chunks"]
 
 
 def connect(scheduler: str | None, workers: int | None, timeout_s: float = 10.0):
@@ -27,27 +27,33 @@ def connect(scheduler: str | None, workers: int | None, timeout_s: float = 10.0)
     return Client(cluster)
 
 
+def close(client, owns_cluster: bool) -> None:
+    """Close a client from :func:`connect`, and its local cluster when we started it."""
+    cluster = getattr(client, "cluster", None)
+    client.close()
+    if owns_cluster and cluster is not None:
+        cluster.close()
+
+
 def map_chunks(
     job: Callable[..., int],
     *args: Any,
+    client,
     chunks: Sequence[int] = (),
-    scheduler: str | None = None,
-    workers: int | None = None,
     progress: Callable[[int], None] | None = None,
 ) -> None:
-    """Run ``job(*args, index)`` for every chunk index on Dask; ``progress(frames)`` as each finishes."""
+    """Run ``job(*args, index)`` for every chunk index on ``client``; ``progress(frames)`` as each finishes."""
     from distributed import as_completed
 
-    client = connect(scheduler, workers)
     try:
+        futures = []
         scattered = [client.scatter(a, broadcast=True) if not isinstance(a, str | int | float) else a for a in args]
         futures = [client.submit(job, *scattered, index, pure=False) for index in chunks]
         for future in as_completed(futures):
             frames = future.result()
             if progress:
                 progress(frames)
-    finally:
-        cluster = getattr(client, "cluster", None)
-        client.close()
-        if scheduler is None and cluster is not None:
-            cluster.close()
+    except BaseException:
+        for future in futures:
+            future.cancel()
+        raise

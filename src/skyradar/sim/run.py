@@ -170,6 +170,11 @@ def _chunk_job(built, key: str, path: str, chunk_frames: int, index: int) -> int
     return sl.stop - sl.start
 
 
+def _chunk_len(writer: FrameStoreWriter, index: int) -> int:
+    sl = writer.chunk_slice(index)
+    return sl.stop - sl.start
+
+
 def simulate_to_zarr(
     built,
     path: str | Path,
@@ -195,21 +200,27 @@ def simulate_to_zarr(
     progress : callable, optional
         Called with the number of frames finished after each chunk.
     """
-    simulator = make_simulator(built)
-    writer = FrameStoreWriter(path, _template(built, chunk_frames, simulator), chunk_frames, fingerprint(built))
-    pending = writer.pending_chunks()
-    if progress and len(pending) < writer.n_chunks:
-        progress(sum(writer.chunk_slice(i).stop - writer.chunk_slice(i).start for i in range(writer.n_chunks))
-                 - sum(writer.chunk_slice(i).stop - writer.chunk_slice(i).start for i in pending))
-    if scheduler is None and not workers:
-        for index in pending:
-            sl = writer.chunk_slice(index)
-            writer.write_chunk(index, simulate_frames(built, np.arange(sl.start, sl.stop), simulator))
-            if progress:
-                progress(sl.stop - sl.start)
-    else:
-        from skyradar.sim.cluster import map_chunks
+    client = None
+    if scheduler is not None or workers:
+        from skyradar.sim.cluster import close, connect, map_chunks
 
-        map_chunks(_chunk_job, built, fingerprint(built), str(writer.partial), chunk_frames, chunks=pending,
-                   scheduler=scheduler, workers=workers, progress=progress)
+        client = connect(scheduler, workers)  # before any output exists: a dead address leaves nothing
+    try:
+        simulator = make_simulator(built)
+        writer = FrameStoreWriter(path, _template(built, chunk_frames, simulator), chunk_frames, fingerprint(built))
+        pending = writer.pending_chunks()
+        if progress and len(pending) < writer.n_chunks:
+            progress(built.times_s.size - sum(_chunk_len(writer, i) for i in pending))
+        if client is None:
+            for index in pending:
+                sl = writer.chunk_slice(index)
+                writer.write_chunk(index, simulate_frames(built, np.arange(sl.start, sl.stop), simulator))
+                if progress:
+                    progress(sl.stop - sl.start)
+        else:
+            map_chunks(_chunk_job, built, fingerprint(built), str(writer.partial), chunk_frames, client=client,
+                       chunks=pending, progress=progress)
+    finally:
+        if client is not None:
+            close(client, owns_cluster=scheduler is None)
     return writer.close()

@@ -13,6 +13,10 @@ with a match threshold; the counts below follow from that matching:
   one it was matched to (CLEAR-MOT style);
 * ``completeness``: share of visible truth frames (in counted segments) matched by a track;
 * GOSPA (García-Fernández et al., alpha = 2) per frame, on the same distance, averaged over frames.
+
+Only confirmed rows (``confirmed`` column, when present) are matched and counted. Innovation
+statistics cover every update of those tracks, including the ones before confirmation (a track's
+first updates are part of tracking it); ``*_confirmed`` repeats them over confirmed rows only.
 """
 
 from __future__ import annotations
@@ -247,11 +251,16 @@ def track_metrics(
 ) -> dict[str, float]:
     """All track metrics of this module in one dict (see the module docstring)."""
     labels = truth_segments(truth, gap_s, min_duration_s)
+    all_rows = tracks
+    if "confirmed" in tracks.columns:
+        tracks = tracks[tracks["confirmed"].to_numpy(bool)]
     matched, gospa_d = match_tracks(tracks, truth, pixel_size, doppler_width_mps, threshold_px, gospa_c_px)
     frag, switches, completeness = _segment_counts(matched, labels)
     ids = np.unique(tracks["track_id"].to_numpy(np.int64))
     true_ids = np.unique(matched[matched >= 0])
-    innov = tracks[["innovation_range_m", "innovation_radial_velocity_mps"]].to_numpy(float)
+    innov_cols = ["innovation_range_m", "innovation_radial_velocity_mps"]
+    innov = all_rows[innov_cols].to_numpy(float)
+    confirmed_only = innovation_stats(tracks[innov_cols].to_numpy(float), pixel_size)
     return {
         "truth_tracks": int(np.unique(labels[labels >= 0]).size),
         "tracks": int(ids.size),
@@ -261,4 +270,6 @@ def track_metrics(
         "completeness": completeness,
         "gospa_mean": float(gospa_d.mean()) if gospa_d.size else float("nan"),
         **innovation_stats(innov, pixel_size),
+        "innov_mean_px_confirmed": confirmed_only["innov_mean_px"],
+        "innov_p95_px_confirmed": confirmed_only["innov_p95_px"],
     }

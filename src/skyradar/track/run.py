@@ -60,7 +60,10 @@ def track_detections(
     origin: tuple[float, float, float] | None = None,
     position_sigma_rad: float = 0.04,
 ) -> pd.DataFrame:
-    """Track a detections table; one output row per confirmed track per frame.
+    """Track a detections table; one output row per track per frame.
+
+    Rows of a track before its confirmation are kept (``confirmed`` False) for tracks that were
+    confirmed later; tentative tracks that never were are dropped.
 
     Parameters
     ----------
@@ -86,14 +89,14 @@ def track_detections(
     >>> t = np.arange(10) * 0.1
     >>> det = pd.DataFrame({"time_s": t, "range_m": 1000 - 50 * t, "radial_velocity_mps": np.full(10, 28.3)})
     >>> out = track_detections(det)
-    >>> out.track_id.nunique(), len(out)
-    (1, 8)
+    >>> out.track_id.nunique(), len(out), int(out.confirmed.sum())
+    (1, 9, 7)
     """
     validate_detections(detections)
     config = config or RadarConfig.seed_prototype()
     motion = make_model(model, config) if isinstance(model, str) else model
     tracker = RangeDopplerTracker(
-        motion, tracker_config, (config.range_resolution_m, config.doppler_resolution_mps)
+        motion, tracker_config, (config.range_resolution_m, config.doppler_resolution_mps), report_tentative=True
     )
     times = detections["time_s"].to_numpy(float)
     z_all = detections[["range_m", "radial_velocity_mps"]].to_numpy(float)
@@ -116,6 +119,7 @@ def track_detections(
             "innov": out.innovation,
             "det": np.where(out.detection_index >= 0, out.detection_index + a, -1),
             "n_updates": out.n_updates,
+            "confirmed": out.confirmed,
         }
         if t3 is not None:
             row["x3"], row["P3"] = _step_3d(t3, out, time_s, ned_all[a:b], z_all[a:b, 0], position_sigma_rad)
@@ -166,6 +170,10 @@ def _assemble(chunks: list[dict[str, np.ndarray]], origin: tuple[float, float, f
     for i in range(3):
         for j in range(3):
             cols[f"cov_pp_{i}{j}"] = P3[:, 3 * i + j]
-    cols["confirmed"] = np.ones(n, bool)
+    cols["confirmed"] = cat("confirmed")
     cols["n_updates"] = cat("n_updates")
-    return pd.DataFrame(cols, columns=TRACK_COLUMNS)
+    df = pd.DataFrame(cols, columns=TRACK_COLUMNS)
+    # Tentative rows are kept only for tracks that were confirmed at some point: their early
+    # updates belong to a real track, the rest is clutter that never became one.
+    real = np.unique(df["track_id"].to_numpy()[df["confirmed"].to_numpy()])
+    return df[np.isin(df["track_id"].to_numpy(), real)].reset_index(drop=True)

@@ -99,6 +99,8 @@ class FrameTracks:
         Innovation of the assigned detection (range [m], radial velocity [m/s]); NaN when coasting.
     alive_ids, alive_detection : ndarray of int
         All live tracks (tentative too) and their assigned detection rows, for the 3-D tracker.
+    confirmed : ndarray of bool, shape (k,)
+        Whether each reported track is confirmed (all True unless ``report_tentative``).
     """
 
     time_s: float
@@ -110,6 +112,7 @@ class FrameTracks:
     innovation: np.ndarray
     alive_ids: np.ndarray
     alive_detection: np.ndarray
+    confirmed: np.ndarray
 
 
 class RangeDopplerTracker:
@@ -126,12 +129,14 @@ class RangeDopplerTracker:
         Same signature as :func:`~skyradar.track.association.associate` (the default).
     initiator, deleter : optional
         Objects with the :class:`MOfN` / :class:`MissDeleter` interface.
+    report_tentative : bool
+        Also report tentative tracks (tracks born in this frame are reported from the next one).
 
     Examples
     --------
     >>> from skyradar.track.models import radar_model
     >>> trk = RangeDopplerTracker(radar_model(78.3))
-    >>> for k in range(5):
+    >>> for k in range(15):
     ...     out = trk.step(0.1 * k, np.array([[1000.0 - 5.0 * k, -50.0 + 78.3]]))
     >>> out.track_id.tolist(), round(float(out.state[0, 1]), 1)
     ([0], -50.0)
@@ -145,8 +150,10 @@ class RangeDopplerTracker:
         associator: Callable[..., Association] = associate,
         initiator: MOfN | None = None,
         deleter: MissDeleter | None = None,
+        report_tentative: bool = False,
     ) -> None:
         self.model = model
+        self.report_tentative = bool(report_tentative)
         self.config = config or TrackerConfig()
         self.pixel_size = pixel_size
         self.associator = associator
@@ -216,7 +223,8 @@ class RangeDopplerTracker:
         self._start(z[new_det])
         alive_ids = t["ids"]
         alive_det = np.concatenate([assigned, new_det])
-        out = t["confirmed"][: assigned.size]
+        confirmed = t["confirmed"][: assigned.size]
+        out = np.ones(assigned.size, bool) if self.report_tentative else confirmed
         return FrameTracks(
             self.time_s,
             t["ids"][: assigned.size][out],
@@ -227,6 +235,7 @@ class RangeDopplerTracker:
             innov[out],
             alive_ids,
             alive_det,
+            confirmed[out],
         )
 
     def _matrices(self, dt: float) -> tuple[np.ndarray, ...]:

@@ -28,7 +28,9 @@ BASE = {
 
 
 def _skyradar(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "skyradar", *args], cwd=cwd, capture_output=True, text=True, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "skyradar", *args], cwd=cwd, capture_output=True, text=True, timeout=300
+    )
 
 
 def _write(tmp_path: Path, data: dict, name: str = "scenario.yaml") -> Path:
@@ -91,20 +93,26 @@ def test_dem_with_too_many_voids(tmp_path):
     elevation[:20, :20] = np.nan  # 4% voids, above the 1% fill limit
     np.savez(tmp_path / "dem.npz", elevation=elevation, dx=1 / 1200, dy=1 / 1200, xmin=4.3, ymax=52.05)
     scenario = _write(tmp_path, {**BASE, "terrain": {"type": "file", "path": "dem.npz"}})
-    _assert_one_line_error(_skyradar("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path), "dem.npz", "elevation")
+    _assert_one_line_error(
+        _skyradar("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path), "dem.npz", "elevation"
+    )
 
 
 def test_wrong_hgt_size(tmp_path):
     (tmp_path / "N52E004.hgt").write_bytes(b"\x00" * 100)
     scenario = _write(tmp_path, {**BASE, "terrain": {"type": "file", "path": "N52E004.hgt"}})
-    _assert_one_line_error(_skyradar("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path), "N52E004.hgt", "size")
+    _assert_one_line_error(
+        _skyradar("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path), "N52E004.hgt", "size"
+    )
 
 
 @pytest.mark.parametrize(
     ("csv", "needles"),
     [
-        ("timestamp,latitude,longitude,altitude\n0,52.0,4.36,1000\n2,52.001,4.36,1000\n1,52.002,4.36,1000\n",
-         ["track.csv", "timestamp", "backwards"]),
+        (
+            "timestamp,latitude,longitude,altitude\n0,52.0,4.36,1000\n2,52.001,4.36,1000\n1,52.002,4.36,1000\n",
+            ["track.csv", "timestamp", "backwards"],
+        ),
         ("timestamp,longitude,altitude\n0,4.36,1000\n1,4.36,1000\n", ["track.csv", "latitude"]),
     ],
 )

@@ -34,7 +34,10 @@ def test_head_on_intruder_is_aliased_to_its_closed_form_pixel(ch2):
 def test_fast_platform_wraps_to_the_right_edge(ch2):
     _, r = ch2
     assert r["wrap60_right_edge"]
-    assert abs(r["wrap60_min_velocity_mps"] - r["wrap60_expected_min_velocity_mps"]) <= 1.5 * r["doppler_bin_mps"]
+    assert (
+        abs(r["wrap60_min_velocity_mps"] - r["wrap60_expected_min_velocity_mps"])
+        <= 1.5 * r["doppler_bin_mps"]
+    )
 
 
 def test_outputs_written(ch2):

@@ -92,7 +92,10 @@ def test_robust_fit_sd_matches_scatter():
 
 
 def test_fits_fail_cleanly_on_too_few_or_degenerate_pairs():
-    for fit in (fit_thesis(np.array([600.0, 700.0]), np.array([-10.0, -20.0])), fit_robust(np.zeros(0), np.zeros(0))):
+    for fit in (
+        fit_thesis(np.array([600.0, 700.0]), np.array([-10.0, -20.0])),
+        fit_robust(np.zeros(0), np.zeros(0)),
+    ):
         assert not fit.ok and np.isnan(fit.h_m)
     assert np.isnan(state_from_abc(-1.0, 0.0, 1.0)[0])
 
@@ -141,6 +144,10 @@ def test_gps_gated_mode_uses_reference_height():
     z = truth.copy()
     z[10, 2] += 200.0
     out = filter_states(
-        t, z, np.tile([0.5, 0.5, 5.0], (t.size, 1)), KalmanSettings(gps_gate_m=150.0), reference_h_m=truth[:, 2]
+        t,
+        z,
+        np.tile([0.5, 0.5, 5.0], (t.size, 1)),
+        KalmanSettings(gps_gate_m=150.0),
+        reference_h_m=truth[:, 2],
     )
     assert not out.accepted[10] and out.accepted[11]

@@ -25,7 +25,9 @@ def flat_ground_cube(vx, vz, h, cfg=CFG, n_points=600_000, seed=0, noise=True, e
     rho_max = np.sqrt((cfg.range_limit_m + cfg.range_resolution_m) ** 2 - h * h)
     rho = rho_max * np.sqrt(rng.random(n_points))
     phi = rng.uniform(-np.radians(75.0), np.radians(75.0), n_points)
-    p = np.stack([rho * np.cos(phi), rho * np.sin(phi), np.full(n_points, h)], axis=1)  # level: fwd, right, down
+    p = np.stack(
+        [rho * np.cos(phi), rho * np.sin(phi), np.full(n_points, h)], axis=1
+    )  # level: fwd, right, down
     r = np.linalg.norm(p, axis=1)
     u = p / r[:, None]
     v_r = -(u @ np.array([vx, 0.0, vz]))
@@ -97,7 +99,9 @@ def test_bin_centre_pairing_biases_height_by_half_a_bin():
 
 def test_intruder_closing_faster_than_the_ground_is_not_the_ridge():
     k = 100  # 1500 m
-    j_ground = int(np.round(ridge_velocity(np.array([k * CFG.range_resolution_m]), 40.0, 0.0, 500.0)[0] / 0.3133))
+    j_ground = int(
+        np.round(ridge_velocity(np.array([k * CFG.range_resolution_m]), 40.0, 0.0, 500.0)[0] / 0.3133)
+    )
     j = j_ground + CFG.n_doppler // 2 - 20  # 6 m/s faster closing
     cube = flat_ground_cube(40.0, 0.0, 500.0, seed=3, extra=[(k, j, 1e-9)])
     ridge = extract_ridge(cube, CFG)
@@ -110,7 +114,10 @@ def test_intruder_closing_faster_than_the_ground_is_not_the_ridge():
 def test_sky_only_frames_are_low_quality_not_wrong():
     rng = np.random.default_rng(4)
     sigma = np.sqrt(CFG.noise_power_w / 2)
-    cube = sigma * (rng.standard_normal((CFG.n_range, CFG.n_doppler, 4)) + 1j * rng.standard_normal((CFG.n_range, CFG.n_doppler, 4)))
+    cube = sigma * (
+        rng.standard_normal((CFG.n_range, CFG.n_doppler, 4))
+        + 1j * rng.standard_normal((CFG.n_range, CFG.n_doppler, 4))
+    )
     cube[60, 100] += 1e-6  # one aircraft
     cube[61, 100] += 3e-7
     for method in ("robust", "thesis"):

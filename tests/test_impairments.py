@@ -213,3 +213,19 @@ def test_frames_helper_is_chunking_invariant():
         ]
     )
     assert np.array_equal(whole, parts)
+
+
+def test_scenario_file_impairments_section(tmp_path):
+    import yaml
+
+    from skyradar.scene.scenario import example_scenario, load_scenario
+
+    data = yaml.safe_load(example_scenario("ch2_flat_forward").read_text())
+    data["impairments"] = {"preset": "thesis_flight_look", "near_range": {"enabled": False}}
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(data))
+    built = load_scenario(tmp_path / "s.yaml").build()
+    assert built.impairments.ground_reflectivity_db == -10.0 and not built.impairments.near_range.enabled
+    data["impairments"] = {"spurs": {"spurs": [{"range_m": 5.0, "velocity_mps": 0.0}]}}
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(data))
+    with pytest.raises(InputError, match="impairments.spurs.spurs.0.power_dbm"):
+        load_scenario(tmp_path / "s.yaml")

@@ -111,24 +111,37 @@ def test_bad_input():
         process_frames(ds, SpurMap(np.zeros((5, 5)), 0.5, 1))
 
 
-def test_cli_process_writes_the_table_and_reports_bad_input(tmp_path, monkeypatch, capsys):
+def run_cli(monkeypatch, *args) -> int:
     from skyradar.cli import main
 
+    monkeypatch.setattr(sys, "argv", ["skyradar", *map(str, args)])
+    try:
+        main()
+    except SystemExit as exc:
+        return int(exc.code or 0)
+    return 0
+
+
+def test_cli_process_writes_the_table_and_reports_bad_input(tmp_path, monkeypatch, capsys):
     ds, _ = scene(n_frames=2)
     ds.to_zarr(tmp_path / "run.zarr")
     out = tmp_path / "det.parquet"
-    monkeypatch.setattr(
-        sys, "argv", ["skyradar", "process", str(tmp_path / "run.zarr"), "-o", str(out), "--json"]
-    )
-    with pytest.raises(SystemExit) as exc:
-        main()
-    assert exc.value.code in (0, None)
+    assert run_cli(monkeypatch, "process", tmp_path / "run.zarr", "-o", out, "--json") == 0
     table = pd.read_parquet(out)
     assert list(table.columns) == DETECTION_COLUMNS and len(table) == 4
-    bad = ds.isel(rx=slice(0, 3))
-    bad.to_zarr(tmp_path / "bad.zarr")
-    monkeypatch.setattr(sys, "argv", ["skyradar", "process", str(tmp_path / "bad.zarr"), "-o", str(out)])
-    with pytest.raises(SystemExit) as exc:
-        main()
-    assert exc.value.code == 2
-    assert "error:" in capsys.readouterr().err
+    assert '"detections": 4' in capsys.readouterr().out.strip().splitlines()[-1]
+    # A spur map learned from the same frames masks both objects.
+    assert (
+        run_cli(monkeypatch, "spur-map", tmp_path / "run.zarr", "-o", tmp_path / "s.npz", "--threshold", 0.4)
+        == 0
+    )
+    assert (
+        run_cli(monkeypatch, "process", tmp_path / "run.zarr", "-o", out, "--spur-map", tmp_path / "s.npz")
+        == 0
+    )
+    assert len(pd.read_parquet(out)) == 0
+    capsys.readouterr()
+    ds.isel(rx=slice(0, 3)).to_zarr(tmp_path / "bad.zarr")
+    assert run_cli(monkeypatch, "process", tmp_path / "bad.zarr", "-o", out) == 2
+    assert capsys.readouterr().err.startswith("error: ")
+    assert run_cli(monkeypatch, "process", tmp_path / "missing.zarr", "-o", out) == 2

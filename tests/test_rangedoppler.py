@@ -221,3 +221,16 @@ def test_benchmark_baseline_computes_the_same_cube():
     )
     ours = range_doppler(adc, CFG, "none", "none")
     assert np.allclose(baseline_range_doppler(adc, CFG), ours, atol=1e-5 * np.abs(ours).max())
+
+
+def test_blas_threads_are_restored_after_concurrent_calls():
+    from concurrent.futures import ThreadPoolExecutor
+
+    from threadpoolctl import threadpool_info
+
+    before = [lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"]
+    adc = tone(20, 3)
+    with ThreadPoolExecutor(3) as pool:
+        results = list(pool.map(lambda _: range_doppler(adc, CFG), range(6)))
+    assert all(np.array_equal(r, results[0]) for r in results)
+    assert [lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"] == before

@@ -22,8 +22,16 @@ SCENARIO = {
     "mount": "forward",
     "terrain": {"type": "flat", "size_m": 3000, "spacing_m": 60},
     "ownship": {"type": "straight", "start_ned_m": [0, 0, -500], "heading_deg": 0, "speed_mps": 40},
-    "intruders": [{"name": "A", "type": "encounter", "kind": "head-on", "t_cpa_s": 30, "rcs_m2": 1.0,
-                   "intruder_speed_mps": 40}],
+    "intruders": [
+        {
+            "name": "A",
+            "type": "encounter",
+            "kind": "head-on",
+            "t_cpa_s": 30,
+            "rcs_m2": 1.0,
+            "intruder_speed_mps": 40,
+        }
+    ],
     "frame_rate_hz": 5.0,
     "duration_s": 1.2,
     "simulation": {"facet_size_m": 30.0},
@@ -43,8 +51,21 @@ def test_local_cluster_writes_the_same_bytes_as_the_plain_loop(tmp_path):
 def test_dead_scheduler_gives_one_line_and_no_output(tmp_path):
     (tmp_path / "s.yaml").write_text(yaml.safe_dump(SCENARIO))
     result = subprocess.run(
-        [sys.executable, "-m", "skyradar", "simulate", "s.yaml", "-o", "run.zarr", "--scheduler", "tcp://127.0.0.1:9"],
-        cwd=tmp_path, capture_output=True, text=True, timeout=120,
+        [
+            sys.executable,
+            "-m",
+            "skyradar",
+            "simulate",
+            "s.yaml",
+            "-o",
+            "run.zarr",
+            "--scheduler",
+            "tcp://127.0.0.1:9",
+        ],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert result.returncode == 2
     assert result.stderr.strip().startswith("error: --scheduler tcp://127.0.0.1:9")

@@ -20,7 +20,9 @@ def _unit(az: float, el: float) -> np.ndarray:
     return np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)])
 
 
-def _place(config: RadarConfig, platform: PlatformState, r_m: float, az: float, el: float, v_r: float, v_perp: float):
+def _place(
+    config: RadarConfig, platform: PlatformState, r_m: float, az: float, el: float, v_r: float, v_perp: float
+):
     """Target at range r_m and antenna-frame direction (az, el) with radial velocity v_r (closed form)."""
     sim = ImageSimulator(config, noise=False)
     geom = sim.geometry(platform)
@@ -34,7 +36,12 @@ def _place(config: RadarConfig, platform: PlatformState, r_m: float, az: float, 
 
 
 def _expected_bins(config: RadarConfig, r_m: float, v_r: float) -> tuple[int, int]:
-    k = int(np.floor((r_m + v_r * config.fc_hz / (config.bandwidth_hz * config.prf_hz)) / config.range_resolution_m + 0.5))
+    k = int(
+        np.floor(
+            (r_m + v_r * config.fc_hz / (config.bandwidth_hz * config.prf_hz)) / config.range_resolution_m
+            + 0.5
+        )
+    )
     j = (int(np.floor(v_r / config.doppler_resolution_mps + 0.5)) + config.n_doppler // 2) % config.n_doppler
     return k, j
 
@@ -50,7 +57,9 @@ def _expected_bins(config: RadarConfig, r_m: float, v_r: float) -> tuple[int, in
     roll=st.floats(-0.5, 0.5),
 )
 def test_point_target_lands_in_closed_form_bin(r_m, az_deg, el_deg, v_r, yaw, pitch, roll):
-    platform = PlatformState(np.array([100.0, -50.0, -800.0]), np.array([40.0, 10.0, -2.0]), np.array([yaw, pitch, roll]))
+    platform = PlatformState(
+        np.array([100.0, -50.0, -800.0]), np.array([40.0, 10.0, -2.0]), np.array([yaw, pitch, roll])
+    )
     sim, target = _place(CFG, platform, r_m, np.radians(az_deg), np.radians(el_deg), v_r, 17.0)
     cube = sim.frame(platform, [target])
     k, j = _expected_bins(CFG, r_m, v_r)

@@ -83,7 +83,9 @@ class Mount:
         """3x3 matrix taking antenna-frame vectors to body-frame vectors."""
         from skyradar.geo import rotation_matrix
 
-        return rotation_matrix(np.radians(self.yaw_deg), np.radians(self.pitch_deg), np.radians(self.roll_deg))
+        return rotation_matrix(
+            np.radians(self.yaw_deg), np.radians(self.pitch_deg), np.radians(self.roll_deg)
+        )
 
 
 def _square_array(wavelength_m: float) -> np.ndarray:
@@ -163,13 +165,21 @@ class RadarConfig:
         rx = _square_array(self.wavelength_m) if self.rx_positions_m is None else self.rx_positions_m
         rx = np.array(rx, dtype=float)
         if rx.ndim != 2 or rx.shape[1] != 3 or rx.shape[0] < 1 or not np.all(np.isfinite(rx)):
-            raise InputError(f"radar.rx_positions_m must be an (n_rx, 3) array of finite metres, got shape {rx.shape}")
+            raise InputError(
+                f"radar.rx_positions_m must be an (n_rx, 3) array of finite metres, got shape {rx.shape}"
+            )
         if rx.shape[0] > 1 and np.ptp(rx, axis=0).max() < 1e-6:
-            raise InputError("radar.rx_positions_m: all receive antennas are at one point; no baseline for DoA")
+            raise InputError(
+                "radar.rx_positions_m: all receive antennas are at one point; no baseline for DoA"
+            )
         tx = np.zeros(3) if self.tx_position_m is None else np.array(self.tx_position_m, dtype=float)
         if tx.shape != (3,) or not np.all(np.isfinite(tx)):
             raise InputError(f"radar.tx_position_m must be 3 finite metres, got {self.tx_position_m!r}")
-        cal = np.ones(rx.shape[0], complex) if self.rx_calibration is None else np.array(self.rx_calibration, complex)
+        cal = (
+            np.ones(rx.shape[0], complex)
+            if self.rx_calibration is None
+            else np.array(self.rx_calibration, complex)
+        )
         if cal.shape != (rx.shape[0],) or not np.all(np.isfinite(cal)) or np.any(cal == 0):
             raise InputError(f"radar.rx_calibration must be {rx.shape[0]} finite non-zero complex gains")
         rx.setflags(write=False)
@@ -180,7 +190,9 @@ class RadarConfig:
         object.__setattr__(self, "rx_calibration", cal)
         object.__setattr__(self, "n_doppler", int(self.n_doppler))
         if self.range_limit_m > self.rmax_m:
-            raise InputError(f"radar.range_limit_m {self.range_limit_m} exceeds the unambiguous range {self.rmax_m:.0f} m")
+            raise InputError(
+                f"radar.range_limit_m {self.range_limit_m} exceeds the unambiguous range {self.rmax_m:.0f} m"
+            )
 
     @classmethod
     def seed_prototype(cls, **changes: Any) -> RadarConfig:
@@ -308,7 +320,9 @@ class RadarConfig:
         data = dict(data)
         ant = data.pop("antenna", None)
         if ant is not None:
-            data["antenna"] = AntennaPattern(GainCut(*ant["azimuth"]), GainCut(*ant["elevation"]), ant["combine"])
+            data["antenna"] = AntennaPattern(
+                GainCut(*ant["azimuth"]), GainCut(*ant["elevation"]), ant["combine"]
+            )
         mount = data.pop("mount", None)
         if mount is not None:
             data["mount"] = Mount(**mount)

@@ -28,7 +28,9 @@ __all__ = [
 EARTH_RADIUS_M = 6_371_008.8  # mean Earth radius, used only by the flat-earth option
 
 
-def rotation_matrix(yaw_rad: np.ndarray | float, pitch_rad: np.ndarray | float, roll_rad: np.ndarray | float) -> np.ndarray:
+def rotation_matrix(
+    yaw_rad: np.ndarray | float, pitch_rad: np.ndarray | float, roll_rad: np.ndarray | float
+) -> np.ndarray:
     """Body-to-parent rotation matrices from ZYX Euler angles (radians).
 
     Returns shape (3, 3) for scalars or (n, 3, 3) for arrays.
@@ -43,11 +45,13 @@ def rotation_matrix(yaw_rad: np.ndarray | float, pitch_rad: np.ndarray | float, 
         cy, sy = np.cos(yaw_rad), np.sin(yaw_rad)
         cp, sp = np.cos(pitch_rad), np.sin(pitch_rad)
         cr, sr = np.cos(roll_rad), np.sin(roll_rad)
-        return np.array([
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ])
+        return np.array(
+            [
+                [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                [-sp, cp * sr, cp * cr],
+            ]
+        )
     angles = np.stack(np.broadcast_arrays(yaw_rad, pitch_rad, roll_rad), axis=-1)
     return Rotation.from_euler("ZYX", angles).as_matrix()
 

@@ -44,8 +44,10 @@ def thesis_baseline_frame(
     north = (lat - lat_r) * k
     east = (lon - lon_r) * k * np.cos(np.radians(lat))
     down = alt_r - elevation_m
-    area = (k * abs(lat_axis_deg[1] - lat_axis_deg[0])) * (k * abs(lon_axis_deg[1] - lon_axis_deg[0])) * np.cos(
-        np.radians(lat)
+    area = (
+        (k * abs(lat_axis_deg[1] - lat_axis_deg[0]))
+        * (k * abs(lon_axis_deg[1] - lon_axis_deg[0]))
+        * np.cos(np.radians(lat))
     )
     ned = np.stack([north.ravel(), east.ravel(), down.ravel()], axis=1)
     rot = (rotation_matrix(*attitude_rad) @ config.mount.rotation).T
@@ -57,14 +59,25 @@ def thesis_baseline_frame(
     refl = np.clip(down / rng_m, 0.0, 1.0)  # cosine of incidence on a level facet
     az, el = np.arctan2(unit[:, 1], unit[:, 0]), np.arcsin(-unit[:, 2])
     gain_db = config.antenna.gain_db(az, el)
-    power = config.pe_w * 10 ** (gain_db / 5) * area * refl * config.wavelength_m**2 / ((4 * np.pi) ** 3 * rng_m**4)
+    power = (
+        config.pe_w
+        * 10 ** (gain_db / 5)
+        * area
+        * refl
+        * config.wavelength_m**2
+        / ((4 * np.pi) ** 3 * rng_m**4)
+    )
     v_r = unit @ (rot @ -np.asarray(velocity_ned_mps))
     k_r = np.round(rng_m / config.range_resolution_m).astype(int)
-    k_d = (np.round(v_r / config.doppler_resolution_mps).astype(int) + config.n_doppler // 2) % config.n_doppler
+    k_d = (
+        np.round(v_r / config.doppler_resolution_mps).astype(int) + config.n_doppler // 2
+    ) % config.n_doppler
     cube = np.zeros((config.n_range, config.n_doppler, config.n_rx), complex)
     inside = k_r < config.n_range
     for q in range(config.n_rx):
-        path = np.linalg.norm(ant - config.tx_position_m, axis=1) + np.linalg.norm(ant - config.rx_positions_m[q], axis=1)
+        path = np.linalg.norm(ant - config.tx_position_m, axis=1) + np.linalg.norm(
+            ant - config.rx_positions_m[q], axis=1
+        )
         values = (np.sqrt(power) * np.exp(2j * np.pi * path / config.wavelength_m))[inside]
         flat = (k_r * config.n_doppler + k_d)[inside]
         plane = cube[..., q].ravel()
@@ -117,12 +130,16 @@ def run(n_frames: int = 20, baseline_frames: int = 2, min_seconds: float = 2.0) 
     speed = 50.0
 
     def platform(i: int) -> PlatformState:
-        return PlatformState(np.array([speed * i / 9.4, 0.0, -1000.0]), np.array([speed, 0.0, 0.0]), np.zeros(3))
+        return PlatformState(
+            np.array([speed * i / 9.4, 0.0, -1000.0]), np.array([speed, 0.0, 0.0]), np.zeros(3)
+        )
 
     coarse = ImageSimulator(config, terrain, origin, facet_size_m=float("inf"), seed=1)
     fine = ImageSimulator(config, terrain, origin, seed=1)
     fps = _time_frames(lambda i: coarse.frame(platform(i), frame_index=i), n_frames, min_seconds)
-    fps_fine = _time_frames(lambda i: fine.frame(platform(i), frame_index=i), max(3, n_frames // 4), min_seconds)
+    fps_fine = _time_frames(
+        lambda i: fine.frame(platform(i), frame_index=i), max(3, n_frames // 4), min_seconds
+    )
 
     ny, nx = terrain.shape
     lat_axis = terrain.lat_deg - terrain.dy * np.arange(ny)
@@ -133,8 +150,14 @@ def run(n_frames: int = 20, baseline_frames: int = 2, min_seconds: float = 2.0) 
     def baseline(i: int) -> np.ndarray:
         lat = lat_c + platform(i).position_ned_m[0] / (EARTH_RADIUS_M * np.pi / 180)
         return thesis_baseline_frame(
-            elevation, lat_axis, lon_axis, config, (lat, lon_c, ground + 1000.0), np.array([speed, 0, 0]),
-            np.zeros(3), rng,
+            elevation,
+            lat_axis,
+            lon_axis,
+            config,
+            (lat, lon_c, ground + 1000.0),
+            np.array([speed, 0, 0]),
+            np.zeros(3),
+            rng,
         )
 
     fps_base = _time_frames(baseline, baseline_frames, 0.0)

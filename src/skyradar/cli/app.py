@@ -19,7 +19,9 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
-experiment_app = typer.Typer(help="Reproduce the thesis chapters (seed-brief.md ch2..ch7).", no_args_is_help=True)
+experiment_app = typer.Typer(
+    help="Reproduce the thesis chapters (seed-brief.md ch2..ch7).", no_args_is_help=True
+)
 bench_app = typer.Typer(help="Speed benchmarks; each prints JSON with --json.", no_args_is_help=True)
 app.add_typer(experiment_app, name="experiment")
 app.add_typer(bench_app, name="bench")

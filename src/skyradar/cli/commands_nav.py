@@ -17,13 +17,19 @@ JsonOption = Annotated[bool, typer.Option("--json", help="Print the result as JS
 
 @app.command()
 def state(
-    run: Annotated[Path, typer.Argument(help="Frames run (Zarr directory or NetCDF file), radar seeing the ground.")],
+    run: Annotated[
+        Path, typer.Argument(help="Frames run (Zarr directory or NetCDF file), radar seeing the ground.")
+    ],
     output: Annotated[Path, typer.Option("-o", "--output", help="State table to write (Parquet).")],
     method: Annotated[
-        str, typer.Option("--method", help="robust (default), thesis, or terrain (DoA + terrain memory, needs AHRS).")
+        str,
+        typer.Option(
+            "--method", help="robust (default), thesis, or terrain (DoA + terrain memory, needs AHRS)."
+        ),
     ] = "robust",
     gps_gate: Annotated[
-        bool, typer.Option("--gps-gate", help="Thesis comparison: gate on the run's own_height_agl_m (150 m).")
+        bool,
+        typer.Option("--gps-gate", help="Thesis comparison: gate on the run's own_height_agl_m (150 m)."),
     ] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -40,7 +46,9 @@ def state(
     ds = open_frames(run)
     config = radar_config_of(ds, str(run))
     table = estimate_run(ds, method=method, gps_gate=gps_gate)
-    write_table(table, output, metadata={"radar_config": config.to_json(), "source": str(run), "method": method})
+    write_table(
+        table, output, metadata={"radar_config": config.to_json(), "source": str(run), "method": method}
+    )
     good = ~table["low_quality"].to_numpy()
     result = {
         "frames": len(table),
@@ -52,7 +60,7 @@ def state(
         "output": str(output),
     }
     if "own_height_agl_m" in ds:
-        err = table["h_m"].to_numpy() - ds["own_height_agl_m"].to_numpy(float)
+        err = table["h_m"].to_numpy() - ds["own_height_agl_m"].to_numpy().astype(float)
         result["h_err_mean_m"] = float(np.nanmean(err)) if np.isfinite(err).any() else float("nan")
         result["h_err_sd_m"] = float(np.nanstd(err)) if np.isfinite(err).any() else float("nan")
     emit_result(result, as_json, "own-ship state")
@@ -60,12 +68,13 @@ def state(
 
 @experiment_app.command("ch5")
 def experiment_ch5(
-    out: Annotated[Path, typer.Option("--out", help="Output directory for table, JSON, states and figures.")] = Path(
-        "out/ch5"
-    ),
+    out: Annotated[
+        Path, typer.Option("--out", help="Output directory for table, JSON, states and figures.")
+    ] = Path("out/ch5"),
     duration_s: Annotated[float, typer.Option("--duration", help="Flight length at 1 frame/s, s.")] = 40.0,
     fast_duration_s: Annotated[
-        float, typer.Option("--fast-duration", help="Flight length at 9.4 frames/s (flat, 19.2 m), s; 0 skips.")
+        float,
+        typer.Option("--fast-duration", help="Flight length at 9.4 frames/s (flat, 19.2 m), s; 0 skips."),
     ] = 8.0,
     as_json: JsonOption = False,
 ) -> None:

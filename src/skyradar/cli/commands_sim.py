@@ -17,7 +17,12 @@ OutDir = Annotated[Path, typer.Option("--out", help="Folder for figures and tabl
 def frame_progress(total: int, label: str) -> Progress:
     """A rich progress bar on stderr for a per-frame job."""
     return Progress(
-        TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(), console=console, transient=True
+        TextColumn(label),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeRemainingColumn(),
+        console=console,
+        transient=True,
     )
 
 
@@ -25,9 +30,13 @@ def frame_progress(total: int, label: str) -> Progress:
 def simulate(
     scenario: Annotated[Path, typer.Argument(help="Scenario YAML file (see `skyradar scenarios`).")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Output run store (Zarr directory).")],
-    chunk_frames: Annotated[int, typer.Option(help="Frames per chunk: the unit of work and of resumption.")] = 16,
+    chunk_frames: Annotated[
+        int, typer.Option(help="Frames per chunk: the unit of work and of resumption.")
+    ] = 16,
     scheduler: Annotated[str | None, typer.Option(help="Address of an existing Dask scheduler.")] = None,
-    workers: Annotated[int | None, typer.Option(help="Run on a local Dask cluster of this many workers.")] = None,
+    workers: Annotated[
+        int | None, typer.Option(help="Run on a local Dask cluster of this many workers.")
+    ] = None,
 ) -> None:
     """Simulate a scenario into a frames store (range x Doppler x rx per frame, plus truth).
 
@@ -87,11 +96,15 @@ def bench_sim(
 @app.command()
 def sweep(
     scenario: Annotated[Path, typer.Argument(help="Scenario YAML file.")],
-    param: Annotated[str, typer.Option(help="Dotted path in the scenario, e.g. terrain.local_sd_m, intruders.0.rcs_m2.")],
+    param: Annotated[
+        str, typer.Option(help="Dotted path in the scenario, e.g. terrain.local_sd_m, intruders.0.rcs_m2.")
+    ],
     values: Annotated[str, typer.Option(help="Comma-separated values, e.g. 0,19.2,39.9.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Table of all runs (.csv or .parquet).")],
     scheduler: Annotated[str | None, typer.Option(help="Address of an existing Dask scheduler.")] = None,
-    workers: Annotated[int | None, typer.Option(help="Run on a local Dask cluster of this many workers.")] = None,
+    workers: Annotated[
+        int | None, typer.Option(help="Run on a local Dask cluster of this many workers.")
+    ] = None,
     json_out: JsonFlag = False,
 ) -> None:
     """Run one scenario over a list of parameter values and collect each run's detectability table."""
@@ -102,7 +115,9 @@ def sweep(
     value_list = parse_values(values)
     with frame_progress(len(value_list), f"sweep {param}") as bar:
         task = bar.add_task("runs", total=len(value_list))
-        table = run_sweep(scenario, param, value_list, scheduler, workers, progress=lambda k: bar.advance(task, k))
+        table = run_sweep(
+            scenario, param, value_list, scheduler, workers, progress=lambda k: bar.advance(task, k)
+        )
     if output.suffix.lower() == ".csv":
         tmp = output.with_name(output.name + ".tmp")
         table.to_csv(tmp, index=False)
@@ -114,3 +129,17 @@ def sweep(
         import json
 
         print(json.dumps({"param": param, "runs": json.loads(table.to_json(orient="records"))}))
+
+
+@bench_app.command("flight")
+def bench_flight(
+    json_out: JsonFlag = False,
+    frames: Annotated[int, typer.Option(help="Frames for the 1- versus 2-worker throughput runs.")] = 600,
+    long_frames: Annotated[
+        int, typer.Option(help="Also run a whole flight of this many frames (memory).")
+    ] = 0,
+) -> None:
+    """Whole-flight simulation throughput on Dask with 1 and 2 workers, and peak memory over a long flight."""
+    from skyradar.benchmarks.flight import run
+
+    emit_result(run(frames=frames, long_frames=long_frames), json_out, "bench flight")

@@ -76,6 +76,9 @@ class AlertConfig:
         Volume whose entry time is the FLARM "time to impact" (default: NMAC cylinder).
     flarm_thresholds_s : tuple of float
         Times to impact of FLARM alarm levels 1, 2, 3, s.
+    min_track_age_s : float
+        A track raises no alert before it is this old, s: a fresh track's velocity has not
+        converged, and its covariance would widen the volumes to anything.
 
     Examples
     --------
@@ -94,6 +97,7 @@ class AlertConfig:
     z_v_vel: float = 1.5
     collision_volume: WellClearVolume = field(default_factory=WellClearVolume.nmac)
     flarm_thresholds_s: tuple[float, float, float] = (18.0, 13.0, 8.0)
+    min_track_age_s: float = 2.0
 
     def __post_init__(self) -> None:
         if not 1 <= self.m <= self.n:

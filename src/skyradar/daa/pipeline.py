@@ -187,6 +187,9 @@ def alerts_from_tracks(
     raw = raw_alert_levels(s, v, config, cov_p, cov_v)
     level = np.zeros(len(df), int)
     for _, idx in df.groupby("track_id", sort=False).indices.items():
+        young = t[idx] - t[idx[0]] < config.min_track_age_s
+        raw["level"][idx[young]] = 0
+        raw["flarm_level"][idx[young]] = 0
         level[idx] = filter_alert_levels(t[idx], raw["level"][idx], config)
     ind = traffic_indication(s, own["own_yaw_rad"])
     out = pd.DataFrame(

@@ -52,7 +52,9 @@ def fit_asymptotes(ground: np.ndarray, config: RadarConfig) -> tuple[float, floa
     return float(np.sqrt(-b / a)), float(np.sqrt(a))
 
 
-def _intruder_pixel(frame: np.ndarray, config: RadarConfig, min_velocity: float) -> tuple[float, float, float]:
+def _intruder_pixel(
+    frame: np.ndarray, config: RadarConfig, min_velocity: float
+) -> tuple[float, float, float]:
     db = strength_db(frame, config)
     db[:, config.doppler_axis_mps < min_velocity] = -np.inf
     k, j = np.unravel_index(np.argmax(db), db.shape)
@@ -89,7 +91,9 @@ def run(out_dir: str | Path = "out/ch2", n_frames: int = 3) -> dict[str, Any]:
 
     fast_frame = fast["frames"][0]
     fast_ground = strength_db(fast_frame, cfg) > GROUND_DB
-    fast_ground[:, cfg.doppler_axis_mps <= cfg.doppler_resolution_mps] = False  # wrapped ground: right of zero
+    fast_ground[:, cfg.doppler_axis_mps <= cfg.doppler_resolution_mps] = (
+        False  # wrapped ground: right of zero
+    )
     wrapped = np.nonzero(fast_ground.any(axis=0))[0]
     wrap_min = float(cfg.doppler_axis_mps[wrapped.min()]) if wrapped.size else float("nan")
     wrap_expected = -60.0 * np.sqrt(1 - (1000.0 / cfg.range_axis_m[-1]) ** 2) + 2 * cfg.v_lim_mps
@@ -133,11 +137,19 @@ def run(out_dir: str | Path = "out/ch2", n_frames: int = 3) -> dict[str, Any]:
 def _figures(out: Path, slow: dict, fast: dict, result: dict[str, Any]) -> None:
     cfg = slow["built"].radar
     save_frame_figure(
-        slow["frames"][0], cfg, out / "ch2_flat_30mps.png", title="1000 m, 30 m/s:",
+        slow["frames"][0],
+        cfg,
+        out / "ch2_flat_30mps.png",
+        title="1000 m, 30 m/s:",
         markers=[(result["intruder_velocity_mps"], result["intruder_range_m"], "head-on intruder (aliased)")],
-        hlines=[(1000.0, "R = H = 1000 m")], vlines=[(-30.0, "V = -30 m/s")],
+        hlines=[(1000.0, "R = H = 1000 m")],
+        vlines=[(-30.0, "V = -30 m/s")],
     )
     save_frame_figure(
-        fast["frames"][0], cfg, out / "ch2_flat_60mps.png", title="1000 m, 60 m/s:",
-        hlines=[(1000.0, "R = H")], vlines=[(-60.0 + 2 * cfg.v_lim_mps, "V = -60 m/s, wrapped")],
+        fast["frames"][0],
+        cfg,
+        out / "ch2_flat_60mps.png",
+        title="1000 m, 60 m/s:",
+        hlines=[(1000.0, "R = H")],
+        vlines=[(-60.0 + 2 * cfg.v_lim_mps, "V = -60 m/s, wrapped")],
     )

@@ -87,7 +87,9 @@ def _raw_row(fit_like, quality: float, low: bool, h_offset: float) -> dict[str, 
     }
 
 
-def _fly(terrain, flight: Flight, config: RadarConfig, facet_size_m: float, seed: int) -> dict[str, pd.DataFrame]:
+def _fly(
+    terrain, flight: Flight, config: RadarConfig, facet_size_m: float, seed: int
+) -> dict[str, pd.DataFrame]:
     """Simulate the flight and run the three per-frame estimators; returns raw tables per method."""
     from skyradar.sim.image import ImageSimulator
 
@@ -111,6 +113,11 @@ def _fly(terrain, flight: Flight, config: RadarConfig, facet_size_m: float, seed
     return {m: pd.DataFrame(r) for m, r in rows.items()}
 
 
+def _stat(values: np.ndarray, fn) -> float:
+    finite = values[np.isfinite(values)]
+    return float(fn(finite)) if finite.size else float("nan")
+
+
 def _errors(table: pd.DataFrame, flight: Flight, warmup_s: float) -> dict[str, float]:
     keep = (flight.times_s - flight.times_s[0]) >= warmup_s
     out: dict[str, float] = {}
@@ -118,10 +125,10 @@ def _errors(table: pd.DataFrame, flight: Flight, warmup_s: float) -> dict[str, f
         h_err = table[f"h{suffix}_m"].to_numpy() - flight.height_agl_m
         vx_err = table[f"vx{suffix}_mps"].to_numpy() - flight.vx_mps
         vz_err = table[f"vz{suffix}_mps"].to_numpy() - flight.vz_mps
-        out[f"{tag}h_err_mean_m"] = float(np.nanmean(h_err[keep]))
-        out[f"{tag}h_err_sd_m"] = float(np.nanstd(h_err[keep]))
-        out[f"{tag}vx_err_sd_mps"] = float(np.nanstd(vx_err[keep]))
-        out[f"{tag}vz_err_sd_mps"] = float(np.nanstd(vz_err[keep]))
+        out[f"{tag}h_err_mean_m"] = _stat(h_err[keep], np.mean)
+        out[f"{tag}h_err_sd_m"] = _stat(h_err[keep], np.std)
+        out[f"{tag}vx_err_sd_mps"] = _stat(vx_err[keep], np.std)
+        out[f"{tag}vz_err_sd_mps"] = _stat(vz_err[keep], np.std)
     out["valid_fraction"] = float(np.mean(np.isfinite(table["h_raw_m"].to_numpy()[keep])))
     return out
 
@@ -129,7 +136,9 @@ def _errors(table: pd.DataFrame, flight: Flight, warmup_s: float) -> dict[str, f
 def _case(name, rate_hz, duration_s, config, facet_size_m, seed, warmup_s, terrain_cache):
     terrain = terrain_cache.setdefault(name, _terrain(name, 16_000.0, seed))
     times = np.arange(0.0, duration_s + 1e-9, 1.0 / rate_hz)
-    flight = terrain_following_flight(terrain, (*terrain.center_latlon, 0.0), times, height_m=700.0, smooth_m=800.0)
+    flight = terrain_following_flight(
+        terrain, (*terrain.center_latlon, 0.0), times, height_m=700.0, smooth_m=800.0
+    )
     raw = _fly(terrain, flight, config, facet_size_m, seed)
     tables, result = {}, {}
     for method, table in raw.items():
@@ -165,7 +174,9 @@ def run(
         results[key][name] = res
         tag = f"{name}_{key}"
         for method, table in tables.items():
-            table = table.assign(truth_h_m=flight.height_agl_m, truth_vx_mps=flight.vx_mps, truth_vz_mps=flight.vz_mps)
+            table = table.assign(
+                truth_h_m=flight.height_agl_m, truth_vx_mps=flight.vx_mps, truth_vz_mps=flight.vz_mps
+            )
             write_table(table, out_dir / f"state_{tag}_{method}.parquet")
         plot_case(out_dir / f"ch5_{tag}.png", flight, tables, f"{name} at {rate:g} Hz")
     table = summary_table(results, THESIS_TABLE)
@@ -173,7 +184,9 @@ def run(
     results.update(
         {
             "table": table.to_dict(orient="records"),
-            "thesis_table": {k: {"h_err_mean_m": m, "h_err_sd_m": s} for k, s_m in THESIS_TABLE.items() for m, s in [s_m]},
+            "thesis_table": {
+                k: {"h_err_mean_m": m, "h_err_sd_m": s} for k, s_m in THESIS_TABLE.items() for m, s in [s_m]
+            },
             "facet_size_m": facet_size_m,
             "duration_s": duration_s,
             "runtime_s": time.perf_counter() - t_start,

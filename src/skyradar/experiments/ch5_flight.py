@@ -58,7 +58,9 @@ def terrain_following_flight(
     north_track = (times - t_mid) * speed_mps
     pad = 3.0 * smooth_m
     grid_n = np.arange(north_track.min() - pad, north_track.max() + pad + step_m, step_m)
-    lat_g, lon_g, _ = ned_to_geodetic(np.column_stack([grid_n, np.zeros_like(grid_n), np.zeros_like(grid_n)]), lat0, lon0, alt0)
+    lat_g, lon_g, _ = ned_to_geodetic(
+        np.column_stack([grid_n, np.zeros_like(grid_n), np.zeros_like(grid_n)]), lat0, lon0, alt0
+    )
     ground = np.asarray(terrain.height_at(lat_g, lon_g), float)
     ground = np.where(np.isfinite(ground), ground, np.nanmean(ground))
     smooth = gaussian_filter1d(ground, smooth_m / step_m, mode="nearest")
@@ -68,7 +70,9 @@ def terrain_following_flight(
     alt = np.interp(north_track, grid_n, alt_g)
     climb = np.gradient(alt_g, step_m) * speed_mps
     vz = -np.interp(north_track, grid_n, climb)
-    lat, lon, _ = ned_to_geodetic(np.column_stack([north_track, np.zeros_like(times), np.zeros_like(times)]), lat0, lon0, alt0)
+    lat, lon, _ = ned_to_geodetic(
+        np.column_stack([north_track, np.zeros_like(times), np.zeros_like(times)]), lat0, lon0, alt0
+    )
     below = np.asarray(terrain.height_at(lat, lon), float)
     alt = alt - np.mean(alt - below) + height_m  # exact mean height at the frame times
     hagl = alt - below

@@ -13,15 +13,22 @@ import pandas as pd  # noqa: E402
 
 __all__ = ["plot_case", "summary_table"]
 
-_STYLE = {"thesis": ("tab:red", "thesis"), "robust": ("tab:blue", "robust"), "terrain": ("tab:green", "terrain-aware")}
+_STYLE = {
+    "thesis": ("tab:red", "thesis"),
+    "robust": ("tab:blue", "robust"),
+    "terrain": ("tab:green", "terrain-aware"),
+}
 
 
 def plot_case(path: Path, flight, tables: dict[str, pd.DataFrame], title: str) -> Path:
     """Three panels (H, V_X, V_Z) of filtered estimates (lines) and raw estimates (dots) vs truth."""
     fig, axes = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
     truth = (flight.height_agl_m, flight.vx_mps, flight.vz_mps)
-    names = (("h_m", "h_raw_m", "height above ground [m]"), ("vx_mps", "vx_raw_mps", "V_X [m/s]"),
-             ("vz_mps", "vz_raw_mps", "V_Z (down) [m/s]"))
+    names = (
+        ("h_m", "h_raw_m", "height above ground [m]"),
+        ("vx_mps", "vx_raw_mps", "V_X [m/s]"),
+        ("vz_mps", "vz_raw_mps", "V_Z (down) [m/s]"),
+    )
     for ax, (col, raw, label), true in zip(axes, names, truth, strict=True):
         ax.plot(flight.times_s, true, "k-", lw=2, label="truth")
         for method, table in tables.items():
@@ -48,6 +55,14 @@ def summary_table(results: dict[str, Any], thesis: dict[str, tuple[float, float]
         for terrain, per_method in per_terrain.items():
             for method, err in per_method.items():
                 ref = thesis.get(terrain, (float("nan"), float("nan")))
-                rows.append({"rate": rate, "terrain": terrain, "method": method, **err,
-                             "thesis_h_err_mean_m": ref[0], "thesis_h_err_sd_m": ref[1]})
+                rows.append(
+                    {
+                        "rate": rate,
+                        "terrain": terrain,
+                        "method": method,
+                        **err,
+                        "thesis_h_err_mean_m": ref[0],
+                        "thesis_h_err_sd_m": ref[1],
+                    }
+                )
     return pd.DataFrame(rows)

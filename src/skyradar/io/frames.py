@@ -7,8 +7,8 @@ and, when simulated, own-ship truth on ``time`` and intruder truth on ``(time, t
 
 Writers never leave a half-written run under the final name: :class:`FrameStoreWriter` writes
 into ``NAME.partial`` chunk by chunk along time, marks each finished chunk, and renames the
-store when the last chunk is in (done marks sit in ``NAME.partial.done``). Re-running with the same fingerprint resumes: finished chunks
-are skipped.
+store when the last chunk is in (done marks sit in ``NAME.partial.done``). Re-running with the
+same fingerprint resumes: finished chunks are skipped.
 """
 
 from __future__ import annotations
@@ -71,7 +71,11 @@ TARGET_VARS: dict[str, tuple[str, str]] = {
 
 def _axis_coords(config: RadarConfig, times_s: np.ndarray) -> dict[str, Any]:
     return {
-        "time": ("time", np.asarray(times_s, float), {"units": "s", "long_name": "frame time from scenario start"}),
+        "time": (
+            "time",
+            np.asarray(times_s, float),
+            {"units": "s", "long_name": "frame time from scenario start"},
+        ),
         "range": ("range", config.range_axis_m, {"units": "m", "long_name": "range bin centre"}),
         "doppler": (
             "doppler",
@@ -115,7 +119,9 @@ def frames_dataset(
     """
     expected = (len(times_s), config.n_range, config.n_doppler, config.n_rx)
     if tuple(iq.shape) != expected:
-        raise InputError(f"frames: iq has shape {tuple(iq.shape)}, expected (time, range, doppler, rx) = {expected}")
+        raise InputError(
+            f"frames: iq has shape {tuple(iq.shape)}, expected (time, range, doppler, rx) = {expected}"
+        )
     data_vars: dict[str, Any] = {
         "iq": (("time", "range", "doppler", "rx"), iq, {"long_name": "complex pixel, |iq|^2 in W"}),
     }
@@ -128,7 +134,10 @@ def frames_dataset(
             units, desc = TARGET_VARS[name]
             data_vars[name] = (("time", "target"), np.asarray(values), {"units": units, "long_name": desc})
         n_targets = np.asarray(next(iter(targets.values()))).shape[1]
-        coords["target"] = ("target", np.array(target_names or [f"T{i}" for i in range(n_targets)], dtype=object))
+        coords["target"] = (
+            "target",
+            np.array(target_names or [f"T{i}" for i in range(n_targets)], dtype=object),
+        )
     all_attrs = {"radar_config": config.to_json(), "skyradar_format": "frames/1"}
     all_attrs.update(attrs or {})
     return xr.Dataset(data_vars, coords=coords, attrs=all_attrs)
@@ -159,10 +168,7 @@ def open_frames(path: str | Path) -> xr.Dataset:
         hint = f" (an unfinished run is at {partial}; rerun to resume)" if partial.exists() else ""
         raise InputError(f"{path}: no such run{hint}")
     try:
-        if path.is_dir():
-            ds = _open_zarr(path)
-        else:
-            ds = xr.open_dataset(path)
+        ds = _open_zarr(path) if path.is_dir() else xr.open_dataset(path)
     except Exception as exc:  # noqa: BLE001 - any reader failure becomes one clear line
         raise InputError(f"{path}: cannot open as a frames store ({type(exc).__name__}: {exc})") from exc
     if "iq" not in ds:
@@ -171,7 +177,9 @@ def open_frames(path: str | Path) -> xr.Dataset:
     if ds.sizes.get("time", 0) == 0:
         raise InputError(f"{path}: empty run (0 frames)")
     if ds.sizes.get("rx") != config.n_rx:
-        raise InputError(f"{path}: field 'rx' has {ds.sizes.get('rx')} antennas, radar_config has {config.n_rx}")
+        raise InputError(
+            f"{path}: field 'rx' has {ds.sizes.get('rx')} antennas, radar_config has {config.n_rx}"
+        )
     for dim, n in (("range", config.n_range), ("doppler", config.n_doppler)):
         if ds.sizes.get(dim) != n:
             raise InputError(f"{path}: dimension '{dim}' is {ds.sizes.get(dim)}, radar_config needs {n}")
@@ -256,4 +264,3 @@ class FrameStoreWriter:
             shutil.rmtree(self.path) if self.path.is_dir() else self.path.unlink()
         self.partial.rename(self.path)
         return self.path
-

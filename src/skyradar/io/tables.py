@@ -53,7 +53,9 @@ def read_table(path: str | Path, required: Iterable[str] = (), sort_by: str | No
         back = (values[1:] < values[:-1]).nonzero()[0]
         if back.size:
             i = int(back[0]) + 1
-            raise InputError(f"{path}: field '{sort_by}' goes backwards at row {i} ({values[i - 1]} -> {values[i]})")
+            raise InputError(
+                f"{path}: field '{sort_by}' goes backwards at row {i} ({values[i - 1]} -> {values[i]})"
+            )
     return df
 
 

@@ -36,7 +36,14 @@ from skyradar.nav.inversion import StateFit, fit_robust, fit_thesis
 from skyradar.nav.kalman_state import KalmanSettings, filter_states
 from skyradar.nav.ridge import Ridge, extract_ridge
 
-__all__ = ["METHODS", "FrameEstimate", "estimate_frame", "mount_height_offset_m", "filter_table", "estimate_run"]
+__all__ = [
+    "METHODS",
+    "FrameEstimate",
+    "estimate_frame",
+    "mount_height_offset_m",
+    "filter_table",
+    "estimate_run",
+]
 
 METHODS = ("thesis", "robust")
 STATE_COLUMNS = ("vx", "vz", "h")
@@ -135,9 +142,9 @@ def filter_table(
 
     ``table`` holds per-frame ``time_s`` and raw ``vx_raw_mps, vz_raw_mps, h_raw_m`` with SDs.
     """
-    raw = table[["vx_raw_mps", "vz_raw_mps", "h_raw_m"]].to_numpy(float)
-    raw_sd = table[["vx_raw_sd_mps", "vz_raw_sd_mps", "h_raw_sd_m"]].to_numpy(float)
-    out = filter_states(table["time_s"].to_numpy(float), raw, raw_sd, settings, reference_h_m)
+    raw = table[["vx_raw_mps", "vz_raw_mps", "h_raw_m"]].to_numpy().astype(float)
+    raw_sd = table[["vx_raw_sd_mps", "vz_raw_sd_mps", "h_raw_sd_m"]].to_numpy().astype(float)
+    out = filter_states(table["time_s"].to_numpy().astype(float), raw, raw_sd, settings, reference_h_m)
     table = table.copy()
     for i, (name, unit) in enumerate(zip(STATE_COLUMNS, ("mps", "mps", "m"), strict=True)):
         table[f"{name}_{unit}"] = out.state[:, i]
@@ -154,7 +161,7 @@ def _attitude(ds: xr.Dataset, i: int) -> tuple[float, float, float]:
 def _frame_rows(ds: xr.Dataset, config: RadarConfig, method: str, progress) -> list[dict]:
     from skyradar.nav.terrain_aware import TerrainAwareEstimator
 
-    times = ds["time"].to_numpy(float)
+    times = ds["time"].to_numpy().astype(float)
     aware = TerrainAwareEstimator(config) if method == "terrain" else None
     rows, prior = [], None
     for i in range(times.size):
@@ -217,6 +224,6 @@ def estimate_run(
     if gps_gate:
         if "own_height_agl_m" not in ds:
             raise InputError("frames: field 'own_height_agl_m' is needed for the GPS gate but missing")
-        reference = ds["own_height_agl_m"].to_numpy(float)
+        reference = ds["own_height_agl_m"].to_numpy().astype(float)
         settings = KalmanSettings(**{**settings.__dict__, "gps_gate_m": 150.0})
     return filter_table(table, settings, reference)

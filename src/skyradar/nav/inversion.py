@@ -228,11 +228,18 @@ def fit_ransac(
     keep = np.zeros(r.size, bool)
     keep[idx[best]] = True
     fit = fit_thesis(np.where(keep, r, np.nan), v)
-    return StateFit(fit.vx_mps, fit.vz_mps, fit.h_m, fit.vx_sd_mps, fit.vz_sd_mps, fit.h_sd_m, keep, fit.rms_mps)
+    return StateFit(
+        fit.vx_mps, fit.vz_mps, fit.h_m, fit.vx_sd_mps, fit.vz_sd_mps, fit.h_sd_m, keep, fit.rms_mps
+    )
 
 
 def _residuals(
-    x: np.ndarray, r: np.ndarray, v: np.ndarray, sigma_v: float, sigma_r: float, prior: np.ndarray | None = None
+    x: np.ndarray,
+    r: np.ndarray,
+    v: np.ndarray,
+    sigma_v: float,
+    sigma_r: float,
+    prior: np.ndarray | None = None,
 ) -> np.ndarray:
     if prior is not None:
         # Prior rows (x - mean) / sd for the components with a finite prior SD.

@@ -100,10 +100,14 @@ def power_image(iq: np.ndarray) -> np.ndarray:
         return np.sum(arr.real.astype(np.float64) ** 2 + arr.imag.astype(np.float64) ** 2, axis=2)
     if arr.ndim == 2 and not np.iscomplexobj(arr):
         return arr.astype(np.float64)
-    raise InputError(f"frame: expected (range, doppler, rx) complex or (range, doppler) power, got shape {arr.shape}")
+    raise InputError(
+        f"frame: expected (range, doppler, rx) complex or (range, doppler) power, got shape {arr.shape}"
+    )
 
 
-def noise_floor_w(power: np.ndarray, n_rx: int, thermal_w: float | None = None, quantile: float = 0.2) -> float:
+def noise_floor_w(
+    power: np.ndarray, n_rx: int, thermal_w: float | None = None, quantile: float = 0.2
+) -> float:
     """Mean noise power per pixel of a summed power image, W.
 
     The ``quantile`` of the image divided by the same quantile of a Gamma(n_rx) variable
@@ -199,7 +203,9 @@ def extract_ridge(
     """
     power = power_image(frame)
     if power.shape != (config.n_range, config.n_doppler):
-        raise InputError(f"frame: shape {power.shape} does not match radar ({config.n_range}, {config.n_doppler})")
+        raise InputError(
+            f"frame: shape {power.shape} does not match radar ({config.n_range}, {config.n_doppler})"
+        )
     n_rx = frame.shape[2] if np.asarray(frame).ndim == 3 else config.n_rx
     noise = noise_floor_w(power, n_rx, config.noise_power_w)
     mask = power > noise * 10 ** (threshold_db / 10.0)

@@ -88,7 +88,8 @@ def ground_points(
     --------
     >>> v = np.array([50.0, 0.0, 0.0])
     >>> u = np.array([[np.cos(0.5), 0.0, np.sin(0.5)]])
-    >>> np.round(ground_points(np.array([1000.0]), -u @ v, u + [0.0, 0.0, 0.02], v, np.array([0.05])), 1).tolist()
+    >>> p = ground_points(np.array([1000.0]), -u @ v, u + [0.0, 0.0, 0.02], v, np.array([0.05]))
+    >>> np.round(p, 1).tolist()
     [[877.5, 0.0, 479.5]]
     """
     u = np.asarray(u_level, float)
@@ -138,7 +139,9 @@ class TerrainAwareEstimator:
         Fewer ridge points or fewer points in the window: low-quality frame, NaN estimates.
     """
 
-    def __init__(self, config: RadarConfig, memory_s: float = 40.0, window_m: float = 150.0, min_points: int = 12):
+    def __init__(
+        self, config: RadarConfig, memory_s: float = 40.0, window_m: float = 150.0, min_points: int = 12
+    ):
         self.config = config
         self.memory_s = float(memory_s)
         self.window_m = float(window_m)
@@ -184,7 +187,9 @@ class TerrainAwareEstimator:
             return failed
         u_ant = u_level[inl] @ ant_to_level  # back to antenna angles for the bound
         snr_db = 10.0 * np.log10(np.maximum(10.0 ** (ridge.snr_db[inl] / 10.0) - 1.0, 1e-3))
-        _, sd_el = doa_crlb(snr_db, np.arctan2(u_ant[:, 1], u_ant[:, 0]), np.arcsin(-u_ant[:, 2]), self.config)
+        _, sd_el = doa_crlb(
+            snr_db, np.arctan2(u_ant[:, 1], u_ant[:, 0]), np.arcsin(-u_ant[:, 2]), self.config
+        )
         pts = ground_points(
             ridge.range_m[inl], ridge.radial_velocity_mps[inl], u_level[inl], vel, np.maximum(sd_el, 0.003)
         )
@@ -196,10 +201,21 @@ class TerrainAwareEstimator:
         sds = np.sqrt(np.clip(np.diag(cov), 0.0, None))
         quality = fit_quality * min(1.0, n_win / self.min_points)
         if not (np.isfinite(h) and h > 0):
-            return TerrainEstimate(vx, vz, float("nan"), float(sds[0]), float(sds[2]), float("nan"), quality, True,
-                                   int(inl.sum()))
+            return TerrainEstimate(
+                vx,
+                vz,
+                float("nan"),
+                float(sds[0]),
+                float(sds[2]),
+                float("nan"),
+                quality,
+                True,
+                int(inl.sum()),
+            )
         self.prior = (vx, vz, h)
-        return TerrainEstimate(vx, vz, h, float(sds[0]), float(sds[2]), h_sd, quality, quality < 0.3, int(inl.sum()))
+        return TerrainEstimate(
+            vx, vz, h, float(sds[0]), float(sds[2]), h_sd, quality, quality < 0.3, int(inl.sum())
+        )
 
     def _height_below(self) -> tuple[float, float, int]:
         pts = np.concatenate([p for _, p in self._points])

@@ -24,8 +24,8 @@ from __future__ import annotations
 from functools import lru_cache
 from typing import Literal
 
+import cv2
 import numpy as np
-from numba import njit
 from scipy import integrate, ndimage, optimize, stats
 
 from skyradar.errors import InputError
@@ -83,51 +83,49 @@ def cfar_factor(
 
 
 def _pad(image: np.ndarray, pr: int, pd: int) -> np.ndarray:
-    # Doppler wraps (aliasing); range edges reflect.
-    image = np.concatenate([image[:, -pd:], image, image[:, :pd]], axis=1) if pd else image
-    return np.pad(image, ((pr, pr), (0, 0)), mode="reflect") if pr else image
+    """Pad by ``pr`` rows (range edges reflect) and ``pd`` columns (Doppler wraps, aliasing)."""
+    n_r, n_d = image.shape
+    out = np.empty((n_r + 2 * pr, n_d + 2 * pd), image.dtype)
+    out[pr : pr + n_r, pd : pd + n_d] = image
+    if pd:
+        out[pr : pr + n_r, :pd] = image[:, n_d - pd :]
+        out[pr : pr + n_r, pd + n_d :] = image[:, :pd]
+    if pr:
+        out[:pr] = out[2 * pr : pr : -1]
+        out[pr + n_r :] = out[pr + n_r - 2 : n_r - 2 : -1]
+    return out
 
 
-@njit(cache=True)
-def _ca_kernel(
-    power: np.ndarray, valid: np.ndarray, gr: int, gd: int, hr: int, hd: int, alpha: np.ndarray
+def _box_sum(padded: np.ndarray, hr: int, hd: int, pr: int, pd: int, shape: tuple[int, int]) -> np.ndarray:
+    s = cv2.boxFilter(
+        padded, cv2.CV_32F, (2 * hd + 1, 2 * hr + 1), normalize=False, borderType=cv2.BORDER_REPLICATE
+    )
+    return s[pr : pr + shape[0], pd : pd + shape[1]]
+
+
+def _ca(
+    power: np.ndarray,
+    exclude: np.ndarray | None,
+    guard: tuple[int, int],
+    half: tuple[int, int],
+    table: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Cell-averaging CFAR from summed-area tables; Doppler wraps, range reflects.
-
-    ``valid`` weights pixels into the training sums (0 for excluded pixels); ``alpha[n]`` is the
-    threshold factor for n training cells.
-    """
-    n_r, n_d = power.shape
-    rows, cols = n_r + 2 * hr, n_d + 2 * hd
-    sp = np.zeros((rows + 1, cols + 1))
-    sv = np.zeros((rows + 1, cols + 1))
-    for a in range(rows):
-        i = a - hr
-        i = -i if i < 0 else (2 * (n_r - 1) - i if i >= n_r else i)
-        acc_p = 0.0
-        acc_v = 0.0
-        for b in range(cols):
-            j = (b - hd) % n_d
-            acc_p += power[i, j] * valid[i, j]
-            acc_v += valid[i, j]
-            sp[a + 1, b + 1] = sp[a, b + 1] + acc_p
-            sv[a + 1, b + 1] = sv[a, b + 1] + acc_v
-    hits = np.zeros((n_r, n_d), np.bool_)
-    noise = np.empty((n_r, n_d), np.float32)
-    n_max = alpha.size - 1
-    for i in range(n_r):
-        for j in range(n_d):
-            r0, r1, c0, c1 = i, i + 2 * hr + 1, j, j + 2 * hd + 1
-            q0, q1, k0, k1 = i + hr - gr, i + hr + gr + 1, j + hd - gd, j + hd + gd + 1
-            tot = sp[r1, c1] - sp[r0, c1] - sp[r1, c0] + sp[r0, c0]
-            tot -= sp[q1, k1] - sp[q0, k1] - sp[q1, k0] + sp[q0, k0]
-            cnt = sv[r1, c1] - sv[r0, c1] - sv[r1, c0] + sv[r0, c0]
-            cnt -= sv[q1, k1] - sv[q0, k1] - sv[q1, k0] + sv[q0, k0]
-            n = min(max(int(cnt + 0.5), 0), n_max)
-            level = max(tot / max(cnt, 1.0), 1e-38)
-            noise[i, j] = level
-            hits[i, j] = n > 0 and valid[i, j] > 0 and power[i, j] > alpha[n] * level
-    return hits, noise
+    (gr, gd), (hr, hd) = guard, half
+    n_train = table.size - 1
+    if exclude is None:
+        padded = _pad(power, hr, hd)
+        total = _box_sum(padded, hr, hd, hr, hd, power.shape) - _box_sum(padded, gr, gd, hr, hd, power.shape)
+        noise = np.maximum(total / np.float32(n_train), np.float32(1e-38))
+        return power > table[n_train] * noise, noise
+    if exclude.shape != power.shape:
+        raise InputError(f"cfar: field 'exclude' has shape {exclude.shape}, image has {power.shape}")
+    valid = (~np.asarray(exclude, bool)).astype(np.float32)
+    p_pad, v_pad = _pad(power * valid, hr, hd), _pad(valid, hr, hd)
+    total = _box_sum(p_pad, hr, hd, hr, hd, power.shape) - _box_sum(p_pad, gr, gd, hr, hd, power.shape)
+    count = _box_sum(v_pad, hr, hd, hr, hd, power.shape) - _box_sum(v_pad, gr, gd, hr, hd, power.shape)
+    n_cells = np.clip(np.rint(count).astype(np.int64), 0, n_train)
+    noise = np.maximum(total / np.maximum(count, np.float32(1.0)), np.float32(1e-38))
+    return (power > table[n_cells] * noise) & (valid > 0) & (n_cells > 0), noise
 
 
 def cfar_2d(
@@ -175,13 +173,8 @@ def cfar_2d(
         raise InputError(f"cfar: guard {guard} / train {train} do not fit an image of shape {power.shape}")
     n_train = (2 * hr + 1) * (2 * hd + 1) - (2 * gr + 1) * (2 * gd + 1)
     if kind == "ca":
-        valid = np.ones(power.shape, np.float32)
-        if exclude is not None:
-            if exclude.shape != power.shape:
-                raise InputError(f"cfar: field 'exclude' has shape {exclude.shape}, image has {power.shape}")
-            valid = (~np.asarray(exclude, bool)).astype(np.float32)
         table = _ca_factor_table(float(pfa), n_train, int(n_integrated))
-        return _ca_kernel(np.ascontiguousarray(power), valid, gr, gd, hr, hd, table)
+        return _ca(power, exclude, (gr, gd), (hr, hd), table)
     alpha = cfar_factor(pfa, n_train, n_integrated, kind, rank)
     if exclude is not None:
         # OS-CFAR: fill excluded pixels with the image median, a noise-like value.
@@ -198,7 +191,5 @@ def cfar_2d(
 
 @lru_cache(maxsize=16)
 def _ca_factor_table(pfa: float, n_max: int, n_integrated: int) -> np.ndarray:
-    table = np.full(n_max + 1, np.inf, np.float32)
-    for n in range(1, n_max + 1):
-        table[n] = cfar_factor(pfa, n, n_integrated)
-    return table
+    n = np.arange(1, n_max + 1)
+    return np.r_[np.inf, stats.f.isf(pfa, 2 * n_integrated, 2 * n * n_integrated)].astype(np.float32)

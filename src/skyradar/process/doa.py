@@ -179,10 +179,24 @@ def array_geometry(
     return _geometry(rx.tobytes(), rx.shape[0], float(config.wavelength_m), facing, _fov_half_angle(config))
 
 
+_FOV_CACHE: dict[int, tuple[object, float]] = {}
+
+
 def _fov_half_angle(config: RadarConfig, max_loss_db: float = 6.0) -> float:
     """Widest off-boresight angle (rad) at which either principal cut is within ``max_loss_db`` of peak."""
-    angle = np.radians(np.arange(0.0, 90.5, 0.5))
     ant = config.antenna
+    cached = _FOV_CACHE.get(id(ant))
+    if cached is not None and cached[0] is ant:  # the pattern is immutable; keyed by identity
+        return cached[1]
+    half = _fov_of_pattern(ant, max_loss_db)
+    if len(_FOV_CACHE) > 64:
+        _FOV_CACHE.clear()
+    _FOV_CACHE[id(ant)] = (ant, half)
+    return half
+
+
+def _fov_of_pattern(ant, max_loss_db: float) -> float:
+    angle = np.radians(np.arange(0.0, 90.5, 0.5))
     half = 0.0
     for cut in (
         ant.gain_db(angle, 0.0),

@@ -25,8 +25,10 @@ that stay in cache, spread over ``workers`` threads, with BLAS held to one threa
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import threading
+from collections.abc import Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
 from functools import lru_cache
 from typing import Any
 
@@ -253,7 +255,7 @@ class RangeDopplerProcessor:
 
         # BLAS threads spinning beside ours (or beside other processes) cost more than they
         # give on small machines: one BLAS thread per worker, parallel over blocks instead.
-        with _blas_controller().limit(limits=1, user_api="blas"):
+        with _one_blas_thread():
             if self.workers > 1 and len(blocks) > 1:
                 list(_thread_pool(self.workers).map(job, blocks))
             else:
@@ -287,9 +289,29 @@ _BLOCK_CHIRPS = 125  # 2 MB of complex64 ADC rows: stays in cache from window to
 
 @lru_cache(maxsize=1)
 def _blas_controller():
-    from threadpoolctl import ThreadpoolController
+    from threadpoolctl import ThreadpoolController  # numpy's BLAS is loaded by now
 
     return ThreadpoolController()
+
+
+_BLAS_LOCK = threading.Lock()
+_BLAS_USERS = [0, None]  # callers inside, threadpoolctl limiter of the first one
+
+
+@contextmanager
+def _one_blas_thread() -> Iterator[None]:
+    """BLAS limited to one thread while any caller (from any thread) is inside."""
+    with _BLAS_LOCK:
+        if _BLAS_USERS[0] == 0:
+            _BLAS_USERS[1] = _blas_controller().limit(limits=1, user_api="blas")
+        _BLAS_USERS[0] += 1
+    try:
+        yield
+    finally:
+        with _BLAS_LOCK:
+            _BLAS_USERS[0] -= 1
+            if _BLAS_USERS[0] == 0:
+                _BLAS_USERS[1].restore_original_limits()
 
 
 @lru_cache(maxsize=4)

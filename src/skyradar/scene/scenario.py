@@ -83,6 +83,7 @@ class BuiltScenario:
     times_s: np.ndarray
     sim_options: dict[str, Any] = field(default_factory=dict)
     source: Path | None = None
+    impairments: Any = None  # skyradar.sim.impairments.ImpairmentConfig or None
 
 
 def _describe(value: Any) -> str:
@@ -336,6 +337,7 @@ class Scenario:
             times_s=times,
             sim_options=m.simulation.model_dump(),
             source=self.source,
+            impairments=m.impairments,
         )
 
 

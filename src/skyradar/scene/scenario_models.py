@@ -26,6 +26,7 @@ are in the field names: metres, m/s, degrees, seconds, Hz. Positions ``*_ned_m``
     start_s: 0
     simulation: {facet_size_m: 30, reflectivity: cosine, occlusion: true, noise: true,
                  flat_earth: false, range_doppler_coupling: true, seed: 0}
+    impairments: {preset: thesis_flight_look}              # optional; see sim/impairments.py
 
 Flight parameters are those of :mod:`skyradar.scene.flights` (``straight``, ``circle``,
 ``circuit``, ``encounter``); file flights take ``path``, ``icao24`` and ``time_zero_s``.
@@ -36,6 +37,8 @@ from __future__ import annotations
 from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+
+from skyradar.sim.impairments import ImpairmentConfig
 
 __all__ = [
     "TAGS",
@@ -283,3 +286,4 @@ class ScenarioModel(_Model):
     duration_s: Positive
     start_s: Finite = 0.0
     simulation: SimulationModel = Field(default_factory=SimulationModel)
+    impairments: ImpairmentConfig | None = None  # skyradar.sim.impairments; e.g. {preset: thesis_flight_look}

@@ -22,8 +22,12 @@ def connect(scheduler: str | None, workers: int | None, timeout_s: float = 10.0)
         try:
             return Client(scheduler, timeout=timeout_s)
         except (OSError, TimeoutError) as exc:
-            raise InputError(f"--scheduler {scheduler}: no Dask scheduler answered within {timeout_s:.0f} s ({exc})") from exc
-    cluster = LocalCluster(n_workers=int(workers or 2), threads_per_worker=1, processes=True, dashboard_address=None)
+            raise InputError(
+                f"--scheduler {scheduler}: no Dask scheduler answered within {timeout_s:.0f} s ({exc})"
+            ) from exc
+    cluster = LocalCluster(
+        n_workers=int(workers or 2), threads_per_worker=1, processes=True, dashboard_address=None
+    )
     return Client(cluster)
 
 
@@ -42,12 +46,14 @@ def map_chunks(
     chunks: Sequence[int] = (),
     progress: Callable[[int], None] | None = None,
 ) -> None:
-    """Run ``job(*args, index)`` for every chunk index on ``client``; ``progress(frames)`` as each finishes."""
+    """Run ``job(*args, index)`` for each chunk index on ``client``; ``progress(frames)`` per chunk."""
     from distributed import as_completed
 
     try:
         futures = []
-        scattered = [client.scatter(a, broadcast=True) if not isinstance(a, str | int | float) else a for a in args]
+        scattered = [
+            client.scatter(a, broadcast=True) if not isinstance(a, str | int | float) else a for a in args
+        ]
         futures = [client.submit(job, *scattered, index, pure=False) for index in chunks]
         for future in as_completed(futures):
             frames = future.result()

@@ -30,7 +30,12 @@ from skyradar.geo import direction_angles, ned_rotation_to, ned_to_geodetic, rot
 from skyradar.sim._terrain_kernel import horizon_map, terrain_returns
 
 __all__ = [
-    "PlatformState", "PointTarget", "AntennaGeometry", "ImageSimulator", "REFLECTIVITY_MODELS", "thermal_noise",
+    "PlatformState",
+    "PointTarget",
+    "AntennaGeometry",
+    "ImageSimulator",
+    "REFLECTIVITY_MODELS",
+    "thermal_noise",
 ]
 
 REFLECTIVITY_MODELS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
@@ -158,10 +163,14 @@ class ImageSimulator:
             body_to_ned = body_to_local
         else:
             # Attitude is relative to the local vertical at the aircraft, not at the origin.
-            body_to_ned = ned_rotation_to(self.origin[0], self.origin[1], float(lat), float(lon)).T @ body_to_local
+            body_to_ned = (
+                ned_rotation_to(self.origin[0], self.origin[1], float(lat), float(lon)).T @ body_to_local
+            )
         ant_to_ned = body_to_ned @ self.config.mount.rotation
         origin = pos + body_to_ned @ np.asarray(self.config.mount.position_m)
-        return AntennaGeometry(origin, ant_to_ned.T, np.asarray(platform.velocity_ned_mps, float), float(lat), float(lon))
+        return AntennaGeometry(
+            origin, ant_to_ned.T, np.asarray(platform.velocity_ned_mps, float), float(lat), float(lon)
+        )
 
     # ---- one frame --------------------------------------------------------------------------
     def frame(
@@ -203,7 +212,17 @@ class ImageSimulator:
             # Each horizon sample stands for a patch this wide (see horizon_map).
             sample_m = max(self.terrain.spacing_m[0] / h_nsub[0], self.terrain.spacing_m[1] / h_nsub[1])
             horizon = horizon_map(
-                p_ned, geom.rot_ned_to_ant, h_nsub[0], h_nsub[1], r_lim, az_bin, h_bin, n_az, n_h, n_blocks, sample_m
+                p_ned,
+                geom.rot_ned_to_ant,
+                h_nsub[0],
+                h_nsub[1],
+                r_lim,
+                az_bin,
+                h_bin,
+                n_az,
+                n_h,
+                n_blocks,
+                sample_m,
             )
         else:
             horizon, az_bin, h_bin = np.zeros((1, 1), np.float32), 1.0, 1.0
@@ -238,7 +257,11 @@ class ImageSimulator:
 
     def _crop(self, geom: AntennaGeometry) -> tuple[slice, slice] | None:
         # Crop around the platform; the mount offset (metres) is added to the reach.
-        reach = self.config.range_limit_m + 2 * self._facet_m + float(np.linalg.norm(self.config.mount.position_m))
+        reach = (
+            self.config.range_limit_m
+            + 2 * self._facet_m
+            + float(np.linalg.norm(self.config.mount.position_m))
+        )
         rows, cols = self.terrain.crop_window(geom.lat_deg, geom.lon_deg, reach)
         if rows.stop - rows.start < 2 or cols.stop - cols.start < 2:
             return None

@@ -19,9 +19,24 @@ import xarray as xr
 from skyradar.io.frames import FrameStoreWriter, frames_dataset
 from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
 
-__all__ = ["make_simulator", "scenario_truth", "simulate_frames", "simulate", "simulate_to_zarr", "fingerprint"]
+__all__ = [
+    "make_simulator",
+    "scenario_truth",
+    "simulate_frames",
+    "simulate",
+    "simulate_to_zarr",
+    "fingerprint",
+]
 
-_SIM_KEYS = ("facet_size_m", "reflectivity", "occlusion", "noise", "flat_earth", "range_doppler_coupling", "seed")
+_SIM_KEYS = (
+    "facet_size_m",
+    "reflectivity",
+    "occlusion",
+    "noise",
+    "flat_earth",
+    "range_doppler_coupling",
+    "seed",
+)
 
 
 def make_simulator(built) -> ImageSimulator:
@@ -75,17 +90,38 @@ def scenario_truth(built, simulator: ImageSimulator | None = None) -> tuple[dict
     if built.terrain is not None:
         agl = own.alt_m - built.terrain.height_at(own.lat_deg, own.lon_deg)
     ownship = {
-        "own_north_m": own.position_ned_m[:, 0], "own_east_m": own.position_ned_m[:, 1],
-        "own_down_m": own.position_ned_m[:, 2], "own_vn_mps": own.velocity_ned_mps[:, 0],
-        "own_ve_mps": own.velocity_ned_mps[:, 1], "own_vd_mps": own.velocity_ned_mps[:, 2],
-        "own_lat_deg": own.lat_deg, "own_lon_deg": own.lon_deg, "own_alt_m": own.alt_m,
-        "own_yaw_rad": own.attitude_rad[:, 0], "own_pitch_rad": own.attitude_rad[:, 1],
-        "own_roll_rad": own.attitude_rad[:, 2], "own_height_agl_m": agl,
+        "own_north_m": own.position_ned_m[:, 0],
+        "own_east_m": own.position_ned_m[:, 1],
+        "own_down_m": own.position_ned_m[:, 2],
+        "own_vn_mps": own.velocity_ned_mps[:, 0],
+        "own_ve_mps": own.velocity_ned_mps[:, 1],
+        "own_vd_mps": own.velocity_ned_mps[:, 2],
+        "own_lat_deg": own.lat_deg,
+        "own_lon_deg": own.lon_deg,
+        "own_alt_m": own.alt_m,
+        "own_yaw_rad": own.attitude_rad[:, 0],
+        "own_pitch_rad": own.attitude_rad[:, 1],
+        "own_roll_rad": own.attitude_rad[:, 2],
+        "own_height_agl_m": agl,
     }
     n_t = len(built.intruders)
-    names = ["tgt_north_m", "tgt_east_m", "tgt_down_m", "tgt_vn_mps", "tgt_ve_mps", "tgt_vd_mps", "tgt_lat_deg",
-             "tgt_lon_deg", "tgt_alt_m", "tgt_range_m", "tgt_radial_velocity_mps", "tgt_azimuth_rad",
-             "tgt_elevation_rad", "tgt_rcs_m2", "tgt_snr_db"]
+    names = [
+        "tgt_north_m",
+        "tgt_east_m",
+        "tgt_down_m",
+        "tgt_vn_mps",
+        "tgt_ve_mps",
+        "tgt_vd_mps",
+        "tgt_lat_deg",
+        "tgt_lon_deg",
+        "tgt_alt_m",
+        "tgt_range_m",
+        "tgt_radial_velocity_mps",
+        "tgt_azimuth_rad",
+        "tgt_elevation_rad",
+        "tgt_rcs_m2",
+        "tgt_snr_db",
+    ]
     targets: dict[str, np.ndarray] = {k: np.full((n, n_t), np.nan) for k in names}
     targets["tgt_visible"] = np.zeros((n, n_t), bool)
     for t, (intruder, present, sample) in enumerate(intruders):
@@ -104,20 +140,30 @@ def scenario_truth(built, simulator: ImageSimulator | None = None) -> tuple[dict
         if not point_targets:
             continue
         g = simulator.target_truth(platform, point_targets)
-        for key, src in (("tgt_range_m", "range_m"), ("tgt_radial_velocity_mps", "radial_velocity_mps"),
-                         ("tgt_azimuth_rad", "azimuth_rad"), ("tgt_elevation_rad", "elevation_rad"),
-                         ("tgt_snr_db", "snr_db"), ("tgt_visible", "visible")):
+        for key, src in (
+            ("tgt_range_m", "range_m"),
+            ("tgt_radial_velocity_mps", "radial_velocity_mps"),
+            ("tgt_azimuth_rad", "azimuth_rad"),
+            ("tgt_elevation_rad", "elevation_rad"),
+            ("tgt_snr_db", "snr_db"),
+            ("tgt_visible", "visible"),
+        ):
             targets[key][i, which] = g[src]
     return ownship, (targets if n_t else {}), [i.name for i in built.intruders]
 
 
 def fingerprint(built) -> str:
     """Hash of everything that determines the frames (scenario text, radar, times, options)."""
-    source_text = built.source.read_text() if getattr(built, "source", None) and Path(built.source).exists() else ""
+    source_text = (
+        built.source.read_text() if getattr(built, "source", None) and Path(built.source).exists() else ""
+    )
     payload = {
-        "name": built.name, "origin": list(built.origin), "radar": built.radar.to_json(),
+        "name": built.name,
+        "origin": list(built.origin),
+        "radar": built.radar.to_json(),
         "times": [float(built.times_s[0]), float(built.times_s[-1]), int(built.times_s.size)],
-        "options": {k: str(v) for k, v in sorted(built.sim_options.items())}, "source": source_text,
+        "options": {k: str(v) for k, v in sorted(built.sim_options.items())},
+        "source": source_text,
         "format": "frames/1",
     }
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
@@ -138,8 +184,11 @@ def simulate(built, progress: Callable[[int], None] | None = None) -> xr.Dataset
 
 def _attrs(built) -> dict[str, Any]:
     return {
-        "scenario": built.name, "origin_lat_deg": built.origin[0], "origin_lon_deg": built.origin[1],
-        "origin_alt_m": built.origin[2], "sim_options": json.dumps({k: str(v) for k, v in built.sim_options.items()}),
+        "scenario": built.name,
+        "origin_lat_deg": built.origin[0],
+        "origin_lon_deg": built.origin[1],
+        "origin_alt_m": built.origin[2],
+        "sim_options": json.dumps({k: str(v) for k, v in built.sim_options.items()}),
     }
 
 
@@ -207,7 +256,9 @@ def simulate_to_zarr(
         client = connect(scheduler, workers)  # before any output exists: a dead address leaves nothing
     try:
         simulator = make_simulator(built)
-        writer = FrameStoreWriter(path, _template(built, chunk_frames, simulator), chunk_frames, fingerprint(built))
+        writer = FrameStoreWriter(
+            path, _template(built, chunk_frames, simulator), chunk_frames, fingerprint(built)
+        )
         pending = writer.pending_chunks()
         if progress and len(pending) < writer.n_chunks:
             progress(built.times_s.size - sum(_chunk_len(writer, i) for i in pending))
@@ -218,8 +269,16 @@ def simulate_to_zarr(
                 if progress:
                     progress(sl.stop - sl.start)
         else:
-            map_chunks(_chunk_job, built, fingerprint(built), str(writer.partial), chunk_frames, client=client,
-                       chunks=pending, progress=progress)
+            map_chunks(
+                _chunk_job,
+                built,
+                fingerprint(built),
+                str(writer.partial),
+                chunk_frames,
+                client=client,
+                chunks=pending,
+                progress=progress,
+            )
     finally:
         if client is not None:
             close(client, owns_cluster=scheduler is None)

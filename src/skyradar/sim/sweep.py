@@ -37,7 +37,9 @@ def set_by_path(data: dict[str, Any], dotted: str, value: Any, source: str = "sc
         last = i == len(keys) - 1
         if isinstance(node, list):
             if not key.isdigit() or int(key) >= len(node):
-                raise InputError(f"{source}: --param {dotted}: '{key}' is not an index of a list of {len(node)}")
+                raise InputError(
+                    f"{source}: --param {dotted}: '{key}' is not an index of a list of {len(node)}"
+                )
             key = int(key)
         elif not isinstance(node, dict):
             raise InputError(f"{source}: --param {dotted}: '{keys[i - 1]}' is not a section")
@@ -70,9 +72,14 @@ def run_table(built, frames: np.ndarray | None = None, chunk: int = 8) -> pd.Dat
     n = built.times_s.size
     if not names:
         return pd.DataFrame({"frames": [n]})
-    k = np.floor((truth["tgt_range_m"] + cfg.range_doppler_coupling_s * truth["tgt_radial_velocity_mps"])
-                 / cfg.range_resolution_m + 0.5)
-    j = (np.floor(truth["tgt_radial_velocity_mps"] / cfg.doppler_resolution_mps + 0.5) + cfg.n_doppler // 2) % cfg.n_doppler
+    k = np.floor(
+        (truth["tgt_range_m"] + cfg.range_doppler_coupling_s * truth["tgt_radial_velocity_mps"])
+        / cfg.range_resolution_m
+        + 0.5
+    )
+    j = (
+        np.floor(truth["tgt_radial_velocity_mps"] / cfg.doppler_resolution_mps + 0.5) + cfg.n_doppler // 2
+    ) % cfg.n_doppler
     visible = truth["tgt_visible"].astype(bool)
     snr = np.full(visible.shape, np.nan)
     for start in range(0, n, chunk):
@@ -85,15 +92,19 @@ def run_table(built, frames: np.ndarray | None = None, chunk: int = 8) -> pd.Dat
     rows = []
     for t, name in enumerate(names):
         seen = visible[:, t]
-        rows.append({
-            "intruder": name,
-            "frames": n,
-            "frames_visible": int(seen.sum()),
-            "expected_snr_db_median": float(np.nanmedian(truth["tgt_snr_db"][seen, t])) if seen.any() else np.nan,
-            "measured_snr_db_median": float(np.nanmedian(snr[seen, t])) if seen.any() else np.nan,
-            "detectable_share": float(np.mean(snr[seen, t] >= DETECTABLE_DB)) if seen.any() else 0.0,
-            "min_range_m": float(np.nanmin(truth["tgt_range_m"][:, t])) if seen.any() else np.nan,
-        })
+        rows.append(
+            {
+                "intruder": name,
+                "frames": n,
+                "frames_visible": int(seen.sum()),
+                "expected_snr_db_median": float(np.nanmedian(truth["tgt_snr_db"][seen, t]))
+                if seen.any()
+                else np.nan,
+                "measured_snr_db_median": float(np.nanmedian(snr[seen, t])) if seen.any() else np.nan,
+                "detectable_share": float(np.mean(snr[seen, t] >= DETECTABLE_DB)) if seen.any() else 0.0,
+                "min_range_m": float(np.nanmin(truth["tgt_range_m"][:, t])) if seen.any() else np.nan,
+            }
+        )
     return pd.DataFrame(rows)
 
 

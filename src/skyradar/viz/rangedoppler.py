@@ -33,7 +33,9 @@ def strength_db(frame: np.ndarray, config: RadarConfig) -> np.ndarray:
     return 10 * np.log10(np.maximum(power, 1e-30) / config.noise_power_w)
 
 
-def plot_strength(frame: np.ndarray, config: RadarConfig, ax=None, vmin: float = -5.0, vmax: float | None = None):
+def plot_strength(
+    frame: np.ndarray, config: RadarConfig, ax=None, vmin: float = -5.0, vmax: float | None = None
+):
     """Strength image (dB over noise) of one (range, doppler, rx) frame.
 
     Examples
@@ -46,7 +48,9 @@ def plot_strength(frame: np.ndarray, config: RadarConfig, ax=None, vmin: float =
     ax = ax or plt.gca()
     db = strength_db(frame, config)
     vmax = float(np.percentile(db, 99.95)) if vmax is None else vmax
-    im = ax.imshow(db, origin="lower", aspect="auto", extent=image_extent(config), cmap="viridis", vmin=vmin, vmax=vmax)
+    im = ax.imshow(
+        db, origin="lower", aspect="auto", extent=image_extent(config), cmap="viridis", vmin=vmin, vmax=vmax
+    )
     ax.set_xlabel("radial velocity [m/s]")
     ax.set_ylabel("range [m]")
     plt.colorbar(im, ax=ax, label="strength over noise [dB]")
@@ -61,7 +65,15 @@ def plot_phase_difference(
     a, b = rx_pair
     phase = np.degrees(np.angle(frame[..., b] * np.conj(frame[..., a])))
     phase = np.where(strength_db(frame, config) >= min_db, phase, np.nan)
-    im = ax.imshow(phase, origin="lower", aspect="auto", extent=image_extent(config), cmap="twilight", vmin=-180, vmax=180)
+    im = ax.imshow(
+        phase,
+        origin="lower",
+        aspect="auto",
+        extent=image_extent(config),
+        cmap="twilight",
+        vmin=-180,
+        vmax=180,
+    )
     ax.set_xlabel("radial velocity [m/s]")
     ax.set_ylabel("range [m]")
     plt.colorbar(im, ax=ax, label=f"phase rx{b} - rx{a} [deg]")

@@ -145,3 +145,67 @@ def test_cli_process_writes_the_table_and_reports_bad_input(tmp_path, monkeypatc
     assert run_cli(monkeypatch, "process", tmp_path / "bad.zarr", "-o", out) == 2
     assert capsys.readouterr().err.startswith("error: ")
     assert run_cli(monkeypatch, "process", tmp_path / "missing.zarr", "-o", out) == 2
+
+
+CH3_KEYS = ("az_sd_deg", "el_sd_deg", "az_crlb_deg", "el_crlb_deg", "dist_mean_m", "calib_phase_err_deg",
+            "detected_frames", "frames", "false_alarms_per_frame")  # fmt: skip
+
+
+def test_ch3_experiment_smoke(tmp_path):
+    from skyradar.experiments.ch3 import run
+
+    result = run(tmp_path, n_frames=8, n_static=10)
+    assert all(k in result for k in CH3_KEYS)
+    assert result["calib_phase_err_deg"] <= 1.0
+    assert result["detected_frames"] >= 7 and result["false_alarms_per_frame"] <= 0.01
+    for name in ("ch3_range_doppler.png", "ch3_track_3d.png", "ch3_errors.png", "ch3.json", "ch3_table.csv"):
+        assert (tmp_path / name).exists()
+
+
+@pytest.mark.slow
+def test_ch3_experiment_acceptance(tmp_path):
+    from skyradar.experiments.ch3 import run
+
+    r = run(tmp_path)
+    assert r["calib_phase_err_deg"] <= 1.0
+    assert r["detected_frames_snr13"] >= 0.95 * r["frames_snr13"]
+    assert r["false_alarms_per_frame"] <= 0.01
+    assert r["az_sd_deg"] <= 1.25 * r["az_crlb_deg"] and r["el_sd_deg"] <= 1.25 * r["el_crlb_deg"]
+
+
+def test_cli_calibrate_then_process_with_the_calibrated_config(tmp_path, monkeypatch, capsys):
+    from skyradar.process.calibration import calibration_phase_error_deg
+
+    cfg = RadarConfig.seed_prototype()
+    rng = np.random.default_rng(7)
+    offsets = np.exp(1j * np.radians([0.0, 70.0, -120.0, 160.0]))
+    building = (438.0, 0.0, np.radians(5.0), np.radians(-1.0), 45.0)
+    aircraft = (1500.0, 20.0, np.radians(-12.0), np.radians(8.0), 35.0)
+    cubes = np.stack([synthetic_frame(cfg, [building, aircraft], rng, rx_gain=offsets)[0] for _ in range(4)])
+    frames_dataset(cubes, np.arange(4) * 0.1, cfg).to_zarr(tmp_path / "run.zarr")
+    args = ["--range", 438, "--azimuth", 5, "--elevation", -1]
+    assert run_cli(monkeypatch, "calibrate", tmp_path / "run.zarr", "-o", tmp_path / "radar.json", *args) == 0
+    cal = RadarConfig.from_json((tmp_path / "radar.json").read_text())
+    assert calibration_phase_error_deg(cal.rx_calibration, offsets) <= 1.0
+    out = tmp_path / "det.parquet"
+    assert (
+        run_cli(
+            monkeypatch,
+            "process",
+            tmp_path / "run.zarr",
+            "-o",
+            out,
+            "--radar-config",
+            tmp_path / "radar.json",
+        )
+        == 0
+    )
+    table = pd.read_parquet(out)
+    plane = table[np.abs(table.range_m - 1500.0) < 10]
+    assert len(plane) == 4
+    assert np.degrees(np.abs(plane.azimuth_rad + np.radians(12.0))).max() < 1.0
+    assert np.degrees(np.abs(plane.elevation_rad - np.radians(8.0))).max() < 1.0
+    capsys.readouterr()
+    wide = ["--range", 438, "--azimuth", 80, "--elevation", 0]
+    assert run_cli(monkeypatch, "calibrate", tmp_path / "run.zarr", "-o", tmp_path / "x.json", *wide) == 2
+    assert "field of view" in capsys.readouterr().err

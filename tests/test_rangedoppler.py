@@ -55,6 +55,21 @@ def test_matches_numpy_reference(method, rw, dw):
     assert np.abs(out - ref).max() < 1e-5 * np.abs(ref).max()
 
 
+@pytest.mark.parametrize("dtype", [np.complex64, np.complex128, np.int16])
+def test_split_dft_paths_match_the_full_fft(dtype):
+    # 2032 = 16 x 127 (compiled radix-4x4 path for complex64), 2040 = 120 x 17 (numpy path)
+    for cfg in (CFG, RadarConfig(prf_hz=10e6 / 2040)):
+        rng = np.random.default_rng(4)
+        shape = (cfg.n_rx, cfg.n_doppler, cfg.samples_per_chirp)
+        adc = rng.standard_normal(shape) * 1000
+        adc = (adc + 1j * rng.standard_normal(shape) * 1000) if dtype != np.int16 else adc
+        adc = adc.astype(dtype)
+        pruned = RangeDopplerProcessor(cfg, "hann", "hamming", method="pruned")
+        assert pruned.method == "pruned"
+        ref = reference(adc, "hann", "hamming", cfg)
+        assert np.abs(pruned(adc) - ref).max() < 1e-5 * np.abs(ref).max()
+
+
 def test_pruned_is_chosen_for_the_prototype_and_fft_for_smooth_lengths():
     assert RangeDopplerProcessor(CFG).method == "pruned"  # 2032 = 16 * 127
     smooth = RadarConfig(fs_hz=10e6, prf_hz=10e6 / 2048)  # 2048 samples per chirp

@@ -42,10 +42,14 @@ def test_track_then_evaluate_against_run_truth(tmp_path, monkeypatch, capsys):
     iq = np.zeros((t.size, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
     targets = {"tgt_range_m": R, "tgt_radial_velocity_mps": V, "tgt_visible": vis}
     frames_dataset(iq, t, cfg, targets=targets).to_zarr(tmp_path / "run.zarr")
-    code, out, err = _cli(monkeypatch, capsys, "track", str(det_path), "-o", str(tmp_path / "trk.parquet"), "--json")
+    code, out, err = _cli(
+        monkeypatch, capsys, "track", str(det_path), "-o", str(tmp_path / "trk.parquet"), "--json"
+    )
     assert code == 0, err
     assert json.loads(out.strip().splitlines()[-1])["tracks"] >= 2
-    code, out, err = _cli(monkeypatch, capsys, "evaluate", str(tmp_path / "run.zarr"), str(tmp_path / "trk.parquet"), "--json")
+    code, out, err = _cli(
+        monkeypatch, capsys, "evaluate", str(tmp_path / "run.zarr"), str(tmp_path / "trk.parquet"), "--json"
+    )
     assert code == 0, err
     res = json.loads(out.strip().splitlines()[-1])
     assert res["truth_tracks"] == 2 and res["tracks"] == 2
@@ -62,10 +66,14 @@ def test_track_bad_inputs_give_one_line_errors(tmp_path, monkeypatch, capsys):
     assert err.startswith("error: ") and "radial_velocity_mps" in err and str(bad) in err
     assert len(err.strip().splitlines()) == 1
     back = tmp_path / "back.csv"
-    pd.DataFrame({"time_s": [0.0, 0.2, 0.1], "range_m": [1.0] * 3, "radial_velocity_mps": [0.0] * 3}).to_csv(back)
+    pd.DataFrame({"time_s": [0.0, 0.2, 0.1], "range_m": [1.0] * 3, "radial_velocity_mps": [0.0] * 3}).to_csv(
+        back
+    )
     code, _, err = _cli(monkeypatch, capsys, "track", str(back), "-o", str(tmp_path / "x.parquet"))
     assert code == 2 and "'time_s' goes backwards at row 2 (0.2 -> 0.1)" in err
-    code, _, err = _cli(monkeypatch, capsys, "track", str(back), "-o", str(tmp_path / "x.parquet"), "--model", "kf")
+    code, _, err = _cli(
+        monkeypatch, capsys, "track", str(back), "-o", str(tmp_path / "x.parquet"), "--model", "kf"
+    )
     assert code == 2 and "--model" in err
     assert not (tmp_path / "x.parquet").exists()
 
@@ -77,6 +85,7 @@ def test_evaluate_without_truth_is_clear_error(tmp_path, monkeypatch, capsys, mi
     frames_dataset(iq, np.arange(3.0), cfg).to_zarr(tmp_path / "run.zarr")
     trk = tmp_path / "t.parquet"
     pd.DataFrame({"time_s": [0.0], "track_id": [0], "range_m": [1.0], "radial_velocity_mps": [0.0],
-                  "innovation_range_m": [0.0], "innovation_radial_velocity_mps": [0.0]}).to_parquet(trk)  # fmt: skip
+                  "innovation_range_m": [0.0],
+                  "innovation_radial_velocity_mps": [0.0]}).to_parquet(trk)  # fmt: skip
     code, _, err = _cli(monkeypatch, capsys, "evaluate", str(tmp_path / "run.zarr"), str(trk))
     assert code == 2 and missing in err and "run.zarr" in err

@@ -58,7 +58,9 @@ def test_innovation_stats_pixels_and_si():
 
 
 def test_pixel_distance_wraps_doppler():
-    d = pixel_distance(np.array([[100.0, 38.0]]), np.array([[115.0, -38.0], [100.0, 30.0]]), (15.0, 0.5), 78.0)
+    d = pixel_distance(
+        np.array([[100.0, 38.0]]), np.array([[115.0, -38.0], [100.0, 30.0]]), (15.0, 0.5), 78.0
+    )
     assert d[0, 0] == pytest.approx(np.hypot(1.0, 4.0))
     assert d[0, 1] == pytest.approx(16.0)
 

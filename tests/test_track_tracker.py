@@ -9,10 +9,10 @@ from skyradar.errors import InputError
 from skyradar.track.association import associate, associate_naive
 from skyradar.track.io import Truth
 from skyradar.track.metrics import track_metrics
+from skyradar.track.models import radar_model
 from skyradar.track.run import track_detections
 from skyradar.track.synthetic import synthetic_detections
 from skyradar.track.tracker import RangeDopplerTracker, TrackerConfig
-from skyradar.track.models import radar_model
 
 CFG = RadarConfig.seed_prototype()
 PIX = (CFG.range_resolution_m, CFG.doppler_resolution_mps)
@@ -58,7 +58,9 @@ def test_two_intruders_crossing_at_close_range_keep_identities(seed):
     t = np.arange(0.0, 12.0, DT)
     # Same range and radial velocity at t = 6 s; opposite radial accelerations (close passes).
     V = np.column_stack([-10.0 + 5.0 * (t - 6.0), -10.0 - 5.0 * (t - 6.0)])
-    R = 600.0 + np.column_stack([-10.0 * (t - 6.0) + 2.5 * (t - 6.0) ** 2, -10.0 * (t - 6.0) - 2.5 * (t - 6.0) ** 2])
+    R = 600.0 + np.column_stack(
+        [-10.0 * (t - 6.0) + 2.5 * (t - 6.0) ** 2, -10.0 * (t - 6.0) - 2.5 * (t - 6.0) ** 2]
+    )
     det = synthetic_detections(t, R, V, pd_detect=0.95, clutter_per_frame=5, seed=seed)
     tracks = track_detections(det, "radar", CFG, frame_times_s=t)
     m = _metrics(tracks, t, R, V)
@@ -94,7 +96,9 @@ def test_time_going_backwards_raises():
     trk.step(1.0, np.zeros((0, 2)))
     with pytest.raises(ValueError, match="backwards"):
         trk.step(0.5, np.zeros((0, 2)))
-    det = pd.DataFrame({"time_s": [0.0, 1.0, 0.5], "range_m": [1.0, 2.0, 3.0], "radial_velocity_mps": [0.0] * 3})
+    det = pd.DataFrame(
+        {"time_s": [0.0, 1.0, 0.5], "range_m": [1.0, 2.0, 3.0], "radial_velocity_mps": [0.0] * 3}
+    )
     with pytest.raises(InputError, match="'time_s' goes backwards at row 2"):
         track_detections(det)
     with pytest.raises(InputError, match="missing column"):
@@ -107,7 +111,9 @@ def test_3d_track_velocity_and_covariance():
     pos = np.array([3000.0, -500.0, -300.0]) + t[:, None] * vel
     R = np.linalg.norm(pos, axis=1)
     V = np.einsum("ij,ij->i", pos, np.broadcast_to(vel, pos.shape)) / R
-    det = synthetic_detections(t, R[:, None], V[:, None], positions_ned_m=pos[:, None, :], sigma_angle_rad=0.02, seed=2)
+    det = synthetic_detections(
+        t, R[:, None], V[:, None], positions_ned_m=pos[:, None, :], sigma_angle_rad=0.02, seed=2
+    )
     tracks = track_detections(det, "radar", CFG, frame_times_s=t, origin=(52.27, 20.91, 100.0))
     last = tracks.iloc[-1]
     assert [last.vn_mps, last.ve_mps, last.vd_mps] == pytest.approx(list(vel), abs=6.0)

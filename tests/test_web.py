@@ -211,3 +211,33 @@ def test_real_server_survives_abrupt_disconnects(run):
             assert json.loads(ws.recv(timeout=10))["type"] == "info"
             assert json.loads(ws.recv(timeout=10))["index"] == 0
         assert httpx.get(url + "/api/info", timeout=10).json()["n_ready"] == 60
+
+
+def test_cli_serve_runs_and_rejects_missing_run(run, tmp_path):
+    import socket
+    import subprocess
+    import sys
+    import time
+
+    import httpx
+
+    entry = [sys.executable, "-c", "from skyradar.cli import main; main()", "serve"]
+    bad = subprocess.run(entry + [str(tmp_path / "none.zarr")], capture_output=True, text=True, timeout=120)
+    assert bad.returncode == 2 and bad.stderr.startswith("error:") and "no such run" in bad.stderr
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    proc = subprocess.Popen(
+        entry + [str(run), "--port", str(port)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE
+    )
+    try:
+        deadline, info = time.monotonic() + 60, None
+        while info is None and time.monotonic() < deadline and proc.poll() is None:
+            try:
+                info = httpx.get(f"http://127.0.0.1:{port}/api/info", timeout=2).json()
+            except httpx.HTTPError:
+                time.sleep(0.2)
+        assert info is not None and info["n_ready"] == 60
+    finally:
+        proc.terminate()
+        proc.wait(timeout=20)

@@ -80,16 +80,21 @@ def thesis_baseline_frame(
         )
         values = (np.sqrt(power) * np.exp(2j * np.pi * path / config.wavelength_m))[inside]
         flat = (k_r * config.n_doppler + k_d)[inside]
-        plane = cube[..., q].ravel()
-        while flat.size:  # the thesis' repeated np.unique: one surface per pixel per pass
-            pixels, first = np.unique(flat, return_index=True)
-            plane[pixels] += values[first]
-            rest = np.ones(flat.size, bool)
-            rest[first] = False
-            flat, values = flat[rest], values[rest]
-        cube[..., q] = plane.reshape(config.n_range, config.n_doppler)
+        cube[..., q] = _unique_scatter(flat, values, cube.shape[:2])
     noise = rng.standard_normal((*cube.shape, 2)) * np.sqrt(config.noise_power_w / 2)
     return cube + noise[..., 0] + 1j * noise[..., 1]
+
+
+def _unique_scatter(flat: np.ndarray, values: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """The thesis' accumulation: place one surface per pixel per pass with ``np.unique`` until done."""
+    plane = np.zeros(shape[0] * shape[1], complex)
+    while flat.size:
+        pixels, first = np.unique(flat, return_index=True)
+        plane[pixels] += values[first]
+        rest = np.ones(flat.size, bool)
+        rest[first] = False
+        flat, values = flat[rest], values[rest]
+    return plane.reshape(shape)
 
 
 def benchmark_tile(directory: Path, seed: int = 0):

@@ -34,7 +34,7 @@ def bench_scene(
     v0 = rng.uniform(-120.0, 60.0, n_targets)
     V = v0 + 8.0 * np.sin(t[:, None] / rng.uniform(2.0, 8.0, n_targets) + rng.uniform(0, 6, n_targets))
     R = rng.uniform(800.0, 4200.0, n_targets) + np.cumsum(V, axis=0) * dt
-    vis = (R > 50.0) & (R < config.range_limit_m)
+    vis = (R > 50.0) & (config.range_limit_m > R)
     clutter = max(detections_per_frame - 0.9 * n_targets, 0.0)
     det = synthetic_detections(t, R, V, vis, config, pd_detect=0.9, clutter_per_frame=clutter, seed=seed)
     z = det[["range_m", "radial_velocity_mps"]].to_numpy(float)
@@ -42,7 +42,9 @@ def bench_scene(
     return t, [z[bounds[k] : bounds[k + 1]] for k in range(n_frames)]
 
 
-def _time_tracker(tracker: RangeDopplerTracker, t: np.ndarray, frames: list[np.ndarray]) -> tuple[float, float]:
+def _time_tracker(
+    tracker: RangeDopplerTracker, t: np.ndarray, frames: list[np.ndarray]
+) -> tuple[float, float]:
     n_tracks = 0
     start = time.perf_counter()
     for time_s, z in zip(t, frames, strict=True):

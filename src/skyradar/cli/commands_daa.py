@@ -8,9 +8,9 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from skyradar.cli.app import app, console, emit_result
+from skyradar.cli.app import app, console, emit_result, experiment_app
 
-__all__ = ["alert", "serve"]
+__all__ = ["alert", "serve", "experiment_encounters"]
 
 
 @app.command()
@@ -82,3 +82,25 @@ def serve(
     web_app = create_app(run, tracks_path=tracks, alerts_path=alerts, speed=speed)
     console.print(f"serving {run} at http://{host}:{port}/  (Ctrl-C to stop)")
     uvicorn.run(web_app, host=host, port=port, log_level="warning")
+
+
+@experiment_app.command("encounters")
+def experiment_encounters(
+    out: Annotated[Path, typer.Option("--out", help="Output directory.")] = Path("out/encounters"),
+    n: Annotated[int, typer.Option("--n", help="Number of encounters.")] = 500,
+    seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
+    no_uncertainty: Annotated[
+        bool, typer.Option("--no-uncertainty", help="Do not widen the volumes by the track covariance.")
+    ] = False,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print the summary as JSON (last stdout line).")
+    ] = False,
+) -> None:
+    """Encounter set (head-on, crossing, overtaking, converging, climbing; conflicts and near misses)
+    through a radar measurement model, the 3-D tracker and the DAA alerting: missed, late and
+    false warnings. The full image chain is not wired (chain = sensor-model).
+    """
+    from skyradar.experiments.encounters import run
+
+    result = run(out, n_encounters=n, seed=seed, uncertainty=not no_uncertainty)
+    emit_result(result, as_json, "encounters")

@@ -8,9 +8,9 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from skyradar.cli.app import app, console, emit_result, experiment_app
+from skyradar.cli.app import app, bench_app, console, emit_result, experiment_app
 
-__all__ = ["state", "experiment_ch5"]
+__all__ = ["state", "experiment_ch5", "bench_state"]
 
 JsonOption = Annotated[bool, typer.Option("--json", help="Print the result as JSON (last stdout line).")]
 
@@ -102,3 +102,14 @@ def experiment_ch5(
         )  # fmt: skip
     console.print(view)
     emit_result({k: v for k, v in result.items() if k != "table"}, as_json, "ch5")
+
+
+@bench_app.command("state")
+def bench_state(
+    seconds: Annotated[float, typer.Option("--seconds", help="Minimum timing per implementation, s.")] = 2.0,
+    as_json: JsonOption = False,
+) -> None:
+    """Flight-state frames per second on 333 x 250 x 4 cubes: robust and terrain-aware vs the thesis' loop."""
+    from skyradar.benchmarks.flight_state import run as run_bench
+
+    emit_result(run_bench(min_time_s=seconds), as_json, "bench state")

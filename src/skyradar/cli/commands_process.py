@@ -1,4 +1,4 @@
-"""Frame processing commands: ``process``, ``spur-map``, ``experiment ch3`` and ``bench process``."""
+"""Processing commands: ``process``, ``calibrate``, ``spur-map``, ``experiment ch3``, ``bench process``."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import typer
 
 from skyradar.cli.app import app, bench_app, console, emit_result, experiment_app
 
-__all__ = ["process", "spur_map", "experiment_ch3", "bench_process"]
+__all__ = ["process", "calibrate", "spur_map", "experiment_ch3", "bench_process"]
 
 JsonOption = Annotated[bool, typer.Option("--json", help="Print the result as JSON (last stdout line).")]
 
@@ -39,6 +39,9 @@ def process(
         Path | None,
         typer.Option("--terrain", help="DEM (.hgt/.tif/.npz) for the ground filter's height test."),
     ] = None,
+    radar_config: Annotated[
+        Path | None, typer.Option("--radar-config", help="RadarConfig JSON (e.g. from `skyradar calibrate`).")
+    ] = None,
     as_json: JsonOption = False,
 ) -> None:
     """Detect objects in every frame and locate them in 3-D: one row per detection per frame.
@@ -52,7 +55,7 @@ def process(
     from skyradar.process.spurs import SpurMap
 
     ds = open_frames(run)
-    config = radar_config_of(ds, str(run))
+    config = _read_config(radar_config) if radar_config is not None else radar_config_of(ds, str(run))
     spurs = SpurMap.load(spur_map, config) if spur_map is not None else None
     dem = None
     if terrain is not None:
@@ -69,6 +72,7 @@ def process(
             spur_mode,
             progress=lambda n: bar.update(task, completed=n),
             source=str(run),
+            config=config,
             pfa=pfa,
         )
     write_table(table, output, metadata={"radar_config": config.to_json(), "source": str(run)})
@@ -82,6 +86,56 @@ def process(
         "output": str(output),
     }
     emit_result(result, as_json, "detections")
+
+
+def _read_config(path: Path):
+    from skyradar.config import RadarConfig
+    from skyradar.errors import InputError
+
+    try:
+        return RadarConfig.from_json(path.read_text())
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read radar config ({exc.strerror})") from None
+    except (ValueError, KeyError, TypeError) as exc:
+        raise InputError(f"{path}: not a radar config ({type(exc).__name__}: {exc})") from None
+
+
+@app.command()
+def calibrate(
+    run: Annotated[
+        Path, typer.Argument(help="Frames run with a reflector at a known position (Zarr or NetCDF).")
+    ],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Calibrated RadarConfig to write (JSON).")],
+    range_m: Annotated[float, typer.Option("--range", help="Reflector range, m.")],
+    azimuth_deg: Annotated[
+        float, typer.Option("--azimuth", help="Reflector azimuth, deg (antenna frame, right +).")
+    ],
+    elevation_deg: Annotated[
+        float, typer.Option("--elevation", help="Reflector elevation, deg (antenna frame, up +).")
+    ],
+    frames: Annotated[int, typer.Option("--frames", help="Frames to average (from the start).")] = 20,
+    phase_only: Annotated[
+        bool, typer.Option("--phase-only", help="Calibrate phases only, not gains.")
+    ] = False,
+    as_json: JsonOption = False,
+) -> None:
+    """Per-antenna phase/gain calibration from a reflector at a known position (thesis: a building)."""
+    import numpy as np
+
+    from skyradar.io.frames import open_frames, radar_config_of
+    from skyradar.io.tables import write_json_atomic
+    from skyradar.process.calibration import calibrate_from_frames, reflector_position
+
+    ds = open_frames(run)
+    config = radar_config_of(ds, str(run))
+    p = reflector_position(range_m, np.radians(azimuth_deg), np.radians(elevation_deg))
+    cube = np.asarray(ds["iq"].isel(time=slice(0, max(frames, 1))).values)
+    calibrated = calibrate_from_frames(cube, p, config, gain=not phase_only)
+    write_json_atomic(output, calibrated.to_dict())
+    phases = np.degrees(np.angle(calibrated.rx_calibration))
+    result = {"frames": int(cube.shape[0]), "output": str(output), "phase_deg": phases.round(3).tolist(),
+              "gain_db": (20 * np.log10(np.abs(calibrated.rx_calibration))).round(3).tolist()}  # fmt: skip
+    emit_result(result, as_json, "calibration")
 
 
 @app.command("spur-map")

@@ -28,13 +28,17 @@ def _origin(text: str | None) -> tuple[float, float, float] | None:
 
 @app.command()
 def track(
-    detections: Annotated[Path, typer.Argument(help="Detections table (Parquet or CSV) from `skyradar process`.")],
+    detections: Annotated[
+        Path, typer.Argument(help="Detections table (Parquet or CSV) from `skyradar process`.")
+    ],
     output: Annotated[Path, typer.Option("-o", "--output", help="Tracks table to write (Parquet).")],
     model: Annotated[
-        str, typer.Option("--model", help="'radar' (aliasing-aware, coupled) or 'traditional' (image tracker).")
+        str,
+        typer.Option("--model", help="'radar' (aliasing-aware, coupled) or 'traditional' (image tracker)."),
     ] = "radar",
     origin: Annotated[
-        str | None, typer.Option("--origin", help="Scenario origin 'lat,lon,alt' for the tracks' lat/lon/alt.")
+        str | None,
+        typer.Option("--origin", help="Scenario origin 'lat,lon,alt' for the tracks' lat/lon/alt."),
     ] = None,
     as_json: JsonOption = False,
 ) -> None:
@@ -63,7 +67,9 @@ def track(
     tracks = track_detections(
         table[keep].reset_index(drop=True), model, config, frame_times_s=frame_times, origin=_origin(origin)
     )
-    write_table(tracks, output, metadata={"radar_config": config.to_json(), "source": str(detections), "model": model})
+    write_table(
+        tracks, output, metadata={"radar_config": config.to_json(), "source": str(detections), "model": model}
+    )
     result = {
         "frames": int(frame_times.size),
         "detections": int(keep.sum()),
@@ -77,9 +83,13 @@ def track(
 
 @app.command()
 def evaluate(
-    run: Annotated[Path, typer.Argument(help="Simulated frames run (Zarr or NetCDF) holding intruder truth.")],
+    run: Annotated[
+        Path, typer.Argument(help="Simulated frames run (Zarr or NetCDF) holding intruder truth.")
+    ],
     tracks: Annotated[Path, typer.Argument(help="Tracks table from `skyradar track`.")],
-    threshold_px: Annotated[float, typer.Option("--threshold-px", help="Track-truth match distance, pixels.")] = 5.0,
+    threshold_px: Annotated[
+        float, typer.Option("--threshold-px", help="Track-truth match distance, pixels.")
+    ] = 5.0,
     gospa_c_px: Annotated[float, typer.Option("--gospa-c", help="GOSPA cut-off distance, pixels.")] = 10.0,
     as_json: JsonOption = False,
 ) -> None:
@@ -103,10 +113,14 @@ def evaluate(
 
 @experiment_app.command("ch4")
 def experiment_ch4(
-    out: Annotated[Path, typer.Option("--out", help="Output directory for tables and figures.")] = Path("out/ch4"),
+    out: Annotated[Path, typer.Option("--out", help="Output directory for tables and figures.")] = Path(
+        "out/ch4"
+    ),
     chain: Annotated[
         str,
-        typer.Option("--chain", help="'full' (simulate frames, detect, track) or 'geometry' (detections from truth)."),
+        typer.Option(
+            "--chain", help="'full' (simulate frames, detect, track) or 'geometry' (detections from truth)."
+        ),
     ] = "full",
     as_json: JsonOption = False,
 ) -> None:
@@ -120,7 +134,9 @@ def experiment_ch4(
 @bench_app.command("track")
 def bench_track(
     frames: Annotated[int, typer.Option("--frames", help="Frames to track.")] = 600,
-    detections: Annotated[int, typer.Option("--detections", help="Detections per frame (clutter included).")] = 200,
+    detections: Annotated[
+        int, typer.Option("--detections", help="Detections per frame (clutter included).")
+    ] = 200,
     as_json: JsonOption = False,
 ) -> None:
     """Tracker frames per second at ~200 detections per frame, against a per-pair-loop baseline."""

@@ -272,6 +272,8 @@ def run(
         "az_sd_deg": table.loc["az_deg", "raw_sd"], "el_sd_deg": table.loc["el_deg", "raw_sd"],
         "az_mean_deg": table.loc["az_deg", "raw_mean"], "el_mean_deg": table.loc["el_deg", "raw_mean"],
         "az_hann_sd_deg": table.loc["az_deg", "hann_sd"], "el_hann_sd_deg": table.loc["el_deg", "hann_sd"],
+        "az_sd_snr13_deg": float(err.az_raw_deg[det & snr_ok].std()),
+        "el_sd_snr13_deg": float(err.el_raw_deg[det & snr_ok].std()),
         "az_crlb_deg": float(np.degrees(np.sqrt(np.mean(sd_az**2)))),
         "el_crlb_deg": float(np.degrees(np.sqrt(np.mean(sd_el**2)))),
         "dist_mean_m": table.loc["dist_m", "raw_mean"], "dist_sd_m": table.loc["dist_m", "raw_sd"],

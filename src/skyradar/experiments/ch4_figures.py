@@ -59,14 +59,18 @@ def _body_frame(results: list[dict], out_dir: Path) -> str:
         rel = truth["pos"] - own.position_ned_m[:, None, :]
         body = np.einsum("nji,nmj->nmi", R, rel)  # R^T (p - own)
         vis = res["visible"]
-        ax.scatter(body[..., 1][vis], body[..., 0][vis], s=3, c="0.75", label="truth (visible)", rasterized=True)
+        ax.scatter(
+            body[..., 1][vis], body[..., 0][vis], s=3, c="0.75", label="truth (visible)", rasterized=True
+        )
         trk = res["tracks"]["radar"]
         trk = trk[np.isfinite(trk.north_m)]
         if len(trk):
             k = trk.frame.to_numpy().astype(int)
             p = trk[["north_m", "east_m", "down_m"]].to_numpy() - own.position_ned_m[k]
             b = np.einsum("nji,nj->ni", R[k], p)
-            ax.scatter(b[:, 1], b[:, 0], s=2, c=_track_colours(trk.track_id.to_numpy()), label="radar-aware tracks")
+            ax.scatter(
+                b[:, 1], b[:, 0], s=2, c=_track_colours(trk.track_id.to_numpy()), label="radar-aware tracks"
+            )
         ax.set_xlim(-4000, 4000)
         ax.set_ylim(-500, 5000)
         ax.set_aspect("equal")

@@ -106,7 +106,9 @@ def _ownship(name: str, duration_s: float) -> Trajectory:
     segs = []
     while sum(s[0] for s in segs) < duration_s + 5:
         segs.append((float(rng.uniform(20, 40)), 0.0, 0.0, float(rng.choice([0.0, 3.0, -3.0]))))
-        segs.append((float(rng.uniform(8, 15)), float(rng.uniform(-0.5, 0.5)), float(rng.choice([-6.0, 6.0])), 0.0))
+        segs.append(
+            (float(rng.uniform(8, 15)), float(rng.uniform(-0.5, 0.5)), float(rng.choice([-6.0, 6.0])), 0.0)
+        )
     return fly(np.array([-3000.0, 0.0, -900.0]), 20.0, 55.0, segs, name="own-free")
 
 
@@ -126,7 +128,11 @@ def _intruder(name: str, i: int, start_s: float, own: Trajectory, rng: np.random
         start = np.array([0.0, 0.0, -10.0])
         turn = float(np.sign(((exit_bearing - RUNWAY_HEADING_DEG + 180) % 360) - 180)) * 3.0
         turn_time = abs(((exit_bearing - RUNWAY_HEADING_DEG + 180) % 360) - 180) / 3.0
-        segs = [(25.0, 1.0, 0.0, 4.0), (turn_time, 0.3, turn, 3.5), (120.0, 0.2, 0.0, float(rng.uniform(1, 3)))]
+        segs = [
+            (25.0, 1.0, 0.0, 4.0),
+            (turn_time, 0.3, turn, 3.5),
+            (120.0, 0.2, 0.0, float(rng.uniform(1, 3))),
+        ]
         return fly(start, RUNWAY_HEADING_DEG, 40.0, segs, start_s, f"departure-{i}")
     # Free airspace: start ahead of the own-ship, heading roughly across or towards it.
     s = own.sample(np.array([start_s]))

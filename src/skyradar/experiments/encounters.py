@@ -7,7 +7,8 @@ minutes on two cores and is not wired here): truth trajectories from
 
 Measurement model, per frame at ``frame_rate_hz``: an intruder inside the range limit and the field
 of view (``fov_deg`` full width in azimuth and elevation around boresight, forward mount) is
-detected with probability ``p_detect``; its range gets Gaussian noise of ``dR / sqrt(12)`` and its
+detected with probability ``p_detect``; its range gets Gaussian noise of ``dR / sqrt(12)`` (the
+range bin's uniform spread) and its
 direction Gaussian azimuth / elevation noise of ``sigma_az_deg`` / ``sigma_el_deg`` (seed-brief.md
 ch3: raw DoA SD 1.8 deg and 2.7 deg).
 
@@ -86,7 +87,7 @@ def _trajectories(p: pd.Series, duration_s: float, t_cpa_s: float):
     return own, intr
 
 
-def _measure(rel: np.ndarray, rng, config: RadarConfig, fov_deg, p_detect, sigma_az, sigma_el):
+def _measure(rel: np.ndarray, rng, config: RadarConfig, fov_deg, p_detect, sigma_az, sigma_el, sigma_r):
     """Noisy NED relative positions (NaN when not detected) and per-axis variances, m^2."""
     r = np.linalg.norm(rel, axis=1)
     az = np.arctan2(rel[:, 1], rel[:, 0])  # forward mount, own-ship level and heading north
@@ -94,12 +95,12 @@ def _measure(rel: np.ndarray, rng, config: RadarConfig, fov_deg, p_detect, sigma
     half = np.radians(fov_deg / 2)
     visible = (r <= config.range_limit_m) & (np.abs(az) <= half) & (np.abs(el) <= half)
     detected = visible & (rng.random(r.size) < p_detect)
-    rm = r + rng.normal(0, config.range_resolution_m / np.sqrt(12), r.size)
+    rm = r + rng.normal(0, sigma_r, r.size)
     azm = az + rng.normal(0, sigma_az, r.size)
     elm = el + rng.normal(0, sigma_el, r.size)
     meas = np.stack([rm * np.cos(elm) * np.cos(azm), rm * np.cos(elm) * np.sin(azm), -rm * np.sin(elm)], -1)
     meas[~detected] = np.nan
-    return meas, (r * max(sigma_az, sigma_el)) ** 2, visible
+    return meas, (r * max(sigma_az, sigma_el)) ** 2 + sigma_r**2, visible
 
 
 _TRACK_COLS = ["time_s", "north_m", "east_m", "down_m", "vn_mps", "ve_mps", "vd_mps"] + [
@@ -136,6 +137,7 @@ def run_encounter(
     p_detect: float = 0.9,
     sigma_az_deg: float = 1.8,
     sigma_el_deg: float = 2.7,
+    sigma_range_m: float | None = None,
     alert_config: AlertConfig | None = None,
 ) -> dict:
     """One encounter (a row of :func:`make_encounters`) through the chain; times in s (NaN when none)."""
@@ -149,7 +151,8 @@ def run_encounter(
     t_lowc = float(t[np.argmax(lowc)]) if lowc.any() else np.nan
     rng = np.random.default_rng(seed)
     sig = np.radians([sigma_az_deg, sigma_el_deg])
-    meas, var, visible = _measure(rel, rng, config, fov_deg, p_detect, *sig)
+    sigma_r = config.range_resolution_m / np.sqrt(12) if sigma_range_m is None else sigma_range_m
+    meas, var, visible = _measure(rel, rng, config, fov_deg, p_detect, *sig, sigma_r)
     tracks = _track(t, meas + own.position_ned_m, var)
     t_warn = np.nan
     if len(tracks):

@@ -355,4 +355,14 @@ def doa_crlb(
 def antenna_to_body(points_m: np.ndarray, config: RadarConfig) -> np.ndarray:
     """Antenna-frame points (..., 3) to the body frame (forward, right, down) via ``config.mount``."""
     mount = config.mount
-    return np.asarray(points_m, float) @ mount.rotation.T + np.asarray(mount.position_m)
+    rotation = _mount_rotation(mount.yaw_deg, mount.pitch_deg, mount.roll_deg)
+    return np.asarray(points_m, float) @ rotation.T + np.asarray(mount.position_m)
+
+
+@lru_cache(maxsize=16)
+def _mount_rotation(yaw_deg: float, pitch_deg: float, roll_deg: float) -> np.ndarray:
+    from skyradar.config import Mount
+
+    rotation = Mount(yaw_deg=yaw_deg, pitch_deg=pitch_deg, roll_deg=roll_deg).rotation
+    rotation.setflags(write=False)
+    return rotation

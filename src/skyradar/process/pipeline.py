@@ -165,6 +165,7 @@ def process_frames(
     progress: Callable[[int], None] | None = None,
     batch_frames: int = 16,
     source: str = "frames",
+    config: RadarConfig | None = None,
     **detect_kwargs: Any,
 ) -> pd.DataFrame:
     """Detections table of a frames Dataset (see the module docstring for the columns).
@@ -180,8 +181,17 @@ def process_frames(
         Ground heights for the ground filter.
     progress : callable, optional
         Called with the number of frames finished after each batch.
+    config : RadarConfig, optional
+        Overrides the run's stored RadarConfig (e.g. one calibrated later); must fit the frames.
     """
-    config = radar_config_of(ds, source)
+    stored = radar_config_of(ds, source)
+    config = stored if config is None else config
+    for name in ("n_range", "n_doppler", "n_rx"):
+        if getattr(config, name) != getattr(stored, name):
+            raise InputError(
+                f"{source}: radar config field '{name}' is {getattr(config, name)}, "
+                f"the frames have {getattr(stored, name)}"
+            )
     n_frames = ds.sizes.get("time", 0)
     if n_frames == 0:
         raise InputError(f"{source}: empty run (0 frames)")

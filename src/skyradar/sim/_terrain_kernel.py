@@ -160,31 +160,65 @@ def _corner_terms(g, i, j, out):
         out[3, c] = g[i + 1, j + 1, c] - g[i + 1, j, c] - g[i, j + 1, c] + g[i, j, c]
 
 
+@njit(inline="always")
+def _patch_point(t, u, w, c):
+    return t[0, c] + u * t[1, c] + w * t[2, c] + u * w * t[3, c]
+
+
+@njit(inline="always")
+def _patch_normal(t, u, w, up):
+    """Upward normal of the bilinear patch at (u, w); its length is the area per unit (u, w)."""
+    dux, duy, duz = t[1, 0] + w * t[3, 0], t[1, 1] + w * t[3, 1], t[1, 2] + w * t[3, 2]
+    dwx, dwy, dwz = t[2, 0] + u * t[3, 0], t[2, 1] + u * t[3, 1], t[2, 2] + u * t[3, 2]
+    nx = duy * dwz - duz * dwy
+    ny = duz * dwx - dux * dwz
+    nz = dux * dwy - duy * dwx
+    if nx * up[0] + ny * up[1] + nz * up[2] < 0.0:
+        return -nx, -ny, -nz, math.sqrt(nx * nx + ny * ny + nz * nz)
+    return nx, ny, nz, math.sqrt(nx * nx + ny * ny + nz * nz)
+
+
+@njit(inline="always")
+def _cell_behind(p_ant, i, j):
+    return (
+        p_ant[i, j, 0] <= 0.0
+        and p_ant[i + 1, j, 0] <= 0.0
+        and p_ant[i, j + 1, 0] <= 0.0
+        and p_ant[i + 1, j + 1, 0] <= 0.0
+    )
+
+
+@njit(inline="always")
+def _hidden(tn, u, w, horizon, az_bin_rad, h_bin_m):
+    pn, pe, pd = _patch_point(tn, u, w, 0), _patch_point(tn, u, w, 1), _patch_point(tn, u, w, 2)
+    ia, k, elev = _polar_bin(pn, pe, pd, az_bin_rad, h_bin_m, horizon.shape[0], horizon.shape[1])
+    return elev < horizon[ia, k]
+
+
+@njit(inline="always")
+def _two_way_paths(x, y, z, tx, rx, r_rx):
+    """Transmitter range (returned) and each receiver's range (into ``r_rx``), m."""
+    dx, dy, dz = x - tx[0], y - tx[1], z - tx[2]
+    r_tx = math.sqrt(dx * dx + dy * dy + dz * dz)
+    for q in range(rx.shape[0]):
+        dx, dy, dz = x - rx[q, 0], y - rx[q, 1], z - rx[q, 2]
+        r_rx[q] = math.sqrt(dx * dx + dy * dy + dz * dz)
+    return r_tx
+
+
+@njit(inline="always")
+def _accumulate(out, blk, kr, kd, amp, r_tx, r_rx, inv_wavelength):
+    # Exact two-way path phase per receiver.
+    for q in range(r_rx.shape[0]):
+        cos_p, sin_p = cis_cycles((r_tx + r_rx[q]) * inv_wavelength)
+        out[blk, kr, kd, q] += complex(amp * cos_p, amp * sin_p)
+
+
 @njit(parallel=True, cache=True, fastmath=True)
 def terrain_returns(
-    p_ned,
-    p_ant,
-    up_ant,
-    tx,
-    rx,
-    v_ground_ant,
-    nsub_r,
-    nsub_c,
-    wavelength,
-    d_range,
-    d_vel,
-    coupling,
-    power_const,
-    gain2,
-    gain2_step,
-    refl_table,
-    horizon,
-    az_bin_rad,
-    h_bin_m,
-    use_horizon,
-    n_blocks,
-    out,
-):
+    p_ned, p_ant, up_ant, tx, rx, v_ground_ant, nsub_r, nsub_c, wavelength, d_range, d_vel, coupling,
+    power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m, use_horizon, n_blocks, out,
+):  # fmt: skip
     """Accumulate terrain returns into ``out`` of shape (n_blocks, n_range, n_doppler, n_rx).
 
     Parameters are in SI units. ``p_ned`` and ``p_ant`` are the cropped grid relative to the
@@ -196,24 +230,16 @@ def terrain_returns(
     spacing ``gain2_step``. ``fastmath`` is safe here: every input is finite.
     """
     ny, nx = p_ned.shape[0], p_ned.shape[1]
-    n_range, n_dopp, n_rx = out.shape[1], out.shape[2], out.shape[3]
-    half = n_dopp // 2
+    n_range, n_dopp = out.shape[1], out.shape[2]
     rows_per_block = (ny - 1 + n_blocks - 1) // n_blocks
     refl_step = 1.0 / (refl_table.shape[0] - 1)
-    inv_wavelength = 1.0 / wavelength
+    r_max = d_range * (n_range + 2)
     for blk in prange(n_blocks):
-        ta = np.empty((4, 3))
-        tn = np.empty((4, 3))
-        r_rx = np.empty(n_rx)
+        ta, tn, r_rx = np.empty((4, 3)), np.empty((4, 3)), np.empty(rx.shape[0])
         for i in range(blk * rows_per_block, min((blk + 1) * rows_per_block, ny - 1)):
             for j in range(nx - 1):
-                if (
-                    p_ant[i, j, 0] <= 0.0
-                    and p_ant[i + 1, j, 0] <= 0.0
-                    and p_ant[i, j + 1, 0] <= 0.0
-                    and p_ant[i + 1, j + 1, 0] <= 0.0
-                ):
-                    continue  # the whole cell is behind the antenna plane
+                if _cell_behind(p_ant, i, j):
+                    continue
                 _corner_terms(p_ant, i, j, ta)
                 if use_horizon:
                     _corner_terms(p_ned, i, j, tn)
@@ -221,66 +247,33 @@ def terrain_returns(
                     u = (a + 0.5) / nsub_r
                     for b in range(nsub_c):
                         w = (b + 0.5) / nsub_c
-                        uw = u * w
-                        x = ta[0, 0] + u * ta[1, 0] + w * ta[2, 0] + uw * ta[3, 0]
-                        if x <= 0.0:
-                            continue
-                        y = ta[0, 1] + u * ta[1, 1] + w * ta[2, 1] + uw * ta[3, 1]
-                        z = ta[0, 2] + u * ta[1, 2] + w * ta[2, 2] + uw * ta[3, 2]
+                        x = _patch_point(ta, u, w, 0)
+                        y, z = _patch_point(ta, u, w, 1), _patch_point(ta, u, w, 2)
                         r0 = math.sqrt(x * x + y * y + z * z)
-                        if r0 > d_range * n_range + 2 * d_range:
+                        if (
+                            x <= 0.0
+                            or r0 > r_max
+                            or (use_horizon and _hidden(tn, u, w, horizon, az_bin_rad, h_bin_m))
+                        ):
                             continue
-                        if use_horizon:
-                            pn = tn[0, 0] + u * tn[1, 0] + w * tn[2, 0] + uw * tn[3, 0]
-                            pe = tn[0, 1] + u * tn[1, 1] + w * tn[2, 1] + uw * tn[3, 1]
-                            pd = tn[0, 2] + u * tn[1, 2] + w * tn[2, 2] + uw * tn[3, 2]
-                            ia, k, elev = _polar_bin(
-                                pn, pe, pd, az_bin_rad, h_bin_m, horizon.shape[0], horizon.shape[1]
-                            )
-                            if elev < horizon[ia, k]:
-                                continue
-                        # Tangents of the bilinear patch give the exact area and normal.
-                        dux, duy, duz = (
-                            ta[1, 0] + w * ta[3, 0],
-                            ta[1, 1] + w * ta[3, 1],
-                            ta[1, 2] + w * ta[3, 2],
-                        )
-                        dwx, dwy, dwz = (
-                            ta[2, 0] + u * ta[3, 0],
-                            ta[2, 1] + u * ta[3, 1],
-                            ta[2, 2] + u * ta[3, 2],
-                        )
-                        nx_ = duy * dwz - duz * dwy
-                        ny_ = duz * dwx - dux * dwz
-                        nz_ = dux * dwy - duy * dwx
-                        area2 = math.sqrt(nx_ * nx_ + ny_ * ny_ + nz_ * nz_)
-                        if area2 == 0.0:
-                            continue
-                        if nx_ * up_ant[0] + ny_ * up_ant[1] + nz_ * up_ant[2] < 0.0:
-                            nx_, ny_, nz_ = -nx_, -ny_, -nz_  # normal points to the sky
-                        inv_r0 = 1.0 / r0
-                        ux, uy, uz = x * inv_r0, y * inv_r0, z * inv_r0
-                        cos_inc = -(nx_ * ux + ny_ * uy + nz_ * uz) / area2
+                        nx_, ny_, nz_, area2 = _patch_normal(ta, u, w, up_ant)
+                        cos_inc = -(nx_ * x + ny_ * y + nz_ * z) / (area2 * r0 + 1e-300)
                         if cos_inc <= 0.0:
-                            continue  # facet turned away from the radar
-                        refl = _table(cos_inc, 0.0, refl_step, refl_table)
-                        gain_lin2 = _table2(uy, uz, gain2_step, gain2)
-                        # Exact two-way paths; bin on their mean half-length.
-                        dx, dy, dz = x - tx[0], y - tx[1], z - tx[2]
-                        r_tx = math.sqrt(dx * dx + dy * dy + dz * dz)
-                        r_rx_sum = 0.0
-                        for q in range(n_rx):
-                            dx, dy, dz = x - rx[q, 0], y - rx[q, 1], z - rx[q, 2]
-                            r_rx[q] = math.sqrt(dx * dx + dy * dy + dz * dz)
-                            r_rx_sum += r_rx[q]
-                        rng = 0.5 * (r_tx + r_rx_sum / n_rx)
-                        v_r = v_ground_ant[0] * ux + v_ground_ant[1] * uy + v_ground_ant[2] * uz
+                            continue  # facet turned away from the radar (or degenerate)
+                        r_tx = _two_way_paths(x, y, z, tx, rx, r_rx)
+                        rng = 0.5 * (r_tx + r_rx.mean())
+                        v_r = (v_ground_ant[0] * x + v_ground_ant[1] * y + v_ground_ant[2] * z) / r0
                         kr = int(math.floor((rng + coupling * v_r) / d_range + 0.5))
                         if kr < 0 or kr >= n_range:
                             continue
-                        kd = (int(math.floor(v_r / d_vel + 0.5)) + half) % n_dopp
-                        area = area2 / (nsub_r * nsub_c)
-                        amp = math.sqrt(power_const * gain_lin2 * area * refl) / (rng * rng)
-                        for q in range(n_rx):
-                            cos_p, sin_p = cis_cycles((r_tx + r_rx[q]) * inv_wavelength)
-                            out[blk, kr, kd, q] += complex(amp * cos_p, amp * sin_p)
+                        kd = (int(math.floor(v_r / d_vel + 0.5)) + n_dopp // 2) % n_dopp
+                        power = (
+                            power_const
+                            * _table2(y / r0, z / r0, gain2_step, gain2)
+                            * _table(cos_inc, 0.0, refl_step, refl_table)
+                            * area2
+                            / (nsub_r * nsub_c)
+                        )
+                        _accumulate(
+                            out, blk, kr, kd, math.sqrt(power) / (rng * rng), r_tx, r_rx, 1.0 / wavelength
+                        )

@@ -200,60 +200,48 @@ class ImageSimulator:
         if crop is None:
             return out[0]
         p_ned = np.ascontiguousarray(self._grid_ned[crop] - geom.origin_ned_m)
-        r_lim = cfg.range_limit_m + cfg.range_resolution_m
-        if self.occlusion:
-            # The horizon follows the terrain's shape, which the DEM resolves at its own spacing:
-            # 2 x 2 samples per DEM cell and bins of half the spacing, not every sub-facet.
-            h_nsub = (min(self._nsub[0], 2), min(self._nsub[1], 2))
-            h_bin = max(self._facet_m, min(self.terrain.spacing_m) / 2.0)
-            n_az = int(np.ceil(2 * np.pi * (r_lim / 2.0) / h_bin))
-            n_h = int(np.ceil(r_lim / h_bin)) + 1
-            az_bin = 2 * np.pi / n_az
-            # Each horizon sample stands for a patch this wide (see horizon_map).
-            sample_m = max(self.terrain.spacing_m[0] / h_nsub[0], self.terrain.spacing_m[1] / h_nsub[1])
-            horizon = horizon_map(
-                p_ned,
-                geom.rot_ned_to_ant,
-                h_nsub[0],
-                h_nsub[1],
-                r_lim,
-                az_bin,
-                h_bin,
-                n_az,
-                n_h,
-                n_blocks,
-                sample_m,
-            )
-        else:
-            horizon, az_bin, h_bin = np.zeros((1, 1), np.float32), 1.0, 1.0
+        horizon, az_bin, h_bin = self._horizon(p_ned, geom, n_blocks)
         rot = geom.rot_ned_to_ant
-        p_ant = p_ned @ rot.T
+        p_ant = np.ascontiguousarray(p_ned @ rot.T)
         power_const = cfg.pe_w * cfg.wavelength_m**2 / (4 * np.pi) ** 3 * self.ground_gain
         terrain_returns(
+            p_ned, p_ant, -rot[:, 2], cfg.tx_position_m, cfg.rx_positions_m, rot @ (-geom.velocity_ned_mps),
+            self._nsub[0], self._nsub[1], cfg.wavelength_m, cfg.range_resolution_m,
+            cfg.doppler_resolution_mps, self.coupling_s, power_const, self._gain2, self._gain2_step,
+            self._refl_table, horizon, az_bin, h_bin, self.occlusion, n_blocks, out,
+        )  # fmt: skip
+        return out[0] if n_blocks == 1 else out.sum(axis=0)
+
+    def _horizon(
+        self, p_ned: np.ndarray, geom: AntennaGeometry, n_blocks: int
+    ) -> tuple[np.ndarray, float, float]:
+        """Polar horizon for the occlusion test, with its azimuth and horizontal-range bin sizes."""
+        if not self.occlusion:
+            return np.zeros((1, 1), np.float32), 1.0, 1.0
+        r_lim = self.config.range_limit_m + self.config.range_resolution_m
+        # The horizon follows the terrain's shape, which the DEM resolves at its own spacing:
+        # 2 x 2 samples per DEM cell and bins of half the spacing, not every sub-facet.
+        h_nsub = (min(self._nsub[0], 2), min(self._nsub[1], 2))
+        h_bin = max(self._facet_m, min(self.terrain.spacing_m) / 2.0)
+        n_az = int(np.ceil(2 * np.pi * (r_lim / 2.0) / h_bin))
+        n_h = int(np.ceil(r_lim / h_bin)) + 1
+        az_bin = 2 * np.pi / n_az
+        # Each horizon sample stands for a patch this wide (see horizon_map).
+        sample_m = max(self.terrain.spacing_m[0] / h_nsub[0], self.terrain.spacing_m[1] / h_nsub[1])
+        horizon = horizon_map(
             p_ned,
-            np.ascontiguousarray(p_ant),
-            -rot[:, 2],
-            cfg.tx_position_m,
-            cfg.rx_positions_m,
-            rot @ (-geom.velocity_ned_mps),
-            self._nsub[0],
-            self._nsub[1],
-            cfg.wavelength_m,
-            cfg.range_resolution_m,
-            cfg.doppler_resolution_mps,
-            self.coupling_s,
-            power_const,
-            self._gain2,
-            self._gain2_step,
-            self._refl_table,
-            horizon,
+            geom.rot_ned_to_ant,
+            h_nsub[0],
+            h_nsub[1],
+            r_lim,
             az_bin,
             h_bin,
-            self.occlusion,
+            n_az,
+            n_h,
             n_blocks,
-            out,
+            sample_m,
         )
-        return out[0] if n_blocks == 1 else out.sum(axis=0)
+        return horizon, az_bin, h_bin
 
     def _crop(self, geom: AntennaGeometry) -> tuple[slice, slice] | None:
         # Crop around the platform; the mount offset (metres) is added to the reach.

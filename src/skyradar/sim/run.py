@@ -81,75 +81,59 @@ def simulate_frames(built, indices: np.ndarray, simulator: ImageSimulator | None
     return out
 
 
-def scenario_truth(built, simulator: ImageSimulator | None = None) -> tuple[dict, dict, list[str]]:
-    """Own-ship truth on time and intruder truth on (time, target), named as in ``skyradar.io.frames``."""
-    simulator = simulator or make_simulator(built)
-    n = built.times_s.size
-    own, intruders = _states(built, np.arange(n))
-    agl = np.full(n, np.nan)
+_TRUTH_FROM_GEOMETRY = {  # frames variable -> ImageSimulator.target_truth key
+    "tgt_range_m": "range_m",
+    "tgt_radial_velocity_mps": "radial_velocity_mps",
+    "tgt_azimuth_rad": "azimuth_rad",
+    "tgt_elevation_rad": "elevation_rad",
+    "tgt_snr_db": "snr_db",
+    "tgt_visible": "visible",
+}
+_XYZ = ("north", "east", "down")
+_VXYZ = ("vn", "ve", "vd")
+
+
+def _ownship_truth(built, own) -> dict[str, np.ndarray]:
+    agl = np.full(own.time_s.size, np.nan)
     if built.terrain is not None:
         agl = own.alt_m - built.terrain.height_at(own.lat_deg, own.lon_deg)
-    ownship = {
-        "own_north_m": own.position_ned_m[:, 0],
-        "own_east_m": own.position_ned_m[:, 1],
-        "own_down_m": own.position_ned_m[:, 2],
-        "own_vn_mps": own.velocity_ned_mps[:, 0],
-        "own_ve_mps": own.velocity_ned_mps[:, 1],
-        "own_vd_mps": own.velocity_ned_mps[:, 2],
-        "own_lat_deg": own.lat_deg,
-        "own_lon_deg": own.lon_deg,
-        "own_alt_m": own.alt_m,
-        "own_yaw_rad": own.attitude_rad[:, 0],
-        "own_pitch_rad": own.attitude_rad[:, 1],
-        "own_roll_rad": own.attitude_rad[:, 2],
-        "own_height_agl_m": agl,
-    }
-    n_t = len(built.intruders)
-    names = [
-        "tgt_north_m",
-        "tgt_east_m",
-        "tgt_down_m",
-        "tgt_vn_mps",
-        "tgt_ve_mps",
-        "tgt_vd_mps",
-        "tgt_lat_deg",
-        "tgt_lon_deg",
-        "tgt_alt_m",
-        "tgt_range_m",
-        "tgt_radial_velocity_mps",
-        "tgt_azimuth_rad",
-        "tgt_elevation_rad",
-        "tgt_rcs_m2",
-        "tgt_snr_db",
-    ]
-    targets: dict[str, np.ndarray] = {k: np.full((n, n_t), np.nan) for k in names}
-    targets["tgt_visible"] = np.zeros((n, n_t), bool)
+    truth = {f"own_{a}_m": own.position_ned_m[:, c] for c, a in enumerate(_XYZ)}
+    truth |= {f"own_{a}_mps": own.velocity_ned_mps[:, c] for c, a in enumerate(_VXYZ)}
+    truth |= {f"own_{a}_rad": own.attitude_rad[:, c] for c, a in enumerate(("yaw", "pitch", "roll"))}
+    truth |= {"own_lat_deg": own.lat_deg, "own_lon_deg": own.lon_deg, "own_alt_m": own.alt_m}
+    return truth | {"own_height_agl_m": agl}
+
+
+def _intruder_truth(built, own, intruders, simulator: ImageSimulator) -> dict[str, np.ndarray]:
+    n, n_t = own.time_s.size, len(intruders)
+    keys = [f"tgt_{a}_m" for a in _XYZ] + [f"tgt_{a}_mps" for a in _VXYZ]
+    keys += ["tgt_lat_deg", "tgt_lon_deg", "tgt_alt_m", "tgt_rcs_m2", *list(_TRUTH_FROM_GEOMETRY)[:-1]]
+    truth = {k: np.full((n, n_t), np.nan) for k in keys} | {"tgt_visible": np.zeros((n, n_t), bool)}
     for t, (intruder, present, sample) in enumerate(intruders):
         if sample is None:
             continue
         rows = np.nonzero(present)[0]
-        for c, key in enumerate(("tgt_north_m", "tgt_east_m", "tgt_down_m")):
-            targets[key][rows, t] = sample.position_ned_m[:, c]
-        for c, key in enumerate(("tgt_vn_mps", "tgt_ve_mps", "tgt_vd_mps")):
-            targets[key][rows, t] = sample.velocity_ned_mps[:, c]
-        targets["tgt_lat_deg"][rows, t], targets["tgt_lon_deg"][rows, t] = sample.lat_deg, sample.lon_deg
-        targets["tgt_alt_m"][rows, t] = sample.alt_m
-        targets["tgt_rcs_m2"][rows, t] = intruder.rcs_m2
+        for c in range(3):
+            truth[f"tgt_{_XYZ[c]}_m"][rows, t] = sample.position_ned_m[:, c]
+            truth[f"tgt_{_VXYZ[c]}_mps"][rows, t] = sample.velocity_ned_mps[:, c]
+        truth["tgt_lat_deg"][rows, t], truth["tgt_lon_deg"][rows, t] = sample.lat_deg, sample.lon_deg
+        truth["tgt_alt_m"][rows, t] = sample.alt_m
+        truth["tgt_rcs_m2"][rows, t] = intruder.rcs_m2
     for i in range(n):
         platform, point_targets, which = _frame_inputs(own, intruders, i)
-        if not point_targets:
-            continue
-        g = simulator.target_truth(platform, point_targets)
-        for key, src in (
-            ("tgt_range_m", "range_m"),
-            ("tgt_radial_velocity_mps", "radial_velocity_mps"),
-            ("tgt_azimuth_rad", "azimuth_rad"),
-            ("tgt_elevation_rad", "elevation_rad"),
-            ("tgt_snr_db", "snr_db"),
-            ("tgt_visible", "visible"),
-        ):
-            targets[key][i, which] = g[src]
-    return ownship, (targets if n_t else {}), [i.name for i in built.intruders]
+        if point_targets:
+            geometry = simulator.target_truth(platform, point_targets)
+            for key, src in _TRUTH_FROM_GEOMETRY.items():
+                truth[key][i, which] = geometry[src]
+    return truth
+
+
+def scenario_truth(built, simulator: ImageSimulator | None = None) -> tuple[dict, dict, list[str]]:
+    """Own-ship truth on time and intruder truth on (time, target), named as in ``skyradar.io.frames``."""
+    simulator = simulator or make_simulator(built)
+    own, intruders = _states(built, np.arange(built.times_s.size))
+    targets = _intruder_truth(built, own, intruders, simulator) if intruders else {}
+    return _ownship_truth(built, own), targets, [i.name for i in built.intruders]
 
 
 def fingerprint(built) -> str:

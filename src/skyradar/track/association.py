@@ -130,10 +130,7 @@ def associate(
     n, m = len(z_pred), len(z)
     if n == 0 or m == 0:
         return Association(np.zeros(0, int), np.zeros(0, int), np.zeros((0, 2)), np.zeros(0))
-    if metric == "l2":
-        window = np.full(n, gate * pixel_size[0])
-    else:
-        window = np.sqrt(gate * S[:, 0, 0])
+    window = np.full(n, gate * pixel_size[0]) if metric == "l2" else np.sqrt(gate * S[:, 0, 0])
     if range_wrap_m is not None:
         window = window + max_alias * np.nan_to_num(np.asarray(range_wrap_m, float))
     order = np.argsort(z[:, 0], kind="stable")
@@ -183,10 +180,17 @@ def associate_naive(
                 y[1] = (y[1] + doppler_width_mps / 2) % doppler_width_mps - doppler_width_mps / 2
             if range_wrap_m is not None and np.isfinite(range_wrap_m[i]) and range_wrap_m[i] > 0:
                 w = range_wrap_m[i]
-                if abs(y[0]) > (np.sqrt(gate * S[i, 0, 0]) if metric != "l2" else gate * pixel_size[0]) + max_alias * w:
+                if (
+                    abs(y[0])
+                    > (np.sqrt(gate * S[i, 0, 0]) if metric != "l2" else gate * pixel_size[0]) + max_alias * w
+                ):
                     continue
                 y[0] = (y[0] + w / 2) % w - w / 2
-            c = float(np.hypot(y[0] / pixel_size[0], y[1] / pixel_size[1])) if metric == "l2" else float(y @ S_inv @ y)
+            c = (
+                float(np.hypot(y[0] / pixel_size[0], y[1] / pixel_size[1]))
+                if metric == "l2"
+                else float(y @ S_inv @ y)
+            )
             if c < gate:
                 C[i, j] = c
                 Y[i, j] = y

@@ -28,7 +28,7 @@ class MissDeleter:
     [False, True, True]
     """
 
-    def __init__(self, max_misses: int = 8, max_coast_s: float = 1.0) -> None:
+    def __init__(self, max_misses: int = 20, max_coast_s: float = 2.0) -> None:
         if max_misses < 1 or not max_coast_s > 0:
             raise ValueError(f"need max_misses >= 1 and max_coast_s > 0, got {max_misses}, {max_coast_s}")
         self.max_misses, self.max_coast_s = int(max_misses), float(max_coast_s)

@@ -11,7 +11,13 @@ from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.io.tables import read_table
 
-__all__ = ["REQUIRED_DETECTION_COLUMNS", "validate_detections", "read_detections", "truth_from_frames", "Truth"]
+__all__ = [
+    "REQUIRED_DETECTION_COLUMNS",
+    "validate_detections",
+    "read_detections",
+    "truth_from_frames",
+    "Truth",
+]
 
 REQUIRED_DETECTION_COLUMNS = ("time_s", "range_m", "radial_velocity_mps")
 
@@ -32,7 +38,9 @@ def validate_detections(df: pd.DataFrame, source: str = "detections") -> pd.Data
         values = pd.to_numeric(df[col], errors="coerce").to_numpy(float)
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
-            raise InputError(f"{source}: field '{col}' is not a finite number at row {bad[0]} ({df[col].iloc[bad[0]]!r})")
+            raise InputError(
+                f"{source}: field '{col}' is not a finite number at row {bad[0]} ({df[col].iloc[bad[0]]!r})"
+            )
     t = df["time_s"].to_numpy(float)
     back = np.flatnonzero(t[1:] < t[:-1])
     if back.size:
@@ -93,7 +101,9 @@ def truth_from_frames(path: str | Path) -> tuple[Truth, RadarConfig]:
     needed = ["tgt_range_m", "tgt_radial_velocity_mps", "tgt_visible"]
     missing = [v for v in needed if v not in ds]
     if missing:
-        raise InputError(f"{path}: no intruder truth (missing variable(s) {missing}); evaluate needs a simulated run")
+        raise InputError(
+            f"{path}: no intruder truth (missing variable(s) {missing}); evaluate needs a simulated run"
+        )
     truth = Truth(
         ds["time"].values,
         ds["tgt_range_m"].values,

@@ -37,10 +37,7 @@ def predict(x: np.ndarray, P: np.ndarray, F: np.ndarray, Q: np.ndarray) -> tuple
     >>> predict(np.array([[0.0, 2.0]]), np.eye(2)[None], F, np.zeros((2, 2)))[0].tolist()
     [[2.0, 2.0]]
     """
-    if F.ndim == 2:
-        x_new = x @ F.T
-    else:
-        x_new = (F @ x[..., None])[..., 0]
+    x_new = x @ F.T if F.ndim == 2 else (F @ x[..., None])[..., 0]
     P_new = F @ P @ np.swapaxes(F, -1, -2) + Q
     return x_new, P_new
 

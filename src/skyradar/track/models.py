@@ -201,7 +201,14 @@ def _jerk_chain_noise(dt: float) -> np.ndarray:
     the entries are the integrals of the products of those responses over ``[0, dt]``.
     """
     p, v, a = 0, 1, 2
-    powers = {(p, p): dt**5 / 20, (p, v): dt**4 / 8, (p, a): dt**3 / 6, (v, v): dt**3 / 3, (v, a): dt**2 / 2, (a, a): dt}
+    powers = {
+        (p, p): dt**5 / 20,
+        (p, v): dt**4 / 8,
+        (p, a): dt**3 / 6,
+        (v, v): dt**3 / 3,
+        (v, a): dt**2 / 2,
+        (a, a): dt,
+    }
     kind = [p, v, v, a]
     Q = np.empty((4, 4))
     for i in range(4):

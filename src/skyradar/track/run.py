@@ -16,7 +16,8 @@ __all__ = ["make_model", "track_detections", "TRACK_COLUMNS"]
 TRACK_COLUMNS = [
     "time_s", "frame", "track_id", "range_m", "radial_velocity_mps", "range_rate_mps", "radial_accel_mps2",
     "var_range_m2", "var_radial_velocity_m2ps2", "innovation_range_m", "innovation_radial_velocity_mps",
-    "detection_row", "north_m", "east_m", "down_m", "vn_mps", "ve_mps", "vd_mps", "lat_deg", "lon_deg", "alt_m",
+    "detection_row", "north_m", "east_m", "down_m", "vn_mps", "ve_mps", "vd_mps",
+    "lat_deg", "lon_deg", "alt_m",
     *[f"cov_pp_{i}{j}" for i in range(3) for j in range(3)], "confirmed", "n_updates",
 ]  # fmt: skip
 _NED = ("north_m", "east_m", "down_m")
@@ -42,7 +43,9 @@ def make_model(name: str, config: RadarConfig, **noise: float) -> MotionModel:
     raise ValueError(f"model must be 'radar' or 'traditional', got {name!r}")
 
 
-def _frame_slices(times: np.ndarray, frame_times_s: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _frame_slices(
+    times: np.ndarray, frame_times_s: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Frame times and [start, stop) row ranges of each frame (empty frames included)."""
     uniq, start = np.unique(times, return_index=True)
     grid = uniq if frame_times_s is None else np.union1d(np.asarray(frame_times_s, float), uniq)
@@ -96,7 +99,10 @@ def track_detections(
     config = config or RadarConfig.seed_prototype()
     motion = make_model(model, config) if isinstance(model, str) else model
     tracker = RangeDopplerTracker(
-        motion, tracker_config, (config.range_resolution_m, config.doppler_resolution_mps), report_tentative=True
+        motion,
+        tracker_config,
+        (config.range_resolution_m, config.doppler_resolution_mps),
+        report_tentative=True,
     )
     times = detections["time_s"].to_numpy(float)
     z_all = detections[["range_m", "radial_velocity_mps"]].to_numpy(float)
@@ -141,7 +147,9 @@ def _step_3d(
     return x[rows], P[rows][:, :3, :3].reshape(-1, 9)
 
 
-def _assemble(chunks: list[dict[str, np.ndarray]], origin: tuple[float, float, float] | None, has3d: bool) -> pd.DataFrame:
+def _assemble(
+    chunks: list[dict[str, np.ndarray]], origin: tuple[float, float, float] | None, has3d: bool
+) -> pd.DataFrame:
     if not chunks or sum(c["track_id"].size for c in chunks) == 0:
         return pd.DataFrame({c: pd.Series(dtype=float) for c in TRACK_COLUMNS})
 

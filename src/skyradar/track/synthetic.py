@@ -3,7 +3,8 @@
 Used to test and benchmark the tracker independently of the simulator and the detector: each
 visible truth is detected with probability ``pd``, its range gets Gaussian noise, its radial
 velocity gets Gaussian noise and is then wrapped into ``[-VLim, VLim)`` as the Doppler FFT does;
-clutter is uniform over the image. The range includes the sawtooth range-Doppler coupling. Optional 3-D positions get an angular error.
+clutter is uniform over the image. The range includes the sawtooth range-Doppler coupling.
+Optional 3-D positions get an angular error.
 """
 
 from __future__ import annotations
@@ -68,14 +69,15 @@ def synthetic_detections(
     t = np.asarray(times_s, float)
     R = np.asarray(range_m, float).reshape(t.size, -1)
     V = np.asarray(radial_velocity_mps, float).reshape(t.size, -1)
-    vis = (R < config.range_limit_m) if visible is None else np.asarray(visible, bool).reshape(R.shape)
+    vis = (config.range_limit_m > R) if visible is None else np.asarray(visible, bool).reshape(R.shape)
     det = vis & (rng.random(R.shape) < pd_detect)
     fi, ti = np.nonzero(det)
     width = 2.0 * config.v_lim_mps
     cols = {
         "time_s": t[fi],
         "frame": fi,
-        "range_m": R[fi, ti] + (config.range_doppler_coupling_s * V[fi, ti] if coupling else 0.0)
+        "range_m": R[fi, ti]
+        + (config.range_doppler_coupling_s * V[fi, ti] if coupling else 0.0)
         + rng.normal(0.0, sigma_range_m, fi.size),
         "radial_velocity_mps": wrap(V[fi, ti] + rng.normal(0.0, sigma_velocity_mps, fi.size), width),
         "target": ti,
@@ -83,7 +85,13 @@ def synthetic_detections(
     if positions_ned_m is not None:
         pos = np.asarray(positions_ned_m, float)[fi, ti]
         err = rng.normal(0.0, 1.0, (fi.size, 3)) * (R[fi, ti] * sigma_angle_rad)[:, None]
-        cols.update({"north_m": pos[:, 0] + err[:, 0], "east_m": pos[:, 1] + err[:, 1], "down_m": pos[:, 2] + err[:, 2]})
+        cols.update(
+            {
+                "north_m": pos[:, 0] + err[:, 0],
+                "east_m": pos[:, 1] + err[:, 1],
+                "down_m": pos[:, 2] + err[:, 2],
+            }
+        )
     n_clutter = rng.poisson(clutter_per_frame, t.size) if clutter_per_frame > 0 else np.zeros(t.size, int)
     cf = np.repeat(np.arange(t.size), n_clutter)
     clutter = {

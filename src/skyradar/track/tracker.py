@@ -29,7 +29,8 @@ from skyradar.track.models import MotionModel
 __all__ = ["TrackerConfig", "FrameTracks", "RangeDopplerTracker"]
 
 _FIELDS = (
-    "x", "P", "ids", "t_update", "hits", "frames", "misses", "confirmed", "n_updates", "hist_t", "hist_r", "resolved",
+    "x", "P", "ids", "t_update", "hits", "frames", "misses", "confirmed", "n_updates",
+    "hist_t", "hist_r", "resolved",
 )  # fmt: skip
 
 
@@ -72,8 +73,8 @@ class TrackerConfig:
     metric: str = "mahalanobis"
     confirm_m: int = 4
     confirm_n: int = 5
-    max_misses: int = 8
-    max_coast_s: float = 1.0
+    max_misses: int = 20
+    max_coast_s: float = 2.0
     history: int = 16
     max_alias: int = 2
     confirmed_first: bool = True
@@ -246,7 +247,10 @@ class RangeDopplerTracker:
                 self._cache.clear()
             m = self.model
             self._cache[key] = (
-                m.transition(dt), m.process_noise(dt), m.transition_unresolved(dt), m.process_noise_unresolved(dt)
+                m.transition(dt),
+                m.process_noise(dt),
+                m.transition_unresolved(dt),
+                m.process_noise_unresolved(dt),
             )
         return self._cache[key]
 
@@ -257,7 +261,9 @@ class RangeDopplerTracker:
         S = H @ t["P"] @ H.T + self._R
         range_wrap = None
         if self._thesis:
-            range_wrap = np.where(t["n_updates"] == 1, m.doppler_width_mps * (self.time_s - t["t_update"]), np.nan)
+            range_wrap = np.where(
+                t["n_updates"] == 1, m.doppler_width_mps * (self.time_s - t["t_update"]), np.nan
+            )
         self._range_wrap = range_wrap
         # Confirmed tracks choose first; tentative tracks share what is left. Otherwise the
         # solver's preference for more pairs lets a new track take a confirmed track's detection
@@ -287,7 +293,9 @@ class RangeDopplerTracker:
             free[dets[a.detection_index]] = False
         if not parts:
             return Association(np.zeros(0, int), np.zeros(0, int), np.zeros((0, 2)), np.zeros(0))
-        return Association(*(np.concatenate([getattr(p, f) for p in parts]) for f in Association.__dataclass_fields__))
+        return Association(
+            *(np.concatenate([getattr(p, f) for p in parts]) for f in Association.__dataclass_fields__)
+        )
 
     def _update(self, assoc: Association, z: np.ndarray) -> None:
         t, m = self.t, self.model
@@ -296,9 +304,7 @@ class RangeDopplerTracker:
             return
         if self._range_wrap is not None:
             self._shift_alias(rows, z[assoc.detection_index, 0], assoc.innovation[:, 0])
-        t["x"][rows], t["P"][rows] = update(
-            t["x"][rows], t["P"][rows], assoc.innovation, self._H, self._R
-        )
+        t["x"][rows], t["P"][rows] = update(t["x"][rows], t["P"][rows], assoc.innovation, self._H, self._R)
         if self._hybrid:
             self._resolve(rows)
         if self._thesis:
@@ -308,7 +314,9 @@ class RangeDopplerTracker:
             ok = np.isfinite(rate)
             r_ok = rows[ok]
             t["x"][r_ok, 2] = rate[ok]
-            self._shift_velocity(r_ok, dealias_velocity(t["x"][r_ok, 1], rate[ok], m.doppler_width_mps) - t["x"][r_ok, 1])
+            self._shift_velocity(
+                r_ok, dealias_velocity(t["x"][r_ok, 1], rate[ok], m.doppler_width_mps) - t["x"][r_ok, 1]
+            )
 
     def _resolve(self, rows: np.ndarray) -> None:
         """Resolve the alias of tracks whose range rate is now known well enough (confident mode)."""

@@ -139,7 +139,9 @@ class RunSource:
         try:
             own = ownship_from_frames(self.ds, str(self._opened))
         except InputError:
-            self.alerts, self.traffic_source = pd.DataFrame(), "none"
+            if self.tracks_path is not None:
+                raise  # tracks cannot be alerted without the own-ship state
+            self.alerts, self.traffic_source = pd.DataFrame(), "none"  # e.g. a real recording: image only
             return
         if self.tracks_path is not None:
             tracks, self.traffic_source = read_table(self.tracks_path, sort_by="time_s"), "tracks"

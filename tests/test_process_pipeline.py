@@ -209,3 +209,33 @@ def test_cli_calibrate_then_process_with_the_calibrated_config(tmp_path, monkeyp
     wide = ["--range", 438, "--azimuth", 80, "--elevation", 0]
     assert run_cli(monkeypatch, "calibrate", tmp_path / "run.zarr", "-o", tmp_path / "x.json", *wide) == 2
     assert "field of view" in capsys.readouterr().err
+
+
+def test_simulated_flight_over_flat_ground_separates_terrain_from_the_intruder():
+    from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
+
+    cfg = RadarConfig.seed_prototype(mount=Mount.preset("forward-down"))
+    terrain = flat_terrain(*ORIGIN[:2], height_m=0.0, size_m=10000.0, spacing_m=60.0)
+    sim = ImageSimulator(cfg, terrain, origin=ORIGIN, seed=1)
+    times = np.array([0.0, 0.1])
+    own = np.array([[30.0 * t, 0.0, -1000.0] for t in times])
+    intruder = np.array([[2000.0 - 50.0 * t, 100.0, -1000.0] for t in times])
+    cubes = [
+        sim.frame(PlatformState(own[i], np.array([30.0, 0, 0]), np.zeros(3)),
+                  [PointTarget(intruder[i], np.array([-50.0, 0, 0]), 10.0)], i)
+        for i in range(2)
+    ]  # fmt: skip
+    lat, lon, alt = ned_to_geodetic(own, *ORIGIN)
+    ownship = {"own_north_m": own[:, 0], "own_east_m": own[:, 1], "own_down_m": own[:, 2],
+               "own_vn_mps": np.full(2, 30.0), "own_ve_mps": np.zeros(2), "own_vd_mps": np.zeros(2),
+               "own_lat_deg": lat, "own_lon_deg": lon, "own_alt_m": alt}  # fmt: skip
+    attrs = {"origin_lat_deg": ORIGIN[0], "origin_lon_deg": ORIGIN[1], "origin_alt_m": ORIGIN[2]}
+    ds = frames_dataset(np.stack(cubes), times, cfg, ownship=ownship, attrs=attrs)
+    table = process_frames(ds, terrain=terrain)
+    for i in range(2):
+        rows = table[table.frame == i]
+        err = np.linalg.norm(rows[["north_m", "east_m", "down_m"]].to_numpy() - intruder[i], axis=1)
+        k = int(np.argmin(err))
+        assert err[k] < 100.0 and not rows.is_ground.iloc[k]
+        others = rows.drop(rows.index[k])
+        assert len(others) >= 3 and others.is_ground.mean() >= 0.9

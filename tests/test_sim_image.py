@@ -219,3 +219,23 @@ def test_attitude_rotates_the_antenna():
 
 def test_speed_of_light_constant():
     assert CFG.range_resolution_m == pytest.approx(SPEED_OF_LIGHT / 2e7)
+
+
+def test_terrain_masks_an_aircraft_behind_a_ridge():
+    elevation = np.zeros((401, 61))
+    ridge_row = 200 - int(2000 / 30.0)
+    elevation[ridge_row - 2 : ridge_row + 3, :] = 900.0
+    terrain = centred_grid(elevation, 0.0, 0.0, 30.0, "ridge")
+    cfg = CFG.replace(mount=Mount.preset("forward"))
+    platform = PlatformState(np.array([0.0, 0.0, -300.0]), np.array([40.0, 0.0, 0.0]), np.zeros(3))
+    behind = PointTarget(np.array([3500.0, 0.0, -400.0]), np.zeros(3), 10.0)  # low, beyond the wall
+    above = PointTarget(np.array([3500.0, 0.0, -2500.0]), np.zeros(3), 10.0)  # high above the wall's shadow
+    in_front = PointTarget(np.array([1000.0, 0.0, -300.0]), np.zeros(3), 10.0)
+    sim = ImageSimulator(cfg, terrain, (0, 0, 0), noise=False, occlusion=True)
+    truth = sim.target_truth(platform, [behind, above, in_front])
+    assert truth["visible"].tolist() == [False, True, True]
+    alone = sim.frame(platform, [behind])
+    ground = sim.frame(platform)
+    np.testing.assert_array_equal(alone, ground)  # the hidden aircraft adds nothing
+    unmasked = ImageSimulator(cfg, terrain, (0, 0, 0), noise=False, occlusion=False)
+    assert unmasked.target_truth(platform, [behind])["visible"].tolist() == [True]

@@ -33,6 +33,7 @@ __all__ = [
     "PlatformState",
     "PointTarget",
     "AntennaGeometry",
+    "TerrainView",
     "ImageSimulator",
     "REFLECTIVITY_MODELS",
     "thermal_noise",
@@ -61,6 +62,16 @@ class PointTarget:
     position_ned_m: np.ndarray
     velocity_ned_mps: np.ndarray
     rcs_m2: float = 1.0
+
+
+@dataclass(frozen=True)
+class TerrainView:
+    """Terrain cropped around the antenna for one frame, and its polar horizon."""
+
+    p_ned: np.ndarray  # grid points relative to the antenna, NED, m
+    horizon: np.ndarray  # (n_az, n_h) elevation angle to beat, rad (1 x 1 of -inf: no occlusion)
+    az_bin_rad: float
+    h_bin_m: float
 
 
 @dataclass(frozen=True)
@@ -179,28 +190,38 @@ class ImageSimulator:
         """Simulate one frame; returns (n_range, n_doppler, n_rx) complex64."""
         cfg = self.config
         geom = self.geometry(platform)
-        if self.terrain is not None:
-            cube = self.terrain_cube(geom)
+        view = self.terrain_view(geom)
+        if view is not None:
+            cube = self.terrain_cube(geom, view)
         else:
             cube = np.zeros((cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex128)
         if targets:
-            _add_targets(cube, cfg, geom, targets, self.coupling_s)
+            _add_targets(cube, cfg, geom, targets, self.coupling_s, _line_of_sight(view, geom, targets))
         if not self.noise:
             return cube.astype(np.complex64)
         frame = thermal_noise(cube.shape, cfg.noise_power_w, (self.seed, int(frame_index)))
         np.add(frame, cube, out=frame, casting="same_kind")
         return frame
 
-    def terrain_cube(self, geom: AntennaGeometry) -> np.ndarray:
+    def terrain_view(self, geom: AntennaGeometry) -> TerrainView | None:
+        """Terrain cropped around the antenna, with its horizon, for one frame (None: none in range)."""
+        if self.terrain is None:
+            return None
+        crop = self._crop(geom)
+        if crop is None:
+            return None
+        p_ned = np.ascontiguousarray(self._grid_ned[crop] - geom.origin_ned_m)
+        return TerrainView(p_ned, *self._horizon(p_ned, geom, get_num_threads()))
+
+    def terrain_cube(self, geom: AntennaGeometry, view: TerrainView | None = None) -> np.ndarray:
         """Terrain returns only, (n_range, n_doppler, n_rx) complex128."""
         cfg = self.config
         n_blocks = get_num_threads()
         out = np.zeros((n_blocks, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex128)
-        crop = self._crop(geom)
-        if crop is None:
+        view = view if view is not None else self.terrain_view(geom)
+        if view is None:
             return out[0]
-        p_ned = np.ascontiguousarray(self._grid_ned[crop] - geom.origin_ned_m)
-        horizon, az_bin, h_bin = self._horizon(p_ned, geom, n_blocks)
+        p_ned, horizon, az_bin, h_bin = view.p_ned, view.horizon, view.az_bin_rad, view.h_bin_m
         rot = geom.rot_ned_to_ant
         p_ant = np.ascontiguousarray(p_ned @ rot.T)
         power_const = cfg.pe_w * cfg.wavelength_m**2 / (4 * np.pi) ** 3 * self.ground_gain
@@ -217,7 +238,7 @@ class ImageSimulator:
     ) -> tuple[np.ndarray, float, float]:
         """Polar horizon for the occlusion test, with its azimuth and horizontal-range bin sizes."""
         if not self.occlusion:
-            return np.zeros((1, 1), np.float32), 1.0, 1.0
+            return np.full((1, 1), -np.inf, np.float32), 1.0, 1.0
         r_lim = self.config.range_limit_m + self.config.range_resolution_m
         # The horizon follows the terrain's shape, which the DEM resolves at its own spacing:
         # 2 x 2 samples per DEM cell and bins of half the spacing, not every sub-facet.
@@ -259,7 +280,8 @@ class ImageSimulator:
     def target_truth(self, platform: PlatformState, targets: Sequence[PointTarget]) -> dict[str, np.ndarray]:
         """Range, radial velocity, antenna-frame angles, expected SNR and visibility per target."""
         geom = self.geometry(platform)
-        return _target_geometry(self.config, geom, targets, self.coupling_s)
+        clear = _line_of_sight(self.terrain_view(geom), geom, targets)
+        return _target_geometry(self.config, geom, targets, self.coupling_s, clear)
 
 
 _NOISE_STREAMS = 4  # fixed, so a frame's noise does not depend on how many threads drew it
@@ -311,8 +333,26 @@ def _reflectivity_table(reflectivity: str | Callable[[np.ndarray], np.ndarray], 
     return table
 
 
+def _line_of_sight(
+    view: TerrainView | None, geom: AntennaGeometry, targets: Sequence[PointTarget]
+) -> np.ndarray:
+    """True for targets not hidden behind terrain (the same horizon test as terrain facets)."""
+    rel = np.array([t.position_ned_m for t in targets], float).reshape(-1, 3) - geom.origin_ned_m
+    if view is None:
+        return np.ones(len(rel), bool)
+    n_az, n_h = view.horizon.shape
+    h = np.hypot(rel[:, 0], rel[:, 1])
+    a = ((np.arctan2(rel[:, 1], rel[:, 0]) + np.pi) / view.az_bin_rad).astype(int) % n_az
+    k = np.minimum((h / view.h_bin_m).astype(int), n_h - 1)
+    return np.arctan2(-rel[:, 2], h) >= view.horizon[a, k]
+
+
 def _target_geometry(
-    cfg: RadarConfig, geom: AntennaGeometry, targets: Sequence[PointTarget], coupling_s: float
+    cfg: RadarConfig,
+    geom: AntennaGeometry,
+    targets: Sequence[PointTarget],
+    coupling_s: float,
+    clear: np.ndarray,
 ):
     pos = np.array([t.position_ned_m for t in targets], float).reshape(-1, 3)
     vel = np.array([t.velocity_ned_mps for t in targets], float).reshape(-1, 3)
@@ -330,7 +370,7 @@ def _target_geometry(
     power_w = cfg.pe_w * 10 ** (gain_db / 5.0) * cfg.wavelength_m**2 * rcs / ((4 * np.pi) ** 3 * half_path**4)
     k = np.floor((half_path + coupling_s * v_r) / cfg.range_resolution_m + 0.5).astype(int)
     j = (np.floor(v_r / cfg.doppler_resolution_mps + 0.5).astype(int) + cfg.n_doppler // 2) % cfg.n_doppler
-    in_view = (p_ant[:, 0] > 0) & (k >= 0) & (k < cfg.n_range)
+    in_view = (p_ant[:, 0] > 0) & (k >= 0) & (k < cfg.n_range) & clear
     return {
         "range_m": half_path,
         "radial_velocity_mps": v_r,
@@ -345,8 +385,10 @@ def _target_geometry(
     }
 
 
-def _add_targets(cube: np.ndarray, cfg: RadarConfig, geom, targets, coupling_s: float) -> None:
-    g = _target_geometry(cfg, geom, targets, coupling_s)
+def _add_targets(
+    cube: np.ndarray, cfg: RadarConfig, geom, targets, coupling_s: float, clear: np.ndarray
+) -> None:
+    g = _target_geometry(cfg, geom, targets, coupling_s, clear)
     keep = g["visible"]
     if not np.any(keep):
         return

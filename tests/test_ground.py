@@ -13,6 +13,7 @@ from skyradar.process.ground import (
     classify_ground,
     doppler_matches_static,
     height_above_ground_m,
+    in_ground_band,
     static_radial_velocity_mps,
 )
 from skyradar.scene.terrain import flat_terrain
@@ -86,3 +87,22 @@ def test_stationary_radar_without_terrain_calls_nothing_ground():
     h = height_above_ground_m(lat, lon, alt, ground_alt_m=0.0)
     assert classify_ground(np.array([500.0]), np.array([0.0]), u, CFG, np.zeros(3), h).all()
     assert geodetic_to_ned(lat, lon, alt, 52.0, 4.0, 0.0).shape == (1, 3)
+
+
+def test_ground_band_is_the_clutter_region_of_a_level_flight():
+    # 1000 m above flat ground at 30 m/s: at 2 km the ground fills |v| <= 30 * sqrt(1 - 0.25) = 26 m/s.
+    v_own = np.array([30.0, 0.0, 0.0])
+    rng = np.full(4, 2000.0)
+    v = np.array([-25.0, 20.0, 30.0, -35.0])
+    assert in_ground_band(rng, v, v_own, 1000.0, CFG, tolerance_mps=0.0).tolist() == [
+        True,
+        True,
+        False,
+        False,
+    ]
+    # Below the own-ship height there is no ground; climbing shifts the band by -v_d h / R.
+    assert not in_ground_band(np.array([800.0]), np.array([0.0]), v_own, 1000.0, CFG).any()
+    climbing = np.array([30.0, 0.0, -10.0])
+    assert in_ground_band(np.array([2000.0]), np.array([30.0]), climbing, 1000.0, CFG, 0.0).all()
+    # Fast flight: the band covers the whole aliased Doppler axis.
+    assert in_ground_band(np.array([3000.0]), np.array([10.0]), np.array([90.0, 0, 0]), 500.0, CFG, 0.0).all()

@@ -25,7 +25,7 @@ __all__ = ["app", "main"]
 def main() -> None:
     """Entry point of the ``skyradar`` script."""
     try:
-        app(standalone_mode=False)
+        code = app(standalone_mode=False)
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         sys.exit(2)
@@ -35,5 +35,9 @@ def main() -> None:
         exc.show()
         sys.exit(exc.exit_code)
     except (KeyboardInterrupt, click.exceptions.Abort):
+        code = 130
+    # With standalone_mode=False click returns 130 on Ctrl-C instead of raising.
+    if code == 130:
         print("interrupted: finished chunks are kept; rerun the same command to resume", file=sys.stderr)
-        sys.exit(130)
+    if isinstance(code, int) and code:
+        sys.exit(code)

@@ -75,7 +75,7 @@ def experiment_ch5(
     fast_duration_s: Annotated[
         float,
         typer.Option("--fast-duration", help="Flight length at 9.4 frames/s (flat, 19.2 m), s; 0 skips."),
-    ] = 8.0,
+    ] = 6.0,
     as_json: JsonOption = False,
 ) -> None:
     """ch5: flight state over flat, fractal (local SD 19.2..345 m) and Jacksboro terrain; three methods.

@@ -91,12 +91,20 @@ def bench_chain(
     as_json: Annotated[
         bool, typer.Option("--json", help="Print the result as JSON (last stdout line).")
     ] = False,
+    flight_frames: Annotated[
+        int, typer.Option(help="Frames of the whole-flight simulation run on 1 and 2 Dask workers (0: skip).")
+    ] = 600,
 ) -> None:
-    """ADC cube -> range-Doppler cube throughput for the seed prototype (4 x 250 x 2032).
+    """ADC cube -> range-Doppler cube throughput, and whole-flight simulation on 1 vs 2 Dask workers.
 
     Prints ``raw_to_rd_fps``, ``realtime_factor`` (fps / 9.4 frames/s) and the same-run baseline
-    (per-channel numpy.fft loop) with the speed-up.
+    (per-channel numpy.fft loop) with the speed-up; then ``sim_fps_1_worker``,
+    ``sim_fps_2_workers`` and ``sim_speedup_2_workers`` for a flight at SRTM spacing.
     """
+    from skyradar.benchmarks import flight
     from skyradar.benchmarks.chain import run
 
-    emit_result(run(n_frames=frames, workers=workers), as_json, "raw chain")
+    result = run(n_frames=frames, workers=workers)
+    if flight_frames:
+        result |= flight.run(frames=flight_frames)
+    emit_result(result, as_json, "raw chain and whole-flight simulation")

@@ -151,7 +151,7 @@ def _case(name, rate_hz, duration_s, config, facet_size_m, seed, warmup_s, terra
 def run(
     out_dir: Path,
     duration_s: float = 40.0,
-    fast_duration_s: float = 10.0,
+    fast_duration_s: float = 6.0,
     terrains: tuple[str, ...] = tuple(TERRAINS),
     fast_terrains: tuple[str, ...] = ("flat", "sd19"),
     facet_size_m: float = 10.0,
@@ -192,5 +192,16 @@ def run(
             "runtime_s": time.perf_counter() - t_start,
         }
     )
-    write_json_atomic(out_dir / "ch5.json", results)
+    write_json_atomic(out_dir / "ch5.json", _finite_or_none(results))
     return results
+
+
+def _finite_or_none(value: Any) -> Any:
+    """NaN (no valid frame) becomes null: strict JSON."""
+    if isinstance(value, dict):
+        return {k: _finite_or_none(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_finite_or_none(v) for v in value]
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    return value

@@ -40,7 +40,7 @@ from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.scene.flights import encounter, straight
 from skyradar.track.tracker3d import Tracker3D
 
-__all__ = ["make_encounters", "run_encounter", "run"]
+__all__ = ["make_encounters", "run_encounters", "run_encounter", "run"]
 
 _KINDS = ("head-on", "crossing", "overtaking", "converging", "climbing")
 
@@ -75,47 +75,56 @@ def make_encounters(n: int, seed: int = 0) -> pd.DataFrame:
     )
 
 
-def _trajectories(p: pd.Series, duration_s: float, t_cpa_s: float):
-    own = straight([0.0, 0.0, -1000.0], 0.0, 50.0, duration_s, rate_hz=10.0)
+def _intruder(own, p: pd.Series, t_cpa_s: float):
     kind = "crossing" if p.kind == "climbing" else p.kind
-    kw = {"crossing_angle_deg": p.crossing_angle_deg} if kind in ("crossing", "converging") else {}
+    kw = {"crossing_angle_deg": float(p.crossing_angle_deg)} if kind in ("crossing", "converging") else {}
     if p.kind == "climbing":
-        kw["intruder_climb_mps"] = p.climb_mps
-    intr = encounter(
-        own, kind, t_cpa_s, p.horizontal_miss_m, p.vertical_miss_m, p.intruder_speed_mps, rate_hz=10.0, **kw
-    )
-    return own, intr
+        kw["intruder_climb_mps"] = float(p.climb_mps)
+    return encounter(
+        own, kind, t_cpa_s, float(p.horizontal_miss_m), float(p.vertical_miss_m), float(p.intruder_speed_mps),
+        rate_hz=10.0, **kw,
+    )  # fmt: skip
 
 
 def _measure(rel: np.ndarray, rng, config: RadarConfig, fov_deg, p_detect, sigma_az, sigma_el, sigma_r):
-    """Noisy NED relative positions (NaN when not detected) and per-axis variances, m^2."""
-    r = np.linalg.norm(rel, axis=1)
-    az = np.arctan2(rel[:, 1], rel[:, 0])  # forward mount, own-ship level and heading north
-    el = np.arctan2(-rel[:, 2], np.hypot(rel[:, 0], rel[:, 1]))
+    """Noisy relative NED positions (NaN when not detected), per-axis variances (m^2) and visibility."""
+    r = np.linalg.norm(rel, axis=-1)
+    az = np.arctan2(rel[..., 1], rel[..., 0])  # forward mount, own-ship level and heading north
+    el = np.arctan2(-rel[..., 2], np.hypot(rel[..., 0], rel[..., 1]))
     half = np.radians(fov_deg / 2)
     visible = (r <= config.range_limit_m) & (np.abs(az) <= half) & (np.abs(el) <= half)
-    detected = visible & (rng.random(r.size) < p_detect)
-    rm = r + rng.normal(0, sigma_r, r.size)
-    azm = az + rng.normal(0, sigma_az, r.size)
-    elm = el + rng.normal(0, sigma_el, r.size)
+    detected = visible & (rng.random(r.shape) < p_detect)
+    rm = r + rng.normal(0, sigma_r, r.shape)
+    azm = az + rng.normal(0, sigma_az, r.shape)
+    elm = el + rng.normal(0, sigma_el, r.shape)
     meas = np.stack([rm * np.cos(elm) * np.cos(azm), rm * np.cos(elm) * np.sin(azm), -rm * np.sin(elm)], -1)
     meas[~detected] = np.nan
     return meas, (r * max(sigma_az, sigma_el)) ** 2 + sigma_r**2, visible
 
 
-_TRACK_COLS = ["time_s", "north_m", "east_m", "down_m", "vn_mps", "ve_mps", "vd_mps"] + [
+_TRACK_COLS = ["time_s", "track_id", "north_m", "east_m", "down_m", "vn_mps", "ve_mps", "vd_mps"] + [
     f"cov_{m}_{i}{j}" for m in ("pp", "vv") for i in range(3) for j in range(3)
 ]
 
 
-def _track(t: np.ndarray, meas_ned: np.ndarray, var: np.ndarray) -> pd.DataFrame:
-    """3-D tracks table (one track, id 0) from noisy NED positions (NaN rows: no detection)."""
-    tracker, rows, ids = Tracker3D(), [], np.array([0])
+def _track(t: np.ndarray, meas_ned: np.ndarray, var: np.ndarray, coast_s: float = 1.0) -> pd.DataFrame:
+    """3-D tracks table, one track per encounter (id = row), from noisy NED positions (n_enc, n_t, 3).
+
+    Like the range-Doppler tracker, a track is dropped after ``coast_s`` without a detection; a later
+    detection starts a new track (same id, fresh filter).
+    """
+    tracker, ids, rows = Tracker3D(), np.arange(meas_ned.shape[0]), []
+    last_seen = np.full(ids.size, -np.inf)
     for i, ti in enumerate(t):
-        x, P = tracker.step(float(ti), ids, meas_ned[i : i + 1], var[i : i + 1])
-        if np.isfinite(x[0, 0]):
-            rows.append(np.concatenate([[ti], x[0], P[0, :3, :3].ravel(), P[0, 3:, 3:].ravel()]))
-    return pd.DataFrame(np.array(rows).reshape(-1, len(_TRACK_COLS)), columns=_TRACK_COLS).assign(track_id=0)
+        seen = np.isfinite(meas_ned[:, i, 0])
+        last_seen[seen] = ti
+        alive = ti - last_seen <= coast_s
+        x, P = tracker.step(float(ti), ids[alive], meas_ned[alive, i], var[alive, i])
+        ok = np.isfinite(x[:, 0])
+        k = int(ok.sum())
+        rows.append(np.hstack([np.full((k, 1), ti), ids[alive][ok, None], x[ok], P[ok, :3, :3].reshape(k, 9),
+                               P[ok, 3:, 3:].reshape(k, 9)]))  # fmt: skip
+    return pd.DataFrame(np.vstack(rows), columns=_TRACK_COLS).astype({"track_id": int})
 
 
 def _ownship_table(t: np.ndarray, own) -> pd.DataFrame:
@@ -127,9 +136,9 @@ def _ownship_table(t: np.ndarray, own) -> pd.DataFrame:
     return pd.DataFrame(cols)
 
 
-def run_encounter(
-    p: pd.Series,
-    seed: int,
+def run_encounters(
+    params: pd.DataFrame,
+    seed: int = 0,
     frame_rate_hz: float = 9.4,
     duration_s: float = 90.0,
     t_cpa_s: float = 60.0,
@@ -139,35 +148,41 @@ def run_encounter(
     sigma_el_deg: float = 2.7,
     sigma_range_m: float | None = None,
     alert_config: AlertConfig | None = None,
-) -> dict:
-    """One encounter (a row of :func:`make_encounters`) through the chain; times in s (NaN when none)."""
+) -> pd.DataFrame:
+    """Encounters (rows of :func:`make_encounters`) through the chain, all at once (one tracker, one
+    alerting pass; encounters are independent). One result row per encounter; times in s, NaN when none.
+    """
     config = RadarConfig.seed_prototype()
-    own_t, int_t = _trajectories(p, duration_s, t_cpa_s)
     t = np.arange(0.0, duration_s, 1.0 / frame_rate_hz)
-    own, intr = own_t.sample(t), int_t.sample(t)
-    rel = intr.position_ned_m - own.position_ned_m
+    own_t = straight([0.0, 0.0, -1000.0], 0.0, 50.0, duration_s, rate_hz=10.0)
+    own = own_t.sample(t)
+    rel = np.stack([_intruder(own_t, p, t_cpa_s).sample(t).position_ned_m for _, p in params.iterrows()])
+    rel -= own.position_ned_m[None]
     vol = WellClearVolume.do365_noncoop()
-    lowc = (np.hypot(rel[:, 0], rel[:, 1]) <= vol.dthr_m) & (np.abs(rel[:, 2]) <= vol.zthr_m)
-    t_lowc = float(t[np.argmax(lowc)]) if lowc.any() else np.nan
-    rng = np.random.default_rng(seed)
+    lowc = (np.hypot(rel[..., 0], rel[..., 1]) <= vol.dthr_m) & (np.abs(rel[..., 2]) <= vol.zthr_m)
+    t_lowc = np.where(lowc.any(axis=1), t[np.argmax(lowc, axis=1)], np.nan)
     sig = np.radians([sigma_az_deg, sigma_el_deg])
     sigma_r = config.range_resolution_m / np.sqrt(12) if sigma_range_m is None else sigma_range_m
-    meas, var, visible = _measure(rel, rng, config, fov_deg, p_detect, *sig, sigma_r)
-    tracks = _track(t, meas + own.position_ned_m, var)
-    t_warn = np.nan
-    if len(tracks):
-        alerts = alerts_from_tracks(tracks, _ownship_table(t, own), alert_config, with_advice=False)
-        warn = alerts["time_s"].to_numpy()[alerts["level"].to_numpy() >= 3]
-        t_warn = float(warn[0]) if warn.size else np.nan
-    window = (t >= t_lowc - 25.0) & (t <= t_lowc) if np.isfinite(t_lowc) else np.zeros(t.size, bool)
-    return {
-        "t_lowc_s": t_lowc,
-        "conflict": bool(lowc.any()),
-        "observable": bool(lowc.any() and window.any() and visible[window].all()),
-        "t_warning_s": t_warn,
-        "min_horizontal_m": float(np.min(np.hypot(rel[:, 0], rel[:, 1]))),
-        "min_vertical_m": float(np.min(np.abs(rel[:, 2]))),
-    }
+    meas, var, visible = _measure(rel, np.random.default_rng(seed), config, fov_deg, p_detect, *sig, sigma_r)
+    tracks = _track(t, meas + own.position_ned_m[None], var)
+    alerts = alerts_from_tracks(tracks, _ownship_table(t, own), alert_config, with_advice=False)
+    warn = alerts[alerts["level"] >= 3].groupby("track_id")["time_s"].min()
+    window = (t[None] >= t_lowc[:, None] - 25.0) & (t[None] <= t_lowc[:, None])
+    return pd.DataFrame(
+        {
+            "t_lowc_s": t_lowc,
+            "conflict": lowc.any(axis=1),
+            "observable": lowc.any(axis=1) & np.all(visible | ~window, axis=1),
+            "t_warning_s": warn.reindex(np.arange(len(params))).to_numpy(float),
+            "min_horizontal_m": np.min(np.hypot(rel[..., 0], rel[..., 1]), axis=1),
+            "min_vertical_m": np.min(np.abs(rel[..., 2]), axis=1),
+        }
+    )
+
+
+def run_encounter(p: pd.Series, seed: int = 0, **kw) -> dict:
+    """One encounter through :func:`run_encounters`; returns its result row as a dict."""
+    return run_encounters(p.to_frame().T.reset_index(drop=True), seed, **kw).iloc[0].to_dict()
 
 
 def _summary(res: pd.DataFrame, late_lead_s: float) -> dict:
@@ -241,11 +256,9 @@ def run(
     out_dir.mkdir(parents=True, exist_ok=True)
     cfg = AlertConfig() if uncertainty else AlertConfig(z_h_pos=0.0, z_h_vel=0.0, z_v_pos=0.0, z_v_vel=0.0)
     enc = make_encounters(n_encounters, seed)
-    rows = []
-    for i, p in enc.iterrows():
-        rows.append(run_encounter(p, seed * 100_003 + int(i), frame_rate_hz, alert_config=cfg,
-                                  sigma_az_deg=sigma_az_deg, sigma_el_deg=sigma_el_deg))  # fmt: skip
-    res = pd.concat([enc, pd.DataFrame(rows)], axis=1)
+    out = run_encounters(enc, seed, frame_rate_hz, alert_config=cfg, sigma_az_deg=sigma_az_deg,
+                         sigma_el_deg=sigma_el_deg)  # fmt: skip
+    res = pd.concat([enc, out], axis=1)
     summary = _summary(res, late_lead_s)
     summary.update(chain="sensor-model", frame_rate_hz=frame_rate_hz, uncertainty=uncertainty,
                    sigma_az_deg=sigma_az_deg, sigma_el_deg=sigma_el_deg, seed=seed)  # fmt: skip

@@ -2,7 +2,8 @@
 
 Per frame: the ground ridge (:mod:`skyradar.nav.ridge`), a flat-plane inversion
 (:mod:`skyradar.nav.inversion`) and a quality figure; over the run: the Kalman filter of
-:mod:`skyradar.nav.kalman_state`. Two methods:
+:mod:`skyradar.nav.kalman_state`. Two flat-plane methods (a third, ``terrain``, from
+:mod:`skyradar.nav.terrain_aware`, is available through :func:`estimate_run`):
 
 ``thesis``
     Ridge pairs at the range-bin centre without the range-Doppler coupling correction, the

@@ -213,18 +213,21 @@ def fit_ransac(
     rng = np.random.default_rng(seed)
     triples = np.sort(rng.random((n_trials, idx.size)).argsort(axis=1)[:, :3], axis=1)
     coefs = _minimal_solutions(r[idx], v[idx], triples)
-    best, best_count, best_cost = None, 0, np.inf
-    for a, b, c in coefs:
-        state = state_from_abc(a, b, c) if np.all(np.isfinite((a, b, c))) else (np.nan,) * 3
-        if not np.isfinite(state[2]):
-            continue
-        err = np.abs(v[idx] - ridge_velocity(r[idx], *state))
-        inl = err < threshold_mps
-        count, cost = int(inl.sum()), float(np.minimum(err, threshold_mps).sum())
-        if count > best_count or (count == best_count and cost < best_cost):
-            best, best_count, best_cost = inl, count, cost
-    if best is None or best_count < 4:
+    # Score every candidate at once: (trials, pairs) radial-velocity errors of the ridge model.
+    with np.errstate(invalid="ignore", divide="ignore"):
+        a, b, c = coefs.T
+        h = np.sqrt(c - b * b / (4.0 * a))
+        vx, vz = np.sqrt(1.0 / a), b / (2.0 * a * h)
+        rr, vv = r[idx][None, :], v[idx][None, :]
+        model = -(vx[:, None] * np.sqrt(rr * rr - h[:, None] ** 2) + (vz * h)[:, None]) / rr
+        err = np.where(np.isfinite(model), np.abs(vv - model), np.inf)
+    valid = (a > 0) & np.isfinite(h) & (h > 0)
+    counts = np.where(valid, (err < threshold_mps).sum(axis=1), 0)
+    costs = np.where(valid, np.minimum(err, threshold_mps).sum(axis=1), np.inf)
+    if counts.max(initial=0) < 4:
         return StateFit.failed(r.size)
+    order = np.lexsort((costs, -counts))
+    best = err[order[0]] < threshold_mps
     keep = np.zeros(r.size, bool)
     keep[idx[best]] = True
     fit = fit_thesis(np.where(keep, r, np.nan), v)

@@ -126,10 +126,11 @@ def noise_floor_w(
     return est
 
 
-def band_start(occupied: np.ndarray) -> int | None:
+def band_start(occupied: np.ndarray) -> np.ndarray | int | None:
     """First occupied Doppler bin after the widest circular run of empty bins (the ground band's start).
 
-    Returns None when the row is all empty or all occupied.
+    ``occupied`` is one row (returns an int, or None when the row is all empty or all
+    occupied) or a 2-D array of rows (returns an int array, -1 for such rows).
 
     Examples
     --------
@@ -138,16 +139,18 @@ def band_start(occupied: np.ndarray) -> int | None:
     >>> band_start(np.array([0, 1, 1, 1, 0, 0, 0, 0], bool))
     1
     """
-    occ = np.asarray(occupied, bool)
-    if not occ.any() or occ.all():
-        return None
-    n = occ.size
-    first = int(np.flatnonzero(occ)[0])
-    gaps = np.concatenate([[False], np.roll(~occ, -first), [False]])  # starts occupied: no gap wraps
-    edges = np.flatnonzero(np.diff(gaps.astype(np.int8)))
-    starts, ends = edges[::2], edges[1::2]
-    i = int(np.argmax(ends - starts))
-    return int((ends[i] + first) % n)
+    occ = np.atleast_2d(np.asarray(occupied, bool))
+    n = occ.shape[1]
+    doubled = np.concatenate([occ, occ], axis=1)
+    index = np.arange(2 * n)
+    # Length of the empty run ending at each position of the doubled (unrolled) circle.
+    last_occupied = np.maximum.accumulate(np.where(doubled, index, -1), axis=1)
+    run = np.where(doubled, 0, index - last_occupied)
+    start = (np.argmax(run, axis=1) + 1) % n
+    start[~occ.any(axis=1) | occ.all(axis=1)] = -1
+    if np.ndim(occupied) == 1:
+        return None if start[0] < 0 else int(start[0])
+    return start
 
 
 def _clean_rows(mask: np.ndarray, max_gap: int, min_len: int) -> np.ndarray:
@@ -215,7 +218,7 @@ def extract_ridge(
     rows = np.flatnonzero(clean.any(axis=1) & ~clean.all(axis=1))
     if rows.size == 0:
         return Ridge.empty(noise, n_occ)
-    dopp = np.array([band_start(clean[r]) for r in rows], dtype=int)
+    dopp = band_start(clean[rows])
     # Unwrap along range (the ridge is continuous in range), then pick the alias turn.
     width = 2.0 * config.v_lim_mps
     vel = np.unwrap(config.doppler_axis_mps[dopp], period=width)

@@ -55,6 +55,7 @@ __all__ = [
     "angles_from_direction",
     "steering_vector",
     "estimate_directions",
+    "direction_coherence",
     "doa_crlb",
     "antenna_to_body",
 ]
@@ -306,6 +307,24 @@ def estimate_directions(
     a = a / np.maximum(norm, 1.0)  # noise can push the in-plane part beyond the unit circle
     third = np.sqrt(np.maximum(1.0 - np.sum(a * a, axis=1, keepdims=True), 0.0))
     return a @ geo.basis.T + third * geo.normal
+
+
+def direction_coherence(
+    pixels: np.ndarray, u: np.ndarray, config: RadarConfig, calibrated: bool = False
+) -> np.ndarray:
+    """How well one plane wave from ``u`` explains the pixels: ``|z . conj(s(u))|^2 / (n ||z||^2)`` in [0, 1].
+
+    About ``SNR / (SNR + 1)`` for a single scatterer; clearly lower when a pixel sums returns
+    from several directions (e.g. ground to the left and right at the same range and Doppler),
+    where the estimated direction means nothing.
+    """
+    z = np.atleast_2d(np.asarray(pixels))
+    if not calibrated:
+        z = z / config.rx_calibration
+    steer = steering_vector(u, config)
+    num = np.abs(np.sum(z * np.conj(steer), axis=1)) ** 2
+    den = config.n_rx * np.maximum(np.sum(np.abs(z) ** 2, axis=1), 1e-300)
+    return num / den
 
 
 def doa_crlb(

@@ -34,7 +34,13 @@ import numpy as np
 
 from skyradar.config import RadarConfig
 
-__all__ = ["static_radial_velocity_mps", "doppler_matches_static", "height_above_ground_m", "classify_ground"]
+__all__ = [
+    "static_radial_velocity_mps",
+    "doppler_matches_static",
+    "in_ground_band",
+    "height_above_ground_m",
+    "classify_ground",
+]
 
 
 def static_radial_velocity_mps(direction_ned: np.ndarray, own_velocity_ned_mps: np.ndarray) -> np.ndarray:
@@ -53,6 +59,34 @@ def doppler_matches_static(
     width = 2.0 * config.v_lim_mps
     diff = np.asarray(radial_velocity_mps, float) - np.asarray(expected_mps, float)
     return np.abs((diff + width / 2.0) % width - width / 2.0) <= tolerance_mps
+
+
+def in_ground_band(
+    range_m: np.ndarray,
+    radial_velocity_mps: np.ndarray,
+    own_velocity_ned_mps: np.ndarray,
+    own_height_agl_m: float,
+    config: RadarConfig,
+    tolerance_mps: float | None = None,
+) -> np.ndarray:
+    """True where some static point of a flat ground at this range has this (aliased) radial velocity.
+
+    Needs no direction: level ground ``h`` below the radar is seen at range R along unit vectors
+    with down component ``h / R``, whose static radial velocities fill
+    ``-v_d h/R +- |v_horizontal| sqrt(1 - (h/R)^2)`` (the clutter region of the range-Doppler
+    image, bounded by R = h and V = -speed). Used for pixels whose direction is unreliable (a
+    pixel summing ground to the left and right of the track).
+    """
+    rng = np.asarray(range_m, float)
+    v = np.asarray(own_velocity_ned_mps, float)
+    tol = 1.5 * config.doppler_resolution_mps if tolerance_mps is None else tolerance_mps
+    u_d = np.clip(own_height_agl_m / np.maximum(rng, 1e-9), 0.0, 1.0)
+    centre = -v[2] * u_d
+    half = np.hypot(v[0], v[1]) * np.sqrt(1.0 - u_d**2) + tol
+    width = 2.0 * config.v_lim_mps
+    diff = (np.asarray(radial_velocity_mps, float) - centre + width / 2.0) % width - width / 2.0
+    reachable = rng >= own_height_agl_m - config.range_resolution_m
+    return reachable & ((np.abs(diff) <= half) | (2.0 * half >= width))
 
 
 def height_above_ground_m(

@@ -37,9 +37,15 @@ from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.geo import ned_rotation_to, ned_to_geodetic, rotation_matrix
 from skyradar.io.frames import radar_config_of
+from skyradar.process.calibration import in_field_of_view
 from skyradar.process.detect import detect, integrate_channels
-from skyradar.process.doa import angles_from_direction, antenna_to_body, estimate_directions
-from skyradar.process.ground import classify_ground, height_above_ground_m
+from skyradar.process.doa import (
+    angles_from_direction,
+    antenna_to_body,
+    direction_coherence,
+    estimate_directions,
+)
+from skyradar.process.ground import classify_ground, height_above_ground_m, in_ground_band
 from skyradar.process.spurs import SpurMap
 
 __all__ = ["DETECTION_COLUMNS", "process_cube", "process_frames", "scenario_origin"]
@@ -50,7 +56,7 @@ DETECTION_COLUMNS = [
     "lat_deg", "lon_deg", "alt_m", "is_ground", "spur",
 ]  # fmt: skip
 _OWN = ("own_north_m", "own_east_m", "own_down_m", "own_vn_mps", "own_ve_mps", "own_vd_mps")
-_ATT = ("own_yaw_rad", "own_pitch_rad", "own_roll_rad")
+_ATT = ("own_yaw_rad", "own_pitch_rad", "own_roll_rad", "own_height_agl_m")
 _GEO = ("own_lat_deg", "own_lon_deg", "own_alt_m")
 
 
@@ -69,7 +75,7 @@ def process_cube(
     ``"flag"`` detects as usual and marks detections whose peak is in the map (thesis).
 
     Returns a dict of equal-length arrays: the detection columns up to ``z_body_m`` plus
-    ``spur`` and ``u_ant`` (n, 3) unit vectors.
+    ``spur``, ``u_ant`` (n, 3) unit vectors and ``coherence`` (:func:`.direction_coherence`).
     """
     if cube.ndim != 3 or cube.shape[2] != config.n_rx:
         raise InputError(f"frame: field 'rx' has {cube.shape[-1]} channels, radar_config has {config.n_rx}")
@@ -82,6 +88,7 @@ def process_cube(
     range_m = det.range_m(config)
     body = antenna_to_body(range_m[:, None] * u, config)
     az, el = angles_from_direction(u)
+    coherence = direction_coherence(cube[det.range_index, det.doppler_index], u, config)
     spur = (
         spur_map.contains(det.range_bin, det.doppler_bin)
         if spur_map is not None
@@ -101,6 +108,7 @@ def process_cube(
         "z_body_m": body[:, 2],
         "spur": spur,
         "u_ant": u,
+        "coherence": coherence,
     }
 
 
@@ -126,7 +134,8 @@ def _own_state(ds: xr.Dataset) -> dict[str, np.ndarray] | None:
         return None
     state = {name: np.asarray(ds[name].values, float) for name in _OWN}
     for name in _ATT + _GEO:
-        state[name] = np.asarray(ds[name].values, float) if name in ds else np.zeros(ds.sizes["time"])
+        missing = np.nan if name == "own_height_agl_m" else 0.0  # unknown height stays unknown
+        state[name] = np.asarray(ds[name].values, float) if name in ds else np.full(ds.sizes["time"], missing)
     state["has_geo"] = np.array(all(name in ds for name in _GEO))
     return state
 
@@ -154,6 +163,38 @@ def _to_world(
     else:
         geo = tuple(np.full(len(ned), np.nan) for _ in range(3))
     return ned, geo, u_ned
+
+
+def _ground_flags(
+    out: dict[str, np.ndarray],
+    own: dict | None,
+    i: int,
+    u_ned: np.ndarray | None,
+    config: RadarConfig,
+    terrain: Any,
+) -> np.ndarray:
+    """Ground filter of one frame: DoA-based where the direction is trustworthy, range-Doppler otherwise."""
+    n = len(out["range_m"])
+    if own is None:
+        return np.zeros(n, bool)
+    vel = np.array([own[k][i] for k in _OWN[3:]])
+    height = None
+    if terrain is not None:
+        height = height_above_ground_m(out["lat_deg"], out["lon_deg"], out["alt_m"], terrain)
+    ground = classify_ground(out["range_m"], out["radial_velocity_mps"], u_ned, config, vel, height)
+    # A direction outside the field of view (or one plane wave explaining the pixel badly) comes
+    # from a pixel mixing returns from several directions, typically ground left and right of
+    # the track: judge those by whether the ground can produce their range and Doppler at all.
+    unreliable = ~in_field_of_view(out["azimuth_rad"], out["elevation_rad"], config, 12.0)
+    unreliable |= out["coherence"] < 0.5
+    own_agl = float(own["own_height_agl_m"][i])
+    if not np.isfinite(own_agl) and terrain is not None and bool(own["has_geo"]):
+        lat, lon = own["own_lat_deg"][i], own["own_lon_deg"][i]
+        own_agl = float(height_above_ground_m([lat], [lon], [own["own_alt_m"][i]], terrain)[0])
+    if np.isfinite(own_agl):
+        band = in_ground_band(out["range_m"], out["radial_velocity_mps"], vel, own_agl, config)
+        ground = np.where(unreliable, band, ground)
+    return ground
 
 
 def process_frames(
@@ -218,14 +259,7 @@ def process_frames(
                 ned, geo, u_ned = _to_world(out, own, i, config, origin)
             out.update(north_m=ned[:, 0], east_m=ned[:, 1], down_m=ned[:, 2])
             out.update(lat_deg=np.asarray(geo[0]), lon_deg=np.asarray(geo[1]), alt_m=np.asarray(geo[2]))
-            vel = None if own is None else np.array([own[k][i] for k in _OWN[3:]])
-            height = None
-            if terrain is not None and own is not None:
-                height = height_above_ground_m(out["lat_deg"], out["lon_deg"], out["alt_m"], terrain)
-            u = u_ned if u_ned is not None else np.full((n, 3), np.nan)
-            out["is_ground"] = classify_ground(
-                out["range_m"], out["radial_velocity_mps"], u, config, vel, height
-            )
+            out["is_ground"] = _ground_flags(out, own, i, u_ned, config, terrain)
             rows.append(out)
         if progress is not None:
             progress(min(start + batch_frames, n_frames))

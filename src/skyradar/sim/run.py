@@ -18,6 +18,7 @@ import xarray as xr
 
 from skyradar.io.frames import FrameStoreWriter, frames_dataset
 from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
+from skyradar.sim.impairments import apply_impairments
 
 __all__ = [
     "make_simulator",
@@ -40,10 +41,14 @@ _SIM_KEYS = (
 
 
 def make_simulator(built) -> ImageSimulator:
-    """An :class:`ImageSimulator` for a BuiltScenario, with its ``sim_options``."""
+    """An :class:`ImageSimulator` for a BuiltScenario, with its ``sim_options`` and impairments."""
     options = {k: v for k, v in built.sim_options.items() if k in _SIM_KEYS and v is not None}
-    extra = {k: v for k, v in built.sim_options.items() if k == "ground_reflectivity_db"}
-    return ImageSimulator(built.radar, built.terrain, built.origin, **options, **extra)
+    impairments = getattr(built, "impairments", None)
+    if impairments is not None:
+        options["ground_reflectivity_db"] = impairments.ground_reflectivity_db
+        if impairments.noise is not None and impairments.noise.enabled:
+            options["noise"] = False  # the impairment's receiver noise replaces the simulator's
+    return ImageSimulator(built.radar, built.terrain, built.origin, **options)
 
 
 def _states(built, indices: np.ndarray):
@@ -75,9 +80,13 @@ def simulate_frames(built, indices: np.ndarray, simulator: ImageSimulator | None
     own, intruders = _states(built, indices)
     cfg = built.radar
     out = np.empty((indices.size, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
+    impairments = getattr(built, "impairments", None)
     for i, frame_index in enumerate(indices):
         platform, targets, _ = _frame_inputs(own, intruders, i)
         out[i] = simulator.frame(platform, targets, frame_index=int(frame_index))
+        if impairments is not None:
+            # Seeded per frame like the thermal noise: any chunking gives the same bytes.
+            out[i] = apply_impairments(out[i], cfg, impairments, int(frame_index))
     return out
 
 

@@ -136,3 +136,46 @@ def test_example_scenarios_listed(tmp_path):
     assert result.returncode == 0
     assert "ch2_flat_forward" in result.stdout
     assert Path(example_scenario("ch2_flat_forward")).exists()
+
+
+def test_ctrl_c_keeps_finished_chunks_and_rerun_resumes(tmp_path):
+    import signal
+    import time
+
+    scenario = _write(tmp_path, {**BASE, "duration_s": 4.0})  # 20 frames, 10 chunks of 2
+    command = [
+        sys.executable,
+        "-m",
+        "skyradar",
+        "simulate",
+        str(scenario),
+        "-o",
+        "run.zarr",
+        "--chunk-frames",
+        "2",
+    ]
+    proc = subprocess.Popen(command, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    marks = tmp_path / "run.zarr.partial.done"
+    deadline = time.time() + 240
+    while not (marks / "0").exists() and time.time() < deadline and proc.poll() is None:
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)
+    _, stderr = proc.communicate(timeout=120)
+    if proc.returncode == 0:
+        pytest.skip("the run finished before the interrupt arrived")
+    assert proc.returncode == 130, stderr
+    assert "rerun the same command to resume" in stderr
+    done_before = {p.name for p in marks.iterdir()}
+    assert "0" in done_before and not (tmp_path / "run.zarr").exists()
+    first_chunk = open_frames_partial(tmp_path / "run.zarr.partial")[:2]
+    result = _skyradar("simulate", str(scenario), "-o", "run.zarr", "--chunk-frames", "2", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    ds = open_frames(tmp_path / "run.zarr")
+    assert ds.iq.shape[0] == 20
+    np.testing.assert_array_equal(ds.iq.values[:2], first_chunk)
+
+
+def open_frames_partial(path: Path) -> np.ndarray:
+    import xarray as xr
+
+    return xr.open_zarr(path, consolidated=False).iq.values

@@ -18,7 +18,9 @@ BASE = {
 
 
 def test_thesis_look_preset_puts_spurs_and_zero_doppler_line_in_every_frame(tmp_path):
-    built = Scenario.from_dict({**BASE, "impairments": {"preset": "thesis_flight_look"}}, tmp_path / "s.yaml").build()
+    built = Scenario.from_dict(
+        {**BASE, "impairments": {"preset": "thesis_flight_look"}}, tmp_path / "s.yaml"
+    ).build()
     cfg = built.radar
     frames = simulate_frames(built, np.arange(2))
     power_db = 10 * np.log10(np.mean(np.abs(frames) ** 2, axis=-1) / cfg.noise_power_w)

@@ -8,8 +8,9 @@ array has unknown per-antenna phase offsets (uniform in +-180 deg) and 0.5 dB ga
 1. Static scene, ``n_static`` frames: a 1000 m^2 building at 438 m, 5 deg right and 1 deg below
    boresight, six static clutter points, and the thesis' flight-data impairments (six fixed
    spurs, zero-Doppler line, near-range leakage; :func:`skyradar.sim.impairments.thesis_flight_look`).
-   A spur map is learned from every lit pixel (thresholds 2/5/10/25 %), and the channels are
-   calibrated on the building.
+   Spur maps are learned from every lit pixel (ours, used for the results) and, for comparison,
+   from Shi-Tomasi corner points as in the thesis, each at thresholds 2/5/10/25 %; the channels
+   are calibrated on the building.
 2. Flyover of a 1 m^2 aircraft in the same static scene, ``n_frames`` frames. Default
    (``path="circuit"``): one racetrack circuit 300 m above the radar between 500 m and 3000 m
    (legs 300 m either side of boresight, 60 m/s, about 95 s), so the frames are spaced about
@@ -163,9 +164,10 @@ def _static_phase(scene: dict, n_static: int) -> tuple[RadarConfig, Any, np.ndar
         for i in range(n_static)
     ]
     cal = calibrate_from_frames(np.stack(raw[: min(20, n_static)]), scene["building_ant"], cfg)
-    spur_map = learn_spur_map(
-        (integrate_channels(c, cal.rx_calibration) for c in raw), cal, SPUR_THRESHOLD, "hits"
-    )
+    powers = [integrate_channels(c, cal.rx_calibration) for c in raw]
+    # Ours: every lit pixel; thesis: Shi-Tomasi corner points, both dilated by one pixel.
+    spur_map = {"hits": learn_spur_map(powers, cal, SPUR_THRESHOLD, "hits"),
+                "corners": learn_spur_map(powers, cal, SPUR_THRESHOLD, "peaks", method="shi-tomasi")}  # fmt: skip
     out = process_cube(raw[0], cal)  # locate the building with the calibrated array, no spur map
     k = int(np.argmin(np.abs(out["range_m"] - BUILDING[0]) + 100 * np.abs(out["radial_velocity_mps"])))
     ned = scene["geom"].origin_ned_m + scene["geom"].rot_ned_to_ant.T @ (out["range_m"][k] * out["u_ant"][k])
@@ -180,9 +182,9 @@ def _flyover(
 ) -> tuple[pd.DataFrame, dict, Any]:
     cfg, sim, imp, geom = scene["config"], scene["sim"], scene["imp"], scene["geom"]
     times, ned, vel = _aircraft(n_frames, geom, path)
-    maps = {t: spur_map.with_threshold(t) for t in THESIS_THRESHOLDS}
-    false_alarms = dict.fromkeys(THESIS_THRESHOLDS, 0)
-    detected = dict.fromkeys(THESIS_THRESHOLDS, 0)
+    maps = {(kind, t): spur_map[kind].with_threshold(t) for kind in spur_map for t in THESIS_THRESHOLDS}
+    false_alarms = dict.fromkeys(maps, 0)
+    detected = dict.fromkeys(maps, 0)
     rows, shown = [], None
     for i in range(n_frames):
         aircraft = PointTarget(ned[i], vel[i], 1.0)
@@ -190,12 +192,12 @@ def _flyover(
         cube = apply_impairments(
             sim.frame(scene["platform"], [*scene["static"], aircraft], 1000 + i), cfg, imp, 1000 + i
         )
-        for thr, smap in maps.items():
+        for key, smap in maps.items():
             out = process_cube(cube, cal, smap)
             k = _match(out, truth, cfg)
-            detected[thr] += k >= 0
-            false_alarms[thr] += len(out["range_m"]) - (k >= 0)
-            if thr != SPUR_THRESHOLD:
+            detected[key] += k >= 0
+            false_alarms[key] += len(out["range_m"]) - (k >= 0)
+            if key != ("hits", SPUR_THRESHOLD):
                 continue
             if shown is None and k >= 0 and truth["snr_db"][0] > 20:
                 shown = (cube, out, truth)
@@ -282,21 +284,22 @@ def run(
         "calib_phase_err_deg": calibration_phase_error_deg(cal.rx_calibration, scene["true_gain"]),
         "detected_frames": int(det.sum()), "frames": n_frames,
         "detected_frames_snr13": int(det[snr_ok].sum()), "frames_snr13": int(snr_ok.sum()),
-        "false_alarms_per_frame": stats["false_alarms"][SPUR_THRESHOLD] / n_frames,
-        "spur_threshold": SPUR_THRESHOLD, "spur_pixels": int(spur_map.mask.sum()), "path": path,
+        "false_alarms_per_frame": stats["false_alarms"][("hits", SPUR_THRESHOLD)] / n_frames,
+        "spur_threshold": SPUR_THRESHOLD, "spur_pixels": int(spur_map["hits"].mask.sum()), "path": path,
         "frame_interval_s": float(track.time_s.diff().median()) if n_frames > 1 else 0.0,
         "min_range_m": float(track.true_range_m.min()), "max_range_m": float(track.true_range_m.max()),
         **building,
     }  # fmt: skip
-    for thr in THESIS_THRESHOLDS:
-        result[f"false_alarms_per_frame_{int(thr * 100)}pct"] = stats["false_alarms"][thr] / n_frames
-        result[f"detected_frames_{int(thr * 100)}pct"] = int(stats["detected"][thr])
+    for (kind, thr), n_fa in stats["false_alarms"].items():
+        tag = f"{int(thr * 100)}pct" + ("" if kind == "hits" else "_corner_map")
+        result[f"false_alarms_per_frame_{tag}"] = n_fa / n_frames
+        result[f"detected_frames_{tag}"] = int(stats["detected"][(kind, thr)])
     write_table(table.reset_index(), out_dir / "ch3_table.parquet")
     table.to_csv(out_dir / "ch3_table.csv")
     write_table(
         pd.concat([track, err.drop(columns=["time_s", "true_snr_db"])], axis=1), out_dir / "ch3_track.parquet"
     )
-    plot_all(out_dir, static_frame, cal, spur_map, shown, track, err, scene["geom"])
+    plot_all(out_dir, static_frame, cal, spur_map["hits"], shown, track, err, scene["geom"])
     result["runtime_s"] = time.perf_counter() - t0
     result = {k: (float(v) if isinstance(v, np.floating) else v) for k, v in result.items()}
     write_json_atomic(out_dir / "ch3.json", result)

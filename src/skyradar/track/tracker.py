@@ -122,10 +122,15 @@ class RangeDopplerTracker:
         if self.time_s is not None and t["ids"].size and time_s > self.time_s:
             dt = time_s - self.time_s
             F, Q, F_u, Q_u = self._matrices(dt)
-            if self._hybrid:
-                resolved = t["resolved"][:, None, None]
-                F, Q = np.where(resolved, F, F_u), np.where(resolved, Q, Q_u)
-            t["x"], t["P"] = predict(t["x"], t["P"], F, Q)
+            if self._hybrid and not t["resolved"].all():
+                # Two groups with one F each: cheaper than stacking a per-track F.
+                for rows, FF, QQ in (
+                    (np.flatnonzero(t["resolved"]), F, Q),
+                    (np.flatnonzero(~t["resolved"]), F_u, Q_u),
+                ):
+                    t["x"][rows], t["P"][rows] = predict(t["x"][rows], t["P"][rows], FF, QQ)
+            else:
+                t["x"], t["P"] = predict(t["x"], t["P"], F, Q)
         self.time_s = float(time_s)
         assoc = self._associate(z)
         assigned = np.full(t["ids"].size, -1)
@@ -174,9 +179,13 @@ class RangeDopplerTracker:
 
     def _associate(self, z: np.ndarray) -> Association:
         t, m = self.t, self.model
-        H = self._H
-        z_pred = t["x"] @ H.T
-        S = H @ t["P"] @ H.T + self._R
+        # H = [[1, c, 0, 0], [0, 1, 0, 0]] written out: S = H P H^T + R without batched matmuls.
+        c, P, x = m.coupling_s, t["P"], t["x"]
+        z_pred = np.column_stack([x[:, 0] + c * x[:, 1], x[:, 1]])
+        S = np.empty((x.shape[0], 2, 2))
+        S[:, 0, 0] = P[:, 0, 0] + 2 * c * P[:, 0, 1] + c * c * P[:, 1, 1] + self._R[0, 0]
+        S[:, 0, 1] = S[:, 1, 0] = P[:, 0, 1] + c * P[:, 1, 1] + self._R[0, 1]
+        S[:, 1, 1] = P[:, 1, 1] + self._R[1, 1]
         range_wrap = None
         if self._thesis:
             range_wrap = np.where(

@@ -25,8 +25,9 @@ def test_traffic_is_reproducible_and_in_ga_speed_range():
 def test_short_geometry_run_writes_tables_and_figures(tmp_path):
     res = run(tmp_path, chain="geometry", interval_s=4.0, tail_s=40.0, workers=1, scenarios=("free",))
     assert "synthesised" in res["detections_source"]
-    for key in ("truth_tracks", "tracks_radar", "tracks_traditional", "innov_mean_radar", "innov_p95_radar",
-                "innov_mean_traditional", "innov_p95_traditional", "gospa_radar", "gospa_traditional"):  # fmt: skip
+    keys = ("truth_tracks", "tracks_radar", "tracks_traditional", "innov_mean_radar", "innov_p95_radar",
+            "innov_mean_traditional", "innov_p95_traditional", "gospa_radar", "gospa_traditional")  # fmt: skip
+    for key in keys:
         assert key in res["scenarios"]["free"]
     assert res["free_truth_tracks"] >= 1
     saved = json.loads((tmp_path / "ch4_results.json").read_text())
@@ -34,3 +35,12 @@ def test_short_geometry_run_writes_tables_and_figures(tmp_path):
     for name in res["figures"]:
         assert (tmp_path / name).stat().st_size > 10_000
     assert (tmp_path / "tracks_free_radar.parquet").exists()
+
+
+def test_bench_track_reports_ours_baseline_and_ratio():
+    from skyradar.benchmarks.track import run as bench
+
+    r = bench(n_frames=15, detections_per_frame=40, n_targets=3, baseline_frames=3)
+    for key in ("frames_per_s", "cpu_frames_per_s", "baseline_frames_per_s", "speedup_same_frames"):
+        assert r[key] > 0
+    assert 30 <= r["detections_per_frame"] <= 50

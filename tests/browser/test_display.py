@@ -8,6 +8,7 @@ on 127.0.0.1 in a thread, bounded in time, and is stopped by the fixture. The sc
 
 from __future__ import annotations
 
+import importlib
 import os
 import shutil
 import subprocess
@@ -49,6 +50,7 @@ def chromium() -> str:
         import playwright  # noqa: F401
     except ImportError:
         _run([sys.executable, "-m", "pip", "install", "--quiet", "playwright>=1.40"], timeout=600)
+        importlib.invalidate_caches()  # make the freshly installed package importable in this process
     return CHROMIUM
 
 

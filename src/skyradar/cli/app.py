@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import json
-import math
 from typing import Any
 
 import typer
 from rich.console import Console
 from rich.table import Table
+
+from skyradar.io.tables import jsonable
 
 __all__ = ["app", "experiment_app", "bench_app", "console", "emit_result"]
 
@@ -30,18 +31,6 @@ app.add_typer(bench_app, name="bench")
 console = Console(stderr=True)
 
 
-def _jsonable(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_jsonable(v) for v in value]
-    if hasattr(value, "item") and callable(value.item):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
 def emit_result(result: dict[str, Any], as_json: bool, title: str) -> None:
     """Show ``result`` as a table (stderr); with ``as_json`` also print it as JSON, the last stdout line."""
     table = Table(title=title)
@@ -54,4 +43,4 @@ def emit_result(result: dict[str, Any], as_json: bool, title: str) -> None:
         table.add_row(str(key), shown)
     console.print(table)
     if as_json:
-        print(json.dumps(_jsonable(result)), flush=True)
+        print(json.dumps(jsonable(result)), flush=True)

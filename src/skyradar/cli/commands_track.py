@@ -67,6 +67,9 @@ def track(
     tracks = track_detections(
         table[keep].reset_index(drop=True), model, config, frame_times_s=frame_times, origin=_origin(origin)
     )
+    # detection_row refers to the input table, not to the filtered one.
+    rows = tracks["detection_row"].to_numpy()
+    tracks["detection_row"] = np.where(rows >= 0, np.flatnonzero(keep)[np.maximum(rows, 0)], -1)
     write_table(
         tracks, output, metadata={"radar_config": config.to_json(), "source": str(detections), "model": model}
     )

@@ -8,9 +8,10 @@ array has unknown per-antenna phase offsets (uniform in +-180 deg) and 0.5 dB ga
 1. Static scene, ``n_static`` frames: a 1000 m^2 building at 438 m, 5 deg right and 1 deg below
    boresight, six static clutter points, and the thesis' flight-data impairments (six fixed
    spurs, zero-Doppler line, near-range leakage; :func:`skyradar.sim.impairments.thesis_flight_look`).
-   Spur maps are learned from every lit pixel (ours, used for the results) and, for comparison,
-   from Shi-Tomasi corner points as in the thesis, each at thresholds 2/5/10/25 %; the channels
-   are calibrated on the building.
+   Spur maps are learned from every lit pixel (ours, used with CA-CFAR for the results) and, for
+   comparison, from Shi-Tomasi corner points as in the thesis (used with the Shi-Tomasi detector,
+   detections inside the map dropped), each at thresholds 2/5/10/25 %; the channels are
+   calibrated on the building.
 2. Flyover of a 1 m^2 aircraft in the same static scene, ``n_frames`` frames. Default
    (``path="circuit"``): one racetrack circuit 300 m above the radar between 500 m and 3000 m
    (legs 300 m either side of boresight, 60 m/s, about 95 s), so the frames are spaced about
@@ -166,8 +167,8 @@ def _static_phase(scene: dict, n_static: int) -> tuple[RadarConfig, Any, np.ndar
     cal = calibrate_from_frames(np.stack(raw[: min(20, n_static)]), scene["building_ant"], cfg)
     powers = [integrate_channels(c, cal.rx_calibration) for c in raw]
     # Ours: every lit pixel; thesis: Shi-Tomasi corner points, both dilated by one pixel.
-    spur_map = {"hits": learn_spur_map(powers, cal, SPUR_THRESHOLD, "hits"),
-                "corners": learn_spur_map(powers, cal, SPUR_THRESHOLD, "peaks", method="shi-tomasi")}  # fmt: skip
+    corners = learn_spur_map(powers, cal, SPUR_THRESHOLD, "peaks", method="shi-tomasi")
+    spur_map = {"hits": learn_spur_map(powers, cal, SPUR_THRESHOLD, "hits"), "corners": corners}
     out = process_cube(raw[0], cal)  # locate the building with the calibrated array, no spur map
     k = int(np.argmin(np.abs(out["range_m"] - BUILDING[0]) + 100 * np.abs(out["radial_velocity_mps"])))
     ned = scene["geom"].origin_ned_m + scene["geom"].rot_ned_to_ant.T @ (out["range_m"][k] * out["u_ant"][k])
@@ -193,7 +194,11 @@ def _flyover(
             sim.frame(scene["platform"], [*scene["static"], aircraft], 1000 + i), cfg, imp, 1000 + i
         )
         for key, smap in maps.items():
-            out = process_cube(cube, cal, smap)
+            if key[0] == "hits":  # ours: CA-CFAR with spur pixels masked
+                out = process_cube(cube, cal, smap)
+            else:  # thesis: Shi-Tomasi corners, detections inside the corner map dropped
+                out = process_cube(cube, cal, smap, method="shi-tomasi", spur_mode="flag")
+                out = {name: value[~out["spur"]] for name, value in out.items()}
             k = _match(out, truth, cfg)
             detected[key] += k >= 0
             false_alarms[key] += len(out["range_m"]) - (k >= 0)

@@ -213,7 +213,10 @@ def _figure(res: pd.DataFrame, path: Path) -> None:
 
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.5))
     warned = res["t_warning_s"].notna()
-    for mask, colour, label in ((warned, "tab:red", "warning issued"), (~warned, "tab:green", "no warning")):
+    hidden = res["conflict"] & ~res["observable"]
+    groups = ((warned & ~hidden, "tab:red", "warning issued"), (~warned & ~hidden, "tab:green", "no warning"),
+              (hidden, "0.6", "conflict outside field of view / range"))  # fmt: skip
+    for mask, colour, label in groups:
         ax[0].scatter(
             res.loc[mask, "min_horizontal_m"], res.loc[mask, "min_vertical_m"], s=8, c=colour, label=label
         )
@@ -221,7 +224,7 @@ def _figure(res: pd.DataFrame, path: Path) -> None:
     ax[0].add_patch(plt.Rectangle((0, 0), vol.dthr_m, vol.zthr_m, fill=False, ls="--", color="k"))
     ax[0].set(xlabel="minimum horizontal separation [m]", ylabel="minimum vertical separation [m]",
               title="encounters (dashed: 2200 ft / 450 ft well clear)")  # fmt: skip
-    ax[0].legend(loc="upper right")
+    ax[0].legend(loc="upper right", fontsize=8)
     lead = (res["t_lowc_s"] - res["t_warning_s"])[res["observable"]]
     ax[1].hist(lead.dropna(), bins=30, color="tab:blue")
     ax[1].axvline(25.0, color="k", ls="--", label="warning alerting time 25 s")

@@ -8,6 +8,7 @@ missing.
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
@@ -16,7 +17,7 @@ import pandas as pd
 
 from skyradar.errors import InputError
 
-__all__ = ["write_table", "read_table", "write_json_atomic"]
+__all__ = ["write_table", "read_table", "write_json_atomic", "jsonable"]
 
 
 def write_table(df: pd.DataFrame, path: str | Path, metadata: dict[str, Any] | None = None) -> Path:
@@ -59,11 +60,24 @@ def read_table(path: str | Path, required: Iterable[str] = (), sort_by: str | No
     return df
 
 
+def jsonable(value: Any) -> Any:
+    """``value`` with numpy scalars made plain and NaN/inf made None (JSON has no NaN)."""
+    if isinstance(value, dict):
+        return {str(k): jsonable(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [jsonable(v) for v in value]
+    if hasattr(value, "item") and callable(value.item) and getattr(value, "ndim", 0) == 0:
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
 def write_json_atomic(path: str | Path, payload: Any) -> Path:
-    """Write JSON to ``path`` through a temporary name and rename."""
+    """Write JSON to ``path`` through a temporary name and rename (NaN and inf become null)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(payload, indent=2, default=float))
+    tmp.write_text(json.dumps(jsonable(payload), indent=2, default=float, allow_nan=False))
     tmp.replace(path)
     return path

@@ -103,6 +103,33 @@ def _box_sum(padded: np.ndarray, hr: int, hd: int, pr: int, pd: int, shape: tupl
     return s[pr : pr + shape[0], pd : pd + shape[1]]
 
 
+_MASK_CACHE: dict[tuple, tuple] = {}
+
+
+def _mask_setup(
+    exclude: np.ndarray, guard: tuple[int, int], half: tuple[int, int], table: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per-pixel weights, 1/training count, threshold factor and usable flag of an exclusion mask.
+
+    Cached for read-only masks (``SpurMap.mask``): a spur map is the same for every frame.
+    """
+    key = (id(exclude), exclude.shape, guard, half, id(table))
+    hit = _MASK_CACHE.get(key)
+    if hit is not None and hit[0] is exclude and hit[1] is table:
+        return hit[2:]
+    (gr, gd), (hr, hd) = guard, half
+    valid = (~exclude).astype(np.float32)
+    v_pad = _pad(valid, hr, hd)
+    count = _box_sum(v_pad, hr, hd, hr, hd, exclude.shape) - _box_sum(v_pad, gr, gd, hr, hd, exclude.shape)
+    n_cells = np.clip(np.rint(count).astype(np.int64), 0, table.size - 1)
+    setup = (valid, 1.0 / np.maximum(count, np.float32(1.0)), table[n_cells], (valid > 0) & (n_cells > 0))
+    if not exclude.flags.writeable:  # a writeable mask could change under the same identity
+        if len(_MASK_CACHE) > 8:
+            _MASK_CACHE.clear()
+        _MASK_CACHE[key] = (exclude, table, *setup)
+    return setup
+
+
 def _ca(
     power: np.ndarray,
     exclude: np.ndarray | None,
@@ -119,13 +146,11 @@ def _ca(
         return power > table[n_train] * noise, noise
     if exclude.shape != power.shape:
         raise InputError(f"cfar: field 'exclude' has shape {exclude.shape}, image has {power.shape}")
-    valid = (~np.asarray(exclude, bool)).astype(np.float32)
-    p_pad, v_pad = _pad(power * valid, hr, hd), _pad(valid, hr, hd)
+    valid, inv_count, alpha, usable = _mask_setup(np.asarray(exclude, bool), (gr, gd), (hr, hd), table)
+    p_pad = _pad(power * valid, hr, hd)
     total = _box_sum(p_pad, hr, hd, hr, hd, power.shape) - _box_sum(p_pad, gr, gd, hr, hd, power.shape)
-    count = _box_sum(v_pad, hr, hd, hr, hd, power.shape) - _box_sum(v_pad, gr, gd, hr, hd, power.shape)
-    n_cells = np.clip(np.rint(count).astype(np.int64), 0, n_train)
-    noise = np.maximum(total / np.maximum(count, np.float32(1.0)), np.float32(1e-38))
-    return (power > table[n_cells] * noise) & (valid > 0) & (n_cells > 0), noise
+    noise = np.maximum(total * inv_count, np.float32(1e-38))
+    return (power > alpha * noise) & usable, noise
 
 
 def cfar_2d(

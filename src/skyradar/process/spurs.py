@@ -28,6 +28,7 @@ from __future__ import annotations
 import os
 from collections.abc import Iterable
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import Any, Literal
 
@@ -107,10 +108,12 @@ class SpurMap:
             raise InputError(f"spur map: need a (frames, range, doppler) stack, got shape {hits.shape}")
         return cls(_dilate(hits).mean(axis=0), threshold, hits.shape[0])
 
-    @property
+    @cached_property
     def mask(self) -> np.ndarray:
-        """Boolean spur image."""
-        return self.frequency > self.threshold
+        """Boolean spur image (computed once; read-only)."""
+        mask = self.frequency > self.threshold
+        mask.setflags(write=False)
+        return mask
 
     def with_threshold(self, threshold: float) -> SpurMap:
         return SpurMap(self.frequency, threshold, self.n_frames)

@@ -111,6 +111,8 @@ class RunSource:
         self.ds, self._opened = ds, target
         self.config = radar_config_of(ds, str(target))
         self.times = np.asarray(ds["time"].values, float)
+        # Truth variables are small and written at creation: keep them in memory.
+        self._own = {k: np.asarray(ds[k].values, float) for k in ds.data_vars if k.startswith("own_")}
         self._compute_alerts()
 
     def _ready_frames(self) -> int:
@@ -164,9 +166,9 @@ class RunSource:
         }
 
     def _ownship(self, i: int) -> dict[str, float] | None:
-        if "own_north_m" not in self.ds:
+        if "own_north_m" not in self._own:
             return None
-        row = {k: float(self.ds[k].values[i]) for k in self.ds.data_vars if k.startswith("own_")}
+        row = {k: float(v[i]) for k, v in self._own.items()}
         yaw = row.get("own_yaw_rad", np.arctan2(row["own_ve_mps"], row["own_vn_mps"]))
         return {
             "north_m": row["own_north_m"],

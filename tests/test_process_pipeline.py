@@ -7,6 +7,8 @@ import sys
 import numpy as np
 import pandas as pd
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from skyradar.benchmarks.process import synthetic_frame
 from skyradar.config import Mount, RadarConfig
@@ -14,6 +16,7 @@ from skyradar.errors import InputError
 from skyradar.geo import direction_angles, ned_rotation_to, ned_to_geodetic, rotation_matrix
 from skyradar.io.frames import frames_dataset
 from skyradar.process.pipeline import DETECTION_COLUMNS, process_frames
+from skyradar.process.smoothing import hann_smooth, hann_window
 from skyradar.process.spurs import SpurMap
 from skyradar.scene.terrain import flat_terrain
 
@@ -241,3 +244,22 @@ def test_simulated_flight_over_flat_ground_separates_terrain_from_the_intruder()
         assert err[k] < 100.0 and not rows.is_ground.iloc[k]
         others = rows.drop(rows.index[k])
         assert len(others) >= 3 and others.is_ground.mean() >= 0.9
+
+
+@given(value=st.floats(-1e4, 1e4), window=st.integers(1, 15), n=st.integers(1, 40))
+def test_hann_smoothing_keeps_constants_and_fills_gaps(value, window, n):
+    x = np.full((n, 3), value)
+    x[n // 2] = np.nan
+    y = hann_smooth(x, window)
+    if n > 1:
+        np.testing.assert_allclose(y[np.isfinite(y)], value, rtol=1e-12, atol=1e-9)
+
+
+def test_hann_smoothing_reduces_white_noise_by_the_window_power():
+    rng = np.random.default_rng(0)
+    noise = rng.standard_normal(200_000)
+    w = hann_window(9)
+    ratio = np.std(hann_smooth(noise, 9)[10:-10]) / np.std(noise)
+    assert ratio == pytest.approx(np.sqrt(np.sum(w**2)), rel=0.02)
+    with pytest.raises(InputError, match="window"):
+        hann_smooth(noise, 0)

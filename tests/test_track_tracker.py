@@ -35,18 +35,22 @@ def test_radial_velocity_crossing_doppler_edge_keeps_one_track(seed):
     assert edge_crossings >= 6
     m = _metrics(track_detections(det, "radar", CFG, frame_times_s=t), t, R[:, None], V[:, None])
     assert (m["tracks"], m["id_switches"], m["fragmentation"], m["false_tracks"]) == (1, 0, 0, 0)
+    thesis = track_detections(det, "radar", CFG, TrackerConfig(dealias="thesis"), frame_times_s=t)
+    mt = _metrics(thesis, t, R[:, None], V[:, None])
+    assert (mt["tracks"], mt["id_switches"]) == (1, 0)
     assert m["completeness"] > 0.95
     # The camera-image tracker splits the same aircraft at the edge: the test can fail.
     mt = _metrics(track_detections(det, "traditional", CFG, frame_times_s=t), t, R[:, None], V[:, None])
     assert mt["tracks"] > 1 and mt["fragmentation"] > 0
 
 
-def test_aliased_track_is_dealiased_to_true_radial_velocity():
+@pytest.mark.parametrize("mode", ["confident", "thesis"])
+def test_aliased_track_is_dealiased_to_true_radial_velocity(mode):
     t = np.arange(0.0, 5.0, DT)
     V = np.full_like(t, -95.0)  # closing fast: two image widths from the measured value
     R = 3000.0 + V * t
     det = synthetic_detections(t, R[:, None], V[:, None], seed=4)
-    tracks = track_detections(det, "radar", CFG, frame_times_s=t)
+    tracks = track_detections(det, "radar", CFG, TrackerConfig(dealias=mode), frame_times_s=t)
     assert tracks.track_id.nunique() == 1
     last = tracks.iloc[-1]
     assert last.radial_velocity_mps == pytest.approx(-95.0, abs=1.0)

@@ -174,6 +174,9 @@ def run_scenario(
             out[f"{key}_{model}"] = m[key]
         out[f"innov_mean_{model}"] = m["innov_mean_px"]
         out[f"innov_p95_{model}"] = m["innov_p95_px"]
+        # Over confirmed rows only (without each track's first, tentative updates), for reference.
+        out[f"innov_p95_confirmed_{model}"] = m["innov_p95_px_confirmed"]
+        out[f"innov_range_p95_m_{model}"] = m["innov_range_p95_m"]
         out[f"gospa_{model}"] = m["gospa_mean"]
         out["tracks"][model] = tracks
     out["detections_table"] = det

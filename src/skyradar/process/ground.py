@@ -68,24 +68,27 @@ def in_ground_band(
     own_height_agl_m: float,
     config: RadarConfig,
     tolerance_mps: float | None = None,
+    terrain_margin_m: float = 30.0,
 ) -> np.ndarray:
-    """True where some static point of a flat ground at this range has this (aliased) radial velocity.
+    """True where some static point of the ground at this range can have this (aliased) radial velocity.
 
-    Needs no direction: level ground ``h`` below the radar is seen at range R along unit vectors
-    with down component ``h / R``, whose static radial velocities fill
-    ``-v_d h/R +- |v_horizontal| sqrt(1 - (h/R)^2)`` (the clutter region of the range-Doppler
-    image, bounded by R = h and V = -speed). Used for pixels whose direction is unreliable (a
-    pixel summing ground to the left and right of the track).
+    Needs no direction: ground ``h`` below the radar is seen at range R along unit vectors with
+    down component ``u_d = h / R``, whose static radial velocities fill
+    ``-v_d u_d +- |v_horizontal| sqrt(1 - u_d^2)`` (the clutter region of the range-Doppler
+    image, bounded by R = h and V = -speed). ``terrain_margin_m`` allows for ground up to that
+    much higher than the ground directly below (it widens the band). Used for pixels whose
+    direction is unreliable (a pixel summing ground to the left and right of the track).
     """
-    rng = np.asarray(range_m, float)
+    rng = np.maximum(np.asarray(range_m, float), 1e-9)
     v = np.asarray(own_velocity_ned_mps, float)
     tol = 1.5 * config.doppler_resolution_mps if tolerance_mps is None else tolerance_mps
-    u_d = np.clip(own_height_agl_m / np.maximum(rng, 1e-9), 0.0, 1.0)
-    centre = -v[2] * u_d
-    half = np.hypot(v[0], v[1]) * np.sqrt(1.0 - u_d**2) + tol
+    u_hi = np.clip(own_height_agl_m / rng, 0.0, 1.0)
+    u_lo = np.clip((own_height_agl_m - terrain_margin_m) / rng, 0.0, 1.0)
+    centre = -v[2] * 0.5 * (u_lo + u_hi)
+    half = np.hypot(v[0], v[1]) * np.sqrt(1.0 - u_lo**2) + abs(v[2]) * 0.5 * (u_hi - u_lo) + tol
     width = 2.0 * config.v_lim_mps
     diff = (np.asarray(radial_velocity_mps, float) - centre + width / 2.0) % width - width / 2.0
-    reachable = rng >= own_height_agl_m - config.range_resolution_m
+    reachable = rng >= own_height_agl_m - terrain_margin_m - config.range_resolution_m
     return reachable & ((np.abs(diff) <= half) | (2.0 * half >= width))
 
 

@@ -43,6 +43,7 @@ from skyradar.process.doa import (
     angles_from_direction,
     antenna_to_body,
     direction_coherence,
+    doa_crlb,
     estimate_directions,
 )
 from skyradar.process.ground import classify_ground, height_above_ground_m, in_ground_band
@@ -178,19 +179,25 @@ def _ground_flags(
     if own is None:
         return np.zeros(n, bool)
     vel = np.array([own[k][i] for k in _OWN[3:]])
+    own_agl = float(own["own_height_agl_m"][i])
+    if not np.isfinite(own_agl) and terrain is not None and bool(own["has_geo"]):
+        lat, lon = own["own_lat_deg"][i], own["own_lon_deg"][i]
+        own_agl = float(height_above_ground_m([lat], [lon], [own["own_alt_m"][i]], terrain)[0])
     height = None
     if terrain is not None:
         height = height_above_ground_m(out["lat_deg"], out["lon_deg"], out["alt_m"], terrain)
-    ground = classify_ground(out["range_m"], out["radial_velocity_mps"], u_ned, config, vel, height)
+    elif np.isfinite(own_agl):
+        # No DEM: a flat ground at the height of the terrain under the own-ship.
+        height = own["own_down_m"][i] + own_agl - out["down_m"]
+    # Tolerances follow each detection's own DoA uncertainty (the Cramer-Rao bound at its SNR).
+    sd_az, sd_el = doa_crlb(out["snr_db"], out["azimuth_rad"], out["elevation_rad"], config)
+    sigma = np.clip(np.nan_to_num(np.maximum(sd_az, sd_el), nan=0.2), np.radians(0.2), np.radians(10.0))
+    ground = classify_ground(out["range_m"], out["radial_velocity_mps"], u_ned, config, vel, height, sigma)
     # A direction outside the field of view (or one plane wave explaining the pixel badly) comes
     # from a pixel mixing returns from several directions, typically ground left and right of
     # the track: judge those by whether the ground can produce their range and Doppler at all.
     unreliable = ~in_field_of_view(out["azimuth_rad"], out["elevation_rad"], config, 12.0)
     unreliable |= out["coherence"] < 0.5
-    own_agl = float(own["own_height_agl_m"][i])
-    if not np.isfinite(own_agl) and terrain is not None and bool(own["has_geo"]):
-        lat, lon = own["own_lat_deg"][i], own["own_lon_deg"][i]
-        own_agl = float(height_above_ground_m([lat], [lon], [own["own_alt_m"][i]], terrain)[0])
     if np.isfinite(own_agl):
         band = in_ground_band(out["range_m"], out["radial_velocity_mps"], vel, own_agl, config)
         ground = np.where(unreliable, band, ground)

@@ -100,7 +100,7 @@ def gospa(distances: np.ndarray, c: float, p: float = 2.0) -> dict[str, float]:
 
     Examples
     --------
-    >>> gospa(np.array([[1.0, 20.0]]), c=10.0)["distance"] ** 2
+    >>> round(gospa(np.array([[1.0, 20.0]]), c=10.0)["distance"] ** 2, 9)
     51.0
     """
     d = np.asarray(distances, float)

@@ -188,7 +188,8 @@ def test_reflectivity_is_pluggable_and_scales_power():
     cos_img = _ground_image(30.0, reflectivity="cosine")
     const_img = _ground_image(30.0, reflectivity="constant")
     custom = _ground_image(30.0, reflectivity=lambda theta: 0.5 * np.cos(theta))
-    np.testing.assert_allclose(custom, 0.5 * cos_img, rtol=1e-6)  # power is linear in reflectivity
+    # Power is linear in reflectivity (to float32 rounding: pixels accumulate in complex64).
+    np.testing.assert_allclose(custom, 0.5 * cos_img, rtol=2e-5)
     # Straight below the incidence is 0: both models agree there; at grazing cosine is darker.
     k_near = int(round(1000.0 / CFG.range_resolution_m))
     k_far = int(round(4500.0 / CFG.range_resolution_m))

@@ -55,11 +55,30 @@ def cis_cycles(x):
 
 
 @njit(inline="always")
+def fast_atan2(y, x):
+    """atan2 to within 1.1e-5 rad (minimax polynomial on [0, 1] plus octant fix-ups)."""
+    ax, ay = abs(x), abs(y)
+    if ax == 0.0 and ay == 0.0:
+        return 0.0
+    swap = ay > ax
+    z = ax / ay if swap else ay / ax
+    z2 = z * z
+    a = z * (0.9998660 + z2 * (-0.3302995 + z2 * (0.1801410 + z2 * (-0.0851330 + z2 * 0.0208351))))
+    if swap:
+        a = 0.5 * math.pi - a
+    if x < 0.0:
+        a = math.pi - a
+    return -a if y < 0.0 else a
+
+
+@njit(inline="always")
 def _polar_bin(n, e, d, az_bin_rad, h_bin_m, n_az, n_h):
+    # Azimuth bin, horizontal-range bin, and the slope -d/h (tan of the elevation angle: the
+    # same order as the angle, without an atan2).
     h = math.sqrt(n * n + e * e)
-    a = int((math.atan2(e, n) + math.pi) / az_bin_rad) % n_az
+    a = int((fast_atan2(e, n) + math.pi) / az_bin_rad) % n_az
     k = min(int(h / h_bin_m), n_h - 1)
-    return a, k, math.atan2(-d, h)
+    return a, k, -d / max(h, 1e-9)
 
 
 @njit(inline="always")
@@ -78,10 +97,10 @@ def _cell_in_front(p_ned, rot_n2a, i, j):
 
 @njit(parallel=True, cache=True)
 def horizon_map(p_ned, rot_n2a, nsub_r, nsub_c, r_lim, az_bin_rad, h_bin_m, n_az, n_h, n_blocks, sample_m):
-    """Highest elevation angle seen so far along each azimuth, before each horizontal-range bin.
+    """Steepest slope (tan of elevation) seen so far along each azimuth, before each range bin.
 
     ``p_ned`` holds grid points relative to the antenna (NED, m). Returns an (n_az, n_h) array:
-    a facet in bin (a, k) is visible if its elevation angle is at least ``out[a, k]``. Only
+    a facet in bin (a, k) is visible if its slope -down/horizontal is at least ``out[a, k]``. Only
     cells in front of the antenna plane count: a ray from the antenna to a point in front
     never passes behind the plane. Each sample stands for a patch ``sample_m`` wide, so it
     raises every azimuth bin that patch spans (near samples span many bins): without this,
@@ -89,10 +108,9 @@ def horizon_map(p_ned, rot_n2a, nsub_r, nsub_c, r_lim, az_bin_rad, h_bin_m, n_az
     """
     ny, nx = p_ned.shape[0], p_ned.shape[1]
     best = np.full((n_blocks, n_az, n_h), -np.inf, dtype=np.float32)
-    rows_per_block = (ny - 1 + n_blocks - 1) // n_blocks
     for blk in prange(n_blocks):
         pt = np.empty(3)
-        for i in range(blk * rows_per_block, min((blk + 1) * rows_per_block, ny - 1)):
+        for i in range(blk, ny - 1, n_blocks):  # interleaved rows: blocks share the work evenly
             for j in range(nx - 1):
                 if not _cell_in_front(p_ned, rot_n2a, i, j):
                     continue
@@ -103,13 +121,13 @@ def horizon_map(p_ned, rot_n2a, nsub_r, nsub_c, r_lim, az_bin_rad, h_bin_m, n_az
                         _bilinear(p_ned, i, j, u, w, pt)
                         if pt[0] * pt[0] + pt[1] * pt[1] > r_lim * r_lim:
                             continue
-                        ia, k, elev = _polar_bin(pt[0], pt[1], pt[2], az_bin_rad, h_bin_m, n_az, n_h)
+                        ia, k, slope = _polar_bin(pt[0], pt[1], pt[2], az_bin_rad, h_bin_m, n_az, n_h)
                         h = math.sqrt(pt[0] * pt[0] + pt[1] * pt[1])
                         spread = min(int(0.5 * sample_m / (max(h, 1.0) * az_bin_rad)) + 1, n_az // 4)
                         for da in range(-spread, spread + 1):
                             ib = (ia + da) % n_az
-                            if elev > best[blk, ib, k]:
-                                best[blk, ib, k] = elev
+                            if slope > best[blk, ib, k]:
+                                best[blk, ib, k] = slope
     # Exclusive running maximum along range: what lies strictly closer can hide a facet.
     out = np.empty((n_az, n_h), dtype=np.float32)
     for ia in prange(n_az):
@@ -189,10 +207,24 @@ def _cell_behind(p_ant, i, j):
 
 
 @njit(inline="always")
+def _cell_beyond(p_ant, i, j, r_max):
+    # No point of the cell can be within r_max when its nearest corner is further than r_max
+    # plus the cell's largest extent.
+    nearest, extent = 1e300, 0.0
+    for ci in range(2):
+        for cj in range(2):
+            x, y, z = p_ant[i + ci, j + cj, 0], p_ant[i + ci, j + cj, 1], p_ant[i + ci, j + cj, 2]
+            nearest = min(nearest, math.sqrt(x * x + y * y + z * z))
+    for c in range(3):
+        extent += abs(p_ant[i + 1, j + 1, c] - p_ant[i, j, c]) + abs(p_ant[i + 1, j, c] - p_ant[i, j + 1, c])
+    return nearest > r_max + extent
+
+
+@njit(inline="always")
 def _hidden(tn, u, w, horizon, az_bin_rad, h_bin_m):
     pn, pe, pd = _patch_point(tn, u, w, 0), _patch_point(tn, u, w, 1), _patch_point(tn, u, w, 2)
-    ia, k, elev = _polar_bin(pn, pe, pd, az_bin_rad, h_bin_m, horizon.shape[0], horizon.shape[1])
-    return elev < horizon[ia, k]
+    ia, k, slope = _polar_bin(pn, pe, pd, az_bin_rad, h_bin_m, horizon.shape[0], horizon.shape[1])
+    return slope < horizon[ia, k]
 
 
 @njit(inline="always")
@@ -231,14 +263,13 @@ def terrain_returns(
     """
     ny, nx = p_ned.shape[0], p_ned.shape[1]
     n_range, n_dopp = out.shape[1], out.shape[2]
-    rows_per_block = (ny - 1 + n_blocks - 1) // n_blocks
     refl_step = 1.0 / (refl_table.shape[0] - 1)
     r_max = d_range * (n_range + 2)
     for blk in prange(n_blocks):
         ta, tn, r_rx = np.empty((4, 3)), np.empty((4, 3)), np.empty(rx.shape[0])
-        for i in range(blk * rows_per_block, min((blk + 1) * rows_per_block, ny - 1)):
+        for i in range(blk, ny - 1, n_blocks):  # interleaved rows: blocks share the work evenly
             for j in range(nx - 1):
-                if _cell_behind(p_ant, i, j):
+                if _cell_behind(p_ant, i, j) or _cell_beyond(p_ant, i, j, r_max):
                     continue
                 _corner_terms(p_ant, i, j, ta)
                 if use_horizon:

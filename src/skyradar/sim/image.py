@@ -18,7 +18,6 @@ Pixel units: |pixel|^2 is received power in W for a scatterer centred in that pi
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,6 +26,7 @@ from numba import get_num_threads
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.geo import direction_angles, ned_rotation_to, ned_to_geodetic, rotation_matrix
+from skyradar.sim._noise_kernel import finalize_frame, frame_key
 from skyradar.sim._terrain_kernel import horizon_map, terrain_returns
 
 __all__ = [
@@ -36,7 +36,6 @@ __all__ = [
     "TerrainView",
     "ImageSimulator",
     "REFLECTIVITY_MODELS",
-    "thermal_noise",
 ]
 
 REFLECTIVITY_MODELS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
@@ -69,7 +68,7 @@ class TerrainView:
     """Terrain cropped around the antenna for one frame, and its polar horizon."""
 
     p_ned: np.ndarray  # grid points relative to the antenna, NED, m
-    horizon: np.ndarray  # (n_az, n_h) elevation angle to beat, rad (1 x 1 of -inf: no occlusion)
+    horizon: np.ndarray  # (n_az, n_h) slope -down/horizontal to beat (1 x 1 of -inf: no occlusion)
     az_bin_rad: float
     h_bin_m: float
 
@@ -154,6 +153,7 @@ class ImageSimulator:
         self._refl_table = _reflectivity_table(reflectivity)
         self._gain2, self._gain2_step = two_way_gain_table(config)
         self._grid_ned = None
+        self._blocks: np.ndarray | None = None
         if terrain is not None:
             self._grid_ned = terrain.points_ned(*self.origin, flat_earth=self.flat_earth)
             dy, dx = terrain.spacing_m
@@ -191,16 +191,14 @@ class ImageSimulator:
         cfg = self.config
         geom = self.geometry(platform)
         view = self.terrain_view(geom)
+        blocks = self._accumulation_blocks()
         if view is not None:
-            cube = self.terrain_cube(geom, view)
-        else:
-            cube = np.zeros((cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex128)
+            self._accumulate_terrain(geom, view, blocks)
         if targets:
-            _add_targets(cube, cfg, geom, targets, self.coupling_s, _line_of_sight(view, geom, targets))
-        if not self.noise:
-            return cube.astype(np.complex64)
-        frame = thermal_noise(cube.shape, cfg.noise_power_w, (self.seed, int(frame_index)))
-        np.add(frame, cube, out=frame, casting="same_kind")
+            _add_targets(blocks[0], cfg, geom, targets, self.coupling_s, _line_of_sight(view, geom, targets))
+        frame = np.empty(blocks.shape[1:], np.complex64)
+        sigma = np.sqrt(cfg.noise_power_w / 2.0) if self.noise else 0.0
+        finalize_frame(blocks, sigma, frame_key(self.seed, int(frame_index)), frame)
         return frame
 
     def terrain_view(self, geom: AntennaGeometry) -> TerrainView | None:
@@ -214,24 +212,36 @@ class ImageSimulator:
         return TerrainView(p_ned, *self._horizon(p_ned, geom, get_num_threads()))
 
     def terrain_cube(self, geom: AntennaGeometry, view: TerrainView | None = None) -> np.ndarray:
-        """Terrain returns only, (n_range, n_doppler, n_rx) complex128."""
-        cfg = self.config
-        n_blocks = get_num_threads()
-        out = np.zeros((n_blocks, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex128)
+        """Terrain returns only, (n_range, n_doppler, n_rx) complex64, without noise."""
+        blocks = self._accumulation_blocks()
         view = view if view is not None else self.terrain_view(geom)
-        if view is None:
-            return out[0]
-        p_ned, horizon, az_bin, h_bin = view.p_ned, view.horizon, view.az_bin_rad, view.h_bin_m
+        if view is not None:
+            self._accumulate_terrain(geom, view, blocks)
+        out = np.empty(blocks.shape[1:], np.complex64)
+        finalize_frame(blocks, 0.0, np.uint64(0), out)
+        return out
+
+    def _accumulation_blocks(self) -> np.ndarray:
+        # One complex64 cube per thread, kept between frames: the final pass reads and clears it.
+        cfg = self.config
+        shape = (get_num_threads(), cfg.n_range, cfg.n_doppler, cfg.n_rx)
+        if self._blocks is None or self._blocks.shape != shape:
+            self._blocks = np.zeros(shape, np.complex64)
+        return self._blocks
+
+    def _accumulate_terrain(self, geom: AntennaGeometry, view: TerrainView, blocks: np.ndarray) -> None:
+        cfg = self.config
         rot = geom.rot_ned_to_ant
-        p_ant = np.ascontiguousarray(p_ned @ rot.T)
+        p_ant = np.ascontiguousarray(view.p_ned @ rot.T)
         power_const = cfg.pe_w * cfg.wavelength_m**2 / (4 * np.pi) ** 3 * self.ground_gain
+        v_ground = rot @ (-geom.velocity_ned_mps)
         terrain_returns(
-            p_ned, p_ant, -rot[:, 2], cfg.tx_position_m, cfg.rx_positions_m, rot @ (-geom.velocity_ned_mps),
+            view.p_ned, p_ant, -rot[:, 2], cfg.tx_position_m, cfg.rx_positions_m, v_ground,
             self._nsub[0], self._nsub[1], cfg.wavelength_m, cfg.range_resolution_m,
             cfg.doppler_resolution_mps, self.coupling_s, power_const, self._gain2, self._gain2_step,
-            self._refl_table, horizon, az_bin, h_bin, self.occlusion, n_blocks, out,
+            self._refl_table, view.horizon, view.az_bin_rad, view.h_bin_m, self.occlusion,
+            blocks.shape[0], blocks,
         )  # fmt: skip
-        return out[0] if n_blocks == 1 else out.sum(axis=0)
 
     def _horizon(
         self, p_ned: np.ndarray, geom: AntennaGeometry, n_blocks: int
@@ -284,28 +294,6 @@ class ImageSimulator:
         return _target_geometry(self.config, geom, targets, self.coupling_s, clear)
 
 
-_NOISE_STREAMS = 4  # fixed, so a frame's noise does not depend on how many threads drew it
-_NOISE_POOL = ThreadPoolExecutor(max_workers=_NOISE_STREAMS)
-
-
-def thermal_noise(shape: tuple[int, ...], power_w: float, key: tuple[int, int]) -> np.ndarray:
-    """Complex Gaussian noise of ``power_w`` per sample, complex64, reproducible from ``key``.
-
-    The array is filled by a fixed number of independent streams in threads (numpy's generators
-    release the GIL while filling), so drawing 333 x 250 x 4 samples per frame uses every core.
-    """
-    out = np.empty((*shape, 2), np.float32)
-    flat = out.reshape(_NOISE_STREAMS, -1) if out.size % _NOISE_STREAMS == 0 else out.reshape(1, -1)
-    streams = np.random.SeedSequence(list(key)).spawn(flat.shape[0])
-
-    def fill(i: int) -> None:
-        np.random.default_rng(streams[i]).standard_normal(out=flat[i], dtype=np.float32)
-
-    list(_NOISE_POOL.map(fill, range(flat.shape[0])))
-    out *= np.float32(np.sqrt(power_w / 2.0))
-    return out.view(np.complex64)[..., 0]
-
-
 def two_way_gain_table(config: RadarConfig, n: int = 1025) -> tuple[np.ndarray, float]:
     """Two-way linear gain G^2 on a grid of antenna-frame direction cosines (u_y, u_z) in [-1, 1]^2.
 
@@ -344,7 +332,7 @@ def _line_of_sight(
     h = np.hypot(rel[:, 0], rel[:, 1])
     a = ((np.arctan2(rel[:, 1], rel[:, 0]) + np.pi) / view.az_bin_rad).astype(int) % n_az
     k = np.minimum((h / view.h_bin_m).astype(int), n_h - 1)
-    return np.arctan2(-rel[:, 2], h) >= view.horizon[a, k]
+    return -rel[:, 2] / np.maximum(h, 1e-9) >= view.horizon[a, k]
 
 
 def _target_geometry(
@@ -396,4 +384,6 @@ def _add_targets(
     phase = 2 * np.pi * np.mod(g["path_m"][keep] / cfg.wavelength_m, 1.0)
     values = amp * np.exp(1j * phase)
     for q in range(cfg.n_rx):
-        np.add.at(cube[..., q], (g["range_bin"][keep], g["doppler_bin"][keep]), values[:, q])
+        np.add.at(
+            cube[..., q], (g["range_bin"][keep], g["doppler_bin"][keep]), values[:, q].astype(cube.dtype)
+        )

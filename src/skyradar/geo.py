@@ -12,6 +12,8 @@ body-frame (forward, right, down) vectors to NED.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pymap3d
 from scipy.spatial.transform import Rotation
@@ -85,11 +87,64 @@ def geodetic_to_ned(
     return np.stack(np.broadcast_arrays(n, e, d), axis=-1).astype(float)
 
 
+_WGS84_A = 6378137.0
+_WGS84_F = 1.0 / 298.257223563
+_WGS84_B = _WGS84_A * (1.0 - _WGS84_F)
+_WGS84_E2 = _WGS84_F * (2.0 - _WGS84_F)
+
+
+def _geodetic_to_ecef(lat_deg: float, lon_deg: float, alt_m: float) -> np.ndarray:
+    lat, lon = np.radians(lat_deg), np.radians(lon_deg)
+    n = _WGS84_A / np.sqrt(1.0 - _WGS84_E2 * np.sin(lat) ** 2)
+    return np.array(
+        [
+            (n + alt_m) * np.cos(lat) * np.cos(lon),
+            (n + alt_m) * np.cos(lat) * np.sin(lon),
+            (n * (1.0 - _WGS84_E2) + alt_m) * np.sin(lat),
+        ]
+    )
+
+
+def ecef_to_geodetic_point(x: float, y: float, z: float) -> tuple[float, float, float]:
+    """One ECEF point (m) to WGS84 (lat_deg, lon_deg, alt_m), Heikkinen's exact closed form.
+
+    Called once per frame; pymap3d's general array path costs tens of times more for one point.
+    """
+    a2, b2 = _WGS84_A**2, _WGS84_B**2
+    ep2 = (a2 - b2) / b2
+    p = math.hypot(x, y)
+    f = 54.0 * b2 * z * z
+    g = p * p + (1.0 - _WGS84_E2) * z * z - _WGS84_E2 * (a2 - b2)
+    c = _WGS84_E2**2 * f * p * p / g**3
+    s = (1.0 + c + math.sqrt(c * c + 2.0 * c)) ** (1.0 / 3.0)
+    k = s + 1.0 + 1.0 / s
+    pp = f / (3.0 * k * k * g * g)
+    q = math.sqrt(1.0 + 2.0 * _WGS84_E2**2 * pp)
+    r0 = -(pp * _WGS84_E2 * p) / (1.0 + q) + math.sqrt(
+        max(
+            0.5 * a2 * (1.0 + 1.0 / q) - pp * (1.0 - _WGS84_E2) * z * z / (q * (1.0 + q)) - 0.5 * pp * p * p,
+            0.0,
+        )
+    )
+    u = math.hypot(p - _WGS84_E2 * r0, z)
+    v = math.sqrt((p - _WGS84_E2 * r0) ** 2 + (1.0 - _WGS84_E2) * z * z)
+    z0 = b2 * z / (_WGS84_A * v)
+    return (
+        math.degrees(math.atan2(z + ep2 * z0, p)),
+        math.degrees(math.atan2(y, x)),
+        u * (1.0 - b2 / (_WGS84_A * v)),
+    )
+
+
 def ned_to_geodetic(
     ned_m: np.ndarray, lat0_deg: float, lon0_deg: float, alt0_m: float = 0.0, flat_earth: bool = False
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Local NED (metres, shape (..., 3)) back to geodetic (lat_deg, lon_deg, alt_m)."""
     ned = np.asarray(ned_m, dtype=float)
+    if ned.shape == (3,) and not flat_earth:
+        ecef = _geodetic_to_ecef(lat0_deg, lon0_deg, alt0_m) + _ecef_from_ned(lat0_deg, lon0_deg) @ ned
+        lat, lon, alt = ecef_to_geodetic_point(*ecef)
+        return np.asarray(lat), np.asarray(lon), np.asarray(alt)
     if flat_earth:
         lat = lat0_deg + np.degrees(ned[..., 0] / EARTH_RADIUS_M)
         lon = lon0_deg + np.degrees(ned[..., 1] / (EARTH_RADIUS_M * np.cos(np.radians(lat0_deg))))

@@ -114,7 +114,10 @@ def _finalize_chunk(blocks, sigma, key, out, lo, hi, zx, zratio):
     # knows, and its wrap-around check made these loops three times slower. Two simple loops,
     # not one fused one, for the same reason.
     part, dst = blocks[:, lo:hi], out[lo:hi]
-    for t in range(hi - lo):
+    has_blocks = part.shape[0] > 0
+    if not has_blocks and sigma <= 0.0:
+        dst[:] = 0
+    for t in range(hi - lo if has_blocks else 0):
         acc = part[0, t]
         for b in range(1, part.shape[0]):
             acc += part[b, t]
@@ -125,7 +128,10 @@ def _finalize_chunk(blocks, sigma, key, out, lo, hi, zx, zratio):
         for t in range(hi - lo):
             nre = sigma * _ziggurat_normal(base + _GAMMA, zx, zratio)
             nim = sigma * _ziggurat_normal(base + uint64(2) * _GAMMA, zx, zratio)
-            dst[t] += complex(nre, nim)
+            if has_blocks:
+                dst[t] += complex(nre, nim)
+            else:
+                dst[t] = complex(nre, nim)
             base += step
     part[:, :] = 0
 
@@ -142,11 +148,16 @@ def _finalize_flat(blocks, sigma, key, out, zx, zratio):
 def finalize_frame(blocks: np.ndarray, sigma: float, key: np.uint64, out: np.ndarray) -> None:
     """``out = sum(blocks) + noise`` (complex64), and ``blocks`` cleared, in one parallel pass.
 
-    ``blocks`` has shape (n_blocks, *out.shape); ``sigma`` is the SD of each of the real and
-    imaginary parts of the noise (0 for none).
+    ``blocks`` has shape (n_blocks, *out.shape), n_blocks may be 0 (noise only); ``sigma`` is
+    the SD of each of the real and imaginary parts of the noise (0 for none).
     """
     _finalize_flat(
-        blocks.reshape(blocks.shape[0], -1), float(sigma), np.uint64(key), out.reshape(-1), _ZIG_X, _ZIG_RATIO
+        blocks.reshape(blocks.shape[0], out.size),
+        float(sigma),
+        np.uint64(key),
+        out.reshape(-1),
+        _ZIG_X,
+        _ZIG_RATIO,
     )
 
 

@@ -14,7 +14,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-__all__ = ["cis_cycles", "horizon_map", "terrain_returns"]
+__all__ = ["add_sparse", "cis_cycles", "fast_atan2", "horizon_map", "terrain_returns"]
 
 
 @njit(inline="always")
@@ -239,17 +239,37 @@ def _two_way_paths(x, y, z, tx, rx, r_rx):
 
 
 @njit(inline="always")
-def _accumulate(out, blk, kr, kd, amp, r_tx, r_rx, inv_wavelength):
-    # Exact two-way path phase per receiver.
-    for q in range(r_rx.shape[0]):
-        cos_p, sin_p = cis_cycles((r_tx + r_rx[q]) * inv_wavelength)
-        out[blk, kr, kd, q] += complex(amp * cos_p, amp * sin_p)
+def _accumulate(out, sparse, blk, kr, kd, amp, r_tx, r_rx, inv_wavelength):
+    # Exact two-way path phase per receiver; into the dense block, or appended to the sparse
+    # list (pixel, value per receiver) when the frame has fewer facets than pixels.
+    idx, val, count = sparse
+    if idx.shape[1] > 0:
+        n = count[blk]
+        idx[blk, n] = kr * out.shape[2] + kd
+        count[blk] = n + 1
+        for q in range(r_rx.shape[0]):
+            cos_p, sin_p = cis_cycles((r_tx + r_rx[q]) * inv_wavelength)
+            val[blk, n, q] = complex(amp * cos_p, amp * sin_p)
+    else:
+        for q in range(r_rx.shape[0]):
+            cos_p, sin_p = cis_cycles((r_tx + r_rx[q]) * inv_wavelength)
+            out[blk, kr, kd, q] += complex(amp * cos_p, amp * sin_p)
+
+
+@njit(cache=True)
+def add_sparse(frame, idx, val, count):
+    """Add recorded contributions into ``frame`` of shape (n_range * n_doppler, n_rx)."""
+    for blk in range(count.shape[0]):
+        for n in range(count[blk]):
+            for q in range(frame.shape[1]):
+                frame[idx[blk, n], q] += val[blk, n, q]
 
 
 @njit(parallel=True, cache=True, fastmath=True)
 def terrain_returns(
     p_ned, p_ant, up_ant, tx, rx, v_ground_ant, nsub_r, nsub_c, wavelength, d_range, d_vel, coupling,
     power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m, use_horizon, n_blocks, out,
+    sparse,
 ):  # fmt: skip
     """Accumulate terrain returns into ``out`` of shape (n_blocks, n_range, n_doppler, n_rx).
 
@@ -259,7 +279,9 @@ def terrain_returns(
     ``v_ground_ant`` is the velocity of the static ground relative to the radar in the antenna
     frame. ``power_const`` is Pe * lambda^2 / (4 pi)^3. ``gain2`` is the two-way linear gain
     G^2 on a regular grid of antenna-frame direction cosines (u_y, u_z) over [-1, 1]^2 with
-    spacing ``gain2_step``. ``fastmath`` is safe here: every input is finite.
+    spacing ``gain2_step``. ``sparse`` is (idx, val, count): with ``idx`` of shape (n_blocks, cap)
+    and cap > 0 contributions are recorded there instead of added to ``out`` (see
+    :func:`add_sparse`). ``fastmath`` is safe here: every input is finite.
     """
     ny, nx = p_ned.shape[0], p_ned.shape[1]
     n_range, n_dopp = out.shape[1], out.shape[2]
@@ -306,5 +328,13 @@ def terrain_returns(
                             / (nsub_r * nsub_c)
                         )
                         _accumulate(
-                            out, blk, kr, kd, math.sqrt(power) / (rng * rng), r_tx, r_rx, 1.0 / wavelength
+                            out,
+                            sparse,
+                            blk,
+                            kr,
+                            kd,
+                            math.sqrt(power) / (rng * rng),
+                            r_tx,
+                            r_rx,
+                            1.0 / wavelength,
                         )

@@ -31,7 +31,7 @@ def _simulated_run(tmp_path, mount: Mount, name: str, n: int = 4, height_m: floa
         )
         cubes.append(sim.frame(own, frame_index=i))
     ds = frames_dataset(np.stack(cubes), times, cfg, ownship={"own_height_agl_m": np.full(n, height_m)})
-    ds.to_zarr(tmp_path / f"{name}.zarr")
+    ds.to_zarr(tmp_path / f"{name}.zarr", consolidated=False)
     return ds
 
 
@@ -42,7 +42,7 @@ def ground_run(tmp_path_factory):
     truth = {"own_height_agl_m": np.full(3, 600.0), "own_pitch_rad": np.zeros(3)}
     ds = frames_dataset(cubes, np.arange(3.0), CFG, ownship=truth)
     path = tmp_path_factory.mktemp("ground") / "ground.zarr"
-    ds.to_zarr(path)
+    ds.to_zarr(path, consolidated=False)
     return ds, path
 
 

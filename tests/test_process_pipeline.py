@@ -127,7 +127,7 @@ def run_cli(monkeypatch, *args) -> int:
 
 def test_cli_process_writes_the_table_and_reports_bad_input(tmp_path, monkeypatch, capsys):
     ds, _ = scene(n_frames=2)
-    ds.to_zarr(tmp_path / "run.zarr")
+    ds.to_zarr(tmp_path / "run.zarr", consolidated=False)
     out = tmp_path / "det.parquet"
     assert run_cli(monkeypatch, "process", tmp_path / "run.zarr", "-o", out, "--json") == 0
     table = pd.read_parquet(out)
@@ -144,7 +144,7 @@ def test_cli_process_writes_the_table_and_reports_bad_input(tmp_path, monkeypatc
     )
     assert len(pd.read_parquet(out)) == 0
     capsys.readouterr()
-    ds.isel(rx=slice(0, 3)).to_zarr(tmp_path / "bad.zarr")
+    ds.isel(rx=slice(0, 3)).to_zarr(tmp_path / "bad.zarr", consolidated=False)
     assert run_cli(monkeypatch, "process", tmp_path / "bad.zarr", "-o", out) == 2
     assert capsys.readouterr().err.startswith("error: ")
     assert run_cli(monkeypatch, "process", tmp_path / "missing.zarr", "-o", out) == 2
@@ -185,7 +185,7 @@ def test_cli_calibrate_then_process_with_the_calibrated_config(tmp_path, monkeyp
     building = (438.0, 0.0, np.radians(5.0), np.radians(-1.0), 45.0)
     aircraft = (1500.0, 20.0, np.radians(-12.0), np.radians(8.0), 35.0)
     cubes = np.stack([synthetic_frame(cfg, [building, aircraft], rng, rx_gain=offsets)[0] for _ in range(4)])
-    frames_dataset(cubes, np.arange(4) * 0.1, cfg).to_zarr(tmp_path / "run.zarr")
+    frames_dataset(cubes, np.arange(4) * 0.1, cfg).to_zarr(tmp_path / "run.zarr", consolidated=False)
     args = ["--range", 438, "--azimuth", 5, "--elevation", -1]
     assert run_cli(monkeypatch, "calibrate", tmp_path / "run.zarr", "-o", tmp_path / "radar.json", *args) == 0
     cal = RadarConfig.from_json((tmp_path / "radar.json").read_text())

@@ -41,7 +41,7 @@ def test_track_then_evaluate_against_run_truth(tmp_path, monkeypatch, capsys):
     det.to_parquet(det_path)
     iq = np.zeros((t.size, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
     targets = {"tgt_range_m": R, "tgt_radial_velocity_mps": V, "tgt_visible": vis}
-    frames_dataset(iq, t, cfg, targets=targets).to_zarr(tmp_path / "run.zarr")
+    frames_dataset(iq, t, cfg, targets=targets).to_zarr(tmp_path / "run.zarr", consolidated=False)
     code, out, err = _cli(
         monkeypatch, capsys, "track", str(det_path), "-o", str(tmp_path / "trk.parquet"), "--json"
     )
@@ -82,7 +82,7 @@ def test_track_bad_inputs_give_one_line_errors(tmp_path, monkeypatch, capsys):
 def test_evaluate_without_truth_is_clear_error(tmp_path, monkeypatch, capsys, missing):
     cfg = RadarConfig.seed_prototype(range_limit_m=300.0, n_doppler=8)
     iq = np.zeros((3, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
-    frames_dataset(iq, np.arange(3.0), cfg).to_zarr(tmp_path / "run.zarr")
+    frames_dataset(iq, np.arange(3.0), cfg).to_zarr(tmp_path / "run.zarr", consolidated=False)
     trk = tmp_path / "t.parquet"
     pd.DataFrame({"time_s": [0.0], "track_id": [0], "range_m": [1.0], "radial_velocity_mps": [0.0],
                   "innovation_range_m": [0.0],

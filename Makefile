@@ -45,8 +45,9 @@ format: $(STAMP_DEV)
 	$(BIN)/ruff format src tests
 	$(BIN)/ruff check --fix src tests
 
+# Every per-frame stage's benchmark; each prints its JSON as the last line.
 bench: $(STAMP_RUN)
-	$(BIN)/skyradar bench sim --json
+	@for name in sim chain process track state; do $(BIN)/skyradar bench $$name --json || exit 1; done
 
 clean:
 	rm -rf $(VENV) $(OUT) build *.egg-info src/*.egg-info

@@ -52,7 +52,9 @@ def test_noise_does_not_depend_on_thread_count():
 
 def test_finalize_sums_blocks_and_clears_them():
     rng = np.random.default_rng(0)
-    blocks = (rng.standard_normal((3, 10, 8, 4)) + 1j * rng.standard_normal((3, 10, 8, 4))).astype(np.complex64)
+    blocks = (rng.standard_normal((3, 10, 8, 4)) + 1j * rng.standard_normal((3, 10, 8, 4))).astype(
+        np.complex64
+    )
     expected = blocks.sum(axis=0)
     out = np.empty((10, 8, 4), np.complex64)
     finalize_frame(blocks, 0.0, frame_key(0, 0), out)

@@ -165,7 +165,6 @@ def test_ch3_experiment_smoke(tmp_path):
         assert (tmp_path / name).exists()
 
 
-@pytest.mark.slow
 def test_ch3_experiment_acceptance(tmp_path):
     from skyradar.experiments.ch3 import run
 

@@ -125,12 +125,15 @@ def experiment_ch4(
             "--chain", help="'full' (simulate frames, detect, track) or 'geometry' (detections from truth)."
         ),
     ] = "full",
+    seed: Annotated[
+        int, typer.Option("--seed", help="Noise seed of the simulator (full chain) or synthetic detections.")
+    ] = 0,
     as_json: JsonOption = False,
 ) -> None:
     """Thesis ch4: radar-aware vs traditional tracker around an airfield (Circuit, Zulu, Free)."""
     from skyradar.experiments.ch4 import run as run_ch4
 
-    result = run_ch4(out, chain=chain)
+    result = run_ch4(out, chain=chain, seed=seed)
     emit_result(result, as_json, "ch4 tracking")
 
 

@@ -1,1 +1,5 @@
-"""Experiments that reproduce seed-brief.md ch2..ch7: each ``run(out_dir) -> dict`` writes figures and a table."""
+"""Experiments that reproduce seed-brief.md ch2..ch7.
+
+Each module's ``run(out_dir, ...) -> dict`` writes its figures (PNG) and its table, and returns
+the measured values that ``skyradar experiment NAME --json`` prints.
+"""

@@ -35,7 +35,7 @@ from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.track.io import Truth
 from skyradar.track.kalman import wrap
 from skyradar.track.metrics import detected_truth, track_metrics, truth_segments
-from skyradar.track.run import track_detections
+from skyradar.track.run import OWNSHIP_COLUMNS, track_detections
 
 __all__ = ["run", "run_scenario", "scenario_truth", "THESIS"]
 
@@ -97,6 +97,7 @@ def _detect_full(truth: dict, config: RadarConfig, seed: int) -> pd.DataFrame:
         rows.append(pd.DataFrame({
             "time_s": t[k], "frame": k, "range_m": det["range_m"],
             "radial_velocity_mps": det["radial_velocity_mps"], "snr_db": det["snr_db"],
+            "azimuth_rad": det["azimuth_rad"], "elevation_rad": det["elevation_rad"],
             "north_m": ned[:, 0], "east_m": ned[:, 1], "down_m": ned[:, 2],
         }))  # fmt: skip
     return pd.concat(rows, ignore_index=True)
@@ -163,9 +164,16 @@ def run_scenario(
         by_snr[f"{thr:g}"] = int(np.unique(labels[labels >= 0]).size)
     out = {"scenario": name, "chain": chain, "frames": int(truth["time_s"].size), "detections": len(det),
            "detect_s": t_detect, "tracks": {}, "truth_tracks_by_snr_db": by_snr}  # fmt: skip
+    own = truth["own"]
+    ownship = pd.DataFrame({"time_s": truth["time_s"], **{
+        c: own.position_ned_m[:, i] if i < 3 else own.velocity_ned_mps[:, i - 3]
+        for i, c in enumerate(OWNSHIP_COLUMNS[1:])}})  # fmt: skip
+    # The geometry chain's DoA noise is a fixed 0.04 rad (see _detect_geometry), not the bound.
+    sigma_rad = 0.04 if chain == "geometry" else None
     for model in ("radar", "traditional"):
         t1 = time.perf_counter()
-        tracks = track_detections(det, model, config, frame_times_s=truth["time_s"], origin=EPBC)
+        tracks = track_detections(det, model, config, frame_times_s=truth["time_s"], origin=EPBC,
+                                  position_sigma_rad=sigma_rad, ownship=ownship)  # fmt: skip
         m = track_metrics(tracks, tr, pixel, width, gap_s=2.0, min_duration_s=0.0, confirm=(4, 5))
         out[f"track_s_{model}"] = time.perf_counter() - t1
         out["truth_tracks"] = m["truth_tracks"]
@@ -191,15 +199,18 @@ def _run_one(args: tuple) -> dict:
 
 def run(
     out_dir: Path, chain: str = "full", frame_rate_hz: float = 9.4, interval_s: float = 15.0,
-    tail_s: float = 45.0, workers: int = 2, scenarios: tuple[str, ...] = SCENARIOS,
+    tail_s: float = 45.0, workers: int = 2, scenarios: tuple[str, ...] = SCENARIOS, seed: int = 0,
 ) -> dict:  # fmt: skip
-    """Run all scenarios (in ``workers`` processes), write tables and figures, return the summary."""
+    """Run all scenarios (in ``workers`` processes), write tables and figures, return the summary.
+
+    ``seed`` seeds the simulator's noise (full chain) or the synthetic detections (geometry chain).
+    """
     from skyradar.experiments.ch4_figures import draw_figures
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
-    jobs = [(name, chain, frame_rate_hz, interval_s, tail_s) for name in scenarios]
+    jobs = [(name, chain, frame_rate_hz, interval_s, tail_s, 1.0, seed) for name in scenarios]
     if workers > 1 and len(jobs) > 1:
         with ProcessPoolExecutor(max_workers=workers) as pool:
             results = list(pool.map(_run_one, jobs))
@@ -216,6 +227,7 @@ def run(
         }
     figures = draw_figures(results, out_dir)
     summary = _summary(per_scenario, chain, time.perf_counter() - start, figures)
+    summary["seed"] = int(seed)
     pd.DataFrame(per_scenario).T.to_csv(out_dir / "ch4_results.csv")
     write_json_atomic(out_dir / "ch4_results.json", summary)
     return summary

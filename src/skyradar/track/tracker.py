@@ -3,8 +3,8 @@
 One frame is: predict every track (one batched Kalman step), gate and assign detections
 (:func:`skyradar.track.association.associate`, Hungarian), update the assigned tracks with the
 model's innovation, de-alias the radial velocity (radar model), start tentative tracks from
-unassigned detections, confirm them M-of-N, and close tracks after misses. The parts are plain
-objects passed in, as in Stone Soup: the motion model (:mod:`skyradar.track.models`), the
+unassigned detections, confirm them M-of-N (sliding window), and close tracks after misses.
+The parts are plain objects passed in, as in Stone Soup: the motion model (:mod:`skyradar.track.models`), the
 associator function, the initiator (:class:`~skyradar.track.initiation.MOfN`) and the deleter
 (:class:`~skyradar.track.deletion.MissDeleter`).
 
@@ -21,7 +21,7 @@ import numpy as np
 from skyradar.track.association import Association, associate
 from skyradar.track.dealias import dealias_velocity, push_history, range_rate_fit
 from skyradar.track.deletion import MissDeleter
-from skyradar.track.initiation import MOfN
+from skyradar.track.initiation import MOfN, push_hit
 from skyradar.track.kalman import predict, update
 from skyradar.track.models import MotionModel
 from skyradar.track.types import FrameTracks, TrackerConfig
@@ -29,7 +29,7 @@ from skyradar.track.types import FrameTracks, TrackerConfig
 __all__ = ["TrackerConfig", "FrameTracks", "RangeDopplerTracker"]
 
 _FIELDS = (
-    "x", "P", "ids", "t_update", "hits", "frames", "misses", "confirmed", "n_updates",
+    "x", "P", "ids", "t_update", "hits", "frames", "window", "misses", "confirmed", "n_updates",
     "hist_t", "hist_r", "resolved",
 )  # fmt: skip
 
@@ -90,6 +90,7 @@ class RangeDopplerTracker:
             "t_update": np.zeros(0),
             "hits": np.zeros(0, np.int64),
             "frames": np.zeros(0, np.int64),
+            "window": np.zeros(0, np.int64),
             "misses": np.zeros(0, np.int64),
             "confirmed": np.zeros(0, bool),
             "n_updates": np.zeros(0, np.int64),
@@ -286,6 +287,7 @@ class RangeDopplerTracker:
         t = self.t
         t["frames"] += 1
         t["hits"] += hit
+        t["window"] = push_hit(t["window"], hit, self.initiator.n)
         t["n_updates"] += hit
         t["misses"] = np.where(hit, 0, t["misses"] + 1)
         t["t_update"] = np.where(hit, self.time_s, t["t_update"])
@@ -294,7 +296,7 @@ class RangeDopplerTracker:
         """Confirm and delete; returns the mask of surviving tracks (in pre-deletion order)."""
         t = self.t
         tentative = ~t["confirmed"]
-        confirmed_now, failed = self.initiator.status(t["hits"], t["frames"])
+        confirmed_now, failed = self.initiator.window_status(t["window"], t["misses"])
         t["confirmed"] = t["confirmed"] | (tentative & confirmed_now)
         dead = (tentative & failed & ~t["confirmed"]) | (
             t["confirmed"] & self.deleter.delete(t["misses"], self.time_s - t["t_update"])
@@ -327,6 +329,7 @@ class RangeDopplerTracker:
             "t_update": np.full(n, self.time_s),
             "hits": np.ones(n, np.int64),
             "frames": np.ones(n, np.int64),
+            "window": np.ones(n, np.int64),
             "misses": np.zeros(n, np.int64),
             "confirmed": np.full(n, self.initiator.m <= 1),
             "n_updates": np.ones(n, np.int64),

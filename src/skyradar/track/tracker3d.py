@@ -5,17 +5,79 @@ ch3), while range and radial velocity are measured to a pixel. So association is
 range-Doppler, and every range-Doppler track owns one 3-D constant-velocity Kalman filter in the
 scenario NED frame, state ``(north, east, down, vn, ve, vd)`` [m, m/s], updated with the position of
 the detection its range-Doppler track was assigned. The filter carries its covariance.
+
+The DoA position is accurate along the line of sight (it sits at the measured range) and poor
+across it (range times the angle error), so its covariance is given per detection
+(:mod:`skyradar.track.measure3d`). When the own-ship state is known, the de-aliased radial
+velocity, the radar's most accurate measurement, updates the velocity too: ``h(x) = u . (v - v_own)``
+with ``u`` the unit line of sight, linearised at the prediction (extended Kalman update). Without it
+the tangential velocity comes from differencing positions that are tens of metres apart, and the
+radial one is no better. Positions that fall outside a chi-square gate of the prediction (DoA
+outliers at low SNR) are not used.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
 from skyradar.track.kalman import predict, update
 
-__all__ = ["Tracker3D", "cv3d_transition", "cv3d_process_noise"]
+__all__ = ["Tracker3D", "RadialObservation", "cv3d_transition", "cv3d_process_noise", "range_rate_update"]
 
 _H3 = np.hstack([np.eye(3), np.zeros((3, 3))])
+
+
+@dataclass(frozen=True)
+class RadialObservation:
+    """Own-ship state and de-aliased radial velocities of one frame, for the 3-D update.
+
+    Attributes
+    ----------
+    own_position_m, own_velocity_mps : ndarray, shape (3,)
+        Own-ship NED position [m] and velocity [m/s] at the frame time.
+    radial_velocity_mps : ndarray, shape (k,)
+        De-aliased radial velocity (positive receding) per track; NaN where none.
+    sigma_mps : float
+        Its standard deviation, m/s.
+    """
+
+    own_position_m: np.ndarray
+    own_velocity_mps: np.ndarray
+    radial_velocity_mps: np.ndarray
+    sigma_mps: float = 0.2
+
+
+def range_rate_update(
+    x: np.ndarray, P: np.ndarray, rr_mps: np.ndarray, obs: RadialObservation
+) -> tuple[np.ndarray, np.ndarray]:
+    """Extended Kalman update of a stack of (p, v) states with their range rates, Joseph form.
+
+    ``h(x) = u . (v - v_own)``, ``u = (p - p_own) / |p - p_own|``; Jacobian ``dh/dp = (w - (u.w) u) / r``
+    with ``w = v - v_own``, ``dh/dv = u``.
+
+    Examples
+    --------
+    >>> obs = RadialObservation(np.zeros(3), np.zeros(3), np.array([-50.0]), 0.2)
+    >>> x = np.array([[1000.0, 0.0, 0.0, 0.0, 0.0, 0.0]])
+    >>> x1, _ = range_rate_update(x, np.eye(6)[None] * 400.0, np.array([-50.0]), obs)
+    >>> round(float(x1[0, 3]), 1)
+    -50.0
+    """
+    d = x[:, :3] - obs.own_position_m
+    r = np.linalg.norm(d, axis=1)
+    u = d / r[:, None]
+    w = x[:, 3:] - obs.own_velocity_mps
+    uw = np.sum(u * w, axis=1)
+    h = np.concatenate([(w - uw[:, None] * u) / r[:, None], u], axis=1)  # (n, 6)
+    Ph = np.einsum("nij,nj->ni", P, h)
+    S = np.einsum("ni,ni->n", h, Ph) + obs.sigma_mps**2
+    K = Ph / S[:, None]
+    x_new = x + K * (rr_mps - uw)[:, None]
+    I_KH = np.eye(6) - K[:, :, None] * h[:, None, :]
+    P_new = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + obs.sigma_mps**2 * K[:, :, None] * K[:, None, :]
+    return x_new, P_new
 
 
 def cv3d_transition(dt_s: float) -> np.ndarray:
@@ -47,6 +109,11 @@ class Tracker3D:
         Process noise (white acceleration), m/s^2.
     init_sigma_velocity_mps : float
         Prior standard deviation of each velocity component of a new filter, m/s.
+    gate : float
+        Chi-square (3 degrees of freedom) gate on DoA positions; 16 keeps 99.9 % of good ones.
+    max_rejects : int
+        After this many consecutive gated-out positions the filter is restarted on the next one
+        (the estimate, not the measurements, is then the likelier culprit).
 
     Examples
     --------
@@ -57,16 +124,30 @@ class Tracker3D:
     (True, True)
     """
 
-    def __init__(self, sigma_accel_mps2: float = 3.0, init_sigma_velocity_mps: float = 60.0) -> None:
+    def __init__(
+        self,
+        sigma_accel_mps2: float = 3.0,
+        init_sigma_velocity_mps: float = 60.0,
+        gate: float = 16.0,
+        max_rejects: int = 5,
+    ) -> None:
         self.sigma_accel_mps2 = float(sigma_accel_mps2)
         self.init_sigma_velocity_mps = float(init_sigma_velocity_mps)
+        self.gate = float(gate)
+        self.max_rejects = int(max_rejects)
         self.ids = np.zeros(0, np.int64)
         self.x = np.zeros((0, 6))
         self.P = np.zeros((0, 6, 6))
+        self.rejects = np.zeros(0, np.int64)
         self.time_s: float | None = None
 
     def step(
-        self, time_s: float, ids: np.ndarray, positions_m: np.ndarray, variances_m2: np.ndarray
+        self,
+        time_s: float,
+        ids: np.ndarray,
+        positions_m: np.ndarray,
+        variances_m2: np.ndarray,
+        radial: RadialObservation | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
         """Move every filter to ``time_s`` and update those whose track has a 3-D position.
 
@@ -78,8 +159,10 @@ class Tracker3D:
             Range-Doppler track ids alive in this frame, increasing; ids not listed are dropped.
         positions_m : ndarray, shape (k, 3)
             NED position of the detection assigned to each track; NaN rows when none.
-        variances_m2 : ndarray, shape (k,)
-            Per-axis variance of each position, m^2.
+        variances_m2 : ndarray, shape (k,) or (k, 3, 3)
+            Per-axis variance of each position, or its full covariance, m^2.
+        radial : RadialObservation, optional
+            Own-ship state and de-aliased radial velocity per track, for a range-rate update.
 
         Returns
         -------
@@ -88,8 +171,11 @@ class Tracker3D:
         P : ndarray, shape (k, 6, 6)
         """
         ids = np.asarray(ids, np.int64)
+        cov = np.asarray(variances_m2, float)
+        if cov.ndim == 1:
+            cov = cov[:, None, None] * np.eye(3)
         keep = np.isin(self.ids, ids)
-        self.ids, self.x, self.P = self.ids[keep], self.x[keep], self.P[keep]
+        self.ids, self.x, self.P, self.rejects = (a[keep] for a in (self.ids, self.x, self.P, self.rejects))
         if self.time_s is not None and self.ids.size and time_s > self.time_s:
             dt = time_s - self.time_s
             self.x, self.P = predict(
@@ -98,31 +184,57 @@ class Tracker3D:
         self.time_s = float(time_s)
         has = np.all(np.isfinite(positions_m), axis=1)
         pos, known = _lookup(self.ids, ids)
-        upd = has & known
-        if np.any(upd):
-            rows = pos[upd]
-            R = variances_m2[upd][:, None, None] * np.eye(3)
-            y = positions_m[upd] - self.x[rows, :3]
-            self.x[rows], self.P[rows] = update(self.x[rows], self.P[rows], y, _H3, R)
+        self._update_positions(np.flatnonzero(has & known), pos, positions_m, cov)
         new = has & ~known
         if np.any(new):
-            self._add(ids[new], positions_m[new], variances_m2[new])
+            self._add(ids[new], positions_m[new], cov[new])
+        pos, found = _lookup(self.ids, ids)
+        if radial is not None:
+            ok = found & np.isfinite(radial.radial_velocity_mps)
+            rows = pos[ok]
+            self.x[rows], self.P[rows] = range_rate_update(
+                self.x[rows], self.P[rows], radial.radial_velocity_mps[ok], radial
+            )
         out_x = np.full((ids.size, 6), np.nan)
         out_P = np.full((ids.size, 6, 6), np.nan)
-        pos, found = _lookup(self.ids, ids)
         out_x[found] = self.x[pos[found]]
         out_P[found] = self.P[pos[found]]
         return out_x, out_P
 
-    def _add(self, ids: np.ndarray, positions_m: np.ndarray, variances_m2: np.ndarray) -> None:
-        x = np.hstack([positions_m, np.zeros((ids.size, 3))])
-        P = np.zeros((ids.size, 6, 6))
-        P[:, [0, 1, 2], [0, 1, 2]] = variances_m2[:, None]
+    def _update_positions(
+        self, sel: np.ndarray, pos: np.ndarray, positions_m: np.ndarray, cov: np.ndarray
+    ) -> None:
+        """Gated linear update of the filters ``pos[sel]`` with ``positions_m[sel]``."""
+        if sel.size == 0:
+            return
+        rows = pos[sel]
+        y = positions_m[sel] - self.x[rows, :3]
+        S = self.P[rows, :3, :3] + cov[sel]
+        nis = np.einsum("ni,ni->n", y, np.linalg.solve(S, y[..., None])[..., 0])
+        ok = nis < self.gate
+        restart = ~ok & (self.rejects[rows] >= self.max_rejects)
+        self.rejects[rows] = np.where(ok, 0, self.rejects[rows] + 1)
+        up = rows[ok]
+        self.x[up], self.P[up] = update(self.x[up], self.P[up], y[ok], _H3, cov[sel][ok])
+        if np.any(restart):
+            x0, P0 = self._initial(positions_m[sel][restart], cov[sel][restart])
+            r = rows[restart]
+            self.x[r], self.P[r], self.rejects[r] = x0, P0, 0
+
+    def _initial(self, positions_m: np.ndarray, cov: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        x = np.hstack([positions_m, np.zeros((positions_m.shape[0], 3))])
+        P = np.zeros((positions_m.shape[0], 6, 6))
+        P[:, :3, :3] = cov
         P[:, [3, 4, 5], [3, 4, 5]] = self.init_sigma_velocity_mps**2
+        return x, P
+
+    def _add(self, ids: np.ndarray, positions_m: np.ndarray, cov: np.ndarray) -> None:
+        x, P = self._initial(positions_m, cov)
         order = np.argsort(np.concatenate([self.ids, ids]), kind="stable")
         self.ids = np.concatenate([self.ids, ids])[order]
         self.x = np.concatenate([self.x, x])[order]
         self.P = np.concatenate([self.P, P])[order]
+        self.rejects = np.concatenate([self.rejects, np.zeros(ids.size, np.int64)])[order]
 
 
 def _lookup(stored: np.ndarray, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -40,6 +40,14 @@ def track(
         str | None,
         typer.Option("--origin", help="Scenario origin 'lat,lon,alt' for the tracks' lat/lon/alt."),
     ] = None,
+    ownship: Annotated[
+        Path | None,
+        typer.Option(
+            "--ownship",
+            help="Own-ship table (time_s, own_north_m..own_vd_mps, NED): the radial velocity then "
+            "updates the 3-D velocity and the DoA error is split along/across the line of sight.",
+        ),
+    ] = None,
     as_json: JsonOption = False,
 ) -> None:
     """Link detections into tracks: one row per confirmed track per frame.
@@ -51,9 +59,9 @@ def track(
     import numpy as np
 
     from skyradar.errors import InputError
-    from skyradar.io.tables import write_table
+    from skyradar.io.tables import read_table, write_table
     from skyradar.track.io import radar_config_from_attrs, read_detections
-    from skyradar.track.run import track_detections
+    from skyradar.track.run import OWNSHIP_COLUMNS, track_detections
 
     if model not in ("radar", "traditional"):
         raise InputError(f"--model: must be 'radar' or 'traditional', got {model!r}")
@@ -64,8 +72,14 @@ def track(
     for flag in ("is_ground", "spur"):
         if flag in table.columns:
             keep &= ~table[flag].fillna(False).to_numpy(bool)
+    own = None if ownship is None else read_table(ownship, required=list(OWNSHIP_COLUMNS), sort_by="time_s")
     tracks = track_detections(
-        table[keep].reset_index(drop=True), model, config, frame_times_s=frame_times, origin=_origin(origin)
+        table[keep].reset_index(drop=True),
+        model,
+        config,
+        frame_times_s=frame_times,
+        origin=_origin(origin),
+        ownship=own,
     )
     # detection_row refers to the input table, not to the filtered one.
     rows = tracks["detection_row"].to_numpy()

@@ -14,7 +14,8 @@ the same detections. Two detection sources:
 Truth tracks, as the thesis' count by hand from the images: an intruder is visible in a frame when
 one of that frame's detections lies within 2 pixels of it (range-Doppler coupling included);
 visible frames with gaps under 2 s (the trackers' coasting time) form one truth track, counted when
-it has 4 detections within 5 consecutive frames somewhere (the trackers' M-of-N). For reference,
+it has 4 detections within 5 consecutive frames somewhere (the trackers' M-of-N, a sliding
+window: :mod:`skyradar.track.initiation`). For reference,
 counts of the same rule on the expected SNR (at least 6, 8, 10 dB, detector-independent) are
 reported too. Writes ``ch4_results.json``/``.csv``, per-scenario detection and track tables, and
 three figures.

@@ -17,20 +17,22 @@ Speed. The prototype's 2032 samples per chirp are 16 x 127; a full FFT of that l
 of its time in the prime factor 127, yet only the first ``n_range`` (333) of the 2032 bins are kept.
 The range transform is therefore split (Cooley-Tukey, ``n = Q*n1 + n2``, ``k = k1 + P*k2`` with
 ``P`` the 5-smooth part of the length): a length-``P`` FFT, a twiddle, and a matrix product with
-the length-``Q`` DFT restricted to the ``k2`` that are kept (for ``P = 16`` the window, length-16
-DFT and twiddle are one compiled pass, :mod:`skyradar.process._rd_kernel`). It is exact (same
-numbers as the full FFT to float32 rounding) and needs about 40 % less CPU time than scipy's full
-FFT (measured by ``skyradar bench chain``); ``method='fft'`` forces the plain FFT. Chirps are
-processed in blocks that stay in cache, spread over ``workers`` threads, with BLAS held to one
-thread meanwhile.
+the length-``Q`` DFT restricted to the ``k2`` that are kept. It is exact (same numbers as the full
+FFT to float32 rounding); ``method='fft'`` forces the plain FFT. For ``P = 16`` (the prototype's
+16 x 127) the frame is done in complex64 end to end without transposes: blocks of chirps (all
+channels) go through one compiled pass (window, length-16 DFT, twiddle;
+:mod:`skyradar.process._rd_kernel`), one real matrix product with the pruned length-Q DFT, and a
+compiled scatter that applies the Doppler weight while writing the kept bins straight into the
+(range, chirp, rx) output; the Doppler FFT then runs in place along the chirp axis of that array,
+which already is the output layout. Blocks stay in cache and are spread over ``workers`` threads
+(BLAS held to one thread meanwhile); :meth:`RangeDopplerProcessor.many` instead keeps ``workers``
+whole frames in flight. ``skyradar bench chain`` measures both.
 """
 
 from __future__ import annotations
 
-import threading
-from collections.abc import Iterator, Sequence
-from concurrent.futures import ThreadPoolExecutor
-from contextlib import contextmanager
+from collections import deque
+from collections.abc import Iterable, Iterator, Sequence
 from functools import lru_cache
 from typing import Any
 
@@ -41,7 +43,7 @@ import scipy.signal
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.io.frames import frames_dataset
-from skyradar.process._rd_kernel import window_dft16_twiddle
+from skyradar.process._rd_fast import BLOCK_ROWS, Split16, frame_pool, one_blas_thread, run_parallel
 
 # fmt: off
 __all__ = [
@@ -167,7 +169,9 @@ class RangeDopplerProcessor:
         Range transform: split DFT that computes only the kept bins, or a full FFT. ``'auto'``
         uses the split form when the chirp length has a prime factor above 5 and few bins are kept.
     workers : int
-        Threads: blocks of chirps are range-transformed in parallel, then the Doppler FFTs.
+        Threads. One frame (:meth:`__call__`): blocks of chirps are range-transformed in
+        parallel, then the Doppler FFTs. Many frames (:meth:`many`): ``workers`` frames in
+        flight, one thread each (higher sustained throughput).
     n_samples : int, optional
         Valid ADC samples per chirp when fewer than ``config.samples_per_chirp`` (the rest is
         zero-padded after windowing, so the range axis keeps its bin spacing).
@@ -206,16 +210,15 @@ class RangeDopplerProcessor:
         if method not in ("pruned", "fft"):
             raise InputError(f"range_doppler: method must be 'auto', 'pruned' or 'fft', got {method!r}")
         self.method = method
-        self._local = threading.local()
+        self._split16: Split16 | None = None
         if method == "pruned":
             self._p, self._q, self._k2 = p, q, k2
             n2 = np.arange(q)
             twiddle = np.exp(-2j * np.pi * np.outer(np.arange(p), n2) / self.n_fft)
             self._twiddle = twiddle.astype(np.complex64).reshape(p, 1, q)
-            self._tr, self._ti = twiddle.real.astype(np.float32), twiddle.imag.astype(np.float32)
-            w16 = np.exp(-2j * np.pi * np.outer(np.arange(4), np.arange(4)) / 16)
-            self._w16r, self._w16i = w16.real.astype(np.float32), w16.imag.astype(np.float32)
             self._dft = np.exp(-2j * np.pi * np.outer(n2, np.arange(k2)) / q).astype(np.complex64)
+            if p == 16:
+                self._split16 = Split16(self.n_fft, config.n_range)
 
     def _range_transform(self, x: np.ndarray, remove_dc: bool) -> np.ndarray:
         """Window and transform (C, n_samples) ADC rows -> first n_range DFT bins (C, n_range)."""
@@ -230,105 +233,94 @@ class RangeDopplerProcessor:
             np.multiply(x, self._w_full, out=xw, casting="unsafe")
             return sfft.fft(xw, axis=-1, workers=1, overwrite_x=True)[:, :n_range]
         p, q, k2 = self._p, self._q, self._k2
-        if p == 16 and x.dtype == np.complex64:  # the prototype: one compiled pass
-            y, z = self._scratch(c)
-            window_dft16_twiddle(
-                np.ascontiguousarray(x), self._w_full, self._w16r, self._w16i, self._tr, self._ti, y
-            )
-            np.matmul(y.reshape(p * c, q), self._dft, out=z.reshape(p * c, k2))
-        else:
-            y = np.empty((p, c, q), np.complex64)
-            # Windowed samples as (n1, chirp, n2): the length-P FFT runs over the outer axis,
-            # where pocketfft vectorises across the contiguous inner axes.
-            np.multiply(
-                x.reshape(c, p, q).transpose(1, 0, 2), self._w_full.reshape(p, 1, q), out=y, casting="unsafe"
-            )
-            y = sfft.fft(y, axis=0, workers=1, overwrite_x=True)
-            y *= self._twiddle
-            z = (y.reshape(p * c, q) @ self._dft).reshape(p, c, k2)
+        y = np.empty((p, c, q), np.complex64)
+        # Windowed samples as (n1, chirp, n2): the length-P FFT runs over the outer axis,
+        # where pocketfft vectorises across the contiguous inner axes.
+        np.multiply(
+            x.reshape(c, p, q).transpose(1, 0, 2), self._w_full.reshape(p, 1, q), out=y, casting="unsafe"
+        )
+        y = sfft.fft(y, axis=0, workers=1, overwrite_x=True)
+        y *= self._twiddle
+        z = (y.reshape(p * c, q) @ self._dft).reshape(p, c, k2)
         # bin k = k1 + P*k2 lives at z[k1, :, k2]: (chirp, k2, k1) order gives increasing k.
         return z.transpose(1, 2, 0).reshape(c, k2 * p)[:, :n_range]
 
-    def _scratch(self, c: int) -> tuple[np.ndarray, np.ndarray]:
-        """Per-thread work arrays, reused: fresh megabyte arrays cost a page fault per page."""
-        local = self._local.__dict__
-        if local.get("c") != c:
-            local.update(c=c, y=np.empty((self._p, c, self._q), np.complex64))
-            local["z"] = np.empty((self._p, c, self._k2), np.complex64)
-        return local["y"], local["z"]
-
-    def _range_stage(self, rows: np.ndarray, remove_dc: bool) -> np.ndarray:
+    def _range_stage(self, rows: np.ndarray, remove_dc: bool, workers: int) -> np.ndarray:
         """Range transform in cache-sized blocks of chirps spread over ``workers`` threads."""
         out = np.empty((rows.shape[0], self.config.n_range), np.complex64)
-        blocks = [slice(s, s + _BLOCK_CHIRPS) for s in range(0, rows.shape[0], _BLOCK_CHIRPS)]
 
         def job(sl: slice) -> None:
             out[sl] = self._range_transform(rows[sl], remove_dc)
 
-        # BLAS threads spinning beside ours (or beside other processes) cost more than they
-        # give on small machines: one BLAS thread per worker, parallel over blocks instead.
-        with _one_blas_thread():
-            if self.workers > 1 and len(blocks) > 1:
-                list(_thread_pool(self.workers).map(job, blocks))
-            else:
-                for sl in blocks:
-                    job(sl)
+        run_parallel(job, [slice(s, s + BLOCK_ROWS) for s in range(0, rows.shape[0], BLOCK_ROWS)], workers)
         return out
 
     def __call__(
         self, adc: np.ndarray, remove_dc: bool = False, calibration: np.ndarray | None = None
     ) -> np.ndarray:
         """Range-Doppler cube (n_range, n_doppler, n_rx) complex64 of one ADC cube (rx, chirp, sample)."""
-        cfg = self.config
+        with one_blas_thread():  # once per frame, not per stage: switching it costs time
+            return self._frame(adc, remove_dc, self._gains(calibration), self.workers)
+
+    def many(
+        self, adc_frames: Iterable[np.ndarray], remove_dc: bool = False, calibration: np.ndarray | None = None
+    ) -> Iterator[np.ndarray]:
+        """Range-Doppler cubes of many ADC cubes, in order, ``workers`` frames in flight.
+
+        Each frame runs on one thread, so the threads never wait for each other inside a frame:
+        the sustained throughput for recordings and simulated flights (``skyradar bench chain``
+        measures both this and the one-frame latency of :meth:`__call__`). BLAS stays at one
+        thread, for the caller too, until the iteration ends.
+
+        Examples
+        --------
+        >>> cfg = RadarConfig.seed_prototype()
+        >>> adc = np.zeros((3, cfg.n_rx, cfg.n_doppler, cfg.samples_per_chirp), np.complex64)
+        >>> [rd.shape for rd in RangeDopplerProcessor(cfg).many(adc)][-1]
+        (333, 250, 4)
+        """
+        gains = self._gains(calibration)
+        # One BLAS limit for the whole batch: switching OpenBLAS's thread count back and forth
+        # between frames, while the other frame's thread is inside a matrix product, costs more
+        # than the frames themselves.
+        with one_blas_thread():
+            if self.workers <= 1:
+                yield from (self._frame(adc, remove_dc, gains, 1) for adc in adc_frames)
+                return
+            pool, pending = frame_pool(self.workers), deque()
+            for adc in adc_frames:
+                pending.append(pool.submit(self._frame, adc, remove_dc, gains, 1))
+                if len(pending) >= self.workers:
+                    yield pending.popleft().result()
+            while pending:
+                yield pending.popleft().result()
+
+    def _gains(self, calibration: np.ndarray | None) -> np.ndarray:
+        n_rx = self.config.n_rx
+        gains = self.config.rx_calibration if calibration is None else np.asarray(calibration, complex)
+        if gains.shape != (n_rx,) or not np.all(np.isfinite(gains)) or np.any(gains == 0):
+            raise InputError(f"range_doppler: calibration must be {n_rx} finite non-zero complex gains")
+        return gains
+
+    def _frame(self, adc: np.ndarray, remove_dc: bool, gains: np.ndarray, workers: int) -> np.ndarray:
+        cfg, adc = self.config, np.asarray(adc)
         expected = (cfg.n_rx, cfg.n_doppler, self.n_samples)
         if adc.ndim != 3 or tuple(adc.shape) != expected:
             raise InputError(f"adc: shape {tuple(adc.shape)}, expected (rx, chirp, sample) = {expected}")
-        gains = cfg.rx_calibration if calibration is None else np.asarray(calibration, complex)
-        if gains.shape != (cfg.n_rx,) or not np.all(np.isfinite(gains)) or np.any(gains == 0):
-            raise InputError(f"range_doppler: calibration must be {cfg.n_rx} finite non-zero complex gains")
+        if self._split16 is not None:
+            # Doppler window, FFT shift (a frequency offset of nV//2 bins), normalisation and
+            # calibration: one complex weight per (chirp, rx), applied while scattering.
+            weight = (self._doppler_weight[:, None] * (self.scale / gains)[None, :]).astype(np.complex64)
+            adc = np.ascontiguousarray(adc, np.complex64)
+            return self._split16(adc, self._w_full, remove_dc, weight.ravel(), workers)
         rows = np.asarray(adc).reshape(cfg.n_rx * cfg.n_doppler, self.n_samples)
-        rng = self._range_stage(rows, remove_dc).reshape(cfg.n_rx, cfg.n_doppler, cfg.n_range)
+        rng = self._range_stage(rows, remove_dc, workers).reshape(cfg.n_rx, cfg.n_doppler, cfg.n_range)
         # Doppler window, FFT shift (a frequency offset of nV//2 bins), normalisation and
         # calibration are one complex weight per (rx, chirp): one pass over the data.
         weight = (self._doppler_weight[None, :] * (self.scale / gains)[:, None]).astype(np.complex64)
         rng *= weight[:, :, None]
-        rd = sfft.fft(rng, axis=1, workers=self.workers, overwrite_x=True)
+        rd = sfft.fft(rng, axis=1, workers=workers, overwrite_x=True)
         return np.ascontiguousarray(rd.transpose(2, 1, 0))
-
-
-_BLOCK_CHIRPS = 125  # 2 MB of complex64 ADC rows: stays in cache from window to matrix product
-
-
-@lru_cache(maxsize=1)
-def _blas_controller():
-    from threadpoolctl import ThreadpoolController  # numpy's BLAS is loaded by now
-
-    return ThreadpoolController()
-
-
-_BLAS_LOCK = threading.Lock()
-_BLAS_USERS = [0, None]  # callers inside, threadpoolctl limiter of the first one
-
-
-@contextmanager
-def _one_blas_thread() -> Iterator[None]:
-    """BLAS limited to one thread while any caller (from any thread) is inside."""
-    with _BLAS_LOCK:
-        if _BLAS_USERS[0] == 0:
-            _BLAS_USERS[1] = _blas_controller().limit(limits=1, user_api="blas")
-        _BLAS_USERS[0] += 1
-    try:
-        yield
-    finally:
-        with _BLAS_LOCK:
-            _BLAS_USERS[0] -= 1
-            if _BLAS_USERS[0] == 0:
-                _BLAS_USERS[1].restore_original_limits()
-
-
-@lru_cache(maxsize=4)
-def _thread_pool(workers: int) -> ThreadPoolExecutor:
-    return ThreadPoolExecutor(max_workers=workers, thread_name_prefix="skyradar-rd")
 
 
 @lru_cache(maxsize=8)
@@ -434,7 +426,14 @@ def rd_frames_dataset(
     if len(adc_frames) != times_s.size:
         raise InputError(f"adc: {len(adc_frames)} frames but {times_s.size} frame times")
     iq = np.empty((times_s.size, config.n_range, config.n_doppler, config.n_rx), np.complex64)
-    for i, frame in enumerate(adc_frames):
-        iq[i] = range_doppler(frame, config, range_window, doppler_window, remove_dc, calibration)
+    if times_s.size:
+        rw, dw, n_samples = (
+            _hashable(range_window),
+            _hashable(doppler_window),
+            int(np.shape(adc_frames[0])[-1]),
+        )
+        proc = _processor(config, rw, dw, "auto", 2, n_samples)
+        for i, rd in enumerate(proc.many(adc_frames, remove_dc, calibration)):
+            iq[i] = rd
     attrs = {"source": "adc", "range_window": str(range_window), "doppler_window": str(doppler_window)}
     return frames_dataset(iq, times_s, config, attrs=attrs, **truth)

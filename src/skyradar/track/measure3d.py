@@ -1,9 +1,12 @@
 """Measurement noise of DoA positions for the 3-D tracker.
 
 A detection's NED position is ``p_own + R u`` with the measured range ``R`` and the estimated
-direction ``u``. Its error along the line of sight is the range error (a few metres, plus the
-range-Doppler coupling ``c V_R`` when the radial velocity is not known unaliased); across it, the
-angle error times the range. The angle error is the Cramer-Rao bound of the phase-difference DoA
+direction ``u``. In principle its error along the line of sight is the range error (a few metres,
+plus the range-Doppler coupling ``c V_R`` when the radial velocity is not known unaliased) and
+across it the angle error times the range; :func:`position_covariance` writes that model. (On the
+full chain the along-sight error was measured at 17-25 m RMS, so the tracker
+(:mod:`skyradar.track.run`) passes an along-sight sigma no smaller than the across-sight one.)
+The angle error is the Cramer-Rao bound of the phase-difference DoA
 (:func:`skyradar.process.doa.doa_crlb`) at the detection's SNR, which matches the measured error of
 the full chain (ch4 Free, RMS across-line-of-sight error / bound: 1.1 at 8-12 dB, 1.0 at 12-16 dB,
 1.1 at 16-22 dB, 1.3 above 22 dB, where a floor takes over).
@@ -24,18 +27,21 @@ def angle_sigma_rad(
     azimuth_rad: np.ndarray | None = None,
     elevation_rad: np.ndarray | None = None,
     floor_rad: float = 0.01,
+    max_rad: float = 0.3,
 ) -> np.ndarray:
     """Per-axis angle standard deviation of a DoA estimate: the CRLB with a floor, radians.
 
     Without angles the bound is taken at boresight. The per-axis value is the RMS of the
-    azimuth and elevation bounds.
+    azimuth and elevation bounds. Above ``max_rad`` (very low SNR, or an estimate at the edge of
+    the field of view, where the bound of a planar array diverges) the position carries no
+    usable direction and the result is ``inf``, so that the 3-D tracker skips it.
 
     Examples
     --------
     >>> cfg = RadarConfig.seed_prototype()
-    >>> s = angle_sigma_rad(np.array([10.0, 30.0]), cfg)
-    >>> bool(s[0] > s[1] >= 0.01)
-    True
+    >>> s = angle_sigma_rad(np.array([10.0, 30.0, -20.0]), cfg)
+    >>> bool(s[0] > s[1] >= 0.01), bool(np.isinf(s[2]))
+    (True, True)
     """
     from skyradar.process.doa import doa_crlb
 
@@ -44,7 +50,8 @@ def angle_sigma_rad(
     el = np.zeros_like(snr) if elevation_rad is None else np.nan_to_num(np.asarray(elevation_rad, float))
     sd_az, sd_el = doa_crlb(snr, az, el, config)
     sigma = np.sqrt(0.5 * (sd_az**2 + sd_el**2))
-    return np.maximum(np.nan_to_num(sigma, nan=np.inf), floor_rad)
+    sigma = np.maximum(np.nan_to_num(sigma, nan=np.inf), floor_rad)
+    return np.where(sigma > max_rad, np.inf, sigma)
 
 
 def position_covariance(

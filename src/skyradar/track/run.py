@@ -211,8 +211,14 @@ class _Measure3D:
         # The DoA point sits at the apparent range R + c V_R; move it to the true range.
         pos = own_p + d * (1.0 - c * np.where(resolved, v_track, v_meas)[:, None] / rng)
         range_sigma = np.where(resolved, sr, np.hypot(sr, 0.5 * c * self.width))
+        # Measured on the full chain (ch4 Free), DoA positions are off along the line of sight by
+        # 17-25 m RMS at high SNR and far more at low SNR (angle outliers), not by the range noise;
+        # trusting the range there slowed the 3-D velocity's convergence (median error 10 vs 6 m/s),
+        # so the along-sight error is never taken below the across-sight one.
+        across = np.linalg.norm(pos - own_p, axis=1) * sigma
         cov = np.full((det.size, 3, 3), np.nan)
-        cov[has] = position_covariance(pos[has], own_p, sigma[has], range_sigma[has])
+        use = has & np.isfinite(sigma)
+        cov[use] = position_covariance(pos[use], own_p, sigma[use], np.maximum(range_sigma, across)[use])
         radial = RadialObservation(own_p, own_v, v_unaliased, self.motion.sigma_velocity_mps)
         return self.t3.step(float(out.time_s), out.alive_ids, pos, cov, radial)
 

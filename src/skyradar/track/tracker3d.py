@@ -6,11 +6,10 @@ range-Doppler, and every range-Doppler track owns one 3-D constant-velocity Kalm
 scenario NED frame, state ``(north, east, down, vn, ve, vd)`` [m, m/s], updated with the position of
 the detection its range-Doppler track was assigned. The filter carries its covariance.
 
-The DoA position is accurate along the line of sight (it sits at the measured range) and poor
-across it (range times the angle error), so its covariance is given per detection
-(:mod:`skyradar.track.measure3d`). When the own-ship state is known, the de-aliased radial
+Each DoA position comes with its own covariance (range times the Cramer-Rao angle error at its
+SNR, :mod:`skyradar.track.measure3d`). When the own-ship state is known, the de-aliased radial
 velocity, the radar's most accurate measurement, updates the velocity too: ``h(x) = u . (v - v_own)``
-with ``u`` the unit line of sight, linearised at the prediction (extended Kalman update). Without it
+with ``u`` the unit line of sight of the prediction (:func:`range_rate_update`). Without it
 the tangential velocity comes from differencing positions that are tens of metres apart, and the
 radial one is no better. Positions that fall outside a chi-square gate of the prediction (DoA
 outliers at low SNR) are not used.
@@ -52,10 +51,15 @@ class RadialObservation:
 def range_rate_update(
     x: np.ndarray, P: np.ndarray, rr_mps: np.ndarray, obs: RadialObservation
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Extended Kalman update of a stack of (p, v) states with their range rates, Joseph form.
+    """Kalman update of a stack of (p, v) states with their range rates, Joseph form.
 
-    ``h(x) = u . (v - v_own)``, ``u = (p - p_own) / |p - p_own|``; Jacobian ``dh/dp = (w - (u.w) u) / r``
-    with ``w = v - v_own``, ``dh/dv = u``.
+    ``h(x) = u . (v - v_own)`` with the line of sight ``u = (p - p_own) / r`` taken from the
+    prediction and held fixed, so the update is linear in the velocity and does not drag the
+    position across the line of sight (an extended update, with ``dh/dp = (w - (u.w) u) / r``,
+    does, and with DoA positions tens of metres off it biased both position and velocity in the
+    ch4 Free scenario). The error of ``u`` enters as measurement noise instead:
+    ``|w_perp|^2 * var(angle)``, ``w = v - v_own``, the angle variance from the predicted position
+    covariance across the line of sight.
 
     Examples
     --------
@@ -70,13 +74,17 @@ def range_rate_update(
     u = d / r[:, None]
     w = x[:, 3:] - obs.own_velocity_mps
     uw = np.sum(u * w, axis=1)
-    h = np.concatenate([(w - uw[:, None] * u) / r[:, None], u], axis=1)  # (n, 6)
+    w_perp2 = np.sum(w * w, axis=1) - uw**2
+    P_pp = P[:, :3, :3]
+    across = np.trace(P_pp, axis1=1, axis2=2) - np.einsum("ni,nij,nj->n", u, P_pp, u)
+    noise = obs.sigma_mps**2 + w_perp2 * across / (2.0 * r**2)
+    h = np.concatenate([np.zeros_like(u), u], axis=1)  # (n, 6)
     Ph = np.einsum("nij,nj->ni", P, h)
-    S = np.einsum("ni,ni->n", h, Ph) + obs.sigma_mps**2
+    S = np.einsum("ni,ni->n", h, Ph) + noise
     K = Ph / S[:, None]
     x_new = x + K * (rr_mps - uw)[:, None]
     I_KH = np.eye(6) - K[:, :, None] * h[:, None, :]
-    P_new = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + obs.sigma_mps**2 * K[:, :, None] * K[:, None, :]
+    P_new = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + noise[:, None, None] * K[:, :, None] * K[:, None, :]
     return x_new, P_new
 
 
@@ -182,7 +190,8 @@ class Tracker3D:
                 self.x, self.P, cv3d_transition(dt), cv3d_process_noise(dt, self.sigma_accel_mps2)
             )
         self.time_s = float(time_s)
-        has = np.all(np.isfinite(positions_m), axis=1)
+        # A position without a finite covariance (e.g. no SNR for its angle error) is not used.
+        has = np.all(np.isfinite(positions_m), axis=1) & np.all(np.isfinite(cov), axis=(1, 2))
         pos, known = _lookup(self.ids, ids)
         self._update_positions(np.flatnonzero(has & known), pos, positions_m, cov)
         new = has & ~known

@@ -1,0 +1,123 @@
+"""3-D track quality for the DAA layer and sliding-window confirmation (issue 5 follow-up)."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from skyradar.config import RadarConfig
+from skyradar.track.kalman import wrap
+from skyradar.track.measure3d import angle_sigma_rad, position_covariance
+from skyradar.track.models import radar_model
+from skyradar.track.run import OWNSHIP_COLUMNS, track_detections
+from skyradar.track.tracker import RangeDopplerTracker, TrackerConfig
+from skyradar.track.tracker3d import RadialObservation, range_rate_update
+
+CFG = RadarConfig.seed_prototype()
+W = 2 * CFG.v_lim_mps
+DT = 0.106
+
+
+def _straight_encounter(seed: int, sigma_angle_rad: float = 0.03, gap=None):
+    """Own-ship flying north at 50 m/s, an intruder flying straight at 60 m/s; DoA positions at
+    the measured (coupled) range with angle noise across the line of sight."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, 25.0, DT)
+    own_v = np.array([50.0, 0.0, 0.0])
+    own = t[:, None] * own_v
+    vel = np.array([-45.0, -40.0, 1.5])
+    pos = np.array([3500.0, 1500.0, -150.0]) + t[:, None] * vel
+    d = pos - own
+    R = np.linalg.norm(d, axis=1)
+    u = d / R[:, None]
+    V = u @ (vel - own_v)
+    a = rng.normal(0.0, sigma_angle_rad, (t.size, 3))
+    a -= np.sum(a * u, axis=1)[:, None] * u
+    un = (u + a) / np.linalg.norm(u + a, axis=1)[:, None]
+    rm = R + CFG.range_doppler_coupling_s * V + rng.normal(0.0, 4.5, t.size)
+    keep = rng.random(t.size) < 0.9
+    if gap is not None:
+        keep[gap[0] : gap[1]] = False
+    ned = own + rm[:, None] * un
+    det = pd.DataFrame({
+        "time_s": t, "frame": np.arange(t.size), "range_m": rm,
+        "radial_velocity_mps": wrap(V + rng.normal(0.0, 0.1, t.size), W),
+        "north_m": ned[:, 0], "east_m": ned[:, 1], "down_m": ned[:, 2],
+    })[keep]  # fmt: skip
+    cols = {
+        c: own[:, i] if i < 3 else np.full(t.size, own_v[i - 3]) for i, c in enumerate(OWNSHIP_COLUMNS[1:])
+    }
+    return t, det, pd.DataFrame({"time_s": t, **cols}), vel, pos, own, own_v
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_straight_intruder_3d_speed_within_a_few_mps_after_convergence(seed):
+    t, det, ownship, vel, pos, own, own_v = _straight_encounter(seed)
+    tracks = track_detections(det, "radar", CFG, frame_times_s=t, ownship=ownship, position_sigma_rad=0.03)
+    assert tracks.track_id.nunique() == 1
+    late = tracks[tracks.time_s > 10.0]
+    v = late[["vn_mps", "ve_mps", "vd_mps"]].to_numpy()
+    speed_err = np.abs(np.linalg.norm(v, axis=1) - np.linalg.norm(vel))
+    assert speed_err.max() < 5.0 and np.median(speed_err) < 2.5
+    # The radial velocity (the radar's accurate measurement) pins the line-of-sight component.
+    k = late.frame.to_numpy()
+    u = (pos[k] - own[k]) / np.linalg.norm(pos[k] - own[k], axis=1)[:, None]
+    radial_err = np.sum(u * (v - vel), axis=1)
+    assert np.median(np.abs(radial_err)) < 0.5
+    # Velocity covariance is written, symmetric and positive definite.
+    cov = late[[f"cov_vv_{i}{j}" for i in range(3) for j in range(3)]].to_numpy(float).reshape(-1, 3, 3)
+    np.testing.assert_allclose(cov, np.swapaxes(cov, 1, 2), atol=1e-9)
+    assert np.all(np.linalg.eigvalsh(cov) > 0)
+    assert all(f"cov_pv_{i}{j}" in tracks.columns for i in range(3) for j in range(3))
+
+
+def test_radial_velocity_update_beats_positions_alone():
+    t, det, ownship, vel, pos, own, _ = _straight_encounter(5, sigma_angle_rad=0.05)
+    errs = []
+    for own_table in (None, ownship):
+        tracks = track_detections(
+            det, "radar", CFG, frame_times_s=t, ownship=own_table, position_sigma_rad=0.05
+        )
+        late = tracks[tracks.time_s > 10.0]
+        k = late.frame.to_numpy()
+        u = (pos[k] - own[k]) / np.linalg.norm(pos[k] - own[k], axis=1)[:, None]
+        v = late[["vn_mps", "ve_mps", "vd_mps"]].to_numpy()
+        errs.append(np.median(np.abs(np.sum(u * (v - vel), axis=1))))
+    assert errs[1] < 0.5 * errs[0]
+
+
+def test_confirmed_false_while_coasting_and_true_again_after():
+    t, det, ownship, *_ = _straight_encounter(0, gap=(100, 110))
+    tracks = track_detections(det, "radar", CFG, frame_times_s=t, ownship=ownship)
+    assert tracks.track_id.nunique() == 1
+    coasting = tracks.misses >= 5
+    assert coasting.any() and not tracks.confirmed[coasting].any()
+    assert tracks.confirmed[tracks.frame > 112].all()
+
+
+def test_patchy_redetection_is_confirmed_by_sliding_window():
+    # Hits in frames 0, 2, 3, 5, 6: no 4-of-5 window starts at the first hit, but 2..6 has four.
+    hits = {0, 2, 3, 5, 6}
+    trk = RangeDopplerTracker(radar_model(W), TrackerConfig(confirm_m=4, confirm_n=5))
+    seen = []
+    for k in range(9):
+        z = np.array([[1500.0 + 2.0 * k, 12.0]]) if k in hits else np.zeros((0, 2))
+        seen.append(trk.step(k * DT, z).track_id.tolist())
+    assert seen[6] == [0] and seen[5] == []
+    # Isolated detections two frames apart never confirm, and die after two misses.
+    trk = RangeDopplerTracker(radar_model(W), TrackerConfig(confirm_m=4, confirm_n=5))
+    for k in range(12):
+        z = np.array([[1500.0 + 2.0 * k, 12.0]]) if k % 3 == 0 else np.zeros((0, 2))
+        assert trk.step(k * DT, z).track_id.size == 0
+
+
+def test_position_covariance_and_range_rate_update_shapes():
+    C = position_covariance(np.array([[0.0, 2000.0, 0.0]]), np.zeros(3), np.array([0.02]), 5.0)
+    np.testing.assert_allclose(np.diag(C[0]), [1600.0, 25.0, 1600.0])
+    s = angle_sigma_rad(np.array([12.0, 25.0]), CFG)
+    assert 0.01 <= s[1] < s[0] < 0.3
+    obs = RadialObservation(np.zeros(3), np.array([50.0, 0.0, 0.0]), np.array([np.nan]), 0.2)
+    x = np.array([[1000.0, 1000.0, 0.0, -40.0, 0.0, 0.0]])
+    x1, P1 = range_rate_update(x, np.eye(6)[None] * 100.0, np.array([-70.0]), obs)
+    u = np.array([1.0, 1.0, 0.0]) / np.sqrt(2.0)
+    assert np.dot(u, x1[0, 3:] - obs.own_velocity_mps) == pytest.approx(-70.0, abs=1.0)
+    assert np.all(np.linalg.eigvalsh(P1[0]) > 0)

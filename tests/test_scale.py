@@ -93,3 +93,37 @@ def test_sweep_parameter_paths():
     with pytest.raises(InputError, match="intruders.3"):
         set_by_path(data, "intruders.3.rcs_m2", 1.0)
     assert parse_values("0, 19.2,cosine") == [0, 19.2, "cosine"]
+
+
+def test_process_on_a_local_cluster_matches_the_plain_loop(tmp_path):
+    built = Scenario.from_dict(SCENARIO, source=tmp_path / "s.yaml").build()
+    run = simulate_to_zarr(built, tmp_path / "run.zarr", chunk_frames=3)
+    tables = {}
+    for name, extra in (("loop", []), ("dask", ["--workers", "2", "--chunk-frames", "2"])):
+        out = tmp_path / f"{name}.parquet"
+        result = subprocess.run(
+            [sys.executable, "-m", "skyradar", "process", str(run), "-o", str(out), *extra],
+            capture_output=True, text=True, timeout=300,
+        )  # fmt: skip
+        assert result.returncode == 0, result.stderr
+        tables[name] = pd.read_parquet(out)
+    assert len(tables["loop"]) > 0
+    assert sorted(tables["dask"]["frame"].unique()) == list(range(6))
+    pd.testing.assert_frame_equal(tables["loop"], tables["dask"])
+
+
+def test_rd_on_a_local_cluster_matches_the_plain_loop(tmp_path):
+    from skyradar.config import RadarConfig
+    from skyradar.io.recordings import write_recording
+    from skyradar.process.rd_run import recording_to_frames
+
+    cfg = RadarConfig.seed_prototype()
+    rng = np.random.default_rng(4)
+    shape = (5, cfg.n_rx, cfg.n_doppler, cfg.samples_per_chirp)
+    adc = (rng.standard_normal(shape) + 1j * rng.standard_normal(shape)).astype(np.complex64)
+    write_recording(tmp_path / "rec.bin", adc, cfg)
+    loop = recording_to_frames(tmp_path / "rec.bin", tmp_path / "loop.zarr", chunk_frames=2)
+    dask = recording_to_frames(tmp_path / "rec.bin", tmp_path / "dask.zarr", chunk_frames=2, workers=2)
+    assert loop["frames"] == dask["frames"] == 5
+    a, b = open_frames(tmp_path / "loop.zarr"), open_frames(tmp_path / "dask.zarr")
+    assert a.iq.values.tobytes() == b.iq.values.tobytes()

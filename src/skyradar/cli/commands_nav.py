@@ -38,6 +38,8 @@ def state(
     Columns: time_s, frame; raw vx_raw_mps, vz_raw_mps (positive down), h_raw_m and their *_sd;
     Kalman-filtered vx_mps, vz_mps, h_m and their *_sd; quality (0..1), low_quality, n_ridge,
     n_inliers, used_by_filter. Frames without ground in view are low quality with NaN estimates.
+    Runs in one process: each frame's estimate builds on the previous one (de-aliasing prior,
+    terrain memory, Kalman filter), so the frames are not split across Dask workers.
     """
     from skyradar.io.frames import open_frames, radar_config_of
     from skyradar.io.tables import write_table

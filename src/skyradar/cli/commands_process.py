@@ -42,6 +42,13 @@ def process(
     radar_config: Annotated[
         Path | None, typer.Option("--radar-config", help="RadarConfig JSON (e.g. from `skyradar calibrate`).")
     ] = None,
+    scheduler: Annotated[str | None, typer.Option(help="Address of an existing Dask scheduler.")] = None,
+    workers: Annotated[
+        int | None, typer.Option(help="Run on a local Dask cluster of this many workers.")
+    ] = None,
+    chunk_frames: Annotated[
+        int, typer.Option(help="Frames per Dask task (with --scheduler/--workers).")
+    ] = 64,
     as_json: JsonOption = False,
 ) -> None:
     """Detect objects in every frame and locate them in 3-D: one row per detection per frame.
@@ -64,17 +71,25 @@ def process(
         dem = read_dem(terrain)
     bar, task = _progress(ds.sizes["time"], "frames")
     with bar:
-        table = process_frames(
-            ds,
-            spurs,
-            dem,
-            method,
-            spur_mode,
-            progress=lambda n: bar.update(task, completed=n),
-            source=str(run),
-            config=config,
-            pfa=pfa,
-        )
+        if scheduler is None and not workers:
+            table = process_frames(
+                ds, spurs, dem, method, spur_mode, progress=lambda n: bar.update(task, completed=n),
+                source=str(run), config=config, pfa=pfa,
+            )  # fmt: skip
+        else:
+            import functools
+
+            import pandas as pd
+
+            from skyradar.process.pipeline import process_chunk
+            from skyradar.sim.cluster import map_frame_chunks
+
+            job = functools.partial(process_chunk, config=config, pfa=pfa)
+            parts = map_frame_chunks(
+                job, str(run), ds.sizes["time"], max(1, chunk_frames), spurs, dem, method, spur_mode,
+                scheduler=scheduler, workers=workers, progress=lambda k: bar.advance(task, k),
+            )  # fmt: skip
+            table = pd.concat(parts, ignore_index=True)
     write_table(table, output, metadata={"radar_config": config.to_json(), "source": str(run)})
     n = ds.sizes["time"]
     result = {

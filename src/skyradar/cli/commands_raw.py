@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import hashlib
-import json
 from pathlib import Path
 from typing import Annotated
 
@@ -14,14 +12,6 @@ from skyradar.cli.app import app, bench_app, console, emit_result
 __all__ = ["rd", "bench_chain"]
 
 WINDOW_HELP = "hann, hamming, blackmanharris, chebyshev[:SIDELOBE_DB] or none."
-
-
-def _fingerprint(path: Path, options: dict) -> str:
-    stat = path.stat()
-    text = json.dumps(
-        {"path": str(path.resolve()), "size": stat.st_size, "mtime": stat.st_mtime_ns, **options}
-    )
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
 @app.command()
@@ -37,6 +27,10 @@ def rd(
         bool, typer.Option("--remove-dc", help="Subtract each chirp's mean (ADC offset).")
     ] = False,
     chunk_frames: Annotated[int, typer.Option("--chunk-frames", min=1, help="Frames per Zarr chunk.")] = 32,
+    scheduler: Annotated[str | None, typer.Option(help="Address of an existing Dask scheduler.")] = None,
+    workers: Annotated[
+        int | None, typer.Option(help="Run on a local Dask cluster of this many workers.")
+    ] = None,
     as_json: Annotated[
         bool, typer.Option("--json", help="Print the summary as JSON (last stdout line).")
     ] = False,
@@ -48,39 +42,14 @@ def rd(
     windows' coherent gain. Written chunk by chunk; an interrupted run resumes. The recording is
     fully checked first: a bad recording leaves no output.
     """
-    import dask.array as da
-    import numpy as np
+    from skyradar.process.rd_run import recording_to_frames
 
-    from skyradar.io.frames import FrameStoreWriter, frames_dataset
-    from skyradar.io.recordings import read_recording
-    from skyradar.process.rangedoppler import RangeDopplerProcessor, window_gain_db
+    def report(frames: int) -> None:
+        console.print(f"{frames} more frames written")
 
-    frames, config = read_recording(recording)
-    n_frames, _, _, n_samples = frames.shape
-    proc = RangeDopplerProcessor(config, range_window, doppler_window, n_samples=n_samples)
-    shape = (n_frames, config.n_range, config.n_doppler, config.n_rx)
-    lazy = da.zeros(shape, dtype=np.complex64, chunks=(chunk_frames, *shape[1:]))
-    attrs = {"source": str(recording), "range_window": range_window, "doppler_window": doppler_window}
-    template = frames_dataset(lazy, frames.times_s, config, attrs=attrs)
-    options = {"rw": range_window, "dw": doppler_window, "dc": remove_dc, "chunk": chunk_frames}
-    writer = FrameStoreWriter(output, template, chunk_frames, _fingerprint(Path(recording), options))
-    pending = writer.pending_chunks()
-    for index in pending:
-        sl = writer.chunk_slice(index)
-        block = np.stack([proc(frames[i], remove_dc=remove_dc) for i in range(sl.start, sl.stop)])
-        writer.write_chunk(index, block)
-        console.print(f"chunk {index + 1}/{writer.n_chunks} ({sl.stop} of {n_frames} frames)")
-    writer.close()
-    result = {
-        "frames": n_frames,
-        "chunks_written": len(pending),
-        "chunks_resumed": writer.n_chunks - len(pending),
-        "n_range": config.n_range,
-        "n_doppler": config.n_doppler,
-        "n_rx": config.n_rx,
-        "window_gain_db": window_gain_db(range_window, doppler_window, config),
-        "output": str(output),
-    }
+    result = recording_to_frames(
+        recording, output, range_window, doppler_window, remove_dc, chunk_frames, scheduler, workers, report
+    )
     emit_result(result, as_json, "range-Doppler frames")
 
 

@@ -49,7 +49,7 @@ from skyradar.process.doa import (
 from skyradar.process.ground import classify_ground, height_above_ground_m, in_ground_band
 from skyradar.process.spurs import SpurMap
 
-__all__ = ["DETECTION_COLUMNS", "process_cube", "process_frames", "scenario_origin"]
+__all__ = ["DETECTION_COLUMNS", "process_chunk", "process_cube", "process_frames", "scenario_origin"]
 
 DETECTION_COLUMNS = [
     "time_s", "frame", "range_m", "radial_velocity_mps", "range_bin", "doppler_bin", "snr_db", "power_db",
@@ -202,6 +202,18 @@ def _ground_flags(
         band = in_ground_band(out["range_m"], out["radial_velocity_mps"], vel, own_agl, config)
         ground = np.where(unreliable, band, ground)
     return ground
+
+
+def process_chunk(path: str, start: int, stop: int, *args: Any, **kwargs: Any) -> pd.DataFrame:
+    """:func:`process_frames` on frames ``start:stop`` of the run at ``path`` (frame numbers kept).
+
+    The unit of work for Dask workers: they open the run themselves.
+    """
+    from skyradar.io.frames import open_frames
+
+    table = process_frames(open_frames(path).isel(time=slice(start, stop)), *args, source=path, **kwargs)
+    table["frame"] += start
+    return table
 
 
 def process_frames(

@@ -11,7 +11,7 @@ from typing import Any
 
 from skyradar.errors import InputError
 
-__all__ = ["connect", "close", "map_chunks"]
+__all__ = ["connect", "close", "map_chunks", "map_frame_chunks"]
 
 
 def connect(scheduler: str | None, workers: int | None, timeout_s: float = 10.0):
@@ -63,3 +63,43 @@ def map_chunks(
         for future in futures:
             future.cancel()
         raise
+
+
+def map_frame_chunks(
+    job: Callable[..., Any],
+    path: str,
+    n_frames: int,
+    chunk_frames: int,
+    *args: Any,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> list[Any]:
+    """``[job(path, start, stop, *args) for each time chunk]`` in order, on Dask or in a plain loop.
+
+    Workers open the run themselves from ``path`` (a shared filesystem), so only the chunk bounds
+    travel to them and only each chunk's (small) result travels back.
+    """
+    bounds = [(s, min(s + chunk_frames, n_frames)) for s in range(0, n_frames, chunk_frames)]
+    if scheduler is None and not workers:
+        results = []
+        for start, stop in bounds:
+            results.append(job(path, start, stop, *args))
+            if progress:
+                progress(stop - start)
+        return results
+    from distributed import as_completed
+
+    client = connect(scheduler, workers)
+    try:
+        futures = [client.submit(job, path, start, stop, *args, pure=False) for start, stop in bounds]
+        order = {f.key: i for i, f in enumerate(futures)}
+        results: list[Any] = [None] * len(futures)
+        for future in as_completed(futures):
+            results[order[future.key]] = future.result()
+            if progress:
+                start, stop = bounds[order[future.key]]
+                progress(stop - start)
+        return results
+    finally:
+        close(client, owns_cluster=scheduler is None)

@@ -31,19 +31,12 @@ from skyradar.daa.advice import resolution_advice
 from skyradar.daa.alerting import AlertConfig, filter_alert_levels, raw_alert_levels
 from skyradar.daa.conflict import traffic_indication
 from skyradar.errors import InputError
+from skyradar.track.run import OWNSHIP_COLUMNS as TRACKER_OWNSHIP_COLUMNS
 
 __all__ = ["TRACK_COLUMNS", "OWNSHIP_COLUMNS", "ownship_from_frames", "truth_tracks", "alerts_from_tracks"]
 
 TRACK_COLUMNS = ["time_s", "track_id", "north_m", "east_m", "down_m", "vn_mps", "ve_mps", "vd_mps"]
-OWNSHIP_COLUMNS = [
-    "time_s",
-    "own_north_m",
-    "own_east_m",
-    "own_down_m",
-    "own_vn_mps",
-    "own_ve_mps",
-    "own_vd_mps",
-]
+OWNSHIP_COLUMNS = list(TRACKER_OWNSHIP_COLUMNS)  # the own-ship table the tracker reads, too
 _COV_P = [f"cov_pp_{i}{j}" for i in range(3) for j in range(3)]
 _COV_V = [f"cov_vv_{i}{j}" for i in range(3) for j in range(3)]
 _OPTIONAL_OWN = ["own_yaw_rad", "own_height_agl_m"]

@@ -142,7 +142,7 @@ def test_ctrl_c_keeps_finished_chunks_and_rerun_resumes(tmp_path):
     import signal
     import time
 
-    scenario = _write(tmp_path, {**BASE, "duration_s": 4.0})  # 20 frames, 10 chunks of 2
+    scenario = _write(tmp_path, {**BASE, "duration_s": 24.0})  # 120 frames, 30 chunks of 4
     command = [
         sys.executable,
         "-m",
@@ -152,7 +152,7 @@ def test_ctrl_c_keeps_finished_chunks_and_rerun_resumes(tmp_path):
         "-o",
         "run.zarr",
         "--chunk-frames",
-        "2",
+        "4",
     ]
     proc = subprocess.Popen(command, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     marks = tmp_path / "run.zarr.partial.done"
@@ -167,12 +167,12 @@ def test_ctrl_c_keeps_finished_chunks_and_rerun_resumes(tmp_path):
     assert "rerun the same command to resume" in stderr
     done_before = {p.name for p in marks.iterdir()}
     assert "0" in done_before and not (tmp_path / "run.zarr").exists()
-    first_chunk = open_frames_partial(tmp_path / "run.zarr.partial")[:2]
-    result = _skyradar("simulate", str(scenario), "-o", "run.zarr", "--chunk-frames", "2", cwd=tmp_path)
+    first_chunk = open_frames_partial(tmp_path / "run.zarr.partial")[:4]
+    result = _skyradar("simulate", str(scenario), "-o", "run.zarr", "--chunk-frames", "4", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     ds = open_frames(tmp_path / "run.zarr")
-    assert ds.iq.shape[0] == 20
-    np.testing.assert_array_equal(ds.iq.values[:2], first_chunk)
+    assert ds.iq.shape[0] == 120
+    np.testing.assert_array_equal(ds.iq.values[:4], first_chunk)
 
 
 def open_frames_partial(path: Path) -> np.ndarray:

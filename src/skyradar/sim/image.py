@@ -18,16 +18,17 @@ Pixel units: |pixel|^2 is received power in W for a scatterer centred in that pi
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 
 import numpy as np
 from numba import get_num_threads
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
-from skyradar.geo import direction_angles, ned_rotation_to, ned_to_geodetic, rotation_matrix
+from skyradar.geo import ned_rotation_to, ned_to_geodetic, rotation_matrix
 from skyradar.sim._noise_kernel import finalize_frame, frame_key
 from skyradar.sim._terrain_kernel import add_sparse, horizon_map, terrain_returns
+from skyradar.sim.geometry import AntennaGeometry, PlatformState, PointTarget, TerrainView
+from skyradar.sim.targets import add_targets, line_of_sight, target_geometry
 
 __all__ = [
     "PlatformState",
@@ -43,45 +44,6 @@ REFLECTIVITY_MODELS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
     "lambert": lambda theta: np.cos(theta) ** 2,
     "constant": lambda theta: np.ones_like(theta),
 }
-
-
-@dataclass(frozen=True)
-class PlatformState:
-    """Own-ship state in the scenario NED frame: position (m), velocity (m/s), yaw/pitch/roll (rad)."""
-
-    position_ned_m: np.ndarray
-    velocity_ned_mps: np.ndarray
-    attitude_rad: np.ndarray
-
-
-@dataclass(frozen=True)
-class PointTarget:
-    """A point scatterer (e.g. an aircraft) in the scenario NED frame with its RCS in m^2."""
-
-    position_ned_m: np.ndarray
-    velocity_ned_mps: np.ndarray
-    rcs_m2: float = 1.0
-
-
-@dataclass(frozen=True)
-class TerrainView:
-    """Terrain cropped around the antenna for one frame, and its polar horizon."""
-
-    p_ned: np.ndarray  # grid points relative to the antenna, NED, m
-    horizon: np.ndarray  # (n_az, n_h) slope -down/horizontal to beat (1 x 1 of -inf: no occlusion)
-    az_bin_rad: float
-    h_bin_m: float
-
-
-@dataclass(frozen=True)
-class AntennaGeometry:
-    """Where the antenna is and how it is turned in the scenario NED frame for one frame."""
-
-    origin_ned_m: np.ndarray  # antenna phase-centre reference point
-    rot_ned_to_ant: np.ndarray  # 3x3, NED vector -> antenna-frame vector
-    velocity_ned_mps: np.ndarray
-    lat_deg: float  # platform position (the antenna is metres away: same crop)
-    lon_deg: float
 
 
 class ImageSimulator:
@@ -206,7 +168,7 @@ class ImageSimulator:
             self._accumulate_terrain(geom, view, blocks, _NO_SPARSE)
             finalize_frame(blocks, sigma, key, frame)
         if targets:
-            _add_targets(frame, cfg, geom, targets, self.coupling_s, _line_of_sight(view, geom, targets))
+            add_targets(frame, cfg, geom, targets, self.coupling_s, line_of_sight(view, geom, targets))
         return frame
 
     def terrain_view(self, geom: AntennaGeometry) -> TerrainView | None:
@@ -321,8 +283,8 @@ class ImageSimulator:
     def target_truth(self, platform: PlatformState, targets: Sequence[PointTarget]) -> dict[str, np.ndarray]:
         """Range, radial velocity, antenna-frame angles, expected SNR and visibility per target."""
         geom = self.geometry(platform)
-        clear = _line_of_sight(self.terrain_view(geom), geom, targets)
-        return _target_geometry(self.config, geom, targets, self.coupling_s, clear)
+        clear = line_of_sight(self.terrain_view(geom), geom, targets)
+        return target_geometry(self.config, geom, targets, self.coupling_s, clear)
 
 
 def two_way_gain_table(config: RadarConfig, n: int = 513) -> tuple[np.ndarray, float]:
@@ -354,71 +316,3 @@ def _reflectivity_table(reflectivity: str | Callable[[np.ndarray], np.ndarray], 
 
 
 _NO_SPARSE = (np.empty((1, 0), np.int64), np.empty((1, 0, 1), np.complex64), np.zeros(1, np.int64))
-
-
-def _line_of_sight(
-    view: TerrainView | None, geom: AntennaGeometry, targets: Sequence[PointTarget]
-) -> np.ndarray:
-    """True for targets not hidden behind terrain (the same horizon test as terrain facets)."""
-    rel = np.array([t.position_ned_m for t in targets], float).reshape(-1, 3) - geom.origin_ned_m
-    if view is None:
-        return np.ones(len(rel), bool)
-    n_az, n_h = view.horizon.shape
-    h = np.hypot(rel[:, 0], rel[:, 1])
-    a = ((np.arctan2(rel[:, 1], rel[:, 0]) + np.pi) / view.az_bin_rad).astype(int) % n_az
-    k = np.minimum((h / view.h_bin_m).astype(int), n_h - 1)
-    return -rel[:, 2] / np.maximum(h, 1e-9) >= view.horizon[a, k]
-
-
-def _target_geometry(
-    cfg: RadarConfig,
-    geom: AntennaGeometry,
-    targets: Sequence[PointTarget],
-    coupling_s: float,
-    clear: np.ndarray,
-):
-    pos = np.array([t.position_ned_m for t in targets], float).reshape(-1, 3)
-    vel = np.array([t.velocity_ned_mps for t in targets], float).reshape(-1, 3)
-    rcs = np.array([t.rcs_m2 for t in targets], float)
-    p_ant = (pos - geom.origin_ned_m) @ geom.rot_ned_to_ant.T
-    v_ant = (vel - geom.velocity_ned_mps) @ geom.rot_ned_to_ant.T
-    r_tx = np.linalg.norm(p_ant - cfg.tx_position_m, axis=1)
-    r_rx = np.linalg.norm(p_ant[:, None, :] - cfg.rx_positions_m[None], axis=2)
-    path = r_tx[:, None] + r_rx
-    rng, az, el = direction_angles(p_ant)
-    u = p_ant / np.maximum(rng, 1e-9)[:, None]
-    v_r = np.einsum("ij,ij->i", v_ant, u)
-    half_path = path.mean(axis=1) / 2.0
-    gain_db = cfg.antenna.gain_db(az, el)
-    power_w = cfg.pe_w * 10 ** (gain_db / 5.0) * cfg.wavelength_m**2 * rcs / ((4 * np.pi) ** 3 * half_path**4)
-    k = np.floor((half_path + coupling_s * v_r) / cfg.range_resolution_m + 0.5).astype(int)
-    j = (np.floor(v_r / cfg.doppler_resolution_mps + 0.5).astype(int) + cfg.n_doppler // 2) % cfg.n_doppler
-    in_view = (p_ant[:, 0] > 0) & (k >= 0) & (k < cfg.n_range) & clear
-    return {
-        "range_m": half_path,
-        "radial_velocity_mps": v_r,
-        "azimuth_rad": az,
-        "elevation_rad": el,
-        "power_w": power_w,
-        "snr_db": 10 * np.log10(np.maximum(power_w, 1e-300) / cfg.noise_power_w),
-        "range_bin": k,
-        "doppler_bin": j,
-        "visible": in_view,
-        "path_m": path,
-    }
-
-
-def _add_targets(
-    cube: np.ndarray, cfg: RadarConfig, geom, targets, coupling_s: float, clear: np.ndarray
-) -> None:
-    g = _target_geometry(cfg, geom, targets, coupling_s, clear)
-    keep = g["visible"]
-    if not np.any(keep):
-        return
-    amp = np.sqrt(g["power_w"][keep])[:, None]
-    phase = 2 * np.pi * np.mod(g["path_m"][keep] / cfg.wavelength_m, 1.0)
-    values = amp * np.exp(1j * phase)
-    for q in range(cfg.n_rx):
-        np.add.at(
-            cube[..., q], (g["range_bin"][keep], g["doppler_bin"][keep]), values[:, q].astype(cube.dtype)
-        )

@@ -79,6 +79,10 @@ class AlertConfig:
     min_track_age_s : float
         A track raises no alert before it is this old, s: a fresh track's velocity has not
         converged, and its covariance would widen the volumes to anything.
+    max_velocity_sigma_mps : float, optional
+        Track-quality gate: a track row whose horizontal velocity standard deviation
+        ``sqrt(cov_vv_00 + cov_vv_11)`` exceeds this raises no alert, m/s (default off). A track seen
+        at long range with noisy DoA can stay unconverged far longer than ``min_track_age_s``.
 
     Examples
     --------
@@ -98,6 +102,7 @@ class AlertConfig:
     collision_volume: WellClearVolume = field(default_factory=WellClearVolume.nmac)
     flarm_thresholds_s: tuple[float, float, float] = (18.0, 13.0, 8.0)
     min_track_age_s: float = 2.0
+    max_velocity_sigma_mps: float | None = None
 
     def __post_init__(self) -> None:
         if not 1 <= self.m <= self.n:

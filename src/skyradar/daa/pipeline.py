@@ -5,7 +5,8 @@ Tracks table (input), one row per track per frame, SI units, NED in the scenario
 them, the position covariance ``cov_pp_00 .. cov_pp_22`` (m^2) and velocity covariance
 ``cov_vv_00 .. cov_vv_22`` (m^2/s^2), row-major 3x3 in NED; missing covariance counts as zero.
 Rows with NaN position or velocity (no direction of arrival) are skipped; with a ``confirmed``
-column only confirmed rows are used.
+column only confirmed rows are used. ``AlertConfig.max_velocity_sigma_mps`` silences rows of tracks
+whose velocity has not converged.
 
 Own-ship table: ``time_s, own_north_m, own_east_m, own_down_m, own_vn_mps, own_ve_mps, own_vd_mps``
 and optionally ``own_yaw_rad`` (heading; else the ground track) and ``own_height_agl_m`` (terrain
@@ -178,6 +179,11 @@ def alerts_from_tracks(
     s, v = p - own_pos, v_int - own_vel
     cov_p, cov_v = _covariances(df)
     raw = raw_alert_levels(s, v, config, cov_p, cov_v)
+    if config.max_velocity_sigma_mps is not None and cov_v is not None:
+        sigma_hv = np.sqrt(np.nan_to_num(cov_v[:, 0, 0] + cov_v[:, 1, 1], nan=np.inf))
+        unconverged = sigma_hv > config.max_velocity_sigma_mps
+        raw["level"][unconverged] = 0
+        raw["flarm_level"][unconverged] = 0
     level = np.zeros(len(df), int)
     for _, idx in df.groupby("track_id", sort=False).indices.items():
         young = t[idx] - t[idx[0]] < config.min_track_age_s

@@ -22,8 +22,10 @@ $(STAMP_DEV): pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e ".[dev]"
 	@touch $@ $(STAMP_RUN)
 
-# Until the end-to-end DAA demo lands, the demo is the ch2 simulator experiment.
+# The end-to-end DAA demo (simulate -> detect -> track -> alert -> report), then the ch2
+# simulator figures.
 demo: $(STAMP_RUN)
+	$(BIN)/skyradar demo --out $(OUT)/demo
 	$(BIN)/skyradar experiment ch2 --out $(OUT)/ch2
 
 test: $(STAMP_DEV)

@@ -27,6 +27,7 @@ import xarray as xr
 
 from skyradar.daa.alerting import AlertConfig
 from skyradar.daa.pipeline import alerts_from_tracks, ownship_from_frames
+from skyradar.errors import InputError
 from skyradar.io.frames import frames_dataset
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.process.pipeline import process_frames
@@ -194,9 +195,11 @@ def run_demo(out_dir: Path, scenario: str | Path | None = None) -> dict[str, Any
 
     t_start = time.perf_counter()
     out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise InputError(f"{out_dir}: --out must be a directory, this is a file")
     out_dir.mkdir(parents=True, exist_ok=True)
     built = load_scenario(scenario or demo_scenario_path()).build()
-    rd_frame = int(np.argmin(np.abs(built.times_s - 0.9 * built.times_s[-1])))
+    rd_frame = built.times_s.size // 2  # mid-run: the collision intruder is tracked then
     chain = run_chain(built, keep_frames=(rd_frame,))
     labels = label_tracks(chain["tracks"], chain["truth"])
     timeline = alert_timeline(chain["alerts"], labels)

@@ -11,6 +11,7 @@ import sys
 import click
 
 import skyradar.cli.commands_daa  # noqa: F401  (registers commands)
+import skyradar.cli.commands_demo  # noqa: F401  (registers commands)
 import skyradar.cli.commands_nav  # noqa: F401  (registers commands)
 import skyradar.cli.commands_process  # noqa: F401  (registers commands)
 import skyradar.cli.commands_raw  # noqa: F401  (registers commands)

@@ -122,16 +122,20 @@ def write_report(
     truth, det, alerts = chain["truth"], chain["detections"], chain["alerts"]
     config = radar_config_of(truth)
     t = float(truth["time"].values[rd_frame])
-    plot_range_doppler(chain["rd_frames"][rd_frame], config, det[det["frame"] == rd_frame],
-                       f"range-Doppler, frame {rd_frame} (t = {t:.1f} s)", out_dir / "range_doppler.png")  # fmt: skip
+    title = f"range-Doppler, frame {rd_frame} (t = {t:.1f} s)"
+    rd_det = det[det["frame"] == rd_frame]
+    plot_range_doppler(chain["rd_frames"][rd_frame], config, rd_det, title, out_dir / "range_doppler.png")
     plot_plan_view(truth, chain["tracks"], labels, alerts, out_dir / "plan_view.png")
     times = truth["time"].values
     plot_alert_timeline(alerts, labels, (float(times[0]), float(times[-1])), out_dir / "alert_timeline.png")
     advice = _advice_rows(alerts)
+    no_advice = "<p>no advice (no corrective or warning alert)</p>"
+    advice_html = advice.to_html(index=False, na_rep="") if len(advice) else no_advice
     page = f"""<!doctype html>
 <html lang="en"><head><meta charset="utf-8"><title>skyradar demo</title>
-<style>body{{font-family:sans-serif;max-width:1000px;margin:auto}} table{{border-collapse:collapse;font-size:13px}}
-td,th{{border:1px solid #ccc;padding:2px 6px}} img{{max-width:100%}}</style></head><body>
+<style>body{{font-family:sans-serif;max-width:1000px;margin:auto}}
+table{{border-collapse:collapse;font-size:13px}} td,th{{border:1px solid #ccc;padding:2px 6px}}
+img{{max-width:100%}}</style></head><body>
 <h1>skyradar demo: {html.escape(str(truth.attrs.get("scenario", "")))}</h1>
 <p>Simulate &rarr; process &rarr; track (3-D, non-ground non-spur detections) &rarr; alert (confirmed
 tracks). Acceptance (warning for the collision intruder, none for anything else):
@@ -143,7 +147,7 @@ tracks). Acceptance (warning for the collision intruder, none for anything else)
 {timeline.round(1).to_html(index=False, na_rep="")}
 <h2>Advice (first frame of each corrective/warning episode)</h2>
 <p>Heading bands: conflict headings [deg]; vertical-speed bands: conflict vertical speeds [m/s].</p>
-{advice.to_html(index=False, na_rep="") if len(advice) else "<p>no advice (no corrective or warning alert)</p>"}
+{advice_html}
 </body></html>
 """
     path = out_dir / "index.html"

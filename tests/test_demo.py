@@ -1,0 +1,129 @@
+"""``skyradar demo``: the embedded scenario end to end, its helpers and the alerting velocity gate."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+import xarray as xr
+from typer.testing import CliRunner
+
+from skyradar.cli import app
+from skyradar.cli.commands_demo import format_timeline
+from skyradar.daa.alerting import AlertConfig
+from skyradar.daa.pipeline import alerts_from_tracks
+from skyradar.demo import alert_timeline, demo_scenario_path, label_tracks, run_demo
+from skyradar.errors import InputError
+from skyradar.scene.scenario import load_scenario
+
+
+def _collision(sigma_v_mps: float, dt: float = 0.5, duration_s: float = 40.0):
+    """Own-ship north at 50 m/s; intruder head-on at 50 m/s, impact at t = 30 s; velocity sigma given."""
+    t = np.arange(0.0, duration_s, dt)
+    own = pd.DataFrame({"time_s": t, "own_north_m": 50.0 * t, "own_east_m": 0.0, "own_down_m": -1000.0,
+                        "own_vn_mps": 50.0, "own_ve_mps": 0.0, "own_vd_mps": 0.0})  # fmt: skip
+    tracks = pd.DataFrame({"time_s": t, "track_id": 1, "north_m": 3000.0 - 50.0 * t, "east_m": 0.0,
+                           "down_m": -1000.0, "vn_mps": -50.0, "ve_mps": 0.0, "vd_mps": 0.0})  # fmt: skip
+    for i in range(3):
+        for j in range(3):
+            tracks[f"cov_vv_{i}{j}"] = sigma_v_mps**2 if i == j else 0.0
+            tracks[f"cov_pp_{i}{j}"] = 1.0 if i == j else 0.0
+    return tracks, own
+
+
+@pytest.mark.parametrize("sigma_v", [1.0, 30.0])
+def test_velocity_gate_silences_only_unconverged_tracks(sigma_v):
+    tracks, own = _collision(sigma_v)
+    gate = AlertConfig(max_velocity_sigma_mps=10.0)
+    gated = alerts_from_tracks(tracks, own, gate, with_advice=False)
+    ungated = alerts_from_tracks(tracks, own, AlertConfig(), with_advice=False)
+    assert ungated["level"].max() == 3  # a head-on collision warns without the gate
+    # sqrt(sigma^2 + sigma^2) is the horizontal velocity sigma the gate compares with 10 m/s.
+    expected = 3 if np.sqrt(2) * sigma_v <= 10.0 else 0
+    assert gated["level"].max() == expected
+    if expected:
+        np.testing.assert_array_equal(gated["level"], ungated["level"])
+
+
+def _truth(names=("a", "b")):
+    t = np.arange(5.0)
+    north = np.stack([100.0 * t, -100.0 * t], -1)
+    zeros = np.zeros_like(north)
+    dims = ("time", "target")
+    data = {"tgt_north_m": (dims, north), "tgt_east_m": (dims, zeros), "tgt_down_m": (dims, zeros)}
+    return xr.Dataset(data, coords={"time": t, "target": list(names)})
+
+
+def test_label_tracks_follows_nearest_truth_and_flags_clutter():
+    truth = _truth()
+    t = np.arange(5.0)
+    tracks = pd.concat([
+        pd.DataFrame({"time_s": t, "track_id": 7, "north_m": -100.0 * t + 20, "east_m": 10.0, "down_m": 0.0}),
+        pd.DataFrame({"time_s": t, "track_id": 8, "north_m": 100.0 * t, "east_m": 5.0, "down_m": -30.0}),
+        pd.DataFrame({"time_s": t, "track_id": 9, "north_m": 0.0, "east_m": 2000.0, "down_m": 0.0}),
+    ])  # fmt: skip
+    assert label_tracks(tracks, truth) == {7: "b", 8: "a", 9: "clutter"}
+
+
+def test_alert_timeline_lists_each_level_change():
+    alerts = pd.DataFrame({
+        "time_s": [0, 1, 2, 3, 4, 0, 1, 2], "track_id": [1, 1, 1, 1, 1, 2, 2, 2],
+        "level": [0, 1, 3, 3, 0, 0, 0, 0], "range_m": 1.0, "bearing_deg": 0.0, "rel_alt_m": 0.0,
+        "time_to_impact_s": np.nan,
+    })  # fmt: skip
+    tl = alert_timeline(alerts, {1: "x"})
+    assert tl[["time_s", "track_id", "level"]].values.tolist() == [[1, 1, 1], [2, 1, 3], [4, 1, 0]]
+    assert tl["intruder"].tolist() == ["x"] * 3
+    assert tl["level_name"].tolist() == ["preventive", "WARNING", "none"]
+    assert "WARNING" in format_timeline(tl)
+    assert format_timeline(tl.iloc[:0]) == "alert timeline: no alerts"
+
+
+def test_demo_out_must_be_a_directory(tmp_path):
+    (tmp_path / "f").write_text("x")
+    with pytest.raises(InputError, match="--out must be a directory"):
+        run_demo(tmp_path / "f")
+
+
+def test_demo_scenario_is_package_data_and_valid():
+    built = load_scenario(demo_scenario_path()).build()
+    assert [i.name for i in built.intruders] == ["collision", "fast-jet", "glider"]
+    assert built.terrain is not None
+
+
+@pytest.fixture(scope="module")
+def demo_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("demo")
+    result = CliRunner().invoke(app, ["demo", "--out", str(out), "--json"])
+    assert result.exit_code == 0, result.output
+    return out, result.stdout
+
+
+def test_demo_warns_for_collision_only(demo_run):
+    out, stdout = demo_run
+    summary = json.loads(stdout.strip().splitlines()[-1])
+    per = summary["intruders"]
+    assert per["collision"]["max_level"] == 3
+    # The warning comes before the scenario's impact at t = 40 s, with time to manoeuvre.
+    assert per["collision"]["first_warning_s"] < 40.0 - 10.0
+    assert all(v["max_level"] < 3 for k, v in per.items() if k != "collision")
+    assert per["fast-jet"]["tracks"] >= 1 and per["glider"]["tracks"] >= 1  # seen, tracked, not warned
+    assert summary["acceptance"] is True
+    alerts = pd.read_parquet(out / "alerts.parquet")
+    tracks = pd.read_parquet(out / "tracks.parquet")
+    assert set(alerts["track_id"]) <= set(tracks.loc[tracks["confirmed"], "track_id"])
+    assert "alert timeline" in stdout and "collision" in stdout and "WARNING" in stdout
+
+
+def test_demo_writes_report(demo_run):
+    out, _ = demo_run
+    page = (out / "index.html").read_text()
+    for name in ("range_doppler.png", "plan_view.png", "alert_timeline.png"):
+        assert (out / name).stat().st_size > 5000
+        assert f'src="{name}"' in page
+    assert "PASS" in page and "Advice" in page
+    assert not list(out.glob("*.partial*"))
+    timeline = pd.read_csv(out / "alert_timeline.csv")
+    assert (timeline.loc[timeline["intruder"] == "collision", "level"] == 3).any()

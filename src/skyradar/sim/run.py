@@ -249,9 +249,8 @@ def simulate_to_zarr(
         client = connect(scheduler, workers)  # before any output exists: a dead address leaves nothing
     try:
         simulator = make_simulator(built)
-        writer = FrameStoreWriter(
-            path, _template(built, chunk_frames, simulator), chunk_frames, fingerprint(built)
-        )
+        key = fingerprint(built)
+        writer = FrameStoreWriter(path, _template(built, chunk_frames, simulator), chunk_frames, key)
         pending = writer.pending_chunks()
         if progress and len(pending) < writer.n_chunks:
             progress(built.times_s.size - sum(_chunk_len(writer, i) for i in pending))
@@ -265,7 +264,7 @@ def simulate_to_zarr(
             map_chunks(
                 _chunk_job,
                 built,
-                fingerprint(built),
+                key,
                 str(writer.partial),
                 chunk_frames,
                 client=client,

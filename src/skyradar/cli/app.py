@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import json
-from typing import Any
+from typing import Annotated, Any
 
 import typer
 from rich.console import Console
@@ -11,7 +11,7 @@ from rich.table import Table
 
 from skyradar.io.tables import jsonable
 
-__all__ = ["app", "experiment_app", "bench_app", "console", "emit_result"]
+__all__ = ["app", "experiment_app", "bench_app", "console", "emit_result", "JsonOption"]
 
 app = typer.Typer(
     name="skyradar",
@@ -26,6 +26,8 @@ experiment_app = typer.Typer(
 bench_app = typer.Typer(help="Speed benchmarks; each prints JSON with --json.", no_args_is_help=True)
 app.add_typer(experiment_app, name="experiment")
 app.add_typer(bench_app, name="bench")
+
+JsonOption = Annotated[bool, typer.Option("--json", help="Print the result as JSON (last stdout line).")]
 
 # Progress bars and tables go to stderr so that stdout's last line is the JSON result.
 console = Console(stderr=True)

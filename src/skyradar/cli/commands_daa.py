@@ -8,7 +8,7 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from skyradar.cli.app import app, console, emit_result, experiment_app
+from skyradar.cli.app import JsonOption, app, console, emit_result, experiment_app
 
 __all__ = ["alert", "serve", "experiment_encounters"]
 
@@ -23,9 +23,7 @@ def alert(
     no_advice: Annotated[
         bool, typer.Option("--no-advice", help="Skip the resolution bands and manoeuvre.")
     ] = False,
-    as_json: Annotated[
-        bool, typer.Option("--json", help="Print the summary as JSON (last stdout line).")
-    ] = False,
+    as_json: JsonOption = False,
 ) -> None:
     """Turn tracks into DO-365-style alert levels, FLARM-style alarms and resolution advice.
 
@@ -92,9 +90,7 @@ def experiment_encounters(
     no_uncertainty: Annotated[
         bool, typer.Option("--no-uncertainty", help="Do not widen the volumes by the track covariance.")
     ] = False,
-    as_json: Annotated[
-        bool, typer.Option("--json", help="Print the summary as JSON (last stdout line).")
-    ] = False,
+    as_json: JsonOption = False,
 ) -> None:
     """Encounter set (head-on, crossing, overtaking, converging, climbing; conflicts and near misses)
     through a radar measurement model, the 3-D tracker and the DAA alerting: missed, late and

@@ -8,7 +8,7 @@ from typing import Annotated
 
 import typer
 
-from skyradar.cli.app import app, emit_result
+from skyradar.cli.app import JsonOption, app, emit_result
 
 __all__ = ["demo", "format_timeline"]
 
@@ -34,9 +34,7 @@ def format_timeline(timeline) -> str:
 @app.command()
 def demo(
     out: Annotated[Path, typer.Option("--out", help="Report folder to write.")] = Path("out/demo"),
-    as_json: Annotated[
-        bool, typer.Option("--json", help="Print the summary as JSON (last stdout line).")
-    ] = False,
+    as_json: JsonOption = False,
 ) -> None:
     """Run the embedded demo end to end and write a report folder (index.html + figures + tables).
 

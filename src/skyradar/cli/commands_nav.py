@@ -8,11 +8,9 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from skyradar.cli.app import app, bench_app, console, emit_result, experiment_app
+from skyradar.cli.app import JsonOption, app, bench_app, console, emit_result, experiment_app
 
 __all__ = ["state", "experiment_ch5", "bench_state"]
-
-JsonOption = Annotated[bool, typer.Option("--json", help="Print the result as JSON (last stdout line).")]
 
 
 @app.command()

@@ -7,11 +7,9 @@ from typing import Annotated
 
 import typer
 
-from skyradar.cli.app import app, bench_app, console, emit_result, experiment_app
+from skyradar.cli.app import JsonOption, app, bench_app, console, emit_result, experiment_app
 
 __all__ = ["process", "calibrate", "spur_map", "experiment_ch3", "bench_process"]
-
-JsonOption = Annotated[bool, typer.Option("--json", help="Print the result as JSON (last stdout line).")]
 
 
 def _progress(total: int, label: str):

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from skyradar.cli.app import app, bench_app, console, emit_result
+from skyradar.cli.app import JsonOption, app, bench_app, console, emit_result
 
 __all__ = ["rd", "bench_chain"]
 
@@ -31,9 +31,7 @@ def rd(
     workers: Annotated[
         int | None, typer.Option(help="Run on a local Dask cluster of this many workers.")
     ] = None,
-    as_json: Annotated[
-        bool, typer.Option("--json", help="Print the summary as JSON (last stdout line).")
-    ] = False,
+    as_json: JsonOption = False,
 ) -> None:
     """Turn a raw ADC recording into range-Doppler frames (the same store the simulator writes).
 
@@ -57,9 +55,7 @@ def rd(
 def bench_chain(
     frames: Annotated[int, typer.Option("--frames", min=2, help="Frames to time.")] = 20,
     workers: Annotated[int, typer.Option("--workers", min=1, help="FFT threads.")] = 2,
-    as_json: Annotated[
-        bool, typer.Option("--json", help="Print the result as JSON (last stdout line).")
-    ] = False,
+    as_json: JsonOption = False,
     flight_frames: Annotated[
         int, typer.Option(help="Frames of the whole-flight simulation run on 1 and 2 Dask workers (0: skip).")
     ] = 600,

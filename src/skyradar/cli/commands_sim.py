@@ -8,9 +8,8 @@ from typing import Annotated
 import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-from skyradar.cli.app import app, bench_app, console, emit_result, experiment_app
+from skyradar.cli.app import JsonOption, app, bench_app, console, emit_result, experiment_app
 
-JsonFlag = Annotated[bool, typer.Option("--json", help="Print the result as JSON (last line of stdout).")]
 OutDir = Annotated[Path, typer.Option("--out", help="Folder for figures and tables.")]
 
 
@@ -70,7 +69,7 @@ def scenarios() -> None:
 
 @experiment_app.command("ch2")
 def experiment_ch2(
-    json_out: JsonFlag = False,
+    json_out: JsonOption = False,
     out: OutDir = Path("out/ch2"),
     frames: Annotated[int, typer.Option(help="Frames per case (timing uses them all).")] = 3,
 ) -> None:
@@ -84,7 +83,7 @@ def experiment_ch2(
 
 @bench_app.command("sim")
 def bench_sim(
-    json_out: JsonFlag = False,
+    json_out: JsonOption = False,
     frames: Annotated[int, typer.Option(help="Frames timed at SRTM spacing (fine: a quarter).")] = 20,
 ) -> None:
     """Simulator frames/s on a 1201 x 1201 SRTM-3 tile versus the thesis' approach, same run."""
@@ -105,7 +104,7 @@ def sweep(
     workers: Annotated[
         int | None, typer.Option(help="Run on a local Dask cluster of this many workers.")
     ] = None,
-    json_out: JsonFlag = False,
+    json_out: JsonOption = False,
 ) -> None:
     """Run one scenario over a list of parameter values and collect each run's detectability table."""
     from skyradar.io.tables import write_table
@@ -133,7 +132,7 @@ def sweep(
 
 @bench_app.command("flight")
 def bench_flight(
-    json_out: JsonFlag = False,
+    json_out: JsonOption = False,
     frames: Annotated[int, typer.Option(help="Frames for the 1- versus 2-worker throughput runs.")] = 600,
     long_frames: Annotated[
         int, typer.Option(help="Also run a whole flight of this many frames (memory).")

@@ -7,11 +7,9 @@ from typing import Annotated
 
 import typer
 
-from skyradar.cli.app import app, bench_app, emit_result, experiment_app
+from skyradar.cli.app import JsonOption, app, bench_app, emit_result, experiment_app
 
 __all__ = ["track", "evaluate", "experiment_ch4", "bench_track"]
-
-JsonOption = Annotated[bool, typer.Option("--json", help="Print the result as JSON (last stdout line).")]
 
 
 def _origin(text: str | None) -> tuple[float, float, float] | None:

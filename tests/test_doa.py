@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 from skyradar.benchmarks.process import synthetic_frame
 from skyradar.config import Mount, RadarConfig
 from skyradar.errors import InputError
+from skyradar.experiments.ch3_scene import square_array_m, unambiguous_half_angle_deg
 from skyradar.geo import rotation_matrix
 from skyradar.process.calibration import (
     calibrate_from_frames,
@@ -36,11 +37,9 @@ LAYOUTS = {
     "3d": CFG.replace(
         rx_positions_m=np.array([[0, 0, 0], [0, LAM / 2, 0], [0, 0, LAM / 2], [LAM / 2, 0, 0]])
     ),
-    # Sparse: 0.6 lambda spacing, every baseline ambiguous (grid search path); grating lobes
+    # ch3's default: 0.6 lambda square, every baseline ambiguous (grid search path); grating lobes
     # 1/0.6 apart in direction cosine stay outside the field of view.
-    "sparse": CFG.replace(
-        rx_positions_m=np.array([[0, 0, 0], [0, 0.6 * LAM, 0], [0, 0, 0.6 * LAM], [0, 0.6 * LAM, 0.6 * LAM]])
-    ),
+    "square_0.6": CFG.replace(rx_positions_m=square_array_m(0.6, LAM)),
     "sparse3d": CFG.replace(
         rx_positions_m=np.array(
             [[0, 0, 0], [0, 0.6 * LAM, 0], [0, 0, 0.6 * LAM], [0.6 * LAM, 0.3 * LAM, 0.3 * LAM]]
@@ -94,7 +93,7 @@ def test_crlb_matches_numerical_fisher_information():
     # Independent check: FIM = (2 / sigma^2) Re(J^H J) of the complex model with unknown
     # amplitude, common phase, az, el, differentiated numerically.
     rng = np.random.default_rng(0)
-    for cfg in (LAYOUTS["square"], LAYOUTS["3d"], LAYOUTS["tilted"]):
+    for cfg in (LAYOUTS["square"], LAYOUTS["3d"], LAYOUTS["tilted"], LAYOUTS["square_0.6"]):
         az, el, snr_db = rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5), 20.0
         theta = np.array([np.sqrt(10 ** (snr_db / 10)), 0.3, az, el])
 
@@ -108,7 +107,7 @@ def test_crlb_matches_numerical_fisher_information():
         assert sd_el == pytest.approx(np.sqrt(crlb[3, 3]), rel=1e-4)
 
 
-@pytest.mark.parametrize("layout", ["square", "tilted", "3d", "sparse"])
+@pytest.mark.parametrize("layout", ["square", "tilted", "3d", "square_0.6"])
 def test_error_sd_within_1_25_crlb_in_every_snr_band(layout):
     cfg = LAYOUTS[layout]
     rng = np.random.default_rng(1)
@@ -124,16 +123,18 @@ def test_error_sd_within_1_25_crlb_in_every_snr_band(layout):
         assert np.std((est_el - el) / sd_el) <= 1.25, snr_db
 
 
-def test_bias_below_0_1_deg_after_calibration():
+@pytest.mark.parametrize("layout", ["square", "square_0.6"])
+def test_bias_below_0_1_deg_after_calibration(layout):
+    cfg = LAYOUTS[layout]
     rng = np.random.default_rng(2)
     offsets = np.array([1.0, 0.9, 1.1, 1.05]) * np.exp(1j * rng.uniform(-np.pi, np.pi, 4))
     reflector = reflector_position(438.0, np.radians(5.0), np.radians(-1.0))
     # A building at 438 m is a strong reflector (50 dB SNR); 10 frames.
     frames = [
-        synthetic_frame(CFG, [(438.0, 0.0, np.radians(5.0), np.radians(-1.0), 50.0)], rng, rx_gain=offsets)[0]
+        synthetic_frame(cfg, [(438.0, 0.0, np.radians(5.0), np.radians(-1.0), 50.0)], rng, rx_gain=offsets)[0]
         for _ in range(10)
     ]
-    cal = calibrate_from_frames(np.stack(frames), reflector, CFG)
+    cal = calibrate_from_frames(np.stack(frames), reflector, cfg)
     assert calibration_phase_error_deg(cal.rx_calibration, offsets) <= 0.1
     n = 20000
     az = rng.uniform(-np.radians(30), np.radians(30), n)
@@ -143,7 +144,7 @@ def test_bias_below_0_1_deg_after_calibration():
     assert abs(np.degrees(np.mean(est_az - az))) < 0.1
     assert abs(np.degrees(np.mean(est_el - el))) < 0.1
     # Without calibration the same data are badly biased: the test can fail.
-    raw_az, _ = angles_from_direction(estimate_directions(z, CFG))
+    raw_az, _ = angles_from_direction(estimate_directions(z, cfg))
     assert abs(np.degrees(np.mean(raw_az - az))) > 1.0
 
 
@@ -181,3 +182,30 @@ def test_body_frame_uses_the_mount_rotation():
     expected = rotation_matrix(0.0, np.radians(15.0), 0.0) @ p_ant[0] + np.array([1.0, 0.0, -0.5])
     np.testing.assert_allclose(body[0], expected)
     assert body[0, 2] < -250  # pitched up: boresight points above the body x axis (down is +z)
+
+
+def test_square_06_unambiguous_to_56_deg_then_aliases_to_the_grating_lobe():
+    # Phase differences of a 0.6 lambda pair wrap where |u| > 1 / (2 * 0.6), i.e. beyond 56.4 deg
+    # on either axis; a target further out is indistinguishable from its grating lobe
+    # u - 1 / 0.6 and is reported there (the price of the wider aperture).
+    cfg = LAYOUTS["square_0.6"]
+    limit = unambiguous_half_angle_deg(0.6)
+    assert limit == pytest.approx(np.degrees(np.arcsin(1 / 1.2)))
+    for axis in (0, 1):
+        for deg in (*np.linspace(-limit + 0.05, limit - 0.05, 41), 60.0, 70.0, -80.0):
+            angles = [np.radians(deg), 0.0] if axis == 0 else [0.0, np.radians(deg)]
+            u = direction_from_angles(*angles)
+            est = np.degrees(angles_from_direction(estimate_directions(steering_vector(u, cfg)[None], cfg)))
+            s = np.sin(np.radians(deg))
+            expected = deg if abs(deg) < limit else np.degrees(np.arcsin(s - np.sign(s) / 0.6))
+            assert est[axis][0] == pytest.approx(expected, abs=1e-6), (axis, deg)
+            assert est[1 - axis][0] == pytest.approx(0.0, abs=1e-6)
+
+
+@settings(max_examples=30, deadline=None)
+@given(az=st.floats(-1.0, 1.0), el=st.floats(-1.0, 1.0), spacing=st.floats(0.1, 1.0))
+def test_crlb_uses_the_actual_layout_and_scales_with_one_over_spacing(az, el, spacing):
+    # Phase per radian of direction is proportional to the baseline, so the bound is too (inverse).
+    sparse = CFG.replace(rx_positions_m=square_array_m(spacing, LAM))
+    for half, wide in zip(doa_crlb(25.0, az, el, CFG), doa_crlb(25.0, az, el, sparse), strict=True):
+        assert wide == pytest.approx(half * 0.5 / spacing, rel=1e-9)

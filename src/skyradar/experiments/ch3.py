@@ -1,9 +1,24 @@
 """ch3: detection and 3-D direction of arrival with a radar on the ground aimed at the sky.
 
 The thesis' field test in simulation (seed-brief.md ch3). The seed prototype stands 2 m above
-the ground near Delft, boresight at bearing -37.7 deg (so the calibration building lies where the
-thesis found it, north-west) and pitched up ``pitch_deg`` (default 10 deg). Its coplanar 2x2
-array has unknown per-antenna phase offsets (uniform in +-180 deg) and 0.5 dB gain errors.
+the ground near Delft, boresight at bearing -37.7 deg and pitched up ``pitch_deg`` (default
+3 deg), so the calibration building (5 deg right, 1 deg below boresight) lies where the thesis
+located it: north-west, about 2 deg above the horizon, 15 m above the radar (thesis: 372 m north,
+239 m west, 16 m up). Its coplanar 2x2 square array (antenna y-z plane) has unknown per-antenna
+phase offsets (uniform in +-180 deg) and 0.5 dB gain errors.
+
+Array spacing ``rx_spacing_wavelengths`` (default 0.6): the Cramer-Rao bound on azimuth and
+elevation scales with 1 / spacing, so 0.6 lambda is 17 % tighter than half a wavelength. The price
+is ambiguity: with side d, a direction whose direction cosine along either array axis exceeds
+lambda / (2 d) gives the same phases as its grating lobe 1 / d away, so directions are unique only
+within ``asin(lambda / (2 d))`` of boresight on either axis: 56.4 deg at 0.6 lambda (0.5 lambda:
+the whole front hemisphere; 0.7 lambda: 45.6 deg). 56 deg is wider than the beam (3 dB at +-35 deg,
+6 dB at +-49.5 deg), so only a strong return far outside the beam can alias into it (a target at
+70 deg azimuth is reported at -47 deg); the circuit stays within 30 deg of boresight.
+:func:`skyradar.process.doa.estimate_directions` resolves the wrapped phases by a beamforming
+search over the 6 dB field of view. The same seed is also flown with every spacing in
+``compare_spacings`` (default 0.5 and 0.7 lambda: same scene, same noise), each calibrated on the
+building, for a paired comparison (``half_wavelength``, ``spacing_sweep``, ``ch3_spacing.png``).
 
 1. Static scene, ``n_static`` frames: a 1000 m^2 building at 438 m, 5 deg right and 1 deg below
    boresight, six static clutter points, and the thesis' flight-data impairments (six fixed
@@ -39,114 +54,35 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from skyradar.config import Mount, RadarConfig
-from skyradar.errors import InputError
-from skyradar.io.tables import write_json_atomic, write_table
-from skyradar.process.calibration import (
-    calibrate_from_frames,
-    calibration_phase_error_deg,
-    reflector_position,
+from skyradar.config import RadarConfig
+from skyradar.experiments.ch3_scene import (
+    BUILDING,
+    aircraft_path,
+    build_scene,
+    square_array_m,
+    unambiguous_half_angle_deg,
 )
+from skyradar.io.tables import write_json_atomic, write_table
+from skyradar.process.calibration import calibrate_from_frames, calibration_phase_error_deg
 from skyradar.process.detect import integrate_channels
 from skyradar.process.doa import doa_crlb
 from skyradar.process.pipeline import process_cube
 from skyradar.process.smoothing import hann_smooth
 from skyradar.process.spurs import THESIS_THRESHOLDS, learn_spur_map
-from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
-from skyradar.sim.impairments import (
-    ChannelErrorsConfig,
-    NoiseConfig,
-    apply_impairments,
-    channel_errors,
-    thesis_flight_look,
-)
+from skyradar.sim.image import PointTarget
+from skyradar.sim.impairments import apply_impairments
 
-__all__ = ["THESIS_TABLE", "run"]
+__all__ = ["THESIS_TABLE", "run", "square_array_m", "unambiguous_half_angle_deg"]
 
-ORIGIN = (52.0, 4.37, 0.0)
-BORESIGHT_BEARING_DEG = -37.7
-BUILDING = (438.0, 5.0, -1.0, 1000.0)  # range m, az deg (right +), el deg (up +), RCS m^2
-FRAME_RATE_HZ = 300 / 32.0
-SPEED_MPS = {"circuit": 60.0, "approach": 70.0}
 HANN_FRAMES = 9
 SPUR_THRESHOLD = 0.05
+OUTLIER_DEG = 10.0  # a DoA error this large is an ambiguity (wrong wrap), not noise
 # seed-brief.md ch3: (raw mean, raw SD, Hann mean, Hann SD)
 THESIS_TABLE = {
     "dist_m": (46.2, 30.3, 30.7, 16.1),
     "az_deg": (-0.4, 1.8, -0.37, 0.8),
     "el_deg": (-0.5, 2.7, -0.43, 1.6),
 }
-
-
-def _scene(pitch_deg: float, seed: int) -> dict[str, Any]:
-    config = RadarConfig.seed_prototype(mount=Mount(Mount.preset("sky").position_m, pitch_deg=pitch_deg))
-    platform = PlatformState(
-        np.array([0.0, 0.0, -2.0]), np.zeros(3), np.array([np.radians(BORESIGHT_BEARING_DEG), 0, 0])
-    )
-    sim = ImageSimulator(config, None, origin=ORIGIN, noise=False, seed=seed)
-    geom = sim.geometry(platform)
-    ant_to_ned = geom.rot_ned_to_ant.T
-    rng = np.random.default_rng([seed, 3])
-    building_ant = reflector_position(BUILDING[0], np.radians(BUILDING[1]), np.radians(BUILDING[2]))
-    static = [PointTarget(geom.origin_ned_m + ant_to_ned @ building_ant, np.zeros(3), BUILDING[3])]
-    for _ in range(6):  # trees, masts, roofs near the horizon
-        p = reflector_position(
-            rng.uniform(150, 2000), np.radians(rng.uniform(-25, 25)), np.radians(rng.uniform(-9, -3))
-        )
-        static.append(PointTarget(geom.origin_ned_m + ant_to_ned @ p, np.zeros(3), rng.uniform(10, 100)))
-    phases = np.r_[0.0, rng.uniform(-180, 180, config.n_rx - 1)]
-    gains = np.r_[0.0, rng.normal(0, 0.5, config.n_rx - 1)]
-    imp = thesis_flight_look(seed).model_copy(
-        update={
-            "channel_errors": ChannelErrorsConfig(gain_db=gains.tolist(), phase_deg=phases.tolist()),
-            "noise": NoiseConfig(),
-        }  # fmt: skip
-    )
-    true_gain = channel_errors(config.n_rx, gains.tolist(), phases.tolist())
-    return {"config": config, "platform": platform, "sim": sim, "geom": geom, "static": static, "imp": imp,
-            "true_gain": true_gain, "building_ant": building_ant}  # fmt: skip
-
-
-def _racetrack(n: int = 6000) -> np.ndarray:
-    """Dense circuit in (forward, right, down) from the radar: legs at +-300 m, turns reaching 500 and
-    3000 m horizontal distance along boresight, 300 m above the radar."""
-    near, far, half, down = 800.0, 2700.0, 300.0, -300.0
-    leg = np.linspace(near, far, n)
-    turn = np.linspace(0.0, np.pi, n)
-    parts = [
-        np.stack([leg, np.full(n, half)], axis=1),  # outbound, right of boresight
-        np.stack([far + half * np.sin(turn), half * np.cos(turn)], axis=1),  # far turn through 3000 m
-        np.stack([leg[::-1], np.full(n, -half)], axis=1),  # inbound
-        np.stack([near - half * np.sin(turn), -half * np.cos(turn)], axis=1),  # near turn through 500 m
-    ]
-    fr = np.concatenate([part[1:] for part in parts])  # each part starts where the last ended
-    return np.column_stack([fr, np.full(len(fr), down)])
-
-
-def _approach(n: int = 4001) -> np.ndarray:
-    """Dense curved, descending approach from 3000 m (quadratic Bezier) in (forward, right, down)."""
-    ctrl = np.array([[2960.0, 450.0, -520.0], [1900.0, 900.0, -380.0], [700.0, -150.0, -160.0]])
-    s = np.linspace(0.0, 1.0, n)[:, None]
-    return (1 - s) ** 2 * ctrl[0] + 2 * s * (1 - s) * ctrl[1] + s**2 * ctrl[2]
-
-
-def _aircraft(n_frames: int, geom, path: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Frame times, NED positions and velocities of the aircraft at constant speed along ``path``."""
-    if path not in ("circuit", "approach"):
-        raise InputError(f"ch3: field 'path' must be 'circuit' or 'approach', got {path!r}")
-    curve = _racetrack() if path == "circuit" else _approach()
-    speed = SPEED_MPS[path]
-    arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(curve, axis=0), axis=1))]
-    # The circuit is flown once in n_frames; the approach at the field frame rate (thesis: 300 in 32 s).
-    dt = arc[-1] / speed / n_frames if path == "circuit" else 1.0 / FRAME_RATE_HZ
-    t = np.arange(n_frames) * dt
-    dist = np.minimum(speed * t, arc[-1])
-    tangent = np.gradient(curve, arc, axis=0)
-    local = np.stack([np.interp(dist, arc, curve[:, k]) for k in range(3)], axis=1)
-    local_v = speed * np.stack([np.interp(dist, arc, tangent[:, k]) for k in range(3)], axis=1)
-    b = np.radians(BORESIGHT_BEARING_DEG)
-    to_ned = np.array([[np.cos(b), -np.sin(b), 0.0], [np.sin(b), np.cos(b), 0.0], [0.0, 0.0, 1.0]])
-    return t, geom.origin_ned_m + local @ to_ned.T, local_v @ to_ned.T
 
 
 def _match(out: dict, truth: dict, config: RadarConfig) -> int:
@@ -158,13 +94,17 @@ def _match(out: dict, truth: dict, config: RadarConfig) -> int:
     return int(hit[np.argmax(out["snr_db"][hit])]) if hit.size else -1
 
 
-def _static_phase(scene: dict, n_static: int) -> tuple[RadarConfig, Any, np.ndarray, dict[str, Any]]:
+def _static_frames(scene: dict, n_static: int) -> list[np.ndarray]:
     cfg, sim, imp = scene["config"], scene["sim"], scene["imp"]
-    raw = [
+    return [
         apply_impairments(sim.frame(scene["platform"], scene["static"], i), cfg, imp, i)
         for i in range(n_static)
     ]
-    cal = calibrate_from_frames(np.stack(raw[: min(20, n_static)]), scene["building_ant"], cfg)
+
+
+def _static_phase(scene: dict, n_static: int) -> tuple[RadarConfig, Any, np.ndarray, dict[str, Any]]:
+    raw = _static_frames(scene, n_static)
+    cal = calibrate_from_frames(np.stack(raw[: min(20, n_static)]), scene["building_ant"], scene["config"])
     powers = [integrate_channels(c, cal.rx_calibration) for c in raw]
     # Ours: every lit pixel; thesis: Shi-Tomasi corner points, both dilated by one pixel.
     corners = learn_spur_map(powers, cal, SPUR_THRESHOLD, "peaks", method="shi-tomasi")
@@ -179,11 +119,16 @@ def _static_phase(scene: dict, n_static: int) -> tuple[RadarConfig, Any, np.ndar
 
 
 def _flyover(
-    scene: dict, cal: RadarConfig, spur_map, n_frames: int, path: str
+    scene: dict, cal: RadarConfig, spur_map, n_frames: int, path: str, all_maps: bool = True
 ) -> tuple[pd.DataFrame, dict, Any]:
+    """Per-frame track table, detection/false-alarm counts per spur map, one frame to show.
+
+    ``all_maps=False`` processes with our map at ``SPUR_THRESHOLD`` only (the array comparisons).
+    """
     cfg, sim, imp, geom = scene["config"], scene["sim"], scene["imp"], scene["geom"]
-    times, ned, vel = _aircraft(n_frames, geom, path)
-    maps = {(kind, t): spur_map[kind].with_threshold(t) for kind in spur_map for t in THESIS_THRESHOLDS}
+    times, ned, vel = aircraft_path(n_frames, geom, path)
+    keys = [(k, t) for k in spur_map for t in THESIS_THRESHOLDS] if all_maps else [("hits", SPUR_THRESHOLD)]
+    maps = {key: spur_map[key[0]].with_threshold(key[1]) for key in keys}
     false_alarms = dict.fromkeys(maps, 0)
     detected = dict.fromkeys(maps, 0)
     rows, shown = [], None
@@ -239,72 +184,151 @@ def _errors(track: pd.DataFrame, geom) -> pd.DataFrame:
     return out
 
 
-def run(
-    out_dir: Path,
-    n_frames: int = 300,
-    n_static: int = 60,
-    pitch_deg: float = 10.0,
-    path: str = "circuit",
-    seed: int = 0,
-) -> dict:
-    """Run the ch3 experiment, write table, JSON and figures into ``out_dir``; return the summary.
-
-    ``path="circuit"`` flies one racetrack circuit between 500 and 3000 m in ``n_frames`` frames;
-    ``"approach"`` the 32 s approach at the field frame rate (module docstring).
-    """
-    from skyradar.experiments.ch3_figures import plot_all
-
-    t0 = time.perf_counter()
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    scene = _scene(pitch_deg, seed)
-    cal, spur_map, static_frame, building = _static_phase(scene, n_static)
-    track, stats, shown = _flyover(scene, cal, spur_map, n_frames, path)
-    err = _errors(track, scene["geom"])
+def _doa_summary(track: pd.DataFrame, err: pd.DataFrame, cal: RadarConfig, spacing: float) -> dict[str, Any]:
+    """Raw DoA error SD, Cramer-Rao bound (RMS over detections) and ambiguity outliers of one array."""
     det = track.detected.to_numpy()
-    snr_ok = track.true_snr_db.to_numpy() >= 13.0
+    az_err, el_err = err.az_raw_deg[det], err.el_raw_deg[det]
     sd_az, sd_el = doa_crlb(track.snr_db[det], track.true_az_rad[det], track.true_el_rad[det], cal)
+    return {
+        "rx_spacing_wavelengths": spacing, "unambiguous_half_angle_deg": unambiguous_half_angle_deg(spacing),
+        "az_sd_deg": float(az_err.std()), "el_sd_deg": float(el_err.std()),
+        "az_crlb_deg": float(np.degrees(np.sqrt(np.mean(sd_az**2)))),
+        "el_crlb_deg": float(np.degrees(np.sqrt(np.mean(sd_el**2)))),
+        # error / bound per detection: the bound varies with SNR and direction along the circuit
+        "az_sd_over_crlb": float(np.std(np.radians(az_err) / sd_az)),
+        "el_sd_over_crlb": float(np.std(np.radians(el_err) / sd_el)),
+        "detected_frames": int(det.sum()),
+        "doa_outliers": int(np.sum((np.abs(az_err) > OUTLIER_DEG) | (np.abs(el_err) > OUTLIER_DEG))),
+    }  # fmt: skip
+
+
+def _compare_array(spacing: float, pitch_deg: float, seed: int, spur_map, n_frames: int, n_static: int,
+                   path: str) -> dict[str, Any]:  # fmt: skip
+    """The same scene and noise seen by another array: calibrate on the building, fly, summarise.
+
+    The spur map of the main array is reused: it is learned from non-coherent channel power,
+    which the antenna layout does not change.
+    """
+    scene = build_scene(pitch_deg, seed, spacing)
+    raw = np.stack(_static_frames(scene, min(20, n_static)))
+    cal = calibrate_from_frames(raw, scene["building_ant"], scene["config"])
+    track, _, _ = _flyover(scene, cal, spur_map, n_frames, path, all_maps=False)
+    summary = _doa_summary(track, _errors(track, scene["geom"]), cal, spacing)
+    summary["calib_phase_err_deg"] = calibration_phase_error_deg(cal.rx_calibration, scene["true_gain"])
+    return summary
+
+
+def _error_table(err: pd.DataFrame, det: np.ndarray) -> pd.DataFrame:
     table = []
     for key, (m_raw, s_raw, m_hann, s_hann) in THESIS_TABLE.items():
-        name = key.rsplit("_", 1)[0]
-        raw, hann = (
-            err[f"{name}_raw_{key.rsplit('_', 1)[1]}"][det],
-            err[f"{name}_hann_{key.rsplit('_', 1)[1]}"][det],
-        )
+        name, unit = key.rsplit("_", 1)
+        raw, hann = err[f"{name}_raw_{unit}"][det], err[f"{name}_hann_{unit}"][det]
         table.append({"quantity": key, "raw_mean": raw.mean(), "raw_sd": raw.std(), "hann_mean": hann.mean(),
                       "hann_sd": hann.std(), "thesis_raw_mean": m_raw, "thesis_raw_sd": s_raw,
                       "thesis_hann_mean": m_hann, "thesis_hann_sd": s_hann})  # fmt: skip
-    table = pd.DataFrame(table).set_index("quantity")
+    return pd.DataFrame(table).set_index("quantity")
+
+
+def _summary(track: pd.DataFrame, err: pd.DataFrame, table: pd.DataFrame, stats: dict, n_frames: int) -> dict:
+    det = track.detected.to_numpy()
+    snr_ok = track.true_snr_db.to_numpy() >= 13.0
     result = {
-        "az_sd_deg": table.loc["az_deg", "raw_sd"], "el_sd_deg": table.loc["el_deg", "raw_sd"],
         "az_mean_deg": table.loc["az_deg", "raw_mean"], "el_mean_deg": table.loc["el_deg", "raw_mean"],
         "az_hann_sd_deg": table.loc["az_deg", "hann_sd"], "el_hann_sd_deg": table.loc["el_deg", "hann_sd"],
         "az_sd_snr13_deg": float(err.az_raw_deg[det & snr_ok].std()),
         "el_sd_snr13_deg": float(err.el_raw_deg[det & snr_ok].std()),
-        "az_crlb_deg": float(np.degrees(np.sqrt(np.mean(sd_az**2)))),
-        "el_crlb_deg": float(np.degrees(np.sqrt(np.mean(sd_el**2)))),
         "dist_mean_m": table.loc["dist_m", "raw_mean"], "dist_sd_m": table.loc["dist_m", "raw_sd"],
         "dist_hann_mean_m": table.loc["dist_m", "hann_mean"],
-        "dist_hann_sd_m": table.loc["dist_m", "hann_sd"],
-        "calib_phase_err_deg": calibration_phase_error_deg(cal.rx_calibration, scene["true_gain"]),
-        "detected_frames": int(det.sum()), "frames": n_frames,
+        "dist_hann_sd_m": table.loc["dist_m", "hann_sd"], "frames": n_frames,
         "detected_frames_snr13": int(det[snr_ok].sum()), "frames_snr13": int(snr_ok.sum()),
         "false_alarms_per_frame": stats["false_alarms"][("hits", SPUR_THRESHOLD)] / n_frames,
-        "spur_threshold": SPUR_THRESHOLD, "spur_pixels": int(spur_map["hits"].mask.sum()), "path": path,
         "frame_interval_s": float(track.time_s.diff().median()) if n_frames > 1 else 0.0,
         "min_range_m": float(track.true_range_m.min()), "max_range_m": float(track.true_range_m.max()),
-        **building,
+        "max_off_boresight_deg": float(np.degrees(np.max(np.arccos(
+            np.cos(track.true_az_rad) * np.cos(track.true_el_rad))))),
     }  # fmt: skip
     for (kind, thr), n_fa in stats["false_alarms"].items():
         tag = f"{int(thr * 100)}pct" + ("" if kind == "hits" else "_corner_map")
         result[f"false_alarms_per_frame_{tag}"] = n_fa / n_frames
         result[f"detected_frames_{tag}"] = int(stats["detected"][(kind, thr)])
+    return result
+
+
+def _write_outputs(out_dir: Path, table: pd.DataFrame, track: pd.DataFrame, err: pd.DataFrame,
+                   sweep: list[dict]) -> None:  # fmt: skip
     write_table(table.reset_index(), out_dir / "ch3_table.parquet")
     table.to_csv(out_dir / "ch3_table.csv")
     write_table(
         pd.concat([track, err.drop(columns=["time_s", "true_snr_db"])], axis=1), out_dir / "ch3_track.parquet"
     )
+    write_table(pd.DataFrame(sweep), out_dir / "ch3_spacing.parquet")
+
+
+def run(
+    out_dir: Path,
+    n_frames: int = 300,
+    n_static: int = 60,
+    pitch_deg: float = 3.0,
+    path: str = "circuit",
+    seed: int = 0,
+    rx_spacing_wavelengths: float = 0.6,
+    compare_spacings: tuple[float, ...] = (0.5, 0.7),
+) -> dict:
+    """Run the ch3 experiment, write table, JSON and figures into ``out_dir``; return the summary.
+
+    Parameters
+    ----------
+    out_dir : Path
+        Output directory (created).
+    n_frames, n_static : int
+        Flyover and static-scene frames.
+    pitch_deg : float
+        Boresight elevation above the horizon, deg (3 deg puts the building where the thesis found it).
+    path : str
+        ``"circuit"`` flies one racetrack circuit between 500 and 3000 m in ``n_frames`` frames;
+        ``"approach"`` the 32 s approach at the field frame rate (module docstring).
+    rx_spacing_wavelengths : float
+        Side of the 2x2 receive square in wavelengths, (0, 1]; unambiguous within
+        ``asin(1 / (2 spacing))`` of boresight on either axis (56.4 deg at 0.6).
+    compare_spacings : tuple of float
+        Further spacings flown with the same seed (DoA summaries under ``spacing_sweep``; 0.5 also
+        under ``half_wavelength``).
+
+    Returns
+    -------
+    dict
+        Summary (also written to ``ch3.json``): errors, bounds, detection counts, calibration.
+    """
+    from skyradar.experiments.ch3_figures import plot_all, plot_spacing
+
+    t0 = time.perf_counter()
+    spacing = float(rx_spacing_wavelengths)
+    others = sorted({float(s) for s in compare_spacings} - {spacing})
+    for s in (spacing, *others):
+        square_array_m(s, 1.0)  # InputError before any work
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    scene = build_scene(pitch_deg, seed, spacing)
+    cal, spur_map, static_frame, building = _static_phase(scene, n_static)
+    track, stats, shown = _flyover(scene, cal, spur_map, n_frames, path)
+    err = _errors(track, scene["geom"])
+    det = track.detected.to_numpy()
+    table = _error_table(err, det)
+    main = _doa_summary(track, err, cal, spacing)
+    main["calib_phase_err_deg"] = calibration_phase_error_deg(cal.rx_calibration, scene["true_gain"])
+    arrays = {spacing: main} | {
+        s: _compare_array(s, pitch_deg, seed, spur_map, n_frames, n_static, path) for s in others
+    }
+    result = {**main, **_summary(track, err, table, stats, n_frames), "pitch_deg": float(pitch_deg),
+              "spur_threshold": SPUR_THRESHOLD, "spur_pixels": int(spur_map["hits"].mask.sum()), "path": path,
+              **building}  # fmt: skip
+    if 0.5 in arrays:
+        result["half_wavelength"] = {k: v for k, v in arrays[0.5].items() if k != "rx_spacing_wavelengths"}
+    result["spacing_sweep"] = [arrays[s] for s in sorted(arrays)]
+    _write_outputs(out_dir, table, track, err, result["spacing_sweep"])
     plot_all(out_dir, static_frame, cal, spur_map["hits"], shown, track, err, scene["geom"])
+    if len(arrays) > 1:
+        plot_spacing(out_dir, result["spacing_sweep"], THESIS_TABLE)
     result["runtime_s"] = time.perf_counter() - t0
     result = {k: (float(v) if isinstance(v, np.floating) else v) for k, v in result.items()}
     write_json_atomic(out_dir / "ch3.json", result)

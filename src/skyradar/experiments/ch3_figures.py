@@ -1,4 +1,5 @@
-"""Figures of the ch3 experiment: range-Doppler with detections, 3-D track vs truth, errors over time."""
+"""Figures of the ch3 experiment: range-Doppler with detections, 3-D track vs truth, errors over time,
+DoA error SD against the Cramer-Rao bound for several array spacings."""
 
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ import pandas as pd  # noqa: E402
 from skyradar.config import RadarConfig  # noqa: E402
 from skyradar.process.detect import integrate_channels  # noqa: E402
 
-__all__ = ["plot_all"]
+__all__ = ["plot_all", "plot_spacing"]
 
 
 def _rd_panel(ax, cube: np.ndarray, config: RadarConfig, title: str) -> None:
@@ -99,3 +100,31 @@ def plot_all(out_dir: Path, static_frame, cal, spur_map, shown, track, err, geom
         plot_track(out_dir, track, err, geom),
         plot_errors(out_dir, err),
     ]
+
+
+def plot_spacing(out_dir: Path, sweep: list[dict], thesis: dict) -> Path:
+    """Raw azimuth/elevation error SD (markers) and Cramer-Rao bound (lines) against the array spacing,
+    with the thesis' raw SD as horizontal lines; the unambiguous half-angle is written at each point."""
+    spacing = np.array([row["rx_spacing_wavelengths"] for row in sweep])
+    fig, ax = plt.subplots(figsize=(7.5, 5))
+    for name, colour in (("az", "tab:blue"), ("el", "tab:orange")):
+        label = "azimuth" if name == "az" else "elevation"
+        ax.plot(spacing, [row[f"{name}_sd_deg"] for row in sweep], "o", c=colour, ms=8, label=f"{label} SD")
+        ax.plot(spacing, [row[f"{name}_crlb_deg"] for row in sweep], "-", c=colour, label=f"{label} CRLB")
+        ax.axhline(thesis[f"{name}_deg"][1], ls="--", c=colour, lw=1, label=f"thesis {label} SD")
+    for row in sweep:
+        ax.annotate(f"+-{row['unambiguous_half_angle_deg']:.0f} deg", (row["rx_spacing_wavelengths"], 0.3),
+                    ha="center", fontsize=8, color="grey")  # fmt: skip
+    ax.set_xticks(spacing)
+    top = max(thesis["az_deg"][1], thesis["el_deg"][1], *(row["az_sd_deg"] for row in sweep))
+    ax.set_ylim(0.0, 1.3 * top)  # room for the legend above the thesis lines
+    ax.set_xlabel("2x2 array spacing [wavelengths] (grey: unambiguous half-angle)")
+    ax.set_ylabel("raw DoA error SD [deg]")
+    ax.set_title("ch3: DoA error vs array spacing (same flyover, same noise)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, ncol=3, loc="upper right")
+    fig.tight_layout()
+    path = out_dir / "ch3_spacing.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -21,6 +21,8 @@ A coarse direction comes first from the pairs at most lambda/2 apart (unambiguou
 a coplanar array, otherwise from a beamforming grid search over the field of view (non-coplanar
 and sparse arrays; grating lobes outside the field of view are ignored); every phase is then unwrapped
 to the value the coarse direction predicts and the least-squares fit is redone on all antennas.
+A square of side d > lambda/2 is unique only within ``asin(lambda / (2 d))`` of boresight on
+either axis (56.4 deg at 0.6 lambda); beyond that a direction is reported at its grating lobe.
 
 Cramer-Rao bound: for ``x_k = A exp(i theta_k) + n_k``, ``n_k ~ CN(0, sigma^2)`` and the unknowns
 (A, phi, az, el), the Fisher information of (az, el) after eliminating the nuisance phase is
@@ -81,6 +83,9 @@ class ArrayGeometry:
     grid : ndarray, shape (n_grid, dims) or None
         Coarse search grid in ``a`` over the field of view (within 6 dB of peak gain) when no
         unambiguous pair set exists.
+    grid_match : ndarray, shape (n_rx, n_grid), complex, or None
+        Conjugate steering vectors of the grid points (precomputed: the complex exponentials
+        cost more than the beamforming product itself).
     """
 
     basis: np.ndarray
@@ -90,6 +95,7 @@ class ArrayGeometry:
     pairs: np.ndarray | None
     pair_solve: np.ndarray | None
     grid: np.ndarray | None
+    grid_match: np.ndarray | None = None
 
     @property
     def dims(self) -> int:
@@ -168,7 +174,8 @@ def _geometry(
         pair_solve = np.linalg.pinv(pair_design)
     else:
         grid = _search_grid(q, basis, normal, wavelength_m, np.asarray(facing), half_angle_rad)
-    return ArrayGeometry(basis, normal, design, solve, pairs, pair_solve, grid)
+    match = None if grid is None else np.ascontiguousarray(np.exp(-1j * grid @ design.T).T)
+    return ArrayGeometry(basis, normal, design, solve, pairs, pair_solve, grid, match)
 
 
 def array_geometry(
@@ -235,8 +242,7 @@ def _coarse(z: np.ndarray, geo: ArrayGeometry) -> np.ndarray:
         d = np.angle(z[:, geo.pairs[:, 1]] * np.conj(z[:, geo.pairs[:, 0]]))
         return d @ geo.pair_solve.T
     # Beamforming: the grid point whose predicted phases best match the measured ones.
-    steer = np.exp(1j * geo.grid @ geo.design.T)  # (n_grid, n_rx)
-    score = np.abs(z @ np.conj(steer).T)  # (n, n_grid)
+    score = np.abs(z @ geo.grid_match)  # (n, n_grid)
     return geo.grid[np.argmax(score, axis=1)]
 
 

@@ -217,35 +217,3 @@ def test_young_tracks_do_not_alert():
     t, raw = out["time_s"].to_numpy(), out["raw_level"].to_numpy()
     assert (raw[t < 2.0] == 0).all() and (raw[t >= 2.0] == 3).all()
     assert t[np.argmax(out["level"].to_numpy() == 3)] == pytest.approx(2.0 + DT)
-
-
-def test_encounter_experiment_noise_free_answers():
-    from skyradar.experiments.encounters import make_encounters, run_encounter
-
-    enc = make_encounters(5)
-    quiet = {"sigma_az_deg": 0.0, "sigma_el_deg": 0.0, "sigma_range_m": 0.0, "p_detect": 1.0}
-    head_on = enc.iloc[0].copy()
-    head_on[["horizontal_miss_m", "vertical_miss_m", "intruder_speed_mps"]] = [0.0, 0.0, 50.0]
-    r = run_encounter(head_on, seed=1, **quiet)
-    # Closing at 100 m/s, CPA at 60 s: loss of well clear at 60 - 670.56 / 100 s; the warning's raw
-    # level starts 25 s before, issued one frame later (2 of 4) and rounded to the frame grid.
-    assert r["conflict"] and r["observable"]
-    assert r["t_lowc_s"] == pytest.approx(60.0 - D_NC / 100.0, abs=0.11)
-    assert r["t_lowc_s"] - r["t_warning_s"] == pytest.approx(25.0, abs=0.25)
-    clear = head_on.copy()
-    clear["horizontal_miss_m"] = 1500.0
-    r = run_encounter(clear, seed=1, **quiet)
-    assert not r["conflict"] and np.isnan(r["t_warning_s"])
-
-
-def test_encounter_experiment_summary(tmp_path):
-    import json
-
-    from skyradar.experiments.encounters import run
-
-    s = run(tmp_path, n_encounters=10, frame_rate_hz=2.0)
-    assert s["encounters"] == 10 and s["chain"] == "sensor-model"
-    assert 0 <= s["missed_warnings"] <= s["observable_conflicts"] <= s["conflicts"] <= 10
-    assert json.loads((tmp_path / "summary.json").read_text())["encounters"] == 10
-    assert (tmp_path / "encounters.png").stat().st_size > 10_000
-    assert len(pd.read_parquet(tmp_path / "encounters.parquet")) == 10

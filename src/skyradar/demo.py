@@ -25,15 +25,11 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from skyradar.daa.alerting import AlertConfig
-from skyradar.daa.pipeline import alerts_from_tracks, ownship_from_frames
+from skyradar.daa.alerting import RADAR_ALERT_CONFIG
 from skyradar.errors import InputError
-from skyradar.io.frames import frames_dataset
+from skyradar.experiments.chain import run_chain as _run_chain
 from skyradar.io.tables import write_json_atomic, write_table
-from skyradar.process.pipeline import process_frames
 from skyradar.scene.scenario import load_scenario
-from skyradar.sim.run import make_simulator, scenario_truth, simulate_frames
-from skyradar.track.run import track_detections
 
 __all__ = [
     "DEMO_SCENARIO",
@@ -47,12 +43,11 @@ __all__ = [
 ]
 
 DEMO_SCENARIO = "demo_circuit.yaml"
-# Default DO-365-style volumes and times; a track raises no alert while its horizontal velocity is
-# known worse than 10 m/s (1 sigma): far DoA tracks converge slowly and their covariance would widen
-# the warning volume to kilometres.
-DEMO_ALERT_CONFIG = AlertConfig(max_velocity_sigma_mps=10.0)
+# Default DO-365-style volumes and times with the radar settings (2 of 4 s persistence, a 6 m/s
+# velocity-convergence gate): far DoA tracks converge slowly and their covariance would widen the
+# warning volume to kilometres.
+DEMO_ALERT_CONFIG = RADAR_ALERT_CONFIG
 LEVEL_NAMES = {0: "none", 1: "preventive", 2: "corrective", 3: "WARNING"}
-_BLOCK_FRAMES = 24
 _MATCH_M = 300.0  # a track is an intruder's if its median distance to that truth is below this
 
 
@@ -61,55 +56,9 @@ def demo_scenario_path() -> Path:
     return Path(str(files("skyradar") / "data" / "scenarios" / DEMO_SCENARIO))
 
 
-def _block_dataset(built, iq, rows, own_truth, tgt_truth, names) -> xr.Dataset:
-    own = {k: v[rows] for k, v in own_truth.items()}
-    tgt = {k: v[rows] for k, v in tgt_truth.items()}
-    attrs = {"scenario": built.name, "origin_lat_deg": built.origin[0], "origin_lon_deg": built.origin[1]}
-    attrs["origin_alt_m"] = built.origin[2]
-    return frames_dataset(iq, built.times_s[rows], built.radar, own, tgt, names, attrs)
-
-
 def run_chain(built, keep_frames: tuple[int, ...] = ()) -> dict[str, Any]:
-    """Simulate, process, track and alert a built scenario; return every intermediate product.
-
-    Returns a dict with ``truth`` (frames Dataset without ``iq``), ``detections``, ``tracks``,
-    ``alerts``, ``ownship`` (tables), ``rd_frames`` ({frame: (n_range, n_doppler, n_rx) complex pixels} for
-    ``keep_frames``) and ``timings_s`` per stage.
-    """
-    timings = {"simulate": 0.0, "process": 0.0}
-    simulator = make_simulator(built)
-    own_truth, tgt_truth, names = scenario_truth(built, simulator)
-    n = built.times_s.size
-    detections, rd, blocks = [], {}, []
-    for start in range(0, n, _BLOCK_FRAMES):
-        rows = np.arange(start, min(start + _BLOCK_FRAMES, n))
-        t0 = time.perf_counter()
-        iq = simulate_frames(built, rows, simulator)
-        timings["simulate"] += time.perf_counter() - t0
-        for f in set(keep_frames).intersection(rows.tolist()):
-            rd[f] = iq[f - start].copy()
-        ds = _block_dataset(built, iq, rows, own_truth, tgt_truth, names)
-        t0 = time.perf_counter()
-        det = process_frames(ds, terrain=built.terrain, source=built.name)
-        det["frame"] += start
-        detections.append(det)
-        timings["process"] += time.perf_counter() - t0
-        blocks.append(ds.drop_vars("iq"))
-    truth = xr.concat(blocks, dim="time")
-    det = pd.concat(detections, ignore_index=True)
-    own = ownship_from_frames(truth, built.name)
-    t0 = time.perf_counter()
-    keep = ~(det["is_ground"].to_numpy(bool) | det["spur"].to_numpy(bool))
-    tracks = track_detections(
-        det[keep].reset_index(drop=True), "radar", built.radar,
-        frame_times_s=built.times_s, origin=built.origin, ownship=own,
-    )  # fmt: skip
-    timings["track"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    alerts = alerts_from_tracks(tracks, own, DEMO_ALERT_CONFIG, source=built.name)
-    timings["alert"] = time.perf_counter() - t0
-    return {"truth": truth, "detections": det, "tracks": tracks, "alerts": alerts, "ownship": own,
-            "rd_frames": rd, "timings_s": timings}  # fmt: skip
+    """:func:`skyradar.experiments.chain.run_chain` with :data:`DEMO_ALERT_CONFIG`."""
+    return _run_chain(built, DEMO_ALERT_CONFIG, keep_frames)
 
 
 def label_tracks(tracks: pd.DataFrame, truth: xr.Dataset, max_distance_m: float = _MATCH_M) -> dict[int, str]:

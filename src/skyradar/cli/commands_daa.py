@@ -85,18 +85,32 @@ def serve(
 @experiment_app.command("encounters")
 def experiment_encounters(
     out: Annotated[Path, typer.Option("--out", help="Output directory.")] = Path("out/encounters"),
-    n: Annotated[int, typer.Option("--n", help="Number of encounters.")] = 500,
+    n: Annotated[int, typer.Option("--n", min=1, help="Number of encounters.")] = 500,
     seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
+    workers: Annotated[
+        int | None, typer.Option(min=1, help="Worker processes (default: up to 2, one per core).")
+    ] = None,
+    frame_rate: Annotated[float, typer.Option(min=0.5, help="Radar frame rate, frames/s.")] = 4.7,
+    buffer: Annotated[
+        float,
+        typer.Option(min=1.0, help="May-alert zone: this many times the well-clear volume."),
+    ] = 1.5,
     no_uncertainty: Annotated[
         bool, typer.Option("--no-uncertainty", help="Do not widen the volumes by the track covariance.")
     ] = False,
     as_json: JsonOption = False,
 ) -> None:
-    """Encounter set (head-on, crossing, overtaking, converging, climbing; conflicts and near misses)
-    through a radar measurement model, the 3-D tracker and the DAA alerting: missed, late and
-    false warnings. The full image chain is not wired (chain = sensor-model).
+    """Encounter set (head-on, crossing, converging, overtaking, climbing; conflicts and near misses),
+    each through the full chain (simulate, detect + DoA, track, alert): missed, late and false
+    warnings, and the warning lead.
     """
+    from skyradar.cli.commands_sim import frame_progress
     from skyradar.experiments.encounters import run
 
-    result = run(out, n_encounters=n, seed=seed, uncertainty=not no_uncertainty)
+    with frame_progress(n, "encounters") as bar:
+        task = bar.add_task("encounters", total=n)
+        result = run(
+            out, n_encounters=n, seed=seed, frame_rate_hz=frame_rate, buffer=buffer, workers=workers,
+            uncertainty=not no_uncertainty, progress=lambda k: bar.update(task, completed=k),
+        )  # fmt: skip
     emit_result(result, as_json, "encounters")

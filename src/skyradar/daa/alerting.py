@@ -27,6 +27,7 @@ __all__ = [
     "LEVEL_NAMES",
     "AlertLevel",
     "AlertConfig",
+    "RADAR_ALERT_CONFIG",
     "raw_alert_levels",
     "AlertFilter",
     "filter_alert_levels",
@@ -66,6 +67,12 @@ class AlertConfig:
         Preventive, corrective, warning (index + 1 is the level number).
     m, n : int
         M-of-N persistence on the raw level.
+    period_s : float, optional
+        Length of one M-of-N sample, s. None: a frame (M of the last N frames). With a period the
+        window is the last ``n * period_s`` seconds and level k needs raw levels >= k on at least
+        ``m / n`` of the window's frames (and on ``m`` frames). DAIDALUS' DO-365B 2 of 4 is meant
+        for 1 Hz surveillance: ``m=2, n=4, period_s=1`` keeps its meaning for a radar at several
+        frames per second, where 2 of 4 frames would be half a second of agreement.
     persistence_s : float
         Minimum time an issued level is held, s.
     hysteresis_s : float
@@ -93,6 +100,7 @@ class AlertConfig:
     levels: tuple[AlertLevel, ...] = field(default_factory=_noncoop_levels)
     m: int = 2
     n: int = 4
+    period_s: float | None = None
     persistence_s: float = 4.0
     hysteresis_s: float = 5.0
     z_h_pos: float = 1.5
@@ -107,11 +115,20 @@ class AlertConfig:
     def __post_init__(self) -> None:
         if not 1 <= self.m <= self.n:
             raise ValueError(f"alert config: need 1 <= m <= n, got m={self.m}, n={self.n}")
+        if self.period_s is not None and not self.period_s > 0:
+            raise ValueError(f"alert config: period_s must be > 0, got {self.period_s}")
 
     @property
     def lookahead_s(self) -> float:
         """The longest alerting time, s."""
         return max(lv.alerting_time_s for lv in self.levels)
+
+
+# For tracks from an onboard radar at several frames per second: DAIDALUS' 2 of 4 at 1 Hz, and no
+# alert from a track whose horizontal velocity is known worse than 6 m/s (1 sigma). On the encounter
+# set (seed 1, 200 encounters) a 10 m/s gate and 2 of 4 frames let far tracks with noisy DoA warn for
+# near misses 1.6-1.9 times outside the volume (10 % of them); with these, none, and no missed warning.
+RADAR_ALERT_CONFIG = AlertConfig(period_s=1.0, max_velocity_sigma_mps=6.0)
 
 
 def raw_alert_levels(
@@ -200,6 +217,7 @@ class AlertFilter:
     def __init__(self, config: AlertConfig | None = None) -> None:
         self.config = config or AlertConfig()
         self._raw: list[int] = []
+        self._times: list[float] = []
         self.level = 0
         self._raised_at = -np.inf
         self._below_since: float | None = None
@@ -207,9 +225,7 @@ class AlertFilter:
     def update(self, time_s: float, raw_level: int) -> int:
         """Feed the raw level of the frame at ``time_s`` (s); return the issued level."""
         cfg = self.config
-        self._raw = (self._raw + [int(raw_level)])[-cfg.n :]
-        counts = [sum(r >= k for r in self._raw) for k in range(1, len(cfg.levels) + 1)]
-        candidate = max([k for k, c in enumerate(counts, start=1) if c >= cfg.m], default=0)
+        candidate = self._m_of_n_level(time_s, int(raw_level))
         if candidate > self.level:
             self.level, self._raised_at, self._below_since = candidate, time_s, None
         elif candidate == self.level:
@@ -221,6 +237,22 @@ class AlertFilter:
             if not held and time_s - self._below_since >= cfg.hysteresis_s:
                 self.level, self._below_since = candidate, None
         return self.level
+
+    def _m_of_n_level(self, time_s: float, raw_level: int) -> int:
+        """Highest level reached by M of the last N samples (frames, or periods of ``period_s``)."""
+        cfg = self.config
+        self._raw.append(raw_level)
+        self._times.append(float(time_s))
+        if cfg.period_s is None:
+            self._raw, self._times = self._raw[-cfg.n :], self._times[-cfg.n :]
+            need = float(cfg.m)
+        else:
+            # Frames strictly inside the window (a tolerance keeps exactly n periods of frames).
+            start = next(i for i, t in enumerate(self._times) if t > time_s - cfg.n * cfg.period_s + 1e-9)
+            self._raw, self._times = self._raw[start:], self._times[start:]
+            need = max(float(cfg.m), cfg.m / cfg.n * len(self._raw))
+        counts = [sum(r >= k for r in self._raw) for k in range(1, len(cfg.levels) + 1)]
+        return max([k for k, c in enumerate(counts, start=1) if c >= need], default=0)
 
 
 def filter_alert_levels(

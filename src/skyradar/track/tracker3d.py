@@ -101,11 +101,20 @@ def cv3d_transition(dt_s: float) -> np.ndarray:
     return F
 
 
-def cv3d_process_noise(dt_s: float, sigma_accel_mps2: float) -> np.ndarray:
-    """White-acceleration process noise for ``(p, v)`` in 3-D, 6x6."""
-    q = sigma_accel_mps2**2
-    block = np.array([[dt_s**3 / 3, dt_s**2 / 2], [dt_s**2 / 2, dt_s]]) * q
-    return np.kron(block, np.eye(3))
+def cv3d_process_noise(dt_s: float, sigma_accel_mps2) -> np.ndarray:
+    """White-acceleration process noise for ``(p, v)`` in 3-D, 6x6.
+
+    ``sigma_accel_mps2`` is one value for all axes or three (north, east, down), m/s^2.
+
+    Examples
+    --------
+    >>> Q = cv3d_process_noise(1.0, [3.0, 3.0, 1.0])
+    >>> float(Q[3, 3]), float(Q[5, 5])
+    (9.0, 1.0)
+    """
+    q = np.broadcast_to(np.asarray(sigma_accel_mps2, float) ** 2, (3,))
+    block = np.array([[dt_s**3 / 3, dt_s**2 / 2], [dt_s**2 / 2, dt_s]])
+    return np.kron(block, np.diag(q))
 
 
 class Tracker3D:
@@ -114,9 +123,16 @@ class Tracker3D:
     Parameters
     ----------
     sigma_accel_mps2 : float
-        Process noise (white acceleration), m/s^2.
+        Horizontal process noise (white acceleration), m/s^2.
     init_sigma_velocity_mps : float
-        Prior standard deviation of each velocity component of a new filter, m/s.
+        Prior standard deviation of each horizontal velocity component of a new filter, m/s.
+    sigma_vertical_accel_mps2 : float
+        Vertical process noise, m/s^2. Aircraft change their vertical speed gently (a 500 ft/min
+        level-off takes several seconds), far more gently than their heading.
+    init_sigma_vertical_mps : float
+        Prior standard deviation of the vertical speed of a new filter (prior mean 0: level), m/s.
+        Light aircraft climb and descend at a few m/s; without this prior the vertical speed is
+        a difference of DoA elevations, metres of noise over a few seconds.
     gate : float
         Chi-square (3 degrees of freedom) gate on DoA positions; 16 keeps 99.9 % of good ones.
     max_rejects : int
@@ -134,13 +150,17 @@ class Tracker3D:
 
     def __init__(
         self,
-        sigma_accel_mps2: float = 3.0,
+        sigma_accel_mps2: float = 2.0,
         init_sigma_velocity_mps: float = 60.0,
         gate: float = 16.0,
         max_rejects: int = 5,
+        sigma_vertical_accel_mps2: float = 0.3,
+        init_sigma_vertical_mps: float = 3.0,
     ) -> None:
         self.sigma_accel_mps2 = float(sigma_accel_mps2)
         self.init_sigma_velocity_mps = float(init_sigma_velocity_mps)
+        self.sigma_vertical_accel_mps2 = float(sigma_vertical_accel_mps2)
+        self.init_sigma_vertical_mps = float(init_sigma_vertical_mps)
         self.gate = float(gate)
         self.max_rejects = int(max_rejects)
         self.ids = np.zeros(0, np.int64)
@@ -187,7 +207,7 @@ class Tracker3D:
         if self.time_s is not None and self.ids.size and time_s > self.time_s:
             dt = time_s - self.time_s
             self.x, self.P = predict(
-                self.x, self.P, cv3d_transition(dt), cv3d_process_noise(dt, self.sigma_accel_mps2)
+                self.x, self.P, cv3d_transition(dt), cv3d_process_noise(dt, self._accel_sigmas())
             )
         self.time_s = float(time_s)
         # A position without a finite covariance (e.g. no SNR for its angle error) is not used.
@@ -234,8 +254,12 @@ class Tracker3D:
         x = np.hstack([positions_m, np.zeros((positions_m.shape[0], 3))])
         P = np.zeros((positions_m.shape[0], 6, 6))
         P[:, :3, :3] = cov
-        P[:, [3, 4, 5], [3, 4, 5]] = self.init_sigma_velocity_mps**2
+        P[:, [3, 4], [3, 4]] = self.init_sigma_velocity_mps**2
+        P[:, 5, 5] = self.init_sigma_vertical_mps**2
         return x, P
+
+    def _accel_sigmas(self) -> tuple[float, float, float]:
+        return (self.sigma_accel_mps2, self.sigma_accel_mps2, self.sigma_vertical_accel_mps2)
 
     def _add(self, ids: np.ndarray, positions_m: np.ndarray, cov: np.ndarray) -> None:
         x, P = self._initial(positions_m, cov)

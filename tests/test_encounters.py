@@ -123,3 +123,30 @@ def test_experiment_writes_its_table_figure_and_summary(tmp_path):
     assert (tmp_path / "encounters.png").stat().st_size > 10_000
     table = pd.read_parquet(tmp_path / "encounters.parquet")
     assert len(table) == 4 and table["frames"].gt(0).all()
+
+
+def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
+    from skyradar.experiments import encounters as E
+
+    key = {
+        "n": 2,
+        "seed": 5,
+        "frame_rate_hz": 4.7,
+        "buffer": 1.5,
+        "uncertainty": True,
+        "version": E._version(),
+    }
+    _, save = E._partial_store(tmp_path, key)
+    fake = {"t_lowc_s": np.nan, "t_cpa_s": 120.0, "conflict": False, "may_alert": False,
+            "observable": False, "t_warning_s": np.nan, "min_horizontal_m": 3000.0, "min_vertical_m": 0.0,
+            "min_distance_m": 3000.0, "t_other_warning_s": np.nan, "frames": 7, "t_start_s": 75.0,
+            "tracks": 0, "detections": 0}  # fmt: skip
+    save({0: fake})  # as left by a run interrupted after its first encounter
+    s = E.run(tmp_path, n_encounters=2, seed=5, workers=1)
+    assert s["resumed_encounters"] == 1
+    table = pd.read_parquet(tmp_path / "encounters.parquet")
+    assert table.loc[0, "frames"] == 7 and table.loc[1, "frames"] > 50  # row 0 kept, row 1 computed
+    assert not list(tmp_path.glob("*.partial*"))
+    # Different settings never reuse another run's rows.
+    save({0: fake})
+    assert E._partial_store(tmp_path, {**key, "seed": 6})[0] == {}

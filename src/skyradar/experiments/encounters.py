@@ -12,8 +12,10 @@ The encounters are independent, so they run in ``workers`` processes (one numba 
 
 from __future__ import annotations
 
+import json
 import os
 import time
+from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import replace
 from multiprocessing import get_context
@@ -41,6 +43,7 @@ __all__ = ["ENCOUNTER_ALERT_CONFIG", "run_encounter", "run_encounters", "run"]
 
 ENCOUNTER_ALERT_CONFIG = RADAR_ALERT_CONFIG
 _RANGE_MARGIN_M = 300.0
+_PARTIAL = "encounters.partial.parquet"
 
 
 def _window(p: pd.Series, frame_rate_hz: float, lookback_s: float, seed: int) -> tuple[float, float]:
@@ -111,37 +114,65 @@ def _run_rows(rows: list[tuple[int, dict]], kw: dict) -> list[tuple[int, dict]]:
 
 
 def run_encounters(
-    params: pd.DataFrame, seed: int = 0, workers: int | None = None, progress=None, **options: Any
+    params: pd.DataFrame,
+    seed: int = 0,
+    workers: int | None = None,
+    progress: Callable[[int], None] | None = None,
+    done: dict[int, dict] | None = None,
+    on_chunk: Callable[[dict[int, dict]], None] | None = None,
+    **options: Any,
 ) -> pd.DataFrame:
     """All encounters (rows of ``params``), ``workers`` processes; one result row per encounter.
 
-    ``progress`` is called with the number of encounters finished. Options go to
-    :func:`run_encounter`.
+    ``progress`` is called with the number of encounters finished; ``done`` holds result rows
+    already computed (skipped here) and ``on_chunk`` receives all rows so far after each chunk
+    of five. Options go to :func:`run_encounter`.
     """
     workers = workers or min(2, os.cpu_count() or 1)
-    records = list(enumerate(params.to_dict("records")))
+    results: dict[int, dict] = dict(done or {})
+    todo = [(i, p) for i, p in enumerate(params.to_dict("records")) if i not in results]
+    chunks = [todo[k : k + 5] for k in range(0, len(todo), 5)]
     kw = {"seed": seed, "options": options}
-    results: dict[int, dict] = {}
+
+    def finished(rows: list[tuple[int, dict]]) -> None:
+        results.update(dict(rows))
+        if on_chunk:
+            on_chunk(results)
+        if progress:
+            progress(len(results))
+
     if workers <= 1:
-        for i, p in records:
-            results[i] = _run_rows([(i, p)], kw)[0][1]
-            if progress:
-                progress(len(results))
-    else:
-        chunks = [records[k : k + 5] for k in range(0, len(records), 5)]
+        for c in chunks:
+            finished(_run_rows(c, kw))
+    elif chunks:
         ctx = get_context("spawn")  # numba's thread pools do not survive fork
         with ProcessPoolExecutor(workers, mp_context=ctx, initializer=_init_worker) as pool:
             futures = [pool.submit(_run_rows, c, kw) for c in chunks]
             try:
                 for fut in as_completed(futures):
-                    results.update(dict(fut.result()))
-                    if progress:
-                        progress(len(results))
+                    finished(fut.result())
             except KeyboardInterrupt:
                 for f in futures:
                     f.cancel()
                 raise
-    return pd.DataFrame([results[i] for i in range(len(records))])
+    return pd.DataFrame([results[i] for i in range(len(params))])
+
+
+def _partial_store(out_dir: Path, key: dict) -> tuple[dict[int, dict], Callable[[dict[int, dict]], None]]:
+    """Rows of an interrupted run with the same settings, and a writer that keeps them up to date."""
+    path, key_path = out_dir / _PARTIAL, out_dir / (_PARTIAL + ".json")
+    done: dict[int, dict] = {}
+    if path.exists() and key_path.exists() and json.loads(key_path.read_text()) == key:
+        table = pd.read_parquet(path)
+        done = {int(i): row for i, row in zip(table.pop("encounter"), table.to_dict("records"), strict=True)}
+    write_json_atomic(key_path, key)
+
+    def save(results: dict[int, dict]) -> None:
+        rows = pd.DataFrame(list(results.values()))
+        rows.insert(0, "encounter", list(results))
+        write_table(rows, path)
+
+    return done, save
 
 
 def run(
@@ -153,13 +184,15 @@ def run(
     buffer: float = 1.5,
     workers: int | None = None,
     uncertainty: bool = True,
-    progress=None,
+    progress: Callable[[int], None] | None = None,
 ) -> dict:
     """Run the encounter set; write ``encounters.parquet``, ``encounters.csv``, ``summary.json`` and
     ``encounters.png`` into ``out_dir``; return the summary.
 
     ``uncertainty=False`` turns off the widening of the volumes by the track covariance. A warning
     with less lead than ``late_lead_s`` (default half the 25 s warning alerting time) is late.
+    Finished encounters are kept in ``encounters.partial.parquet`` while the run goes on; a run
+    that was interrupted resumes from them when started again with the same settings.
     """
     t0 = time.perf_counter()
     out_dir = Path(out_dir)
@@ -168,12 +201,15 @@ def run(
     if not uncertainty:
         cfg = replace(cfg, z_h_pos=0.0, z_h_vel=0.0, z_v_pos=0.0, z_v_vel=0.0)
     enc = make_encounters(n_encounters, seed)
-    out = run_encounters(enc, seed, workers, progress, frame_rate_hz=frame_rate_hz, buffer=buffer,
+    key = {"n": n_encounters, "seed": seed, "frame_rate_hz": frame_rate_hz, "buffer": buffer,
+           "uncertainty": uncertainty, "version": _version()}  # fmt: skip
+    done, save = _partial_store(out_dir, key)
+    out = run_encounters(enc, seed, workers, progress, done, save, frame_rate_hz=frame_rate_hz, buffer=buffer,
                          alert_config=cfg)  # fmt: skip
     res = pd.concat([enc, out], axis=1)
     summary = summarise(res, late_lead_s)
     summary.update(chain="full", frames=int(res["frames"].sum()), frame_rate_hz=frame_rate_hz, buffer=buffer,
-                   uncertainty=uncertainty, seed=seed,
+                   uncertainty=uncertainty, seed=seed, resumed_encounters=len(done),
                    other_track_warnings=int(res["t_other_warning_s"].notna().sum()))  # fmt: skip
     write_table(res, out_dir / "encounters.parquet")
     res.to_csv(out_dir / "encounters.csv.partial", index=False)
@@ -181,4 +217,12 @@ def run(
     plot_encounters(res, out_dir / "encounters.png", buffer, cfg.levels[-1].alerting_time_s)
     summary["runtime_s"] = round(time.perf_counter() - t0, 1)
     write_json_atomic(out_dir / "summary.json", summary)
+    for name in (_PARTIAL, _PARTIAL + ".json"):
+        (out_dir / name).unlink(missing_ok=True)
     return summary
+
+
+def _version() -> str:
+    from importlib.metadata import version
+
+    return version("skyradar")

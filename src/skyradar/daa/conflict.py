@@ -129,7 +129,7 @@ def horizontal_violation(s: np.ndarray, v: np.ndarray, dthr_m, tthr_s=0.0) -> np
     # Unclipped closest approach of the whole line: only used where s.v < 0 (approaching).
     dcpa2 = dist2 - np.where(vv > 0, sv * sv / np.where(vv > 0, vv, 1.0), 0.0)
     dcpa = np.sqrt(np.maximum(dcpa2, 0.0))
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         taumod = np.where(sv < 0, (dthr**2 - dist2) / np.where(sv < 0, sv, -1.0), -1.0)
     return (dist2 <= dthr**2) | ((dcpa <= dthr) & (sv < 0) & (taumod >= 0) & (taumod <= tthr_s))
 

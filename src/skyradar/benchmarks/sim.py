@@ -146,9 +146,11 @@ def run(n_frames: int = 40, baseline_frames: int = 6, min_seconds: float = 2.0) 
 
     coarse = ImageSimulator(config, terrain, origin, facet_size_m=float("inf"), seed=1)
     fine = ImageSimulator(config, terrain, origin, seed=1)
-    fps = _time_frames(lambda i: coarse.frame(platform(i), frame_index=i), n_frames, min_seconds)
+    # Into one preallocated frame, as simulate_frames writes into its stack of frames.
+    buffer = np.empty((config.n_range, config.n_doppler, config.n_rx), np.complex64)
+    fps = _time_frames(lambda i: coarse.frame(platform(i), frame_index=i, out=buffer), n_frames, min_seconds)
     fps_fine = _time_frames(
-        lambda i: fine.frame(platform(i), frame_index=i), max(3, n_frames // 4), min_seconds
+        lambda i: fine.frame(platform(i), frame_index=i, out=buffer), max(3, n_frames // 4), min_seconds
     )
 
     ny, nx = terrain.shape

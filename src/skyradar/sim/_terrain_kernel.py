@@ -1,10 +1,12 @@
 """Compiled inner loop of the image-domain simulator: terrain facets into the range-Doppler cube.
 
-Everything per facet happens in one pass without intermediate arrays: bilinear sub-facet
-position, exact surface area and normal, behind-the-antenna and range culling, line-of-sight
-test against a polar horizon, two-way antenna gain, incidence-angle reflectivity, radar
-equation, exact two-way path phase per receive antenna, and the scatter-add into the pixel.
-Row blocks run in parallel, each into its own cube, so no two threads add into one pixel.
+Per sub-facet: bilinear position, exact surface area and normal, behind-the-antenna and range
+culling, line-of-sight test against a polar horizon, two-way antenna gain, incidence-angle
+reflectivity, radar equation, exact two-way path phase per receive antenna, and the
+scatter-add into the pixel. Whole grid cells are culled first. The sub-facets then go through
+the vectorised batches of ``_terrain_batch`` (a cell at a time, or a row's worth of small
+cells), or, as the reference, through the scalar loop here one at a time. Row blocks run in
+parallel, each into its own cube, so no two threads add into one pixel.
 """
 
 from __future__ import annotations
@@ -14,61 +16,23 @@ import math
 import numpy as np
 from numba import njit, prange, uint64
 
-__all__ = ["add_sparse", "cis_cycles", "fast_atan2", "horizon_map", "terrain_returns"]
+from skyradar.sim._elementary import cis_cycles, fast_atan2, wrap_index
+from skyradar.sim._terrain_batch import (
+    CELL_FIELDS,
+    cell_geometry,
+    cell_geometry_scalar,
+    item_returns,
+    scatter_items,
+)
 
-
-@njit(inline="always")
-def _bilinear(p, i, j, u, w, out):
-    for c in range(3):
-        out[c] = (
-            (1 - u) * (1 - w) * p[i, j, c]
-            + (1 - u) * w * p[i, j + 1, c]
-            + u * (1 - w) * p[i + 1, j, c]
-            + u * w * p[i + 1, j + 1, c]
-        )
-
-
-@njit(inline="always")
-def cis_cycles(x):
-    """(cos, sin) of 2*pi*x for any real ``x`` (cycles), error below 1e-9.
-
-    Reduce to the nearest quarter cycle, evaluate Taylor polynomials on [-pi/4, pi/4] and
-    rotate by the quadrant: about four times cheaper than libm's fmod + cos + sin, which
-    dominated the per-facet cost.
-    """
-    q = 4.0 * (x - math.floor(x))
-    n = math.floor(q + 0.5)
-    r = (q - n) * (0.5 * math.pi)
-    r2 = r * r
-    s = r * (1.0 - r2 / 6.0 * (1.0 - r2 / 20.0 * (1.0 - r2 / 42.0 * (1.0 - r2 / 72.0 * (1.0 - r2 / 110.0)))))
-    c = 1.0 - r2 / 2.0 * (
-        1.0 - r2 / 12.0 * (1.0 - r2 / 30.0 * (1.0 - r2 / 56.0 * (1.0 - r2 / 90.0 * (1.0 - r2 / 132.0))))
-    )
-    quadrant = int(n) % 4
-    if quadrant == 0:
-        return c, s
-    if quadrant == 1:
-        return -s, c
-    if quadrant == 2:
-        return -c, -s
-    return s, -c
-
-
-@njit(inline="always")
-def fast_atan2(y, x):
-    """atan2 to within 1.1e-5 rad (minimax polynomial on [0, 1] plus octant fix-ups)."""
-    ax, ay = abs(x), abs(y)
-    if ax == 0.0 and ay == 0.0:
-        return 0.0
-    swap = ay > ax
-    z = ax / ay if swap else ay / ax
-    z2 = z * z
-    a = z * (0.9998660 + z2 * (-0.3302995 + z2 * (0.1801410 + z2 * (-0.0851330 + z2 * 0.0208351))))
-    if swap:
-        a = 0.5 * math.pi - a
-    if x < 0.0:
-        a = math.pi - a
-    return -a if y < 0.0 else a
+__all__ = [
+    "add_sparse",
+    "cis_cycles",
+    "fast_atan2",
+    "relative_points",
+    "rotate_points",
+    "terrain_returns",
+]
 
 
 @njit(inline="always")
@@ -76,68 +40,9 @@ def _polar_bin(n, e, d, az_bin_rad, h_bin_m, n_az, n_h):
     # Azimuth bin, horizontal-range bin, and the slope -d/h (tan of the elevation angle: the
     # same order as the angle, without an atan2).
     h = math.sqrt(n * n + e * e)
-    a = int((fast_atan2(e, n) + math.pi) / az_bin_rad) % n_az
+    a = wrap_index(int((fast_atan2(e, n) + math.pi) / az_bin_rad), n_az)
     k = min(int(h / h_bin_m), n_h - 1)
     return a, k, -d / max(h, 1e-9)
-
-
-@njit(inline="always")
-def _cell_in_front(p_ned, rot_n2a, i, j):
-    for ci in range(2):
-        for cj in range(2):
-            xa = (
-                rot_n2a[0, 0] * p_ned[i + ci, j + cj, 0]
-                + rot_n2a[0, 1] * p_ned[i + ci, j + cj, 1]
-                + rot_n2a[0, 2] * p_ned[i + ci, j + cj, 2]
-            )
-            if xa > 0.0:
-                return True
-    return False
-
-
-@njit(parallel=True, cache=True)
-def horizon_map(p_ned, rot_n2a, nsub_r, nsub_c, r_lim, az_bin_rad, h_bin_m, n_az, n_h, n_blocks, sample_m):
-    """Steepest slope (tan of elevation) seen so far along each azimuth, before each range bin.
-
-    ``p_ned`` holds grid points relative to the antenna (NED, m). Returns an (n_az, n_h) array:
-    a facet in bin (a, k) is visible if its slope -down/horizontal is at least ``out[a, k]``. Only
-    cells in front of the antenna plane count: a ray from the antenna to a point in front
-    never passes behind the plane. Each sample stands for a patch ``sample_m`` wide, so it
-    raises every azimuth bin that patch spans (near samples span many bins): without this,
-    narrow bins between sparse near samples would let far terrain show through a ridge.
-    """
-    ny, nx = p_ned.shape[0], p_ned.shape[1]
-    best = np.full((n_blocks, n_az, n_h), -np.inf, dtype=np.float32)
-    for blk in prange(n_blocks):
-        pt = np.empty(3)
-        for i in range(blk, ny - 1, n_blocks):  # interleaved rows: blocks share the work evenly
-            for j in range(nx - 1):
-                if not _cell_in_front(p_ned, rot_n2a, i, j):
-                    continue
-                for a in range(nsub_r):
-                    u = (a + 0.5) / nsub_r
-                    for b in range(nsub_c):
-                        w = (b + 0.5) / nsub_c
-                        _bilinear(p_ned, i, j, u, w, pt)
-                        if pt[0] * pt[0] + pt[1] * pt[1] > r_lim * r_lim:
-                            continue
-                        ia, k, slope = _polar_bin(pt[0], pt[1], pt[2], az_bin_rad, h_bin_m, n_az, n_h)
-                        h = math.sqrt(pt[0] * pt[0] + pt[1] * pt[1])
-                        spread = min(int(0.5 * sample_m / (max(h, 1.0) * az_bin_rad)) + 1, n_az // 4)
-                        for da in range(-spread, spread + 1):
-                            ib = (ia + da) % n_az
-                            if slope > best[blk, ib, k]:
-                                best[blk, ib, k] = slope
-    # Exclusive running maximum along range: what lies strictly closer can hide a facet.
-    out = np.empty((n_az, n_h), dtype=np.float32)
-    for ia in prange(n_az):
-        running = -np.inf
-        for k in range(n_h):
-            out[ia, k] = running
-            for blk in range(n_blocks):
-                if best[blk, ia, k] > running:
-                    running = best[blk, ia, k]
-    return out
 
 
 @njit(inline="always")
@@ -210,15 +115,15 @@ def _cell_behind(p_ant, i, j):
 @njit(inline="always")
 def _cell_beyond(p_ant, i, j, r_max):
     # No point of the cell can be within r_max when its nearest corner is further than r_max
-    # plus the cell's largest extent.
-    nearest, extent = 1e300, 0.0
+    # plus the cell's largest extent (compared squared: no square roots).
+    nearest2, extent = 1e300, 0.0
     for ci in range(2):
         for cj in range(2):
             x, y, z = p_ant[i + ci, j + cj, 0], p_ant[i + ci, j + cj, 1], p_ant[i + ci, j + cj, 2]
-            nearest = min(nearest, math.sqrt(x * x + y * y + z * z))
+            nearest2 = min(nearest2, x * x + y * y + z * z)
     for c in range(3):
         extent += abs(p_ant[i + 1, j + 1, c] - p_ant[i, j, c]) + abs(p_ant[i + 1, j, c] - p_ant[i, j + 1, c])
-    return nearest > r_max + extent
+    return nearest2 > (r_max + extent) * (r_max + extent)
 
 
 @njit(inline="always")
@@ -260,20 +165,68 @@ def _accumulate(out, sparse, blk, kr, kd, amp, r_tx, r_rx, inv_wavelength):
             pixel[q] += complex(amp * cos_p, amp * sin_p)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
+def relative_points(grid, row0, row1, col0, col1, origin, out):
+    """``out[:] = grid[row0:row1, col0:col1] - origin``; ``out`` is (rows, cols, 3), C order.
+
+    numpy's broadcast subtract runs its inner loop over the last axis, three elements long,
+    and took 0.17 ms for a 5 km crop; this takes a tenth of that.
+    """
+    block = grid[row0:row1, col0:col1]
+    o0, o1, o2 = origin[0], origin[1], origin[2]
+    for i in range(block.shape[0]):
+        src, dst = block[i], out[i]
+        for j in range(dst.shape[0]):
+            dst[j, 0] = src[j, 0] - o0
+            dst[j, 1] = src[j, 1] - o1
+            dst[j, 2] = src[j, 2] - o2
+    return out
+
+
+@njit(parallel=True, cache=True, error_model="numpy")
 def add_sparse(frame, idx, val, count):
-    """Add recorded contributions into ``frame`` of shape (n_range * n_doppler, n_rx)."""
-    for blk in range(count.shape[0]):
-        for n in range(count[blk]):
-            for q in range(frame.shape[1]):
-                frame[idx[blk, n], q] += val[blk, n, q]
+    """Add recorded contributions into ``frame`` of shape (n_range * n_doppler, n_rx).
+
+    One share of the pixels per list (the lists are per thread): each thread takes a
+    contiguous share (the share its noise pass just wrote, still in its cache) and scans every
+    list for it. Per pixel the additions keep the order of the lists.
+    """
+    n_parts = count.shape[0]
+    n_pix = frame.shape[0]
+    for part in prange(n_parts):
+        lo, hi = part * n_pix // n_parts, (part + 1) * n_pix // n_parts
+        for blk in range(count.shape[0]):
+            pixels, values = idx[blk], val[blk]
+            for n in range(count[blk]):
+                p = pixels[n]
+                if p < lo or p >= hi:
+                    continue
+                # Unsigned pixel index (>= 0 by construction): no wrap-around check.
+                dst, src = frame[uint64(p)], values[n]
+                for q in range(dst.shape[0]):
+                    dst[q] += src[q]
 
 
-@njit(parallel=True, cache=True, fastmath=True)
+@njit(cache=True, error_model="numpy")
+def rotate_points(points, rot, out):
+    """``out[:] = points @ rot.T`` for (ny, nx, 3) points and a 3 x 3 rotation (C order)."""
+    r00, r01, r02, r10, r11, r12 = rot[0, 0], rot[0, 1], rot[0, 2], rot[1, 0], rot[1, 1], rot[1, 2]
+    r20, r21, r22 = rot[2, 0], rot[2, 1], rot[2, 2]
+    for i in range(points.shape[0]):
+        src, dst = points[i], out[i]
+        for j in range(src.shape[0]):
+            x, y, z = src[j, 0], src[j, 1], src[j, 2]
+            dst[j, 0] = r00 * x + r01 * y + r02 * z
+            dst[j, 1] = r10 * x + r11 * y + r12 * z
+            dst[j, 2] = r20 * x + r21 * y + r22 * z
+    return out
+
+
+@njit(parallel=True, cache=True, fastmath=True, error_model="numpy")
 def terrain_returns(
     p_ned, p_ant, up_ant, tx, rx, v_ground_ant, nsub_r, nsub_c, wavelength, d_range, d_vel, coupling,
     power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m, use_horizon, n_blocks, out,
-    sparse,
+    sparse, mode,
 ):  # fmt: skip
     """Accumulate terrain returns into ``out`` of shape (n_blocks, n_range, n_doppler, n_rx).
 
@@ -285,60 +238,102 @@ def terrain_returns(
     G^2 on a regular grid of antenna-frame direction cosines (u_y, u_z) over [-1, 1]^2 with
     spacing ``gain2_step``. ``sparse`` is (idx, val, count): with ``idx`` of shape (n_blocks, cap)
     and cap > 0 contributions are recorded there instead of added to ``out`` (see
-    :func:`add_sparse`). ``fastmath`` is safe here: every input is finite.
+    :func:`add_sparse`). ``mode`` 1 runs the vectorised batches of ``_terrain_batch``, 0 the
+    scalar loop below, one sub-facet at a time (the same physics term for term: the reference
+    the batches are tested against). ``fastmath`` is safe here: every input is finite.
     """
     ny, nx = p_ned.shape[0], p_ned.shape[1]
     n_range, n_dopp = out.shape[1], out.shape[2]
-    refl_step = 1.0 / (refl_table.shape[0] - 1)
     r_max = d_range * (n_range + 2)
+    n_sub = nsub_r * nsub_c
+    batched = mode == 1
+    # Cells are gathered into batches of up to 512 sub-facets (one cell at least), by row.
+    per_cell = n_sub >= 8  # then the cell's own geometry loops are long enough to vectorise
+    cap = max(n_sub, 512) if batched else 0
+    us, ws = np.empty(n_sub), np.empty(n_sub)
+    for m in range(n_sub):
+        us[m], ws[m] = (m // nsub_c + 0.5) / nsub_r, (m % nsub_c + 0.5) / nsub_c
+    inv_wl = 1.0 / wavelength
     for blk in prange(n_blocks):
         ta, tn, r_rx = np.empty((4, 3)), np.empty((4, 3)), np.empty(rx.shape[0])
+        scratch = np.zeros((CELL_FIELDS, cap))
+        r_rx_sub, cos_sin = np.empty((rx.shape[0], cap)), np.empty((2, rx.shape[0], cap), np.float32)
+        k = 0  # items in the batch
         for i in range(blk, ny - 1, n_blocks):  # interleaved rows: blocks share the work evenly
             for j in range(nx - 1):
-                if _cell_behind(p_ant, i, j) or _cell_beyond(p_ant, i, j, r_max):
+                skip = _cell_behind(p_ant, i, j) or _cell_beyond(p_ant, i, j, r_max)
+                if not skip:
+                    _corner_terms(p_ant, i, j, ta)
+                    if use_horizon:
+                        _corner_terms(p_ned, i, j, tn)
+                if batched:
+                    if not skip:
+                        if per_cell:
+                            cell_geometry(scratch, k, ta, tn, us, ws, up_ant, use_horizon)
+                        else:
+                            cell_geometry_scalar(scratch, k, ta, tn, us, ws, up_ant, use_horizon)
+                        k += n_sub
+                    # The batch is full, or the block's last cell is done: into the cube.
+                    if k > 0 and (k + n_sub > cap or (j == nx - 2 and i + n_blocks >= ny - 1)):
+                        item_returns(
+                            scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel,
+                            coupling, n_range, n_dopp, inv_wl, power_const, n_sub, gain2, gain2_step,
+                            refl_table, horizon, az_bin_rad, h_bin_m, use_horizon,
+                        )  # fmt: skip
+                        scatter_items(out, sparse, blk, scratch, cos_sin, k)
+                        k = 0
                     continue
-                _corner_terms(p_ant, i, j, ta)
-                if use_horizon:
-                    _corner_terms(p_ned, i, j, tn)
-                for a in range(nsub_r):
-                    u = (a + 0.5) / nsub_r
-                    for b in range(nsub_c):
-                        w = (b + 0.5) / nsub_c
-                        x = _patch_point(ta, u, w, 0)
-                        y, z = _patch_point(ta, u, w, 1), _patch_point(ta, u, w, 2)
-                        r0 = math.sqrt(x * x + y * y + z * z)
-                        if (
-                            x <= 0.0
-                            or r0 > r_max
-                            or (use_horizon and _hidden(tn, u, w, horizon, az_bin_rad, h_bin_m))
-                        ):
-                            continue
-                        nx_, ny_, nz_, area2 = _patch_normal(ta, u, w, up_ant)
-                        cos_inc = -(nx_ * x + ny_ * y + nz_ * z) / (area2 * r0 + 1e-300)
-                        if cos_inc <= 0.0:
-                            continue  # facet turned away from the radar (or degenerate)
-                        r_tx = _two_way_paths(x, y, z, tx, rx, r_rx)
-                        rng = 0.5 * (r_tx + r_rx.mean())
-                        v_r = (v_ground_ant[0] * x + v_ground_ant[1] * y + v_ground_ant[2] * z) / r0
-                        kr = int(math.floor((rng + coupling * v_r) / d_range + 0.5))
-                        if kr < 0 or kr >= n_range:
-                            continue
-                        kd = (int(math.floor(v_r / d_vel + 0.5)) + n_dopp // 2) % n_dopp
-                        power = (
-                            power_const
-                            * _table2(y / r0, z / r0, gain2_step, gain2)
-                            * _table(cos_inc, 0.0, refl_step, refl_table)
-                            * area2
-                            / (nsub_r * nsub_c)
-                        )
-                        _accumulate(
-                            out,
-                            sparse,
-                            blk,
-                            kr,
-                            kd,
-                            math.sqrt(power) / (rng * rng),
-                            r_tx,
-                            r_rx,
-                            1.0 / wavelength,
-                        )
+                if skip:
+                    continue
+                _reference_cell(
+                    ta, tn, up_ant, tx, rx, r_rx, v_ground_ant, nsub_r, nsub_c, wavelength, d_range, d_vel,
+                    coupling, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m,
+                    use_horizon, r_max, out, sparse, blk,
+                )  # fmt: skip
+
+
+@njit(inline="always")
+def _reference_cell(ta, tn, up_ant, tx, rx, r_rx, v_ground_ant, nsub_r, nsub_c, wavelength, d_range, d_vel,
+                    coupling, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m,
+                    use_horizon, r_max, out, sparse, blk):  # fmt: skip
+    """The scalar reference: one cell's sub-facets one at a time, with early exits."""
+    n_range, n_dopp = out.shape[1], out.shape[2]
+    refl_step = 1.0 / (refl_table.shape[0] - 1)
+    for a in range(nsub_r):
+        u = (a + 0.5) / nsub_r
+        for b in range(nsub_c):
+            w = (b + 0.5) / nsub_c
+            x = _patch_point(ta, u, w, 0)
+            y, z = _patch_point(ta, u, w, 1), _patch_point(ta, u, w, 2)
+            r0 = math.sqrt(x * x + y * y + z * z)
+            if x <= 0.0 or r0 > r_max or (use_horizon and _hidden(tn, u, w, horizon, az_bin_rad, h_bin_m)):
+                continue
+            nx_, ny_, nz_, area2 = _patch_normal(ta, u, w, up_ant)
+            cos_inc = -(nx_ * x + ny_ * y + nz_ * z) / (area2 * r0 + 1e-300)
+            if cos_inc <= 0.0:
+                continue  # facet turned away from the radar (or degenerate)
+            r_tx = _two_way_paths(x, y, z, tx, rx, r_rx)
+            rng = 0.5 * (r_tx + r_rx.mean())
+            v_r = (v_ground_ant[0] * x + v_ground_ant[1] * y + v_ground_ant[2] * z) / r0
+            kr = int(math.floor((rng + coupling * v_r) / d_range + 0.5))
+            if kr < 0 or kr >= n_range:
+                continue
+            kd = wrap_index(int(math.floor(v_r / d_vel + 0.5)) + n_dopp // 2, n_dopp)
+            power = (
+                power_const
+                * _table2(y / r0, z / r0, gain2_step, gain2)
+                * _table(cos_inc, 0.0, refl_step, refl_table)
+                * area2
+                / (nsub_r * nsub_c)
+            )
+            _accumulate(
+                out,
+                sparse,
+                blk,
+                kr,
+                kd,
+                math.sqrt(power) / (rng * rng),
+                r_tx,
+                r_rx,
+                1.0 / wavelength,
+            )

@@ -25,8 +25,14 @@ from numba import get_num_threads
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.geo import ned_rotation_to, ned_to_geodetic, rotation_matrix
+from skyradar.sim._horizon_kernel import horizon_map
 from skyradar.sim._noise_kernel import finalize_frame, frame_key
-from skyradar.sim._terrain_kernel import add_sparse, horizon_map, terrain_returns
+from skyradar.sim._terrain_kernel import (
+    add_sparse,
+    relative_points,
+    rotate_points,
+    terrain_returns,
+)
 from skyradar.sim.geometry import AntennaGeometry, PlatformState, PointTarget, TerrainView
 from skyradar.sim.targets import add_targets, line_of_sight, target_geometry
 
@@ -116,9 +122,16 @@ class ImageSimulator:
         self._gain2, self._gain2_step = two_way_gain_table(config)
         self._grid_ned = None
         self._blocks: np.ndarray | None = None
+        # 1: the kernel's vectorised batches; 0: its scalar reference loop (tests compare them).
+        self._kernel_mode = 1
+        # Per-frame work arrays kept between frames (fresh ones cost page faults every frame).
+        self._scratch: dict[str, np.ndarray] = {}
+        self._mount_rotation = config.mount.rotation
+        self._mount_position_m = np.asarray(config.mount.position_m, float)
         if terrain is not None:
             self._grid_ned = terrain.points_ned(*self.origin, flat_earth=self.flat_earth)
-            dy, dx = terrain.spacing_m
+            self._spacing_m = terrain.spacing_m
+            dy, dx = self._spacing_m
             self._nsub = (
                 max(1, int(np.ceil(dy / self.facet_size_m))),
                 max(1, int(np.ceil(dx / self.facet_size_m))),
@@ -139,46 +152,75 @@ class ImageSimulator:
             body_to_ned = (
                 ned_rotation_to(self.origin[0], self.origin[1], float(lat), float(lon)).T @ body_to_local
             )
-        ant_to_ned = body_to_ned @ self.config.mount.rotation
-        origin = pos + body_to_ned @ np.asarray(self.config.mount.position_m)
+        ant_to_ned = body_to_ned @ self._mount_rotation
+        origin = pos + body_to_ned @ self._mount_position_m
         return AntennaGeometry(
             origin, ant_to_ned.T, np.asarray(platform.velocity_ned_mps, float), float(lat), float(lon)
         )
 
     # ---- one frame --------------------------------------------------------------------------
     def frame(
-        self, platform: PlatformState, targets: Sequence[PointTarget] = (), frame_index: int = 0
+        self,
+        platform: PlatformState,
+        targets: Sequence[PointTarget] = (),
+        frame_index: int = 0,
+        out: np.ndarray | None = None,
     ) -> np.ndarray:
-        """Simulate one frame; returns (n_range, n_doppler, n_rx) complex64."""
+        """Simulate one frame; returns (n_range, n_doppler, n_rx) complex64.
+
+        ``out``, if given, is a C-contiguous complex64 array of that shape that receives the
+        frame (and is returned): a caller filling a preallocated stack of frames skips a fresh
+        2.7 MB allocation and its page faults per frame.
+        """
         cfg = self.config
         geom = self.geometry(platform)
-        view = self.terrain_view(geom)
-        frame = np.empty((cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
+        view = self._terrain_view(geom, self._scratch)
+        frame = self._output(out)
         sigma = np.sqrt(cfg.noise_power_w / 2.0) if self.noise else 0.0
         key = frame_key(self.seed, int(frame_index))
         if view is None:
             finalize_frame(self._no_blocks(), sigma, key, frame)
         elif self._sparse_suits(view):
-            sparse = self._sparse_buffers(view)
-            self._accumulate_terrain(geom, view, self._no_blocks(), sparse)
+            sparse = self._sparse_buffers(view, self._scratch)
+            self._accumulate_terrain(geom, view, self._no_blocks(), sparse, self._scratch)
             finalize_frame(self._no_blocks(), sigma, key, frame)
             add_sparse(frame.reshape(-1, cfg.n_rx), *sparse)
         else:
             blocks = self._accumulation_blocks()
-            self._accumulate_terrain(geom, view, blocks, _NO_SPARSE)
+            self._accumulate_terrain(geom, view, blocks, _NO_SPARSE, self._scratch)
             finalize_frame(blocks, sigma, key, frame)
         if targets:
             add_targets(frame, cfg, geom, targets, self.coupling_s, line_of_sight(view, geom, targets))
         return frame
 
+    def _output(self, out: np.ndarray | None) -> np.ndarray:
+        cfg = self.config
+        shape = (cfg.n_range, cfg.n_doppler, cfg.n_rx)
+        if out is None:
+            return np.empty(shape, np.complex64)
+        if out.shape != shape or out.dtype != np.complex64 or not out.flags.c_contiguous:
+            raise InputError(
+                f"simulation: out must be a C-contiguous complex64 array of shape {shape}, "
+                f"got {out.dtype} {out.shape}" + ("" if out.flags.c_contiguous else " (not contiguous)")
+            )
+        return out
+
     def terrain_view(self, geom: AntennaGeometry) -> TerrainView | None:
         """Terrain cropped around the antenna, with its horizon, for one frame (None: none in range)."""
+        return self._terrain_view(geom, None)
+
+    def _terrain_view(self, geom: AntennaGeometry, scratch: dict | None) -> TerrainView | None:
+        # With ``scratch`` the points land in an array reused by the next frame: only for a
+        # view that does not outlive the frame.
         if self.terrain is None:
             return None
         crop = self._crop(geom)
         if crop is None:
             return None
-        p_ned = np.ascontiguousarray(self._grid_ned[crop] - geom.origin_ned_m)
+        rows, cols = crop
+        p_ned = _array(scratch, "p_ned", (rows.stop - rows.start, cols.stop - cols.start, 3), np.float64)
+        origin = np.asarray(geom.origin_ned_m, float)
+        relative_points(self._grid_ned, rows.start, rows.stop, cols.start, cols.stop, origin, p_ned)
         return TerrainView(p_ned, *self._horizon(p_ned, geom, get_num_threads()))
 
     def terrain_cube(self, geom: AntennaGeometry, view: TerrainView | None = None) -> np.ndarray:
@@ -210,22 +252,29 @@ class ImageSimulator:
             1
         ] <= self.config.n_range * self.config.n_doppler
 
-    def _sparse_buffers(self, view: TerrainView) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _sparse_buffers(
+        self, view: TerrainView, scratch: dict | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         n_blocks = get_num_threads()
         ny, nx = view.p_ned.shape[:2]
         cap = -(-(ny - 1) // n_blocks) * (nx - 1) * self._nsub[0] * self._nsub[1]
         return (
-            np.empty((n_blocks, cap), np.int64),
-            np.empty((n_blocks, cap, self.config.n_rx), np.complex64),
+            _array(scratch, "sparse_idx", (n_blocks, cap), np.int64),
+            _array(scratch, "sparse_val", (n_blocks, cap, self.config.n_rx), np.complex64),
             np.zeros(n_blocks, np.int64),
         )
 
     def _accumulate_terrain(
-        self, geom: AntennaGeometry, view: TerrainView, blocks: np.ndarray, sparse
+        self,
+        geom: AntennaGeometry,
+        view: TerrainView,
+        blocks: np.ndarray,
+        sparse,
+        scratch: dict | None = None,
     ) -> None:
         cfg = self.config
         rot = geom.rot_ned_to_ant
-        p_ant = np.ascontiguousarray(view.p_ned @ rot.T)
+        p_ant = rotate_points(view.p_ned, rot, _array(scratch, "p_ant", view.p_ned.shape, np.float64))
         power_const = cfg.pe_w * cfg.wavelength_m**2 / (4 * np.pi) ** 3 * self.ground_gain
         v_ground = rot @ (-geom.velocity_ned_mps)
         terrain_returns(
@@ -233,7 +282,7 @@ class ImageSimulator:
             self._nsub[0], self._nsub[1], cfg.wavelength_m, cfg.range_resolution_m,
             cfg.doppler_resolution_mps, self.coupling_s, power_const, self._gain2, self._gain2_step,
             self._refl_table, view.horizon, view.az_bin_rad, view.h_bin_m, self.occlusion,
-            get_num_threads(), blocks, sparse,
+            blocks.shape[0] or sparse[0].shape[0], blocks, sparse, self._kernel_mode,
         )  # fmt: skip
 
     def _horizon(
@@ -246,12 +295,12 @@ class ImageSimulator:
         # The horizon follows the terrain's shape, which the DEM resolves at its own spacing:
         # 2 x 2 samples per DEM cell and bins of half the spacing, not every sub-facet.
         h_nsub = (min(self._nsub[0], 2), min(self._nsub[1], 2))
-        h_bin = max(self._facet_m, min(self.terrain.spacing_m) / 2.0)
+        h_bin = max(self._facet_m, min(self._spacing_m) / 2.0)
         n_az = int(np.ceil(2 * np.pi * (r_lim / 2.0) / h_bin))
         n_h = int(np.ceil(r_lim / h_bin)) + 1
         az_bin = 2 * np.pi / n_az
         # Each horizon sample stands for a patch this wide (see horizon_map).
-        sample_m = max(self.terrain.spacing_m[0] / h_nsub[0], self.terrain.spacing_m[1] / h_nsub[1])
+        sample_m = max(self._spacing_m[0] / h_nsub[0], self._spacing_m[1] / h_nsub[1])
         horizon = horizon_map(
             p_ned,
             geom.rot_ned_to_ant,
@@ -269,11 +318,7 @@ class ImageSimulator:
 
     def _crop(self, geom: AntennaGeometry) -> tuple[slice, slice] | None:
         # Crop around the platform; the mount offset (metres) is added to the reach.
-        reach = (
-            self.config.range_limit_m
-            + 2 * self._facet_m
-            + float(np.linalg.norm(self.config.mount.position_m))
-        )
+        reach = self.config.range_limit_m + 2 * self._facet_m + float(np.linalg.norm(self._mount_position_m))
         rows, cols = self.terrain.crop_window(geom.lat_deg, geom.lon_deg, reach)
         if rows.stop - rows.start < 2 or cols.stop - cols.start < 2:
             return None
@@ -313,6 +358,16 @@ def _reflectivity_table(reflectivity: str | Callable[[np.ndarray], np.ndarray], 
     if table.shape != (n,) or not np.all(np.isfinite(table)) or np.any(table < 0):
         raise InputError("simulation.reflectivity: the function must return finite non-negative factors")
     return table
+
+
+def _array(scratch: dict | None, name: str, shape: tuple[int, ...], dtype) -> np.ndarray:
+    """An uninitialised array, kept in ``scratch`` and reused while the shape stays (None: fresh)."""
+    if scratch is None:
+        return np.empty(shape, dtype)
+    array = scratch.get(name)
+    if array is None or array.shape != tuple(shape) or array.dtype != dtype:
+        array = scratch[name] = np.empty(shape, dtype)
+    return array
 
 
 _NO_SPARSE = (np.empty((1, 0), np.int64), np.empty((1, 0, 1), np.complex64), np.zeros(1, np.int64))

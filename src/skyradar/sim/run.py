@@ -83,7 +83,7 @@ def simulate_frames(built, indices: np.ndarray, simulator: ImageSimulator | None
     impairments = getattr(built, "impairments", None)
     for i, frame_index in enumerate(indices):
         platform, targets, _ = _frame_inputs(own, intruders, i)
-        out[i] = simulator.frame(platform, targets, frame_index=int(frame_index))
+        simulator.frame(platform, targets, frame_index=int(frame_index), out=out[i])
         if impairments is not None:
             # Seeded per frame like the thermal noise: any chunking gives the same bytes.
             out[i] = apply_impairments(out[i], cfg, impairments, int(frame_index))

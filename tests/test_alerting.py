@@ -217,3 +217,20 @@ def test_young_tracks_do_not_alert():
     t, raw = out["time_s"].to_numpy(), out["raw_level"].to_numpy()
     assert (raw[t < 2.0] == 0).all() and (raw[t >= 2.0] == 3).all()
     assert t[np.argmax(out["level"].to_numpy() == 3)] == pytest.approx(2.0 + DT)
+
+
+def test_m_of_n_over_periods_counts_seconds_not_frames():
+    # 5 frames/s. DAIDALUS' 2 of 4 at 1 Hz: half of the last 4 s of frames must reach the level.
+    t = np.round(np.arange(0.0, 10.0, 0.2), 6)
+    raw = np.where(t >= 3.0, 3, 0)
+    kw = {"m": 2, "n": 4, "persistence_s": 0.0, "hysteresis_s": 0.0}
+    by_period = filter_alert_levels(t, raw, AlertConfig(period_s=1.0, **kw))
+    by_frame = filter_alert_levels(t, raw, AlertConfig(**kw))
+    assert t[np.argmax(by_frame == 3)] == pytest.approx(3.2)  # 2 of the last 4 frames
+    assert t[np.argmax(by_period == 3)] == pytest.approx(4.8)  # 10 of the 20 frames in (0.8, 4.8]
+    # A 0.4 s flicker raises a frame-based alert but not a period-based one.
+    flicker = np.where((t >= 3.0) & (t < 3.4), 3, 0)
+    assert filter_alert_levels(t, flicker, AlertConfig(**kw)).max() == 3
+    assert filter_alert_levels(t, flicker, AlertConfig(period_s=1.0, **kw)).max() == 0
+    with pytest.raises(ValueError, match="period_s"):
+        AlertConfig(period_s=0.0)

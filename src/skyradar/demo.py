@@ -21,12 +21,11 @@ from importlib.resources import files
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pandas as pd
-import xarray as xr
 
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG
 from skyradar.errors import InputError
+from skyradar.experiments.chain import label_tracks
 from skyradar.experiments.chain import run_chain as _run_chain
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.scene.scenario import load_scenario
@@ -48,7 +47,6 @@ DEMO_SCENARIO = "demo_circuit.yaml"
 # warning volume to kilometres.
 DEMO_ALERT_CONFIG = RADAR_ALERT_CONFIG
 LEVEL_NAMES = {0: "none", 1: "preventive", 2: "corrective", 3: "WARNING"}
-_MATCH_M = 300.0  # a track is an intruder's if its median distance to that truth is below this
 
 
 def demo_scenario_path() -> Path:
@@ -59,33 +57,6 @@ def demo_scenario_path() -> Path:
 def run_chain(built, keep_frames: tuple[int, ...] = ()) -> dict[str, Any]:
     """:func:`skyradar.experiments.chain.run_chain` with :data:`DEMO_ALERT_CONFIG`."""
     return _run_chain(built, DEMO_ALERT_CONFIG, keep_frames)
-
-
-def label_tracks(tracks: pd.DataFrame, truth: xr.Dataset, max_distance_m: float = _MATCH_M) -> dict[int, str]:
-    """Name of the intruder each track follows (median 3-D distance to its truth), else ``'clutter'``.
-
-    Examples
-    --------
-    >>> t = xr.Dataset({"tgt_north_m": (("time", "target"), [[0.0]]), "tgt_east_m": (("time", "target"),
-    ...     [[0.0]]), "tgt_down_m": (("time", "target"), [[0.0]])}, coords={"time": [0.0], "target": ["a"]})
-    >>> tr = pd.DataFrame({"time_s": [0.0, 0.0], "track_id": [1, 2], "north_m": [10.0, 900.0],
-    ...     "east_m": [0.0, 0.0], "down_m": [0.0, 0.0]})
-    >>> label_tracks(tr, t)
-    {1: 'a', 2: 'clutter'}
-    """
-    times = np.asarray(truth["time"].values, float)
-    names = [str(x) for x in truth["target"].values]
-    truth_pos = np.stack([truth[f"tgt_{a}_m"].values for a in ("north", "east", "down")], -1)
-    labels = {}
-    for tid, g in tracks.groupby("track_id"):
-        idx = np.clip(np.searchsorted(times, g["time_s"].to_numpy(float)), 0, times.size - 1)
-        err = g[["north_m", "east_m", "down_m"]].to_numpy(float)[:, None, :] - truth_pos[idx]
-        with np.errstate(all="ignore"):
-            dist = np.linalg.norm(err, axis=-1)
-            med = np.array([np.nanmedian(d) if np.isfinite(d).any() else np.inf for d in dist.T])
-        best = int(np.argmin(med)) if med.size else -1
-        labels[int(tid)] = names[best] if best >= 0 and med[best] < max_distance_m else "clutter"
-    return labels
 
 
 def alert_timeline(alerts: pd.DataFrame, labels: dict[int, str]) -> pd.DataFrame:

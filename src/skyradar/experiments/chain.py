@@ -21,7 +21,9 @@ from skyradar.process.pipeline import process_frames
 from skyradar.sim.run import make_simulator, scenario_truth, simulate_frames
 from skyradar.track.run import track_detections
 
-__all__ = ["run_chain"]
+__all__ = ["run_chain", "label_tracks"]
+
+_MATCH_M = 300.0  # a track is an intruder's if its median distance to that truth is below this
 
 
 def _truth_dataset(built, simulator) -> xr.Dataset:
@@ -100,3 +102,30 @@ def run_chain(
     timings["alert"] = time.perf_counter() - t0
     return {"truth": truth, "detections": det, "tracks": tracks, "alerts": alerts, "ownship": own,
             "rd_frames": rd, "timings_s": timings}  # fmt: skip
+
+
+def label_tracks(tracks: pd.DataFrame, truth: xr.Dataset, max_distance_m: float = _MATCH_M) -> dict[int, str]:
+    """Name of the intruder each track follows (median 3-D distance to its truth), else ``'clutter'``.
+
+    Examples
+    --------
+    >>> t = xr.Dataset({"tgt_north_m": (("time", "target"), [[0.0]]), "tgt_east_m": (("time", "target"),
+    ...     [[0.0]]), "tgt_down_m": (("time", "target"), [[0.0]])}, coords={"time": [0.0], "target": ["a"]})
+    >>> tr = pd.DataFrame({"time_s": [0.0, 0.0], "track_id": [1, 2], "north_m": [10.0, 900.0],
+    ...     "east_m": [0.0, 0.0], "down_m": [0.0, 0.0]})
+    >>> label_tracks(tr, t)
+    {1: 'a', 2: 'clutter'}
+    """
+    times = np.asarray(truth["time"].values, float)
+    names = [str(x) for x in truth["target"].values]
+    truth_pos = np.stack([truth[f"tgt_{a}_m"].values for a in ("north", "east", "down")], -1)
+    labels = {}
+    for tid, g in tracks.groupby("track_id"):
+        idx = np.clip(np.searchsorted(times, g["time_s"].to_numpy(float)), 0, times.size - 1)
+        err = g[["north_m", "east_m", "down_m"]].to_numpy(float)[:, None, :] - truth_pos[idx]
+        with np.errstate(all="ignore"):
+            dist = np.linalg.norm(err, axis=-1)
+            med = np.array([np.nanmedian(d) if np.isfinite(d).any() else np.inf for d in dist.T])
+        best = int(np.argmin(med)) if med.size else -1
+        labels[int(tid)] = names[best] if best >= 0 and med[best] < max_distance_m else "clutter"
+    return labels

@@ -28,8 +28,7 @@ import numpy as np
 import pandas as pd
 
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig
-from skyradar.demo import label_tracks
-from skyradar.experiments.chain import run_chain
+from skyradar.experiments.chain import label_tracks, run_chain
 from skyradar.experiments.encounter_set import (
     encounter_scenario,
     make_encounters,

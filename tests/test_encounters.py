@@ -134,6 +134,7 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
         "frame_rate_hz": 4.7,
         "buffer": 1.5,
         "uncertainty": True,
+        "terrain": None,
         "version": E._version(),
     }
     _, save = E._partial_store(tmp_path, key)
@@ -150,3 +151,15 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
     # Different settings never reuse another run's rows.
     save({0: fake})
     assert E._partial_store(tmp_path, {**key, "seed": 6})[0] == {}
+
+
+def test_flat_terrain_variant_puts_ground_under_the_whole_window():
+    d = encounter_scenario(_row(), T_CPA_S - 40.0, 42.0, 4.7, 0, terrain="flat")
+    built = Scenario.from_dict(d).build()
+    assert built.terrain is not None and d["simulation"]["facet_size_m"] == 30.0
+    own = built.ownship.sample(built.times_s).position_ned_m
+    # Own-ship passes the origin at the CPA, so the ground reaches past the range limit all along.
+    assert np.abs(own[:, 0]).max() + built.radar.range_limit_m < 8000.0
+    assert own[:, 2] == pytest.approx(-1000.0)
+    with pytest.raises(ValueError, match="terrain"):
+        encounter_scenario(_row(), 0.0, 1.0, 4.7, 0, terrain="hills")

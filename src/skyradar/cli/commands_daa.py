@@ -98,6 +98,10 @@ def experiment_encounters(
     no_uncertainty: Annotated[
         bool, typer.Option("--no-uncertainty", help="Do not widen the volumes by the track covariance.")
     ] = False,
+    terrain: Annotated[
+        str,
+        typer.Option(help="'none' (clear sky) or 'flat' (flat ground 1000 m below: clutter; slower)."),
+    ] = "none",
     as_json: JsonOption = False,
 ) -> None:
     """Encounter set (head-on, crossing, converging, overtaking, climbing; conflicts and near misses),
@@ -105,12 +109,17 @@ def experiment_encounters(
     warnings, and the warning lead.
     """
     from skyradar.cli.commands_sim import frame_progress
+    from skyradar.errors import InputError
     from skyradar.experiments.encounters import run
+
+    if terrain not in ("none", "flat"):
+        raise InputError(f"experiment encounters: option '--terrain' must be none or flat, got {terrain!r}")
 
     with frame_progress(n, "encounters") as bar:
         task = bar.add_task("encounters", total=n)
         result = run(
             out, n_encounters=n, seed=seed, frame_rate_hz=frame_rate, buffer=buffer, workers=workers,
             uncertainty=not no_uncertainty, progress=lambda k: bar.update(task, completed=k),
+            terrain=None if terrain == "none" else terrain,
         )  # fmt: skip
     emit_result(result, as_json, "encounters")

@@ -102,24 +102,39 @@ def _intruder_spec(p: pd.Series) -> dict[str, Any]:
 
 
 def encounter_scenario(
-    p: pd.Series, start_s: float, duration_s: float, frame_rate_hz: float, seed: int
+    p: pd.Series,
+    start_s: float,
+    duration_s: float,
+    frame_rate_hz: float,
+    seed: int,
+    terrain: str | None = None,
 ) -> dict[str, Any]:
     """Scenario dict (:meth:`skyradar.scene.scenario.Scenario.from_dict`) of one encounter row.
 
-    No terrain: the encounters are flown in clear sky, so every detection is the intruder or noise.
+    Own-ship passes the origin at the CPA. ``terrain``: None flies the encounter in clear sky
+    (every detection is the intruder or noise); ``"flat"`` puts flat ground ``OWN_ALTITUDE_M``
+    below, 16 km square around the origin, simulated with 30 m facets (two range bins), so the
+    ground clutter fills the range-Doppler image behind and around the intruder.
     """
-    return {
+    scenario = {
         "name": f"encounter {p['kind']}",
         "origin": {"lat_deg": 52.0, "lon_deg": 5.0, "alt_m": 0.0},
         "mount": "forward",
-        "ownship": {"type": "straight", "start_ned_m": [0.0, 0.0, -OWN_ALTITUDE_M], "heading_deg": 0.0,
-                    "speed_mps": OWN_SPEED_MPS, "start_time_s": 0.0, "duration_s": T_CPA_S + 10.0},
+        "ownship": {"type": "straight", "start_ned_m": [-OWN_SPEED_MPS * T_CPA_S, 0.0, -OWN_ALTITUDE_M],
+                    "heading_deg": 0.0, "speed_mps": OWN_SPEED_MPS, "start_time_s": 0.0,
+                    "duration_s": T_CPA_S + 10.0},
         "intruders": [_intruder_spec(p)],
         "frame_rate_hz": frame_rate_hz,
         "start_s": float(start_s),
         "duration_s": float(duration_s),
         "simulation": {"noise": True, "seed": int(seed)},
     }  # fmt: skip
+    if terrain == "flat":
+        scenario["terrain"] = {"type": "flat", "size_m": 16_000.0, "spacing_m": 30.0}
+        scenario["simulation"]["facet_size_m"] = 30.0
+    elif terrain is not None:
+        raise ValueError(f"encounters: terrain must be None or 'flat', got {terrain!r}")
+    return scenario
 
 
 def relative_truth(built) -> tuple[np.ndarray, np.ndarray]:

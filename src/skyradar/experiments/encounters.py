@@ -49,7 +49,7 @@ _PARTIAL = "encounters.partial.parquet"
 
 def _window(p: pd.Series, frame_rate_hz: float, lookback_s: float, seed: int) -> tuple[float, float]:
     """Frame window (start, duration) in s: ``lookback_s`` before the LoWC or CPA, in range."""
-    built = Scenario.from_dict(encounter_scenario(p, 0.0, 1.0, frame_rate_hz, seed)).build()
+    built = Scenario.from_dict(encounter_scenario(p, 0.0, 1.0, frame_rate_hz, seed, None)).build()
     t, rel = relative_truth(built)
     lowc = score_encounter(t, rel, np.array([]), pd.DataFrame({"time_s": [], "observable": []}), 1.0, 0.0)
     t_event = lowc["t_lowc_s"] if lowc["conflict"] else lowc["t_cpa_s"]
@@ -80,6 +80,7 @@ def run_encounter(
     min_snr_db: float = 13.0,
     observe_window_s: float = 12.5,
     alert_config: AlertConfig | None = None,
+    terrain: str | None = None,
 ) -> dict[str, Any]:
     """One encounter row through the full chain; its result row (times in s, NaN when none).
 
@@ -87,7 +88,7 @@ def run_encounter(
     ``t_other_warning_s`` the first warning of any other track (noise).
     """
     start, duration = _window(p, frame_rate_hz, lookback_s, seed)
-    built = Scenario.from_dict(encounter_scenario(p, start, duration, frame_rate_hz, seed)).build()
+    built = Scenario.from_dict(encounter_scenario(p, start, duration, frame_rate_hz, seed, terrain)).build()
     chain = run_chain(built, alert_config or ENCOUNTER_ALERT_CONFIG, with_advice=False)
     labels = label_tracks(chain["tracks"], chain["truth"])
     alerts = chain["alerts"]
@@ -186,14 +187,17 @@ def run(
     workers: int | None = None,
     uncertainty: bool = True,
     progress: Callable[[int], None] | None = None,
+    terrain: str | None = None,
 ) -> dict:
     """Run the encounter set; write ``encounters.parquet``, ``encounters.csv``, ``summary.json`` and
     ``encounters.png`` into ``out_dir``; return the summary.
 
     ``uncertainty=False`` turns off the widening of the volumes by the track covariance. A warning
     with less lead than ``late_lead_s`` (default half the 25 s warning alerting time) is late.
-    Finished encounters are kept in ``encounters.partial.parquet`` while the run goes on; a run
-    that was interrupted resumes from them when started again with the same settings.
+    ``terrain="flat"`` flies the set over flat ground (clutter, slower; see
+    :func:`~skyradar.experiments.encounter_set.encounter_scenario`). Finished encounters are kept
+    in ``encounters.partial.parquet`` while the run goes on; a run that was interrupted resumes
+    from them when started again with the same settings.
     """
     t0 = time.perf_counter()
     out_dir = Path(out_dir)
@@ -203,14 +207,15 @@ def run(
         cfg = replace(cfg, z_h_pos=0.0, z_h_vel=0.0, z_v_pos=0.0, z_v_vel=0.0)
     enc = make_encounters(n_encounters, seed)
     key = {"n": n_encounters, "seed": seed, "frame_rate_hz": frame_rate_hz, "buffer": buffer,
-           "uncertainty": uncertainty, "version": _version()}  # fmt: skip
+           "uncertainty": uncertainty, "terrain": terrain, "version": _version()}  # fmt: skip
     done, save = _partial_store(out_dir, key)
     out = run_encounters(enc, seed, workers, progress, done, save, frame_rate_hz=frame_rate_hz, buffer=buffer,
-                         alert_config=cfg)  # fmt: skip
+                         alert_config=cfg, terrain=terrain)  # fmt: skip
     res = pd.concat([enc, out], axis=1)
     summary = summarise(res, late_lead_s)
     summary.update(chain="full", frames=int(res["frames"].sum()), frame_rate_hz=frame_rate_hz, buffer=buffer,
-                   uncertainty=uncertainty, seed=seed, resumed_encounters=len(done),
+                   uncertainty=uncertainty, seed=seed, terrain=terrain or "none",
+                   resumed_encounters=len(done),
                    other_track_warnings=int(res["t_other_warning_s"].notna().sum()))  # fmt: skip
     write_table(res, out_dir / "encounters.parquet")
     res.to_csv(out_dir / "encounters.csv.partial", index=False)

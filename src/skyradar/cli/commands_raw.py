@@ -58,7 +58,7 @@ def bench_chain(
     as_json: JsonOption = False,
     flight_frames: Annotated[
         int, typer.Option(help="Frames of the whole-flight simulation run on 1 and 2 Dask workers (0: skip).")
-    ] = 600,
+    ] = 2400,
 ) -> None:
     """ADC cube -> range-Doppler cube throughput, and whole-flight simulation on 1 vs 2 Dask workers.
 

@@ -133,7 +133,7 @@ def sweep(
 @bench_app.command("flight")
 def bench_flight(
     json_out: JsonOption = False,
-    frames: Annotated[int, typer.Option(help="Frames for the 1- versus 2-worker throughput runs.")] = 600,
+    frames: Annotated[int, typer.Option(help="Frames for the 1- versus 2-worker throughput runs.")] = 2400,
     long_frames: Annotated[
         int, typer.Option(help="Also run a whole flight of this many frames (memory).")
     ] = 0,

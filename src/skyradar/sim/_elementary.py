@@ -20,6 +20,20 @@ _COS_F32 = tuple(np.float32(c) for c in (-1 / 2, 1 / 24, -1 / 720, 1 / 40320))
 
 
 @njit(inline="always")
+def _by_quadrant(c, s, n):
+    """(cos, sin) of the angle ``n`` quarter turns past the one whose (cos, sin) is (c, s)."""
+    # Selects, not branches: the quadrant of a path phase is random, and the mispredicted
+    # branches cost more than the polynomials.
+    quadrant = int(n) & 3
+    odd = (quadrant & 1) != 0
+    cos_q = s if odd else c
+    sin_q = c if odd else s
+    cos_q = -cos_q if quadrant == 1 or quadrant == 2 else cos_q
+    sin_q = -sin_q if quadrant >= 2 else sin_q
+    return cos_q, sin_q
+
+
+@njit(inline="always")
 def cis_cycles(x):
     """(cos, sin) of 2*pi*x for any real ``x`` (cycles), error below 1e-9.
 
@@ -35,15 +49,7 @@ def cis_cycles(x):
     c = 1.0 - r2 / 2.0 * (
         1.0 - r2 / 12.0 * (1.0 - r2 / 30.0 * (1.0 - r2 / 56.0 * (1.0 - r2 / 90.0 * (1.0 - r2 / 132.0))))
     )
-    # Rotate by the quadrant with selects, not branches: the quadrant of a path phase is
-    # random, and the mispredicted branches cost more than the polynomials.
-    quadrant = int(n) & 3
-    odd = (quadrant & 1) != 0
-    cos_q = s if odd else c
-    sin_q = c if odd else s
-    cos_q = -cos_q if quadrant == 1 or quadrant == 2 else cos_q
-    sin_q = -sin_q if quadrant >= 2 else sin_q
-    return cos_q, sin_q
+    return _by_quadrant(c, s, n)
 
 
 @njit(inline="always")
@@ -60,13 +66,7 @@ def cis_cycles_f32(x):
     r2 = r * r
     s = r * (_F1 + r2 * (_SIN_F32[0] + r2 * (_SIN_F32[1] + r2 * (_SIN_F32[2] + r2 * _SIN_F32[3]))))
     c = _F1 + r2 * (_COS_F32[0] + r2 * (_COS_F32[1] + r2 * (_COS_F32[2] + r2 * _COS_F32[3])))
-    quadrant = int(n) & 3
-    odd = (quadrant & 1) != 0
-    cos_q = s if odd else c
-    sin_q = c if odd else s
-    cos_q = -cos_q if quadrant == 1 or quadrant == 2 else cos_q
-    sin_q = -sin_q if quadrant >= 2 else sin_q
-    return cos_q, sin_q
+    return _by_quadrant(c, s, n)
 
 
 @njit(inline="always")

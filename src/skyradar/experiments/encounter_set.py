@@ -32,6 +32,7 @@ __all__ = [
     "make_encounters",
     "encounter_scenario",
     "relative_truth",
+    "event_times",
     "score_encounter",
     "summarise",
     "plot_encounters",
@@ -149,6 +150,21 @@ def _first(mask: np.ndarray, t: np.ndarray) -> float:
     return float(t[np.argmax(mask)]) if mask.any() else float("nan")
 
 
+def event_times(t: np.ndarray, rel: np.ndarray) -> tuple[float, float]:
+    """First loss of well clear (NaN: none) and closest approach of a dense relative truth, s.
+
+    Examples
+    --------
+    >>> t = np.arange(0.0, 20.0, 0.5)
+    >>> rel = np.stack([1000.0 - 100.0 * t, np.zeros_like(t), np.zeros_like(t)], axis=1)
+    >>> event_times(t, rel)
+    (3.5, 10.0)
+    """
+    vol = WellClearVolume.do365_noncoop()
+    lowc = (np.hypot(rel[:, 0], rel[:, 1]) <= vol.dthr_m) & (np.abs(rel[:, 2]) <= vol.zthr_m)
+    return _first(lowc, t), float(t[np.argmin(np.linalg.norm(rel, axis=1))])
+
+
 def score_encounter(
     t: np.ndarray, rel: np.ndarray, warn_times_s: np.ndarray, observed: pd.DataFrame, buffer: float,
     observe_window_s: float,
@@ -161,7 +177,7 @@ def score_encounter(
     """
     vol = WellClearVolume.do365_noncoop()
     horiz, vert = np.hypot(rel[:, 0], rel[:, 1]), np.abs(rel[:, 2])
-    t_lowc = _first((horiz <= vol.dthr_m) & (vert <= vol.zthr_m), t)
+    t_lowc, t_cpa = event_times(t, rel)
     in_buffer = (horiz <= buffer * vol.dthr_m) & (vert <= buffer * vol.zthr_m)
     warn = np.sort(np.asarray(warn_times_s, float))
     t_warn = float(warn[0]) if warn.size else float("nan")
@@ -173,7 +189,7 @@ def score_encounter(
         observable = bool(window.any() and ok[window].all())
     return {
         "t_lowc_s": t_lowc,
-        "t_cpa_s": float(t[np.argmin(np.linalg.norm(rel, axis=1))]),
+        "t_cpa_s": t_cpa,
         "conflict": conflict,
         "may_alert": bool(not conflict and in_buffer.any()),
         "observable": observable,

@@ -31,6 +31,7 @@ from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig
 from skyradar.experiments.chain import label_tracks, run_chain
 from skyradar.experiments.encounter_set import (
     encounter_scenario,
+    event_times,
     make_encounters,
     plot_encounters,
     relative_truth,
@@ -40,24 +41,26 @@ from skyradar.experiments.encounter_set import (
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.scene.scenario import Scenario
 
-__all__ = ["ENCOUNTER_ALERT_CONFIG", "run_encounter", "run_encounters", "run"]
+__all__ = ["run_encounter", "run_encounters", "run"]
 
-ENCOUNTER_ALERT_CONFIG = RADAR_ALERT_CONFIG
 _RANGE_MARGIN_M = 300.0
 _PARTIAL = "encounters.partial.parquet"
 
 
-def _window(p: pd.Series, frame_rate_hz: float, lookback_s: float, seed: int) -> tuple[float, float]:
-    """Frame window (start, duration) in s: ``lookback_s`` before the LoWC or CPA, in range."""
+def _window(
+    p: pd.Series, frame_rate_hz: float, lookback_s: float, seed: int
+) -> tuple[float, float, np.ndarray, np.ndarray]:
+    """Frame window (start, duration) in s, ``lookback_s`` before the LoWC or CPA and in range,
+    and the dense relative truth (times, NED m) it was chosen on."""
     built = Scenario.from_dict(encounter_scenario(p, 0.0, 1.0, frame_rate_hz, seed, None)).build()
     t, rel = relative_truth(built)
-    lowc = score_encounter(t, rel, np.array([]), pd.DataFrame({"time_s": [], "observable": []}), 1.0, 0.0)
-    t_event = lowc["t_lowc_s"] if lowc["conflict"] else lowc["t_cpa_s"]
+    t_lowc, t_cpa = event_times(t, rel)
+    t_event = t_lowc if np.isfinite(t_lowc) else t_cpa
     in_range = np.linalg.norm(rel, axis=1) <= built.radar.range_limit_m + _RANGE_MARGIN_M
     first = float(t[np.argmax(in_range & (t <= t_event))]) if in_range.any() else t_event - lookback_s
     start = max(t_event - lookback_s, first, float(t[0]))
     end = min(t_event + 2.0, float(t[-1]))
-    return start, max(end - start, 2.0 / frame_rate_hz)
+    return start, max(end - start, 2.0 / frame_rate_hz), t, rel
 
 
 def _observable(truth, fov_deg: float, min_snr_db: float) -> pd.DataFrame:
@@ -87,14 +90,14 @@ def run_encounter(
     ``t_warning_s`` is the first warning (level 3) of a track that follows the intruder;
     ``t_other_warning_s`` the first warning of any other track (noise).
     """
-    start, duration = _window(p, frame_rate_hz, lookback_s, seed)
+    # The frame window and terrain do not change the trajectories: one dense truth serves both.
+    start, duration, t, rel = _window(p, frame_rate_hz, lookback_s, seed)
     built = Scenario.from_dict(encounter_scenario(p, start, duration, frame_rate_hz, seed, terrain)).build()
-    chain = run_chain(built, alert_config or ENCOUNTER_ALERT_CONFIG, with_advice=False)
+    chain = run_chain(built, alert_config or RADAR_ALERT_CONFIG, with_advice=False)
     labels = label_tracks(chain["tracks"], chain["truth"])
     alerts = chain["alerts"]
     warn = alerts[alerts["level"] >= 3] if len(alerts) else alerts
     mine = warn["track_id"].map(lambda i: labels.get(int(i)) == "intruder").to_numpy(bool)
-    t, rel = relative_truth(built)
     observed = _observable(chain["truth"], fov_deg, min_snr_db)
     row = score_encounter(t, rel, warn["time_s"].to_numpy(float)[mine], observed, buffer, observe_window_s)
     other = warn["time_s"].to_numpy(float)[~mine]
@@ -202,7 +205,7 @@ def run(
     t0 = time.perf_counter()
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    cfg = ENCOUNTER_ALERT_CONFIG
+    cfg = RADAR_ALERT_CONFIG
     if not uncertainty:
         cfg = replace(cfg, z_h_pos=0.0, z_h_vel=0.0, z_v_pos=0.0, z_v_vel=0.0)
     enc = make_encounters(n_encounters, seed)

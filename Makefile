@@ -7,7 +7,7 @@ STAMP_RUN := $(VENV)/.installed-run
 STAMP_DEV := $(VENV)/.installed-dev
 OUT ?= out
 
-.PHONY: demo test test-slow test-browser lint format bench clean
+.PHONY: demo test test-slow test-browser browser-deps lint format bench clean
 
 $(BIN)/python:
 	@command -v $(PYTHON) >/dev/null 2>&1 || { echo "error: $(PYTHON) not found; set PYTHON=/path/to/python3.11" >&2; exit 1; }
@@ -28,16 +28,33 @@ demo: $(STAMP_RUN)
 	$(BIN)/skyradar demo --out $(OUT)/demo
 	$(BIN)/skyradar experiment ch2 --out $(OUT)/ch2
 
-# Includes the headless-Chromium display test: its setup installs Debian's chromium when missing.
-test: $(STAMP_DEV)
+# Debian's chromium for the headless display test (Playwright drives it; Playwright's own browser
+# download is never used). Installed here, once and visibly, never from inside a test: apt-get runs
+# only when $(CHROMIUM) is missing, and needs root (CI runs `make test` as root).
+CHROMIUM := /usr/bin/chromium
+
+$(CHROMIUM):
+	@if [ "$$(id -u)" != 0 ]; then \
+	  echo "error: $(CHROMIUM) is missing and installing it needs root: run 'sudo apt-get install -y chromium' (Debian/Ubuntu), then 'make test' again" >&2; \
+	  exit 1; fi
+	@echo "browser-deps: $(CHROMIUM) missing; running apt-get update && apt-get install -y chromium"
+	DEBIAN_FRONTEND=noninteractive apt-get update -qq
+	DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium
+	@test -x $(CHROMIUM) || { echo "error: apt-get install chromium did not provide $(CHROMIUM)" >&2; exit 1; }
+
+browser-deps: $(CHROMIUM)
+
+# Unit tests, the docstring examples of every module (--doctest-modules, see pyproject.toml) and
+# the headless-Chromium display test.
+test: $(STAMP_DEV) browser-deps
 	SKYRADAR_SCREENSHOT_DIR=$(OUT)/browser $(BIN)/python -m pytest -q -m "not slow"
 
 test-slow: $(STAMP_DEV)
 	$(BIN)/python -m pytest -q -m "slow"
 
-# The browser test alone: headless Chromium drives the live display; the test installs Debian's
-# chromium itself when missing. The screenshot lands in $(OUT)/browser/display.png.
-test-browser: $(STAMP_DEV)
+# The browser test alone: headless Chromium drives the live display. The screenshot lands in
+# $(OUT)/browser/display.png.
+test-browser: $(STAMP_DEV) browser-deps
 	SKYRADAR_SCREENSHOT_DIR=$(OUT)/browser $(BIN)/python -m pytest -q -m browser tests/browser
 
 lint: $(STAMP_DEV)

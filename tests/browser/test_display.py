@@ -1,21 +1,21 @@
 """Headless Chromium loads the live display, sees the intruders and the warning at the right time.
 
-Setup installs what is missing: Debian's ``chromium`` (apt-get) and the ``playwright`` Python
-package (pip; the browser build Playwright would download is never used). The display server runs
-on 127.0.0.1 in a thread, bounded in time, and is stopped by the fixture. The screenshot goes to
-``$SKYRADAR_SCREENSHOT_DIR`` (``make test-browser`` sets ``out/browser``) or the test's tmp dir.
+Nothing is installed from here: ``make test`` / ``make test-browser`` install Debian's ``chromium``
+(target ``browser-deps``) and the ``playwright`` Python package (dev extra; the browser build
+Playwright would download is never used). A missing ``/usr/bin/chromium`` fails the test with the
+command that provides it. The display server runs on 127.0.0.1 in a thread, bounded in time, and
+is stopped by the fixture. The screenshot goes to ``$SKYRADAR_SCREENSHOT_DIR`` (``make
+test-browser`` sets ``out/browser``) or the test's tmp dir.
 """
 
 from __future__ import annotations
 
-import importlib
 import os
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from playwright.sync_api import sync_playwright
 
 pytestmark = [
     pytest.mark.browser,
@@ -32,25 +32,12 @@ WARNING_AT_S = 35.0
 WARNING_COLOUR = (0xFF, 0x30, 0x30)
 
 
-def _run(cmd: list[str], timeout: float) -> None:
-    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-    if proc.returncode != 0:
-        pytest.fail(f"setup step failed: {' '.join(cmd)}\n{proc.stderr[-2000:]}")
-
-
 @pytest.fixture(scope="session")
 def chromium() -> str:
     if not Path(CHROMIUM).exists():
-        env = {**os.environ, "DEBIAN_FRONTEND": "noninteractive"}
-        for cmd in (["apt-get", "update", "-qq"], ["apt-get", "install", "-y", "-qq", "chromium"]):
-            subprocess.run(cmd, capture_output=True, text=True, timeout=900, env=env, check=False)
-        if not Path(CHROMIUM).exists():
-            pytest.fail(f"{CHROMIUM} missing and `apt-get install chromium` did not provide it")
-    try:
-        import playwright  # noqa: F401
-    except ImportError:
-        _run([sys.executable, "-m", "pip", "install", "--quiet", "playwright>=1.40"], timeout=600)
-        importlib.invalidate_caches()  # make the freshly installed package importable in this process
+        pytest.fail(
+            f"{CHROMIUM} is missing: run `make browser-deps` (as root it runs `apt-get install -y chromium`)"
+        )
     return CHROMIUM
 
 
@@ -75,8 +62,6 @@ def _count_colour(page, selector: str, rgb: tuple[int, int, int]) -> int:
 
 
 def test_display_shows_intruders_and_warning(chromium, display_url, tmp_path):
-    from playwright.sync_api import sync_playwright
-
     shot_dir = Path(os.environ.get("SKYRADAR_SCREENSHOT_DIR", tmp_path))
     shot_dir.mkdir(parents=True, exist_ok=True)
     with sync_playwright() as pw:

@@ -135,7 +135,7 @@ class RadarConfig:
     --------
     >>> cfg = RadarConfig.seed_prototype()
     >>> round(cfg.range_resolution_m, 2), round(cfg.v_lim_mps, 2), cfg.n_range, cfg.n_doppler
-    (14.99, 39.16, 333, 250)
+    (14.99, 39.13, 333, 250)
     """
 
     fc_hz: float = 9.425e9

@@ -93,8 +93,11 @@ def run(min_time_s: float = 2.0, n_points: int = 400_000) -> dict[str, Any]:
 
     Examples
     --------
-    >>> sorted(run(min_time_s=0.0, n_points=20_000))[:3]
-    ['baseline_fps', 'frame_shape', 'robust_fps']
+    >>> result = run(min_time_s=0.0, n_points=20_000)
+    >>> sorted(k for k in result if k.endswith("_fps"))
+    ['baseline_fps', 'robust_fps', 'terrain_aware_fps']
+    >>> all(result[k] > 0 for k in result if k.endswith("_fps"))
+    True
     """
     config = RadarConfig.seed_prototype(mount=Mount.preset("forward-down"))
     cubes = [flat_ground_frame(config, 30.0, 0.0, 600.0, n_points, seed) for seed in range(3)]

@@ -42,8 +42,9 @@ def plot_strength(
     --------
     >>> cfg = RadarConfig.seed_prototype()
     >>> im = plot_strength(np.ones((cfg.n_range, cfg.n_doppler, cfg.n_rx)) * 1e-9, cfg)
-    >>> im.get_extent()[0] < 0 < im.get_extent()[1]
+    >>> bool(im.get_extent()[0] < 0 < im.get_extent()[1])
     True
+    >>> plt.close(im.figure)
     """
     ax = ax or plt.gca()
     db = strength_db(frame, config)

@@ -196,9 +196,9 @@ class Scenario:
         m = self.model
         overrides = m.radar.model_dump(exclude_none=True, exclude={"antenna"})
         mount = self._mount()
+        if m.radar.antenna is not None:
+            overrides["antenna"] = self._antenna(m.radar.antenna)
         try:
-            if m.radar.antenna is not None:
-                overrides["antenna"] = self._antenna(m.radar.antenna)
             radar = RadarConfig.seed_prototype(mount=mount, **overrides)
         except InputError as exc:
             raise self._fail("radar", exc) from None
@@ -213,9 +213,15 @@ class Scenario:
     def _antenna(self, a: AntennaModel):
         from skyradar.antenna import AntennaPattern
 
-        if a.azimuth_csv is not None:
-            return AntennaPattern.from_csv(self._path(a.azimuth_csv), self._path(a.elevation_csv), a.combine)
-        return AntennaPattern.default(a.beamwidth_deg if a.beamwidth_deg is not None else 70.0, a.combine)
+        if a.cuts_csv is None and a.azimuth_csv is None:
+            try:
+                return AntennaPattern.default(a.beamwidth_deg or 70.0, a.combine)
+            except InputError as exc:
+                raise self._fail("radar.antenna", exc) from None
+        # Measured cuts: the CSV's own errors name that file, its line and column.
+        if a.cuts_csv is not None:
+            return AntennaPattern.from_cuts_csv(self._path(a.cuts_csv), a.combine)
+        return AntennaPattern.from_csv(self._path(a.azimuth_csv), self._path(a.elevation_csv), a.combine)
 
     def _mount(self) -> Mount:
         mm = self.model.mount

@@ -8,7 +8,8 @@ are in the field names: metres, m/s, degrees, seconds, Hz. Positions ``*_ned_m``
     origin: {lat_deg: 52.0, lon_deg: 4.36, alt_m: 0.0}     # optional (see scenario.py)
     radar:                                                 # optional RadarConfig overrides
       range_limit_m: 5000
-      antenna: {beamwidth_deg: 70, combine: L1}            # or azimuth_csv + elevation_csv
+      antenna: {beamwidth_deg: 70, combine: L1}            # synthetic; measured cuts: azimuth_csv +
+                                                           #   elevation_csv, or cuts_csv
     mount: forward-down                                    # preset, or {preset, position_m,
                                                            #   yaw_deg, pitch_deg, roll_deg}
     terrain: {type: fractal, local_sd_m: 20, seed: 1, size_m: 12000, spacing_m: 30, height_m: 0}
@@ -78,9 +79,16 @@ class OriginModel(_Model):
 
 
 class AntennaModel(_Model):
+    """Synthetic pattern (``beamwidth_deg``, the default 70) or measured cuts from CSV.
+
+    Measured: ``azimuth_csv`` + ``elevation_csv`` (columns ``angle_deg,gain_db``) or one
+    ``cuts_csv`` (columns ``cut,angle_deg,gain_db``); paths relative to the scenario file.
+    """
+
     beamwidth_deg: float | None = Field(None, ge=1.0, le=180.0)
     azimuth_csv: str | None = None
     elevation_csv: str | None = None
+    cuts_csv: str | None = None
     combine: Literal["L1", "L2"] = "L1"
 
     @model_validator(mode="after")
@@ -88,8 +96,9 @@ class AntennaModel(_Model):
         csvs = (self.azimuth_csv is None, self.elevation_csv is None)
         if csvs[0] != csvs[1]:
             raise ValueError("give both azimuth_csv and elevation_csv, or neither")
-        if self.azimuth_csv is not None and self.beamwidth_deg is not None:
-            raise ValueError("give beamwidth_deg or the two CSV cuts, not both")
+        sources = [self.beamwidth_deg is not None, self.azimuth_csv is not None, self.cuts_csv is not None]
+        if sum(sources) > 1:
+            raise ValueError("give one of beamwidth_deg, azimuth_csv + elevation_csv, or cuts_csv")
         return self
 
 

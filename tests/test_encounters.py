@@ -22,6 +22,55 @@ from skyradar.scene.scenario import Scenario
 
 D_NC, Z_NC = 2200 * FT, 450 * FT
 NO_FRAMES = pd.DataFrame({"time_s": [], "observable": []})
+HALF_FOV_DEG, RANGE_LIMIT_M, OBSERVE_WINDOW_S = 35.0, 5000.0, 12.5  # run_encounter's defaults, seed prototype
+
+
+def _closed_form_rel(p: pd.Series, t: np.ndarray) -> np.ndarray:
+    """Intruder minus own-ship NED position (m) at times ``t`` (s), from the encounter definition alone.
+
+    Own-ship flies north, level, at OWN_SPEED_MPS; the intruder flies straight at its speed on
+    own-ship's track plus the kind's angle (head-on 180 deg, overtaking 0, else the crossing angle),
+    climbing at ``climb_mps``; at T_CPA_S it is ``horizontal_miss_m`` away perpendicular to the
+    horizontal relative velocity, on own-ship's ``side``, and ``vertical_miss_m`` above.
+    """
+    angle = {"head-on": 180.0, "overtaking": 0.0}.get(p["kind"], p["crossing_angle_deg"])
+    track = np.radians(angle)
+    a = p["intruder_speed_mps"] * np.array([np.cos(track), np.sin(track)]) - [OWN_SPEED_MPS, 0.0]
+    d = p["horizontal_miss_m"] * np.array([-a[1], a[0]]) / np.linalg.norm(a)
+    if (d[1] >= 0) != (p["side"] == "right"):  # own-ship's right is east
+        d = -d
+    climb = 0.0 if np.isnan(p["climb_mps"]) else p["climb_mps"]
+    tau = np.asarray(t, float) - T_CPA_S
+    return np.stack([d[0] + a[0] * tau, d[1] + a[1] * tau, -(p["vertical_miss_m"] + climb * tau)], axis=1)
+
+
+def _closed_form_lowc(p: pd.Series, scale: float = 1.0) -> float:
+    """First time (s) the intruder is inside ``scale`` times the DO-365 volume; NaN when it never is.
+
+    Horizontal separation is hypot(h, |v_rel| (t - T_CPA_S)), vertical |v + climb (t - T_CPA_S)|.
+    """
+    d, z = scale * D_NC, scale * Z_NC
+    h, v = p["horizontal_miss_m"], p["vertical_miss_m"]
+    if h > d or abs(v) > z:
+        return float("nan")
+    angle = {"head-on": 180.0, "overtaking": 0.0}.get(p["kind"], p["crossing_angle_deg"])
+    track = np.radians(angle)
+    speed = np.hypot(p["intruder_speed_mps"] * np.cos(track) - OWN_SPEED_MPS,
+                     p["intruder_speed_mps"] * np.sin(track))  # fmt: skip
+    t_h = T_CPA_S - np.sqrt(d**2 - h**2) / speed
+    climb = 0.0 if np.isnan(p["climb_mps"]) else abs(p["climb_mps"])  # climbing rows have v = 0
+    t_v = T_CPA_S - z / climb if climb else -np.inf
+    return float(max(t_h, t_v))
+
+
+def _geometrically_observable(p: pd.Series, t_lowc: float) -> bool:
+    """Within the 70 deg field of view (level own-ship, forward mount) and the range limit over the
+    whole window before the LoWC; the SNR is well above the 13 dB threshold at these ranges."""
+    rel = _closed_form_rel(p, np.arange(t_lowc - OBSERVE_WINDOW_S, t_lowc + 1e-9, 0.05))
+    az = np.degrees(np.arctan2(rel[:, 1], rel[:, 0]))
+    el = np.degrees(np.arctan2(-rel[:, 2], np.hypot(rel[:, 0], rel[:, 1])))
+    inside = (np.abs(az) <= HALF_FOV_DEG) & (np.abs(el) <= HALF_FOV_DEG)
+    return bool(np.all(inside & (np.linalg.norm(rel, axis=1) <= RANGE_LIMIT_M)))
 
 
 def _row(kind="head-on", h=0.0, v=0.0, speed=50.0, rcs=5.0, **kw) -> pd.Series:
@@ -113,16 +162,50 @@ def test_full_chain_warns_head_on_collision_and_stays_quiet_when_far():
     assert np.isnan(far["t_warning_s"]) and np.isnan(far["t_other_warning_s"])
 
 
-def test_experiment_writes_its_table_figure_and_summary(tmp_path):
+def test_scoring_matches_the_closed_form_on_a_seeded_set():
+    # Every kind, misses on both sides of the volume and of the may-alert buffer.
+    enc = make_encounters(40, seed=7)
+    expected = enc.apply(_closed_form_lowc, axis=1)
+    assert 5 <= expected.notna().sum() <= 35  # the set holds conflicts and non-conflicts
+    for i, p in enc.iterrows():
+        built = Scenario.from_dict(encounter_scenario(p, 60.0, 10.0, 4.7, 0)).build()
+        t, rel = relative_truth(built)
+        np.testing.assert_allclose(rel, _closed_form_rel(p, t), atol=0.05, err_msg=f"encounter {i}")
+        r = score_encounter(t, rel, np.array([]), NO_FRAMES, 1.5, OBSERVE_WINDOW_S)
+        assert r["conflict"] == np.isfinite(expected[i]), i
+        if r["conflict"]:  # dense truth every 0.05 s: the first sample inside the volume
+            assert expected[i] <= r["t_lowc_s"] < expected[i] + 0.05 + 1e-6, i
+        assert r["may_alert"] == (not r["conflict"] and np.isfinite(_closed_form_lowc(p, 1.5))), i
+
+
+def test_experiment_counts_match_the_geometry_and_warns_every_observable_conflict(tmp_path):
     from skyradar.experiments.encounters import run
+
+    enc = make_encounters(4, seed=2)
+    t_lowc = enc.apply(_closed_form_lowc, axis=1)
+    conflict = t_lowc.notna()
+    observable = pd.Series(
+        [conflict[i] and _geometrically_observable(enc.loc[i], t_lowc[i]) for i in enc.index]
+    )
+    may_alert = ~conflict & enc.apply(_closed_form_lowc, axis=1, scale=1.5).notna()
+    # This set: three conflicts (head-on, crossing, overtaking), all in view; one clear converging.
+    assert (conflict.sum(), observable.sum(), may_alert.sum()) == (3, 3, 0)
 
     s = run(tmp_path, n_encounters=4, seed=2, workers=2)
     assert s["encounters"] == 4 and s["chain"] == "full" and s["frames"] > 4 * 50
-    assert 0 <= s["missed_warnings"] <= s["observable_conflicts"] <= s["conflicts"] <= 4
-    assert json.loads((tmp_path / "summary.json").read_text())["encounters"] == 4
-    assert (tmp_path / "encounters.png").stat().st_size > 10_000
+    assert (s["conflicts"], s["observable_conflicts"]) == (conflict.sum(), observable.sum())
+    assert (s["may_alert_encounters"], s["must_not_alert_encounters"]) == (may_alert.sum(), 1)
+    assert s["missed_warnings"] == 0 and s["false_warnings"] == 0 and s["other_track_warnings"] == 0
     table = pd.read_parquet(tmp_path / "encounters.parquet")
     assert len(table) == 4 and table["frames"].gt(0).all()
+    assert table["conflict"].tolist() == conflict.tolist()
+    assert table["observable"].tolist() == observable.tolist()
+    np.testing.assert_allclose(table["t_lowc_s"], t_lowc, atol=0.06)
+    warned = table[conflict]
+    assert (warned["t_warning_s"] < warned["t_lowc_s"]).all()  # every conflict warned before its LoWC
+    assert table.loc[~conflict, "t_warning_s"].isna().all()
+    assert json.loads((tmp_path / "summary.json").read_text())["encounters"] == 4
+    assert (tmp_path / "encounters.png").stat().st_size > 10_000
 
 
 def test_interrupted_run_resumes_from_its_partial_table(tmp_path):

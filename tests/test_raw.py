@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.process.rangedoppler import range_doppler, window_gain_db
+from skyradar.sim import image
 from skyradar.sim.raw import adc_noise, received_power_w, simulate_adc
 
 CFG = RadarConfig.seed_prototype()
@@ -72,9 +73,6 @@ def test_on_bin_power_equals_radar_equation_after_window_gain(k, j, alias, windo
     # A fast target migrates up to a third of a range bin over the frame: a scalloping loss of up
     # to about half a dB at short range with the rectangular window (physics, not error).
     assert np.all(np.abs(power_db - expected_db) < 1.0)
-
-
-image = pytest.importorskip("skyradar.sim.image")
 
 
 @settings(max_examples=10, deadline=None)

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import yaml
 
+from skyradar import cli
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.io.recordings import read_recording, write_recording
@@ -179,7 +180,6 @@ def test_writer_rejects_bad_input_and_leaves_nothing(tmp_path):
 
 
 def run_cli(monkeypatch, capsys, *args: str) -> tuple[int, str, str]:
-    cli = pytest.importorskip("skyradar.cli", exc_type=ImportError)
     monkeypatch.setattr("sys.argv", ["skyradar", *args])
     code = 0
     try:

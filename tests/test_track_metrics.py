@@ -5,14 +5,12 @@ import datetime
 import numpy as np
 import pandas as pd
 import pytest
+from stonesoup.measures import Euclidean  # stonesoup is a dev extra: a missing one is an error, not a skip
+from stonesoup.metricgenerator.ospametric import GOSPAMetric
+from stonesoup.types.state import State
 
 from skyradar.track.io import Truth
 from skyradar.track.metrics import gospa, innovation_stats, pixel_distance, track_metrics, truth_segments
-
-stonesoup = pytest.importorskip("stonesoup")
-from stonesoup.measures import Euclidean  # noqa: E402
-from stonesoup.metricgenerator.ospametric import GOSPAMetric  # noqa: E402
-from stonesoup.types.state import State  # noqa: E402
 
 
 def _stonesoup_gospa(est, tru, c, p):

@@ -6,9 +6,11 @@ this module imports them and turns bad input into one line on stderr with exit c
 
 from __future__ import annotations
 
+import importlib
 import sys
+from types import ModuleType
 
-import click
+import typer
 
 import skyradar.cli.commands_daa  # noqa: F401  (registers commands)
 import skyradar.cli.commands_demo  # noqa: F401  (registers commands)
@@ -23,6 +25,32 @@ from skyradar.errors import InputError
 __all__ = ["app", "main"]
 
 
+def _click_exception_modules() -> list[ModuleType]:
+    """The ``exceptions`` modules of every click the installed typer may raise from.
+
+    typer >= 0.2x vendors click as ``typer._click``; older typer raises the separate click package's
+    classes. Catch both, so usage errors stay short whichever typer is installed.
+    """
+    modules = []
+    for name in ("typer._click.exceptions", "click.exceptions"):
+        try:
+            modules.append(importlib.import_module(name))
+        except ImportError:
+            continue
+    return modules
+
+
+def _classes(name: str, *extra: type) -> tuple[type, ...]:
+    found = [getattr(module, name) for module in _click_exception_modules() if hasattr(module, name)]
+    return tuple(dict.fromkeys([*found, *extra]))
+
+
+_NO_ARGS_IS_HELP = _classes("NoArgsIsHelpError")
+_CLICK_ERRORS = _classes("ClickException")
+_EXITS = _classes("Exit", typer.Exit)
+_ABORTS = _classes("Abort", typer.Abort)
+
+
 def main() -> None:
     """Entry point of the ``skyradar`` script."""
     try:
@@ -30,12 +58,19 @@ def main() -> None:
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         sys.exit(2)
-    except click.exceptions.Exit as exc:
+    except _NO_ARGS_IS_HELP as exc:
+        # A bare `skyradar` (or `skyradar bench`) asks for help: Typer's rich help is already printed
+        # while the exception was built; the plain one is the message.
+        text = exc.format_message()
+        if text.strip():
+            print(text)
+        sys.exit(0)
+    except _EXITS as exc:
         sys.exit(exc.exit_code)
-    except click.ClickException as exc:
+    except _CLICK_ERRORS as exc:
         exc.show()
         sys.exit(exc.exit_code)
-    except (KeyboardInterrupt, click.exceptions.Abort):
+    except (KeyboardInterrupt, *_ABORTS):
         code = 130
     # With standalone_mode=False click returns 130 on Ctrl-C instead of raising.
     if code == 130:

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import math
+from collections.abc import Callable
 from typing import Annotated, Any
 
 import typer
@@ -11,7 +13,10 @@ from rich.table import Table
 
 from skyradar.io.tables import jsonable
 
-__all__ = ["app", "experiment_app", "bench_app", "console", "emit_result", "JsonOption"]
+__all__ = [
+    "app", "experiment_app", "bench_app", "console", "emit_result", "JsonOption", "number_in",
+    "check_number", "POSITIVE", "NON_NEGATIVE", "COUNT", "PROBABILITY",
+]  # fmt: skip
 
 app = typer.Typer(
     name="skyradar",
@@ -46,3 +51,71 @@ def emit_result(result: dict[str, Any], as_json: bool, title: str) -> None:
     console.print(table)
     if as_json:
         print(json.dumps(jsonable(result)), flush=True)
+
+
+def check_number(
+    name: str,
+    value: float | None,
+    low: float | None = None,
+    high: float | None = None,
+    *,
+    low_open: bool = False,
+    high_open: bool = False,
+) -> float | None:
+    """``value`` if finite and within the bounds, else :class:`InputError` naming ``name`` and the value.
+
+    ``None`` (an option left unset) passes. Typer's ``min``/``max`` let NaN through (every comparison
+    with NaN is false), so every float option is checked here.
+
+    Examples
+    --------
+    >>> check_number("--seconds", 2.0, 0.0, low_open=True)
+    2.0
+    >>> check_number("--seconds", float("nan"), 0.0, low_open=True)
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: --seconds: must be a finite number > 0, got nan
+    """
+    from skyradar.errors import InputError
+
+    if value is None:
+        return None
+    below = low is not None and (value <= low if low_open else value < low)
+    above = high is not None and (value >= high if high_open else value > high)
+    if not math.isfinite(value) or below or above:
+        bounds = []
+        if low is not None:
+            bounds.append(f"{'>' if low_open else '>='} {low:g}")
+        if high is not None:
+            bounds.append(f"{'<' if high_open else '<='} {high:g}")
+        rule = " ".join(["an integer" if isinstance(value, int) else "a finite number", " and ".join(bounds)])
+        raise InputError(f"{name}: must be {rule.strip()}, got {value!r}")
+    return value
+
+
+def number_in(
+    low: float | None = None, high: float | None = None, *, low_open: bool = False, high_open: bool = False
+) -> Callable[..., Any]:
+    """A Typer option callback that applies :func:`check_number` under the option's own name.
+
+    Examples
+    --------
+    >>> callback = number_in(0.0, 1.0, low_open=True, high_open=True)
+    >>> callback(None, None, 0.5)
+    0.5
+    """
+
+    def callback(ctx: typer.Context, param: typer.CallbackParam, value: Any) -> Any:
+        # During shell completion or --help parsing the value may be absent.
+        if ctx is not None and getattr(ctx, "resilient_parsing", False):
+            return value
+        name = param.opts[0] if param is not None and param.opts else "value"
+        return check_number(name, value, low, high, low_open=low_open, high_open=high_open)
+
+    return callback
+
+
+POSITIVE = number_in(0.0, low_open=True)  # durations, distances, rates: finite and > 0
+NON_NEGATIVE = number_in(0.0)  # counts and durations where 0 means "skip"
+COUNT = number_in(1)  # frames, workers, chunk sizes: at least one
+PROBABILITY = number_in(0.0, 1.0, low_open=True, high_open=True)

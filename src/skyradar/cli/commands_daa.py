@@ -8,7 +8,7 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from skyradar.cli.app import JsonOption, app, console, emit_result, experiment_app
+from skyradar.cli.app import NON_NEGATIVE, JsonOption, app, console, emit_result, experiment_app, number_in
 
 __all__ = ["alert", "serve", "experiment_encounters"]
 
@@ -86,14 +86,18 @@ def serve(
 def experiment_encounters(
     out: Annotated[Path, typer.Option("--out", help="Output directory.")] = Path("out/encounters"),
     n: Annotated[int, typer.Option("--n", min=1, help="Number of encounters.")] = 500,
-    seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
+    seed: Annotated[int, typer.Option("--seed", callback=NON_NEGATIVE, help="Random seed.")] = 0,
     workers: Annotated[
         int | None, typer.Option(min=1, help="Worker processes (default: up to 2, one per core).")
     ] = None,
-    frame_rate: Annotated[float, typer.Option(min=0.5, help="Radar frame rate, frames/s.")] = 4.7,
+    frame_rate: Annotated[
+        float, typer.Option(callback=number_in(0.5, 100.0), help="Radar frame rate, frames/s.")
+    ] = 4.7,
     buffer: Annotated[
         float,
-        typer.Option(min=1.0, help="May-alert zone: this many times the well-clear volume."),
+        typer.Option(
+            callback=number_in(1.0, 100.0), help="May-alert zone: this many times the well-clear volume."
+        ),
     ] = 1.5,
     no_uncertainty: Annotated[
         bool, typer.Option("--no-uncertainty", help="Do not widen the volumes by the track covariance.")

@@ -8,7 +8,16 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from skyradar.cli.app import JsonOption, app, bench_app, console, emit_result, experiment_app
+from skyradar.cli.app import (
+    NON_NEGATIVE,
+    POSITIVE,
+    JsonOption,
+    app,
+    bench_app,
+    console,
+    emit_result,
+    experiment_app,
+)
 
 __all__ = ["state", "experiment_ch5", "bench_state"]
 
@@ -71,10 +80,16 @@ def experiment_ch5(
     out: Annotated[
         Path, typer.Option("--out", help="Output directory for table, JSON, states and figures.")
     ] = Path("out/ch5"),
-    duration_s: Annotated[float, typer.Option("--duration", help="Flight length at 1 frame/s, s.")] = 40.0,
+    duration_s: Annotated[
+        float, typer.Option("--duration", callback=POSITIVE, help="Flight length at 1 frame/s, s.")
+    ] = 40.0,
     fast_duration_s: Annotated[
         float,
-        typer.Option("--fast-duration", help="Flight length at 9.4 frames/s (flat, 19.2 m), s; 0 skips."),
+        typer.Option(
+            "--fast-duration",
+            callback=NON_NEGATIVE,
+            help="Flight length at 9.4 frames/s (flat, 19.2 m), s; 0 skips.",
+        ),
     ] = 6.0,
     as_json: JsonOption = False,
 ) -> None:
@@ -106,7 +121,9 @@ def experiment_ch5(
 
 @bench_app.command("state")
 def bench_state(
-    seconds: Annotated[float, typer.Option("--seconds", help="Minimum timing per implementation, s.")] = 2.0,
+    seconds: Annotated[
+        float, typer.Option("--seconds", callback=POSITIVE, help="Minimum timing per implementation, s.")
+    ] = 2.0,
     as_json: JsonOption = False,
 ) -> None:
     """Flight-state frames per second on 333 x 250 x 4 cubes: robust and terrain-aware vs the thesis' loop."""

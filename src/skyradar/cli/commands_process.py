@@ -7,7 +7,20 @@ from typing import Annotated
 
 import typer
 
-from skyradar.cli.app import JsonOption, app, bench_app, console, emit_result, experiment_app
+from skyradar.cli.app import (
+    COUNT,
+    NON_NEGATIVE,
+    POSITIVE,
+    PROBABILITY,
+    JsonOption,
+    app,
+    bench_app,
+    check_number,
+    console,
+    emit_result,
+    experiment_app,
+    number_in,
+)
 
 __all__ = ["process", "calibrate", "spur_map", "experiment_ch3", "bench_process"]
 
@@ -32,7 +45,12 @@ def process(
         typer.Option("--spur-mode", help="'mask' spur pixels before detection or 'flag' detections in them."),
     ] = "mask",
     method: Annotated[str, typer.Option("--method", help="Detector: cfar, os-cfar or shi-tomasi.")] = "cfar",
-    pfa: Annotated[float, typer.Option("--pfa", help="CFAR false-alarm probability per pixel.")] = 2e-8,
+    pfa: Annotated[
+        float,
+        typer.Option(
+            "--pfa", callback=PROBABILITY, help="CFAR false-alarm probability per pixel, in (0, 1)."
+        ),
+    ] = 2e-8,
     terrain: Annotated[
         Path | None,
         typer.Option("--terrain", help="DEM (.hgt/.tif/.npz) for the ground filter's height test."),
@@ -42,10 +60,10 @@ def process(
     ] = None,
     scheduler: Annotated[str | None, typer.Option(help="Address of an existing Dask scheduler.")] = None,
     workers: Annotated[
-        int | None, typer.Option(help="Run on a local Dask cluster of this many workers.")
+        int | None, typer.Option(callback=COUNT, help="Run on a local Dask cluster of this many workers.")
     ] = None,
     chunk_frames: Annotated[
-        int, typer.Option(help="Frames per Dask task (with --scheduler/--workers).")
+        int, typer.Option(callback=COUNT, help="Frames per Dask task (with --scheduler/--workers).")
     ] = 64,
     as_json: JsonOption = False,
 ) -> None:
@@ -119,14 +137,26 @@ def calibrate(
         Path, typer.Argument(help="Frames run with a reflector at a known position (Zarr or NetCDF).")
     ],
     output: Annotated[Path, typer.Option("-o", "--output", help="Calibrated RadarConfig to write (JSON).")],
-    range_m: Annotated[float, typer.Option("--range", help="Reflector range, m.")],
+    range_m: Annotated[float, typer.Option("--range", callback=POSITIVE, help="Reflector range, m.")],
     azimuth_deg: Annotated[
-        float, typer.Option("--azimuth", help="Reflector azimuth, deg (antenna frame, right +).")
+        float,
+        typer.Option(
+            "--azimuth",
+            callback=number_in(-180.0, 180.0),
+            help="Reflector azimuth, deg (antenna frame, right +).",
+        ),
     ],
     elevation_deg: Annotated[
-        float, typer.Option("--elevation", help="Reflector elevation, deg (antenna frame, up +).")
+        float,
+        typer.Option(
+            "--elevation",
+            callback=number_in(-90.0, 90.0),
+            help="Reflector elevation, deg (antenna frame, up +).",
+        ),
     ],
-    frames: Annotated[int, typer.Option("--frames", help="Frames to average (from the start).")] = 20,
+    frames: Annotated[
+        int, typer.Option("--frames", callback=COUNT, help="Frames to average (from the start).")
+    ] = 20,
     phase_only: Annotated[
         bool, typer.Option("--phase-only", help="Calibrate phases only, not gains.")
     ] = False,
@@ -156,7 +186,12 @@ def spur_map(
     run: Annotated[Path, typer.Argument(help="Frames of a static scene (Zarr directory or NetCDF file).")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Spur map to write (.npz).")],
     threshold: Annotated[
-        float, typer.Option("--threshold", help="Hit frequency above which a pixel is a spur.")
+        float,
+        typer.Option(
+            "--threshold",
+            callback=PROBABILITY,
+            help="Hit frequency above which a pixel is a spur, in (0, 1).",
+        ),
     ] = 0.05,
     pixels: Annotated[
         str, typer.Option("--pixels", help="'peaks' (detector points, thesis) or 'hits' (every lit pixel).")
@@ -188,15 +223,18 @@ def experiment_ch3(
     out: Annotated[Path, typer.Option("--out", help="Output directory for figures and tables.")] = Path(
         "out/ch3"
     ),
-    frames: Annotated[int, typer.Option("--frames", help="Flyover frames (thesis: 300).")] = 300,
+    frames: Annotated[
+        int, typer.Option("--frames", callback=COUNT, help="Flyover frames (thesis: 300).")
+    ] = 300,
     path: Annotated[
         str, typer.Option("--path", help="'circuit' (500-3000 m racetrack) or 'approach' (32 s at 9.4 fps).")
     ] = "circuit",
-    seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
+    seed: Annotated[int, typer.Option("--seed", callback=NON_NEGATIVE, help="Random seed.")] = 0,
     rx_spacing: Annotated[
         float,
         typer.Option(
             "--rx-spacing",
+            callback=number_in(0.0, 1.0, low_open=True),
             help="Side of the 2x2 receive square, wavelengths, in (0, 1]. 0.6: CRLB 17 % below 0.5's, "
             "unambiguous within +-56 deg of boresight (0.5: whole front hemisphere).",
         ),
@@ -208,7 +246,10 @@ def experiment_ch3(
         ),
     ] = "0.5,0.7",
     pitch: Annotated[
-        float, typer.Option("--pitch", help="Boresight elevation above the horizon, deg.")
+        float,
+        typer.Option(
+            "--pitch", callback=number_in(-90.0, 90.0), help="Boresight elevation above the horizon, deg."
+        ),
     ] = 3.0,
     as_json: JsonOption = False,
 ) -> None:
@@ -222,6 +263,8 @@ def experiment_ch3(
         raise InputError(
             f"experiment ch3: option '--compare' must be comma-separated numbers, got {compare!r}"
         ) from None
+    for spacing in others:
+        check_number("--compare", spacing, 0.0, 1.0, low_open=True)
     result = run_ch3(
         out, n_frames=frames, path=path, seed=seed, pitch_deg=pitch, rx_spacing_wavelengths=rx_spacing,
         compare_spacings=others,
@@ -231,7 +274,9 @@ def experiment_ch3(
 
 @bench_app.command("process")
 def bench_process(
-    seconds: Annotated[float, typer.Option("--seconds", help="Minimum timing per implementation, s.")] = 2.0,
+    seconds: Annotated[
+        float, typer.Option("--seconds", callback=POSITIVE, help="Minimum timing per implementation, s.")
+    ] = 2.0,
     as_json: JsonOption = False,
 ) -> None:
     """Detection + DoA frames per second on prototype-size cubes (333 x 250 x 4), ours vs a baseline."""

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from skyradar.cli.app import JsonOption, app, bench_app, console, emit_result
+from skyradar.cli.app import COUNT, NON_NEGATIVE, JsonOption, app, bench_app, console, emit_result
 
 __all__ = ["rd", "bench_chain"]
 
@@ -29,7 +29,7 @@ def rd(
     chunk_frames: Annotated[int, typer.Option("--chunk-frames", min=1, help="Frames per Zarr chunk.")] = 32,
     scheduler: Annotated[str | None, typer.Option(help="Address of an existing Dask scheduler.")] = None,
     workers: Annotated[
-        int | None, typer.Option(help="Run on a local Dask cluster of this many workers.")
+        int | None, typer.Option(callback=COUNT, help="Run on a local Dask cluster of this many workers.")
     ] = None,
     as_json: JsonOption = False,
 ) -> None:
@@ -57,7 +57,11 @@ def bench_chain(
     workers: Annotated[int, typer.Option("--workers", min=1, help="FFT threads.")] = 2,
     as_json: JsonOption = False,
     flight_frames: Annotated[
-        int, typer.Option(help="Frames of the whole-flight simulation run on 1 and 2 Dask workers (0: skip).")
+        int,
+        typer.Option(
+            callback=NON_NEGATIVE,
+            help="Frames of the whole-flight simulation run on 1 and 2 Dask workers (0: skip).",
+        ),
     ] = 2400,
 ) -> None:
     """ADC cube -> range-Doppler cube throughput, and whole-flight simulation on 1 vs 2 Dask workers.

@@ -7,7 +7,18 @@ from typing import Annotated
 
 import typer
 
-from skyradar.cli.app import JsonOption, app, bench_app, emit_result, experiment_app
+from skyradar.cli.app import (
+    COUNT,
+    NON_NEGATIVE,
+    POSITIVE,
+    JsonOption,
+    app,
+    bench_app,
+    check_number,
+    console,
+    emit_result,
+    experiment_app,
+)
 
 __all__ = ["track", "evaluate", "experiment_ch4", "bench_track"]
 
@@ -21,6 +32,9 @@ def _origin(text: str | None) -> tuple[float, float, float] | None:
         lat, lon, alt = (float(v) for v in text.split(","))
     except ValueError as exc:
         raise InputError(f"--origin: expected 'lat_deg,lon_deg,alt_m', got {text!r}") from exc
+    check_number("--origin: field 'lat_deg'", lat, -90.0, 90.0)
+    check_number("--origin: field 'lon_deg'", lon, -180.0, 180.0)
+    check_number("--origin: field 'alt_m'", alt, -500.0, 30_000.0)
     return lat, lon, alt
 
 
@@ -63,6 +77,7 @@ def track(
 
     if model not in ("radar", "traditional"):
         raise InputError(f"--model: must be 'radar' or 'traditional', got {model!r}")
+    origin_lla = _origin(origin)
     table = read_detections(detections)
     config = radar_config_from_attrs(table)
     frame_times = np.unique(table["time_s"].to_numpy(float))
@@ -76,7 +91,7 @@ def track(
         model,
         config,
         frame_times_s=frame_times,
-        origin=_origin(origin),
+        origin=origin_lla,
         ownship=own,
     )
     # detection_row refers to the input table, not to the filtered one.
@@ -85,6 +100,12 @@ def track(
     write_table(
         tracks, output, metadata={"radar_config": config.to_json(), "source": str(detections), "model": model}
     )
+    if tracks.empty:
+        # A clear sky (no detections, or only ground and spurs) is a normal outcome, not an error.
+        console.print(
+            f"no tracks: {int(keep.sum())} of {len(table)} detections left after dropping ground and "
+            f"spurs; wrote an empty tracks table to {output}"
+        )
     result = {
         "frames": int(frame_times.size),
         "detections": int(keep.sum()),
@@ -103,9 +124,11 @@ def evaluate(
     ],
     tracks: Annotated[Path, typer.Argument(help="Tracks table from `skyradar track`.")],
     threshold_px: Annotated[
-        float, typer.Option("--threshold-px", help="Track-truth match distance, pixels.")
+        float, typer.Option("--threshold-px", callback=POSITIVE, help="Track-truth match distance, pixels.")
     ] = 5.0,
-    gospa_c_px: Annotated[float, typer.Option("--gospa-c", help="GOSPA cut-off distance, pixels.")] = 10.0,
+    gospa_c_px: Annotated[
+        float, typer.Option("--gospa-c", callback=POSITIVE, help="GOSPA cut-off distance, pixels.")
+    ] = 10.0,
     as_json: JsonOption = False,
 ) -> None:
     """Score tracks against the run's truth: track and truth counts, fragmentation, identity
@@ -138,22 +161,32 @@ def experiment_ch4(
         ),
     ] = "full",
     seed: Annotated[
-        int, typer.Option("--seed", help="Noise seed of the simulator (full chain) or synthetic detections.")
+        int,
+        typer.Option(
+            "--seed",
+            callback=NON_NEGATIVE,
+            help="Noise seed of the simulator (full chain) or synthetic detections.",
+        ),
     ] = 0,
     as_json: JsonOption = False,
 ) -> None:
     """Thesis ch4: radar-aware vs traditional tracker around an airfield (Circuit, Zulu, Free)."""
+    from skyradar.errors import InputError
     from skyradar.experiments.ch4 import run as run_ch4
 
+    # Checked here, before the process pool: a worker's error would come back as a long traceback.
+    if chain not in ("full", "geometry"):
+        raise InputError(f"--chain: must be 'full' or 'geometry', got {chain!r}")
     result = run_ch4(out, chain=chain, seed=seed)
     emit_result(result, as_json, "ch4 tracking")
 
 
 @bench_app.command("track")
 def bench_track(
-    frames: Annotated[int, typer.Option("--frames", help="Frames to track.")] = 600,
+    frames: Annotated[int, typer.Option("--frames", callback=COUNT, help="Frames to track.")] = 600,
     detections: Annotated[
-        int, typer.Option("--detections", help="Detections per frame (clutter included).")
+        int,
+        typer.Option("--detections", callback=NON_NEGATIVE, help="Detections per frame (clutter included)."),
     ] = 200,
     as_json: JsonOption = False,
 ) -> None:

@@ -13,7 +13,7 @@ from skyradar.track.models import MotionModel, radar_model, traditional_model
 from skyradar.track.tracker import RangeDopplerTracker, TrackerConfig
 from skyradar.track.tracker3d import RadialObservation, Tracker3D
 
-__all__ = ["make_model", "track_detections", "TRACK_COLUMNS", "OWNSHIP_COLUMNS"]
+__all__ = ["make_model", "track_detections", "empty_tracks", "TRACK_COLUMNS", "OWNSHIP_COLUMNS"]
 
 TRACK_COLUMNS = [
     "time_s", "frame", "track_id", "range_m", "radial_velocity_mps", "range_rate_mps", "radial_accel_mps2",
@@ -34,6 +34,25 @@ OWNSHIP_COLUMNS = (
     "own_ve_mps",
     "own_vd_mps",
 )
+
+
+_INTEGER_COLUMNS = ("frame", "track_id", "detection_row", "n_updates", "misses")
+
+
+def empty_tracks() -> pd.DataFrame:
+    """A tracks table with no rows: :data:`TRACK_COLUMNS` with the dtypes of a non-empty one.
+
+    Examples
+    --------
+    >>> empty = empty_tracks()
+    >>> len(empty), list(empty.columns) == TRACK_COLUMNS, str(empty["detection_row"].dtype)
+    (0, True, 'int64')
+    """
+    # Integer row indices stay integer so that callers can index with them even when empty.
+    def dtype(column: str) -> type:
+        return np.int64 if column in _INTEGER_COLUMNS else bool if column == "confirmed" else float
+
+    return pd.DataFrame({c: pd.Series(dtype=dtype(c)) for c in TRACK_COLUMNS}, columns=TRACK_COLUMNS)
 
 
 def make_model(name: str, config: RadarConfig, **noise: float) -> MotionModel:
@@ -227,7 +246,7 @@ def _assemble(
     chunks: list[dict[str, np.ndarray]], origin: tuple[float, float, float] | None, has3d: bool
 ) -> pd.DataFrame:
     if not chunks or sum(c["track_id"].size for c in chunks) == 0:
-        return pd.DataFrame({c: pd.Series(dtype=float) for c in TRACK_COLUMNS})
+        return empty_tracks()
 
     def cat(key: str) -> np.ndarray:
         return np.concatenate([c[key] for c in chunks])

@@ -27,6 +27,7 @@ from skyradar.daa.alerting import RADAR_ALERT_CONFIG
 from skyradar.errors import InputError
 from skyradar.experiments.chain import label_tracks
 from skyradar.experiments.chain import run_chain as _run_chain
+from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.scene.scenario import load_scenario
 
@@ -127,8 +128,7 @@ def run_demo(out_dir: Path, scenario: str | Path | None = None) -> dict[str, Any
     write_table(chain["detections"], out_dir / "detections.parquet")
     write_table(chain["tracks"], out_dir / "tracks.parquet")
     write_table(chain["alerts"], out_dir / "alerts.parquet")
-    timeline.to_csv(out_dir / "alert_timeline.csv.partial", index=False)
-    (out_dir / "alert_timeline.csv.partial").replace(out_dir / "alert_timeline.csv")
+    write_csv_atomic(timeline, out_dir / "alert_timeline.csv", index=False)
     write_report(out_dir, chain, labels, timeline, summary, rd_frame)
     summary["runtime_s"] = round(time.perf_counter() - t_start, 1)
     write_json_atomic(out_dir / "summary.json", summary)

@@ -21,6 +21,7 @@ import pandas as pd
 import yaml
 
 from skyradar.config import RadarConfig
+from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic
 from skyradar.scene.scenario import Scenario, example_scenario
 from skyradar.sim.run import make_simulator, scenario_truth, simulate_frames
@@ -129,7 +130,7 @@ def run(out_dir: str | Path = "out/ch2", n_frames: int = 3) -> dict[str, Any]:
         ],
         columns=["quantity", "measured", "closed_form"],
     )
-    table.to_csv(out / "ch2_table.csv", index=False)
+    write_csv_atomic(table, out / "ch2_table.csv", index=False)
     write_json_atomic(out / "ch2.json", result)
     return result
 

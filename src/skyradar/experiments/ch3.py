@@ -62,6 +62,7 @@ from skyradar.experiments.ch3_scene import (
     square_array_m,
     unambiguous_half_angle_deg,
 )
+from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.process.calibration import calibrate_from_frames, calibration_phase_error_deg
 from skyradar.process.detect import integrate_channels
@@ -257,7 +258,7 @@ def _summary(track: pd.DataFrame, err: pd.DataFrame, table: pd.DataFrame, stats:
 def _write_outputs(out_dir: Path, table: pd.DataFrame, track: pd.DataFrame, err: pd.DataFrame,
                    sweep: list[dict]) -> None:  # fmt: skip
     write_table(table.reset_index(), out_dir / "ch3_table.parquet")
-    table.to_csv(out_dir / "ch3_table.csv")
+    write_csv_atomic(table, out_dir / "ch3_table.csv")
     write_table(
         pd.concat([track, err.drop(columns=["time_s", "true_snr_db"])], axis=1), out_dir / "ch3_track.parquet"
     )

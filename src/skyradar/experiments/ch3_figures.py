@@ -14,6 +14,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from skyradar.config import RadarConfig  # noqa: E402
+from skyradar.io.atomic import savefig_atomic  # noqa: E402
 from skyradar.process.detect import integrate_channels  # noqa: E402
 
 __all__ = ["plot_all", "plot_spacing"]
@@ -45,7 +46,7 @@ def plot_range_doppler(out_dir: Path, static_frame, cal, spur_map, shown) -> Pat
         )
     fig.tight_layout()
     path = out_dir / "ch3_range_doppler.png"
-    fig.savefig(path, dpi=110)
+    savefig_atomic(fig, path, dpi=110)
     plt.close(fig)
     return path
 
@@ -69,7 +70,7 @@ def plot_track(out_dir: Path, track: pd.DataFrame, err: pd.DataFrame, geom: Any)
     ax.legend()
     ax.set_title("ch3: aircraft track from single-frame 3-D DoA")
     path = out_dir / "ch3_track_3d.png"
-    fig.savefig(path, dpi=110)
+    savefig_atomic(fig, path, dpi=110)
     plt.close(fig)
     return path
 
@@ -88,7 +89,7 @@ def plot_errors(out_dir: Path, err: pd.DataFrame) -> Path:
     axes[3].set_xlabel("time [s]")
     fig.tight_layout()
     path = out_dir / "ch3_errors.png"
-    fig.savefig(path, dpi=110)
+    savefig_atomic(fig, path, dpi=110)
     plt.close(fig)
     return path
 
@@ -125,6 +126,6 @@ def plot_spacing(out_dir: Path, sweep: list[dict], thesis: dict) -> Path:
     ax.legend(fontsize=8, ncol=3, loc="upper right")
     fig.tight_layout()
     path = out_dir / "ch3_spacing.png"
-    fig.savefig(path, dpi=110)
+    savefig_atomic(fig, path, dpi=110)
     plt.close(fig)
     return path

@@ -32,6 +32,7 @@ import pandas as pd
 
 from skyradar.config import RadarConfig
 from skyradar.experiments.ch4_flights import EPBC, SCENARIOS, build_traffic
+from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.track.io import Truth
 from skyradar.track.kalman import wrap
@@ -229,7 +230,7 @@ def run(
     figures = draw_figures(results, out_dir)
     summary = _summary(per_scenario, chain, time.perf_counter() - start, figures)
     summary["seed"] = int(seed)
-    pd.DataFrame(per_scenario).T.to_csv(out_dir / "ch4_results.csv")
+    write_csv_atomic(pd.DataFrame(per_scenario).T, out_dir / "ch4_results.csv")
     write_json_atomic(out_dir / "ch4_results.json", summary)
     return summary
 

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from skyradar.config import RadarConfig
+from skyradar.io.atomic import savefig_atomic
 from skyradar.track.kalman import wrap
 
 __all__ = ["draw_figures"]
@@ -42,7 +43,7 @@ def _range_doppler(results: list[dict], out_dir: Path, config: RadarConfig) -> s
             ax.set_ylabel("range [m]")
     fig.tight_layout()
     path = out_dir / "ch4_tracks_range_doppler.png"
-    fig.savefig(path, dpi=90)
+    savefig_atomic(fig, path, dpi=90)
     plt.close(fig)
     return path.name
 
@@ -80,7 +81,7 @@ def _body_frame(results: list[dict], out_dir: Path) -> str:
         ax.legend(loc="lower right", fontsize=8, markerscale=3)
     fig.tight_layout()
     path = out_dir / "ch4_tracks_body.png"
-    fig.savefig(path, dpi=90)
+    savefig_atomic(fig, path, dpi=90)
     plt.close(fig)
     return path.name
 
@@ -105,7 +106,7 @@ def _innovation_hist(results: list[dict], out_dir: Path, config: RadarConfig) ->
         ax.legend(fontsize=8)
     fig.tight_layout()
     path = out_dir / "ch4_innovation_hist.png"
-    fig.savefig(path, dpi=90)
+    savefig_atomic(fig, path, dpi=90)
     plt.close(fig)
     return path.name
 

@@ -24,6 +24,7 @@ import numpy as np
 import pandas as pd
 
 from skyradar.daa.conflict import WellClearVolume
+from skyradar.io.atomic import savefig_atomic
 
 __all__ = [
     "OWN_SPEED_MPS",
@@ -254,5 +255,5 @@ def plot_encounters(res: pd.DataFrame, path: Path, buffer: float, warning_time_s
               title="warning lead")  # fmt: skip
     ax[1].legend()
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    savefig_atomic(fig, path, dpi=110)
     plt.close(fig)

@@ -38,6 +38,7 @@ from skyradar.experiments.encounter_set import (
     score_encounter,
     summarise,
 )
+from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.scene.scenario import Scenario
 
@@ -221,8 +222,7 @@ def run(
                    resumed_encounters=len(done),
                    other_track_warnings=int(res["t_other_warning_s"].notna().sum()))  # fmt: skip
     write_table(res, out_dir / "encounters.parquet")
-    res.to_csv(out_dir / "encounters.csv.partial", index=False)
-    (out_dir / "encounters.csv.partial").replace(out_dir / "encounters.csv")
+    write_csv_atomic(res, out_dir / "encounters.csv", index=False)
     plot_encounters(res, out_dir / "encounters.png", buffer, cfg.levels[-1].alerting_time_s)
     summary["runtime_s"] = round(time.perf_counter() - t0, 1)
     write_json_atomic(out_dir / "summary.json", summary)

@@ -34,14 +34,14 @@ supplies the radar fields and ``axes`` (default ``frame, rx, chirp, sample``); w
 seed prototype's parameters are assumed.
 
 Every inconsistency raises :class:`InputError` naming the file, the field and the value, before any
-output is written. :func:`write_recording` writes both files through temporary names.
+output is written. :func:`write_recording` streams the frames in chunks and writes both files through
+unique temporary names, renamed when complete.
 """
 
 from __future__ import annotations
 
 import json
 import math
-import os
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -51,6 +51,8 @@ import yaml
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
+from skyradar.io.atomic import atomic_path
+from skyradar.io.safe_yaml import load_yaml
 
 __all__ = ["AXES", "DTYPES", "AdcFrames", "read_recording", "write_recording"]
 
@@ -125,7 +127,9 @@ def _sidecar_of(path: Path) -> Path | None:
 def _load_sidecar(path: Path) -> dict[str, Any]:
     try:
         text = path.read_text()
-        meta = json.loads(text) if path.suffix == ".json" else yaml.safe_load(text)
+        meta = json.loads(text) if path.suffix == ".json" else load_yaml(text, path)
+    except InputError:
+        raise
     except (OSError, ValueError, yaml.YAMLError) as exc:
         raise InputError(f"{path}: cannot parse sidecar ({type(exc).__name__}: {exc})") from exc
     if not isinstance(meta, dict):
@@ -319,6 +323,32 @@ def read_recording(path: str | Path) -> tuple[AdcFrames, RadarConfig]:
     return AdcFrames(raw, axes, pairs, scale, times), config
 
 
+_CHUNK_BYTES = 64 * 2**20  # input bytes converted at a time by write_recording
+
+
+def _frames_per_chunk(frames: np.ndarray) -> int:
+    """Frames per write chunk: about ``_CHUNK_BYTES`` of input, at least one frame."""
+    frame_bytes = max(1, int(np.prod(frames.shape[1:], dtype=np.int64)) * frames.itemsize)
+    return max(1, _CHUNK_BYTES // frame_bytes)
+
+
+def _peak(frames: np.ndarray, step: int) -> float:
+    """Largest magnitude in ``frames``, ``step`` frames at a time (0 for no samples)."""
+    if frames.size == 0:
+        return 0.0
+    return max(float(np.abs(frames[i : i + step]).max()) for i in range(0, len(frames), step))
+
+
+def _encode(block: np.ndarray, scale: float, code: str, per: int) -> np.ndarray:
+    """Frames as stored on disk: divided by ``scale``, (I, Q) pairs, rounded and clipped for int16."""
+    values = block / scale
+    if per == 2:
+        values = np.stack([values.real, values.imag], axis=-1)
+    if code == "i2":
+        values = np.clip(np.round(values), -32768, 32767)
+    return values.astype("<" + code)
+
+
 def write_recording(
     path: str | Path,
     frames: np.ndarray,
@@ -329,6 +359,10 @@ def write_recording(
     sidecar_format: str = "json",
 ) -> Path:
     """Write frames (frame, rx, chirp, sample) as ``NAME.bin`` plus a sidecar, atomically.
+
+    The frames are converted and written a few at a time (about 64 MB of input per step), so
+    memory stays bounded whatever the recording's length: ``frames`` may be a memory-mapped
+    array larger than RAM.
 
     Parameters
     ----------
@@ -359,16 +393,14 @@ def write_recording(
             f"write_recording: frames must be (frame, rx, chirp, sample), got shape {frames.shape}"
         )
     code, per = DTYPES[dtype]
-    if scale is None:
-        peak = float(np.abs(frames).max()) if frames.size else 0.0
-        scale = peak / 30000.0 if code == "i2" and peak > 0 else 1.0
-    values = frames / scale
-    if per == 2:
-        values = np.stack([values.real, values.imag], axis=-1)
-    elif np.iscomplexobj(values):
+    if per == 1 and np.iscomplexobj(frames):
         raise InputError(f"write_recording: dtype {dtype!r} is real but the frames are complex")
-    if code == "i2":
-        values = np.clip(np.round(values), -32768, 32767)
+    if path.suffix.lower() in (".json", ".yaml", ".yml"):
+        raise InputError(f"write_recording: data file {path} would be its own sidecar; name it NAME.bin")
+    step = _frames_per_chunk(frames)
+    if scale is None:
+        peak = _peak(frames, step)
+        scale = peak / 30000.0 if code == "i2" and peak > 0 else 1.0
     meta = {
         "format": "skyradar-adc/1",
         "data_file": path.name,
@@ -391,14 +423,11 @@ def write_recording(
         meta["frame_times_s"] = [float(t) for t in times_s]
     meta = json.loads(json.dumps(meta, default=float))  # plain Python types for YAML too
     sidecar = path.with_suffix(".json" if sidecar_format == "json" else ".yaml")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp_data, tmp_side = path.with_name(path.name + ".tmp"), sidecar.with_name(sidecar.name + ".tmp")
-    try:
-        values.astype("<" + code).tofile(tmp_data)
-        tmp_side.write_text(json.dumps(meta, indent=1) if sidecar_format == "json" else yaml.safe_dump(meta))
-        os.replace(tmp_data, path)
-        os.replace(tmp_side, sidecar)
-    finally:
-        for tmp in (tmp_data, tmp_side):
-            tmp.unlink(missing_ok=True)
+    text = json.dumps(meta, indent=1) if sidecar_format == "json" else yaml.safe_dump(meta)
+    # The data file is renamed first (inner block), then the sidecar that describes it.
+    with atomic_path(sidecar) as tmp_side, atomic_path(path) as tmp_data:
+        with open(tmp_data, "wb") as f:
+            for i in range(0, len(frames), step):
+                _encode(frames[i : i + step], scale, code, per).tofile(f)
+        tmp_side.write_text(text)
     return sidecar

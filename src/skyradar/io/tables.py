@@ -1,8 +1,8 @@
 """Tables (detections, tracks, states, poses, alerts) as pandas DataFrames in Parquet.
 
-Writers go through a temporary name and rename, so an interrupted job never leaves a
-half-written file under the final name. Readers check required columns and say which are
-missing.
+Writers go through a unique temporary name and rename (:mod:`skyradar.io.atomic`), so an
+interrupted job never leaves a half-written file under the final name nor a stray temporary file.
+Readers check required columns and say which are missing.
 """
 
 from __future__ import annotations
@@ -16,21 +16,17 @@ from typing import Any
 import pandas as pd
 
 from skyradar.errors import InputError
+from skyradar.io.atomic import write_text_atomic, write_with
 
 __all__ = ["write_table", "read_table", "write_json_atomic", "jsonable"]
 
 
 def write_table(df: pd.DataFrame, path: str | Path, metadata: dict[str, Any] | None = None) -> Path:
     """Write ``df`` to Parquet atomically; ``metadata`` goes into ``df.attrs`` (kept by pyarrow)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
     if metadata:
         df = df.copy()
         df.attrs.update(metadata)
-    df.to_parquet(tmp, index=False)
-    tmp.replace(path)
-    return path
+    return write_with(path, lambda tmp: df.to_parquet(tmp, index=False))
 
 
 def read_table(path: str | Path, required: Iterable[str] = (), sort_by: str | None = None) -> pd.DataFrame:
@@ -75,9 +71,4 @@ def jsonable(value: Any) -> Any:
 
 def write_json_atomic(path: str | Path, payload: Any) -> Path:
     """Write JSON to ``path`` through a temporary name and rename (NaN and inf become null)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(jsonable(payload), indent=2, default=float, allow_nan=False))
-    tmp.replace(path)
-    return path
+    return write_text_atomic(path, json.dumps(jsonable(payload), indent=2, default=float, allow_nan=False))

@@ -25,7 +25,6 @@ Examples
 
 from __future__ import annotations
 
-import os
 from collections.abc import Iterable
 from dataclasses import dataclass
 from functools import cached_property
@@ -127,12 +126,16 @@ class SpurMap:
 
     def save(self, path: str | Path) -> Path:
         """Write to ``.npz`` atomically."""
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.name + ".tmp.npz")
-        np.savez_compressed(tmp, frequency=self.frequency, threshold=self.threshold, n_frames=self.n_frames)
-        os.replace(tmp, path)
-        return path
+        from skyradar.io.atomic import write_with
+
+        # savez appends ".npz" to a name without it: give it the open file so the name is kept.
+        def save(tmp: Path) -> None:
+            with open(tmp, "wb") as f:
+                np.savez_compressed(
+                    f, frequency=self.frequency, threshold=self.threshold, n_frames=self.n_frames
+                )
+
+        return write_with(path, save)
 
     @classmethod
     def load(cls, path: str | Path, config: RadarConfig | None = None) -> SpurMap:

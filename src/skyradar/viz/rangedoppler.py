@@ -16,6 +16,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from skyradar.config import RadarConfig  # noqa: E402
+from skyradar.io.atomic import savefig_atomic  # noqa: E402
 
 __all__ = ["image_extent", "plot_strength", "plot_phase_difference", "save_frame_figure"]
 
@@ -110,8 +111,7 @@ def save_frame_figure(
             ax.legend(loc="upper left", fontsize=8, framealpha=0.6)
     axes[0].set_title(f"{title} strength")
     axes[1].set_title(f"{title} phase difference")
-    tmp = path.with_name(path.stem + ".tmp" + path.suffix)
-    fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    tmp.replace(path)
-    return path
+    try:
+        return savefig_atomic(fig, path, dpi=110)
+    finally:
+        plt.close(fig)

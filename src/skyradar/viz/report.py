@@ -17,6 +17,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from skyradar.io.atomic import savefig_atomic, write_text_atomic  # noqa: E402
 from skyradar.io.frames import radar_config_of  # noqa: E402
 from skyradar.viz.rangedoppler import plot_strength  # noqa: E402
 
@@ -27,11 +28,10 @@ _INTRUDER_COLOURS = ("#d81b60", "#1e88e5", "#43a047", "#8e24aa", "#00897b")
 
 
 def _save(fig, path: Path) -> Path:
-    tmp = path.with_name(path.name + ".partial.png")
-    fig.savefig(tmp, dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    tmp.replace(path)
-    return path
+    try:
+        return savefig_atomic(fig, path, dpi=110, bbox_inches="tight")
+    finally:
+        plt.close(fig)
 
 
 def plot_range_doppler(frame, config, detections: pd.DataFrame, title: str, path: Path) -> Path:
@@ -150,8 +150,4 @@ tracks). Acceptance (warning for the collision intruder, none for anything else)
 {advice_html}
 </body></html>
 """
-    path = out_dir / "index.html"
-    tmp = out_dir / "index.html.partial"
-    tmp.write_text(page)
-    tmp.replace(path)
-    return path
+    return write_text_atomic(out_dir / "index.html", page)

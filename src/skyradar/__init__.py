@@ -3,8 +3,10 @@
 The pipeline, one subpackage per stage::
 
     scene -> sim -> process -> track -> daa
-                    process -> nav (flight state, GPS check)
-    passive (ATC radar as illuminator)
+                    process -> nav (own-ship height and velocity over the terrain)
+
+Not built yet: the GPS check against a map (seed-brief.md ch6) and passive radar with an ATC
+radar as illuminator (ch7).
 """
 
 from skyradar.antenna import AntennaPattern

@@ -1,8 +1,8 @@
 """Whole-flight simulation throughput on Dask, 1 versus 2 workers, and memory over a long flight.
 
-The flight circles (radius 20 km, 50 m/s, 1000 m above the terrain) over the 1201 x 1201
-SRTM-3 tile of :mod:`skyradar.benchmarks.sim`, at the prototype's 9.4 frames/s, with DEM-spacing
-facets. Each chunk of frames is simulated on a worker and reduced there to a per-frame summary
+The flight circles (radius 20 km, 50 m/s, 1000 m above the terrain) over the synthetic 1201 x
+1201 SRTM-3-format tile of :mod:`skyradar.benchmarks.sim`, at the prototype's 9.4 frames/s, with
+DEM-spacing facets. Each chunk of frames is simulated on a worker and reduced there to a per-frame summary
 (total received power, strongest pixel), so a 20000-frame flight is measured without writing
 53 GB of frames; ``store=True`` writes the frames to Zarr instead (bounded by disk, not memory).
 Peak resident memory is read from every process (client and workers) after each chunk, so

@@ -119,3 +119,43 @@ def test_bad_option_values_give_one_line(tmp_path, args, needles):
     result = _skyradar(*args, cwd=tmp_path, timeout=60)
     _assert_one_line_error(result, *needles)
     assert not (tmp_path / "out").exists()  # refused before any work
+
+
+# --- hostile YAML ------------------------------------------------------------------------------------
+
+
+def _billion_laughs(path: Path) -> Path:
+    """357 bytes that stand for 9^9 (387 million) strings through nested aliases."""
+    lines = ["name:", '  - &a ["lol","lol","lol","lol","lol","lol","lol","lol","lol"]']
+    for prev, level in zip("abcdefgh", "bcdefghi", strict=True):
+        lines.append(f"  - &{level} [" + ",".join([f"*{prev}"] * 9) + "]")
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def _limit_memory() -> None:  # runs in the child: a bomb must fail fast, not take the machine
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))
+
+
+@pytest.mark.parametrize("command", ["simulate", "sweep"])
+def test_yaml_alias_bomb_is_refused_quickly(tmp_path, command):
+    bomb = _billion_laughs(tmp_path / "bomb.yaml")
+    args = ["simulate", str(bomb), "-o", "run.zarr"]
+    if command == "sweep":
+        args = ["sweep", str(bomb), "--param", "duration_s", "--values", "1", "-o", "t.csv"]
+    try:
+        result = subprocess.run(
+            [sys.executable, "-m", "skyradar", *args], cwd=tmp_path, capture_output=True, text=True,
+            timeout=60, preexec_fn=_limit_memory,
+        )  # fmt: skip
+    except subprocess.TimeoutExpired:
+        pytest.fail("the YAML bomb was expanded (no answer within 60 s)")
+    _assert_one_line_error(result, "bomb.yaml", "aliases expand")
+
+
+def test_recursive_yaml_alias_is_refused(tmp_path):
+    scenario = tmp_path / "loop.yaml"
+    scenario.write_text("name: &a [1, *a]\n")
+    _assert_one_line_error(_skyradar("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path), "loop.yaml")

@@ -27,11 +27,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 from pydantic import ValidationError
 
 from skyradar.config import Mount, RadarConfig
 from skyradar.errors import InputError
+from skyradar.io.safe_yaml import load_yaml, short_repr
 from skyradar.scene.scenario_models import (
     TAGS,
     AntennaModel,
@@ -87,8 +87,8 @@ class BuiltScenario:
 
 
 def _describe(value: Any) -> str:
-    text = repr(value) if isinstance(value, str) else str(value)
-    return text if len(text) <= 60 else text[:57] + "..."
+    # Bounded: str() of a value built from YAML aliases can expand to gigabytes.
+    return short_repr(value)
 
 
 def _format_error(source: str, err: dict[str, Any]) -> str:
@@ -137,12 +137,10 @@ def load_scenario(path: str | Path) -> Scenario:
     if not path.is_file():
         raise InputError(f"{path}: no such scenario file")
     try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}" if mark is not None else ""
-        problem = getattr(exc, "problem", None) or type(exc).__name__
-        raise InputError(f"{path}: not valid YAML{where} ({problem})") from None
+        text = path.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot read scenario ({type(exc).__name__}: {exc})") from None
+    data = load_yaml(text, path)
     if not isinstance(data, dict):
         raise InputError(
             f"{path}: must be a mapping of sections (name, radar, ownship, ...), got {type(data).__name__}"
@@ -234,7 +232,7 @@ class Scenario:
         changes = mm.model_dump(exclude_none=True, exclude={"preset"})
         return Mount(**{**base.__dict__, **changes})
 
-    def _terrain(self, origin: tuple[float, float, float] | None):
+    def _terrain(self, origin: tuple[float, float, float] | None, bounds=None):
         t = self.model.terrain
         if t is None:
             return None
@@ -244,7 +242,7 @@ class Scenario:
             if t.type == "jacksboro":
                 return terrain_mod.jacksboro()
             if t.type == "file":
-                return terrain_mod.read_dem(self._path(t.path))
+                return terrain_mod.read_dem(self._path(t.path), bounds=bounds)
             if origin is None:
                 raise InputError(
                     f"field 'origin': is required for {t.type} terrain (it is centred on the origin)"
@@ -300,6 +298,21 @@ class Scenario:
             f"{self._label}: field 'origin': is required when own-ship is parametric and terrain is not a DEM"
         )
 
+    def _dem_under_flight(self, terrain, origin, own, radar: RadarConfig):
+        """The terrain, a DEM read only where the radar can see from the flight, checked to lie under it."""
+        from skyradar.scene.dem_coverage import check_dem_covers, footprint_bounds
+
+        if terrain is None:
+            # The simulator crops within the range limit plus a few facets of each position.
+            area = footprint_bounds(own.lat_deg, own.lon_deg, radar.range_limit_m + 1000.0)
+            terrain = self._terrain(origin, area)
+        if terrain is not None and self.model.terrain.type in ("file", "jacksboro"):
+            try:
+                check_dem_covers(terrain, own.lat_deg, own.lon_deg, own.time_s, origin)
+            except InputError as exc:
+                raise self._fail("terrain", exc) from None
+        return terrain
+
     # ---- all together -------------------------------------------------------------------------
     def build(self) -> BuiltScenario:
         """Make the radar, terrain, trajectories and frame times (see :class:`BuiltScenario`)."""
@@ -307,8 +320,6 @@ class Scenario:
         radar = self._radar()
         times = self.frame_times()
         origin, ownship, terrain = self._origin()
-        if terrain is None:
-            terrain = self._terrain(origin)
         if ownship is None:
             ownship = self._flight(m.ownship, "ownship", origin, None, "ownship")
         if not np.all(ownship.covers(times)):
@@ -317,6 +328,7 @@ class Scenario:
                 f"{ownship.start_s:.6g}..{ownship.end_s:.6g} s but the frames need "
                 f"{times[0]:.6g}..{times[-1]:.6g} s (start_s, duration_s)"
             )
+        terrain = self._dem_under_flight(terrain, origin, ownship.sample(times), radar)
         intruders: list[Intruder] = []
         for i, spec in enumerate(m.intruders):
             traj = self._flight(spec, f"intruders.{i}", origin, ownship, spec.name or f"intruder{i}")

@@ -20,6 +20,7 @@ import pandas as pd
 import yaml
 
 from skyradar.errors import InputError
+from skyradar.io.safe_yaml import load_yaml
 from skyradar.scene.scenario import Scenario
 from skyradar.sim.run import make_simulator, scenario_truth, simulate_frames
 
@@ -126,9 +127,10 @@ def sweep(
     """One table: every run's :func:`run_table` with a leading column holding the parameter value."""
     path = Path(scenario)
     try:
-        data = yaml.safe_load(path.read_text())
-    except (OSError, yaml.YAMLError) as exc:
-        raise InputError(f"{path}: cannot read scenario ({exc})") from exc
+        text = path.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot read scenario ({type(exc).__name__}: {exc})") from None
+    data = load_yaml(text, path)
     for value in values:  # fail fast on a bad path or value, before any work
         Scenario.from_dict(set_by_path(data, param, value, str(path)), source=path)
     if scheduler is None and not workers:

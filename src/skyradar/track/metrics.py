@@ -12,6 +12,7 @@ with a match threshold; the counts below follow from that matching:
 * ``id_switches``: frames in which a truth segment is matched to a different track than the last
   one it was matched to (CLEAR-MOT style);
 * ``completeness``: share of visible truth frames (in counted segments) matched by a track;
+* ``missed_truth_tracks``: counted truth segments that no confirmed track was ever matched to;
 * GOSPA (García-Fernández et al., alpha = 2) per frame, on the same distance, averaged over frames.
 
 Only confirmed rows (``confirmed`` column, when present) are matched and counted. Innovation
@@ -286,9 +287,9 @@ def _match_frame(
     return out
 
 
-def _segment_counts(matched: np.ndarray, labels: np.ndarray) -> tuple[int, int, float]:
-    """Fragmentation, identity switches and completeness from per-frame matches."""
-    frag = switches = 0
+def _segment_counts(matched: np.ndarray, labels: np.ndarray) -> tuple[int, int, float, int]:
+    """Fragmentation, identity switches, completeness and missed segments from per-frame matches."""
+    frag = switches = missed = 0
     counted = labels >= 0
     hit = counted & (matched >= 0)
     completeness = float(hit.sum() / counted.sum()) if counted.any() else float("nan")
@@ -296,10 +297,11 @@ def _segment_counts(matched: np.ndarray, labels: np.ndarray) -> tuple[int, int, 
         seq = matched[labels == seg]  # time order: boolean masks keep row-major order per target
         seq = seq[seq >= 0]
         if seq.size == 0:
+            missed += 1
             continue
         frag += np.unique(seq).size - 1
         switches += int(np.count_nonzero(seq[1:] != seq[:-1]))
-    return frag, switches, completeness
+    return frag, switches, completeness, missed
 
 
 def track_metrics(
@@ -312,18 +314,31 @@ def track_metrics(
     gap_s: float = 2.0,
     min_duration_s: float = 2.0,
     confirm: tuple[int, int] = (1, 1),
+    counted: np.ndarray | None = None,
 ) -> dict[str, float]:
     """All track metrics of this module in one dict (see the module docstring).
 
     The defaults bridge truth gaps shorter than the tracker's coasting time (2 s) and do not count
     truth segments shorter than 2 s (a count by hand would not see them as tracks either).
+    ``counted`` (bool, shape of ``truth.visible``, within it) selects the frames that make up the
+    counted truth segments, e.g. those with enough expected SNR; tracks are still matched against
+    every visible truth, so a track on an aircraft too faint to be counted is not a false track;
+    GOSPA is taken against the counted truths only (one too faint is not a missed target).
     """
-    labels = truth_segments(truth, gap_s, min_duration_s, confirm)
+    if counted is None:
+        counted = truth.visible
+    counted = np.asarray(counted, bool) & truth.visible
+    counted_truth = Truth(truth.time_s, truth.range_m, truth.radial_velocity_mps, counted)
+    labels = truth_segments(counted_truth, gap_s, min_duration_s, confirm)
     all_rows = tracks
     if "confirmed" in tracks.columns:
         tracks = tracks[tracks["confirmed"].to_numpy(bool)]
     matched, gospa_d = match_tracks(tracks, truth, pixel_size, doppler_width_mps, threshold_px, gospa_c_px)
-    frag, switches, completeness = _segment_counts(matched, labels)
+    if not np.array_equal(counted, truth.visible):
+        gospa_d = match_tracks(
+            tracks, counted_truth, pixel_size, doppler_width_mps, threshold_px, gospa_c_px
+        )[1]
+    frag, switches, completeness, missed = _segment_counts(matched, labels)
     ids = np.unique(tracks["track_id"].to_numpy(np.int64))
     true_ids = np.unique(matched[matched >= 0])
     innov_cols = ["innovation_range_m", "innovation_radial_velocity_mps"]
@@ -336,6 +351,7 @@ def track_metrics(
         "fragmentation": int(frag),
         "id_switches": int(switches),
         "completeness": completeness,
+        "missed_truth_tracks": int(missed),
         "gospa_mean": float(gospa_d.mean()) if gospa_d.size else float("nan"),
         **innovation_stats(innov, pixel_size),
         "innov_mean_px_confirmed": confirmed_only["innov_mean_px"],

@@ -33,6 +33,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+import numba
 import numpy as np
 
 from skyradar.config import RadarConfig
@@ -311,4 +312,7 @@ def run(n_frames: int = 40, baseline_frames: int = 6, min_seconds: float = 2.0) 
         "speedup_vs_thesis_code": fps / THESIS_FRAMES_PER_S,
         "timing": f"median frame time after one warm-up frame, at least {min_seconds:g} s per implementation",
         "load_average_1min": [load_before, os.getloadavg()[0]],
+        # Ours runs on numba threads: under load they wait for each other (see the README).
+        "numba_threads": numba.get_num_threads(),
+        "numba_threading_layer": numba.threading_layer(),
     }

@@ -159,3 +159,110 @@ def test_recursive_yaml_alias_is_refused(tmp_path):
     scenario = tmp_path / "loop.yaml"
     scenario.write_text("name: &a [1, *a]\n")
     _assert_one_line_error(_skyradar("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path), "loop.yaml")
+
+
+# --- nonsense in frames, recordings and scenarios ---------------------------------------------------
+
+
+def _store(path: Path, *, nan_frame: int | None = None, times: list[float] | None = None) -> Path:
+    """A tiny frames store (6 frames of 40 x 16 x 4) written the way the test suite writes runs."""
+    from skyradar.config import RadarConfig
+    from skyradar.io.frames import frames_dataset
+
+    cfg = RadarConfig.seed_prototype(range_limit_m=600.0, n_doppler=16)
+    rng = np.random.default_rng(0)
+    shape = (6, cfg.n_range, cfg.n_doppler, cfg.n_rx)
+    iq = (rng.normal(size=shape) + 1j * rng.normal(size=shape)).astype(np.complex64) * 1e-7
+    if nan_frame is not None:
+        iq[nan_frame, 3, 2, 1] = np.nan
+    t = np.arange(6) * 0.1 if times is None else np.asarray(times, float)
+    frames_dataset(iq, t, cfg).to_zarr(path, consolidated=False)
+    return path
+
+
+@pytest.mark.parametrize("command", ["process", "state"])
+def test_nan_frame_is_refused_naming_file_and_frame(tmp_path, command):
+    run = _store(tmp_path / "run.zarr", nan_frame=4)
+    result = _skyradar(command, str(run), "-o", "out.parquet", cwd=tmp_path)
+    _assert_one_line_error(result, "run.zarr", "'iq'", "frame 4", "nan")
+    assert not (tmp_path / "out.parquet").exists()
+
+
+@pytest.mark.parametrize("command", ["process", "state"])
+@pytest.mark.parametrize("times", [[0, 0.1, 0.2, 0.2, 0.3, 0.4], [0, 0.1, 0.2, 0.15, 0.3, 0.4]])
+def test_repeated_or_backward_frame_times_are_refused(tmp_path, command, times):
+    run = _store(tmp_path / "run.zarr", times=times)
+    result = _skyradar(command, str(run), "-o", "out.parquet", cwd=tmp_path)
+    _assert_one_line_error(result, "run.zarr", "'time'", "frame 3")
+
+
+def test_state_on_store_with_zero_range_bins_names_the_file(tmp_path):
+    import json
+
+    import xarray as xr
+
+    run = _store(tmp_path / "ok.zarr")
+    ds = xr.open_zarr(run, consolidated=False).isel(range=slice(0, 0)).load()
+    cfg = json.loads(ds.attrs["radar_config"])
+    cfg["range_limit_m"] = 1.0
+    ds.attrs["radar_config"] = json.dumps(cfg)
+    ds.to_zarr(tmp_path / "empty.zarr", consolidated=False)
+    result = _skyradar("state", str(tmp_path / "empty.zarr"), "-o", "s.parquet", cwd=tmp_path)
+    _assert_one_line_error(result, "empty.zarr", "range_limit_m", "0 range bins")
+
+
+def test_cfar_that_does_not_fit_names_the_run(tmp_path):
+    from skyradar.config import RadarConfig
+    from skyradar.io.frames import frames_dataset
+
+    cfg = RadarConfig.seed_prototype(range_limit_m=90.0, n_doppler=16)  # 6 range bins
+    iq = np.ones((2, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
+    frames_dataset(iq, np.arange(2) * 0.1, cfg).to_zarr(tmp_path / "small.zarr", consolidated=False)
+    result = _skyradar("process", "small.zarr", "-o", "d.parquet", cwd=tmp_path)
+    _assert_one_line_error(result, "small.zarr", "cfar")
+
+
+def _recording(path: Path, nan_frame: int | None = None) -> Path:
+    from skyradar.config import RadarConfig
+
+    cfg = RadarConfig.seed_prototype()
+    adc = np.ones((3, cfg.n_rx, 8, cfg.samples_per_chirp), np.complex64)
+    if nan_frame is not None:
+        adc[nan_frame, 0, 0, 5] = np.inf
+    np.save(path, adc)
+    return path
+
+
+def test_rd_refuses_non_finite_samples_before_writing(tmp_path):
+    rec = _recording(tmp_path / "rec.npy", nan_frame=2)
+    result = _skyradar("rd", str(rec), "-o", "rd.zarr", cwd=tmp_path)
+    _assert_one_line_error(result, "rec.npy", "frame 2", "inf")
+    assert not any(tmp_path.glob("rd.zarr*"))
+
+
+def test_rd_refuses_repeated_frame_times(tmp_path):
+    import json
+
+    rec = _recording(tmp_path / "rec.npy")
+    (tmp_path / "rec.json").write_text(json.dumps({"frame_times_s": [0.0, 0.1, 0.1]}))
+    result = _skyradar("rd", str(rec), "-o", "rd.zarr", cwd=tmp_path)
+    _assert_one_line_error(result, "rec.json", "frame_times_s", "frame 2")
+
+
+def test_scenario_with_zero_range_bins_is_refused(tmp_path):
+    import yaml
+
+    scenario = {
+        "name": "tiny",
+        "origin": {"lat_deg": 52.0, "lon_deg": 4.36, "alt_m": 0.0},
+        "mount": "forward",
+        "radar": {"range_limit_m": 1},
+        "terrain": {"type": "flat", "size_m": 3000, "spacing_m": 60},
+        "ownship": {"type": "straight", "start_ned_m": [0, 0, -500], "heading_deg": 0, "speed_mps": 40},
+        "frame_rate_hz": 5.0,
+        "duration_s": 1.0,
+    }
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(scenario))
+    result = _skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
+    _assert_one_line_error(result, "s.yaml", "range_limit_m", "0 range bins")
+    assert not any(tmp_path.glob("run.zarr*"))

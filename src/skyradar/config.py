@@ -193,6 +193,11 @@ class RadarConfig:
             raise InputError(
                 f"radar.range_limit_m {self.range_limit_m} exceeds the unambiguous range {self.rmax_m:.0f} m"
             )
+        if self.n_range < 2:  # an image needs range bins; 0 bins crashed every stage downstream
+            raise InputError(
+                f"radar.range_limit_m {self.range_limit_m} gives {self.n_range} range bins of "
+                f"{self.range_resolution_m:.2f} m; needs at least 2"
+            )
 
     @classmethod
     def seed_prototype(cls, **changes: Any) -> RadarConfig:

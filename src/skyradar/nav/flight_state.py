@@ -33,6 +33,7 @@ import xarray as xr
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.geo import rotation_matrix
+from skyradar.io.checks import check_finite_frames, check_frame_times
 from skyradar.nav.inversion import StateFit, fit_robust, fit_thesis
 from skyradar.nav.kalman_state import KalmanSettings, filter_states
 from skyradar.nav.ridge import Ridge, extract_ridge
@@ -159,7 +160,7 @@ def _attitude(ds: xr.Dataset, i: int) -> tuple[float, float, float]:
     return tuple(float(ds[n][i]) if n in ds else 0.0 for n in names)  # type: ignore[return-value]
 
 
-def _frame_rows(ds: xr.Dataset, config: RadarConfig, method: str, progress) -> list[dict]:
+def _frame_rows(ds: xr.Dataset, config: RadarConfig, method: str, progress, source: str) -> list[dict]:
     from skyradar.nav.terrain_aware import TerrainAwareEstimator
 
     times = ds["time"].to_numpy().astype(float)
@@ -168,6 +169,7 @@ def _frame_rows(ds: xr.Dataset, config: RadarConfig, method: str, progress) -> l
     for i in range(times.size):
         attitude = _attitude(ds, i)
         frame = np.asarray(ds.iq[i].values)
+        check_finite_frames(frame[None], i, source)  # a NaN would come out as a wrong state, not an error
         if aware is not None:
             est = aware.update(times[i], frame, attitude)
             fit, quality, low, n_ridge, n_in = est, est.quality, est.low_quality, est.n_points, est.n_points
@@ -203,8 +205,9 @@ def estimate_run(
     settings: KalmanSettings | None = None,
     gps_gate: bool = False,
     progress: Callable[[int, int], None] | None = None,
+    source: str = "frames",
 ) -> pd.DataFrame:
-    """Per-frame raw and filtered flight state of a frames Dataset.
+    """Per-frame raw and filtered flight state of a frames Dataset (``source`` names it in errors).
 
     ``method`` is ``thesis``, ``robust`` or ``terrain`` (:mod:`skyradar.nav.terrain_aware`,
     which takes the attitude from the run's ``own_yaw_rad/own_pitch_rad/own_roll_rad``, i.e. an
@@ -217,14 +220,15 @@ def estimate_run(
 
     if method not in (*METHODS, "terrain"):
         raise InputError(f"flight state: field 'method' must be thesis, robust or terrain, got {method!r}")
-    config = radar_config_of(ds)
-    table = pd.DataFrame(_frame_rows(ds, config, method, progress))
+    config = radar_config_of(ds, source)
+    check_frame_times(ds["time"].values, source)
+    table = pd.DataFrame(_frame_rows(ds, config, method, progress, source))
     if settings is None:
         settings = KalmanSettings(terrain_psd=400.0) if method == "terrain" else KalmanSettings()
     reference = None
     if gps_gate:
         if "own_height_agl_m" not in ds:
-            raise InputError("frames: field 'own_height_agl_m' is needed for the GPS gate but missing")
+            raise InputError(f"{source}: field 'own_height_agl_m' is needed for the GPS gate but missing")
         reference = ds["own_height_agl_m"].to_numpy().astype(float)
         settings = KalmanSettings(**{**settings.__dict__, "gps_gate_m": 150.0})
     return filter_table(table, settings, reference)

@@ -36,6 +36,7 @@ import xarray as xr
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.geo import ned_rotation_to, ned_to_geodetic, rotation_matrix
+from skyradar.io.checks import check_finite_frames
 from skyradar.io.frames import radar_config_of
 from skyradar.process.calibration import in_field_of_view
 from skyradar.process.detect import detect, integrate_channels
@@ -266,9 +267,13 @@ def process_frames(
     rows: list[dict[str, np.ndarray]] = []
     for start in range(0, n_frames, batch_frames):
         block = np.asarray(ds["iq"].isel(time=slice(start, start + batch_frames)).values)
+        check_finite_frames(block, start, source)
         for offset, cube in enumerate(block):
             i = start + offset
-            out = process_cube(cube, config, spur_map, method, spur_mode, **detect_kwargs)
+            try:
+                out = process_cube(cube, config, spur_map, method, spur_mode, **detect_kwargs)
+            except InputError as exc:  # e.g. CFAR windows that do not fit: say which run
+                raise InputError(f"{source}: {exc}") from None
             n = len(out["range_m"])
             out["time_s"] = np.full(n, times[i])
             out["frame"] = np.full(n, i, np.int64)

@@ -18,6 +18,7 @@ from skyradar.cli.app import (
     emit_result,
     experiment_app,
 )
+from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["state", "experiment_ch5", "bench_state"]
 
@@ -38,6 +39,7 @@ def state(
         bool,
         typer.Option("--gps-gate", help="Thesis comparison: gate on the run's own_height_agl_m (150 m)."),
     ] = False,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
     """Own-ship flight state over the terrain from the ground returns of every frame (ch5).
@@ -49,12 +51,18 @@ def state(
     terrain memory, Kalman filter), so the frames are not split across Dask workers.
     """
     from skyradar.io.frames import open_frames, radar_config_of
+    from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_table
     from skyradar.nav.flight_state import estimate_run
 
+    check_output(output, [run], overwrite, kind="table")
+    from skyradar.errors import InputError
+
+    if method not in ("thesis", "robust", "terrain"):
+        raise InputError(f"--method: must be thesis, robust or terrain, got {method!r}")
     ds = open_frames(run)
     config = radar_config_of(ds, str(run))
-    table = estimate_run(ds, method=method, gps_gate=gps_gate)
+    table = estimate_run(ds, method=method, gps_gate=gps_gate, source=str(run))
     write_table(
         table, output, metadata={"radar_config": config.to_json(), "source": str(run), "method": method}
     )
@@ -91,32 +99,57 @@ def experiment_ch5(
             help="Flight length at 9.4 frames/s (flat, 19.2 m), s; 0 skips.",
         ),
     ] = 6.0,
+    ahrs_noise: Annotated[
+        bool,
+        typer.Option(
+            "--ahrs-noise/--no-ahrs-noise",
+            help="Also estimate with a typical MEMS AHRS's attitude (seeded noise + bias), not the truth.",
+        ),
+    ] = True,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
     """ch5: flight state over flat, fractal (local SD 19.2..345 m) and Jacksboro terrain; three methods.
 
-    Prints the height error mean/SD and V_X, V_Z error SD per terrain for the thesis, robust and
-    terrain-aware methods next to the thesis' published numbers.
+    Prints the height error mean/SD, V_X, V_Z error SD and the share of frames with a filtered
+    (and a raw) estimate per terrain for the thesis, robust and terrain-aware methods, with the
+    true attitude and with the AHRS attitude, next to the thesis' published numbers.
     """
-    from skyradar.experiments.ch5 import run
+    from skyradar.experiments.ch5 import TYPICAL_AHRS, check_run_options, run
 
+    check_run_options(duration_s, fast_duration_s)  # before any output: a bad option is one line
+    from skyradar.io.outputs import check_output, mark_folder
+
+    check_output(out, (), overwrite, kind="folder", option="--out")
+    mark_folder(out)
     console.print(f"ch5: simulating and estimating into {out} ...")
-    result = run(out, duration_s=duration_s, fast_duration_s=fast_duration_s)
+    result = run(
+        out, duration_s=duration_s, fast_duration_s=fast_duration_s, ahrs=TYPICAL_AHRS if ahrs_noise else None
+    )
     table = result["table"]
+    for source, label in (("true", "true attitude"), ("ahrs", "AHRS attitude")):
+        rows = [row for row in table if row["attitude"] == source]
+        if rows:
+            console.print(_ch5_view(rows, label))
+    emit_result({k: v for k, v in result.items() if k != "table"}, as_json, "ch5")
+
+
+def _ch5_view(rows: list[dict], label: str):
+    """The ch5 table of one attitude source (fits 80 columns)."""
     from rich.table import Table
 
-    view = Table(title="ch5: filtered errors (thesis numbers in brackets)")
-    for col in ("rate", "terrain", "method", "h mean [m]", "h SD [m]", "V_X SD [m/s]", "V_Z SD [m/s]"):
+    view = Table(title=f"ch5, {label}: filtered errors [thesis]; valid/raw = share of frames estimated")
+    for col in ("rate", "terrain", "method", "h mean m", "h SD m", "VX SD", "VZ SD", "valid", "raw"):
         view.add_column(col)
-    for row in table:
-        ref = "" if not np.isfinite(row["thesis_h_err_mean_m"]) else f" ({row['thesis_h_err_mean_m']:g})"
-        ref_sd = "" if not np.isfinite(row["thesis_h_err_sd_m"]) else f" ({row['thesis_h_err_sd_m']:g})"
+    for row in rows:
+        ref = "" if not np.isfinite(row["thesis_h_err_mean_m"]) else f" [{row['thesis_h_err_mean_m']:g}]"
+        ref_sd = "" if not np.isfinite(row["thesis_h_err_sd_m"]) else f" [{row['thesis_h_err_sd_m']:g}]"
         view.add_row(
-            row["rate"], row["terrain"], row["method"], f"{row['h_err_mean_m']:.1f}{ref}",
+            row["rate"][5:], row["terrain"], row["method"], f"{row['h_err_mean_m']:.1f}{ref}",
             f"{row['h_err_sd_m']:.1f}{ref_sd}", f"{row['vx_err_sd_mps']:.2f}", f"{row['vz_err_sd_mps']:.2f}",
+            f"{row['valid_fraction']:.2f}", f"{row['raw_valid_fraction']:.2f}",
         )  # fmt: skip
-    console.print(view)
-    emit_result({k: v for k, v in result.items() if k != "table"}, as_json, "ch5")
+    return view
 
 
 @bench_app.command("state")

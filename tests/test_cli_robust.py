@@ -266,3 +266,30 @@ def test_scenario_with_zero_range_bins_is_refused(tmp_path):
     result = _skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
     _assert_one_line_error(result, "s.yaml", "range_limit_m", "0 range bins")
     assert not any(tmp_path.glob("run.zarr*"))
+
+
+@pytest.mark.parametrize(
+    ("rows", "needles"),
+    [
+        # 104 deg of latitude in 1 s (a sign error in one ADS-B message)
+        (["0,52,4,1000", "1,-52,4,1000", "2,-52,4,1000"], ["track.csv", "row 1", "latitude", "Mach 3"]),
+        # -100000 ft
+        (["0,52,4,1000", "10,52.001,4,-100000"], ["track.csv", "row 1", "'altitude'", "-100000"]),
+    ],
+)
+def test_implausible_trajectory_file_is_refused(tmp_path, rows, needles):
+    import yaml
+
+    (tmp_path / "track.csv").write_text("\n".join(["timestamp,latitude,longitude,altitude", *rows]) + "\n")
+    scenario = {
+        "name": "jump",
+        "mount": "forward",
+        "terrain": {"type": "flat", "size_m": 3000, "spacing_m": 60},
+        "ownship": "track.csv",
+        "frame_rate_hz": 1.0,
+        "duration_s": 1.0,
+    }
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(scenario))
+    result = _skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
+    _assert_one_line_error(result, *needles)
+    assert not any(tmp_path.glob("run.zarr*"))

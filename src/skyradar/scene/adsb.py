@@ -37,6 +37,10 @@ __all__ = ["FT_M", "KT_MPS", "FPM_MPS", "read_track_table", "read_trajectory", "
 FT_M = 0.3048  # international foot, m (exact)
 KT_MPS = 1852.0 / 3600.0  # knot, m/s (exact)
 FPM_MPS = FT_M / 60.0  # foot per minute, m/s (exact)
+# Plausibility limits for aircraft tracks from files: a GA sensor meets nothing faster than Mach 3
+# (a bad ADS-B message or a unit mix-up is), nor anything below the Dead Sea or above 30 km.
+MAX_SPEED_MPS = 3 * 343.0
+ALT_LIMITS_M = (-500.0, 30_000.0)
 _OPENSKY_VELOCITY = ("groundspeed", "track", "vertical_rate")
 _SI_VELOCITY = ("vn", "ve", "vd")
 
@@ -165,6 +169,18 @@ def _local_velocity(path: Path, df: pd.DataFrame, rows: np.ndarray) -> np.ndarra
     return None
 
 
+def _check_speed(path: Path, rows: np.ndarray, t: np.ndarray, pos: np.ndarray, label: str) -> None:
+    """Refuse a jump between consecutive rows faster than :data:`MAX_SPEED_MPS` (NED chords are exact)."""
+    speed = np.linalg.norm(np.diff(pos, axis=0), axis=1) / np.diff(t)
+    fast = np.flatnonzero(speed > MAX_SPEED_MPS)
+    if fast.size:
+        i = int(fast[0]) + 1
+        raise InputError(
+            f"{path}: fields 'latitude', 'longitude', altitude at row {rows[i]}: a jump of "
+            f"{speed[i - 1]:.0f} m/s from row {rows[i - 1]} (above Mach 3, {MAX_SPEED_MPS:.0f} m/s){label}"
+        )
+
+
 def _one_trajectory(
     path: Path,
     df: pd.DataFrame,
@@ -195,10 +211,21 @@ def _one_trajectory(
             raise InputError(
                 f"{path}: field '{field_name}' out of range at row {rows[i]} ({values[i]}){label}"
             )
+    alt_field = "alt_m" if "alt_m" in df.columns else "altitude"
+    low = np.flatnonzero((alt < ALT_LIMITS_M[0]) | (alt > ALT_LIMITS_M[1]))
+    if low.size:
+        i = int(low[0])
+        raw = df[alt_field].iloc[i]
+        raw = raw.item() if hasattr(raw, "item") else raw
+        raise InputError(
+            f"{path}: field '{alt_field}' out of range at row {rows[i]} ({raw!r}; "
+            f"{alt[i]:.0f} m is outside [{ALT_LIMITS_M[0]:g}, {ALT_LIMITS_M[1]:g}] m){label}"
+        )
     origin = (
         (float(lat[0]), float(lon[0]), float(alt[0])) if origin is None else tuple(float(v) for v in origin)
     )
     pos = geodetic_to_ned(lat, lon, alt, *origin)
+    _check_speed(path, rows, t, pos, label)
     zero = float(t[0]) if time_zero_s is None else float(time_zero_s)
     t_rel = t - zero
     derived = np.gradient(pos, t_rel, axis=0, edge_order=2 if t.size > 2 else 1)

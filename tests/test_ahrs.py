@@ -54,3 +54,22 @@ def test_zero_model_returns_the_truth():
 def test_bad_input_names_the_field(truth, times, model, field):
     with pytest.raises(InputError, match=field):
         ahrs_attitude(truth, times, model)
+
+
+def test_state_estimation_uses_the_ahrs_attitude_not_the_runs_truth():
+    # The cubes carry no direction information (identical channels), so only "same" / "different"
+    # is checked here; the physical size (V_Z error ~ -V * pitch error) is checked on simulated
+    # frames in test_flight_state_experiment.py.
+    from pandas.testing import assert_frame_equal
+
+    from skyradar.io.frames import frames_dataset
+    from skyradar.nav.flight_state import estimate_run
+    from test_flight_state_ridge import CFG, flat_ground_cube
+
+    cubes = np.stack([flat_ground_cube(45.0, 0.0, 600.0, seed=s) for s in range(3)])
+    ds = frames_dataset(cubes, np.arange(3.0), CFG, ownship={"own_pitch_rad": np.zeros(3)})
+    truth = estimate_run(ds, method="terrain")
+    zero = AhrsModel(0.0, 0.0, 100.0, 0.0, 0.0, 300.0)
+    assert_frame_equal(estimate_run(ds, method="terrain", ahrs=zero), truth)
+    tilted = estimate_run(ds, method="terrain", ahrs=AhrsModel(roll_pitch_bias_deg=2.0), ahrs_seed=0)
+    assert np.all(tilted["vz_raw_mps"] != truth["vz_raw_mps"])

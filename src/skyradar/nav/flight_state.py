@@ -34,6 +34,7 @@ from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.geo import rotation_matrix
 from skyradar.io.checks import check_finite_frames, check_frame_times
+from skyradar.nav.ahrs import AhrsModel, ahrs_attitude
 from skyradar.nav.inversion import StateFit, fit_robust, fit_thesis
 from skyradar.nav.kalman_state import KalmanSettings, filter_states
 from skyradar.nav.ridge import Ridge, extract_ridge
@@ -155,19 +156,25 @@ def filter_table(
     return table
 
 
-def _attitude(ds: xr.Dataset, i: int) -> tuple[float, float, float]:
+def _attitudes(ds: xr.Dataset, times: np.ndarray, ahrs: AhrsModel | None, seed: int) -> np.ndarray:
+    """(n, 3) yaw, pitch, roll: the run's own_*_rad (level north when absent), through ``ahrs`` if given."""
     names = ("own_yaw_rad", "own_pitch_rad", "own_roll_rad")
-    return tuple(float(ds[n][i]) if n in ds else 0.0 for n in names)  # type: ignore[return-value]
+    attitude = np.column_stack(
+        [ds[n].to_numpy().astype(float) if n in ds else np.zeros(times.size) for n in names]
+    )
+    return attitude if ahrs is None else ahrs_attitude(attitude, times, ahrs, seed=seed)
 
 
-def _frame_rows(ds: xr.Dataset, config: RadarConfig, method: str, progress, source: str) -> list[dict]:
+def _frame_rows(
+    ds: xr.Dataset, config: RadarConfig, method: str, progress, source: str, attitudes: np.ndarray
+) -> list[dict]:
     from skyradar.nav.terrain_aware import TerrainAwareEstimator
 
     times = ds["time"].to_numpy().astype(float)
     aware = TerrainAwareEstimator(config) if method == "terrain" else None
     rows, prior = [], None
     for i in range(times.size):
-        attitude = _attitude(ds, i)
+        attitude = attitudes[i]
         frame = np.asarray(ds.iq[i].values)
         check_finite_frames(frame[None], i, source)  # a NaN would come out as a wrong state, not an error
         if aware is not None:
@@ -206,6 +213,8 @@ def estimate_run(
     gps_gate: bool = False,
     progress: Callable[[int, int], None] | None = None,
     source: str = "frames",
+    ahrs: AhrsModel | None = None,
+    ahrs_seed: int = 0,
 ) -> pd.DataFrame:
     """Per-frame raw and filtered flight state of a frames Dataset (``source`` names it in errors).
 
@@ -214,7 +223,9 @@ def estimate_run(
     AHRS; level flight heading north when absent). Returns a DataFrame with ``time_s, frame,
     vx_raw_mps, vz_raw_mps, h_raw_m`` (+ ``_sd``), filtered ``vx_mps, vz_mps, h_m`` (+ ``_sd``),
     ``quality, low_quality, n_ridge, n_inliers, used_by_filter``. With ``gps_gate`` the
-    thesis' 150 m gate against ``own_height_agl_m`` (comparison only).
+    thesis' 150 m gate against ``own_height_agl_m`` (comparison only). With ``ahrs``
+    (:class:`skyradar.nav.ahrs.AhrsModel`) the run's attitude, the simulator's truth, reaches the
+    estimators only through that model's seeded (``ahrs_seed``) errors.
     """
     from skyradar.io.frames import radar_config_of
 
@@ -222,7 +233,8 @@ def estimate_run(
         raise InputError(f"flight state: field 'method' must be thesis, robust or terrain, got {method!r}")
     config = radar_config_of(ds, source)
     check_frame_times(ds["time"].values, source)
-    table = pd.DataFrame(_frame_rows(ds, config, method, progress, source))
+    attitudes = _attitudes(ds, ds["time"].to_numpy().astype(float), ahrs, ahrs_seed)
+    table = pd.DataFrame(_frame_rows(ds, config, method, progress, source, attitudes))
     if settings is None:
         settings = KalmanSettings(terrain_psd=400.0) if method == "terrain" else KalmanSettings()
     reference = None

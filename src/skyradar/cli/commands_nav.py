@@ -136,9 +136,11 @@ def experiment_ch5(
 
 def _ch5_view(rows: list[dict], label: str):
     """The ch5 table of one attitude source (fits 80 columns)."""
+    from rich.markup import escape
     from rich.table import Table
 
-    view = Table(title=f"ch5, {label}: filtered errors [thesis]; valid/raw = share of frames estimated")
+    title = f"ch5, {label}: filtered errors [thesis]; valid/raw = share of frames estimated"
+    view = Table(title=escape(title))  # the brackets are text, not rich markup
     for col in ("rate", "terrain", "method", "h mean m", "h SD m", "VX SD", "VZ SD", "valid", "raw"):
         view.add_column(col)
     for row in rows:

@@ -13,7 +13,17 @@ filter of :mod:`skyradar.nav.kalman_state`:
 - ``terrain``: DoA ground points and terrain memory (:mod:`skyradar.nav.terrain_aware`).
 
 Errors are filtered estimate minus truth after a ``warmup_s`` start (the filter converging);
-``h`` is the height of the own-ship reference point above the terrain directly below.
+``h`` is the height of the own-ship reference point above the terrain directly below. The
+statistics skip frames without an estimate, so each case also reports ``valid_fraction`` (share
+of scored frames with a finite filtered estimate), ``raw_valid_fraction`` (the per-frame
+estimator gave one) and ``used_fraction`` (the filter accepted it); :data:`ACCEPTANCE` states the
+bounds they must meet.
+
+Every flight is simulated once and estimated twice: with the simulator's true attitude, and with
+the attitude of a typical MEMS AHRS (:mod:`skyradar.nav.ahrs`, seeded by ``seed``), so no truth
+reaches the estimators in the second run. The only other truth an estimator sees is the thesis
+method's 150 m GPS gate, which uses the true height above ground as a stand-in for GPS height
+minus a DEM (comparison only, as in the thesis).
 """
 
 from __future__ import annotations

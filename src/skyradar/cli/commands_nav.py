@@ -131,6 +131,12 @@ def experiment_ch5(
         rows = [row for row in table if row["attitude"] == source]
         if rows:
             console.print(_ch5_view(rows, label))
+    missed = result["acceptance_failures"]
+    console.print(
+        f"acceptance (stated for the default 40 s run): {len(missed)} bound(s) missed, listed in ch5.json"
+        if missed
+        else "acceptance: every case meets its stated valid-fraction bound"
+    )
     emit_result({k: v for k, v in result.items() if k != "table"}, as_json, "ch5")
 
 

@@ -125,3 +125,10 @@ def test_cli_refuses_a_flight_shorter_than_the_warmup(tmp_path, args, needles):
     for needle in needles:
         assert needle in lines[0], lines[0]
     assert not (tmp_path / "o").exists()
+
+
+def test_without_ahrs_noise_only_the_true_attitude_run_is_reported(tmp_path):
+    result = run(tmp_path, **SHORT, ahrs=None)
+    assert result["ahrs"] is None and result["ahrs_model"] is None
+    assert {row["attitude"] for row in result["table"]} == {"true"}
+    assert not list(tmp_path.glob("*_ahrs.parquet"))

@@ -31,11 +31,14 @@ def alert(
     450 ft; alerting times 55/55/25 s; 2-of-4 persistence, 5 s hysteresis).
     """
     from skyradar.daa.pipeline import TRACK_COLUMNS, alerts_from_tracks, ownship_from_frames
+    from skyradar.daa.provenance import check_tracks_match_run
     from skyradar.io.frames import open_frames
     from skyradar.io.tables import read_table, write_table
 
     table = read_table(tracks, required=TRACK_COLUMNS, sort_by="time_s")
-    own = ownship_from_frames(open_frames(ownship), str(ownship))
+    run_ds = open_frames(ownship)
+    check_tracks_match_run(table.attrs, str(tracks), run_ds, str(ownship))
+    own = ownship_from_frames(run_ds, str(ownship))
     alerts = alerts_from_tracks(table, own, with_advice=not no_advice, source=str(tracks))
     write_table(alerts, output)
     warn = alerts[alerts["level"] >= 3]

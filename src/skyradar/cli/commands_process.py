@@ -82,9 +82,10 @@ def process(
     spurs = SpurMap.load(spur_map, config) if spur_map is not None else None
     dem = None
     if terrain is not None:
-        from skyradar.scene.dem_readers import read_dem
+        from skyradar.scene.dem_coverage import dem_for_run
 
-        dem = read_dem(terrain)
+        # Only the window the own-ship can see is read; a DEM away from the track is refused.
+        dem = dem_for_run(terrain, ds, config.range_limit_m, str(run))
     bar, task = _progress(ds.sizes["time"], "frames")
     with bar:
         if scheduler is None and not workers:
@@ -106,7 +107,12 @@ def process(
                 scheduler=scheduler, workers=workers, progress=lambda k: bar.advance(task, k),
             )  # fmt: skip
             table = pd.concat(parts, ignore_index=True)
-    write_table(table, output, metadata={"radar_config": config.to_json(), "source": str(run)})
+    from skyradar.daa.provenance import ownship_signature
+
+    # The own-ship signature lets `alert` check that the tracks and its --ownship run belong together.
+    meta = {"radar_config": config.to_json(), "source": str(run)}
+    meta.update({"ownship_signature": sig} if (sig := ownship_signature(ds, str(run))) else {})
+    write_table(table, output, metadata=meta)
     n = ds.sizes["time"]
     result = {
         "frames": n,

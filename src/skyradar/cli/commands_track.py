@@ -97,9 +97,10 @@ def track(
     # detection_row refers to the input table, not to the filtered one.
     rows = tracks["detection_row"].to_numpy()
     tracks["detection_row"] = np.where(rows >= 0, np.flatnonzero(keep)[np.maximum(rows, 0)], -1)
-    write_table(
-        tracks, output, metadata={"radar_config": config.to_json(), "source": str(detections), "model": model}
-    )
+    meta = {"radar_config": config.to_json(), "source": str(detections), "model": model}
+    if table.attrs.get("ownship_signature"):  # carried on for `alert` (see skyradar.daa.provenance)
+        meta["ownship_signature"] = table.attrs["ownship_signature"]
+    write_table(tracks, output, metadata=meta)
     if tracks.empty:
         # A clear sky (no detections, or only ground and spurs) is a normal outcome, not an error.
         console.print(

@@ -20,7 +20,7 @@ from scipy.sparse.linalg import spsolve
 
 from skyradar.errors import InputError
 from skyradar.geo import geodetic_to_ned
-from skyradar.scene.terrain import Terrain
+from skyradar.scene.terrain import Bounds, Terrain
 
 __all__ = ["read_dem", "read_hgt", "read_geotiff", "read_npz", "jacksboro", "fill_voids", "SRTM_VOID"]
 
@@ -92,11 +92,13 @@ def _fill(z: np.ndarray, source: str, max_void_fraction: float, nodata: float | 
     return fill_voids(z, _void_mask(z, nodata), source, max_void_fraction)
 
 
-def read_hgt(path: str | Path, max_void_fraction: float = 0.01) -> Terrain:
+def read_hgt(path: str | Path, max_void_fraction: float = 0.01, bounds: Bounds | None = None) -> Terrain:
     """Read an SRTM ``.hgt`` tile (1201x1201 or 3601x3601 big-endian int16).
 
     The file name gives the south-west corner (``N52E004.hgt``: 52 N, 4 E); row 0 is the
     north edge at lat + 1. Heights are taken as given (SRTM is relative to the EGM96 geoid).
+    With ``bounds`` (south, west, north, east in degrees) only the samples inside them (plus one
+    of margin) are read and void-filled; a box that misses the tile raises :class:`InputError`.
 
     Examples
     --------
@@ -123,14 +125,45 @@ def read_hgt(path: str | Path, max_void_fraction: float = 0.01) -> Terrain:
     n = {1201 * 1201 * 2: 1201, 3601 * 3601 * 2: 3601}.get(size)
     if n is None:
         raise InputError(f"{path.name}: size {size} bytes is not a 1201x1201 or 3601x3601 int16 tile")
-    raw = np.fromfile(path, dtype=">i2").reshape(n, n)
-    z = _fill(raw, path.name, max_void_fraction)
     step = 1.0 / (n - 1)
-    return Terrain.geographic(z, lat_deg + 1.0, float(lon_deg), step, step, source=path.name)
+    north, west = lat_deg + 1.0, float(lon_deg)
+    rows, cols = slice(0, n), slice(0, n)
+    if bounds is not None:
+        extent = Bounds(float(lat_deg), west, north, west + 1.0)
+        rows = _index_span((north - bounds.north_deg) / step, (north - bounds.south_deg) / step, n)
+        cols = _index_span((bounds.west_deg - west) / step, (bounds.east_deg - west) / step, n)
+        _check_overlap(path.name, extent, bounds, rows, cols)
+    raw = np.array(np.memmap(path, dtype=">i2", mode="r", shape=(n, n))[rows, cols])
+    z = _fill(raw, path.name, max_void_fraction)
+    lat0, lon0 = north - rows.start * step, west + cols.start * step
+    return Terrain.geographic(z, lat0, lon0, step, step, source=path.name)
 
 
-def read_geotiff(path: str | Path, max_void_fraction: float = 0.01) -> Terrain:
+def _index_span(first: float, last: float, n: int) -> slice:
+    """Sample indices from ``first`` to ``last`` (fractional) plus one of margin, clipped to [0, n)."""
+    lo = int(np.clip(np.floor(min(first, last)) - 1, 0, n))
+    hi = int(np.clip(np.ceil(max(first, last)) + 2, 0, n))
+    return slice(lo, max(lo, hi))
+
+
+def _check_overlap(name: str, extent: Bounds, bounds: Bounds, rows: slice, cols: slice) -> None:
+    if rows.stop - rows.start < 2 or cols.stop - cols.start < 2:
+        from skyradar.scene.dem_coverage import DemCoverageError
+
+        raise DemCoverageError(
+            f"{name}: the DEM covers lat {extent.south_deg:.6g}..{extent.north_deg:.6g}, lon "
+            f"{extent.west_deg:.6g}..{extent.east_deg:.6g}, outside the area the flight needs "
+            f"(lat {bounds.south_deg:.6g}..{bounds.north_deg:.6g}, "
+            f"lon {bounds.west_deg:.6g}..{bounds.east_deg:.6g})"
+        )
+
+
+def read_geotiff(path: str | Path, max_void_fraction: float = 0.01, bounds: Bounds | None = None) -> Terrain:
     """Read band 1 of a GeoTIFF DEM with rasterio.
+
+    With ``bounds`` (south, west, north, east in degrees, WGS84) only the window covering them
+    (plus one pixel of margin) is read: a country-size DEM costs the memory of the flight's area.
+    A box that misses the raster raises :class:`InputError`.
 
     A geographic CRS gives a geographic grid; a projected CRS gives a projected grid anchored
     at pixel [0, 0] (its centre transformed to WGS84 lat/lon), with the spacing scaled to ground
@@ -143,15 +176,18 @@ def read_geotiff(path: str | Path, max_void_fraction: float = 0.01) -> Terrain:
     path = Path(path)
     try:
         with rasterio.open(path) as ds:
-            z, nodata, tf, crs = ds.read(1), ds.nodata, ds.transform, ds.crs
+            nodata, tf, crs = ds.nodata, ds.transform, ds.crs
+            if crs is None:
+                raise InputError(f"{path.name}: field 'crs' is missing; cannot place the grid on the earth")
+            if tf.b != 0 or tf.d != 0:
+                raise InputError(
+                    f"{path.name}: field 'transform' is rotated or sheared ({tuple(tf)[:6]}); not supported"
+                )
+            window = None if bounds is None else _geotiff_window(ds, bounds, path.name)
+            z = ds.read(1, window=window)
+            tf = tf if window is None else ds.window_transform(window)
     except RasterioError as exc:
         raise InputError(f"{path.name}: cannot read GeoTIFF ({exc})") from exc
-    if crs is None:
-        raise InputError(f"{path.name}: field 'crs' is missing; cannot place the grid on the earth")
-    if tf.b != 0 or tf.d != 0:
-        raise InputError(
-            f"{path.name}: field 'transform' is rotated or sheared ({tuple(tf)[:6]}); not supported"
-        )
     z = _fill(z, path.name, max_void_fraction, nodata)
     if tf.e > 0:  # rows run south to north
         z, tf = z[::-1], tf @ rasterio.Affine.translation(0, z.shape[0]) @ rasterio.Affine.scale(1, -1)
@@ -169,6 +205,25 @@ def read_geotiff(path: str | Path, max_void_fraction: float = 0.01) -> Terrain:
     rotation = float(np.degrees(np.arctan2(ned[0, 1], ned[0, 0])))
     dy_m, dx_m = -tf.e * unit_m * up_m / 1000.0, tf.a * unit_m * right_m / 1000.0
     return Terrain.projected(z, lat0[0], lon0[0], dy_m, dx_m, rotation_deg=rotation, source=path.name)
+
+
+def _geotiff_window(ds, bounds: Bounds, name: str):
+    """Pixel window of ``ds`` covering the WGS84 box ``bounds`` (plus one pixel of margin)."""
+    from rasterio.warp import transform_bounds
+    from rasterio.windows import Window
+
+    left, bottom, right, top = transform_bounds(
+        "EPSG:4326", ds.crs, bounds.west_deg, bounds.south_deg, bounds.east_deg, bounds.north_deg,
+        densify_pts=21,
+    )  # fmt: skip
+    inverse = ~ds.transform
+    cols, rows = zip(*(inverse @ (x, y) for x in (left, right) for y in (bottom, top)), strict=True)
+    rs = _index_span(min(rows) - 0.5, max(rows) - 0.5, ds.height)  # pixel centres at +0.5
+    cs = _index_span(min(cols) - 0.5, max(cols) - 0.5, ds.width)
+    full = ds.bounds
+    lat, lon = _to_wgs84(ds.crs, [full.left, full.right], [full.bottom, full.top])
+    _check_overlap(name, Bounds(min(lat), min(lon), max(lat), max(lon)), bounds, rs, cs)
+    return Window(cs.start, rs.start, cs.stop - cs.start, rs.stop - rs.start)
 
 
 def _to_wgs84(crs, xs: list[float], ys: list[float]) -> tuple[list[float], list[float]]:
@@ -257,8 +312,17 @@ def jacksboro(max_void_fraction: float = 0.01) -> Terrain:
 _READERS = {".hgt": read_hgt, ".tif": read_geotiff, ".tiff": read_geotiff, ".npz": read_npz}
 
 
-def read_dem(path: str | Path, max_void_fraction: float = 0.01, height_offset_m: float = 0.0) -> Terrain:
+def read_dem(
+    path: str | Path,
+    max_void_fraction: float = 0.01,
+    height_offset_m: float = 0.0,
+    bounds: Bounds | None = None,
+) -> Terrain:
     """Read a DEM by suffix: ``.hgt`` (SRTM), ``.tif``/``.tiff`` (GeoTIFF), ``.npz``.
+
+    ``bounds`` (south, west, north, east, degrees): read only that area of ``.hgt`` and GeoTIFF
+    files (``.npz`` files are read whole); see
+    :func:`skyradar.scene.dem_coverage.footprint_bounds`.
 
     Voids up to ``max_void_fraction`` of the samples are filled; more raise InputError.
     ``height_offset_m`` is added to every elevation: Terrain heights are above the WGS84
@@ -283,7 +347,8 @@ def read_dem(path: str | Path, max_void_fraction: float = 0.01, height_offset_m:
         raise InputError(
             f"{path.name}: field 'max_void_fraction' must be within [0, 1] ({max_void_fraction})"
         )
-    terrain = reader(path, max_void_fraction)
+    windowed = reader is not read_npz  # .npz files are small and read whole
+    terrain = reader(path, max_void_fraction, bounds) if windowed else reader(path, max_void_fraction)
     if height_offset_m:
         terrain = replace(terrain, elevation_m=terrain.elevation_m + np.float32(height_offset_m))
     return terrain

@@ -242,7 +242,7 @@ class Scenario:
             if t.type == "jacksboro":
                 return terrain_mod.jacksboro()
             if t.type == "file":
-                return terrain_mod.read_dem(self._path(t.path), bounds=bounds)
+                return _read_dem_near(self._path(t.path), bounds, origin)
             if origin is None:
                 raise InputError(
                     f"field 'origin': is required for {t.type} terrain (it is centred on the origin)"
@@ -357,6 +357,18 @@ class Scenario:
             source=self.source,
             impairments=m.impairments,
         )
+
+
+def _read_dem_near(path: Path, bounds, origin) -> Any:
+    from skyradar.scene.dem_coverage import DemCoverageError
+    from skyradar.scene.dem_readers import read_dem
+
+    try:
+        return read_dem(path, bounds=bounds)
+    except DemCoverageError as exc:
+        if origin is None:
+            raise
+        raise DemCoverageError(f"{exc}; scenario origin lat {origin[0]:.6g}, lon {origin[1]:.6g}") from None
 
 
 def _read_flight(path: Path, icao24: str | None, origin, time_zero_s: float | None) -> Trajectory:

@@ -293,3 +293,26 @@ def test_implausible_trajectory_file_is_refused(tmp_path, rows, needles):
     result = _skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
     _assert_one_line_error(result, *needles)
     assert not any(tmp_path.glob("run.zarr*"))
+
+
+@pytest.mark.parametrize(
+    ("args", "needles"),
+    [
+        (("process", "run.zarr", "-o", "d.parquet", "--method", "bogus"), ["--method", "bogus"]),
+        (("process", "run.zarr", "-o", "d.parquet", "--spur-mode", "bogus"), ["--spur-mode", "bogus"]),
+        (("spur-map", "run.zarr", "-o", "s.npz", "--pixels", "bogus"), ["--pixels", "bogus"]),
+        (("state", "run.zarr", "-o", "s.parquet", "--method", "bogus"), ["--method", "bogus"]),
+        (("calibrate", "run.zarr", "-o", "c.json", "--range", "5000", "--azimuth", "0", "--elevation", "0"),
+         ["--range", "5000", "run.zarr"]),
+        (("experiment", "ch3", "--path", "bogus"), ["--path", "bogus"]),
+    ],
+)  # fmt: skip
+def test_options_are_named_in_their_errors(tmp_path, args, needles):
+    _store(tmp_path / "run.zarr")
+    _assert_one_line_error(_skyradar(*args, cwd=tmp_path), *needles)
+
+
+def test_rd_names_the_window_option(tmp_path):
+    rec = _recording(tmp_path / "rec.npy")
+    result = _skyradar("rd", str(rec), "-o", "rd.zarr", "--doppler-window", "bogus", cwd=tmp_path)
+    _assert_one_line_error(result, "--doppler-window", "bogus")

@@ -15,7 +15,7 @@ from skyradar.io.tables import jsonable
 
 __all__ = [
     "app", "experiment_app", "bench_app", "console", "emit_result", "JsonOption", "number_in",
-    "check_number", "POSITIVE", "NON_NEGATIVE", "COUNT", "PROBABILITY",
+    "check_number", "check_choice", "POSITIVE", "NON_NEGATIVE", "COUNT", "PROBABILITY",
 ]  # fmt: skip
 
 app = typer.Typer(
@@ -120,3 +120,20 @@ POSITIVE = number_in(0.0, low_open=True)  # durations, distances, rates: finite 
 NON_NEGATIVE = number_in(0.0)  # counts and durations where 0 means "skip"
 COUNT = number_in(1)  # frames, workers, chunk sizes: at least one
 PROBABILITY = number_in(0.0, 1.0, low_open=True, high_open=True)
+
+
+def check_choice(option: str, value: str, choices: tuple[str, ...]) -> str:
+    """``value`` if it is one of ``choices``, else :class:`InputError` naming the option.
+
+    Checked before any file is opened, so the message names the option, not a library field.
+
+    Examples
+    --------
+    >>> check_choice("--model", "radar", ("radar", "traditional"))
+    'radar'
+    """
+    from skyradar.errors import InputError
+
+    if value not in choices:
+        raise InputError(f"{option}: must be one of {', '.join(choices)}, got {value!r}")
+    return value

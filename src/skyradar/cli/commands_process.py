@@ -15,12 +15,14 @@ from skyradar.cli.app import (
     JsonOption,
     app,
     bench_app,
+    check_choice,
     check_number,
     console,
     emit_result,
     experiment_app,
     number_in,
 )
+from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["process", "calibrate", "spur_map", "experiment_ch3", "bench_process"]
 
@@ -29,7 +31,7 @@ def _progress(total: int, label: str):
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
 
     bar = Progress("[progress.description]{task.description}", BarColumn(), MofNCompleteColumn(),
-                   TimeRemainingColumn(), console=console)  # fmt: skip
+                   TimeRemainingColumn(), console=console, transient=True)  # fmt: skip
     return bar, bar.add_task(label, total=total)
 
 
@@ -65,6 +67,7 @@ def process(
     chunk_frames: Annotated[
         int, typer.Option(callback=COUNT, help="Frames per Dask task (with --scheduler/--workers).")
     ] = 64,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
     """Detect objects in every frame and locate them in 3-D: one row per detection per frame.
@@ -73,10 +76,14 @@ def process(
     azimuth/elevation_rad (antenna frame), x/y/z_body_m, north/east/down_m, lat/lon/alt, is_ground, spur.
     """
     from skyradar.io.frames import open_frames, radar_config_of
+    from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_table
     from skyradar.process.pipeline import process_frames
     from skyradar.process.spurs import SpurMap
 
+    check_choice("--method", method, ("cfar", "os-cfar", "shi-tomasi"))
+    check_choice("--spur-mode", spur_mode, ("mask", "flag"))
+    check_output(output, [run, spur_map, terrain, radar_config], overwrite, kind="table")
     ds = open_frames(run)
     config = _read_config(radar_config) if radar_config is not None else radar_config_of(ds, str(run))
     spurs = SpurMap.load(spur_map, config) if spur_map is not None else None
@@ -166,17 +173,25 @@ def calibrate(
     phase_only: Annotated[
         bool, typer.Option("--phase-only", help="Calibrate phases only, not gains.")
     ] = False,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
     """Per-antenna phase/gain calibration from a reflector at a known position (thesis: a building)."""
     import numpy as np
 
+    from skyradar.errors import InputError
     from skyradar.io.frames import open_frames, radar_config_of
+    from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_json_atomic
     from skyradar.process.calibration import calibrate_from_frames, reflector_position
 
+    check_output(output, [run], overwrite, kind="file")
     ds = open_frames(run)
     config = radar_config_of(ds, str(run))
+    if range_m >= config.range_limit_m:
+        raise InputError(
+            f"--range: {range_m:g} m is beyond {run}'s processed range ({config.range_limit_m:g} m)"
+        )
     p = reflector_position(range_m, np.radians(azimuth_deg), np.radians(elevation_deg))
     cube = np.asarray(ds["iq"].isel(time=slice(0, max(frames, 1))).values)
     calibrated = calibrate_from_frames(cube, p, config, gain=not phase_only)
@@ -202,15 +217,19 @@ def spur_map(
     pixels: Annotated[
         str, typer.Option("--pixels", help="'peaks' (detector points, thesis) or 'hits' (every lit pixel).")
     ] = "hits",
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
     """Learn a spur map from frames of a static scene (every fixed bright pixel is a spur)."""
     import numpy as np
 
     from skyradar.io.frames import open_frames, radar_config_of
+    from skyradar.io.outputs import check_output
     from skyradar.process.detect import integrate_channels
     from skyradar.process.spurs import learn_spur_map
 
+    check_choice("--pixels", pixels, ("peaks", "hits"))
+    check_output(output, [run], overwrite, kind="file")
     ds = open_frames(run)
     config = radar_config_of(ds, str(run))
     frames = (
@@ -257,11 +276,16 @@ def experiment_ch3(
             "--pitch", callback=number_in(-90.0, 90.0), help="Boresight elevation above the horizon, deg."
         ),
     ] = 3.0,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
     """ch3: radar on the ground aimed at the sky: spur map, calibration on a building, aircraft flyover."""
     from skyradar.errors import InputError
     from skyradar.experiments.ch3 import run as run_ch3
+    from skyradar.io.outputs import check_output, mark_folder
+
+    check_choice("--path", path, ("circuit", "approach"))
+    check_output(out, (), overwrite, kind="folder", option="--out")
 
     try:
         others = tuple(float(s) for s in compare.split(",") if s.strip())
@@ -271,6 +295,7 @@ def experiment_ch3(
         ) from None
     for spacing in others:
         check_number("--compare", spacing, 0.0, 1.0, low_open=True)
+    mark_folder(out)
     result = run_ch3(
         out, n_frames=frames, path=path, seed=seed, pitch_deg=pitch, rx_spacing_wavelengths=rx_spacing,
         compare_spacings=others,

@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from skyradar.cli.app import COUNT, NON_NEGATIVE, JsonOption, app, bench_app, console, emit_result
+from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["rd", "bench_chain"]
 
@@ -31,6 +32,10 @@ def rd(
     workers: Annotated[
         int | None, typer.Option(callback=COUNT, help="Run on a local Dask cluster of this many workers.")
     ] = None,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
+    compress: Annotated[
+        str, typer.Option("--compress", help="Lossless codec for the pixels: none, zstd or blosc.")
+    ] = "none",
     as_json: JsonOption = False,
 ) -> None:
     """Turn a raw ADC recording into range-Doppler frames (the same store the simulator writes).
@@ -40,14 +45,23 @@ def rd(
     windows' coherent gain. Written chunk by chunk; an interrupted run resumes. The recording is
     fully checked first: a bad recording leaves no output.
     """
+    from skyradar.errors import InputError
     from skyradar.process.rd_run import recording_to_frames
+    from skyradar.process.windows import get_window
+
+    for option, spec in (("--range-window", range_window), ("--doppler-window", doppler_window)):
+        try:
+            get_window(spec, 8)
+        except InputError as exc:  # name the option, not the library's "window:"
+            raise InputError(f"{option}: {str(exc).removeprefix('window: ')}") from None
 
     def report(frames: int) -> None:
         console.print(f"{frames} more frames written")
 
     result = recording_to_frames(
-        recording, output, range_window, doppler_window, remove_dc, chunk_frames, scheduler, workers, report
-    )
+        recording, output, range_window, doppler_window, remove_dc, chunk_frames, scheduler, workers, report,
+        overwrite=overwrite, compressor=compress,
+    )  # fmt: skip
     emit_result(result, as_json, "range-Doppler frames")
 
 

@@ -19,6 +19,7 @@ from skyradar.cli.app import (
     emit_result,
     experiment_app,
 )
+from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["track", "evaluate", "experiment_ch4", "bench_track"]
 
@@ -60,6 +61,7 @@ def track(
             "updates the 3-D velocity and the DoA error is split along/across the line of sight.",
         ),
     ] = None,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
     """Link detections into tracks: one row per confirmed track per frame.
@@ -71,12 +73,14 @@ def track(
     import numpy as np
 
     from skyradar.errors import InputError
+    from skyradar.io.outputs import check_output
     from skyradar.io.tables import read_table, write_table
     from skyradar.track.io import radar_config_from_attrs, read_detections
     from skyradar.track.run import OWNSHIP_COLUMNS, track_detections
 
     if model not in ("radar", "traditional"):
         raise InputError(f"--model: must be 'radar' or 'traditional', got {model!r}")
+    check_output(output, [detections, ownship], overwrite, kind="table")
     origin_lla = _origin(origin)
     table = read_detections(detections)
     config = radar_config_from_attrs(table)
@@ -105,7 +109,8 @@ def track(
         # A clear sky (no detections, or only ground and spurs) is a normal outcome, not an error.
         console.print(
             f"no tracks: {int(keep.sum())} of {len(table)} detections left after dropping ground and "
-            f"spurs; wrote an empty tracks table to {output}"
+            f"spurs; wrote an empty tracks table to {output}",
+            soft_wrap=True,
         )
     result = {
         "frames": int(frame_times.size),
@@ -169,6 +174,7 @@ def experiment_ch4(
             help="Noise seed of the simulator (full chain) or synthetic detections.",
         ),
     ] = 0,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
     """Thesis ch4: radar-aware vs traditional tracker around an airfield (Circuit, Zulu, Free)."""
@@ -178,7 +184,10 @@ def experiment_ch4(
     # Checked here, before the process pool: a worker's error would come back as a long traceback.
     if chain not in ("full", "geometry"):
         raise InputError(f"--chain: must be 'full' or 'geometry', got {chain!r}")
-    result = run_ch4(out, chain=chain, seed=seed)
+    from skyradar.io.outputs import check_output, mark_folder
+
+    check_output(out, (), overwrite, kind="folder", option="--out")
+    result = run_ch4(mark_folder(out), chain=chain, seed=seed)
     emit_result(result, as_json, "ch4 tracking")
 
 

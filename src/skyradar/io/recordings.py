@@ -198,11 +198,12 @@ def _frame_times(sidecar: Path, meta: dict[str, Any], n_frames: int, config: Rad
         times = np.asarray(meta["frame_times_s"], float)
         if times.shape != (n_frames,) or not np.all(np.isfinite(times)):
             raise InputError(f"{sidecar}: field 'frame_times_s' must hold {n_frames} finite times")
-        back = np.flatnonzero(np.diff(times) < 0)
+        back = np.flatnonzero(np.diff(times) <= 0)  # a repeated time is as wrong as a backward one
         if back.size:
             i = int(back[0]) + 1
+            what = "repeats" if times[i] == times[i - 1] else "goes backwards"
             raise InputError(
-                f"{sidecar}: field 'frame_times_s' goes backwards at {i} ({times[i - 1]} -> {times[i]})"
+                f"{sidecar}: field 'frame_times_s' {what} at frame {i} ({times[i - 1]} -> {times[i]})"
             )
         return times
     period = (

@@ -342,11 +342,14 @@ def _peak(frames: np.ndarray, step: int) -> float:
 
 def _encode(block: np.ndarray, scale: float, code: str, per: int) -> np.ndarray:
     """Frames as stored on disk: divided by ``scale``, (I, Q) pairs, rounded and clipped for int16."""
-    values = block / scale
+    values = np.asarray(block / scale)  # the only full-size temporary: the rest is in place
     if per == 2:
-        values = np.stack([values.real, values.imag], axis=-1)
+        # A complex array is (real, imag) pairs in memory already: view it as such, no copy.
+        values = values.astype(np.result_type(values, np.complex64), copy=False)
+        values = values.view(values.real.dtype).reshape(*values.shape, 2)
     if code == "i2":
-        values = np.clip(np.round(values), -32768, 32767)
+        np.round(values, out=values)
+        np.clip(values, -32768, 32767, out=values)
     return values.astype("<" + code)
 
 

@@ -316,3 +316,16 @@ def test_rd_names_the_window_option(tmp_path):
     rec = _recording(tmp_path / "rec.npy")
     result = _skyradar("rd", str(rec), "-o", "rd.zarr", "--doppler-window", "bogus", cwd=tmp_path)
     _assert_one_line_error(result, "--doppler-window", "bogus")
+
+
+@pytest.mark.parametrize(
+    ("rows", "needles"),
+    [([], ["own.csv", "no rows"]), (["0,0,0,nan,0,0,0", "1,0,0,0,0,0,0"], ["own.csv", "own_down_m", "nan"])],
+)
+def test_track_refuses_empty_or_nan_ownship(tmp_path, rows, needles):
+    source = _detections(tmp_path / "det.parquet", 3, False)
+    header = "time_s,own_north_m,own_east_m,own_down_m,own_vn_mps,own_ve_mps,own_vd_mps"
+    (tmp_path / "own.csv").write_text("\n".join([header, *rows]) + "\n")
+    result = _skyradar("track", str(source), "-o", "t.parquet", "--ownship", "own.csv", cwd=tmp_path)
+    _assert_one_line_error(result, *needles)
+    assert not (tmp_path / "t.parquet").exists()

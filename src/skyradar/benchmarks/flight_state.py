@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from skyradar.config import Mount, RadarConfig
+from skyradar.errors import InputError
 from skyradar.nav.flight_state import estimate_frame
 from skyradar.nav.inversion import state_from_abc
 from skyradar.nav.terrain_aware import TerrainAwareEstimator
@@ -79,6 +80,8 @@ def baseline_frame(
 
 
 def _rate(fn, cubes, min_time_s: float) -> float:
+    if not 0.0 < min_time_s < float("inf"):  # NaN never compares >=: the loop would never end
+        raise InputError(f"bench state: min_time_s must be finite and > 0, got {min_time_s}")
     n, start = 0, time.perf_counter()
     while True:
         for cube in cubes:

@@ -20,6 +20,7 @@ import numpy as np
 from scipy import ndimage
 
 from skyradar.config import RadarConfig
+from skyradar.errors import InputError
 from skyradar.process.detect import cfar_factor
 from skyradar.process.doa import direction_from_angles
 from skyradar.process.pipeline import process_cube
@@ -99,6 +100,8 @@ def baseline_process(cube: np.ndarray, config: RadarConfig, pfa: float = 2e-8) -
 
 def _frames_per_s(fn, cubes: list[np.ndarray], min_time_s: float) -> tuple[float, float]:
     """(wall-clock, process-CPU) frames per second; CPU time is robust to a busy shared machine."""
+    if not 0.0 < min_time_s < float("inf"):  # NaN never compares >=: the loop would never end
+        raise InputError(f"bench process: min_time_s must be finite and > 0, got {min_time_s}")
     fn(cubes[0])  # warm-up (numba compile, caches)
     n, t0, c0 = 0, time.perf_counter(), time.process_time()
     while True:

@@ -19,6 +19,7 @@ import time
 import numpy as np
 
 from skyradar.config import RadarConfig
+from skyradar.errors import InputError
 from skyradar.track.association import associate_naive
 from skyradar.track.run import make_model
 from skyradar.track.synthetic import synthetic_detections
@@ -72,6 +73,11 @@ def run(
     >>> sorted(k for k in r if k.endswith("frames_per_s"))
     ['baseline_frames_per_s', 'cpu_frames_per_s', 'frames_per_s', 'target_frames_per_s']
     """
+    if n_frames < 1 or detections_per_frame < 0 or n_targets < 1 or baseline_frames < 1:
+        raise InputError(
+            f"bench track: need n_frames >= 1, detections_per_frame >= 0, n_targets >= 1 and "
+            f"baseline_frames >= 1, got {n_frames}, {detections_per_frame}, {n_targets}, {baseline_frames}"
+        )
     config = RadarConfig.seed_prototype()
     t, frames = bench_scene(n_frames, detections_per_frame, n_targets, seed, config)
     pixel = (config.range_resolution_m, config.doppler_resolution_mps)

@@ -75,7 +75,7 @@ def track(
     from skyradar.errors import InputError
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import read_table, write_table
-    from skyradar.track.io import radar_config_from_attrs, read_detections
+    from skyradar.track.io import radar_config_from_attrs, read_detections, validate_ownship
     from skyradar.track.run import OWNSHIP_COLUMNS, track_detections
 
     if model not in ("radar", "traditional"):
@@ -89,7 +89,10 @@ def track(
     for flag in ("is_ground", "spur"):
         if flag in table.columns:
             keep &= ~table[flag].fillna(False).to_numpy(bool)
-    own = None if ownship is None else read_table(ownship, required=list(OWNSHIP_COLUMNS), sort_by="time_s")
+    own = None
+    if ownship is not None:
+        own = read_table(ownship, required=list(OWNSHIP_COLUMNS), sort_by="time_s")
+        validate_ownship(own, OWNSHIP_COLUMNS, str(ownship))
     tracks = track_detections(
         table[keep].reset_index(drop=True),
         model,

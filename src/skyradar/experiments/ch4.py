@@ -318,8 +318,19 @@ def run(
 
     ``seed`` seeds the simulator's noise (full chain) or the synthetic detections (geometry chain).
     """
+    from skyradar.errors import InputError
     from skyradar.experiments.ch4_figures import draw_figures
 
+    # Checked before the process pool: a worker's error comes back as a long traceback.
+    if chain not in ("full", "geometry"):
+        raise InputError(f"experiment ch4: chain must be 'full' or 'geometry', got {chain!r}")
+    unknown = [name for name in scenarios if name not in SCENARIOS]
+    if unknown:
+        raise InputError(f"experiment ch4: unknown scenario(s) {unknown}; choose from {list(SCENARIOS)}")
+    if not (np.isfinite(frame_rate_hz) and frame_rate_hz > 0 and int(workers) >= 1):
+        raise InputError(
+            f"experiment ch4: need frame_rate_hz > 0 and workers >= 1, got {frame_rate_hz}, {workers}"
+        )
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()

@@ -198,6 +198,8 @@ def cfar_2d(
     if min(gr, gd, tr, td) < 0 or hd >= power.shape[1] // 2 or hr >= power.shape[0] // 2:
         raise InputError(f"cfar: guard {guard} / train {train} do not fit an image of shape {power.shape}")
     n_train = (2 * hr + 1) * (2 * hd + 1) - (2 * gr + 1) * (2 * gd + 1)
+    if not 0.0 < pfa < 1.0:  # the CA table below skips cfar_factor's check (pfa 5 gave NaN thresholds)
+        raise InputError(f"cfar: field 'pfa' must be in (0, 1), got {pfa}")
     if kind == "ca":
         table = _ca_factor_table(float(pfa), n_train, int(n_integrated))
         return _ca(power, exclude, (gr, gd), (hr, hd), table)

@@ -14,6 +14,7 @@ from skyradar.io.tables import read_table
 __all__ = [
     "REQUIRED_DETECTION_COLUMNS",
     "validate_detections",
+    "validate_ownship",
     "read_detections",
     "truth_from_frames",
     "Truth",
@@ -46,6 +47,37 @@ def validate_detections(df: pd.DataFrame, source: str = "detections") -> pd.Data
     if back.size:
         i = int(back[0]) + 1
         raise InputError(f"{source}: field 'time_s' goes backwards at row {i} ({t[i - 1]} -> {t[i]})")
+    return df
+
+
+def validate_ownship(df: pd.DataFrame, columns: tuple[str, ...], source: str = "ownship") -> pd.DataFrame:
+    """Check an own-ship table: ``columns`` present, at least one row, finite, time strictly increasing.
+
+    Examples
+    --------
+    >>> own = pd.DataFrame({"time_s": [0.0, 1.0], "own_north_m": [0.0, 40.0]})
+    >>> len(validate_ownship(own, ("time_s", "own_north_m")))
+    2
+    """
+    missing = [c for c in columns if c not in df.columns]
+    if missing:
+        raise InputError(f"{source}: missing column(s) {missing} (have {list(df.columns)})")
+    if len(df) == 0:
+        raise InputError(f"{source}: no rows; the own-ship state is needed at every frame")
+    for col in columns:
+        values = pd.to_numeric(df[col], errors="coerce").to_numpy(float)
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            raw = df[col].iloc[bad[0]]
+            raw = raw.item() if hasattr(raw, "item") else raw
+            raise InputError(f"{source}: field '{col}' is not a finite number at row {bad[0]} ({raw!r})")
+    t = df[columns[0]].to_numpy(float)
+    back = np.flatnonzero(np.diff(t) <= 0)
+    if back.size:
+        i = int(back[0]) + 1
+        raise InputError(
+            f"{source}: field '{columns[0]}' does not increase at row {i} ({t[i - 1]} -> {t[i]})"
+        )
     return df
 
 

@@ -6,8 +6,7 @@ import numpy as np
 import pandas as pd
 
 from skyradar.config import RadarConfig
-from skyradar.errors import InputError
-from skyradar.track.io import validate_detections
+from skyradar.track.io import validate_detections, validate_ownship
 from skyradar.track.measure3d import angle_sigma_rad, position_covariance
 from skyradar.track.models import MotionModel, radar_model, traditional_model
 from skyradar.track.tracker import RangeDopplerTracker, TrackerConfig
@@ -48,6 +47,7 @@ def empty_tracks() -> pd.DataFrame:
     >>> len(empty), list(empty.columns) == TRACK_COLUMNS, str(empty["detection_row"].dtype)
     (0, True, 'int64')
     """
+
     # Integer row indices stay integer so that callers can index with them even when empty.
     def dtype(column: str) -> type:
         return np.int64 if column in _INTEGER_COLUMNS else bool if column == "confirmed" else float
@@ -197,9 +197,7 @@ class _Measure3D:
             self.sigma = np.full(len(det), 0.04 if sigma_rad is None else float(sigma_rad))
         self.own = None
         if ownship is not None:
-            missing = [c for c in OWNSHIP_COLUMNS if c not in ownship.columns]
-            if missing:
-                raise InputError(f"ownship: missing column(s) {missing}")
+            validate_ownship(ownship, OWNSHIP_COLUMNS)
             t = ownship["time_s"].to_numpy(float)
             self.own = np.column_stack(
                 [np.interp(grid, t, ownship[c].to_numpy(float)) for c in OWNSHIP_COLUMNS[1:]]

@@ -170,14 +170,18 @@ def test_alerts_table_is_displayed(run, tmp_path):
 def test_rejects_paths_outside_the_run(tmp_path):
     served = tmp_path / "served"
     run = write_sample_run(served / "run.zarr", n_frames=3)
-    (served / "report.txt").write_text("inside")
+    table = write_table(truth_tracks(sample_run_dataset(n_frames=3)), served / "tracks.parquet")
+    (served / "report.txt").write_text("sibling")  # next to the run but not given: not served
     secret = tmp_path / "secret.txt"
     secret.write_text("TOP-SECRET")
     os.symlink(secret, served / "link.txt")
-    with TestClient(create_app(run)) as c:
-        ok = c.get("/files/report.txt")
-        assert ok.status_code == 200 and ok.text == "inside"
+    with TestClient(create_app(run, tracks_path=table)) as c:
+        ok = c.get("/files/tracks.parquet")
+        assert ok.status_code == 200 and ok.content == table.read_bytes()
         attempts = [
+            "/files/report.txt",
+            "/files/%2e%2e/served/tracks.parquet",
+            "/files/%2Ftracks.parquet",
             "/files/..%2Fsecret.txt",
             "/files/%2e%2e/secret.txt",
             "/files/..%5Csecret.txt",
@@ -241,3 +245,206 @@ def test_cli_serve_runs_and_rejects_missing_run(run, tmp_path):
     finally:
         proc.terminate()
         proc.wait(timeout=20)
+
+
+# --- Safe by default (issue 11): served files, origin, command queue, hostile commands, CLI checks.
+
+
+def _assert_one_line_error(result, *needles):
+    assert result.returncode == 2, result.stderr
+    lines = [line for line in result.stderr.strip().splitlines() if line.strip()]
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith("error: ") and "Traceback" not in result.stderr
+    for needle in needles:
+        assert needle in lines[0], lines[0]
+
+
+def _serve(*args, timeout=120):
+    import subprocess
+    import sys
+
+    cmd = [sys.executable, "-m", "skyradar", "serve", *args]
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+
+
+def _listening_port():
+    """A socket listening on a free 127.0.0.1 port (the caller closes it)."""
+    import socket
+
+    sock = socket.socket()
+    sock.bind(("127.0.0.1", 0))
+    sock.listen()
+    return sock, sock.getsockname()[1]
+
+
+def test_files_serves_only_the_tables_given(tmp_path):
+    """A run in a home folder: its neighbours (``.ssh/``, other files) are not served, only the tables."""
+    home = tmp_path / "home"
+    run = write_sample_run(home / "run.zarr", n_frames=3)
+    (home / ".ssh").mkdir()
+    (home / ".ssh" / "id_ed25519").write_text("PRIVATE-KEY")
+    (home / "notes.txt").write_text("PRIVATE-NOTES")
+    import xarray as xr
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = xr.open_zarr(run)
+    table = alerts_from_tracks(truth_tracks(ds), ownship_from_frames(ds))
+    alerts = write_table(table, home / "alerts.parquet")
+    with TestClient(create_app(run, alerts_path=alerts)) as c:
+        ok = c.get("/files/alerts.parquet")
+        assert ok.status_code == 200 and ok.content == alerts.read_bytes()
+        for url in ["/files/.ssh/id_ed25519", "/files/notes.txt", "/files/run.zarr/zarr.json", "/files/"]:
+            r = c.get(url)
+            assert r.status_code in (403, 404), url
+            assert "PRIVATE" not in r.text
+    with TestClient(create_app(run)) as c:  # no tables given: nothing is served under /files
+        assert c.get("/files/alerts.parquet").status_code == 404
+
+
+def test_websocket_rejects_foreign_origin(client):
+    from starlette.websockets import WebSocketDisconnect
+
+    for origin in ["http://evil.example", "http://testserver.evil.example", "http://localhost:9999", "null"]:
+        with (
+            pytest.raises(WebSocketDisconnect) as exc,
+            client.websocket_connect("/ws", headers={"origin": origin}),
+        ):
+            pass
+        assert exc.value.code == 1008, origin
+    with client.websocket_connect("/ws", headers={"origin": "http://testserver"}) as ws:
+        assert ws.receive_json()["type"] == "info"
+
+
+def test_real_server_checks_origin_against_its_host(run):
+    from websockets.exceptions import InvalidStatus
+    from websockets.sync.client import connect
+
+    with serve_in_thread(create_app(run, autoplay=False)) as url:
+        ws_url, port = url.replace("http", "ws") + "/ws", url.rsplit(":", 1)[1]
+        for origin in [url, f"http://localhost:{port}"]:
+            with connect(ws_url, open_timeout=10, origin=origin) as ws:
+                assert json.loads(ws.recv(timeout=10))["type"] == "info"
+        with pytest.raises(InvalidStatus):
+            connect(ws_url, open_timeout=10, origin="https://evil.example")
+
+
+def test_command_queue_is_bounded():
+    """A client flooding commands fills at most COMMAND_QUEUE_SIZE slots; the newest commands are kept."""
+    import asyncio
+
+    from starlette.websockets import WebSocketDisconnect
+
+    from skyradar.web.server import COMMAND_QUEUE_SIZE, _read_commands
+
+    n = 20 * COMMAND_QUEUE_SIZE
+
+    class Flood:
+        sent = 0
+
+        async def receive_text(self):
+            if self.sent == n:
+                raise WebSocketDisconnect(1000)
+            self.sent += 1
+            return json.dumps({"cmd": "seek", "index": self.sent})
+
+    async def main():
+        queue = asyncio.Queue(maxsize=COMMAND_QUEUE_SIZE)
+        # The guard only turns a blocked reader (an old-style `await queue.put`) into a failure.
+        await asyncio.wait_for(_read_commands(Flood(), queue), timeout=30)
+        return [queue.get_nowait() for _ in range(queue.qsize())]
+
+    items = asyncio.run(main())
+    assert len(items) <= COMMAND_QUEUE_SIZE
+    assert items[-1] is None  # the disconnect is never dropped
+    assert items[-2] == {"cmd": "seek", "index": n}  # the newest command survives
+
+
+def test_websocket_survives_hostile_commands(run):
+    """Over real TCP: numbers out of range, wrong types, deep or huge JSON are ignored or clamped."""
+    from websockets.sync.client import connect
+
+    def recv(ws):
+        return json.loads(ws.recv(timeout=20))  # the timeout only guards against a hang
+
+    server = serve_in_thread(create_app(run, autoplay=False))
+    with server as url, connect(url.replace("http", "ws") + "/ws", open_timeout=10, max_size=None) as ws:
+        assert recv(ws)["type"] == "info"
+        assert recv(ws)["index"] == 0
+        ws.send(json.dumps({"cmd": "speed", "value": 4}))
+        ws.send(json.dumps({"cmd": "seek", "index": 3}))  # frames carry the replay state
+        assert recv(ws)["speed"] == 4.0
+        hostile = [
+            '{"cmd": "seek", "index": 1e999}',
+            '{"cmd": "seek", "index": -1e999}',
+            '{"cmd": "seek", "index": NaN}',
+            '{"cmd": "seek", "time_s": NaN}',
+            '{"cmd": "seek", "time_s": -Infinity}',
+            '{"cmd": "seek", "index": "abc"}',
+            '{"cmd": "seek", "index": [1]}',
+            '{"cmd": "seek", "index": true}',
+            '{"cmd": "speed", "value": NaN}',
+            '{"cmd": "speed", "value": "fast"}',
+            '{"cmd": "speed", "value": -1e999}',
+            '{"cmd": ["seek"]}',
+            '{"cmd": "seek", "index": ' + "9" * 5000 + "}",  # int() refuses > 4300 digits
+            "[" * 100_000,  # deeper than the JSON parser's recursion limit
+            json.dumps({"cmd": "seek", "index": 1, "pad": "x" * 2_000_000}),
+        ]
+        for text in hostile:
+            ws.send(text)
+        ws.send(json.dumps({"cmd": "seek", "index": 7}))
+        for _ in range(len(hostile) + 2):
+            last = recv(ws)
+            if last.get("index") == 7:
+                break
+        assert last["index"] == 7 and last["speed"] == 4.0 and last["playing"] is False
+        ws.send(json.dumps({"cmd": "seek", "time_s": float("inf")}))  # sent as Infinity: the last frame
+        assert recv(ws)["index"] == 59
+        ws.send('{"cmd": "speed", "value": 1e999}')  # clamped to the fastest replay
+        ws.send(json.dumps({"cmd": "seek", "index": 2}))
+        assert recv(ws)["speed"] == 100.0
+
+
+@pytest.mark.parametrize("speed", ["0", "-2", "nan"])
+def test_cli_serve_rejects_bad_speed(run, speed):
+    result = _serve(str(run), "--port", "0", "--speed", speed, timeout=60)
+    _assert_one_line_error(result, "--speed", speed)
+
+
+def test_cli_serve_port_taken_is_one_line(run):
+    sock, port = _listening_port()
+    with sock:
+        result = _serve(str(run), "--port", str(port))
+    _assert_one_line_error(result, f"127.0.0.1:{port}", "in use")
+
+
+def test_cli_serve_warns_when_not_loopback(run):
+    """Binding a non-loopback address prints a warning first (the port is taken so nothing is exposed)."""
+    sock, port = _listening_port()
+    with sock:
+        result = _serve(str(run), "--host", "0.0.0.0", "--port", str(port))
+    lines = result.stderr.strip().splitlines()
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert len(lines) == 2 and lines[0].startswith("warning: ") and "0.0.0.0" in lines[0]
+    assert lines[1].startswith("error: ") and f"0.0.0.0:{port}" in lines[1]
+
+
+def test_loopback_and_origin_rules():
+    from skyradar.web.net import is_loopback, origin_allowed
+
+    assert is_loopback("127.0.0.1") and is_loopback("::1") and is_loopback("[::1]")
+    assert not is_loopback("0.0.0.0") and not is_loopback("::") and not is_loopback("10.0.0.1")
+    assert origin_allowed("http://[::1]:8765", "localhost:8765")
+    assert origin_allowed("http://radar.local:8000", "radar.local:8000")
+    assert not origin_allowed("http://localhost:8765", "radar.local:8765")  # page from elsewhere
+    assert not origin_allowed("http://radar.local:8001", "radar.local:8000")
+    assert not origin_allowed("file://", "127.0.0.1:8765") and not origin_allowed("http://x", None)
+
+
+def test_serve_binds_loopback_by_default():
+    import inspect
+
+    from skyradar.cli.commands_daa import serve
+
+    assert inspect.signature(serve).parameters["host"].default == "127.0.0.1"

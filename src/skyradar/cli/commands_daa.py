@@ -8,7 +8,7 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from skyradar.cli.app import NON_NEGATIVE, JsonOption, app, console, emit_result, experiment_app, number_in
+from skyradar.cli.app import NON_NEGATIVE, JsonOption, app, emit_result, experiment_app, number_in
 
 __all__ = ["alert", "serve", "experiment_encounters"]
 
@@ -60,9 +60,12 @@ def serve(
     run: Annotated[
         Path, typer.Argument(help="Frames run (Zarr); RUN.partial is followed while being written.")
     ],
-    port: Annotated[int, typer.Option("--port", help="TCP port.")] = 8765,
+    port: Annotated[int, typer.Option("--port", help="TCP port (0: any free port).")] = 8765,
     host: Annotated[
-        str, typer.Option("--host", help="Address to bind (default: this machine only).")
+        str,
+        typer.Option(
+            "--host", help="Address to bind (default: this machine only; others get a warning: no login)."
+        ),
     ] = "127.0.0.1",
     tracks: Annotated[
         Path | None, typer.Option("--tracks", help="Tracks table to alert on and display.")
@@ -70,19 +73,31 @@ def serve(
     alerts: Annotated[
         Path | None, typer.Option("--alerts", help="Alerts table (from `skyradar alert`).")
     ] = None,
-    speed: Annotated[float, typer.Option("--speed", help="Replay speed (1 = real time).")] = 1.0,
+    speed: Annotated[float, typer.Option("--speed", help="Replay speed, 0.1 to 100 (1 = real time).")] = 1.0,
 ) -> None:
     """Live traffic display of a run in the browser: plan view, alerts, bands, range-Doppler image.
 
-    Without --alerts or --tracks a simulated run's intruder truth is alerted and shown.
+    Without --alerts or --tracks a simulated run's intruder truth is alerted and shown. Only the
+    page, the run's frames and the given tables are served, to pages from this server only.
     """
+    import sys
+
     import uvicorn
 
+    from skyradar.web.net import bind_socket, is_loopback
     from skyradar.web.server import create_app
 
     web_app = create_app(run, tracks_path=tracks, alerts_path=alerts, speed=speed)
-    console.print(f"serving {run} at http://{host}:{port}/  (Ctrl-C to stop)")
-    uvicorn.run(web_app, host=host, port=port, log_level="warning")
+    if not is_loopback(host):
+        print(
+            f"warning: --host {host} is not a loopback address: anyone who can reach it can watch this run",
+            file=sys.stderr,
+        )
+    sock = bind_socket(host, port)  # a taken port is one clear line here, not a server log
+    where = f"[{host}]" if ":" in host else host
+    print(f"serving {run} at http://{where}:{sock.getsockname()[1]}/  (Ctrl-C to stop)", file=sys.stderr)
+    server = uvicorn.Server(uvicorn.Config(web_app, host=host, port=port, log_level="warning"))
+    server.run(sockets=[sock])
 
 
 @experiment_app.command("encounters")

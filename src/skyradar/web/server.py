@@ -4,7 +4,8 @@ Endpoints
 ---------
 ``GET /``                 the page (``static/index.html``; no build step)
 ``GET /static/{path}``    the page's JS and CSS
-``GET /files/{path}``     files of the run's folder (tables, report figures); nothing outside it
+``GET /files/{name}``     the tables given with ``tracks_path`` / ``alerts_path``, by file name (for
+                          download); nothing else: not the run's folder, its neighbours or the store
 ``GET /api/info``         run summary (frame times, whether it is still being written)
 ``GET /api/frame/{i}``    one frame's payload as JSON (``?image=false`` leaves out the image)
 ``WS  /ws``               replay: the server sends ``info`` then ``frame`` messages at the run's
@@ -12,6 +13,15 @@ Endpoints
                           ``{"cmd": "speed", "value": 4}``, ``{"cmd": "seek", "index": 12}`` or
                           ``{"cmd": "seek", "time_s": 30.5}``. At the end of a finished run the
                           server sends ``{"type": "end"}`` and pauses; a growing run is polled.
+                          Frames carry the replay state (``playing``, ``speed``).
+
+Safety: the page reads frames only through ``/api`` and ``/ws``, so ``/files`` serves only the
+tables named when the app was built. ``/ws`` accepts only same-origin pages (see
+:func:`skyradar.web.net.origin_allowed`; others are closed with 1008, policy violation). Commands
+wait in a queue of :data:`COMMAND_QUEUE_SIZE` (a flooding client loses its oldest commands, not
+the server its memory); commands longer than :data:`MAX_COMMAND_CHARS`, not JSON, or with
+values that are not numbers (or a speed <= 0) are ignored; seeks and speeds out of range, even
+infinite, are clamped.
 
 Run it with ``skyradar serve RUN.zarr`` (binds 127.0.0.1 by default).
 """
@@ -22,6 +32,7 @@ import asyncio
 import contextlib
 import json
 import logging
+import math
 import threading
 import time
 from collections.abc import Iterator
@@ -32,12 +43,57 @@ from typing import Any
 from fastapi import FastAPI, HTTPException, WebSocket, WebSocketDisconnect
 from fastapi.responses import FileResponse, JSONResponse
 
+from skyradar.errors import InputError
+from skyradar.web.net import origin_allowed
 from skyradar.web.source import RunSource
 
-__all__ = ["STATIC_DIR", "create_app", "safe_path", "serve_in_thread"]
+__all__ = [
+    "COMMAND_QUEUE_SIZE",
+    "MAX_COMMAND_CHARS",
+    "SPEED_RANGE",
+    "STATIC_DIR",
+    "check_speed",
+    "create_app",
+    "safe_path",
+    "serve_in_thread",
+]
 
 STATIC_DIR = Path(__file__).parent / "static"
+COMMAND_QUEUE_SIZE = 32  # commands waiting per client; a click rate, not a flood, fits
+MAX_COMMAND_CHARS = 1024  # the longest real command is about 40 characters
+SPEED_RANGE = (0.1, 100.0)  # replay speed limits (times real time)
+_POLICY_VIOLATION = 1008  # WebSocket close code
 _log = logging.getLogger(__name__)
+
+
+def check_speed(speed: float, option: str = "--speed") -> float:
+    """``speed`` as a float if it is a finite replay speed within :data:`SPEED_RANGE`; else InputError.
+
+    Examples
+    --------
+    >>> check_speed(4)
+    4.0
+    >>> check_speed(0)
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: serve: option '--speed' must be from 0.1 to 100 (times real time), got 0
+    """
+    lo, hi = SPEED_RANGE
+    value = float(speed)
+    if not lo <= value <= hi:  # also false for NaN
+        raise InputError(
+            f"serve: option '{option}' must be from {lo:g} to {hi:g} (times real time), got {speed}"
+        )
+    return value
+
+
+def _served_files(*tables: Path | None) -> dict[str, Path]:
+    """Name -> resolved path of the tables ``/files`` may serve (checked again at each request)."""
+    served = {}
+    for table in tables:
+        if table is not None:
+            served[Path(table).name] = Path(table).resolve()
+    return served
 
 
 def safe_path(root: Path, relative: str) -> Path:
@@ -74,7 +130,6 @@ def create_app(
     alerts_path: str | Path | None = None,
     speed: float = 1.0,
     autoplay: bool = True,
-    files_root: str | Path | None = None,
 ) -> FastAPI:
     """Build the display app for one run.
 
@@ -85,16 +140,25 @@ def create_app(
     tracks_path, alerts_path : path, optional
         Tables to display (alerts preferred; tracks are alerted on load; else the run's truth).
     speed : float
-        Initial replay speed (1 = real time).
+        Initial replay speed (1 = real time), within :data:`SPEED_RANGE`.
     autoplay : bool
         Start playing when a client connects.
-    files_root : path, optional
-        Folder served under ``/files`` (default: the folder holding the run).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from fastapi.testclient import TestClient
+    >>> from skyradar.web.sample import write_sample_run
+    >>> run = write_sample_run(Path(tempfile.mkdtemp()) / "run.zarr", n_frames=3)
+    >>> with TestClient(create_app(run)) as client:
+    ...     client.get("/api/info").json()["n_ready"], client.get("/files/run.zarr").status_code
+    (3, 404)
     """
-    source = RunSource(
-        run_path, Path(tracks_path) if tracks_path else None, Path(alerts_path) if alerts_path else None
-    )
-    root = Path(files_root) if files_root else Path(run_path).resolve().parent
+    speed = check_speed(speed)
+    tracks_path = Path(tracks_path) if tracks_path else None
+    alerts_path = Path(alerts_path) if alerts_path else None
+    source = RunSource(run_path, tracks_path, alerts_path)
+    served = _served_files(tracks_path, alerts_path)
     app = FastAPI(title="skyradar live display")
     app.state.source = source
 
@@ -106,9 +170,13 @@ def create_app(
     def static(path: str) -> FileResponse:
         return FileResponse(safe_path(STATIC_DIR, path))
 
-    @app.get("/files/{path:path}")
-    def files(path: str) -> FileResponse:
-        return FileResponse(safe_path(root, path))
+    @app.get("/files/{name:path}")
+    def files(name: str) -> FileResponse:
+        # Looked up by exact name: no path is built from the request.
+        target = served.get(name)
+        if target is None or not target.is_file() or Path(target).resolve() != target:
+            raise HTTPException(status_code=404, detail="not found")
+        return FileResponse(target, filename=name)
 
     @app.get("/api/info")
     def info() -> JSONResponse:
@@ -125,8 +193,13 @@ def create_app(
 
     @app.websocket("/ws")
     async def ws(websocket: WebSocket) -> None:
+        origin, host = websocket.headers.get("origin"), websocket.headers.get("host")
+        if not origin_allowed(origin, host, "https" if websocket.url.scheme == "wss" else "http"):
+            _log.warning("refused display WebSocket from origin %r (served as %r)", origin, host)
+            await websocket.close(code=_POLICY_VIOLATION)
+            return
         await websocket.accept()
-        queue: asyncio.Queue = asyncio.Queue()
+        queue: asyncio.Queue = asyncio.Queue(maxsize=COMMAND_QUEUE_SIZE)
         reader = asyncio.create_task(_read_commands(websocket, queue))
         try:
             await _play(websocket, source, queue, _Player(playing=autoplay, speed=speed))
@@ -141,19 +214,61 @@ def create_app(
     return app
 
 
+def _offer(queue: asyncio.Queue, item: dict[str, Any] | None) -> None:
+    """Put ``item`` without waiting; when the queue is full, drop its oldest command first."""
+    while True:
+        try:
+            queue.put_nowait(item)
+            return
+        except asyncio.QueueFull:
+            queue.get_nowait()
+
+
+def _parse_command(text: Any) -> dict[str, Any] | None:
+    """The command in one client message, or None for anything that is not a short JSON object."""
+    if not isinstance(text, str) or len(text) > MAX_COMMAND_CHARS:
+        return None
+    try:
+        msg = json.loads(text)
+    except (ValueError, RecursionError):  # bad JSON, an int of > 4300 digits, nesting too deep
+        return None
+    return msg if isinstance(msg, dict) and isinstance(msg.get("cmd"), str) else None
+
+
 async def _read_commands(websocket: WebSocket, queue: asyncio.Queue) -> None:
-    """Forward client commands to ``queue``; ``None`` when the client disconnects."""
+    """Forward client commands to ``queue`` (bounded: see :func:`_offer`); ``None`` when the client leaves."""
     try:
         while True:
-            text = await websocket.receive_text()
-            try:
-                msg = json.loads(text)
-            except json.JSONDecodeError:
-                continue
-            if isinstance(msg, dict):
-                await queue.put(msg)
+            msg = _parse_command(await websocket.receive_text())
+            if msg is not None:
+                _offer(queue, msg)
     except Exception:  # noqa: BLE001 - any receive failure means the client is gone
-        await queue.put(None)
+        _offer(queue, None)
+
+
+def _number(value: Any) -> float | None:
+    """``value`` as a float (may be +-inf) if it is a JSON number that is not NaN; else None."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return None
+    value = float(value)  # an int too large for a float cannot come out of a 1 kB message
+    return None if math.isnan(value) else value
+
+
+def _seek_index(cmd: dict[str, Any], source: RunSource, current: int) -> int:
+    """Frame index a seek asks for, clamped to the ready frames; ``current`` if the seek is not usable."""
+    last = max(source.n_ready - 1, 0)
+    if "time_s" in cmd:
+        t = _number(cmd["time_s"])
+        if t is None:
+            return current
+        times = source.times[: last + 1]
+        index = int(abs(times - min(max(t, times[0]), times[-1])).argmin())  # +-inf: first / last
+    else:
+        x = _number(cmd.get("index", 0))
+        if x is None:
+            return current
+        index = int(min(max(x, 0.0), float(last)))
+    return min(max(index, 0), last)
 
 
 def _apply(cmd: dict[str, Any], p: _Player, source: RunSource) -> None:
@@ -165,18 +280,12 @@ def _apply(cmd: dict[str, Any], p: _Player, source: RunSource) -> None:
     elif kind == "pause":
         p.playing = False
     elif kind == "speed":
-        with contextlib.suppress(TypeError, ValueError):
-            p.speed = min(max(float(cmd.get("value", 1.0)), 0.1), 100.0)
+        value = _number(cmd.get("value", 1.0))
+        if value is not None and value > 0:  # a speed of zero or less means nothing: ignored
+            p.speed = min(max(value, SPEED_RANGE[0]), SPEED_RANGE[1])
     elif kind == "seek":
         source.refresh()
-        if "time_s" in cmd:
-            with contextlib.suppress(TypeError, ValueError):
-                t = float(cmd["time_s"])
-                p.index = int(abs(source.times[: max(source.n_ready, 1)] - t).argmin())
-        else:
-            with contextlib.suppress(TypeError, ValueError):
-                p.index = int(cmd.get("index", 0))
-        p.index = min(max(p.index, 0), max(source.n_ready - 1, 0))
+        p.index = _seek_index(cmd, source, p.index)
         p.send, p.ended = True, False
 
 
@@ -187,7 +296,8 @@ async def _play(websocket: WebSocket, source: RunSource, queue: asyncio.Queue, p
     due = loop.time()
     while True:
         if p.send and p.index < source.n_ready:
-            await websocket.send_json(await asyncio.to_thread(source.frame, p.index))
+            payload = await asyncio.to_thread(source.frame, p.index)
+            await websocket.send_json({**payload, "playing": p.playing, "speed": p.speed})
             p.send = False
             nxt = p.index + 1
             step = source.times[nxt] - source.times[p.index] if nxt < len(source.times) else 0.5

@@ -96,7 +96,7 @@ def run(min_time_s: float = 2.0, n_points: int = 400_000) -> dict[str, Any]:
 
     Examples
     --------
-    >>> result = run(min_time_s=0.0, n_points=20_000)
+    >>> result = run(min_time_s=1e-3, n_points=20_000)
     >>> sorted(k for k in result if k.endswith("_fps"))
     ['baseline_fps', 'robust_fps', 'terrain_aware_fps']
     >>> all(result[k] > 0 for k in result if k.endswith("_fps"))

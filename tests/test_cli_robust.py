@@ -180,10 +180,18 @@ def _store(path: Path, *, nan_frame: int | None = None, times: list[float] | Non
     return path
 
 
-@pytest.mark.parametrize("command", ["process", "state"])
+@pytest.mark.parametrize(
+    "command",
+    [
+        ("process", "-o", "out.parquet"),
+        ("state", "-o", "out.parquet"),
+        ("spur-map", "-o", "out.parquet"),
+        ("calibrate", "-o", "out.parquet", "--range", "300", "--azimuth", "0", "--elevation", "0"),
+    ],
+)
 def test_nan_frame_is_refused_naming_file_and_frame(tmp_path, command):
     run = _store(tmp_path / "run.zarr", nan_frame=4)
-    result = _skyradar(command, str(run), "-o", "out.parquet", cwd=tmp_path)
+    result = _skyradar(command[0], str(run), *command[1:], cwd=tmp_path)
     _assert_one_line_error(result, "run.zarr", "'iq'", "frame 4", "nan")
     assert not (tmp_path / "out.parquet").exists()
 

@@ -180,6 +180,7 @@ def calibrate(
     import numpy as np
 
     from skyradar.errors import InputError
+    from skyradar.io.checks import check_finite_frames
     from skyradar.io.frames import open_frames, radar_config_of
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_json_atomic
@@ -194,6 +195,7 @@ def calibrate(
         )
     p = reflector_position(range_m, np.radians(azimuth_deg), np.radians(elevation_deg))
     cube = np.asarray(ds["iq"].isel(time=slice(0, max(frames, 1))).values)
+    check_finite_frames(cube, 0, run)
     calibrated = calibrate_from_frames(cube, p, config, gain=not phase_only)
     write_json_atomic(output, calibrated.to_dict())
     phases = np.degrees(np.angle(calibrated.rx_calibration))
@@ -223,6 +225,7 @@ def spur_map(
     """Learn a spur map from frames of a static scene (every fixed bright pixel is a spur)."""
     import numpy as np
 
+    from skyradar.io.checks import check_finite_frames
     from skyradar.io.frames import open_frames, radar_config_of
     from skyradar.io.outputs import check_output
     from skyradar.process.detect import integrate_channels
@@ -232,11 +235,14 @@ def spur_map(
     check_output(output, [run], overwrite, kind="file")
     ds = open_frames(run)
     config = radar_config_of(ds, str(run))
-    frames = (
-        integrate_channels(np.asarray(ds["iq"][i].values), config.rx_calibration)
-        for i in range(ds.sizes["time"])
-    )
-    learned = learn_spur_map(frames, config, threshold, pixels)
+
+    def frames():
+        for i in range(ds.sizes["time"]):
+            cube = np.asarray(ds["iq"][i].values)
+            check_finite_frames(cube[None], i, run)  # a NaN frame would silently mark no spurs
+            yield integrate_channels(cube, config.rx_calibration)
+
+    learned = learn_spur_map(frames(), config, threshold, pixels)
     learned.save(output)
     result = {"frames": learned.n_frames, "spur_pixels": int(learned.mask.sum()), "threshold": threshold,
               "output": str(output)}  # fmt: skip

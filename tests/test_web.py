@@ -242,9 +242,14 @@ def test_cli_serve_runs_and_rejects_missing_run(run, tmp_path):
             except httpx.HTTPError:
                 time.sleep(0.2)
         assert info is not None and info["n_ready"] == 60
+        # Bound to loopback: a request addressed to another name (DNS rebinding) is refused.
+        base = f"http://127.0.0.1:{port}/api/info"
+        assert httpx.get(base, headers={"host": f"attacker.example:{port}"}, timeout=5).status_code == 403
+        assert httpx.get(base, headers={"host": f"localhost:{port}"}, timeout=5).status_code == 200
     finally:
         proc.terminate()
-        proc.wait(timeout=20)
+        _, err = proc.communicate(timeout=20)
+    assert "warning" not in err.decode()  # the default host is loopback
 
 
 # --- Safe by default (issue 11): served files, origin, command queue, hostile commands, CLI checks.
@@ -448,3 +453,21 @@ def test_serve_binds_loopback_by_default():
     from skyradar.cli.commands_daa import serve
 
     assert inspect.signature(serve).parameters["host"].default == "127.0.0.1"
+
+
+def test_loopback_host_only_refuses_other_names(run):
+    from starlette.websockets import WebSocketDisconnect
+
+    from skyradar.web.net import LoopbackHostOnly
+
+    with TestClient(LoopbackHostOnly(create_app(run, autoplay=False)), base_url="http://127.0.0.1:8765") as c:
+        assert c.get("/api/info").status_code == 200
+        assert c.get("/api/info", headers={"host": "attacker.example:8765"}).status_code == 403
+        with c.websocket_connect("/ws", headers={"host": "localhost:8765"}) as ws:
+            assert ws.receive_json()["type"] == "info"
+        with (
+            pytest.raises(WebSocketDisconnect) as exc,
+            c.websocket_connect("/ws"),  # the test client's WebSocket host is "testserver"
+        ):
+            pass
+        assert exc.value.code == 1008

@@ -84,19 +84,27 @@ def serve(
 
     import uvicorn
 
-    from skyradar.web.net import bind_socket, is_loopback
-    from skyradar.web.server import create_app
+    from skyradar.web.net import LoopbackHostOnly, bind_socket, is_loopback
+    from skyradar.web.server import check_speed, create_app
 
-    web_app = create_app(run, tracks_path=tracks, alerts_path=alerts, speed=speed)
-    if not is_loopback(host):
+    check_speed(speed)
+    local = is_loopback(host)
+    if not local:
         print(
             f"warning: --host {host} is not a loopback address: anyone who can reach it can watch this run",
             file=sys.stderr,
         )
     sock = bind_socket(host, port)  # a taken port is one clear line here, not a server log
+    try:
+        web_app = create_app(run, tracks_path=tracks, alerts_path=alerts, speed=speed)
+    except BaseException:
+        sock.close()
+        raise
     where = f"[{host}]" if ":" in host else host
     print(f"serving {run} at http://{where}:{sock.getsockname()[1]}/  (Ctrl-C to stop)", file=sys.stderr)
-    server = uvicorn.Server(uvicorn.Config(web_app, host=host, port=port, log_level="warning"))
+    # On loopback, refuse requests addressed to other names (DNS rebinding from a web page).
+    asgi = LoopbackHostOnly(web_app) if local else web_app
+    server = uvicorn.Server(uvicorn.Config(asgi, host=host, port=port, log_level="warning"))
     server.run(sockets=[sock])
 
 

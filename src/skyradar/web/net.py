@@ -2,7 +2,8 @@
 
 The display has no login: anyone who can open its port can watch the run. It therefore binds to
 127.0.0.1 by default, warns when told to bind elsewhere, and accepts WebSocket connections only
-from pages it served itself (a page on another site must not drive or read the replay).
+from pages it served itself (a page on another site must not drive or read the replay). Bound to
+loopback, it also answers only requests addressed to a loopback name (:class:`LoopbackHostOnly`).
 """
 
 from __future__ import annotations
@@ -10,13 +11,19 @@ from __future__ import annotations
 import errno
 import ipaddress
 import socket
+from typing import Any
 from urllib.parse import urlsplit
 
 from skyradar.errors import InputError
 
-__all__ = ["LOOPBACK_NAMES", "bind_socket", "is_loopback", "origin_allowed"]
+__all__ = [
+    "LoopbackHostOnly",
+    "bind_socket",
+    "host_is_loopback",
+    "is_loopback",
+    "origin_allowed",
+]
 
-LOOPBACK_NAMES = ("localhost", "127.0.0.1", "[::1]")
 _DEFAULT_PORTS = {"http": 80, "https": 443, "ws": 80, "wss": 443}
 
 
@@ -122,3 +129,45 @@ def bind_socket(host: str, port: int) -> socket.socket:
         where = f"[{host}]:{port}" if ":" in host else f"{host}:{port}"
         raise InputError(f"serve: cannot listen on {where}: {reason}") from exc
     return sock
+
+
+def host_is_loopback(host_header: str | None) -> bool:
+    """True if a request's ``Host`` header names this machine by a loopback name or address.
+
+    Examples
+    --------
+    >>> host_is_loopback("127.0.0.1:8765"), host_is_loopback("[::1]:8765"), host_is_loopback("localhost")
+    (True, True, True)
+    >>> host_is_loopback("attacker.example:8765"), host_is_loopback(None)
+    (False, False)
+    """
+    hp = _host_port(host_header, "http") if host_header else None
+    return hp is not None and is_loopback(hp[0])
+
+
+class LoopbackHostOnly:
+    """ASGI wrapper refusing requests whose ``Host`` is not a loopback name (HTTP 403, WebSocket 1008).
+
+    A server bound to 127.0.0.1 is still reachable from a web page through DNS rebinding (a name
+    that first resolves to the attacker, then to 127.0.0.1); such requests carry the attacker's
+    name in ``Host``, so refusing other names closes that door.
+    """
+
+    def __init__(self, app: Any):
+        self.app = app
+
+    async def __call__(self, scope: dict, receive: Any, send: Any) -> None:
+        if scope["type"] in ("http", "websocket"):
+            headers = dict(scope.get("headers") or [])
+            host = headers.get(b"host", b"").decode("latin-1")
+            if not host_is_loopback(host):
+                if scope["type"] == "websocket":
+                    await send({"type": "websocket.close", "code": 1008})
+                    return
+                body = b"forbidden: this display answers only to localhost / 127.0.0.1 / [::1]\n"
+                await send({"type": "http.response.start", "status": 403,
+                            "headers": [(b"content-type", b"text/plain"),
+                                        (b"content-length", str(len(body)).encode())]})  # fmt: skip
+                await send({"type": "http.response.body", "body": body})
+                return
+        await self.app(scope, receive, send)

@@ -193,25 +193,30 @@ def create_app(
 
     @app.websocket("/ws")
     async def ws(websocket: WebSocket) -> None:
-        origin, host = websocket.headers.get("origin"), websocket.headers.get("host")
-        if not origin_allowed(origin, host, "https" if websocket.url.scheme == "wss" else "http"):
-            _log.warning("refused display WebSocket from origin %r (served as %r)", origin, host)
-            await websocket.close(code=_POLICY_VIOLATION)
-            return
-        await websocket.accept()
-        queue: asyncio.Queue = asyncio.Queue(maxsize=COMMAND_QUEUE_SIZE)
-        reader = asyncio.create_task(_read_commands(websocket, queue))
-        try:
-            await _play(websocket, source, queue, _Player(playing=autoplay, speed=speed))
-        except (WebSocketDisconnect, RuntimeError, OSError) as exc:
-            # A client that goes away mid-stream ends only its own replay.
-            _log.info("display client left: %s", type(exc).__name__)
-        finally:
-            reader.cancel()
-            with contextlib.suppress(asyncio.CancelledError, Exception):
-                await reader
+        await _replay(websocket, source, _Player(playing=autoplay, speed=speed))
 
     return app
+
+
+async def _replay(websocket: WebSocket, source: RunSource, player: _Player) -> None:
+    """One client's replay: same-origin check, then commands in (bounded queue) and frames out."""
+    origin, host = websocket.headers.get("origin"), websocket.headers.get("host")
+    if not origin_allowed(origin, host, "https" if websocket.url.scheme == "wss" else "http"):
+        _log.warning("refused display WebSocket from origin %r (served as %r)", origin, host)
+        await websocket.close(code=_POLICY_VIOLATION)
+        return
+    await websocket.accept()
+    queue: asyncio.Queue = asyncio.Queue(maxsize=COMMAND_QUEUE_SIZE)
+    reader = asyncio.create_task(_read_commands(websocket, queue))
+    try:
+        await _play(websocket, source, queue, player)
+    except (WebSocketDisconnect, RuntimeError, OSError) as exc:
+        # A client that goes away mid-stream ends only its own replay.
+        _log.info("display client left: %s", type(exc).__name__)
+    finally:
+        reader.cancel()
+        with contextlib.suppress(asyncio.CancelledError, Exception):
+            await reader
 
 
 def _offer(queue: asyncio.Queue, item: dict[str, Any] | None) -> None:

@@ -9,6 +9,7 @@ import numpy as np
 import typer
 
 from skyradar.cli.app import NON_NEGATIVE, JsonOption, app, emit_result, experiment_app, number_in
+from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["alert", "serve", "experiment_encounters"]
 
@@ -23,6 +24,7 @@ def alert(
     no_advice: Annotated[
         bool, typer.Option("--no-advice", help="Skip the resolution bands and manoeuvre.")
     ] = False,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
     """Turn tracks into DO-365-style alert levels, FLARM-style alarms and resolution advice.
@@ -33,8 +35,10 @@ def alert(
     from skyradar.daa.pipeline import TRACK_COLUMNS, alerts_from_tracks, ownship_from_frames
     from skyradar.daa.provenance import check_tracks_match_run
     from skyradar.io.frames import open_frames
+    from skyradar.io.outputs import check_output
     from skyradar.io.tables import read_table, write_table
 
+    check_output(output, [tracks, ownship], overwrite, kind="table")
     table = read_table(tracks, required=TRACK_COLUMNS, sort_by="time_s")
     run_ds = open_frames(ownship)
     check_tracks_match_run(table.attrs, str(tracks), run_ds, str(ownship))
@@ -132,6 +136,7 @@ def experiment_encounters(
         str,
         typer.Option(help="'none' (clear sky) or 'flat' (flat ground 1000 m below: clutter; slower)."),
     ] = "none",
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
     """Encounter set (head-on, crossing, converging, overtaking, climbing; conflicts and near misses),
@@ -141,10 +146,13 @@ def experiment_encounters(
     from skyradar.cli.commands_sim import frame_progress
     from skyradar.errors import InputError
     from skyradar.experiments.encounters import run
+    from skyradar.io.outputs import check_output, mark_folder
 
     if terrain not in ("none", "flat"):
         raise InputError(f"experiment encounters: option '--terrain' must be none or flat, got {terrain!r}")
 
+    check_output(out, (), overwrite, kind="folder", option="--out")
+    mark_folder(out)
     with frame_progress(n, "encounters") as bar:
         task = bar.add_task("encounters", total=n)
         result = run(

@@ -9,6 +9,7 @@ from typing import Annotated
 import typer
 
 from skyradar.cli.app import JsonOption, app, emit_result
+from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["demo", "format_timeline"]
 
@@ -34,6 +35,7 @@ def format_timeline(timeline) -> str:
 @app.command()
 def demo(
     out: Annotated[Path, typer.Option("--out", help="Report folder to write.")] = Path("out/demo"),
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
     """Run the embedded demo end to end and write a report folder (index.html + figures + tables).
@@ -45,8 +47,10 @@ def demo(
     import pandas as pd
 
     from skyradar.demo import run_demo
+    from skyradar.io.outputs import check_output, mark_folder
 
-    summary = run_demo(out)
+    check_output(out, (), overwrite, kind="folder", option="--out")
+    summary = run_demo(mark_folder(out))
     timeline = pd.read_csv(out / "alert_timeline.csv")
     print(format_timeline(timeline), flush=True)
     print(f"report: {out / 'index.html'}  ({summary['runtime_s']:.1f} s)", flush=True)

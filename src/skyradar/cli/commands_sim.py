@@ -18,8 +18,10 @@ from skyradar.cli.app import (
     emit_result,
     experiment_app,
 )
+from skyradar.io.outputs import OVERWRITE_HELP
 
 OutDir = Annotated[Path, typer.Option("--out", help="Folder for figures and tables.")]
+
 
 
 def frame_progress(total: int, label: str) -> Progress:
@@ -45,6 +47,15 @@ def simulate(
     workers: Annotated[
         int | None, typer.Option(callback=COUNT, help="Run on a local Dask cluster of this many workers.")
     ] = None,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
+    compress: Annotated[
+        str,
+        typer.Option(
+            "--compress",
+            help="Lossless codec for the pixels: none (8 bytes per complex pixel), zstd, or blosc "
+            "(zstd with byte shuffle). Readable by every command.",
+        ),
+    ] = "none",
 ) -> None:
     """Simulate a scenario into a frames store (range x Doppler x rx per frame, plus truth).
 
@@ -52,18 +63,24 @@ def simulate(
     interruption, the same command resumes without recomputing finished chunks.
     """
     from skyradar.errors import InputError
+    from skyradar.io.frames import COMPRESSORS
+    from skyradar.io.outputs import check_output
     from skyradar.scene.scenario import load_scenario
     from skyradar.sim.run import simulate_to_zarr
 
     if chunk_frames < 1:
         raise InputError(f"--chunk-frames must be >= 1, got {chunk_frames}")
+    if compress not in COMPRESSORS:
+        raise InputError(f"--compress: must be one of {', '.join(COMPRESSORS)}, got {compress!r}")
+    check_output(output, [scenario], overwrite, kind="frames store")  # before any work
     built = load_scenario(scenario).build()
     n = built.times_s.size
     with frame_progress(n, f"simulate {built.name}") as bar:
         task = bar.add_task("frames", total=n)
         path = simulate_to_zarr(
-            built, output, chunk_frames, scheduler, workers, progress=lambda k: bar.advance(task, k)
-        )
+            built, output, chunk_frames, scheduler, workers, progress=lambda k: bar.advance(task, k),
+            overwrite=overwrite, compressor=compress,
+        )  # fmt: skip
     console.print(f"wrote {n} frames to {path}")
 
 
@@ -81,11 +98,14 @@ def experiment_ch2(
     json_out: JsonOption = False,
     out: OutDir = Path("out/ch2"),
     frames: Annotated[int, typer.Option(callback=COUNT, help="Frames per case (timing uses them all).")] = 3,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
 ) -> None:
     """Flat ground at 1000 m: asymptotes R = H and V = -speed, aliased head-on intruder, 60 m/s wrap."""
     from skyradar.experiments.ch2 import run
+    from skyradar.io.outputs import check_output, mark_folder
 
-    result = run(out, n_frames=frames)
+    check_output(out, (), overwrite, kind="folder", option="--out")
+    result = run(mark_folder(out), n_frames=frames)
     console.print(f"figures and table in {out}")
     emit_result(result, json_out, "ch2: simulator against closed form")
 
@@ -129,13 +149,17 @@ def sweep(
     workers: Annotated[
         int | None, typer.Option(callback=COUNT, help="Run on a local Dask cluster of this many workers.")
     ] = None,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     json_out: JsonOption = False,
 ) -> None:
     """Run one scenario over a list of parameter values and collect each run's detectability table."""
+    from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_table
     from skyradar.sim.sweep import parse_values
     from skyradar.sim.sweep import sweep as run_sweep
 
+    kind = "file" if output.suffix.lower() == ".csv" else "table"
+    check_output(output, [scenario], overwrite, kind=kind)
     value_list = parse_values(values)
     with frame_progress(len(value_list), f"sweep {param}") as bar:
         task = bar.add_task("runs", total=len(value_list))

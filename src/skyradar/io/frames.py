@@ -8,7 +8,8 @@ and, when simulated, own-ship truth on ``time`` and intruder truth on ``(time, t
 Writers never leave a half-written run under the final name: :class:`FrameStoreWriter` writes
 into ``NAME.partial`` chunk by chunk along time, marks each finished chunk, and renames the
 store when the last chunk is in (done marks sit in ``NAME.partial.done``). Re-running with the
-same fingerprint resumes: finished chunks are skipped.
+same fingerprint resumes: finished chunks are skipped. A finished store carries the attribute
+``skyradar_complete``; :func:`open_frames` refuses ``.partial`` and unfinished stores.
 """
 
 from __future__ import annotations
@@ -23,6 +24,8 @@ import xarray as xr
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
+from skyradar.io.checks import check_frame_times
+from skyradar.io.outputs import check_disk_space, check_output, is_ours, notify, replace_path
 
 __all__ = [
     "OWNSHIP_VARS",
@@ -31,7 +34,13 @@ __all__ = [
     "radar_config_of",
     "open_frames",
     "FrameStoreWriter",
+    "COMPRESSORS",
+    "store_bytes",
+    "check_store_space",
 ]
+
+# Lossless codecs for ``iq`` (Zarr v3). "none" stores raw complex64 (8 bytes per pixel).
+COMPRESSORS = ("none", "zstd", "blosc")
 
 # Truth variables written by the simulator: name -> (units, description).
 OWNSHIP_VARS: dict[str, tuple[str, str]] = {
@@ -153,7 +162,10 @@ def radar_config_of(ds: xr.Dataset, source: str = "frames") -> RadarConfig:
     text = ds.attrs.get("radar_config")
     if text is None:
         raise InputError(f"{source}: no 'radar_config' attribute; not a skyradar frames store")
-    return RadarConfig.from_json(text)
+    try:
+        return RadarConfig.from_json(text)
+    except InputError as exc:  # name the store: "radar.x ..." alone does not say which file
+        raise InputError(f"{source}: attribute 'radar_config': {exc}") from None
 
 
 def open_frames(path: str | Path) -> xr.Dataset:
@@ -163,6 +175,11 @@ def open_frames(path: str | Path) -> xr.Dataset:
     inconsistent with its own RadarConfig.
     """
     path = Path(path)
+    if path.name.endswith(".partial"):
+        raise InputError(
+            f"{path}: an unfinished run (still being written, or interrupted); rerun the command that "
+            f"writes {path.name.removesuffix('.partial')} to resume it"
+        )
     if not path.exists():
         partial = path.with_name(path.name + ".partial")
         hint = f" (an unfinished run is at {partial}; rerun to resume)" if partial.exists() else ""
@@ -171,11 +188,17 @@ def open_frames(path: str | Path) -> xr.Dataset:
         ds = _open_zarr(path) if path.is_dir() else xr.open_dataset(path)
     except Exception as exc:  # noqa: BLE001 - any reader failure becomes one clear line
         raise InputError(f"{path}: cannot open as a frames store ({type(exc).__name__}: {exc})") from exc
+    if "skyradar_fingerprint" in ds.attrs and not ds.attrs.get("skyradar_complete"):
+        raise InputError(
+            f"{path}: unfinished run (no 'skyradar_complete' attribute: interrupted, or written by an "
+            "older skyradar); rerun the command that wrote it"
+        )
     if "iq" not in ds:
         raise InputError(f"{path}: missing variable 'iq'")
     config = radar_config_of(ds, str(path))
     if ds.sizes.get("time", 0) == 0:
         raise InputError(f"{path}: empty run (0 frames)")
+    check_frame_times(ds["time"].values, path)
     if ds.sizes.get("rx") != config.n_rx:
         raise InputError(
             f"{path}: field 'rx' has {ds.sizes.get('rx')} antennas, radar_config has {config.n_rx}"
@@ -184,6 +207,37 @@ def open_frames(path: str | Path) -> xr.Dataset:
         if ds.sizes.get(dim) != n:
             raise InputError(f"{path}: dimension '{dim}' is {ds.sizes.get(dim)}, radar_config needs {n}")
     return ds
+
+
+# Measured stored/raw size of ``iq`` per codec: 16 prototype frames (333 x 250 x 4) of
+# circuit_three_intruders.yaml, fractal terrain, thermal noise on (`skyradar simulate --compress C`,
+# size of chunk 0). Noise makes complex64 nearly incompressible: lossless codecs save 6-9 %.
+COMPRESSION_RATIO = {"none": 1.0, "zstd": 0.94, "blosc": 0.92}
+
+
+def store_bytes(config: RadarConfig, n_frames: int, compressor: str = "none") -> float:
+    """Estimated size of a frames store's ``iq``, bytes (8 bytes per complex64 pixel times the codec ratio).
+
+    Examples
+    --------
+    >>> store_bytes(RadarConfig.seed_prototype(), 1) == 333 * 250 * 4 * 8
+    True
+    """
+    pixels = float(n_frames) * config.n_range * config.n_doppler * config.n_rx
+    return pixels * 8.0 * COMPRESSION_RATIO.get(compressor, 1.0)
+
+
+def check_store_space(
+    path: str | Path, config: RadarConfig, n_frames: int, chunk_frames: int, compressor: str = "none"
+) -> None:
+    """Refuse to start when the store's unwritten chunks do not fit on the disk of ``path``."""
+    path = Path(path)
+    n_chunks = max(1, -(-int(n_frames) // max(1, int(chunk_frames))))
+    marks = path.with_name(path.name + ".partial.done")
+    done = sum(1 for p in marks.iterdir() if p.name.isdigit()) if marks.is_dir() else 0
+    # Unwritten chunks, each stored whole (the last one is padded to chunk_frames).
+    padded = max(0, n_chunks - done) * max(1, int(chunk_frames))
+    check_disk_space(path, store_bytes(config, padded, compressor), f"a {n_frames}-frame store")
 
 
 class FrameStoreWriter:
@@ -199,28 +253,73 @@ class FrameStoreWriter:
     chunk_frames : int
         Frames per chunk along time.
     fingerprint : str
-        Identifies the job (e.g. a hash of the scenario); a partial store with another
-        fingerprint is discarded rather than resumed.
+        Identifies the job (inputs, options, chunking, package version); a partial store with
+        another fingerprint is our own stale run: it is discarded (said on stderr), not resumed.
+    overwrite : bool
+        Allow replacing an existing ``path`` that skyradar did not write (see :mod:`skyradar.io.outputs`).
+    inputs : iterable of path
+        The job's inputs: the output may not be, contain or lie inside any of them.
+    compressor : {"none", "zstd", "blosc"}
+        Lossless codec for ``iq`` (see :data:`COMPRESSORS`).
     """
 
-    def __init__(self, path: str | Path, template: xr.Dataset, chunk_frames: int, fingerprint: str) -> None:
+    def __init__(
+        self,
+        path: str | Path,
+        template: xr.Dataset,
+        chunk_frames: int,
+        fingerprint: str,
+        overwrite: bool = False,
+        inputs: tuple = (),
+        compressor: str = "none",
+    ) -> None:
         self.path = Path(path)
+        check_output(self.path, inputs, overwrite, kind="frames store")
+        self.overwrite = overwrite
         self.partial = self.path.with_name(self.path.name + ".partial")
         self.chunk_frames = int(chunk_frames)
         self.n_frames = template.sizes["time"]
         self.n_chunks = -(-self.n_frames // self.chunk_frames)
         # Done marks live beside the store: zarr must not find foreign files inside it.
         self._marks = self.partial.with_name(self.partial.name + ".done")
-        if self.partial.exists() and self._fingerprint_on_disk() != fingerprint:
-            shutil.rmtree(self.partial)
-            shutil.rmtree(self._marks, ignore_errors=True)
+        # The chunk layout, codec and package version are part of every job: resuming across them
+        # would mix layouts or leave chunks unwritten (zeros).
+        fingerprint = f"{fingerprint}-c{self.chunk_frames}-{compressor}-v{_version()}"
+        if self.partial.exists() or self.partial.is_symlink():
+            self._check_partial_is_ours()
+            on_disk = self._fingerprint_on_disk()
+            if on_disk != fingerprint:
+                notify(
+                    f"{self.partial}: discarding an unfinished run of other inputs or options "
+                    f"(fingerprint {on_disk} != {fingerprint}); starting afresh"
+                )
+                shutil.rmtree(self.partial)
+                self._remove_marks()
         if not self.partial.exists():
-            shutil.rmtree(self._marks, ignore_errors=True)
+            self._remove_marks()
             template = template.assign_attrs(skyradar_fingerprint=fingerprint)
-            encoding = {"iq": {"chunks": (self.chunk_frames, *template.iq.shape[1:])}}
+            encoding = {"iq": {"chunks": (self.chunk_frames, *template.iq.shape[1:]), **_codec(compressor)}}
             template.to_zarr(self.partial, compute=False, encoding=encoding, mode="w", consolidated=False)
             self._marks.mkdir()
         self._marks.mkdir(exist_ok=True)
+
+    def _check_partial_is_ours(self) -> None:
+        marked = is_ours(self.partial, "frames store") or self._marks.is_dir()
+        ours = marked and not self.partial.is_symlink()
+        if not ours:
+            raise InputError(
+                f"{self.partial}: exists and is not an unfinished skyradar run; move it away or choose "
+                "another output"
+            )
+
+    def _remove_marks(self) -> None:
+        if not (self._marks.exists() or self._marks.is_symlink()):
+            return
+        if self._marks.is_symlink() or not self._marks.is_dir() or any(
+            not p.name.isdigit() for p in self._marks.iterdir()
+        ):
+            raise InputError(f"{self._marks}: exists and is not skyradar's chunk marks; move it away")
+        shutil.rmtree(self._marks)
 
     @classmethod
     def attach(cls, partial: str | Path, chunk_frames: int, n_frames: int) -> FrameStoreWriter:
@@ -255,12 +354,38 @@ class FrameStoreWriter:
         (self._marks / str(index)).touch()
 
     def close(self) -> Path:
-        """Rename the finished store to its final name (replacing an older run of that name)."""
+        """Mark the store complete and move it to its final name.
+
+        An older run of that name is renamed aside first and deleted only once the new one is in
+        place; a path skyradar did not write is replaced only with ``overwrite``.
+        """
+        import zarr
+
         missing = self.pending_chunks()
         if missing:
             raise RuntimeError(f"{self.partial}: chunks {missing[:5]} not written; cannot finalise")
+        # Checked again: something may have appeared at the final name while we were working.
+        check_output(self.path, (), self.overwrite, kind="frames store")
+        zarr.open_group(self.partial, mode="r+").attrs["skyradar_complete"] = True
+        replace_path(self.partial, self.path)
         shutil.rmtree(self._marks)
-        if self.path.exists():
-            shutil.rmtree(self.path) if self.path.is_dir() else self.path.unlink()
-        self.partial.rename(self.path)
         return self.path
+
+
+def _version() -> str:
+    from skyradar import __version__
+
+    return __version__
+
+
+def _codec(compressor: str) -> dict[str, Any]:
+    """Zarr v3 encoding for ``iq``: raw, zstd, or blosc-zstd with byte shuffle."""
+    from zarr.codecs import BloscCodec, ZstdCodec
+
+    if compressor == "none":
+        return {"compressors": None}
+    if compressor == "zstd":
+        return {"compressors": [ZstdCodec(level=3)]}
+    if compressor == "blosc":
+        return {"compressors": [BloscCodec(cname="zstd", clevel=3, shuffle="shuffle", typesize=4)]}
+    raise InputError(f"--compress: must be one of {', '.join(COMPRESSORS)}, got {compressor!r}")

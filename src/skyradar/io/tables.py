@@ -22,10 +22,13 @@ __all__ = ["write_table", "read_table", "write_json_atomic", "jsonable"]
 
 
 def write_table(df: pd.DataFrame, path: str | Path, metadata: dict[str, Any] | None = None) -> Path:
-    """Write ``df`` to Parquet atomically; ``metadata`` goes into ``df.attrs`` (kept by pyarrow)."""
-    if metadata:
-        df = df.copy()
-        df.attrs.update(metadata)
+    """Write ``df`` to Parquet atomically; ``metadata`` goes into ``df.attrs`` (kept by pyarrow).
+
+    ``skyradar_format`` in the metadata marks the file as ours (:mod:`skyradar.io.outputs` then
+    lets a later run replace it without ``--overwrite``).
+    """
+    df = df.copy(deep=False)
+    df.attrs.update({"skyradar_format": "table/1", **(metadata or {})})
     return write_with(path, lambda tmp: df.to_parquet(tmp, index=False))
 
 

@@ -15,18 +15,35 @@ from typing import Any
 
 import numpy as np
 
-from skyradar.io.frames import FrameStoreWriter, frames_dataset
+from skyradar.io.checks import check_finite_frames
+from skyradar.io.frames import FrameStoreWriter, check_store_space, frames_dataset
+from skyradar.io.outputs import check_output
 from skyradar.io.recordings import read_recording
 from skyradar.process.rangedoppler import RangeDopplerProcessor, window_gain_db
 
-__all__ = ["recording_to_frames"]
+__all__ = ["recording_to_frames", "recording_files"]
 
 
-def _fingerprint(path: Path, options: dict[str, Any]) -> str:
-    stat = path.stat()
-    text = json.dumps(
-        {"path": str(path.resolve()), "size": stat.st_size, "mtime": stat.st_mtime_ns, **options}
-    )
+def recording_files(recording: str | Path, frames: Any = None) -> list[Path]:
+    """The files a recording is made of: the named one, its sidecar and its data file.
+
+    Every existing NAME.{json,yaml,yml,bin,dat,npy} beside it, and the memory-mapped data file.
+    """
+    path = Path(recording)
+    files = [path] + [path.with_suffix(s) for s in (".json", ".yaml", ".yml", ".bin", ".dat", ".npy")]
+    mapped = getattr(getattr(frames, "raw", None), "filename", None)
+    if mapped:
+        files.append(Path(mapped))
+    return [f for f in dict.fromkeys(files) if f.exists()]
+
+
+def _fingerprint(files: list[Path], options: dict[str, Any]) -> str:
+    # Size and modification time of every file (hashing a multi-GB recording would cost a full read);
+    # the writer adds the chunk layout, codec and package version.
+    from skyradar import __version__
+
+    stats = {str(f.resolve()): [f.stat().st_size, f.stat().st_mtime_ns] for f in files}
+    text = json.dumps({"files": stats, "version": __version__, **options}, sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -41,6 +58,15 @@ def _write_chunk(recording: str, partial: str, chunk_frames: int, options: dict[
     return sl.stop - sl.start
 
 
+def _check_samples(frames, source: str | Path, chunk_frames: int) -> None:
+    """Refuse a recording with NaN/inf samples before anything is written, naming the frame."""
+    if frames.raw.dtype.kind not in "fc":
+        return  # integer ADC codes are always finite (and scaled by a finite factor)
+    for start in range(0, len(frames), chunk_frames):
+        stop = min(start + chunk_frames, len(frames))
+        check_finite_frames(np.stack([frames[i] for i in range(start, stop)]), start, source, "samples")
+
+
 def recording_to_frames(
     recording: str | Path,
     output: str | Path,
@@ -51,14 +77,23 @@ def recording_to_frames(
     scheduler: str | None = None,
     workers: int | None = None,
     progress: Callable[[int], None] | None = None,
+    overwrite: bool = False,
+    compressor: str = "none",
 ) -> dict[str, Any]:
     """Turn a recording into a frames store; returns a summary (frames, chunks written/resumed...).
 
-    The recording is fully checked before anything is written; a bad recording leaves no output.
+    The output is checked first (never the recording, its sidecar or data file; an existing path
+    skyradar did not write only with ``overwrite``), then the recording and the free disk space,
+    all before anything is written; a bad recording leaves no output.
     """
     import dask.array as da
 
+    check_output(output, recording_files(recording), overwrite, kind="frames store")
     frames, config = read_recording(recording)  # raises InputError on a bad recording
+    inputs = recording_files(recording, frames)
+    check_output(output, inputs, overwrite, kind="frames store")
+    check_store_space(output, config, frames.shape[0], chunk_frames, compressor)
+    _check_samples(frames, recording, chunk_frames)
     n_frames = frames.shape[0]
     RangeDopplerProcessor(config, range_window, doppler_window, n_samples=frames.shape[3])  # checks windows
     shape = (n_frames, config.n_range, config.n_doppler, config.n_rx)
@@ -72,7 +107,8 @@ def recording_to_frames(
         client = connect(scheduler, workers)  # before any output exists: a dead address leaves nothing
     try:
         template = frames_dataset(lazy, frames.times_s, config, attrs=attrs)
-        writer = FrameStoreWriter(output, template, chunk_frames, _fingerprint(Path(recording), options))
+        key = _fingerprint(inputs, options)
+        writer = FrameStoreWriter(output, template, chunk_frames, key, overwrite, inputs, compressor)
         pending = writer.pending_chunks()
         args = (str(recording), str(writer.partial), chunk_frames, options)
         if client is None:

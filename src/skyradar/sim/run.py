@@ -16,7 +16,8 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from skyradar.io.frames import FrameStoreWriter, frames_dataset
+from skyradar.io.frames import FrameStoreWriter, check_store_space, frames_dataset
+from skyradar.io.outputs import check_output
 from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
 from skyradar.sim.impairments import apply_impairments
 
@@ -27,6 +28,7 @@ __all__ = [
     "simulate",
     "simulate_to_zarr",
     "fingerprint",
+    "referenced_files",
 ]
 
 _SIM_KEYS = (
@@ -145,8 +147,50 @@ def scenario_truth(built, simulator: ImageSimulator | None = None) -> tuple[dict
     return _ownship_truth(built, own), targets, [i.name for i in built.intruders]
 
 
+def referenced_files(built) -> list[Path]:
+    """Every file the scenario file of ``built`` refers to (trajectories, DEMs, antenna cuts).
+
+    Read from the scenario's own fields named ``path`` or ``*_csv``, resolved as the scenario
+    resolves them (relative to its folder). Empty when the scenario has no source file.
+    """
+    source = getattr(built, "source", None)
+    if not source or not Path(source).is_file():
+        return []
+    from skyradar.scene.scenario import load_scenario
+
+    scenario = load_scenario(source)
+    found: list[Path] = []
+
+    def walk(value: Any, key: str) -> None:
+        if isinstance(value, dict):
+            for k, v in value.items():
+                walk(v, str(k))
+        elif isinstance(value, list | tuple):
+            for v in value:
+                walk(v, key)
+        elif isinstance(value, str) and (key == "path" or key.endswith("_csv")):
+            found.append(scenario._path(value))
+
+    walk(scenario.model.model_dump(), "")
+    return found
+
+
+def _file_digest(path: Path) -> str:
+    try:
+        with open(path, "rb") as f:
+            return hashlib.file_digest(f, "sha256").hexdigest()  # streams: big DEMs are fine
+    except OSError:
+        return "unreadable"
+
+
 def fingerprint(built) -> str:
-    """Hash of everything that determines the frames (scenario text, radar, times, options)."""
+    """Hash of everything that determines the frames.
+
+    The scenario text, every file it refers to (contents), radar, times, options and the package
+    version. (:class:`~skyradar.io.frames.FrameStoreWriter` adds the chunk layout and codec.)
+    """
+    from skyradar import __version__
+
     source_text = (
         built.source.read_text() if getattr(built, "source", None) and Path(built.source).exists() else ""
     )
@@ -157,6 +201,8 @@ def fingerprint(built) -> str:
         "times": [float(built.times_s[0]), float(built.times_s[-1]), int(built.times_s.size)],
         "options": {k: str(v) for k, v in sorted(built.sim_options.items())},
         "source": source_text,
+        "files": {str(p): _file_digest(p) for p in referenced_files(built)},
+        "version": __version__,
         "format": "frames/1",
     }
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
@@ -224,6 +270,8 @@ def simulate_to_zarr(
     scheduler: str | None = None,
     workers: int | None = None,
     progress: Callable[[int], None] | None = None,
+    overwrite: bool = False,
+    compressor: str = "none",
 ) -> Path:
     """Simulate into a Zarr store chunk by chunk; rerunning resumes an interrupted run.
 
@@ -241,7 +289,17 @@ def simulate_to_zarr(
         and ``workers`` the chunks run in a plain loop in this process.
     progress : callable, optional
         Called with the number of frames finished after each chunk.
+    overwrite : bool
+        Replace an existing ``path`` skyradar did not write (never the scenario or its files).
+    compressor : {"none", "zstd", "blosc"}
+        Lossless codec for ``iq``.
+
+    Before any work the output is checked (:func:`skyradar.io.outputs.check_output`) and the
+    disk must hold the estimated store.
     """
+    inputs = (getattr(built, "source", None), *referenced_files(built))
+    check_output(path, inputs, overwrite, kind="frames store")
+    check_store_space(path, built.radar, built.times_s.size, chunk_frames, compressor)
     client = None
     if scheduler is not None or workers:
         from skyradar.sim.cluster import close, connect, map_chunks
@@ -250,7 +308,8 @@ def simulate_to_zarr(
     try:
         simulator = make_simulator(built)
         key = fingerprint(built)
-        writer = FrameStoreWriter(path, _template(built, chunk_frames, simulator), chunk_frames, key)
+        template = _template(built, chunk_frames, simulator)
+        writer = FrameStoreWriter(path, template, chunk_frames, key, overwrite, inputs, compressor)
         pending = writer.pending_chunks()
         if progress and len(pending) < writer.n_chunks:
             progress(built.times_s.size - sum(_chunk_len(writer, i) for i in pending))

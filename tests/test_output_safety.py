@@ -130,9 +130,10 @@ def test_rd_onto_its_recording_refused(tmp_path):
 def test_process_onto_its_run_refused(tmp_path):
     run = _store(tmp_path / "run.zarr")
     before = _tree(run)
-    result = _skyradar("process", "run.zarr", "-o", "run.zarr", "--overwrite", cwd=tmp_path)
-    _assert_one_line_error(result, "run.zarr", "input")
-    assert _tree(run) == before
+    for extra in ((), ("--overwrite",)):
+        result = _skyradar("process", "run.zarr", "-o", "run.zarr", *extra, cwd=tmp_path)
+        _assert_one_line_error(result, "run.zarr", "input")
+        assert _tree(run) == before
 
 
 def test_track_onto_its_detections_refused(tmp_path):
@@ -192,29 +193,28 @@ def test_resume_with_another_chunk_size_starts_afresh(tmp_path):
     _interrupted(scenario, tmp_path / "run.zarr", chunk_frames=2)
     result = _skyradar("simulate", "s.yaml", "-o", "run.zarr", "--chunk-frames", "4", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
-    assert "discarding" in result.stderr
     iq = open_frames(tmp_path / "run.zarr").iq.values
-    assert not np.any(iq == 7 + 7j)
     assert np.all(np.abs(iq).reshape(iq.shape[0], -1).max(axis=1) > 0)  # no frame left all zeros
+    assert not np.any(iq == 7 + 7j)
+    assert "discarding" in result.stderr
 
 
 def test_resume_after_a_referenced_file_changed_starts_afresh(tmp_path):
-    cuts = tmp_path / "cuts.csv"
-    angles = np.arange(-90, 91, 10)
+    own = tmp_path / "own.csv"
 
-    def write_cuts(peak_db: float) -> None:
-        rows = [f"{cut},{a},{peak_db - abs(a) / 10}" for cut in ("azimuth", "elevation") for a in angles]
-        cuts.write_text("cut,angle_deg,gain_db\n" + "\n".join(rows) + "\n")
+    def write_ownship(alt_ft: float) -> None:
+        rows = [f"{1700000000 + k},aaaaaa,OWN,{52.0 + k * 4e-4},4.36,{alt_ft},80,0,0" for k in range(6)]
+        head = "timestamp,icao24,callsign,latitude,longitude,altitude,groundspeed,track,vertical_rate\n"
+        own.write_text(head + "\n".join(rows) + "\n")
 
-    write_cuts(10.0)
-    data = {**TINY, "radar": {**TINY["radar"], "antenna": {"cuts_csv": "cuts.csv"}}}
-    scenario = _scenario(tmp_path, data)
+    write_ownship(1000.0)
+    scenario = _scenario(tmp_path, {**TINY, "ownship": "own.csv"})
     _interrupted(scenario, tmp_path / "run.zarr", chunk_frames=2)
-    write_cuts(3.0)  # the user edits the antenna cuts, then reruns the same command
+    write_ownship(1500.0)  # the user edits the own-ship track, then reruns the same command
     result = _skyradar("simulate", "s.yaml", "-o", "run.zarr", "--chunk-frames", "2", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
+    assert not np.any(open_frames(tmp_path / "run.zarr").iq.values == 7 + 7j)  # no old frames mixed in
     assert "discarding" in result.stderr
-    assert not np.any(open_frames(tmp_path / "run.zarr").iq.values == 7 + 7j)
 
 
 def test_same_job_still_resumes(tmp_path):
@@ -276,3 +276,19 @@ def test_compressed_store_reads_back_identical(tmp_path):
         "--compress",
         "lzw",
     )
+
+
+def test_rd_resume_key_covers_sidecar_data_file_and_chunking(tmp_path):
+    from skyradar.io.recordings import read_recording, write_recording
+    from skyradar.process.rd_run import _fingerprint, recording_files
+
+    cfg = RadarConfig.seed_prototype(n_doppler=8)
+    write_recording(tmp_path / "rec.bin", np.ones((2, 4, 8, cfg.samples_per_chirp), np.complex64), cfg)
+    frames, _ = read_recording(tmp_path / "rec.json")
+    files = recording_files(tmp_path / "rec.json", frames)
+    assert {f.name for f in files} == {"rec.json", "rec.bin"}
+    before = _fingerprint(files, {"chunk": 32})
+    sidecar = tmp_path / "rec.json"
+    sidecar.write_text(sidecar.read_text() + "\n")  # an edited sidecar is another job
+    assert _fingerprint(files, {"chunk": 32}) != before
+    assert _fingerprint(files, {"chunk": 16}) != _fingerprint(files, {"chunk": 32})

@@ -49,6 +49,9 @@ _LAZY = {
 
 __all__ = ["Terrain", "Bounds", "metres_per_degree", *_LAZY]
 
+# Index distance (grid cells) within which a position counts as on the edge: float rounding only.
+_EDGE_TOL = 1e-9
+
 
 def __getattr__(name: str) -> Any:
     if name in _LAZY:
@@ -232,6 +235,10 @@ class Terrain:
         """Bilinear elevation (metres) at fractional indices; NaN outside ``[0, n-1]``."""
         ny, nx = self.shape
         row, col = np.broadcast_arrays(np.asarray(row, float), np.asarray(col, float))
+        # A position on the grid's edge comes back from index_of a few ulps outside it
+        # (120.0000000000017): snap such rounding onto the edge instead of calling it outside.
+        row = np.where(np.abs(row - np.clip(row, 0, ny - 1)) < _EDGE_TOL, np.clip(row, 0, ny - 1), row)
+        col = np.where(np.abs(col - np.clip(col, 0, nx - 1)) < _EDGE_TOL, np.clip(col, 0, nx - 1), col)
         inside = (row >= 0) & (row <= ny - 1) & (col >= 0) & (col <= nx - 1)
         r0 = np.clip(np.floor(np.where(inside, row, 0.0)), 0, ny - 2).astype(np.intp)
         c0 = np.clip(np.floor(np.where(inside, col, 0.0)), 0, nx - 2).astype(np.intp)

@@ -78,8 +78,7 @@ def _detections(path: Path, n: int, ground: bool) -> Path:
     return path
 
 
-@pytest.mark.parametrize(("n", "ground"), [(0, False), (12, True)])
-@pytest.mark.parametrize("model", ["radar", "traditional"])
+@pytest.mark.parametrize(("n", "ground", "model"), [(0, False, "radar"), (12, True, "traditional")])
 def test_track_without_air_detections_writes_empty_table(tmp_path, n, ground, model):
     from skyradar.track.run import TRACK_COLUMNS
 
@@ -196,8 +195,10 @@ def test_nan_frame_is_refused_naming_file_and_frame(tmp_path, command):
     assert not (tmp_path / "out.parquet").exists()
 
 
-@pytest.mark.parametrize("command", ["process", "state"])
-@pytest.mark.parametrize("times", [[0, 0.1, 0.2, 0.2, 0.3, 0.4], [0, 0.1, 0.2, 0.15, 0.3, 0.4]])
+@pytest.mark.parametrize(
+    ("command", "times"),
+    [("process", [0, 0.1, 0.2, 0.2, 0.3, 0.4]), ("state", [0, 0.1, 0.2, 0.15, 0.3, 0.4])],
+)
 def test_repeated_or_backward_frame_times_are_refused(tmp_path, command, times):
     run = _store(tmp_path / "run.zarr", times=times)
     result = _skyradar(command, str(run), "-o", "out.parquet", cwd=tmp_path)

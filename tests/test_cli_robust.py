@@ -258,22 +258,33 @@ def test_rd_refuses_repeated_frame_times(tmp_path):
     _assert_one_line_error(result, "rec.json", "frame_times_s", "frame 2")
 
 
-def test_scenario_with_zero_range_bins_is_refused(tmp_path):
+_OWN = {"type": "straight", "start_ned_m": [0, 0, -500], "heading_deg": 0, "speed_mps": 40}
+
+
+@pytest.mark.parametrize(
+    ("change", "needles"),
+    [
+        ({"radar": {"range_limit_m": 1}}, ["range_limit_m", "0 range bins"]),
+        ({"duration_s": 1e12}, ["duration_s", "frame_rate_hz", "frames"]),  # used to be a MemoryError
+        ({"ownship": {**_OWN, "speed_mps": 1e9}}, ["ownship", "speed", "Mach 3"]),
+        ({"ownship": {**_OWN, "start_ned_m": [0, 0, 1e7]}}, ["ownship", "altitude"]),
+    ],
+)
+def test_nonsense_scenario_is_refused(tmp_path, change, needles):
     import yaml
 
     scenario = {
         "name": "tiny",
         "origin": {"lat_deg": 52.0, "lon_deg": 4.36, "alt_m": 0.0},
         "mount": "forward",
-        "radar": {"range_limit_m": 1},
         "terrain": {"type": "flat", "size_m": 3000, "spacing_m": 60},
-        "ownship": {"type": "straight", "start_ned_m": [0, 0, -500], "heading_deg": 0, "speed_mps": 40},
+        "ownship": _OWN,
         "frame_rate_hz": 5.0,
         "duration_s": 1.0,
     }
-    (tmp_path / "s.yaml").write_text(yaml.safe_dump(scenario))
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump({**scenario, **change}))
     result = _skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
-    _assert_one_line_error(result, "s.yaml", "range_limit_m", "0 range bins")
+    _assert_one_line_error(result, "s.yaml", *needles)
     assert not any(tmp_path.glob("run.zarr*"))
 
 

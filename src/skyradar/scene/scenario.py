@@ -43,6 +43,9 @@ from skyradar.scene.scenario_models import (
 )
 from skyradar.scene.trajectories import Trajectory
 
+# 10^7 frames is 12 days at the prototype's 9.4 frames/s and about 2.7 PB of frames.
+MAX_FRAMES = 10_000_000
+
 __all__ = [
     "Scenario",
     "BuiltScenario",
@@ -188,6 +191,11 @@ class Scenario:
         """Frame times start_s + k / frame_rate_hz inside [start_s, start_s + duration_s), s."""
         m = self.model
         n = max(1, int(np.floor(m.duration_s * m.frame_rate_hz + 1e-9)))
+        if n > MAX_FRAMES:  # the time axis alone would not fit in memory, let alone the store
+            raise InputError(
+                f"{self._label}: fields 'duration_s' ({m.duration_s:g}) x 'frame_rate_hz' "
+                f"({m.frame_rate_hz:g}) give {n:.3g} frames; at most {MAX_FRAMES:.0e}"
+            )
         return m.start_s + np.arange(n) / m.frame_rate_hz
 
     def _radar(self) -> RadarConfig:
@@ -273,7 +281,9 @@ class Scenario:
             params = spec.model_dump(exclude={"type", "name", "rcs_m2", "time_offset_s"})
             params["duration_s"] = params["duration_s"] or m.duration_s
             params["start_time_s"] = m.start_s if params["start_time_s"] is None else params["start_time_s"]
-            return getattr(flights, spec.type)(origin=origin, name=name, **params)
+            traj = getattr(flights, spec.type)(origin=origin, name=name, **params)
+            _check_plausible(traj)
+            return traj
         except InputError as exc:
             raise self._fail(section, exc) from None
 
@@ -369,6 +379,27 @@ def _read_dem_near(path: Path, bounds, origin) -> Any:
         if origin is None:
             raise
         raise DemCoverageError(f"{exc}; scenario origin lat {origin[0]:.6g}, lon {origin[1]:.6g}") from None
+
+
+def _check_plausible(traj: Trajectory) -> None:
+    """Refuse a parametric flight faster than Mach 3 or outside [-500 m, 30 km] altitude (files: adsb)."""
+    from skyradar.geo import ned_to_geodetic
+    from skyradar.scene.adsb import ALT_LIMITS_M, MAX_SPEED_MPS
+
+    speed = np.linalg.norm(traj.velocity_ned_mps, axis=1)
+    if np.any(speed > MAX_SPEED_MPS):
+        i = int(np.argmax(speed > MAX_SPEED_MPS))
+        raise InputError(
+            f"speed {speed[i]:.4g} m/s at t = {traj.time_s[i]:g} s is above Mach 3 ({MAX_SPEED_MPS:.0f} m/s)"
+        )
+    alt = np.asarray(ned_to_geodetic(traj.position_ned_m, *traj.origin)[2], float)
+    out = (alt < ALT_LIMITS_M[0]) | (alt > ALT_LIMITS_M[1])
+    if np.any(out):
+        i = int(np.argmax(out))
+        raise InputError(
+            f"altitude {alt[i]:.4g} m at t = {traj.time_s[i]:g} s is outside "
+            f"[{ALT_LIMITS_M[0]:g}, {ALT_LIMITS_M[1]:g}] m"
+        )
 
 
 def _read_flight(path: Path, icao24: str | None, origin, time_zero_s: float | None) -> Trajectory:

@@ -36,6 +36,13 @@ def rd(
     compress: Annotated[
         str, typer.Option("--compress", help="Lossless codec for the pixels: none, zstd or blosc.")
     ] = "none",
+    precision: Annotated[
+        str,
+        typer.Option(
+            "--precision",
+            help="Pixel format: complex64 (exact) or cint16 (int16 I/Q, a scale per frame, range, rx).",
+        ),
+    ] = "complex64",
     as_json: JsonOption = False,
 ) -> None:
     """Turn a raw ADC recording into range-Doppler frames (the same store the simulator writes).
@@ -46,9 +53,14 @@ def rd(
     fully checked first: a bad recording leaves no output.
     """
     from skyradar.errors import InputError
+    from skyradar.io.frames import COMPRESSORS, PRECISIONS
     from skyradar.process.rd_run import recording_to_frames
     from skyradar.process.windows import get_window
 
+    choices = (("--compress", compress, COMPRESSORS), ("--precision", precision, PRECISIONS))
+    for option, value, allowed in choices:
+        if value not in allowed:
+            raise InputError(f"{option}: must be one of {', '.join(allowed)}, got {value!r}")
     for option, spec in (("--range-window", range_window), ("--doppler-window", doppler_window)):
         try:
             get_window(spec, 8)
@@ -60,7 +72,7 @@ def rd(
 
     result = recording_to_frames(
         recording, output, range_window, doppler_window, remove_dc, chunk_frames, scheduler, workers, report,
-        overwrite=overwrite, compressor=compress,
+        overwrite=overwrite, compressor=compress, precision=precision,
     )  # fmt: skip
     emit_result(result, as_json, "range-Doppler frames")
 

@@ -56,6 +56,15 @@ def simulate(
             "(zstd with byte shuffle). Readable by every command.",
         ),
     ] = "none",
+    precision: Annotated[
+        str,
+        typer.Option(
+            "--precision",
+            help="Pixel format: complex64 (exact, 8 bytes per pixel) or cint16 (int16 I/Q with a scale "
+            "per frame, range bin and rx: 4 bytes per pixel, rounding error at most half a step). "
+            "Readable by every command.",
+        ),
+    ] = "complex64",
 ) -> None:
     """Simulate a scenario into a frames store (range x Doppler x rx per frame, plus truth).
 
@@ -63,7 +72,7 @@ def simulate(
     interruption, the same command resumes without recomputing finished chunks.
     """
     from skyradar.errors import InputError
-    from skyradar.io.frames import COMPRESSORS
+    from skyradar.io.frames import COMPRESSORS, PRECISIONS
     from skyradar.io.outputs import check_output
     from skyradar.scene.scenario import load_scenario
     from skyradar.sim.run import simulate_to_zarr
@@ -72,6 +81,8 @@ def simulate(
         raise InputError(f"--chunk-frames must be >= 1, got {chunk_frames}")
     if compress not in COMPRESSORS:
         raise InputError(f"--compress: must be one of {', '.join(COMPRESSORS)}, got {compress!r}")
+    if precision not in PRECISIONS:
+        raise InputError(f"--precision: must be one of {', '.join(PRECISIONS)}, got {precision!r}")
     check_output(output, [scenario], overwrite, kind="frames store")  # before any work
     built = load_scenario(scenario).build()
     n = built.times_s.size
@@ -79,7 +90,7 @@ def simulate(
         task = bar.add_task("frames", total=n)
         path = simulate_to_zarr(
             built, output, chunk_frames, scheduler, workers, progress=lambda k: bar.advance(task, k),
-            overwrite=overwrite, compressor=compress,
+            overwrite=overwrite, compressor=compress, precision=precision,
         )  # fmt: skip
     console.print(f"wrote {n} frames to {path}")
 

@@ -51,7 +51,7 @@ def _write_chunk(recording: str, partial: str, chunk_frames: int, options: dict[
     frames, config = read_recording(recording)
     n_samples = frames.shape[3]
     proc = RangeDopplerProcessor(config, options["rw"], options["dw"], n_samples=n_samples)
-    writer = FrameStoreWriter.attach(partial, chunk_frames, frames.shape[0])
+    writer = FrameStoreWriter.attach(partial, chunk_frames, frames.shape[0], options["precision"])
     sl = writer.chunk_slice(index)
     block = np.stack([proc(frames[i], remove_dc=options["dc"]) for i in range(sl.start, sl.stop)])
     writer.write_chunk(index, block)
@@ -79,6 +79,7 @@ def recording_to_frames(
     progress: Callable[[int], None] | None = None,
     overwrite: bool = False,
     compressor: str = "none",
+    precision: str = "complex64",
 ) -> dict[str, Any]:
     """Turn a recording into a frames store; returns a summary (frames, chunks written/resumed...).
 
@@ -92,7 +93,7 @@ def recording_to_frames(
     frames, config = read_recording(recording)  # raises InputError on a bad recording
     inputs = recording_files(recording, frames)
     check_output(output, inputs, overwrite, kind="frames store")
-    check_store_space(output, config, frames.shape[0], chunk_frames, compressor)
+    check_store_space(output, config, frames.shape[0], chunk_frames, compressor, precision)
     _check_samples(frames, recording, chunk_frames)
     n_frames = frames.shape[0]
     RangeDopplerProcessor(config, range_window, doppler_window, n_samples=frames.shape[3])  # checks windows
@@ -100,6 +101,7 @@ def recording_to_frames(
     lazy = da.zeros(shape, dtype=np.complex64, chunks=(chunk_frames, *shape[1:]))
     attrs = {"source": str(recording), "range_window": range_window, "doppler_window": doppler_window}
     options = {"rw": range_window, "dw": doppler_window, "dc": remove_dc, "chunk": chunk_frames}
+    options["precision"] = precision  # also in the writer's fingerprint; the workers need it to encode
     client = None
     if scheduler is not None or workers:
         from skyradar.sim.cluster import connect
@@ -108,7 +110,9 @@ def recording_to_frames(
     try:
         template = frames_dataset(lazy, frames.times_s, config, attrs=attrs)
         key = _fingerprint(inputs, options)
-        writer = FrameStoreWriter(output, template, chunk_frames, key, overwrite, inputs, compressor)
+        writer = FrameStoreWriter(
+            output, template, chunk_frames, key, overwrite, inputs, compressor, precision
+        )
         pending = writer.pending_chunks()
         args = (str(recording), str(writer.partial), chunk_frames, options)
         if client is None:
@@ -134,5 +138,6 @@ def recording_to_frames(
         "n_doppler": config.n_doppler,
         "n_rx": config.n_rx,
         "window_gain_db": window_gain_db(range_window, doppler_window, config),
+        "precision": precision,
         "output": str(output),
     }

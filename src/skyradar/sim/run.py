@@ -244,7 +244,7 @@ def _template(built, chunk_frames: int, simulator: ImageSimulator) -> xr.Dataset
 _WORKER_SIMULATORS: dict[str, ImageSimulator] = {}
 
 
-def _chunk_job(built, key: str, path: str, chunk_frames: int, index: int) -> int:
+def _chunk_job(built, key: str, path: str, chunk_frames: int, precision: str, index: int) -> int:
     # Runs on a Dask worker: one simulator per scenario per worker process (terrain set-up once).
     import numba
 
@@ -252,7 +252,7 @@ def _chunk_job(built, key: str, path: str, chunk_frames: int, index: int) -> int
     if key not in _WORKER_SIMULATORS:
         _WORKER_SIMULATORS.clear()
         _WORKER_SIMULATORS[key] = make_simulator(built)
-    writer = FrameStoreWriter.attach(path, chunk_frames, built.times_s.size)
+    writer = FrameStoreWriter.attach(path, chunk_frames, built.times_s.size, precision)
     sl = writer.chunk_slice(index)
     writer.write_chunk(index, simulate_frames(built, np.arange(sl.start, sl.stop), _WORKER_SIMULATORS[key]))
     return sl.stop - sl.start
@@ -272,6 +272,7 @@ def simulate_to_zarr(
     progress: Callable[[int], None] | None = None,
     overwrite: bool = False,
     compressor: str = "none",
+    precision: str = "complex64",
 ) -> Path:
     """Simulate into a Zarr store chunk by chunk; rerunning resumes an interrupted run.
 
@@ -293,13 +294,16 @@ def simulate_to_zarr(
         Replace an existing ``path`` skyradar did not write (never the scenario or its files).
     compressor : {"none", "zstd", "blosc"}
         Lossless codec for ``iq``.
+    precision : {"complex64", "cint16"}
+        Pixel format; cint16 halves the raw size at a bounded rounding error
+        (:mod:`skyradar.io.cint16`).
 
     Before any work the output is checked (:func:`skyradar.io.outputs.check_output`) and the
     disk must hold the estimated store.
     """
     inputs = (getattr(built, "source", None), *referenced_files(built))
     check_output(path, inputs, overwrite, kind="frames store")
-    check_store_space(path, built.radar, built.times_s.size, chunk_frames, compressor)
+    check_store_space(path, built.radar, built.times_s.size, chunk_frames, compressor, precision)
     client = None
     if scheduler is not None or workers:
         from skyradar.sim.cluster import close, connect, map_chunks
@@ -309,7 +313,7 @@ def simulate_to_zarr(
         simulator = make_simulator(built)
         key = fingerprint(built)
         template = _template(built, chunk_frames, simulator)
-        writer = FrameStoreWriter(path, template, chunk_frames, key, overwrite, inputs, compressor)
+        writer = FrameStoreWriter(path, template, chunk_frames, key, overwrite, inputs, compressor, precision)
         pending = writer.pending_chunks()
         if progress and len(pending) < writer.n_chunks:
             progress(built.times_s.size - sum(_chunk_len(writer, i) for i in pending))
@@ -326,6 +330,7 @@ def simulate_to_zarr(
                 key,
                 str(writer.partial),
                 chunk_frames,
+                precision,
                 client=client,
                 chunks=pending,
                 progress=progress,

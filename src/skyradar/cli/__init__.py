@@ -56,7 +56,9 @@ def main() -> None:
     try:
         code = app(standalone_mode=False)
     except InputError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        # One line even when a wrapped library message spans several (pandas' CSV parser errors do).
+        message = " ".join(part.strip() for part in str(exc).splitlines() if part.strip())
+        print(f"error: {message}", file=sys.stderr)
         sys.exit(2)
     except _NO_ARGS_IS_HELP as exc:
         # A bare `skyradar` (or `skyradar bench`) asks for help: Typer's rich help is already printed

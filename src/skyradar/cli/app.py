@@ -15,7 +15,7 @@ from skyradar.io.tables import jsonable
 
 __all__ = [
     "app", "experiment_app", "bench_app", "console", "emit_result", "JsonOption", "number_in",
-    "check_number", "check_choice", "POSITIVE", "NON_NEGATIVE", "COUNT", "PROBABILITY",
+    "check_number", "check_choice", "POSITIVE", "NON_NEGATIVE", "COUNT", "PROBABILITY", "WORKERS",
 ]  # fmt: skip
 
 app = typer.Typer(
@@ -120,6 +120,16 @@ POSITIVE = number_in(0.0, low_open=True)  # durations, distances, rates: finite 
 NON_NEGATIVE = number_in(0.0)  # counts and durations where 0 means "skip"
 COUNT = number_in(1)  # frames, workers, chunk sizes: at least one
 PROBABILITY = number_in(0.0, 1.0, low_open=True, high_open=True)
+
+
+def WORKERS(ctx: typer.Context, param: typer.CallbackParam, value: int | None) -> int | None:  # noqa: N802
+    """Callback for local worker counts: 1 to 4 per core (:func:`~skyradar.sim.cluster.check_workers`)."""
+    from skyradar.sim.cluster import check_workers
+
+    if ctx is not None and getattr(ctx, "resilient_parsing", False):
+        return value
+    name = param.opts[0] if param is not None and param.opts else "--workers"
+    return check_workers(value, name)
 
 
 def check_choice(option: str, value: str, choices: tuple[str, ...]) -> str:

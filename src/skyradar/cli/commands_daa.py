@@ -52,6 +52,8 @@ def alert(
         "tracks_with_warning": int(warn["track_id"].nunique()),
         "first_warning_s": float(warn["time_s"].min()) if len(warn) else float("nan"),
         "max_level": int(alerts["level"].max()) if len(alerts) else 0,
+        # NaN position/velocity (no direction of arrival) cannot be alerted on: say how many.
+        "rows_skipped_no_state": int(alerts.attrs.get("rows_skipped_no_state", 0)),
         "output": str(output),
     }
     for level in (1, 2, 3):
@@ -147,7 +149,9 @@ def experiment_encounters(
     from skyradar.errors import InputError
     from skyradar.experiments.encounters import run
     from skyradar.io.outputs import check_output, mark_folder
+    from skyradar.sim.cluster import check_workers
 
+    check_workers(workers)
     if terrain not in ("none", "flat"):
         raise InputError(f"experiment encounters: option '--terrain' must be none or flat, got {terrain!r}")
 

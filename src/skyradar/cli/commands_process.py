@@ -12,6 +12,7 @@ from skyradar.cli.app import (
     NON_NEGATIVE,
     POSITIVE,
     PROBABILITY,
+    WORKERS,
     JsonOption,
     app,
     bench_app,
@@ -62,7 +63,7 @@ def process(
     ] = None,
     scheduler: Annotated[str | None, typer.Option(help="Address of an existing Dask scheduler.")] = None,
     workers: Annotated[
-        int | None, typer.Option(callback=COUNT, help="Run on a local Dask cluster of this many workers.")
+        int | None, typer.Option(callback=WORKERS, help="Run on a local Dask cluster of this many workers.")
     ] = None,
     chunk_frames: Annotated[
         int, typer.Option(callback=COUNT, help="Frames per Dask task (with --scheduler/--workers).")

@@ -100,15 +100,42 @@ def _covariances(df: pd.DataFrame) -> tuple[np.ndarray | None, np.ndarray | None
     return cov_p, cov_v
 
 
+def _numeric(df: pd.DataFrame, col: str, source: str, allow_nan: bool) -> np.ndarray:
+    """Column ``col`` as float; a non-number, an infinity (or a NaN unless allowed) names its row."""
+    values = pd.to_numeric(df[col], errors="coerce").to_numpy(float)
+    raw_nan = pd.isna(df[col]).to_numpy()
+    bad = np.flatnonzero(np.isinf(values) | (np.isnan(values) & (~raw_nan | (not allow_nan))))
+    if bad.size:
+        raw = df[col].iloc[bad[0]]
+        raw = raw.item() if hasattr(raw, "item") else raw
+        raise InputError(f"{source}: field '{col}' is not a finite number at row {bad[0]} ({raw!r})")
+    return values
+
+
 def _clean_tracks(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
+    """Checked, confirmed rows with a 3-D state; ``attrs['rows_skipped_no_state']`` counts the others.
+
+    NaN position/velocity means "no direction of arrival" and skips the row; anything else that
+    is not a finite number (a string, an infinity, a NaN time or id) is refused naming the row.
+    """
     missing = [c for c in TRACK_COLUMNS if c not in tracks]
     if missing:
         raise InputError(f"{source}: missing column(s) {missing}")
-    df = tracks
+    df = tracks.reset_index(drop=True)
+    cols = {c: _numeric(df, c, source, allow_nan=c not in ("time_s", "track_id")) for c in TRACK_COLUMNS}
+    df = df.assign(**cols)
     if "confirmed" in df:
-        df = df[df["confirmed"].astype(bool)]
+        flag = df["confirmed"]
+        if flag.dtype != bool and not flag.isin([0, 1]).all():
+            bad = int(np.flatnonzero(~flag.isin([0, 1]))[0])
+            raise InputError(
+                f"{source}: field 'confirmed' is not a boolean at row {bad} ({flag.iloc[bad]!r})"
+            )
+        df = df[flag.astype(bool).to_numpy()]
     ok = np.isfinite(df[TRACK_COLUMNS[2:]].to_numpy(float)).all(axis=1)
-    return df[ok].sort_values(["time_s", "track_id"], kind="stable").reset_index(drop=True)
+    clean = df[ok].sort_values(["time_s", "track_id"], kind="stable").reset_index(drop=True)
+    clean.attrs["rows_skipped_no_state"] = int((~ok).sum())
+    return clean
 
 
 def _advice_columns(out: pd.DataFrame, s, v_int, own_vel, height, raw, config: AlertConfig) -> None:
@@ -215,4 +242,5 @@ def alerts_from_tracks(
     )
     if with_advice:
         _advice_columns(out, s, v_int, own_vel, own.get("own_height_agl_m"), raw, config)
+    out.attrs["rows_skipped_no_state"] = df.attrs["rows_skipped_no_state"]
     return out

@@ -44,6 +44,7 @@ from skyradar.config import RadarConfig
 from skyradar.experiments.ch4_flights import EPBC, SCENARIOS, Traffic, build_traffic
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
+from skyradar.sim.cluster import check_workers
 from skyradar.track.io import Truth
 from skyradar.track.kalman import wrap
 from skyradar.track.metrics import track_metrics, truth_segments
@@ -331,6 +332,7 @@ def run(
         raise InputError(
             f"experiment ch4: need frame_rate_hz > 0 and workers >= 1, got {frame_rate_hz}, {workers}"
         )
+    check_workers(workers)  # a fork pool of 10**20 processes exhausted memory
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()

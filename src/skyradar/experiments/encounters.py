@@ -41,6 +41,7 @@ from skyradar.experiments.encounter_set import (
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.scene.scenario import Scenario
+from skyradar.sim.cluster import check_workers
 
 __all__ = ["run_encounter", "run_encounters", "run"]
 
@@ -134,7 +135,7 @@ def run_encounters(
     already computed (skipped here) and ``on_chunk`` receives all rows so far after each chunk
     of five. Options go to :func:`run_encounter`.
     """
-    workers = workers or min(2, os.cpu_count() or 1)
+    workers = check_workers(workers) or min(2, os.cpu_count() or 1)  # 10**20 spawned until memory ran out
     results: dict[int, dict] = dict(done or {})
     todo = [(i, p) for i, p in enumerate(params.to_dict("records")) if i not in results]
     chunks = [todo[k : k + 5] for k in range(0, len(todo), 5)]

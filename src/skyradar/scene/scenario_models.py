@@ -64,8 +64,20 @@ __all__ = [
 TAGS = frozenset({"flat", "fractal", "file", "jacksboro", "straight", "circle", "circuit", "encounter"})
 
 Vector3 = tuple[float, float, float]
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-Finite = Annotated[float, Field(allow_inf_nan=False)]
+
+
+def _not_bool(value: Any) -> Any:
+    # pydantic's lax mode reads YAML's true/false as 1.0/0.0; a boolean is never a quantity.
+    if isinstance(value, bool):
+        raise ValueError("must be a number, not a boolean")
+    return value
+
+
+Positive = Annotated[float, BeforeValidator(_not_bool), Field(gt=0, allow_inf_nan=False)]
+Finite = Annotated[float, BeforeValidator(_not_bool), Field(allow_inf_nan=False)]
+# Scenario times stay within +-1e9 s (about 32 years): beyond that float64 frame times lose the
+# resolution the frame grid needs (start_s 1e308 was reported as "time_s not increasing").
+Time = Annotated[float, BeforeValidator(_not_bool), Field(ge=-1e9, le=1e9, allow_inf_nan=False)]
 
 
 class _Model(BaseModel):
@@ -166,7 +178,7 @@ Terrain = Annotated[
 
 class _Timed(_Model):
     duration_s: Positive | None = None  # default: the scenario's duration_s
-    start_time_s: Finite | None = None  # default: the scenario's start_s
+    start_time_s: Time | None = None  # default: the scenario's start_s
     rate_hz: Positive = 20.0
 
 
@@ -217,7 +229,7 @@ class CircuitFlight(_Timed):
 class EncounterFlight(_Model):
     type: Literal["encounter"]
     kind: Literal["head-on", "crossing", "overtaking", "converging"]
-    t_cpa_s: Finite
+    t_cpa_s: Time
     horizontal_miss_m: float = Field(0.0, ge=0.0, allow_inf_nan=False)
     vertical_miss_m: Finite = 0.0
     intruder_speed_mps: Positive | None = None
@@ -293,6 +305,6 @@ class ScenarioModel(_Model):
     intruders: list[IntruderSpec] = Field(default_factory=list)
     frame_rate_hz: Positive = 9.4
     duration_s: Positive
-    start_s: Finite = 0.0
+    start_s: Time = 0.0
     simulation: SimulationModel = Field(default_factory=SimulationModel)
     impairments: ImpairmentConfig | None = None  # skyradar.sim.impairments; e.g. {preset: thesis_flight_look}

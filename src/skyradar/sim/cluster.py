@@ -6,12 +6,51 @@ count travels back to the client, and an interrupted run keeps every finished ch
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Sequence
 from typing import Any
 
 from skyradar.errors import InputError
 
-__all__ = ["connect", "close", "map_chunks", "map_frame_chunks"]
+__all__ = ["connect", "close", "map_chunks", "map_frame_chunks", "check_workers", "max_local_workers"]
+
+_WORKERS_PER_CORE = 4  # more local worker processes than this only thrash (each holds numba + numpy)
+
+
+def max_local_workers() -> int:
+    """The most local worker processes a command starts: 4 per core of this machine.
+
+    Examples
+    --------
+    >>> max_local_workers() >= 4
+    True
+    """
+    return _WORKERS_PER_CORE * (os.cpu_count() or 1)
+
+
+def check_workers(workers: int | None, option: str = "--workers") -> int | None:
+    """``workers`` if None or a whole number from 1 to :func:`max_local_workers`, else :class:`InputError`.
+
+    Without this bound ``--workers 99999999999999999999`` forked processes until the machine ran
+    out of memory.
+
+    Examples
+    --------
+    >>> check_workers(2)
+    2
+    >>> check_workers(10**20)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: --workers: must be an integer from 1 to ..., got 100000000000000000000
+    """
+    if workers is None:
+        return None
+    limit = max_local_workers()
+    if isinstance(workers, bool) or int(workers) != workers or not 1 <= workers <= limit:
+        raise InputError(
+            f"{option}: must be an integer from 1 to {limit} (4 per core on this machine), got {workers!r}"
+        )
+    return int(workers)
 
 
 def connect(scheduler: str | None, workers: int | None, timeout_s: float = 10.0):
@@ -25,6 +64,7 @@ def connect(scheduler: str | None, workers: int | None, timeout_s: float = 10.0)
             raise InputError(
                 f"--scheduler {scheduler}: no Dask scheduler answered within {timeout_s:.0f} s ({exc})"
             ) from exc
+    check_workers(workers)
     cluster = LocalCluster(
         n_workers=int(workers or 2), threads_per_worker=1, processes=True, dashboard_address=None
     )

@@ -1,0 +1,145 @@
+"""Hostile inputs a reviewer tried against the integrated CLI: each once failed (traceback, two-line
+error, fork bomb, silently wrong answer) and now ends in one line naming file/option, field and value.
+
+Every case runs through the real entry point (``python -m skyradar``). One tiny simulated run is
+shared by the module (a few seconds); tracks tables are made from its truth in-process.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+BASE = {
+    "name": "tiny",
+    "origin": {"lat_deg": 52.0, "lon_deg": 4.36, "alt_m": 0.0},
+    "mount": "forward",
+    "terrain": {"type": "flat", "size_m": 3000, "spacing_m": 60},
+    "ownship": {"type": "straight", "start_ned_m": [0, 0, -500], "heading_deg": 0, "speed_mps": 40},
+    "intruders": [{"name": "A", "type": "encounter", "kind": "head-on", "t_cpa_s": 20, "rcs_m2": 1.0}],
+    "frame_rate_hz": 5.0,
+    "duration_s": 0.8,
+    "simulation": {"facet_size_m": 30.0},
+}
+
+
+def _skyradar(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "skyradar", *args], cwd=cwd, capture_output=True, text=True, timeout=300
+    )
+
+
+def _assert_one_line_error(result: subprocess.CompletedProcess, *needles: str) -> None:
+    assert result.returncode == 2, result.stderr
+    assert "Traceback" not in result.stderr
+    lines = [line for line in result.stderr.strip().splitlines() if line.strip()]
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith("error: "), lines[0]
+    for needle in needles:
+        assert needle in lines[0], lines[0]
+
+
+@pytest.fixture(scope="module")
+def tiny_run(tmp_path_factory) -> Path:
+    """A 4-frame simulated run plus a tracks table made from its intruder truth."""
+    from skyradar.daa.pipeline import truth_tracks
+    from skyradar.io.frames import open_frames
+
+    folder = tmp_path_factory.mktemp("hostile")
+    (folder / "s.yaml").write_text(yaml.safe_dump(BASE))
+    result = _skyradar("simulate", "s.yaml", "-o", "run.zarr", "--chunk-frames", "4", cwd=folder)
+    assert result.returncode == 0, result.stderr
+    tracks = truth_tracks(open_frames(folder / "run.zarr"), visible_only=False)
+    assert len(tracks) >= 2
+    tracks.to_parquet(folder / "tracks.parquet", index=False)
+    return folder
+
+
+def _tracks_variant(folder: Path, name: str, change) -> str:
+    import pandas as pd
+
+    tracks = pd.read_parquet(folder / "tracks.parquet")
+    change(tracks)
+    tracks.to_parquet(folder / name, index=False)
+    return name
+
+
+def _set(column: str, value, rows=slice(0, 1)):
+    def change(df):
+        if isinstance(value, str):
+            df[column] = df[column].astype(object)
+        elif column == "track_id":
+            df[column] = df[column].astype(float)
+        df.loc[df.index[rows], column] = value
+
+    return change
+
+
+@pytest.mark.parametrize(
+    ("name", "change", "needles"),
+    [
+        # NaN time or id went through np.interp into alerts with NaN times, exit 0.
+        ("nan_time.parquet", _set("time_s", np.nan), ["nan_time.parquet", "'time_s'", "row 0"]),
+        ("nan_id.parquet", _set("track_id", np.nan), ["nan_id.parquet", "'track_id'", "row 0"]),
+        # A string velocity was a ValueError traceback.
+        ("str_v.parquet", _set("vn_mps", "fast", slice(None)), ["str_v.parquet", "'vn_mps'", "fast"]),
+        # An infinite position was dropped like a missing one: no alert and no word.
+        ("inf_n.parquet", _set("north_m", np.inf, slice(None)), ["inf_n.parquet", "'north_m'", "inf"]),
+    ],
+)
+def test_alert_refuses_corrupt_track_values(tiny_run, name, change, needles):
+    _tracks_variant(tiny_run, name, change)
+    result = _skyradar("alert", name, "--ownship", "run.zarr", "-o", f"alerts_{name}", cwd=tiny_run)
+    _assert_one_line_error(result, *needles)
+    assert not (tiny_run / f"alerts_{name}").exists()
+
+
+def test_alert_counts_rows_without_velocity(tiny_run):
+    # NaN velocity means "no direction of arrival": skipped, but no longer silently.
+    name = _tracks_variant(tiny_run, "nan_v.parquet", _set("vn_mps", np.nan, slice(None)))
+    result = _skyradar(
+        "alert", name, "--ownship", "run.zarr", "-o", "alerts_nan_v.parquet", "--json", cwd=tiny_run
+    )
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout.strip().splitlines()[-1])
+    assert summary["rows"] == 0
+    assert summary["rows_skipped_no_state"] > 0
+
+
+def test_parquet_named_csv_is_one_line(tiny_run):
+    # pandas' CSV parser error spans two lines; the CLI printed both.
+    (tiny_run / "tracks_as.csv").write_bytes((tiny_run / "tracks.parquet").read_bytes())
+    result = _skyradar("track", "tracks_as.csv", "-o", "t.parquet", cwd=tiny_run)
+    _assert_one_line_error(result, "tracks_as.csv")
+
+
+@pytest.mark.parametrize(
+    ("change", "needles"),
+    [
+        # YAML true was read as 1.0 frames/s: one frame simulated, exit 0.
+        ({"frame_rate_hz": True}, ["frame_rate_hz", "boolean"]),
+        # start_s 1e308 was blamed on the trajectory's time_s.
+        ({"start_s": 1e308}, ["'start_s'", "1e+308"]),
+    ],
+)
+def test_scenario_wrong_types_are_refused(tmp_path, change, needles):
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump({**BASE, **change}))
+    result = _skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
+    _assert_one_line_error(result, "s.yaml", *needles)
+    assert not any(tmp_path.glob("run.zarr*"))
+
+
+@pytest.mark.parametrize("command", ["simulate", "process"])
+def test_huge_worker_count_is_refused_before_any_process_starts(tiny_run, command):
+    # --workers 10**20 started a local cluster and the machine ran out of memory (exit 137).
+    source = "s.yaml" if command == "simulate" else "run.zarr"
+    output = "w.zarr" if command == "simulate" else "w.parquet"
+    result = _skyradar(command, source, "-o", output, "--workers", str(10**20), cwd=tiny_run)
+    _assert_one_line_error(result, "--workers", str(10**20))
+    assert not any(tiny_run.glob("w.*"))

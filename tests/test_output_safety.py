@@ -255,7 +255,9 @@ def test_state_refuses_an_unfinished_store_renamed_by_hand(tmp_path):
 
 
 def test_simulate_refuses_a_run_that_cannot_fit(tmp_path):
-    _scenario(tmp_path, {**TINY, "radar": {}, "duration_s": 1e6})
+    # A slow own-ship: the run is absurdly long (13 TB of frames), the flight itself plausible.
+    slow = {**TINY["ownship"], "speed_mps": 0.01}
+    _scenario(tmp_path, {**TINY, "radar": {}, "duration_s": 1e6, "ownship": slow})
     result = _skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path, timeout=120)
     _assert_one_line_error(result, "run.zarr", "GB", "free")
     assert not any(tmp_path.glob("run.zarr*"))

@@ -115,6 +115,20 @@ def test_client_disconnect_mid_stream(run):
         assert c.get("/api/info").status_code == 200
 
 
+def test_growing_cint16_run_is_shown_decoded(tmp_path):
+    # A cint16 store holds int16 codes and scales, no `iq`: the display must decode it while growing.
+    ds = sample_run_dataset(n_frames=20)
+    template = ds.assign(iq=ds["iq"].chunk({"time": 10}))
+    writer = FrameStoreWriter(tmp_path / "live.zarr", template, 10, fingerprint="t", precision="cint16")
+    writer.write_chunk(0, ds["iq"].values[0:10])
+    with TestClient(create_app(tmp_path / "live.zarr", speed=100.0)) as c:
+        info = c.get("/api/info").json()
+        assert info["growing"] and info["n_ready"] == 10 and info["n_total"] == 20
+        frame = c.get("/api/frame/9").json()
+        assert frame["index"] == 9 and frame["rd_png"].startswith("data:image/png")
+        assert c.get("/api/frame/10").status_code == 404
+
+
 def test_growing_run_is_followed_until_renamed(tmp_path):
     ds = sample_run_dataset(n_frames=30)
     template = ds.assign(iq=ds["iq"].chunk({"time": 10}))

@@ -74,6 +74,7 @@ def simulate(
     from skyradar.errors import InputError
     from skyradar.io.frames import COMPRESSORS, PRECISIONS
     from skyradar.io.outputs import check_output
+    from skyradar.io.store_size import check_store_space
     from skyradar.scene.scenario import load_scenario
     from skyradar.sim.run import simulate_to_zarr
 
@@ -84,7 +85,11 @@ def simulate(
     if precision not in PRECISIONS:
         raise InputError(f"--precision: must be one of {', '.join(PRECISIONS)}, got {precision!r}")
     check_output(output, [scenario], overwrite, kind="frames store")  # before any work
-    built = load_scenario(scenario).build()
+    loaded = load_scenario(scenario)
+    # Before the build: a huge run is refused in a second, not after minutes of truth geometry.
+    check_store_space(output, loaded.radar_config(), loaded.frame_times().size, chunk_frames, compress,
+                      precision)  # fmt: skip
+    built = loaded.build()
     n = built.times_s.size
     with frame_progress(n, f"simulate {built.name}") as bar:
         task = bar.add_task("frames", total=n)

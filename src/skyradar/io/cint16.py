@@ -22,7 +22,7 @@ to the noise floor is below CFAR's resolution); worst row -14.8 dB (the stronges
 where the step follows the peak); worst single pixel -10.2 dB. Storage: 4 bytes per pixel plus
 4 per (frame, range, rx) against 8 for complex64, and noise codes of a few bits compress well:
 0.52 MB per prototype frame with ``--compress zstd`` against 2.66 MB raw complex64 (see
-:data:`skyradar.io.frames.CINT16_COMPRESSION_RATIO`).
+:data:`skyradar.io.store_size.CINT16_COMPRESSION_RATIO`).
 
 :func:`decode` turns such a Dataset back into the usual one with lazy complex64 ``iq``.
 """

@@ -198,6 +198,10 @@ class Scenario:
             )
         return m.start_s + np.arange(n) / m.frame_rate_hz
 
+    def radar_config(self) -> RadarConfig:
+        """The scenario's RadarConfig (mount and overrides applied), without building anything else."""
+        return self._radar()
+
     def _radar(self) -> RadarConfig:
         m = self.model
         overrides = m.radar.model_dump(exclude_none=True, exclude={"antenna"})

@@ -23,6 +23,7 @@ import xarray as xr
 
 from skyradar.daa.pipeline import alerts_from_tracks, ownship_from_frames, truth_tracks
 from skyradar.errors import InputError
+from skyradar.io import cint16
 from skyradar.io.frames import FrameStoreWriter, open_frames, radar_config_of
 from skyradar.io.tables import read_table
 
@@ -104,7 +105,8 @@ class RunSource:
             ds = open_frames(target)
         else:
             try:
-                ds = xr.open_zarr(target, consolidated=False)
+                # A cint16 run holds int16 codes and scales: decode to the usual complex64 iq.
+                ds = cint16.decode(xr.open_zarr(target, consolidated=False))
             except Exception:  # noqa: BLE001 - a store still being created is simply not ready yet
                 return
             radar_config_of(ds, str(target))

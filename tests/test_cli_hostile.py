@@ -143,3 +143,31 @@ def test_huge_worker_count_is_refused_before_any_process_starts(tiny_run, comman
     result = _skyradar(command, source, "-o", output, "--workers", str(10**20), cwd=tiny_run)
     _assert_one_line_error(result, "--workers", str(10**20))
     assert not any(tiny_run.glob("w.*"))
+
+
+@pytest.mark.parametrize(
+    ("args", "needles"),
+    [
+        # --frames 10**20 was blamed on the ch2 scenario's duration_s.
+        (["experiment", "ch2", "--frames", str(10**20)], ["--frames", str(10**20)]),
+        # --duration 1e308 and --n 10**20 were numpy "Maximum allowed size exceeded" tracebacks.
+        (["experiment", "ch5", "--duration", "1e308"], ["--duration", "1e+308"]),
+        (["experiment", "encounters", "--n", str(10**20)], ["--n", str(10**20)]),
+    ],
+)
+def test_experiment_sizes_are_bounded_before_the_output_folder(tmp_path, args, needles):
+    result = _skyradar(*args, "--out", "out", cwd=tmp_path)
+    _assert_one_line_error(result, *needles)
+    assert not (tmp_path / "out").exists()  # refused before the folder is made
+
+
+def test_evaluate_refuses_nan_radial_velocity(tiny_run):
+    # A NaN in a scored column was a scipy "matrix contains invalid numeric entries" traceback.
+    import pandas as pd
+
+    tracks = pd.read_parquet(tiny_run / "tracks.parquet").assign(
+        range_m=1000.0, radial_velocity_mps=np.nan, innovation_range_m=0.0, innovation_radial_velocity_mps=0.0
+    )
+    tracks.to_parquet(tiny_run / "eval_nan.parquet", index=False)
+    result = _skyradar("evaluate", "run.zarr", "eval_nan.parquet", cwd=tiny_run)
+    _assert_one_line_error(result, "eval_nan.parquet", "'radial_velocity_mps'", "row 0")

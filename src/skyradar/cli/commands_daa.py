@@ -117,7 +117,10 @@ def serve(
 @experiment_app.command("encounters")
 def experiment_encounters(
     out: Annotated[Path, typer.Option("--out", help="Output directory.")] = Path("out/encounters"),
-    n: Annotated[int, typer.Option("--n", min=1, help="Number of encounters.")] = 500,
+    n: Annotated[
+        int,
+        typer.Option("--n", callback=number_in(1, 100_000), help="Number of encounters (at most 100000)."),
+    ] = 500,
     seed: Annotated[int, typer.Option("--seed", callback=NON_NEGATIVE, help="Random seed.")] = 0,
     workers: Annotated[
         int | None, typer.Option(min=1, help="Worker processes (default: up to 2, one per core).")

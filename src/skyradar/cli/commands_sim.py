@@ -17,6 +17,7 @@ from skyradar.cli.app import (
     console,
     emit_result,
     experiment_app,
+    number_in,
 )
 from skyradar.io.outputs import OVERWRITE_HELP
 
@@ -113,7 +114,10 @@ def scenarios() -> None:
 def experiment_ch2(
     json_out: JsonOption = False,
     out: OutDir = Path("out/ch2"),
-    frames: Annotated[int, typer.Option(callback=COUNT, help="Frames per case (timing uses them all).")] = 3,
+    frames: Annotated[
+        int,
+        typer.Option(callback=number_in(1, 200), help="Frames per case, at most 200 (timing uses them all)."),
+    ] = 3,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
 ) -> None:
     """Flat ground at 1000 m: asymptotes R = H and V = -speed, aliased head-on intruder, 60 m/s wrap."""

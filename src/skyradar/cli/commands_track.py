@@ -152,6 +152,7 @@ def evaluate(
         required=["time_s", "track_id", "range_m", "radial_velocity_mps", "innovation_range_m",
                   "innovation_radial_velocity_mps"],
         sort_by="time_s",
+        finite=["time_s", "track_id", "range_m", "radial_velocity_mps"],  # NaN was a scipy traceback
     )  # fmt: skip
     pixel = (config.range_resolution_m, config.doppler_resolution_mps)
     result = track_metrics(table, truth, pixel, 2.0 * config.v_lim_mps, threshold_px, gospa_c_px)

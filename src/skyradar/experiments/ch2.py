@@ -21,6 +21,7 @@ import pandas as pd
 import yaml
 
 from skyradar.config import RadarConfig
+from skyradar.errors import InputError
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic
 from skyradar.scene.scenario import Scenario, example_scenario
@@ -73,8 +74,18 @@ def _case(speed: float, n_frames: int) -> dict[str, Any]:
     return {"built": built, "frames": frames, "fps": fps, "truth": targets}
 
 
+# Both cases hold their frames in memory (2.7 MB each for the prototype): 200 per case is about 1 GB.
+MAX_FRAMES_PER_CASE = 200
+
+
 def run(out_dir: str | Path = "out/ch2", n_frames: int = 3) -> dict[str, Any]:
-    """Simulate the ch2 cases, write figures and the table, return the measured values."""
+    """Simulate the ch2 cases, write figures and the table, return the measured values.
+
+    ``n_frames`` (1 to :data:`MAX_FRAMES_PER_CASE`) frames per case; more is refused before any
+    work (``--frames 10**20`` was reported as the scenario's ``duration_s``).
+    """
+    if not 1 <= n_frames <= MAX_FRAMES_PER_CASE:
+        raise InputError(f"--frames: must be an integer >= 1 and <= {MAX_FRAMES_PER_CASE}, got {n_frames!r}")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     slow, fast = _case(30.0, n_frames), _case(60.0, n_frames)

@@ -45,6 +45,7 @@ from skyradar.nav.flight_state import estimate_frame, filter_table, mount_height
 from skyradar.nav.kalman_state import KalmanSettings
 from skyradar.nav.ridge import extract_ridge
 from skyradar.nav.terrain_aware import TerrainAwareEstimator
+from skyradar.scene.scenario import MAX_FRAMES
 
 __all__ = ["ACCEPTANCE", "TERRAINS", "THESIS_TABLE", "TYPICAL_AHRS", "check_run_options", "run"]
 
@@ -257,6 +258,13 @@ def check_run_options(
     for name, value, ok in checks:
         if not (np.isfinite(value) and ok):
             raise InputError(f"ch5: option '{name}' must be a finite number in range, got {value!r}")
+    # As for scenarios, at most MAX_FRAMES frames (1 and 9.4 frames/s); 1e308 was a numpy traceback.
+    for name, value, rate_hz in (("--duration", duration_s, 1.0), ("--fast-duration", fast_duration_s, 9.4)):
+        if value * rate_hz > MAX_FRAMES:
+            raise InputError(
+                f"ch5: option '{name}' must be at most {MAX_FRAMES / rate_hz:.4g} s "
+                f"({MAX_FRAMES:.0e} frames at {rate_hz:g} frames/s), got {value!r}"
+            )
     # Errors are scored after the warm-up: a flight no longer than it would score no frame at all.
     for name, value in (("--duration", duration_s), ("--fast-duration", fast_duration_s)):
         if value <= warmup_s and not (name == "--fast-duration" and value == 0):

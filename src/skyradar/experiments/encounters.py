@@ -28,6 +28,7 @@ import numpy as np
 import pandas as pd
 
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig
+from skyradar.errors import InputError
 from skyradar.experiments.chain import label_tracks, run_chain
 from skyradar.experiments.encounter_set import (
     encounter_scenario,
@@ -43,7 +44,9 @@ from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.scene.scenario import Scenario
 from skyradar.sim.cluster import check_workers
 
-__all__ = ["run_encounter", "run_encounters", "run"]
+__all__ = ["run_encounter", "run_encounters", "run", "MAX_ENCOUNTERS"]
+
+MAX_ENCOUNTERS = 100_000  # 200 times the thesis-sized set; more is a typo, not a plan
 
 _RANGE_MARGIN_M = 300.0
 _PARTIAL = "encounters.partial.parquet"
@@ -204,6 +207,8 @@ def run(
     in ``encounters.partial.parquet`` while the run goes on; a run that was interrupted resumes
     from them when started again with the same settings.
     """
+    if not 1 <= n_encounters <= MAX_ENCOUNTERS:  # 10**20 was a numpy "Maximum allowed size" traceback
+        raise InputError(f"--n: must be an integer >= 1 and <= {MAX_ENCOUNTERS}, got {n_encounters!r}")
     t0 = time.perf_counter()
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -13,6 +13,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from skyradar.errors import InputError
@@ -32,11 +33,14 @@ def write_table(df: pd.DataFrame, path: str | Path, metadata: dict[str, Any] | N
     return write_with(path, lambda tmp: df.to_parquet(tmp, index=False))
 
 
-def read_table(path: str | Path, required: Iterable[str] = (), sort_by: str | None = None) -> pd.DataFrame:
+def read_table(
+    path: str | Path, required: Iterable[str] = (), sort_by: str | None = None, finite: Iterable[str] = ()
+) -> pd.DataFrame:
     """Read a Parquet (or CSV) table and check that ``required`` columns are present.
 
-    With ``sort_by`` the column must be non-decreasing; a clear error names the first row
-    where it goes backwards.
+    Columns in ``finite`` must hold finite numbers: a string, NaN or inf names its row. With
+    ``sort_by`` the column must be non-decreasing; a clear error names the first row where it
+    goes backwards.
     """
     path = Path(path)
     if not path.exists():
@@ -48,6 +52,8 @@ def read_table(path: str | Path, required: Iterable[str] = (), sort_by: str | No
     missing = [c for c in required if c not in df.columns]
     if missing:
         raise InputError(f"{path}: missing column(s) {missing} (have {list(df.columns)})")
+    for col in finite:
+        _check_finite(df, col, path)
     if sort_by is not None and len(df) > 1:
         values = df[sort_by].to_numpy()
         back = (values[1:] < values[:-1]).nonzero()[0]
@@ -57,6 +63,15 @@ def read_table(path: str | Path, required: Iterable[str] = (), sort_by: str | No
                 f"{path}: field '{sort_by}' goes backwards at row {i} ({values[i - 1]} -> {values[i]})"
             )
     return df
+
+
+def _check_finite(df: pd.DataFrame, col: str, path: Path) -> None:
+    values = pd.to_numeric(df[col], errors="coerce").to_numpy(float)
+    bad = (~np.isfinite(values)).nonzero()[0]
+    if bad.size:
+        raw = df[col].iloc[bad[0]]
+        raw = raw.item() if hasattr(raw, "item") else raw
+        raise InputError(f"{path}: field '{col}' is not a finite number at row {bad[0]} ({raw!r})")
 
 
 def jsonable(value: Any) -> Any:

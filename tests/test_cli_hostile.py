@@ -171,3 +171,17 @@ def test_evaluate_refuses_nan_radial_velocity(tiny_run):
     tracks.to_parquet(tiny_run / "eval_nan.parquet", index=False)
     result = _skyradar("evaluate", "run.zarr", "eval_nan.parquet", cwd=tiny_run)
     _assert_one_line_error(result, "eval_nan.parquet", "'radial_velocity_mps'", "row 0")
+
+
+@pytest.mark.parametrize(
+    ("args", "needles"),
+    [
+        # Each was a traceback ("Maximum allowed size exceeded", "lam value too large") or blamed a
+        # temporary scenario file's duration_s.
+        (["bench", "chain", "--workers", str(10**20)], ["--workers", str(10**20)]),
+        (["bench", "track", "--detections", str(10**20)], ["--detections", str(10**20)]),
+        (["bench", "flight", "--frames", str(10**20)], ["--frames", str(10**20)]),
+    ],
+)
+def test_bench_sizes_are_bounded(tmp_path, args, needles):
+    _assert_one_line_error(_skyradar(*args, cwd=tmp_path), *needles)

@@ -78,6 +78,11 @@ def run(
             f"bench track: need n_frames >= 1, detections_per_frame >= 0, n_targets >= 1 and "
             f"baseline_frames >= 1, got {n_frames}, {detections_per_frame}, {n_targets}, {baseline_frames}"
         )
+    # Upper bounds: the scene is built in memory up front (10**20 frames was a numpy traceback).
+    limits = (("--frames", n_frames, 100_000), ("--detections", detections_per_frame, 10_000))
+    for option, value, high in limits:
+        if value > high:
+            raise InputError(f"bench track: option '{option}' must be at most {high}, got {value}")
     config = RadarConfig.seed_prototype()
     t, frames = bench_scene(n_frames, detections_per_frame, n_targets, seed, config)
     pixel = (config.range_resolution_m, config.doppler_resolution_mps)

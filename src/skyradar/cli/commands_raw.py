@@ -7,7 +7,16 @@ from typing import Annotated
 
 import typer
 
-from skyradar.cli.app import COUNT, NON_NEGATIVE, JsonOption, app, bench_app, console, emit_result
+from skyradar.cli.app import (
+    COUNT,
+    WORKERS,
+    JsonOption,
+    app,
+    bench_app,
+    console,
+    emit_result,
+    number_in,
+)
 from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["rd", "bench_chain"]
@@ -79,13 +88,18 @@ def rd(
 
 @bench_app.command("chain")
 def bench_chain(
-    frames: Annotated[int, typer.Option("--frames", min=2, help="Frames to time.")] = 20,
-    workers: Annotated[int, typer.Option("--workers", min=1, help="FFT threads.")] = 2,
+    frames: Annotated[
+        int,
+        typer.Option(
+            "--frames", callback=number_in(2, 100), help="Frames to time (held in memory): 2 to 100."
+        ),
+    ] = 20,
+    workers: Annotated[int, typer.Option("--workers", callback=WORKERS, help="FFT threads.")] = 2,
     as_json: JsonOption = False,
     flight_frames: Annotated[
         int,
         typer.Option(
-            callback=NON_NEGATIVE,
+            callback=number_in(0, 10_000_000),
             help="Frames of the whole-flight simulation run on 1 and 2 Dask workers (0: skip).",
         ),
     ] = 2400,

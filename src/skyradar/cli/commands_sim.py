@@ -10,7 +10,6 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from skyradar.cli.app import (
     COUNT,
-    NON_NEGATIVE,
     JsonOption,
     app,
     bench_app,
@@ -22,7 +21,6 @@ from skyradar.cli.app import (
 from skyradar.io.outputs import OVERWRITE_HELP
 
 OutDir = Annotated[Path, typer.Option("--out", help="Folder for figures and tables.")]
-
 
 
 def frame_progress(total: int, label: str) -> Progress:
@@ -134,7 +132,10 @@ def experiment_ch2(
 def bench_sim(
     json_out: JsonOption = False,
     frames: Annotated[
-        int, typer.Option(callback=COUNT, help="Frames timed at DEM spacing, at least (fine: a quarter).")
+        int,
+        typer.Option(
+            callback=number_in(1, 10_000), help="Frames timed at DEM spacing, at least (fine: a quarter)."
+        ),
     ] = 20,
     seconds: Annotated[
         float, typer.Option(help="Time each implementation for at least this long, s (0 to 600).")
@@ -203,10 +204,16 @@ def sweep(
 def bench_flight(
     json_out: JsonOption = False,
     frames: Annotated[
-        int, typer.Option(callback=COUNT, help="Frames for the 1- versus 2-worker throughput runs.")
+        int,
+        typer.Option(
+            callback=number_in(1, 10_000_000), help="Frames for the 1- versus 2-worker throughput runs."
+        ),
     ] = 2400,
     long_frames: Annotated[
-        int, typer.Option(callback=NON_NEGATIVE, help="Also run a whole flight of this many frames (memory).")
+        int,
+        typer.Option(
+            callback=number_in(0, 10_000_000), help="Also run a whole flight of this many frames (memory)."
+        ),
     ] = 0,
 ) -> None:
     """Whole-flight simulation throughput on Dask with 1 and 2 workers, and peak memory over a long flight."""

@@ -185,3 +185,18 @@ def test_evaluate_refuses_nan_radial_velocity(tiny_run):
 )
 def test_bench_sizes_are_bounded(tmp_path, args, needles):
     _assert_one_line_error(_skyradar(*args, cwd=tmp_path), *needles)
+
+
+def test_duplicate_yaml_key_is_refused(tmp_path):
+    # PyYAML kept the last duration_s without a word: a 1 s scenario became a 50000 s run.
+    text = yaml.safe_dump(BASE) + "duration_s: 50000\n"
+    (tmp_path / "s.yaml").write_text(text)
+    result = _skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
+    _assert_one_line_error(result, "s.yaml", "'duration_s'", "twice")
+    assert not any(tmp_path.glob("run.zarr*"))
+
+
+def test_serve_bad_host_is_one_line(tiny_run):
+    # The non-loopback warning was printed before the address was checked: two lines.
+    result = _skyradar("serve", "run.zarr", "--host", "999.1.1.1", "--port", "0", cwd=tiny_run)
+    _assert_one_line_error(result, "--host", "999.1.1.1")

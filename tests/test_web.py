@@ -438,15 +438,26 @@ def test_cli_serve_port_taken_is_one_line(run):
     _assert_one_line_error(result, f"127.0.0.1:{port}", "in use")
 
 
-def test_cli_serve_warns_when_not_loopback(run):
-    """Binding a non-loopback address prints a warning first (the port is taken so nothing is exposed)."""
+def test_cli_serve_warns_when_not_loopback(run, monkeypatch, capsys):
+    """A server about to start on a non-loopback address warns (the server itself is not run here)."""
+    import uvicorn
+
+    from skyradar.cli.commands_daa import serve
+
+    monkeypatch.setattr(uvicorn.Server, "run", lambda self, sockets=None: None)
+    serve(run, port=0, host="0.0.0.0", tracks=None, alerts=None, speed=1.0)
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert lines[0].startswith("warning: ") and "0.0.0.0" in lines[0]
+
+
+def test_cli_serve_error_on_non_loopback_is_one_line(run):
+    """A taken port on a non-loopback address is one line: no warning for a server that never starts."""
     sock, port = _listening_port()
     with sock:
         result = _serve(str(run), "--host", "0.0.0.0", "--port", str(port))
     lines = result.stderr.strip().splitlines()
     assert result.returncode == 2 and "Traceback" not in result.stderr
-    assert len(lines) == 2 and lines[0].startswith("warning: ") and "0.0.0.0" in lines[0]
-    assert lines[1].startswith("error: ") and f"0.0.0.0:{port}" in lines[1]
+    assert len(lines) == 1 and lines[0].startswith("error: ") and f"0.0.0.0:{port}" in lines[0]
 
 
 def test_loopback_and_origin_rules():

@@ -95,17 +95,17 @@ def serve(
 
     check_speed(speed)
     local = is_loopback(host)
-    if not local:
-        print(
-            f"warning: --host {host} is not a loopback address: anyone who can reach it can watch this run",
-            file=sys.stderr,
-        )
-    sock = bind_socket(host, port)  # a taken port is one clear line here, not a server log
+    sock = bind_socket(host, port)  # a taken port or a bad --host is one clear line here, not a server log
     try:
         web_app = create_app(run, tracks_path=tracks, alerts_path=alerts, speed=speed)
     except BaseException:
         sock.close()
         raise
+    if not local:  # warned once the server is about to start, so that any error stays one line
+        print(
+            f"warning: --host {host} is not a loopback address: anyone who can reach it can watch this run",
+            file=sys.stderr,
+        )
     where = f"[{host}]" if ":" in host else host
     print(f"serving {run} at http://{where}:{sock.getsockname()[1]}/  (Ctrl-C to stop)", file=sys.stderr)
     # On loopback, refuse requests addressed to other names (DNS rebinding from a web page).

@@ -5,7 +5,8 @@ in microseconds, but anything that then walks the value (validation, ``str()`` i
 message, JSON) expands it to 10^9 items and tens of GB. :func:`load_yaml` composes the node
 graph first, counts the nodes the document stands for with every alias expanded (memoised,
 so counting costs one pass over the distinct nodes) and refuses documents above
-:data:`MAX_EXPANDED_NODES` before constructing anything.
+:data:`MAX_EXPANDED_NODES` before constructing anything. A key given twice in one mapping is
+refused too (PyYAML would keep the last one without a word).
 """
 
 from __future__ import annotations
@@ -60,6 +61,28 @@ def expanded_size(node: yaml.Node, limit: int = MAX_EXPANDED_NODES) -> int:
     return size(node)
 
 
+def _refuse_duplicate_keys(node: yaml.Node, source: str | Path) -> None:
+    """A key twice in one mapping: PyYAML keeps the last silently (``duration_s`` given twice)."""
+    seen: set[int] = set()
+    stack = [node]
+    while stack:
+        n = stack.pop()
+        if id(n) in seen or isinstance(n, yaml.ScalarNode):
+            continue
+        seen.add(id(n))
+        if isinstance(n, yaml.SequenceNode):
+            stack.extend(n.value)
+            continue
+        keys: set[tuple[str, str]] = set()
+        for key, value in n.value:
+            if isinstance(key, yaml.ScalarNode) and key.tag != "tag:yaml.org,2002:merge":
+                if (key.tag, key.value) in keys:
+                    where = f"line {key.start_mark.line + 1}"
+                    raise InputError(f"{source}: key '{key.value}' appears twice in one mapping ({where})")
+                keys.add((key.tag, key.value))
+            stack.extend((key, value))
+
+
 def load_yaml(text: str, source: str | Path, limit: int = MAX_EXPANDED_NODES) -> Any:
     """Parse ``text`` (from ``source``, named in errors) with the safe loader, refusing alias bombs.
 
@@ -71,6 +94,10 @@ def load_yaml(text: str, source: str | Path, limit: int = MAX_EXPANDED_NODES) ->
     Traceback (most recent call last):
     ...
     skyradar.errors.InputError: s.yaml: aliases expand the document to more than 10 nodes; refused
+    >>> load_yaml("duration_s: 1\\nduration_s: 50000", "s.yaml")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: s.yaml: key 'duration_s' appears twice in one mapping (line 2)
     """
     loader = yaml.SafeLoader(text)
     try:
@@ -83,6 +110,7 @@ def load_yaml(text: str, source: str | Path, limit: int = MAX_EXPANDED_NODES) ->
             raise InputError(f"{source}: {exc}; refused") from None
         if n > limit:
             raise InputError(f"{source}: aliases expand the document to more than {limit} nodes; refused")
+        _refuse_duplicate_keys(node, source)
         return loader.construct_document(node)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)

@@ -66,6 +66,15 @@ def test_raw_levels_switch_at_alerting_times():
     )
 
 
+def test_alerts_keep_integer_track_ids():
+    # The demo's timeline formats ids as integers; a float id (7.0) broke it.
+    own, tracks = _head_on(duration_s=10.0)
+    out = alerts_from_tracks(tracks.assign(track_id=7), own, with_advice=False)
+    assert np.issubdtype(out["track_id"].dtype, np.integer) and set(out["track_id"]) == {7}
+    with pytest.raises(InputError, match="'track_id' is not a whole number at row 0"):
+        alerts_from_tracks(tracks.assign(track_id=7.5), own, source="t.parquet")
+
+
 def test_flarm_level_and_sector_in_pipeline():
     own, tracks = _head_on(start_m=3000.0, duration_s=30.0)
     out = alerts_from_tracks(tracks, own, with_advice=False)

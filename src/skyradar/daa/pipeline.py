@@ -123,7 +123,12 @@ def _clean_tracks(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
         raise InputError(f"{source}: missing column(s) {missing}")
     df = tracks.reset_index(drop=True)
     cols = {c: _numeric(df, c, source, allow_nan=c not in ("time_s", "track_id")) for c in TRACK_COLUMNS}
-    df = df.assign(**cols)
+    ids = cols["track_id"]
+    if (ids != np.round(ids)).any():
+        bad = int(np.flatnonzero(ids != np.round(ids))[0])
+        raise InputError(f"{source}: field 'track_id' is not a whole number at row {bad} ({ids[bad]!r})")
+    # Track ids stay integers in the alerts, as the tracker wrote them.
+    df = df.assign(**cols | {"track_id": ids.astype(np.int64)})
     if "confirmed" in df:
         flag = df["confirmed"]
         if flag.dtype != bool and not flag.isin([0, 1]).all():

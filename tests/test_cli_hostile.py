@@ -200,3 +200,24 @@ def test_serve_bad_host_is_one_line(tiny_run):
     # The non-loopback warning was printed before the address was checked: two lines.
     result = _skyradar("serve", "run.zarr", "--host", "999.1.1.1", "--port", "0", cwd=tiny_run)
     _assert_one_line_error(result, "--host", "999.1.1.1")
+
+
+def test_chunk_larger_than_the_run_is_the_whole_run(tmp_path):
+    # --chunk-frames 10**20 once sized the disk check for a 10^20-frame chunk ("needs 2.66e+17 GB").
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(BASE))
+    result = _skyradar("simulate", "s.yaml", "-o", "run.zarr", "--chunk-frames", str(10**20), cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    from skyradar.io.frames import open_frames
+
+    assert open_frames(tmp_path / "run.zarr").sizes["time"] == 4
+
+
+def test_directory_as_table_and_sweep_suffix(tmp_path):
+    (tmp_path / "folder.parquet").mkdir()
+    _assert_one_line_error(_skyradar("track", "folder.parquet", "-o", "t.parquet", cwd=tmp_path),
+                           "folder.parquet", "is a directory")  # fmt: skip
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(BASE))
+    result = _skyradar("sweep", "s.yaml", "--param", "intruders.0.rcs_m2", "--values", "1,2", "-o", "x.txt",
+                       cwd=tmp_path)  # fmt: skip
+    _assert_one_line_error(result, "x.txt", ".csv or .parquet")
+    assert not (tmp_path / "x.txt").exists()

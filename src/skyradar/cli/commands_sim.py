@@ -174,11 +174,15 @@ def sweep(
     json_out: JsonOption = False,
 ) -> None:
     """Run one scenario over a list of parameter values and collect each run's detectability table."""
+    from skyradar.errors import InputError
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_table
     from skyradar.sim.sweep import parse_values
     from skyradar.sim.sweep import sweep as run_sweep
 
+    if output.suffix.lower() not in (".csv", ".parquet"):
+        raise InputError(f"-o/--output: {output}: must end in .csv or .parquet (the table's format), "
+                         f"got {output.suffix or 'no suffix'!r}")  # fmt: skip
     kind = "file" if output.suffix.lower() == ".csv" else "table"
     check_output(output, [scenario], overwrite, kind=kind)
     value_list = parse_values(values)

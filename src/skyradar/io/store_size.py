@@ -58,10 +58,11 @@ def check_store_space(
 ) -> None:
     """Refuse to start when the store's unwritten chunks do not fit on the disk of ``path``."""
     path = Path(path)
-    n_chunks = max(1, -(-int(n_frames) // max(1, int(chunk_frames))))
+    chunk_frames = max(1, min(int(chunk_frames), int(n_frames)))  # a chunk is at most the whole run
+    n_chunks = max(1, -(-int(n_frames) // chunk_frames))
     marks = path.with_name(path.name + ".partial.done")
     done = sum(1 for p in marks.iterdir() if p.name.isdigit()) if marks.is_dir() else 0
     # Unwritten chunks, each stored whole (the last one is padded to chunk_frames).
-    padded = max(0, n_chunks - done) * max(1, int(chunk_frames))
+    padded = max(0, n_chunks - done) * chunk_frames
     need = store_bytes(config, padded, compressor, precision)
     check_disk_space(path, need, f"a {n_frames}-frame {precision} store")

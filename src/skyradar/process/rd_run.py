@@ -93,6 +93,7 @@ def recording_to_frames(
     frames, config = read_recording(recording)  # raises InputError on a bad recording
     inputs = recording_files(recording, frames)
     check_output(output, inputs, overwrite, kind="frames store")
+    chunk_frames = max(1, min(int(chunk_frames), frames.shape[0]))  # a chunk is at most the whole run
     check_store_space(output, config, frames.shape[0], chunk_frames, compressor, precision)
     _check_samples(frames, recording, chunk_frames)
     n_frames = frames.shape[0]

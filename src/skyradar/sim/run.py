@@ -303,6 +303,8 @@ def simulate_to_zarr(
     """
     inputs = (getattr(built, "source", None), *referenced_files(built))
     check_output(path, inputs, overwrite, kind="frames store")
+    # A chunk longer than the run is the whole run (--chunk-frames 10**20 must not size a 10^20 chunk).
+    chunk_frames = max(1, min(int(chunk_frames), built.times_s.size))
     check_store_space(path, built.radar, built.times_s.size, chunk_frames, compressor, precision)
     client = None
     if scheduler is not None or workers:

@@ -46,8 +46,10 @@ browser-deps: $(CHROMIUM)
 
 # Unit tests, the docstring examples of every module (--doctest-modules, see pyproject.toml) and
 # the headless-Chromium display test.
+# Two workers, one per core; loadscope keeps a module's shared fixtures (one simulated run) in
+# one worker instead of building them twice.
 test: $(STAMP_DEV) browser-deps
-	SKYRADAR_SCREENSHOT_DIR=$(OUT)/browser $(BIN)/python -m pytest -q -m "not slow"
+	SKYRADAR_SCREENSHOT_DIR=$(OUT)/browser $(BIN)/python -m pytest -q -m "not slow" -n 2 --dist loadscope
 
 test-slow: $(STAMP_DEV)
 	$(BIN)/python -m pytest -q -m "slow"

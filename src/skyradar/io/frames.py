@@ -216,7 +216,6 @@ def open_frames(path: str | Path) -> xr.Dataset:
     return ds
 
 
-
 class FrameStoreWriter:
     """Write a frames Dataset to Zarr chunk by chunk along time, resumably and atomically.
 
@@ -304,8 +303,10 @@ class FrameStoreWriter:
     def _remove_marks(self) -> None:
         if not (self._marks.exists() or self._marks.is_symlink()):
             return
-        if self._marks.is_symlink() or not self._marks.is_dir() or any(
-            not p.name.isdigit() for p in self._marks.iterdir()
+        if (
+            self._marks.is_symlink()
+            or not self._marks.is_dir()
+            or any(not p.name.isdigit() for p in self._marks.iterdir())
         ):
             raise InputError(f"{self._marks}: exists and is not skyradar's chunk marks; move it away")
         shutil.rmtree(self._marks)

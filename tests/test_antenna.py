@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
 
+from cli_helpers import assert_one_line_error as _assert_one_line_error
+from cli_helpers import skyradar as _skyradar
 from skyradar.antenna import AntennaPattern, GainCut, read_gain_cut, read_gain_cuts
 from skyradar.errors import InputError
 from skyradar.io.frames import open_frames, radar_config_of
@@ -30,22 +30,6 @@ SCENARIO = {
     "frame_rate_hz": 5.0,
     "duration_s": 0.4,
 }
-
-
-def _skyradar(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "skyradar", *args], cwd=cwd, capture_output=True, text=True, timeout=300
-    )
-
-
-def _assert_one_line_error(result: subprocess.CompletedProcess, *needles: str) -> None:
-    assert result.returncode == 2, result.stderr
-    lines = [line for line in result.stderr.strip().splitlines() if line.strip()]
-    assert len(lines) == 1, result.stderr
-    assert lines[0].startswith("error: ")
-    assert "Traceback" not in result.stderr
-    for needle in needles:
-        assert needle in lines[0], lines[0]
 
 
 def _scenario_with_cuts(tmp_path: Path, az: str = AZ, el: str = EL) -> Path:

@@ -13,22 +13,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-
-def _skyradar(*args: str, cwd: Path, timeout: float = 120) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "skyradar", *args], cwd=cwd, capture_output=True, text=True, timeout=timeout
-    )
-
-
-def _assert_one_line_error(result: subprocess.CompletedProcess, *needles: str) -> None:
-    assert result.returncode == 2, result.stderr
-    lines = [line for line in result.stderr.strip().splitlines() if line.strip()]
-    assert len(lines) == 1, result.stderr
-    assert lines[0].startswith("error: "), lines[0]
-    assert "Traceback" not in result.stderr
-    for needle in needles:
-        assert needle in lines[0], lines[0]
-
+from cli_helpers import assert_one_line_error as _assert_one_line_error
+from cli_helpers import skyradar as _skyradar
 
 # --- usage errors and help -------------------------------------------------------------------------
 

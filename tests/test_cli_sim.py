@@ -10,6 +10,8 @@ import numpy as np
 import pytest
 import yaml
 
+from cli_helpers import assert_one_line_error as _assert_one_line_error
+from cli_helpers import skyradar as _skyradar
 from skyradar.io.frames import FrameStoreWriter, open_frames
 from skyradar.scene.scenario import Scenario, example_scenario
 from skyradar.sim.run import _template, fingerprint, make_simulator, simulate_to_zarr
@@ -27,26 +29,10 @@ BASE = {
 }
 
 
-def _skyradar(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "skyradar", *args], cwd=cwd, capture_output=True, text=True, timeout=300
-    )
-
-
 def _write(tmp_path: Path, data: dict, name: str = "scenario.yaml") -> Path:
     path = tmp_path / name
     path.write_text(yaml.safe_dump(data))
     return path
-
-
-def _assert_one_line_error(result: subprocess.CompletedProcess, *needles: str) -> None:
-    assert result.returncode == 2, result.stderr
-    lines = [line for line in result.stderr.strip().splitlines() if line.strip()]
-    assert len(lines) == 1, result.stderr
-    assert lines[0].startswith("error: ")
-    assert "Traceback" not in result.stderr
-    for needle in needles:
-        assert needle in lines[0], lines[0]
 
 
 def test_simulate_writes_frames_and_truth(tmp_path):

@@ -6,14 +6,14 @@ Every case goes through the real entry point (``python -m skyradar``) in a subpr
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import yaml
 
+from cli_helpers import assert_one_line_error as _assert_one_line_error
+from cli_helpers import skyradar as _skyradar
 from skyradar.config import RadarConfig
 from skyradar.io.frames import FrameStoreWriter, frames_dataset, open_frames
 from skyradar.scene.scenario import load_scenario
@@ -30,22 +30,6 @@ TINY = {
     "duration_s": 1.2,
     "simulation": {"facet_size_m": 50.0},
 }
-
-
-def _skyradar(*args: str, cwd: Path, timeout: float = 300) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "skyradar", *args], cwd=cwd, capture_output=True, text=True, timeout=timeout
-    )
-
-
-def _assert_one_line_error(result: subprocess.CompletedProcess, *needles: str) -> None:
-    assert result.returncode == 2, result.stderr
-    lines = [line for line in result.stderr.strip().splitlines() if line.strip()]
-    assert len(lines) == 1, result.stderr
-    assert lines[0].startswith("error: ")
-    assert "Traceback" not in result.stderr
-    for needle in needles:
-        assert needle in lines[0], lines[0]
 
 
 def _scenario(folder: Path, data: dict | None = None, name: str = "s.yaml") -> Path:

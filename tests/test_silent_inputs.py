@@ -3,8 +3,6 @@ another run's own-ship; and the DEM window the scenario reads."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +11,8 @@ import pytest
 import rasterio
 import yaml
 
+from cli_helpers import assert_one_line_error as _assert_one_line_error
+from cli_helpers import skyradar as _skyradar
 from skyradar.errors import InputError
 from skyradar.io.frames import open_frames
 from skyradar.scene.dem_coverage import dem_for_run
@@ -31,21 +31,6 @@ BASE = {
     "duration_s": 1.0,
     "simulation": {"facet_size_m": 30.0},
 }
-
-
-def _skyradar(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "skyradar", *args], cwd=cwd, capture_output=True, text=True, timeout=300
-    )
-
-
-def _assert_one_line_error(result: subprocess.CompletedProcess, *needles: str) -> None:
-    assert result.returncode == 2, result.stdout + result.stderr
-    lines = [line for line in result.stderr.strip().splitlines() if line.strip()]
-    assert len(lines) == 1, result.stderr
-    assert lines[0].startswith("error: ") and "Traceback" not in result.stderr
-    for needle in needles:
-        assert needle in lines[0], lines[0]
 
 
 def _hgt(directory: Path, name: str) -> Path:

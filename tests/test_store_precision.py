@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +12,8 @@ import yaml
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
+from cli_helpers import assert_one_line_error as _assert_one_line_error
+from cli_helpers import skyradar as _skyradar
 from skyradar.config import RadarConfig
 from skyradar.io import cint16, frames
 from skyradar.io.frames import FrameStoreWriter, check_store_space, frames_dataset, open_frames, store_bytes
@@ -32,25 +32,10 @@ BASE = {
 }
 
 
-def _skyradar(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "skyradar", *args], cwd=cwd, capture_output=True, text=True, timeout=300
-    )
-
-
 def _write(tmp_path: Path, data: dict, name: str = "scenario.yaml") -> Path:
     path = tmp_path / name
     path.write_text(yaml.safe_dump(data))
     return path
-
-
-def _assert_one_line_error(result: subprocess.CompletedProcess, *needles: str) -> None:
-    assert result.returncode == 2, result.stderr
-    lines = [line for line in result.stderr.strip().splitlines() if line.strip()]
-    assert len(lines) == 1, result.stderr
-    assert lines[0].startswith("error: ") and "Traceback" not in result.stderr
-    for needle in needles:
-        assert needle in lines[0], lines[0]
 
 
 # Float32 rounding of code * scale adds at most 2^-24 * 32767 steps to the half-step rounding error.

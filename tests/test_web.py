@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
+from cli_helpers import assert_one_line_error as _assert_one_line_error
 from skyradar.daa.pipeline import alerts_from_tracks, ownship_from_frames, truth_tracks
 from skyradar.errors import InputError
 from skyradar.io.frames import FrameStoreWriter
@@ -267,15 +268,6 @@ def test_cli_serve_runs_and_rejects_missing_run(run, tmp_path):
 
 
 # --- Safe by default (issue 11): served files, origin, command queue, hostile commands, CLI checks.
-
-
-def _assert_one_line_error(result, *needles):
-    assert result.returncode == 2, result.stderr
-    lines = [line for line in result.stderr.strip().splitlines() if line.strip()]
-    assert len(lines) == 1, result.stderr
-    assert lines[0].startswith("error: ") and "Traceback" not in result.stderr
-    for needle in needles:
-        assert needle in lines[0], lines[0]
 
 
 def _serve(*args, timeout=120):

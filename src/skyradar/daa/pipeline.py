@@ -32,6 +32,7 @@ from skyradar.daa.advice import resolution_advice
 from skyradar.daa.alerting import AlertConfig, filter_alert_levels, raw_alert_levels
 from skyradar.daa.conflict import traffic_indication
 from skyradar.errors import InputError
+from skyradar.io.tables import finite_column
 from skyradar.track.run import OWNSHIP_COLUMNS as TRACKER_OWNSHIP_COLUMNS
 
 __all__ = ["TRACK_COLUMNS", "OWNSHIP_COLUMNS", "ownship_from_frames", "truth_tracks", "alerts_from_tracks"]
@@ -100,18 +101,6 @@ def _covariances(df: pd.DataFrame) -> tuple[np.ndarray | None, np.ndarray | None
     return cov_p, cov_v
 
 
-def _numeric(df: pd.DataFrame, col: str, source: str, allow_nan: bool) -> np.ndarray:
-    """Column ``col`` as float; a non-number, an infinity (or a NaN unless allowed) names its row."""
-    values = pd.to_numeric(df[col], errors="coerce").to_numpy(float)
-    raw_nan = pd.isna(df[col]).to_numpy()
-    bad = np.flatnonzero(np.isinf(values) | (np.isnan(values) & (~raw_nan | (not allow_nan))))
-    if bad.size:
-        raw = df[col].iloc[bad[0]]
-        raw = raw.item() if hasattr(raw, "item") else raw
-        raise InputError(f"{source}: field '{col}' is not a finite number at row {bad[0]} ({raw!r})")
-    return values
-
-
 def _clean_tracks(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
     """Checked, confirmed rows with a 3-D state; ``attrs['rows_skipped_no_state']`` counts the others.
 
@@ -122,7 +111,7 @@ def _clean_tracks(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
     if missing:
         raise InputError(f"{source}: missing column(s) {missing}")
     df = tracks.reset_index(drop=True)
-    cols = {c: _numeric(df, c, source, allow_nan=c not in ("time_s", "track_id")) for c in TRACK_COLUMNS}
+    cols = {c: finite_column(df, c, source, allow_nan=c not in ("time_s", "track_id")) for c in TRACK_COLUMNS}
     ids = cols["track_id"]
     if (ids != np.round(ids)).any():
         bad = int(np.flatnonzero(ids != np.round(ids))[0])

@@ -17,8 +17,12 @@ from skyradar.errors import InputError
 __all__ = ["check_frame_times", "check_finite_frames"]
 
 
-def check_frame_times(times_s: np.ndarray, source: str | Path, field: str = "time") -> np.ndarray:
+def check_frame_times(
+    times_s: np.ndarray, source: str | Path, field: str = "time", index_name: str = "frame"
+) -> np.ndarray:
     """``times_s`` as floats if finite and strictly increasing, else :class:`InputError`.
+
+    The message names the first bad element as ``index_name`` (a frame, or a table's row).
 
     Examples
     --------
@@ -33,13 +37,13 @@ def check_frame_times(times_s: np.ndarray, source: str | Path, field: str = "tim
     bad = np.flatnonzero(~np.isfinite(t))
     if bad.size:
         raise InputError(
-            f"{source}: field '{field}' is not a finite number at frame {bad[0]} (got {t[bad[0]]})"
+            f"{source}: field '{field}' is not a finite number at {index_name} {bad[0]} (got {t[bad[0]]})"
         )
     back = np.flatnonzero(np.diff(t) <= 0.0)
     if back.size:
         i = int(back[0]) + 1
         raise InputError(
-            f"{source}: field '{field}' does not increase at frame {i} ({t[i - 1]:g} -> {t[i]:g} s)"
+            f"{source}: field '{field}' does not increase at {index_name} {i} ({t[i - 1]:g} -> {t[i]:g} s)"
         )
     return t
 

@@ -19,7 +19,7 @@ import pandas as pd
 from skyradar.errors import InputError
 from skyradar.io.atomic import write_text_atomic, write_with
 
-__all__ = ["write_table", "read_table", "write_json_atomic", "jsonable"]
+__all__ = ["finite_column", "write_table", "read_table", "write_json_atomic", "jsonable"]
 
 
 def write_table(df: pd.DataFrame, path: str | Path, metadata: dict[str, Any] | None = None) -> Path:
@@ -55,7 +55,7 @@ def read_table(
     if missing:
         raise InputError(f"{path}: missing column(s) {missing} (have {list(df.columns)})")
     for col in finite:
-        _check_finite(df, col, path)
+        finite_column(df, col, path)
     if sort_by is not None and len(df) > 1:
         values = df[sort_by].to_numpy()
         back = (values[1:] < values[:-1]).nonzero()[0]
@@ -67,13 +67,29 @@ def read_table(
     return df
 
 
-def _check_finite(df: pd.DataFrame, col: str, path: Path) -> None:
+def finite_column(df: pd.DataFrame, col: str, source: str | Path, allow_nan: bool = False) -> np.ndarray:
+    """Column ``col`` as float, refusing a non-number or infinity (and NaN unless ``allow_nan``).
+
+    The :class:`InputError` names ``source``, the field, the first bad row and its raw value.
+
+    Examples
+    --------
+    >>> finite_column(pd.DataFrame({"x": [1, 2.5]}), "x", "t.csv")
+    array([1. , 2.5])
+    >>> finite_column(pd.DataFrame({"x": [1.0, "a"]}), "x", "t.csv")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: t.csv: field 'x' is not a finite number at row 1 ('a')
+    """
     values = pd.to_numeric(df[col], errors="coerce").to_numpy(float)
-    bad = (~np.isfinite(values)).nonzero()[0]
+    # A NaN that was NaN in the file may be allowed; one made by coercing a string never is.
+    was_nan = pd.isna(df[col]).to_numpy()
+    bad = np.flatnonzero(np.isinf(values) | (np.isnan(values) & (~was_nan | (not allow_nan))))
     if bad.size:
         raw = df[col].iloc[bad[0]]
         raw = raw.item() if hasattr(raw, "item") else raw
-        raise InputError(f"{path}: field '{col}' is not a finite number at row {bad[0]} ({raw!r})")
+        raise InputError(f"{source}: field '{col}' is not a finite number at row {bad[0]} ({raw!r})")
+    return values
 
 
 def jsonable(value: Any) -> Any:

@@ -9,7 +9,8 @@ import pandas as pd
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
-from skyradar.io.tables import read_table
+from skyradar.io.checks import check_frame_times
+from skyradar.io.tables import finite_column, read_table
 
 __all__ = [
     "REQUIRED_DETECTION_COLUMNS",
@@ -65,19 +66,8 @@ def validate_ownship(df: pd.DataFrame, columns: tuple[str, ...], source: str = "
     if len(df) == 0:
         raise InputError(f"{source}: no rows; the own-ship state is needed at every frame")
     for col in columns:
-        values = pd.to_numeric(df[col], errors="coerce").to_numpy(float)
-        bad = np.flatnonzero(~np.isfinite(values))
-        if bad.size:
-            raw = df[col].iloc[bad[0]]
-            raw = raw.item() if hasattr(raw, "item") else raw
-            raise InputError(f"{source}: field '{col}' is not a finite number at row {bad[0]} ({raw!r})")
-    t = df[columns[0]].to_numpy(float)
-    back = np.flatnonzero(np.diff(t) <= 0)
-    if back.size:
-        i = int(back[0]) + 1
-        raise InputError(
-            f"{source}: field '{columns[0]}' does not increase at row {i} ({t[i - 1]} -> {t[i]})"
-        )
+        finite_column(df, col, source)
+    check_frame_times(df[columns[0]].to_numpy(float), source, field=columns[0], index_name="row")
     return df
 
 

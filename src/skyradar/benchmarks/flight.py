@@ -80,7 +80,7 @@ def run_flight(built, workers: int, chunk_frames: int = 64, store: Path | None =
     """Simulate the whole flight on a local cluster of ``workers``; frames/s and memory per chunk."""
     from distributed import as_completed
 
-    from skyradar.sim.cluster import close, connect
+    from skyradar.parallel import close, connect
     from skyradar.sim.run import simulate_to_zarr
 
     n = built.times_s.size

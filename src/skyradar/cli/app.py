@@ -123,8 +123,8 @@ PROBABILITY = number_in(0.0, 1.0, low_open=True, high_open=True)
 
 
 def WORKERS(ctx: typer.Context, param: typer.CallbackParam, value: int | None) -> int | None:  # noqa: N802
-    """Callback for local worker counts: 1 to 4 per core (:func:`~skyradar.sim.cluster.check_workers`)."""
-    from skyradar.sim.cluster import check_workers
+    """Callback for local worker counts: 1 to 4 per core (:func:`~skyradar.parallel.check_workers`)."""
+    from skyradar.parallel import check_workers
 
     if ctx is not None and getattr(ctx, "resilient_parsing", False):
         return value

@@ -152,7 +152,7 @@ def experiment_encounters(
     from skyradar.errors import InputError
     from skyradar.experiments.encounters import run
     from skyradar.io.outputs import check_output, mark_folder
-    from skyradar.sim.cluster import check_workers
+    from skyradar.parallel import check_workers
 
     check_workers(workers)
     if terrain not in ("none", "flat"):

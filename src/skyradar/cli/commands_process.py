@@ -107,7 +107,7 @@ def process(
             import pandas as pd
 
             from skyradar.process.pipeline import process_chunk
-            from skyradar.sim.cluster import map_frame_chunks
+            from skyradar.parallel import map_frame_chunks
 
             job = functools.partial(process_chunk, config=config, pfa=pfa)
             parts = map_frame_chunks(

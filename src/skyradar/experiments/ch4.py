@@ -44,7 +44,7 @@ from skyradar.config import RadarConfig
 from skyradar.experiments.ch4_flights import EPBC, SCENARIOS, Traffic, build_traffic
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
-from skyradar.sim.cluster import check_workers
+from skyradar.parallel import check_workers
 from skyradar.track.io import Truth
 from skyradar.track.kalman import wrap
 from skyradar.track.metrics import track_metrics, truth_segments

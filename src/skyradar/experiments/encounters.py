@@ -42,7 +42,7 @@ from skyradar.experiments.encounter_set import (
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.scene.scenario import Scenario
-from skyradar.sim.cluster import check_workers
+from skyradar.parallel import check_workers
 
 __all__ = ["run_encounter", "run_encounters", "run", "MAX_ENCOUNTERS"]
 

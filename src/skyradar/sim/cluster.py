@@ -1,145 +1,15 @@
-"""Run per-chunk jobs on Dask: an existing cluster (``--scheduler ADDRESS``) or a local one.
+"""Deprecated alias of :mod:`skyradar.parallel` (the generic Dask helper moved there in issue 16).
 
-Each job writes its own chunk into the shared store and marks it done, so nothing but a frame
-count travels back to the client, and an interrupted run keeps every finished chunk.
+Kept for one release so code outside the package that imported ``skyradar.sim.cluster`` keeps working.
 """
 
-from __future__ import annotations
+import warnings
 
-import os
-from collections.abc import Callable, Sequence
-from typing import Any
+from skyradar.parallel import *  # noqa: F403
+from skyradar.parallel import __all__  # noqa: F401
 
-from skyradar.errors import InputError
-
-__all__ = ["connect", "close", "map_chunks", "map_frame_chunks", "check_workers", "max_local_workers"]
-
-_WORKERS_PER_CORE = 4  # more local worker processes than this only thrash (each holds numba + numpy)
-
-
-def max_local_workers() -> int:
-    """The most local worker processes a command starts: 4 per core of this machine.
-
-    Examples
-    --------
-    >>> max_local_workers() >= 4
-    True
-    """
-    return _WORKERS_PER_CORE * (os.cpu_count() or 1)
-
-
-def check_workers(workers: int | None, option: str = "--workers") -> int | None:
-    """``workers`` if None or a whole number from 1 to :func:`max_local_workers`, else :class:`InputError`.
-
-    Without this bound ``--workers 99999999999999999999`` forked processes until the machine ran
-    out of memory.
-
-    Examples
-    --------
-    >>> check_workers(2)
-    2
-    >>> check_workers(10**20)  # doctest: +ELLIPSIS
-    Traceback (most recent call last):
-    ...
-    skyradar.errors.InputError: --workers: must be an integer from 1 to ..., got 100000000000000000000
-    """
-    if workers is None:
-        return None
-    limit = max_local_workers()
-    if isinstance(workers, bool) or int(workers) != workers or not 1 <= workers <= limit:
-        raise InputError(
-            f"{option}: must be an integer from 1 to {limit} (4 per core on this machine), got {workers!r}"
-        )
-    return int(workers)
-
-
-def connect(scheduler: str | None, workers: int | None, timeout_s: float = 10.0):
-    """A ``distributed.Client`` on ``scheduler``, or on a new local cluster of ``workers`` processes."""
-    from distributed import Client, LocalCluster
-
-    if scheduler is not None:
-        try:
-            return Client(scheduler, timeout=timeout_s)
-        except (OSError, TimeoutError) as exc:
-            raise InputError(
-                f"--scheduler {scheduler}: no Dask scheduler answered within {timeout_s:.0f} s ({exc})"
-            ) from exc
-    check_workers(workers)
-    cluster = LocalCluster(
-        n_workers=int(workers or 2), threads_per_worker=1, processes=True, dashboard_address=None
-    )
-    return Client(cluster)
-
-
-def close(client, owns_cluster: bool) -> None:
-    """Close a client from :func:`connect`, and its local cluster when we started it."""
-    cluster = getattr(client, "cluster", None)
-    client.close()
-    if owns_cluster and cluster is not None:
-        cluster.close()
-
-
-def map_chunks(
-    job: Callable[..., int],
-    *args: Any,
-    client,
-    chunks: Sequence[int] = (),
-    progress: Callable[[int], None] | None = None,
-) -> None:
-    """Run ``job(*args, index)`` for each chunk index on ``client``; ``progress(frames)`` per chunk."""
-    from distributed import as_completed
-
-    try:
-        futures = []
-        scattered = [
-            client.scatter(a, broadcast=True) if not isinstance(a, str | int | float) else a for a in args
-        ]
-        futures = [client.submit(job, *scattered, index, pure=False) for index in chunks]
-        for future in as_completed(futures):
-            frames = future.result()
-            if progress:
-                progress(frames)
-    except BaseException:
-        for future in futures:
-            future.cancel()
-        raise
-
-
-def map_frame_chunks(
-    job: Callable[..., Any],
-    path: str,
-    n_frames: int,
-    chunk_frames: int,
-    *args: Any,
-    scheduler: str | None = None,
-    workers: int | None = None,
-    progress: Callable[[int], None] | None = None,
-) -> list[Any]:
-    """``[job(path, start, stop, *args) for each time chunk]`` in order, on Dask or in a plain loop.
-
-    Workers open the run themselves from ``path`` (a shared filesystem), so only the chunk bounds
-    travel to them and only each chunk's (small) result travels back.
-    """
-    bounds = [(s, min(s + chunk_frames, n_frames)) for s in range(0, n_frames, chunk_frames)]
-    if scheduler is None and not workers:
-        results = []
-        for start, stop in bounds:
-            results.append(job(path, start, stop, *args))
-            if progress:
-                progress(stop - start)
-        return results
-    from distributed import as_completed
-
-    client = connect(scheduler, workers)
-    try:
-        futures = [client.submit(job, path, start, stop, *args, pure=False) for start, stop in bounds]
-        order = {f.key: i for i, f in enumerate(futures)}
-        results: list[Any] = [None] * len(futures)
-        for future in as_completed(futures):
-            results[order[future.key]] = future.result()
-            if progress:
-                start, stop = bounds[order[future.key]]
-                progress(stop - start)
-        return results
-    finally:
-        close(client, owns_cluster=scheduler is None)
+warnings.warn(
+    "skyradar.sim.cluster is deprecated: import skyradar.parallel instead",
+    DeprecationWarning,
+    stacklevel=2,
+)

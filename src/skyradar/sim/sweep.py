@@ -140,7 +140,7 @@ def sweep(
             if progress:
                 progress(1)
     else:
-        from skyradar.sim.cluster import close, connect
+        from skyradar.parallel import close, connect
 
         client = connect(scheduler, workers)
         try:

@@ -1,6 +1,6 @@
 """Radar hardware description and every quantity derived from it.
 
-The default is the seed prototype of seed-brief.md: a 9.425 GHz sawtooth FMCW radar sweeping
+The default is the thesis prototype of seed-brief.md: a 9.425 GHz sawtooth FMCW radar sweeping
 10 MHz per chirp at 4921 chirps/s, sampled at 10 MHz, 250 chirps per frame, four receive
 antennas in a coplanar 2x2 square, processed to 5 km.
 
@@ -16,14 +16,17 @@ the aircraft body frame (forward, right, down).
 from __future__ import annotations
 
 import json
+import warnings
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from skyradar.antenna import AntennaPattern, GainCut
 from skyradar.errors import InputError
+from skyradar.units import centred_bin, centred_bin_value, nearest_bin
 
 __all__ = ["SPEED_OF_LIGHT", "BOLTZMANN", "Mount", "RadarConfig"]
 
@@ -133,7 +136,7 @@ class RadarConfig:
 
     Examples
     --------
-    >>> cfg = RadarConfig.seed_prototype()
+    >>> cfg = RadarConfig.prototype_2022()
     >>> round(cfg.range_resolution_m, 2), round(cfg.v_lim_mps, 2), cfg.n_range, cfg.n_doppler
     (14.99, 39.13, 333, 250)
     """
@@ -200,9 +203,19 @@ class RadarConfig:
             )
 
     @classmethod
-    def seed_prototype(cls, **changes: Any) -> RadarConfig:
-        """The thesis prototype (seed-brief.md), with optional field overrides."""
+    def prototype_2022(cls, **changes: Any) -> RadarConfig:
+        """The 2022 thesis prototype (seed-brief.md), with optional field overrides."""
         return cls(**changes)
+
+    @classmethod
+    def seed_prototype(cls, **changes: Any) -> RadarConfig:
+        """Deprecated name of :meth:`prototype_2022`; removed in the next release."""
+        warnings.warn(
+            "RadarConfig.seed_prototype() is deprecated; use RadarConfig.prototype_2022()",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return cls.prototype_2022(**changes)
 
     def replace(self, **changes: Any) -> RadarConfig:
         """A copy with some fields changed (dataclasses.replace)."""
@@ -273,7 +286,41 @@ class RadarConfig:
     @cached_property
     def doppler_axis_mps(self) -> np.ndarray:
         """Doppler bin centres (j - nV/2) * dV, m/s (FFT-shifted order)."""
-        return (np.arange(self.n_doppler) - self.n_doppler // 2) * self.doppler_resolution_mps
+        return centred_bin_value(np.arange(self.n_doppler), self.doppler_resolution_mps, self.n_doppler)
+
+    # ---- bin <-> physical units (skyradar.units: ties round up, Doppler wraps) -------------
+    def range_bin(self, range_m: ArrayLike, radial_velocity_mps: ArrayLike = 0.0) -> np.ndarray:
+        """Range bin (int64, unclipped) where a return at ``range_m`` moving at ``radial_velocity_mps`` shows.
+
+        The sawtooth chirp shifts it by ``v * range_doppler_coupling_s``: ``floor((R + v c) / dR + 0.5)``.
+
+        >>> cfg = RadarConfig.prototype_2022()
+        >>> cfg.range_bin([0.0, 1010.0]).tolist(), int(cfg.range_bin(1010.0, 30.0))
+        ([0, 67], 68)
+        """
+        shift_m = np.asarray(radial_velocity_mps, float) * self.range_doppler_coupling_s
+        return nearest_bin(np.asarray(range_m, float) + shift_m, self.range_resolution_m)
+
+    def doppler_bin(self, radial_velocity_mps: ArrayLike) -> np.ndarray:
+        """Doppler bin (FFT-shifted) of a radial velocity, wrapped into ``[0, n_doppler)`` (int64).
+
+        >>> cfg = RadarConfig.prototype_2022()
+        >>> cfg.doppler_bin([0.0, -cfg.v_lim_mps, cfg.v_lim_mps]).tolist()
+        [125, 0, 0]
+        """
+        return centred_bin(radial_velocity_mps, self.doppler_resolution_mps, self.n_doppler)
+
+    def range_at_bin_m(self, range_bin: ArrayLike) -> np.ndarray:
+        """Range ``k * dR`` of a (possibly fractional) range bin, m."""
+        return np.asarray(range_bin, float) * self.range_resolution_m
+
+    def radial_velocity_at_bin_mps(self, doppler_bin: ArrayLike) -> np.ndarray:
+        """Radial velocity ``(j - nV // 2) * dV`` of a (possibly fractional) Doppler bin, m/s.
+
+        >>> float(RadarConfig.prototype_2022().radial_velocity_at_bin_mps(125.5)) > 0
+        True
+        """
+        return centred_bin_value(doppler_bin, self.doppler_resolution_mps, self.n_doppler)
 
     @property
     def pe_w(self) -> float:

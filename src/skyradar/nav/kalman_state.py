@@ -17,7 +17,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
+from skyradar.kalman import innovation_covariance, update
+
 __all__ = ["KalmanSettings", "FilterOutput", "filter_states"]
+
+_OBSERVE_ALL = np.eye(3)  # every frame measures the whole state (V_X, V_Z, H)
 
 
 @dataclass(frozen=True)
@@ -124,12 +128,11 @@ def filter_states(
         if usable and x is None:
             x, p, t_prev, accepted[i] = z.copy(), np.diag(r_diag), t[i], True
         elif usable:
-            innov = z - x
-            s_mat = p + np.diag(r_diag)
+            innov, r_mat = z - x, np.diag(r_diag)
+            s_mat = innovation_covariance(p, _OBSERVE_ALL, r_mat)
             d2 = float(innov @ np.linalg.solve(s_mat, innov))
             if d2 <= gate or s.gps_gate_m is not None:
-                gain = p @ np.linalg.inv(s_mat)
-                x, p = x + gain @ innov, (np.eye(3) - gain) @ p
+                x, p = update(x, p, innov, _OBSERVE_ALL, r_mat, s_mat)
                 accepted[i], rejections = True, 0
             else:
                 rejections += 1

@@ -83,7 +83,7 @@ def test_written_files_get_the_usual_permissions(tmp_path):
 def test_crashed_figure_leaves_no_temporary(tmp_path, monkeypatch):
     from skyradar.viz.rangedoppler import save_frame_figure
 
-    cfg = RadarConfig.seed_prototype(n_doppler=8, range_limit_m=300.0)
+    cfg = RadarConfig.prototype_2022(n_doppler=8, range_limit_m=300.0)
     frame = np.ones((cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
     target = tmp_path / "f.png"
     target.write_bytes(b"old figure")
@@ -115,7 +115,7 @@ def test_outputs_go_through_the_atomic_helpers():
 
 
 # ---------------------------------------------------------------- streamed recordings
-CFG = RadarConfig.seed_prototype(n_doppler=8, range_limit_m=300.0)
+CFG = RadarConfig.prototype_2022(n_doppler=8, range_limit_m=300.0)
 
 
 def _old_encoding(frames: np.ndarray, dtype: str) -> bytes:
@@ -140,7 +140,7 @@ def test_streamed_recording_bytes_are_unchanged(tmp_path, monkeypatch, dtype):
         frames = frames.real.copy()
     frame_bytes = frames[0].nbytes
     monkeypatch.setattr(recordings, "_CHUNK_BYTES", 2 * frame_bytes, raising=False)  # 4 chunks
-    cfg = RadarConfig.seed_prototype(n_doppler=8, range_limit_m=300.0)
+    cfg = RadarConfig.prototype_2022(n_doppler=8, range_limit_m=300.0)
     sidecar = write_recording(tmp_path / "r.bin", frames, cfg, dtype=dtype)
     assert (tmp_path / "r.bin").read_bytes() == _old_encoding(frames, dtype)
     got, _ = read_recording(sidecar)

@@ -20,7 +20,7 @@ ORIGIN = (52.0, 4.36, 100.0)
 
 @pytest.mark.parametrize("mount", ["forward", "forward-down"])
 def test_ours_and_both_baselines_give_the_same_cube(mount):
-    config = RadarConfig.seed_prototype(range_limit_m=1500.0, mount=Mount.preset(mount))
+    config = RadarConfig.prototype_2022(range_limit_m=1500.0, mount=Mount.preset(mount))
     terrain = fractal_terrain(52.0, 4.36, 30.0, size_m=5000.0, spacing_m=50.0, seed=3, mean_height_m=100.0)
     ours = ImageSimulator(
         config, terrain, ORIGIN, facet_size_m=float("inf"), occlusion=False, flat_earth=True, noise=False
@@ -45,7 +45,7 @@ def test_ours_and_both_baselines_give_the_same_cube(mount):
 
 
 def test_baselines_add_thermal_noise_of_the_configured_power():
-    config = RadarConfig.seed_prototype(range_limit_m=600.0)
+    config = RadarConfig.prototype_2022(range_limit_m=600.0)
     terrain = fractal_terrain(52.0, 4.36, 0.0, size_m=1000.0, spacing_m=100.0, mean_height_m=-5000.0)
     geom = ImageSimulator(config, terrain, ORIGIN, flat_earth=True).geometry(
         PlatformState(np.zeros(3), np.array([40.0, 0, 0]), np.zeros(3))

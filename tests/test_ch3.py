@@ -15,7 +15,7 @@ from skyradar.experiments.ch3 import run
 from skyradar.experiments.ch3_scene import build_scene, square_array_m, unambiguous_half_angle_deg
 from skyradar.geo import direction_angles
 
-LAM = RadarConfig.seed_prototype().wavelength_m
+LAM = RadarConfig.prototype_2022().wavelength_m
 
 
 @settings(max_examples=30, deadline=None)
@@ -30,7 +30,7 @@ def test_square_array_is_a_centred_square_in_the_y_z_plane(spacing):
 
 
 def test_default_layout_is_the_half_wavelength_square():
-    np.testing.assert_allclose(square_array_m(0.5, LAM), RadarConfig.seed_prototype().rx_positions_m)
+    np.testing.assert_allclose(square_array_m(0.5, LAM), RadarConfig.prototype_2022().rx_positions_m)
 
 
 @pytest.mark.parametrize("bad", [0.0, -0.6, 1.2, float("nan"), float("inf")])

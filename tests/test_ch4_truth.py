@@ -18,7 +18,7 @@ from skyradar.experiments.ch4 import (
 from skyradar.experiments.ch4_flights import Traffic, fly
 from skyradar.process.detect import detect, integrate_channels
 
-CONFIG = RadarConfig.seed_prototype()
+CONFIG = RadarConfig.prototype_2022()
 
 
 def _frames(n: int, rate_hz: float = 10.0) -> np.ndarray:

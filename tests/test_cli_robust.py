@@ -66,7 +66,7 @@ def _detections(path: Path, n: int, ground: bool) -> Path:
 
 @pytest.mark.parametrize(("n", "ground", "model"), [(0, False, "radar"), (12, True, "traditional")])
 def test_track_without_air_detections_writes_empty_table(tmp_path, n, ground, model):
-    from skyradar.track.run import TRACK_COLUMNS
+    from skyradar.track.track_table import TRACK_COLUMNS
 
     source = _detections(tmp_path / "det.parquet", n, ground)
     result = _skyradar("track", str(source), "-o", "trk.parquet", "--model", model, cwd=tmp_path)
@@ -154,7 +154,7 @@ def _store(path: Path, *, nan_frame: int | None = None, times: list[float] | Non
     from skyradar.config import RadarConfig
     from skyradar.io.frames import frames_dataset
 
-    cfg = RadarConfig.seed_prototype(range_limit_m=600.0, n_doppler=16)
+    cfg = RadarConfig.prototype_2022(range_limit_m=600.0, n_doppler=16)
     rng = np.random.default_rng(0)
     shape = (6, cfg.n_range, cfg.n_doppler, cfg.n_rx)
     iq = (rng.normal(size=shape) + 1j * rng.normal(size=shape)).astype(np.complex64) * 1e-7
@@ -210,7 +210,7 @@ def test_cfar_that_does_not_fit_names_the_run(tmp_path):
     from skyradar.config import RadarConfig
     from skyradar.io.frames import frames_dataset
 
-    cfg = RadarConfig.seed_prototype(range_limit_m=90.0, n_doppler=16)  # 6 range bins
+    cfg = RadarConfig.prototype_2022(range_limit_m=90.0, n_doppler=16)  # 6 range bins
     iq = np.ones((2, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
     frames_dataset(iq, np.arange(2) * 0.1, cfg).to_zarr(tmp_path / "small.zarr", consolidated=False)
     result = _skyradar("process", "small.zarr", "-o", "d.parquet", cwd=tmp_path)
@@ -220,7 +220,7 @@ def test_cfar_that_does_not_fit_names_the_run(tmp_path):
 def _recording(path: Path, nan_frame: int | None = None) -> Path:
     from skyradar.config import RadarConfig
 
-    cfg = RadarConfig.seed_prototype()
+    cfg = RadarConfig.prototype_2022()
     adc = np.ones((3, cfg.n_rx, 8, cfg.samples_per_chirp), np.complex64)
     if nan_frame is not None:
         adc[nan_frame, 0, 0, 5] = np.inf

@@ -14,7 +14,9 @@ from cli_helpers import assert_one_line_error as _assert_one_line_error
 from cli_helpers import skyradar as _skyradar
 from skyradar.io.frames import FrameStoreWriter, open_frames
 from skyradar.scene.scenario import Scenario, example_scenario
-from skyradar.sim.run import _template, fingerprint, make_simulator, simulate_to_zarr
+from skyradar.sim.fingerprint import fingerprint
+from skyradar.sim.scenario_frames import make_simulator
+from skyradar.sim.simulate_store import _template, simulate_to_zarr
 
 BASE = {
     "name": "tiny",

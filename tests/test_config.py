@@ -1,4 +1,4 @@
-"""RadarConfig, antenna pattern and mount against the seed prototype's published numbers."""
+"""RadarConfig, antenna pattern and mount against the thesis prototype's published numbers."""
 
 from __future__ import annotations
 
@@ -12,8 +12,8 @@ from skyradar.config import SPEED_OF_LIGHT, Mount, RadarConfig
 from skyradar.errors import InputError
 
 
-def test_seed_prototype_derived_quantities():
-    cfg = RadarConfig.seed_prototype()
+def test_prototype_2022_derived_quantities():
+    cfg = RadarConfig.prototype_2022()
     assert cfg.wavelength_m == pytest.approx(0.03181, abs=1e-5)
     assert cfg.rmax_m == pytest.approx(30_460, rel=1e-3)  # c Fs / (2 B PRF), about 30.5 km
     assert cfg.range_resolution_m == pytest.approx(14.99, abs=0.01)
@@ -30,7 +30,7 @@ def test_seed_prototype_derived_quantities():
 
 
 def test_default_array_is_coplanar_half_wavelength_square():
-    cfg = RadarConfig.seed_prototype()
+    cfg = RadarConfig.prototype_2022()
     rx = cfg.rx_positions_m
     assert np.allclose(rx[:, 0], 0.0)
     spacing = np.linalg.norm(rx[1] - rx[0])
@@ -38,7 +38,7 @@ def test_default_array_is_coplanar_half_wavelength_square():
 
 
 def test_round_trip_through_json():
-    cfg = RadarConfig.seed_prototype(
+    cfg = RadarConfig.prototype_2022(
         mount=Mount.preset("side-right"), rx_calibration=np.exp(1j * np.array([0.1, -0.2, 0.3, 0.0]))
     )
     again = RadarConfig.from_json(cfg.to_json())
@@ -60,7 +60,7 @@ def test_round_trip_through_json():
 )
 def test_bad_config_names_the_field(changes, field):
     with pytest.raises(InputError, match=field):
-        RadarConfig.seed_prototype(**changes)
+        RadarConfig.prototype_2022(**changes)
 
 
 def test_default_pattern_beamwidth_and_peak():

@@ -12,7 +12,7 @@ from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.process.detect import blob_peaks, cfar_2d, cfar_factor, detect, integrate_channels, refine_peaks
 
-CFG = RadarConfig.seed_prototype()
+CFG = RadarConfig.prototype_2022()
 
 
 def noise_power(shape, n_int, rng):

@@ -29,7 +29,7 @@ from skyradar.process.doa import (
     steering_vector,
 )
 
-CFG = RadarConfig.seed_prototype()
+CFG = RadarConfig.prototype_2022()
 LAM = CFG.wavelength_m
 LAYOUTS = {
     "square": CFG,

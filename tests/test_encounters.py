@@ -22,7 +22,7 @@ from skyradar.scene.scenario import Scenario
 
 D_NC, Z_NC = 2200 * FT, 450 * FT
 NO_FRAMES = pd.DataFrame({"time_s": [], "observable": []})
-HALF_FOV_DEG, RANGE_LIMIT_M, OBSERVE_WINDOW_S = 35.0, 5000.0, 12.5  # run_encounter's defaults, seed prototype
+HALF_FOV_DEG, RANGE_LIMIT_M, OBSERVE_WINDOW_S = 35.0, 5000.0, 12.5  # run_encounter's defaults, 2022 prototype
 
 
 def _closed_form_rel(p: pd.Series, t: np.ndarray) -> np.ndarray:

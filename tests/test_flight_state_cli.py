@@ -20,7 +20,7 @@ def _simulated_run(tmp_path, mount: Mount, name: str, n: int = 4, height_m: floa
     from skyradar.scene.terrain import flat_terrain
     from skyradar.sim.image import ImageSimulator, PlatformState
 
-    cfg = RadarConfig.seed_prototype(mount=mount, range_limit_m=2500.0)
+    cfg = RadarConfig.prototype_2022(mount=mount, range_limit_m=2500.0)
     terrain = flat_terrain(52.0, 5.0, 0.0, size_m=8000.0)
     sim = ImageSimulator(cfg, terrain, origin=(52.0, 5.0, 0.0), facet_size_m=10.0, seed=1)
     times = np.arange(n, dtype=float)

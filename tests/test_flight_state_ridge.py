@@ -16,7 +16,7 @@ from skyradar.nav.flight_state import estimate_frame
 from skyradar.nav.inversion import ridge_velocity
 from skyradar.nav.ridge import band_start, extract_ridge, noise_floor_w
 
-CFG = RadarConfig.seed_prototype(mount=Mount.preset("forward-down"), range_limit_m=2500.0)
+CFG = RadarConfig.prototype_2022(mount=Mount.preset("forward-down"), range_limit_m=2500.0)
 
 
 def flat_ground_cube(vx, vz, h, cfg=CFG, n_points=600_000, seed=0, noise=True, extra=()):

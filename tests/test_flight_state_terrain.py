@@ -11,7 +11,7 @@ from skyradar.benchmarks.flight_state import flat_ground_frame
 from skyradar.config import Mount, RadarConfig
 from skyradar.nav.terrain_aware import TerrainAwareEstimator, ground_points, level_velocity
 
-CFG = RadarConfig.seed_prototype(mount=Mount.preset("forward-down"), range_limit_m=2500.0)
+CFG = RadarConfig.prototype_2022(mount=Mount.preset("forward-down"), range_limit_m=2500.0)
 
 
 def _hilly_points(rng, n=300, h=700.0):

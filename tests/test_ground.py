@@ -18,7 +18,7 @@ from skyradar.process.ground import (
 )
 from skyradar.scene.terrain import flat_terrain
 
-CFG = RadarConfig.seed_prototype()
+CFG = RadarConfig.prototype_2022()
 
 
 @given(

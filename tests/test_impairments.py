@@ -26,7 +26,7 @@ from skyradar.sim.impairments import (
 )
 from skyradar.sim.raw import simulate_adc
 
-CFG = RadarConfig.seed_prototype()
+CFG = RadarConfig.prototype_2022()
 NV = CFG.n_doppler
 
 

@@ -17,7 +17,9 @@ from cli_helpers import skyradar as _skyradar
 from skyradar.config import RadarConfig
 from skyradar.io.frames import FrameStoreWriter, frames_dataset, open_frames
 from skyradar.scene.scenario import load_scenario
-from skyradar.sim.run import _template, fingerprint, make_simulator
+from skyradar.sim.fingerprint import fingerprint
+from skyradar.sim.scenario_frames import make_simulator
+from skyradar.sim.simulate_store import _template
 
 TINY = {
     "name": "tiny",
@@ -40,7 +42,7 @@ def _scenario(folder: Path, data: dict | None = None, name: str = "s.yaml") -> P
 
 def _store(path: Path, n: int = 4) -> Path:
     """A small finished frames store (written by frames_dataset + to_zarr, like the test suite's)."""
-    cfg = RadarConfig.seed_prototype(range_limit_m=600.0, n_doppler=16)
+    cfg = RadarConfig.prototype_2022(range_limit_m=600.0, n_doppler=16)
     rng = np.random.default_rng(0)
     shape = (n, cfg.n_range, cfg.n_doppler, cfg.n_rx)
     iq = (rng.normal(size=shape) + 1j * rng.normal(size=shape)).astype(np.complex64) * 1e-7
@@ -103,7 +105,7 @@ def test_simulate_refuses_partial_name_and_symlink_to_input(tmp_path):
 
 
 def test_rd_onto_its_recording_refused(tmp_path):
-    cfg = RadarConfig.seed_prototype()
+    cfg = RadarConfig.prototype_2022()
     rec = tmp_path / "rec.npy"
     np.save(rec, np.ones((2, cfg.n_rx, 8, cfg.samples_per_chirp), np.complex64))
     before = rec.read_bytes()
@@ -266,9 +268,9 @@ def test_compressed_store_reads_back_identical(tmp_path):
 
 def test_rd_resume_key_covers_sidecar_data_file_and_chunking(tmp_path):
     from skyradar.io.recordings import read_recording, write_recording
-    from skyradar.process.rd_run import _fingerprint, recording_files
+    from skyradar.process.rd_store import _fingerprint, recording_files
 
-    cfg = RadarConfig.seed_prototype(n_doppler=8)
+    cfg = RadarConfig.prototype_2022(n_doppler=8)
     write_recording(tmp_path / "rec.bin", np.ones((2, 4, 8, cfg.samples_per_chirp), np.complex64), cfg)
     frames, _ = read_recording(tmp_path / "rec.json")
     files = recording_files(tmp_path / "rec.json", frames)

@@ -21,7 +21,7 @@ from skyradar.process.spurs import SpurMap
 from skyradar.scene.terrain import flat_terrain
 
 ORIGIN = (52.0, 4.0, 0.0)
-CFG = RadarConfig.seed_prototype(mount=Mount.preset("forward-down"))
+CFG = RadarConfig.prototype_2022(mount=Mount.preset("forward-down"))
 
 
 def scene(n_frames=3, seed=0):
@@ -168,7 +168,7 @@ def test_ch3_experiment_smoke(tmp_path):
 def test_cli_calibrate_then_process_with_the_calibrated_config(tmp_path, monkeypatch, capsys):
     from skyradar.process.calibration import calibration_phase_error_deg
 
-    cfg = RadarConfig.seed_prototype()
+    cfg = RadarConfig.prototype_2022()
     rng = np.random.default_rng(7)
     offsets = np.exp(1j * np.radians([0.0, 70.0, -120.0, 160.0]))
     building = (438.0, 0.0, np.radians(5.0), np.radians(-1.0), 45.0)
@@ -206,7 +206,7 @@ def test_cli_calibrate_then_process_with_the_calibrated_config(tmp_path, monkeyp
 def test_simulated_flight_over_flat_ground_separates_terrain_from_the_intruder():
     from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
 
-    cfg = RadarConfig.seed_prototype(mount=Mount.preset("forward-down"))
+    cfg = RadarConfig.prototype_2022(mount=Mount.preset("forward-down"))
     terrain = flat_terrain(*ORIGIN[:2], height_m=0.0, size_m=10000.0, spacing_m=60.0)
     sim = ImageSimulator(cfg, terrain, origin=ORIGIN, seed=1)
     times = np.array([0.0, 0.1])

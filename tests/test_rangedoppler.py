@@ -19,7 +19,7 @@ from skyradar.process.rangedoppler import (
     window_noise_gain_db,
 )
 
-CFG = RadarConfig.seed_prototype()
+CFG = RadarConfig.prototype_2022()
 NS, NV = CFG.samples_per_chirp, CFG.n_doppler
 WINDOWS = ["none", "hann", "hamming", "blackmanharris", "chebyshev", "chebyshev:60"]
 
@@ -252,7 +252,7 @@ def test_rd_frames_dataset_has_the_frames_form():
 
 
 def test_benchmark_baseline_computes_the_same_cube():
-    from skyradar.benchmarks.chain import baseline_range_doppler
+    from skyradar.benchmarks.range_doppler import baseline_range_doppler
 
     rng = np.random.default_rng(9)
     adc = (rng.standard_normal((CFG.n_rx, NV, NS)) + 1j * rng.standard_normal((CFG.n_rx, NV, NS))).astype(

@@ -15,7 +15,7 @@ from skyradar.process.rangedoppler import range_doppler, window_gain_db
 from skyradar.sim import image
 from skyradar.sim.raw import adc_noise, received_power_w, simulate_adc
 
-CFG = RadarConfig.seed_prototype()
+CFG = RadarConfig.prototype_2022()
 NV = CFG.n_doppler
 
 

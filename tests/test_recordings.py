@@ -13,7 +13,7 @@ from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.io.recordings import read_recording, write_recording
 
-CFG = RadarConfig.seed_prototype(n_doppler=6, range_limit_m=600.0)
+CFG = RadarConfig.prototype_2022(n_doppler=6, range_limit_m=600.0)
 NS = CFG.samples_per_chirp
 
 

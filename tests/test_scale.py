@@ -13,7 +13,7 @@ import yaml
 from skyradar.errors import InputError
 from skyradar.io.frames import open_frames
 from skyradar.scene.scenario import Scenario
-from skyradar.sim.run import simulate_to_zarr
+from skyradar.sim.simulate_store import simulate_to_zarr
 from skyradar.sim.sweep import parse_values, set_by_path, sweep
 
 SCENARIO = {
@@ -115,9 +115,9 @@ def test_process_on_a_local_cluster_matches_the_plain_loop(tmp_path):
 def test_rd_on_a_local_cluster_matches_the_plain_loop(tmp_path):
     from skyradar.config import RadarConfig
     from skyradar.io.recordings import write_recording
-    from skyradar.process.rd_run import recording_to_frames
+    from skyradar.process.rd_store import recording_to_frames
 
-    cfg = RadarConfig.seed_prototype()
+    cfg = RadarConfig.prototype_2022()
     rng = np.random.default_rng(4)
     shape = (5, cfg.n_rx, cfg.n_doppler, cfg.samples_per_chirp)
     adc = (rng.standard_normal(shape) + 1j * rng.standard_normal(shape)).astype(np.complex64)

@@ -19,7 +19,7 @@ from skyradar.scene.dem_coverage import dem_for_run
 from skyradar.scene.dem_readers import read_dem, read_geotiff
 from skyradar.scene.scenario import Scenario, load_scenario
 from skyradar.scene.terrain import Bounds
-from skyradar.sim.run import simulate_to_zarr
+from skyradar.sim.simulate_store import simulate_to_zarr
 
 BASE = {
     "name": "tiny",

@@ -9,11 +9,11 @@ from hypothesis import strategies as st
 
 from skyradar.config import SPEED_OF_LIGHT, Mount, RadarConfig
 from skyradar.geo import rotation_matrix
-from skyradar.scene.synthetic import centred_grid, flat_terrain
+from skyradar.scene.synthetic_terrain import centred_grid, flat_terrain
 from skyradar.scene.terrain import Terrain
 from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
 
-CFG = RadarConfig.seed_prototype()
+CFG = RadarConfig.prototype_2022()
 
 
 def _unit(az: float, el: float) -> np.ndarray:

@@ -9,13 +9,13 @@ from numba import njit
 from skyradar.config import Mount, RadarConfig
 from skyradar.errors import InputError
 from skyradar.geo import rotation_matrix
-from skyradar.scene.synthetic import centred_grid
+from skyradar.scene.synthetic_terrain import centred_grid
 from skyradar.sim._elementary import cis_cycles, cis_cycles_f32, fast_atan2, wrap_index
 from skyradar.sim._horizon_kernel import horizon_map
 from skyradar.sim._terrain_kernel import add_sparse, relative_points, rotate_points
 from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
 
-CFG = RadarConfig.seed_prototype()
+CFG = RadarConfig.prototype_2022()
 
 
 def _hills(spacing_m: float, n: int = 141, seed: int = 3):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from skyradar.scene.scenario import Scenario
-from skyradar.sim.run import make_simulator, simulate_frames
+from skyradar.sim.scenario_frames import make_simulator, simulate_frames
 
 BASE = {
     "name": "impaired",

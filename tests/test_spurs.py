@@ -11,7 +11,7 @@ from skyradar.errors import InputError
 from skyradar.process.detect import detect, integrate_channels
 from skyradar.process.spurs import THESIS_THRESHOLDS, OnlineSpurMap, SpurMap, detection_pixels, learn_spur_map
 
-CFG = RadarConfig.seed_prototype()
+CFG = RadarConfig.prototype_2022()
 # Fixed self-interference: (range bin, Doppler bin, SNR dB); one on the Doppler edge, one weak.
 SPURS = [(20, 125, 35.0), (150, 0, 25.0), (260, 60, 16.0), (7, 200, 45.0)]
 

@@ -95,7 +95,7 @@ def test_encode_refuses_nan():
 
 
 def _tiny_config() -> RadarConfig:
-    return RadarConfig.seed_prototype()
+    return RadarConfig.prototype_2022()
 
 
 def _write_store(path: Path, iq: np.ndarray, precision: str, compressor: str = "none") -> Path:
@@ -211,7 +211,7 @@ def test_rd_writes_cint16_store_within_the_bound(tmp_path):
     from skyradar.io.recordings import write_recording
     from skyradar.process.rangedoppler import range_doppler
 
-    cfg = RadarConfig.seed_prototype(n_doppler=6, range_limit_m=600.0)
+    cfg = RadarConfig.prototype_2022(n_doppler=6, range_limit_m=600.0)
     rng = np.random.default_rng(0)
     shape = (3, cfg.n_rx, cfg.n_doppler, cfg.samples_per_chirp)
     data = (rng.standard_normal(shape) + 1j * rng.standard_normal(shape)).astype(np.complex64)

@@ -10,7 +10,7 @@ import pytest
 from skyradar.cli import main
 from skyradar.config import RadarConfig
 from skyradar.io.frames import frames_dataset
-from skyradar.track.synthetic import synthetic_detections
+from skyradar.track.simulated_detections import synthetic_detections
 
 
 def _cli(monkeypatch, capsys, *args):
@@ -32,7 +32,7 @@ def _scene(cfg, n=120, dt=0.106):
 
 
 def test_track_then_evaluate_against_run_truth(tmp_path, monkeypatch, capsys):
-    cfg = RadarConfig.seed_prototype(range_limit_m=600.0, n_doppler=16)
+    cfg = RadarConfig.prototype_2022(range_limit_m=600.0, n_doppler=16)
     t, R, V = _scene(cfg)
     vis = (R > 30) & (R < 590)
     det = synthetic_detections(t, R, V, vis, cfg, pd_detect=0.95, clutter_per_frame=1, seed=3)
@@ -80,7 +80,7 @@ def test_track_bad_inputs_give_one_line_errors(tmp_path, monkeypatch, capsys):
 
 @pytest.mark.parametrize("missing", ["tgt_visible"])
 def test_evaluate_without_truth_is_clear_error(tmp_path, monkeypatch, capsys, missing):
-    cfg = RadarConfig.seed_prototype(range_limit_m=300.0, n_doppler=8)
+    cfg = RadarConfig.prototype_2022(range_limit_m=300.0, n_doppler=8)
     iq = np.zeros((3, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
     frames_dataset(iq, np.arange(3.0), cfg).to_zarr(tmp_path / "run.zarr", consolidated=False)
     trk = tmp_path / "t.parquet"

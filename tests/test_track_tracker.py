@@ -10,11 +10,11 @@ from skyradar.track.association import associate, associate_naive
 from skyradar.track.io import Truth
 from skyradar.track.metrics import track_metrics
 from skyradar.track.models import radar_model
-from skyradar.track.run import track_detections
-from skyradar.track.synthetic import synthetic_detections
+from skyradar.track.simulated_detections import synthetic_detections
+from skyradar.track.track_table import track_detections
 from skyradar.track.tracker import RangeDopplerTracker, TrackerConfig
 
-CFG = RadarConfig.seed_prototype()
+CFG = RadarConfig.prototype_2022()
 PIX = (CFG.range_resolution_m, CFG.doppler_resolution_mps)
 W = 2 * CFG.v_lim_mps
 DT = 0.106

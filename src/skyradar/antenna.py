@@ -190,7 +190,7 @@ def read_gain_cuts(path: str | Path) -> tuple[GainCut, GainCut]:
 
 def _default_cut(beamwidth_deg: float, peak_db: float) -> GainCut:
     # Synthetic: Gaussian main lobe (-3 dB at half the beamwidth) floored 30 dB below peak, a
-    # stand-in for a patch array of about 70 deg beamwidth (the seed prototype's field of view).
+    # stand-in for a patch array of about 70 deg beamwidth (the thesis prototype's field of view).
     angle = np.linspace(-180.0, 180.0, 721)
     loss = 12.0 * (angle / beamwidth_deg) ** 2
     return GainCut(angle, peak_db - np.minimum(loss, 30.0))

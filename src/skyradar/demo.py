@@ -5,9 +5,9 @@ seeded fractal terrain with three intruders: ``collision`` (converging, zero mis
 ``fast-jet`` (head-on, its closing speed aliases in Doppler; a near miss that stays outside the
 warning volume) and ``glider`` (well clear). The chain:
 
-1. :func:`skyradar.sim.run.simulate_frames` in blocks (the whole cube would be ~750 MB);
+1. :func:`skyradar.sim.scenario_frames.simulate_frames` in blocks (the whole cube would be ~750 MB);
 2. :func:`skyradar.process.pipeline.process_frames` on each block (detections, DoA, ground flags);
-3. :func:`skyradar.track.run.track_detections` on the detections that are neither ground nor spur,
+3. :func:`skyradar.track.track_table.track_detections` on the detections that are neither ground nor spur,
    with the own-ship state (3-D tracks with covariance and a ``confirmed`` flag);
 4. :func:`skyradar.daa.pipeline.alerts_from_tracks` on the confirmed 3-D tracks, with
    :data:`DEMO_ALERT_CONFIG` (default volumes and times plus a velocity-convergence gate);
@@ -25,8 +25,8 @@ import pandas as pd
 
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG
 from skyradar.errors import InputError
-from skyradar.experiments.chain import label_tracks
-from skyradar.experiments.chain import run_chain as _run_chain
+from skyradar.experiments.daa_chain import label_tracks
+from skyradar.experiments.daa_chain import run_chain as _run_chain
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.scene.scenario import load_scenario
@@ -56,7 +56,7 @@ def demo_scenario_path() -> Path:
 
 
 def run_chain(built, keep_frames: tuple[int, ...] = ()) -> dict[str, Any]:
-    """:func:`skyradar.experiments.chain.run_chain` with :data:`DEMO_ALERT_CONFIG`."""
+    """:func:`skyradar.experiments.daa_chain.run_chain` with :data:`DEMO_ALERT_CONFIG`."""
     return _run_chain(built, DEMO_ALERT_CONFIG, keep_frames)
 
 

@@ -57,7 +57,7 @@ _SIMULATORS: dict[int, Any] = {}
 def _summary_job(built, chunk_frames: int, index: int) -> dict[str, Any]:
     import numba
 
-    from skyradar.sim.run import make_simulator, simulate_frames
+    from skyradar.sim.scenario_frames import make_simulator, simulate_frames
 
     numba.set_num_threads(1)
     key = id(built)
@@ -81,12 +81,12 @@ def run_flight(built, workers: int, chunk_frames: int = 64, store: Path | None =
     from distributed import as_completed
 
     from skyradar.parallel import close, connect
-    from skyradar.sim.run import simulate_to_zarr
+    from skyradar.sim.simulate_store import simulate_to_zarr
 
     n = built.times_s.size
     client = connect(None, workers)
     try:
-        client.run(lambda: __import__("skyradar.sim.run"))  # imports and numba caches before timing
+        client.run(lambda: __import__("skyradar.sim.simulate_store"))  # imports, numba caches before timing
         built_future = client.scatter(built, broadcast=True)
         warm = [client.submit(_summary_job, built_future, 1, i, pure=False) for i in range(workers)]
         client.gather(warm)

@@ -102,7 +102,7 @@ def run(min_time_s: float = 2.0, n_points: int = 400_000) -> dict[str, Any]:
     >>> all(result[k] > 0 for k in result if k.endswith("_fps"))
     True
     """
-    config = RadarConfig.seed_prototype(mount=Mount.preset("forward-down"))
+    config = RadarConfig.prototype_2022(mount=Mount.preset("forward-down"))
     cubes = [flat_ground_frame(config, 30.0, 0.0, 600.0, n_points, seed) for seed in range(3)]
     aware = TerrainAwareEstimator(config)
     clock = iter(np.arange(0.0, 1e6))

@@ -119,7 +119,7 @@ def run(n_cubes: int = 8, n_targets: int = 5, min_time_s: float = 2.0, seed: int
     process-CPU second (``cpu_frames_per_s``: what a free core would do), the machine's load
     average, the cube shape and the detections per frame of each (they should agree).
     """
-    config = RadarConfig.seed_prototype()
+    config = RadarConfig.prototype_2022()
     rng = np.random.default_rng(seed)
     cubes = []
     for _ in range(n_cubes):

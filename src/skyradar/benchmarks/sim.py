@@ -3,7 +3,7 @@
 Terrain: a SYNTHETIC 1201 x 1201 tile in SRTM-3 ``.hgt`` format (one degree at 3 arc-seconds,
 about 90 m; rolling hills from seeded noise, written to disk and read back by the ``.hgt``
 reader). It is not SRTM data: it only has the size, spacing and file format of an SRTM-3 tile.
-The radar is the seed prototype 1000 m above the tile's centre, flying level at 50 m/s.
+The radar is the thesis prototype 1000 m above the tile's centre, flying level at 50 m/s.
 
 Three implementations of one physics, timed by one rule (median frame time after a warm-up):
 a facet per DEM cell (its bilinear centre, exact normal and area), the thesis' flat-earth
@@ -189,7 +189,7 @@ def numpy_baseline_frame(
     Examples
     --------
     >>> from skyradar.scene.terrain import flat_terrain
-    >>> cfg = RadarConfig.seed_prototype(range_limit_m=1000.0)
+    >>> cfg = RadarConfig.prototype_2022(range_limit_m=1000.0)
     >>> origin = (52.0, 4.36, 0.0)
     >>> ground = flat_terrain(*origin, size_m=3000.0, spacing_m=50.0)
     >>> sim = ImageSimulator(cfg, ground, origin, facet_size_m=float("inf"), occlusion=False, flat_earth=True)
@@ -252,7 +252,7 @@ def _time_frames(fn, n_frames: int, min_seconds: float) -> float:
 def run(n_frames: int = 40, baseline_frames: int = 6, min_seconds: float = 2.0) -> dict[str, Any]:
     """Frames/s of the simulator and of both baselines on the synthetic tile, in one run."""
     load_before = os.getloadavg()[0]
-    config = RadarConfig.seed_prototype()
+    config = RadarConfig.prototype_2022()
     with tempfile.TemporaryDirectory() as tmp:
         terrain = benchmark_tile(Path(tmp))
     lat_c, lon_c = terrain.center_latlon

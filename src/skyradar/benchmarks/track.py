@@ -21,8 +21,8 @@ import numpy as np
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.track.association import associate_naive
-from skyradar.track.run import make_model
-from skyradar.track.synthetic import synthetic_detections
+from skyradar.track.simulated_detections import synthetic_detections
+from skyradar.track.track_table import make_model
 from skyradar.track.tracker import RangeDopplerTracker
 
 __all__ = ["bench_scene", "run"]
@@ -83,7 +83,7 @@ def run(
     for option, value, high in limits:
         if value > high:
             raise InputError(f"bench track: option '{option}' must be at most {high}, got {value}")
-    config = RadarConfig.seed_prototype()
+    config = RadarConfig.prototype_2022()
     t, frames = bench_scene(n_frames, detections_per_frame, n_targets, seed, config)
     pixel = (config.range_resolution_m, config.doppler_resolution_mps)
     model = make_model("radar", config)

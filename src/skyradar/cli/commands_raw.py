@@ -63,7 +63,7 @@ def rd(
     """
     from skyradar.errors import InputError
     from skyradar.io.frames import COMPRESSORS, PRECISIONS
-    from skyradar.process.rd_run import recording_to_frames
+    from skyradar.process.rd_store import recording_to_frames
     from skyradar.process.windows import get_window
 
     choices = (("--compress", compress, COMPRESSORS), ("--precision", precision, PRECISIONS))
@@ -111,7 +111,7 @@ def bench_chain(
     ``sim_fps_2_workers`` and ``sim_speedup_2_workers`` for a flight at SRTM spacing.
     """
     from skyradar.benchmarks import flight
-    from skyradar.benchmarks.chain import run
+    from skyradar.benchmarks.range_doppler import run
 
     result = run(n_frames=frames, workers=workers)
     if flight_frames:

@@ -75,7 +75,7 @@ def simulate(
     from skyradar.io.outputs import check_output
     from skyradar.io.store_size import check_store_space
     from skyradar.scene.scenario import load_scenario
-    from skyradar.sim.run import simulate_to_zarr
+    from skyradar.sim.simulate_store import simulate_to_zarr
 
     if chunk_frames < 1:
         raise InputError(f"--chunk-frames must be >= 1, got {chunk_frames}")

@@ -76,7 +76,7 @@ def track(
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import read_table, write_table
     from skyradar.track.io import radar_config_from_attrs, read_detections, validate_ownship
-    from skyradar.track.run import OWNSHIP_COLUMNS, track_detections
+    from skyradar.track.track_table import OWNSHIP_COLUMNS, track_detections
 
     if model not in ("radar", "traditional"):
         raise InputError(f"--model: must be 'radar' or 'traditional', got {model!r}")

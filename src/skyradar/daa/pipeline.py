@@ -33,7 +33,7 @@ from skyradar.daa.alerting import AlertConfig, filter_alert_levels, raw_alert_le
 from skyradar.daa.conflict import traffic_indication
 from skyradar.errors import InputError
 from skyradar.io.tables import finite_column
-from skyradar.track.run import OWNSHIP_COLUMNS as TRACKER_OWNSHIP_COLUMNS
+from skyradar.track.track_table import OWNSHIP_COLUMNS as TRACKER_OWNSHIP_COLUMNS
 
 __all__ = ["TRACK_COLUMNS", "OWNSHIP_COLUMNS", "ownship_from_frames", "truth_tracks", "alerts_from_tracks"]
 

@@ -25,7 +25,7 @@ from skyradar.errors import InputError
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic
 from skyradar.scene.scenario import Scenario, example_scenario
-from skyradar.sim.run import make_simulator, scenario_truth, simulate_frames
+from skyradar.sim.scenario_frames import make_simulator, scenario_truth, simulate_frames
 from skyradar.viz.rangedoppler import save_frame_figure, strength_db
 
 __all__ = ["run", "fit_asymptotes"]

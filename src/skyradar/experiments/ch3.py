@@ -1,6 +1,6 @@
 """ch3: detection and 3-D direction of arrival with a radar on the ground aimed at the sky.
 
-The thesis' field test in simulation (seed-brief.md ch3). The seed prototype stands 2 m above
+The thesis' field test in simulation (seed-brief.md ch3). The thesis prototype stands 2 m above
 the ground near Delft, boresight at bearing -37.7 deg and pitched up ``pitch_deg`` (default
 3 deg), so the calibration building (5 deg right, 1 deg below boresight) lies where the thesis
 located it: north-west, about 2 deg above the horizon, 15 m above the radar (thesis: 372 m north,

@@ -58,7 +58,7 @@ def build_scene(pitch_deg: float, seed: int, spacing: float) -> dict[str, Any]:
     Everything random is drawn from ``seed`` alone, so two spacings see the same scene and noise.
     Returns a dict with ``config, platform, sim, geom, static, imp, true_gain, building_ant``.
     """
-    config = RadarConfig.seed_prototype(mount=Mount(Mount.preset("sky").position_m, pitch_deg=pitch_deg))
+    config = RadarConfig.prototype_2022(mount=Mount(Mount.preset("sky").position_m, pitch_deg=pitch_deg))
     config = config.replace(rx_positions_m=square_array_m(spacing, config.wavelength_m))
     platform = PlatformState(
         np.array([0.0, 0.0, -2.0]), np.zeros(3), np.array([np.radians(BORESIGHT_BEARING_DEG), 0, 0])

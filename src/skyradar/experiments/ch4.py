@@ -9,7 +9,7 @@ the same detections. Two detection sources:
   :func:`skyradar.process.pipeline.process_cube` (CA-CFAR, sub-pixel peaks, phase-difference DoA).
 * ``chain='geometry'``: detections synthesised from the truth geometry: range and aliased radial
   velocity with noise, detection probability from the expected SNR, DoA with angular noise, and
-  uniform clutter (:func:`skyradar.track.synthetic.synthetic_detections` style).
+  uniform clutter (:func:`skyradar.track.simulated_detections.synthetic_detections` style).
 
 True tracks are counted from the scenario, never from the detections being scored
 (:func:`scenario_visibility`, :func:`count_truth_tracks`). An intruder is detectable in a frame when
@@ -48,7 +48,7 @@ from skyradar.parallel import check_workers
 from skyradar.track.io import Truth
 from skyradar.track.kalman import wrap
 from skyradar.track.metrics import track_metrics, truth_segments
-from skyradar.track.run import OWNSHIP_COLUMNS, track_detections
+from skyradar.track.track_table import OWNSHIP_COLUMNS, track_detections
 from skyradar.track.types import TrackerConfig
 
 __all__ = [
@@ -80,7 +80,7 @@ def detection_threshold_snr_db(config: RadarConfig, probability: float = 0.5) ->
 
     Examples
     --------
-    >>> round(detection_threshold_snr_db(RadarConfig.seed_prototype()), 1)
+    >>> round(detection_threshold_snr_db(RadarConfig.prototype_2022()), 1)
     7.5
     """
     from skyradar.process.cfar import cfar_factor
@@ -239,7 +239,7 @@ def run_scenario(
 ) -> dict:  # fmt: skip
     """Truth, detections, both trackers and their metrics for one scenario (``traffic``: see
     :func:`scenario_truth`)."""
-    config = RadarConfig.seed_prototype()
+    config = RadarConfig.prototype_2022()
     truth = scenario_truth(name, config, frame_rate_hz, interval_s, tail_s, traffic)
     t0 = time.perf_counter()
     if chain == "full":
@@ -371,7 +371,7 @@ def _summary(per: dict, chain: str, elapsed_s: float, figures: list[str]) -> dic
         "elapsed_s": elapsed_s,
         "truth_rule": (
             "from the scenario, not the detections: in front, in range and line of sight with expected "
-            f"SNR >= {detection_threshold_snr_db(RadarConfig.seed_prototype()):.1f} dB (CA-CFAR Pd 50 %), "
+            f"SNR >= {detection_threshold_snr_db(RadarConfig.prototype_2022()):.1f} dB (CA-CFAR Pd 50 %), "
             f"gaps <= {tc.max_coast_s:g} s bridged, spans with >= {tc.confirm_m} of {tc.confirm_n} frames"
         ),
     }

@@ -116,7 +116,7 @@ def draw_figures(results: list[dict], out_dir: Path) -> list[str]:
     import matplotlib
 
     matplotlib.use("Agg")
-    config = RadarConfig.seed_prototype()
+    config = RadarConfig.prototype_2022()
     return [
         _range_doppler(results, out_dir, config),
         _body_frame(results, out_dir),

@@ -327,7 +327,7 @@ def run(
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     t_start = time.perf_counter()
-    config = RadarConfig.seed_prototype(mount=Mount.preset("forward-down"))
+    config = RadarConfig.prototype_2022(mount=Mount.preset("forward-down"))
     cache: dict[str, Any] = {}
     sources = ("true", "ahrs") if ahrs is not None else ("true",)
     by_source: dict[str, dict[str, Any]] = {src: {"rate_1hz": {}, "rate_9p4hz": {}} for src in sources}

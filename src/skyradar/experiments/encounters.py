@@ -1,7 +1,7 @@
 """Encounter set: does the DAA chain warn in time for conflicts, and stay quiet for near misses?
 
 Every encounter of :func:`skyradar.experiments.encounter_set.make_encounters` runs through the full
-chain of :func:`skyradar.experiments.chain.run_chain`: the image simulator (seed prototype, forward
+chain of :func:`skyradar.experiments.daa_chain.run_chain`: the image simulator (thesis prototype, forward
 mount, thermal noise, clear sky), detection and DoA, the radar-aware tracker with 3-D state, and
 the alerting stage (DO-365 non-cooperative volume, DAIDALUS alerting times, M-of-N persistence,
 volumes widened by the track covariance). Frames cover the last ``lookback_s`` before the loss of
@@ -29,7 +29,7 @@ import pandas as pd
 
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig
 from skyradar.errors import InputError
-from skyradar.experiments.chain import label_tracks, run_chain
+from skyradar.experiments.daa_chain import label_tracks, run_chain
 from skyradar.experiments.encounter_set import (
     encounter_scenario,
     event_times,

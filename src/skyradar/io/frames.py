@@ -127,7 +127,7 @@ def frames_dataset(
 
     Examples
     --------
-    >>> cfg = RadarConfig.seed_prototype()
+    >>> cfg = RadarConfig.prototype_2022()
     >>> cube = np.zeros((2, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
     >>> frames_dataset(cube, np.array([0.0, 0.1]), cfg).iq.dims
     ('time', 'range', 'doppler', 'rx')

@@ -31,7 +31,7 @@ other than 4 needs ``radar.rx_positions_m``. A 3-D recording without a ``frame``
 
 ``.npy`` files carry dtype and shape themselves; a sidecar with the same stem is optional and
 supplies the radar fields and ``axes`` (default ``frame, rx, chirp, sample``); without one the
-seed prototype's parameters are assumed.
+thesis prototype's parameters are assumed.
 
 Every inconsistency raises :class:`InputError` naming the file, the field and the value, before any
 output is written. :func:`write_recording` streams the frames in chunks and writes both files through
@@ -279,7 +279,7 @@ def read_recording(path: str | Path) -> tuple[AdcFrames, RadarConfig]:
     Examples
     --------
     >>> import tempfile
-    >>> cfg = RadarConfig.seed_prototype(n_doppler=8)
+    >>> cfg = RadarConfig.prototype_2022(n_doppler=8)
     >>> adc = np.full((2, 4, 8, cfg.samples_per_chirp), 1 + 1j, np.complex64)
     >>> d = Path(tempfile.mkdtemp())
     >>> _ = write_recording(d / "rec.bin", adc, cfg, scale=0.5)
@@ -299,7 +299,7 @@ def read_recording(path: str | Path) -> tuple[AdcFrames, RadarConfig]:
         raw, pairs, data = _open_npy(path, meta)
         sidecar = sidecar or path
         meta.setdefault("axes", list(AXES if raw.ndim == 4 else AXES[1:]))
-        proto = RadarConfig.seed_prototype()
+        proto = RadarConfig.prototype_2022()
         for key, value in (("sample_rate_hz", proto.fs_hz), ("fc_hz", proto.fc_hz),
                            ("bandwidth_hz", proto.bandwidth_hz), ("prf_hz", proto.prf_hz)):  # fmt: skip
             meta.setdefault(key, value)

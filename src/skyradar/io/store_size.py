@@ -35,7 +35,7 @@ def store_bytes(
 
     Examples
     --------
-    >>> cfg = RadarConfig.seed_prototype()
+    >>> cfg = RadarConfig.prototype_2022()
     >>> store_bytes(cfg, 1) == 333 * 250 * 4 * 8
     True
     >>> store_bytes(cfg, 1, precision="cint16") == 333 * 250 * 4 * 4 + 333 * 4 * 4

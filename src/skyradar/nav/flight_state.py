@@ -98,7 +98,7 @@ def estimate_frame(
 
     Examples
     --------
-    >>> cfg = RadarConfig.seed_prototype()
+    >>> cfg = RadarConfig.prototype_2022()
     >>> est = estimate_frame(np.zeros((cfg.n_range, cfg.n_doppler)), cfg)
     >>> est.low_quality, est.fit.h_m
     (True, nan)

@@ -200,7 +200,7 @@ def extract_ridge(
 
     Examples
     --------
-    >>> cfg = RadarConfig.seed_prototype()
+    >>> cfg = RadarConfig.prototype_2022()
     >>> extract_ridge(np.zeros((cfg.n_range, cfg.n_doppler)), cfg).range_m.size
     0
     """

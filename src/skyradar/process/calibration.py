@@ -11,7 +11,7 @@ with weights ``|x_0|`` (a matched combiner). Only relative gains are observable:
 Examples
 --------
 >>> from skyradar.config import RadarConfig
->>> cfg = RadarConfig.seed_prototype()
+>>> cfg = RadarConfig.prototype_2022()
 >>> p = reflector_position(438.0, np.radians(5.0), np.radians(-1.0))
 >>> offsets = np.exp(1j * np.radians([0.0, 40.0, -70.0, 120.0]))
 >>> pixels = (expected_pixels(p, cfg) * offsets)[None, :]

@@ -13,7 +13,7 @@ axis wraps around (aliasing), so every window and every blob wraps across its ed
 Examples
 --------
 >>> from skyradar.config import RadarConfig
->>> cfg = RadarConfig.seed_prototype()
+>>> cfg = RadarConfig.prototype_2022()
 >>> rng = np.random.default_rng(0)
 >>> shape = (cfg.n_range, cfg.n_doppler, cfg.n_rx)
 >>> cube = (rng.standard_normal(shape) + 1j * rng.standard_normal(shape)) * np.sqrt(cfg.noise_power_w / 2)

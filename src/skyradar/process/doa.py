@@ -32,7 +32,7 @@ du/del . r_k)`` and ``SNR = A^2 / sigma^2`` per channel and pixel; ``CRLB = J^-1
 Examples
 --------
 >>> from skyradar.config import RadarConfig
->>> cfg = RadarConfig.seed_prototype()
+>>> cfg = RadarConfig.prototype_2022()
 >>> u = direction_from_angles(np.radians(10.0), np.radians(-5.0))
 >>> pixels = steering_vector(u, cfg)[None, :]
 >>> az, el = angles_from_direction(estimate_directions(pixels, cfg))
@@ -357,7 +357,7 @@ def doa_crlb(
 
     Examples
     --------
-    >>> cfg = RadarConfig.seed_prototype()
+    >>> cfg = RadarConfig.prototype_2022()
     >>> sd_az, sd_el = doa_crlb(30.0, 0.0, 0.0, cfg)
     >>> round(float(np.degrees(sd_az)), 3) == round(float(np.degrees(sd_el)), 3)  # square array
     True

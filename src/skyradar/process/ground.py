@@ -17,7 +17,7 @@ what keeps them airborne, so give a terrain when there is one.
 Examples
 --------
 >>> from skyradar.config import RadarConfig
->>> cfg = RadarConfig.seed_prototype()
+>>> cfg = RadarConfig.prototype_2022()
 >>> u = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # ahead, straight down
 >>> static_radial_velocity_mps(u, np.array([30.0, 0.0, 0.0])).tolist()
 [-30.0, -0.0]

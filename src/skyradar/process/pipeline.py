@@ -13,7 +13,7 @@ Examples
 --------
 >>> from skyradar.config import RadarConfig
 >>> from skyradar.io.frames import frames_dataset
->>> cfg = RadarConfig.seed_prototype()
+>>> cfg = RadarConfig.prototype_2022()
 >>> rng = np.random.default_rng(0)
 >>> shape = (1, cfg.n_range, cfg.n_doppler, cfg.n_rx)
 >>> iq = (rng.standard_normal(shape) + 1j * rng.standard_normal(shape)) * np.sqrt(cfg.noise_power_w / 2)

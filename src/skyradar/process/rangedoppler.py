@@ -184,7 +184,7 @@ class RangeDopplerProcessor:
 
         Examples
         --------
-        >>> cfg = RadarConfig.seed_prototype()
+        >>> cfg = RadarConfig.prototype_2022()
         >>> adc = np.zeros((3, cfg.n_rx, cfg.n_doppler, cfg.samples_per_chirp), np.complex64)
         >>> [rd.shape for rd in RangeDopplerProcessor(cfg).many(adc)][-1]
         (333, 250, 4)
@@ -281,7 +281,7 @@ def range_doppler(
 
     Examples
     --------
-    >>> cfg = RadarConfig.seed_prototype()
+    >>> cfg = RadarConfig.prototype_2022()
     >>> t = np.arange(cfg.samples_per_chirp) / cfg.fs_hz
     >>> tone = np.exp(2j * np.pi * 10 * cfg.prf_hz * t)  # beat frequency of range bin 10
     >>> adc = np.broadcast_to(tone, (cfg.n_rx, cfg.n_doppler, t.size))
@@ -327,7 +327,7 @@ def rd_frames_dataset(
 
     Examples
     --------
-    >>> cfg = RadarConfig.seed_prototype()
+    >>> cfg = RadarConfig.prototype_2022()
     >>> adc = np.zeros((2, cfg.n_rx, cfg.n_doppler, cfg.samples_per_chirp), np.complex64)
     >>> rd_frames_dataset(adc, np.array([0.0, 0.1]), cfg).iq.shape
     (2, 333, 250, 4)

@@ -15,7 +15,7 @@ the time the scene takes to move by a pixel.
 Examples
 --------
 >>> from skyradar.config import RadarConfig
->>> cfg = RadarConfig.seed_prototype()
+>>> cfg = RadarConfig.prototype_2022()
 >>> hits = np.zeros((10, cfg.n_range, cfg.n_doppler), bool)
 >>> hits[:, 50, 0] = True  # a spur on the Doppler edge, in every frame
 >>> spur_map = SpurMap.from_hits(hits, threshold=0.05)

@@ -96,7 +96,7 @@ def window_gain_db(
     >>> round(window_gain_db('hann', 'hann'), 2)
     -12.04
     """
-    return _gain_db(range_window, doppler_window, config or RadarConfig.seed_prototype(), 1)
+    return _gain_db(range_window, doppler_window, config or RadarConfig.prototype_2022(), 1)
 
 
 def window_noise_gain_db(
@@ -109,4 +109,4 @@ def window_noise_gain_db(
     >>> round(window_noise_gain_db('hann', 'hann'), 2)
     -8.52
     """
-    return _gain_db(range_window, doppler_window, config or RadarConfig.seed_prototype(), 2)
+    return _gain_db(range_window, doppler_window, config or RadarConfig.prototype_2022(), 2)

@@ -209,7 +209,7 @@ class Scenario:
         if m.radar.antenna is not None:
             overrides["antenna"] = self._antenna(m.radar.antenna)
         try:
-            radar = RadarConfig.seed_prototype(mount=mount, **overrides)
+            radar = RadarConfig.prototype_2022(mount=mount, **overrides)
         except InputError as exc:
             raise self._fail("radar", exc) from None
         max_rate = 1.0 / radar.frame_duration_s

@@ -115,7 +115,7 @@ class AntennaModel(_Model):
 
 
 class RadarModel(_Model):
-    """Overrides of :class:`skyradar.config.RadarConfig` fields; unset fields keep the seed prototype."""
+    """Overrides of :class:`skyradar.config.RadarConfig` fields; unset fields keep the thesis prototype."""
 
     fc_hz: Positive | None = None
     fs_hz: Positive | None = None

@@ -18,7 +18,7 @@ in reality (the tangent plane itself would rise 2.8 m above the ground 6 km from
 
 Readers (:func:`read_dem`, :func:`jacksboro`) live in :mod:`skyradar.scene.dem_readers` and
 synthetic surfaces (:func:`flat_terrain`, :func:`fractal_terrain`, :func:`roughness_map`) in
-:mod:`skyradar.scene.synthetic`; both are importable from this module too.
+:mod:`skyradar.scene.synthetic_terrain`; both are importable from this module too.
 """
 
 from __future__ import annotations
@@ -41,10 +41,10 @@ _LAZY = {
     "read_geotiff": "skyradar.scene.dem_readers",
     "read_npz": "skyradar.scene.dem_readers",
     "jacksboro": "skyradar.scene.dem_readers",
-    "flat_terrain": "skyradar.scene.synthetic",
-    "fractal_terrain": "skyradar.scene.synthetic",
-    "roughness_map": "skyradar.scene.synthetic",
-    "local_height_sd": "skyradar.scene.synthetic",
+    "flat_terrain": "skyradar.scene.synthetic_terrain",
+    "fractal_terrain": "skyradar.scene.synthetic_terrain",
+    "roughness_map": "skyradar.scene.synthetic_terrain",
+    "local_height_sd": "skyradar.scene.synthetic_terrain",
 }
 
 __all__ = ["Terrain", "Bounds", "metres_per_degree", *_LAZY]

@@ -83,7 +83,7 @@ class ImageSimulator:
 
     Examples
     --------
-    >>> cfg = RadarConfig.seed_prototype()
+    >>> cfg = RadarConfig.prototype_2022()
     >>> sim = ImageSimulator(cfg, noise=False)
     >>> own = PlatformState(np.zeros(3), np.array([30.0, 0, 0]), np.zeros(3))
     >>> cube = sim.frame(own, [PointTarget(np.array([1500.0, 0, 0]), np.zeros(3))])

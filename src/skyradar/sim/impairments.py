@@ -26,7 +26,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
-from skyradar.sim.impairment_effects import (
+from skyradar.sim.impairment_signals import (
     apply_channel_errors,
     channel_errors,
     dbm_to_w,

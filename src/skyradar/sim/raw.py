@@ -53,7 +53,7 @@ def received_power_w(config: RadarConfig, positions_m: np.ndarray, rcs_m2: np.nd
 
     Examples
     --------
-    >>> cfg = RadarConfig.seed_prototype()
+    >>> cfg = RadarConfig.prototype_2022()
     >>> p = received_power_w(cfg, np.array([[1000.0, 0, 0]]), 1.0)
     >>> round(float(10 * np.log10(p[0] / cfg.noise_power_w)), 1)  # single-pixel SNR, dB
     30.6
@@ -77,7 +77,7 @@ def adc_noise(config: RadarConfig, seed: int | np.random.SeedSequence | None = N
 
     Examples
     --------
-    >>> cfg = RadarConfig.seed_prototype()
+    >>> cfg = RadarConfig.prototype_2022()
     >>> n = adc_noise(cfg, seed=1)
     >>> n.shape, bool(abs(np.mean(abs(n) ** 2) / (cfg.noise_power_w * n.shape[1] * n.shape[2]) - 1) < 0.01)
     ((4, 250, 2032), True)
@@ -164,7 +164,7 @@ def simulate_adc(
     Examples
     --------
     >>> from skyradar.process.rangedoppler import range_doppler
-    >>> cfg = RadarConfig.seed_prototype()
+    >>> cfg = RadarConfig.prototype_2022()
     >>> adc = simulate_adc(cfg, [[1500.0, 0, 0]], [[-20.0, 0, 0]], noise=False)
     >>> rd = range_doppler(adc, cfg)
     >>> k, j = np.unravel_index(np.abs(rd[..., 0]).argmax(), rd.shape[:2])

@@ -22,7 +22,7 @@ import yaml
 from skyradar.errors import InputError
 from skyradar.io.safe_yaml import load_yaml
 from skyradar.scene.scenario import Scenario
-from skyradar.sim.run import make_simulator, scenario_truth, simulate_frames
+from skyradar.sim.scenario_frames import make_simulator, scenario_truth, simulate_frames
 
 __all__ = ["set_by_path", "parse_values", "run_table", "sweep"]
 

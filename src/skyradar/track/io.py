@@ -78,14 +78,14 @@ def read_detections(path: str | Path) -> pd.DataFrame:
 
 
 def radar_config_from_attrs(df: pd.DataFrame) -> RadarConfig:
-    """The RadarConfig stored in a table's attrs (``radar_config`` JSON), else the seed prototype."""
+    """The RadarConfig stored in a table's attrs (``radar_config`` JSON), else the thesis prototype."""
     text = df.attrs.get("radar_config") if hasattr(df, "attrs") else None
     if text:
         try:
             return RadarConfig.from_json(text if isinstance(text, str) else str(text))
         except Exception:  # noqa: BLE001 - unreadable metadata falls back to the documented default
             pass
-    return RadarConfig.seed_prototype()
+    return RadarConfig.prototype_2022()
 
 
 class Truth:

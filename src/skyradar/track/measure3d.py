@@ -5,7 +5,7 @@ direction ``u``. In principle its error along the line of sight is the range err
 plus the range-Doppler coupling ``c V_R`` when the radial velocity is not known unaliased) and
 across it the angle error times the range; :func:`position_covariance` writes that model. (On the
 full chain the along-sight error was measured at 17-25 m RMS, so the tracker
-(:mod:`skyradar.track.run`) passes an along-sight sigma no smaller than the across-sight one.)
+(:mod:`skyradar.track.track_table`) passes an along-sight sigma no smaller than the across-sight one.)
 The angle error is the Cramer-Rao bound of the phase-difference DoA
 (:func:`skyradar.process.doa.doa_crlb`) at the detection's SNR, which matches the measured error of
 the full chain (ch4 Free, RMS across-line-of-sight error / bound: 1.1 at 8-12 dB, 1.0 at 12-16 dB,
@@ -38,7 +38,7 @@ def angle_sigma_rad(
 
     Examples
     --------
-    >>> cfg = RadarConfig.seed_prototype()
+    >>> cfg = RadarConfig.prototype_2022()
     >>> s = angle_sigma_rad(np.array([10.0, 30.0, -20.0]), cfg)
     >>> bool(s[0] > s[1] >= 0.01), bool(np.isinf(s[2]))
     (True, True)

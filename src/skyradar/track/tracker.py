@@ -83,7 +83,7 @@ class RangeDopplerTracker:
         self._range_wrap: np.ndarray | None = None
         self._cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         k = self.config.history
-        self.t = {
+        self.tracks = {
             "x": np.zeros((0, 4)),
             "P": np.zeros((0, 4, 4)),
             "ids": np.zeros(0, np.int64),
@@ -109,7 +109,7 @@ class RangeDopplerTracker:
     @property
     def n_tracks(self) -> int:
         """Live tracks, tentative and confirmed."""
-        return int(self.t["ids"].size)
+        return int(self.tracks["ids"].size)
 
     def step(self, time_s: float, z: np.ndarray) -> FrameTracks:
         """Process one frame of detections ``z`` (m, 2) = (range [m], radial velocity [m/s]).
@@ -119,24 +119,24 @@ class RangeDopplerTracker:
         if self.time_s is not None and time_s < self.time_s:
             raise ValueError(f"time goes backwards ({self.time_s} -> {time_s})")
         z = np.asarray(z, float).reshape(-1, 2)
-        t = self.t
-        if self.time_s is not None and t["ids"].size and time_s > self.time_s:
+        tr = self.tracks
+        if self.time_s is not None and tr["ids"].size and time_s > self.time_s:
             dt = time_s - self.time_s
             F, Q, F_u, Q_u = self._matrices(dt)
-            if self._hybrid and not t["resolved"].all():
+            if self._hybrid and not tr["resolved"].all():
                 # Two groups with one F each: cheaper than stacking a per-track F.
                 for rows, FF, QQ in (
-                    (np.flatnonzero(t["resolved"]), F, Q),
-                    (np.flatnonzero(~t["resolved"]), F_u, Q_u),
+                    (np.flatnonzero(tr["resolved"]), F, Q),
+                    (np.flatnonzero(~tr["resolved"]), F_u, Q_u),
                 ):
-                    t["x"][rows], t["P"][rows] = predict(t["x"][rows], t["P"][rows], FF, QQ)
+                    tr["x"][rows], tr["P"][rows] = predict(tr["x"][rows], tr["P"][rows], FF, QQ)
             else:
-                t["x"], t["P"] = predict(t["x"], t["P"], F, Q)
+                tr["x"], tr["P"] = predict(tr["x"], tr["P"], F, Q)
         self.time_s = float(time_s)
         assoc = self._associate(z)
-        assigned = np.full(t["ids"].size, -1)
+        assigned = np.full(tr["ids"].size, -1)
         assigned[assoc.track_index] = assoc.detection_index
-        innov = np.full((t["ids"].size, 2), np.nan)
+        innov = np.full((tr["ids"].size, 2), np.nan)
         innov[assoc.track_index] = assoc.innovation
         self._update(assoc, z)
         self._bookkeep(assigned >= 0)
@@ -146,16 +146,16 @@ class RangeDopplerTracker:
         used[assoc.detection_index] = True
         new_det = np.flatnonzero(~used)
         self._start(z[new_det])
-        alive_ids = t["ids"]
+        alive_ids = tr["ids"]
         alive_det = np.concatenate([assigned, new_det])
-        confirmed = t["confirmed"][: assigned.size]
+        confirmed = tr["confirmed"][: assigned.size]
         out = np.ones(assigned.size, bool) if self.report_tentative else confirmed
         return FrameTracks(
             self.time_s,
-            t["ids"][: assigned.size][out],
-            t["x"][: assigned.size][out],
-            t["P"][: assigned.size][out],
-            t["n_updates"][: assigned.size][out],
+            tr["ids"][: assigned.size][out],
+            tr["x"][: assigned.size][out],
+            tr["P"][: assigned.size][out],
+            tr["n_updates"][: assigned.size][out],
             assigned[out],
             innov[out],
             alive_ids,
@@ -179,9 +179,9 @@ class RangeDopplerTracker:
         return self._cache[key]
 
     def _associate(self, z: np.ndarray) -> Association:
-        t, m = self.t, self.model
+        tr, m = self.tracks, self.model
         # H = [[1, c, 0, 0], [0, 1, 0, 0]] written out: S = H P H^T + R without batched matmuls.
-        c, P, x = m.coupling_s, t["P"], t["x"]
+        c, P, x = m.coupling_s, tr["P"], tr["x"]
         z_pred = np.column_stack([x[:, 0] + c * x[:, 1], x[:, 1]])
         S = np.empty((x.shape[0], 2, 2))
         S[:, 0, 0] = P[:, 0, 0] + 2 * c * P[:, 0, 1] + c * c * P[:, 1, 1] + self._R[0, 0]
@@ -190,16 +190,16 @@ class RangeDopplerTracker:
         range_wrap = None
         if self._thesis:
             range_wrap = np.where(
-                t["n_updates"] == 1, m.doppler_width_mps * (self.time_s - t["t_update"]), np.nan
+                tr["n_updates"] == 1, m.doppler_width_mps * (self.time_s - tr["t_update"]), np.nan
             )
         self._range_wrap = range_wrap
         # Confirmed tracks choose first; tentative tracks share what is left. Otherwise the
         # solver's preference for more pairs lets a new track take a confirmed track's detection
         # while the confirmed track is handed a clutter point.
         if self.config.confirmed_first:
-            stages = [np.flatnonzero(t["confirmed"]), np.flatnonzero(~t["confirmed"])]
+            stages = [np.flatnonzero(tr["confirmed"]), np.flatnonzero(~tr["confirmed"])]
         else:
-            stages = [np.arange(t["ids"].size)]
+            stages = [np.arange(tr["ids"].size)]
         free = np.ones(len(z), bool)
         parts = []
         for rows in stages:
@@ -226,45 +226,46 @@ class RangeDopplerTracker:
         )
 
     def _update(self, assoc: Association, z: np.ndarray) -> None:
-        t, m = self.t, self.model
+        tr, m = self.tracks, self.model
         rows = assoc.track_index
         if rows.size == 0:
             return
         if self._range_wrap is not None:
             self._shift_alias(rows, z[assoc.detection_index, 0], assoc.innovation[:, 0])
-        t["x"][rows], t["P"][rows] = update(t["x"][rows], t["P"][rows], assoc.innovation, self._H, self._R)
+        x, P = tr["x"][rows], tr["P"][rows]
+        tr["x"][rows], tr["P"][rows] = update(x, P, assoc.innovation, self._H, self._R)
         if self._hybrid:
             self._resolve(rows)
         if self._thesis:
-            push_history(t["hist_t"], rows, np.full(rows.size, self.time_s), t["n_updates"][rows])
-            push_history(t["hist_r"], rows, z[assoc.detection_index, 0], t["n_updates"][rows])
-            rate = range_rate_fit(t["hist_t"][rows], t["hist_r"][rows], t["n_updates"][rows] + 1)
+            push_history(tr["hist_t"], rows, np.full(rows.size, self.time_s), tr["n_updates"][rows])
+            push_history(tr["hist_r"], rows, z[assoc.detection_index, 0], tr["n_updates"][rows])
+            rate = range_rate_fit(tr["hist_t"][rows], tr["hist_r"][rows], tr["n_updates"][rows] + 1)
             ok = np.isfinite(rate)
             r_ok = rows[ok]
-            t["x"][r_ok, 2] = rate[ok]
+            tr["x"][r_ok, 2] = rate[ok]
             self._shift_velocity(
-                r_ok, dealias_velocity(t["x"][r_ok, 1], rate[ok], m.doppler_width_mps) - t["x"][r_ok, 1]
+                r_ok, dealias_velocity(tr["x"][r_ok, 1], rate[ok], m.doppler_width_mps) - tr["x"][r_ok, 1]
             )
 
     def _resolve(self, rows: np.ndarray) -> None:
         """Resolve the alias of tracks whose range rate is now known well enough (confident mode)."""
-        t, width = self.t, self.model.doppler_width_mps
-        sd = np.sqrt(t["P"][rows, 2, 2])
-        now = ~t["resolved"][rows] & (sd < self.config.resolve_fraction * width)
+        tr, width = self.tracks, self.model.doppler_width_mps
+        sd = np.sqrt(tr["P"][rows, 2, 2])
+        now = ~tr["resolved"][rows] & (sd < self.config.resolve_fraction * width)
         r = rows[now]
-        self._shift_velocity(r, dealias_velocity(t["x"][r, 1], t["x"][r, 2], width) - t["x"][r, 1])
-        t["resolved"][r] = True
-        done = rows[t["resolved"][rows]]
+        self._shift_velocity(r, dealias_velocity(tr["x"][r, 1], tr["x"][r, 2], width) - tr["x"][r, 1])
+        tr["resolved"][r] = True
+        done = rows[tr["resolved"][rows]]
         # Once resolved, range follows V_R; the range-rate state simply reports it.
-        t["x"][done, 2] = t["x"][done, 1]
+        tr["x"][done, 2] = tr["x"][done, 1]
 
     def _shift_velocity(self, rows: np.ndarray, delta_mps: np.ndarray) -> None:
         """Move V_R by whole image widths, keeping the predicted observed range unchanged.
 
         The observed range is ``R + c V_R`` (range-Doppler coupling), so R moves by ``-c dV``.
         """
-        self.t["x"][rows, 1] += delta_mps
-        self.t["x"][rows, 0] -= self.model.coupling_s * delta_mps
+        self.tracks["x"][rows, 1] += delta_mps
+        self.tracks["x"][rows, 0] -= self.model.coupling_s * delta_mps
 
     def _shift_alias(self, rows: np.ndarray, range_m: np.ndarray, wrapped_m: np.ndarray) -> None:
         """Move single-observation tracks to the alias their wrapped range innovation chose.
@@ -273,45 +274,45 @@ class RangeDopplerTracker:
         de-aliasing rule with the range rate of the first two observations, so the prediction is
         shifted by ``k`` image widths (range by ``k W dt``) before the ordinary update.
         """
-        t, width = self.t, self.model.doppler_width_mps
+        tr, width = self.tracks, self.model.doppler_width_mps
         span = self._range_wrap[rows]
         use = np.isfinite(span) & (span > 0)
         if not np.any(use):
             return
         r = rows[use]
-        k = np.round((range_m[use] - t["x"][r, 0] - wrapped_m[use]) / span[use])
-        t["x"][r, 0] += k * span[use]
+        k = np.round((range_m[use] - tr["x"][r, 0] - wrapped_m[use]) / span[use])
+        tr["x"][r, 0] += k * span[use]
         self._shift_velocity(r, k * width)
 
     def _bookkeep(self, hit: np.ndarray) -> None:
-        t = self.t
-        t["frames"] += 1
-        t["hits"] += hit
-        t["window"] = push_hit(t["window"], hit, self.initiator.n)
-        t["n_updates"] += hit
-        t["misses"] = np.where(hit, 0, t["misses"] + 1)
-        t["t_update"] = np.where(hit, self.time_s, t["t_update"])
+        tr = self.tracks
+        tr["frames"] += 1
+        tr["hits"] += hit
+        tr["window"] = push_hit(tr["window"], hit, self.initiator.n)
+        tr["n_updates"] += hit
+        tr["misses"] = np.where(hit, 0, tr["misses"] + 1)
+        tr["t_update"] = np.where(hit, self.time_s, tr["t_update"])
 
     def _manage(self) -> np.ndarray:
         """Confirm and delete; returns the mask of surviving tracks (in pre-deletion order)."""
-        t = self.t
-        tentative = ~t["confirmed"]
-        confirmed_now, failed = self.initiator.window_status(t["window"], t["misses"])
-        t["confirmed"] = t["confirmed"] | (tentative & confirmed_now)
-        dead = (tentative & failed & ~t["confirmed"]) | (
-            t["confirmed"] & self.deleter.delete(t["misses"], self.time_s - t["t_update"])
+        tr = self.tracks
+        tentative = ~tr["confirmed"]
+        confirmed_now, failed = self.initiator.window_status(tr["window"], tr["misses"])
+        tr["confirmed"] = tr["confirmed"] | (tentative & confirmed_now)
+        dead = (tentative & failed & ~tr["confirmed"]) | (
+            tr["confirmed"] & self.deleter.delete(tr["misses"], self.time_s - tr["t_update"])
         )
         alive = ~dead
         if np.any(dead):
             for name in _FIELDS:
-                t[name] = t[name][alive]
+                tr[name] = tr[name][alive]
         return alive
 
     def _start(self, z_new: np.ndarray) -> None:
         n = len(z_new)
         if n == 0:
             return
-        t, m = self.t, self.model
+        tr, m = self.tracks, self.model
         x = np.zeros((n, 4))
         x[:, :2] = z_new
         x[:, 0] -= m.coupling_s * z_new[:, 1]
@@ -339,4 +340,4 @@ class RangeDopplerTracker:
         }
         self._next_id += n
         for name in _FIELDS:
-            t[name] = np.concatenate([t[name], new[name]])
+            tr[name] = np.concatenate([tr[name], new[name]])

@@ -41,7 +41,7 @@ def plot_strength(
 
     Examples
     --------
-    >>> cfg = RadarConfig.seed_prototype()
+    >>> cfg = RadarConfig.prototype_2022()
     >>> im = plot_strength(np.ones((cfg.n_range, cfg.n_doppler, cfg.n_rx)) * 1e-9, cfg)
     >>> bool(im.get_extent()[0] < 0 < im.get_extent()[1])
     True

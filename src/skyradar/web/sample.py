@@ -65,7 +65,7 @@ def sample_run_dataset(
     >>> ds.sizes["time"], list(ds["target"].values)
     (3, ['head-on', 'crossing'])
     """
-    config = config or RadarConfig.seed_prototype()
+    config = config or RadarConfig.prototype_2022()
     t = np.arange(n_frames) * dt_s
     own, tgt = _truth(t, config.range_limit_m)
     iq = np.zeros((n_frames, config.n_range, config.n_doppler, config.n_rx), np.complex64)

@@ -1,4 +1,4 @@
-"""Benchmark of the raw chain: ADC cube to range-Doppler cube for the seed prototype.
+"""Benchmark of the raw chain: ADC cube to range-Doppler cube for the thesis prototype.
 
 One frame is 4 rx x 250 chirps x 2032 complex samples. Ours is
 :class:`skyradar.process.rangedoppler.RangeDopplerProcessor` (Hann windows, split range DFT that
@@ -84,7 +84,7 @@ def _frames(config: RadarConfig, n_frames: int) -> list[np.ndarray]:
 
 def run(n_frames: int = 20, workers: int = 2) -> dict[str, Any]:
     """Time ours and the baseline on ``n_frames`` prototype frames; returns the result dict."""
-    config = RadarConfig.seed_prototype()
+    config = RadarConfig.prototype_2022()
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     frames = _frames(config, max(2, int(n_frames)))
     ours_s, ours_cpu = _batch_seconds(RangeDopplerProcessor(config, workers=workers), frames)

@@ -1,0 +1,124 @@
+"""The thesis' pre-processing of radar and map images before they are compared (seed-brief.md ch6).
+
+Each method is a scaling step followed by a transform, as in the thesis:
+
+========================  ================================  ==========================================
+method                    scaling                           transform
+========================  ================================  ==========================================
+``"gamma"``               gamma correction (0.5)            none (the thesis' 53 % false-positive baseline)
+``"threshold_entropy"``   threshold at the mean (method 5)  local entropy (``skimage.filters.rank``)
+``"clahe_ridge"``         CLAHE (method 8)                  Sato ridge operator (Hessian eigenvalues)
+``"clahe_entropy"``       CLAHE (method 9)                  local entropy
+========================  ================================  ==========================================
+
+Near-range returns are much brighter than far ones and "could not be flattened analytically" (thesis):
+the local contrast steps (CLAHE, entropy) are what make a radar image comparable with a map. Every
+method returns a float32 image in ``[0, 1]`` with 0 outside the valid mask, so SSIM can use
+``data_range=1``. All transforms are (nearly) rotation invariant, so a world map can be processed once
+and then sampled at any pose (:mod:`skyradar.nav.gpscheck.compare`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from skimage import exposure, filters
+from skimage.morphology import disk
+from skimage.util import img_as_ubyte
+
+from skyradar.errors import InputError
+
+__all__ = ["METHODS", "THESIS_METHOD_NUMBER", "scale_to_unit", "preprocess"]
+
+METHODS = ("gamma", "threshold_entropy", "clahe_ridge", "clahe_entropy")
+THESIS_METHOD_NUMBER = {"threshold_entropy": 5, "clahe_ridge": 8, "clahe_entropy": 9}
+
+
+def scale_to_unit(
+    image: np.ndarray, mask: np.ndarray | None = None, *, log_power: bool = False, percentiles=(1.0, 99.0)
+) -> np.ndarray:
+    """Map the ``percentiles`` of the valid pixels to 0..1 (clipped); 0 outside ``mask``.
+
+    Parameters
+    ----------
+    image : 2-D array
+        Radar power (linear, set ``log_power``) or a map image; NaN counts as outside the mask.
+    mask : 2-D bool array, optional
+        Valid pixels (default: the finite ones).
+    log_power : bool
+        Convert linear power to dB first (radar images span many decades).
+
+    Examples
+    --------
+    >>> scale_to_unit(np.array([[1.0, 10.0], [100.0, np.nan]]), log_power=True, percentiles=(0, 100)).tolist()
+    [[0.0, 0.5], [1.0, 0.0]]
+    """
+    image = np.asarray(image, dtype=np.float64)
+    valid = np.isfinite(image) if mask is None else (np.asarray(mask, bool) & np.isfinite(image))
+    if log_power:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            image = 10.0 * np.log10(np.where(valid, np.maximum(image, 1e-30), 1.0))
+    out = np.zeros(image.shape, dtype=np.float32)
+    if not valid.any():
+        return out
+    low, high = np.percentile(image[valid], percentiles)
+    span = high - low if high > low else 1.0
+    out[valid] = np.clip((image[valid] - low) / span, 0.0, 1.0)
+    return out
+
+
+def _entropy(unit: np.ndarray, radius_px: int) -> np.ndarray:
+    """Local Shannon entropy (bits) of an 8-bit copy, scaled by its 8-bit maximum to 0..1."""
+    return filters.rank.entropy(img_as_ubyte(unit), disk(radius_px)).astype(np.float32) / 8.0
+
+
+def preprocess(
+    image: np.ndarray,
+    method: str,
+    mask: np.ndarray | None = None,
+    *,
+    log_power: bool = False,
+    clahe_kernel_px: int = 32,
+    ridge_sigmas_px: tuple[float, ...] = (1.0, 2.0),
+    entropy_radius_px: int = 3,
+) -> np.ndarray:
+    """One of :data:`METHODS` applied to a radar or map image: float32 in 0..1, 0 outside the mask.
+
+    Parameters
+    ----------
+    image : 2-D array
+        Radar ground image (linear power, with ``log_power=True``) or a rendered map.
+    method : str
+        One of :data:`METHODS`.
+    mask : 2-D bool array, optional
+        Valid pixels (default: the finite ones); the result is 0 elsewhere.
+    clahe_kernel_px, ridge_sigmas_px, entropy_radius_px : scales in pixels
+        CLAHE tile size, Sato scales and entropy disc radius; keep them equal for radar and map.
+
+    Examples
+    --------
+    >>> img = np.zeros((40, 40)); img[:, 20] = 1.0  # a bright line
+    >>> out = preprocess(img, "clahe_ridge")
+    >>> out.dtype.name, bool(out[:, 20].mean() > 5 * out[:, :10].mean())
+    ('float32', True)
+    """
+    if method not in METHODS:
+        raise InputError(f"--method: must be one of {', '.join(METHODS)}, got {method!r}")
+    unit = scale_to_unit(image, mask, log_power=log_power)
+    valid = np.isfinite(np.asarray(image, float)) if mask is None else np.asarray(mask, bool)
+    if method == "gamma":
+        out = unit**0.5
+    elif method == "threshold_entropy":
+        level = unit[valid].mean() if valid.any() else 0.5
+        out = _entropy((unit > level).astype(np.float32), entropy_radius_px)
+    else:
+        kernel = max(8, min(clahe_kernel_px, *unit.shape))
+        equalised = exposure.equalize_adapthist(unit, kernel_size=kernel).astype(np.float32)
+        if method == "clahe_entropy":
+            out = _entropy(equalised, entropy_radius_px)
+        else:
+            ridge = filters.sato(equalised, sigmas=ridge_sigmas_px, black_ridges=False, mode="reflect")
+            top = np.percentile(ridge[valid], 99.0) if valid.any() else 0.0
+            out = np.clip(ridge / top, 0.0, 1.0) if top > 0 else np.zeros_like(ridge)
+    out = np.asarray(out, dtype=np.float32)
+    out[~valid] = 0.0
+    return out

@@ -102,7 +102,8 @@ FILTERS = {
 
 
 def _terrain(name: str, size_m: float, seed: int):
-    from skyradar.scene.terrain import flat_terrain, fractal_terrain, jacksboro
+    from skyradar.scene.dem_readers import jacksboro
+    from skyradar.scene.synthetic_terrain import flat_terrain, fractal_terrain
 
     sd = TERRAINS[name]
     if sd is None:
@@ -361,16 +362,6 @@ def run(
             "runtime_s": time.perf_counter() - t_start,
         }
     )
-    write_json_atomic(out_dir / "ch5.json", _finite_or_none(results))
+    write_json_atomic(out_dir / "ch5.json", results)  # NaN (no valid frame) -> null
     return results
 
-
-def _finite_or_none(value: Any) -> Any:
-    """NaN (no valid frame) becomes null: strict JSON."""
-    if isinstance(value, dict):
-        return {k: _finite_or_none(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_finite_or_none(v) for v in value]
-    if isinstance(value, float) and not np.isfinite(value):
-        return None
-    return value

@@ -93,11 +93,22 @@ def finite_column(df: pd.DataFrame, col: str, source: str | Path, allow_nan: boo
 
 
 def jsonable(value: Any) -> Any:
-    """``value`` with numpy scalars made plain and NaN/inf made None (JSON has no NaN)."""
+    """``value`` with numpy scalars and arrays made plain and NaN/inf made None (JSON has no NaN).
+
+    The one JSON sanitiser: results printed with ``--json``, written by :func:`write_json_atomic` and sent
+    by the live display all go through it.
+
+    Examples
+    --------
+    >>> jsonable({"a": np.float32(1.5), "b": np.array([1.0, np.nan]), 3: (np.int64(2), float("inf"))})
+    {'a': 1.5, 'b': [1.0, None], '3': [2, None]}
+    """
     if isinstance(value, dict):
         return {str(k): jsonable(v) for k, v in value.items()}
     if isinstance(value, list | tuple):
         return [jsonable(v) for v in value]
+    if isinstance(value, np.ndarray) and value.ndim > 0:
+        return [jsonable(v) for v in value.tolist()]
     if hasattr(value, "item") and callable(value.item) and getattr(value, "ndim", 0) == 0:
         value = value.item()
     if isinstance(value, float) and not math.isfinite(value):

@@ -8,9 +8,9 @@ range bin. This module returns it, unaliased.
 
 Steps per frame:
 
-1. Power image (sum of |iq|^2 over receivers) and a noise floor: the larger of the thermal noise
-   of the RadarConfig and a low quantile of the image scaled by the chi-square statistics of
-   ``n_rx`` summed exponentials, so real data with a raised floor are gated correctly.
+1. Power image (sum of |iq|^2 over receivers, :func:`summed_power_image`) and a noise floor: the
+   larger of the thermal noise of the RadarConfig and a low quantile of the image scaled by the
+   chi-square statistics of ``n_rx`` summed exponentials, so real data with a raised floor gate correctly.
 2. Gate: pixels ``threshold_db`` above the noise floor are "occupied"; per range bin, fades of
    up to ``max_gap_bins`` Doppler bins inside the band are closed and runs shorter than
    ``min_band_bins`` (noise, small intruders) are dropped. All of this is circular in Doppler.
@@ -42,8 +42,9 @@ from scipy import ndimage, stats
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
+from skyradar.process.power import power_image
 
-__all__ = ["Ridge", "power_image", "noise_floor_w", "band_start", "extract_ridge"]
+__all__ = ["Ridge", "summed_power_image", "noise_floor_w", "band_start", "extract_ridge"]
 
 
 @dataclass(frozen=True)
@@ -85,19 +86,21 @@ class Ridge:
         return cls(e, e, e.astype(int), e.astype(int), e, noise_w, n_occupied)
 
 
-def power_image(iq: np.ndarray) -> np.ndarray:
-    """Summed received power per pixel, W: (range, doppler, rx) complex -> (range, doppler).
+def summed_power_image(iq: np.ndarray) -> np.ndarray:
+    """Channel-SUMMED received power per pixel, W (float64): (range, doppler, rx) complex -> (range, doppler).
 
-    A real 2-D array is taken as a power image already.
+    ``n_rx`` times :func:`skyradar.process.power.power_image` (the channel mean), so thermal noise
+    is a sum of ``n_rx`` exponentials, as :func:`noise_floor_w` assumes. A real 2-D array is taken
+    as a summed power image already.
 
     Examples
     --------
-    >>> power_image(np.full((2, 3, 4), 1 + 1j)).tolist()[0]
+    >>> summed_power_image(np.full((2, 3, 4), 1 + 1j)).tolist()[0]
     [8.0, 8.0, 8.0]
     """
     arr = np.asarray(iq)
     if arr.ndim == 3:
-        return np.sum(arr.real.astype(np.float64) ** 2 + arr.imag.astype(np.float64) ** 2, axis=2)
+        return arr.shape[2] * power_image(arr, dtype=np.float64)
     if arr.ndim == 2 and not np.iscomplexobj(arr):
         return arr.astype(np.float64)
     raise InputError(
@@ -204,7 +207,7 @@ def extract_ridge(
     >>> extract_ridge(np.zeros((cfg.n_range, cfg.n_doppler)), cfg).range_m.size
     0
     """
-    power = power_image(frame)
+    power = summed_power_image(frame)
     if power.shape != (config.n_range, config.n_doppler):
         raise InputError(
             f"frame: shape {power.shape} does not match radar ({config.n_range}, {config.n_doppler})"

@@ -5,7 +5,8 @@ small blob. A plain threshold splits the blob into several detections; here ever
 returns one detection per connected blob, at the blob's brightest pixel, refined to sub-pixel
 accuracy by a parabola through the dB values of the peak and its neighbours.
 
-Images are the non-coherent mean over receive channels, ``mean_k |x_k / c_k|^2`` (W), so the
+Images are the non-coherent mean over receive channels, ``mean_k |x_k / c_k|^2`` (W,
+:func:`skyradar.process.power.power_image`, also importable here as ``integrate_channels``), so the
 thermal noise per pixel keeps its single-channel mean ``config.noise_power_w`` and follows a
 Gamma(L, 1/L) law for L channels; the CFAR factors below are exact for that law. The Doppler
 axis wraps around (aliasing), so every window and every blob wraps across its edges.
@@ -35,6 +36,7 @@ from numba import njit
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.process.cfar import cfar_2d, cfar_factor
+from skyradar.process.power import power_image
 
 __all__ = [
     "Detections",
@@ -79,11 +81,11 @@ class Detections:
 
     def range_m(self, config: RadarConfig) -> np.ndarray:
         """Range of each detection, m (bin k centred at k*dR)."""
-        return self.range_bin * config.range_resolution_m
+        return config.range_at_bin_m(self.range_bin)
 
     def radial_velocity_mps(self, config: RadarConfig) -> np.ndarray:
         """Radial velocity (aliased into [-VLim, VLim)), m/s, positive receding."""
-        v = (self.doppler_bin - config.n_doppler // 2) * config.doppler_resolution_mps
+        v = config.radial_velocity_at_bin_mps(self.doppler_bin)
         return (v + config.v_lim_mps) % (2.0 * config.v_lim_mps) - config.v_lim_mps
 
     def select(self, keep: np.ndarray) -> Detections:
@@ -91,40 +93,8 @@ class Detections:
         return Detections(*(getattr(self, f)[keep] for f in self.__dataclass_fields__))
 
 
-@njit(cache=True, fastmath=True)
-def _mean_power(iq: np.ndarray, weight: np.ndarray) -> np.ndarray:
-    # iq: (n_range, n_doppler, 2 n_rx) float32 view of the complex cube (re, im interleaved).
-    n_r, n_d, n_k = iq.shape
-    out = np.empty((n_r, n_d), np.float32)
-    for i in range(n_r):
-        for j in range(n_d):
-            acc = np.float32(0.0)
-            for k in range(n_k):
-                v = iq[i, j, k]
-                acc += v * v * weight[k]
-            out[i, j] = acc
-    return out
-
-
-def integrate_channels(cube: np.ndarray, calibration: np.ndarray | None = None) -> np.ndarray:
-    """Non-coherent mean of ``|x_k / c_k|^2`` over receive channels, W (float32).
-
-    Parameters
-    ----------
-    cube : ndarray, shape (n_range, n_doppler, n_rx), complex
-        One range-Doppler frame.
-    calibration : ndarray, shape (n_rx,), complex, optional
-        Per-channel complex gains the signal is divided by (``RadarConfig.rx_calibration``).
-    """
-    cube = np.asarray(cube)
-    if cube.ndim != 3:
-        raise InputError(f"frame: expected (range, doppler, rx) array, got shape {cube.shape}")
-    n_rx = cube.shape[2]
-    gain = np.ones(n_rx) if calibration is None else np.asarray(calibration)
-    if gain.shape != (n_rx,):
-        raise InputError(f"frame: field 'rx' has {n_rx} channels, calibration has {gain.shape[0]}")
-    weight = np.repeat(1.0 / (np.abs(gain) ** 2 * n_rx), 2).astype(np.float32)
-    return _mean_power(np.ascontiguousarray(cube, dtype=np.complex64).view(np.float32), weight)
+# The channel-integrated image has one home, skyradar.process.power; the old name stays importable here.
+integrate_channels = power_image
 
 
 def shi_tomasi(

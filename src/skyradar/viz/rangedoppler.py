@@ -17,6 +17,7 @@ import numpy as np  # noqa: E402
 
 from skyradar.config import RadarConfig  # noqa: E402
 from skyradar.io.atomic import savefig_atomic  # noqa: E402
+from skyradar.process.power import power_image  # noqa: E402
 
 __all__ = ["image_extent", "plot_strength", "plot_phase_difference", "save_frame_figure"]
 
@@ -29,8 +30,8 @@ def image_extent(config: RadarConfig) -> tuple[float, float, float, float]:
 
 
 def strength_db(frame: np.ndarray, config: RadarConfig) -> np.ndarray:
-    """Non-coherent sum over antennas, dB relative to the per-pixel noise power."""
-    power = np.sum(np.abs(frame) ** 2, axis=-1) / frame.shape[-1]
+    """Channel-mean power (:func:`skyradar.process.power.power_image`), dB over the per-pixel noise power."""
+    power = power_image(frame, dtype=np.float64)
     return 10 * np.log10(np.maximum(power, 1e-30) / config.noise_power_w)
 
 

@@ -21,11 +21,13 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from skyradar.daa.pipeline import alerts_from_tracks, ownship_from_frames, truth_tracks
+from skyradar.daa.pipeline import alerts_for_run
+from skyradar.daa.run_tables import has_ownship
 from skyradar.errors import InputError
 from skyradar.io import cint16
 from skyradar.io.frames import FrameStoreWriter, open_frames, radar_config_of
-from skyradar.io.tables import read_table
+from skyradar.io.tables import jsonable, read_table
+from skyradar.process.power import power_image
 
 __all__ = ["RunSource", "range_doppler_png"]
 
@@ -39,7 +41,7 @@ _ADVICE_KEYS = (
 
 
 def range_doppler_png(iq_frame: np.ndarray, noise_power_w: float, span_db: float = 40.0) -> bytes:
-    """Colour PNG of one (range, doppler, rx) frame: receiver-summed power, noise floor to +span_db.
+    """Colour PNG of one (range, doppler, rx) frame: receiver-integrated power, noise floor to +span_db.
 
     Range grows upwards, radial velocity to the right.
 
@@ -49,8 +51,8 @@ def range_doppler_png(iq_frame: np.ndarray, noise_power_w: float, span_db: float
     >>> png[:4]
     b'\\x89PNG'
     """
-    power = np.sum(np.abs(iq_frame) ** 2, axis=-1)
-    floor_db = 10 * np.log10(iq_frame.shape[-1] * noise_power_w)
+    power = power_image(iq_frame, dtype=np.float64)  # channel mean: noise averages noise_power_w
+    floor_db = 10 * np.log10(noise_power_w)
     db = 10 * np.log10(np.maximum(power, 1e-30))
     img = np.clip((db - floor_db + 3.0) / (span_db + 3.0), 0.0, 1.0)
     img8 = (img[::-1] * 255).astype(np.uint8)
@@ -140,18 +142,14 @@ class RunSource:
             self.alerts = read_table(self.alerts_path, required=["time_s", "track_id", "level"])
             self.traffic_source = "alerts"
             return
-        try:
-            own = ownship_from_frames(self.ds, str(self._opened))
-        except InputError:
-            if self.tracks_path is not None:
-                raise  # tracks cannot be alerted without the own-ship state
+        if self.tracks_path is None and not has_ownship(self.ds):
             self.alerts, self.traffic_source = pd.DataFrame(), "none"  # e.g. a real recording: image only
             return
-        if self.tracks_path is not None:
-            tracks, self.traffic_source = read_table(self.tracks_path, sort_by="time_s"), "tracks"
-        else:
-            tracks, self.traffic_source = truth_tracks(self.ds), "truth"
-        self.alerts = alerts_from_tracks(tracks, own, source=str(self.tracks_path or self._opened))
+        tracks = None if self.tracks_path is None else read_table(self.tracks_path, sort_by="time_s")
+        self.traffic_source = "truth" if tracks is None else "tracks"
+        # Tracks without the run's own-ship state cannot be alerted: alerts_for_run says so.
+        names = {"run_name": str(self._opened), "tracks_name": str(self.tracks_path)}
+        self.alerts = alerts_for_run(self.ds, tracks, **names)
 
     def info(self) -> dict[str, Any]:
         """Run summary for the page."""
@@ -189,11 +187,11 @@ class RunSource:
         rows = self.alerts[np.abs(self.alerts["time_s"].to_numpy() - t) <= dt]
         keys = ["track_id", "level", "flarm_level", "sector", "layer", "range_m", "bearing_deg", "tcpa_s",
                 "rel_north_m", "rel_east_m", "rel_alt_m", "climb_rate_mps"]  # fmt: skip
-        traffic = [{k: _plain(r[k]) for k in keys if k in r} for r in rows.to_dict("records")]
+        traffic = [{k: jsonable(r[k]) for k in keys if k in r} for r in rows.to_dict("records")]
         advice = None
         if len(rows) and "heading_bands_deg" in rows and rows["level"].max() > 0:
             r0 = rows.iloc[0]
-            advice = {k: _plain(r0[k]) for k in _ADVICE_KEYS if k in rows}
+            advice = {k: jsonable(r0[k]) for k in _ADVICE_KEYS if k in rows}
         return traffic, advice
 
     def frame(self, i: int, with_image: bool = True) -> dict[str, Any]:
@@ -219,13 +217,3 @@ class RunSource:
                 payload["rd_png"] = "data:image/png;base64," + base64.b64encode(png).decode()
         return payload
 
-
-def _plain(value: Any) -> Any:
-    """JSON-safe Python value (numpy scalars and arrays, NaN -> None)."""
-    if isinstance(value, np.ndarray | list | tuple):
-        return [_plain(v) for v in value]
-    if hasattr(value, "item"):
-        value = value.item()
-    if isinstance(value, float) and not np.isfinite(value):
-        return None
-    return value

@@ -12,7 +12,7 @@ import pytest
 
 from skyradar.benchmarks.sim import FacetPhysics, numpy_baseline_frame, thesis_baseline_frame
 from skyradar.config import Mount, RadarConfig
-from skyradar.scene.terrain import fractal_terrain
+from skyradar.scene.synthetic_terrain import fractal_terrain
 from skyradar.sim.image import ImageSimulator, PlatformState
 
 ORIGIN = (52.0, 4.36, 100.0)

@@ -17,7 +17,7 @@ from test_flight_state_ridge import CFG, flat_ground_cube
 
 def _simulated_run(tmp_path, mount: Mount, name: str, n: int = 4, height_m: float = 600.0):
     """A run from the image simulator over flat ground (first use compiles its kernel: slow)."""
-    from skyradar.scene.terrain import flat_terrain
+    from skyradar.scene.synthetic_terrain import flat_terrain
     from skyradar.sim.image import ImageSimulator, PlatformState
 
     cfg = RadarConfig.prototype_2022(mount=mount, range_limit_m=2500.0)

@@ -16,7 +16,7 @@ from skyradar.process.ground import (
     in_ground_band,
     static_radial_velocity_mps,
 )
-from skyradar.scene.terrain import flat_terrain
+from skyradar.scene.synthetic_terrain import flat_terrain
 
 CFG = RadarConfig.prototype_2022()
 

@@ -18,7 +18,7 @@ from skyradar.io.frames import frames_dataset
 from skyradar.process.pipeline import DETECTION_COLUMNS, process_frames
 from skyradar.process.smoothing import hann_smooth, hann_window
 from skyradar.process.spurs import SpurMap
-from skyradar.scene.terrain import flat_terrain
+from skyradar.scene.synthetic_terrain import flat_terrain
 
 ORIGIN = (52.0, 4.0, 0.0)
 CFG = RadarConfig.prototype_2022(mount=Mount.preset("forward-down"))

@@ -12,15 +12,9 @@ from rasterio.warp import transform as warp_transform
 
 from skyradar.errors import InputError
 from skyradar.geo import geodetic_to_ned
-from skyradar.scene.terrain import (
-    Terrain,
-    flat_terrain,
-    fractal_terrain,
-    jacksboro,
-    local_height_sd,
-    read_dem,
-    roughness_map,
-)
+from skyradar.scene.dem_readers import jacksboro, read_dem
+from skyradar.scene.synthetic_terrain import flat_terrain, fractal_terrain, local_height_sd, roughness_map
+from skyradar.scene.terrain import Terrain
 
 N = 1201
 THESIS_SD_M = [19.2, 39.9, 63.6, 251.2, 345.0]

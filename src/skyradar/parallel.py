@@ -11,6 +11,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from skyradar.errors import InputError
+from skyradar.extras import import_extra
 
 __all__ = ["connect", "close", "map_chunks", "map_frame_chunks", "check_workers", "max_local_workers"]
 
@@ -54,8 +55,13 @@ def check_workers(workers: int | None, option: str = "--workers") -> int | None:
 
 
 def connect(scheduler: str | None, workers: int | None, timeout_s: float = 10.0):
-    """A ``distributed.Client`` on ``scheduler``, or on a new local cluster of ``workers`` processes."""
-    from distributed import Client, LocalCluster
+    """A ``distributed.Client`` on ``scheduler``, or on a new local cluster of ``workers`` processes.
+
+    Needs the optional ``dask`` extra (:class:`~skyradar.extras.MissingExtraError` otherwise); runs
+    without ``--workers`` / ``--scheduler`` never get here and need no Dask scheduler.
+    """
+    distributed = import_extra("distributed", "dask", "--workers/--scheduler (a Dask cluster)")
+    Client, LocalCluster = distributed.Client, distributed.LocalCluster
 
     if scheduler is not None:
         try:
@@ -128,9 +134,9 @@ def map_frame_chunks(
             if progress:
                 progress(stop - start)
         return results
+    client = connect(scheduler, workers)
     from distributed import as_completed
 
-    client = connect(scheduler, workers)
     try:
         futures = [client.submit(job, path, start, stop, *args, pure=False) for start, stop in bounds]
         order = {f.key: i for i, f in enumerate(futures)}

@@ -78,11 +78,11 @@ def _summary_job(built, chunk_frames: int, index: int) -> dict[str, Any]:
 
 def run_flight(built, workers: int, chunk_frames: int = 64, store: Path | None = None) -> dict[str, Any]:
     """Simulate the whole flight on a local cluster of ``workers``; frames/s and memory per chunk."""
-    from distributed import as_completed
-
+    from skyradar.extras import import_extra
     from skyradar.parallel import close, connect
     from skyradar.sim.simulate_store import simulate_to_zarr
 
+    as_completed = import_extra("distributed", "dask", "skyradar bench flight").as_completed
     n = built.times_s.size
     client = connect(None, workers)
     try:

@@ -43,7 +43,7 @@ def ownship_signature(ds: xr.Dataset, source: str) -> str | None:
     >>> sig["time_span_s"], sig["samples"][-1]
     ([0.0, 3.0], [3.0, 30.0, 0.0, -500.0])
     """
-    from skyradar.process.pipeline import scenario_origin
+    from skyradar.io.run_origin import scenario_origin
 
     if not all(name in ds for name in _POS) or ds.sizes.get("time", 0) == 0:
         return None
@@ -119,7 +119,7 @@ def check_tracks_match_run(tracks_attrs: dict[str, Any], tracks_path: str, ds: x
     anywhere along its ``source`` chain, or without own-ship state in ``ds``, nothing can be
     compared and nothing is raised (the time-span check of the alerting still applies).
     """
-    from skyradar.process.pipeline import scenario_origin
+    from skyradar.io.run_origin import scenario_origin
 
     made_text = _signature_of(tracks_attrs)
     if made_text is None or not all(name in ds for name in _POS) or ds.sizes.get("time", 0) == 0:

@@ -45,7 +45,7 @@ def terrain_following_flight(
 
     Examples
     --------
-    >>> from skyradar.scene.terrain import flat_terrain
+    >>> from skyradar.scene.synthetic_terrain import flat_terrain
     >>> t = flat_terrain(52.0, 4.0, size_m=6000.0)
     >>> f = terrain_following_flight(t, (52.0, 4.0, 0.0), np.arange(5.0))
     >>> round(float(f.height_agl_m.mean()), 3), round(float(f.vx_mps[0]), 2)

@@ -25,7 +25,6 @@ Examples
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable
 from typing import Any, Literal
 
@@ -38,6 +37,7 @@ from skyradar.errors import InputError
 from skyradar.geo import ned_rotation_to, ned_to_geodetic, rotation_matrix
 from skyradar.io.checks import check_finite_frames
 from skyradar.io.frames import radar_config_of
+from skyradar.io.run_origin import scenario_origin  # re-exported: it lived here before issue 16
 from skyradar.process.calibration import in_field_of_view
 from skyradar.process.detect import detect, integrate_channels
 from skyradar.process.doa import (
@@ -112,23 +112,6 @@ def process_cube(
         "u_ant": u,
         "coherence": coherence,
     }
-
-
-def scenario_origin(ds: xr.Dataset) -> tuple[float, float, float] | None:
-    """Geodetic origin (lat_deg, lon_deg, alt_m) of the run's NED frame from its attributes, if stored."""
-    attrs = ds.attrs
-    if all(k in attrs for k in ("origin_lat_deg", "origin_lon_deg")):
-        return (
-            float(attrs["origin_lat_deg"]),
-            float(attrs["origin_lon_deg"]),
-            float(attrs.get("origin_alt_m", 0.0)),
-        )
-    origin = attrs.get("origin")
-    if origin is not None:
-        values = json.loads(origin) if isinstance(origin, str) else list(origin)
-        if len(values) >= 2:
-            return float(values[0]), float(values[1]), float(values[2]) if len(values) > 2 else 0.0
-    return None
 
 
 def _own_state(ds: xr.Dataset) -> dict[str, np.ndarray] | None:

@@ -124,7 +124,7 @@ def dem_for_run(path: str | Path, ds: Any, range_limit_m: float, source: str) ->
 
 def _run_track(ds: Any, source: str) -> tuple[np.ndarray, np.ndarray, tuple[float, ...] | None]:
     from skyradar.geo import ned_to_geodetic
-    from skyradar.process.pipeline import scenario_origin
+    from skyradar.io.run_origin import scenario_origin
 
     origin = scenario_origin(ds)
     if "own_lat_deg" in ds and "own_lon_deg" in ds:

@@ -19,6 +19,7 @@ from scipy import sparse
 from scipy.sparse.linalg import spsolve
 
 from skyradar.errors import InputError
+from skyradar.extras import import_extra
 from skyradar.geo import geodetic_to_ned
 from skyradar.scene.terrain import Bounds, Terrain
 
@@ -170,10 +171,11 @@ def read_geotiff(path: str | Path, max_void_fraction: float = 0.01, bounds: Boun
     metres and the grid's rotation from true north (meridian convergence) measured at the anchor.
     The nodata value and NaN are voids.
     """
-    import rasterio
+    path = Path(path)
+    # The later rasterio imports of this module run only after this one succeeded.
+    rasterio = import_extra("rasterio", "geo", f"{path.name}: reading a GeoTIFF")
     from rasterio.errors import RasterioError
 
-    path = Path(path)
     try:
         with rasterio.open(path) as ds:
             nodata, tf, crs = ds.nodata, ds.transform, ds.crs

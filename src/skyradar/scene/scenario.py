@@ -86,7 +86,7 @@ class BuiltScenario:
     times_s: np.ndarray
     sim_options: dict[str, Any] = field(default_factory=dict)
     source: Path | None = None
-    impairments: Any = None  # skyradar.sim.impairments.ImpairmentConfig or None
+    impairments: Any = None  # skyradar.scene.impairment_config.ImpairmentConfig or None
 
 
 def _describe(value: Any) -> str:
@@ -248,11 +248,12 @@ class Scenario:
         t = self.model.terrain
         if t is None:
             return None
-        from skyradar.scene import terrain as terrain_mod
+        from skyradar.scene.dem_readers import jacksboro
+        from skyradar.scene.synthetic_terrain import flat_terrain, fractal_terrain
 
         try:
             if t.type == "jacksboro":
-                return terrain_mod.jacksboro()
+                return jacksboro()
             if t.type == "file":
                 return _read_dem_near(self._path(t.path), bounds, origin)
             if origin is None:
@@ -261,9 +262,9 @@ class Scenario:
                 )
             height = origin[2] if t.height_m is None else t.height_m
             if isinstance(t, FlatTerrainModel):
-                return terrain_mod.flat_terrain(origin[0], origin[1], height, t.size_m, t.spacing_m)
+                return flat_terrain(origin[0], origin[1], height, t.size_m, t.spacing_m)
             assert isinstance(t, FractalTerrainModel)
-            return terrain_mod.fractal_terrain(
+            return fractal_terrain(
                 origin[0], origin[1], t.local_sd_m, size_m=t.size_m, spacing_m=t.spacing_m, seed=t.seed,
                 mean_height_m=height,
             )  # fmt: skip

@@ -39,7 +39,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
-from skyradar.sim.impairments import ImpairmentConfig
+from skyradar.scene.impairment_config import ImpairmentConfig
 
 __all__ = [
     "TAGS",
@@ -307,4 +307,4 @@ class ScenarioModel(_Model):
     duration_s: Positive
     start_s: Time = 0.0
     simulation: SimulationModel = Field(default_factory=SimulationModel)
-    impairments: ImpairmentConfig | None = None  # skyradar.sim.impairments; e.g. {preset: thesis_flight_look}
+    impairments: ImpairmentConfig | None = None  # e.g. {preset: thesis_flight_look}

@@ -1,0 +1,107 @@
+"""The package layering (README, "Architecture"; pyproject.toml [tool.importlinter]).
+
+A package imports only the layers below it. The contract is checked on the real code, and on a tiny
+copy of the package tree with a deliberate back-import, to show the check can fail.
+"""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+import tomllib
+import warnings
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+LINT_IMPORTS = [sys.executable, "-c", "import sys; from importlinter.cli import lint_imports_command; "
+                "sys.exit(lint_imports_command())"]  # fmt: skip
+
+
+def _lint(config: Path, cwd: Path, pythonpath: Path) -> subprocess.CompletedProcess:
+    # A subprocess: the tiny tree must shadow the installed skyradar on sys.path.
+    return subprocess.run(
+        [*LINT_IMPORTS, "--config", str(config), "--no-cache", "--no-logo"],
+        cwd=cwd, capture_output=True, text=True, timeout=120,
+        env={"PYTHONPATH": str(pythonpath), "PATH": "/usr/bin:/bin"},
+    )  # fmt: skip
+
+
+def _layer_names() -> list[str]:
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]
+    (contract,) = config["contracts"]
+    names = []
+    for layer in contract["layers"]:
+        names += [n.strip() for n in layer.split("|") if not n.strip().startswith("(")]
+    return names
+
+
+@pytest.fixture
+def tiny_tree(tmp_path: Path) -> Path:
+    """Every layer of the contract as an empty module, beside a copy of the real pyproject.toml."""
+    src = tmp_path / "src" / "skyradar"
+    src.mkdir(parents=True)
+    (src / "__init__.py").write_text("")
+    for name in _layer_names():
+        if name.startswith("__"):
+            (src / f"{name}.py").write_text("")
+        else:
+            (src / name).mkdir()
+            (src / name / "__init__.py").write_text("")
+    (src / "sim" / "engine.py").write_text("from skyradar.scene import models\n")  # downward: allowed
+    (src / "scene" / "models.py").write_text("from skyradar import errors\n")
+    shutil.copy(ROOT / "pyproject.toml", tmp_path / "pyproject.toml")
+    return tmp_path
+
+
+def test_the_real_code_keeps_the_layers():
+    result = _lint(ROOT / "pyproject.toml", ROOT, ROOT / "src")
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "skyradar layers KEPT" in result.stdout
+
+
+def test_the_tiny_tree_passes_before_the_back_import(tiny_tree: Path):
+    result = _lint(tiny_tree / "pyproject.toml", tiny_tree, tiny_tree / "src")
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
+@pytest.mark.parametrize(
+    ("module", "code", "needle"),
+    [
+        # A lazy import inside a function is still an import (scene imported sim.impairments so).
+        (
+            "scene/lazy.py",
+            "def f():\n    from skyradar.sim import engine\n",
+            "skyradar.scene.lazy -> skyradar.sim",
+        ),
+        ("process/beside.py", "import skyradar.sim.engine\n", "skyradar.process.beside -> skyradar.sim"),
+        ("errors.py", "from skyradar.units import x\n", "skyradar.errors -> skyradar.units"),
+    ],
+    ids=["lazy-back-import", "beside", "within-layer-1"],
+)
+def test_a_deliberate_back_import_breaks_the_check(tiny_tree: Path, module: str, code: str, needle: str):
+    (tiny_tree / "src" / "skyradar" / module).write_text(code)
+    result = _lint(tiny_tree / "pyproject.toml", tiny_tree, tiny_tree / "src")
+    assert result.returncode == 1, result.stdout + result.stderr
+    assert "skyradar layers BROKEN" in result.stdout
+    assert needle in result.stdout
+
+
+def test_a_new_package_outside_the_layering_breaks_the_check(tiny_tree: Path):
+    (tiny_tree / "src" / "skyradar" / "radarheads").mkdir()
+    (tiny_tree / "src" / "skyradar" / "radarheads" / "__init__.py").write_text("")
+    result = _lint(tiny_tree / "pyproject.toml", tiny_tree, tiny_tree / "src")
+    assert result.returncode != 0
+    assert "skyradar.radarheads" in result.stdout + result.stderr
+
+
+def test_the_old_terrain_names_still_import_with_a_deprecation_warning():
+    import skyradar.scene.terrain as terrain
+    from skyradar.scene.synthetic_terrain import flat_terrain
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert terrain.flat_terrain is flat_terrain
+    assert any(issubclass(w.category, DeprecationWarning) for w in caught)

@@ -188,7 +188,7 @@ def numpy_baseline_frame(
 
     Examples
     --------
-    >>> from skyradar.scene.terrain import flat_terrain
+    >>> from skyradar.scene.synthetic_terrain import flat_terrain
     >>> cfg = RadarConfig.prototype_2022(range_limit_m=1000.0)
     >>> origin = (52.0, 4.36, 0.0)
     >>> ground = flat_terrain(*origin, size_m=3000.0, spacing_m=50.0)

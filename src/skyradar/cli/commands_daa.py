@@ -88,6 +88,9 @@ def serve(
     """
     import sys
 
+    from skyradar.extras import require_extra
+
+    require_extra("web", "skyradar serve")  # before anything: one line naming the extra, not a traceback
     import uvicorn
 
     from skyradar.web.net import LoopbackHostOnly, bind_socket, is_loopback

@@ -17,11 +17,12 @@ compiled pass): a GPS check scores hundreds of candidate poses per frame, so thi
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 
 import numpy as np
 from affine import Affine
-from numba import njit
+from numba import njit, prange
 
 from skyradar.errors import InputError
 
@@ -184,30 +185,45 @@ class PoseGrid:
         return north_m + forward * c - right * s, east_m + forward * s + right * c
 
 
-@njit(cache=True, nogil=True, boundscheck=False)
-def _sample_kernel(image, n0, e0, pix, poses, f0, r0, bpix, rows, cols, fill, out):
+@njit(cache=True, nogil=True, boundscheck=False, fastmath=True)
+def _sample_one(image, n0, e0, pix, pose, f0, r0, bpix, fill, out):
     nr, nc = image.shape
-    for k in range(poses.shape[0]):
-        c, s = np.cos(poses[k, 2]), np.sin(poses[k, 2])
-        # Pixel coordinates are affine in (i, j): step them instead of recomputing the rotation.
-        row_base = (poses[k, 0] + f0 * c - r0 * s - n0) / pix
-        col_base = (poses[k, 1] + f0 * s + r0 * c - e0) / pix
-        drow_i, dcol_i = bpix * c / pix, bpix * s / pix
-        drow_j, dcol_j = -bpix * s / pix, bpix * c / pix
-        for i in range(rows):
-            for j in range(cols):
-                r = row_base + i * drow_i + j * drow_j
-                q = col_base + i * dcol_i + j * dcol_j
-                # A hair of tolerance so a pixel exactly on the raster's edge is not lost to rounding.
-                if r < -1e-6 or q < -1e-6 or r > nr - 1 + 1e-6 or q > nc - 1 + 1e-6:
-                    out[k, i, j] = fill
-                    continue
+    rows, cols = out.shape
+    c, s = np.cos(pose[2]), np.sin(pose[2])
+    # Pixel coordinates are affine in (i, j): step them instead of recomputing the rotation.
+    row_base = (pose[0] + f0 * c - r0 * s - n0) / pix
+    col_base = (pose[1] + f0 * s + r0 * c - e0) / pix
+    drow_i, dcol_i = bpix * c / pix, bpix * s / pix
+    drow_j, dcol_j = -bpix * s / pix, bpix * c / pix
+    # A hair of tolerance so a pixel exactly on the raster's edge is not lost to rounding.
+    low, row_high, col_high = -1e-6, nr - 1 + 1e-6, nc - 1 + 1e-6
+    for i in range(rows):
+        row_i = row_base + i * drow_i
+        col_i = col_base + i * dcol_i
+        for j in range(cols):
+            r = row_i + j * drow_j
+            q = col_i + j * dcol_j
+            if r > low and q > low and r < row_high and q < col_high:
                 ri = min(max(int(r), 0), nr - 2)
                 qi = min(max(int(q), 0), nc - 2)
-                fr, fq = r - ri, q - qi
-                top = image[ri, qi] * (1.0 - fq) + image[ri, qi + 1] * fq
-                bottom = image[ri + 1, qi] * (1.0 - fq) + image[ri + 1, qi + 1] * fq
-                out[k, i, j] = top * (1.0 - fr) + bottom * fr
+                fr, fq = np.float32(r - ri), np.float32(q - qi)
+                top = image[ri, qi] + (image[ri, qi + 1] - image[ri, qi]) * fq
+                bottom = image[ri + 1, qi] + (image[ri + 1, qi + 1] - image[ri + 1, qi]) * fq
+                out[i, j] = top + (bottom - top) * fr
+            else:
+                out[i, j] = fill
+
+
+@njit(cache=True, nogil=True)
+def _sample_serial(image, n0, e0, pix, poses, f0, r0, bpix, fill, out):
+    for k in range(poses.shape[0]):
+        _sample_one(image, n0, e0, pix, poses[k], f0, r0, bpix, fill, out[k])
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _sample_parallel(image, n0, e0, pix, poses, f0, r0, bpix, fill, out):
+    for k in prange(poses.shape[0]):
+        _sample_one(image, n0, e0, pix, poses[k], f0, r0, bpix, fill, out[k])
 
 
 def sample_at_poses(
@@ -250,9 +266,13 @@ def sample_at_poses(
         raise InputError(f"sample_at_poses: poses must be (n, 3) north, east, heading; got {poses.shape}")
     rows, cols = pose_grid.shape
     out = np.empty((poses.shape[0], rows, cols), dtype=np.float32)
-    _sample_kernel(
+    # Poses in parallel from the main thread only: numba's default (workqueue) threading layer must not
+    # be entered from two threads at once, as Dask worker threads would.
+    many = poses.shape[0] >= 8 and threading.current_thread() is threading.main_thread()
+    kernel = _sample_parallel if many else _sample_serial
+    kernel(
         image, grid.north0_m, grid.east0_m, grid.pixel_m, poses, pose_grid.forward0_m, pose_grid.right0_m,
-        pose_grid.pixel_m, rows, cols, np.float32(fill), out,
+        pose_grid.pixel_m, np.float32(fill), out,
     )  # fmt: skip
     return out[0] if single else out
 

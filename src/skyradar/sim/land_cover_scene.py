@@ -175,6 +175,14 @@ class LandCoverSimulator:
             return np.empty(0, np.int64), np.empty(0)
         return facets["pixel"], facets["power_w"]
 
+    def lit_mask(self, platform: PlatformState) -> np.ndarray:
+        """Grid pixels that return power this frame: in range, in front of the antenna, not in shadow."""
+        mask = np.zeros(self.grid.shape, bool)
+        facets = self._facets(platform)
+        if facets is not None:
+            mask[facets["row"], facets["col"]] = True
+        return mask
+
     def ground_returns(self, platform: PlatformState, frame_index: int = 0) -> tuple[np.ndarray, np.ndarray]:
         """Facet pixel indices and their complex values per receive antenna, (n,) and (n, n_rx)."""
         cfg = self.config
@@ -230,6 +238,8 @@ class LandCoverSimulator:
             "pixel": (k * cfg.n_doppler + j)[inside],
             "power_w": power[inside],
             "path_m": path[inside],
+            "row": rows[inside],
+            "col": cols[inside],
         }
 
     def _shadowed(

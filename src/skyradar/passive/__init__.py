@@ -1,0 +1,6 @@
+"""Passive bistatic radar with a rotating ATC primary radar as illuminator (seed-brief ch7).
+
+Illuminator model, scene and IQ recording simulator (:mod:`.illuminator`, :mod:`.scene`,
+:mod:`.simulate`); the processor (pulses, matched filter, MTI, CFAR, bistatic localisation) beside them.
+Layer 3: imports only errors, units, geo, config, io and scene.
+"""

@@ -263,3 +263,30 @@ def test_bad_rasters_are_one_line_errors(tmp_path):
         with pytest.raises(InputError, match=needle) as err:
             read_map_raster(path)
         assert str(path) in str(err.value) and "\n" not in str(err.value)
+
+
+# --- sea from coastline ways ----------------------------------------------------------------------
+
+
+def test_sea_is_on_the_right_of_the_coastline():
+    from shapely.geometry import LineString, box
+
+    from skyradar.scene.coastline import sea_polygons
+
+    square = box(0.0, 0.0, 100.0, 100.0)
+    # A bay entering and leaving through the east edge, like Helsinki's. Walked west along y = 30 the
+    # bay (y > 30) is on the right: it is sea. Walked the other way, the rest of the square is.
+    bay = LineString([(100.0, 30.0), (60.0, 30.0), (60.0, 70.0), (100.0, 70.0)])
+    water = sea_polygons([bay], square)
+    assert sum(p.area for p in water) == pytest.approx(40.0 * 40.0)
+    land_side = sea_polygons([bay.reverse()], square)
+    assert sum(p.area for p in land_side) == pytest.approx(100.0 * 100.0 - 40.0 * 40.0)
+    # A coastline ending in the middle of the map names no side: no sea rather than a wrong one.
+    assert sea_polygons([LineString([(100.0, 50.0), (50.0, 50.0)])], square) == []
+
+
+def test_helsinki_sea_lies_off_the_buildings(helsinki):
+    sea = helsinki.water[helsinki.water.osm_id == -1]
+    assert sea.area.sum() > 50_000  # the bays reaching into the extract from the east
+    on_buildings = sea.union_all().intersection(helsinki.buildings.union_all()).area
+    assert on_buildings < 0.01 * sea.area.sum()

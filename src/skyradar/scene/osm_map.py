@@ -14,7 +14,8 @@ What is kept, and why:
   :data:`ROAD_WIDTH_M`. Ways tagged ``tunnel`` are dropped: neither radar nor a map shows them.
 - Lone trees (``natural=tree`` nodes) join the forest layer as discs of :data:`TREE_RADIUS_M`: in a city
   they are most of the vegetation a radar sees.
-- Sea drawn only by ``natural=coastline`` lines is not filled (OSM keeps the open sea outside any polygon).
+- The sea, which OSM draws only as ``natural=coastline`` lines, is cut out of the features' box by those
+  lines (:func:`skyradar.scene.coastline.sea_polygons`) and joins the water layer with ``osm_id`` -1.
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ import shapely
 
 from skyradar.errors import InputError
 from skyradar.geo import geodetic_to_ned
+from skyradar.scene.coastline import sea_polygons
 from skyradar.scene.ground_grid import GroundGrid
 
 __all__ = [
@@ -263,6 +265,11 @@ def _geodetic_layers(raw: dict) -> dict[str, gpd.GeoDataFrame]:
     layers.update(_area_layers(raw["areas"]))
     trees = raw["trees"]
     layers["trees"] = _pick(trees, _kind(trees, ("Point",))) if _present(trees) else _empty({})
+    areas = raw["areas"]
+    layers["coastline"] = _empty({})
+    if _present(areas):
+        coast = (_tag(areas, "natural").astype(str) == "coastline") & _kind(areas, ("LineString",))
+        layers["coastline"] = _pick(areas, coast)
     return layers
 
 
@@ -276,13 +283,26 @@ def _to_local(layers: dict[str, gpd.GeoDataFrame], lat0_deg: float, lon0_deg: fl
     for name, layer in layers.items():
         if len(layer):
             geometry = shapely.transform(layer.geometry.to_numpy(), lonlat_to_east_north)
-            if name not in ("roads", "railways", "trees"):
+            if name not in ("roads", "railways", "trees", "coastline"):
                 # OSM polygons are often self-touching; repair them so areas and unions are defined.
                 # Zero-area ones (ways clipped at the extract's edge) collapse to empty and are dropped.
                 geometry = shapely.make_valid(geometry, method="structure", keep_collapsed=False)
             layer.geometry = geometry
             layer = layer[~shapely.is_empty(geometry)].reset_index(drop=True)
         layers[name] = layer
+
+
+def _add_sea(layers: dict[str, gpd.GeoDataFrame]) -> None:
+    """Sea cut from the features' box by the coastline ways joins the water layer (``osm_id`` -1)."""
+    coastline = layers.pop("coastline")
+    if not len(coastline):
+        return
+    boxes = np.array([layer.total_bounds for layer in layers.values() if len(layer)])
+    box = shapely.box(boxes[:, 0].min(), boxes[:, 1].min(), boxes[:, 2].max(), boxes[:, 3].max())
+    sea = sea_polygons(coastline.geometry.to_numpy(), box)
+    if sea:
+        sea_rows = gpd.GeoDataFrame({"osm_id": np.full(len(sea), -1, dtype=np.int64)}, geometry=sea)
+        layers["water"] = pd.concat([layers["water"], sea_rows], ignore_index=True)
 
 
 def read_osm_map(
@@ -333,6 +353,7 @@ def read_osm_map(
         origin_lon_deg = float((boxes[:, 0].min() + boxes[:, 2].max()) / 2)
         origin_lat_deg = float((boxes[:, 1].min() + boxes[:, 3].max()) / 2)
     _to_local(layers, origin_lat_deg, origin_lon_deg)
+    _add_sea(layers)
     trees = layers.pop("trees")
     forest = layers["forest"].assign(tree=False)
     if len(trees):  # buffered in metres, after the conversion

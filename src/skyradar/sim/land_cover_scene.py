@@ -207,27 +207,28 @@ class LandCoverSimulator:
             raise InputError(
                 f"land cover: the antenna must be above the ground, got down = {antenna[2]:.1f} m"
             )
-        window = _window(grid, antenna, cfg.range_limit_m + cfg.range_resolution_m)
+        reach = cfg.range_limit_m + cfg.range_resolution_m
+        window = _window(grid, antenna, np.sqrt(max(reach**2 - antenna_up**2, 0.0)))
         if window is None:
             return None
         rows, cols = window
         north, east = grid.pixel_to_world(rows, cols)
-        top = self.height_m[rows, cols]
-        rel = np.stack([north - antenna[0], east - antenna[1], -top - antenna[2]], axis=-1)
+        rel = np.stack(
+            [north - antenna[0], east - antenna[1], -self.height_m[rows, cols] - antenna[2]], axis=-1
+        )
         p_ant = rel @ geom.rot_ned_to_ant.T
-        slant = np.linalg.norm(rel, axis=-1)
-        keep = (p_ant[:, 0] > 0) & (slant <= cfg.range_limit_m + cfg.range_resolution_m)
+        slant2 = np.einsum("ij,ij->i", rel, rel)
+        keep = (p_ant[:, 0] > 0) & (slant2 <= reach**2)
         if self.shadow:
             keep[keep] = ~self._shadowed(rows[keep], cols[keep], antenna, antenna_up)
-        rows, cols, rel, p_ant, slant = rows[keep], cols[keep], rel[keep], p_ant[keep], slant[keep]
+        rows, cols, rel, p_ant, slant2 = rows[keep], cols[keep], rel[keep], p_ant[keep], slant2[keep]
+        slant = np.sqrt(slant2)
         code = self.class_code[rows, cols]
         grazing = np.arcsin(np.clip(rel[:, 2] / np.maximum(slant, 1e-9), -1.0, 1.0))  # facet below: down > 0
         _, az, el = direction_angles(p_ant)
         gain2 = 10.0 ** (cfg.antenna.gain_db(az, el) / 5.0)
         sigma_m2 = sigma0(code, grazing) * self._texture[rows, cols] * grid.pixel_m**2
-        path = np.linalg.norm(p_ant - cfg.tx_position_m, axis=1)[:, None] + np.linalg.norm(
-            p_ant[:, None, :] - cfg.rx_positions_m[None], axis=2
-        )
+        path = _path_m(p_ant, slant2, cfg.tx_position_m) + _path_m(p_ant, slant2, cfg.rx_positions_m)
         half_path = path.mean(axis=1) / 2.0
         power = cfg.pe_w * gain2 * cfg.wavelength_m**2 * sigma_m2 / ((4 * np.pi) ** 3 * half_path**4)
         v_r = (p_ant / slant[:, None]) @ (geom.rot_ned_to_ant @ -np.asarray(geom.velocity_ned_mps, float))
@@ -250,6 +251,12 @@ class LandCoverSimulator:
         shadowed(self.height_m, rows.astype(np.int64), cols.astype(np.int64), antenna_rc, antenna_up,
                  self.grid.pixel_m, out)  # fmt: skip
         return out
+
+
+def _path_m(p_ant: np.ndarray, norm2: np.ndarray, antennas: np.ndarray) -> np.ndarray:
+    """Exact distances (n, m) from points (n, 3) to m antenna phase centres: |p|^2 - 2 p.a + |a|^2."""
+    a = np.atleast_2d(np.asarray(antennas, float))
+    return np.sqrt(np.maximum(norm2[:, None] - 2.0 * p_ant @ a.T + np.sum(a * a, axis=1), 0.0))
 
 
 def _window(

@@ -1,0 +1,94 @@
+"""Raw IQ files: ``NAME.cf32`` or ``NAME.ci16`` (interleaved little-endian I/Q) with a sidecar.
+
+The sidecar ``NAME.json`` / ``NAME.yaml`` holds ``sample_rate_hz``, ``center_frequency_hz``, optional
+``n_samples`` and ``start_time``, ``receiver`` (``latitude``, ``longitude``, ``altitude``) and
+``illuminator`` (the ``skyradar:illuminator`` object of :mod:`skyradar.io.sigmf_io`).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable
+from pathlib import Path
+
+import numpy as np
+
+from skyradar.errors import InputError
+from skyradar.io.atomic import atomic_path, write_text_atomic
+from skyradar.io.iq_recording import DATATYPES, IqRecording, _illuminator, _position
+from skyradar.io.safe_yaml import load_yaml
+
+__all__ = ["RAW_SUFFIXES", "read_raw_iq", "write_raw_iq"]
+
+RAW_SUFFIXES = {".cf32": "cf32_le", ".ci16": "ci16_le", ".cs16": "ci16_le"}
+
+
+def read_raw_iq(data_path: str | Path, require_illuminator: bool = True) -> IqRecording:
+    """Open ``NAME.cf32``/``NAME.ci16`` with its sidecar ``NAME.json``/``.yaml``/``.yml``."""
+    data_path = Path(data_path)
+    if not data_path.exists():
+        raise InputError(f"{data_path}: no such file")
+    sidecars = [data_path.with_suffix(s) for s in (".json", ".yaml", ".yml")]
+    sidecar = next((p for p in sidecars if p.exists()), None)
+    if sidecar is None:
+        raise InputError(f"{data_path}: no sidecar {data_path.stem}.json or .yaml with sample_rate_hz etc.")
+    try:
+        info = json.loads(sidecar.read_text()) if sidecar.suffix == ".json" else load_yaml(sidecar)
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{sidecar}: cannot read sidecar ({exc})") from None
+    if not isinstance(info, dict):
+        raise InputError(f"{sidecar}: sidecar must be a mapping, got {type(info).__name__}")
+    for key in ("sample_rate_hz", "center_frequency_hz"):
+        value = info.get(key)
+        if (
+            not isinstance(value, int | float)
+            or not np.isfinite(value)
+            or value < 0
+            or (key == "sample_rate_hz" and value == 0)
+        ):
+            raise InputError(f"{sidecar}: field '{key}' must be a positive number, got {value!r}")
+    illum, illum_pos = _illuminator(str(sidecar), info.get("illuminator"), require_illuminator)
+    receiver = info.get("receiver")
+    fields = {
+        **info,
+        "receiver_geodetic": _position(str(sidecar), "receiver", receiver),
+        "illuminator": illum,
+        "illuminator_geodetic": illum_pos,
+        "receiver": receiver,
+    }
+    return IqRecording(sidecar, data_path, RAW_SUFFIXES[data_path.suffix.lower()], 0, fields)
+
+
+def write_raw_iq(
+    path: str | Path, samples: Iterable[np.ndarray] | np.ndarray, sidecar: dict, datatype: str = "cf32_le"
+) -> Path:
+    """Write a raw ``.cf32``/``.ci16`` file and its ``.json`` sidecar (both atomically); return the data path.
+
+    ``ci16`` samples are the complex values times 32768, rounded and clipped to int16.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> side = {"sample_rate_hz": 5e6, "center_frequency_hz": 2.8e9,
+    ...         "receiver": {"latitude": 52.0, "longitude": 5.0, "altitude": 40.0},
+    ...         "illuminator": {"latitude": 52.1, "longitude": 5.0, "altitude": 20.0}}
+    >>> p = write_raw_iq(Path(tempfile.mkdtemp()) / "r.ci16", np.full(4, 0.5 + 0.25j), side, "ci16_le")
+    >>> read_raw_iq(p).read(0, 2).tolist()
+    [(0.5+0.25j), (0.5+0.25j)]
+    """
+    path = Path(path)
+    if datatype not in DATATYPES:
+        raise InputError(f"{path}: datatype {datatype!r} not writable; use one of {', '.join(DATATYPES)}")
+    blocks = [samples] if isinstance(samples, np.ndarray) else samples
+    n = 0
+    with atomic_path(path) as tmp, open(tmp, "wb") as f:
+        for block in blocks:
+            block = np.asarray(block, dtype=np.complex64).ravel()
+            n += block.size
+            if datatype == "ci16_le":
+                codes = np.clip(np.rint(block.view(np.float32) * 32768.0), -32768, 32767).astype("<i2")
+                f.write(codes.tobytes())
+            else:
+                f.write(block.astype("<c8").tobytes())
+    write_text_atomic(path.with_suffix(".json"), json.dumps({**sidecar, "n_samples": n}, indent=2))
+    return path

@@ -1,0 +1,135 @@
+"""A single-channel IQ recording of a passive receiver, memory-mapped, with the metadata a processor needs.
+
+:class:`IqRecording` is what :func:`skyradar.io.sigmf_io.read_iq_recording` returns for a SigMF pair or a
+raw ``.cf32``/``.ci16`` file with a sidecar (:mod:`skyradar.io.iq_raw`). The samples stay memory-mapped
+and are read in chunks (:meth:`IqRecording.chunks`), so memory is bounded by the chunk size, not the
+recording. Sample values are as recorded (the simulator writes sqrt(W) at the receiver input); ``ci16``
+codes are divided by 32768.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from skyradar.errors import InputError
+
+__all__ = ["DATATYPES", "IqRecording"]
+
+# SigMF datatype -> (numpy element dtype on disk, scale to float)
+DATATYPES: dict[str, tuple[str, float]] = {"cf32_le": ("<c8", 1.0), "ci16_le": ("<i2", 1.0 / 32768.0)}
+_POSITION = ("latitude", "longitude", "altitude")
+
+
+def _position(where: str, field: str, obj: Any) -> tuple[float, float, float]:
+    try:
+        lat, lon, alt = (float(obj[k]) for k in _POSITION)
+    except (KeyError, TypeError, ValueError):
+        raise InputError(
+            f"{where}: field '{field}' needs latitude, longitude and altitude, got {obj!r}"
+        ) from None
+    if not (abs(lat) <= 90 and abs(lon) <= 360 and np.isfinite(alt)):
+        raise InputError(f"{where}: field '{field}' has an impossible position {(lat, lon, alt)}")
+    return lat, lon, alt
+
+
+class IqRecording:
+    """A memory-mapped single-channel IQ recording with the metadata a passive processor needs.
+
+    Attributes
+    ----------
+    path, data_path : Path
+        The metadata (or sidecar) file and the sample file.
+    datatype : str
+        ``"cf32_le"`` or ``"ci16_le"``.
+    sample_rate_hz, center_frequency_hz : float
+    n_samples : int
+    start_time : str or None
+        ISO 8601 UTC time of sample 0.
+    receiver_geodetic, illuminator_geodetic : tuple of float
+        (lat_deg, lon_deg, alt_m), WGS84.
+    illuminator, receiver : dict
+        The ``skyradar:illuminator`` and ``skyradar:receiver`` objects.
+    """
+
+    def __init__(self, path: Path, data_path: Path, datatype: str, offset_bytes: int, info: dict) -> None:
+        self.path, self.data_path, self.datatype = Path(path), Path(data_path), datatype
+        self.sample_rate_hz = float(info["sample_rate_hz"])
+        self.center_frequency_hz = float(info["center_frequency_hz"])
+        self.start_time: str | None = info.get("start_time")
+        self.receiver_geodetic: tuple[float, float, float] = info["receiver_geodetic"]
+        self.illuminator: dict = info["illuminator"]
+        self.illuminator_geodetic = info["illuminator_geodetic"]
+        self.receiver: dict = info.get("receiver", {})
+        dtype, self._scale = DATATYPES[datatype]
+        sample_bytes = np.dtype(dtype).itemsize * (2 if datatype == "ci16_le" else 1)
+        size = self.data_path.stat().st_size - offset_bytes
+        if size < 0 or size % sample_bytes:
+            raise InputError(
+                f"{self.data_path}: data file of {size + offset_bytes} bytes ends inside a sample "
+                f"({datatype}, {sample_bytes} bytes per sample after {offset_bytes} header bytes): truncated?"
+            )
+        self.n_samples = size // sample_bytes
+        expected = info.get("n_samples")
+        if expected is not None and int(expected) > self.n_samples:
+            raise InputError(
+                f"{self.data_path}: data file holds {self.n_samples} samples, shorter than the "
+                f"{int(expected)} its metadata ({self.path.name}) says"
+            )
+        shape = (self.n_samples, 2) if datatype == "ci16_le" else (self.n_samples,)
+        self._raw = (
+            np.memmap(self.data_path, dtype=dtype, mode="r", offset=offset_bytes, shape=shape)
+            if self.n_samples
+            else np.zeros(shape, dtype)
+        )
+        stem = self.path.name.removesuffix(".sigmf-meta")
+        stem = stem.rsplit(".", 1)[0] if stem == self.path.name else stem
+        truth = self.path.with_name(stem + ".truth.parquet")
+        self.truth_table_path = truth if truth.exists() else None
+        truth_json = self.path.with_name(stem + ".truth.json")
+        self.truth_json_path = truth_json if truth_json.exists() else None
+
+    @property
+    def duration_s(self) -> float:
+        return self.n_samples / self.sample_rate_hz
+
+    def read(self, start: int, count: int) -> np.ndarray:
+        """Samples ``start .. start + count`` (clipped at the end) as a new complex64 array."""
+        start = max(int(start), 0)
+        stop = min(start + max(int(count), 0), self.n_samples)
+        block = self._raw[start:stop]
+        if self.datatype == "ci16_le":
+            out = np.empty(stop - start if stop > start else 0, np.complex64)
+            out.real, out.imag = block[:, 0], block[:, 1]
+            return out * np.float32(self._scale)
+        return np.array(block, dtype=np.complex64)
+
+    def chunks(self, chunk_samples: int, overlap: int = 0) -> Iterator[tuple[int, np.ndarray]]:
+        """Yield ``(start, samples)`` for consecutive chunks; each holds ``overlap`` extra samples after it.
+
+        Memory is one chunk (plus overlap) at a time whatever the recording's length.
+        """
+        if chunk_samples < 1 or overlap < 0:
+            raise InputError(f"chunk_samples must be >= 1 and overlap >= 0, got {chunk_samples}, {overlap}")
+        for start in range(0, self.n_samples, chunk_samples):
+            yield start, self.read(start, chunk_samples + overlap)
+
+    def __repr__(self) -> str:
+        return (
+            f"IqRecording({self.path.name}, {self.datatype}, {self.n_samples} samples at "
+            f"{self.sample_rate_hz / 1e6:g} MS/s, {self.duration_s:.3f} s)"
+        )
+
+
+def _illuminator(where: str, obj: Any, required: bool) -> tuple[dict, tuple | None]:
+    if not isinstance(obj, dict) or not all(k in obj for k in _POSITION):
+        if required:
+            raise InputError(
+                f"{where}: field 'skyradar:illuminator' has no position (latitude, longitude, altitude): "
+                f"the transmitter's site is needed to place echoes (got {obj!r})"
+            )
+        return (obj if isinstance(obj, dict) else {}), None
+    return obj, _position(where, "skyradar:illuminator", obj)

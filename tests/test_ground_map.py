@@ -14,7 +14,7 @@ import numpy as np
 import pymap3d
 import pytest
 import rasterio
-from rasterio.transform import from_origin
+from affine import Affine
 from scipy import ndimage
 
 from skyradar.errors import InputError
@@ -232,7 +232,9 @@ def test_geotiff_lands_where_pymap3d_puts_it(tmp_path):
         "dtype": "float32",
         "crs": "EPSG:32635",
     }
-    with rasterio.open(path, "w", transform=from_origin(easting0, northing0, 1.0, 1.0), **profile) as dst:
+    with rasterio.open(
+        path, "w", transform=Affine(1.0, 0.0, easting0, 0.0, -1.0, northing0), **profile
+    ) as dst:
         dst.write(data, 1)
     from pyproj import Transformer
 
@@ -249,6 +251,7 @@ def test_geotiff_lands_where_pymap3d_puts_it(tmp_path):
     assert bright.sum() == pytest.approx(400, rel=0.1)
 
 
+@pytest.mark.filterwarnings("ignore::rasterio.errors.NotGeoreferencedWarning")  # writing the plain file
 def test_bad_rasters_are_one_line_errors(tmp_path):
     plain = tmp_path / "plain.tif"
     with rasterio.open(plain, "w", driver="GTiff", width=8, height=8, count=1, dtype="uint8") as dst:
@@ -290,3 +293,11 @@ def test_helsinki_sea_lies_off_the_buildings(helsinki):
     assert sea.area.sum() > 50_000  # the bays reaching into the extract from the east
     on_buildings = sea.union_all().intersection(helsinki.buildings.union_all()).area
     assert on_buildings < 0.01 * sea.area.sum()
+
+
+def test_supersampled_map_is_the_block_mean_of_the_fine_one(helsinki):
+    coarse = GroundGrid.from_extent(-200.0, 200.0, -150.0, 150.0, pixel_m=4.0)
+    fine = GroundGrid.from_extent(-200.0, 200.0, -150.0, 150.0, pixel_m=1.0)
+    smooth = render_reference_map(helsinki, coarse, supersample=4)
+    blocks = render_reference_map(helsinki, fine).reshape(100, 4, 75, 4).mean(axis=(1, 3))
+    np.testing.assert_allclose(smooth, blocks, atol=1e-6)

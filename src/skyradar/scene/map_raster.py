@@ -75,7 +75,7 @@ def read_map_raster(
     """
     path = Path(path)
     if not path.is_file():
-        raise InputError(f"{path}: map raster does not exist")
+        raise InputError(f"{path}: map raster {'is not a file' if path.exists() else 'does not exist'}")
     try:
         with warnings.catch_warnings():
             # A raster without georeference is reported below as one InputError line, not a warning.

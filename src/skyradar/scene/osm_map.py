@@ -336,7 +336,7 @@ def read_osm_map(
     """
     path = Path(path)
     if not path.is_file():
-        raise InputError(f"{path}: map file does not exist")
+        raise InputError(f"{path}: map file {'is not a file' if path.exists() else 'does not exist'}")
     try:
         raw = _read_raw(path, None if bounding_box is None else [float(v) for v in bounding_box])
     except Exception as err:  # pyrosm raises PBFException, protobuf DecodeError, OSError, ValueError...

@@ -43,10 +43,7 @@ def flat_ground_frame(
         config.antenna.gain_db(np.arctan2(u_ant[:, 1], u_ant[:, 0]), np.arcsin(-u_ant[:, 2])) / 5.0
     )
     amp = np.sqrt(config.pe_w * gain2 * config.wavelength_m**2 * area * h_m / r / ((4 * np.pi) ** 3 * r**4))
-    k = np.floor((r + config.range_doppler_coupling_s * v_r) / config.range_resolution_m + 0.5).astype(int)
-    j = (
-        np.floor(v_r / config.doppler_resolution_mps + 0.5).astype(int) + config.n_doppler // 2
-    ) % config.n_doppler
+    k, j = config.range_bin(r, v_r), config.doppler_bin(v_r)
     ok = (k < config.n_range) & (u_ant[:, 0] > 0)
     # Exact two-way phase per receiver so the DoA of the terrain-aware method is meaningful.
     pa = r[ok, None] * u_ant[ok]

@@ -65,10 +65,7 @@ def synthetic_frame(
         value = amp * np.exp(
             1j * (2 * np.pi * np.mod(path / config.wavelength_m, 1.0) + rng.uniform(0, 2 * np.pi))
         )
-        k = int(np.floor(range_m / config.range_resolution_m + 0.5))
-        j = (
-            int(np.floor(v_mps / config.doppler_resolution_mps + 0.5)) + config.n_doppler // 2
-        ) % config.n_doppler
+        k, j = int(config.range_bin(range_m)), int(config.doppler_bin(v_mps))
         cube[k, j, :] += (value * gain).astype(np.complex64)
         pixels.append((k, j))
     return cube, pixels

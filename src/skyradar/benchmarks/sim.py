@@ -40,6 +40,7 @@ from skyradar.config import RadarConfig
 from skyradar.geo import geodetic_to_ned
 from skyradar.sim.geometry import AntennaGeometry
 from skyradar.sim.image import ImageSimulator, PlatformState, _reflectivity_table, two_way_gain_table
+from skyradar.units import nearest_bin
 
 __all__ = [
     "FacetPhysics",
@@ -116,8 +117,8 @@ def facet_returns(
     r_rx = np.linalg.norm(p[:, None, :] - cfg.rx_positions_m[None], axis=2)  # (m, n_rx)
     rng = 0.5 * (r_tx + r_rx.mean(axis=1))
     v_r = p @ (geom.rot_ned_to_ant @ -geom.velocity_ned_mps) / r0
-    kr = np.floor((rng + physics.coupling_s * v_r) / cfg.range_resolution_m + 0.5)
-    kd = (np.floor(v_r / cfg.doppler_resolution_mps + 0.5) + cfg.n_doppler // 2) % cfg.n_doppler
+    kr = nearest_bin(rng + physics.coupling_s * v_r, cfg.range_resolution_m)
+    kd = cfg.doppler_bin(v_r)
     ok = (cos_inc > 0.0) & (kr >= 0) & (kr < cfg.n_range)
     power = (
         physics.power_const
@@ -249,6 +250,24 @@ def _time_frames(fn, n_frames: int, min_seconds: float) -> float:
     return 1.0 / float(np.median(times))
 
 
+def _baseline_fps(config, terrain, origin, geometry, n_frames, baseline_frames, min_seconds) -> tuple:
+    """Frames/s of the thesis-style and the numpy baseline, on the same tile and geometry as ours."""
+    physics, rng = FacetPhysics(config), np.random.default_rng(1)
+    ny, nx = terrain.shape
+    lat, lon = terrain.latlon_of(np.arange(ny, dtype=float)[:, None], np.arange(nx, dtype=float)[None, :])
+    elevation = terrain.elevation_m.astype(float)
+    fps_thesis = _time_frames(
+        lambda i: thesis_baseline_frame(lat, lon, elevation, origin, geometry(i), physics, rng),
+        baseline_frames,
+        min_seconds,
+    )
+    grid = terrain.points_ned(*origin, flat_earth=True)
+    fps_numpy = _time_frames(
+        lambda i: numpy_baseline_frame(terrain, grid, geometry(i), physics, rng), n_frames, min_seconds
+    )
+    return fps_thesis, fps_numpy
+
+
 def run(n_frames: int = 40, baseline_frames: int = 6, min_seconds: float = 2.0) -> dict[str, Any]:
     """Frames/s of the simulator and of both baselines on the synthetic tile, in one run."""
     load_before = os.getloadavg()[0]
@@ -278,23 +297,9 @@ def run(n_frames: int = 40, baseline_frames: int = 6, min_seconds: float = 2.0) 
     fps, fps_full = ours_fps(same, n_frames), ours_fps(full, n_frames)
     fps_fine = ours_fps(fine, max(3, n_frames // 4))
 
-    physics, rng = FacetPhysics(config), np.random.default_rng(1)
+    ours_geometry = (config, terrain, origin, lambda i: same.geometry(platform(i)))
+    fps_thesis, fps_numpy = _baseline_fps(*ours_geometry, n_frames, baseline_frames, min_seconds)
     ny, nx = terrain.shape
-    lat, lon = terrain.latlon_of(np.arange(ny, dtype=float)[:, None], np.arange(nx, dtype=float)[None, :])
-    elevation = terrain.elevation_m.astype(float)
-    fps_thesis = _time_frames(
-        lambda i: thesis_baseline_frame(
-            lat, lon, elevation, origin, same.geometry(platform(i)), physics, rng
-        ),
-        baseline_frames,
-        min_seconds,
-    )
-    grid = terrain.points_ned(*origin, flat_earth=True)
-    fps_numpy = _time_frames(
-        lambda i: numpy_baseline_frame(terrain, grid, same.geometry(platform(i)), physics, rng),
-        n_frames,
-        min_seconds,
-    )
     return {
         "terrain": f"{ny}x{nx} {TERRAIN_NOTE}",
         "terrain_synthetic": True,

@@ -78,6 +78,47 @@ def _case(speed: float, n_frames: int) -> dict[str, Any]:
 MAX_FRAMES_PER_CASE = 200
 
 
+def _slow_case_measures(slow: dict) -> dict[str, Any]:
+    """30 m/s case: the ground's near-range and velocity asymptotes, and the intruder's pixel."""
+    cfg = slow["built"].radar
+    frame = slow["frames"][0]
+    ground = strength_db(frame, cfg) > GROUND_DB
+    ground[:, cfg.doppler_axis_mps > cfg.doppler_resolution_mps] = False  # ground never recedes at 30 m/s
+    first_ground = float(cfg.range_axis_m[np.nonzero(ground.any(axis=1))[0].min()])
+    h_fit, v_fit = fit_asymptotes(ground, cfg)
+    tgt_r, tgt_v, tgt_db = _intruder_pixel(frame, cfg, 5.0)
+    true_r = float(slow["truth"]["tgt_range_m"][0, 0])
+    true_v = float(slow["truth"]["tgt_radial_velocity_mps"][0, 0])
+    k_exp, j_exp = int(cfg.range_bin(true_r, true_v)), int(cfg.doppler_bin(true_v))
+    return {
+        "asymptote_range_m": h_fit,
+        "asymptote_range_expected_m": 1000.0,
+        "first_ground_range_m": first_ground,
+        "asymptote_velocity_mps": -v_fit,
+        "asymptote_velocity_expected_mps": -30.0,
+        "intruder_range_m": tgt_r,
+        "intruder_velocity_mps": tgt_v,
+        "intruder_snr_db": tgt_db,
+        "intruder_expected_range_m": float(cfg.range_axis_m[k_exp]),
+        "intruder_expected_velocity_mps": float(cfg.doppler_axis_mps[j_exp]),
+        "intruder_true_radial_velocity_mps": true_v,
+    }
+
+
+def _wrap_measures(fast: dict, cfg) -> dict[str, Any]:
+    """60 m/s case: the ground wraps past -VLim and reappears at the right edge of the image."""
+    fast_ground = strength_db(fast["frames"][0], cfg) > GROUND_DB
+    fast_ground[:, cfg.doppler_axis_mps <= cfg.doppler_resolution_mps] = False  # wrapped: right of zero
+    wrapped = np.nonzero(fast_ground.any(axis=0))[0]
+    wrap_min = float(cfg.doppler_axis_mps[wrapped.min()]) if wrapped.size else float("nan")
+    wrap_expected = -60.0 * np.sqrt(1 - (1000.0 / cfg.range_axis_m[-1]) ** 2) + 2 * cfg.v_lim_mps
+    return {
+        "wrap60_right_edge": bool(wrapped.size and wrapped.max() == cfg.n_doppler - 1),
+        "wrap60_min_velocity_mps": wrap_min,
+        "wrap60_expected_min_velocity_mps": float(wrap_expected),
+    }
+
+
 def run(out_dir: str | Path = "out/ch2", n_frames: int = 3) -> dict[str, Any]:
     """Simulate the ch2 cases, write figures and the table, return the measured values.
 
@@ -90,57 +131,23 @@ def run(out_dir: str | Path = "out/ch2", n_frames: int = 3) -> dict[str, Any]:
     out.mkdir(parents=True, exist_ok=True)
     slow, fast = _case(30.0, n_frames), _case(60.0, n_frames)
     cfg = slow["built"].radar
-    frame = slow["frames"][0]
-    ground = strength_db(frame, cfg) > GROUND_DB
-    ground[:, cfg.doppler_axis_mps > cfg.doppler_resolution_mps] = False  # ground never recedes at 30 m/s
-    first_ground = float(cfg.range_axis_m[np.nonzero(ground.any(axis=1))[0].min()])
-    h_fit, v_fit = fit_asymptotes(ground, cfg)
-    tgt_r, tgt_v, tgt_db = _intruder_pixel(frame, cfg, 5.0)
-    true_r = float(slow["truth"]["tgt_range_m"][0, 0])
-    true_v = float(slow["truth"]["tgt_radial_velocity_mps"][0, 0])
-    k_exp = int(np.floor((true_r + true_v * cfg.range_doppler_coupling_s) / cfg.range_resolution_m + 0.5))
-    j_exp = (int(np.floor(true_v / cfg.doppler_resolution_mps + 0.5)) + cfg.n_doppler // 2) % cfg.n_doppler
-
-    fast_frame = fast["frames"][0]
-    fast_ground = strength_db(fast_frame, cfg) > GROUND_DB
-    fast_ground[:, cfg.doppler_axis_mps <= cfg.doppler_resolution_mps] = (
-        False  # wrapped ground: right of zero
-    )
-    wrapped = np.nonzero(fast_ground.any(axis=0))[0]
-    wrap_min = float(cfg.doppler_axis_mps[wrapped.min()]) if wrapped.size else float("nan")
-    wrap_expected = -60.0 * np.sqrt(1 - (1000.0 / cfg.range_axis_m[-1]) ** 2) + 2 * cfg.v_lim_mps
-
-    result = {
-        "asymptote_range_m": h_fit,
-        "asymptote_range_expected_m": 1000.0,
-        "first_ground_range_m": first_ground,
-        "asymptote_velocity_mps": -v_fit,
-        "asymptote_velocity_expected_mps": -30.0,
-        "intruder_range_m": tgt_r,
-        "intruder_velocity_mps": tgt_v,
-        "intruder_snr_db": tgt_db,
-        "intruder_expected_range_m": float(cfg.range_axis_m[k_exp]),
-        "intruder_expected_velocity_mps": float(cfg.doppler_axis_mps[j_exp]),
-        "intruder_true_radial_velocity_mps": true_v,
-        "wrap60_right_edge": bool(wrapped.size and wrapped.max() == cfg.n_doppler - 1),
-        "wrap60_min_velocity_mps": wrap_min,
-        "wrap60_expected_min_velocity_mps": float(wrap_expected),
-        "range_bin_m": cfg.range_resolution_m,
-        "doppler_bin_mps": cfg.doppler_resolution_mps,
-        "frames_per_s": slow["fps"],
-        "thesis_frames_per_s": 3.3,
-    }
+    result = _slow_case_measures(slow) | _wrap_measures(fast, cfg)
+    result |= {"range_bin_m": cfg.range_resolution_m, "doppler_bin_mps": cfg.doppler_resolution_mps}
+    result |= {"frames_per_s": slow["fps"], "thesis_frames_per_s": 3.3}
     _figures(out, slow, fast, result)
+    r = result
     table = pd.DataFrame(
         [
-            ("near-range asymptote R [m]", h_fit, 1000.0),
-            ("velocity asymptote V [m/s]", -v_fit, -30.0),
-            ("intruder range [m]", tgt_r, result["intruder_expected_range_m"]),
-            ("intruder radial velocity (aliased) [m/s]", tgt_v, result["intruder_expected_velocity_mps"]),
-            ("60 m/s: wrapped ground starts at [m/s]", wrap_min, wrap_expected),
+            ("near-range asymptote R [m]", r["asymptote_range_m"], 1000.0),
+            ("velocity asymptote V [m/s]", r["asymptote_velocity_mps"], -30.0),
+            ("intruder range [m]", r["intruder_range_m"], r["intruder_expected_range_m"]),
+            ("intruder radial velocity (aliased) [m/s]", r["intruder_velocity_mps"],
+             r["intruder_expected_velocity_mps"]),
+            ("60 m/s: wrapped ground starts at [m/s]", r["wrap60_min_velocity_mps"],
+             r["wrap60_expected_min_velocity_mps"]),
         ],
         columns=["quantity", "measured", "closed_form"],
-    )
+    )  # fmt: skip
     write_csv_atomic(table, out / "ch2_table.csv", index=False)
     write_json_atomic(out / "ch2.json", result)
     return result

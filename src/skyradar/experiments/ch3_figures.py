@@ -40,10 +40,8 @@ def plot_range_doppler(out_dir: Path, static_frame, cal, spur_map, shown) -> Pat
         cube, out, truth = shown
         _rd_panel(axes[1], cube, cal, "flyover frame: detections (o), aircraft truth (x)")
         axes[1].scatter(out["radial_velocity_mps"], out["range_m"], s=80, facecolors="none", edgecolors="red")
-        v_true = (truth["doppler_bin"][0] - cal.n_doppler // 2) * cal.doppler_resolution_mps
-        axes[1].scatter(
-            [v_true], [truth["range_bin"][0] * cal.range_resolution_m], marker="x", c="white", s=60
-        )
+        v_true = cal.radial_velocity_at_bin_mps(truth["doppler_bin"][0])
+        axes[1].scatter([v_true], [cal.range_at_bin_m(truth["range_bin"][0])], marker="x", c="white", s=60)
     fig.tight_layout()
     path = out_dir / "ch3_range_doppler.png"
     savefig_atomic(fig, path, dpi=110)

@@ -109,7 +109,7 @@ def estimate_frame(
         ridge = extract_ridge(frame, config, threshold_db=threshold_db, prior_state=prior_state)
     if method == "thesis":
         # The thesis paired the ridge velocity with the range-bin centre (apparent range).
-        fit = fit_thesis(ridge.range_bin * config.range_resolution_m, ridge.radial_velocity_mps)
+        fit = fit_thesis(config.range_at_bin_m(ridge.range_bin), ridge.radial_velocity_mps)
     else:
         prior = None
         if prior_state is not None and np.all(np.isfinite(prior_state)):

@@ -145,10 +145,10 @@ def calibrate_from_frames(
         )
     _check_fov(position_m, config, 6.0)
     rng_m = float(np.linalg.norm(position_m)) + radial_velocity_mps * config.range_doppler_coupling_s
-    r0 = int(round(rng_m / config.range_resolution_m))
+    r0 = int(config.range_bin(rng_m))
     if not 0 <= r0 < config.n_range:
         raise InputError(f"calibration: field 'reflector' range {rng_m:.0f} m is beyond the processed range")
-    d0 = int(round(radial_velocity_mps / config.doppler_resolution_mps)) + config.n_doppler // 2
+    d0 = int(config.doppler_bin(radial_velocity_mps))
     rows = np.arange(max(r0 - search_bins[0], 0), min(r0 + search_bins[0] + 1, config.n_range))
     cols = np.arange(d0 - search_bins[1], d0 + search_bins[1] + 1) % config.n_doppler
     pixels = np.empty((cube.shape[0], config.n_rx), complex)

@@ -26,21 +26,15 @@ def _phasors(rng: np.random.Generator, shape: tuple[int, ...]) -> np.ndarray:
     return np.exp(2j * np.pi * rng.random(shape))
 
 
-def _doppler_bin(config: RadarConfig, velocity_mps: float) -> int:
-    return (
-        int(np.floor(velocity_mps / config.doppler_resolution_mps + 0.5)) + config.n_doppler // 2
-    ) % config.n_doppler
-
-
 # ---- spurs --------------------------------------------------------------------------------------
 def _spur_pixels(config, spurs, spur_map, map_power_dbm) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     rows, cols, power = [], [], []
     for r_m, v_mps, p_dbm in spurs:
-        k = int(np.floor(r_m / config.range_resolution_m + 0.5))
+        k = int(config.range_bin(r_m))
         if not 0 <= k < config.n_range:
             raise InputError(f"impairments.spurs: range_m {r_m} is outside 0..{config.range_limit_m} m")
         rows.append(k)
-        cols.append(_doppler_bin(config, v_mps))
+        cols.append(int(config.doppler_bin(v_mps)))
         power.append(dbm_to_w(p_dbm))
     if spur_map is not None:
         spur_map = np.asarray(spur_map, bool)
@@ -142,7 +136,7 @@ def zero_doppler_line(
     p_dbm = power_dbm_at_100m - falloff_db_per_decade * np.log10(r / 100.0)
     amp = np.sqrt(dbm_to_w(p_dbm))
     rng = np.random.default_rng([seed, 2])
-    centre = config.n_doppler // 2
+    centre = int(config.doppler_bin(0.0))
     for offset in range(-(int(width_bins) // 2), int(width_bins) // 2 + 1):
         phase = _phasors(rng, (config.n_range, config.n_rx))
         cube[:, (centre + offset) % config.n_doppler, :] = (0.5 ** abs(offset)) * amp[:, None] * phase

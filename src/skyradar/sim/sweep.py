@@ -73,15 +73,9 @@ def run_table(built, frames: np.ndarray | None = None, chunk: int = 8) -> pd.Dat
     n = built.times_s.size
     if not names:
         return pd.DataFrame({"frames": [n]})
-    k = np.floor(
-        (truth["tgt_range_m"] + cfg.range_doppler_coupling_s * truth["tgt_radial_velocity_mps"])
-        / cfg.range_resolution_m
-        + 0.5
-    )
-    j = (
-        np.floor(truth["tgt_radial_velocity_mps"] / cfg.doppler_resolution_mps + 0.5) + cfg.n_doppler // 2
-    ) % cfg.n_doppler
     visible = truth["tgt_visible"].astype(bool)
+    v_r = np.where(visible, truth["tgt_radial_velocity_mps"], 0.0)  # NaN where absent: no bin
+    k, j = cfg.range_bin(np.where(visible, truth["tgt_range_m"], 0.0), v_r), cfg.doppler_bin(v_r)
     snr = np.full(visible.shape, np.nan)
     for start in range(0, n, chunk):
         idx = np.arange(start, min(start + chunk, n))

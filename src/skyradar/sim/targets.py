@@ -14,6 +14,7 @@ import numpy as np
 from skyradar.config import RadarConfig
 from skyradar.geo import direction_angles
 from skyradar.sim.geometry import AntennaGeometry, PointTarget, TerrainView
+from skyradar.units import nearest_bin
 
 __all__ = ["line_of_sight", "target_geometry", "add_targets"]
 
@@ -53,8 +54,8 @@ def target_geometry(
     half_path = path.mean(axis=1) / 2.0
     gain_db = cfg.antenna.gain_db(az, el)
     power_w = cfg.pe_w * 10 ** (gain_db / 5.0) * cfg.wavelength_m**2 * rcs / ((4 * np.pi) ** 3 * half_path**4)
-    k = np.floor((half_path + coupling_s * v_r) / cfg.range_resolution_m + 0.5).astype(int)
-    j = (np.floor(v_r / cfg.doppler_resolution_mps + 0.5).astype(int) + cfg.n_doppler // 2) % cfg.n_doppler
+    k = nearest_bin(half_path + coupling_s * v_r, cfg.range_resolution_m)  # coupling_s may differ from cfg's
+    j = cfg.doppler_bin(v_r)
     in_view = (p_ant[:, 0] > 0) & (k >= 0) & (k < cfg.n_range) & clear
     return {
         "range_m": half_path,

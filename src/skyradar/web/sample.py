@@ -70,16 +70,12 @@ def sample_run_dataset(
     own, tgt = _truth(t, config.range_limit_m)
     iq = np.zeros((n_frames, config.n_range, config.n_doppler, config.n_rx), np.complex64)
     amp = np.sqrt(config.noise_power_w * 100.0)
-    dv = config.doppler_resolution_mps
     for i in range(n_frames):
         for k in range(tgt["tgt_range_m"].shape[1]):
             if not tgt["tgt_visible"][i, k]:
                 continue
-            r_bin = int(round(tgt["tgt_range_m"][i, k] / config.range_resolution_m))
-            d_bin = (
-                int(round(tgt["tgt_radial_velocity_mps"][i, k] / dv + config.n_doppler / 2))
-                % config.n_doppler
-            )
+            r_bin = int(config.range_bin(tgt["tgt_range_m"][i, k]))
+            d_bin = int(config.doppler_bin(tgt["tgt_radial_velocity_mps"][i, k]))
             # A 3x3 blob (Hann-windowed main lobe: -6 dB on the neighbours), Doppler wrapping around.
             for dr, dd in np.ndindex(3, 3):
                 rr, jj = r_bin + dr - 1, (d_bin + dd - 1) % config.n_doppler

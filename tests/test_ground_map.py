@@ -8,6 +8,9 @@ at known coordinates.
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import warnings
 
 import numpy as np
@@ -302,3 +305,31 @@ def test_supersampled_map_is_the_block_mean_of_the_fine_one(helsinki):
     smooth = render_reference_map(helsinki, coarse, supersample=4)
     blocks = render_reference_map(helsinki, fine).reshape(100, 4, 75, 4).mean(axis=(1, 3))
     np.testing.assert_allclose(smooth, blocks, atol=1e-6)
+
+
+def test_map_modules_import_without_the_geo_extra_and_name_it_when_used(tmp_path):
+    """Ground grids, land-cover codes and the coverage check need no geo libraries; reading a map names the
+    missing extra in one line."""
+    blocker = (
+        "import sys\n"
+        "class B:\n"
+        "    def find_spec(self, name, path=None, target=None):\n"
+        "        if name.split('.')[0] in {'rasterio', 'pyrosm', 'geopandas', 'shapely', 'affine'}:\n"
+        "            raise ModuleNotFoundError(name)\n"
+        "sys.meta_path.insert(0, B())\n"
+    )
+    (tmp_path / "sitecustomize.py").write_text(blocker)
+    code = (
+        "import numpy as np\n"
+        "from skyradar.scene import ground_grid, land_cover, map_raster, map_render, osm_map\n"
+        "grid = ground_grid.GroundGrid(0.0, 0.0, 1.0, (4, 4))\n"
+        "map_render.check_map_covers(grid, np.array([1.0]), np.array([1.0]))\n"
+        "print(float(land_cover.sigma0(land_cover.GRASS, 1.0)) > 0)\n"
+        f"osm_map.read_osm_map({str(HELSINKI)!r})\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(tmp_path)}
+    result = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120
+    )
+    assert result.stdout.strip() == "True", result.stderr
+    assert "MissingExtraError" in result.stderr and "pip install 'skyradar[geo]'" in result.stderr

@@ -19,12 +19,16 @@ from __future__ import annotations
 
 import threading
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-from affine import Affine
 from numba import njit, prange
 
 from skyradar.errors import InputError
+from skyradar.extras import import_extra
+
+if TYPE_CHECKING:
+    from affine import Affine
 
 __all__ = ["GroundGrid", "PoseGrid", "sample_at_pose", "sample_at_poses"]
 
@@ -106,7 +110,8 @@ class GroundGrid:
     def transform(self) -> Affine:
         """Affine map (column, row) -> (east_m, north_m) of pixel corners, as rasterio expects."""
         east_min, _, north_min, _ = self.extent_m
-        return Affine(self.pixel_m, 0.0, east_min, 0.0, self.pixel_m, north_min)
+        affine = import_extra("affine", "geo", "GroundGrid.transform")  # comes with rasterio
+        return affine.Affine(self.pixel_m, 0.0, east_min, 0.0, self.pixel_m, north_min)
 
     def world_to_pixel(
         self, north_m: np.ndarray | float, east_m: np.ndarray | float

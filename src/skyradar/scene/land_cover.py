@@ -42,9 +42,8 @@ returns rise, nor at the lowest grazing angles (below about 1 deg) where Billing
 from __future__ import annotations
 
 import numpy as np
-import shapely
-from rasterio.features import rasterize
 
+from skyradar.extras import import_extra
 from skyradar.scene.ground_grid import GroundGrid
 from skyradar.scene.osm_map import MapLayers
 
@@ -97,6 +96,7 @@ def _shapes(geometries: np.ndarray, value: float) -> list[tuple[object, float]]:
 
 def land_cover_shapes(layers: MapLayers) -> list[tuple[object, int]]:
     """(geometry, class code) pairs in painting order: later shapes cover earlier ones."""
+    shapely = import_extra("shapely", "geo", "rasterising a map")
     roads = shapely.buffer(layers.roads.geometry.to_numpy(), layers.roads["width_m"].to_numpy() / 2)
     rails = shapely.buffer(layers.railways.geometry.to_numpy(), RAIL_WIDTH_M / 2)
     return [
@@ -126,6 +126,7 @@ def rasterise_land_cover(layers: MapLayers, grid: GroundGrid) -> tuple[np.ndarra
     Examples
     --------
     >>> import geopandas as gpd
+    >>> import geopandas as gpd
     >>> from shapely.geometry import box
     >>> empty = gpd.GeoDataFrame(geometry=[])
     >>> houses = gpd.GeoDataFrame({"height_m": [12.0]}, geometry=[box(0.0, 0.0, 4.0, 2.0)])
@@ -135,6 +136,7 @@ def rasterise_land_cover(layers: MapLayers, grid: GroundGrid) -> tuple[np.ndarra
     >>> int((code == BUILDING).sum()), float(height.max())
     (8, 12.0)
     """
+    rasterize = import_extra("rasterio.features", "geo", "rasterising a map").rasterize
     kwargs = {"out_shape": grid.shape, "transform": grid.transform, "all_touched": False}
     shapes = land_cover_shapes(layers)
     code = np.zeros(grid.shape, dtype=np.uint8)

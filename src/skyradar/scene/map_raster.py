@@ -12,15 +12,18 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import rasterio
-from rasterio.crs import CRS
-from rasterio.warp import Resampling, reproject, transform_bounds
 
 from skyradar.errors import InputError
+from skyradar.extras import import_extra
 from skyradar.geo import geodetic_to_ned
 from skyradar.scene.ground_grid import GroundGrid
+
+if TYPE_CHECKING:
+    import rasterio
+    from rasterio.crs import CRS
 
 __all__ = ["MapRaster", "local_crs", "read_map_raster"]
 
@@ -38,12 +41,14 @@ class MapRaster:
 
 def local_crs(origin_lat_deg: float, origin_lon_deg: float) -> CRS:
     """The CRS whose (x, y) in metres is the local (east, north) about a WGS84 origin."""
-    return CRS.from_proj4(
+    crs = import_extra("rasterio.crs", "geo", "reading a raster map")
+    return crs.CRS.from_proj4(
         f"+proj=aeqd +lat_0={origin_lat_deg!r} +lon_0={origin_lon_deg!r} +datum=WGS84 +units=m"
     )
 
 
 def _default_grid(src: rasterio.DatasetReader, lat0: float, lon0: float) -> GroundGrid:
+    transform_bounds = import_extra("rasterio.warp", "geo", "reading a raster map").transform_bounds
     west, south, east, north = transform_bounds(src.crs, "EPSG:4326", *src.bounds, densify_pts=21)
     corners = geodetic_to_ned(np.array([south, north]), np.array([west, east]), 0.0, lat0, lon0)
     # Native resolution: the source pixel's ground size at the origin.
@@ -74,6 +79,8 @@ def read_map_raster(
         One line naming the file: missing, unreadable, no georeference, or no such band.
     """
     path = Path(path)
+    rasterio = import_extra("rasterio", "geo", f"reading {path}")
+    warp = import_extra("rasterio.warp", "geo", f"reading {path}")
     if not path.is_file():
         raise InputError(f"{path}: map raster {'is not a file' if path.exists() else 'does not exist'}")
     try:
@@ -90,16 +97,17 @@ def read_map_raster(
         if not 1 <= band <= src.count:
             raise InputError(f"{path}: band {band} does not exist (the raster has {src.count})")
         if origin_lat_deg is None or origin_lon_deg is None:
-            west, south, east, north = transform_bounds(src.crs, "EPSG:4326", *src.bounds, densify_pts=21)
+            bounds = warp.transform_bounds(src.crs, "EPSG:4326", *src.bounds, densify_pts=21)
+            west, south, east, north = bounds
             origin_lat_deg, origin_lon_deg = (south + north) / 2, (west + east) / 2
         grid = grid or _default_grid(src, origin_lat_deg, origin_lon_deg)
         image = np.full(grid.shape, np.nan, dtype=np.float32)
-        reproject(
+        warp.reproject(
             source=rasterio.band(src, band),
             destination=image,
             dst_transform=grid.transform,
             dst_crs=local_crs(origin_lat_deg, origin_lon_deg),
             dst_nodata=np.nan,
-            resampling=Resampling.bilinear,
+            resampling=warp.Resampling.bilinear,
         )
     return MapRaster(image, grid, float(origin_lat_deg), float(origin_lon_deg), str(path))

@@ -13,15 +13,17 @@ built or demolished since the survey, digitising offsets of a few metres).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-import geopandas as gpd
 import numpy as np
-import shapely
-from rasterio.features import rasterize
 
 from skyradar.errors import InputError
+from skyradar.extras import import_extra
 from skyradar.scene.ground_grid import GroundGrid
 from skyradar.scene.osm_map import ROAD_CLASSES, MapLayers
+
+if TYPE_CHECKING:
+    import geopandas as gpd
 
 __all__ = ["MAP_STYLE", "MapStyle", "render_reference_map", "outdated_map", "check_map_covers"]
 
@@ -51,6 +53,7 @@ def _paint(image: np.ndarray, geometries: np.ndarray, value: float, grid: Ground
     geometries = [g for g in geometries if g is not None and not g.is_empty]
     if not geometries:
         return
+    rasterize = import_extra("rasterio.features", "geo", "drawing a map").rasterize
     mask = rasterize(
         [(g, 1) for g in geometries], out_shape=grid.shape, transform=grid.transform, fill=0, dtype="uint8"
     )
@@ -70,6 +73,7 @@ def render_reference_map(
     Examples
     --------
     >>> from skyradar.scene.ground_grid import GroundGrid
+    >>> import geopandas as gpd
     >>> from shapely.geometry import LineString
     >>> empty = gpd.GeoDataFrame(geometry=[])
     >>> road = gpd.GeoDataFrame({"road_class": ["primary"], "width_m": [12.0]},
@@ -90,6 +94,7 @@ def render_reference_map(
         )
         image = render_reference_map(layers, fine, style)
         return image.reshape(grid.shape[0], n, grid.shape[1], n).mean(axis=(1, 3), dtype=np.float32)
+    shapely = import_extra("shapely", "geo", "drawing a map")
     image = np.full(grid.shape, style.background, dtype=np.float32)
     for name in ("open_land", "grass", "forest", "water"):
         _paint(image, getattr(layers, name).geometry.to_numpy(), getattr(style, name), grid)
@@ -124,11 +129,10 @@ def _drop(layer: gpd.GeoDataFrame, fraction: float, rng: np.random.Generator, wh
 def _jitter(layer: gpd.GeoDataFrame, jitter_m: float, rng: np.random.Generator) -> gpd.GeoDataFrame:
     if jitter_m == 0 or not len(layer):
         return layer
+    gpd = import_extra("geopandas", "geo", "outdated_map")
+    translate = import_extra("shapely.affinity", "geo", "outdated_map").translate
     shift = rng.normal(0.0, jitter_m, size=(len(layer), 2))
-    moved = [
-        shapely.affinity.translate(g, dx, dy)
-        for g, (dx, dy) in zip(layer.geometry.to_numpy(), shift, strict=True)
-    ]
+    moved = [translate(g, dx, dy) for g, (dx, dy) in zip(layer.geometry.to_numpy(), shift, strict=True)]
     out = layer.copy()
     out.geometry = gpd.GeoSeries(moved, index=layer.index)
     return out
@@ -150,6 +154,7 @@ def outdated_map(
 
     Examples
     --------
+    >>> import geopandas as gpd
     >>> from shapely.geometry import box
     >>> empty = gpd.GeoDataFrame(geometry=[])
     >>> houses = gpd.GeoDataFrame({"height_m": np.full(10, 9.0)},

@@ -25,16 +25,19 @@ import re
 import warnings
 from dataclasses import dataclass, replace
 from pathlib import Path
+from types import ModuleType
+from typing import TYPE_CHECKING
 
-import geopandas as gpd
 import numpy as np
 import pandas as pd
-import shapely
 
 from skyradar.errors import InputError
+from skyradar.extras import import_extra
 from skyradar.geo import geodetic_to_ned
-from skyradar.scene.coastline import sea_polygons
 from skyradar.scene.ground_grid import GroundGrid
+
+if TYPE_CHECKING:
+    import geopandas as gpd
 
 __all__ = [
     "AREA_LAYERS",
@@ -178,13 +181,21 @@ def _not_tunnel(gdf: gpd.GeoDataFrame) -> np.ndarray:
     return np.array([t is None or t != t or t == "no" for t in tunnel], dtype=bool)  # t != t: NaN
 
 
+def _geo() -> tuple[ModuleType, ModuleType]:
+    """geopandas and shapely, imported when a map is read: the module itself imports without the extra."""
+    what = "reading an OpenStreetMap map"
+    return import_extra("geopandas", "geo", what), import_extra("shapely", "geo", what)
+
+
 def _empty(columns: dict[str, str]) -> gpd.GeoDataFrame:
+    gpd, _ = _geo()
     columns = {"osm_id": "int64", **columns}
     return gpd.GeoDataFrame({name: np.array([], dtype=dtype) for name, dtype in columns.items()}, geometry=[])
 
 
 def _pick(gdf: gpd.GeoDataFrame, keep: np.ndarray, **columns: np.ndarray) -> gpd.GeoDataFrame:
     """The kept rows as a fresh GeoDataFrame: geometry, OSM id and the given per-kept-row columns."""
+    gpd, _ = _geo()
     ids = gdf["id"].to_numpy(dtype=np.int64)[keep] if "id" in gdf.columns else np.full(keep.sum(), -1)
     data = {"osm_id": ids, **columns}
     return gpd.GeoDataFrame(data, geometry=gpd.GeoSeries(gdf.geometry.to_numpy()[keep])).reset_index(
@@ -214,7 +225,7 @@ def _area_layers(areas: gpd.GeoDataFrame | None) -> dict[str, gpd.GeoDataFrame]:
 
 
 def _read_raw(path: Path, bounding_box: list[float] | None) -> dict[str, gpd.GeoDataFrame | None]:
-    import pyrosm  # noqa: PLC0415 - heavy (geopandas, pyproj); only map users pay for it
+    pyrosm = import_extra("pyrosm", "geo", f"reading {path}")
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # pyrosm's pandas/shapely deprecation chatter
@@ -275,6 +286,7 @@ def _geodetic_layers(raw: dict) -> dict[str, gpd.GeoDataFrame]:
 
 def _to_local(layers: dict[str, gpd.GeoDataFrame], lat0_deg: float, lon0_deg: float) -> None:
     """Geometry to local (east_m, north_m), in place; polygons repaired."""
+    _, shapely = _geo()
 
     def lonlat_to_east_north(coords: np.ndarray) -> np.ndarray:
         ned = geodetic_to_ned(coords[:, 1], coords[:, 0], 0.0, lat0_deg, lon0_deg)
@@ -294,6 +306,9 @@ def _to_local(layers: dict[str, gpd.GeoDataFrame], lat0_deg: float, lon0_deg: fl
 
 def _add_sea(layers: dict[str, gpd.GeoDataFrame]) -> None:
     """Sea cut from the features' box by the coastline ways joins the water layer (``osm_id`` -1)."""
+    from skyradar.scene.coastline import sea_polygons  # noqa: PLC0415 - needs shapely (the geo extra)
+
+    gpd, shapely = _geo()
     coastline = layers.pop("coastline")
     if not len(coastline):
         return
@@ -337,6 +352,8 @@ def read_osm_map(
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{path}: map file {'is not a file' if path.exists() else 'does not exist'}")
+    _geo()  # a missing 'geo' extra is named as such, not as an unreadable file
+    import_extra("pyrosm", "geo", f"reading {path}")
     try:
         raw = _read_raw(path, None if bounding_box is None else [float(v) for v in bounding_box])
     except Exception as err:  # pyrosm raises PBFException, protobuf DecodeError, OSError, ValueError...
@@ -354,6 +371,7 @@ def read_osm_map(
         origin_lat_deg = float((boxes[:, 1].min() + boxes[:, 3].max()) / 2)
     _to_local(layers, origin_lat_deg, origin_lon_deg)
     _add_sea(layers)
+    _, shapely = _geo()
     trees = layers.pop("trees")
     forest = layers["forest"].assign(tree=False)
     if len(trees):  # buffered in metres, after the conversion

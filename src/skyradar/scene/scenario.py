@@ -87,6 +87,7 @@ class BuiltScenario:
     sim_options: dict[str, Any] = field(default_factory=dict)
     source: Path | None = None
     impairments: Any = None  # skyradar.scene.impairment_config.ImpairmentConfig or None
+    land_cover: Any = None  # skyradar.scene.ground_map.LandCover (the ground_map section) or None
 
 
 def _describe(value: Any) -> str:
@@ -309,9 +310,32 @@ class Scenario:
             terrain = self._terrain(None)
             lat, lon = terrain.center_latlon
             return (lat, lon, float(terrain.height_at(lat, lon))), None, terrain
+        if m.ground_map is not None:  # the map's centre, on the ground
+            cover = self._land_cover(None)
+            return (cover.layers.origin_lat_deg, cover.layers.origin_lon_deg, 0.0), None, None
         raise InputError(
             f"{self._label}: field 'origin': is required when own-ship is parametric and terrain is not a DEM"
         )
+
+    def _land_cover(self, origin):
+        """The ground_map section's land cover around ``origin`` (None: the map's centre), read once."""
+        from skyradar.extras import require_extra
+
+        require_extra("geo", "a scenario with a ground_map")
+        from skyradar.scene.ground_map import land_cover_from_osm, osm_path
+
+        g = self.model.ground_map
+        if self.model.terrain is not None:
+            raise InputError(f"{self._label}: field 'ground_map': give terrain or ground_map, not both")
+        cached = getattr(self, "_cover", None)
+        if cached is None or (origin is not None and (origin[0], origin[1]) != cached[0]):
+            lat, lon = (None, None) if origin is None else (origin[0], origin[1])
+            try:
+                cover = land_cover_from_osm(osm_path(g.path, self.base_dir), lat, lon, g.pixel_m)
+            except InputError as exc:
+                raise self._fail("ground_map", exc) from None
+            self._cover = ((cover.layers.origin_lat_deg, cover.layers.origin_lon_deg), cover)
+        return self._cover[1]
 
     def _dem_under_flight(self, terrain, origin, own, radar: RadarConfig):
         """The terrain, a DEM read only where the radar can see from the flight, checked to lie under it."""
@@ -344,6 +368,12 @@ class Scenario:
                 f"{times[0]:.6g}..{times[-1]:.6g} s (start_s, duration_s)"
             )
         terrain = self._dem_under_flight(terrain, origin, ownship.sample(times), radar)
+        land_cover = self._land_cover(origin) if m.ground_map is not None else None
+        if land_cover is not None:
+            try:
+                land_cover.check_under(ownship.sample(times).position_ned_m)
+            except InputError as exc:
+                raise self._fail("ground_map", exc) from None
         intruders: list[Intruder] = []
         for i, spec in enumerate(m.intruders):
             traj = self._flight(spec, f"intruders.{i}", origin, ownship, spec.name or f"intruder{i}")
@@ -371,6 +401,7 @@ class Scenario:
             sim_options=m.simulation.model_dump(),
             source=self.source,
             impairments=m.impairments,
+            land_cover=land_cover,
         )
 
 

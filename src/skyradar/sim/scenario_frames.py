@@ -40,6 +40,13 @@ def make_simulator(built) -> ImageSimulator:
         options["ground_reflectivity_db"] = impairments.ground_reflectivity_db
         if impairments.noise is not None and impairments.noise.enabled:
             options["noise"] = False  # the impairment's receiver noise replaces the simulator's
+    land_cover = getattr(built, "land_cover", None)
+    if land_cover is not None:  # the ground is a map's land cover (ch6), flat at the origin's altitude
+        from skyradar.sim.land_cover_scene import LandCoverSimulator
+
+        cover, seed, noise = land_cover, options.get("seed", 0), options.get("noise", True)
+        code, height = cover.class_code, cover.height_m
+        return LandCoverSimulator(built.radar, code, height, cover.grid, built.origin, seed, noise)
     return ImageSimulator(built.radar, built.terrain, built.origin, **options)
 
 
@@ -98,6 +105,8 @@ def _ownship_truth(built, own) -> dict[str, np.ndarray]:
     agl = np.full(own.time_s.size, np.nan)
     if built.terrain is not None:
         agl = own.alt_m - built.terrain.height_at(own.lat_deg, own.lon_deg)
+    elif getattr(built, "land_cover", None) is not None:
+        agl = -own.position_ned_m[:, 2]  # flat map ground at the origin
     truth = {f"own_{a}_m": own.position_ned_m[:, c] for c, a in enumerate(_XYZ)}
     truth |= {f"own_{a}_mps": own.velocity_ned_mps[:, c] for c, a in enumerate(_VXYZ)}
     truth |= {f"own_{a}_rad": own.attitude_rad[:, c] for c, a in enumerate(("yaw", "pitch", "roll"))}

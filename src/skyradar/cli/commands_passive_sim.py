@@ -27,6 +27,52 @@ def _start_time(value: str | None) -> dt.datetime | None:
     return t if t.tzinfo else t.replace(tzinfo=dt.UTC)
 
 
+def _check_outputs(output: Path, adsb: Path | None, overwrite: bool) -> Path:
+    """The metadata path, after checking that it, its data file and the truth files may be written."""
+    from skyradar.io.outputs import check_output
+    from skyradar.io.sigmf_io import sigmf_paths
+    from skyradar.passive.truth import truth_paths
+
+    meta, data = sigmf_paths(output)
+    if meta.name != Path(output).name and Path(output).suffix not in ("", ".sigmf-data"):
+        raise InputError(f"--output {output}: name the recording NAME.sigmf-meta")
+    for path in (meta, data, *truth_paths(meta)):
+        check_output(path, inputs=[adsb], overwrite=overwrite, kind="file")
+    return meta
+
+
+def _scene(scenario: str, duration_s: float, seed: int, adsb, start_time, no_aircraft: bool):
+    import dataclasses
+
+    from skyradar.passive.scene import aircraft_from_adsb, thesis_scene
+
+    check_choice("SCENARIO", scenario, SCENARIOS)
+    if adsb is not None and no_aircraft:
+        raise InputError("--adsb and --no-aircraft: choose one")
+    scene = thesis_scene(duration_s=duration_s, seed=seed, aircraft=not no_aircraft and adsb is None)
+    when = _start_time(start_time)
+    if when is not None:
+        scene = dataclasses.replace(scene, start_time=when)
+    if adsb is not None:
+        planes = aircraft_from_adsb(adsb, scene.receiver, start_time=when)
+        scene = dataclasses.replace(scene, aircraft=tuple(planes))
+    return scene
+
+
+def _run(scene, meta: Path, sample_rate_hz: float, chunk_samples: int, total: int) -> Path:
+    from rich.progress import BarColumn, Progress, TimeRemainingColumn
+
+    from skyradar.passive.simulate import simulate_recording
+
+    with Progress("simulating", BarColumn(), TimeRemainingColumn(), console=console) as bar:
+        task = bar.add_task("samples", total=total)
+        path = simulate_recording(
+            scene, meta, sample_rate_hz, chunk_samples, overwrite=True,
+            progress=lambda done, _total: bar.update(task, completed=done),
+        )  # fmt: skip
+    return path
+
+
 @app.command("simulate-passive")
 def simulate_passive(
     scenario: Annotated[str, typer.Argument(help="Built-in geometry: thesis (seed-brief ch7).")] = "thesis",
@@ -61,52 +107,23 @@ def simulate_passive(
 ) -> None:
     """Simulate the IQ a passive receiver records near a rotating S-band ATC radar, as SigMF.
 
-    Direct path through the radar's antenna pattern, echoes of building clusters, ground clutter and
-    aircraft (bistatic radar equation, bistatic Doppler), thermal noise; streamed to disk in chunks.
-    Truth for scoring goes to NAME.truth.parquet and NAME.truth.json, not into the SigMF metadata.
+    Direct path, echoes of towns, ground clutter and aircraft, noise; streamed in chunks. Truth goes to
+    NAME.truth.parquet / NAME.truth.json, not into the SigMF metadata.
     """
-    import dataclasses
-
-    from skyradar.io.outputs import check_disk_space, check_output
-    from skyradar.io.sigmf_io import sigmf_paths
-    from skyradar.passive.scene import aircraft_from_adsb, thesis_scene
-    from skyradar.passive.simulate import check_sample_rate, simulate_recording
+    from skyradar.io.outputs import check_disk_space
+    from skyradar.passive.simulate import check_sample_rate
     from skyradar.passive.truth import truth_paths
 
-    check_choice("SCENARIO", scenario, SCENARIOS)
-    if adsb is not None and no_aircraft:
-        raise InputError("--adsb and --no-aircraft: choose one")
-    meta, data = sigmf_paths(output)
-    if meta.name != Path(output).name and Path(output).suffix not in ("", ".sigmf-data"):
-        raise InputError(f"--output {output}: name the recording NAME.sigmf-meta")
-    for path in (meta, data, *truth_paths(meta)):
-        check_output(path, inputs=[adsb], overwrite=overwrite, kind="file")
-    scene = thesis_scene(duration_s=duration_s, seed=seed, aircraft=not no_aircraft and adsb is None)
-    when = _start_time(start_time)
-    if when is not None:
-        scene = dataclasses.replace(scene, start_time=when)
-    if adsb is not None:
-        planes = aircraft_from_adsb(adsb, scene.receiver, start_time=when)
-        scene = dataclasses.replace(scene, aircraft=tuple(planes))
+    meta = _check_outputs(output, adsb, overwrite)
+    scene = _scene(scenario, duration_s, seed, adsb, start_time, no_aircraft)
     check_sample_rate(scene, sample_rate_hz)
     total = int(round(duration_s * sample_rate_hz))
-    check_disk_space(data, 8.0 * total, "the recording")
-
-    from rich.progress import BarColumn, Progress, TimeRemainingColumn
-
-    with Progress("simulating", BarColumn(), TimeRemainingColumn(), console=console) as bar:
-        task = bar.add_task("samples", total=total)
-        path = simulate_recording(
-            scene, meta, sample_rate_hz, chunk_samples, overwrite=True,
-            progress=lambda done, _total: bar.update(task, completed=done),
-        )  # fmt: skip
+    check_disk_space(meta, 8.0 * total, "the recording")
+    path = _run(scene, meta, sample_rate_hz, chunk_samples, total)
     table, summary = truth_paths(path)
-    result = {
-        "recording": str(path),
-        "samples": total,
-        "duration_s": duration_s,
-        "sample_rate_hz": sample_rate_hz,
-        "aircraft": len(scene.aircraft),
+    result = {"recording": str(path), "samples": total, "duration_s": duration_s}
+    result |= {"sample_rate_hz": sample_rate_hz, "aircraft": len(scene.aircraft)}
+    result |= {
         "static_reflectors": len(scene.reflectors),
         "truth_table": str(table),
         "truth_summary": str(summary),

@@ -179,6 +179,25 @@ class Illuminator:
     def pulses(self) -> tuple[Pulse, Pulse]:
         return self.long_pulse, self.short_pulse
 
+    def pulse_baseband(self, pulse: Pulse, sample_rate_hz: float) -> np.ndarray:
+        """The transmitted ``pulse`` sampled from its start (unit amplitude, complex64)."""
+        n = int(math.ceil(pulse.width_s * sample_rate_hz - 1e-6))  # 100 us at 5 MS/s: 500, not 501
+        return lfm_baseband(np.arange(n) / sample_rate_hz, pulse.width_s, pulse.bandwidth_hz, pulse.offset_hz)
+
+    def long_pulse_baseband(self, sample_rate_hz: float) -> np.ndarray:
+        """The long (LFM) pulse as a matched-filter template: 500 samples for 100 us at 5 MS/s.
+
+        Examples
+        --------
+        >>> Illuminator(52.0, 5.0, 30.0).long_pulse_baseband(5e6).shape
+        (500,)
+        """
+        return self.pulse_baseband(self.long_pulse, sample_rate_hz)
+
+    def short_pulse_baseband(self, sample_rate_hz: float) -> np.ndarray:
+        """The short (unmodulated) pulse at its offset frequency."""
+        return self.pulse_baseband(self.short_pulse, sample_rate_hz)
+
     # ---- antenna ---------------------------------------------------------------------------
     def beam_azimuth_rad(self, t_s: np.ndarray | float, azimuth_at_t0_rad: float) -> np.ndarray:
         """Main-beam azimuth (clockwise from north, wrapped to [0, 2 pi)) at times ``t_s``."""
@@ -197,6 +216,14 @@ class Illuminator:
         d1 = bw * np.sqrt(np.log(1.0 / sl) / (4.0 * np.log(2.0)))
         envelope = np.clip(sl * (d1 / np.maximum(d, 1e-12)) ** 2, bl, sl)
         return np.maximum(main, envelope)
+
+    @property
+    def sidelobe_reach_rad(self) -> float:
+        """Angle off the beam axis beyond which the pattern is the back-lobe floor (radians)."""
+        bw = np.radians(self.beamwidth_az_deg)
+        sl, bl = 10.0 ** (self.sidelobe_db / 10.0), 10.0 ** (self.backlobe_db / 10.0)
+        d1 = bw * np.sqrt(np.log(1.0 / sl) / (4.0 * np.log(2.0)))
+        return float(max(d1 * np.sqrt(sl / bl), bw * np.sqrt(np.log(1.0 / bl) / (4.0 * np.log(2.0)))))
 
     # ---- timing ----------------------------------------------------------------------------
     def pulse_times_s(

@@ -189,11 +189,15 @@ def building_cluster(
     rng: np.random.Generator,
     n_points: int = 40,
     radius_m: float = 400.0,
-    rcs_median_m2: float = 30.0,
+    rcs_median_m2: float = 1000.0,
     height_below_antenna_m: float = 25.0,
 ) -> Reflectors:
     """A town as a Gaussian cloud of point scatterers with log-normal RCS (sigma 1 neper), at a bearing and
-    distance from the receiver."""
+    distance from the receiver.
+
+    A median of 1000 m^2 per point (walls and roofs facing both sites, corner reflections) puts a town
+    15-20 dB above the rural clutter points around it, as the towns stood out in the thesis' recording.
+    """
     centre = distance_m * np.array([np.cos(np.radians(bearing_deg)), np.sin(np.radians(bearing_deg))])
     ne = centre + rng.normal(0.0, radius_m / 2.0, size=(n_points, 2))
     down = _ground_down(ne[:, 0], ne[:, 1], height_below_antenna_m)

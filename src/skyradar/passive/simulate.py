@@ -23,6 +23,8 @@ not depend on the chunk size.
 from __future__ import annotations
 
 import math
+from collections import deque
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numba
@@ -126,7 +128,8 @@ class _Synthesiser:
         """The summed far-sidelobe echo of every static reflector for a pulse emitted ``frac`` samples
         after a sample instant (samples from that instant on)."""
         key = (pulse_index, int(round(frac * 1e9)))
-        if key not in self._cache:
+        block = self._cache.get(key)  # read once: another thread may clear the cache meanwhile
+        if block is None:
             if len(self._cache) > 64:  # a stagger that is no multiple of the sample period: no reuse
                 self._cache.clear()
             n = int(math.ceil((self.max_delay_s + pulse.width_s) * self.fs)) + 2
@@ -139,7 +142,7 @@ class _Synthesiser:
                 np.full(m, pulse.bandwidth_hz / pulse.width_s),
             )  # fmt: skip
             self._cache[key] = block
-        return self._cache[key]
+        return block
 
     def contributions(self, t_emit: np.ndarray):
         """(t_emit, tau0, tau_rate, amplitude) of the direct path, near-beam static echoes and aircraft."""
@@ -156,9 +159,15 @@ class _Synthesiser:
         n = t_emit.size
         out = [(t_emit, np.full(n, scene.baseline_m / C_MPS), np.zeros(n), np.sqrt(p_direct))]
         if self.tau.size:
-            excess = np.sqrt(ill.pattern_gain(self.az[None, :] - az_beam[:, None])) - self.floor
-            i_pulse, i_refl = np.nonzero(excess > 1e-12 * self.floor)
-            amp = self.amp1[i_refl] * excess[i_pulse, i_refl]
+            # Only reflectors within the sidelobe reach of the arc the beam sweeps here rise above the floor.
+            sweep = ill.rotation_rate_rad_s * (t_emit[-1] - t_emit[0])
+            centre = ill.beam_azimuth_rad(0.5 * (t_emit[0] + t_emit[-1]), scene.azimuth_at_t0_rad)
+            off = np.abs(np.mod(self.az - centre + np.pi, 2 * np.pi) - np.pi)
+            near = np.nonzero(off <= 0.5 * sweep + ill.sidelobe_reach_rad + 1e-6)[0]
+            excess = np.sqrt(ill.pattern_gain(self.az[near][None, :] - az_beam[:, None])) - self.floor
+            i_pulse, i_near = np.nonzero(excess > 1e-12 * self.floor)
+            i_refl = near[i_near]
+            amp = self.amp1[i_refl] * excess[i_pulse, i_near]
             out.append((t_emit[i_pulse], self.tau[i_refl], np.zeros(i_pulse.size), amp))
         for plane in scene.aircraft:
             out.append(self._aircraft(plane, t_emit))
@@ -242,6 +251,13 @@ def check_sample_rate(scene: PassiveScene, sample_rate_hz: float) -> None:
             )
 
 
+def _write_next(writer: SigmfWriter, pending: deque, progress, total: int) -> None:
+    block = pending.popleft().result()
+    writer.write(block)
+    if progress is not None:
+        progress(min(writer.n_samples, total), total)
+
+
 def simulate_recording(
     scene: PassiveScene,
     path: str | Path,
@@ -249,15 +265,17 @@ def simulate_recording(
     chunk_samples: int = 1 << 20,
     overwrite: bool = False,
     progress=None,
+    workers: int = 2,
 ) -> Path:
     """Simulate ``scene`` into ``NAME.sigmf-meta``/``-data`` plus the truth sidecars; return the meta path.
 
-    ``progress``, if given, is called with (samples done, total) after each chunk.
+    ``progress``, if given, is called with (samples done, total) after each chunk. ``workers`` threads
+    simulate chunks in parallel; the samples do not depend on it.
     """
     from skyradar.passive.truth import write_truth
 
-    if chunk_samples < 1:
-        raise InputError(f"chunk_samples must be >= 1, got {chunk_samples}")
+    if chunk_samples < 1 or workers < 1:
+        raise InputError(f"chunk_samples and workers must be >= 1, got {chunk_samples}, {workers}")
     check_sample_rate(scene, sample_rate_hz)
     meta_path, _ = sigmf_paths(path)
     synth = _Synthesiser(scene, float(sample_rate_hz))
@@ -273,12 +291,20 @@ def simulate_recording(
         description=scene.description,
         overwrite=overwrite,
     ) as writer:
-        for start in range(0, total, chunk_samples):
+
+        def job(start: int) -> np.ndarray:
             stop = min(start + chunk_samples, total)
-            writer.write(
-                simulate_chunk(scene, sample_rate_hz, start, stop, synthesiser=synth).astype(np.complex64)
-            )
-            if progress is not None:
-                progress(stop, total)
+            return simulate_chunk(scene, sample_rate_hz, start, stop, synthesiser=synth).astype(np.complex64)
+
+        # Chunks are independent: `workers` threads (numba and numpy release the GIL) compute them, at most
+        # workers + 1 in memory, written in order.
+        with ThreadPoolExecutor(max_workers=workers) as pool:
+            pending: deque = deque()
+            for start in range(0, total, chunk_samples):
+                pending.append(pool.submit(job, start))
+                if len(pending) > workers:
+                    _write_next(writer, pending, progress, total)
+            while pending:
+                _write_next(writer, pending, progress, total)
     write_truth(scene, meta_path, sample_rate_hz)
     return meta_path

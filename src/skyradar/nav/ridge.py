@@ -43,6 +43,7 @@ from scipy import stats
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
+from skyradar.nav._flight_state_kernels import ridge_rows
 from skyradar.process.power import power_image
 
 __all__ = ["Ridge", "summed_power_image", "noise_floor_w", "band_start", "extract_ridge"]
@@ -163,56 +164,6 @@ def band_start(occupied: np.ndarray) -> np.ndarray | int | None:
     return start
 
 
-def _row_closing(mask: np.ndarray, length: int) -> np.ndarray:
-    """``scipy.ndimage.binary_closing(mask, structure=np.ones((1, length)))``, from row shifts.
-
-    The same pixels as scipy's (tests/test_ridge_speed.py compares them), for a fraction of its time:
-    a dilation (outside the array counts as empty) then an erosion (outside counts as empty too).
-    """
-    n, c = mask.shape[1], length // 2
-    dilated = np.zeros_like(mask)
-    for d in range(-(length - 1 - c), c + 1):  # dilated[:, j] = any(mask[:, j + d])
-        if d >= 0:
-            dilated[:, : n - d] |= mask[:, d:]
-        else:
-            dilated[:, -d:] |= mask[:, : n + d]
-    closed = dilated.copy()
-    for d in range(-c, length - c):  # closed[:, j] = all(dilated[:, j + d]), False past the edges
-        if d > 0:
-            closed[:, : n - d] &= dilated[:, d:]
-            closed[:, n - d :] = False
-        elif d < 0:
-            closed[:, -d:] &= dilated[:, : n + d]
-            closed[:, :-d] = False
-    return closed
-
-
-def _run_lengths(mask: np.ndarray) -> np.ndarray:
-    """Length of the horizontal run of True each pixel belongs to (0 for False pixels)."""
-    rows, n = mask.shape
-    padded = np.zeros((rows, n + 1), np.int8)  # a False column ends every row's last run
-    padded[:, :n] = mask
-    flat = padded.ravel()
-    edges = np.diff(flat, prepend=np.int8(0))
-    starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
-    lengths = ends - starts
-    run = np.zeros(flat.size, np.int64)
-    run[flat.astype(bool)] = np.repeat(lengths, lengths)
-    return run.reshape(rows, n + 1)[:, :n]
-
-
-def _clean_rows(mask: np.ndarray, max_gap: int, min_len: int) -> np.ndarray:
-    """Close fades of up to ``max_gap`` bins and drop runs shorter than ``min_len``, circularly per row."""
-    n = mask.shape[1]
-    doubled = np.concatenate([mask, mask], axis=1)
-    if max_gap > 0:
-        doubled = _row_closing(doubled, max_gap + 1) | doubled
-    run = _run_lengths(doubled)
-    run = np.maximum(run[:, :n], run[:, n:])
-    closed = doubled[:, :n] | doubled[:, n:]
-    return closed & (run >= min_len)
-
-
 def extract_ridge(
     frame: np.ndarray,
     config: RadarConfig,
@@ -260,11 +211,10 @@ def extract_ridge(
     mask = power > noise * 10 ** (threshold_db / 10.0)
     mask[: int(np.ceil(min_range_m / config.range_resolution_m))] = False
     n_occ = int(mask.sum())
-    clean = _clean_rows(mask, max_gap_bins, min_band_bins)
-    rows = np.flatnonzero(clean.any(axis=1) & ~clean.all(axis=1))
+    # Per range row: fades closed, short runs dropped, the band's first bin (see band_start).
+    rows, dopp = ridge_rows(mask, max_gap_bins, min_band_bins)
     if rows.size == 0:
         return Ridge.empty(noise, n_occ)
-    dopp = band_start(clean[rows])
     # Unwrap along range (the ridge is continuous in range), then pick the alias turn.
     width = 2.0 * config.v_lim_mps
     vel = np.unwrap(config.doppler_axis_mps[dopp], period=width)

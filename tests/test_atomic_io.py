@@ -19,8 +19,9 @@ from matplotlib.figure import Figure  # noqa: E402
 
 from skyradar.config import RadarConfig  # noqa: E402
 from skyradar.errors import InputError  # noqa: E402
-from skyradar.io import recordings  # noqa: E402
-from skyradar.io.recordings import read_recording, write_recording  # noqa: E402
+from skyradar.io import recording_writer, recordings  # noqa: E402
+from skyradar.io.recording_writer import write_recording  # noqa: E402
+from skyradar.io.recordings import read_recording  # noqa: E402
 from skyradar.io.tables import read_table, write_json_atomic, write_table  # noqa: E402
 
 SRC = Path(__file__).resolve().parents[1] / "src" / "skyradar"
@@ -103,7 +104,7 @@ def test_outputs_go_through_the_atomic_helpers():
     pattern = re.compile(r"\.(to_csv|savefig|write_text)\(")
     folders = ("experiments", "viz", "benchmarks")
     files = [p for folder in folders for p in sorted((SRC / folder).rglob("*.py"))]
-    names = ("demo.py", "io/tables.py", "io/recordings.py", "process/spurs.py", "cli/commands_sim.py")
+    names = ("demo.py", "io/tables.py", "io/recording_writer.py", "process/spurs.py", "cli/commands_sim.py")
     files += [SRC / name for name in names]
     offenders = []
     for path in files:
@@ -139,7 +140,7 @@ def test_streamed_recording_bytes_are_unchanged(tmp_path, monkeypatch, dtype):
     if dtype in ("int16", "float32"):
         frames = frames.real.copy()
     frame_bytes = frames[0].nbytes
-    monkeypatch.setattr(recordings, "_CHUNK_BYTES", 2 * frame_bytes, raising=False)  # 4 chunks
+    monkeypatch.setattr(recording_writer, "_CHUNK_BYTES", 2 * frame_bytes, raising=False)  # 4 chunks
     cfg = RadarConfig.prototype_2022(n_doppler=8, range_limit_m=300.0)
     sidecar = write_recording(tmp_path / "r.bin", frames, cfg, dtype=dtype)
     assert (tmp_path / "r.bin").read_bytes() == _old_encoding(frames, dtype)
@@ -156,7 +157,7 @@ def test_recording_write_memory_is_bounded(tmp_path, monkeypatch):
     frames[:] = 1.0 + 0.5j
     frames[5, 1, 2, 3] = 4.0 - 3.0j
     chunk = frames[0].nbytes
-    monkeypatch.setattr(recordings, "_CHUNK_BYTES", chunk, raising=False)
+    monkeypatch.setattr(recording_writer, "_CHUNK_BYTES", chunk, raising=False)
     tracemalloc.start()
     try:
         write_recording(tmp_path / "r.bin", frames, CFG)

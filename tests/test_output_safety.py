@@ -267,7 +267,8 @@ def test_compressed_store_reads_back_identical(tmp_path):
 
 
 def test_rd_resume_key_covers_sidecar_data_file_and_chunking(tmp_path):
-    from skyradar.io.recordings import read_recording, write_recording
+    from skyradar.io.recording_writer import write_recording
+    from skyradar.io.recordings import read_recording
     from skyradar.process.rd_store import _fingerprint, recording_files
 
     cfg = RadarConfig.prototype_2022(n_doppler=8)

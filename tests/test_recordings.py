@@ -11,7 +11,8 @@ import yaml
 from skyradar import cli
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
-from skyradar.io.recordings import read_recording, write_recording
+from skyradar.io.recording_writer import write_recording
+from skyradar.io.recordings import read_recording
 
 CFG = RadarConfig.prototype_2022(n_doppler=6, range_limit_m=600.0)
 NS = CFG.samples_per_chirp

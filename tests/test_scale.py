@@ -114,7 +114,7 @@ def test_process_on_a_local_cluster_matches_the_plain_loop(tmp_path):
 
 def test_rd_on_a_local_cluster_matches_the_plain_loop(tmp_path):
     from skyradar.config import RadarConfig
-    from skyradar.io.recordings import write_recording
+    from skyradar.io.recording_writer import write_recording
     from skyradar.process.rd_store import recording_to_frames
 
     cfg = RadarConfig.prototype_2022()

@@ -208,7 +208,7 @@ def test_process_on_cint16_store_matches_complex64(tmp_path):
 
 
 def test_rd_writes_cint16_store_within_the_bound(tmp_path):
-    from skyradar.io.recordings import write_recording
+    from skyradar.io.recording_writer import write_recording
     from skyradar.process.rangedoppler import range_doppler
 
     cfg = RadarConfig.prototype_2022(n_doppler=6, range_limit_m=600.0)

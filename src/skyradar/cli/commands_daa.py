@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated
 
-import numpy as np
 import typer
 
 from skyradar.cli.app import NON_NEGATIVE, JsonOption, app, emit_result, experiment_app, number_in
@@ -32,8 +31,7 @@ def alert(
     Levels: 0 none, 1 preventive, 2 corrective, 3 warning (non-cooperative well clear: 2200 ft,
     450 ft; alerting times 55/55/25 s; 2-of-4 persistence, 5 s hysteresis).
     """
-    from skyradar.daa.pipeline import TRACK_COLUMNS, alerts_from_tracks, ownship_from_frames
-    from skyradar.daa.provenance import check_tracks_match_run
+    from skyradar.daa.pipeline import TRACK_COLUMNS, alert_summary, alerts_for_run
     from skyradar.io.frames import open_frames
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import read_table, write_table
@@ -41,24 +39,13 @@ def alert(
     check_output(output, [tracks, ownship], overwrite, kind="table")
     table = read_table(tracks, required=TRACK_COLUMNS, sort_by="time_s")
     run_ds = open_frames(ownship)
-    check_tracks_match_run(table.attrs, str(tracks), run_ds, str(ownship))
-    own = ownship_from_frames(run_ds, str(ownship))
-    alerts = alerts_from_tracks(table, own, with_advice=not no_advice, source=str(tracks))
+    alerts = alerts_for_run(
+        run_ds, table, with_advice=not no_advice, run_name=str(ownship), tracks_name=str(tracks)
+    )
     write_table(alerts, output)
-    warn = alerts[alerts["level"] >= 3]
-    result = {
-        "rows": len(alerts),
-        "tracks": int(alerts["track_id"].nunique()),
-        "tracks_with_warning": int(warn["track_id"].nunique()),
-        "first_warning_s": float(warn["time_s"].min()) if len(warn) else float("nan"),
-        "max_level": int(alerts["level"].max()) if len(alerts) else 0,
-        # NaN position/velocity (no direction of arrival) cannot be alerted on: say how many.
-        "rows_skipped_no_state": int(alerts.attrs.get("rows_skipped_no_state", 0)),
-        "output": str(output),
-    }
-    for level in (1, 2, 3):
-        result[f"rows_level_{level}"] = int(np.sum(alerts["level"].to_numpy() == level))
-    emit_result(result, as_json, "alerts")
+    summary = alert_summary(alerts)
+    levels = {key: summary.pop(key) for key in ("rows_level_1", "rows_level_2", "rows_level_3")}
+    emit_result(summary | {"output": str(output)} | levels, as_json, "alerts")
 
 
 @app.command()

@@ -54,6 +54,7 @@ def state(
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_table
     from skyradar.nav.flight_state import estimate_run
+    from skyradar.nav.state_summary import state_summary
 
     check_output(output, [run], overwrite, kind="table")
     from skyradar.errors import InputError
@@ -66,21 +67,11 @@ def state(
     write_table(
         table, output, metadata={"radar_config": config.to_json(), "source": str(run), "method": method}
     )
-    good = ~table["low_quality"].to_numpy()
-    result = {
-        "frames": len(table),
-        "low_quality_frames": int((~good).sum()),
-        "mean_quality": float(table["quality"].mean()),
-        "h_m_median": float(np.nanmedian(table["h_m"])) if good.any() else float("nan"),
-        "vx_mps_median": float(np.nanmedian(table["vx_mps"])) if good.any() else float("nan"),
-        "vz_mps_median": float(np.nanmedian(table["vz_mps"])) if good.any() else float("nan"),
-        "output": str(output),
-    }
-    if "own_height_agl_m" in ds:
-        err = table["h_m"].to_numpy() - ds["own_height_agl_m"].to_numpy().astype(float)
-        result["h_err_mean_m"] = float(np.nanmean(err)) if np.isfinite(err).any() else float("nan")
-        result["h_err_sd_m"] = float(np.nanstd(err)) if np.isfinite(err).any() else float("nan")
-    emit_result(result, as_json, "own-ship state")
+    truth = ds["own_height_agl_m"].to_numpy() if "own_height_agl_m" in ds else None
+    summary = state_summary(table, truth)
+    # "output" after the medians and before the height error, as the command always printed it.
+    head = {k: v for k, v in summary.items() if not k.startswith("h_err")}
+    emit_result(head | {"output": str(output)} | summary, as_json, "own-ship state")
 
 
 @experiment_app.command("ch5")

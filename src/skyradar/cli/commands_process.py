@@ -36,38 +36,46 @@ def _progress(total: int, label: str):
     return bar, bar.add_task(label, total=total)
 
 
+# The options of `process`, named once so that the command reads as: parse, call, write, print.
+_SpurMapOpt = Annotated[
+    Path | None, typer.Option("--spur-map", help="Spur map (.npz from `skyradar spur-map`).")
+]
+_SpurModeOpt = Annotated[
+    str, typer.Option("--spur-mode", help="'mask' spur pixels before detection or 'flag' detections in them.")
+]
+_MethodOpt = Annotated[str, typer.Option("--method", help="Detector: cfar, os-cfar or shi-tomasi.")]
+_PfaOpt = Annotated[
+    float,
+    typer.Option("--pfa", callback=PROBABILITY, help="CFAR false-alarm probability per pixel, in (0, 1)."),
+]
+_TerrainOpt = Annotated[
+    Path | None, typer.Option("--terrain", help="DEM (.hgt/.tif/.npz) for the ground filter's height test.")
+]
+_RadarConfigOpt = Annotated[
+    Path | None, typer.Option("--radar-config", help="RadarConfig JSON (e.g. from `skyradar calibrate`).")
+]
+_SchedulerOpt = Annotated[str | None, typer.Option(help="Address of an existing Dask scheduler.")]
+_WorkersOpt = Annotated[
+    int | None, typer.Option(callback=WORKERS, help="Run on a local Dask cluster of this many workers.")
+]
+_ChunkFramesOpt = Annotated[
+    int, typer.Option(callback=COUNT, help="Frames per Dask task (with --scheduler/--workers).")
+]
+
+
 @app.command()
 def process(
     run: Annotated[Path, typer.Argument(help="Frames run (Zarr directory or NetCDF file).")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Detections table to write (Parquet).")],
-    spur_map: Annotated[
-        Path | None, typer.Option("--spur-map", help="Spur map (.npz from `skyradar spur-map`).")
-    ] = None,
-    spur_mode: Annotated[
-        str,
-        typer.Option("--spur-mode", help="'mask' spur pixels before detection or 'flag' detections in them."),
-    ] = "mask",
-    method: Annotated[str, typer.Option("--method", help="Detector: cfar, os-cfar or shi-tomasi.")] = "cfar",
-    pfa: Annotated[
-        float,
-        typer.Option(
-            "--pfa", callback=PROBABILITY, help="CFAR false-alarm probability per pixel, in (0, 1)."
-        ),
-    ] = 2e-8,
-    terrain: Annotated[
-        Path | None,
-        typer.Option("--terrain", help="DEM (.hgt/.tif/.npz) for the ground filter's height test."),
-    ] = None,
-    radar_config: Annotated[
-        Path | None, typer.Option("--radar-config", help="RadarConfig JSON (e.g. from `skyradar calibrate`).")
-    ] = None,
-    scheduler: Annotated[str | None, typer.Option(help="Address of an existing Dask scheduler.")] = None,
-    workers: Annotated[
-        int | None, typer.Option(callback=WORKERS, help="Run on a local Dask cluster of this many workers.")
-    ] = None,
-    chunk_frames: Annotated[
-        int, typer.Option(callback=COUNT, help="Frames per Dask task (with --scheduler/--workers).")
-    ] = 64,
+    spur_map: _SpurMapOpt = None,
+    spur_mode: _SpurModeOpt = "mask",
+    method: _MethodOpt = "cfar",
+    pfa: _PfaOpt = 2e-8,
+    terrain: _TerrainOpt = None,
+    radar_config: _RadarConfigOpt = None,
+    scheduler: _SchedulerOpt = None,
+    workers: _WorkersOpt = None,
+    chunk_frames: _ChunkFramesOpt = 64,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -76,10 +84,11 @@ def process(
     Columns: time_s, frame, range_m, radial_velocity_mps, range/doppler_bin, snr_db, power_db,
     azimuth/elevation_rad (antenna frame), x/y/z_body_m, north/east/down_m, lat/lon/alt, is_ground, spur.
     """
+    from skyradar.daa.provenance import ownship_signature
     from skyradar.io.frames import open_frames, radar_config_of
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_table
-    from skyradar.process.pipeline import process_frames
+    from skyradar.process.detect_run import detect_run, detection_summary
     from skyradar.process.spurs import SpurMap
 
     check_choice("--method", method, ("cfar", "os-cfar", "shi-tomasi"))
@@ -88,49 +97,25 @@ def process(
     ds = open_frames(run)
     config = _read_config(radar_config) if radar_config is not None else radar_config_of(ds, str(run))
     spurs = SpurMap.load(spur_map, config) if spur_map is not None else None
-    dem = None
-    if terrain is not None:
-        from skyradar.scene.dem_coverage import dem_for_run
-
-        # Only the window the own-ship can see is read; a DEM away from the track is refused.
-        dem = dem_for_run(terrain, ds, config.range_limit_m, str(run))
+    dem = _terrain_window(terrain, ds, config, run) if terrain is not None else None
     bar, task = _progress(ds.sizes["time"], "frames")
     with bar:
-        if scheduler is None and not workers:
-            table = process_frames(
-                ds, spurs, dem, method, spur_mode, progress=lambda n: bar.update(task, completed=n),
-                source=str(run), config=config, pfa=pfa,
-            )  # fmt: skip
-        else:
-            import functools
-
-            import pandas as pd
-
-            from skyradar.process.pipeline import process_chunk
-            from skyradar.parallel import map_frame_chunks
-
-            job = functools.partial(process_chunk, config=config, pfa=pfa)
-            parts = map_frame_chunks(
-                job, str(run), ds.sizes["time"], max(1, chunk_frames), spurs, dem, method, spur_mode,
-                scheduler=scheduler, workers=workers, progress=lambda k: bar.advance(task, k),
-            )  # fmt: skip
-            table = pd.concat(parts, ignore_index=True)
-    from skyradar.daa.provenance import ownship_signature
-
+        table = detect_run(
+            run, ds, config, spurs, dem, method, spur_mode, pfa, scheduler, workers, chunk_frames,
+            progress=lambda n: bar.update(task, completed=n),
+        )  # fmt: skip
     # The own-ship signature lets `alert` check that the tracks and its --ownship run belong together.
     meta = {"radar_config": config.to_json(), "source": str(run)}
     meta.update({"ownship_signature": sig} if (sig := ownship_signature(ds, str(run))) else {})
     write_table(table, output, metadata=meta)
-    n = ds.sizes["time"]
-    result = {
-        "frames": n,
-        "detections": len(table),
-        "detections_per_frame": len(table) / n,
-        "ground": int(table["is_ground"].sum()),
-        "spur": int(table["spur"].sum()),
-        "output": str(output),
-    }
-    emit_result(result, as_json, "detections")
+    emit_result(detection_summary(table, ds.sizes["time"]) | {"output": str(output)}, as_json, "detections")
+
+
+def _terrain_window(terrain: Path, ds, config, run: Path):
+    from skyradar.scene.dem_coverage import dem_for_run
+
+    # Only the window the own-ship can see is read; a DEM away from the track is refused.
+    return dem_for_run(terrain, ds, config.range_limit_m, str(run))
 
 
 def _read_config(path: Path):

@@ -17,6 +17,7 @@ from skyradar.cli.app import (
     emit_result,
     number_in,
 )
+from skyradar.errors import InputError
 from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["rd", "bench_chain"]
@@ -86,6 +87,16 @@ def rd(
     emit_result(result, as_json, "range-Doppler frames")
 
 
+def _no_flight_frames(value: int) -> int:
+    # `bench chain` used to run the flight benchmark too; one benchmark per command now.
+    if value:
+        raise InputError(
+            f"--flight-frames {value}: bench chain no longer runs the flight benchmark; "
+            f"use `skyradar bench flight --frames {value}`"
+        )
+    return value
+
+
 @bench_app.command("chain")
 def bench_chain(
     frames: Annotated[
@@ -99,21 +110,16 @@ def bench_chain(
     flight_frames: Annotated[
         int,
         typer.Option(
-            callback=number_in(0, 10_000_000),
-            help="Frames of the whole-flight simulation run on 1 and 2 Dask workers (0: skip).",
+            hidden=True, callback=_no_flight_frames, help="Deprecated: see `bench flight`."
         ),
-    ] = 2400,
+    ] = 0,
 ) -> None:
-    """ADC cube -> range-Doppler cube throughput, and whole-flight simulation on 1 vs 2 Dask workers.
+    """ADC cube -> range-Doppler cube throughput against a per-channel numpy.fft loop.
 
     Prints ``raw_to_rd_fps``, ``realtime_factor`` (fps / 9.4 frames/s) and the same-run baseline
-    (per-channel numpy.fft loop) with the speed-up; then ``sim_fps_1_worker``,
-    ``sim_fps_2_workers`` and ``sim_speedup_2_workers`` for a flight at SRTM spacing.
+    (per-channel numpy.fft loop) with the speed-up. The whole-flight simulation on Dask is
+    ``skyradar bench flight``.
     """
-    from skyradar.benchmarks import flight
     from skyradar.benchmarks.range_doppler import run
 
-    result = run(n_frames=frames, workers=workers)
-    if flight_frames:
-        result |= flight.run(frames=flight_frames)
-    emit_result(result, as_json, "raw chain and whole-flight simulation")
+    emit_result(run(n_frames=frames, workers=workers), as_json, "raw chain")

@@ -35,6 +35,25 @@ def frame_progress(total: int, label: str) -> Progress:
     )
 
 
+_CompressOpt = Annotated[
+    str,
+    typer.Option(
+        "--compress",
+        help="Lossless codec for the pixels: none (8 bytes per complex pixel), zstd, or blosc "
+        "(zstd with byte shuffle). Readable by every command.",
+    ),
+]
+_PrecisionOpt = Annotated[
+    str,
+    typer.Option(
+        "--precision",
+        help="Pixel format: complex64 (exact, 8 bytes per pixel) or cint16 (int16 I/Q with a scale "
+        "per frame, range bin and rx: 4 bytes per pixel, rounding error at most half a step). "
+        "Readable by every command.",
+    ),
+]
+
+
 @app.command()
 def simulate(
     scenario: Annotated[Path, typer.Argument(help="Scenario YAML file (see `skyradar scenarios`).")],
@@ -47,23 +66,8 @@ def simulate(
         int | None, typer.Option(callback=COUNT, help="Run on a local Dask cluster of this many workers.")
     ] = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
-    compress: Annotated[
-        str,
-        typer.Option(
-            "--compress",
-            help="Lossless codec for the pixels: none (8 bytes per complex pixel), zstd, or blosc "
-            "(zstd with byte shuffle). Readable by every command.",
-        ),
-    ] = "none",
-    precision: Annotated[
-        str,
-        typer.Option(
-            "--precision",
-            help="Pixel format: complex64 (exact, 8 bytes per pixel) or cint16 (int16 I/Q with a scale "
-            "per frame, range bin and rx: 4 bytes per pixel, rounding error at most half a step). "
-            "Readable by every command.",
-        ),
-    ] = "complex64",
+    compress: _CompressOpt = "none",
+    precision: _PrecisionOpt = "complex64",
 ) -> None:
     """Simulate a scenario into a frames store (range x Doppler x rx per frame, plus truth).
 

@@ -39,28 +39,31 @@ def _origin(text: str | None) -> tuple[float, float, float] | None:
     return lat, lon, alt
 
 
+_ModelOpt = Annotated[
+    str, typer.Option("--model", help="'radar' (aliasing-aware, coupled) or 'traditional' (image tracker).")
+]
+_OriginOpt = Annotated[
+    str | None, typer.Option("--origin", help="Scenario origin 'lat,lon,alt' for the tracks' lat/lon/alt.")
+]
+_OwnshipOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--ownship",
+        help="Own-ship table (time_s, own_north_m..own_vd_mps, NED): the radial velocity then "
+        "updates the 3-D velocity and the DoA error is split along/across the line of sight.",
+    ),
+]
+
+
 @app.command()
 def track(
     detections: Annotated[
         Path, typer.Argument(help="Detections table (Parquet or CSV) from `skyradar process`.")
     ],
     output: Annotated[Path, typer.Option("-o", "--output", help="Tracks table to write (Parquet).")],
-    model: Annotated[
-        str,
-        typer.Option("--model", help="'radar' (aliasing-aware, coupled) or 'traditional' (image tracker)."),
-    ] = "radar",
-    origin: Annotated[
-        str | None,
-        typer.Option("--origin", help="Scenario origin 'lat,lon,alt' for the tracks' lat/lon/alt."),
-    ] = None,
-    ownship: Annotated[
-        Path | None,
-        typer.Option(
-            "--ownship",
-            help="Own-ship table (time_s, own_north_m..own_vd_mps, NED): the radial velocity then "
-            "updates the 3-D velocity and the DoA error is split along/across the line of sight.",
-        ),
-    ] = None,
+    model: _ModelOpt = "radar",
+    origin: _OriginOpt = None,
+    ownship: _OwnshipOpt = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -76,7 +79,7 @@ def track(
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import read_table, write_table
     from skyradar.track.io import radar_config_from_attrs, read_detections, validate_ownship
-    from skyradar.track.track_table import OWNSHIP_COLUMNS, track_detections
+    from skyradar.track.track_table import OWNSHIP_COLUMNS, track_air_detections
 
     if model not in ("radar", "traditional"):
         raise InputError(f"--model: must be 'radar' or 'traditional', got {model!r}")
@@ -84,26 +87,11 @@ def track(
     origin_lla = _origin(origin)
     table = read_detections(detections)
     config = radar_config_from_attrs(table)
-    frame_times = np.unique(table["time_s"].to_numpy(float))
-    keep = np.ones(len(table), bool)
-    for flag in ("is_ground", "spur"):
-        if flag in table.columns:
-            keep &= ~table[flag].fillna(False).to_numpy(bool)
     own = None
     if ownship is not None:
         own = read_table(ownship, required=list(OWNSHIP_COLUMNS), sort_by="time_s")
         validate_ownship(own, OWNSHIP_COLUMNS, str(ownship))
-    tracks = track_detections(
-        table[keep].reset_index(drop=True),
-        model,
-        config,
-        frame_times_s=frame_times,
-        origin=origin_lla,
-        ownship=own,
-    )
-    # detection_row refers to the input table, not to the filtered one.
-    rows = tracks["detection_row"].to_numpy()
-    tracks["detection_row"] = np.where(rows >= 0, np.flatnonzero(keep)[np.maximum(rows, 0)], -1)
+    tracks, n_used = track_air_detections(table, model, config, origin_lla, own)
     meta = {"radar_config": config.to_json(), "source": str(detections), "model": model}
     if table.attrs.get("ownship_signature"):  # carried on for `alert` (see skyradar.daa.provenance)
         meta["ownship_signature"] = table.attrs["ownship_signature"]
@@ -111,18 +99,13 @@ def track(
     if tracks.empty:
         # A clear sky (no detections, or only ground and spurs) is a normal outcome, not an error.
         console.print(
-            f"no tracks: {int(keep.sum())} of {len(table)} detections left after dropping ground and "
+            f"no tracks: {n_used} of {len(table)} detections left after dropping ground and "
             f"spurs; wrote an empty tracks table to {output}",
             soft_wrap=True,
         )
-    result = {
-        "frames": int(frame_times.size),
-        "detections": int(keep.sum()),
-        "tracks": int(tracks["track_id"].nunique()),
-        "rows": len(tracks),
-        "model": model,
-        "output": str(output),
-    }
+    n_frames = int(np.unique(table["time_s"].to_numpy(float)).size)
+    result = {"frames": n_frames, "detections": n_used, "tracks": int(tracks["track_id"].nunique())}
+    result |= {"rows": len(tracks), "model": model, "output": str(output)}
     emit_result(result, as_json, "tracks")
 
 

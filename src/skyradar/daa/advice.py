@@ -22,7 +22,14 @@ import numpy as np
 
 from skyradar.daa.conflict import WellClearVolume, cpa, loss_of_well_clear_interval
 
-__all__ = ["heading_bands", "vertical_speed_bands", "band_intervals", "mvp_velocity", "resolution_advice"]
+__all__ = [
+    "heading_bands",
+    "vertical_speed_bands",
+    "band_intervals",
+    "mvp_velocity",
+    "resolution_advice",
+    "advice_columns",
+]
 
 
 def _entry_times(
@@ -170,6 +177,39 @@ def band_intervals(
     return out
 
 
+def _mvp_horizontal(s: np.ndarray, vrel: np.ndarray, pz: np.ndarray) -> np.ndarray:
+    """Horizontal MVP push (n, 2) per conflict: along the miss vector, intrusion over tcpa."""
+    tcpa, _, _ = cpa(s, vrel)
+    dist = np.maximum(np.hypot(s[:, 0], s[:, 1]), 1e-6)
+    dcpa = s[:, :2] + vrel[:, :2] * tcpa[:, None]
+    dabs = np.hypot(dcpa[:, 0], dcpa[:, 1])
+    head_on = dabs <= 10.0
+    # Head-on: no miss vector to push along, so push perpendicular to the line of sight.
+    perp = np.stack([-s[:, 1], s[:, 0]], axis=-1) / dist[:, None] * 10.0
+    dcpa = np.where(head_on[:, None], perp, dcpa)
+    dabs = np.where(head_on, 10.0, dabs)
+    tdiv = np.maximum(np.abs(tcpa), 0.5)
+    outside = (pz < dist) & (dabs < dist)
+    erratum = np.cos(np.arcsin(np.minimum(pz / dist, 1.0)) - np.arcsin(np.minimum(dabs / dist, 1.0)))
+    push = np.where(outside, pz / np.where(outside, erratum, 1.0) - dabs, pz - dabs)
+    return push[:, None] * dcpa / (tdiv * dabs)[:, None]
+
+
+def _mvp_vertical(s, vrel, t_los, hpz, lookahead_s: float) -> np.ndarray:
+    """Vertical MVP push (n,) per conflict, up positive as in BlueSky."""
+    # Intrusion over the time to co-altitude, against the relative vertical rate; with no
+    # relative rate, away from the intruder's side.
+    d_up, v_up = -s[:, 2], -vrel[:, 2]
+    moving = np.abs(v_up) > 0
+    tsol = np.where(moving, np.abs(d_up) / np.where(moving, np.abs(v_up), 1.0), t_los)
+    i_v = np.where(moving, hpz, hpz - np.abs(d_up))
+    slow = tsol > lookahead_s
+    tsol = np.maximum(np.where(slow, t_los, tsol), 0.5)
+    i_v = np.where(slow, hpz, i_v)
+    sign = np.where(moving, -np.sign(v_up), np.where(d_up >= 0, 1.0, -1.0))
+    return i_v / tsol * sign
+
+
 def mvp_velocity(
     own_vel_mps: np.ndarray,
     s: np.ndarray,
@@ -206,32 +246,8 @@ def mvp_velocity(
     if not conf.any():
         return own.copy(), conf
     s, vrel, t_los = s[conf], vrel[conf], t_los[conf]
-    pz, hpz = dthr[conf] * resofac, zthr[conf] * resofac
-    tcpa, _, _ = cpa(s, vrel)
-    dist = np.maximum(np.hypot(s[:, 0], s[:, 1]), 1e-6)
-    dcpa = s[:, :2] + vrel[:, :2] * tcpa[:, None]
-    dabs = np.hypot(dcpa[:, 0], dcpa[:, 1])
-    head_on = dabs <= 10.0
-    # Head-on: no miss vector to push along, so push perpendicular to the line of sight.
-    perp = np.stack([-s[:, 1], s[:, 0]], axis=-1) / dist[:, None] * 10.0
-    dcpa = np.where(head_on[:, None], perp, dcpa)
-    dabs = np.where(head_on, 10.0, dabs)
-    tdiv = np.maximum(np.abs(tcpa), 0.5)
-    outside = (pz < dist) & (dabs < dist)
-    erratum = np.cos(np.arcsin(np.minimum(pz / dist, 1.0)) - np.arcsin(np.minimum(dabs / dist, 1.0)))
-    push = np.where(outside, pz / np.where(outside, erratum, 1.0) - dabs, pz - dabs)
-    dv_h = push[:, None] * dcpa / (tdiv * dabs)[:, None]
-    # Vertical (up positive in BlueSky): intrusion over the time to co-altitude, against the
-    # relative vertical rate; with no relative rate, away from the intruder's side.
-    d_up, v_up = -s[:, 2], -vrel[:, 2]
-    moving = np.abs(v_up) > 0
-    tsol = np.where(moving, np.abs(d_up) / np.where(moving, np.abs(v_up), 1.0), t_los)
-    i_v = np.where(moving, hpz, hpz - np.abs(d_up))
-    slow = tsol > lookahead_s
-    tsol = np.maximum(np.where(slow, t_los, tsol), 0.5)
-    i_v = np.where(slow, hpz, i_v)
-    sign = np.where(moving, -np.sign(v_up), np.where(d_up >= 0, 1.0, -1.0))
-    dv_up = i_v / tsol * sign
+    dv_h = _mvp_horizontal(s, vrel, dthr[conf] * resofac)
+    dv_up = _mvp_vertical(s, vrel, t_los, zthr[conf] * resofac, lookahead_s)
     new = own.copy()
     new[:2] -= dv_h.sum(axis=0)
     new[2] += dv_up.sum()  # own vs_up -= dv_up, i.e. down += dv_up
@@ -311,3 +327,41 @@ def resolution_advice(
         "preferred_vs_mps": pref_v,
         "n_conflicts": int(conf.sum()),
     }
+
+
+def advice_columns(
+    alerts, s, v_int, own_vel, height_agl_m, dthr_m, zthr_m, volume: WellClearVolume, alerting_time_s: float
+) -> None:
+    """Add the per-frame advice columns to an alerts table (in place), on frames with an issued alert.
+
+    ``alerts`` is sorted by time with a ``level`` column; ``s``, ``v_int`` (intruder position
+    relative to the own-ship, intruder velocity), ``own_vel``, ``dthr_m`` and ``zthr_m`` are per
+    row, ``height_agl_m`` per row or None. Each frame's :func:`resolution_advice` is repeated on
+    every row of the frame; frames with no alert get empty bands and NaN preferences.
+    """
+    n = len(alerts)
+    names = ("heading_bands_deg", "vs_bands_mps", "terrain_vs_bands_mps")
+    lists: dict[str, list] = {name: [[]] * n for name in names}  # shared empty list; replaced, never mutated
+    pref = {"preferred_heading_deg": np.full(n, np.nan), "preferred_vs_mps": np.full(n, np.nan)}
+    times = alerts["time_s"].to_numpy()
+    alerting = alerts["level"].to_numpy() > 0
+    # Rows are sorted by time, so each frame is one contiguous block.
+    starts = np.flatnonzero(np.r_[True, times[1:] != times[:-1]])
+    stops = np.r_[starts[1:], n]
+    for a, b in zip(starts, stops, strict=True):
+        if not alerting[a:b].any():
+            continue
+        adv = resolution_advice(
+            own_vel[a], s[a:b], v_int[a:b], volume, alerting_time_s,
+            height_agl_m=None if height_agl_m is None else float(height_agl_m[a]),
+            dthr_m=dthr_m[a:b], zthr_m=zthr_m[a:b],
+        )  # fmt: skip
+        for name in names:
+            flat = [float(x) for band in adv[name] for x in band]
+            lists[name][a:b] = [flat] * (b - a)
+        for name in pref:
+            pref[name][a:b] = adv[name]
+    for name in names:
+        alerts[name] = lists[name]
+    for name, values in pref.items():
+        alerts[name] = values

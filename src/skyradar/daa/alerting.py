@@ -134,6 +134,24 @@ class AlertConfig:
 RADAR_ALERT_CONFIG = AlertConfig(period_s=1.0, max_velocity_sigma_mps=6.0, z_v_vel=1.0)
 
 
+def _volume_levels(s, v, tcpa, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2):
+    """Highest level whose (widened) volume is lost within its alerting time, its entry time,
+    and the widened thresholds ``{level: (dthr_m, zthr_m)}`` of every level."""
+    level = np.zeros(len(s), int)
+    t_in_out = np.full(len(s), np.nan)
+    widened = {}
+    z = (config.z_h_pos, config.z_h_vel, config.z_v_pos, config.z_v_vel)
+    for k, lv in enumerate(config.levels, start=1):
+        t_ref = np.clip(tcpa, 0.0, lv.alerting_time_s)
+        dthr, zthr = widened_thresholds(lv.volume, cov_pos_m2, cov_vel_m2ps2, t_ref, *z)
+        widened[k] = (dthr, zthr)
+        t_in, _ = loss_of_well_clear_interval(s, v, lv.volume, lv.alerting_time_s, dthr, zthr)
+        hit = np.isfinite(t_in)
+        level = np.where(hit, k, level)
+        t_in_out = np.where(hit, t_in, t_in_out)
+    return level, t_in_out, widened
+
+
 def raw_alert_levels(
     s: np.ndarray,
     v: np.ndarray,
@@ -168,26 +186,7 @@ def raw_alert_levels(
     s = np.atleast_2d(np.asarray(s, float))
     v = np.atleast_2d(np.asarray(v, float))
     tcpa, hmd, vmd = cpa(s, v)
-    level = np.zeros(len(s), int)
-    t_in_out = np.full(len(s), np.nan)
-    widened = {}
-    for k, lv in enumerate(config.levels, start=1):
-        t_ref = np.clip(tcpa, 0.0, lv.alerting_time_s)
-        dthr, zthr = widened_thresholds(
-            lv.volume,
-            cov_pos_m2,
-            cov_vel_m2ps2,
-            t_ref,
-            config.z_h_pos,
-            config.z_h_vel,
-            config.z_v_pos,
-            config.z_v_vel,
-        )
-        widened[k] = (dthr, zthr)
-        t_in, _ = loss_of_well_clear_interval(s, v, lv.volume, lv.alerting_time_s, dthr, zthr)
-        hit = np.isfinite(t_in)
-        level = np.where(hit, k, level)
-        t_in_out = np.where(hit, t_in, t_in_out)
+    level, t_in_out, widened = _volume_levels(s, v, tcpa, config, cov_pos_m2, cov_vel_m2ps2)
     t_imp, _ = loss_of_well_clear_interval(s, v, config.collision_volume, config.flarm_thresholds_s[0])
     corrective = widened[min(2, len(config.levels))]
     return {

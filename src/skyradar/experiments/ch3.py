@@ -265,6 +265,24 @@ def _write_outputs(out_dir: Path, table: pd.DataFrame, track: pd.DataFrame, err:
     write_table(pd.DataFrame(sweep), out_dir / "ch3_spacing.parquet")
 
 
+def _spacings(rx_spacing_wavelengths: float, compare_spacings) -> tuple[float, list[float]]:
+    """The flown receive spacing and the further ones to compare, each checked."""
+    spacing = float(rx_spacing_wavelengths)
+    others = sorted({float(s) for s in compare_spacings} - {spacing})
+    for s in (spacing, *others):
+        square_array_m(s, 1.0)
+    return spacing, others
+
+
+def _spacing_sweep(arrays: dict[float, dict]) -> dict[str, Any]:
+    """``spacing_sweep`` (DoA summary per spacing, ascending) and ``half_wavelength`` when flown."""
+    out: dict[str, Any] = {}
+    if 0.5 in arrays:
+        out["half_wavelength"] = {k: v for k, v in arrays[0.5].items() if k != "rx_spacing_wavelengths"}
+    out["spacing_sweep"] = [arrays[s] for s in sorted(arrays)]
+    return out
+
+
 def run(
     out_dir: Path,
     n_frames: int = 300,
@@ -303,32 +321,23 @@ def run(
     from skyradar.experiments.ch3_figures import plot_all, plot_spacing
 
     t0 = time.perf_counter()
-    spacing = float(rx_spacing_wavelengths)
-    others = sorted({float(s) for s in compare_spacings} - {spacing})
-    for s in (spacing, *others):
-        square_array_m(s, 1.0)  # InputError before any work
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    spacing, others = _spacings(rx_spacing_wavelengths, compare_spacings)  # InputError before any work
+    (out_dir := Path(out_dir)).mkdir(parents=True, exist_ok=True)
     scene = build_scene(pitch_deg, seed, spacing)
     cal, spur_map, static_frame, building = _static_phase(scene, n_static)
     track, stats, shown = _flyover(scene, cal, spur_map, n_frames, path)
     err = _errors(track, scene["geom"])
-    det = track.detected.to_numpy()
-    table = _error_table(err, det)
+    table = _error_table(err, track.detected.to_numpy())
     main = _doa_summary(track, err, cal, spacing)
     main["calib_phase_err_deg"] = calibration_phase_error_deg(cal.rx_calibration, scene["true_gain"])
-    arrays = {spacing: main} | {
-        s: _compare_array(s, pitch_deg, seed, spur_map, n_frames, n_static, path) for s in others
-    }
+    compared = {s: _compare_array(s, pitch_deg, seed, spur_map, n_frames, n_static, path) for s in others}
     result = {**main, **_summary(track, err, table, stats, n_frames), "pitch_deg": float(pitch_deg),
               "spur_threshold": SPUR_THRESHOLD, "spur_pixels": int(spur_map["hits"].mask.sum()), "path": path,
               **building}  # fmt: skip
-    if 0.5 in arrays:
-        result["half_wavelength"] = {k: v for k, v in arrays[0.5].items() if k != "rx_spacing_wavelengths"}
-    result["spacing_sweep"] = [arrays[s] for s in sorted(arrays)]
+    result |= _spacing_sweep({spacing: main} | compared)
     _write_outputs(out_dir, table, track, err, result["spacing_sweep"])
     plot_all(out_dir, static_frame, cal, spur_map["hits"], shown, track, err, scene["geom"])
-    if len(arrays) > 1:
+    if len(result["spacing_sweep"]) > 1:
         plot_spacing(out_dir, result["spacing_sweep"], THESIS_TABLE)
     result["runtime_s"] = time.perf_counter() - t0
     result = {k: (float(v) if isinstance(v, np.floating) else v) for k, v in result.items()}

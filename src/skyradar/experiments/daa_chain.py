@@ -15,7 +15,8 @@ import pandas as pd
 import xarray as xr
 
 from skyradar.daa.alerting import AlertConfig
-from skyradar.daa.pipeline import alerts_from_tracks, ownship_from_frames
+from skyradar.daa.pipeline import alerts_from_tracks
+from skyradar.daa.run_tables import ownship_from_frames
 from skyradar.io.frames import frames_dataset
 from skyradar.process.pipeline import process_frames
 from skyradar.sim.scenario_frames import make_simulator, scenario_truth, simulate_frames

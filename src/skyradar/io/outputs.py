@@ -169,21 +169,26 @@ def check_output(
     out = _resolved(path)
     _check_not_input(out, inputs, label)
     _check_not_precious(out, label, kind)
-    if not (path.exists() or path.is_symlink()):
-        return path
+    if path.exists() or path.is_symlink():
+        _check_replaceable(path, label, kind, overwrite)
+    return path
+
+
+def _check_replaceable(path: Path, label: str, kind: str, overwrite: bool) -> None:
+    """An existing output may be replaced (or written into) only when skyradar wrote it or --overwrite."""
     if kind in ("table", "file") and path.is_dir() and not path.is_symlink():
         raise InputError(f"{label}: is an existing folder; the output is a file, name a new path")
     if kind == "folder":
         if not path.is_dir():
             raise InputError(f"{label}: exists and is not a folder; name a new path")
         if is_ours(path, kind) or overwrite or not any(path.iterdir()):
-            return path
+            return
         raise InputError(
             f"{label}: folder exists, is not empty and was not written by skyradar "
             f"(no {FOLDER_MARKER}); pass --overwrite to write into it"
         )
     if is_ours(path, kind) or overwrite:
-        return path
+        return
     raise InputError(
         f"{label}: exists and is not a {kind} written by skyradar; pass --overwrite to replace it"
     )

@@ -34,8 +34,7 @@ supplies the radar fields and ``axes`` (default ``frame, rx, chirp, sample``); w
 thesis prototype's parameters are assumed.
 
 Every inconsistency raises :class:`InputError` naming the file, the field and the value, before any
-output is written. :func:`write_recording` streams the frames in chunks and writes both files through
-unique temporary names, renamed when complete.
+output is written. :func:`skyradar.io.recording_writer.write_recording` writes this format.
 """
 
 from __future__ import annotations
@@ -51,10 +50,9 @@ import yaml
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
-from skyradar.io.atomic import atomic_path
 from skyradar.io.safe_yaml import load_yaml
 
-__all__ = ["AXES", "DTYPES", "AdcFrames", "read_recording", "write_recording"]
+__all__ = ["AXES", "DTYPES", "AdcFrames", "read_recording"]
 
 AXES = ("frame", "rx", "chirp", "sample")
 # Sidecar dtype name -> (numpy element dtype, values per sample)
@@ -261,6 +259,14 @@ def _open_npy(path: Path, meta: dict[str, Any]) -> tuple[np.ndarray, bool, Path]
     return raw, False, path
 
 
+def _assume_prototype(meta: dict[str, Any]) -> None:
+    """Sweep fields a ``.npy`` recording's sidecar leaves out: the thesis prototype's."""
+    proto = RadarConfig.prototype_2022()
+    for key, value in (("sample_rate_hz", proto.fs_hz), ("fc_hz", proto.fc_hz),
+                       ("bandwidth_hz", proto.bandwidth_hz), ("prf_hz", proto.prf_hz)):  # fmt: skip
+        meta.setdefault(key, value)
+
+
 def read_recording(path: str | Path) -> tuple[AdcFrames, RadarConfig]:
     """Open a raw ADC recording (binary + sidecar, or ``.npy``) without reading it into memory.
 
@@ -279,6 +285,7 @@ def read_recording(path: str | Path) -> tuple[AdcFrames, RadarConfig]:
     Examples
     --------
     >>> import tempfile
+    >>> from skyradar.io.recording_writer import write_recording
     >>> cfg = RadarConfig.prototype_2022(n_doppler=8)
     >>> adc = np.full((2, 4, 8, cfg.samples_per_chirp), 1 + 1j, np.complex64)
     >>> d = Path(tempfile.mkdtemp())
@@ -299,10 +306,7 @@ def read_recording(path: str | Path) -> tuple[AdcFrames, RadarConfig]:
         raw, pairs, data = _open_npy(path, meta)
         sidecar = sidecar or path
         meta.setdefault("axes", list(AXES if raw.ndim == 4 else AXES[1:]))
-        proto = RadarConfig.prototype_2022()
-        for key, value in (("sample_rate_hz", proto.fs_hz), ("fc_hz", proto.fc_hz),
-                           ("bandwidth_hz", proto.bandwidth_hz), ("prf_hz", proto.prf_hz)):  # fmt: skip
-            meta.setdefault(key, value)
+        _assume_prototype(meta)
     else:
         if sidecar is None:
             raise InputError(
@@ -324,114 +328,17 @@ def read_recording(path: str | Path) -> tuple[AdcFrames, RadarConfig]:
     return AdcFrames(raw, axes, pairs, scale, times), config
 
 
-_CHUNK_BYTES = 64 * 2**20  # input bytes converted at a time by write_recording
+def __getattr__(name: str) -> Any:
+    # write_recording moved to skyradar.io.recording_writer (issue 16); the old name stays one release.
+    if name == "write_recording":
+        import warnings
 
+        from skyradar.io.recording_writer import write_recording
 
-def _frames_per_chunk(frames: np.ndarray) -> int:
-    """Frames per write chunk: about ``_CHUNK_BYTES`` of input, at least one frame."""
-    frame_bytes = max(1, int(np.prod(frames.shape[1:], dtype=np.int64)) * frames.itemsize)
-    return max(1, _CHUNK_BYTES // frame_bytes)
-
-
-def _peak(frames: np.ndarray, step: int) -> float:
-    """Largest magnitude in ``frames``, ``step`` frames at a time (0 for no samples)."""
-    if frames.size == 0:
-        return 0.0
-    return max(float(np.abs(frames[i : i + step]).max()) for i in range(0, len(frames), step))
-
-
-def _encode(block: np.ndarray, scale: float, code: str, per: int) -> np.ndarray:
-    """Frames as stored on disk: divided by ``scale``, (I, Q) pairs, rounded and clipped for int16."""
-    values = np.asarray(block / scale)  # the only full-size temporary: the rest is in place
-    if per == 2:
-        # A complex array is (real, imag) pairs in memory already: view it as such, no copy.
-        values = values.astype(np.result_type(values, np.complex64), copy=False)
-        values = values.view(values.real.dtype).reshape(*values.shape, 2)
-    if code == "i2":
-        np.round(values, out=values)
-        np.clip(values, -32768, 32767, out=values)
-    return values.astype("<" + code)
-
-
-def write_recording(
-    path: str | Path,
-    frames: np.ndarray,
-    config: RadarConfig,
-    dtype: str = "complex_int16",
-    scale: float | None = None,
-    times_s: np.ndarray | None = None,
-    sidecar_format: str = "json",
-) -> Path:
-    """Write frames (frame, rx, chirp, sample) as ``NAME.bin`` plus a sidecar, atomically.
-
-    The frames are converted and written a few at a time (about 64 MB of input per step), so
-    memory stays bounded whatever the recording's length: ``frames`` may be a memory-mapped
-    array larger than RAM.
-
-    Parameters
-    ----------
-    path : path
-        Data file name; the sidecar gets the same stem with ``.json`` or ``.yaml``.
-    frames : ndarray, shape (n_frames, n_rx, n_chirps, n_samples)
-    config : RadarConfig
-        Radar parameters recorded in the sidecar.
-    dtype : str
-        One of :data:`DTYPES`; integer types are quantised as ``round(x / scale)``.
-    scale : float, optional
-        Value of one count; default so that the largest magnitude uses 30000 counts (int16)
-        or 1.0 (float types).
-    times_s : ndarray, optional
-        Frame times, s (default back-to-back frames).
-    sidecar_format : {'json', 'yaml'}
-
-    Returns
-    -------
-    Path of the sidecar.
-    """
-    path = Path(path)
-    if dtype not in DTYPES:
-        raise InputError(f"write_recording: dtype {dtype!r}; choose from {sorted(DTYPES)}")
-    frames = np.asarray(frames)
-    if frames.ndim != 4:
-        raise InputError(
-            f"write_recording: frames must be (frame, rx, chirp, sample), got shape {frames.shape}"
+        warnings.warn(
+            "skyradar.io.recordings.write_recording is deprecated; use skyradar.io.recording_writer",
+            DeprecationWarning,
+            stacklevel=2,
         )
-    code, per = DTYPES[dtype]
-    if per == 1 and np.iscomplexobj(frames):
-        raise InputError(f"write_recording: dtype {dtype!r} is real but the frames are complex")
-    if path.suffix.lower() in (".json", ".yaml", ".yml"):
-        raise InputError(f"write_recording: data file {path} would be its own sidecar; name it NAME.bin")
-    step = _frames_per_chunk(frames)
-    if scale is None:
-        peak = _peak(frames, step)
-        scale = peak / 30000.0 if code == "i2" and peak > 0 else 1.0
-    meta = {
-        "format": "skyradar-adc/1",
-        "data_file": path.name,
-        "dtype": dtype,
-        "byte_order": "little",
-        "shape": list(frames.shape),
-        "axes": list(AXES),
-        "sample_rate_hz": config.fs_hz,
-        "fc_hz": config.fc_hz,
-        "bandwidth_hz": config.bandwidth_hz,
-        "prf_hz": config.prf_hz,
-        "scale": float(scale),
-        "radar": {
-            k: v
-            for k, v in config.to_dict().items()
-            if k not in ("fc_hz", "fs_hz", "bandwidth_hz", "prf_hz", "n_doppler")
-        },
-    }
-    if times_s is not None:
-        meta["frame_times_s"] = [float(t) for t in times_s]
-    meta = json.loads(json.dumps(meta, default=float))  # plain Python types for YAML too
-    sidecar = path.with_suffix(".json" if sidecar_format == "json" else ".yaml")
-    text = json.dumps(meta, indent=1) if sidecar_format == "json" else yaml.safe_dump(meta)
-    # The data file is renamed first (inner block), then the sidecar that describes it.
-    with atomic_path(sidecar) as tmp_side, atomic_path(path) as tmp_data:
-        with open(tmp_data, "wb") as f:
-            for i in range(0, len(frames), step):
-                _encode(frames[i : i + step], scale, code, per).tofile(f)
-        tmp_side.write_text(text)
-    return sidecar
+        return write_recording
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -204,13 +204,20 @@ def cfar_2d(
         table = _ca_factor_table(float(pfa), n_train, int(n_integrated))
         return _ca(power, exclude, (gr, gd), (hr, hd), table)
     alpha = cfar_factor(pfa, n_train, n_integrated, kind, rank)
+    k = int(round(0.75 * n_train)) if rank is None else int(rank)
+    return _os(power, exclude, (gr, gd), (tr, td), k, alpha)
+
+
+def _os(power, exclude, guard: tuple[int, int], train: tuple[int, int], k: int, alpha: float):
+    """OS-CFAR: the ``k``-th smallest training cell (scipy rank filter) as the noise estimate."""
+    (gr, gd), (tr, td) = guard, train
+    hr, hd = gr + tr, gd + td
     if exclude is not None:
-        # OS-CFAR: fill excluded pixels with the image median, a noise-like value.
+        # Fill excluded pixels with the image median, a noise-like value.
         power = np.where(exclude, np.median(power), power).astype(np.float32)
     padded = _pad(power, hr, hd)
     footprint = np.ones((2 * hr + 1, 2 * hd + 1), bool)
     footprint[tr : tr + 2 * gr + 1, td : td + 2 * gd + 1] = False
-    k = int(round(0.75 * n_train)) if rank is None else int(rank)
     full = ndimage.rank_filter(padded, k - 1, footprint=footprint, mode="nearest")
     noise = np.maximum(full[hr : hr + power.shape[0], hd : hd + power.shape[1]], np.float32(1e-38))
     hits = power > np.float32(alpha) * noise

@@ -200,6 +200,42 @@ def process_chunk(path: str, start: int, stop: int, *args: Any, **kwargs: Any) -
     return table
 
 
+def _checked_config(ds: xr.Dataset, config: RadarConfig | None, spur_map, source: str) -> RadarConfig:
+    """The radar config to process ``ds`` with (the stored one unless given), checked against the frames."""
+    stored = radar_config_of(ds, source)
+    config = stored if config is None else config
+    for name in ("n_range", "n_doppler", "n_rx"):
+        if getattr(config, name) != getattr(stored, name):
+            raise InputError(
+                f"{source}: radar config field '{name}' is {getattr(config, name)}, "
+                f"the frames have {getattr(stored, name)}"
+            )
+    if ds.sizes.get("time", 0) == 0:
+        raise InputError(f"{source}: empty run (0 frames)")
+    if ds.sizes.get("rx") != config.n_rx:
+        raise InputError(
+            f"{source}: field 'rx' has {ds.sizes.get('rx')} antennas, radar_config has {config.n_rx}"
+        )
+    if spur_map is not None and spur_map.frequency.shape != (config.n_range, config.n_doppler):
+        raise InputError(f"{source}: spur map shape {spur_map.frequency.shape} does not fit the frames")
+    return config
+
+
+def _located(out: dict, time_s: float, i: int, own, origin, config: RadarConfig, terrain) -> dict:
+    """One frame's detections with time, frame, world position (NaN without own-ship) and ground flag."""
+    n = len(out["range_m"])
+    out["time_s"] = np.full(n, time_s)
+    out["frame"] = np.full(n, i, np.int64)
+    nan = np.full(n, np.nan)
+    ned, geo, u_ned = (np.full((n, 3), np.nan), (nan, nan, nan), None)
+    if own is not None:
+        ned, geo, u_ned = _to_world(out, own, i, config, origin)
+    out.update(north_m=ned[:, 0], east_m=ned[:, 1], down_m=ned[:, 2])
+    out.update(lat_deg=np.asarray(geo[0]), lon_deg=np.asarray(geo[1]), alt_m=np.asarray(geo[2]))
+    out["is_ground"] = _ground_flags(out, own, i, u_ned, config, terrain)
+    return out
+
+
 def process_frames(
     ds: xr.Dataset,
     spur_map: SpurMap | None = None,
@@ -228,23 +264,8 @@ def process_frames(
     config : RadarConfig, optional
         Overrides the run's stored RadarConfig (e.g. one calibrated later); must fit the frames.
     """
-    stored = radar_config_of(ds, source)
-    config = stored if config is None else config
-    for name in ("n_range", "n_doppler", "n_rx"):
-        if getattr(config, name) != getattr(stored, name):
-            raise InputError(
-                f"{source}: radar config field '{name}' is {getattr(config, name)}, "
-                f"the frames have {getattr(stored, name)}"
-            )
-    n_frames = ds.sizes.get("time", 0)
-    if n_frames == 0:
-        raise InputError(f"{source}: empty run (0 frames)")
-    if ds.sizes.get("rx") != config.n_rx:
-        raise InputError(
-            f"{source}: field 'rx' has {ds.sizes.get('rx')} antennas, radar_config has {config.n_rx}"
-        )
-    if spur_map is not None and spur_map.frequency.shape != (config.n_range, config.n_doppler):
-        raise InputError(f"{source}: spur map shape {spur_map.frequency.shape} does not fit the frames")
+    config = _checked_config(ds, config, spur_map, source)
+    n_frames = ds.sizes["time"]
     own, origin = _own_state(ds), scenario_origin(ds)
     times = np.asarray(ds["time"].values, float)
     rows: list[dict[str, np.ndarray]] = []
@@ -257,17 +278,7 @@ def process_frames(
                 out = process_cube(cube, config, spur_map, method, spur_mode, **detect_kwargs)
             except InputError as exc:  # e.g. CFAR windows that do not fit: say which run
                 raise InputError(f"{source}: {exc}") from None
-            n = len(out["range_m"])
-            out["time_s"] = np.full(n, times[i])
-            out["frame"] = np.full(n, i, np.int64)
-            nan = np.full(n, np.nan)
-            ned, geo, u_ned = (np.full((n, 3), np.nan), (nan, nan, nan), None)
-            if own is not None:
-                ned, geo, u_ned = _to_world(out, own, i, config, origin)
-            out.update(north_m=ned[:, 0], east_m=ned[:, 1], down_m=ned[:, 2])
-            out.update(lat_deg=np.asarray(geo[0]), lon_deg=np.asarray(geo[1]), alt_m=np.asarray(geo[2]))
-            out["is_ground"] = _ground_flags(out, own, i, u_ned, config, terrain)
-            rows.append(out)
+            rows.append(_located(out, times[i], i, own, origin, config, terrain))
         if progress is not None:
             progress(min(start + batch_frames, n_frames))
     table = {c: np.concatenate([r[c] for r in rows]) for c in DETECTION_COLUMNS}

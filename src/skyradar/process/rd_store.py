@@ -67,6 +67,40 @@ def _check_samples(frames, source: str | Path, chunk_frames: int) -> None:
         check_finite_frames(np.stack([frames[i] for i in range(start, stop)]), start, source, "samples")
 
 
+def _checked_inputs(recording, output, overwrite: bool, chunk_frames: int, compressor: str, precision: str):
+    """The recording, its radar, its files and the chunk length, once output, input and disk are checked."""
+    check_output(output, recording_files(recording), overwrite, kind="frames store")
+    frames, config = read_recording(recording)  # raises InputError on a bad recording
+    inputs = recording_files(recording, frames)
+    check_output(output, inputs, overwrite, kind="frames store")
+    chunk_frames = max(1, min(int(chunk_frames), frames.shape[0]))  # a chunk is at most the whole run
+    check_store_space(output, config, frames.shape[0], chunk_frames, compressor, precision)
+    _check_samples(frames, recording, chunk_frames)
+    return frames, config, inputs, chunk_frames
+
+
+def _template(frames, config, chunk_frames: int, attrs: dict[str, Any]):
+    """The store's layout: lazy zeros of the run's shape, with the recording's times and radar."""
+    import dask.array as da
+
+    shape = (frames.shape[0], config.n_range, config.n_doppler, config.n_rx)
+    lazy = da.zeros(shape, dtype=np.complex64, chunks=(chunk_frames, *shape[1:]))
+    return frames_dataset(lazy, frames.times_s, config, attrs=attrs)
+
+
+def _write_pending(args: tuple, pending: list[int], client, progress: Callable[[int], None] | None) -> None:
+    """Process and write the chunks ``pending`` here, or on the Dask ``client``."""
+    if client is None:
+        for index in pending:
+            done = _write_chunk(*args, index)
+            if progress:
+                progress(done)
+        return
+    from skyradar.parallel import map_chunks
+
+    map_chunks(_write_chunk, *args, client=client, chunks=pending, progress=progress)
+
+
 def recording_to_frames(
     recording: str | Path,
     output: str | Path,
@@ -87,47 +121,31 @@ def recording_to_frames(
     skyradar did not write only with ``overwrite``), then the recording and the free disk space,
     all before anything is written; a bad recording leaves no output.
     """
-    import dask.array as da
-
-    check_output(output, recording_files(recording), overwrite, kind="frames store")
-    frames, config = read_recording(recording)  # raises InputError on a bad recording
-    inputs = recording_files(recording, frames)
-    check_output(output, inputs, overwrite, kind="frames store")
-    chunk_frames = max(1, min(int(chunk_frames), frames.shape[0]))  # a chunk is at most the whole run
-    check_store_space(output, config, frames.shape[0], chunk_frames, compressor, precision)
-    _check_samples(frames, recording, chunk_frames)
+    frames, config, inputs, chunk_frames = _checked_inputs(
+        recording, output, overwrite, chunk_frames, compressor, precision
+    )
     n_frames = frames.shape[0]
     RangeDopplerProcessor(config, range_window, doppler_window, n_samples=frames.shape[3])  # checks windows
-    shape = (n_frames, config.n_range, config.n_doppler, config.n_rx)
-    lazy = da.zeros(shape, dtype=np.complex64, chunks=(chunk_frames, *shape[1:]))
     attrs = {"source": str(recording), "range_window": range_window, "doppler_window": doppler_window}
+    template = _template(frames, config, chunk_frames, attrs)
     options = {"rw": range_window, "dw": doppler_window, "dc": remove_dc, "chunk": chunk_frames}
     options["precision"] = precision  # also in the writer's fingerprint; the workers need it to encode
     client = None
     if scheduler is not None or workers:
-        from skyradar.sim.cluster import connect
+        from skyradar.parallel import connect
 
         client = connect(scheduler, workers)  # before any output exists: a dead address leaves nothing
     try:
-        template = frames_dataset(lazy, frames.times_s, config, attrs=attrs)
         key = _fingerprint(inputs, options)
         writer = FrameStoreWriter(
             output, template, chunk_frames, key, overwrite, inputs, compressor, precision
         )
         pending = writer.pending_chunks()
-        args = (str(recording), str(writer.partial), chunk_frames, options)
-        if client is None:
-            for index in pending:
-                done = _write_chunk(*args, index)
-                if progress:
-                    progress(done)
-        else:
-            from skyradar.sim.cluster import map_chunks
-
-            map_chunks(_write_chunk, *args, client=client, chunks=pending, progress=progress)
+        job_args = (str(recording), str(writer.partial), chunk_frames, options)
+        _write_pending(job_args, pending, client, progress)
     finally:
         if client is not None:
-            from skyradar.sim.cluster import close
+            from skyradar.parallel import close
 
             close(client, owns_cluster=scheduler is None)
     writer.close()

@@ -161,6 +161,28 @@ def _turtle(
     return np.array(xy0)[k] + np.stack([dx, dy], axis=-1), heading
 
 
+def _circuit_sides(speed: float, bank_deg: float, upwind_m, width_m, final_m) -> tuple[float, ...]:
+    """Checked upwind, width and final lengths, and the turn radius they must leave room for."""
+    bank = np.radians(_check("bank_deg", bank_deg))
+    if bank >= np.radians(80.0):
+        raise InputError(f"field 'bank_deg': must be < 80 (got {bank_deg})")
+    radius = speed**2 / (GRAVITY_MPS2 * np.tan(bank))
+    upwind, width, final = (
+        _check(n, v) for n, v in (("upwind_m", upwind_m), ("width_m", width_m), ("final_m", final_m))
+    )
+    for field, value, need in (
+        ("upwind_m", upwind, radius),
+        ("final_m", final, radius),
+        ("width_m", width, 2 * radius),
+    ):
+        if value < need:
+            raise InputError(
+                f"field '{field}': must be >= {need:.0f} m for {np.degrees(bank):.0f} deg turns "
+                f"at {speed:g} m/s (got {value:g})"
+            )
+    return upwind, width, final, radius
+
+
 def circuit(
     runway_threshold_ned_m,
     runway_heading_deg: float,
@@ -201,23 +223,7 @@ def circuit(
     threshold = _vector("runway_threshold_ned_m", runway_threshold_ned_m)
     height = _check("pattern_altitude_m", pattern_altitude_m)
     speed = _check("speed_mps", speed_mps)
-    bank = np.radians(_check("bank_deg", bank_deg))
-    if bank >= np.radians(80.0):
-        raise InputError(f"field 'bank_deg': must be < 80 (got {bank_deg})")
-    radius = speed**2 / (GRAVITY_MPS2 * np.tan(bank))
-    upwind, width, final = (
-        _check(n, v) for n, v in (("upwind_m", upwind_m), ("width_m", width_m), ("final_m", final_m))
-    )
-    for field, value, need in (
-        ("upwind_m", upwind, radius),
-        ("final_m", final, radius),
-        ("width_m", width, 2 * radius),
-    ):
-        if value < need:
-            raise InputError(
-                f"field '{field}': must be >= {need:.0f} m for {np.degrees(bank):.0f} deg turns "
-                f"at {speed:g} m/s (got {value:g})"
-            )
+    upwind, width, final, radius = _circuit_sides(speed, bank_deg, upwind_m, width_m, final_m)
     if start_leg not in _CIRCUIT_LEGS:
         raise InputError(f"field 'start_leg': must be one of {list(_CIRCUIT_LEGS)} (got {start_leg!r})")
     legs = [
@@ -257,6 +263,21 @@ def _circuit_profile(
     alt = np.minimum(np.minimum(climbing, descending), height)
     slope = np.where(alt == climbing, up, np.where(alt == descending, -down, 0.0))
     return alt, slope
+
+
+def _ownship_at(ownship: Trajectory, t_s: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """Own-ship position, velocity and ground speed at ``t_s``; refused without a ground track."""
+    # Beyond own-ship's span, its last (or first) state is extrapolated in a straight line.
+    t_near = min(max(t_s, ownship.start_s), ownship.end_s)
+    own = ownship.sample([t_near])
+    v_o = own.velocity_ned_mps[0]
+    p_o = own.position_ned_m[0] + v_o * (t_s - t_near)
+    ground = float(np.hypot(v_o[0], v_o[1]))
+    if ground < _MIN_TRACK_SPEED_MPS:
+        raise InputError(
+            f"field 't_cpa_s': own-ship '{ownship.name}' has no track at {t_s} s (speed {ground:.2f} m/s)"
+        )
+    return p_o, v_o, ground
 
 
 def encounter(
@@ -301,16 +322,7 @@ def encounter(
     t_cpa_s = float(t_cpa_s)
     if not np.isfinite(t_cpa_s):
         raise InputError(f"field 't_cpa_s': must be finite (got {t_cpa_s})")
-    # Beyond own-ship's span, its last (or first) state is extrapolated in a straight line.
-    t_near = min(max(t_cpa_s, ownship.start_s), ownship.end_s)
-    own = ownship.sample([t_near])
-    v_o = own.velocity_ned_mps[0]
-    p_o = own.position_ned_m[0] + v_o * (t_cpa_s - t_near)
-    ground = float(np.hypot(v_o[0], v_o[1]))
-    if ground < _MIN_TRACK_SPEED_MPS:
-        raise InputError(
-            f"field 't_cpa_s': own-ship '{ownship.name}' has no track at {t_cpa_s} s (speed {ground:.2f} m/s)"
-        )
+    p_o, v_o, ground = _ownship_at(ownship, t_cpa_s)
     psi = np.arctan2(v_o[1], v_o[0])
     angle = {"head-on": 180.0, "overtaking": 0.0, "crossing": 90.0, "converging": 45.0}[kind]
     if kind in ("crossing", "converging") and crossing_angle_deg is not None:

@@ -22,7 +22,6 @@ Example
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -31,9 +30,10 @@ from pydantic import ValidationError
 
 from skyradar.config import Mount, RadarConfig
 from skyradar.errors import InputError
-from skyradar.io.safe_yaml import load_yaml, short_repr
+from skyradar.io.safe_yaml import load_yaml
+from skyradar.scene.examples import example_scenario, list_example_scenarios
+from skyradar.scene.scenario_errors import validation_error_line
 from skyradar.scene.scenario_models import (
-    TAGS,
     AntennaModel,
     EncounterFlight,
     FileFlight,
@@ -41,6 +41,7 @@ from skyradar.scene.scenario_models import (
     FractalTerrainModel,
     ScenarioModel,
 )
+from skyradar.scene.scenario_sources import check_plausible, encounter_flight, read_dem_near, read_flight
 from skyradar.scene.trajectories import Trajectory
 
 # 10^7 frames is 12 days at the prototype's 9.4 frames/s and about 2.7 PB of frames.
@@ -54,9 +55,6 @@ __all__ = [
     "example_scenario",
     "list_example_scenarios",
 ]
-
-_SENSE = {"greater_than": ">", "greater_than_equal": ">=", "less_than": "<", "less_than_equal": "<="}
-_SENSE_KEY = {"greater_than": "gt", "greater_than_equal": "ge", "less_than": "lt", "less_than_equal": "le"}
 
 
 @dataclass(frozen=True)
@@ -88,48 +86,6 @@ class BuiltScenario:
     source: Path | None = None
     impairments: Any = None  # skyradar.scene.impairment_config.ImpairmentConfig or None
     land_cover: Any = None  # skyradar.scene.ground_map.LandCover (the ground_map section) or None
-
-
-def _describe(value: Any) -> str:
-    # Bounded: str() of a value built from YAML aliases can expand to gigabytes.
-    return short_repr(value)
-
-
-def _format_error(source: str, err: dict[str, Any]) -> str:
-    """One line from a pydantic error: file, dotted field, what is wrong, the value."""
-    loc = [
-        str(p) for p in err["loc"] if not (isinstance(p, str) and (p in TAGS or p.startswith("function-")))
-    ]
-    dotted = ".".join(loc) or "(top level)"
-    kind, ctx, value = err["type"], err.get("ctx", {}), err.get("input")
-    if kind == "extra_forbidden":
-        return f"{source}: unknown key '{dotted}'"
-    if kind == "missing" or (kind in ("model_attributes_type", "dict_type") and value is None):
-        return f"{source}: field '{dotted}': is required"
-    if kind in ("model_attributes_type", "dict_type"):
-        return f"{source}: field '{dotted}': must be a mapping of keys (got {_describe(value)})"
-    if kind in _SENSE:
-        what = f"must be {_SENSE[kind]} {ctx[_SENSE_KEY[kind]]:g}"
-    elif kind == "union_tag_invalid":
-        what = f"'type' must be one of {ctx['expected_tags']}"
-        value = ctx.get("tag")
-    elif kind == "union_tag_not_found":
-        return f"{source}: field '{dotted}': needs a 'type'"
-    elif kind == "literal_error":
-        what = f"must be one of {ctx['expected']}"
-    elif kind in (
-        "float_parsing",
-        "float_type",
-        "int_parsing",
-        "int_type",
-        "int_from_float",
-        "finite_number",
-    ):
-        what = "must be a finite number" if kind != "int_from_float" else "must be a whole number"
-    else:
-        what = str(err["msg"]).removeprefix("Value error, ")
-        what = what[:1].lower() + what[1:]
-    return f"{source}: field '{dotted}': {what} (got {_describe(value)})"
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -169,7 +125,7 @@ class Scenario:
         try:
             model = ScenarioModel.model_validate(data)
         except ValidationError as exc:
-            raise InputError(_format_error(label, exc.errors()[0])) from None
+            raise InputError(validation_error_line(label, exc.errors()[0])) from None
         return cls(model, source)
 
     @property
@@ -256,7 +212,7 @@ class Scenario:
             if t.type == "jacksboro":
                 return jacksboro()
             if t.type == "file":
-                return _read_dem_near(self._path(t.path), bounds, origin)
+                return read_dem_near(self._path(t.path), bounds, origin)
             if origin is None:
                 raise InputError(
                     f"field 'origin': is required for {t.type} terrain (it is centred on the origin)"
@@ -278,17 +234,17 @@ class Scenario:
         m = self.model
         try:
             if isinstance(spec, FileFlight):
-                return _read_flight(self._path(spec.path), spec.icao24, origin, spec.time_zero_s)
+                return read_flight(self._path(spec.path), spec.icao24, origin, spec.time_zero_s)
             if isinstance(spec, EncounterFlight):
                 params = spec.model_dump(exclude={"type", "name", "rcs_m2", "time_offset_s"})
-                return _encounter(ownship, params, name)
+                return encounter_flight(ownship, params, name)
             from skyradar.scene import flights
 
             params = spec.model_dump(exclude={"type", "name", "rcs_m2", "time_offset_s"})
             params["duration_s"] = params["duration_s"] or m.duration_s
             params["start_time_s"] = m.start_s if params["start_time_s"] is None else params["start_time_s"]
             traj = getattr(flights, spec.type)(origin=origin, name=name, **params)
-            _check_plausible(traj)
+            check_plausible(traj)
             return traj
         except InputError as exc:
             raise self._fail(section, exc) from None
@@ -403,77 +359,3 @@ class Scenario:
             impairments=m.impairments,
             land_cover=land_cover,
         )
-
-
-def _read_dem_near(path: Path, bounds, origin) -> Any:
-    from skyradar.scene.dem_coverage import DemCoverageError
-    from skyradar.scene.dem_readers import read_dem
-
-    try:
-        return read_dem(path, bounds=bounds)
-    except DemCoverageError as exc:
-        if origin is None:
-            raise
-        raise DemCoverageError(f"{exc}; scenario origin lat {origin[0]:.6g}, lon {origin[1]:.6g}") from None
-
-
-def _check_plausible(traj: Trajectory) -> None:
-    """Refuse a parametric flight faster than Mach 3 or outside [-500 m, 30 km] altitude (files: adsb)."""
-    from skyradar.geo import ned_to_geodetic
-    from skyradar.scene.adsb import ALT_LIMITS_M, MAX_SPEED_MPS
-
-    speed = np.linalg.norm(traj.velocity_ned_mps, axis=1)
-    if np.any(speed > MAX_SPEED_MPS):
-        i = int(np.argmax(speed > MAX_SPEED_MPS))
-        raise InputError(
-            f"speed {speed[i]:.4g} m/s at t = {traj.time_s[i]:g} s is above Mach 3 ({MAX_SPEED_MPS:.0f} m/s)"
-        )
-    alt = np.asarray(ned_to_geodetic(traj.position_ned_m, *traj.origin)[2], float)
-    out = (alt < ALT_LIMITS_M[0]) | (alt > ALT_LIMITS_M[1])
-    if np.any(out):
-        i = int(np.argmax(out))
-        raise InputError(
-            f"altitude {alt[i]:.4g} m at t = {traj.time_s[i]:g} s is outside "
-            f"[{ALT_LIMITS_M[0]:g}, {ALT_LIMITS_M[1]:g}] m"
-        )
-
-
-def _read_flight(path: Path, icao24: str | None, origin, time_zero_s: float | None) -> Trajectory:
-    from skyradar.scene.adsb import read_trajectories, read_trajectory
-
-    if icao24 is None:
-        return read_trajectory(path, origin=origin, time_zero_s=time_zero_s)
-    tracks = read_trajectories(path, origin=origin, time_zero_s=time_zero_s)
-    if icao24 not in tracks:
-        raise InputError(f"field 'icao24': {icao24!r} is not in {path} (has {sorted(tracks)[:10]})")
-    return tracks[icao24]
-
-
-def _encounter(ownship: Trajectory, params: dict[str, Any], name: str) -> Trajectory:
-    from skyradar.scene.flights import encounter
-
-    return encounter(ownship, name=name, **params)
-
-
-def _scenario_dir():
-    return resources.files("skyradar") / "data" / "scenarios"
-
-
-def list_example_scenarios() -> list[str]:
-    """Names of the example scenarios shipped with skyradar.
-
-    Examples
-    --------
-    >>> "ch2_flat_forward" in list_example_scenarios()
-    True
-    """
-    return sorted(p.name[: -len(".yaml")] for p in _scenario_dir().iterdir() if p.name.endswith(".yaml"))
-
-
-def example_scenario(name: str) -> Path:
-    """Path of a shipped example scenario (see :func:`list_example_scenarios`)."""
-    stem = name[: -len(".yaml")] if name.endswith(".yaml") else name
-    path = _scenario_dir() / f"{stem}.yaml"
-    if not path.is_file():
-        raise InputError(f"example scenario {name!r} unknown; choose from {list_example_scenarios()}")
-    return Path(str(path))

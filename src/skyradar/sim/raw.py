@@ -124,6 +124,22 @@ def _as_points(name: str, values: np.ndarray | None, n: int | None) -> np.ndarra
     return arr
 
 
+def _beat_signal(config: RadarConfig, pos, vel, power, t_ref: float, chunk: int) -> np.ndarray:
+    """Sum of the scatterers' beat signals (complex128, noise-free), ``chunk`` scatterers per call."""
+    shape = (config.n_rx, config.n_doppler, config.samples_per_chirp)
+    acc = np.zeros(shape, np.complex128)
+    keep = np.flatnonzero(power > 0)
+    amp = np.sqrt(power)
+    for start in range(0, keep.size, max(1, int(chunk))):
+        sel = keep[start : start + chunk]
+        _beat_kernel(
+            acc, np.ascontiguousarray(pos[sel]), np.ascontiguousarray(vel[sel]), amp[sel],
+            config.tx_position_m, config.rx_positions_m, config.fc_hz, config.chirp_slope_hz_per_s,
+            config.fs_hz, config.prf_hz, t_ref, SPEED_OF_LIGHT,
+        )  # fmt: skip
+    return acc
+
+
 def simulate_adc(
     config: RadarConfig,
     positions_m: np.ndarray,
@@ -180,18 +196,7 @@ def simulate_adc(
     if not np.all(np.isfinite(power)) or np.any(power < 0):
         raise InputError("raw simulation: received power must be finite and >= 0")
     t_ref = config.frame_duration_s / 2.0 if t_ref_s is None else float(t_ref_s)
-    shape = (config.n_rx, config.n_doppler, config.samples_per_chirp)
-    acc = np.zeros(shape, np.complex128)
-    keep = np.flatnonzero(power > 0)
-    amp = np.sqrt(power)
-    for start in range(0, keep.size, max(1, int(chunk))):
-        sel = keep[start : start + chunk]
-        _beat_kernel(
-            acc, np.ascontiguousarray(pos[sel]), np.ascontiguousarray(vel[sel]), amp[sel],
-            config.tx_position_m, config.rx_positions_m, config.fc_hz, config.chirp_slope_hz_per_s,
-            config.fs_hz, config.prf_hz, t_ref, SPEED_OF_LIGHT,
-        )  # fmt: skip
-    adc = acc.astype(np.complex64)
+    adc = _beat_signal(config, pos, vel, power, t_ref, chunk).astype(np.complex64)
     if noise:
         adc += adc_noise(config, seed)
     return adc

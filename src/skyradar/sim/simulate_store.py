@@ -99,7 +99,7 @@ def simulate_to_zarr(
     check_store_space(path, built.radar, built.times_s.size, chunk_frames, compressor, precision)
     client = None
     if scheduler is not None or workers:
-        from skyradar.parallel import close, connect, map_chunks
+        from skyradar.parallel import close, connect
 
         client = connect(scheduler, workers)  # before any output exists: a dead address leaves nothing
     try:
@@ -107,28 +107,26 @@ def simulate_to_zarr(
         key = fingerprint(built)
         template = _template(built, chunk_frames, simulator)
         writer = FrameStoreWriter(path, template, chunk_frames, key, overwrite, inputs, compressor, precision)
-        pending = writer.pending_chunks()
-        if progress and len(pending) < writer.n_chunks:
-            progress(built.times_s.size - sum(_chunk_len(writer, i) for i in pending))
-        if client is None:
-            for index in pending:
-                sl = writer.chunk_slice(index)
-                writer.write_chunk(index, simulate_frames(built, np.arange(sl.start, sl.stop), simulator))
-                if progress:
-                    progress(sl.stop - sl.start)
-        else:
-            map_chunks(
-                _chunk_job,
-                built,
-                key,
-                str(writer.partial),
-                chunk_frames,
-                precision,
-                client=client,
-                chunks=pending,
-                progress=progress,
-            )
+        _write_pending(built, writer, simulator, key, client, progress)
     finally:
         if client is not None:
             close(client, owns_cluster=scheduler is None)
     return writer.close()
+
+
+def _write_pending(built, writer: FrameStoreWriter, simulator, key: str, client, progress) -> None:
+    """Simulate and write the chunks the store still lacks, here or on the Dask ``client``."""
+    from skyradar.parallel import map_chunks
+
+    pending = writer.pending_chunks()
+    if progress and len(pending) < writer.n_chunks:  # resumed: count the chunks already there
+        progress(built.times_s.size - sum(_chunk_len(writer, i) for i in pending))
+    if client is None:
+        for index in pending:
+            sl = writer.chunk_slice(index)
+            writer.write_chunk(index, simulate_frames(built, np.arange(sl.start, sl.stop), simulator))
+            if progress:
+                progress(sl.stop - sl.start)
+        return
+    job_args = (built, key, str(writer.partial), writer.chunk_frames, writer.precision)
+    map_chunks(_chunk_job, *job_args, client=client, chunks=pending, progress=progress)

@@ -86,6 +86,31 @@ def _solve(track_idx: np.ndarray, det_idx: np.ndarray, cost: np.ndarray) -> np.n
     return np.concatenate([np.flatnonzero(alone), pair_of[r[keep], c[keep]]])
 
 
+def _pairs_in_range_window(
+    r_pred: np.ndarray, r_det: np.ndarray, window: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """(track, detection) index pairs with ``|r_det - r_pred| <= window`` of the track, by track.
+
+    Sorting the detections by range makes this O((n + m) log m + pairs) instead of n x m.
+    """
+    order = np.argsort(r_det, kind="stable")
+    r_sorted = r_det[order]
+    lo = np.searchsorted(r_sorted, r_pred - window, "left")
+    hi = np.searchsorted(r_sorted, r_pred + window, "right")
+    counts = hi - lo
+    t_idx = np.repeat(np.arange(r_pred.size), counts)
+    offsets = np.arange(int(counts.sum())) - np.repeat(np.cumsum(counts) - counts, counts)
+    return t_idx, order[lo[t_idx] + offsets]
+
+
+def _mahalanobis_costs(y: np.ndarray, S: np.ndarray, t_idx: np.ndarray) -> np.ndarray:
+    """``y^T S^-1 y`` per pair for 2x2 ``S`` of track ``t_idx``."""
+    # Inverse terms once per track, then gathered per pair (cheaper than S[t_idx]).
+    det = S[:, 0, 0] * S[:, 1, 1] - S[:, 0, 1] ** 2
+    ia, ib, id_ = S[:, 1, 1] / det, -S[:, 0, 1] / det, S[:, 0, 0] / det
+    return ia[t_idx] * y[:, 0] ** 2 + 2.0 * ib[t_idx] * y[:, 0] * y[:, 1] + id_[t_idx] * y[:, 1] ** 2
+
+
 def associate(
     z_pred: np.ndarray,
     S: np.ndarray,
@@ -133,24 +158,10 @@ def associate(
     window = np.full(n, gate * pixel_size[0]) if metric == "l2" else np.sqrt(gate * S[:, 0, 0])
     if range_wrap_m is not None:
         window = window + max_alias * np.nan_to_num(np.asarray(range_wrap_m, float))
-    order = np.argsort(z[:, 0], kind="stable")
-    r_sorted = z[order, 0]
-    lo = np.searchsorted(r_sorted, z_pred[:, 0] - window, "left")
-    hi = np.searchsorted(r_sorted, z_pred[:, 0] + window, "right")
-    counts = hi - lo
-    total = int(counts.sum())
-    t_idx = np.repeat(np.arange(n), counts)
-    offsets = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
-    d_idx = order[lo[t_idx] + offsets]
+    t_idx, d_idx = _pairs_in_range_window(z_pred[:, 0], z[:, 0], window)
     rw = None if range_wrap_m is None else np.asarray(range_wrap_m, float)[t_idx]
     y = innovation(z[d_idx], z_pred[t_idx], doppler_width_mps, rw)
-    if metric == "l2":
-        cost = pair_costs(y, S[t_idx], metric, pixel_size)
-    else:
-        # Inverse terms once per track, then gathered per pair (cheaper than S[t_idx]).
-        det = S[:, 0, 0] * S[:, 1, 1] - S[:, 0, 1] ** 2
-        ia, ib, id_ = S[:, 1, 1] / det, -S[:, 0, 1] / det, S[:, 0, 0] / det
-        cost = ia[t_idx] * y[:, 0] ** 2 + 2.0 * ib[t_idx] * y[:, 0] * y[:, 1] + id_[t_idx] * y[:, 1] ** 2
+    cost = pair_costs(y, S[t_idx], metric, pixel_size) if metric == "l2" else _mahalanobis_costs(y, S, t_idx)
     ok = cost < gate
     t_idx, d_idx, y, cost = t_idx[ok], d_idx[ok], y[ok], cost[ok]
     pick = _solve(t_idx, d_idx, cost)

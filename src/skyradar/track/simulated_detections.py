@@ -32,6 +32,7 @@ def synthetic_detections(
     sigma_angle_rad: float = 0.04,
     seed: int = 0,
     coupling: bool = True,
+    clutter_min_range_m: float = 0.0,
 ) -> pd.DataFrame:
     """Detections table (``time_s, frame, range_m, radial_velocity_mps, target``) from truth.
 
@@ -46,8 +47,8 @@ def synthetic_detections(
         Sets VLim and the processed range (default: thesis prototype).
     sigma_range_m, sigma_velocity_mps : float
         Measurement noise.
-    pd_detect : float
-        Probability of detection of a visible truth.
+    pd_detect : float or ndarray, shape (n_time, n_target)
+        Probability of detection of a visible truth (an array: per truth and frame, e.g. from its SNR).
     clutter_per_frame : float
         Mean number of clutter detections per frame (Poisson), uniform over the image.
     positions_ned_m : ndarray, shape (n_time, n_target, 3), optional
@@ -56,6 +57,8 @@ def synthetic_detections(
     coupling : bool
         Add the sawtooth range-Doppler coupling ``config.range_doppler_coupling_s * V`` (true,
         unaliased ``V``) to the range, as the radar measures it.
+    clutter_min_range_m : float
+        Clutter is uniform in range over ``[clutter_min_range_m, range_limit_m)``.
 
     Examples
     --------
@@ -67,42 +70,48 @@ def synthetic_detections(
     config = config or RadarConfig.prototype_2022()
     rng = np.random.default_rng(seed)
     t = np.asarray(times_s, float)
-    R = np.asarray(range_m, float).reshape(t.size, -1)
-    V = np.asarray(radial_velocity_mps, float).reshape(t.size, -1)
+    R, V = (np.asarray(a, float).reshape(t.size, -1) for a in (range_m, radial_velocity_mps))
     vis = (config.range_limit_m > R) if visible is None else np.asarray(visible, bool).reshape(R.shape)
     det = vis & (rng.random(R.shape) < pd_detect)
     fi, ti = np.nonzero(det)
-    width = 2.0 * config.v_lim_mps
-    cols = {
-        "time_s": t[fi],
-        "frame": fi,
-        "range_m": R[fi, ti]
-        + (config.range_doppler_coupling_s * V[fi, ti] if coupling else 0.0)
-        + rng.normal(0.0, sigma_range_m, fi.size),
-        "radial_velocity_mps": wrap(V[fi, ti] + rng.normal(0.0, sigma_velocity_mps, fi.size), width),
-        "target": ti,
-    }
+    # One generator, drawn in a fixed order (detections, noise, positions, clutter): same seed, same table.
+    cols = _noisy_truth(rng, t, R, V, fi, ti, config, sigma_range_m, sigma_velocity_mps, coupling)
     if positions_ned_m is not None:
-        pos = np.asarray(positions_ned_m, float)[fi, ti]
-        err = rng.normal(0.0, 1.0, (fi.size, 3)) * (R[fi, ti] * sigma_angle_rad)[:, None]
-        cols.update(
-            {
-                "north_m": pos[:, 0] + err[:, 0],
-                "east_m": pos[:, 1] + err[:, 1],
-                "down_m": pos[:, 2] + err[:, 2],
-            }
-        )
+        cols |= _noisy_positions(rng, np.asarray(positions_ned_m, float)[fi, ti], R[fi, ti] * sigma_angle_rad)
+    clutter = _clutter(rng, t, clutter_per_frame, config, positions_ned_m is not None, clutter_min_range_m)
+    df = pd.concat([pd.DataFrame(cols), pd.DataFrame(clutter)], ignore_index=True)
+    return df.sort_values(["time_s", "range_m"], kind="stable").reset_index(drop=True)
+
+
+def _noisy_truth(rng, t, R, V, fi, ti, config: RadarConfig, sigma_range_m, sigma_velocity_mps, coupling):
+    """Detections of the truths at (frame ``fi``, target ``ti``): noisy range, noisy wrapped velocity."""
+    width = 2.0 * config.v_lim_mps
+    range_m = R[fi, ti] + (config.range_doppler_coupling_s * V[fi, ti] if coupling else 0.0)
+    range_m = range_m + rng.normal(0.0, sigma_range_m, fi.size)
+    velocity = wrap(V[fi, ti] + rng.normal(0.0, sigma_velocity_mps, fi.size), width)
+    return {"time_s": t[fi], "frame": fi, "range_m": range_m, "radial_velocity_mps": velocity, "target": ti}
+
+
+def _noisy_positions(rng, pos: np.ndarray, sigma_m: np.ndarray) -> dict[str, np.ndarray]:
+    """NED positions with isotropic Gaussian error of ``sigma_m`` (range x angular error) per row."""
+    err = rng.normal(0.0, 1.0, (pos.shape[0], 3)) * sigma_m[:, None]
+    return {name: pos[:, c] + err[:, c] for c, name in enumerate(("north_m", "east_m", "down_m"))}
+
+
+def _clutter(
+    rng, t, clutter_per_frame: float, config: RadarConfig, with_positions: bool, min_range_m: float
+) -> dict:
+    """Poisson-many clutter detections per frame, uniform over the image (``target`` -1, no position)."""
     n_clutter = rng.poisson(clutter_per_frame, t.size) if clutter_per_frame > 0 else np.zeros(t.size, int)
     cf = np.repeat(np.arange(t.size), n_clutter)
     clutter = {
         "time_s": t[cf],
         "frame": cf,
-        "range_m": rng.uniform(0.0, config.range_limit_m, cf.size),
+        "range_m": rng.uniform(min_range_m, config.range_limit_m, cf.size),
         "radial_velocity_mps": rng.uniform(-config.v_lim_mps, config.v_lim_mps, cf.size),
         "target": np.full(cf.size, -1),
     }
-    if positions_ned_m is not None:
+    if with_positions:
         for name in ("north_m", "east_m", "down_m"):
             clutter[name] = np.full(cf.size, np.nan)
-    df = pd.concat([pd.DataFrame(cols), pd.DataFrame(clutter)], ignore_index=True)
-    return df.sort_values(["time_s", "range_m"], kind="stable").reset_index(drop=True)
+    return clutter

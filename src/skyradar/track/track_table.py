@@ -12,7 +12,14 @@ from skyradar.track.models import MotionModel, radar_model, traditional_model
 from skyradar.track.tracker import RangeDopplerTracker, TrackerConfig
 from skyradar.track.tracker3d import RadialObservation, Tracker3D
 
-__all__ = ["make_model", "track_detections", "empty_tracks", "TRACK_COLUMNS", "OWNSHIP_COLUMNS"]
+__all__ = [
+    "make_model",
+    "track_detections",
+    "track_air_detections",
+    "empty_tracks",
+    "TRACK_COLUMNS",
+    "OWNSHIP_COLUMNS",
+]
 
 TRACK_COLUMNS = [
     "time_s", "frame", "track_id", "range_m", "radial_velocity_mps", "range_rate_mps", "radial_accel_mps2",
@@ -140,41 +147,81 @@ def track_detections(
     validate_detections(detections)
     config = config or RadarConfig.prototype_2022()
     motion = make_model(model, config) if isinstance(model, str) else model
-    tracker = RangeDopplerTracker(
-        motion,
-        tracker_config,
-        (config.range_resolution_m, config.doppler_resolution_mps),
-        report_tentative=True,
-    )
-    times = detections["time_s"].to_numpy(float)
+    pixel = (config.range_resolution_m, config.doppler_resolution_mps)
+    tracker = RangeDopplerTracker(motion, tracker_config, pixel, report_tentative=True)
+    grid, lo, hi = _frame_slices(detections["time_s"].to_numpy(float), frame_times_s)
+    m3 = _Measure3D(detections, config, motion, position_sigma_rad, ownship, grid)
+    return _assemble(_run_tracker(tracker, m3, detections, grid, lo, hi), origin, m3.active)
+
+
+def _run_tracker(tracker: RangeDopplerTracker, m3, detections: pd.DataFrame, grid, lo, hi) -> list[dict]:
+    """Step the tracker (and the 3-D tracks) frame by frame; one dict of column arrays per frame."""
     z_all = detections[["range_m", "radial_velocity_mps"]].to_numpy(float)
     frames_col = detections["frame"].to_numpy() if "frame" in detections.columns else None
-    grid, lo, hi = _frame_slices(times, frame_times_s)
-    m3 = _Measure3D(detections, config, motion, position_sigma_rad, ownship, grid)
     chunks: list[dict[str, np.ndarray]] = []
     for k, (time_s, a, b) in enumerate(zip(grid, lo, hi, strict=True)):
         out = tracker.step(float(time_s), z_all[a:b])
-        n = out.track_id.size
         frame = frames_col[a] if (frames_col is not None and b > a) else k
-        rows = np.searchsorted(out.alive_ids, out.track_id)
-        misses = tracker.tracks["misses"][rows]
-        row = {
-            "time_s": np.full(n, time_s),
-            "frame": np.full(n, frame, np.int64),
-            "track_id": out.track_id,
-            "state": out.state,
-            "var": out.covariance[:, [0, 1], [0, 1]],
-            "innov": out.innovation,
-            "det": np.where(out.detection_index >= 0, out.detection_index + a, -1),
-            "n_updates": out.n_updates,
-            "confirmed": out.confirmed & (misses < tracker.initiator.n),
-            "misses": misses,
-        }
+        row = _frame_rows(tracker, out, time_s, frame, a)
         if m3.active:
             x, P = m3.step(tracker, out, k, a, b)
+            rows = np.searchsorted(out.alive_ids, out.track_id)
             row["x3"], row["P3"] = x[rows], P[rows]
         chunks.append(row)
-    return _assemble(chunks, origin, m3.active)
+    return chunks
+
+
+def _frame_rows(tracker: RangeDopplerTracker, out, time_s: float, frame: int, first_row: int) -> dict:
+    """One frame's track rows (``out`` from :meth:`RangeDopplerTracker.step`) as column arrays."""
+    n = out.track_id.size
+    misses = tracker.tracks["misses"][np.searchsorted(out.alive_ids, out.track_id)]
+    return {
+        "time_s": np.full(n, time_s),
+        "frame": np.full(n, frame, np.int64),
+        "track_id": out.track_id,
+        "state": out.state,
+        "var": out.covariance[:, [0, 1], [0, 1]],
+        "innov": out.innovation,
+        "det": np.where(out.detection_index >= 0, out.detection_index + first_row, -1),
+        "n_updates": out.n_updates,
+        # A confirmed track coasting confirm_n frames is an extrapolation, no longer confirmed.
+        "confirmed": out.confirmed & (misses < tracker.initiator.n),
+        "misses": misses,
+    }
+
+
+def track_air_detections(
+    detections: pd.DataFrame,
+    model: str = "radar",
+    config: RadarConfig | None = None,
+    origin: tuple[float, float, float] | None = None,
+    ownship: pd.DataFrame | None = None,
+) -> tuple[pd.DataFrame, int]:
+    """Tracks of a ``skyradar process`` table without its ground and spur detections.
+
+    Every frame of the table counts (a frame whose detections are all ground is a miss), and
+    ``detection_row`` refers to the rows of ``detections``. Returns the tracks and the number of
+    detections tracked.
+
+    Examples
+    --------
+    >>> t = np.arange(10) * 0.1
+    >>> det = pd.DataFrame({"time_s": t, "range_m": 1000 - 50 * t, "radial_velocity_mps": np.full(10, 28.3),
+    ...                     "is_ground": t > 0.75})
+    >>> tracks, n_used = track_air_detections(det)
+    >>> n_used, int(tracks.detection_row.max())
+    (8, 7)
+    """
+    frame_times = np.unique(detections["time_s"].to_numpy(float))
+    keep = np.ones(len(detections), bool)
+    for flag in ("is_ground", "spur"):
+        if flag in detections.columns:
+            keep &= ~detections[flag].fillna(False).to_numpy(bool)
+    air = detections[keep].reset_index(drop=True)
+    tracks = track_detections(air, model, config, frame_times_s=frame_times, origin=origin, ownship=ownship)
+    rows = tracks["detection_row"].to_numpy()
+    tracks["detection_row"] = np.where(rows >= 0, np.flatnonzero(keep)[np.maximum(rows, 0)], -1)
+    return tracks, int(keep.sum())
 
 
 class _Measure3D:

@@ -161,6 +161,13 @@ def create_app(
     served = _served_files(tracks_path, alerts_path)
     app = FastAPI(title="skyradar live display")
     app.state.source = source
+    _add_page_routes(app, served)
+    _add_run_routes(app, source, autoplay, speed)
+    return app
+
+
+def _add_page_routes(app: FastAPI, served: dict[str, Path]) -> None:
+    """The page, its static files, and the tables given on the command line (by exact name)."""
 
     @app.get("/")
     def index() -> FileResponse:
@@ -178,6 +185,10 @@ def create_app(
             raise HTTPException(status_code=404, detail="not found")
         return FileResponse(target, filename=name)
 
+
+def _add_run_routes(app: FastAPI, source: RunSource, autoplay: bool, speed: float) -> None:
+    """The run's summary and frames, and the replay websocket (each client gets its own player)."""
+
     @app.get("/api/info")
     def info() -> JSONResponse:
         source.refresh()
@@ -194,8 +205,6 @@ def create_app(
     @app.websocket("/ws")
     async def ws(websocket: WebSocket) -> None:
         await _replay(websocket, source, _Player(playing=autoplay, speed=speed))
-
-    return app
 
 
 async def _replay(websocket: WebSocket, source: RunSource, player: _Player) -> None:

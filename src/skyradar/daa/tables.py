@@ -1,0 +1,89 @@
+"""The DAA input tables: their columns, and the checks every track row and own-ship state pass.
+
+Tracks table (input), one row per track per frame, SI units, NED in the scenario frame:
+``time_s, track_id, north_m, east_m, down_m, vn_mps, ve_mps, vd_mps`` and, when the tracker gives
+them, the position covariance ``cov_pp_00 .. cov_pp_22`` (m^2) and velocity covariance
+``cov_vv_00 .. cov_vv_22`` (m^2/s^2), row-major 3x3 in NED; missing covariance counts as zero.
+Rows with NaN position or velocity (no direction of arrival) are skipped; with a ``confirmed``
+column only confirmed rows are used. ``AlertConfig.max_velocity_sigma_mps`` silences rows of tracks
+whose velocity has not converged.
+
+Own-ship table: ``time_s, own_north_m, own_east_m, own_down_m, own_vn_mps, own_ve_mps, own_vd_mps``
+and optionally ``own_yaw_rad`` (heading; else the ground track) and ``own_height_agl_m`` (terrain
+advice). :func:`skyradar.daa.run_tables.ownship_from_frames` reads it from a frames run.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from skyradar.errors import InputError
+from skyradar.io.tables import finite_column
+from skyradar.track.track_table import OWNSHIP_COLUMNS as TRACKER_OWNSHIP_COLUMNS
+
+__all__ = ["TRACK_COLUMNS", "OWNSHIP_COLUMNS", "OPTIONAL_OWNSHIP_COLUMNS", "clean_tracks", "interp_ownship",
+           "covariances"]  # fmt: skip
+
+TRACK_COLUMNS = ["time_s", "track_id", "north_m", "east_m", "down_m", "vn_mps", "ve_mps", "vd_mps"]
+OWNSHIP_COLUMNS = list(TRACKER_OWNSHIP_COLUMNS)  # the own-ship table the tracker reads, too
+OPTIONAL_OWNSHIP_COLUMNS = ["own_yaw_rad", "own_height_agl_m"]
+_COV_P = [f"cov_pp_{i}{j}" for i in range(3) for j in range(3)]
+_COV_V = [f"cov_vv_{i}{j}" for i in range(3) for j in range(3)]
+
+
+def clean_tracks(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
+    """Checked, confirmed rows with a 3-D state; ``attrs['rows_skipped_no_state']`` counts the others.
+
+    NaN position/velocity means "no direction of arrival" and skips the row; anything else that
+    is not a finite number (a string, an infinity, a NaN time or id) is refused naming the row.
+    """
+    missing = [c for c in TRACK_COLUMNS if c not in tracks]
+    if missing:
+        raise InputError(f"{source}: missing column(s) {missing}")
+    df = tracks.reset_index(drop=True)
+    cols = {c: finite_column(df, c, source, allow_nan=c not in ("time_s", "track_id")) for c in TRACK_COLUMNS}
+    ids = cols["track_id"]
+    if (ids != np.round(ids)).any():
+        bad = int(np.flatnonzero(ids != np.round(ids))[0])
+        raise InputError(f"{source}: field 'track_id' is not a whole number at row {bad} ({ids[bad]!r})")
+    # Track ids stay integers in the alerts, as the tracker wrote them.
+    df = df.assign(**cols | {"track_id": ids.astype(np.int64)})
+    if "confirmed" in df:
+        flag = df["confirmed"]
+        if flag.dtype != bool and not flag.isin([0, 1]).all():
+            bad = int(np.flatnonzero(~flag.isin([0, 1]))[0])
+            raise InputError(
+                f"{source}: field 'confirmed' is not a boolean at row {bad} ({flag.iloc[bad]!r})"
+            )
+        df = df[flag.astype(bool).to_numpy()]
+    ok = np.isfinite(df[TRACK_COLUMNS[2:]].to_numpy(float)).all(axis=1)
+    clean = df[ok].sort_values(["time_s", "track_id"], kind="stable").reset_index(drop=True)
+    clean.attrs["rows_skipped_no_state"] = int((~ok).sum())
+    return clean
+
+
+def interp_ownship(own: pd.DataFrame, times: np.ndarray, source: str) -> dict[str, np.ndarray]:
+    """Own-ship state at ``times`` (linear; heading unwrapped; else the ground track)."""
+    own = own.sort_values("time_s")
+    t = own["time_s"].to_numpy(float)
+    if times.size and (times.min() < t[0] - 1.0 or times.max() > t[-1] + 1.0):
+        raise InputError(
+            f"{source}: field 'time_s' ({times.min():.2f}..{times.max():.2f} s) outside the own-ship "
+            f"state ({t[0]:.2f}..{t[-1]:.2f} s)"
+        )
+    out = {}
+    for c in OWNSHIP_COLUMNS[1:] + [c for c in OPTIONAL_OWNSHIP_COLUMNS if c in own]:
+        values = own[c].to_numpy(float)
+        values = np.unwrap(values) if c == "own_yaw_rad" else values
+        out[c] = np.interp(times, t, values)
+    if "own_yaw_rad" not in out:
+        out["own_yaw_rad"] = np.arctan2(out["own_ve_mps"], out["own_vn_mps"])
+    return out
+
+
+def covariances(df: pd.DataFrame) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Position and velocity covariances (n, 3, 3) of the rows, or None without the columns."""
+    cov_p = df[_COV_P].to_numpy(float).reshape(-1, 3, 3) if all(c in df for c in _COV_P) else None
+    cov_v = df[_COV_V].to_numpy(float).reshape(-1, 3, 3) if all(c in df for c in _COV_V) else None
+    return cov_p, cov_v

@@ -1,0 +1,35 @@
+"""The example scenarios shipped with skyradar (``skyradar scenarios`` lists them)."""
+
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+
+from skyradar.errors import InputError
+
+__all__ = ["list_example_scenarios", "example_scenario"]
+
+
+def _scenario_dir():
+    # Shipped inside the package, so they work from a wheel as from a checkout.
+    return resources.files("skyradar") / "data" / "scenarios"
+
+
+def list_example_scenarios() -> list[str]:
+    """Names of the example scenarios shipped with skyradar.
+
+    Examples
+    --------
+    >>> "ch2_flat_forward" in list_example_scenarios()
+    True
+    """
+    return sorted(p.name[: -len(".yaml")] for p in _scenario_dir().iterdir() if p.name.endswith(".yaml"))
+
+
+def example_scenario(name: str) -> Path:
+    """Path of a shipped example scenario (see :func:`list_example_scenarios`)."""
+    stem = name[: -len(".yaml")] if name.endswith(".yaml") else name
+    path = _scenario_dir() / f"{stem}.yaml"
+    if not path.is_file():
+        raise InputError(f"example scenario {name!r} unknown; choose from {list_example_scenarios()}")
+    return Path(str(path))

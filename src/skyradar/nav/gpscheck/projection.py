@@ -29,6 +29,7 @@ import numpy as np
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.geo import direction_angles, rotation_matrix
+from skyradar.process.power import power_image
 from skyradar.scene.ground_grid import PoseGrid
 
 __all__ = ["frame_power", "antenna_pose", "ground_image", "ground_in_view_fraction"]
@@ -47,7 +48,7 @@ def frame_power(iq: np.ndarray) -> np.ndarray:
         return np.abs(iq) ** 2
     if iq.ndim != 3:
         raise InputError(f"gpscheck: a frame must be (range, doppler[, rx]), got shape {iq.shape}")
-    return np.mean(iq.real**2 + iq.imag**2, axis=2)
+    return power_image(iq)  # the one channel-mean power image (skyradar.process.power)
 
 
 def antenna_pose(config: RadarConfig, attitude_rad: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
@@ -79,6 +80,16 @@ def _check_state(attitude_rad, velocity_ned_mps, height_m: float) -> tuple[np.nd
     if not (np.isfinite(height_m) and height_m > 0):
         raise InputError(f"gpscheck: height_m (above ground) must be a positive number, got {height_m!r}")
     return att, vel
+
+
+def _check_power(power_rd: np.ndarray, config: RadarConfig) -> np.ndarray:
+    power_rd = np.asarray(power_rd, float)
+    if power_rd.shape != (config.n_range, config.n_doppler):
+        raise InputError(
+            f"gpscheck: frame power has shape {power_rd.shape}, expected (range, doppler) = "
+            f"{(config.n_range, config.n_doppler)}"
+        )
+    return power_rd
 
 
 def _bilinear_rd(power_rd: np.ndarray, k: np.ndarray, j: np.ndarray) -> np.ndarray:
@@ -117,33 +128,27 @@ def ground_image(
         Ground pixels in horizontal body axes (forward, right) around the point below the aircraft.
     attitude_rad : (yaw, pitch, roll)
         Aircraft attitude, rad; the grid turns with the yaw (heading).
-    velocity_ned_mps : (3,) array
-        Aircraft velocity over the ground (NED), m/s.
-    height_m : float
-        Aircraft height above the (flat) ground, m.
+    velocity_ned_mps, height_m : (3,) array, float
+        Aircraft velocity over the ground (NED), m/s, and height above the flat ground, m.
     beam_db : float
-        Pixels where the one-way antenna gain is more than ``-beam_db`` dB below its peak are NaN
-        (outside the beam; this removes the mirror side of the track).
+        NaN where the one-way gain is below peak + ``beam_db`` (outside the beam: the mirror side).
     compensate : bool
-        Divide by the flat-ground expectation ``G^2 / R^4`` (normalised to 1 at the brightest
-        pixel's geometry): the near-range brightening the thesis could only fight with local contrast.
+        Divide by the flat-ground expectation ``G^2 (h / R)^4`` (the near-range brightening).
 
     Returns
     -------
-    (rows, cols) float32 array of ``pose_grid.shape``; NaN where the ground is not seen.
+    float32 array of ``pose_grid.shape``; NaN where the ground is not seen.
 
     Examples
     --------
-    A point on the ground 300 m right of an aircraft at 200 m, flying north at 50 m/s with a
-    right wingtip radar, lights the pixel it was put in:
+    A point 300 m right of an aircraft at 200 m flying north lights the pixel it was put in:
 
     >>> from skyradar.config import Mount
     >>> cfg = RadarConfig.prototype_2022(
     ...     bandwidth_hz=50e6, fs_hz=40e6, prf_hz=10e3, range_limit_m=600.0,
     ...     mount=Mount(yaw_deg=90.0, pitch_deg=-30.0))
-    >>> r = float(np.hypot(300.0, 200.0))
     >>> power = np.zeros((cfg.n_range, cfg.n_doppler))
-    >>> power[int(cfg.range_bin(r)), int(cfg.doppler_bin(0.0))] = 1.0
+    >>> power[int(cfg.range_bin(np.hypot(300.0, 200.0))), int(cfg.doppler_bin(0.0))] = 1.0
     >>> grid = PoseGrid(-50.0, 250.0, 5.0, (21, 21))
     >>> image = ground_image(power, cfg, grid, (0.0, 0.0, 0.0), (50.0, 0.0, 0.0), 200.0)
     >>> i, j = np.unravel_index(np.nanargmax(image), image.shape)
@@ -151,26 +156,30 @@ def ground_image(
     (0.0, 300.0)
     """
     att, vel = _check_state(attitude_rad, velocity_ned_mps, height_m)
-    power_rd = np.asarray(power_rd, float)
-    if power_rd.shape != (config.n_range, config.n_doppler):
-        raise InputError(
-            f"gpscheck: frame power has shape {power_rd.shape}, expected (range, doppler) = "
-            f"{(config.n_range, config.n_doppler)}"
-        )
+    power_rd = _check_power(power_rd, config)
+    k, j, gain_db, rng = _pixel_bins(config, pose_grid, att, vel, height_m)
+    image = _bilinear_rd(power_rd, k, j)
+    if compensate:
+        expected = 10.0 ** (gain_db / 5.0) * (height_m / rng) ** 4
+        image = image / np.maximum(expected, 1e-30)
+    seen = np.isfinite(gain_db) & (gain_db >= beam_db) & (k <= config.n_range - 1)
+    return np.where(seen, image, np.nan).astype(np.float32)
+
+
+def _pixel_bins(
+    config: RadarConfig, pose_grid: PoseGrid, att: np.ndarray, vel: np.ndarray, height_m: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Fractional range and Doppler bins of every ground pixel, its one-way gain below the peak (dB;
+    -inf behind the antenna) and its slant range (m)."""
     p_ant, rng = _ground_vectors(config, pose_grid, att, height_m)
     u = p_ant / np.maximum(rng, 1e-9)[..., None]
     _, rot = antenna_pose(config, att)
     v_r = -(u @ (rot @ vel))  # static ground moves at -v relative to the radar; receding positive
     k = (rng + v_r * config.range_doppler_coupling_s) / config.range_resolution_m
     j = v_r / config.doppler_resolution_mps + config.n_doppler // 2
-    image = _bilinear_rd(power_rd, k, j)
     _, az, el = direction_angles(p_ant)
-    gain_db = config.antenna.gain_db(az, el)
-    if compensate:
-        expected = 10.0 ** ((gain_db - config.antenna.peak_db) / 5.0) * (height_m / rng) ** 4
-        image = image / np.maximum(expected, 1e-30)
-    seen = (p_ant[..., 0] > 0) & (gain_db - config.antenna.peak_db >= beam_db) & (k <= config.n_range - 1)
-    return np.where(seen, image, np.nan).astype(np.float32)
+    gain_db = np.where(p_ant[..., 0] > 0, config.antenna.gain_db(az, el) - config.antenna.peak_db, -np.inf)
+    return k, j, gain_db, rng
 
 
 def _ground_vectors(

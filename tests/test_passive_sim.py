@@ -201,6 +201,14 @@ def test_simulation_memory_is_bounded_by_the_chunk(tmp_path):
         tracemalloc.stop()
     assert peaks[1] < 1.3 * peaks[0]  # five times the samples, the same working set
     assert peaks[1] < 40 * (1 << 14) * 16  # a few chunk-sized buffers
+    from skyradar.io.sigmf_io import read_iq_recording
+
+    rec = read_iq_recording(tmp_path / "r0.2.sigmf-meta")
+    tracemalloc.start()
+    total = sum(float(np.abs(chunk).sum()) for _, chunk in rec.chunks(1 << 14, overlap=500))
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert total > 0 and peak < 4 * ((1 << 14) + 500) * 8  # reading holds about one chunk too
 
 
 def test_truth_rows_sit_where_the_beam_points():

@@ -116,7 +116,10 @@ def simulate_passive(
 
     meta = _check_outputs(output, adsb, overwrite)
     scene = _scene(scenario, duration_s, seed, adsb, start_time, no_aircraft)
-    check_sample_rate(scene, sample_rate_hz)
+    try:
+        check_sample_rate(scene, sample_rate_hz)
+    except InputError as exc:
+        raise InputError(f"--sample-rate-hz {sample_rate_hz:g}: {exc}") from None
     total = int(round(duration_s * sample_rate_hz))
     check_disk_space(meta, 8.0 * total, "the recording")
     path = _run(scene, meta, sample_rate_hz, chunk_samples, total)

@@ -246,8 +246,8 @@ def check_sample_rate(scene: PassiveScene, sample_rate_hz: float) -> None:
         edge = abs(p.offset_hz) + 0.5 * p.bandwidth_hz + (1.0 / p.width_s if p.bandwidth_hz == 0 else 0.0)
         if edge > sample_rate_hz / 2:
             raise InputError(
-                f"sample rate {sample_rate_hz:g} Hz: the illuminator's {name} reaches {edge:g} Hz from the "
-                f"carrier, beyond the Nyquist limit {sample_rate_hz / 2:g} Hz"
+                f"the illuminator's {name} reaches {edge:g} Hz from the carrier, beyond the Nyquist limit "
+                f"{sample_rate_hz / 2:g} Hz of sample rate {sample_rate_hz:g} Hz"
             )
 
 

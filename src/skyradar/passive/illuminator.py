@@ -16,7 +16,8 @@ band 2 700-2 900 MHz", Annex 1, Table 1 (aeronautical radionavigation radars): 2
 about 1.4 deg azimuth beamwidth, about 33-34 dBi antenna gain, solid-state transmitters of tens of kW
 peak power with short pulses of about 1 us and long, frequency-modulated pulses of about 100 us, PRFs
 near 1 kHz with stagger. The defaults below are one representative set within those ranges, not one
-column of the table. 13.5 rpm makes the thesis' 40 s recording exactly 9 sweeps.
+column of the table; they were chosen without the table at hand (written offline), so check a value
+against the Recommendation before quoting it. 13.5 rpm makes the thesis' 40 s recording 9 sweeps.
 """
 
 from __future__ import annotations

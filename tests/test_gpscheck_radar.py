@@ -144,6 +144,20 @@ def _angles(points, geom):
     return direction_angles((points - geom.origin_ned_m) @ geom.rot_ned_to_ant.T)
 
 
+def test_forest_texture_has_mean_one_and_the_stated_spread():
+    from skyradar.scene.land_cover import FOREST
+    from skyradar.sim.land_cover_scene import FOREST_TEXTURE_DB
+
+    grid = GroundGrid.from_extent(0.0, 400.0, 0.0, 400.0, pixel_m=1.0)
+    code = np.full(grid.shape, FOREST, np.int8)
+    code[:, :10] = GRASS
+    texture = LandCoverSimulator(CFG, code, np.zeros(grid.shape), grid)._texture
+    assert np.all(texture[:, :10] == 1.0)
+    forest = texture[:, 10:]
+    assert forest.mean() == pytest.approx(1.0, abs=0.05)
+    assert np.std(10 * np.log10(forest)) == pytest.approx(FOREST_TEXTURE_DB, rel=0.1)
+
+
 def test_wing_up_frame_sees_sky():
     level = ground_in_view_fraction(CFG, (0.0, 0.0, 0.0), HEIGHT_M)
     wing_up = ground_in_view_fraction(CFG, (0.0, 0.0, np.radians(-40.0)), HEIGHT_M)

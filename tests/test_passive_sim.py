@@ -136,13 +136,13 @@ def test_aircraft_echo_phase_follows_the_bistatic_doppler():
     traj = Trajectory.from_states(
         t, p0 + t[:, None] * v, np.tile(v, (2, 1)), origin=thesis_scene().receiver.geodetic
     )
-    scene = _scene(aircraft=[Aircraft(traj, 1.0)], beam_at=p0, duration_s=0.06)
-    n = int(0.06 * FS)
+    scene = _scene(aircraft=[Aircraft(traj, 1.0)], beam_at=p0, duration_s=0.035)
+    n = int(0.035 * FS)
     echo = simulate_chunk(scene, FS, 0, n, noise=False) - simulate_chunk(
         _scene(beam_at=p0), FS, 0, n, noise=False
     )
     ill, tx = scene.illuminator, _tx_ned(scene)
-    _, t_pri = ill.pulse_times_s(scene.first_pulse_s, 0.0, 0.055)
+    _, t_pri = ill.pulse_times_s(scene.first_pulse_s, 0.0, 0.03)
     ts = np.arange(n) / FS
     phases, taus = [], []
     for te in t_pri:
@@ -190,9 +190,9 @@ def test_chunked_recording_equals_one_shot_and_sigmf_round_trip(tmp_path):
 
 
 def test_simulation_memory_is_bounded_by_the_chunk(tmp_path):
-    scene = thesis_scene(duration_s=0.2)
+    scene = thesis_scene(duration_s=0.15)
     peaks = []
-    for duration in (0.04, 0.2):
+    for duration in (0.03, 0.15):
         s = dataclasses.replace(scene, duration_s=duration)
         simulate_chunk(s, FS, 0, 10)  # compile and warm caches outside the measurement
         tracemalloc.start()
@@ -203,7 +203,7 @@ def test_simulation_memory_is_bounded_by_the_chunk(tmp_path):
     assert peaks[1] < 40 * (1 << 14) * 16  # a few chunk-sized buffers
     from skyradar.io.sigmf_io import read_iq_recording
 
-    rec = read_iq_recording(tmp_path / "r0.2.sigmf-meta")
+    rec = read_iq_recording(tmp_path / "r0.15.sigmf-meta")
     tracemalloc.start()
     total = sum(float(np.abs(chunk).sum()) for _, chunk in rec.chunks(1 << 14, overlap=500))
     peak = tracemalloc.get_traced_memory()[1]

@@ -53,7 +53,7 @@ def ch6_radar_config(side: str = "right") -> RadarConfig:
     1.0 x 1.7 km, so the footprint is scaled down by ten: 500 m processed range (from 200 m above
     the ground the beam meets the ground from about 120 m to 460 m to the side) and 3 m range bins
     (50 MHz sweep: a street or a house is a few bins, as a road was for the thesis). The ADC rate
-    goes to 40 MHz so the unambiguous range ``c Fs / (2 B PRF)`` (1.2 km) stays beyond the 500 m,
+    goes to 40 MHz so the unambiguous range ``c Fs / (2 B PRF)`` (12 km) stays beyond the 500 m,
     and the chirp rate to 10 kHz to keep the thesis' Nyquist of about 80 m/s (79.5 m/s): a GA
     aircraft at 50-60 m/s sees its sideways beam within +-30 m/s, never wrapped. 256 chirps give
     0.62 m/s Doppler bins: 0.7 deg of angle broadside at 50 m/s, about 5 m at 400 m. The antenna is
@@ -64,7 +64,7 @@ def ch6_radar_config(side: str = "right") -> RadarConfig:
     --------
     >>> cfg = ch6_radar_config()
     >>> round(cfg.range_resolution_m, 2), round(cfg.v_lim_mps, 1), cfg.n_range, cfg.mount.yaw_deg
-    (3.0, 79.6, 166, 90.0)
+    (3.0, 79.5, 166, 90.0)
     """
     if side not in ("right", "left"):
         raise InputError(f"ch6 radar: side must be 'right' or 'left', got {side!r}")

@@ -110,8 +110,27 @@ def test_simulate_passive_cli_writes_a_readable_recording_and_refuses_bad_input(
     assert rec.n_samples == 100_000 and rec.truth_table_path is not None
     again = skyradar("simulate-passive", "-o", "r.sigmf-meta", "--duration-s", "0.02", cwd=tmp_path)
     assert_one_line_error(again, "--overwrite")
-    slow = skyradar("simulate-passive", "-o", "s", "--sample-rate-hz", "3e6", cwd=tmp_path)
-    assert_one_line_error(slow, "--sample-rate-hz 3e+06", "Nyquist")
     assert sorted(p.name for p in tmp_path.iterdir()) == [
         "r.sigmf-data", "r.sigmf-meta", "r.truth.json", "r.truth.parquet",
     ]  # fmt: skip
+
+
+def test_passive_refuses_unreadable_recordings_in_one_line(tmp_path):
+    """Issue 15's bad inputs that belong to reading, through the real `skyradar passive` entry point."""
+    cases = {
+        "cu8": lambda d: d["global"].update({"core:datatype": "cu8"}),
+        "short": None,
+        "noillum": lambda d: d["global"]["skyradar:illuminator"].pop("latitude"),
+    }
+    for name, change in cases.items():
+        meta, _ = _recording(tmp_path, name=name)
+        if change is None:
+            data = tmp_path / f"{name}.sigmf-data"
+            data.write_bytes(data.read_bytes()[:8000])
+        else:
+            _edit_meta(meta, change)
+    needles = {"cu8": ("core:datatype", "cu8"), "short": ("shorter than",), "noillum": ("no position",)}
+    for name, words in needles.items():
+        result = skyradar("passive", f"{name}.sigmf-meta", "-o", f"{name}.parquet", cwd=tmp_path)
+        assert_one_line_error(result, f"{name}.sigmf", *words)
+        assert not (tmp_path / f"{name}.parquet").exists()

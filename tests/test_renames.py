@@ -45,3 +45,13 @@ def test_seed_prototype_is_a_deprecated_alias_of_prototype_2022():
     with pytest.warns(DeprecationWarning, match="prototype_2022"):
         old = RadarConfig.seed_prototype(n_doppler=64)
     assert old == RadarConfig.prototype_2022(n_doppler=64)
+
+
+def test_write_recording_old_home_is_a_deprecated_alias():
+    from skyradar.io import recordings
+    from skyradar.io.recording_writer import write_recording
+
+    with pytest.warns(DeprecationWarning, match="recording_writer"):
+        assert recordings.write_recording is write_recording
+    with pytest.raises(AttributeError):
+        recordings.no_such_name  # noqa: B018

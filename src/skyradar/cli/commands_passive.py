@@ -1,0 +1,148 @@
+"""``skyradar passive``, ``skyradar experiment ch7`` and ``skyradar bench passive`` (seed-brief ch7)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from skyradar.cli.app import (
+    COUNT,
+    NON_NEGATIVE,
+    POSITIVE,
+    JsonOption,
+    app,
+    bench_app,
+    console,
+    emit_result,
+    experiment_app,
+)  # fmt: skip
+from skyradar.io.outputs import OVERWRITE_HELP
+
+__all__ = ["passive", "experiment_ch7", "bench_passive"]
+
+
+@app.command()
+def passive(
+    recording: Annotated[
+        Path,
+        typer.Argument(
+            help="IQ recording: NAME.sigmf-meta (or -data), or a raw NAME.cf32/NAME.ci16 with a "
+            "NAME.json/NAME.yaml sidecar; must name the illuminator and its position."
+        ),
+    ],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Detections table to write (Parquet).")],
+    pulse: Annotated[
+        str,
+        typer.Option(
+            "--pulse",
+            help="Matched-filter template: 'metadata' (the illuminator's long pulse as described) or "
+            "'recording' (the strongest direct-path pulse of the first rotation).",
+        ),
+    ] = "metadata",
+    max_range_km: Annotated[
+        float,
+        typer.Option("--max-range-km", callback=POSITIVE, help="Largest bistatic range R1+R2-L, km."),
+    ] = 45.0,
+    chunk_samples: Annotated[
+        int,
+        typer.Option("--chunk-samples", callback=COUNT, help="Samples per chunk (bounds memory)."),
+    ] = 1 << 20,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
+    as_json: JsonOption = False,
+) -> None:
+    """Passive bistatic detections from an ATC-radar-illuminated recording.
+
+    Finds the direct-path pulses and the scan phase, matched-filters (Hann), cancels static returns
+    over pulses, integrates each dwell, runs CFAR and places each echo on its bistatic ellipse along
+    the beam. Writes one row per detection: time_s, sweep, channel (static/moving), bistatic_range_m,
+    doppler_hz, snr_db, azimuth_deg, east_m, north_m (from the receiver), r_tx_m, r_rx_m.
+    """
+    from skyradar.cli.app import check_choice
+    from skyradar.io.outputs import check_output
+    from skyradar.io.sigmf_io import read_iq_recording, sigmf_paths
+    from skyradar.io.tables import write_table
+    from skyradar.passive.pipeline import PassiveSettings, process_recording
+
+    check_choice("--pulse", pulse, ("metadata", "recording"))
+    inputs = [recording, *_recording_files(recording, sigmf_paths)]
+    check_output(output, inputs, overwrite, kind="table")
+    rec = read_iq_recording(recording)
+    settings = PassiveSettings(
+        max_bistatic_range_m=max_range_km * 1e3, pulse=pulse, chunk_samples=chunk_samples
+    )
+    with _progress(rec.n_samples) as update:
+        result = process_recording(rec, settings, progress=update)
+    det = result.detections
+    meta = {"source": str(recording), "pulse": pulse, "scan_period_s": result.scan_period_s}
+    write_table(det, output, metadata=meta)
+    summary = {
+        "pulses": result.n_pulses, "dwells": result.n_dwells, "sweeps": int(det["sweep"].nunique()),
+        "detections": len(det), "moving": int((det["channel"] == "moving").sum()),
+        "static": int((det["channel"] == "static").sum()), "blind_zone_dropped": result.masked,
+        "scan_period_s": result.scan_period_s, "output": str(output),
+    }  # fmt: skip
+    emit_result(summary, as_json, "passive detections")
+
+
+def _recording_files(path: Path, sigmf_paths) -> list[Path]:
+    """The files a recording consists of (so none of them can be the output)."""
+    name = path.name
+    if name.endswith((".sigmf-meta", ".sigmf-data")) or path.suffix == "":
+        return list(sigmf_paths(path))
+    return [path.with_suffix(".json"), path.with_suffix(".yaml")]
+
+
+class _progress:
+    """A rich bar over recording samples; a no-op when stderr is not a terminal."""
+
+    def __init__(self, total: int) -> None:
+        from skyradar.cli.commands_sim import frame_progress
+
+        self.total = total
+        self.bar = frame_progress(total, "passive: samples")
+
+    def __enter__(self):
+        self.bar.__enter__()
+        task = self.bar.add_task("passive", total=self.total)
+        return lambda done, total: self.bar.update(task, completed=done)
+
+    def __exit__(self, *exc) -> None:
+        self.bar.__exit__(*exc)
+
+
+@experiment_app.command("ch7")
+def experiment_ch7(
+    out: Annotated[Path, typer.Option("--out", help="Output directory for figures and tables.")] = Path(
+        "out/ch7"
+    ),
+    seconds: Annotated[
+        float, typer.Option("--seconds", callback=POSITIVE, help="Recording length (thesis: 40 s, 9 sweeps).")
+    ] = 40.0,
+    seed: Annotated[int, typer.Option("--seed", callback=NON_NEGATIVE, help="Random seed of the scene.")] = 0,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
+    as_json: JsonOption = False,
+) -> None:
+    """ch7: passive radar with an ATC radar as illuminator: test pulse, thesis geometry, 9 sweeps."""
+    from skyradar.experiments.ch7 import run as run_ch7
+    from skyradar.io.outputs import check_output, mark_folder
+
+    check_output(out, (), overwrite, kind="folder", option="--out")
+    mark_folder(out)
+    result = run_ch7(out, seconds=seconds, seed=seed)
+    emit_result(result, as_json, "ch7: passive bistatic radar")
+
+
+@bench_app.command("passive")
+def bench_passive(
+    seconds: Annotated[
+        float, typer.Option("--seconds", callback=POSITIVE, help="Length of the shorter test recording, s.")
+    ] = 4.0,
+    as_json: JsonOption = False,
+) -> None:
+    """Passive processing speed (real-time factor at 5 MS/s) and memory for two recording lengths."""
+    from skyradar.benchmarks.passive import run as run_bench
+
+    console.print("bench passive: simulating two recordings, then processing them", soft_wrap=True)
+    emit_result(run_bench(seconds=seconds), as_json, "bench passive")

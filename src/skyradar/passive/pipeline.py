@@ -1,0 +1,273 @@
+"""Passive processing of a whole recording, streamed in chunks: IQ -> detections table.
+
+Pass over the recording chunk by chunk (:class:`~skyradar.passive.profiles.ProfileExtractor`): pulse
+profiles go into a rolling buffer one dwell long; each dwell (hop a quarter dwell) is searched by
+:func:`~skyradar.passive.dwell.detect_dwell`. Memory is one chunk plus one dwell of profiles, plus a
+few numbers per pulse (time and direct-path amplitude) for the scan phase. At the end the scan phase
+(:func:`~skyradar.passive.pulses.scan_phase`) gives each candidate its beam azimuth; candidates of one
+target in overlapping dwells merge into one detection (azimuth the SNR-weighted mean); the bistatic
+ellipse gives east/north; the blind zone is dropped.
+
+Output columns: ``time_s, sweep, channel, bistatic_range_m, doppler_hz, snr_db, azimuth_deg, east_m,
+north_m, r_tx_m, r_rx_m`` (east/north in metres from the receiver, in its horizontal plane).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import pandas as pd
+
+from skyradar.errors import InputError
+from skyradar.geo import geodetic_to_ned
+from skyradar.passive.bistatic import C_MPS, ellipse_point, in_blind_zone
+from skyradar.passive.dwell import DwellSettings, detect_dwells
+from skyradar.passive.illuminator import Illuminator, lfm_baseband
+from skyradar.passive.mti import dwell_pulses
+from skyradar.passive.profiles import ProfileExtractor, read_chunks
+from skyradar.passive.pulses import estimate_pulse, scan_phase
+
+__all__ = ["PassiveSettings", "PassiveResult", "process_recording", "merge_candidates", "drop_sidelobes",
+           "COLUMNS"]  # fmt: skip
+
+COLUMNS = ["time_s", "sweep", "channel", "bistatic_range_m", "doppler_hz", "snr_db", "azimuth_deg",
+           "east_m", "north_m", "r_tx_m", "r_rx_m"]  # fmt: skip
+
+
+@dataclass(frozen=True)
+class PassiveSettings:
+    """Processing choices. ``pulse``: ``"metadata"`` (the illuminator's long pulse as the operator
+    gives it) or ``"recording"`` (the strongest direct-path pulse of the first rotation)."""
+
+    max_bistatic_range_m: float = 45_000.0
+    pulse: str = "metadata"
+    window: str | None = "hann"
+    chunk_samples: int = 1 << 20
+    hop_fraction: float = 0.25
+    blind_half_width_deg: float = 4.0
+    min_bistatic_range_m: float | None = None
+    sidelobe_margin_db: float = 10.0
+    dwell: DwellSettings = field(default_factory=DwellSettings)
+
+
+@dataclass
+class PassiveResult:
+    detections: pd.DataFrame
+    n_pulses: int
+    n_dwells: int
+    scan_period_s: float
+    crossings_s: np.ndarray
+    masked: int
+    pulse_source: str
+
+
+def _geometry(recording) -> tuple[np.ndarray, float]:
+    rx = recording.receiver_geodetic
+    ned = geodetic_to_ned(*recording.illuminator_geodetic, *rx)
+    tx_en = np.array([ned[1], ned[0]])
+    return tx_en, float(np.mod(np.arctan2(-tx_en[0], -tx_en[1]), 2 * np.pi))
+
+
+def _template(recording, ill: Illuminator, settings: PassiveSettings) -> np.ndarray:
+    fs = recording.sample_rate_hz
+    if settings.pulse == "metadata":
+        lp = ill.long_pulse
+        n = int(round(lp.width_s * fs))
+        return np.asarray(
+            lfm_baseband(np.arange(n) / fs, lp.width_s, lp.bandwidth_hz, lp.offset_hz), np.complex128
+        )
+    if settings.pulse != "recording":
+        raise InputError(f"passive: pulse source must be 'metadata' or 'recording', got {settings.pulse!r}")
+    width = int(round(ill.long_pulse.width_s * fs))
+    best, best_energy = 0, -1.0
+    stop = min(recording.n_samples, int((ill.rotation_period_s + 0.1) * fs))
+    for start in range(0, stop, settings.chunk_samples):
+        x = recording.read(start, settings.chunk_samples)
+        energy = float(np.max(np.abs(x))) if x.size else 0.0
+        if energy > best_energy:
+            best, best_energy = start + int(np.argmax(np.abs(x))), energy
+    block = recording.read(max(best - 4 * width, 0), 8 * width)
+    return estimate_pulse(block, width)
+
+
+def process_recording(
+    recording, settings: PassiveSettings | None = None, progress: Callable[[int, int], None] | None = None
+) -> PassiveResult:
+    """Detections of a passive recording (an :class:`skyradar.io.sigmf_io.IqRecording`)."""
+    from threadpoolctl import threadpool_limits
+
+    # The dwell products are small (tens x hundreds): threaded BLAS only spins on them.
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _process(recording, settings, progress)
+
+
+def _process(recording, settings: PassiveSettings | None, progress) -> PassiveResult:
+    s = settings or PassiveSettings()
+    ill = Illuminator.from_metadata(recording.illuminator)
+    fs = recording.sample_rate_hz
+    tx_en, bearing = _geometry(recording)
+    template = _template(recording, ill, s)
+    n_lags = int(np.ceil(s.max_bistatic_range_m / C_MPS * fs)) + 1
+    extractor = ProfileExtractor(template, fs, n_lags, min(ill.pri_s), window=s.window)
+    pri = ill.mean_pri_s
+    n_dwell = dwell_pulses(np.radians(ill.beamwidth_az_deg), ill.rotation_rate_rad_s, pri)
+    hop = max(1, int(round(n_dwell * s.hop_fraction)))
+    bandwidth = max(ill.long_pulse.bandwidth_hz, 1.0 / ill.long_pulse.width_s)
+    min_range = s.min_bistatic_range_m if s.min_bistatic_range_m is not None else 2.0 * C_MPS / bandwidth
+    # The guard covers the Hann-weighted compressed pulse (about 2 fs/B lags each side).
+    dwell = replace(
+        s.dwell, min_lag=max(s.dwell.min_lag, int(np.ceil(min_range / C_MPS * fs))),
+        guard_lags=max(s.dwell.guard_lags, int(np.ceil(2 * fs / bandwidth))),
+    )  # fmt: skip
+    if dwell.zero_doppler_guard_hz == 0.0:
+        dwell = replace(dwell, zero_doppler_guard_hz=1.5 / (n_dwell * pri))
+
+    times, amps, candidates = [], [], []
+    buf_p: list[np.ndarray] = []
+    buf_t: list[np.ndarray] = []
+    n_dwells = 0
+    for start, chunk, out in _profiles_ahead(
+        extractor, read_chunks(recording, s.chunk_samples, extractor.overlap)
+    ):
+        times.append(out.times_s)
+        amps.append(np.abs(out.amplitude).astype(np.float32))
+        buf_p.append(out.profiles)
+        buf_t.append(out.times_s)
+        prof, tim = np.concatenate(buf_p), np.concatenate(buf_t)
+        starts = np.arange(0, tim.size - n_dwell + 1, hop)
+        if starts.size:
+            idx = starts[:, None] + np.arange(n_dwell)[None, :]
+            candidates += detect_dwells(prof[idx], tim[idx], 1.0 / pri, dwell)
+            n_dwells += starts.size
+        i = int(starts[-1] + hop) if starts.size else 0
+        buf_p, buf_t = [prof[i:]], [tim[i:]]
+        if progress is not None:
+            progress(start + chunk, recording.n_samples)
+    times_all = np.concatenate(times) if times else np.zeros(0)
+    if times_all.size == 0:
+        raise InputError(
+            f"{recording.path}: no direct-path pulse found (no matched-filter peak 30 dB above the median)"
+        )
+    scan = scan_phase(
+        times_all, np.concatenate(amps), ill.rotation_period_s, bearing, 1, source=str(recording.path),
+    )  # fmt: skip
+    table = pd.DataFrame(candidates, columns=["channel", "lag", "doppler_hz", "snr_db", "time_s"])
+    table["bistatic_range_m"] = table["lag"] * C_MPS / fs
+    table["azimuth_rad"] = scan.azimuth_rad(table["time_s"].to_numpy())
+    merged = merge_candidates(table, C_MPS / bandwidth, 1.5 * n_dwell * pri, 2.0 / (n_dwell * pri))
+    merged["sweep"] = scan.sweep(merged["time_s"].to_numpy()) if len(merged) else []
+    merged = drop_sidelobes(merged, 1.5 * C_MPS / bandwidth, 2.0 / (n_dwell * pri), s.sidelobe_margin_db)
+    blind = in_blind_zone(
+        merged["bistatic_range_m"].to_numpy(), merged["azimuth_rad"].to_numpy(), bearing, min_range,
+        np.radians(s.blind_half_width_deg),
+    )  # fmt: skip
+    merged = merged[~blind].reset_index(drop=True)
+    det = _positions(merged, tx_en, scan)
+    n_pulses, n_masked = int(times_all.size), int(blind.sum())
+    return PassiveResult(det, n_pulses, n_dwells, scan.period_s, scan.crossings_s, n_masked, s.pulse)
+
+
+def _profiles_ahead(extractor: ProfileExtractor, chunks):
+    """``(start, chunk, profiles)`` per chunk, the next chunk's profiles computed in a second thread.
+
+    The matched filter and FFTs release the GIL, so the filtering of chunk k+1 overlaps the dwell
+    detection of chunk k on a second core; at most two chunks are in memory.
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        pending = None
+        for start, x, chunk in chunks:
+            future = pool.submit(extractor.process, start, x, chunk)
+            if pending is not None:
+                yield pending[0], pending[1], pending[2].result()
+            pending = (start, chunk, future)
+        if pending is not None:
+            yield pending[0], pending[1], pending[2].result()
+
+
+def _positions(merged: pd.DataFrame, tx_en: np.ndarray, scan) -> pd.DataFrame:
+    point, r1, r2 = ellipse_point(
+        merged["bistatic_range_m"].to_numpy(), merged["azimuth_rad"].to_numpy(), tx_en, np.zeros(2)
+    )
+    det = merged.assign(
+        sweep=scan.sweep(merged["time_s"].to_numpy()).astype(np.int64),
+        azimuth_deg=np.degrees(merged["azimuth_rad"]),
+        east_m=point[:, 0], north_m=point[:, 1], r_tx_m=r1, r_rx_m=r2,
+    )  # fmt: skip
+    return det[COLUMNS].sort_values(["time_s", "bistatic_range_m"]).reset_index(drop=True)
+
+
+def merge_candidates(
+    table: pd.DataFrame, range_tol_m: float, time_tol_s: float, doppler_tol_hz: float
+) -> pd.DataFrame:
+    """One detection per target from the candidates of overlapping dwells.
+
+    Strongest first, each candidate absorbs the unassigned ones of its channel within the range,
+    time and (moving channel) Doppler tolerances; the azimuth is the SNR-weighted circular mean of the
+    group, everything else the strongest candidate's.
+
+    Examples
+    --------
+    >>> t = pd.DataFrame({"channel": ["static"] * 3, "doppler_hz": 0.0, "snr_db": [20.0, 20.0, 10.0],
+    ...                   "time_s": [1.0, 1.01, 1.0], "bistatic_range_m": [5000.0, 5010.0, 9000.0],
+    ...                   "azimuth_rad": [0.10, 0.12, 0.5]})
+    >>> m = merge_candidates(t, 100.0, 0.05, 50.0)
+    >>> len(m), round(float(m["azimuth_rad"].iloc[0]), 3)
+    (2, 0.11)
+    """
+    if table.empty:
+        return table.assign(azimuth_rad=pd.Series(dtype=float))
+    t = table.sort_values("snr_db", ascending=False).reset_index(drop=True)
+    free = np.ones(len(t), bool)
+    rows = []
+    rng, tim, dop = (t[c].to_numpy() for c in ("bistatic_range_m", "time_s", "doppler_hz"))
+    chan, az, w = t["channel"].to_numpy(), t["azimuth_rad"].to_numpy(), 10 ** (t["snr_db"].to_numpy() / 10)
+    for i in range(len(t)):
+        if not free[i]:
+            continue
+        near = (
+            free
+            & (chan == chan[i])
+            & (np.abs(rng - rng[i]) <= range_tol_m)
+            & (np.abs(tim - tim[i]) <= time_tol_s)
+        )
+        if chan[i] == "moving":
+            near &= np.abs(dop - dop[i]) <= doppler_tol_hz
+        free &= ~near
+        row = t.iloc[i].to_dict()
+        row["azimuth_rad"] = float(np.mod(np.angle(np.sum(w[near] * np.exp(1j * az[near]))), 2 * np.pi))
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def drop_sidelobes(
+    table: pd.DataFrame, range_tol_m: float, doppler_tol_hz: float, margin_db: float
+) -> pd.DataFrame:
+    """Drop detections seen through the illuminator's sidelobes.
+
+    A reflector near the receiver is lit by the sidelobes at every beam azimuth; each such look would be
+    placed on the ellipse in the wrong direction. Within one sweep and channel, a detection at least
+    ``margin_db`` weaker than another at the same bistatic range (and Doppler, moving channel) is such a
+    look and is dropped: the main beam's is the strongest.
+
+    Examples
+    --------
+    >>> t = pd.DataFrame({"sweep": [0, 0, 0, 1], "channel": "moving", "doppler_hz": 100.0,
+    ...                   "bistatic_range_m": [2600.0, 2610.0, 9000.0, 2600.0], "snr_db": [40.0, 15, 15, 15]})
+    >>> drop_sidelobes(t, 300.0, 50.0, 10.0).index.tolist()
+    [0, 2, 3]
+    """
+    if table.empty:
+        return table
+    keep = np.ones(len(table), bool)
+    for _, group in table.groupby(["sweep", "channel"]):
+        rng, dop, snr = (group[c].to_numpy() for c in ("bistatic_range_m", "doppler_hz", "snr_db"))
+        same = (np.abs(rng[:, None] - rng[None, :]) <= range_tol_m) & (
+            np.abs(dop[:, None] - dop[None, :]) <= doppler_tol_hz
+        )
+        louder = same & (snr[None, :] >= snr[:, None] + margin_db)
+        keep[table.index.get_indexer(group.index)] = ~louder.any(axis=1)
+    return table[keep]

@@ -14,7 +14,9 @@ import typer
 
 import skyradar.cli.commands_daa  # noqa: F401  (registers commands)
 import skyradar.cli.commands_demo  # noqa: F401  (registers commands)
+import skyradar.cli.commands_gpscheck  # noqa: F401  (registers commands)
 import skyradar.cli.commands_nav  # noqa: F401  (registers commands)
+import skyradar.cli.commands_passive  # noqa: F401  (registers commands)
 import skyradar.cli.commands_passive_sim  # noqa: F401  (registers commands)
 import skyradar.cli.commands_process  # noqa: F401  (registers commands)
 import skyradar.cli.commands_raw  # noqa: F401  (registers commands)

@@ -24,7 +24,7 @@ from numba import njit, prange
 from skyradar.errors import InputError
 from skyradar.scene.ground_grid import GroundGrid, PoseGrid, sample_at_poses
 
-__all__ = ["ssim_scores", "decoy_poses", "score_poses", "DecoyResult", "decoy_test"]
+__all__ = ["ssim_scores", "decoy_poses", "crop_to_mask", "score_poses", "DecoyResult", "decoy_test"]
 
 
 @njit(cache=True)
@@ -162,6 +162,30 @@ def decoy_poses(
     )
 
 
+def crop_to_mask(radar: np.ndarray, mask: np.ndarray, *grids: PoseGrid | None):
+    """Radar, mask and pose grids cut to the mask's bounding box: the work a footprint needs, no more.
+
+    Examples
+    --------
+    >>> body = PoseGrid(0.0, 0.0, 1.0, (5, 5))
+    >>> mask = np.zeros((5, 5), bool); mask[1:3, 2:4] = True
+    >>> radar, mask, cut = crop_to_mask(np.ones((5, 5)), mask, body)
+    >>> radar.shape, float(cut.forward0_m), float(cut.right0_m)
+    ((2, 2), 1.0, 2.0)
+    """
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    if not rows.size:
+        return (radar, mask, *grids)
+    r0, r1, c0, c1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+    cut = [
+        None if g is None else PoseGrid(g.forward0_m + r0 * g.pixel_m, g.right0_m + c0 * g.pixel_m, g.pixel_m,
+                                        (max(r1 - r0, 2), max(c1 - c0, 2)))
+        for g in grids
+    ]  # fmt: skip
+    r1, c1 = r0 + max(r1 - r0, 2), c0 + max(c1 - c0, 2)
+    return (radar[r0:r1, c0:c1], mask[r0:r1, c0:c1], *cut)
+
+
 def score_poses(
     radar: np.ndarray,
     radar_mask: np.ndarray,
@@ -169,12 +193,17 @@ def score_poses(
     grid: GroundGrid,
     pose_grid: PoseGrid,
     poses: np.ndarray,
+    map_pose_grid: PoseGrid | None = None,
 ) -> np.ndarray:
     """SSIM of the pre-processed radar image against the pre-processed map sampled at each pose.
 
     ``map_world`` lies on ``grid``; ``radar`` and ``radar_mask`` on ``pose_grid``; outside the map reads 0.
+    ``map_pose_grid`` (default ``pose_grid``) is where the map is sampled: ``pose_grid`` moved by the
+    expected layover (:func:`skyradar.nav.gpscheck.check.layover_grid`).
     """
-    candidates = sample_at_poses(map_world, grid, pose_grid, np.atleast_2d(poses), fill=0.0)
+    where = pose_grid if map_pose_grid is None else map_pose_grid
+    radar, radar_mask, where = crop_to_mask(radar, np.asarray(radar_mask, bool), where)
+    candidates = sample_at_poses(map_world, grid, where, np.atleast_2d(poses), fill=0.0)
     return ssim_scores(radar, candidates, radar_mask)
 
 
@@ -202,6 +231,7 @@ def decoy_test(
     true_pose: np.ndarray,
     rng: np.random.Generator,
     n_decoys: int = 300,
+    map_pose_grid: PoseGrid | None = None,
 ) -> DecoyResult:
     """The thesis' test: score the true pose and ``n_decoys`` false ones, pick the best.
 
@@ -219,7 +249,7 @@ def decoy_test(
     """
     true_pose = np.asarray(true_pose, dtype=float)
     poses = np.vstack([true_pose[None], decoy_poses(true_pose, rng, n_decoys)])
-    scores = score_poses(radar, radar_mask, map_world, grid, pose_grid, poses)
+    scores = score_poses(radar, radar_mask, map_world, grid, pose_grid, poses, map_pose_grid)
     best = int(np.nanargmax(scores))
     d_heading = (poses[best, 2] - true_pose[2] + np.pi) % (2 * np.pi) - np.pi
     return DecoyResult(

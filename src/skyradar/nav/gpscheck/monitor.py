@@ -23,8 +23,8 @@ from skyradar.errors import InputError
 from skyradar.nav.gpscheck.search import PoseOffset
 
 __all__ = [
-    "CONSISTENT", "INCONSISTENT", "WING_UP", "LOW_STRUCTURE", "VERDICTS", "MonitorSettings",
-    "inconsistency", "frame_verdict", "alerts",
+    "CONSISTENT", "INCONSISTENT", "DEFAULT_SETTINGS", "WING_UP", "LOW_STRUCTURE", "VERDICTS",
+    "MonitorSettings", "inconsistency", "frame_verdict", "alerts",
 ]  # fmt: skip
 
 CONSISTENT = "consistent"
@@ -53,7 +53,10 @@ class MonitorSettings:
             raise InputError(f"MonitorSettings: alert_frames must be at least 1, got {self.alert_frames!r}")
 
 
-def inconsistency(offset: PoseOffset, settings: MonitorSettings = MonitorSettings()) -> float:
+DEFAULT_SETTINGS = MonitorSettings()
+
+
+def inconsistency(offset: PoseOffset, settings: MonitorSettings = DEFAULT_SETTINGS) -> float:
     """How far the correction is outside the tolerances: > 1 is inconsistent.
 
     Examples
@@ -67,7 +70,7 @@ def inconsistency(offset: PoseOffset, settings: MonitorSettings = MonitorSetting
 
 
 def frame_verdict(
-    ground_fraction: float, offset: PoseOffset | None, settings: MonitorSettings = MonitorSettings()
+    ground_fraction: float, offset: PoseOffset | None, settings: MonitorSettings = DEFAULT_SETTINGS
 ) -> str:
     """One frame's verdict from the share of the beam on the ground and the search's correction.
 

@@ -21,6 +21,7 @@ and then sampled at any pose (:mod:`skyradar.nav.gpscheck.compare`).
 from __future__ import annotations
 
 import numpy as np
+from scipy.ndimage import median_filter
 from skimage import exposure, filters
 from skimage.morphology import disk
 from skimage.util import img_as_ubyte
@@ -77,6 +78,8 @@ def preprocess(
     mask: np.ndarray | None = None,
     *,
     log_power: bool = False,
+    invert: bool = False,
+    despeckle_px: int = 0,
     clahe_kernel_px: int = 32,
     ridge_sigmas_px: tuple[float, ...] = (1.0, 2.0),
     entropy_radius_px: int = 3,
@@ -91,6 +94,11 @@ def preprocess(
         One of :data:`METHODS`.
     mask : 2-D bool array, optional
         Valid pixels (default: the finite ones); the result is 0 elsewhere.
+    invert : bool
+        Turn the grey levels over first: a map draws roads light and buildings dark, a radar sees
+        buildings bright and roads dark, so the map is inverted to give both the radar's polarity.
+    despeckle_px : int
+        Median filter of this size (pixels) after scaling: speckle is the radar's, not the map's.
     clahe_kernel_px, ridge_sigmas_px, entropy_radius_px : scales in pixels
         CLAHE tile size, Sato scales and entropy disc radius; keep them equal for radar and map.
 
@@ -105,6 +113,10 @@ def preprocess(
         raise InputError(f"--method: must be one of {', '.join(METHODS)}, got {method!r}")
     unit = scale_to_unit(image, mask, log_power=log_power)
     valid = np.isfinite(np.asarray(image, float)) if mask is None else np.asarray(mask, bool)
+    if invert:
+        unit = np.where(valid, 1.0 - unit, 0.0).astype(np.float32)
+    if despeckle_px > 1:
+        unit = median_filter(unit, size=despeckle_px)
     if method == "gamma":
         out = unit**0.5
     elif method == "threshold_entropy":

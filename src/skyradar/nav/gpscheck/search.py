@@ -22,9 +22,10 @@ import numpy as np
 from scipy import fft
 
 from skyradar.errors import InputError
+from skyradar.nav.gpscheck.compare import crop_to_mask
 from skyradar.scene.ground_grid import GroundGrid, PoseGrid, sample_at_poses
 
-__all__ = ["PoseOffset", "ncc_surface", "search_offset", "fuse_offsets"]
+__all__ = ["PoseOffset", "ncc_surface", "search_offset", "similarity_surface", "fuse_offsets"]
 
 
 @dataclass(frozen=True)
@@ -101,13 +102,15 @@ def _psr(surface: np.ndarray, peak: tuple[int, int], exclude_px: int) -> float:
 class _Searcher:
     """The FFTs of one radar frame, reused for every heading tried."""
 
-    def __init__(self, radar, mask, map_world, grid, pose_grid, gps_pose, margin_m):
+    def __init__(self, radar, mask, map_world, grid, pose_grid, gps_pose, margin_m, map_pose_grid=None):
         self.map_world, self.grid, self.gps = map_world, grid, np.asarray(gps_pose, float)
         self.pix = pose_grid.pixel_m
         self.m = int(np.ceil(margin_m / self.pix))
-        h, w = pose_grid.shape
+        where = pose_grid if map_pose_grid is None else map_pose_grid
+        radar, mask, where = crop_to_mask(radar, mask, where)
+        h, w = where.shape
         self.big = PoseGrid(
-            pose_grid.forward0_m - self.m * self.pix, pose_grid.right0_m - self.m * self.pix, self.pix,
+            where.forward0_m - self.m * self.pix, where.right0_m - self.m * self.pix, self.pix,
             (h + 2 * self.m, w + 2 * self.m),
         )  # fmt: skip
         self.fft_shape = (fft.next_fast_len(h + 2 * self.m), fft.next_fast_len(w + 2 * self.m, real=True))
@@ -139,6 +142,7 @@ def search_offset(
     max_heading_deg: float = 15.0,
     coarse_step_deg: float = 1.5,
     fine_step_deg: float = 0.25,
+    map_pose_grid: PoseGrid | None = None,
 ) -> PoseOffset:
     """Coarse-to-fine search for the offset from ``gps_pose`` that best aligns radar and map.
 
@@ -152,6 +156,8 @@ def search_offset(
         ``(north_m, east_m, heading_rad)`` reported by GPS.
     margin_m, max_heading_deg : float
         Search extent: shifts up to ``margin_m`` each way, headings within ``+-max_heading_deg``.
+    map_pose_grid : PoseGrid, optional
+        Where the map is sampled (default ``pose_grid``): moved by the expected layover.
 
     Examples
     --------
@@ -168,7 +174,7 @@ def search_offset(
     radar_mask = np.asarray(radar_mask, bool) & np.isfinite(radar)
     if radar_mask.sum() < 16:
         raise InputError("search_offset: the radar footprint has fewer than 16 valid pixels")
-    s = _Searcher(radar, radar_mask, map_world, grid, pose_grid, gps_pose, margin_m)
+    s = _Searcher(radar, radar_mask, map_world, grid, pose_grid, gps_pose, margin_m, map_pose_grid)
     coarse = np.radians(np.arange(-max_heading_deg, max_heading_deg + 1e-9, coarse_step_deg))
     c_surf = s.surfaces(coarse)
     best = int(np.argmax([sf.max() for sf in c_surf]))
@@ -201,6 +207,25 @@ def search_offset(
         gps_ncc=float(zero),
         psr=_psr(surface, (a, b), max(2, int(round(10.0 / s.pix)))),
     )
+
+
+def similarity_surface(
+    radar: np.ndarray,
+    radar_mask: np.ndarray,
+    map_world: np.ndarray,
+    grid: GroundGrid,
+    pose_grid: PoseGrid,
+    pose: np.ndarray,
+    margin_m: float = 150.0,
+    map_pose_grid: PoseGrid | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """NCC over body shifts at the pose's heading, and the shift axis in metres (forward = rows).
+
+    Entry ``[a, b]`` scores the pose moved by ``axis[a]`` forward and ``axis[b]`` right.
+    """
+    radar_mask = np.asarray(radar_mask, bool) & np.isfinite(radar)
+    s = _Searcher(radar, radar_mask, map_world, grid, pose_grid, pose, margin_m, map_pose_grid)
+    return s.surfaces(np.zeros(1))[0], (np.arange(s.shifts[0]) - s.m) * s.pix
 
 
 def fuse_offsets(offsets: list[PoseOffset], min_psr: float = 0.0) -> PoseOffset | None:

@@ -1,0 +1,242 @@
+"""The GPS check of a run: per frame, radar ground image against the map at the GPS pose.
+
+Glue between the frames store, the map and the per-frame steps: :func:`radar_side` refuses a radar that
+does not look sideways, :func:`prepare_map` renders and pre-processes the reference map once (the
+pre-processing is rotation invariant, so the world map is processed once and sampled at any pose),
+:func:`check_frame` projects one frame, scores the GPS pose with SSIM, searches for the correction
+and gives the verdict, and :func:`check_run` does it for the frames of a run, with the alert.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+import pandas as pd
+from skimage.transform import downscale_local_mean
+
+from skyradar.config import RadarConfig
+from skyradar.errors import InputError
+from skyradar.io.frames_model import frame_times_s
+from skyradar.nav.gpscheck.compare import ssim_scores
+from skyradar.nav.gpscheck.monitor import (
+    DEFAULT_SETTINGS,
+    WING_UP,
+    MonitorSettings,
+    alerts,
+    frame_verdict,
+    inconsistency,
+)
+from skyradar.nav.gpscheck.preprocess import preprocess
+from skyradar.nav.gpscheck.projection import frame_power, ground_image, ground_in_view_fraction
+from skyradar.nav.gpscheck.search import PoseOffset, search_offset
+from skyradar.scene.ground_grid import GroundGrid, PoseGrid, sample_at_pose
+from skyradar.scene.map_render import check_map_covers, render_reference_map
+
+__all__ = [
+    "PIXEL_M", "DEFAULT_METHOD", "MAP_OPTIONS", "RADAR_OPTIONS", "radar_side", "pose_grid_for", "render_map",
+    "prepare_map", "building_height_m", "layover_grid", "FrameCheck", "check_frame", "check_run",
+]  # fmt: skip
+
+PIXEL_M = 4.0  # about the ch6 radar's 3 m range resolution; 4 m keeps one frame's search under 0.5 s
+DEFAULT_METHOD = "clahe_ridge"
+# The map draws roads light and buildings dark; the radar sees them the other way round: invert the map.
+# Speckle is the radar's alone: a 3 x 3 median on the radar image.
+MAP_OPTIONS = {"invert": True}
+RADAR_OPTIONS = {"log_power": True, "despeckle_px": 3}
+
+
+def radar_side(config: RadarConfig, source: str = "run") -> str:
+    """``"right"`` or ``"left"``: the side a wingtip radar looks at; one-line error for any other mount.
+
+    Examples
+    --------
+    >>> from skyradar.config import Mount
+    >>> radar_side(RadarConfig(mount=Mount.preset("side-left")))
+    'left'
+    """
+    yaw = (config.mount.yaw_deg + 180.0) % 360.0 - 180.0
+    if not 45.0 <= abs(yaw) <= 135.0:
+        raise InputError(
+            f"{source}: radar mount yaw {config.mount.yaw_deg:g} deg looks forward or backward;"
+            " the GPS check needs a side-looking wingtip mount (side-right or side-left, yaw +-90 deg)"
+        )
+    return "right" if yaw > 0 else "left"
+
+
+def pose_grid_for(config: RadarConfig, pixel_m: float = PIXEL_M, source: str = "run") -> PoseGrid:
+    """The body-aligned ground grid of the radar's side, out to its processed range."""
+    return PoseGrid.side_looking(config.range_limit_m, pixel_m, radar_side(config, source))
+
+
+def building_height_m(layers) -> float:
+    """The map's representative building height: the footprint-area-weighted mean (0 without buildings).
+
+    Large buildings dominate what a radar sees, hence the area weights.
+    """
+    buildings = layers.buildings
+    if not len(buildings):
+        return 0.0
+    return float(np.average(buildings["height_m"].to_numpy(float), weights=buildings.area.to_numpy() + 1e-9))
+
+
+def layover_grid(pose_grid: PoseGrid, mask: np.ndarray, height_agl_m: float, building_m: float) -> PoseGrid:
+    """``pose_grid`` moved sideways by the layover of roofs ``building_m`` high, to sample the map on.
+
+    A roof ``h`` high at ground range ``x`` is at slant range ``sqrt(x^2 + (H - h)^2)``, which the ground
+    projection puts at about ``x - H h / x``: buildings appear ``H h / x`` closer to the aircraft. The
+    map is sampled that much farther out so its buildings land where the radar shows them; ``x`` is the
+    footprint's mean ground range.
+
+    Examples
+    --------
+    >>> body = PoseGrid.side_looking(range_m=400.0, pixel_m=4.0)
+    >>> moved = layover_grid(body, np.ones(body.shape, bool), 200.0, 10.0)
+    >>> round(float(moved.right0_m - body.right0_m), 2)
+    10.0
+    """
+    right = np.broadcast_to(pose_grid.right_m[None, :], pose_grid.shape)[mask]
+    if not right.size or building_m <= 0:
+        return pose_grid
+    x = float(np.mean(np.abs(right)))
+    shift = height_agl_m * building_m / max(x, height_agl_m) * np.sign(np.mean(right))
+    return replace(pose_grid, right0_m=pose_grid.right0_m + shift)
+
+
+def render_map(layers, grid: GroundGrid) -> np.ndarray:
+    """The reference map on ``grid``, drawn at half the pixel size and averaged (no lost thin roads)."""
+    half = GroundGrid(
+        grid.north0_m - grid.pixel_m / 4, grid.east0_m - grid.pixel_m / 4, grid.pixel_m / 2,
+        (2 * grid.shape[0], 2 * grid.shape[1]),
+    )  # fmt: skip
+    return downscale_local_mean(render_reference_map(layers, half), (2, 2)).astype(np.float32)
+
+
+def prepare_map(map_image: np.ndarray, methods: Sequence[str]) -> dict[str, np.ndarray]:
+    """The map pre-processed by each method (NaN, no data, is masked)."""
+    valid = np.isfinite(map_image)
+    return {method: preprocess(map_image, method, valid, **MAP_OPTIONS) for method in methods}
+
+
+@dataclass(frozen=True)
+class FrameCheck:
+    """One frame's GPS check."""
+
+    ground_fraction: float
+    gps_ssim: float
+    offset: PoseOffset | None
+    verdict: str
+
+
+def check_frame(
+    radar_image: np.ndarray,
+    ground_fraction: float,
+    gps_pose: np.ndarray,
+    map_processed: np.ndarray,
+    grid: GroundGrid,
+    pose_grid: PoseGrid,
+    method: str = DEFAULT_METHOD,
+    settings: MonitorSettings = DEFAULT_SETTINGS,
+    height_agl_m: float = 0.0,
+    building_m: float = 0.0,
+    **search_options,
+) -> FrameCheck:
+    """Score the GPS pose (SSIM), search for the correction and give the verdict for one frame.
+
+    ``radar_image`` is the frame's ground image (linear power, NaN where unseen) on ``pose_grid``.
+    A wing-up frame (``ground_fraction`` below the setting) is not searched. ``height_agl_m`` and
+    ``building_m`` (the map's building height) set the layover correction (:func:`layover_grid`).
+    """
+    mask = np.isfinite(radar_image)
+    if ground_fraction < settings.min_ground_fraction or mask.sum() < 64:
+        return FrameCheck(float(ground_fraction), float("nan"), None, WING_UP)
+    radar = preprocess(radar_image, method, mask, **RADAR_OPTIONS)
+    map_grid = layover_grid(pose_grid, mask, height_agl_m, building_m)
+    at_gps = sample_at_pose(map_processed, grid, map_grid, *gps_pose, fill=0.0)
+    score = ssim_scores(radar, at_gps, mask)
+    offset = search_offset(
+        radar, mask, map_processed, grid, pose_grid, gps_pose, map_pose_grid=map_grid, **search_options
+    )
+    return FrameCheck(
+        float(ground_fraction), float(score), offset, frame_verdict(ground_fraction, offset, settings)
+    )
+
+
+def _state(ds, i: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """GPS pose (north, east, heading), attitude, velocity and height above ground of frame ``i``."""
+    get = lambda name: float(ds[name].values[i])  # noqa: E731
+    attitude = np.array([get("own_yaw_rad"), get("own_pitch_rad"), get("own_roll_rad")])
+    velocity = np.array([get("own_vn_mps"), get("own_ve_mps"), get("own_vd_mps")])
+    height = get("own_height_agl_m") if "own_height_agl_m" in ds else -get("own_down_m")
+    return np.array([get("own_north_m"), get("own_east_m"), attitude[0]]), attitude, velocity, height
+
+
+def _row(frame: int, time_s: float, gps: np.ndarray, result: FrameCheck, settings) -> dict:
+    off, nan = result.offset, float("nan")
+    row = {
+        "frame": frame, "time_s": time_s, "gps_north_m": float(gps[0]), "gps_east_m": float(gps[1]),
+        "gps_heading_deg": float(np.degrees(gps[2])), "ground_fraction": result.ground_fraction,
+        "gps_ssim": result.gps_ssim,
+    }  # fmt: skip
+    for name in ("gps_ncc", "peak_ncc", "psr", "d_north_m", "d_east_m", "d_heading_deg"):
+        row[name] = getattr(off, name) if off else nan
+    row["correction_m"] = off.distance_m if off else nan
+    row["inconsistency"] = inconsistency(off, settings) if off else nan
+    row["verdict"] = result.verdict
+    return row
+
+
+def check_run(
+    ds,
+    config: RadarConfig,
+    map_processed: np.ndarray,
+    grid: GroundGrid,
+    *,
+    frames: Sequence[int] | None = None,
+    method: str = DEFAULT_METHOD,
+    gps_offset: Sequence[float] = (0.0, 0.0, 0.0),
+    settings: MonitorSettings = DEFAULT_SETTINGS,
+    pixel_m: float = PIXEL_M,
+    source: str = "run",
+    map_extent=None,
+    map_source: str | None = None,
+    building_m: float = 0.0,
+    progress=None,
+) -> pd.DataFrame:
+    """The GPS check of the chosen frames of a frames dataset; one row per frame.
+
+    ``gps_offset`` ``(north_m, east_m, heading_deg)`` is added to the run's own-ship pose: a biased or
+    spoofed GPS. With ``map_extent`` (MapLayers or GroundGrid) every frame's footprint at the GPS pose
+    must lie on the map (one-line error naming ``map_source`` otherwise). ``building_m`` is the map's
+    building height for the layover correction (:func:`building_height_m`). Columns: frame, time_s,
+    gps_north_m, gps_east_m, gps_heading_deg, ground_fraction, gps_ssim, gps_ncc, peak_ncc, psr,
+    d_north_m, d_east_m, d_heading_deg, correction_m, inconsistency, verdict, alert.
+    """
+    pose_grid = pose_grid_for(config, pixel_m, source)
+    needed = ("own_north_m", "own_east_m", "own_yaw_rad", "own_pitch_rad", "own_roll_rad", "own_vn_mps")
+    missing = [name for name in needed if name not in ds]
+    if missing:
+        raise InputError(f"{source}: the run has no own-ship state ({', '.join(missing)}) for the GPS pose")
+    frames = range(ds.sizes["time"]) if frames is None else frames
+    offset = np.array([gps_offset[0], gps_offset[1], np.radians(gps_offset[2])])
+    rows, times_s = [], frame_times_s(ds)
+    for i in frames:
+        gps, attitude, velocity, height = _state(ds, i)
+        gps = gps + offset
+        power = frame_power(ds["iq"].values[i])
+        image = ground_image(power, config, pose_grid, attitude, velocity, height)
+        fraction = ground_in_view_fraction(config, attitude, height)
+        seen = np.isfinite(image)
+        if map_extent is not None and seen.any():
+            north, east = pose_grid.world_points(*gps)
+            check_map_covers(map_extent, north[seen], east[seen], source=map_source)
+        result = check_frame(
+            image, fraction, gps, map_processed, grid, pose_grid, method, settings, height, building_m
+        )
+        rows.append(_row(int(i), float(times_s[i]), gps, result, settings))
+        if progress is not None:
+            progress()
+    table = pd.DataFrame(rows)
+    table["alert"] = alerts(list(table["verdict"]), settings.alert_frames) if len(table) else []
+    return table

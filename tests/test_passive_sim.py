@@ -14,6 +14,8 @@ import numpy as np
 import pymap3d
 import pytest
 import scipy.signal
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from skyradar.passive.illuminator import Illuminator, lfm_baseband
 from skyradar.passive.scene import Aircraft, Reflectors, aircraft_from_adsb, thesis_scene
@@ -239,3 +241,25 @@ def test_aircraft_from_an_adsb_file_is_placed_in_the_receiver_frame(tmp_path):
     assert present.tolist() == [True, True, False]
     expected = pymap3d.geodetic2ned(52.11, 5.30, 1500 * 0.3048, *scene.receiver.geodetic)
     np.testing.assert_allclose(pos[0], expected, atol=0.5)
+
+
+@given(
+    first=st.floats(-0.01, 0.01),
+    a=st.floats(-0.05, 0.05),
+    split=st.floats(0.0, 0.02),
+    length=st.floats(0.0, 0.02),
+)
+@settings(max_examples=60, deadline=None)
+def test_pulse_schedule_splits_exactly_at_any_chunk_boundary(first, a, split, length):
+    ill = Illuminator(52.0, 5.0, 20.0)
+    b, c = a + split, a + split + length
+    k_ab, t_ab = ill.pulse_times_s(first, a, b)
+    k_bc, t_bc = ill.pulse_times_s(first, b, c)
+    k_ac, t_ac = ill.pulse_times_s(first, a, c)
+    assert np.concatenate([k_ab, k_bc]).tolist() == k_ac.tolist()
+    np.testing.assert_array_equal(np.concatenate([t_ab, t_bc]), t_ac)
+    assert np.all((t_ac >= a) & (t_ac < c)) and np.all(np.diff(k_ac) == 1)
+    # pulse k starts where the stagger cycle puts it
+    cycle_start = first + (k_ac // 4) * sum(ill.pri_s)
+    within = np.concatenate([[0.0], np.cumsum(ill.pri_s)[:-1]])[k_ac % 4]
+    np.testing.assert_allclose(t_ac, cycle_start + within, atol=1e-12)

@@ -10,6 +10,9 @@ the first sample (``T`` the rotation period), so a 40 s recording at 13.5 rpm ha
 
 ``NAME.truth.json`` holds the scan and timing a processor must recover (beam azimuth at sample 0,
 emission time of PRI 0, the times the beam points at the receiver) and a summary of each cluster.
+Azimuths (``azimuth_from_tx_deg``, ``azimuth_at_t0_deg``) are clockwise from north of the receiver's NED
+frame, measured at the transmitter in that frame; true north at the transmitter differs by the meridian
+convergence (0.13 deg for the thesis geometry).
 """
 
 from __future__ import annotations

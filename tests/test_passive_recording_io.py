@@ -56,6 +56,11 @@ def test_raw_cf32_and_ci16_with_sidecar(tmp_path):
         rec = read_iq_recording(write_raw_iq(tmp_path / f"r{suffix}", x, side, datatype))
         np.testing.assert_allclose(rec.read(0, 64), x, atol=tol)
         assert rec.illuminator_geodetic == (TX["latitude"], TX["longitude"], TX["altitude"])
+    import yaml
+
+    (tmp_path / "r.json").rename(tmp_path / "r.yaml")  # the ci16 file's sidecar, now as YAML
+    (tmp_path / "r.yaml").write_text(yaml.safe_dump(json.loads((tmp_path / "r.yaml").read_text())))
+    np.testing.assert_allclose(read_iq_recording(tmp_path / "r.ci16").read(0, 64), x, atol=1 / 32768)
 
 
 @pytest.mark.parametrize(

@@ -33,7 +33,8 @@ def read_raw_iq(data_path: str | Path, require_illuminator: bool = True) -> IqRe
     if sidecar is None:
         raise InputError(f"{data_path}: no sidecar {data_path.stem}.json or .yaml with sample_rate_hz etc.")
     try:
-        info = json.loads(sidecar.read_text()) if sidecar.suffix == ".json" else load_yaml(sidecar)
+        text = sidecar.read_text()
+        info = json.loads(text) if sidecar.suffix == ".json" else load_yaml(text, sidecar)
     except (OSError, ValueError) as exc:
         raise InputError(f"{sidecar}: cannot read sidecar ({exc})") from None
     if not isinstance(info, dict):

@@ -79,6 +79,7 @@ def baseline_frame(
 def _rate(fn, cubes, min_time_s: float) -> float:
     if not 0.0 < min_time_s < float("inf"):  # NaN never compares >=: the loop would never end
         raise InputError(f"bench state: min_time_s must be finite and > 0, got {min_time_s}")
+    fn(cubes[0])  # warm-up: numba compiles (or loads its cache) on the first call; not a frame's cost
     n, start = 0, time.perf_counter()
     while True:
         for cube in cubes:

@@ -71,6 +71,7 @@ def test_raw_cf32_and_ci16_with_sidecar(tmp_path):
         (lambda d: d["global"].pop("skyradar:illuminator"), "no position"),
         (lambda d: d["global"].pop("core:geolocation"), "core:geolocation"),
         (lambda d: d["global"].update({"core:sample_rate": "fast"}), "not valid SigMF"),
+        (lambda d: d["global"].update({"skyradar:sample_count": "many"}), "skyradar:sample_count"),
     ],
 )
 def test_bad_metadata_is_one_line(tmp_path, change, needle):

@@ -74,7 +74,11 @@ class IqRecording:
             )
         self.n_samples = size // sample_bytes
         expected = info.get("n_samples")
-        if expected is not None and int(expected) > self.n_samples:
+        if expected is not None and (
+            isinstance(expected, bool) or not isinstance(expected, int) or expected < 0
+        ):
+            raise InputError(f"{self.path}: field 'n_samples' must be a whole number >= 0, got {expected!r}")
+        if expected is not None and expected > self.n_samples:
             raise InputError(
                 f"{self.data_path}: data file holds {self.n_samples} samples, shorter than the "
                 f"{int(expected)} its metadata ({self.path.name}) says"

@@ -90,7 +90,12 @@ def _read_sigmf(meta_path: Path, data_path: Path, require_illuminator: bool) -> 
     for a in meta.get("annotations", []):
         ends.append(int(a["core:sample_start"]) + int(a.get("core:sample_count", 0)))
     if "skyradar:sample_count" in glob:
-        ends.append(int(glob["skyradar:sample_count"]))
+        count = glob["skyradar:sample_count"]
+        if isinstance(count, bool) or not isinstance(count, int) or count < 0:
+            raise InputError(
+                f"{meta_path}: field 'skyradar:sample_count' must be a whole number, got {count!r}"
+            )
+        ends.append(count)
     illum, illum_pos = _illuminator(str(meta_path), glob.get("skyradar:illuminator"), require_illuminator)
     info = {
         "sample_rate_hz": glob["core:sample_rate"] if "core:sample_rate" in glob else _missing(meta_path),

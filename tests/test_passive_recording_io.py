@@ -72,6 +72,14 @@ def test_raw_cf32_and_ci16_with_sidecar(tmp_path):
         (lambda d: d["global"].pop("core:geolocation"), "core:geolocation"),
         (lambda d: d["global"].update({"core:sample_rate": "fast"}), "not valid SigMF"),
         (lambda d: d["global"].update({"skyradar:sample_count": "many"}), "skyradar:sample_count"),
+        (lambda d: d["global"].update({"skyradar:receiver": "x"}), "skyradar:receiver"),
+        (
+            lambda d: [
+                d["captures"][0].pop("core:frequency"),
+                d["global"]["skyradar:illuminator"].pop("carrier_frequency_hz"),
+            ],
+            "core:freq",
+        ),
     ],
 )
 def test_bad_metadata_is_one_line(tmp_path, change, needle):
@@ -99,7 +107,7 @@ def test_raw_without_sidecar_or_illuminator(tmp_path):
     with pytest.raises(InputError, match="no sidecar"):
         read_iq_recording(tmp_path / "x.cf32")
     (tmp_path / "x.json").write_text(
-        json.dumps({"sample_rate_hz": 5e6, "center_frequency_hz": 0, "receiver": RX})
+        json.dumps({"sample_rate_hz": 5e6, "center_frequency_hz": 2.8e9, "receiver": RX})
     )
     with pytest.raises(InputError, match="no position"):
         read_iq_recording(tmp_path / "x.cf32")

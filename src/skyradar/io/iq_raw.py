@@ -42,10 +42,10 @@ def read_raw_iq(data_path: str | Path, require_illuminator: bool = True) -> IqRe
     for key in ("sample_rate_hz", "center_frequency_hz"):
         value = info.get(key)
         if (
-            not isinstance(value, int | float)
+            isinstance(value, bool)
+            or not isinstance(value, int | float)
             or not np.isfinite(value)
-            or value < 0
-            or (key == "sample_rate_hz" and value == 0)
+            or value <= 0
         ):
             raise InputError(f"{sidecar}: field '{key}' must be a positive number, got {value!r}")
     illum, illum_pos = _illuminator(str(sidecar), info.get("illuminator"), require_illuminator)

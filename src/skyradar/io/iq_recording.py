@@ -67,7 +67,12 @@ class IqRecording:
         dtype, self._scale = DATATYPES[datatype]
         sample_bytes = np.dtype(dtype).itemsize * (2 if datatype == "ci16_le" else 1)
         size = self.data_path.stat().st_size - offset_bytes
-        if size < 0 or size % sample_bytes:
+        if size < 0:
+            raise InputError(
+                f"{self.data_path}: data file of {size + offset_bytes} bytes is shorter than its "
+                f"{offset_bytes}-byte header (core:header_bytes)"
+            )
+        if size % sample_bytes:
             raise InputError(
                 f"{self.data_path}: data file of {size + offset_bytes} bytes ends inside a sample "
                 f"({datatype}, {sample_bytes} bytes per sample after {offset_bytes} header bytes): truncated?"

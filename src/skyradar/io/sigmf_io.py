@@ -99,17 +99,34 @@ def _read_sigmf(meta_path: Path, data_path: Path, require_illuminator: bool) -> 
     illum, illum_pos = _illuminator(str(meta_path), glob.get("skyradar:illuminator"), require_illuminator)
     info = {
         "sample_rate_hz": glob["core:sample_rate"] if "core:sample_rate" in glob else _missing(meta_path),
-        "center_frequency_hz": captures[0].get("core:frequency", illum.get("carrier_frequency_hz", 0.0)),
+        "center_frequency_hz": _centre_frequency(meta_path, captures[0], illum),
         "start_time": captures[0].get("core:datetime"),
         "receiver_geodetic": (float(lat), float(lon), float(alt[0]) if alt else 0.0),
         "illuminator": illum,
         "illuminator_geodetic": illum_pos,
-        "receiver": glob.get("skyradar:receiver", {}),
+        "receiver": _mapping(meta_path, "skyradar:receiver", glob.get("skyradar:receiver", {})),
         "n_samples": max(ends) if ends else None,
     }
     if not data_path.exists():
         raise InputError(f"{meta_path}: its data file {data_path.name} does not exist")
     return IqRecording(meta_path, data_path, datatype, int(captures[0].get("core:header_bytes", 0)), info)
+
+
+def _centre_frequency(where: Path, capture: dict, illuminator: dict) -> float:
+    # The receiver's tuning; without it the illuminator's carrier (a passive receiver tunes to it).
+    value = capture.get("core:frequency", illuminator.get("carrier_frequency_hz"))
+    if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
+        raise InputError(
+            f"{where}: field 'core:frequency' (first capture) is {value!r} and the illuminator names no "
+            "carrier_frequency_hz: the centre frequency is needed for Doppler"
+        )
+    return float(value)
+
+
+def _mapping(where: Path, field: str, value: object) -> dict:
+    if not isinstance(value, dict):
+        raise InputError(f"{where}: field '{field}' must be an object, got {value!r}")
+    return value
 
 
 def _missing(where: Path) -> float:

@@ -17,6 +17,7 @@ import scipy.signal
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from skyradar.errors import InputError
 from skyradar.passive.illuminator import Illuminator, lfm_baseband
 from skyradar.passive.scene import Aircraft, Reflectors, aircraft_from_adsb, thesis_scene
 from skyradar.passive.simulate import simulate_chunk, simulate_recording
@@ -263,3 +264,20 @@ def test_pulse_schedule_splits_exactly_at_any_chunk_boundary(first, a, split, le
     cycle_start = first + (k_ac // 4) * sum(ill.pri_s)
     within = np.concatenate([[0.0], np.cumsum(ill.pri_s)[:-1]])[k_ac % 4]
     np.testing.assert_allclose(t_ac, cycle_start + within, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("change", "needle"),
+    [
+        ({"rotation_rpm": "fast"}, "'rotation_rpm' must be a finite number"),
+        ({"long_pulse": "x"}, "'long_pulse' must be an object"),
+        ({"long_pulse": {"width_s": 2e-3}}, "must fit the shortest PRI"),
+        ({"pri_s": []}, "'pri_s' is empty"),
+        ({"rotation_direction": "anticlockwise"}, "only 'clockwise'"),
+    ],
+)
+def test_illuminator_metadata_errors_name_the_field(change, needle):
+    meta = Illuminator(52.0, 5.0, 20.0).to_metadata()
+    assert Illuminator.from_metadata(meta) == Illuminator(52.0, 5.0, 20.0)
+    with pytest.raises(InputError, match=needle):
+        Illuminator.from_metadata({**meta, **change})

@@ -69,6 +69,15 @@ def lfm_baseband(t_s: np.ndarray, width_s: float, bandwidth_hz: float, offset_hz
     return np.where(inside, np.exp(1j * phase), 0.0).astype(np.complex64)
 
 
+_PULSE_KEYS = ("width_s", "bandwidth_hz", "offset_hz", "delay_s")
+
+
+def _number(name: str, value: object) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise InputError(f"illuminator: field '{name}' must be a finite number, got {value!r}")
+    return float(value)
+
+
 def _positive(name: str, value: float) -> float:
     value = float(value)
     if not math.isfinite(value) or value <= 0:
@@ -147,15 +156,30 @@ class Illuminator:
         names = {f.name for f in fields(cls)}
         kwargs = {k: v for k, v in meta.items() if k in names}
         for key in ("long_pulse", "short_pulse"):
-            if isinstance(kwargs.get(key), dict):
-                known = Pulse.__dataclass_fields__
-                kwargs[key] = Pulse(**{k: float(v) for k, v in kwargs[key].items() if k in known})
+            if key in kwargs:
+                value = kwargs[key]
+                if not isinstance(value, dict):
+                    raise InputError(f"illuminator: field '{key}' must be an object, got {value!r}")
+                kwargs[key] = Pulse(
+                    **{k: _number(f"{key}.{k}", v) for k, v in value.items() if k in _PULSE_KEYS}
+                )
         if "pri_s" in kwargs:
-            kwargs["pri_s"] = tuple(float(p) for p in kwargs["pri_s"])
+            values = kwargs["pri_s"] if isinstance(kwargs["pri_s"], list | tuple) else [kwargs["pri_s"]]
+            kwargs["pri_s"] = tuple(_number("pri_s", p) for p in values)
+            if not kwargs["pri_s"]:
+                raise InputError("illuminator: field 'pri_s' is empty")
+        for key in names - {"name", "long_pulse", "short_pulse", "pri_s"}:
+            if key in kwargs:
+                kwargs[key] = _number(key, kwargs[key])
+        return cls(**kwargs)
+
+    @classmethod
+    def from_recording(cls, recording) -> Illuminator:
+        """From an :class:`~skyradar.io.iq_recording.IqRecording`'s ``illuminator``; errors name its file."""
         try:
-            return cls(**kwargs)
-        except TypeError as exc:
-            raise InputError(f"illuminator: {exc}") from None
+            return cls.from_metadata(recording.illuminator)
+        except InputError as exc:
+            raise InputError(f"{recording.path}: {exc}") from None
 
     def replaced(self, **changes) -> Illuminator:
         return replace(self, **changes)

@@ -67,17 +67,14 @@ def synthetic_detections(
     >>> det.radial_velocity_mps.round(0).tolist()
     [18.0, 18.0, 18.0]
     """
-    config = config or RadarConfig.prototype_2022()
-    rng = np.random.default_rng(seed)
+    config, rng = config or RadarConfig.prototype_2022(), np.random.default_rng(seed)
     t = np.asarray(times_s, float)
     R, V = (np.asarray(a, float).reshape(t.size, -1) for a in (range_m, radial_velocity_mps))
     vis = (config.range_limit_m > R) if visible is None else np.asarray(visible, bool).reshape(R.shape)
-    det = vis & (rng.random(R.shape) < pd_detect)
-    fi, ti = np.nonzero(det)
     # One generator, drawn in a fixed order (detections, noise, positions, clutter): same seed, same table.
+    fi, ti = np.nonzero(vis & (rng.random(R.shape) < pd_detect))
     cols = _noisy_truth(rng, t, R, V, fi, ti, config, sigma_range_m, sigma_velocity_mps, coupling)
-    if positions_ned_m is not None:
-        cols |= _noisy_positions(rng, np.asarray(positions_ned_m, float)[fi, ti], R[fi, ti] * sigma_angle_rad)
+    cols |= _noisy_positions(rng, positions_ned_m, fi, ti, R[fi, ti] * sigma_angle_rad)
     clutter = _clutter(rng, t, clutter_per_frame, config, positions_ned_m is not None, clutter_min_range_m)
     df = pd.concat([pd.DataFrame(cols), pd.DataFrame(clutter)], ignore_index=True)
     return df.sort_values(["time_s", "range_m"], kind="stable").reset_index(drop=True)
@@ -92,8 +89,11 @@ def _noisy_truth(rng, t, R, V, fi, ti, config: RadarConfig, sigma_range_m, sigma
     return {"time_s": t[fi], "frame": fi, "range_m": range_m, "radial_velocity_mps": velocity, "target": ti}
 
 
-def _noisy_positions(rng, pos: np.ndarray, sigma_m: np.ndarray) -> dict[str, np.ndarray]:
-    """NED positions with isotropic Gaussian error of ``sigma_m`` (range x angular error) per row."""
+def _noisy_positions(rng, positions_ned_m, fi, ti, sigma_m: np.ndarray) -> dict[str, np.ndarray]:
+    """Positions of the truths at (``fi``, ``ti``) with isotropic Gaussian error ``sigma_m``; {} without."""
+    if positions_ned_m is None:
+        return {}
+    pos = np.asarray(positions_ned_m, float)[fi, ti]
     err = rng.normal(0.0, 1.0, (pos.shape[0], 3)) * sigma_m[:, None]
     return {name: pos[:, c] + err[:, c] for c, name in enumerate(("north_m", "east_m", "down_m"))}
 

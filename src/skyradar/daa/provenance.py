@@ -20,6 +20,7 @@ import numpy as np
 import xarray as xr
 
 from skyradar.errors import InputError
+from skyradar.io.frames_model import frame_times_s
 
 __all__ = ["ownship_signature", "check_tracks_match_run"]
 
@@ -47,7 +48,7 @@ def ownship_signature(ds: xr.Dataset, source: str) -> str | None:
 
     if not all(name in ds for name in _POS) or ds.sizes.get("time", 0) == 0:
         return None
-    t = np.asarray(ds["time"].values, float)
+    t = frame_times_s(ds)
     pos = np.stack([np.asarray(ds[name].values, float) for name in _POS], axis=-1)
     picks = np.unique(np.linspace(0, t.size - 1, _N_SAMPLES).round().astype(int))
     origin = scenario_origin(ds)
@@ -125,7 +126,7 @@ def check_tracks_match_run(tracks_attrs: dict[str, Any], tracks_path: str, ds: x
     if made_text is None or not all(name in ds for name in _POS) or ds.sizes.get("time", 0) == 0:
         return
     made = json.loads(made_text)
-    t = np.asarray(ds["time"].values, float)
+    t = frame_times_s(ds)
     pos = np.stack([np.asarray(ds[name].values, float) for name in _POS], axis=-1)
     origin = scenario_origin(ds)
     why = _mismatch(made, origin, t, pos)

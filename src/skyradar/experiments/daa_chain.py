@@ -18,6 +18,7 @@ from skyradar.daa.alerting import AlertConfig
 from skyradar.daa.pipeline import alerts_from_tracks
 from skyradar.daa.run_tables import ownship_from_frames
 from skyradar.io.frames import frames_dataset
+from skyradar.io.frames_model import frame_times_s
 from skyradar.process.pipeline import process_frames
 from skyradar.sim.scenario_frames import make_simulator, scenario_truth, simulate_frames
 from skyradar.track.track_table import track_detections
@@ -33,7 +34,7 @@ def _truth_dataset(built, simulator) -> xr.Dataset:
     cfg = built.radar
     shape = (built.times_s.size, cfg.n_range, cfg.n_doppler, cfg.n_rx)
     attrs = {"scenario": built.name, "origin_lat_deg": built.origin[0], "origin_lon_deg": built.origin[1],
-             "origin_alt_m": built.origin[2]}  # fmt: skip
+             "origin_alt_m": built.origin[2], "start_time": getattr(built, "start_time", None)}  # fmt: skip
     iq = np.broadcast_to(np.zeros((), np.complex64), shape)
     return frames_dataset(iq, built.times_s, cfg, own, tgt, names, attrs)
 
@@ -117,7 +118,7 @@ def label_tracks(tracks: pd.DataFrame, truth: xr.Dataset, max_distance_m: float 
     >>> label_tracks(tr, t)
     {1: 'a', 2: 'clutter'}
     """
-    times = np.asarray(truth["time"].values, float)
+    times = frame_times_s(truth)
     names = [str(x) for x in truth["target"].values]
     truth_pos = np.stack([truth[f"tgt_{a}_m"].values for a in ("north", "east", "down")], -1)
     labels = {}

@@ -40,6 +40,7 @@ from skyradar.experiments.encounter_set import (
     summarise,
 )
 from skyradar.io.atomic import write_csv_atomic
+from skyradar.io.frames_model import frame_times_s
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.scene.scenario import Scenario
 from skyradar.parallel import check_workers
@@ -75,7 +76,7 @@ def _observable(truth, fov_deg: float, min_snr_db: float) -> pd.DataFrame:
     with np.errstate(invalid="ignore"):
         ok = truth["tgt_visible"].values[:, 0] & (np.abs(az) <= half) & (np.abs(el) <= half)
         ok &= truth["tgt_snr_db"].values[:, 0] >= min_snr_db
-    return pd.DataFrame({"time_s": truth["time"].values, "observable": ok})
+    return pd.DataFrame({"time_s": frame_times_s(truth), "observable": ok})
 
 
 def run_encounter(

@@ -135,7 +135,7 @@ def decode(ds: xr.Dataset) -> xr.Dataset:
     iq = da.blockwise(
         decode_block, "trdx", codes, "trdxp", scale, "trx", dtype=np.complex64, concatenate=True
     )
-    attrs = {"long_name": "complex pixel, |iq|^2 in W (decoded from int16 codes)"}
+    attrs = {"units": "W^0.5", "long_name": "complex pixel, |iq|^2 in W (decoded from int16 codes)"}
     return ds.drop_vars(["iq_int16", "iq_scale"]).assign(iq=(_IQ_DIMS, iq, attrs))
 
 

@@ -26,6 +26,18 @@ from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.io import cint16
 from skyradar.io.checks import check_frame_times
+from skyradar.io.frames_model import (
+    DEFAULT_START_TIME,
+    IQ_LONG_NAME,
+    OWNSHIP_VARS,
+    TARGET_VARS,
+    axis_coordinates,
+    format_start_time,
+    frame_times_s,
+    parse_start_time,
+    radar_attrs,
+    variable_attrs,
+)
 from skyradar.io.outputs import check_output, is_ours, notify, replace_path
 from skyradar.io.store_size import check_store_space, store_bytes
 
@@ -33,6 +45,7 @@ __all__ = [
     "OWNSHIP_VARS",
     "TARGET_VARS",
     "frames_dataset",
+    "frame_times_s",
     "radar_config_of",
     "open_frames",
     "FrameStoreWriter",
@@ -48,59 +61,6 @@ COMPRESSORS = ("none", "zstd", "blosc")
 # see :mod:`skyradar.io.cint16` for the error bound).
 PRECISIONS = cint16.PRECISIONS
 
-# Truth variables written by the simulator: name -> (units, description).
-OWNSHIP_VARS: dict[str, tuple[str, str]] = {
-    "own_north_m": ("m", "own-ship (radar reference point) north in the scenario NED frame"),
-    "own_east_m": ("m", "own-ship east in the scenario NED frame"),
-    "own_down_m": ("m", "own-ship down in the scenario NED frame"),
-    "own_vn_mps": ("m/s", "own-ship velocity north"),
-    "own_ve_mps": ("m/s", "own-ship velocity east"),
-    "own_vd_mps": ("m/s", "own-ship velocity down"),
-    "own_lat_deg": ("degree", "own-ship WGS84 latitude"),
-    "own_lon_deg": ("degree", "own-ship WGS84 longitude"),
-    "own_alt_m": ("m", "own-ship altitude above the WGS84 ellipsoid"),
-    "own_yaw_rad": ("rad", "own-ship heading (yaw) from north"),
-    "own_pitch_rad": ("rad", "own-ship pitch, positive nose-up"),
-    "own_roll_rad": ("rad", "own-ship roll (bank), positive right wing down"),
-    "own_height_agl_m": ("m", "own-ship height above the terrain directly below"),
-}
-TARGET_VARS: dict[str, tuple[str, str]] = {
-    "tgt_north_m": ("m", "intruder north in the scenario NED frame"),
-    "tgt_east_m": ("m", "intruder east"),
-    "tgt_down_m": ("m", "intruder down"),
-    "tgt_vn_mps": ("m/s", "intruder velocity north"),
-    "tgt_ve_mps": ("m/s", "intruder velocity east"),
-    "tgt_vd_mps": ("m/s", "intruder velocity down"),
-    "tgt_lat_deg": ("degree", "intruder WGS84 latitude"),
-    "tgt_lon_deg": ("degree", "intruder WGS84 longitude"),
-    "tgt_alt_m": ("m", "intruder altitude above the WGS84 ellipsoid"),
-    "tgt_range_m": ("m", "range from the radar"),
-    "tgt_radial_velocity_mps": ("m/s", "true radial velocity (not aliased), positive receding"),
-    "tgt_azimuth_rad": ("rad", "azimuth in the antenna frame, positive right"),
-    "tgt_elevation_rad": ("rad", "elevation in the antenna frame, positive up"),
-    "tgt_rcs_m2": ("m^2", "radar cross-section"),
-    "tgt_snr_db": ("dB", "expected single-pixel SNR from the radar equation"),
-    "tgt_visible": ("1", "inside range, field of view and line of sight"),
-}
-
-
-def _axis_coords(config: RadarConfig, times_s: np.ndarray) -> dict[str, Any]:
-    return {
-        "time": (
-            "time",
-            np.asarray(times_s, float),
-            {"units": "s", "long_name": "frame time from scenario start"},
-        ),
-        "range": ("range", config.range_axis_m, {"units": "m", "long_name": "range bin centre"}),
-        "doppler": (
-            "doppler",
-            config.doppler_axis_mps,
-            {"units": "m/s", "long_name": "radial velocity bin centre, positive receding"},
-        ),
-        "rx": ("rx", np.arange(config.n_rx), {"long_name": "receive antenna index"}),
-    }
-
-
 def frames_dataset(
     iq: Any,
     times_s: np.ndarray,
@@ -109,8 +69,13 @@ def frames_dataset(
     targets: Mapping[str, np.ndarray] | None = None,
     target_names: list[str] | None = None,
     attrs: Mapping[str, Any] | None = None,
+    start_time: Any = None,
 ) -> xr.Dataset:
     """Wrap a (time, range, doppler, rx) cube and truth arrays into the frames Dataset.
+
+    The data model (absolute UTC ``time`` plus elapsed ``time_s``, CF attributes, ``radar_*``
+    attributes) is described in :mod:`skyradar.io.frames_model`; read frame times with
+    :func:`frame_times_s`.
 
     Parameters
     ----------
@@ -124,6 +89,10 @@ def frames_dataset(
         Truth arrays keyed by the names in ``OWNSHIP_VARS`` / ``TARGET_VARS``.
     target_names : list of str, optional
         One name per intruder (the ``target`` coordinate).
+    attrs : mapping, optional
+        Extra dataset attributes (a ``start_time`` here is used when the argument is not given).
+    start_time : str or datetime64, optional
+        ISO 8601 UTC instant of ``times_s = 0``; default ``DEFAULT_START_TIME`` (1970-01-01T00:00:00Z).
 
     Examples
     --------
@@ -138,23 +107,27 @@ def frames_dataset(
             f"frames: iq has shape {tuple(iq.shape)}, expected (time, range, doppler, rx) = {expected}"
         )
     data_vars: dict[str, Any] = {
-        "iq": (("time", "range", "doppler", "rx"), iq, {"long_name": "complex pixel, |iq|^2 in W"}),
+        "iq": (("time", "range", "doppler", "rx"), iq, {"units": "W^0.5", "long_name": IQ_LONG_NAME}),
     }
     for name, values in (ownship or {}).items():
         units, desc = OWNSHIP_VARS[name]
-        data_vars[name] = ("time", np.asarray(values), {"units": units, "long_name": desc})
-    coords = _axis_coords(config, times_s)
+        data_vars[name] = ("time", np.asarray(values), variable_attrs(name, units, desc))
+    if start_time is None:
+        start_time = (attrs or {}).get("start_time")
+    start = parse_start_time(DEFAULT_START_TIME if start_time is None else start_time, "frames")
+    coords = axis_coordinates(config, times_s, start)
     if targets:
         for name, values in targets.items():
             units, desc = TARGET_VARS[name]
-            data_vars[name] = (("time", "target"), np.asarray(values), {"units": units, "long_name": desc})
+            data_vars[name] = (("time", "target"), np.asarray(values), variable_attrs(name, units, desc))
         n_targets = np.asarray(next(iter(targets.values()))).shape[1]
         coords["target"] = (
             "target",
             np.array(target_names or [f"T{i}" for i in range(n_targets)], dtype=object),
+            {"long_name": "intruder name"},
         )
-    all_attrs = {"radar_config": config.to_json(), "skyradar_format": "frames/1"}
-    all_attrs.update(attrs or {})
+    all_attrs = {"Conventions": "CF-1.10", "radar_config": config.to_json(), "skyradar_format": "frames/2"}
+    all_attrs |= radar_attrs(config) | dict(attrs or {}) | {"start_time": format_start_time(start)}
     return xr.Dataset(data_vars, coords=coords, attrs=all_attrs)
 
 
@@ -175,10 +148,11 @@ def radar_config_of(ds: xr.Dataset, source: str = "frames") -> RadarConfig:
 
 
 def open_frames(path: str | Path) -> xr.Dataset:
-    """Open a frames store (Zarr directory or NetCDF file) and check it is usable.
+    """Open a frames store (a Zarr directory) and check it is usable.
 
-    Raises :class:`InputError` naming the file when it is missing, unfinished, empty or
-    inconsistent with its own RadarConfig.
+    Raises :class:`InputError` naming the file when it is missing, not a directory, unfinished, empty
+    or inconsistent with its own RadarConfig. Stores written before absolute time (float ``time``,
+    no ``start_time``) still open; :func:`frame_times_s` reads their elapsed seconds.
     """
     path = Path(path)
     if path.name.endswith(".partial"):
@@ -190,8 +164,10 @@ def open_frames(path: str | Path) -> xr.Dataset:
         partial = path.with_name(path.name + ".partial")
         hint = f" (an unfinished run is at {partial}; rerun to resume)" if partial.exists() else ""
         raise InputError(f"{path}: no such run{hint}")
+    if not path.is_dir():  # NetCDF cannot hold complex64 iq with the engines we ship: Zarr only
+        raise InputError(f"{path}: not a frames store (a frames run is a Zarr directory)")
     try:
-        ds = _open_zarr(path) if path.is_dir() else xr.open_dataset(path)
+        ds = _open_zarr(path)
     except Exception as exc:  # noqa: BLE001 - any reader failure becomes one clear line
         raise InputError(f"{path}: cannot open as a frames store ({type(exc).__name__}: {exc})") from exc
     ds = cint16.decode(ds)  # a cint16 store reads as lazy complex64 iq like any other
@@ -205,7 +181,7 @@ def open_frames(path: str | Path) -> xr.Dataset:
     config = radar_config_of(ds, str(path))
     if ds.sizes.get("time", 0) == 0:
         raise InputError(f"{path}: empty run (0 frames)")
-    check_frame_times(ds["time"].values, path)
+    check_frame_times(frame_times_s(ds), path)
     if ds.sizes.get("rx") != config.n_rx:
         raise InputError(
             f"{path}: field 'rx' has {ds.sizes.get('rx')} antennas, radar_config has {config.n_rx}"

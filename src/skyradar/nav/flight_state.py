@@ -34,6 +34,7 @@ from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.geo import rotation_matrix
 from skyradar.io.checks import check_finite_frames, check_frame_times
+from skyradar.io.frames_model import frame_times_s
 from skyradar.nav.ahrs import AhrsModel, ahrs_attitude
 from skyradar.nav.inversion import StateFit, fit_robust, fit_thesis
 from skyradar.nav.kalman_state import KalmanSettings, filter_states
@@ -170,7 +171,7 @@ def _frame_rows(
 ) -> list[dict]:
     from skyradar.nav.terrain_aware import TerrainAwareEstimator
 
-    times = ds["time"].to_numpy().astype(float)
+    times = frame_times_s(ds)
     aware = TerrainAwareEstimator(config) if method == "terrain" else None
     rows, prior = [], None
     for i in range(times.size):
@@ -232,8 +233,8 @@ def estimate_run(
     if method not in (*METHODS, "terrain"):
         raise InputError(f"flight state: field 'method' must be thesis, robust or terrain, got {method!r}")
     config = radar_config_of(ds, source)
-    check_frame_times(ds["time"].values, source)
-    attitudes = _attitudes(ds, ds["time"].to_numpy().astype(float), ahrs, ahrs_seed)
+    check_frame_times(frame_times_s(ds), source)
+    attitudes = _attitudes(ds, frame_times_s(ds), ahrs, ahrs_seed)
     table = pd.DataFrame(_frame_rows(ds, config, method, progress, source, attitudes))
     if settings is None:
         settings = KalmanSettings(terrain_psd=400.0) if method == "terrain" else KalmanSettings()

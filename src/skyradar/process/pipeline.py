@@ -37,6 +37,7 @@ from skyradar.errors import InputError
 from skyradar.geo import ned_rotation_to, ned_to_geodetic, rotation_matrix
 from skyradar.io.checks import check_finite_frames
 from skyradar.io.frames import radar_config_of
+from skyradar.io.frames_model import frame_times_s
 from skyradar.io.run_origin import scenario_origin  # re-exported: it lived here before issue 16
 from skyradar.process.calibration import in_field_of_view
 from skyradar.process.detect import detect, integrate_channels
@@ -267,7 +268,7 @@ def process_frames(
     config = _checked_config(ds, config, spur_map, source)
     n_frames = ds.sizes["time"]
     own, origin = _own_state(ds), scenario_origin(ds)
-    times = np.asarray(ds["time"].values, float)
+    times = frame_times_s(ds)
     rows: list[dict[str, np.ndarray]] = []
     for start in range(0, n_frames, batch_frames):
         block = np.asarray(ds["iq"].isel(time=slice(start, start + batch_frames)).values)

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from skyradar.errors import InputError
+from skyradar.io.frames_model import frame_times_s
 from skyradar.scene.terrain import Bounds, Terrain, metres_per_degree
 
 __all__ = ["DemCoverageError", "footprint_bounds", "check_dem_covers", "dem_for_run"]
@@ -112,7 +113,7 @@ def dem_for_run(path: str | Path, ds: Any, range_limit_m: float, source: str) ->
     from skyradar.scene.dem_readers import read_dem
 
     lat, lon, origin = _run_track(ds, source)
-    times = np.asarray(ds["time"].values, float)
+    times = frame_times_s(ds)
     try:
         terrain = read_dem(path, bounds=footprint_bounds(lat, lon, range_limit_m + _MARGIN_M))
     except DemCoverageError as exc:

@@ -30,6 +30,7 @@ from pydantic import ValidationError
 
 from skyradar.config import Mount, RadarConfig
 from skyradar.errors import InputError
+from skyradar.io.frames_model import parse_start_time
 from skyradar.io.safe_yaml import load_yaml
 from skyradar.scene.examples import example_scenario, list_example_scenarios
 from skyradar.scene.scenario_errors import validation_error_line
@@ -86,6 +87,7 @@ class BuiltScenario:
     source: Path | None = None
     impairments: Any = None  # skyradar.scene.impairment_config.ImpairmentConfig or None
     land_cover: Any = None  # skyradar.scene.ground_map.LandCover (the ground_map section) or None
+    start_time: Any = None  # numpy datetime64[ns], UTC of t = 0 s (the start_time field), or None
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -358,4 +360,5 @@ class Scenario:
             source=self.source,
             impairments=m.impairments,
             land_cover=land_cover,
+            start_time=None if m.start_time is None else parse_start_time(m.start_time, self._label),
         )

@@ -26,6 +26,8 @@ are in the field names: metres, m/s, degrees, seconds, Hz. Positions ``*_ned_m``
     frame_rate_hz: 9.4
     duration_s: 60
     start_s: 0
+    start_time: 2026-05-01T10:00:00Z                       # optional: UTC of t = 0 s (frames' time
+                                                           #   coordinate); default 1970-01-01T00:00:00Z
     simulation: {facet_size_m: 30, reflectivity: cosine, occlusion: true, noise: true,
                  flat_earth: false, range_doppler_coupling: true, seed: 0}
     impairments: {preset: thesis_flight_look}              # optional; see sim/impairments.py
@@ -36,6 +38,7 @@ Flight parameters are those of :mod:`skyradar.scene.flights` (``straight``, ``ci
 
 from __future__ import annotations
 
+from datetime import datetime
 from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
@@ -321,5 +324,6 @@ class ScenarioModel(_Model):
     frame_rate_hz: Positive = 9.4
     duration_s: Positive
     start_s: Time = 0.0
+    start_time: datetime | str | None = None  # ISO 8601 UTC instant of t = 0 s; default 1970-01-01T00:00:00Z
     simulation: SimulationModel = Field(default_factory=SimulationModel)
     impairments: ImpairmentConfig | None = None  # e.g. {preset: thesis_flight_look}

@@ -160,11 +160,14 @@ def simulate(built, progress: Callable[[int], None] | None = None) -> xr.Dataset
 
 
 def frames_attrs(built) -> dict[str, Any]:
-    """The scenario attributes a frames dataset carries (name, origin, simulator options)."""
-    return {
+    """The scenario attributes a frames dataset carries (name, origin, simulator options, start time)."""
+    attrs = {
         "scenario": built.name,
         "origin_lat_deg": built.origin[0],
         "origin_lon_deg": built.origin[1],
         "origin_alt_m": built.origin[2],
         "sim_options": json.dumps({k: str(v) for k, v in built.sim_options.items()}),
     }
+    if getattr(built, "start_time", None) is not None:  # else frames_dataset's documented default
+        attrs["start_time"] = built.start_time
+    return attrs

@@ -10,6 +10,7 @@ import pandas as pd
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.io.checks import check_frame_times
+from skyradar.io.frames_model import frame_times_s
 from skyradar.io.tables import finite_column, read_table
 
 __all__ = [
@@ -127,7 +128,7 @@ def truth_from_frames(path: str | Path) -> tuple[Truth, RadarConfig]:
             f"{path}: no intruder truth (missing variable(s) {missing}); evaluate needs a simulated run"
         )
     truth = Truth(
-        ds["time"].values,
+        frame_times_s(ds),
         ds["tgt_range_m"].values,
         ds["tgt_radial_velocity_mps"].values,
         ds["tgt_visible"].values.astype(bool),

@@ -19,6 +19,7 @@ import pandas as pd  # noqa: E402
 
 from skyradar.io.atomic import savefig_atomic, write_text_atomic  # noqa: E402
 from skyradar.io.frames import radar_config_of  # noqa: E402
+from skyradar.io.frames_model import frame_times_s  # noqa: E402
 from skyradar.viz.rangedoppler import plot_strength  # noqa: E402
 
 __all__ = ["LEVEL_COLOURS", "plot_range_doppler", "plot_plan_view", "plot_alert_timeline", "write_report"]
@@ -121,12 +122,12 @@ def write_report(
     out_dir = Path(out_dir)
     truth, det, alerts = chain["truth"], chain["detections"], chain["alerts"]
     config = radar_config_of(truth)
-    t = float(truth["time"].values[rd_frame])
+    t = float(frame_times_s(truth)[rd_frame])
     title = f"range-Doppler, frame {rd_frame} (t = {t:.1f} s)"
     rd_det = det[det["frame"] == rd_frame]
     plot_range_doppler(chain["rd_frames"][rd_frame], config, rd_det, title, out_dir / "range_doppler.png")
     plot_plan_view(truth, chain["tracks"], labels, alerts, out_dir / "plan_view.png")
-    times = truth["time"].values
+    times = frame_times_s(truth)
     plot_alert_timeline(alerts, labels, (float(times[0]), float(times[-1])), out_dir / "alert_timeline.png")
     advice = _advice_rows(alerts)
     no_advice = "<p>no advice (no corrective or warning alert)</p>"

@@ -26,6 +26,7 @@ from skyradar.daa.run_tables import has_ownship
 from skyradar.errors import InputError
 from skyradar.io import cint16
 from skyradar.io.frames import FrameStoreWriter, open_frames, radar_config_of
+from skyradar.io.frames_model import frame_times_s
 from skyradar.io.tables import jsonable, read_table
 from skyradar.process.power import power_image
 
@@ -114,7 +115,7 @@ class RunSource:
             radar_config_of(ds, str(target))
         self.ds, self._opened = ds, target
         self.config = radar_config_of(ds, str(target))
-        self.times = np.asarray(ds["time"].values, float)
+        self.times = frame_times_s(ds)
         # Truth variables are small and written at creation: keep them in memory.
         self._own = {k: np.asarray(ds[k].values, float) for k in ds.data_vars if k.startswith("own_")}
         self._compute_alerts()

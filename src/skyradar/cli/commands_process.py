@@ -65,7 +65,7 @@ _ChunkFramesOpt = Annotated[
 
 @app.command()
 def process(
-    run: Annotated[Path, typer.Argument(help="Frames run (Zarr directory or NetCDF file).")],
+    run: Annotated[Path, typer.Argument(help="Frames run (Zarr directory).")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Detections table to write (Parquet).")],
     spur_map: _SpurMapOpt = None,
     spur_mode: _SpurModeOpt = "mask",
@@ -133,7 +133,7 @@ def _read_config(path: Path):
 @app.command()
 def calibrate(
     run: Annotated[
-        Path, typer.Argument(help="Frames run with a reflector at a known position (Zarr or NetCDF).")
+        Path, typer.Argument(help="Frames run (Zarr) with a reflector at a known position.")
     ],
     output: Annotated[Path, typer.Option("-o", "--output", help="Calibrated RadarConfig to write (JSON).")],
     range_m: Annotated[float, typer.Option("--range", callback=POSITIVE, help="Reflector range, m.")],
@@ -192,7 +192,7 @@ def calibrate(
 
 @app.command("spur-map")
 def spur_map(
-    run: Annotated[Path, typer.Argument(help="Frames of a static scene (Zarr directory or NetCDF file).")],
+    run: Annotated[Path, typer.Argument(help="Frames of a static scene (Zarr directory).")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Spur map to write (.npz).")],
     threshold: Annotated[
         float,

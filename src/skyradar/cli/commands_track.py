@@ -112,7 +112,7 @@ def track(
 @app.command()
 def evaluate(
     run: Annotated[
-        Path, typer.Argument(help="Simulated frames run (Zarr or NetCDF) holding intruder truth.")
+        Path, typer.Argument(help="Simulated frames run (Zarr) holding intruder truth.")
     ],
     tracks: Annotated[Path, typer.Argument(help="Tracks table from `skyradar track`.")],
     threshold_px: Annotated[

@@ -117,7 +117,7 @@ class Truth:
 
 
 def truth_from_frames(path: str | Path) -> tuple[Truth, RadarConfig]:
-    """Intruder truth and radar config from a simulated frames store (Zarr or NetCDF)."""
+    """Intruder truth and radar config from a simulated frames store (Zarr)."""
     from skyradar.io.frames import open_frames, radar_config_of
 
     ds = open_frames(path)

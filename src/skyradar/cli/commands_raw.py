@@ -109,9 +109,7 @@ def bench_chain(
     as_json: JsonOption = False,
     flight_frames: Annotated[
         int,
-        typer.Option(
-            hidden=True, callback=_no_flight_frames, help="Deprecated: see `bench flight`."
-        ),
+        typer.Option(hidden=True, callback=_no_flight_frames, help="Deprecated: see `bench flight`."),
     ] = 0,
 ) -> None:
     """ADC cube -> range-Doppler cube throughput against a per-channel numpy.fft loop.

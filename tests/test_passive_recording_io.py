@@ -122,7 +122,8 @@ def test_simulate_passive_cli_writes_a_readable_recording_and_refuses_bad_input(
     assert summary["samples"] == 100_000 and summary["aircraft"] == 1
     rec = read_iq_recording(tmp_path / "r.sigmf-meta")
     assert rec.n_samples == 100_000 and rec.truth_table_path is not None
-    again = skyradar("simulate-passive", "-o", "r.sigmf-meta", "--duration-s", "0.02", cwd=tmp_path)
+    # Refusals before any work: an existing output and a sample rate below the pulses' band.
+    again = skyradar("simulate-passive", "-o", "r.sigmf-meta", "--sample-rate-hz", "3e6", cwd=tmp_path)
     assert_one_line_error(again, "--overwrite")
     assert sorted(p.name for p in tmp_path.iterdir()) == [
         "r.sigmf-data", "r.sigmf-meta", "r.truth.json", "r.truth.parquet",

@@ -193,9 +193,9 @@ def test_chunked_recording_equals_one_shot_and_sigmf_round_trip(tmp_path):
 
 
 def test_simulation_memory_is_bounded_by_the_chunk(tmp_path):
-    scene = thesis_scene(duration_s=0.15)
+    scene = thesis_scene(duration_s=0.1)
     peaks = []
-    for duration in (0.03, 0.15):
+    for duration in (0.02, 0.1):
         s = dataclasses.replace(scene, duration_s=duration)
         simulate_chunk(s, FS, 0, 10)  # compile and warm caches outside the measurement
         tracemalloc.start()
@@ -206,7 +206,7 @@ def test_simulation_memory_is_bounded_by_the_chunk(tmp_path):
     assert peaks[1] < 40 * (1 << 14) * 16  # a few chunk-sized buffers
     from skyradar.io.sigmf_io import read_iq_recording
 
-    rec = read_iq_recording(tmp_path / "r0.15.sigmf-meta")
+    rec = read_iq_recording(tmp_path / "r0.1.sigmf-meta")
     tracemalloc.start()
     total = sum(float(np.abs(chunk).sum()) for _, chunk in rec.chunks(1 << 14, overlap=500))
     peak = tracemalloc.get_traced_memory()[1]

@@ -69,8 +69,9 @@ def plot_plan_view(
         ax.plot(g["east_m"], g["north_m"], "-", color=c, lw=2.5, alpha=0.7)
         ax.annotate(f"T{tid}", (g["east_m"].iloc[-1], g["north_m"].iloc[-1]), fontsize=7, color=c)
     warn = alerts[alerts["level"] >= 3]
-    ax.plot(warn["rel_east_m"] + np.interp(warn["time_s"], truth["time"], truth["own_east_m"]),
-            warn["rel_north_m"] + np.interp(warn["time_s"], truth["time"], truth["own_north_m"]),
+    t = frame_times_s(truth)
+    ax.plot(warn["rel_east_m"] + np.interp(warn["time_s"], t, truth["own_east_m"]),
+            warn["rel_north_m"] + np.interp(warn["time_s"], t, truth["own_north_m"]),
             "x", color=LEVEL_COLOURS[3], ms=6, label="track position at warning")  # fmt: skip
     ax.set_xlabel("east [m]")
     ax.set_ylabel("north [m]")

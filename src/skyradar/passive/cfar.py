@@ -3,7 +3,11 @@
 The noise level at each cell is the mean power of a box of training cells around it, leaving out a
 smaller guard box (the target's own spread). With ``n`` training cells of exponentially distributed
 noise power, the threshold ``alpha * noise`` with ``alpha = n (pfa^(-1/n) - 1)`` gives the false-alarm
-probability ``pfa`` (Richards, Fundamentals of Radar Signal Processing, eq. 6.17).
+probability ``pfa`` (Richards, Fundamentals of Radar Signal Processing, eq. 6.17). Oversampled maps
+(neighbouring cells correlated, as after a matched filter sampled faster than its bandwidth) have fewer
+independent training cells than cells: ``cells_per_independent`` divides ``n`` in the threshold, else
+the noise estimate is noisier than the design assumes and false alarms come orders of magnitude more
+often.
 """
 
 from __future__ import annotations
@@ -68,6 +72,7 @@ def ca_cfar(
     train: int | tuple[int, ...],
     pfa: float,
     mode: str | tuple[str, ...] = "reflect",
+    cells_per_independent: float = 1.0,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Detections (boolean map) and signal-to-noise ratio (linear) of a CA-CFAR.
 
@@ -81,7 +86,8 @@ def ca_cfar(
     """
     noise, n_train = ca_cfar_noise(power, guard, train, mode)
     snr = np.asarray(power, dtype=float) / np.maximum(noise, 1e-300)
-    return snr > ca_threshold_factor(n_train, pfa), snr
+    n_independent = max(1, int(n_train / max(cells_per_independent, 1.0)))
+    return snr > ca_threshold_factor(n_independent, pfa), snr
 
 
 def local_peaks(hits: np.ndarray, snr: np.ndarray, batch: bool = False) -> list[tuple[int, ...]]:

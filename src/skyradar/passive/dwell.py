@@ -33,7 +33,8 @@ class DwellSettings:
     pfa_static: float = 1e-6
     pfa_moving: float = 1e-8
     guard_lags: int = 3
-    train_lags: int = 16
+    train_lags: int = 40
+    lags_per_independent: float = 1.0
     cancel: str = "mti3"
     doppler_oversample: int = 2
     zero_doppler_guard_hz: float = 0.0
@@ -80,7 +81,10 @@ def detect_dwells(
     t_mid = times_s.mean(axis=1)
     out: list[dict] = []
     static_power = np.abs(profiles[:, :, lo:].mean(axis=1)) ** 2  # (dwells, lags)
-    hits, snr = ca_cfar(static_power, (0, s.guard_lags), (0, s.train_lags), s.pfa_static)
+    hits, snr = ca_cfar(
+        static_power, (0, s.guard_lags), (0, s.train_lags), s.pfa_static,
+        cells_per_independent=s.lags_per_independent,
+    )  # fmt: skip
     for w, k in local_peaks(hits, snr, batch=True):
         lag = lo + _refine_lag(static_power[w], k)
         out.append(_candidate("static", lag, 0.0, snr[w, k], t_mid[w]))
@@ -92,7 +96,10 @@ def detect_dwells(
     n_dop = max(4, s.doppler_oversample * n)
     doppler = (np.arange(n_dop) - n_dop // 2) * (prf_hz / n_dop)
     power = np.abs(_spectra(cancelled, t_kept, doppler)) ** 2  # (dwells, Doppler, lags)
-    hits, snr = ca_cfar(power, (0, 0, s.guard_lags), (0, 0, s.train_lags), s.pfa_moving)
+    hits, snr = ca_cfar(
+        power, (0, 0, s.guard_lags), (0, 0, s.train_lags), s.pfa_moving,
+        cells_per_independent=s.lags_per_independent,
+    )  # fmt: skip
     hits &= (np.abs(doppler) >= s.zero_doppler_guard_hz)[None, :, None]
     for w, d, k in local_peaks(hits, snr, batch=True):
         lag = lo + _refine_lag(power[w, d], k)

@@ -120,6 +120,7 @@ def _process(recording, settings: PassiveSettings | None, progress) -> PassiveRe
     dwell = replace(
         s.dwell, min_lag=max(s.dwell.min_lag, int(np.ceil(min_range / C_MPS * fs))),
         guard_lags=max(s.dwell.guard_lags, int(np.ceil(2 * fs / bandwidth))),
+        lags_per_independent=max(s.dwell.lags_per_independent, 1.5 * fs / bandwidth),  # Hann widens 1.5x
     )  # fmt: skip
     if dwell.zero_doppler_guard_hz == 0.0:
         dwell = replace(dwell, zero_doppler_guard_hz=1.5 / (n_dwell * pri))

@@ -126,10 +126,20 @@ class ProfileExtractor:
         segments = y[(peaks - _PAD)[:, None] + np.arange(self.n_fft)[None, :]]
         near = segments[:, _PAD - _FIT : _PAD + _FIT + 1]
         coef = near @ self._fit.T  # least-squares amplitude for every fractional delay
-        best = np.argmax(np.abs(coef) ** 2 * self._fit_energy[None, :], axis=1)  # largest explained energy
-        amplitude = coef[np.arange(peaks.size), best]
-        frac = self.deltas[best]
-        segments = segments - amplitude[:, None] * self.responses[best]
+        explained = np.abs(coef) ** 2 * self._fit_energy[None, :]
+        best = np.clip(np.argmax(explained, axis=1), 1, self.deltas.size - 2)
+        rows = np.arange(peaks.size)
+        # Between grid points: a parabola through the explained energies, the response interpolated
+        # quadratically (the residue then falls with the square of the grid step).
+        e0, e1, e2 = (explained[rows, best + k] for k in (-1, 0, 1))
+        den = e0 - 2 * e1 + e2
+        u = np.clip(np.where(den < 0, 0.5 * (e0 - e2) / np.where(den < 0, den, -1.0), 0.0), -0.5, 0.5)
+        r0, r1, r2 = (self.responses[best + k] for k in (-1, 0, 1))
+        response = r1 + 0.5 * u[:, None] * (r2 - r0) + 0.5 * (u**2)[:, None] * (r2 - 2 * r1 + r0)
+        fit = response[:, _PAD - _FIT : _PAD + _FIT + 1]
+        amplitude = np.sum(np.conj(fit) * near, axis=1) / np.sum(np.abs(fit) ** 2, axis=1)
+        frac = self.deltas[best] + u / _N_FRAC
+        segments = segments - amplitude[:, None] * response
         # A shift by a fraction of a sample is a linear phase across the spectrum.
         ramp = np.exp(2j * np.pi * np.outer(frac, self._k) / self.n_fft)
         profiles = np.fft.ifft(np.fft.fft(segments, axis=1) * ramp, axis=1)[:, _PAD : _PAD + self.n_lags]

@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated
 
-import numpy as np
 import typer
 
 from skyradar.cli.app import (
@@ -55,9 +54,13 @@ def parse_frames(text: str | None, n_frames: int) -> list[int]:
     return picked
 
 
-def _load_map(path: Path, ds, pixel_m: float):
-    """(map image, grid, extent to check coverage against, building height) from .osm.pbf or GeoTIFF."""
+def _load_map(path: Path, ds, pixel_m: float, covers):
+    """(map image, grid, building height) from .osm.pbf or GeoTIFF; ``covers(extent)`` checks the
+    footprints against the map before it is rendered."""
     from skyradar.errors import InputError
+    from skyradar.extras import require_extra
+
+    require_extra("geo", "skyradar gpscheck --map")
     from skyradar.nav.gpscheck.check import building_height_m, render_map
 
     origin = (ds.attrs.get("origin_lat_deg"), ds.attrs.get("origin_lon_deg"))
@@ -66,44 +69,58 @@ def _load_map(path: Path, ds, pixel_m: float):
         from skyradar.scene.osm_map import read_osm_map
 
         layers = read_osm_map(path, *origin)
+        covers(layers)
         grid = layers.grid(pixel_m, margin_m=300.0)
-        return render_map(layers, grid), grid, layers, building_height_m(layers)
+        return render_map(layers, grid), grid, building_height_m(layers)
     if name.endswith((".tif", ".tiff")):
         from skyradar.scene.map_raster import read_map_raster
 
         raster = read_map_raster(path, None, *origin)
-        return raster.image, raster.grid, raster.grid, 0.0
+        covers(raster.grid)
+        return raster.image, raster.grid, 0.0
     raise InputError(
         f"--map: {path} must be an OpenStreetMap .osm.pbf extract or a GeoTIFF (.tif), by its name"
     )
 
 
+_OffsetNorth = Annotated[
+    float, typer.Option("--gps-offset-north-m", callback=number_in(-1e4, 1e4), help="Add to GPS north, m.")
+]
+_OffsetEast = Annotated[
+    float, typer.Option("--gps-offset-east-m", callback=number_in(-1e4, 1e4), help="Add to GPS east, m.")
+]
+_OffsetHeading = Annotated[
+    float,
+    typer.Option("--gps-offset-heading-deg", callback=number_in(-180, 180), help="Add to heading, deg."),
+]
+_Buildings = Annotated[
+    float | None,
+    typer.Option(
+        "--building-height-m", callback=number_in(0.0, 500.0),
+        help="Typical building height for the layover correction (default: the OSM map's; 0 for a raster).",
+    ),
+]  # fmt: skip
+_Frames = Annotated[
+    str | None, typer.Option("--frames", help="Frames to check: START:STOP or a comma list (default all).")
+]
+_Run = Annotated[Path, typer.Argument(help="Frames run (Zarr) of a side-looking (wingtip) radar.")]
+_Map = Annotated[Path, typer.Option("--map", help="Reference map: OpenStreetMap .osm.pbf or GeoTIFF.")]
+_Method = Annotated[
+    str, typer.Option("--method", help="Pre-processing: clahe_ridge (default), clahe_entropy, ...")
+]
+
+
 @app.command()
 def gpscheck(
-    run: Annotated[
-        Path, typer.Argument(help="Frames run (Zarr or NetCDF) of a side-looking (wingtip) radar.")
-    ],
-    map_path: Annotated[
-        Path, typer.Option("--map", help="Reference map: OpenStreetMap .osm.pbf or GeoTIFF.")
-    ],
+    run: _Run,
+    map_path: _Map,
     output: Annotated[Path, typer.Option("-o", "--output", help="Per-frame check table to write (Parquet).")],
-    method: Annotated[
-        str, typer.Option("--method", help="Pre-processing: clahe_ridge (default), clahe_entropy, ...")
-    ] = "clahe_ridge",
-    frames: Annotated[
-        str | None,
-        typer.Option("--frames", help="Frames to check: START:STOP or a comma list (default all)."),
-    ] = None,
-    offset_north_m: Annotated[
-        float,
-        typer.Option("--gps-offset-north-m", callback=number_in(-1e4, 1e4), help="Add to GPS north, m."),
-    ] = 0.0,
-    offset_east_m: Annotated[
-        float, typer.Option("--gps-offset-east-m", callback=number_in(-1e4, 1e4), help="Add to GPS east, m.")
-    ] = 0.0,
-    offset_heading_deg: Annotated[
-        float, typer.Option("--gps-offset-heading-deg", callback=number_in(-180, 180), help="Add to heading.")
-    ] = 0.0,
+    method: _Method = "clahe_ridge",
+    frames: _Frames = None,
+    offset_north_m: _OffsetNorth = 0.0,
+    offset_east_m: _OffsetEast = 0.0,
+    offset_heading_deg: _OffsetHeading = 0.0,
+    building_height: _Buildings = None,
     alert_frames: Annotated[
         int, typer.Option("--alert-frames", callback=COUNT, help="Alert after this many inconsistent frames.")
     ] = 3,
@@ -121,7 +138,7 @@ def gpscheck(
     from skyradar.io.frames import open_frames, radar_config_of
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_table
-    from skyradar.nav.gpscheck.check import PIXEL_M, check_run, prepare_map, radar_side
+    from skyradar.nav.gpscheck.check import PIXEL_M, check_coverage, check_run, prepare_map, radar_side
     from skyradar.nav.gpscheck.monitor import MonitorSettings
     from skyradar.nav.gpscheck.preprocess import METHODS
 
@@ -131,37 +148,52 @@ def gpscheck(
     config = radar_config_of(ds, str(run))
     radar_side(config, str(run))  # a forward mount is refused before the map is read
     picked = parse_frames(frames, ds.sizes["time"])
-    image, grid, extent, building_m = _load_map(map_path, ds, PIXEL_M)
+    gps_offset = (offset_north_m, offset_east_m, offset_heading_deg)
+
+    def covers(extent) -> None:
+        check_coverage(ds, config, extent, frames=picked, gps_offset=gps_offset, source=str(run),
+                       map_source=str(map_path))  # fmt: skip
+
+    image, grid, building_m = _load_map(map_path, ds, PIXEL_M, covers)
+    building_m = building_m if building_height is None else building_height
     maps = prepare_map(image, [method])
     settings = MonitorSettings(alert_frames=alert_frames)
     table = check_run(
         ds, config, maps[method], grid, frames=picked, method=method, settings=settings, source=str(run),
-        gps_offset=(offset_north_m, offset_east_m, offset_heading_deg), map_extent=extent,
-        map_source=str(map_path), building_m=building_m,
+        gps_offset=gps_offset, building_m=building_m,
     )  # fmt: skip
     write_table(table, output, metadata={"radar_config": config.to_json(), "source": str(run),
                                          "map": str(map_path), "method": method})  # fmt: skip
+    result = _summary(table, output)
+    _print_summary(result, table, alert_frames)
+    emit_result(result, as_json, "gpscheck")
+
+
+def _summary(table, output: Path) -> dict:
     counts = table["verdict"].value_counts().to_dict()
     decided = table["verdict"].isin(["consistent", "inconsistent"])
     alert_rows = table[table["alert"]]
-    result = {
+    return {
         "frames": len(table),
         "consistent": counts.get("consistent", 0),
         "inconsistent": counts.get("inconsistent", 0),
         "no_decision_wing_up": counts.get("no decision: wing up", 0),
         "no_decision_structure": counts.get("no decision: too little structure", 0),
-        "median_correction_m": float(np.median(table.loc[decided, "correction_m"]))
-        if decided.any()
-        else None,
+        "median_correction_m": float(table.loc[decided, "correction_m"].median()) if decided.any() else None,
         "alert": bool(len(alert_rows)),
         "alert_frame": int(alert_rows["frame"].iloc[0]) if len(alert_rows) else None,
         "output": str(output),
     }
+
+
+def _print_summary(result: dict, table, alert_frames: int) -> None:
+    """The one-line summary, and the alert line when there is one."""
     console.print(
         f"gpscheck: {result['frames']} frames: {result['consistent']} consistent, {result['inconsistent']}"
         f" inconsistent, {result['no_decision_wing_up']} no decision (wing up),"
         f" {result['no_decision_structure']} no decision (too little structure)"
     )
+    alert_rows = table[table["alert"]]
     if len(alert_rows):
         first = alert_rows.iloc[0]
         console.print(
@@ -169,7 +201,6 @@ def gpscheck(
             f" {int(first['frame'])} (t = {first['time_s']:.1f} s): correction {first['correction_m']:.0f} m,"
             f" {first['d_heading_deg']:+.1f} deg"
         )
-    emit_result(result, as_json, "gpscheck")
 
 
 @experiment_app.command("ch6")

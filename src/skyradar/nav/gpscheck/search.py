@@ -90,6 +90,14 @@ def _parabola(m1: float, m0: float, p1: float) -> float:
     return float(np.clip(0.5 * (m1 - p1) / den, -0.5, 0.5)) if den < 0 else 0.0
 
 
+def _subpixel(surface: np.ndarray, a: int, b: int) -> tuple[float, float]:
+    """Sub-pixel peak offsets along rows and columns (0 at the surface's edge)."""
+    rows, cols = surface.shape
+    da = _parabola(surface[a - 1, b], surface[a, b], surface[a + 1, b]) if 0 < a < rows - 1 else 0.0
+    db = _parabola(surface[a, b - 1], surface[a, b], surface[a, b + 1]) if 0 < b < cols - 1 else 0.0
+    return da, db
+
+
 def _psr(surface: np.ndarray, peak: tuple[int, int], exclude_px: int) -> float:
     """Peak-to-sidelobe ratio: (peak - mean) / SD of the surface outside ``exclude_px`` of the peak."""
     rows, cols = np.ogrid[: surface.shape[0], : surface.shape[1]]
@@ -130,6 +138,15 @@ class _Searcher:
         return out
 
 
+def _fine(s: _Searcher, centre_rad: float, coarse_step_deg: float, fine_step_deg: float):
+    """Headings around the best coarse one: (headings, best surface, peak per heading, best index)."""
+    fine = centre_rad + np.radians(np.arange(-coarse_step_deg, coarse_step_deg + 1e-9, fine_step_deg))
+    f_surf = s.surfaces(fine)
+    peaks = np.array([sf.max() for sf in f_surf])
+    k = int(np.argmax(peaks))
+    return fine, f_surf[k], peaks, k
+
+
 def search_offset(
     radar: np.ndarray,
     radar_mask: np.ndarray,
@@ -148,16 +165,12 @@ def search_offset(
 
     Parameters
     ----------
-    radar, radar_mask : arrays on ``pose_grid``
-        Pre-processed radar ground image and its footprint.
-    map_world : array on ``grid``
-        Map pre-processed the same way.
+    radar, radar_mask, map_world : pre-processed radar and its footprint on ``pose_grid``; map on ``grid``.
     gps_pose : (3,) array
         ``(north_m, east_m, heading_rad)`` reported by GPS.
     margin_m, max_heading_deg : float
         Search extent: shifts up to ``margin_m`` each way, headings within ``+-max_heading_deg``.
-    map_pose_grid : PoseGrid, optional
-        Where the map is sampled (default ``pose_grid``): moved by the expected layover.
+    map_pose_grid : PoseGrid, optional; where the map is sampled (default ``pose_grid``).
 
     Examples
     --------
@@ -171,29 +184,16 @@ def search_offset(
     >>> round(off.d_north_m), round(off.d_east_m), round(off.d_heading_deg)
     (-30, 20, -4)
     """
-    radar_mask = np.asarray(radar_mask, bool) & np.isfinite(radar)
-    if radar_mask.sum() < 16:
+    if (np.asarray(radar_mask, bool) & np.isfinite(radar)).sum() < 16:
         raise InputError("search_offset: the radar footprint has fewer than 16 valid pixels")
-    s = _Searcher(radar, radar_mask, map_world, grid, pose_grid, gps_pose, margin_m, map_pose_grid)
+    s = _Searcher(radar, radar_mask & np.isfinite(radar), map_world, grid, pose_grid, gps_pose, margin_m,
+                  map_pose_grid)  # fmt: skip
     coarse = np.radians(np.arange(-max_heading_deg, max_heading_deg + 1e-9, coarse_step_deg))
     c_surf = s.surfaces(coarse)
-    best = int(np.argmax([sf.max() for sf in c_surf]))
-    fine = coarse[best] + np.radians(np.arange(-coarse_step_deg, coarse_step_deg + 1e-9, fine_step_deg))
-    f_surf = s.surfaces(fine)
-    peaks = np.array([sf.max() for sf in f_surf])
-    k = int(np.argmax(peaks))
-    surface = f_surf[k]
+    fine, surface, peaks, k = _fine(s, coarse[int(np.argmax([sf.max() for sf in c_surf]))], coarse_step_deg,
+                                    fine_step_deg)  # fmt: skip
     a, b = np.unravel_index(int(np.argmax(surface)), surface.shape)
-    da = (
-        _parabola(surface[a - 1, b], surface[a, b], surface[a + 1, b])
-        if 0 < a < surface.shape[0] - 1
-        else 0.0
-    )
-    db = (
-        _parabola(surface[a, b - 1], surface[a, b], surface[a, b + 1])
-        if 0 < b < surface.shape[1] - 1
-        else 0.0
-    )
+    da, db = _subpixel(surface, a, b)
     dk = _parabola(peaks[k - 1], peaks[k], peaks[k + 1]) if 0 < k < len(peaks) - 1 else 0.0
     d_heading = fine[k] + dk * np.radians(fine_step_deg)
     psi = s.gps[2] + d_heading

@@ -220,6 +220,24 @@ def refine_peaks(power: np.ndarray, r: np.ndarray, d: np.ndarray) -> tuple[np.nd
     return r + dr, (d + dd) % n_d
 
 
+def _shi_tomasi_blobs(power: np.ndarray, noise_power_w: float, min_snr_db: float, exclude) -> tuple:
+    """Peaks of the blobs around the Shi-Tomasi corners of the dB image that reach ``min_snr_db``."""
+    floor = np.float32(noise_power_w * 1e-3)
+    image = power if exclude is None else np.where(exclude, np.float32(noise_power_w), power)
+    corners = shi_tomasi(10.0 * np.log10(np.maximum(image, floor)))
+    corners = _snap_to_max(image, corners)
+    noise_all = np.full(len(corners), noise_power_w, np.float32)
+    strong = power[corners[:, 0], corners[:, 1]] >= noise_all * (1.0 + 10 ** (min_snr_db / 10.0))
+    seeds = np.zeros(power.shape, bool)
+    seeds[corners[strong, 0], corners[strong, 1]] = True
+    # Each strong corner stands for its whole blob (pixels above half its SNR): one object, one detection.
+    grow = power > noise_all.dtype.type(noise_power_w * (1.0 + 0.5 * 10 ** (min_snr_db / 10.0)))
+    if exclude is not None:
+        seeds &= ~exclude
+        grow &= ~exclude
+    return blob_peaks(grow | seeds, power, seeds)
+
+
 def detect(
     power: np.ndarray,
     config: RadarConfig,
@@ -261,20 +279,7 @@ def detect(
         r, d = blob_peaks(hits, power)
         noise = noise_map[r, d] if use_cfar_noise else np.full(r.size, config.noise_power_w, np.float32)
     elif method == "shi-tomasi":
-        floor = np.float32(config.noise_power_w * 1e-3)
-        image = power if exclude is None else np.where(exclude, np.float32(config.noise_power_w), power)
-        corners = shi_tomasi(10.0 * np.log10(np.maximum(image, floor)))
-        corners = _snap_to_max(image, corners)
-        noise_all = np.full(len(corners), config.noise_power_w, np.float32)
-        strong = power[corners[:, 0], corners[:, 1]] >= noise_all * (1.0 + 10 ** (min_snr_db / 10.0))
-        seeds = np.zeros(power.shape, bool)
-        seeds[corners[strong, 0], corners[strong, 1]] = True
-        # Each strong corner stands for its whole blob (pixels above half its SNR): one object, one detection.
-        grow = power > noise_all.dtype.type(config.noise_power_w * (1.0 + 0.5 * 10 ** (min_snr_db / 10.0)))
-        if exclude is not None:
-            seeds &= ~exclude
-            grow &= ~exclude
-        r, d = blob_peaks(grow | seeds, power, seeds)
+        r, d = _shi_tomasi_blobs(power, config.noise_power_w, min_snr_db, exclude)
         noise = np.full(r.size, config.noise_power_w, np.float32)
     else:
         raise InputError(f"detect: field 'method' must be 'cfar', 'os-cfar' or 'shi-tomasi', got {method!r}")

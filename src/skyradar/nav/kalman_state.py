@@ -74,6 +74,20 @@ def _transition(dt: float, s: KalmanSettings) -> tuple[np.ndarray, np.ndarray]:
     return f, qm
 
 
+def _gated_update(x, p, z, r_diag, gate: float, s: KalmanSettings, rejections: int):
+    """Kalman update with ``z`` unless it fails the chi-square gate; after ``max_rejections``
+    rejections in a row the filter restarts from ``z``. Returns x, P, accepted, rejections."""
+    innov, r_mat = z - x, np.diag(r_diag)
+    s_mat = innovation_covariance(p, _OBSERVE_ALL, r_mat)
+    d2 = float(innov @ np.linalg.solve(s_mat, innov))
+    if d2 <= gate or s.gps_gate_m is not None:  # the thesis' GPS gate replaces the chi-square gate
+        x, p = update(x, p, innov, _OBSERVE_ALL, r_mat, s_mat)
+        return x, p, True, 0
+    if rejections + 1 >= s.max_rejections:
+        return z.copy(), np.diag(r_diag), True, 0
+    return x, p, False, rejections + 1
+
+
 def filter_states(
     times_s: np.ndarray,
     measured: np.ndarray,
@@ -128,16 +142,7 @@ def filter_states(
         if usable and x is None:
             x, p, t_prev, accepted[i] = z.copy(), np.diag(r_diag), t[i], True
         elif usable:
-            innov, r_mat = z - x, np.diag(r_diag)
-            s_mat = innovation_covariance(p, _OBSERVE_ALL, r_mat)
-            d2 = float(innov @ np.linalg.solve(s_mat, innov))
-            if d2 <= gate or s.gps_gate_m is not None:
-                x, p = update(x, p, innov, _OBSERVE_ALL, r_mat, s_mat)
-                accepted[i], rejections = True, 0
-            else:
-                rejections += 1
-                if rejections >= s.max_rejections:
-                    x, p, accepted[i], rejections = z.copy(), np.diag(r_diag), True, 0
+            x, p, accepted[i], rejections = _gated_update(x, p, z, r_diag, gate, s, rejections)
         if x is not None:
             out_x[i], out_sd[i] = x, np.sqrt(np.clip(np.diag(p), 0.0, None))
     return FilterOutput(out_x, out_sd, accepted)

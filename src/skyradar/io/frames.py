@@ -61,6 +61,24 @@ COMPRESSORS = ("none", "zstd", "blosc")
 # see :mod:`skyradar.io.cint16` for the error bound).
 PRECISIONS = cint16.PRECISIONS
 
+def _add_truth(data_vars: dict, coords: dict, ownship, targets, target_names) -> None:
+    """Own-ship truth on ``time`` and intruder truth on (``time``, ``target``), with CF attributes."""
+    for name, values in (ownship or {}).items():
+        units, desc = OWNSHIP_VARS[name]
+        data_vars[name] = ("time", np.asarray(values), variable_attrs(name, units, desc))
+    if not targets:
+        return
+    for name, values in targets.items():
+        units, desc = TARGET_VARS[name]
+        data_vars[name] = (("time", "target"), np.asarray(values), variable_attrs(name, units, desc))
+    n_targets = np.asarray(next(iter(targets.values()))).shape[1]
+    coords["target"] = (
+        "target",
+        np.array(target_names or [f"T{i}" for i in range(n_targets)], dtype=object),
+        {"long_name": "intruder name"},
+    )
+
+
 def frames_dataset(
     iq: Any,
     times_s: np.ndarray,
@@ -109,23 +127,11 @@ def frames_dataset(
     data_vars: dict[str, Any] = {
         "iq": (("time", "range", "doppler", "rx"), iq, {"units": "W^0.5", "long_name": IQ_LONG_NAME}),
     }
-    for name, values in (ownship or {}).items():
-        units, desc = OWNSHIP_VARS[name]
-        data_vars[name] = ("time", np.asarray(values), variable_attrs(name, units, desc))
     if start_time is None:
         start_time = (attrs or {}).get("start_time")
     start = parse_start_time(DEFAULT_START_TIME if start_time is None else start_time, "frames")
     coords = axis_coordinates(config, times_s, start)
-    if targets:
-        for name, values in targets.items():
-            units, desc = TARGET_VARS[name]
-            data_vars[name] = (("time", "target"), np.asarray(values), variable_attrs(name, units, desc))
-        n_targets = np.asarray(next(iter(targets.values()))).shape[1]
-        coords["target"] = (
-            "target",
-            np.array(target_names or [f"T{i}" for i in range(n_targets)], dtype=object),
-            {"long_name": "intruder name"},
-        )
+    _add_truth(data_vars, coords, ownship, targets, target_names)
     all_attrs = {"Conventions": "CF-1.10", "radar_config": config.to_json(), "skyradar_format": "frames/2"}
     all_attrs |= radar_attrs(config) | dict(attrs or {}) | {"start_time": format_start_time(start)}
     return xr.Dataset(data_vars, coords=coords, attrs=all_attrs)

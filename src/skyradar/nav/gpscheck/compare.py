@@ -44,6 +44,24 @@ def _box(s, i, j, h):
     return s[i + h + 1, j + h + 1] - s[i - h, j + h + 1] - s[i + h + 1, j - h] + s[i - h, j - h]
 
 
+@njit(cache=True)
+def _integrals(x, y, sy, syy, sxy):
+    """Summed-area tables of y, y*y and x*y in one pass (no temporaries: this runs once per pose)."""
+    rows, cols = x.shape
+    for i in range(rows):
+        ay = 0.0
+        ayy = 0.0
+        axy = 0.0
+        for j in range(cols):
+            v = np.float64(y[i, j])
+            ay += v
+            ayy += v * v
+            axy += x[i, j] * v
+            sy[i + 1, j + 1] = sy[i, j + 1] + ay
+            syy[i + 1, j + 1] = syy[i, j + 1] + ayy
+            sxy[i + 1, j + 1] = sxy[i, j + 1] + axy
+
+
 @njit(cache=True, parallel=True)
 def _ssim_kernel(x, centres, candidates, half, c1, c2, out):
     npix = (2 * half + 1) ** 2
@@ -56,9 +74,12 @@ def _ssim_kernel(x, centres, candidates, half, c1, c2, out):
         i, j = centres[c, 0], centres[c, 1]
         ux[c] = _box(sx, i, j, half) / npix
         vx[c] = cov_norm * (_box(sxx, i, j, half) / npix - ux[c] * ux[c])
+    rows, cols = x.shape
     for k in prange(candidates.shape[0]):
-        y = candidates[k].astype(np.float64)
-        sy, syy, sxy = _integral(y), _integral(y * y), _integral(x * y)
+        sy = np.zeros((rows + 1, cols + 1))
+        syy = np.zeros((rows + 1, cols + 1))
+        sxy = np.zeros((rows + 1, cols + 1))
+        _integrals(x, candidates[k], sy, syy, sxy)
         total = 0.0
         for c in range(n_c):
             i, j = centres[c, 0], centres[c, 1]

@@ -139,4 +139,4 @@ def test_gpscheck_end_to_end_consistent_then_spoofed(town_run, tmp_path):
     # The correction undoes the spoof: about 80 m back west.
     assert np.all(np.abs(table["d_east_m"] + 80.0) < 15.0), table.to_string()
     assert table["alert"].tolist() == [False, True]
-    assert "ALERT: GPS inconsistent" in spoofed.stderr
+    assert "ALERT at frame 1 (t = 1.0 s): GPS inconsistent with the radar" in spoofed.stderr

@@ -191,15 +191,17 @@ def _print_summary(result: dict, table, alert_frames: int) -> None:
     console.print(
         f"gpscheck: {result['frames']} frames: {result['consistent']} consistent, {result['inconsistent']}"
         f" inconsistent, {result['no_decision_wing_up']} no decision (wing up),"
-        f" {result['no_decision_structure']} no decision (too little structure)"
+        f" {result['no_decision_structure']} no decision (too little structure)",
+        soft_wrap=True,  # one line whatever the terminal width
     )
     alert_rows = table[table["alert"]]
     if len(alert_rows):
         first = alert_rows.iloc[0]
         console.print(
-            f"ALERT: GPS inconsistent with the radar for {alert_frames} decided frames in a row from frame"
-            f" {int(first['frame'])} (t = {first['time_s']:.1f} s): correction {first['correction_m']:.0f} m,"
-            f" {first['d_heading_deg']:+.1f} deg"
+            f"ALERT at frame {int(first['frame'])} (t = {first['time_s']:.1f} s): GPS inconsistent with the"
+            f" radar for {alert_frames} decided frames in a row; correction {first['correction_m']:.0f} m,"
+            f" {first['d_heading_deg']:+.1f} deg",
+            soft_wrap=True,
         )
 
 

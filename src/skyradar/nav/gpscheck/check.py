@@ -214,6 +214,7 @@ def check_coverage(
     pixel_m: float = PIXEL_M,
     source: str = "run",
     map_source: str | None = None,
+    min_ground_fraction: float = DEFAULT_SETTINGS.min_ground_fraction,
 ) -> None:
     """One-line error naming the map when a frame's ground footprint at the GPS pose is off the map.
 
@@ -228,6 +229,8 @@ def check_coverage(
     offset = np.array([gps_offset[0], gps_offset[1], np.radians(gps_offset[2])])
     for i in range(ds.sizes["time"]) if frames is None else frames:
         gps, attitude, velocity, height = _state(ds, i)
+        if ground_in_view_fraction(config, attitude, height) < min_ground_fraction:
+            continue  # a wing-up frame is "no decision" wherever its sliver of ground falls
         seen = np.isfinite(ground_image(ones, config, pose_grid, attitude, velocity, height))
         if seen.any():
             north, east = pose_grid.world_points(*(gps + offset))

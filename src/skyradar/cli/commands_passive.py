@@ -125,12 +125,21 @@ def experiment_ch7(
     as_json: JsonOption = False,
 ) -> None:
     """ch7: passive radar with an ATC radar as illuminator: test pulse, thesis geometry, 9 sweeps."""
+    from skyradar.cli.commands_sim import frame_progress
     from skyradar.experiments.ch7 import run as run_ch7
     from skyradar.io.outputs import check_output, mark_folder
 
     check_output(out, (), overwrite, kind="folder", option="--out")
     mark_folder(out)
-    result = run_ch7(out, seconds=seconds, seed=seed)
+    with frame_progress(1, "ch7: samples") as bar:
+        tasks: dict[str, int] = {}
+
+        def progress(stage: str, done: int, total: int) -> None:
+            if stage not in tasks:
+                tasks[stage] = bar.add_task(stage, total=total)
+            bar.update(tasks[stage], completed=done)
+
+        result = run_ch7(out, seconds=seconds, seed=seed, progress=progress)
     emit_result(result, as_json, "ch7: passive bistatic radar")
 
 

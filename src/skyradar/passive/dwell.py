@@ -52,7 +52,9 @@ def _refine_lag(power_row: np.ndarray, k: int) -> float:
 def detect_dwell(
     profiles: np.ndarray, times_s: np.ndarray, prf_hz: float, settings: DwellSettings
 ) -> list[dict]:
-    """Candidates (channel, lag, doppler_hz, snr_db, time_s) in one dwell's profile matrix.
+    """Candidates (channel, lag, doppler_hz, snr_db, time_s, power_db) in one dwell's profile matrix.
+
+    ``snr_db`` is against the CFAR's local noise estimate, ``power_db`` the cell's power (filter units).
 
     Examples
     --------
@@ -87,7 +89,7 @@ def detect_dwells(
     )  # fmt: skip
     for w, k in local_peaks(hits, snr, batch=True):
         lag = lo + _refine_lag(static_power[w], k)
-        out.append(_candidate("static", lag, 0.0, snr[w, k], t_mid[w]))
+        out.append(_candidate("static", lag, 0.0, snr[w, k], t_mid[w], static_power[w, k]))
 
     n_cut = {"mti2": 1, "mti3": 2, "mti4": 3}.get(s.cancel, 0)
     n = profiles.shape[1] - n_cut
@@ -103,7 +105,7 @@ def detect_dwells(
     hits &= (np.abs(doppler) >= s.zero_doppler_guard_hz)[None, :, None]
     for w, d, k in local_peaks(hits, snr, batch=True):
         lag = lo + _refine_lag(power[w, d], k)
-        out.append(_candidate("moving", lag, float(doppler[d]), snr[w, d, k], t_mid[w]))
+        out.append(_candidate("moving", lag, float(doppler[d]), snr[w, d, k], t_mid[w], power[w, d, k]))
     return out
 
 
@@ -126,11 +128,6 @@ def _spectra(profiles: np.ndarray, times_s: np.ndarray, doppler_hz: np.ndarray) 
     return np.matmul(steer, profiles.astype(np.complex128))
 
 
-def _candidate(channel: str, lag: float, doppler_hz: float, snr: float, t: float) -> dict:
-    return {
-        "channel": channel,
-        "lag": lag,
-        "doppler_hz": doppler_hz,
-        "snr_db": 10 * np.log10(snr),
-        "time_s": t,
-    }
+def _candidate(channel: str, lag: float, doppler_hz: float, snr: float, t: float, power: float) -> dict:
+    return {"channel": channel, "lag": lag, "doppler_hz": doppler_hz, "snr_db": 10 * np.log10(snr),
+            "time_s": t, "power_db": 10 * np.log10(power + 1e-300)}  # fmt: skip

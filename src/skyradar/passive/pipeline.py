@@ -48,7 +48,7 @@ class PassiveSettings:
     hop_fraction: float = 0.25
     blind_half_width_deg: float = 4.0
     min_bistatic_range_m: float | None = None
-    sidelobe_margin_db: float = 10.0
+    sidelobe_margin_db: float = 15.0
     dwell: DwellSettings = field(default_factory=DwellSettings)
 
 
@@ -68,6 +68,15 @@ def _geometry(recording) -> tuple[np.ndarray, float]:
     ned = geodetic_to_ned(*recording.illuminator_geodetic, *rx)
     tx_en = np.array([ned[1], ned[0]])
     return tx_en, float(np.mod(np.arctan2(-tx_en[0], -tx_en[1]), 2 * np.pi))
+
+
+def _pulse_models(ill: Illuminator, settings: PassiveSettings) -> dict:
+    """The long pulse's formula (sampled at fractional delays) and the short pulse's delay and width."""
+    lp, sp = ill.long_pulse, ill.short_pulse
+    out: dict = {"companion": (sp.delay_s - lp.delay_s, sp.width_s)}
+    if settings.pulse == "metadata":
+        out["pulse_at"] = lambda t: lfm_baseband(t, lp.width_s, lp.bandwidth_hz, lp.offset_hz)
+    return out
 
 
 def _template(recording, ill: Illuminator, settings: PassiveSettings) -> np.ndarray:
@@ -110,7 +119,9 @@ def _process(recording, settings: PassiveSettings | None, progress) -> PassiveRe
     tx_en, bearing = _geometry(recording)
     template = _template(recording, ill, s)
     n_lags = int(np.ceil(s.max_bistatic_range_m / C_MPS * fs)) + 1
-    extractor = ProfileExtractor(template, fs, n_lags, min(ill.pri_s), window=s.window)
+    extractor = ProfileExtractor(
+        template, fs, n_lags, min(ill.pri_s), window=s.window, **_pulse_models(ill, s)
+    )
     pri = ill.mean_pri_s
     n_dwell = dwell_pulses(np.radians(ill.beamwidth_az_deg), ill.rotation_rate_rad_s, pri)
     hop = max(1, int(round(n_dwell * s.hop_fraction)))
@@ -154,12 +165,14 @@ def _process(recording, settings: PassiveSettings | None, progress) -> PassiveRe
     scan = scan_phase(
         times_all, np.concatenate(amps), ill.rotation_period_s, bearing, 1, source=str(recording.path),
     )  # fmt: skip
-    table = pd.DataFrame(candidates, columns=["channel", "lag", "doppler_hz", "snr_db", "time_s"])
+    table = pd.DataFrame(candidates, columns=["channel", "lag", "doppler_hz", "snr_db", "time_s", "power_db"])
     table["bistatic_range_m"] = table["lag"] * C_MPS / fs
     table["azimuth_rad"] = scan.azimuth_rad(table["time_s"].to_numpy())
     merged = merge_candidates(table, C_MPS / bandwidth, 1.5 * n_dwell * pri, 2.0 / (n_dwell * pri))
     merged["sweep"] = scan.sweep(merged["time_s"].to_numpy()) if len(merged) else []
-    merged = drop_sidelobes(merged, 1.5 * C_MPS / bandwidth, 2.0 / (n_dwell * pri), s.sidelobe_margin_db)
+    merged = drop_sidelobes(
+        merged, 1.5 * C_MPS / bandwidth, 2.0 / (n_dwell * pri), s.sidelobe_margin_db, n_dwell * pri
+    )
     blind = in_blind_zone(
         merged["bistatic_range_m"].to_numpy(), merged["azimuth_rad"].to_numpy(), bearing, min_range,
         np.radians(s.blind_half_width_deg),
@@ -206,9 +219,10 @@ def merge_candidates(
 ) -> pd.DataFrame:
     """One detection per target from the candidates of overlapping dwells.
 
-    Strongest first, each candidate absorbs the unassigned ones of its channel within the range,
-    time and (moving channel) Doppler tolerances; the azimuth is the SNR-weighted circular mean of the
-    group, everything else the strongest candidate's.
+    Strongest (``power_db``, else ``snr_db``) first, each candidate absorbs the unassigned ones of its
+    channel within the range, time and (moving channel) Doppler tolerances; the azimuth is the
+    power-weighted circular mean of the group (the power follows the beam's pattern across the
+    overlapping dwells), everything else the strongest candidate's.
 
     Examples
     --------
@@ -221,11 +235,12 @@ def merge_candidates(
     """
     if table.empty:
         return table.assign(azimuth_rad=pd.Series(dtype=float))
-    t = table.sort_values("snr_db", ascending=False).reset_index(drop=True)
+    key = "power_db" if "power_db" in table else "snr_db"
+    t = table.sort_values(key, ascending=False).reset_index(drop=True)
     free = np.ones(len(t), bool)
     rows = []
     rng, tim, dop = (t[c].to_numpy() for c in ("bistatic_range_m", "time_s", "doppler_hz"))
-    chan, az, w = t["channel"].to_numpy(), t["azimuth_rad"].to_numpy(), 10 ** (t["snr_db"].to_numpy() / 10)
+    chan, az, w = t["channel"].to_numpy(), t["azimuth_rad"].to_numpy(), 10 ** (t[key].to_numpy() / 10)
     for i in range(len(t)):
         if not free[i]:
             continue
@@ -245,30 +260,33 @@ def merge_candidates(
 
 
 def drop_sidelobes(
-    table: pd.DataFrame, range_tol_m: float, doppler_tol_hz: float, margin_db: float
+    table: pd.DataFrame, range_tol_m: float, doppler_tol_hz: float, margin_db: float, time_tol_s: float = 0.0
 ) -> pd.DataFrame:
-    """Drop detections seen through the illuminator's sidelobes.
+    """Drop detections seen through the illuminator's sidelobes or the Doppler taper's sidelobes.
 
-    A reflector near the receiver is lit by the sidelobes at every beam azimuth; each such look would be
-    placed on the ellipse in the wrong direction. Within one sweep and channel, a detection at least
-    ``margin_db`` weaker than another at the same bistatic range (and Doppler, moving channel) is such a
-    look and is dropped: the main beam's is the strongest.
+    A strong reflector is lit by the sidelobes at every beam azimuth; each such look would be placed on
+    the ellipse in the wrong direction. Within one sweep and channel, a detection at least ``margin_db``
+    weaker (``power_db``, else ``snr_db``) than another at the same bistatic range and Doppler is such a
+    look and is dropped (the main beam's is the strongest); so is one at the same range within
+    ``time_tol_s`` of a stronger one at another Doppler (the Doppler sidelobes of the same echo).
 
     Examples
     --------
-    >>> t = pd.DataFrame({"sweep": [0, 0, 0, 1], "channel": "moving", "doppler_hz": 100.0,
+    >>> t = pd.DataFrame({"sweep": [0, 0, 0, 1], "channel": "moving", "doppler_hz": 100.0, "time_s": 1.0,
     ...                   "bistatic_range_m": [2600.0, 2610.0, 9000.0, 2600.0], "snr_db": [40.0, 15, 15, 15]})
     >>> drop_sidelobes(t, 300.0, 50.0, 10.0).index.tolist()
     [0, 2, 3]
     """
     if table.empty:
         return table
+    key = "power_db" if "power_db" in table else "snr_db"
     keep = np.ones(len(table), bool)
     for _, group in table.groupby(["sweep", "channel"]):
-        rng, dop, snr = (group[c].to_numpy() for c in ("bistatic_range_m", "doppler_hz", "snr_db"))
-        same = (np.abs(rng[:, None] - rng[None, :]) <= range_tol_m) & (
-            np.abs(dop[:, None] - dop[None, :]) <= doppler_tol_hz
+        rng, dop, snr, tim = (group[c].to_numpy() for c in ("bistatic_range_m", "doppler_hz", key, "time_s"))
+        same_range = np.abs(rng[:, None] - rng[None, :]) <= range_tol_m
+        same = (np.abs(dop[:, None] - dop[None, :]) <= doppler_tol_hz) | (
+            np.abs(tim[:, None] - tim[None, :]) <= time_tol_s
         )
-        louder = same & (snr[None, :] >= snr[:, None] + margin_db)
+        louder = same_range & same & (snr[None, :] >= snr[:, None] + margin_db)
         keep[table.index.get_indexer(group.index)] = ~louder.any(axis=1)
     return table[keep]

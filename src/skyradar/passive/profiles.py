@@ -16,6 +16,7 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.signal.windows import hann
 
 from skyradar.passive.matched_filter import filter_taps, matched_filter
 from skyradar.passive.pulses import find_direct_pulses
@@ -68,6 +69,7 @@ class ProfileExtractor:
         window: str | None = "hann",
         threshold_db: float = 30.0,
         pulse_at: Callable[[np.ndarray], np.ndarray] | None = None,
+        companion: tuple[float, float] | None = None,
     ) -> None:
         self.pulse = np.asarray(pulse, np.complex128)
         self.fs = float(sample_rate_hz)
@@ -83,22 +85,49 @@ class ProfileExtractor:
         fit = self.responses[:, _PAD - _FIT : _PAD + _FIT + 1]
         self._fit_energy = np.sum(np.abs(fit) ** 2, axis=1)
         self._fit = np.conj(fit) / self._fit_energy[:, None]
+        # The other pulse of the PRI (an ATC radar's short pulse, at a known delay after the long one)
+        # leaks through the filter: its direct path is blanked, i.e. its few raw samples' contribution
+        # to the filter output is subtracted (the filter is linear). Echoes lose those microseconds only.
+        self.blank = None
+        if companion is not None:
+            delay, width = companion
+            first = int(np.floor(delay * self.fs)) - 2
+            self.blank = (first, int(np.ceil(width * self.fs)) + 5)
+        taps_len = self.pulse.size
+        self._n_corr = 1 << int(np.ceil(np.log2(self.n_fft + 2 * taps_len)))
+        q = self.pulse * (hann(taps_len, sym=False)[::-1] if window == "hann" else 1.0)  # h reversed
+        self._q_spec = np.conj(np.fft.fft(q, self._n_corr))
 
-    def _responses(self, pulse_at: Callable[[np.ndarray], np.ndarray] | None) -> np.ndarray:
+    def _responses(
+        self, pulse_at: Callable[[np.ndarray], np.ndarray] | None, extra: int | None = None
+    ) -> np.ndarray:
         """Filter output (lags -_PAD .. n_fft - _PAD) for the pulse delayed by each grid fraction."""
         n = self.pulse.size
+        m = n + 1
         out = np.empty((self.deltas.size, self.n_fft), np.complex128)
         spectrum = np.fft.fft(self.pulse, 2 * n)
         freq = np.fft.fftfreq(2 * n)
         for i, delta in enumerate(self.deltas):
             if pulse_at is not None:
-                shifted = np.asarray(pulse_at((np.arange(n + 1) - delta) / self.fs), np.complex128)
+                shifted = np.asarray(pulse_at((np.arange(m) - delta) / self.fs), np.complex128)
             else:
-                shifted = np.fft.ifft(spectrum * np.exp(-2j * np.pi * freq * delta))[: n + 1]
-            x = np.zeros(_PAD + n + self.n_fft, np.complex128)
-            x[_PAD : _PAD + n + 1] = shifted
+                shifted = np.fft.ifft(spectrum * np.exp(-2j * np.pi * freq * delta))[:m]
+            x = np.zeros(_PAD + n + self.n_fft + m, np.complex128)
+            x[_PAD : _PAD + m] = shifted
             out[i] = matched_filter(x, self.pulse, self.window, align="start")[: self.n_fft]
         return out
+
+    def _blanked(self, x: np.ndarray, peaks: np.ndarray) -> np.ndarray:
+        """Filter output (segment lags) of just the companion pulse's raw samples, per pulse."""
+        first, width = self.blank
+        at = peaks[:, None] + first + np.arange(width)[None, :]
+        ok = (at >= 0) & (at < x.size)
+        snippet = np.where(ok, x[np.clip(at, 0, x.size - 1)], 0)
+        block = np.zeros((peaks.size, self._n_corr), np.complex128)
+        offset = first + _PAD  # the snippet's first sample, counted from the segment's first lag
+        block[:, offset : offset + width] = snippet
+        corr = np.fft.ifft(np.fft.fft(block, axis=1) * self._q_spec[None, :], axis=1)
+        return corr[:, : self.n_fft]
 
     @property
     def overlap(self) -> int:
@@ -124,6 +153,8 @@ class ProfileExtractor:
             empty = np.zeros((0, self.n_lags), np.complex64)
             return PulseProfiles(np.zeros(0), np.zeros(0, np.complex128), empty)
         segments = y[(peaks - _PAD)[:, None] + np.arange(self.n_fft)[None, :]]
+        if self.blank is not None:
+            segments = segments - self._blanked(x, peaks)
         near = segments[:, _PAD - _FIT : _PAD + _FIT + 1]
         coef = near @ self._fit.T  # least-squares amplitude for every fractional delay
         explained = np.abs(coef) ** 2 * self._fit_energy[None, :]

@@ -151,7 +151,8 @@ def _score_frame(
 def _roc(search: pd.DataFrame) -> tuple[pd.DataFrame, dict[str, Any]]:
     """Detection rate per spoof case against the false-alarm rate of the unspoofed frames."""
     null = search[(search["case"] == "0 m") & search["decided"]]["statistic"].to_numpy()
-    thresholds = np.unique(np.concatenate([[0.0, DEFAULT_SETTINGS.max_position_m], null, null + 1e-9]))
+    every = search[search["decided"]]["statistic"].to_numpy()
+    thresholds = np.unique(np.concatenate([[0.0, 1.0], every, every + 1e-9]))
     rows = []
     for thr in thresholds:
         row = {"threshold": thr, "false_alarm": float(np.mean(null > thr)) if null.size else float("nan")}

@@ -130,8 +130,10 @@ def plot_roc(path: Path, roc: pd.DataFrame) -> Path:
     """Detection rate against false-alarm rate, one curve per spoof case."""
     fig, ax = plt.subplots(figsize=(6, 5))
     for case in [c for c in roc.columns if c not in ("threshold", "false_alarm")]:
-        order = np.argsort(roc["false_alarm"].to_numpy(), kind="stable")
-        ax.step(roc["false_alarm"].to_numpy()[order], roc[case].to_numpy()[order], where="post", label=case)
+        # Both rates fall as the threshold rises: walking the thresholds down traces the curve.
+        order = np.argsort(roc["threshold"].to_numpy())[::-1]
+        ax.plot(roc["false_alarm"].to_numpy()[order], roc[case].to_numpy()[order], drawstyle="steps-post",
+                label=case)  # fmt: skip
     ax.axvline(0.05, color="grey", ls=":")
     ax.set_xlabel("false-alarm rate (unspoofed frames)")
     ax.set_ylabel("detection rate (decided frames)")

@@ -1,4 +1,3 @@
-"""Own-ship navigation from radar: flight state (height and velocity) over the terrain.
-
-The GPS check against a map (seed-brief.md ch6) is not built.
+"""Own-ship navigation from radar: flight state (height and velocity) over the terrain (ch5), and the
+GPS integrity check of a side-looking radar against a map (ch6, :mod:`skyradar.nav.gpscheck`).
 """

@@ -67,9 +67,10 @@ format: $(STAMP_DEV)
 	$(BIN)/ruff format src tests
 	$(BIN)/ruff check --fix src tests
 
-# Every per-frame stage's benchmark; each prints its JSON as the last line.
+# Every per-frame stage's benchmark and the whole-flight one (flight: no longer inside chain); each prints
+# its JSON as the last line.
 bench: $(STAMP_RUN)
-	@for name in sim chain process track state; do $(BIN)/skyradar bench $$name --json || exit 1; done
+	@for name in sim chain flight process track state; do $(BIN)/skyradar bench $$name --json || exit 1; done
 
 clean:
 	rm -rf $(VENV) $(OUT) build *.egg-info src/*.egg-info

@@ -54,7 +54,7 @@ def parse_frames(text: str | None, n_frames: int) -> list[int]:
     return picked
 
 
-def _load_map(path: Path, ds, pixel_m: float, covers):
+def _load_map(path: Path, ds, pixel_m: float, covers, run: Path):
     """(map image, grid, building height) from .osm.pbf or GeoTIFF; ``covers(extent)`` checks the
     footprints against the map before it is rendered."""
     from skyradar.errors import InputError
@@ -64,6 +64,8 @@ def _load_map(path: Path, ds, pixel_m: float, covers):
     from skyradar.nav.gpscheck.check import building_height_m, render_map
 
     origin = (ds.attrs.get("origin_lat_deg"), ds.attrs.get("origin_lon_deg"))
+    if None in origin:  # own_north_m/own_east_m mean nothing on a map without the frame's origin
+        raise InputError(f"{run}: no origin_lat_deg/origin_lon_deg attributes to put the run on the map")
     name = path.name.lower()
     if name.endswith(".pbf"):
         from skyradar.scene.osm_map import read_osm_map
@@ -154,7 +156,7 @@ def gpscheck(
         check_coverage(ds, config, extent, frames=picked, gps_offset=gps_offset, source=str(run),
                        map_source=str(map_path))  # fmt: skip
 
-    image, grid, building_m = _load_map(map_path, ds, PIXEL_M, covers)
+    image, grid, building_m = _load_map(map_path, ds, PIXEL_M, covers, run)
     building_m = building_m if building_height is None else building_height
     maps = prepare_map(image, [method])
     settings = MonitorSettings(alert_frames=alert_frames)

@@ -46,8 +46,8 @@ from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.parallel import check_workers
 from skyradar.track.io import Truth
-from skyradar.track.kalman import wrap
 from skyradar.track.metrics import track_metrics, truth_segments
+from skyradar.track.simulated_detections import synthetic_detections
 from skyradar.track.track_table import OWNSHIP_COLUMNS, track_detections
 from skyradar.track.types import TrackerConfig
 
@@ -203,34 +203,18 @@ def _detect_full(truth: dict, config: RadarConfig, seed: int) -> pd.DataFrame:
 def _detect_geometry(truth: dict, config: RadarConfig, seed: int, clutter_per_frame: float) -> pd.DataFrame:
     """Detections from truth, mimicking the full chain's measured behaviour: Pd from SNR (logistic,
     50 % at 6.7 dB, 0.8 dB scale), range noise 4.4 m, Doppler noise 0.093 m/s, aliasing, range-Doppler
-    coupling, DoA with 0.04 rad error, and uniform clutter."""
-    rng = np.random.default_rng(seed)
-    t = truth["time_s"]
+    coupling, DoA with 0.04 rad error, and uniform clutter beyond 100 m (SNR column: 12 dB)."""
     snr = np.nan_to_num(truth["snr_db"], nan=-99.0)
-    pd_ = 1.0 / (1.0 + np.exp(-(snr - 6.7) / 0.8))
-    hit = truth["front"] & (rng.random(snr.shape) < pd_) & (truth["range_m"] < config.range_limit_m)
-    fi, ti = np.nonzero(hit)
-    r = truth["range_m"][fi, ti]
-    v = truth["radial_velocity_mps"][fi, ti]
-    # Range as the sawtooth chirp shows it (coupling), quantisation-like noise, aliased Doppler.
-    range_m = r + config.range_doppler_coupling_s * v + rng.normal(0, 4.4, fi.size)
-    vel_m = wrap(v + rng.normal(0, 0.093, fi.size), 2 * config.v_lim_mps)
-    ned = truth["pos"][fi, ti] + rng.normal(0, 1, (fi.size, 3)) * (r * 0.04)[:, None]
-    det = pd.DataFrame({"time_s": t[fi], "frame": fi, "range_m": range_m, "radial_velocity_mps": vel_m,
-                        "snr_db": snr[fi, ti], "north_m": ned[:, 0], "east_m": ned[:, 1],
-                        "down_m": ned[:, 2]})  # fmt: skip
-    nc = rng.poisson(clutter_per_frame, t.size)
-    cf = np.repeat(np.arange(t.size), nc)
-    clutter = pd.DataFrame({
-        "time_s": t[cf], "frame": cf, "range_m": rng.uniform(100.0, config.range_limit_m, cf.size),
-        "radial_velocity_mps": rng.uniform(-config.v_lim_mps, config.v_lim_mps, cf.size), "snr_db": 12.0,
-        "north_m": np.nan, "east_m": np.nan, "down_m": np.nan,
-    })  # fmt: skip
-    return (
-        pd.concat([det, clutter], ignore_index=True)
-        .sort_values(["time_s", "range_m"], kind="stable")
-        .reset_index(drop=True)
-    )
+    det = synthetic_detections(
+        truth["time_s"], truth["range_m"], truth["radial_velocity_mps"],
+        visible=truth["front"] & (truth["range_m"] < config.range_limit_m), config=config,
+        sigma_range_m=4.4, sigma_velocity_mps=0.093, pd_detect=1.0 / (1.0 + np.exp(-(snr - 6.7) / 0.8)),
+        clutter_per_frame=clutter_per_frame, positions_ned_m=truth["pos"], sigma_angle_rad=0.04, seed=seed,
+        clutter_min_range_m=100.0,
+    )  # fmt: skip
+    target = det["target"].to_numpy()
+    det["snr_db"] = np.where(target >= 0, snr[det["frame"].to_numpy(), np.maximum(target, 0)], 12.0)
+    return det
 
 
 def run_scenario(

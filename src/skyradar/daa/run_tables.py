@@ -11,6 +11,7 @@ import xarray as xr
 
 from skyradar.daa.tables import OPTIONAL_OWNSHIP_COLUMNS, OWNSHIP_COLUMNS, TRACK_COLUMNS
 from skyradar.errors import InputError
+from skyradar.io.frames_model import frame_times_s
 
 __all__ = ["has_ownship", "ownship_from_frames", "truth_tracks"]
 
@@ -31,7 +32,7 @@ def ownship_from_frames(ds: xr.Dataset, source: str = "frames") -> pd.DataFrame:
     missing = [c for c in OWNSHIP_COLUMNS[1:] if c not in ds]
     if missing:
         raise InputError(f"{source}: no own-ship state (missing variable(s) {missing})")
-    cols = {"time_s": np.asarray(ds["time"].values, float)}
+    cols = {"time_s": frame_times_s(ds)}
     for name in OWNSHIP_COLUMNS[1:] + [c for c in OPTIONAL_OWNSHIP_COLUMNS if c in ds]:
         cols[name] = np.asarray(ds[name].values, float)
     return pd.DataFrame(cols)
@@ -48,7 +49,7 @@ def truth_tracks(ds: xr.Dataset, visible_only: bool = True) -> pd.DataFrame:
     names = ["north_m", "east_m", "down_m", "vn_mps", "ve_mps", "vd_mps"]
     if "tgt_north_m" not in ds:
         return pd.DataFrame({c: pd.Series(dtype=float) for c in TRACK_COLUMNS})
-    t = np.asarray(ds["time"].values, float)
+    t = frame_times_s(ds)
     n_t, n_tgt = ds["tgt_north_m"].shape
     cols = {"time_s": np.repeat(t, n_tgt), "track_id": np.tile(np.arange(n_tgt), n_t)}
     for c in names:

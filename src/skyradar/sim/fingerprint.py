@@ -70,6 +70,7 @@ def fingerprint(built) -> str:
         "source": source_text,
         "files": {str(p): _file_digest(p) for p in referenced_files(built)},
         "version": __version__,
-        "format": "frames/1",
+        "format": "frames/2",  # frames/2: UTC datetime time + time_s, CF and radar_* attributes
+        "start_time": str(getattr(built, "start_time", None)),
     }
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]

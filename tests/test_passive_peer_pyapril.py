@@ -44,7 +44,7 @@ def _dwell():
 
 def _ours(pulse, starts, surv) -> float:
     ex = ProfileExtractor(pulse, FS, 96, 0.9e-3, window=None)
-    out = ex.process(0, np.concatenate([np.zeros(8, complex), surv]), surv.size)
+    out = ex.process(0, np.concatenate([np.zeros(ex.front, complex), surv]), surv.size)
     assert np.allclose(out.times_s * FS, starts, atol=0.01)
     cancelled = cancel_static(out.profiles, "eca", order=0)
     spec = doppler_spectrum(cancelled, out.times_s, np.array([DOPPLER]), taper=None)

@@ -149,7 +149,7 @@ def test_profiles_remove_the_direct_path_and_keep_a_weak_echo_at_fractional_dela
     for t0 in t0s:
         x += pulse_at(n_samples / fs - t0) + 1e-3 * pulse_at(n_samples / fs - t0 - echo_delay)
     ex = ProfileExtractor(pulse_at(np.arange(n) / fs), fs, 128, 0.9e-3, pulse_at=pulse_at)
-    out = ex.process(0, np.concatenate([np.zeros(8, complex), x]), x.size)
+    out = ex.process(0, np.concatenate([np.zeros(ex.front, complex), x]), x.size)
     assert out.profiles.shape[0] == 10
     np.testing.assert_allclose(out.times_s, t0s, atol=1 / fs / 50)
     peak = np.abs(out.profiles).max(axis=0)

@@ -87,7 +87,10 @@ def detect_dwells(
         static_power, (0, s.guard_lags), (0, s.train_lags), s.pfa_static,
         cells_per_independent=s.lags_per_independent,
     )  # fmt: skip
+    last = static_power.shape[1] - 1
     for w, k in local_peaks(hits, snr, batch=True):
+        if k in (0, last):
+            continue  # the group rises towards the blind lags (or beyond the last): its peak lies there
         lag = lo + _refine_lag(static_power[w], k)
         out.append(_candidate("static", lag, 0.0, snr[w, k], t_mid[w], static_power[w, k]))
 
@@ -103,9 +106,14 @@ def detect_dwells(
         cells_per_independent=s.lags_per_independent,
     )  # fmt: skip
     hits &= (np.abs(doppler) >= s.zero_doppler_guard_hz)[None, :, None]
+    static_sum = static_power * profiles.shape[1] ** 2  # the zero-Doppler sum, on the moving power's scale
     for w, d, k in local_peaks(hits, snr, batch=True):
+        if k in (0, last):
+            continue
         lag = lo + _refine_lag(power[w, d], k)
-        out.append(_candidate("moving", lag, float(doppler[d]), snr[w, d, k], t_mid[w], power[w, d, k]))
+        cand = _candidate("moving", lag, float(doppler[d]), snr[w, d, k], t_mid[w], power[w, d, k])
+        cand["static_db"] = 10 * np.log10(static_sum[w, k] + 1e-300)
+        out.append(cand)
     return out
 
 

@@ -49,6 +49,7 @@ class PassiveSettings:
     blind_half_width_deg: float = 4.0
     min_bistatic_range_m: float | None = None
     sidelobe_margin_db: float = 15.0
+    max_clutter_to_signal_db: float = 20.0
     dwell: DwellSettings = field(default_factory=DwellSettings)
 
 
@@ -126,7 +127,7 @@ def _process(recording, settings: PassiveSettings | None, progress) -> PassiveRe
     n_dwell = dwell_pulses(np.radians(ill.beamwidth_az_deg), ill.rotation_rate_rad_s, pri)
     hop = max(1, int(round(n_dwell * s.hop_fraction)))
     bandwidth = max(ill.long_pulse.bandwidth_hz, 1.0 / ill.long_pulse.width_s)
-    min_range = s.min_bistatic_range_m if s.min_bistatic_range_m is not None else 2.0 * C_MPS / bandwidth
+    min_range = s.min_bistatic_range_m if s.min_bistatic_range_m is not None else 3.0 * C_MPS / bandwidth
     # The guard covers the Hann-weighted compressed pulse (about 2 fs/B lags each side).
     dwell = replace(
         s.dwell, min_lag=max(s.dwell.min_lag, int(np.ceil(min_range / C_MPS * fs))),
@@ -141,7 +142,7 @@ def _process(recording, settings: PassiveSettings | None, progress) -> PassiveRe
     buf_t: list[np.ndarray] = []
     n_dwells = 0
     for start, chunk, out in _profiles_ahead(
-        extractor, read_chunks(recording, s.chunk_samples, extractor.overlap)
+        extractor, read_chunks(recording, s.chunk_samples, extractor.overlap, extractor.front)
     ):
         times.append(out.times_s)
         amps.append(np.abs(out.amplitude).astype(np.float32))
@@ -165,14 +166,21 @@ def _process(recording, settings: PassiveSettings | None, progress) -> PassiveRe
     scan = scan_phase(
         times_all, np.concatenate(amps), ill.rotation_period_s, bearing, 1, source=str(recording.path),
     )  # fmt: skip
-    table = pd.DataFrame(candidates, columns=["channel", "lag", "doppler_hz", "snr_db", "time_s", "power_db"])
+    cols = ["channel", "lag", "doppler_hz", "snr_db", "time_s", "power_db", "static_db"]
+    table = pd.DataFrame(candidates, columns=cols)
+    # Next to zero Doppler, a weak moving detection beside a much stronger static return at the same
+    # lag is that return's cancellation residue (the beam's sweep modulates it), not a mover.
+    near_zero = table["doppler_hz"].abs() < 2.0 / (n_dwell * pri)
+    residue = near_zero & (table["static_db"] - table["power_db"] > s.max_clutter_to_signal_db)
+    table = table[~residue].reset_index(drop=True)
     table["bistatic_range_m"] = table["lag"] * C_MPS / fs
     table["azimuth_rad"] = scan.azimuth_rad(table["time_s"].to_numpy())
     merged = merge_candidates(table, C_MPS / bandwidth, 1.5 * n_dwell * pri, 2.0 / (n_dwell * pri))
     merged["sweep"] = scan.sweep(merged["time_s"].to_numpy()) if len(merged) else []
     merged = drop_sidelobes(
-        merged, 1.5 * C_MPS / bandwidth, 2.0 / (n_dwell * pri), s.sidelobe_margin_db, n_dwell * pri
-    )
+        merged, 1.5 * C_MPS / bandwidth, 2.0 / (n_dwell * pri), s.sidelobe_margin_db, n_dwell * pri,
+        scan.period_s,
+    )  # fmt: skip
     blind = in_blind_zone(
         merged["bistatic_range_m"].to_numpy(), merged["azimuth_rad"].to_numpy(), bearing, min_range,
         np.radians(s.blind_half_width_deg),
@@ -260,33 +268,40 @@ def merge_candidates(
 
 
 def drop_sidelobes(
-    table: pd.DataFrame, range_tol_m: float, doppler_tol_hz: float, margin_db: float, time_tol_s: float = 0.0
+    table: pd.DataFrame,
+    range_tol_m: float,
+    doppler_tol_hz: float,
+    margin_db: float,
+    time_tol_s: float = 0.0,
+    period_s: float = np.inf,
 ) -> pd.DataFrame:
     """Drop detections seen through the illuminator's sidelobes or the Doppler taper's sidelobes.
 
     A strong reflector is lit by the sidelobes at every beam azimuth; each such look would be placed on
     the ellipse in the wrong direction. Within one sweep and channel, a detection at least ``margin_db``
     weaker (``power_db``, else ``snr_db``) than another at the same bistatic range and Doppler is such a
-    look and is dropped (the main beam's is the strongest); so is one at the same range within
+    look and is dropped (the main beam's is the strongest), compared within one rotation ``period_s``
+    either way (so the first and last partial sweeps are judged too); so is one at the same range within
     ``time_tol_s`` of a stronger one at another Doppler (the Doppler sidelobes of the same echo).
 
     Examples
     --------
-    >>> t = pd.DataFrame({"sweep": [0, 0, 0, 1], "channel": "moving", "doppler_hz": 100.0, "time_s": 1.0,
+    >>> t = pd.DataFrame({"channel": "moving", "doppler_hz": 100.0, "time_s": [1.0, 2.0, 2.0, 9.0],
     ...                   "bistatic_range_m": [2600.0, 2610.0, 9000.0, 2600.0], "snr_db": [40.0, 15, 15, 15]})
-    >>> drop_sidelobes(t, 300.0, 50.0, 10.0).index.tolist()
+    >>> drop_sidelobes(t, 300.0, 50.0, 10.0, period_s=4.4).index.tolist()
     [0, 2, 3]
     """
     if table.empty:
         return table
     key = "power_db" if "power_db" in table else "snr_db"
     keep = np.ones(len(table), bool)
-    for _, group in table.groupby(["sweep", "channel"]):
-        rng, dop, snr, tim = (group[c].to_numpy() for c in ("bistatic_range_m", "doppler_hz", key, "time_s"))
+    for _, group in table.groupby("channel"):
+        rng, dop, pwr, tim = (group[c].to_numpy() for c in ("bistatic_range_m", "doppler_hz", key, "time_s"))
         same_range = np.abs(rng[:, None] - rng[None, :]) <= range_tol_m
-        same = (np.abs(dop[:, None] - dop[None, :]) <= doppler_tol_hz) | (
-            np.abs(tim[:, None] - tim[None, :]) <= time_tol_s
+        dt = np.abs(tim[:, None] - tim[None, :])
+        same = ((np.abs(dop[:, None] - dop[None, :]) <= doppler_tol_hz) & (dt <= period_s)) | (
+            dt <= time_tol_s
         )
-        louder = same_range & same & (snr[None, :] >= snr[:, None] + margin_db)
+        louder = same_range & same & (pwr[None, :] >= pwr[:, None] + margin_db)
         keep[table.index.get_indexer(group.index)] = ~louder.any(axis=1)
     return table[keep]

@@ -54,7 +54,7 @@ class ProfileExtractor:
     ...     x[start : start + 100] += pulse
     ...     x[start + 40 : start + 140] += 0.01 * pulse     # an echo 40 samples later
     >>> ex = ProfileExtractor(pulse, fs, n_lags=64, min_pri_s=8e-4, threshold=1.0)
-    >>> out = ex.process(0, x)
+    >>> out = ex.process(0, np.concatenate([np.zeros(ex.front), x]), x.size)  # x from sample -front
     >>> out.profiles.shape, int(np.argmax(abs(out.profiles[0])))
     ((10, 64), 40)
     """
@@ -130,16 +130,22 @@ class ProfileExtractor:
         return corr[:, : self.n_fft]
 
     @property
+    def front(self) -> int:
+        """Samples before each chunk given to :meth:`process` (a PRI's worth and the pulse)."""
+        return self.min_separation + self.pulse.size + _PAD
+
+    @property
     def overlap(self) -> int:
         """Samples after each chunk the filter and the last pulse's profile need."""
         return self.n_fft + self.pulse.size
 
     def process(self, start: int, x: np.ndarray, chunk: int | None = None) -> PulseProfiles:
-        """Profiles of the pulses whose direct path arrives in ``x[_PAD : _PAD + chunk]``.
+        """Profiles of the pulses whose direct path arrives in ``x[front : front + chunk]``.
 
-        ``x`` holds the recording from sample ``start - _PAD`` (zeros before sample 0) and at least
-        ``overlap`` samples beyond the chunk (fewer at the recording's end: pulses too close to the
-        end are dropped).
+        ``x`` holds the recording from sample ``start - front`` (zeros before sample 0; ``front`` is
+        :attr:`front`) and at least ``overlap`` samples beyond the chunk (fewer at the recording's end:
+        pulses too close to the end are dropped). The front lets the pulse finder see the previous
+        direct path, so a chunk never starts with that pulse's tail taken for a pulse.
         """
         chunk = x.size if chunk is None else int(chunk)
         y = matched_filter(x, self.pulse, self.window, align="start")
@@ -148,7 +154,8 @@ class ProfileExtractor:
         if threshold is None:
             threshold = float(np.median(mag)) * 10 ** (self.threshold_db / 20)
         peaks = find_direct_pulses(mag, self.min_separation, threshold)
-        peaks = peaks[(peaks >= _PAD) & (peaks < _PAD + chunk) & (peaks - _PAD + self.n_fft <= y.size)]
+        f = self.front
+        peaks = peaks[(peaks >= f) & (peaks < f + chunk) & (peaks - _PAD + self.n_fft <= y.size)]
         if peaks.size == 0:
             empty = np.zeros((0, self.n_lags), np.complex64)
             return PulseProfiles(np.zeros(0), np.zeros(0, np.complex128), empty)
@@ -175,7 +182,7 @@ class ProfileExtractor:
         ramp = np.exp(2j * np.pi * np.outer(frac, self._k) / self.n_fft)
         profiles = np.fft.ifft(np.fft.fft(segments, axis=1) * ramp, axis=1)[:, _PAD : _PAD + self.n_lags]
         profiles *= (np.conj(amplitude) / np.maximum(np.abs(amplitude), 1e-30))[:, None]
-        times = (start - _PAD + peaks + frac) / self.fs
+        times = (start - f + peaks + frac) / self.fs
         return PulseProfiles(times, amplitude, profiles.astype(np.complex64))
 
     def stream(self, chunks: Iterable[tuple[int, np.ndarray, int]]) -> Iterator[PulseProfiles]:
@@ -188,12 +195,14 @@ class ProfileExtractor:
         return filter_taps(self.pulse, self.window)
 
 
-def read_chunks(recording, chunk_samples: int, overlap: int) -> Iterator[tuple[int, np.ndarray, int]]:
-    """``(start, samples from start - _PAD, chunk length)`` over a recording with ``read(start, count)``."""
+def read_chunks(
+    recording, chunk_samples: int, overlap: int, front: int
+) -> Iterator[tuple[int, np.ndarray, int]]:
+    """``(start, samples from start - front, chunk length)`` over a recording with ``read(start, count)``."""
     n = int(recording.n_samples)
     for start in range(0, n, chunk_samples):
-        lo = start - _PAD
-        x = recording.read(max(lo, 0), chunk_samples + overlap + min(lo, 0) + _PAD)
+        lo = start - front
+        x = recording.read(max(lo, 0), chunk_samples + overlap + min(lo, 0) + front)
         if lo < 0:
             x = np.concatenate([np.zeros(-lo, x.dtype), x])
         yield start, x, min(chunk_samples, n - start)

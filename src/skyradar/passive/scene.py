@@ -328,7 +328,7 @@ def thesis_scene(duration_s: float = 40.0, seed: int = 0, aircraft: bool = True)
         building_cluster(name, bearing, dist, rng)
         for name, bearing, dist in [
             ("cluster N 14.5 km", 20.0, 14_500.0),
-            ("cluster E 15.5 km", 75.0, 15_500.0),
+            ("cluster E 15.5 km", 100.0, 15_500.0),  # 17 deg off the radar-to-receiver look
             ("cluster SE 17 km", 130.0, 17_000.0),
             ("cluster S 18.5 km", 170.0, 18_500.0),
             ("cluster NW 19.5 km", 320.0, 19_500.0),

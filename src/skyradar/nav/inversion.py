@@ -341,6 +341,12 @@ def fit_robust(
     x0 = np.clip(x0, [1e-3, -np.inf, 1.0], [np.inf, np.inf, 0.999 * h_max])
     args = (rg, vg, sigma_v_mps, sigma_r_m, pri)
     bounds = ([1e-3, -np.inf, 1.0], [np.inf, np.inf, h_max])
+    x_fit, jac_fit = _huber_fit(x0, bounds, f_scale, args)
+    return _robust_result(x_fit, jac_fit, args, good, f_scale)
+
+
+def _huber_fit(x0: np.ndarray, bounds, f_scale: float, args: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """Huber-loss minimum and Jacobian of the ridge residuals within ``bounds``."""
     # The same Huber minimum as scipy's least_squares, without its per-iteration overhead (most of
     # a frame's time); scipy when the reweighted Gauss-Newton does not converge.
     fast = huber_least_squares(_residuals, _jacobian, x0, *map(np.array, bounds), f_scale, args)
@@ -350,18 +356,27 @@ def fit_robust(
             bounds=bounds,
         )  # fmt: skip
         fast = sol.x, sol.jac
-    x_fit, jac_fit = fast
+    return fast
+
+
+def _robust_result(x_fit, jac_fit, args: tuple, good: np.ndarray, f_scale: float) -> StateFit:
+    """The fit with its inliers (normalised residual below 3 f_scale) and residual-scaled SDs.
+
+    ``args`` are the residual arguments (finite ranges, velocities, noise SDs, prior); ``good``
+    marks those pairs among all the input pairs.
+    """
+    rg, vg, sigma_v_mps, sigma_r_m, _ = args
     vx, vz, h = (float(x) for x in x_fit)
     res = _residuals(x_fit, rg, vg, sigma_v_mps, sigma_r_m)
     inl = np.abs(res) < 3.0 * f_scale
     if inl.sum() < 4 or not (vx > 0 and h > 0):
-        return StateFit.failed(r.size)
+        return StateFit.failed(good.size)
     jac = jac_fit[: rg.size][inl]
     # Scale the covariance by the observed residual spread (at least the assumed noise).
     s2 = max(float(np.mean(res[inl] ** 2)), 1.0)
     cov = np.linalg.pinv(jac.T @ jac) * s2
     sds = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    keep = np.zeros(r.size, bool)
+    keep = np.zeros(good.size, bool)
     keep[np.flatnonzero(good)[inl]] = True
     rms = float(np.sqrt(np.mean((vg[inl] - ridge_velocity(rg[inl], vx, vz, h)) ** 2)))
     return StateFit(vx, vz, h, float(sds[0]), float(sds[1]), float(sds[2]), keep, rms)

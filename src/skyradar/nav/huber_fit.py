@@ -45,6 +45,22 @@ def _robust_jacobian(jac: np.ndarray, f: np.ndarray, f_scale: float) -> np.ndarr
     return jac * np.sqrt(scale)[:, None]
 
 
+def _halving_step(fun, args: tuple, x, step, lower, upper, cost: float, f_scale: float):
+    """``x + t step`` (clipped to the bounds) with ``t`` halved from 1 until the cost does not rise.
+
+    The reweighted Gauss-Newton step is a descent direction, so a small enough ``t`` always works;
+    below 1e-12 the last trial is returned. Returns the point, its residuals and its cost.
+    """
+    t = 1.0
+    while True:
+        x_new = np.clip(x + t * step, lower, upper)
+        f_new = fun(x_new, *args)
+        cost_new = huber_cost(f_new, f_scale)
+        if cost_new <= cost or t < 1e-12:
+            return x_new, f_new, cost_new
+        t *= 0.5
+
+
 def huber_least_squares(
     fun: Callable[..., np.ndarray],
     jac: Callable[..., np.ndarray],
@@ -94,14 +110,7 @@ def huber_least_squares(
             step[free] = np.linalg.solve(normal, -grad[free])
         except np.linalg.LinAlgError:
             return None
-        t = 1.0
-        while True:  # halve until the cost does not rise (the reweighted step is a descent direction)
-            x_new = np.clip(x + t * step, lower, upper)
-            f_new = fun(x_new, *args)
-            cost_new = huber_cost(f_new, f_scale)
-            if cost_new <= cost or t < 1e-12:
-                break
-            t *= 0.5
+        x_new, f_new, cost_new = _halving_step(fun, args, x, step, lower, upper, cost, f_scale)
         done = np.all(np.abs(x_new - x) <= xtol * np.maximum(np.abs(x), 1.0))
         x, f, cost = x_new, f_new, min(cost, cost_new)
         if done:

@@ -57,7 +57,7 @@ def _measure(recording, chunk: int) -> dict[str, float]:
     }
 
 
-def run(seconds: float = 4.0, workdir: Path | None = None) -> dict[str, Any]:
+def run(seconds: float = 3.0, workdir: Path | None = None) -> dict[str, Any]:
     """Simulate, then time and measure the processing of ``seconds`` and ``2 * seconds`` of recording."""
     from skyradar.io.sigmf_io import read_iq_recording
     from skyradar.passive.scene import thesis_scene

@@ -74,16 +74,19 @@ def passive(
     )
     with _progress(rec.n_samples) as update:
         result = process_recording(rec, settings, progress=update)
-    det = result.detections
     meta = {"source": str(recording), "pulse": pulse, "scan_period_s": result.scan_period_s}
-    write_table(det, output, metadata=meta)
-    summary = {
+    write_table(result.detections, output, metadata=meta)
+    emit_result(_summary(result, output), as_json, "passive detections")
+
+
+def _summary(result, output: Path) -> dict:
+    det = result.detections
+    return {
         "pulses": result.n_pulses, "dwells": result.n_dwells, "sweeps": int(det["sweep"].nunique()),
         "detections": len(det), "moving": int((det["channel"] == "moving").sum()),
         "static": int((det["channel"] == "static").sum()), "blind_zone_dropped": result.masked,
         "scan_period_s": result.scan_period_s, "output": str(output),
     }  # fmt: skip
-    emit_result(summary, as_json, "passive detections")
 
 
 def _recording_files(path: Path, sigmf_paths) -> list[Path]:
@@ -147,7 +150,7 @@ def experiment_ch7(
 def bench_passive(
     seconds: Annotated[
         float, typer.Option("--seconds", callback=POSITIVE, help="Length of the shorter test recording, s.")
-    ] = 4.0,
+    ] = 3.0,
     as_json: JsonOption = False,
 ) -> None:
     """Passive processing speed (real-time factor at 5 MS/s) and memory for two recording lengths."""

@@ -44,6 +44,33 @@ def _near(det: pd.DataFrame, pts: pd.DataFrame, radius_m: float, time_tol_s: flo
     return close
 
 
+def _aircraft(det: pd.DataFrame, plane: pd.DataFrame, aircraft_m: float, time_tol_s: float, rot):
+    """Position errors of the aircraft's beam passes that were seen, and the rotations they fall in."""
+    errors, seen_rot = [], set()
+    for _, row in plane.iterrows():
+        cand = det[np.abs(det["time_s"] - row["time_s"]) <= time_tol_s]
+        if cand.empty:
+            continue
+        dist = np.hypot(cand["east_m"] - row["east_m"], cand["north_m"] - row["north_m"])
+        if dist.min() <= aircraft_m:
+            errors.append(float(round(dist.min(), 1)))
+            seen_rot.add(int(rot(row["time_s"])))
+    return errors, seen_rot
+
+
+def _explained(det, truth, plane, range_tol_m, az_tol_deg, aircraft_m, time_tol_s, match_m):
+    """Detections explained by a reflector: by resolution cell, and by a ``match_m`` position match."""
+    static_truth = truth[truth["kind"] != "aircraft"]
+    explained = (
+        _in_cell(det, static_truth, range_tol_m, az_tol_deg).any(axis=1) if len(det) else np.zeros(0, bool)
+    )
+    strict = _near(det, static_truth, match_m, None).any(axis=1) if len(det) else np.zeros(0, bool)
+    if len(det) and len(plane):
+        by_plane = _near(det, plane, aircraft_m, time_tol_s).any(axis=1)
+        explained, strict = explained | by_plane, strict | by_plane
+    return explained, strict
+
+
 def score(
     det: pd.DataFrame,
     truth: pd.DataFrame,
@@ -84,23 +111,10 @@ def score(
                 seen[rot(pts["time_s"].iloc[j])] = 1
         clusters[str(name)] = seen.tolist()
     plane = truth[truth["kind"] == "aircraft"].reset_index(drop=True)
-    errors, seen_rot = [], set()
-    for _, row in plane.iterrows():
-        cand = det[np.abs(det["time_s"] - row["time_s"]) <= time_tol_s]
-        if cand.empty:
-            continue
-        dist = np.hypot(cand["east_m"] - row["east_m"], cand["north_m"] - row["north_m"])
-        if dist.min() <= aircraft_m:
-            errors.append(float(round(dist.min(), 1)))
-            seen_rot.add(int(rot(row["time_s"])))
-    static_truth = truth[truth["kind"] != "aircraft"]
-    explained = (
-        _in_cell(det, static_truth, range_tol_m, az_tol_deg).any(axis=1) if len(det) else np.zeros(0, bool)
+    errors, seen_rot = _aircraft(det, plane, aircraft_m, time_tol_s, rot)
+    explained, strict = _explained(
+        det, truth, plane, range_tol_m, az_tol_deg, aircraft_m, time_tol_s, match_m
     )
-    strict = _near(det, static_truth, match_m, None).any(axis=1) if len(det) else np.zeros(0, bool)
-    if len(det) and len(plane):
-        by_plane = _near(det, plane, aircraft_m, time_tol_s).any(axis=1)
-        explained, strict = explained | by_plane, strict | by_plane
     false_rot = np.bincount(rot(det["time_s"][~explained]), minlength=n_rot) if len(det) else np.zeros(n_rot)
     return {
         "rotations": n_rot,

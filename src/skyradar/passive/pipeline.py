@@ -46,9 +46,10 @@ class PassiveSettings:
     window: str | None = "hann"
     chunk_samples: int = 1 << 20
     hop_fraction: float = 0.25
-    blind_half_width_deg: float = 4.0
+    blind_half_width_deg: float = 2.5
     min_bistatic_range_m: float | None = None
     sidelobe_margin_db: float = 15.0
+    merge_time_dwells: float = 1.5
     max_clutter_to_signal_db: float = 20.0
     dwell: DwellSettings = field(default_factory=DwellSettings)
 
@@ -137,27 +138,9 @@ def _process(recording, settings: PassiveSettings | None, progress) -> PassiveRe
     if dwell.zero_doppler_guard_hz == 0.0:
         dwell = replace(dwell, zero_doppler_guard_hz=1.5 / (n_dwell * pri))
 
-    times, amps, candidates = [], [], []
-    buf_p: list[np.ndarray] = []
-    buf_t: list[np.ndarray] = []
-    n_dwells = 0
-    for start, chunk, out in _profiles_ahead(
-        extractor, read_chunks(recording, s.chunk_samples, extractor.overlap, extractor.front)
-    ):
-        times.append(out.times_s)
-        amps.append(np.abs(out.amplitude).astype(np.float32))
-        buf_p.append(out.profiles)
-        buf_t.append(out.times_s)
-        prof, tim = np.concatenate(buf_p), np.concatenate(buf_t)
-        starts = np.arange(0, tim.size - n_dwell + 1, hop)
-        if starts.size:
-            idx = starts[:, None] + np.arange(n_dwell)[None, :]
-            candidates += detect_dwells(prof[idx], tim[idx], 1.0 / pri, dwell)
-            n_dwells += starts.size
-        i = int(starts[-1] + hop) if starts.size else 0
-        buf_p, buf_t = [prof[i:]], [tim[i:]]
-        if progress is not None:
-            progress(start + chunk, recording.n_samples)
+    times, amps, candidates, n_dwells = _stream(
+        recording, s, extractor, n_dwell, hop, 1.0 / pri, dwell, progress
+    )
     times_all = np.concatenate(times) if times else np.zeros(0)
     if times_all.size == 0:
         raise InputError(
@@ -175,7 +158,9 @@ def _process(recording, settings: PassiveSettings | None, progress) -> PassiveRe
     table = table[~residue].reset_index(drop=True)
     table["bistatic_range_m"] = table["lag"] * C_MPS / fs
     table["azimuth_rad"] = scan.azimuth_rad(table["time_s"].to_numpy())
-    merged = merge_candidates(table, C_MPS / bandwidth, 1.5 * n_dwell * pri, 2.0 / (n_dwell * pri))
+    merged = merge_candidates(
+        table, C_MPS / bandwidth, s.merge_time_dwells * n_dwell * pri, 2.0 / (n_dwell * pri)
+    )
     merged["sweep"] = scan.sweep(merged["time_s"].to_numpy()) if len(merged) else []
     merged = drop_sidelobes(
         merged, 1.5 * C_MPS / bandwidth, 2.0 / (n_dwell * pri), s.sidelobe_margin_db, n_dwell * pri,
@@ -189,6 +174,32 @@ def _process(recording, settings: PassiveSettings | None, progress) -> PassiveRe
     det = _positions(merged, tx_en, scan)
     n_pulses, n_masked = int(times_all.size), int(blind.sum())
     return PassiveResult(det, n_pulses, n_dwells, scan.period_s, scan.crossings_s, n_masked, s.pulse)
+
+
+def _stream(recording, s: PassiveSettings, extractor, n_dwell: int, hop: int, prf: float, dwell, progress):
+    """Chunks -> pulse profiles -> dwells (every ``hop`` pulses) -> candidates; pulse times, amplitudes."""
+    times, amps, candidates = [], [], []
+    buf_p: list[np.ndarray] = []
+    buf_t: list[np.ndarray] = []
+    n_dwells = 0
+    for start, chunk, out in _profiles_ahead(
+        extractor, read_chunks(recording, s.chunk_samples, extractor.overlap, extractor.front)
+    ):
+        times.append(out.times_s)
+        amps.append(np.abs(out.amplitude).astype(np.float32))
+        buf_p.append(out.profiles)
+        buf_t.append(out.times_s)
+        prof, tim = np.concatenate(buf_p), np.concatenate(buf_t)
+        starts = np.arange(0, tim.size - n_dwell + 1, hop)
+        if starts.size:
+            idx = starts[:, None] + np.arange(n_dwell)[None, :]
+            candidates += detect_dwells(prof[idx], tim[idx], prf, dwell)
+            n_dwells += starts.size
+        i = int(starts[-1] + hop) if starts.size else 0
+        buf_p, buf_t = [prof[i:]], [tim[i:]]
+        if progress is not None:
+            progress(start + chunk, recording.n_samples)
+    return times, amps, candidates, n_dwells
 
 
 def _profiles_ahead(extractor: ProfileExtractor, chunks):

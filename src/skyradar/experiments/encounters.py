@@ -42,8 +42,8 @@ from skyradar.experiments.encounter_set import (
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.frames_model import frame_times_s
 from skyradar.io.tables import write_json_atomic, write_table
-from skyradar.scene.scenario import Scenario
 from skyradar.parallel import check_workers
+from skyradar.scene.scenario import Scenario
 
 __all__ = ["run_encounter", "run_encounters", "run", "MAX_ENCOUNTERS"]
 

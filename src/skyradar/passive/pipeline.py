@@ -48,7 +48,8 @@ class PassiveSettings:
     hop_fraction: float = 0.25
     blind_half_width_deg: float = 2.5
     min_bistatic_range_m: float | None = None
-    sidelobe_margin_db: float = 15.0
+    sidelobe_margin_db: float = 15.0  # moving channel: a mover's main looks vary more from sweep to sweep
+    static_sidelobe_margin_db: float = 10.0
     merge_time_dwells: float = 1.5
     max_clutter_to_signal_db: float = 20.0
     dwell: DwellSettings = field(default_factory=DwellSettings)
@@ -162,10 +163,12 @@ def _process(recording, settings: PassiveSettings | None, progress) -> PassiveRe
         table, C_MPS / bandwidth, s.merge_time_dwells * n_dwell * pri, 2.0 / (n_dwell * pri)
     )
     merged["sweep"] = scan.sweep(merged["time_s"].to_numpy()) if len(merged) else []
-    merged = drop_sidelobes(
-        merged, 1.5 * C_MPS / bandwidth, 2.0 / (n_dwell * pri), s.sidelobe_margin_db, n_dwell * pri,
-        scan.period_s,
-    )  # fmt: skip
+    tols = (1.5 * C_MPS / bandwidth, 2.0 / (n_dwell * pri))
+    is_static = merged["channel"] == "static" if len(merged) else pd.Series(dtype=bool)
+    merged = pd.concat([
+        drop_sidelobes(merged[is_static], *tols, s.static_sidelobe_margin_db, n_dwell * pri, scan.period_s),
+        drop_sidelobes(merged[~is_static], *tols, s.sidelobe_margin_db, n_dwell * pri, scan.period_s),
+    ])  # fmt: skip
     blind = in_blind_zone(
         merged["bistatic_range_m"].to_numpy(), merged["azimuth_rad"].to_numpy(), bearing, min_range,
         np.radians(s.blind_half_width_deg),

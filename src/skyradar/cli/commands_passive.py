@@ -124,6 +124,10 @@ def experiment_ch7(
         float, typer.Option("--seconds", callback=POSITIVE, help="Recording length (thesis: 40 s, 9 sweeps).")
     ] = 40.0,
     seed: Annotated[int, typer.Option("--seed", callback=NON_NEGATIVE, help="Random seed of the scene.")] = 0,
+    keep_recording: Annotated[
+        bool,
+        typer.Option("--keep-recording", help="Keep the simulated recording (1.6 GB for 40 s) in --out."),
+    ] = False,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -142,7 +146,7 @@ def experiment_ch7(
                 tasks[stage] = bar.add_task(stage, total=total)
             bar.update(tasks[stage], completed=done)
 
-        result = run_ch7(out, seconds=seconds, seed=seed, progress=progress)
+        result = run_ch7(out, seconds=seconds, seed=seed, progress=progress, keep_recording=keep_recording)
     emit_result(result, as_json, "ch7: passive bistatic radar")
 
 

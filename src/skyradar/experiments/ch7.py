@@ -9,7 +9,8 @@
    (:mod:`skyradar.experiments.ch7_score`).
 
 Writes ``ch7_testpulse.png``, ``ch7_sweeps.png``, ``ch7_aircraft.png``, ``ch7_table.csv`` (thesis
-beside ours), ``ch7_detections.parquet`` and ``ch7.json`` into ``out_dir``.
+beside ours), ``ch7_detections.parquet`` and ``ch7.json`` into ``out_dir`` (and, with
+``keep_recording``, the SigMF recording and its truth tables).
 """
 
 from __future__ import annotations
@@ -45,8 +46,28 @@ def _simulate(out_dir: Path, seconds: float, seed: int, progress) -> Path:
     )
 
 
-def run(out_dir: Path, seconds: float = 40.0, seed: int = 0, progress=None) -> dict[str, Any]:
-    """Run ch7; ``progress(stage, done, total)`` is called while simulating and processing."""
+def run(
+    out_dir: Path, seconds: float = 40.0, seed: int = 0, progress=None, keep_recording: bool = False
+) -> dict[str, Any]:
+    """Run ch7; ``progress(stage, done, total)`` is called while simulating and processing.
+
+    The recording (1.6 GB for 40 s) is simulated into a temporary folder inside ``out_dir`` and
+    deleted at the end unless ``keep_recording`` (then it and its truth tables move into ``out_dir``).
+    """
+    import shutil
+    import tempfile
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=out_dir, prefix=".ch7-recording-") as tmp:
+        result = _run(out_dir, Path(tmp), seconds, seed, progress)
+        if keep_recording:
+            for path in Path(tmp).iterdir():
+                shutil.move(str(path), out_dir / path.name)
+    return result
+
+
+def _run(out_dir: Path, tmp: Path, seconds: float, seed: int, progress) -> dict[str, Any]:
     from skyradar.experiments.ch7_figures import (
         aircraft_figure,
         plan_view_figure,
@@ -57,19 +78,17 @@ def run(out_dir: Path, seconds: float = 40.0, seed: int = 0, progress=None) -> d
     from skyradar.io.sigmf_io import read_iq_recording
     from skyradar.passive.pipeline import _geometry, process_recording
 
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     test_pulse_figure(out_dir / "ch7_testpulse.png")
     pulse = test_pulse_numbers()
-    meta = _simulate(out_dir, seconds, seed, (lambda d, n: progress("simulate", d, n)) if progress else None)
+    meta = _simulate(tmp, seconds, seed, (lambda d, n: progress("simulate", d, n)) if progress else None)
     t_sim = time.perf_counter() - t0
     rec = read_iq_recording(meta)
     t1 = time.perf_counter()
     res = process_recording(rec, progress=(lambda d, n: progress("process", d, n)) if progress else None)
     t_proc = time.perf_counter() - t1
     det = res.detections
-    write_table(det, out_dir / "ch7_detections.parquet", metadata={"source": str(meta)})
+    write_table(det, out_dir / "ch7_detections.parquet", metadata={"source": meta.name})
     truth = pd.read_parquet(rec.truth_table_path)
     s = score(det, truth, res.scan_period_s, seconds)
     n_rot = s["rotations"]

@@ -1,7 +1,7 @@
 """Passive processing of a whole recording, streamed in chunks: IQ -> detections table.
 
 Pass over the recording chunk by chunk (:class:`~skyradar.passive.profiles.ProfileExtractor`): pulse
-profiles go into a rolling buffer one dwell long; each dwell (hop a quarter dwell) is searched by
+profiles go into a rolling buffer one dwell long; each dwell (hop about a third of a dwell) is searched by
 :func:`~skyradar.passive.dwell.detect_dwell`. Memory is one chunk plus one dwell of profiles, plus a
 few numbers per pulse (time and direct-path amplitude) for the scan phase. At the end the scan phase
 (:func:`~skyradar.passive.pulses.scan_phase`) gives each candidate its beam azimuth; candidates of one
@@ -45,7 +45,7 @@ class PassiveSettings:
     pulse: str = "metadata"
     window: str | None = "hann"
     chunk_samples: int = 1 << 20
-    hop_fraction: float = 0.25
+    hop_fraction: float = 0.35
     blind_half_width_deg: float = 2.5
     min_bistatic_range_m: float | None = None
     sidelobe_margin_db: float = 15.0  # moving channel: a mover's main looks vary more from sweep to sweep
@@ -150,25 +150,8 @@ def _process(recording, settings: PassiveSettings | None, progress) -> PassiveRe
     scan = scan_phase(
         times_all, np.concatenate(amps), ill.rotation_period_s, bearing, 1, source=str(recording.path),
     )  # fmt: skip
-    cols = ["channel", "lag", "doppler_hz", "snr_db", "time_s", "power_db", "static_db"]
-    table = pd.DataFrame(candidates, columns=cols)
-    # Next to zero Doppler, a weak moving detection beside a much stronger static return at the same
-    # lag is that return's cancellation residue (the beam's sweep modulates it), not a mover.
-    near_zero = table["doppler_hz"].abs() < 2.0 / (n_dwell * pri)
-    residue = near_zero & (table["static_db"] - table["power_db"] > s.max_clutter_to_signal_db)
-    table = table[~residue].reset_index(drop=True)
-    table["bistatic_range_m"] = table["lag"] * C_MPS / fs
-    table["azimuth_rad"] = scan.azimuth_rad(table["time_s"].to_numpy())
-    merged = merge_candidates(
-        table, C_MPS / bandwidth, s.merge_time_dwells * n_dwell * pri, 2.0 / (n_dwell * pri)
-    )
-    merged["sweep"] = scan.sweep(merged["time_s"].to_numpy()) if len(merged) else []
-    tols = (1.5 * C_MPS / bandwidth, 2.0 / (n_dwell * pri))
-    is_static = merged["channel"] == "static" if len(merged) else pd.Series(dtype=bool)
-    merged = pd.concat([
-        drop_sidelobes(merged[is_static], *tols, s.static_sidelobe_margin_db, n_dwell * pri, scan.period_s),
-        drop_sidelobes(merged[~is_static], *tols, s.sidelobe_margin_db, n_dwell * pri, scan.period_s),
-    ])  # fmt: skip
+    dwell_s = n_dwell * pri
+    merged = _looks(candidates, s, scan, fs, C_MPS / bandwidth, dwell_s)
     blind = in_blind_zone(
         merged["bistatic_range_m"].to_numpy(), merged["azimuth_rad"].to_numpy(), bearing, min_range,
         np.radians(s.blind_half_width_deg),
@@ -177,6 +160,29 @@ def _process(recording, settings: PassiveSettings | None, progress) -> PassiveRe
     det = _positions(merged, tx_en, scan)
     n_pulses, n_masked = int(times_all.size), int(blind.sum())
     return PassiveResult(det, n_pulses, n_dwells, scan.period_s, scan.crossings_s, n_masked, s.pulse)
+
+
+def _looks(candidates: list[dict], s: PassiveSettings, scan, fs: float, resolution_m: float, dwell_s: float):
+    """Candidates -> one detection per look: residue dropped, overlapping dwells merged, sidelobe looks
+    dropped; with bistatic range, beam azimuth and sweep."""
+    cols = ["channel", "lag", "doppler_hz", "snr_db", "time_s", "power_db", "static_db"]
+    table = pd.DataFrame(candidates, columns=cols)
+    # Next to zero Doppler, a weak moving detection beside a much stronger static return at the same
+    # lag is that return's cancellation residue (the beam's sweep modulates it), not a mover.
+    near_zero = table["doppler_hz"].abs() < 2.0 / dwell_s
+    residue = near_zero & (table["static_db"] - table["power_db"] > s.max_clutter_to_signal_db)
+    table = table[~residue].reset_index(drop=True)
+    table["bistatic_range_m"] = table["lag"] * C_MPS / fs
+    table["azimuth_rad"] = scan.azimuth_rad(table["time_s"].to_numpy())
+    merged = merge_candidates(table, resolution_m, s.merge_time_dwells * dwell_s, 2.0 / dwell_s)
+    merged["sweep"] = scan.sweep(merged["time_s"].to_numpy()) if len(merged) else []
+    tols = (1.5 * resolution_m, 2.0 / dwell_s)
+    is_static = merged["channel"] == "static" if len(merged) else pd.Series(dtype=bool)
+    merged = pd.concat([
+        drop_sidelobes(merged[is_static], *tols, s.static_sidelobe_margin_db, dwell_s, scan.period_s),
+        drop_sidelobes(merged[~is_static], *tols, s.sidelobe_margin_db, dwell_s, scan.period_s),
+    ])  # fmt: skip
+    return merged
 
 
 def _stream(recording, s: PassiveSettings, extractor, n_dwell: int, hop: int, prf: float, dwell, progress):

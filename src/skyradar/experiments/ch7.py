@@ -71,16 +71,16 @@ def _run(out_dir: Path, tmp: Path, seconds: float, seed: int, progress) -> dict[
     from skyradar.experiments.ch7_figures import (
         aircraft_figure,
         plan_view_figure,
-        test_pulse_figure,
-        test_pulse_numbers,
+        thesis_pulse_figure,
+        thesis_pulse_numbers,
     )
     from skyradar.experiments.ch7_score import score
     from skyradar.io.sigmf_io import read_iq_recording
     from skyradar.passive.pipeline import _geometry, process_recording
 
     t0 = time.perf_counter()
-    test_pulse_figure(out_dir / "ch7_testpulse.png")
-    pulse = test_pulse_numbers()
+    thesis_pulse_figure(out_dir / "ch7_testpulse.png")
+    pulse = thesis_pulse_numbers()
     meta = _simulate(tmp, seconds, seed, (lambda d, n: progress("simulate", d, n)) if progress else None)
     t_sim = time.perf_counter() - t0
     rec = read_iq_recording(meta)

@@ -14,12 +14,12 @@ import pandas as pd  # noqa: E402
 from skyradar.io.atomic import savefig_atomic  # noqa: E402
 from skyradar.passive.matched_filter import lfm_pulse, matched_filter, thesis_test_pulse  # noqa: E402
 
-__all__ = ["test_pulse_figure", "plan_view_figure", "test_pulse_numbers"]
+__all__ = ["thesis_pulse_figure", "plan_view_figure", "thesis_pulse_numbers"]
 
 _FS = 20e6
 
 
-def test_pulse_numbers() -> dict:
+def thesis_pulse_numbers() -> dict:
     """Peak time and the 0.01 echo's visibility (strongest peak in 0.16-0.18 ms at 0.17 ms) per window."""
     from scipy import signal
 
@@ -39,7 +39,7 @@ def test_pulse_numbers() -> dict:
     return out
 
 
-def test_pulse_figure(path: Path) -> Path:
+def thesis_pulse_figure(path: Path) -> Path:
     """Filter output (dB) of the test pulse plus a 0.01 copy 0.02 ms later, without and with Hann."""
     t, s = thesis_test_pulse(_FS)
     d = int(round(2e-5 * _FS))

@@ -8,9 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import rasterio  # noqa: F401  (the map side needs the geo extra, a dev dependency: fail, never skip)
 from scipy import stats
-
-pytest.importorskip("rasterio")  # the map side (scene.land_cover) needs the geo extra
 
 from skyradar.errors import InputError
 from skyradar.nav.gpscheck.projection import frame_power, ground_image, ground_in_view_fraction

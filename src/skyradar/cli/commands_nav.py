@@ -25,9 +25,7 @@ __all__ = ["state", "experiment_ch5", "bench_state"]
 
 @app.command()
 def state(
-    run: Annotated[
-        Path, typer.Argument(help="Frames run (Zarr directory), radar seeing the ground.")
-    ],
+    run: Annotated[Path, typer.Argument(help="Frames run (Zarr directory), radar seeing the ground.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="State table to write (Parquet).")],
     method: Annotated[
         str,

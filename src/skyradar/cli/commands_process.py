@@ -132,9 +132,7 @@ def _read_config(path: Path):
 
 @app.command()
 def calibrate(
-    run: Annotated[
-        Path, typer.Argument(help="Frames run (Zarr) with a reflector at a known position.")
-    ],
+    run: Annotated[Path, typer.Argument(help="Frames run (Zarr) with a reflector at a known position.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Calibrated RadarConfig to write (JSON).")],
     range_m: Annotated[float, typer.Option("--range", callback=POSITIVE, help="Reflector range, m.")],
     azimuth_deg: Annotated[

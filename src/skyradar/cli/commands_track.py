@@ -111,9 +111,7 @@ def track(
 
 @app.command()
 def evaluate(
-    run: Annotated[
-        Path, typer.Argument(help="Simulated frames run (Zarr) holding intruder truth.")
-    ],
+    run: Annotated[Path, typer.Argument(help="Simulated frames run (Zarr) holding intruder truth.")],
     tracks: Annotated[Path, typer.Argument(help="Tracks table from `skyradar track`.")],
     threshold_px: Annotated[
         float, typer.Option("--threshold-px", callback=POSITIVE, help="Track-truth match distance, pixels.")

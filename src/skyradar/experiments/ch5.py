@@ -364,4 +364,3 @@ def run(
     )
     write_json_atomic(out_dir / "ch5.json", results)  # NaN (no valid frame) -> null
     return results
-

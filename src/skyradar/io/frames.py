@@ -61,6 +61,7 @@ COMPRESSORS = ("none", "zstd", "blosc")
 # see :mod:`skyradar.io.cint16` for the error bound).
 PRECISIONS = cint16.PRECISIONS
 
+
 def _add_truth(data_vars: dict, coords: dict, ownship, targets, target_names) -> None:
     """Own-ship truth on ``time`` and intruder truth on (``time``, ``target``), with CF attributes."""
     for name, values in (ownship or {}).items():

@@ -47,5 +47,3 @@ def innovation(
         if np.any(use):
             y[..., 0] = np.where(use, wrap(y[..., 0], np.where(use, rw, 1.0)), y[..., 0])
     return y
-
-

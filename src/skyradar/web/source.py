@@ -217,4 +217,3 @@ class RunSource:
                 png = range_doppler_png(np.asarray(self.ds["iq"][i].values), self.config.noise_power_w)
                 payload["rd_png"] = "data:image/png;base64," + base64.b64encode(png).decode()
         return payload
-

@@ -175,7 +175,7 @@ def check_frame(
 
 def _state(ds, i: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """GPS pose (north, east, heading), attitude, velocity and height above ground of frame ``i``."""
-    get = lambda name: float(ds[name].values[i])  # noqa: E731
+    get = lambda name: float(ds[name].isel(time=i).values)  # noqa: E731
     attitude = np.array([get("own_yaw_rad"), get("own_pitch_rad"), get("own_roll_rad")])
     velocity = np.array([get("own_vn_mps"), get("own_ve_mps"), get("own_vd_mps")])
     height = get("own_height_agl_m") if "own_height_agl_m" in ds else -get("own_down_m")
@@ -268,7 +268,7 @@ def check_run(
     for i in frames:
         gps, attitude, velocity, height = _state(ds, i)
         gps = gps + offset
-        power = frame_power(ds["iq"].values[i])
+        power = frame_power(ds["iq"].isel(time=int(i)).values)  # one frame, not the whole store per frame
         image = ground_image(power, config, pose_grid, attitude, velocity, height)
         fraction = ground_in_view_fraction(config, attitude, height)
         result = check_frame(

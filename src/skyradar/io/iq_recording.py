@@ -1,8 +1,8 @@
-"""A single-channel IQ recording of a passive receiver, memory-mapped, with the metadata a processor needs.
+"""A single-channel IQ recording of a passive receiver, read in chunks, with the metadata a processor needs.
 
 :class:`IqRecording` is what :func:`skyradar.io.sigmf_io.read_iq_recording` returns for a SigMF pair or a
-raw ``.cf32``/``.ci16`` file with a sidecar (:mod:`skyradar.io.iq_raw`). The samples stay memory-mapped
-and are read in chunks (:meth:`IqRecording.chunks`), so memory is bounded by the chunk size, not the
+raw ``.cf32``/``.ci16`` file with a sidecar (:mod:`skyradar.io.iq_raw`). The samples stay on disk and
+are read in chunks (:meth:`IqRecording.chunks`), so memory is bounded by the chunk size, not the
 recording. Sample values are as recorded (the simulator writes sqrt(W) at the receiver input); ``ci16``
 codes are divided by 32768.
 """
@@ -37,7 +37,7 @@ def _position(where: str, field: str, obj: Any) -> tuple[float, float, float]:
 
 
 class IqRecording:
-    """A memory-mapped single-channel IQ recording with the metadata a passive processor needs.
+    """A single-channel IQ recording on disk, read in chunks, with the metadata a passive processor needs.
 
     Attributes
     ----------
@@ -88,12 +88,7 @@ class IqRecording:
                 f"{self.data_path}: data file holds {self.n_samples} samples, shorter than the "
                 f"{int(expected)} its metadata ({self.path.name}) says"
             )
-        shape = (self.n_samples, 2) if datatype == "ci16_le" else (self.n_samples,)
-        self._raw = (
-            np.memmap(self.data_path, dtype=dtype, mode="r", offset=offset_bytes, shape=shape)
-            if self.n_samples
-            else np.zeros(shape, dtype)
-        )
+        self._dtype, self._offset, self._sample_bytes = dtype, offset_bytes, sample_bytes
         stem = self.path.name.removesuffix(".sigmf-meta")
         stem = stem.rsplit(".", 1)[0] if stem == self.path.name else stem
         truth = self.path.with_name(stem + ".truth.parquet")
@@ -109,12 +104,17 @@ class IqRecording:
         """Samples ``start .. start + count`` (clipped at the end) as a new complex64 array."""
         start = max(int(start), 0)
         stop = min(start + max(int(count), 0), self.n_samples)
-        block = self._raw[start:stop]
+        n = max(stop - start, 0)
+        # A plain read per call, not a long-lived memmap: pages of a mapping stay in the process's RSS
+        # once touched, which would grow with the recording; this keeps memory at one chunk.
+        with open(self.data_path, "rb") as f:
+            f.seek(self._offset + start * self._sample_bytes)
+            block = np.fromfile(f, dtype=self._dtype, count=n * (2 if self.datatype == "ci16_le" else 1))
         if self.datatype == "ci16_le":
-            out = np.empty(stop - start if stop > start else 0, np.complex64)
-            out.real, out.imag = block[:, 0], block[:, 1]
+            out = np.empty(n, np.complex64)
+            out.real, out.imag = block[0::2], block[1::2]
             return out * np.float32(self._scale)
-        return np.array(block, dtype=np.complex64)
+        return block.astype(np.complex64, copy=False)
 
     def chunks(self, chunk_samples: int, overlap: int = 0) -> Iterator[tuple[int, np.ndarray]]:
         """Yield ``(start, samples)`` for consecutive chunks; each holds ``overlap`` extra samples after it.

@@ -20,7 +20,7 @@ A raw ``NAME.cf32`` or ``NAME.ci16`` file (interleaved little-endian I/Q) is rea
 ``NAME.json`` / ``NAME.yaml``: ``sample_rate_hz``, ``center_frequency_hz``, optional ``n_samples`` and
 ``start_time``, ``receiver`` (``latitude``, ``longitude``, ``altitude``) and ``illuminator`` (as above).
 
-:func:`read_iq_recording` returns an :class:`IqRecording`: the samples stay memory-mapped and are read
+:func:`read_iq_recording` returns an :class:`IqRecording`: the samples stay on disk and are read
 in chunks (:meth:`IqRecording.chunks`), so memory is bounded by the chunk size, not the recording.
 Sample values are as recorded (the simulator writes sqrt(W) at the receiver input); ``ci16`` codes
 are divided by 32768. Bad input raises :class:`~skyradar.errors.InputError` naming file, field, value.

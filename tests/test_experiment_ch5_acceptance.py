@@ -14,6 +14,10 @@ import pytest
 from skyradar.experiments.ch5 import ACCEPTANCE, run
 from skyradar.experiments.ch5_report import acceptance_failures
 
+# The whole ch5 experiment (about 1.5-2 CPU-minutes): `make test-slow`. `make test` keeps the short
+# run of the same code in tests/test_flight_state_experiment.py.
+pytestmark = pytest.mark.slow
+
 SOURCES = ("true", "ahrs")
 
 

@@ -4,9 +4,8 @@ The pipeline, one subpackage per stage::
 
     scene -> sim -> process -> track -> daa
                     process -> nav (own-ship height and velocity over the terrain)
-
-Not built yet: the GPS check against a map (seed-brief.md ch6) and passive radar with an ATC
-radar as illuminator (ch7).
+    scene (map) -> sim (side-looking) -> nav.gpscheck (GPS check against the map, seed-brief.md ch6)
+    io (SigMF IQ) -> passive (passive radar with an ATC radar as illuminator, ch7)
 """
 
 from skyradar.antenna import AntennaPattern

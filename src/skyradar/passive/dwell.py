@@ -31,7 +31,7 @@ class DwellSettings:
 
     min_lag: int = 4
     pfa_static: float = 1e-6
-    pfa_moving: float = 1e-8
+    pfa_moving: float = 1e-10  # 1e-8 left 1-3 false moving detections a sweep on seeds 1 and 2 (of 0-3)
     guard_lags: int = 3
     train_lags: int = 40
     lags_per_independent: float = 1.0

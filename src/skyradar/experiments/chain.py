@@ -3,23 +3,7 @@
 Now: :mod:`skyradar.experiments.daa_chain`.
 """
 
-import importlib
-import warnings
-
+from skyradar.deprecation import alias_getattr
 from skyradar.experiments.daa_chain import *  # noqa: F403
 
-_NEW = ("skyradar.experiments.daa_chain",)
-warnings.warn(
-    "skyradar.experiments.chain is deprecated; import from skyradar.experiments.daa_chain",
-    DeprecationWarning,
-    stacklevel=2,
-)
-
-
-def __getattr__(name: str):
-    # Private names too, as the old module had them (tests and scripts may use them).
-    for module in _NEW:
-        value = getattr(importlib.import_module(module), name, _NEW)
-        if value is not _NEW:
-            return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__ = alias_getattr("skyradar.experiments.chain", ("skyradar.experiments.daa_chain",))

@@ -83,6 +83,7 @@ def test_small_run_compares_arrays_on_the_same_flyover(tmp_path):
         assert (tmp_path / name).exists()
 
 
+@pytest.mark.slow  # minutes of CPU: `make test-slow` (make test stays under 10 min)
 def test_ch3_default_array_beats_the_thesis_and_meets_acceptance(tmp_path):
     r = run(tmp_path, compare_spacings=())
     assert r["az_sd_deg"] < 1.8 and r["el_sd_deg"] < 2.7  # thesis raw SD

@@ -95,6 +95,7 @@ def test_sweep_parameter_paths():
     assert parse_values("0, 19.2,cosine") == [0, 19.2, "cosine"]
 
 
+@pytest.mark.slow  # minutes of CPU: `make test-slow` (make test stays under 10 min)
 def test_process_on_a_local_cluster_matches_the_plain_loop(tmp_path):
     built = Scenario.from_dict(SCENARIO, source=tmp_path / "s.yaml").build()
     run = simulate_to_zarr(built, tmp_path / "run.zarr", chunk_frames=3)
@@ -112,6 +113,7 @@ def test_process_on_a_local_cluster_matches_the_plain_loop(tmp_path):
     pd.testing.assert_frame_equal(tables["loop"], tables["dask"])
 
 
+@pytest.mark.slow  # minutes of CPU: `make test-slow` (make test stays under 10 min)
 def test_rd_on_a_local_cluster_matches_the_plain_loop(tmp_path):
     from skyradar.config import RadarConfig
     from skyradar.io.recording_writer import write_recording

@@ -188,6 +188,7 @@ def _detections(tmp_path: Path, scenario: Path, precision: str) -> pd.DataFrame:
     return table
 
 
+@pytest.mark.slow  # minutes of CPU: `make test-slow` (make test stays under 10 min)
 def test_process_on_cint16_store_matches_complex64(tmp_path):
     # Three frames 1 s before a head-on CPA over flat ground 500 m below: an intruder and clutter.
     scenario = _write(tmp_path, {**BASE, "start_s": 18.6, "duration_s": 0.6})

@@ -117,6 +117,9 @@ def number_in(
 
 
 POSITIVE = number_in(0.0, low_open=True)  # durations, distances, rates: finite and > 0
+BenchSecondsOption = Annotated[
+    float, typer.Option("--seconds", callback=POSITIVE, help="Minimum timing per implementation, s.")
+]
 NON_NEGATIVE = number_in(0.0)  # counts and durations where 0 means "skip"
 COUNT = number_in(1)  # frames, workers, chunk sizes: at least one
 PROBABILITY = number_in(0.0, 1.0, low_open=True, high_open=True)

@@ -10,7 +10,7 @@ import typer
 from skyradar.cli.app import (
     COUNT,
     NON_NEGATIVE,
-    POSITIVE,
+    BenchSecondsOption,
     JsonOption,
     app,
     bench_app,
@@ -266,9 +266,7 @@ def _print_ch6(rows: list[dict]) -> None:
 
 @bench_app.command("gpscheck")
 def bench_gpscheck(
-    seconds: Annotated[
-        float, typer.Option("--seconds", callback=POSITIVE, help="Minimum timing per implementation, s.")
-    ] = 2.0,
+    seconds: BenchSecondsOption = 2.0,
     as_json: JsonOption = False,
 ) -> None:
     """One GPS-check frame (300 poses by SSIM; the continuous search) vs a straightforward baseline."""

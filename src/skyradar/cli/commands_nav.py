@@ -11,6 +11,7 @@ import typer
 from skyradar.cli.app import (
     NON_NEGATIVE,
     POSITIVE,
+    BenchSecondsOption,
     JsonOption,
     app,
     bench_app,
@@ -151,9 +152,7 @@ def _ch5_view(rows: list[dict], label: str):
 
 @bench_app.command("state")
 def bench_state(
-    seconds: Annotated[
-        float, typer.Option("--seconds", callback=POSITIVE, help="Minimum timing per implementation, s.")
-    ] = 2.0,
+    seconds: BenchSecondsOption = 2.0,
     as_json: JsonOption = False,
 ) -> None:
     """Flight-state frames per second on 333 x 250 x 4 cubes: robust and terrain-aware vs the thesis' loop."""

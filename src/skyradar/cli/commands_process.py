@@ -13,6 +13,7 @@ from skyradar.cli.app import (
     POSITIVE,
     PROBABILITY,
     WORKERS,
+    BenchSecondsOption,
     JsonOption,
     app,
     bench_app,
@@ -295,9 +296,7 @@ def experiment_ch3(
 
 @bench_app.command("process")
 def bench_process(
-    seconds: Annotated[
-        float, typer.Option("--seconds", callback=POSITIVE, help="Minimum timing per implementation, s.")
-    ] = 2.0,
+    seconds: BenchSecondsOption = 2.0,
     as_json: JsonOption = False,
 ) -> None:
     """Detection + DoA frames per second on prototype-size cubes (333 x 250 x 4), ours vs a baseline."""

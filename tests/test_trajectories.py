@@ -277,17 +277,19 @@ def test_read_trajectories_groups_by_aircraft(tmp_path):
         (lambda d: d.drop(columns="latitude"), "track.csv: missing required field 'latitude'"),
         (lambda d: d.drop(columns="altitude"), "track.csv: missing required field 'altitude'"),
         (lambda d: d.drop(columns="timestamp"), "track.csv: missing required field 'timestamp'"),
+        # Steps back in time, repeated times and NaN positions are repaired (tests/test_adsb_clean.py);
+        # what cannot be is refused with the reason:
         (
-            lambda d: d.assign(timestamp=[1000.0, 1001.0, 999.0, 1002.0]),
-            r"track.csv: field 'timestamp' goes backwards at row 2 \(1001.0 -> 999.0\)",
+            lambda d: d.assign(timestamp=[1000.0, 1001.0, 1001.0, 1002.0], latitude=[52, 52, 52.1, 52]),
+            r"track.csv: field 'timestamp' repeats at rows \[1, 2\] with positions 11132 m apart",
         ),
         (
-            lambda d: d.assign(timestamp=[1000.0, 1001.0, 1001.0, 1002.0]),
-            "track.csv: field 'timestamp' repeats at row 2",
+            lambda d: d.assign(longitude=[4.0, np.nan, np.nan, np.nan]),
+            "track.csv: field 'timestamp' has 1 row.* with a time and a position",
         ),
         (
-            lambda d: d.assign(longitude=[4.0, np.nan, 4.0, 4.0]),
-            "track.csv: field 'longitude' is NaN .*row 1",
+            lambda d: d.assign(timestamp=[5e9, 5e9 + 1, 5e9 + 2, 5e9 + 3]),
+            "track.csv: field 'timestamp' runs from 5e.09 to .*fits no one unit",
         ),
         (
             lambda d: d.assign(latitude=[52.0, 52.0, 95.0, 52.0]),

@@ -19,11 +19,20 @@ terrain and aircraft over a scenario's extent, see :mod:`skyradar.scene.trajecto
 velocity columns are absent, or a row has NaN velocity, velocities come from the positions
 (``np.gradient`` in the NED frame). Times are stored relative to the file's first timestamp
 unless ``time_zero_s`` is given; the unix time of zero is kept as ``Trajectory.epoch_s``.
+
+Real downloads are repaired first (:mod:`skyradar.scene.adsb_clean`: epoch milliseconds, rows out
+of order, duplicated timestamps, rows without a position, ``geoaltitude`` preferred to barometric
+altitude) and each file's repairs are logged in one line; files may be ``.gz``, ``.bz2`` or ``.xz``
+compressed, and JSON may be records, JSON lines or any orient of pandas' ``to_json``.
 """
 
 from __future__ import annotations
 
+import bz2
+import gzip
 import json
+import logging
+import lzma
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +40,7 @@ import pandas as pd
 
 from skyradar.errors import InputError
 from skyradar.geo import geodetic_to_ned
+from skyradar.scene.adsb_clean import altitude_m, clean_rows, time_seconds
 
 __all__ = ["FT_M", "KT_MPS", "FPM_MPS", "read_track_table", "read_trajectory", "read_trajectories"]
 
@@ -43,6 +53,9 @@ MAX_SPEED_MPS = 3 * 343.0
 ALT_LIMITS_M = (-500.0, 30_000.0)
 _OPENSKY_VELOCITY = ("groundspeed", "track", "vertical_rate")
 _SI_VELOCITY = ("vn", "ve", "vd")
+_log = logging.getLogger(__name__)
+_TIME_NAMES = {"timestamp", "time", "time_s"}
+_OPENERS = {".gz": gzip.open, ".bz2": bz2.open, ".xz": lzma.open}
 
 
 def read_track_table(path: str | Path) -> pd.DataFrame:
@@ -73,96 +86,52 @@ def read_track_table(path: str | Path) -> pd.DataFrame:
 
 
 def _read_json(path: Path, lines: bool) -> pd.DataFrame:
-    text = path.read_text()
+    opener = _OPENERS.get(path.suffix.lower())
+    if opener is None and path.suffix.lower() == ".zst":
+        raise InputError(f"{path}: .zst is not supported here; decompress it first (zstd -d) or use .gz")
+    with (opener or open)(path, "rt", encoding="utf-8") as fh:
+        text = fh.read()
     data = [json.loads(line) for line in text.splitlines() if line.strip()] if lines else json.loads(text)
-    if isinstance(data, dict) and data and all(isinstance(v, list) for v in data.values()):
-        return pd.DataFrame(data)  # column orientation: {"latitude": [...], ...}
+    if isinstance(data, dict) and isinstance(data.get("data"), list):
+        if isinstance(data.get("columns"), list):  # pandas orient="split"
+            return pd.DataFrame(data["data"], columns=data["columns"])
+        data = data["data"]  # pandas orient="table": records under "data"
+    if isinstance(data, dict) and data and all(isinstance(v, list | dict) for v in data.values()):
+        frame = pd.DataFrame(data)  # orient="columns" (pandas' default; dict of dicts) or dict of lists
+        inner = next(iter(data.values()))
+        if isinstance(inner, dict) and not set(data) & _TIME_NAMES and set(inner) & _TIME_NAMES:
+            frame = frame.T.infer_objects()  # orient="index": one object per row
+        return frame
     if not isinstance(data, list) or not all(isinstance(row, dict) for row in data):
         raise InputError(f"{path}: JSON must be a list of records (objects), got {type(data).__name__}")
     return pd.DataFrame.from_records(data)
 
 
-def _normalise(df: pd.DataFrame) -> pd.DataFrame:
-    """Map OpenSky Impala state-vector columns onto the SI convention."""
+def _normalise(df: pd.DataFrame) -> tuple[pd.DataFrame, bool]:
+    """Map OpenSky Impala state-vector columns onto the SI convention; (frame, whether Impala)."""
     cols = set(df.columns)
     if "latitude" in cols or not {"lat", "lon"} <= cols:
-        return df
+        return df, False
     out = df.rename(columns={"lat": "latitude", "lon": "longitude", "time": "timestamp"})
-    alt = next((c for c in ("geoaltitude", "baroaltitude") if c in cols), None)
-    if alt is not None and "alt_m" not in cols:
-        out["alt_m"] = out[alt]
     if {"velocity", "heading", "vertrate"} <= cols and not {"vn", "ve", "vd"} & cols:
         speed = pd.to_numeric(out["velocity"], errors="coerce")
         heading = np.radians(pd.to_numeric(out["heading"], errors="coerce"))
         out["vn"], out["ve"] = speed * np.cos(heading), speed * np.sin(heading)
         out["vd"] = -pd.to_numeric(out["vertrate"], errors="coerce")
-    return out
+    return out, True
 
 
-def _time_seconds(path: Path, df: pd.DataFrame) -> tuple[str, np.ndarray]:
-    """(column, seconds) from ``time_s`` or ``timestamp`` (unix seconds or ISO datetimes)."""
-    col = "time_s" if "time_s" in df.columns else "timestamp"
-    if col not in df.columns:
-        raise InputError(
-            f"{path}: missing required field 'timestamp' (or 'time_s'); columns are {list(df.columns)}"
-        )
-    raw = df[col]
-    if pd.api.types.is_datetime64_any_dtype(raw):
-        parsed = raw
-    elif pd.api.types.is_numeric_dtype(raw):
-        return col, raw.to_numpy(dtype=float)
-    else:
-        numeric = pd.to_numeric(raw, errors="coerce")
-        if numeric.notna().all():
-            return col, numeric.to_numpy(dtype=float)
-        parsed = pd.to_datetime(raw, errors="coerce", utc=True, format="ISO8601")
-        bad = parsed.isna() & raw.notna()
-        if bad.any():
-            row = int(np.nonzero(bad.to_numpy())[0][0])
-            raise InputError(f"{path}: field '{col}' is not a time at row {row} ({raw.iloc[row]!r})")
-    if parsed.dt.tz is None:
-        parsed = parsed.dt.tz_localize("UTC")
-    seconds = (parsed - pd.Timestamp(0, tz="UTC")).dt.total_seconds().to_numpy(dtype=float)
-    return col, np.where(parsed.isna().to_numpy(), np.nan, seconds)
+def _number(df: pd.DataFrame, name: str) -> np.ndarray:
+    """A numeric column, NaN where missing or not a number."""
+    return pd.to_numeric(df[name], errors="coerce").to_numpy(dtype=float)
 
 
-def _column(
-    path: Path, df: pd.DataFrame, name: str, rows: np.ndarray, required: bool = True
-) -> np.ndarray | None:
-    if name not in df.columns:
-        if required:
-            raise InputError(f"{path}: missing required field '{name}'; columns are {list(df.columns)}")
-        return None
-    values = pd.to_numeric(df[name], errors="coerce").to_numpy(dtype=float)
-    if required:
-        bad = ~np.isfinite(values)
-        if bad.any():
-            i = int(np.nonzero(bad)[0][0])
-            raise InputError(
-                f"{path}: field '{name}' is NaN or not a number at row {rows[i]} ({df[name].iloc[i]!r})"
-            )
-    return values
-
-
-def _check_times(path: Path, col: str, t: np.ndarray, raw: pd.Series, label: str) -> None:
-    if t.size < 2:
-        raise InputError(
-            f"{path}: field '{col}' has {t.size} row(s){label}; a trajectory needs at least 2 points"
-        )
-    steps = np.diff(t)
-    if np.any(steps <= 0):
-        i = int(np.nonzero(steps <= 0)[0][0]) + 1
-        what = "repeats" if steps[i - 1] == 0 else "goes backwards"
-        before, after = (v.item() if hasattr(v, "item") else v for v in (raw.iloc[i - 1], raw.iloc[i]))
-        raise InputError(f"{path}: field '{col}' {what} at row {raw.index[i]} ({before} -> {after}){label}")
-
-
-def _local_velocity(path: Path, df: pd.DataFrame, rows: np.ndarray) -> np.ndarray | None:
+def _local_velocity(df: pd.DataFrame) -> np.ndarray | None:
     """Velocities (n, 3) in the local NED frame, NaN where a row has none; None without columns."""
     if all(c in df.columns for c in _SI_VELOCITY):
-        return np.stack([_column(path, df, c, rows, required=False) for c in _SI_VELOCITY], axis=-1)
+        return np.stack([_number(df, c) for c in _SI_VELOCITY], axis=-1)
     if all(c in df.columns for c in _OPENSKY_VELOCITY):
-        gs, trk, vr = (_column(path, df, c, rows, required=False) for c in _OPENSKY_VELOCITY)
+        gs, trk, vr = (_number(df, c) for c in _OPENSKY_VELOCITY)
         gs = gs * KT_MPS
         trk = np.radians(trk)
         return np.stack([gs * np.cos(trk), gs * np.sin(trk), -vr * FPM_MPS], axis=-1)
@@ -170,15 +139,58 @@ def _local_velocity(path: Path, df: pd.DataFrame, rows: np.ndarray) -> np.ndarra
 
 
 def _check_speed(path: Path, rows: np.ndarray, t: np.ndarray, pos: np.ndarray, label: str) -> None:
-    """Refuse a jump between consecutive rows faster than :data:`MAX_SPEED_MPS` (NED chords are exact)."""
-    speed = np.linalg.norm(np.diff(pos, axis=0), axis=1) / np.diff(t)
-    fast = np.flatnonzero(speed > MAX_SPEED_MPS)
+    """Refuse a jump between consecutive rows beyond :data:`MAX_SPEED_MPS` plus the position noise."""
+    from skyradar.scene.adsb_clean import POSITION_NOISE_M
+
+    dist, dt = np.linalg.norm(np.diff(pos, axis=0), axis=1), np.diff(t)
+    fast = np.flatnonzero(dist > MAX_SPEED_MPS * dt + POSITION_NOISE_M)
     if fast.size:
         i = int(fast[0]) + 1
         raise InputError(
             f"{path}: fields 'latitude', 'longitude', altitude at row {rows[i]}: a jump of "
-            f"{speed[i - 1]:.0f} m/s from row {rows[i - 1]} (above Mach 3, {MAX_SPEED_MPS:.0f} m/s){label}"
+            f"{dist[i - 1]:.0f} m in {dt[i - 1]:g} s from row {rows[i - 1]} "
+            f"(above Mach 3, {MAX_SPEED_MPS:.0f} m/s){label}"
         )
+
+
+def _check_ranges(path, rows, lat, lon, alt, alt_field: str, label: str) -> None:
+    for field_name, values, limit in (("latitude", lat, 90.0), ("longitude", lon, 360.0)):
+        out = np.abs(values) > limit
+        if out.any():
+            i = int(np.nonzero(out)[0][0])
+            raise InputError(
+                f"{path}: field '{field_name}' out of range at row {rows[i]} ({values[i]}){label}"
+            )
+    low = np.flatnonzero((alt < ALT_LIMITS_M[0]) | (alt > ALT_LIMITS_M[1]))
+    if low.size:
+        i = int(low[0])
+        raise InputError(
+            f"{path}: field '{alt_field}' out of range at row {rows[i]} ({alt[i]:.0f} m is outside "
+            f"[{ALT_LIMITS_M[0]:g}, {ALT_LIMITS_M[1]:g}] m){label}"
+        )
+
+
+def _drop_glitches(path, rows, t, lat, lon, alt, alt_field: str, label: str, notes: list[str]) -> np.ndarray:
+    """Mask of the fixes to keep: implausible ones dropped within the budget, else InputError."""
+    from skyradar.scene.adsb_clean import GLITCH_BUDGET, glitch_rows
+
+    in_range = (np.abs(lat) <= 90.0) & (np.abs(lon) <= 360.0)
+    in_range &= (alt >= ALT_LIMITS_M[0]) & (alt <= ALT_LIMITS_M[1])
+    keep = in_range.copy()
+    if in_range.sum() >= 2:
+        ok = np.flatnonzero(in_range)
+        pos = geodetic_to_ned(lat[ok], lon[ok], alt[ok], lat[ok[0]], lon[ok[0]], alt[ok[0]])
+        keep[ok[glitch_rows(pos, t[ok], MAX_SPEED_MPS)]] = False
+    dropped = int(len(t) - keep.sum())
+    if dropped > GLITCH_BUDGET * len(t) or keep.sum() < 2:
+        _check_ranges(path, rows, lat, lon, alt, alt_field, label)  # the first bad value, named
+        pos = geodetic_to_ned(lat, lon, alt, lat[0], lon[0], alt[0])
+        _check_speed(path, rows, t, pos, label)
+        raise InputError(f"{path}: fewer than 2 plausible fixes{label}")
+    if dropped:
+        out = int((~in_range).sum())
+        notes.append(f"dropped {dropped} glitch fix(es) ({out} out of range, {dropped - out} out of reach)")
+    return keep
 
 
 def _one_trajectory(
@@ -188,48 +200,28 @@ def _one_trajectory(
     name: str,
     time_zero_s: float | None,
     label: str = "",
+    impala: bool = False,
 ):
+    """(trajectory, repair notes) of one aircraft's rows."""
     from skyradar.scene.trajectories import Trajectory, origin_to_local_rotation
 
-    rows = df.index.to_numpy()
-    col, t = _time_seconds(path, df)
-    bad = ~np.isfinite(t)
-    if bad.any():
-        i = int(np.nonzero(bad)[0][0])
-        raise InputError(f"{path}: field '{col}' is NaN at row {rows[i]}{label}")
-    _check_times(path, col, t, df[col], label)
-    lat = _column(path, df, "latitude", rows)
-    lon = _column(path, df, "longitude", rows)
-    if "alt_m" in df.columns:
-        alt = _column(path, df, "alt_m", rows)
-    else:
-        alt = _column(path, df, "altitude", rows) * FT_M
-    for field_name, values, limit in (("latitude", lat, 90.0), ("longitude", lon, 360.0)):
-        out = np.abs(values) > limit
-        if out.any():
-            i = int(np.nonzero(out)[0][0])
-            raise InputError(
-                f"{path}: field '{field_name}' out of range at row {rows[i]} ({values[i]}){label}"
-            )
-    alt_field = "alt_m" if "alt_m" in df.columns else "altitude"
-    low = np.flatnonzero((alt < ALT_LIMITS_M[0]) | (alt > ALT_LIMITS_M[1]))
-    if low.size:
-        i = int(low[0])
-        raw = df[alt_field].iloc[i]
-        raw = raw.item() if hasattr(raw, "item") else raw
+    df, col, t, alt, alt_field, notes = clean_rows(path, df, impala, label)
+    if t.size < 2:
         raise InputError(
-            f"{path}: field '{alt_field}' out of range at row {rows[i]} ({raw!r}; "
-            f"{alt[i]:.0f} m is outside [{ALT_LIMITS_M[0]:g}, {ALT_LIMITS_M[1]:g}] m){label}"
+            f"{path}: field '{col}' has {t.size} row(s) with a time and a position{label}; "
+            "a trajectory needs at least 2 points"
         )
+    lat, lon = _number(df, "latitude"), _number(df, "longitude")
+    keep = _drop_glitches(path, df.index.to_numpy(), t, lat, lon, alt, alt_field, label, notes)
+    df, t, lat, lon, alt = df[keep], t[keep], lat[keep], lon[keep], alt[keep]
     origin = (
         (float(lat[0]), float(lon[0]), float(alt[0])) if origin is None else tuple(float(v) for v in origin)
     )
     pos = geodetic_to_ned(lat, lon, alt, *origin)
-    _check_speed(path, rows, t, pos, label)
     zero = float(t[0]) if time_zero_s is None else float(time_zero_s)
     t_rel = t - zero
     derived = np.gradient(pos, t_rel, axis=0, edge_order=2 if t.size > 2 else 1)
-    local = _local_velocity(path, df, rows)
+    local = _local_velocity(df)
     if local is None:
         vel = derived
     else:
@@ -237,7 +229,15 @@ def _one_trajectory(
         missing = ~np.all(np.isfinite(vel), axis=1)
         vel[missing] = derived[missing]
     epoch = zero if col == "timestamp" else float("nan")
-    return Trajectory.from_states(t_rel, pos, vel, origin=origin, name=name, epoch_s=epoch)
+    traj = Trajectory.from_states(t_rel, pos, vel, origin=origin, name=name, epoch_s=epoch)
+    return traj, notes
+
+
+def _report(path: Path, notes: dict[str, list[str]]) -> None:
+    """ONE line per file naming every repair (WARNING: shown on stderr without logging set up)."""
+    parts = [f"{key}: {', '.join(n)}" if key else ", ".join(n) for key, n in notes.items() if n]
+    if parts:
+        _log.warning("%s: cleaned: %s", path, "; ".join(parts))
 
 
 def read_trajectory(
@@ -246,12 +246,15 @@ def read_trajectory(
     name: str | None = None,
     time_zero_s: float | None = None,
 ):
-    """Read one aircraft's track from a CSV, Parquet or JSON file.
+    """Read one aircraft's track from a CSV, Parquet or JSON file (plain or .gz/.bz2/.xz).
+
+    The repairs of :mod:`skyradar.scene.adsb_clean` are applied and reported in one line.
 
     Parameters
     ----------
     path : str or Path
-        ``.csv``, ``.parquet`` or ``.json`` (list of records; ``.jsonl`` for JSON lines).
+        ``.csv``, ``.parquet`` or ``.json`` (records, or any pandas ``to_json`` orient;
+        ``.jsonl`` for JSON lines), optionally compressed (``.csv.gz``, ``.json.gz``...).
     origin : (lat_deg, lon_deg, alt_m), optional
         NED frame origin; defaults to the first point of the track.
     name : str, optional
@@ -274,13 +277,37 @@ def read_trajectory(
     (111.3, 304.8)
     """
     path = Path(path)
-    df = _normalise(read_track_table(path))
+    df, impala = _normalise(read_track_table(path))
     if "icao24" in df.columns and df["icao24"].nunique(dropna=True) > 1:
         ids = sorted(str(v) for v in df["icao24"].dropna().unique())
         raise InputError(
             f"{path}: field 'icao24' has {len(ids)} aircraft ({', '.join(ids[:5])}...); use read_trajectories"
         )
-    return _one_trajectory(path, df, origin, name or _default_name(df, path), time_zero_s)
+    name = name or _default_name(df, path)
+    traj, notes = _one_trajectory(path, df, origin, name, time_zero_s, impala=impala)
+    _report(path, {"": notes})
+    return traj
+
+
+def _shared_frame(path: Path, df: pd.DataFrame, impala: bool, origin, time_zero_s):
+    """Default origin (first row with a full position) and time zero (earliest time) of a file."""
+    if time_zero_s is None:
+        col, t, _ = time_seconds(path, df)
+        finite = t[np.isfinite(t)]
+        if finite.size == 0:
+            raise InputError(f"{path}: field '{col}' has no valid time")
+        time_zero_s = float(finite.min())
+    if origin is None:
+        try:
+            alt = altitude_m(df, impala)[0]
+        except InputError as exc:
+            raise InputError(f"{path}: {exc}; columns are {list(df.columns)}") from None
+        lat, lon = (_number(df, c) for c in ("latitude", "longitude"))
+        ok = np.flatnonzero(np.isfinite(lat) & np.isfinite(lon) & np.isfinite(alt))
+        if ok.size == 0:
+            raise InputError(f"{path}: no row has a latitude, longitude and altitude")
+        origin = (float(lat[ok[0]]), float(lon[ok[0]]), float(alt[ok[0]]))
+    return origin, time_zero_s
 
 
 def read_trajectories(
@@ -290,41 +317,33 @@ def read_trajectories(
 
     The origin defaults to the first row's position and time zero to the earliest timestamp,
     so all trajectories stay in step. Without an ``icao24`` column the file is one aircraft,
-    keyed by its file stem.
+    keyed by its file stem. Repairs are reported in one line for the file.
 
     Returns
     -------
     dict of str to Trajectory
     """
     path = Path(path)
-    df = _normalise(read_track_table(path))
+    df, impala = _normalise(read_track_table(path))
+    for name in ("latitude", "longitude"):
+        if name not in df.columns:
+            raise InputError(f"{path}: missing required field '{name}'; columns are {list(df.columns)}")
     if "icao24" not in df.columns:
-        return {path.stem: _one_trajectory(path, df, origin, _default_name(df, path), time_zero_s)}
+        traj, notes = _one_trajectory(path, df, origin, _default_name(df, path), time_zero_s, impala=impala)
+        _report(path, {"": notes})
+        return {path.stem: traj}
     if df["icao24"].isna().any():
         row = int(np.nonzero(df["icao24"].isna().to_numpy())[0][0])
         raise InputError(f"{path}: field 'icao24' is empty at row {row}")
-    if origin is None or time_zero_s is None:
-        col, t = _time_seconds(path, df)
-        rows = df.index.to_numpy()
-        if time_zero_s is None:
-            finite = t[np.isfinite(t)]
-            if finite.size == 0:
-                raise InputError(f"{path}: field '{col}' has no valid time")
-            time_zero_s = float(finite.min())
-        if origin is None:
-            lat = _column(path, df.iloc[:1], "latitude", rows[:1])
-            lon = _column(path, df.iloc[:1], "longitude", rows[:1])
-            alt = (
-                _column(path, df.iloc[:1], "alt_m", rows[:1])
-                if "alt_m" in df.columns
-                else _column(path, df.iloc[:1], "altitude", rows[:1]) * FT_M
-            )
-            origin = (float(lat[0]), float(lon[0]), float(alt[0]))
-    out = {}
+    origin, time_zero_s = _shared_frame(path, df, impala, origin, time_zero_s)
+    out, notes = {}, {}
     for icao, group in df.groupby("icao24", sort=False):
         key = str(icao)
-        label = f" (icao24 {key})"
-        out[key] = _one_trajectory(path, group, origin, _default_name(group, path, key), time_zero_s, label)
+        name = _default_name(group, path, key)
+        out[key], notes[key] = _one_trajectory(
+            path, group, origin, name, time_zero_s, f" (icao24 {key})", impala
+        )
+    _report(path, notes)
     return out
 
 

@@ -33,12 +33,18 @@ __all__ = ["SPEED_OF_LIGHT", "BOLTZMANN", "Mount", "RadarConfig"]
 SPEED_OF_LIGHT = 299_792_458.0  # m/s
 BOLTZMANN = 1.380649e-23  # J/K
 
-_MOUNT_PRESETS: dict[str, dict[str, Any]] = {
-    "forward": {"position_m": (2.0, 0.0, 0.0), "yaw_deg": 0.0, "pitch_deg": 0.0, "roll_deg": 0.0},
-    "forward-down": {"position_m": (2.0, 0.0, 0.3), "yaw_deg": 0.0, "pitch_deg": -30.0, "roll_deg": 0.0},
-    "side-right": {"position_m": (0.0, 5.0, 0.0), "yaw_deg": 90.0, "pitch_deg": -30.0, "roll_deg": 0.0},
-    "side-left": {"position_m": (0.0, -5.0, 0.0), "yaw_deg": -90.0, "pitch_deg": -30.0, "roll_deg": 0.0},
-    "sky": {"position_m": (0.0, 0.0, 0.0), "yaw_deg": 0.0, "pitch_deg": 0.0, "roll_deg": 0.0},
+# name: (position_m = lever arm (forward, right, down) m, yaw_deg, pitch_deg); roll 0.
+_MOUNT_PRESETS: dict[str, tuple[tuple[float, float, float], float, float]] = {
+    "forward": ((2.0, 0.0, 0.0), 0.0, 0.0),
+    "nose": ((2.0, 0.0, 0.0), 0.0, 0.0),
+    "forward-down": ((2.0, 0.0, 0.3), 0.0, -30.0),
+    "side-right": ((0.0, 5.0, 0.0), 90.0, -30.0),
+    "side-left": ((0.0, -5.0, 0.0), -90.0, -30.0),
+    # DAA heads: with the nose's +-35 deg, wingtip heads yawed +-75 deg reach +-110 deg (RTCA DO-366).
+    "right-wingtip": ((0.5, 5.0, 0.0), 75.0, 0.0),
+    "left-wingtip": ((0.5, -5.0, 0.0), -75.0, 0.0),
+    "tail": ((-6.0, 0.0, 0.0), 180.0, 0.0),
+    "sky": ((0.0, 0.0, 0.0), 0.0, 0.0),
 }
 
 
@@ -76,10 +82,11 @@ class Mount:
 
     @classmethod
     def preset(cls, name: str) -> Mount:
-        """``forward``, ``forward-down``, ``side-right``, ``side-left`` (wingtips) or ``sky``."""
+        """A named placement (the table above): forward = nose, left/right-wingtip, tail, side-*, ..."""
         if name not in _MOUNT_PRESETS:
             raise InputError(f"mount preset {name!r} unknown; choose from {sorted(_MOUNT_PRESETS)}")
-        return cls(**_MOUNT_PRESETS[name])
+        position_m, yaw_deg, pitch_deg = _MOUNT_PRESETS[name]
+        return cls(position_m, yaw_deg, pitch_deg, 0.0)
 
     @property
     def rotation(self) -> np.ndarray:
@@ -210,11 +217,8 @@ class RadarConfig:
     @classmethod
     def seed_prototype(cls, **changes: Any) -> RadarConfig:
         """Deprecated name of :meth:`prototype_2022`; removed in the next release."""
-        warnings.warn(
-            "RadarConfig.seed_prototype() is deprecated; use RadarConfig.prototype_2022()",
-            DeprecationWarning,
-            stacklevel=2,
-        )
+        msg = "RadarConfig.seed_prototype() is deprecated; use RadarConfig.prototype_2022()"
+        warnings.warn(msg, DeprecationWarning, stacklevel=2)
         return cls.prototype_2022(**changes)
 
     def replace(self, **changes: Any) -> RadarConfig:
@@ -357,12 +361,8 @@ class RadarConfig:
                 "azimuth": [ant.azimuth.angle_deg.tolist(), ant.azimuth.gain_db.tolist()],
                 "elevation": [ant.elevation.angle_deg.tolist(), ant.elevation.gain_db.tolist()],
             },
-            "mount": {
-                "position_m": list(self.mount.position_m),
-                "yaw_deg": self.mount.yaw_deg,
-                "pitch_deg": self.mount.pitch_deg,
-                "roll_deg": self.mount.roll_deg,
-            },
+            "mount": {"position_m": list(self.mount.position_m)}
+            | {k: getattr(self.mount, k) for k in ("yaw_deg", "pitch_deg", "roll_deg")},
             "rx_calibration": [[c.real, c.imag] for c in self.rx_calibration],
         }
 

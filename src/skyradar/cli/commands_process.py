@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Annotated
 
@@ -87,9 +88,10 @@ def process(
     """
     from skyradar.daa.provenance import ownship_signature
     from skyradar.io.frames import open_frames, radar_config_of
+    from skyradar.io.frames_heads import store_heads
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_table
-    from skyradar.process.detect_run import detect_run, detection_summary
+    from skyradar.process.detect_run import detect_run_heads, detection_summary
     from skyradar.process.spurs import SpurMap
 
     check_choice("--method", method, ("cfar", "os-cfar", "shi-tomasi"))
@@ -99,14 +101,17 @@ def process(
     config = _read_config(radar_config) if radar_config is not None else radar_config_of(ds, str(run))
     spurs = SpurMap.load(spur_map, config) if spur_map is not None else None
     dem = _terrain_window(terrain, ds, config, run) if terrain is not None else None
-    bar, task = _progress(ds.sizes["time"], "frames")
-    with bar:
-        table = detect_run(
-            run, ds, config, spurs, dem, method, spur_mode, pfa, scheduler, workers, chunk_frames,
-            progress=lambda n: bar.update(task, completed=n),
+    bar, task = _progress(ds.sizes["time"] * len(store_heads(run) or [run]), "frames")
+    with bar:  # every radar head of the run, one table with a `radar` column (skyradar.io.frames_heads)
+        table, configs = detect_run_heads(
+            run, None if radar_config is None else config, lambda n: bar.update(task, completed=n),
+            spurs=spurs, terrain=dem, method=method, spur_mode=spur_mode, pfa=pfa, scheduler=scheduler,
+            workers=workers, chunk_frames=chunk_frames,
         )  # fmt: skip
     # The own-ship signature lets `alert` check that the tracks and its --ownship run belong together.
     meta = {"radar_config": config.to_json(), "source": str(run)}
+    if len(configs) > 1:  # each head's RadarConfig (mount, lever arm); radar_config is the first's
+        meta["radar_heads"] = json.dumps({name: c.to_dict() for name, c in configs.items()})
     meta.update({"ownship_signature": sig} if (sig := ownship_signature(ds, str(run))) else {})
     write_table(table, output, metadata=meta)
     emit_result(detection_summary(table, ds.sizes["time"]) | {"output": str(output)}, as_json, "detections")

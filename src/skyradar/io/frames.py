@@ -25,6 +25,7 @@ import xarray as xr
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.io import cint16
+from skyradar.io import frames_heads as heads
 from skyradar.io.checks import check_frame_times
 from skyradar.io.frames_model import (
     DEFAULT_START_TIME,
@@ -154,8 +155,11 @@ def radar_config_of(ds: xr.Dataset, source: str = "frames") -> RadarConfig:
         raise InputError(f"{source}: attribute 'radar_config': {exc}") from None
 
 
-def open_frames(path: str | Path) -> xr.Dataset:
+def open_frames(path: str | Path, head: int | str | None = None) -> xr.Dataset:
     """Open a frames store (a Zarr directory) and check it is usable.
+
+    A store of several radar heads (:mod:`skyradar.io.frames_heads`) opens as the single-head
+    Dataset of ``head`` (name or index; default the first head).
 
     Raises :class:`InputError` naming the file when it is missing, not a directory, unfinished, empty
     or inconsistent with its own RadarConfig. Stores written before absolute time (float ``time``,
@@ -177,7 +181,7 @@ def open_frames(path: str | Path) -> xr.Dataset:
         ds = _open_zarr(path)
     except Exception as exc:  # noqa: BLE001 - any reader failure becomes one clear line
         raise InputError(f"{path}: cannot open as a frames store ({type(exc).__name__}: {exc})") from exc
-    ds = cint16.decode(ds)  # a cint16 store reads as lazy complex64 iq like any other
+    ds = cint16.decode(heads.open_head(path, ds, head))  # cint16 reads as complex64 iq like any other
     if "skyradar_fingerprint" in ds.attrs and not ds.attrs.get("skyradar_complete"):
         raise InputError(
             f"{path}: unfinished run (no 'skyradar_complete' attribute: interrupted, or written by an "
@@ -206,9 +210,9 @@ class FrameStoreWriter:
     ----------
     path : path
         Final store name; work happens in ``path + ".partial"`` until :meth:`close`.
-    template : xr.Dataset
+    template : xr.Dataset or dict of str to xr.Dataset
         The full Dataset with ``iq`` as a lazy (dask) array; every other variable is written
-        at creation.
+        at creation. Several radar heads: {head name: Dataset}, one Zarr group each.
     chunk_frames : int
         Frames per chunk along time.
     fingerprint : str
@@ -243,7 +247,8 @@ class FrameStoreWriter:
         self.overwrite = overwrite
         self.partial = self.path.with_name(self.path.name + ".partial")
         self.chunk_frames = int(chunk_frames)
-        self.n_frames = template.sizes["time"]
+        self.groups, templates = heads.head_templates(template)  # groups [None]: one head, the root
+        self.n_frames = templates[0].sizes["time"]
         self.n_chunks = -(-self.n_frames // self.chunk_frames)
         # Done marks live beside the store: zarr must not find foreign files inside it.
         self._marks = self.partial.with_name(self.partial.name + ".done")
@@ -262,17 +267,24 @@ class FrameStoreWriter:
                 self._remove_marks()
         if not self.partial.exists():
             self._remove_marks()
-            template = template.assign_attrs(skyradar_fingerprint=fingerprint, skyradar_precision=precision)
-            if precision == "cint16":
-                template, encoding = cint16.encode_template(template, self.chunk_frames)
-                encoding["iq_int16"].update(_codec(compressor, typesize=2))
-                encoding["iq_scale"].update(_codec(compressor))
-            else:
-                chunks = (self.chunk_frames, *template.iq.shape[1:])
-                encoding = {"iq": {"chunks": chunks, **_codec(compressor)}}
-            template.to_zarr(self.partial, compute=False, encoding=encoding, mode="w", consolidated=False)
+            attrs = {"skyradar_fingerprint": fingerprint, "skyradar_precision": precision}
+            heads.write_heads_root(self.partial, attrs, self.groups)  # several heads: names at the root
+            for group, one in zip(self.groups, templates, strict=True):
+                self._create(one.assign_attrs(attrs), group, compressor)
             self._marks.mkdir()
         self._marks.mkdir(exist_ok=True)
+
+    def _create(self, template: xr.Dataset, group: str | None, compressor: str) -> None:
+        if self.precision == "cint16":
+            template, encoding = cint16.encode_template(template, self.chunk_frames)
+            encoding["iq_int16"].update(_codec(compressor, typesize=2))
+            encoding["iq_scale"].update(_codec(compressor))
+        else:
+            chunks = (self.chunk_frames, *template.iq.shape[1:])
+            encoding = {"iq": {"chunks": chunks, **_codec(compressor)}}
+        template.to_zarr(
+            self.partial, group=group, compute=False, encoding=encoding, mode="w", consolidated=False
+        )
 
     def _check_partial_is_ours(self) -> None:
         marked = is_ours(self.partial, "frames store") or self._marks.is_dir()
@@ -309,6 +321,7 @@ class FrameStoreWriter:
 
             precision = zarr.open_group(self.partial, mode="r").attrs.get("skyradar_precision", "complex64")
         self.precision = precision
+        self.groups = heads.store_heads(self.partial) or [None]
         self.path = self.partial.with_name(self.partial.name.removesuffix(".partial"))
         self.chunk_frames, self.n_frames = int(chunk_frames), int(n_frames)
         self.n_chunks = -(-self.n_frames // self.chunk_frames)
@@ -328,9 +341,13 @@ class FrameStoreWriter:
         """Chunk indices not yet written (all of them on a fresh store)."""
         return [i for i in range(self.n_chunks) if not (self._marks / str(i)).exists()]
 
-    def write_chunk(self, index: int, iq: np.ndarray) -> None:
-        """Write frames of chunk ``index`` (shape (n, range, doppler, rx)) and mark it done."""
-        sl = self.chunk_slice(index)
+    def write_chunk(self, index: int, iq: np.ndarray | Mapping[str, np.ndarray]) -> None:
+        """Write frames of chunk ``index`` ((n, range, doppler, rx); heads: {name: frames}); mark it done."""
+        for group, cube in (iq if isinstance(iq, Mapping) else {None: iq}).items():
+            self._write_piece(self.chunk_slice(index), cube, group)
+        (self._marks / str(index)).touch()
+
+    def _write_piece(self, sl: slice, iq: np.ndarray, group: str | None) -> None:
         dims = ("time", "range", "doppler", "rx")
         region = {"time": sl, "range": slice(None), "doppler": slice(None), "rx": slice(None)}
         if self.precision == "cint16":
@@ -342,9 +359,7 @@ class FrameStoreWriter:
             region["iq_part"] = slice(None)
         else:
             variables = {"iq": (dims, iq.astype(np.complex64, copy=False))}
-        piece = xr.Dataset(variables)
-        piece.to_zarr(self.partial, region=region, consolidated=False)
-        (self._marks / str(index)).touch()
+        xr.Dataset(variables).to_zarr(self.partial, group=group, region=region, consolidated=False)
 
     def close(self) -> Path:
         """Mark the store complete and move it to its final name.
@@ -360,6 +375,7 @@ class FrameStoreWriter:
         # Checked again: something may have appeared at the final name while we were working.
         check_output(self.path, (), self.overwrite, kind="frames store")
         zarr.open_group(self.partial, mode="r+").attrs["skyradar_complete"] = True
+        heads.mark_heads_complete(self.partial, self.groups)
         replace_path(self.partial, self.path)
         shutil.rmtree(self._marks)
         return self.path

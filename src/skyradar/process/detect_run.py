@@ -16,11 +16,13 @@ import pandas as pd
 import xarray as xr
 
 from skyradar.config import RadarConfig
+from skyradar.io.frames import open_frames
+from skyradar.io.frames_heads import store_heads
 from skyradar.parallel import map_frame_chunks
 from skyradar.process.pipeline import process_chunk, process_frames
 from skyradar.process.spurs import SpurMap
 
-__all__ = ["detect_run", "detection_summary"]
+__all__ = ["detect_run", "detect_run_heads", "merge_head_tables", "detection_summary"]
 
 
 def detect_run(
@@ -36,8 +38,9 @@ def detect_run(
     workers: int | None = None,
     chunk_frames: int = 64,
     progress: Callable[[int], None] | None = None,
+    head: str | None = None,
 ) -> pd.DataFrame:
-    """Detections table of the frames run at ``run`` (opened as ``ds``).
+    """Detections table of the frames run at ``run`` (opened as ``ds``; radar ``head`` of it).
 
     Without ``scheduler`` and ``workers`` the frames are processed here; else in chunks of
     ``chunk_frames`` on an existing Dask scheduler or a local cluster of ``workers``. ``progress``
@@ -55,12 +58,77 @@ def detect_run(
         if progress:
             progress(done)
 
-    job = functools.partial(process_chunk, config=config, pfa=pfa)
+    job = functools.partial(process_chunk if head is None else _head_chunk, config=config, pfa=pfa)
+    job = job if head is None else functools.partial(job, head=head)
     parts = map_frame_chunks(
         job, str(run), ds.sizes["time"], max(1, chunk_frames), spurs, terrain, method, spur_mode,
         scheduler=scheduler, workers=workers, progress=advance,
     )  # fmt: skip
     return pd.concat(parts, ignore_index=True)
+
+
+def _head_chunk(path: str, start: int, stop: int, *args: Any, head: str, **kwargs: Any) -> pd.DataFrame:
+    # process_chunk for one head of a multi-head run (a Dask worker opens the run itself).
+    table = process_frames(
+        open_frames(path, head).isel(time=slice(start, stop)), *args, source=path, **kwargs
+    )
+    table["frame"] += start
+    return table
+
+
+def merge_head_tables(tables: dict[str, pd.DataFrame]) -> pd.DataFrame:
+    """One detections table from each head's: a ``radar`` column (head name), rows in time order.
+
+    Within a frame the heads keep their order, and their rows their own order.
+
+    Examples
+    --------
+    >>> a = pd.DataFrame({"time_s": [0.0, 0.1], "frame": [0, 1]})
+    >>> b = pd.DataFrame({"time_s": [0.0], "frame": [0]})
+    >>> merge_head_tables({"nose": a, "left": b})[["frame", "radar"]].values.tolist()
+    [[0, 'nose'], [0, 'left'], [1, 'nose']]
+    """
+    parts = [
+        t.assign(radar=pd.Series([name] * len(t), index=t.index, dtype=object)) for name, t in tables.items()
+    ]
+    merged = pd.concat(parts, ignore_index=True)
+    return merged.sort_values("time_s", kind="stable", ignore_index=True)
+
+
+def detect_run_heads(
+    run: str | Path,
+    config: RadarConfig | None = None,
+    progress: Callable[[int], None] | None = None,
+    **kwargs: Any,
+) -> tuple[pd.DataFrame, dict[str, RadarConfig]]:
+    """Detections of every radar head of the run at ``run``, merged (:func:`merge_head_tables`).
+
+    ``kwargs`` are :func:`detect_run`'s (spurs, terrain, method, ...). ``config`` replaces the
+    stored RadarConfig of a single-head run (a multi-head run refuses it: which head would it be?).
+    Returns the table and each head's RadarConfig. ``progress`` gets frames done over all heads.
+    """
+    from skyradar.errors import InputError
+    from skyradar.io.frames import radar_config_of
+
+    names = store_heads(run)
+    if names is not None and config is not None:
+        raise InputError(
+            f"--radar-config: {run} has {len(names)} radar heads {names}; each keeps its stored config"
+        )
+    tables, configs, done = {}, {}, 0
+    for name in names or ["radar"]:
+        ds = open_frames(run, None if names is None else name)
+        cfg = config if config is not None else radar_config_of(ds, str(run))
+        tables[name] = detect_run(
+            run, ds, cfg, progress=functools.partial(_shifted, progress, done) if progress else None,
+            head=None if names is None else name, **kwargs,
+        )  # fmt: skip
+        configs[name], done = cfg, done + ds.sizes["time"]
+    return merge_head_tables(tables), configs
+
+
+def _shifted(progress: Callable[[int], None], offset: int, n: int) -> None:
+    progress(offset + n)
 
 
 def detection_summary(table: pd.DataFrame, n_frames: int) -> dict[str, Any]:

@@ -7,7 +7,16 @@ from pathlib import Path
 
 from skyradar.errors import InputError
 
-__all__ = ["list_example_scenarios", "example_scenario"]
+__all__ = ["list_example_scenarios", "example_scenario", "THREE_HEAD_RADARS"]
+
+# The shipped three-head layout (a scenario's ``radars:`` list): the nose's 70 deg beam covers
+# +-35 deg and wingtip heads yawed +-75 deg cover 40..110 deg each side, so the three reach the
+# +-110 deg azimuth field of regard of RTCA DO-366 (presets in skyradar.config.Mount).
+THREE_HEAD_RADARS: list[dict] = [
+    {"name": "nose", "mount": "nose"},
+    {"name": "left", "mount": "left-wingtip"},
+    {"name": "right", "mount": "right-wingtip"},
+]
 
 
 def _scenario_dir():

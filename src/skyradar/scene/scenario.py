@@ -33,6 +33,7 @@ from skyradar.errors import InputError
 from skyradar.io.frames_model import parse_start_time
 from skyradar.io.safe_yaml import load_yaml
 from skyradar.scene.examples import example_scenario, list_example_scenarios
+from skyradar.scene.radar_heads import SINGLE_HEAD_NAME, RadarHead, scenario_heads
 from skyradar.scene.scenario_errors import validation_error_line
 from skyradar.scene.scenario_models import (
     AntennaModel,
@@ -88,6 +89,11 @@ class BuiltScenario:
     impairments: Any = None  # skyradar.scene.impairment_config.ImpairmentConfig or None
     land_cover: Any = None  # skyradar.scene.ground_map.LandCover (the ground_map section) or None
     start_time: Any = None  # numpy datetime64[ns], UTC of t = 0 s (the start_time field), or None
+    heads: list[RadarHead] = field(default_factory=list)  # the radar heads; [] means one: `radar`
+
+    def __post_init__(self) -> None:
+        if not self.heads:  # built by hand with one radar: that is the one head
+            object.__setattr__(self, "heads", [RadarHead(SINGLE_HEAD_NAME, self.radar)])
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -158,19 +164,22 @@ class Scenario:
         return m.start_s + np.arange(n) / m.frame_rate_hz
 
     def radar_config(self) -> RadarConfig:
-        """The scenario's RadarConfig (mount and overrides applied), without building anything else."""
-        return self._radar()
+        """The (first head's) RadarConfig, mount and overrides applied, without building the rest."""
+        return scenario_heads(self)[0].config
 
-    def _radar(self) -> RadarConfig:
+    def _radar(self, head=None, mount: Mount | None = None, section: str = "radar") -> RadarConfig:
+        """The top-level radar, or a head's (``head``: its RadarModel overrides, ``mount``)."""
         m = self.model
         overrides = m.radar.model_dump(exclude_none=True, exclude={"antenna"})
-        mount = self._mount()
-        if m.radar.antenna is not None:
-            overrides["antenna"] = self._antenna(m.radar.antenna)
+        overrides |= head.model_dump(exclude_none=True, exclude={"antenna"}) if head is not None else {}
+        mount = self._mount(m.mount) if mount is None else mount
+        antenna = head.antenna if head is not None and head.antenna is not None else m.radar.antenna
+        if antenna is not None:
+            overrides["antenna"] = self._antenna(antenna)
         try:
             radar = RadarConfig.prototype_2022(mount=mount, **overrides)
         except InputError as exc:
-            raise self._fail("radar", exc) from None
+            raise self._fail(section, exc) from None
         max_rate = 1.0 / radar.frame_duration_s
         if m.frame_rate_hz > max_rate:
             raise InputError(
@@ -192,15 +201,19 @@ class Scenario:
             return AntennaPattern.from_cuts_csv(self._path(a.cuts_csv), a.combine)
         return AntennaPattern.from_csv(self._path(a.azimuth_csv), self._path(a.elevation_csv), a.combine)
 
-    def _mount(self) -> Mount:
-        mm = self.model.mount
+    def _mount(self, mm, section: str = "mount") -> Mount:
         if mm is None:
             return Mount()
         try:
             base = Mount.preset(mm.preset) if mm.preset is not None else Mount()
         except InputError as exc:
-            raise InputError(f"{self._label}: field 'mount.preset': {exc}") from None
+            raise InputError(f"{self._label}: field '{section}.preset': {exc}") from None
         changes = mm.model_dump(exclude_none=True, exclude={"preset"})
+        if "lever_arm_m" in changes:  # another name for position_m
+            if "position_m" in changes:
+                msg = f"field '{section}': give lever_arm_m or position_m, not both"
+                raise InputError(f"{self._label}: {msg}")
+            changes["position_m"] = changes.pop("lever_arm_m")
         return Mount(**{**base.__dict__, **changes})
 
     def _terrain(self, origin: tuple[float, float, float] | None, bounds=None):
@@ -314,7 +327,8 @@ class Scenario:
     def build(self) -> BuiltScenario:
         """Make the radar, terrain, trajectories and frame times (see :class:`BuiltScenario`)."""
         m = self.model
-        radar = self._radar()
+        heads = scenario_heads(self)
+        radar = heads[0].config
         times = self.frame_times()
         origin, ownship, terrain = self._origin()
         if ownship is None:
@@ -352,6 +366,7 @@ class Scenario:
             name=m.name,
             origin=tuple(float(v) for v in origin),
             radar=radar,
+            heads=heads,
             terrain=terrain,
             ownship=ownship,
             intruders=intruders,

@@ -12,6 +12,9 @@ are in the field names: metres, m/s, degrees, seconds, Hz. Positions ``*_ned_m``
                                                            #   elevation_csv, or cuts_csv
     mount: forward-down                                    # preset, or {preset, position_m,
                                                            #   yaw_deg, pitch_deg, roll_deg}
+    radars:                                                # or several heads (instead of mount), each
+      - {name: nose, mount: nose}                          #   a mount and optional radar overrides;
+      - {name: left, mount: left-wingtip, radar: {pe_dbm: 40}}   # lever_arm_m = position_m
     terrain: {type: fractal, local_sd_m: 20, seed: 1, size_m: 12000, spacing_m: 30, height_m: 0}
                                                            # or flat | file (path) | jacksboro
     ground_map: {path: map.osm.pbf, pixel_m: 2}            # or, instead of terrain: a map's land cover
@@ -50,6 +53,7 @@ __all__ = [
     "AntennaModel",
     "RadarModel",
     "MountModel",
+    "RadarHeadModel",
     "OriginModel",
     "FlatTerrainModel",
     "FractalTerrainModel",
@@ -145,9 +149,18 @@ class MountModel(_Model):
 
     preset: str | None = None
     position_m: Vector3 | None = None
+    lever_arm_m: Vector3 | None = None  # the same as position_m (body frame forward, right, down, m)
     yaw_deg: Finite | None = None
     pitch_deg: Finite | None = None
     roll_deg: Finite | None = None
+
+
+class RadarHeadModel(_Model):
+    """One radar head of a multi-head aircraft: its name, mount and overrides of the top-level radar."""
+
+    name: str = Field(min_length=1)
+    mount: Annotated[MountModel, BeforeValidator(_mount_shorthand)]
+    radar: RadarModel | None = None
 
 
 class _GridTerrain(_Model):
@@ -317,6 +330,7 @@ class ScenarioModel(_Model):
     origin: OriginModel | None = None
     radar: RadarModel = Field(default_factory=RadarModel)
     mount: Annotated[MountModel | None, BeforeValidator(_mount_shorthand)] = None
+    radars: list[RadarHeadModel] | None = Field(None, min_length=1)  # several heads (radar_heads.py)
     terrain: Terrain | None = None
     ground_map: GroundMapModel | None = None  # instead of terrain: flat land cover from a map
     ownship: Ownship

@@ -16,6 +16,7 @@ import numpy as np
 import xarray as xr
 
 from skyradar.io.frames import frames_dataset
+from skyradar.scene.radar_heads import head_of
 from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
 from skyradar.sim.impairments import apply_impairments
 
@@ -32,8 +33,10 @@ _SIM_KEYS = (
 )
 
 
-def make_simulator(built) -> ImageSimulator:
-    """An :class:`ImageSimulator` for a BuiltScenario, with its ``sim_options`` and impairments."""
+def make_simulator(built, head: int | str = 0) -> ImageSimulator:
+    """An :class:`ImageSimulator` of one radar head (index or name) of a BuiltScenario, with its
+    ``sim_options`` and impairments; frames and truth of that head come from it."""
+    radar = head_of(built.heads, head, "make_simulator").config
     options = {k: v for k, v in built.sim_options.items() if k in _SIM_KEYS and v is not None}
     impairments = getattr(built, "impairments", None)
     if impairments is not None:
@@ -46,8 +49,8 @@ def make_simulator(built) -> ImageSimulator:
 
         cover, seed, noise = land_cover, options.get("seed", 0), options.get("noise", True)
         code, height = cover.class_code, cover.height_m
-        return LandCoverSimulator(built.radar, code, height, cover.grid, built.origin, seed, noise)
-    return ImageSimulator(built.radar, built.terrain, built.origin, **options)
+        return LandCoverSimulator(radar, code, height, cover.grid, built.origin, seed, noise)
+    return ImageSimulator(radar, built.terrain, built.origin, **options)
 
 
 def _states(built, indices: np.ndarray):
@@ -73,11 +76,11 @@ def _frame_inputs(own, intruders, i: int) -> tuple[PlatformState, list[PointTarg
 
 
 def simulate_frames(built, indices: np.ndarray, simulator: ImageSimulator | None = None) -> np.ndarray:
-    """Frames ``indices`` of the scenario as an (n, range, doppler, rx) complex64 array."""
+    """Frames ``indices`` of the simulator's head as an (n, range, doppler, rx) complex64 array."""
     simulator = simulator or make_simulator(built)
     indices = np.asarray(indices)
     own, intruders = _states(built, indices)
-    cfg = built.radar
+    cfg = simulator.config
     out = np.empty((indices.size, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
     impairments = getattr(built, "impairments", None)
     for i, frame_index in enumerate(indices):
@@ -146,17 +149,17 @@ def scenario_truth(built, simulator: ImageSimulator | None = None) -> tuple[dict
     return _ownship_truth(built, own), targets, [i.name for i in built.intruders]
 
 
-def simulate(built, progress: Callable[[int], None] | None = None) -> xr.Dataset:
-    """Whole scenario in memory (small runs, tests)."""
-    simulator = make_simulator(built)
-    n = built.times_s.size
-    iq = np.empty((n, built.radar.n_range, built.radar.n_doppler, built.radar.n_rx), np.complex64)
+def simulate(built, progress: Callable[[int], None] | None = None, head: int | str = 0) -> xr.Dataset:
+    """Whole scenario in memory (small runs, tests), one radar head."""
+    simulator = make_simulator(built, head)
+    n, cfg = built.times_s.size, simulator.config
+    iq = np.empty((n, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
     for i in range(n):
         iq[i] = simulate_frames(built, np.array([i]), simulator)[0]
         if progress:
             progress(1)
     ownship, targets, names = scenario_truth(built, simulator)
-    return frames_dataset(iq, built.times_s, built.radar, ownship, targets, names, frames_attrs(built))
+    return frames_dataset(iq, built.times_s, cfg, ownship, targets, names, frames_attrs(built))
 
 
 def frames_attrs(built) -> dict[str, Any]:

@@ -2,7 +2,8 @@
 
 Each chunk is a pure function of the scenario and its frame indices (noise is seeded per frame), so
 a plain loop, a local Dask cluster and a remote one write the same bytes, and an interrupted run
-resumes where it stopped.
+resumes where it stopped. A scenario with several radar heads writes one Zarr group per head
+(:mod:`skyradar.io.frames_heads`); one head writes the store as before.
 """
 
 from __future__ import annotations
@@ -25,14 +26,30 @@ __all__ = ["simulate_to_zarr"]
 def _template(built, chunk_frames: int, simulator: ImageSimulator) -> xr.Dataset:
     import dask.array as da
 
-    cfg = built.radar
+    cfg = simulator.config
     shape = (built.times_s.size, cfg.n_range, cfg.n_doppler, cfg.n_rx)
     iq = da.zeros(shape, dtype=np.complex64, chunks=(chunk_frames, -1, -1, -1))
     ownship, targets, names = scenario_truth(built, simulator)
     return frames_dataset(iq, built.times_s, cfg, ownship, targets, names, frames_attrs(built))
 
 
-_WORKER_SIMULATORS: dict[str, ImageSimulator] = {}
+def _templates(built, chunk_frames: int, simulators: list) -> xr.Dataset | dict[str, xr.Dataset]:
+    """One head: its Dataset (the store as before); several: {head name: Dataset}, a group each."""
+    if len(simulators) == 1:
+        return _template(built, chunk_frames, simulators[0])
+    return {
+        h.name: _template(built, chunk_frames, sim) for h, sim in zip(built.heads, simulators, strict=True)
+    }
+
+
+def _frames(built, rows: np.ndarray, simulators: list) -> np.ndarray | dict[str, np.ndarray]:
+    """Frames ``rows`` of every head, in the form :meth:`FrameStoreWriter.write_chunk` takes."""
+    if len(simulators) == 1:
+        return simulate_frames(built, rows, simulators[0])
+    return {h.name: simulate_frames(built, rows, s) for h, s in zip(built.heads, simulators, strict=True)}
+
+
+_WORKER_SIMULATORS: dict[str, list] = {}
 
 
 def _chunk_job(built, key: str, path: str, chunk_frames: int, precision: str, index: int) -> int:
@@ -42,10 +59,10 @@ def _chunk_job(built, key: str, path: str, chunk_frames: int, precision: str, in
     numba.set_num_threads(1)  # one worker per core; threads inside would oversubscribe
     if key not in _WORKER_SIMULATORS:
         _WORKER_SIMULATORS.clear()
-        _WORKER_SIMULATORS[key] = make_simulator(built)
+        _WORKER_SIMULATORS[key] = [make_simulator(built, h) for h in range(len(built.heads))]
     writer = FrameStoreWriter.attach(path, chunk_frames, built.times_s.size, precision)
     sl = writer.chunk_slice(index)
-    writer.write_chunk(index, simulate_frames(built, np.arange(sl.start, sl.stop), _WORKER_SIMULATORS[key]))
+    writer.write_chunk(index, _frames(built, np.arange(sl.start, sl.stop), _WORKER_SIMULATORS[key]))
     return sl.stop - sl.start
 
 
@@ -96,25 +113,26 @@ def simulate_to_zarr(
     check_output(path, inputs, overwrite, kind="frames store")
     # A chunk longer than the run is the whole run (--chunk-frames 10**20 must not size a 10^20 chunk).
     chunk_frames = max(1, min(int(chunk_frames), built.times_s.size))
-    check_store_space(path, built.radar, built.times_s.size, chunk_frames, compressor, precision)
+    n = len(built.heads)  # several heads: n times the frames (sized with the first head's hardware)
+    check_store_space(path, built.radar, n * built.times_s.size, n * chunk_frames, compressor, precision)
     client = None
     if scheduler is not None or workers:
         from skyradar.parallel import close, connect
 
         client = connect(scheduler, workers)  # before any output exists: a dead address leaves nothing
     try:
-        simulator = make_simulator(built)
+        simulators = [make_simulator(built, h) for h in range(len(built.heads))]
         key = fingerprint(built)
-        template = _template(built, chunk_frames, simulator)
+        template = _templates(built, chunk_frames, simulators)
         writer = FrameStoreWriter(path, template, chunk_frames, key, overwrite, inputs, compressor, precision)
-        _write_pending(built, writer, simulator, key, client, progress)
+        _write_pending(built, writer, simulators, key, client, progress)
     finally:
         if client is not None:
             close(client, owns_cluster=scheduler is None)
     return writer.close()
 
 
-def _write_pending(built, writer: FrameStoreWriter, simulator, key: str, client, progress) -> None:
+def _write_pending(built, writer: FrameStoreWriter, simulators: list, key: str, client, progress) -> None:
     """Simulate and write the chunks the store still lacks, here or on the Dask ``client``."""
     from skyradar.parallel import map_chunks
 
@@ -124,7 +142,7 @@ def _write_pending(built, writer: FrameStoreWriter, simulator, key: str, client,
     if client is None:
         for index in pending:
             sl = writer.chunk_slice(index)
-            writer.write_chunk(index, simulate_frames(built, np.arange(sl.start, sl.stop), simulator))
+            writer.write_chunk(index, _frames(built, np.arange(sl.start, sl.stop), simulators))
             if progress:
                 progress(sl.stop - sl.start)
         return

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from skyradar.errors import InputError
-from skyradar.nav.ahrs import AhrsModel, ahrs_attitude
+from skyradar.sim.navigation import AhrsModel, ahrs_attitude
 
 
 def test_errors_have_the_model_sizes_over_a_long_record():

@@ -12,7 +12,7 @@ import pytest
 
 from skyradar.experiments.ch5 import run
 from skyradar.experiments.ch5_report import acceptance_failures
-from skyradar.nav.ahrs import AhrsModel, ahrs_attitude
+from skyradar.sim.navigation import AhrsModel, ahrs_attitude
 
 SHORT = {"duration_s": 4.0, "fast_duration_s": 0.0, "terrains": ("flat",), "warmup_s": 1.0}
 SPEED_MPS = 55.0  # ch5's ground speed

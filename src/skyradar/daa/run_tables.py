@@ -1,4 +1,4 @@
-"""DAA tables taken from a frames run: the own-ship state and, for a simulated run, the truth as tracks.
+"""DAA tables from a frames run: the own-ship navigation state and, for a simulated run, truth as tracks.
 
 Both follow :mod:`skyradar.daa.tables`.
 """
@@ -12,6 +12,7 @@ import xarray as xr
 from skyradar.daa.tables import OPTIONAL_OWNSHIP_COLUMNS, OWNSHIP_COLUMNS, TRACK_COLUMNS
 from skyradar.errors import InputError
 from skyradar.io.frames_model import frame_times_s
+from skyradar.io.navigation import navigation_state
 
 __all__ = ["has_ownship", "ownship_from_frames", "truth_tracks"]
 
@@ -24,18 +25,25 @@ def has_ownship(ds: xr.Dataset) -> bool:
     >>> has_ownship(xr.Dataset())
     False
     """
-    return all(c in ds for c in OWNSHIP_COLUMNS[1:])
+    names = set(ds.variables)
+    return any(all(f"{p}{c[4:]}" in names for c in OWNSHIP_COLUMNS[1:]) for p in ("nav_", "own_"))
 
 
 def ownship_from_frames(ds: xr.Dataset, source: str = "frames") -> pd.DataFrame:
-    """Own-ship truth of a frames run as a table (:mod:`skyradar.daa.tables`)."""
-    missing = [c for c in OWNSHIP_COLUMNS[1:] if c not in ds]
+    """Own-ship state of a frames run as a table (:mod:`skyradar.daa.tables`): what the aircraft knows.
+
+    The values are the run's navigation solution (``nav_*``, GNSS/AHRS with errors) read by
+    :func:`skyradar.io.navigation.navigation_state`; only a store written before navigation
+    existed gives its ``own_*`` truth (``attrs["navigation_source"] == "truth"``).
+    """
+    state = navigation_state(ds, source)
+    missing = [c for c in OWNSHIP_COLUMNS[1:] if state is None or c not in state]
     if missing:
         raise InputError(f"{source}: no own-ship state (missing variable(s) {missing})")
-    cols = {"time_s": frame_times_s(ds)}
-    for name in OWNSHIP_COLUMNS[1:] + [c for c in OPTIONAL_OWNSHIP_COLUMNS if c in ds]:
-        cols[name] = np.asarray(ds[name].values, float)
-    return pd.DataFrame(cols)
+    keep = ["time_s", *OWNSHIP_COLUMNS[1:], *(c for c in OPTIONAL_OWNSHIP_COLUMNS if c in state)]
+    table = state[keep].copy()
+    table.attrs["navigation_source"] = state.attrs["navigation_source"]
+    return table
 
 
 def truth_tracks(ds: xr.Dataset, visible_only: bool = True) -> pd.DataFrame:

@@ -20,7 +20,7 @@ estimator gave one) and ``used_fraction`` (the filter accepted it); :data:`ACCEP
 bounds they must meet.
 
 Every flight is simulated once and estimated twice: with the simulator's true attitude, and with
-the attitude of a typical MEMS AHRS (:mod:`skyradar.nav.ahrs`, seeded by ``seed``), so no truth
+the attitude of a typical MEMS AHRS (:mod:`skyradar.sim.navigation`, seeded by ``seed``), so no truth
 reaches the estimators in the second run. The only other truth an estimator sees is the thesis
 method's 150 m GPS gate, which uses the true height above ground as a stand-in for GPS height
 minus a DEM (comparison only, as in the thesis).
@@ -40,7 +40,7 @@ from skyradar.errors import InputError
 from skyradar.experiments.ch5_flight import Flight, terrain_following_flight
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
-from skyradar.nav.ahrs import AhrsModel, ahrs_attitude
+from skyradar.sim.navigation import AhrsModel, ahrs_attitude
 from skyradar.nav.flight_state import estimate_frame, filter_table, mount_height_offset_m
 from skyradar.nav.kalman_state import KalmanSettings
 from skyradar.nav.ridge import extract_ridge

@@ -35,7 +35,7 @@ from skyradar.errors import InputError
 from skyradar.geo import rotation_matrix
 from skyradar.io.checks import check_finite_frames, check_frame_times
 from skyradar.io.frames_model import frame_times_s
-from skyradar.nav.ahrs import AhrsModel, ahrs_attitude
+from skyradar.sim.navigation import AhrsModel, ahrs_attitude
 from skyradar.nav.inversion import StateFit, fit_robust, fit_thesis
 from skyradar.nav.kalman_state import KalmanSettings, filter_states
 from skyradar.nav.ridge import Ridge, extract_ridge
@@ -225,7 +225,7 @@ def estimate_run(
     vx_raw_mps, vz_raw_mps, h_raw_m`` (+ ``_sd``), filtered ``vx_mps, vz_mps, h_m`` (+ ``_sd``),
     ``quality, low_quality, n_ridge, n_inliers, used_by_filter``. With ``gps_gate`` the
     thesis' 150 m gate against ``own_height_agl_m`` (comparison only). With ``ahrs``
-    (:class:`skyradar.nav.ahrs.AhrsModel`) the run's attitude, the simulator's truth, reaches the
+    (:class:`skyradar.sim.navigation.AhrsModel`) the run's attitude, the simulator's truth, reaches the
     estimators only through that model's seeded (``ahrs_seed``) errors.
     """
     from skyradar.io.frames import radar_config_of

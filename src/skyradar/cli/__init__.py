@@ -21,6 +21,7 @@ import skyradar.cli.commands_passive_sim  # noqa: F401  (registers commands)
 import skyradar.cli.commands_process  # noqa: F401  (registers commands)
 import skyradar.cli.commands_raw  # noqa: F401  (registers commands)
 import skyradar.cli.commands_track  # noqa: F401  (registers commands)
+import skyradar.cli.commands_traffic  # noqa: F401  (registers commands)
 from skyradar.cli import commands_sim  # noqa: F401  (registers commands)
 from skyradar.cli.app import app
 from skyradar.errors import InputError

@@ -22,6 +22,31 @@ from skyradar.io.outputs import OVERWRITE_HELP
 __all__ = ["make_encounter"]
 
 _Icao = Annotated[str | None, typer.Option(help="Aircraft address to take from a file holding several.")]
+_Track = Annotated[Path, typer.Argument(help="Track file (ADS-B/GPS: CSV, JSON, Parquet; .gz too).")]
+_Output = Annotated[
+    Path,
+    typer.Option("-o", "--output", help="Scenario YAML to write (+ NAME.ownship.csv, NAME.intruder.csv)."),
+]
+_Miss = Annotated[float, typer.Option("--miss-m", callback=NON_NEGATIVE, help="Horizontal miss at CPA, m.")]
+_Vertical = Annotated[
+    float, typer.Option("--vertical-miss-m", help="Intruder height above the own ship at CPA, m.")
+]
+_TCpa = Annotated[
+    float | None,
+    typer.Option("--t-cpa", help="CPA time, s after the own ship's first fix (default: middle)."),
+]
+_TIntruder = Annotated[
+    float | None,
+    typer.Option(
+        "--intruder-time", help="Intruder time moved to the CPA, s after its first fix (default: middle)."
+    ),
+]
+_Rotate = Annotated[float, typer.Option("--rotate-deg", help="Turn the intruder's flight, deg clockwise.")]
+_Side = Annotated[str, typer.Option("--side", help="Side of the own ship's track: right or left.")]
+_Before = Annotated[
+    float, typer.Option("--before-s", callback=POSITIVE, help="Scenario start, s before CPA.")
+]
+_After = Annotated[float, typer.Option("--after-s", callback=POSITIVE, help="Scenario end, s after CPA.")]
 
 
 def _flight(path: Path, icao24: str | None):
@@ -37,91 +62,64 @@ def _side_files(output: Path) -> tuple[Path, Path]:
     return output.with_name(f"{stem}.ownship.csv"), output.with_name(f"{stem}.intruder.csv")
 
 
-@app.command("make-encounter")
-def make_encounter(
-    ownship: Annotated[
-        Path, typer.Argument(help="Own-ship track (ADS-B/GPS file: CSV, JSON, Parquet, .gz).")
-    ],
-    intruder: Annotated[
-        Path, typer.Argument(help="Intruder track (same formats); moved to meet the own ship.")
-    ],
-    output: Annotated[
-        Path,
-        typer.Option(
-            "-o", "--output", help="Scenario YAML to write (+ NAME.ownship.csv, NAME.intruder.csv)."
-        ),
-    ],
-    miss_m: Annotated[
-        float, typer.Option("--miss-m", callback=NON_NEGATIVE, help="Horizontal miss at CPA, m.")
-    ] = 150.0,
-    vertical_miss_m: Annotated[
-        float, typer.Option("--vertical-miss-m", help="Intruder height above the own ship at CPA, m.")
-    ] = 0.0,
-    t_cpa: Annotated[
-        float | None,
-        typer.Option("--t-cpa", help="CPA time, s after the own ship's first fix (default: middle)."),
-    ] = None,
-    intruder_time: Annotated[
-        float | None,
-        typer.Option(
-            "--intruder-time", help="Intruder time moved to the CPA, s after its first fix (default: middle)."
-        ),
-    ] = None,
-    rotate_deg: Annotated[
-        float, typer.Option("--rotate-deg", help="Turn the intruder's flight, deg clockwise.")
-    ] = 0.0,
-    side: Annotated[
-        str, typer.Option("--side", help="Side of the own ship's track: right or left.")
-    ] = "right",
-    before_s: Annotated[
-        float, typer.Option("--before-s", callback=POSITIVE, help="Scenario start, s before CPA.")
-    ] = 60.0,
-    after_s: Annotated[
-        float, typer.Option("--after-s", callback=POSITIVE, help="Scenario end, s after CPA.")
-    ] = 20.0,
-    ownship_icao24: _Icao = None,
-    intruder_icao24: _Icao = None,
-    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
-    as_json: JsonOption = False,
-) -> None:
-    """Make an encounter from two recorded flights: the intruder's track is shifted in time and
-    space (and optionally turned) so that it passes the own ship at the given miss distances at
-    the given time. Writes a scenario for `skyradar simulate` and the two tracks it flies; the
-    files are cleaned on the way (one line on stderr says how)."""
+def _write(output: Path, own, intr, t_cpa: float, window_s: tuple[float, float], name: str) -> dict:
+    """Write the scenario and its two tracks (atomically); the files written and the real CPA."""
     import yaml
 
     from skyradar.io.atomic import write_csv_atomic, write_text_atomic
-    from skyradar.io.outputs import check_output
-    from skyradar.scene.encounter_from_tracks import (
-        encounter_from_tracks,
-        encounter_scenario,
-        horizontal_cpa,
-        trajectory_table,
-    )
+    from skyradar.scene.encounter_from_tracks import encounter_scenario, horizontal_cpa, trajectory_table
 
-    check_choice("--side", side, ("right", "left"))
-    check_number("--vertical-miss-m", vertical_miss_m, -10_000.0, 10_000.0)
-    check_number("--rotate-deg", rotate_deg, -360.0, 360.0)
     own_csv, intr_csv = _side_files(output)
-    for path in (output, own_csv, intr_csv):
-        check_output(path, [ownship, intruder], overwrite, kind="file")
-    a, b = _flight(ownship, ownship_icao24), _flight(intruder, intruder_icao24)
-    t_cpa = 0.5 * a.end_s if t_cpa is None else t_cpa
-    own, intr = encounter_from_tracks(a, b, t_cpa, miss_m, vertical_miss_m, intruder_time, rotate_deg, side)
-    scenario = encounter_scenario(own, intr, own_csv.name, intr_csv.name, t_cpa, before_s, after_s,
-                                  name=f"{a.name} meets {b.name}")  # fmt: skip
+    scenario = encounter_scenario(own, intr, own_csv.name, intr_csv.name, t_cpa, *window_s, name=name)
     write_csv_atomic(trajectory_table(own), own_csv, index=False)
     write_csv_atomic(trajectory_table(intr), intr_csv, index=False)
     write_text_atomic(output, yaml.safe_dump(scenario, sort_keys=False))
     window = (scenario["start_s"], scenario["start_s"] + scenario["duration_s"])
     t, h_m, v_m = horizontal_cpa(own, intr, window=window)  # what the scenario really flies
+    result = {"output": str(output), "ownship": str(own_csv), "intruder": str(intr_csv)}
+    result |= {"t_cpa_s": t, "horizontal_miss_m": h_m, "vertical_miss_m": v_m}
+    return result | {"start_s": scenario["start_s"], "duration_s": scenario["duration_s"]}
+
+
+@app.command("make-encounter")
+def make_encounter(
+    ownship: _Track,
+    intruder: _Track,
+    output: _Output,
+    miss_m: _Miss = 150.0,
+    vertical_miss_m: _Vertical = 0.0,
+    t_cpa: _TCpa = None,
+    intruder_time: _TIntruder = None,
+    rotate_deg: _Rotate = 0.0,
+    side: _Side = "right",
+    before_s: _Before = 60.0,
+    after_s: _After = 20.0,
+    ownship_icao24: _Icao = None,
+    intruder_icao24: _Icao = None,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
+    as_json: JsonOption = False,
+) -> None:
+    """Make an encounter from two recorded flights (OWNSHIP, INTRUDER): the intruder's track is
+    shifted in time and space (and optionally turned) so that it passes the own ship at the given
+    miss distances at the given time. Writes a scenario for `skyradar simulate` and the two tracks
+    it flies; the files are cleaned on the way (one line on stderr says how)."""
+    from skyradar.io.outputs import check_output
+    from skyradar.scene.encounter_from_tracks import encounter_from_tracks
+
+    check_choice("--side", side, ("right", "left"))
+    check_number("--vertical-miss-m", vertical_miss_m, -10_000.0, 10_000.0)
+    check_number("--rotate-deg", rotate_deg, -360.0, 360.0)
+    for path in (output, *_side_files(output)):
+        check_output(path, [ownship, intruder], overwrite, kind="file")
+    a, b = _flight(ownship, ownship_icao24), _flight(intruder, intruder_icao24)
+    t_cpa = 0.5 * a.end_s if t_cpa is None else t_cpa
+    own, intr = encounter_from_tracks(a, b, t_cpa, miss_m, vertical_miss_m, intruder_time, rotate_deg, side)
+    result = _write(output, own, intr, t_cpa, (before_s, after_s), f"{a.name} meets {b.name}")
+    t, h_m = result["t_cpa_s"], result["horizontal_miss_m"]
     if abs(t - t_cpa) > 0.1 or abs(h_m - miss_m) > 1.0:  # manoeuvring flights: say what they really do
         console.print(
             f"note: the flights manoeuvre near the meeting: closest approach {h_m:.0f} m at {t:.2f} s "
             f"(asked {miss_m:g} m at {t_cpa:g} s); try another --t-cpa or --intruder-time",
             soft_wrap=True,
         )
-    result = {"output": str(output), "ownship": str(own_csv), "intruder": str(intr_csv)}
-    result |= {"t_cpa_s": t, "horizontal_miss_m": h_m, "vertical_miss_m": v_m}
-    result |= {"start_s": scenario["start_s"], "duration_s": scenario["duration_s"]}
     emit_result(result, as_json, "encounter")

@@ -96,13 +96,8 @@ def encounter_from_tracks(
     >>> round(t, 2), round(h_m, 2), round(v_m, 2)
     (60.0, 150.0, 30.0)
     """
-    _check_request(horizontal_miss_m, vertical_miss_m, rotate_deg, side)
     t_b = 0.5 * (intruder.start_s + intruder.end_s) if intruder_time_s is None else float(intruder_time_s)
-    for traj, when, what in ((ownship, t_cpa_s, "closest-approach time"), (intruder, t_b, "intruder time")):
-        if not traj.covers(when):
-            raise InputError(
-                f"{what}: {when:g} s is outside '{traj.name}' ({traj.start_s:g}..{traj.end_s:g} s)"
-            )
+    _check_request(ownship, intruder, t_cpa_s, t_b, (horizontal_miss_m, vertical_miss_m, rotate_deg), side)
     meet = ownship.sample(t_cpa_s)
     own = ownship.reframed((float(meet.lat_deg[0]), float(meet.lon_deg[0]), float(meet.alt_m[0])))
     b_meet = intruder.sample(t_b)
@@ -113,14 +108,16 @@ def encounter_from_tracks(
         origin=own.origin, name=intruder.name, epoch_s=intruder.epoch_s - (t_cpa_s - t_b),
     )  # fmt: skip
     a_state, b_state = own.sample(t_cpa_s), turned.sample(t_cpa_s)
-    rel_vel = b_state.velocity_ned_mps[0] - a_state.velocity_ned_mps[0]
-    u = _miss_direction(a_state.velocity_ned_mps[0], rel_vel, side)
+    u = _miss_direction(
+        a_state.velocity_ned_mps[0], b_state.velocity_ned_mps[0] - a_state.velocity_ned_mps[0], side
+    )
     want = horizontal_miss_m * u + np.array([0.0, 0.0, -vertical_miss_m])  # intruder - own at the CPA
     shift = a_state.position_ned_m[0] - b_state.position_ned_m[0] + want
     return own, _refined(own, turned, shift, t_cpa_s, want)
 
 
-def _check_request(horizontal_miss_m: float, vertical_miss_m: float, rotate_deg: float, side: str) -> None:
+def _check_request(ownship, intruder, t_cpa_s: float, t_b: float, numbers, side: str) -> None:
+    horizontal_miss_m, vertical_miss_m, rotate_deg = numbers
     if not np.isfinite(horizontal_miss_m) or horizontal_miss_m < 0:
         raise InputError(f"horizontal miss: must be a finite distance >= 0 m, got {horizontal_miss_m!r}")
     for name, value in (("vertical miss", vertical_miss_m), ("rotation", rotate_deg)):
@@ -128,6 +125,11 @@ def _check_request(horizontal_miss_m: float, vertical_miss_m: float, rotate_deg:
             raise InputError(f"{name}: must be finite, got {value!r}")
     if side not in ("right", "left"):
         raise InputError(f"side: must be 'right' or 'left', got {side!r}")
+    for traj, when, what in ((ownship, t_cpa_s, "closest-approach time"), (intruder, t_b, "intruder time")):
+        if not traj.covers(when):
+            raise InputError(
+                f"{what}: {when:g} s is outside '{traj.name}' ({traj.start_s:g}..{traj.end_s:g} s)"
+            )
 
 
 def _refined(own: Trajectory, turned: Trajectory, shift: np.ndarray, t_cpa_s: float, want: np.ndarray):

@@ -24,13 +24,14 @@ from skyradar.track.deletion import MissDeleter
 from skyradar.track.initiation import MOfN, push_hit
 from skyradar.track.kalman import predict, update
 from skyradar.track.models import MotionModel
+from skyradar.track.reacquisition import LostTracks, anchor_fields, set_anchor
 from skyradar.track.types import FrameTracks, TrackerConfig
 
 __all__ = ["TrackerConfig", "FrameTracks", "RangeDopplerTracker"]
 
 _FIELDS = (
     "x", "P", "ids", "t_update", "hits", "frames", "window", "misses", "confirmed", "n_updates",
-    "hist_t", "hist_r", "resolved",
+    "hist_t", "hist_r", "resolved", "anchor_x", "anchor_P", "anchor_t", "anchor_resolved", "was_confirmed",
 )  # fmt: skip
 
 
@@ -48,6 +49,10 @@ class RangeDopplerTracker:
         Same signature as :func:`~skyradar.track.association.associate` (the default).
     initiator, deleter : optional
         Objects with the :class:`MOfN` / :class:`MissDeleter` interface.
+    reacquirer : optional
+        Object with the :class:`~skyradar.track.reacquisition.LostTracks` interface: keeps closed
+        confirmed tracks and gives their id to a newly confirmed track on the same aircraft
+        (default from ``config.reacquire_s``; ``reacquire_s=0`` turns it off).
     report_tentative : bool
         Also report tentative tracks (tracks born in this frame are reported from the next one).
 
@@ -70,6 +75,7 @@ class RangeDopplerTracker:
         initiator: MOfN | None = None,
         deleter: MissDeleter | None = None,
         report_tentative: bool = False,
+        reacquirer: LostTracks | None = None,
     ) -> None:
         self.model = model
         self.report_tentative = bool(report_tentative)
@@ -78,6 +84,11 @@ class RangeDopplerTracker:
         self.associator = associator
         self.initiator = initiator or MOfN(self.config.confirm_m, self.config.confirm_n)
         self.deleter = deleter or MissDeleter(self.config.max_misses, self.config.max_coast_s)
+        self.reacquirer = reacquirer or LostTracks(
+            model, self.config.reacquire_s, self.config.reacquire_jerk_mps3, self.config.gate,
+            self.config.resolve_fraction * model.doppler_width_mps,
+        )  # fmt: skip
+        self._reacquired = np.zeros((0, 2), np.int64)
         self.time_s: float | None = None
         self._next_id = 0
         self._range_wrap: np.ndarray | None = None
@@ -97,6 +108,7 @@ class RangeDopplerTracker:
             "hist_t": np.zeros((0, k)),
             "hist_r": np.zeros((0, k)),
             "resolved": np.zeros(0, bool),
+            **anchor_fields(np.zeros((0, 4)), np.zeros((0, 4, 4)), 0.0),
         }
         if self.config.dealias not in ("confident", "thesis"):
             raise ValueError(f"dealias must be 'confident' or 'thesis', got {self.config.dealias!r}")
@@ -139,7 +151,7 @@ class RangeDopplerTracker:
         innov = np.full((tr["ids"].size, 2), np.nan)
         innov[assoc.track_index] = assoc.innovation
         self._update(assoc, z)
-        self._bookkeep(assigned >= 0)
+        self._bookkeep(assigned >= 0, tr["misses"] >= self.initiator.n)
         alive = self._manage()
         assigned, innov = assigned[alive], innov[alive]
         used = np.zeros(len(z), bool)
@@ -161,6 +173,7 @@ class RangeDopplerTracker:
             alive_ids,
             alive_det,
             confirmed[out],
+            self._reacquired,
         )
 
     def _matrices(self, dt: float) -> tuple[np.ndarray, ...]:
@@ -284,8 +297,16 @@ class RangeDopplerTracker:
         tr["x"][r, 0] += k * span[use]
         self._shift_velocity(r, k * width)
 
-    def _bookkeep(self, hit: np.ndarray) -> None:
+    def _bookkeep(self, hit: np.ndarray, long_gap: np.ndarray) -> None:
         tr = self.tracks
+        # A confirmed track updated after coasting initiator.n frames or more may have taken clutter in
+        # its grown gate: it must be confirmed again (M-of-N) and keeps its anchor meanwhile.
+        again = hit & long_gap & tr["confirmed"]
+        tr["confirmed"] &= ~again
+        tr["window"] = np.where(again, 0, tr["window"])
+        # The anchor moves only with updates right after another (a gate that had no time to grow).
+        solid = hit & (tr["misses"] <= 1) & tr["confirmed"]
+        set_anchor(tr, np.flatnonzero(solid), self.time_s)
         tr["frames"] += 1
         tr["hits"] += hit
         tr["window"] = push_hit(tr["window"], hit, self.initiator.n)
@@ -294,19 +315,44 @@ class RangeDopplerTracker:
         tr["t_update"] = np.where(hit, self.time_s, tr["t_update"])
 
     def _manage(self) -> np.ndarray:
-        """Confirm and delete; returns the mask of surviving tracks (in pre-deletion order)."""
+        """Confirm, delete and reacquire; returns the surviving tracks' pre-deletion rows, by id."""
         tr = self.tracks
         tentative = ~tr["confirmed"]
         confirmed_now, failed = self.initiator.window_status(tr["window"], tr["misses"])
         tr["confirmed"] = tr["confirmed"] | (tentative & confirmed_now)
+        set_anchor(tr, np.flatnonzero(tentative & tr["confirmed"]), self.time_s)
         dead = (tentative & failed & ~tr["confirmed"]) | (
             tr["confirmed"] & self.deleter.delete(tr["misses"], self.time_s - tr["t_update"])
         )
-        alive = ~dead
-        if np.any(dead):
+        # Closed tracks that were ever confirmed are kept as lost, at their last solid update.
+        lost = dead & tr["was_confirmed"]
+        self.reacquirer.add(tr["ids"][lost], tr["anchor_x"][lost], tr["anchor_P"][lost],
+                            tr["anchor_resolved"][lost], tr["anchor_t"][lost])  # fmt: skip
+        self._reacquire(np.flatnonzero(tentative & tr["confirmed"] & ~tr["was_confirmed"] & ~dead))
+        tr["was_confirmed"] |= tr["confirmed"]
+        alive = np.flatnonzero(~dead)
+        # A reacquired track has an older id: keep the rows sorted by id, as callers look ids up.
+        alive = alive[np.argsort(tr["ids"][alive], kind="stable")]
+        if alive.size != tr["ids"].size or np.any(np.diff(alive) < 0):
             for name in _FIELDS:
                 tr[name] = tr[name][alive]
         return alive
+
+    def _reacquire(self, rows: np.ndarray) -> None:
+        """Give newly confirmed tracks ``rows`` the id (and the resolved alias) of a lost track."""
+        tr = self.tracks
+        self._reacquired = np.zeros((0, 2), np.int64)
+        if rows.size == 0 or len(self.reacquirer) == 0:
+            return
+        lost_ids, alias = self.reacquirer.match(tr["x"][rows], tr["P"][rows], self.time_s)
+        hit = lost_ids >= 0
+        self._reacquired = np.column_stack([tr["ids"][rows[hit]], lost_ids[hit]])
+        tr["ids"][rows[hit]] = lost_ids[hit]
+        sure = hit & np.isfinite(alias)
+        r = rows[sure]
+        self._shift_velocity(r, alias[sure] * self.model.doppler_width_mps)
+        tr["resolved"][r] = True
+        tr["x"][r, 2] = tr["x"][r, 1]
 
     def _start(self, z_new: np.ndarray) -> None:
         n = len(z_new)
@@ -337,6 +383,7 @@ class RangeDopplerTracker:
             "hist_t": hist_t,
             "hist_r": hist_r,
             "resolved": np.zeros(n, bool),
+            **anchor_fields(x, np.broadcast_to(self._P0, (n, 4, 4)), self.time_s),
         }
         self._next_id += n
         for name in _FIELDS:

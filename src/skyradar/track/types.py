@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -42,6 +42,11 @@ class TrackerConfig:
         deviation against ``W/2 = 39`` m/s, which is why the second is the default.
     resolve_fraction : float
         Range-rate standard deviation, as a fraction of ``W``, below which the alias is resolved.
+    reacquire_s : float
+        A closed confirmed track can be taken up again, with its id, by a track confirmed up to
+        this long after (:mod:`skyradar.track.reacquisition`), s; 0 turns reacquisition off.
+    reacquire_jerk_mps3 : float
+        White jerk of a lost track's prediction across the gap, m/s^3.
     """
 
     gate: float = 16.0
@@ -55,6 +60,8 @@ class TrackerConfig:
     confirmed_first: bool = True
     dealias: str = "confident"
     resolve_fraction: float = 1.0 / 6.0
+    reacquire_s: float = 8.0
+    reacquire_jerk_mps3: float = 1.5
 
 
 @dataclass(frozen=True)
@@ -77,6 +84,8 @@ class FrameTracks:
         All live tracks (tentative too) and their assigned detection rows, for the 3-D tracker.
     confirmed : ndarray of bool, shape (k,)
         Whether each reported track is confirmed (all True unless ``report_tentative``).
+    reacquired : ndarray of int, shape (r, 2)
+        (id at birth, lost id it took) of the tracks that reacquired a lost track in this frame.
     """
 
     time_s: float
@@ -89,3 +98,4 @@ class FrameTracks:
     alive_ids: np.ndarray
     alive_detection: np.ndarray
     confirmed: np.ndarray
+    reacquired: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))

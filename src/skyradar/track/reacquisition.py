@@ -1,0 +1,229 @@
+"""Reacquisition of lost tracks: one track id per aircraft through detection gaps of several seconds.
+
+The deleter (:class:`~skyradar.track.deletion.MissDeleter`) closes a confirmed track after a short
+coasting time (2 s): coasting longer would let the track's gate, which grows with the model's white
+jerk, take any detection within a large part of the image. An aircraft that fades for a few seconds
+(beam edge, SNR dip, a turn) then comes back as a new track, a fragment. This role keeps the closed
+confirmed tracks for ``max_age_s`` seconds instead of forgetting them, without reporting or gating
+them. When a new track is confirmed (M-of-N, so never on one clutter point), it is compared with
+every lost track predicted to the same time with a gentler process noise (``q_jerk_mps3``, the
+jerk an aircraft sustains over seconds rather than the frame-to-frame one); a pair within the
+chi-square gate gives the new track the lost track's id (Hungarian assignment on the Mahalanobis
+distance, each lost track used once). The comparison is done on the observed range and radial
+velocity (``H x``, so an unresolved Doppler alias and the range-Doppler coupling of the new track do
+not matter), with the Doppler difference wrapped the short way round the image; the new track then
+takes the lost track's alias of the radial velocity when the prediction's velocity uncertainty is
+small enough to choose it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from skyradar.track.kalman import predict, wrap
+from skyradar.track.models import MotionModel
+
+__all__ = ["LostTracks", "anchor_fields", "set_anchor", "manoeuvre_transition"]
+
+
+class LostTracks:
+    """Closed confirmed tracks kept for reacquisition by a newly confirmed track.
+
+    Parameters
+    ----------
+    model : MotionModel
+        The tracker's motion model (prediction, measurement matrix and noise).
+    max_age_s : float
+        A lost track is forgotten this long after it was closed, s (0 disables reacquisition).
+    q_jerk_mps3 : float
+        White jerk of the prediction across the gap, m/s^3.
+    gate : float
+        Chi-square gate (2 degrees of freedom) on the difference of the observed states.
+    resolve_sd_mps : float
+        The new track takes the lost track's alias when the predicted radial velocity's standard
+        deviation is below this, m/s.
+    tau_s, sigma_accel_mps2 : float
+        Across the gap the radial acceleration is a manoeuvre that decays with time constant
+        ``tau_s`` (Singer's model): a circling glider's radial acceleration changes sign within
+        seconds, and extrapolating it unchanged over a gap misses the aircraft. Its uncertainty
+        grows by ``sigma_accel_mps2`` (radar model only).
+
+    Examples
+    --------
+    >>> from skyradar.track.models import radar_model
+    >>> lost = LostTracks(radar_model(78.3))
+    >>> x = np.array([[2000.0, -60.0, -60.0, 0.0]])
+    >>> lost.add(np.array([4]), x, np.diag([16.0, 0.04, 1.0, 0.25])[None], np.array([True]), 10.0)
+    >>> new = np.array([[1760.0, 18.3, 18.3, 0.0]])  # 4 s later, radial velocity aliased by +W
+    >>> ids, alias = lost.match(new, np.diag([16.0, 0.04, 900.0, 1.0])[None], 14.0)
+    >>> ids.tolist(), alias.tolist()
+    ([4], [-1.0])
+    """
+
+    def __init__(
+        self,
+        model: MotionModel,
+        max_age_s: float = 8.0,
+        q_jerk_mps3: float = 1.5,
+        gate: float = 16.0,
+        resolve_sd_mps: float = 13.0,
+        tau_s: float = 2.0,
+        sigma_accel_mps2: float = 4.0,
+    ) -> None:
+        if max_age_s < 0 or not q_jerk_mps3 > 0 or not gate > 0:
+            raise ValueError(
+                f"need max_age_s >= 0, q_jerk_mps3 > 0, gate > 0; got {max_age_s}, {q_jerk_mps3}, {gate}"
+            )
+        self.model = model
+        self.tau_s, self.sigma_accel_mps2 = float(tau_s), float(sigma_accel_mps2)
+        self._gentle = replace(model, q_velocity_mps3=float(q_jerk_mps3), q_range_mps2=float(q_jerk_mps3))
+        self.max_age_s, self.gate, self.resolve_sd_mps = float(max_age_s), float(gate), float(resolve_sd_mps)
+        self.ids = np.zeros(0, np.int64)
+        self.x = np.zeros((0, 4))
+        self.P = np.zeros((0, 4, 4))
+        self.resolved = np.zeros(0, bool)
+        self.time_s = np.zeros(0)
+
+    def __len__(self) -> int:
+        return int(self.ids.size)
+
+    def add(
+        self, ids: np.ndarray, x: np.ndarray, P: np.ndarray, resolved: np.ndarray, time_s: np.ndarray | float
+    ) -> None:
+        """Keep closed tracks: states ``x`` (k, 4) and covariances ``P`` (k, 4, 4) at ``time_s``."""
+        if self.max_age_s == 0 or len(ids) == 0:
+            return
+        self.ids = np.concatenate([self.ids, np.asarray(ids, np.int64)])
+        self.x = np.concatenate([self.x, x])
+        self.P = np.concatenate([self.P, P])
+        self.resolved = np.concatenate([self.resolved, np.asarray(resolved, bool)])
+        self.time_s = np.concatenate([self.time_s, np.broadcast_to(np.asarray(time_s, float), (len(ids),))])
+
+    def expire(self, time_s: float) -> None:
+        """Forget lost tracks closed more than ``max_age_s`` before ``time_s``."""
+        keep = time_s - self.time_s <= self.max_age_s
+        if not keep.all():
+            self._take(keep)
+
+    def match(self, x: np.ndarray, P: np.ndarray, time_s: float) -> tuple[np.ndarray, np.ndarray]:
+        """Lost id for each newly confirmed track (-1: none), and the alias shift of its velocity.
+
+        Parameters
+        ----------
+        x, P : ndarray, shapes (k, 4), (k, 4, 4)
+            States of the newly confirmed tracks at ``time_s``.
+
+        Returns
+        -------
+        ids : ndarray of int, shape (k,)
+            Reacquired lost track id, -1 for a new aircraft. Matched lost tracks are removed.
+        alias : ndarray of float, shape (k,)
+            Whole Doppler widths to add to the new track's radial velocity, NaN when not matched or
+            when the prediction cannot choose the alias (set only for lost tracks whose own alias
+            was resolved).
+        """
+        self.expire(time_s)
+        k = len(x)
+        ids, alias = np.full(k, -1, np.int64), np.full(k, np.nan)
+        if k == 0 or self.ids.size == 0:
+            return ids, alias
+        z_lost, S_lost = self._predicted_observation(time_s)
+        H = self.model.measurement_matrix
+        z_new = x @ H.T
+        S_new = H @ P @ H.T
+        y = z_new[:, None, :] - z_lost[None, :, :]
+        if self.model.wrap_doppler:
+            y[..., 1] = wrap(y[..., 1], self.model.doppler_width_mps)
+        S = S_new[:, None] + S_lost[None, :] + self.model.measurement_noise
+        d2 = np.einsum("abi,abi->ab", y, np.linalg.solve(S, y[..., None])[..., 0])
+        cost = np.where(d2 < self.gate, d2, 1e12)
+        r, c = linear_sum_assignment(cost)
+        ok = cost[r, c] < self.gate
+        r, c = r[ok], c[ok]
+        ids[r] = self.ids[c]
+        width = self.model.doppler_width_mps
+        sure = self.resolved[c] & (np.sqrt(S_lost[c, 1, 1]) < self.resolve_sd_mps) & self.model.wrap_doppler
+        alias[r] = np.where(sure, np.round((z_lost[c, 1] - x[r, 1]) / width), np.nan)
+        drop = np.ones(self.ids.size, bool)
+        drop[c] = False
+        self._take(drop)
+        return ids, alias
+
+    def _predicted_observation(self, time_s: float) -> tuple[np.ndarray, np.ndarray]:
+        """Observed (range, radial velocity) of every lost track at ``time_s`` and its covariance."""
+        m, H = self._gentle, self.model.measurement_matrix
+        z = np.empty((self.ids.size, 2))
+        S = np.empty((self.ids.size, 2, 2))
+        for i in range(self.ids.size):
+            dt = float(time_s - self.time_s[i])
+            resolved = self.resolved[i] or not self.model.dealias
+            F = m.transition(np.array(dt)) if resolved else m.transition_unresolved(dt)
+            Q = m.process_noise(np.array(dt)) if resolved else m.process_noise_unresolved(dt)
+            P = self.P[i : i + 1].copy()
+            if self.model.coupled:
+                F = manoeuvre_transition(dt, self.tau_s, resolved)
+                P[:, 3, 3] += self.sigma_accel_mps2**2
+            xp, Pp = predict(self.x[i : i + 1], P, F, Q)
+            z[i] = H @ xp[0]
+            S[i] = H @ Pp[0] @ H.T
+        return z, S
+
+    def _take(self, keep: np.ndarray) -> None:
+        self.ids, self.x, self.P = self.ids[keep], self.x[keep], self.P[keep]
+        self.resolved, self.time_s = self.resolved[keep], self.time_s[keep]
+
+
+def manoeuvre_transition(dt_s: float, tau_s: float, resolved: bool = True) -> np.ndarray:
+    """Radar-model transition over ``dt_s`` with the radial acceleration decaying as ``exp(-t / tau)``.
+
+    The acceleration adds ``g1 = tau (1 - exp(-dt / tau))`` to the velocities and
+    ``g2 = tau (dt - g1)`` to the range; range follows ``V_R`` once the alias is resolved, the
+    range-rate state before.
+
+    Examples
+    --------
+    >>> F = manoeuvre_transition(2.0, 1e4)  # tau >> dt: constant acceleration
+    >>> F[0].round(3).tolist(), F[1].round(3).tolist()
+    ([1.0, 2.0, 0.0, 2.0], [0.0, 1.0, 0.0, 2.0])
+    """
+    x = dt_s / tau_s
+    g1 = -tau_s * np.expm1(-x)
+    g2 = tau_s * tau_s * (x + np.expm1(-x))
+    decay = np.exp(-x)
+    F = np.eye(4)
+    F[0, 1 if resolved else 2] = dt_s
+    F[0, 3], F[1, 3], F[2, 3], F[3, 3] = g2, g1, g1, decay
+    return F
+
+
+def anchor_fields(x: np.ndarray, P: np.ndarray, time_s: float) -> dict[str, np.ndarray]:
+    """Anchor columns of new tracks for the tracker's struct of arrays (the state they start from).
+
+    A track's anchor is its state just after its last solid update: an update while confirmed and
+    not after a long coast, when the gate was small. A track lost after taking a clutter point in a
+    grown gate is then remembered where it last was reliably, not where the clutter took it.
+
+    Examples
+    --------
+    >>> sorted(anchor_fields(np.zeros((2, 4)), np.zeros((2, 4, 4)), 1.0))
+    ['anchor_P', 'anchor_resolved', 'anchor_t', 'anchor_x', 'was_confirmed']
+    """
+    n = len(x)
+    return {
+        "anchor_x": np.array(x, float),
+        "anchor_P": np.array(P, float),
+        "anchor_t": np.full(n, float(time_s)),
+        "anchor_resolved": np.zeros(n, bool),
+        "was_confirmed": np.zeros(n, bool),
+    }
+
+
+def set_anchor(tracks: dict[str, np.ndarray], rows: np.ndarray, time_s: float) -> None:
+    """Anchor tracks ``rows`` of the tracker's struct of arrays at their current state, in place."""
+    tracks["anchor_x"][rows] = tracks["x"][rows]
+    tracks["anchor_P"][rows] = tracks["P"][rows]
+    tracks["anchor_t"][rows] = time_s
+    tracks["anchor_resolved"][rows] = tracks["resolved"][rows]

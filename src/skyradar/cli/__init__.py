@@ -14,6 +14,7 @@ import typer
 
 import skyradar.cli.commands_daa  # noqa: F401  (registers commands)
 import skyradar.cli.commands_demo  # noqa: F401  (registers commands)
+import skyradar.cli.commands_export  # noqa: F401  (registers commands)
 import skyradar.cli.commands_gpscheck  # noqa: F401  (registers commands)
 import skyradar.cli.commands_nav  # noqa: F401  (registers commands)
 import skyradar.cli.commands_passive  # noqa: F401  (registers commands)

@@ -1,0 +1,94 @@
+"""A frames run's own-ship and intruder states as plain tables (``skyradar export``).
+
+The own-ship table holds, per frame, the navigation solution the chain used (``nav_*``: GNSS and
+AHRS with errors) beside the simulator's truth (``own_*``), so that anyone can measure what a
+navigation error did. The intruder table holds the intruder truth (``tgt_*``) in long form, one
+row per frame and intruder; a store of several radar heads adds each head's own view
+(``tgt_visible``, ``tgt_snr_db``... that depend on the head) as ``<variable>@<head>`` columns.
+Both carry ``time_s`` (s since the run's start) and ``utc`` (the instant, from ``start_time``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from skyradar.io.frames_model import frame_times_s, start_time_of
+
+__all__ = ["ownship_table", "intruder_table", "export_paths"]
+
+
+def _clock(ds: xr.Dataset) -> dict[str, np.ndarray]:
+    t = frame_times_s(ds)
+    utc = start_time_of(ds) + (t * 1e9).round().astype("timedelta64[ns]")
+    return {"time_s": t, "utc": pd.DatetimeIndex(utc).tz_localize("UTC")}
+
+
+def ownship_table(ds: xr.Dataset) -> pd.DataFrame:
+    """Per-frame own-ship navigation (``nav_*``) and truth (``own_*``) of a frames Dataset.
+
+    Examples
+    --------
+    >>> ds = xr.Dataset({"own_north_m": ("time", [0.0, 9.0]), "nav_north_m": ("time", [1.0, 8.0])},
+    ...                 coords={"time": [0.0, 0.1]})
+    >>> ownship_table(ds).drop(columns="utc").to_dict("list")
+    {'time_s': [0.0, 0.1], 'nav_north_m': [1.0, 8.0], 'own_north_m': [0.0, 9.0]}
+    """
+    cols = _clock(ds)
+    for prefix in ("nav_", "own_"):
+        for name in sorted(str(v) for v in ds.data_vars):
+            if name.startswith(prefix) and ds[name].dims == ("time",):
+                cols[name] = np.asarray(ds[name].values)
+    return pd.DataFrame(cols)
+
+
+def intruder_table(ds: xr.Dataset, head_views: dict[str, xr.Dataset] | None = None) -> pd.DataFrame:
+    """Intruder truth (``tgt_*``) in long form: one row per frame and intruder.
+
+    ``head_views`` (head name to that head's Dataset) adds the head-dependent variables of each
+    head as ``<variable>@<head>`` columns.
+
+    Examples
+    --------
+    >>> ds = xr.Dataset({"tgt_north_m": (("time", "target"), [[1.0, 2.0], [3.0, 4.0]])},
+    ...                 coords={"time": [0.0, 0.1], "target": ["A", "B"]})
+    >>> intruder_table(ds)[["time_s", "target", "tgt_north_m"]].values.tolist()
+    [[0.0, 'A', 1.0], [0.0, 'B', 2.0], [0.1, 'A', 3.0], [0.1, 'B', 4.0]]
+    """
+    names = [str(v) for v in ds.data_vars if str(v).startswith("tgt_") and ds[v].dims == ("time", "target")]
+    if not names:
+        return pd.DataFrame({"time_s": pd.Series(dtype=float), "target": pd.Series(dtype=str)})
+    n_t, n_tgt = ds[names[0]].shape
+    clock = _clock(ds)
+    cols = {"time_s": np.repeat(clock["time_s"], n_tgt), "utc": np.repeat(clock["utc"], n_tgt)}
+    targets = ds["target"].values if "target" in ds.coords else np.array([f"T{i}" for i in range(n_tgt)])
+    cols["target"] = np.tile(np.array([str(v) for v in targets], dtype=object), n_t)  # any string dtype
+    cols["target_index"] = np.tile(np.arange(n_tgt), n_t)
+    for name in names:
+        cols[name] = np.asarray(ds[name].values).ravel()
+    for head, view in (head_views or {}).items():
+        for name in names:
+            if name in view and not np.array_equal(view[name].values, ds[name].values, equal_nan=True):
+                cols[f"{name}@{head}"] = np.asarray(view[name].values).ravel()
+    return pd.DataFrame(cols)
+
+
+def export_paths(output: str | Path) -> tuple[Path, Path]:
+    """(own-ship table, intruder table) for ``output``: a folder gets ``ownship.parquet`` and
+    ``intruders.parquet``; a ``NAME.parquet`` file is the own-ship table, ``NAME.intruders.parquet``
+    beside it the intruders.
+
+    Examples
+    --------
+    >>> [p.as_posix() for p in export_paths("out/run1")]
+    ['out/run1/ownship.parquet', 'out/run1/intruders.parquet']
+    >>> [p.name for p in export_paths("run1.parquet")]
+    ['run1.parquet', 'run1.intruders.parquet']
+    """
+    output = Path(output)
+    if output.suffix.lower() == ".parquet":
+        return output, output.with_name(output.name[: -len(".parquet")] + ".intruders.parquet")
+    return output / "ownship.parquet", output / "intruders.parquet"

@@ -1,0 +1,59 @@
+"""`skyradar export`: own-ship navigation and truth, and intruder truth, of a run as Parquet tables."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from cli_helpers import assert_one_line_error, skyradar
+from skyradar.io.frames import FrameStoreWriter
+from skyradar.io.run_export import intruder_table
+from skyradar.web.sample import sample_run_dataset
+
+
+def _write_run(path, n_frames: int = 8):
+    """The web sample run with a navigation solution beside the truth (GNSS 2.5 m north, 0.01 rad yaw)."""
+    ds = sample_run_dataset(n_frames=n_frames)
+    ds = ds.assign(nav_north_m=ds["own_north_m"] + 2.5, nav_yaw_rad=ds["own_yaw_rad"] + 0.01)
+    ds.attrs |= {"origin_lat_deg": 47.0, "origin_lon_deg": 11.0, "start_time": "2026-05-01T10:00:00Z"}
+    writer = FrameStoreWriter(path, ds.assign(iq=ds["iq"].chunk({"time": 4})), 4, fingerprint="export-test")
+    for k in writer.pending_chunks():
+        writer.write_chunk(k, ds["iq"].values[writer.chunk_slice(k)])
+    writer.close()
+    return ds
+
+
+def test_export_writes_navigation_truth_and_intruders(tmp_path):
+    ds = _write_run(tmp_path / "run.zarr")
+    result = skyradar("export", "run.zarr", "-o", "tables", "--json", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    out = json.loads(result.stdout.strip().splitlines()[-1])
+    assert (out["ownship_rows"], out["intruder_rows"], out["targets"], out["navigation"]) == (8, 16, 2, True)
+    own = pd.read_parquet(tmp_path / "tables" / "ownship.parquet")
+    np.testing.assert_array_equal(own["nav_north_m"], ds["own_north_m"].values + 2.5)  # navigation
+    np.testing.assert_array_equal(own["own_north_m"], ds["own_north_m"].values)  # and truth, side by side
+    assert own["utc"].iloc[1] == pd.Timestamp("2026-05-01T10:00:01Z")
+    intr = pd.read_parquet(tmp_path / "tables" / "intruders.parquet")
+    crossing = intr[intr["target"] == "crossing"]
+    np.testing.assert_array_equal(crossing["tgt_east_m"], ds["tgt_east_m"].sel(target="crossing").values)
+    bad = skyradar("export", "tables", "-o", "again", cwd=tmp_path)  # a folder of tables is not a run
+    assert_one_line_error(bad, "tables")
+
+
+def test_intruder_table_adds_each_heads_view():
+    ds = sample_run_dataset(n_frames=3)
+    left = ds.assign(tgt_visible=~ds["tgt_visible"])
+    table = intruder_table(ds, {"left": left, "same": ds})
+    assert "tgt_visible@left" in table and "tgt_visible@same" not in table  # only what differs
+    np.testing.assert_array_equal(table["tgt_visible@left"], ~table["tgt_visible"])
+    assert table[["time_s", "target_index"]].values.tolist()[:3] == [[0.0, 0], [0.0, 1], [1.0, 0]]
+
+
+@pytest.mark.parametrize("name", ["run.parquet"])
+def test_export_paths_beside_a_parquet_name(name):
+    from skyradar.io.run_export import export_paths
+
+    assert [p.name for p in export_paths(name)] == ["run.parquet", "run.intruders.parquet"]

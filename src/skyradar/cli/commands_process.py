@@ -51,10 +51,23 @@ _PfaOpt = Annotated[
     typer.Option("--pfa", callback=PROBABILITY, help="CFAR false-alarm probability per pixel, in (0, 1)."),
 ]
 _TerrainOpt = Annotated[
-    Path | None, typer.Option("--terrain", help="DEM (.hgt/.tif/.npz) for the ground filter's height test.")
+    str | None,
+    typer.Option(
+        "--terrain",
+        help="Ground for the ground filter: a DEM file (.hgt/.tif/.npz) or flat, fractal, jacksboro, none "
+        "(default: the scenario terrain the run records, if any).",
+    ),
 ]
 _RadarConfigOpt = Annotated[
     Path | None, typer.Option("--radar-config", help="RadarConfig JSON (e.g. from `skyradar calibrate`).")
+]
+_SuppressionOpt = Annotated[
+    str,
+    typer.Option(
+        "--suppression",
+        help="Ground clutter suppression before detection: auto (where the run has own-ship velocity, "
+        "attitude and height above ground), knowledge-aided (required), none.",
+    ),
 ]
 _SchedulerOpt = Annotated[str | None, typer.Option(help="Address of an existing Dask scheduler.")]
 _WorkersOpt = Annotated[
@@ -75,6 +88,7 @@ def process(
     pfa: _PfaOpt = 2e-8,
     terrain: _TerrainOpt = None,
     radar_config: _RadarConfigOpt = None,
+    suppression: _SuppressionOpt = "auto",
     scheduler: _SchedulerOpt = None,
     workers: _WorkersOpt = None,
     chunk_frames: _ChunkFramesOpt = 64,
@@ -96,17 +110,19 @@ def process(
 
     check_choice("--method", method, ("cfar", "os-cfar", "shi-tomasi"))
     check_choice("--spur-mode", spur_mode, ("mask", "flag"))
-    check_output(output, [run, spur_map, terrain, radar_config], overwrite, kind="table")
+    check_choice("--suppression", suppression, ("auto", "knowledge-aided", "none"))
+    dem_path = Path(terrain) if terrain is not None and Path(terrain).exists() else None
+    check_output(output, [run, spur_map, dem_path, radar_config], overwrite, kind="table")
     ds = open_frames(run)
     config = _read_config(radar_config) if radar_config is not None else radar_config_of(ds, str(run))
     spurs = SpurMap.load(spur_map, config) if spur_map is not None else None
-    dem = _terrain_window(terrain, ds, config, run) if terrain is not None else None
+    dem = _terrain_window(terrain, ds, config, run)
     bar, task = _progress(ds.sizes["time"] * len(store_heads(run) or [run]), "frames")
     with bar:  # every radar head of the run, one table with a `radar` column (skyradar.io.frames_heads)
         table, configs = detect_run_heads(
             run, None if radar_config is None else config, lambda n: bar.update(task, completed=n),
             spurs=spurs, terrain=dem, method=method, spur_mode=spur_mode, pfa=pfa, scheduler=scheduler,
-            workers=workers, chunk_frames=chunk_frames,
+            workers=workers, chunk_frames=chunk_frames, suppression=suppression,
         )  # fmt: skip
     # The own-ship signature lets `alert` check that the tracks and its --ownship run belong together.
     meta = {"radar_config": config.to_json(), "source": str(run)}
@@ -117,11 +133,15 @@ def process(
     emit_result(detection_summary(table, ds.sizes["time"]) | {"output": str(output)}, as_json, "detections")
 
 
-def _terrain_window(terrain: Path, ds, config, run: Path):
-    from skyradar.scene.dem_coverage import dem_for_run
+def _terrain_window(terrain: str | None, ds, config, run: Path):
+    from skyradar.scene.terrain_names import recorded_terrain, terrain_for_run
 
-    # Only the window the own-ship can see is read; a DEM away from the track is refused.
-    return dem_for_run(terrain, ds, config.range_limit_m, str(run))
+    if terrain is None:  # the scenario terrain the run was simulated over, if it records one
+        return recorded_terrain(ds, str(run))
+    if terrain.strip().lower() == "none":
+        return None
+    # Only the window the own-ship can see is read; a terrain away from the track is refused.
+    return terrain_for_run(terrain, ds, config.range_limit_m, str(run))
 
 
 def _read_config(path: Path):

@@ -35,7 +35,7 @@ from numba import njit
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
-from skyradar.process.cfar import cfar_2d, cfar_factor
+from skyradar.process.cfar import cfar_2d, cfar_2d_floor, cfar_factor
 from skyradar.process.power import power_image
 
 __all__ = [
@@ -238,6 +238,14 @@ def _shi_tomasi_blobs(power: np.ndarray, noise_power_w: float, min_snr_db: float
     return blob_peaks(grow | seeds, power, seeds)
 
 
+def _suppressed_cfar(power, config, channels, exclude, train_exclude, guard, train, pfa):
+    """CA-CFAR of a clutter-suppressed image: spur pixels out of everything, clutter out of training."""
+    skip = exclude if train_exclude is None else train_exclude
+    skip = skip if exclude is None or train_exclude is None else exclude | train_exclude
+    hits, noise_map = cfar_2d_floor(power, channels, config.noise_power_w, skip, guard, train, pfa)
+    return (hits if exclude is None else hits & ~exclude), noise_map
+
+
 def detect(
     power: np.ndarray,
     config: RadarConfig,
@@ -248,6 +256,8 @@ def detect(
     min_snr_db: float = 12.0,
     use_cfar_noise: bool = True,
     exclude: np.ndarray | None = None,
+    channels: np.ndarray | None = None,
+    train_exclude: np.ndarray | None = None,
 ) -> Detections:
     """Detect objects in a channel-integrated power image: one detection per blob.
 
@@ -266,6 +276,10 @@ def detect(
         SNR against the CFAR noise estimate (True) or against ``config.noise_power_w``.
     exclude : ndarray of bool, optional
         Pixels never detected and left out of CFAR training (e.g. ``SpurMap.mask``).
+    channels, train_exclude : ndarray, optional
+        A clutter-suppressed image (:mod:`skyradar.process.clutter_suppress`): channels left per
+        pixel and pixels kept out of CFAR training only; CA-CFAR then uses
+        :func:`skyradar.process.cfar.cfar_2d_floor` (calibrated noise floor).
     """
     power = np.asarray(power, dtype=np.float32)
     if power.shape != (config.n_range, config.n_doppler):
@@ -273,7 +287,11 @@ def detect(
             f"frame: power image shape {power.shape} does not match radar_config "
             f"{(config.n_range, config.n_doppler)}"
         )
-    if method in ("cfar", "os-cfar"):
+    if channels is not None and method == "cfar":
+        hits, noise_map = _suppressed_cfar(power, config, channels, exclude, train_exclude, guard, train, pfa)
+        r, d = blob_peaks(hits, power)
+        noise = noise_map[r, d] if use_cfar_noise else np.full(r.size, config.noise_power_w, np.float32)
+    elif method in ("cfar", "os-cfar"):
         kind = "ca" if method == "cfar" else "os"
         hits, noise_map = cfar_2d(power, guard, train, pfa, kind, config.n_rx, exclude=exclude)
         r, d = blob_peaks(hits, power)

@@ -39,17 +39,19 @@ def detect_run(
     chunk_frames: int = 64,
     progress: Callable[[int], None] | None = None,
     head: str | None = None,
+    suppression: str = "none",
 ) -> pd.DataFrame:
     """Detections table of the frames run at ``run`` (opened as ``ds``; radar ``head`` of it).
 
     Without ``scheduler`` and ``workers`` the frames are processed here; else in chunks of
     ``chunk_frames`` on an existing Dask scheduler or a local cluster of ``workers``. ``progress``
-    is called with the number of frames done so far.
+    is called with the number of frames done so far. ``suppression``: see :func:`process_frames`.
     """
     if scheduler is None and not workers:
         return process_frames(
-            ds, spurs, terrain, method, spur_mode, progress=progress, source=str(run), config=config, pfa=pfa
-        )
+            ds, spurs, terrain, method, spur_mode, progress=progress, source=str(run), config=config, pfa=pfa,
+            suppression=suppression,
+        )  # fmt: skip
     done = 0
 
     def advance(n: int) -> None:
@@ -58,7 +60,9 @@ def detect_run(
         if progress:
             progress(done)
 
-    job = functools.partial(process_chunk if head is None else _head_chunk, config=config, pfa=pfa)
+    job = functools.partial(
+        process_chunk if head is None else _head_chunk, config=config, pfa=pfa, suppression=suppression
+    )
     job = job if head is None else functools.partial(job, head=head)
     parts = map_frame_chunks(
         job, str(run), ds.sizes["time"], max(1, chunk_frames), spurs, terrain, method, spur_mode,

@@ -3,11 +3,13 @@
 One row per detection per frame with the columns of :data:`DETECTION_COLUMNS` (SI units,
 radians). ``range_m`` is the apparent range of the peak (bin ``k`` at ``k * dR``): the sawtooth
 range-Doppler coupling (``v * fc / (B PRF)``, 0.19 m per m/s) is left in because the measured
-radial velocity may be aliased. World coordinates need own-ship truth in the Dataset
-(``own_*`` variables); the scenario's geodetic origin is read from the attributes
+radial velocity may be aliased. World coordinates need the own-ship navigation state in the
+Dataset (``nav_*`` variables, GNSS/AHRS with errors, via :func:`skyradar.io.navigation.navigation_state`;
+``own_*`` truth only in stores written before navigation existed, with a logged note and
+``table.attrs["navigation_source"] == "truth"``); the scenario's geodetic origin is read from the attributes
 ``origin_lat_deg``, ``origin_lon_deg``, ``origin_alt_m`` (or ``origin`` as a list) when present,
 otherwise latitude/longitude/altitude are taken relative to the own-ship position (about 2 m off
-at 5 km from the origin). Without own-ship truth those columns are NaN.
+at 5 km from the origin). Without an own-ship state those columns are NaN.
 
 Examples
 --------
@@ -38,17 +40,17 @@ from skyradar.geo import ned_rotation_to, ned_to_geodetic, rotation_matrix
 from skyradar.io.checks import check_finite_frames
 from skyradar.io.frames import radar_config_of
 from skyradar.io.frames_model import frame_times_s
+from skyradar.io.navigation import navigation_state
 from skyradar.io.run_origin import scenario_origin  # re-exported: it lived here before issue 16
-from skyradar.process.calibration import in_field_of_view
+from skyradar.process.clutter_frames import detect_suppressed, frame_clutter
 from skyradar.process.detect import detect, integrate_channels
 from skyradar.process.doa import (
     angles_from_direction,
     antenna_to_body,
     direction_coherence,
-    doa_crlb,
     estimate_directions,
 )
-from skyradar.process.ground import classify_ground, height_above_ground_m, in_ground_band
+from skyradar.process.ground import flag_ground, height_above_ground_m, surface_height_fn
 from skyradar.process.spurs import SpurMap
 
 __all__ = ["DETECTION_COLUMNS", "process_chunk", "process_cube", "process_frames", "scenario_origin"]
@@ -69,13 +71,15 @@ def process_cube(
     spur_map: SpurMap | None = None,
     method: Literal["cfar", "os-cfar", "shi-tomasi"] = "cfar",
     spur_mode: Literal["mask", "flag"] = "mask",
+    clutter: Any = None,
     **detect_kwargs: Any,
 ) -> dict[str, np.ndarray]:
     """Detection and DoA for one (n_range, n_doppler, n_rx) frame, antenna and body frames.
 
     With a spur map, ``spur_mode="mask"`` removes spur pixels before detection (they are neither
     detected nor used as CFAR training cells, so an object beside a spur line stays visible);
-    ``"flag"`` detects as usual and marks detections whose peak is in the map (thesis).
+    ``"flag"`` detects as usual and marks detections whose peak is in the map (thesis). With
+    ``clutter`` (a :class:`skyradar.process.clutter.ClutterSubspace`) ground clutter is suppressed first.
 
     Returns a dict of equal-length arrays: the detection columns up to ``z_body_m`` plus
     ``spur``, ``u_ant`` (n, 3) unit vectors and ``coherence`` (:func:`.direction_coherence`).
@@ -84,14 +88,18 @@ def process_cube(
         raise InputError(f"frame: field 'rx' has {cube.shape[-1]} channels, radar_config has {config.n_rx}")
     if spur_mode not in ("mask", "flag"):
         raise InputError(f"process: field 'spur_mode' must be 'mask' or 'flag', got {spur_mode!r}")
-    power = integrate_channels(cube, config.rx_calibration)
     masking = spur_map is not None and spur_mode == "mask"
-    det = detect(power, config, method=method, exclude=spur_map.mask if masking else None, **detect_kwargs)
-    u = estimate_directions(cube[det.range_index, det.doppler_index], config)
+    exclude = spur_map.mask if masking else None
+    if clutter is not None:  # a ClutterSubspace: knowledge-aided suppression before detection
+        det, u, coherence = detect_suppressed(cube, config, clutter, exclude, method, **detect_kwargs)
+    else:
+        power = integrate_channels(cube, config.rx_calibration)
+        det = detect(power, config, method=method, exclude=exclude, **detect_kwargs)
+        u = estimate_directions(cube[det.range_index, det.doppler_index], config)
+        coherence = direction_coherence(cube[det.range_index, det.doppler_index], u, config)
     range_m = det.range_m(config)
     body = antenna_to_body(range_m[:, None] * u, config)
     az, el = angles_from_direction(u)
-    coherence = direction_coherence(cube[det.range_index, det.doppler_index], u, config)
     spur = (
         spur_map.contains(det.range_bin, det.doppler_bin)
         if spur_map is not None
@@ -115,15 +123,32 @@ def process_cube(
     }
 
 
-def _own_state(ds: xr.Dataset) -> dict[str, np.ndarray] | None:
-    if not all(name in ds for name in _OWN):
+def _own_state(ds: xr.Dataset, source: str = "frames") -> dict[str, np.ndarray] | None:
+    """Own-ship state per frame as the aircraft knows it: the navigation solution, never the truth.
+
+    :func:`skyradar.io.navigation.navigation_state` reads ``nav_*`` (``own_*`` only for stores
+    written before navigation existed); keys keep the own-ship table's ``own_*`` names.
+    """
+    nav = navigation_state(ds, source)
+    if nav is None or not all(name in nav for name in _OWN):
         return None
-    state = {name: np.asarray(ds[name].values, float) for name in _OWN}
+    state = {name: nav[name].to_numpy(float) for name in _OWN}
     for name in _ATT + _GEO:
         missing = np.nan if name == "own_height_agl_m" else 0.0  # unknown height stays unknown
-        state[name] = np.asarray(ds[name].values, float) if name in ds else np.full(ds.sizes["time"], missing)
-    state["has_geo"] = np.array(all(name in ds for name in _GEO))
+        state[name] = nav[name].to_numpy(float) if name in nav else np.full(len(nav), missing)
+    state["has_geo"] = np.array(all(name in nav for name in _GEO))
+    state["navigation_source"] = nav.attrs["navigation_source"]
     return state
+
+
+def _body_to_ned(own: dict[str, np.ndarray], i: int, origin: tuple | None) -> np.ndarray:
+    """Rotation of frame ``i`` from the body frame to the scenario NED frame."""
+    body_to_ned = rotation_matrix(own["own_yaw_rad"][i], own["own_pitch_rad"][i], own["own_roll_rad"][i])
+    if origin is not None and bool(own["has_geo"]):
+        # Attitude is relative to the local vertical at the aircraft (as in the simulator).
+        lat, lon = own["own_lat_deg"][i], own["own_lon_deg"][i]
+        body_to_ned = ned_rotation_to(origin[0], origin[1], lat, lon).T @ body_to_ned
+    return body_to_ned
 
 
 def _to_world(
@@ -131,14 +156,8 @@ def _to_world(
 ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray]:
     """NED position, geodetic position and NED unit direction of one frame's detections."""
     pos = np.array([own["own_north_m"][i], own["own_east_m"][i], own["own_down_m"][i]])
-    body_to_ned = rotation_matrix(own["own_yaw_rad"][i], own["own_pitch_rad"][i], own["own_roll_rad"][i])
+    body_to_ned = _body_to_ned(own, i, origin)
     has_geo = bool(own["has_geo"])
-    if origin is not None and has_geo:
-        # Attitude is relative to the local vertical at the aircraft (as in the simulator).
-        body_to_ned = (
-            ned_rotation_to(origin[0], origin[1], own["own_lat_deg"][i], own["own_lon_deg"][i]).T
-            @ body_to_ned
-        )
     body = np.stack([out["x_body_m"], out["y_body_m"], out["z_body_m"]], axis=1)
     ned = pos + body @ body_to_ned.T
     u_ned = out["u_ant"] @ (body_to_ned @ config.mount.rotation).T
@@ -158,35 +177,35 @@ def _ground_flags(
     u_ned: np.ndarray | None,
     config: RadarConfig,
     terrain: Any,
+    origin: tuple | None = None,
 ) -> np.ndarray:
-    """Ground filter of one frame: DoA-based where the direction is trustworthy, range-Doppler otherwise."""
+    """Ground filter of one frame (:func:`skyradar.process.ground.flag_ground`).
+
+    The surface is the terrain (DEM) under each detection, else (and beyond the DEM) a flat
+    ground at the terrain height under the own-ship, from its navigated height above ground or
+    the DEM; with neither, nothing is ground.
+    """
     n = len(out["range_m"])
-    if own is None:
+    if own is None or n == 0:
         return np.zeros(n, bool)
-    vel = np.array([own[k][i] for k in _OWN[3:]])
     own_agl = float(own["own_height_agl_m"][i])
-    if not np.isfinite(own_agl) and terrain is not None and bool(own["has_geo"]):
-        lat, lon = own["own_lat_deg"][i], own["own_lon_deg"][i]
-        own_agl = float(height_above_ground_m([lat], [lon], [own["own_alt_m"][i]], terrain)[0])
-    height = None
-    if terrain is not None:
-        height = height_above_ground_m(out["lat_deg"], out["lon_deg"], out["alt_m"], terrain)
-    elif np.isfinite(own_agl):
-        # No DEM: a flat ground at the height of the terrain under the own-ship.
-        height = own["own_down_m"][i] + own_agl - out["down_m"]
-    # Tolerances follow each detection's own DoA uncertainty (the Cramer-Rao bound at its SNR).
-    sd_az, sd_el = doa_crlb(out["snr_db"], out["azimuth_rad"], out["elevation_rad"], config)
-    sigma = np.clip(np.nan_to_num(np.maximum(sd_az, sd_el), nan=0.2), np.radians(0.2), np.radians(10.0))
-    ground = classify_ground(out["range_m"], out["radial_velocity_mps"], u_ned, config, vel, height, sigma)
-    # A direction outside the field of view (or one plane wave explaining the pixel badly) comes
-    # from a pixel mixing returns from several directions, typically ground left and right of
-    # the track: judge those by whether the ground can produce their range and Doppler at all.
-    unreliable = ~in_field_of_view(out["azimuth_rad"], out["elevation_rad"], config, 12.0)
-    unreliable |= out["coherence"] < 0.5
-    if np.isfinite(own_agl):
-        band = in_ground_band(out["range_m"], out["radial_velocity_mps"], vel, own_agl, config)
-        ground = np.where(unreliable, band, ground)
-    return ground
+    pos = np.array([own["own_north_m"][i], own["own_east_m"][i], own["own_down_m"][i]])
+    geo_ref = (float(own["own_lat_deg"][i]), float(own["own_lon_deg"][i]), float(own["own_alt_m"][i]))
+    located = origin is not None or bool(own["has_geo"])
+
+    def geodetic(points: np.ndarray):
+        if origin is not None:
+            return ned_to_geodetic(points, *origin)
+        return ned_to_geodetic(points - pos, *geo_ref)
+
+    if terrain is not None and located and not np.isfinite(own_agl):
+        own_agl = float(height_above_ground_m(*geodetic(pos[None]), terrain)[0])
+    if not np.isfinite(own_agl):
+        return np.zeros(n, bool)  # no terrain, no own-ship height: Doppler alone cannot decide
+    height_fn = surface_height_fn(pos[2] + own_agl, terrain if located else None, geodetic)
+    vel = np.array([own[k][i] for k in _OWN[3:]])
+    ant_to_ned = _body_to_ned(own, i, origin) @ config.mount.rotation
+    return flag_ground(out, u_ned, vel, ant_to_ned, height_fn, own_agl, config)
 
 
 def process_chunk(path: str, start: int, stop: int, *args: Any, **kwargs: Any) -> pd.DataFrame:
@@ -233,7 +252,7 @@ def _located(out: dict, time_s: float, i: int, own, origin, config: RadarConfig,
         ned, geo, u_ned = _to_world(out, own, i, config, origin)
     out.update(north_m=ned[:, 0], east_m=ned[:, 1], down_m=ned[:, 2])
     out.update(lat_deg=np.asarray(geo[0]), lon_deg=np.asarray(geo[1]), alt_m=np.asarray(geo[2]))
-    out["is_ground"] = _ground_flags(out, own, i, u_ned, config, terrain)
+    out["is_ground"] = _ground_flags(out, own, i, u_ned, config, terrain, origin)
     return out
 
 
@@ -247,6 +266,7 @@ def process_frames(
     batch_frames: int = 16,
     source: str = "frames",
     config: RadarConfig | None = None,
+    suppression: str = "none",
     **detect_kwargs: Any,
 ) -> pd.DataFrame:
     """Detections table of a frames Dataset (see the module docstring for the columns).
@@ -264,10 +284,13 @@ def process_frames(
         Called with the number of frames finished after each batch.
     config : RadarConfig, optional
         Overrides the run's stored RadarConfig (e.g. one calibrated later); must fit the frames.
+    suppression : {"none", "knowledge-aided", "auto"}
+        Ground clutter suppression before detection (:mod:`skyradar.process.clutter_frames`):
+        "auto" suppresses where the own-ship state allows, "knowledge-aided" requires it.
     """
     config = _checked_config(ds, config, spur_map, source)
     n_frames = ds.sizes["time"]
-    own, origin = _own_state(ds), scenario_origin(ds)
+    own, origin = _own_state(ds, source), scenario_origin(ds)
     times = frame_times_s(ds)
     rows: list[dict[str, np.ndarray]] = []
     for start in range(0, n_frames, batch_frames):
@@ -276,11 +299,13 @@ def process_frames(
         for offset, cube in enumerate(block):
             i = start + offset
             try:
-                out = process_cube(cube, config, spur_map, method, spur_mode, **detect_kwargs)
+                clutter = frame_clutter(suppression, own, i, config, terrain, source)
+                out = process_cube(cube, config, spur_map, method, spur_mode, clutter, **detect_kwargs)
             except InputError as exc:  # e.g. CFAR windows that do not fit: say which run
                 raise InputError(f"{source}: {exc}") from None
             rows.append(_located(out, times[i], i, own, origin, config, terrain))
         if progress is not None:
             progress(min(start + batch_frames, n_frames))
-    table = {c: np.concatenate([r[c] for r in rows]) for c in DETECTION_COLUMNS}
-    return pd.DataFrame(table)[DETECTION_COLUMNS]
+    table = pd.DataFrame({c: np.concatenate([r[c] for r in rows]) for c in DETECTION_COLUMNS})
+    table.attrs["navigation_source"] = None if own is None else str(own["navigation_source"])
+    return table

@@ -1,0 +1,228 @@
+"""Clutter suppression inside the frames pipeline: per-frame geometry (cached) and DoA after projection.
+
+:func:`frame_subspace` turns one frame's navigation state (the own-ship dict of
+:mod:`skyradar.process.pipeline`: velocity, attitude, height above ground, optional terrain) into
+the predicted clutter subspace. Over flat ground the prediction depends on the velocity in the
+body frame, pitch, roll and height only, so it is cached on those (rounded to 0.05 m/s, 0.05 deg
+and 1 m): a straight level flight computes it once. With a terrain it depends on the position
+too (rounded to 30 m).
+
+:func:`directions_after_projection` estimates the direction of a detection whose cell was
+projected: the unit vector maximising ``|s^H P z|^2 / (s^H P s)`` (the projected matched filter)
+on a 2 deg grid over the field of view, refined on a 0.05 deg grid (+-1.5 deg); the plain phase estimate of
+the unsuppressed snapshot would follow the clutter that dominates the cell. With two nulls
+elevation is often unobservable (see the function).
+
+Examples
+--------
+>>> from skyradar.config import RadarConfig
+>>> from skyradar.process.doa import direction_from_angles, steering_vector
+>>> cfg = RadarConfig.prototype_2022()
+>>> z = steering_vector(direction_from_angles(0.2, -0.1), cfg)[None]
+>>> u = directions_after_projection(z, np.eye(4)[None], cfg)
+>>> np.degrees(np.arctan2(u[0, 1], u[0, 0])).round(1), np.degrees(np.arcsin(-u[0, 2])).round(1)
+(np.float64(11.5), np.float64(-5.7))
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from typing import Any
+
+import numpy as np
+
+from skyradar.config import RadarConfig
+from skyradar.errors import InputError
+from skyradar.geo import rotation_matrix
+from skyradar.process.clutter import ClutterSubspace, clutter_subspace
+from skyradar.process.clutter_suppress import projected_snapshots, suppress_clutter
+from skyradar.process.detect import Detections, detect
+from skyradar.process.doa import (
+    direction_coherence,
+    direction_from_angles,
+    estimate_directions,
+    steering_vector,
+)
+
+__all__ = [
+    "frame_subspace",
+    "frame_clutter",
+    "directions_after_projection",
+    "detect_suppressed",
+    "SUPPRESSIONS",
+]
+
+SUPPRESSIONS = ("none", "knowledge-aided", "auto")
+_CACHE: OrderedDict[tuple, ClutterSubspace] = OrderedDict()
+
+
+def _depth_fn(terrain: Any, lat_deg: float, lon_deg: float, alt_m: float):
+    """Ground depth below the radar at NED offsets, from a terrain's ``height_at(lat, lon)``."""
+    height_at = terrain.height_at if hasattr(terrain, "height_at") else terrain
+    m_lat = 111_132.954 - 559.822 * np.cos(2 * np.radians(lat_deg))  # metres per degree (WGS84 series)
+    m_lon = 111_412.84 * np.cos(np.radians(lat_deg))
+
+    def depth(dn: np.ndarray, de: np.ndarray) -> np.ndarray:
+        h = np.asarray(height_at(lat_deg + dn / m_lat, lon_deg + de / m_lon), float)
+        return alt_m - np.where(np.isfinite(h), h, alt_m - 1e9)  # outside the DEM: no ground
+
+    return depth
+
+
+def frame_subspace(
+    own: dict[str, np.ndarray], i: int, config: RadarConfig, terrain: Any = None
+) -> ClutterSubspace | None:
+    """Predicted clutter subspace of frame ``i`` (None when the height above ground is unknown)."""
+    yaw, pitch, roll = (float(own[k][i]) for k in ("own_yaw_rad", "own_pitch_rad", "own_roll_rad"))
+    v_ned = np.array([own[k][i] for k in ("own_vn_mps", "own_ve_mps", "own_vd_mps")], float)
+    height = float(own["own_height_agl_m"][i])
+    geo = bool(own["has_geo"]) and terrain is not None
+    if not np.isfinite(height) and not geo:
+        return None
+    if geo:
+        lat, lon, alt = (float(own[k][i]) for k in ("own_lat_deg", "own_lon_deg", "own_alt_m"))
+        key = ("terrain", id(terrain), round(lat * 3600), round(lon * 3600), round(alt), round(yaw, 3))
+        depth_fn = _depth_fn(terrain, lat, lon, alt)
+        height = float(depth_fn(np.zeros(1), np.zeros(1))[0])
+        body_to_ned = rotation_matrix(yaw, pitch, roll)
+    else:
+        # Flat ground is the same in every direction: work in a heading-free frame.
+        body_to_ned = rotation_matrix(0.0, pitch, roll)
+        v_ned = rotation_matrix(yaw, 0.0, 0.0).T @ v_ned
+        depth_fn = None
+        key = ("flat", *np.round(v_ned / 0.05).astype(int), round(np.degrees(pitch) / 0.05),
+               round(np.degrees(roll) / 0.05), round(height))  # fmt: skip
+    key = (*key, id(config))
+    hit = _CACHE.get(key)
+    if hit is not None:
+        _CACHE.move_to_end(key)
+        return hit
+    ant_to_ned = body_to_ned @ config.mount.rotation
+    sub = clutter_subspace(config, v_ned, ant_to_ned, height, depth_fn, n_azimuth=720)
+    _CACHE[key] = sub
+    while len(_CACHE) > 4:
+        _CACHE.popitem(last=False)
+    return sub
+
+
+def _grid(az_deg: np.ndarray, el_deg: np.ndarray) -> tuple[np.ndarray, tuple[int, int]]:
+    a, e = np.meshgrid(np.radians(az_deg), np.radians(el_deg), indexing="ij")
+    return direction_from_angles(a.ravel(), e.ravel()), a.shape
+
+
+_COARSE: dict[int, tuple[RadarConfig, np.ndarray, np.ndarray, tuple[int, int]]] = {}
+_PLANE_WAVE = 0.9  # unsuppressed coherence above which the plain DoA is kept in a projected cell
+_OBSERVABLE_DB = 1.0  # normalised score contrast along elevation below which elevation is unobservable
+
+
+def _coarse(config: RadarConfig) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
+    hit = _COARSE.get(id(config))
+    if hit is None or hit[0] is not config:
+        u, shape = _grid(np.arange(-70.0, 70.5, 2.0), np.arange(-70.0, 70.5, 2.0))
+        hit = (config, u, steering_vector(u, config), shape)
+        _COARSE.clear()
+        _COARSE[id(config)] = hit
+    return hit[1], hit[2], hit[3]
+
+
+def directions_after_projection(pixels: np.ndarray, proj: np.ndarray, config: RadarConfig) -> np.ndarray:
+    """Antenna-frame unit vectors (n, 3) of calibrated snapshots (n, n_rx) seen through ``proj``.
+
+    Where the nulls take the elevation dimension (a pair of clutter directions left and right at
+    one elevation spans both azimuth phases: the projected matched filter is flat in elevation
+    within ``_OBSERVABLE_DB``), elevation is unobservable in that cell and the detection is
+    placed in the antenna's horizontal plane (elevation 0, co-altitude for a level forward
+    radar): a prior, not a measurement; the azimuth is still measured.
+    """
+    out = np.zeros((len(pixels), 3))
+    u_c, s_c, shape = _coarse(config)
+    fine_off = np.arange(-1.5, 1.525, 0.05)
+    for n, (z, p) in enumerate(zip(pixels, proj, strict=True)):
+        score = _score(s_c, z, p).reshape(shape)
+        ia, ie = np.unravel_index(np.argmax(score), shape)
+        along_el = score[ia]
+        best = u_c[np.ravel_multi_index((ia, ie), shape)]
+        az, el = np.degrees(np.arctan2(best[1], best[0])), np.degrees(np.arcsin(-best[2]))
+        if 10 * np.log10(along_el.max() / max(np.median(along_el), 1e-300)) < _OBSERVABLE_DB:
+            fine, _ = _grid(az + fine_off, np.zeros(1))
+        else:
+            fine, _ = _grid(az + fine_off, el + fine_off)
+        out[n] = fine[np.argmax(_score(steering_vector(fine, config), z, p))]
+    return out
+
+
+def _score(steer: np.ndarray, z: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Projected matched filter ``|s^H P z|^2 / (s^H P s)`` for rows ``s`` of ``steer``."""
+    ps = steer @ p.T  # rows: (P s)^T, P Hermitian
+    num = np.abs(np.conj(ps) @ z) ** 2
+    return num / np.maximum(np.sum(np.abs(ps) ** 2, axis=1), 1e-9)
+
+
+def detect_suppressed(
+    cube: np.ndarray,
+    config: RadarConfig,
+    clutter: ClutterSubspace,
+    exclude: np.ndarray | None = None,
+    method: str = "cfar",
+    **detect_kwargs: Any,
+) -> tuple[Detections, np.ndarray, np.ndarray]:
+    """Detections, antenna-frame directions and coherence of one frame after clutter suppression.
+
+    Detection runs on the projected, renormalised image (CA-CFAR with each pixel's channel count,
+    training outside unsuppressed clutter, :func:`skyradar.process.cfar.cfar_2d_floor`); cells
+    that were not projected, or where one plane wave explains the unsuppressed snapshot (coherence
+    >= 0.9: the target dominates the clutter), keep the plain DoA of
+    :func:`skyradar.process.doa.estimate_directions`.
+    """
+    sup = suppress_clutter(cube, clutter, config)
+    det = detect(
+        sup.power, config, method=method, exclude=exclude, channels=sup.channels,
+        train_exclude=sup.unsuppressed, **detect_kwargs,
+    )  # fmt: skip
+    pixels = cube[det.range_index, det.doppler_index]
+    u = estimate_directions(pixels, config)
+    coherence = direction_coherence(pixels, u, config)
+    nulls = sup.nulls[det.range_index, det.doppler_index]
+    projected = (nulls > 0) & (coherence < _PLANE_WAVE)  # one plane wave explains it: the target dominates
+    if projected.any():
+        z = pixels[projected] / config.rx_calibration
+        vectors = clutter.vectors[det.range_index[projected], det.doppler_index[projected]]
+        proj, y = projected_snapshots(z, vectors, nulls[projected])
+        u[projected] = directions_after_projection(z, proj, config)
+        ps = steering_vector(u[projected], config)
+        ps = np.einsum("nkl,nl->nk", proj, ps)
+        num = np.abs(np.sum(np.conj(ps) * y, axis=1)) ** 2
+        den = np.maximum(np.sum(np.abs(ps) ** 2, axis=1) * np.sum(np.abs(y) ** 2, axis=1), 1e-300)
+        coherence[projected] = num / den  # the projected matched filter's fit, in [0, 1]
+    return det, u, coherence
+
+
+def frame_clutter(
+    suppression: str,
+    own: dict | None,
+    i: int,
+    config: RadarConfig,
+    terrain: Any = None,
+    source: str = "frames",
+) -> ClutterSubspace | None:
+    """The clutter subspace frame ``i`` is suppressed with under ``suppression``, or None.
+
+    ``"none"``: never. ``"knowledge-aided"``: always; InputError when the run has no own-ship
+    state (velocity, attitude and height above ground, or a terrain under a geodetic position).
+    ``"auto"``: knowledge-aided where that state exists, none elsewhere.
+    """
+    if suppression not in SUPPRESSIONS:
+        raise InputError(
+            f"{source}: field 'suppression' must be one of {', '.join(SUPPRESSIONS)}, got {suppression!r}"
+        )
+    if suppression == "none":
+        return None
+    sub = None if own is None else frame_subspace(own, i, config, terrain)
+    if sub is None and suppression == "knowledge-aided":
+        what = (
+            "own-ship state (own_*/nav_* variables)"
+            if own is None
+            else "height above ground (own_height_agl_m or a terrain)"
+        )
+        raise InputError(f"{source}: suppression 'knowledge-aided' needs the {what}; frame {i} has none")
+    return sub

@@ -1,18 +1,24 @@
 """Separate airborne objects from ground and terrain returns.
 
-Two independent tests, combined with AND where both are available:
+A detection is ground only when its 3-D position lies on the surface within its uncertainty, or
+its Doppler and angle match the ground there (:func:`classify_ground`):
 
-* height: the detection's altitude against the terrain under its 3-D position (``Terrain.height_at``
-  at the detection's latitude/longitude, or a flat ground altitude). A return within the height
-  margin of the ground, or below it, is a ground candidate. The margin grows with range because
-  the vertical position error is about ``range * sd(elevation)``.
+* position: its height ``h`` above the terrain under it (``Terrain.height_at``, or a flat ground
+  at the height of the ground under the own-ship) against its standard deviation ``sd``
+  (:func:`height_sd_m`: the DoA Cramer-Rao bound at its SNR times the range, the range error,
+  the surface's own error). ``h <= 3 sd`` is "on the surface"; ``h < -3 sd`` is below it.
 * Doppler: a static surface point in direction ``u`` (NED unit vector from the radar) has radial
-  velocity ``-v_own . u`` (positive receding). A return whose measured radial velocity matches
-  that value, modulo the aliasing width ``2 VLim``, is consistent with a static surface.
+  velocity ``-v_own . u`` (positive receding); the measured one matches it, modulo ``2 VLim``,
+  within the resolution and 3 sd of that value's change with the DoA error
+  (:func:`static_doppler_sd_mps`: near the velocity vector it hardly changes).
 
-With neither test available (no terrain and no own-ship velocity) nothing is called ground.
-Aircraft flying perpendicular to the line of sight share the static Doppler; the height test is
-what keeps them airborne, so give a terrain when there is one.
+Ground = (on the surface AND (static Doppler OR ``3 sd <= 30 m``, a position that precise))
+OR (static Doppler AND the ray reaches the surface within two range bins: range sidelobes and
+straddle) OR below the surface. So a slow, crossing or circling aircraft above the terrain is
+kept even when its radial velocity equals the static one, and an uncertain position leaves the
+decision to the Doppler. Without a height above ground (no terrain, no own-ship height) nothing
+is ground: Doppler alone cannot tell an aircraft crossing the line of sight from the ground.
+Pixels whose direction is unreliable are handled by :func:`flag_ground`.
 
 Examples
 --------
@@ -40,7 +46,20 @@ __all__ = [
     "in_ground_band",
     "height_above_ground_m",
     "classify_ground",
+    "height_sd_m",
+    "direction_derivatives",
+    "static_doppler_sd_mps",
+    "ground_in_elevation",
+    "surface_height_fn",
+    "flag_ground",
 ]
+
+
+_ONE_DEG = float(np.radians(1.0))
+# DoA error floor beyond the Cramer-Rao bound (attitude and calibration errors), and the surface's
+# own height uncertainty (DEM error, relief inside a range cell, navigation altitude error).
+ANGLE_FLOOR_RAD = float(np.radians(0.3))
+SURFACE_SD_M = 10.0
 
 
 def static_radial_velocity_mps(direction_ned: np.ndarray, own_velocity_ned_mps: np.ndarray) -> np.ndarray:
@@ -109,6 +128,83 @@ def height_above_ground_m(
     return np.full(alt.shape, np.nan)
 
 
+def direction_derivatives(u_ant: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Derivatives of antenna-frame unit vectors (n, 3) with respect to azimuth and elevation, (n, 3) each.
+
+    Examples
+    --------
+    >>> d_az, d_el = direction_derivatives(np.array([[1.0, 0.0, 0.0]]))
+    >>> d_az.tolist(), d_el.tolist()  # boresight: azimuth moves it right, elevation up (-z)
+    ([[-0.0, 1.0, 0.0]], [[-0.0, -0.0, -1.0]])
+    """
+    u = np.asarray(u_ant, float)
+    az = np.arctan2(u[:, 1], u[:, 0])
+    el = np.arcsin(np.clip(-u[:, 2], -1.0, 1.0))
+    d_az = np.stack([-np.cos(el) * np.sin(az), np.cos(el) * np.cos(az), np.zeros_like(az)], axis=1)
+    d_el = np.stack([-np.sin(el) * np.cos(az), -np.sin(el) * np.sin(az), -np.cos(el)], axis=1)
+    return d_az, d_el
+
+
+def static_doppler_sd_mps(
+    u_ant: np.ndarray,
+    sd_az_rad: np.ndarray,
+    sd_el_rad: np.ndarray,
+    ant_to_ned: np.ndarray,
+    own_velocity_ned_mps: np.ndarray,
+) -> np.ndarray:
+    """Standard deviation of the static radial velocity ``-v . u`` of a direction known to the DoA error, m/s.
+
+    Near the velocity vector (straight ahead in level flight) the static Doppler hardly changes
+    with the angle, so the test stays sharp there even at low SNR; abeam it changes fastest.
+
+    Examples
+    --------
+    >>> ahead = static_doppler_sd_mps(np.array([[1.0, 0, 0]]), 0.05, 0.05, np.eye(3), np.array([50.0, 0, 0]))
+    >>> abeam = static_doppler_sd_mps(np.array([[0, 1.0, 0]]), 0.05, 0.05, np.eye(3), np.array([50.0, 0, 0]))
+    >>> round(float(ahead[0]), 3), round(float(abeam[0]), 3)
+    (0.0, 2.5)
+    """
+    d_az, d_el = direction_derivatives(u_ant)
+    v_ant = np.asarray(ant_to_ned, float).T @ np.asarray(own_velocity_ned_mps, float)
+    return np.hypot((d_az @ v_ant) * sd_az_rad, (d_el @ v_ant) * sd_el_rad)
+
+
+def height_sd_m(
+    range_m: np.ndarray,
+    sd_az_rad: np.ndarray,
+    sd_el_rad: np.ndarray,
+    u_ant: np.ndarray,
+    ant_to_ned: np.ndarray,
+    config: RadarConfig,
+    surface_sd_m: float = 10.0,
+) -> np.ndarray:
+    """Standard deviation of a detection's height above the surface, m.
+
+    The DoA errors (``sd_az_rad``, ``sd_el_rad``, antenna frame) move the point by
+    ``R d(u_down)/d(angle)``; the range error (half a bin: straddle) moves it by ``sd_R u_down``;
+    ``surface_sd_m`` is the uncertainty of the surface itself (DEM error, relief inside a cell,
+    navigation altitude error). ``ant_to_ned`` (3, 3) rotates antenna-frame vectors to NED.
+
+    Examples
+    --------
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> u = np.array([[1.0, 0.0, 0.0]])  # boresight, level: only the elevation error moves it vertically
+    >>> float(np.round(height_sd_m(np.array([2000.0]), 0.01, 0.01, u, np.eye(3), cfg, 0.0), 1)[0])
+    20.0
+    """
+    u = np.asarray(u_ant, float)
+    d_az, d_el = direction_derivatives(u)
+    down = np.asarray(ant_to_ned, float)[2]  # NED "down" row: u_down = down . u_ant
+    rng = np.asarray(range_m, float)
+    sd_range = 0.5 * config.range_resolution_m
+    return np.sqrt(
+        (rng * (d_az @ down) * sd_az_rad) ** 2
+        + (rng * (d_el @ down) * sd_el_rad) ** 2
+        + (sd_range * (u @ down)) ** 2
+        + surface_sd_m**2
+    )
+
+
 def classify_ground(
     range_m: np.ndarray,
     radial_velocity_mps: np.ndarray,
@@ -116,46 +212,149 @@ def classify_ground(
     config: RadarConfig,
     own_velocity_ned_mps: np.ndarray | None = None,
     height_agl_m: np.ndarray | None = None,
-    angle_sd_rad: float = np.radians(1.0),
+    angle_sd_rad: np.ndarray | float = _ONE_DEG,
     height_margin_m: float = 30.0,
+    height_sd: np.ndarray | None = None,
+    leakage_bins: float = 2.0,
+    doppler_sd: np.ndarray | None = None,
 ) -> np.ndarray:
-    """True for detections that look like ground returns.
+    """True for ground returns: on the surface, or in a ground direction at ground Doppler.
 
-    Parameters
-    ----------
-    range_m, radial_velocity_mps : ndarray, shape (n,)
-        Measured range and (aliased) radial velocity.
-    direction_ned : ndarray, shape (n, 3)
-        Unit vectors from the radar to the detections in NED (NaN where no DoA).
-    config : RadarConfig
-        Doppler resolution and aliasing width.
-    own_velocity_ned_mps : ndarray, shape (3,), optional
-        Own-ship velocity; enables the Doppler test.
-    height_agl_m : ndarray, shape (n,), optional
-        Height above the ground (:func:`height_above_ground_m`); enables the height test.
-    angle_sd_rad : float
-        Expected DoA error, widens both tolerances.
-    height_margin_m : float
-        Smallest height margin.
+    The rule is the module docstring's. ``range_m``, ``radial_velocity_mps`` (aliased) and
+    ``height_agl_m`` (:func:`height_above_ground_m`, NaN: unknown) have shape (n,);
+    ``direction_ned`` (n, 3) are unit vectors radar -> detection; ``angle_sd_rad`` is the DoA
+    error. ``height_sd`` (:func:`height_sd_m`, default ``range * angle_sd_rad``) and
+    ``doppler_sd`` (:func:`static_doppler_sd_mps`, default ``speed * angle_sd_rad``) are the
+    standard deviations of the height and of the static radial velocity; ``height_margin_m`` is
+    the 3-sd height below which the position alone proves ground; ``leakage_bins`` the range
+    bins a ground return leaks (window sidelobes, straddle). No height: nothing is ground.
+
+    Examples
+    --------
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> u = np.array([[0.8, 0.0, 0.6], [0.8, 0.0, 0.6], [0.8, 0.0, 0.6]])  # 37 deg down, ahead
+    >>> v_static = float(static_radial_velocity_mps(u[:1], np.array([50.0, 0, 0]))[0])
+    >>> h = np.array([5.0, 250.0, 5.0])  # on the ground, an aircraft 250 m up, a mover on the ground
+    >>> classify_ground(np.full(3, 1000.0), np.array([v_static, v_static, 20.0]), u, cfg,
+    ...                 np.array([50.0, 0, 0]), h, height_sd=np.full(3, 8.0)).tolist()
+    [True, False, True]
     """
     rng = np.asarray(range_m, float)
-    result = np.ones(rng.shape, bool)
-    tested = False
-    if height_agl_m is not None:
-        h = np.asarray(height_agl_m, float)
-        if np.any(np.isfinite(h)):
-            margin = np.maximum(height_margin_m, 3.0 * rng * angle_sd_rad)
-            result &= np.isfinite(h) & (h <= margin)
-            tested = True
+    if height_agl_m is None:
+        return np.zeros(rng.shape, bool)
+    h = np.asarray(height_agl_m, float)
+    sd = rng * np.asarray(angle_sd_rad, float) if height_sd is None else np.asarray(height_sd, float)
+    u = np.asarray(direction_ned, float)
+    static = np.zeros(rng.shape, bool)
     if own_velocity_ned_mps is not None and np.all(np.isfinite(own_velocity_ned_mps)):
         speed = float(np.linalg.norm(own_velocity_ned_mps))
-        u = np.asarray(direction_ned, float)
         expected = static_radial_velocity_mps(u, own_velocity_ned_mps)
-        tol = 1.5 * config.doppler_resolution_mps + 3.0 * speed * angle_sd_rad
-        # A stationary radar sees everything static at zero Doppler: only useful together with height.
-        if speed > config.doppler_resolution_mps or tested:
-            result &= np.isfinite(expected) & doppler_matches_static(
-                radial_velocity_mps, expected, config, tol
-            )
-            tested = True
-    return result if tested else np.zeros(rng.shape, bool)
+        spread = speed * np.asarray(angle_sd_rad, float) if doppler_sd is None else np.asarray(doppler_sd)
+        tol = 1.5 * config.doppler_resolution_mps + 3.0 * spread
+        static = np.isfinite(expected) & doppler_matches_static(radial_velocity_mps, expected, config, tol)
+    with np.errstate(invalid="ignore"):
+        on_surface = h <= 3.0 * sd
+        conclusive = 3.0 * sd <= height_margin_m
+        leak = leakage_bins * config.range_resolution_m * np.abs(np.nan_to_num(u[:, 2]))
+        along_ray = h <= 3.0 * sd + leak
+        below = h < -3.0 * sd
+    return np.isfinite(h) & ((on_surface & (static | conclusive)) | (static & along_ray) | below)
+
+
+def ground_in_elevation(
+    range_m: np.ndarray,
+    elevation_rad: np.ndarray,
+    height_fn: Callable[[np.ndarray], np.ndarray],
+    antenna_ned_m: np.ndarray,
+    ant_to_ned: np.ndarray,
+    margin_m: np.ndarray | float,
+    max_azimuth_rad: float = np.radians(70.0),
+    n_azimuth: int = 29,
+) -> np.ndarray:
+    """True where some azimuth within ``+-max_azimuth_rad`` puts ``(range, elevation)`` on the surface.
+
+    For pixels whose azimuth means nothing (ground to the left and right of the track in one
+    range-Doppler cell). Returns from the same antenna elevation add up with the same phase step
+    across the vertical baseline, so the elevation of such a mixture is still that of the
+    ground; an aircraft mixed with ground pulls it towards the aircraft. ``height_fn`` maps NED
+    points (m, shape (..., 3)) to heights above the surface (NaN: unknown, not ground).
+    """
+    az = np.linspace(-max_azimuth_rad, max_azimuth_rad, n_azimuth)
+    el = np.asarray(elevation_rad, float)[:, None]
+    u_ant = np.stack(np.broadcast_arrays(np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)), -1)
+    points = np.asarray(antenna_ned_m, float) + np.asarray(range_m, float)[:, None, None] * (
+        u_ant @ np.asarray(ant_to_ned, float).T
+    )
+    h = height_fn(points)
+    margin = np.broadcast_to(np.asarray(margin_m, float), el.shape[:1])[:, None]
+    with np.errstate(invalid="ignore"):
+        return np.any(np.abs(h) <= margin, axis=1)
+
+
+def surface_height_fn(
+    flat_down_m: float, terrain: Any, geodetic: Callable[[np.ndarray], tuple]
+) -> Callable[[np.ndarray], np.ndarray]:
+    """Height above the surface of NED points (..., 3): the DEM, else a flat ground at ``flat_down_m``.
+
+    ``geodetic`` maps NED points to (lat, lon, alt); beyond the DEM the flat ground is used.
+
+    Examples
+    --------
+    >>> f = surface_height_fn(1000.0, None, None)
+    >>> f(np.array([[0.0, 0.0, 800.0]])).tolist()
+    [200.0]
+    """
+
+    def height(points: np.ndarray) -> np.ndarray:
+        points = np.asarray(points, float)
+        flat = flat_down_m - points[..., 2]
+        if terrain is None:
+            return flat
+        dem = height_above_ground_m(*geodetic(points), terrain)
+        return np.where(np.isfinite(dem), dem, flat)
+
+    return height
+
+
+def flag_ground(
+    out: dict[str, np.ndarray],
+    u_ned: np.ndarray,
+    own_velocity_ned_mps: np.ndarray,
+    ant_to_ned: np.ndarray,
+    height_fn: Callable[[np.ndarray], np.ndarray],
+    own_height_agl_m: float,
+    config: RadarConfig,
+) -> np.ndarray:
+    """``is_ground`` of one frame's detections (dict of columns as built by the pipeline).
+
+    Reliable directions: :func:`classify_ground` with each detection's height uncertainty
+    (:func:`height_sd_m` from the Cramer-Rao bound at its SNR, floored for attitude and
+    calibration errors). Unreliable ones (outside the field of view, or one plane wave explaining
+    the pixel badly: ground left and right of the track in one cell, or an aircraft mixed with
+    ground) are ground only when the ground can produce their range and Doppler
+    (:func:`in_ground_band`) AND their elevation points at the surface for some azimuth
+    (:func:`ground_in_elevation`): an aircraft mixed with ground pulls the elevation up and is kept.
+    """
+    from skyradar.process.calibration import in_field_of_view
+    from skyradar.process.doa import doa_crlb
+
+    rng = np.asarray(out["range_m"], float)
+    sd_az, sd_el = doa_crlb(out["snr_db"], out["azimuth_rad"], out["elevation_rad"], config)
+    sd_az, sd_el = (np.clip(np.nan_to_num(s, nan=0.2), ANGLE_FLOOR_RAD, 0.2) for s in (sd_az, sd_el))
+    points = np.stack([out["north_m"], out["east_m"], out["down_m"]], axis=1)
+    sd_h = height_sd_m(rng, sd_az, sd_el, out["u_ant"], ant_to_ned, config, SURFACE_SD_M)
+    vel, sigma = own_velocity_ned_mps, np.maximum(sd_az, sd_el)
+    sd_v = static_doppler_sd_mps(out["u_ant"], sd_az, sd_el, ant_to_ned, vel)
+    v_r = out["radial_velocity_mps"]
+    h = height_fn(points)
+    ground = classify_ground(rng, v_r, u_ned, config, vel, h, sigma, height_sd=sd_h, doppler_sd=sd_v)
+    unreliable = ~in_field_of_view(out["azimuth_rad"], out["elevation_rad"], config, 12.0)
+    unreliable |= out["coherence"] < 0.5
+    sel = unreliable & in_ground_band(rng, v_r, vel, own_height_agl_m, config)
+    hit = np.zeros(rng.shape, bool)
+    if sel.any():
+        antenna = points[0] - rng[0] * u_ned[0]
+        margin = 3.0 * np.hypot(rng[sel] * sd_el[sel], SURFACE_SD_M)
+        el = out["elevation_rad"][sel]
+        hit[sel] = ground_in_elevation(rng[sel], el, height_fn, antenna, ant_to_ned, margin)
+    return np.where(unreliable, hit, ground)

@@ -44,6 +44,7 @@ from skyradar.scene.scenario_models import (
     ScenarioModel,
 )
 from skyradar.scene.scenario_sources import check_plausible, encounter_flight, read_dem_near, read_flight
+from skyradar.scene.terrain_names import terrain_spec_attr
 from skyradar.scene.trajectories import Trajectory
 
 # 10^7 frames is 12 days at the prototype's 9.4 frames/s and about 2.7 PB of frames.
@@ -89,7 +90,9 @@ class BuiltScenario:
     impairments: Any = None  # skyradar.scene.impairment_config.ImpairmentConfig or None
     land_cover: Any = None  # skyradar.scene.ground_map.LandCover (the ground_map section) or None
     start_time: Any = None  # numpy datetime64[ns], UTC of t = 0 s (the start_time field), or None
+    navigation: Any = None  # skyradar.scene.navigation_config.NavigationConfig (None: perfect)
     heads: list[RadarHead] = field(default_factory=list)  # the radar heads; [] means one: `radar`
+    terrain_spec: str | None = None  # JSON of a built-in terrain section (recorded in the run's attrs)
 
     def __post_init__(self) -> None:
         if not self.heads:  # built by hand with one radar: that is the one head
@@ -376,4 +379,6 @@ class Scenario:
             impairments=m.impairments,
             land_cover=land_cover,
             start_time=None if m.start_time is None else parse_start_time(m.start_time, self._label),
+            navigation=m.navigation,
+            terrain_spec=terrain_spec_attr(m.terrain),
         )

@@ -19,6 +19,7 @@ from skyradar.io.frames import frames_dataset
 from skyradar.scene.radar_heads import head_of
 from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
 from skyradar.sim.impairments import apply_impairments
+from skyradar.sim.navigation import navigation_variables
 
 __all__ = ["make_simulator", "scenario_truth", "simulate_frames", "simulate", "frames_attrs"]
 
@@ -30,6 +31,9 @@ _SIM_KEYS = (
     "flat_earth",
     "range_doppler_coupling",
     "seed",
+    "psf",
+    "speckle",
+    "swerling",
 )
 
 
@@ -146,7 +150,9 @@ def scenario_truth(built, simulator: ImageSimulator | None = None) -> tuple[dict
     simulator = simulator or make_simulator(built)
     own, intruders = _states(built, np.arange(built.times_s.size))
     targets = _intruder_truth(built, own, intruders, simulator) if intruders else {}
-    return _ownship_truth(built, own), targets, [i.name for i in built.intruders]
+    ownship = _ownship_truth(built, own)
+    # The navigation solution (nav_*) beside the truth: the chain reads only nav_* (issue 13.2).
+    return ownship | navigation_variables(built, ownship), targets, [i.name for i in built.intruders]
 
 
 def simulate(built, progress: Callable[[int], None] | None = None, head: int | str = 0) -> xr.Dataset:
@@ -171,6 +177,8 @@ def frames_attrs(built) -> dict[str, Any]:
         "origin_alt_m": built.origin[2],
         "sim_options": json.dumps({k: str(v) for k, v in built.sim_options.items()}),
     }
+    if getattr(built, "terrain_spec", None):  # `process` rebuilds the run's built-in terrain from it
+        attrs["terrain"] = built.terrain_spec
     if getattr(built, "start_time", None) is not None:  # else frames_dataset's documented default
         attrs["start_time"] = built.start_time
     return attrs

@@ -12,9 +12,11 @@ from types import ModuleType
 
 import typer
 
+import skyradar.cli.commands_clutter  # noqa: F401  (registers commands)
 import skyradar.cli.commands_daa  # noqa: F401  (registers commands)
 import skyradar.cli.commands_demo  # noqa: F401  (registers commands)
 import skyradar.cli.commands_export  # noqa: F401  (registers commands)
+import skyradar.cli.commands_encounters  # noqa: F401  (registers commands)
 import skyradar.cli.commands_gpscheck  # noqa: F401  (registers commands)
 import skyradar.cli.commands_nav  # noqa: F401  (registers commands)
 import skyradar.cli.commands_passive  # noqa: F401  (registers commands)

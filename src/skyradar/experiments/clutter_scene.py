@@ -41,6 +41,7 @@ def scene_dict(
     noise: bool = True,
     intruder: bool = True,
     size_m: float = 14_000.0,
+    rcs_m2: float = 1.0,
 ) -> dict[str, Any]:
     """Scenario dict (:meth:`Scenario.from_dict`) of the scene; ``ground=False`` is the clear-sky twin."""
     data: dict[str, Any] = {
@@ -52,7 +53,7 @@ def scene_dict(
                     "speed_mps": OWN_SPEED_MPS},
         "intruders": [{"name": "head-on", "type": "encounter", "kind": "head-on",
                        "t_cpa_s": start_range_m / closing_mps,
-                       "intruder_speed_mps": closing_mps - OWN_SPEED_MPS, "rcs_m2": 1.0}],
+                       "intruder_speed_mps": closing_mps - OWN_SPEED_MPS, "rcs_m2": float(rcs_m2)}],
         "frame_rate_hz": frame_rate_hz,
         "duration_s": n_frames / frame_rate_hz,
         "start_s": 0.0,

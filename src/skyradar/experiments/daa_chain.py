@@ -3,6 +3,11 @@
 Used by ``skyradar demo`` and ``skyradar experiment encounters``. Frames are simulated and
 processed in blocks of ``block_frames`` so that memory stays bounded (a minute of frames is
 ~750 MB); only the detections, tracks and alerts tables are kept, plus any frames asked for.
+
+Every radar head of the scenario (``built.heads``) is simulated and processed; the detections
+table names the head in its ``radar`` column and one tracker fuses the heads in the world frame
+(:mod:`skyradar.track.fusion`). :func:`track_and_alert` re-tracks a detections table with only
+some heads, so one simulation scores a single head and several side by side.
 """
 
 from __future__ import annotations
@@ -17,13 +22,16 @@ import xarray as xr
 from skyradar.daa.alerting import AlertConfig
 from skyradar.daa.pipeline import alerts_from_tracks
 from skyradar.daa.run_tables import ownship_from_frames
+from skyradar.errors import InputError
 from skyradar.io.frames import frames_dataset
 from skyradar.io.frames_model import frame_times_s
+from skyradar.process.detect_run import merge_head_tables
 from skyradar.process.pipeline import process_frames
+from skyradar.scene.radar_heads import select_heads
 from skyradar.sim.scenario_frames import make_simulator, scenario_truth, simulate_frames
 from skyradar.track.track_table import track_detections
 
-__all__ = ["run_chain", "label_tracks"]
+__all__ = ["run_chain", "track_and_alert", "label_tracks"]
 
 _MATCH_M = 300.0  # a track is an intruder's if its median distance to that truth is below this
 
@@ -31,7 +39,7 @@ _MATCH_M = 300.0  # a track is an intruder's if its median distance to that trut
 def _truth_dataset(built, simulator) -> xr.Dataset:
     """Frames Dataset of the whole run with a zero-stride placeholder ``iq`` (no memory)."""
     own, tgt, names = scenario_truth(built, simulator)
-    cfg = built.radar
+    cfg = simulator.config
     shape = (built.times_s.size, cfg.n_range, cfg.n_doppler, cfg.n_rx)
     attrs = {"scenario": built.name, "origin_lat_deg": built.origin[0], "origin_lon_deg": built.origin[1],
              "origin_alt_m": built.origin[2], "start_time": getattr(built, "start_time", None)}  # fmt: skip
@@ -39,25 +47,30 @@ def _truth_dataset(built, simulator) -> xr.Dataset:
     return frames_dataset(iq, built.times_s, cfg, own, tgt, names, attrs)
 
 
-def _detect(built, keep_frames, block_frames, timings) -> tuple[pd.DataFrame, xr.Dataset, dict]:
-    simulator = make_simulator(built)
-    truth = _truth_dataset(built, simulator)
+def _detect(built, heads, keep_frames, block_frames, timings, options) -> tuple[pd.DataFrame, dict, dict]:
+    """Detections of every head in ``heads`` (merged, ``radar`` column), each head's truth, kept frames."""
+    simulators = {h.name: make_simulator(built, h.name) for h in heads}
+    truths = {name: _truth_dataset(built, sim) for name, sim in simulators.items()}
     n = built.times_s.size
-    detections, rd = [], {}
+    detections: dict[str, list] = {name: [] for name in simulators}
+    rd: dict = {}
     for start in range(0, n, block_frames):
         rows = np.arange(start, min(start + block_frames, n))
-        t0 = time.perf_counter()
-        iq = simulate_frames(built, rows, simulator)
-        timings["simulate"] += time.perf_counter() - t0
-        for f in set(keep_frames).intersection(rows.tolist()):
-            rd[f] = iq[f - start].copy()
-        ds = truth.isel(time=slice(start, start + rows.size)).assign(iq=(truth["iq"].dims, iq))
-        t0 = time.perf_counter()
-        det = process_frames(ds, terrain=built.terrain, source=built.name)
-        det["frame"] += start
-        detections.append(det)
-        timings["process"] += time.perf_counter() - t0
-    return pd.concat(detections, ignore_index=True), truth.drop_vars("iq"), rd
+        for name, simulator in simulators.items():
+            t0 = time.perf_counter()
+            iq = simulate_frames(built, rows, simulator)
+            timings["simulate"] += time.perf_counter() - t0
+            for f in set(keep_frames).intersection(rows.tolist()) if name == heads[0].name else ():
+                rd[f] = iq[f - start].copy()  # the first head's range-Doppler cube
+            truth = truths[name]
+            ds = truth.isel(time=slice(start, start + rows.size)).assign(iq=(truth["iq"].dims, iq))
+            t0 = time.perf_counter()
+            det = process_frames(ds, terrain=built.terrain, source=built.name, **options)
+            det["frame"] += start
+            detections[name].append(det)
+            timings["process"] += time.perf_counter() - t0
+    merged = merge_head_tables({name: pd.concat(d, ignore_index=True) for name, d in detections.items()})
+    return merged, {name: t.drop_vars("iq") for name, t in truths.items()}, rd
 
 
 def run_chain(
@@ -66,6 +79,8 @@ def run_chain(
     keep_frames: tuple[int, ...] = (),
     block_frames: int = 16,
     with_advice: bool = True,
+    heads: list[str] | None = None,
+    process_options: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Simulate, process, track and alert a built scenario; return every intermediate product.
 
@@ -81,29 +96,66 @@ def run_chain(
         Frames simulated and processed at a time (memory bound).
     with_advice : bool
         Compute resolution advice on alerting frames (off for scoring runs: faster).
+    heads : list of str, optional
+        Radar heads to simulate and fuse (names in ``built.heads``); default all.
+    process_options : dict, optional
+        Keyword arguments of :func:`skyradar.process.pipeline.process_frames` (e.g. ``pfa``).
 
     Returns
     -------
     dict
-        ``truth`` (frames Dataset without ``iq``), ``detections``, ``tracks``, ``alerts``,
-        ``ownship`` (tables), ``rd_frames`` ({frame: (n_range, n_doppler, n_rx) complex64}) and
-        ``timings_s`` per stage.
+        ``truth`` (the first head's frames Dataset without ``iq``), ``truth_by_head`` ({head:
+        Dataset}: intruder angles, SNR and visibility as each head sees them), ``detections`` (with
+        the ``radar`` column), ``tracks``, ``alerts``, ``ownship`` (tables), ``rd_frames`` ({frame:
+        (n_range, n_doppler, n_rx) complex64} of the first head) and ``timings_s`` per stage.
     """
+    chosen = select_heads(built.heads, heads, "run_chain")
     timings = {"simulate": 0.0, "process": 0.0}
-    det, truth, rd = _detect(built, keep_frames, block_frames, timings)
+    det, truths, rd = _detect(built, chosen, keep_frames, block_frames, timings, process_options or {})
+    truth = truths[chosen[0].name]
+    out = track_and_alert(det, built, None, alert_config, with_advice, truth)
+    return {"truth": truth, "truth_by_head": truths, "detections": det, "tracks": out["tracks"],
+            "alerts": out["alerts"], "ownship": out["ownship"], "rd_frames": rd,
+            "timings_s": timings | out["timings_s"]}  # fmt: skip
+
+
+def track_and_alert(
+    detections: pd.DataFrame,
+    built,
+    heads: list[str] | None = None,
+    alert_config: AlertConfig | None = None,
+    with_advice: bool = True,
+    truth: xr.Dataset | None = None,
+) -> dict[str, Any]:
+    """Track (all heads fused) and alert a detections table of ``built``, with only ``heads`` of it.
+
+    ``truth`` is a frames Dataset of the run (own-ship variables; default: computed again). The
+    air detections (not ground, not spur) of the chosen heads are tracked; ``detection_row`` of
+    the tracks indexes that subset. Returns ``tracks``, ``alerts``, ``ownship``, ``detections``
+    (the subset) and ``timings_s`` (track, alert).
+    """
+    chosen = select_heads(built.heads, heads, "track_and_alert")
+    if len({(h.config.v_lim_mps, h.config.range_resolution_m) for h in chosen}) > 1:
+        names = [h.name for h in chosen]
+        raise InputError(f"track_and_alert: heads {names} differ in Doppler width or range resolution; "
+                         "one tracker needs the same for all")  # fmt: skip
+    truth = truth if truth is not None else _truth_dataset(built, make_simulator(built)).drop_vars("iq")
     own = ownship_from_frames(truth, built.name)
+    mine = np.ones(len(detections), bool)
+    if heads is not None and "radar" in detections.columns:
+        mine = detections["radar"].isin([h.name for h in chosen]).to_numpy(bool)
+    keep = mine & ~(detections["is_ground"].to_numpy(bool) | detections["spur"].to_numpy(bool))
     t0 = time.perf_counter()
-    keep = ~(det["is_ground"].to_numpy(bool) | det["spur"].to_numpy(bool))
     tracks = track_detections(
-        det[keep].reset_index(drop=True), "radar", built.radar,
+        detections[keep].reset_index(drop=True), "radar", chosen[0].config,
         frame_times_s=built.times_s, origin=built.origin, ownship=own,
     )  # fmt: skip
-    timings["track"] = time.perf_counter() - t0
+    timings = {"track": time.perf_counter() - t0}
     t0 = time.perf_counter()
     alerts = alerts_from_tracks(tracks, own, alert_config, with_advice=with_advice, source=built.name)
     timings["alert"] = time.perf_counter() - t0
-    return {"truth": truth, "detections": det, "tracks": tracks, "alerts": alerts, "ownship": own,
-            "rd_frames": rd, "timings_s": timings}  # fmt: skip
+    return {"tracks": tracks, "alerts": alerts, "ownship": own, "detections": detections[mine],
+            "timings_s": timings}  # fmt: skip
 
 
 def label_tracks(tracks: pd.DataFrame, truth: xr.Dataset, max_distance_m: float = _MATCH_M) -> dict[int, str]:

@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 
 from skyradar.config import RadarConfig
+from skyradar.track.fusion import fuse_heads, restore_detection_rows
 from skyradar.track.io import validate_detections, validate_ownship
 from skyradar.track.measure3d import angle_sigma_rad, position_covariance
 from skyradar.track.models import MotionModel, radar_model, traditional_model
@@ -114,8 +115,8 @@ def track_detections(
     ----------
     detections : DataFrame
         Needs ``time_s, range_m, radial_velocity_mps``; with ``north_m, east_m, down_m`` a 3-D
-        track is kept per range-Doppler track. ``snr_db`` (and ``azimuth_rad, elevation_rad``)
-        set the DoA angle error from its Cramer-Rao bound.
+        track is kept per range-Doppler track. ``snr_db`` (and angles) sets the DoA error (Cramer-Rao
+        bound). Several heads (``radar`` column) are fused first (:mod:`skyradar.track.fusion`).
     model : {'radar', 'traditional'} or MotionModel
     config : RadarConfig, optional
         Sets the Doppler width and pixel size (default: thesis prototype).
@@ -144,14 +145,15 @@ def track_detections(
     >>> out.track_id.nunique(), len(out), int(out.confirmed.sum())
     (1, 9, 7)
     """
-    validate_detections(detections)
     config = config or RadarConfig.prototype_2022()
+    detections, head_rows = fuse_heads(validate_detections(detections), config)  # heads -> one stream
     motion = make_model(model, config) if isinstance(model, str) else model
     pixel = (config.range_resolution_m, config.doppler_resolution_mps)
     tracker = RangeDopplerTracker(motion, tracker_config, pixel, report_tentative=True)
     grid, lo, hi = _frame_slices(detections["time_s"].to_numpy(float), frame_times_s)
     m3 = _Measure3D(detections, config, motion, position_sigma_rad, ownship, grid)
-    return _assemble(_run_tracker(tracker, m3, detections, grid, lo, hi), origin, m3.active)
+    tracks = _assemble(_run_tracker(tracker, m3, detections, grid, lo, hi), origin, m3.active)
+    return restore_detection_rows(tracks, head_rows)
 
 
 def _run_tracker(tracker: RangeDopplerTracker, m3, detections: pd.DataFrame, grid, lo, hi) -> list[dict]:

@@ -67,6 +67,12 @@ OWNSHIP_VARS: dict[str, tuple[str, str]] = {
     "own_roll_rad": ("rad", "own-ship roll (bank), positive right wing down"),
     "own_height_agl_m": ("m", "own-ship height above the terrain directly below"),
 }
+# The navigation solution (GNSS/AHRS with errors, skyradar.sim.navigation) beside the truth:
+# what process, track and alert read (skyradar.io.navigation).
+OWNSHIP_VARS |= {
+    f"nav_{name[4:]}": (units, f"navigation (GNSS/AHRS with errors): {desc.replace('own-ship ', '')}")
+    for name, (units, desc) in list(OWNSHIP_VARS.items())
+}
 TARGET_VARS: dict[str, tuple[str, str]] = {
     "tgt_north_m": ("m", "intruder north in the scenario NED frame"),
     "tgt_east_m": ("m", "intruder east"),

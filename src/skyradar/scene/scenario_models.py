@@ -34,6 +34,9 @@ are in the field names: metres, m/s, degrees, seconds, Hz. Positions ``*_ned_m``
     simulation: {facet_size_m: 30, reflectivity: cosine, occlusion: true, noise: true,
                  flat_earth: false, range_doppler_coupling: true, seed: 0}
     impairments: {preset: thesis_flight_look}              # optional; see sim/impairments.py
+    navigation: ga-typical                                 # own-ship GNSS/AHRS errors: perfect |
+                                                           #   ga-typical (default) | only-heading ...
+                                                           #   | {model: ga-typical, heading_bias_deg: 3}
 
 Flight parameters are those of :mod:`skyradar.scene.flights` (``straight``, ``circle``,
 ``circuit``, ``encounter``); file flights take ``path``, ``icao24`` and ``time_zero_s``.
@@ -47,6 +50,7 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
 from skyradar.scene.impairment_config import ImpairmentConfig
+from skyradar.scene.navigation_config import NavigationConfig, with_preset
 
 __all__ = [
     "TAGS",
@@ -323,6 +327,9 @@ class SimulationModel(_Model):
     flat_earth: bool = False
     range_doppler_coupling: bool = True
     seed: int = Field(0, ge=0)
+    psf: bool = False  # the range/Doppler windows' point-spread (sim.psf)
+    speckle: bool = False  # terrain speckle, new every frame
+    swerling: Literal[0, 1] = 0  # target RCS: constant (0) or Swerling 1
 
 
 class ScenarioModel(_Model):
@@ -341,3 +348,7 @@ class ScenarioModel(_Model):
     start_time: datetime | str | None = None  # ISO 8601 UTC instant of t = 0 s; default 1970-01-01T00:00:00Z
     simulation: SimulationModel = Field(default_factory=SimulationModel)
     impairments: ImpairmentConfig | None = None  # e.g. {preset: thesis_flight_look}
+    # Own-ship GNSS/AHRS errors the chain sees (skyradar.scene.navigation_config); default ga-typical.
+    navigation: Annotated[NavigationConfig, BeforeValidator(with_preset)] = Field(
+        default_factory=lambda: NavigationConfig.model_validate(with_preset(None))
+    )

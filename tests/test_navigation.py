@@ -166,7 +166,7 @@ def test_truth_never_enters_process_track_or_alert():
 def test_stores_written_before_navigation_fall_back_to_truth_with_a_note(caplog):
     ds = _scene(n_frames=2)
     old = ds.drop_vars([v for v in ds.data_vars if v.startswith("nav_")])
-    with caplog.at_level(logging.WARNING, logger="skyradar.io.navigation"):
+    with caplog.at_level(logging.INFO, logger="skyradar.io.navigation"):
         state = navigation_state(old, "old.zarr")
         table = process_frames(old)
     assert state.attrs["navigation_source"] == "truth" and table.attrs["navigation_source"] == "truth"

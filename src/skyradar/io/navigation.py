@@ -75,7 +75,7 @@ def navigation_state(ds: xr.Dataset, source: str = "frames") -> pd.DataFrame | N
         return None
     prefix = "nav_" if kind == "navigation" else "own_"
     if kind == "truth":
-        _LOG.warning("%s: no navigation (nav_*) variables; using the own-ship truth (own_*) instead", source)
+        _LOG.info("%s: no navigation (nav_*) variables; using the own-ship truth (own_*) instead", source)
     cols: dict[str, np.ndarray] = {"time_s": frame_times_s(ds)}
     for name in STATE_COLUMNS:
         var = prefix + name[4:]

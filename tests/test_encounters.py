@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 from skyradar.daa.conflict import FT
+from skyradar.errors import InputError
 from skyradar.experiments.encounter_set import (
     OWN_SPEED_MPS,
     T_CPA_S,
@@ -151,13 +152,13 @@ def test_summary_counts():
 def test_full_chain_warns_head_on_collision_and_stays_quiet_when_far():
     from skyradar.experiments.encounters import run_encounter
 
-    hit = run_encounter(_row(), seed=1)
+    (hit,) = run_encounter(_row(), seed=1, frame_rate_hz=4.7)
     assert hit["conflict"] and hit["observable"]
     assert hit["t_lowc_s"] == pytest.approx(T_CPA_S - D_NC / 100.0, abs=0.06)
     # Warned well ahead of the loss of well clear, by a track that follows the intruder.
     assert 12.5 <= hit["t_lowc_s"] - hit["t_warning_s"] <= 30.0
     assert hit["tracks"] >= 1 and hit["frames"] > 150
-    far = run_encounter(_row(h=2.5 * D_NC), seed=1)
+    (far,) = run_encounter(_row(h=2.5 * D_NC), seed=1, frame_rate_hz=4.7)
     assert not far["conflict"] and not far["may_alert"]
     assert np.isnan(far["t_warning_s"]) and np.isnan(far["t_other_warning_s"])
 
@@ -191,13 +192,15 @@ def test_experiment_counts_match_the_geometry_and_warns_every_observable_conflic
     # This set: three conflicts (head-on, crossing, overtaking), all in view; one clear converging.
     assert (conflict.sum(), observable.sum(), may_alert.sum()) == (3, 3, 0)
 
-    s = run(tmp_path, n_encounters=4, seed=2, workers=2)
+    s = run(tmp_path, n_encounters=4, seed=2, workers=2, frame_rate_hz=4.7, layouts=("single",))
     assert s["encounters"] == 4 and s["chain"] == "full" and s["frames"] > 4 * 50
+    assert (s["terrain"], s["layout"], len(s["rows"])) == ("none", "single", 1)
+    assert s["warned_before_lowc"] == conflict.sum() and s["unwarned_by_cause"]["missed"] == 0
     assert (s["conflicts"], s["observable_conflicts"]) == (conflict.sum(), observable.sum())
     assert (s["may_alert_encounters"], s["must_not_alert_encounters"]) == (may_alert.sum(), 1)
     assert s["missed_warnings"] == 0 and s["false_warnings"] == 0 and s["other_track_warnings"] == 0
     table = pd.read_parquet(tmp_path / "encounters.parquet")
-    assert len(table) == 4 and table["frames"].gt(0).all()
+    assert len(table) == 4 and table["frames"].gt(0).all() and (table["layout"] == "single").all()
     assert table["conflict"].tolist() == conflict.tolist()
     assert table["observable"].tolist() == observable.tolist()
     np.testing.assert_allclose(table["t_lowc_s"], t_lowc, atol=0.06)
@@ -211,38 +214,41 @@ def test_experiment_counts_match_the_geometry_and_warns_every_observable_conflic
 def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
     from skyradar.experiments import encounters as E
 
-    key = {
-        "n": 2,
-        "seed": 5,
-        "frame_rate_hz": 4.7,
-        "buffer": 1.5,
-        "uncertainty": True,
-        "terrain": None,
-        "version": E._version(),
-    }
+    settings = {"n": 2, "seed": 5, "frame_rate_hz": 4.7, "buffer": 1.5, "uncertainty": True,
+                "terrains": ["none"], "layouts": ["single"], "navigation": "ga-typical",
+                "suppression": "auto", "late_lead_s": 12.5}  # fmt: skip
+    key = {**settings, "version": E._version()}
     _, save = E._partial_store(tmp_path, key)
     fake = {"t_lowc_s": np.nan, "t_cpa_s": 120.0, "conflict": False, "may_alert": False,
             "observable": False, "t_warning_s": np.nan, "min_horizontal_m": 3000.0, "min_vertical_m": 0.0,
-            "min_distance_m": 3000.0, "t_other_warning_s": np.nan, "frames": 7, "t_start_s": 75.0,
-            "tracks": 0, "detections": 0}  # fmt: skip
-    save({0: fake})  # as left by a run interrupted after its first encounter
-    s = E.run(tmp_path, n_encounters=2, seed=5, workers=1)
+            "min_distance_m": 3000.0,
+            "cause": "", "intruder_tracks": 0, "clutter_tracks": 0, "clutter_warning_tracks": 0,
+            "ground_tracks": 0, "ground_warning_tracks": 0, "t_other_warning_s": np.nan, "tracks": 0,
+            "own_agl_m": np.nan, "layout": "single", "detections": 0, "frames": 7, "t_start_s": 75.0,
+            "flight_s": 1.5, "mirrored": False, "vertical_miss_flown_m": 0.0, "own_altitude_m": 1000.0,
+            "simulate_s": 0.0, "process_s": 0.0, "track_s": 0.0, "alert_s": 0.0}  # fmt: skip
+    save({("none", 0): [fake]})  # as left by a run interrupted after its first encounter
+    s = E.run(tmp_path, n_encounters=2, seed=5, workers=1, frame_rate_hz=4.7, layouts=("single",))
     assert s["resumed_encounters"] == 1
     table = pd.read_parquet(tmp_path / "encounters.parquet")
     assert table.loc[0, "frames"] == 7 and table.loc[1, "frames"] > 50  # row 0 kept, row 1 computed
     assert not list(tmp_path.glob("*.partial*"))
     # Different settings never reuse another run's rows.
-    save({0: fake})
+    save({("none", 0): [fake]})
     assert E._partial_store(tmp_path, {**key, "seed": 6})[0] == {}
+    assert E._partial_store(tmp_path, {**key, "navigation": "perfect"})[0] == {}
 
 
 def test_flat_terrain_variant_puts_ground_under_the_whole_window():
     d = encounter_scenario(_row(), T_CPA_S - 40.0, 42.0, 4.7, 0, terrain="flat")
     built = Scenario.from_dict(d).build()
-    assert built.terrain is not None and d["simulation"]["facet_size_m"] == 30.0
+    assert built.terrain is not None and "facet_size_m" not in d["simulation"]  # the scenario default
     own = built.ownship.sample(built.times_s).position_ned_m
     # Own-ship passes the origin at the CPA, so the ground reaches past the range limit all along.
     assert np.abs(own[:, 0]).max() + built.radar.range_limit_m < 8000.0
     assert own[:, 2] == pytest.approx(-1000.0)
-    with pytest.raises(ValueError, match="terrain"):
-        encounter_scenario(_row(), 0.0, 1.0, 4.7, 0, terrain="hills")
+    low = encounter_scenario(_row(), T_CPA_S - 40.0, 42.0, 4.7, 0, terrain="flat-300")
+    low = Scenario.from_dict(low).build()
+    assert low.ownship.sample(low.times_s).position_ned_m[:, 2] == pytest.approx(-300.0)
+    with pytest.raises(InputError, match="terrain"):
+        encounter_scenario(_row(), 0.0, 1.0, 4.7, 0, terrain="moon")

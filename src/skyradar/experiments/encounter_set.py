@@ -110,32 +110,52 @@ def encounter_scenario(
     frame_rate_hz: float,
     seed: int,
     terrain: str | None = None,
+    *,
+    radars: list[dict] | None = None,
+    navigation: str | dict | None = None,
+    own_altitude_m: float | None = None,
+    terrain_seed: int | None = None,
 ) -> dict[str, Any]:
     """Scenario dict (:meth:`skyradar.scene.scenario.Scenario.from_dict`) of one encounter row.
 
     Own-ship passes the origin at the CPA. ``terrain``: None flies the encounter in clear sky
-    (every detection is the intruder or noise); ``"flat"`` puts flat ground ``OWN_ALTITUDE_M``
-    below, 16 km square around the origin, simulated with 30 m facets (two range bins), so the
-    ground clutter fills the range-Doppler image behind and around the intruder.
+    (every detection is the intruder or noise); a name of
+    :data:`skyradar.experiments.encounter_terrain.TERRAINS` puts that ground under it (``"flat"``:
+    flat ground ``OWN_ALTITUDE_M`` below, 16 km square around the origin, so the ground clutter
+    fills the range-Doppler image behind and around the intruder), simulated with the scenario
+    defaults (facets no coarser than half a range bin) with the range and Doppler windows'
+    point-spread, terrain speckle and Swerling 1 aircraft. ``own_altitude_m`` replaces the terrain's
+    nominal own-ship altitude (:func:`~skyradar.experiments.encounter_terrain.site`; over hills
+    and Jacksboro it is chosen from the ground under the track). ``radars`` is the scenario's
+    ``radars:`` list (None: one forward head) and ``navigation`` its ``navigation:`` key (None:
+    the scenario default). ``terrain_seed`` (default ``seed``) picks the hills surface and the
+    point over Jacksboro.
     """
+    from skyradar.experiments.encounter_terrain import site
+
+    where = site(terrain, seed if terrain_seed is None else terrain_seed)
+    alt = where["own_altitude_m"] if own_altitude_m is None else float(own_altitude_m)
     scenario = {
         "name": f"encounter {p['kind']}",
-        "origin": {"lat_deg": 52.0, "lon_deg": 5.0, "alt_m": 0.0},
-        "mount": "forward",
-        "ownship": {"type": "straight", "start_ned_m": [-OWN_SPEED_MPS * T_CPA_S, 0.0, -OWN_ALTITUDE_M],
+        "origin": where["origin"],
+        "ownship": {"type": "straight", "start_ned_m": [-OWN_SPEED_MPS * T_CPA_S, 0.0, -alt],
                     "heading_deg": 0.0, "speed_mps": OWN_SPEED_MPS, "start_time_s": 0.0,
                     "duration_s": T_CPA_S + 10.0},
         "intruders": [_intruder_spec(p)],
         "frame_rate_hz": frame_rate_hz,
         "start_s": float(start_s),
         "duration_s": float(duration_s),
-        "simulation": {"noise": True, "seed": int(seed)},
+        # The simulator's realistic options (sim.image): window point-spread, terrain speckle, Swerling 1.
+        "simulation": {"noise": True, "seed": int(seed), "psf": True, "speckle": True, "swerling": 1},
     }  # fmt: skip
-    if terrain == "flat":
-        scenario["terrain"] = {"type": "flat", "size_m": 16_000.0, "spacing_m": 30.0}
-        scenario["simulation"]["facet_size_m"] = 30.0
-    elif terrain is not None:
-        raise ValueError(f"encounters: terrain must be None or 'flat', got {terrain!r}")
+    if radars is None:
+        scenario["mount"] = "forward"
+    else:
+        scenario["radars"] = [dict(r) for r in radars]
+    if navigation is not None:
+        scenario["navigation"] = navigation
+    if where["terrain"] is not None:
+        scenario["terrain"] = where["terrain"]
     return scenario
 
 

@@ -1,13 +1,15 @@
 """Encounter set: does the DAA chain warn in time for conflicts, and stay quiet for near misses?
 
 Every encounter of :func:`skyradar.experiments.encounter_set.make_encounters` runs through the full
-chain of :func:`skyradar.experiments.daa_chain.run_chain`: the image simulator (thesis prototype, forward
-mount, thermal noise, clear sky), detection and DoA, the radar-aware tracker with 3-D state, and
-the alerting stage (DO-365 non-cooperative volume, DAIDALUS alerting times, M-of-N persistence,
-volumes widened by the track covariance). Frames cover the last ``lookback_s`` before the loss of
-well clear (or the CPA), and start no earlier than the intruder is inside the range limit: 40 s
-is the 25 s warning alerting time plus 15 s to confirm a track and let its velocity converge
-(on the seed-1 set, 45 s gave the same warnings and 35 s cut the median lead by 2 s).
+chain (:func:`skyradar.experiments.encounter_chain.run_encounter`): the image simulator at the
+prototype's 9.4 Hz, every radar head of the layout, own-ship navigation with the errors of typical
+GA avionics (``ga-typical``; scoring alone uses the truth), processing with clutter suppression and
+ground flags, the world-frame tracker and the alerting stage (DO-365 non-cooperative volume,
+DAIDALUS alerting times, M-of-N persistence, volumes widened by the track covariance). Each
+terrain (:mod:`skyradar.experiments.encounter_terrain`) flies the same encounter set; each layout
+(``single``: the forward +-35 deg head; ``three-head``: nose and both wingtips, +-110 deg) is
+scored on the same simulated frames. Results: one row per terrain and layout
+(:func:`~skyradar.experiments.encounter_score.summarise_layout`).
 
 The encounters are independent, so they run in ``workers`` processes (one numba thread each).
 """
@@ -24,94 +26,23 @@ from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pandas as pd
 
-from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig
+from skyradar.daa.alerting import RADAR_ALERT_CONFIG
 from skyradar.errors import InputError
-from skyradar.experiments.daa_chain import label_tracks, run_chain
-from skyradar.experiments.encounter_set import (
-    encounter_scenario,
-    event_times,
-    make_encounters,
-    plot_encounters,
-    relative_truth,
-    score_encounter,
-    summarise,
-)
-from skyradar.io.atomic import write_csv_atomic
-from skyradar.io.frames_model import frame_times_s
+from skyradar.experiments.encounter_chain import FRAME_RATE_HZ, LAYOUTS, SUPPRESSION, run_encounter
+from skyradar.experiments.encounter_report import write_report
+from skyradar.experiments.encounter_set import make_encounters
+from skyradar.experiments.encounter_terrain import TERRAINS
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.parallel import check_workers
-from skyradar.scene.scenario import Scenario
 
-__all__ = ["run_encounter", "run_encounters", "run", "MAX_ENCOUNTERS"]
+__all__ = ["run_encounter", "run_encounters", "run", "MAX_ENCOUNTERS", "DEFAULT_ENCOUNTERS"]
 
 MAX_ENCOUNTERS = 100_000  # 200 times the thesis-sized set; more is a typo, not a plan
-
-_RANGE_MARGIN_M = 300.0
+DEFAULT_ENCOUNTERS = 40  # clear sky, both layouts, 2 workers: within 5 minutes on 2 cores
 _PARTIAL = "encounters.partial.parquet"
-
-
-def _window(
-    p: pd.Series, frame_rate_hz: float, lookback_s: float, seed: int
-) -> tuple[float, float, np.ndarray, np.ndarray]:
-    """Frame window (start, duration) in s, ``lookback_s`` before the LoWC or CPA and in range,
-    and the dense relative truth (times, NED m) it was chosen on."""
-    built = Scenario.from_dict(encounter_scenario(p, 0.0, 1.0, frame_rate_hz, seed, None)).build()
-    t, rel = relative_truth(built)
-    t_lowc, t_cpa = event_times(t, rel)
-    t_event = t_lowc if np.isfinite(t_lowc) else t_cpa
-    in_range = np.linalg.norm(rel, axis=1) <= built.radar.range_limit_m + _RANGE_MARGIN_M
-    first = float(t[np.argmax(in_range & (t <= t_event))]) if in_range.any() else t_event - lookback_s
-    start = max(t_event - lookback_s, first, float(t[0]))
-    end = min(t_event + 2.0, float(t[-1]))
-    return start, max(end - start, 2.0 / frame_rate_hz), t, rel
-
-
-def _observable(truth, fov_deg: float, min_snr_db: float) -> pd.DataFrame:
-    half = np.radians(fov_deg / 2)
-    az = truth["tgt_azimuth_rad"].values[:, 0]
-    el = truth["tgt_elevation_rad"].values[:, 0]
-    with np.errstate(invalid="ignore"):
-        ok = truth["tgt_visible"].values[:, 0] & (np.abs(az) <= half) & (np.abs(el) <= half)
-        ok &= truth["tgt_snr_db"].values[:, 0] >= min_snr_db
-    return pd.DataFrame({"time_s": frame_times_s(truth), "observable": ok})
-
-
-def run_encounter(
-    p: pd.Series,
-    seed: int = 0,
-    frame_rate_hz: float = 4.7,
-    lookback_s: float = 40.0,
-    buffer: float = 1.5,
-    fov_deg: float = 70.0,
-    min_snr_db: float = 13.0,
-    observe_window_s: float = 12.5,
-    alert_config: AlertConfig | None = None,
-    terrain: str | None = None,
-) -> dict[str, Any]:
-    """One encounter row through the full chain; its result row (times in s, NaN when none).
-
-    ``t_warning_s`` is the first warning (level 3) of a track that follows the intruder;
-    ``t_other_warning_s`` the first warning of any other track (noise).
-    """
-    # The frame window and terrain do not change the trajectories: one dense truth serves both.
-    start, duration, t, rel = _window(p, frame_rate_hz, lookback_s, seed)
-    built = Scenario.from_dict(encounter_scenario(p, start, duration, frame_rate_hz, seed, terrain)).build()
-    chain = run_chain(built, alert_config or RADAR_ALERT_CONFIG, with_advice=False)
-    labels = label_tracks(chain["tracks"], chain["truth"])
-    alerts = chain["alerts"]
-    warn = alerts[alerts["level"] >= 3] if len(alerts) else alerts
-    mine = warn["track_id"].map(lambda i: labels.get(int(i)) == "intruder").to_numpy(bool)
-    observed = _observable(chain["truth"], fov_deg, min_snr_db)
-    row = score_encounter(t, rel, warn["time_s"].to_numpy(float)[mine], observed, buffer, observe_window_s)
-    other = warn["time_s"].to_numpy(float)[~mine]
-    row.update(t_other_warning_s=float(other.min()) if other.size else float("nan"),
-               frames=int(built.times_s.size), t_start_s=start,
-               tracks=int(chain["tracks"]["track_id"].nunique()),
-               detections=len(chain["detections"]))  # fmt: skip
-    return row
+_CHUNK = 4  # encounters per worker task
 
 
 def _init_worker() -> None:
@@ -120,8 +51,11 @@ def _init_worker() -> None:
     numba.set_num_threads(1)
 
 
-def _run_rows(rows: list[tuple[int, dict]], kw: dict) -> list[tuple[int, dict]]:
-    return [(i, run_encounter(pd.Series(p), seed=kw["seed"] + i, **kw["options"])) for i, p in rows]
+def _run_rows(tasks: list[tuple[str, int, dict]], kw: dict) -> list[tuple[str, int, list[dict]]]:
+    return [
+        (terrain, i, run_encounter(pd.Series(p), seed=kw["seed"] + i, terrain=terrain, **kw["options"]))
+        for terrain, i, p in tasks
+    ]
 
 
 def run_encounters(
@@ -129,24 +63,28 @@ def run_encounters(
     seed: int = 0,
     workers: int | None = None,
     progress: Callable[[int], None] | None = None,
-    done: dict[int, dict] | None = None,
-    on_chunk: Callable[[dict[int, dict]], None] | None = None,
+    done: dict[tuple[str, int], list[dict]] | None = None,
+    on_chunk: Callable[[dict], None] | None = None,
+    terrains: tuple[str, ...] = ("none",),
     **options: Any,
 ) -> pd.DataFrame:
-    """All encounters (rows of ``params``), ``workers`` processes; one result row per encounter.
+    """All encounters (rows of ``params``) over every terrain, ``workers`` processes.
 
-    ``progress`` is called with the number of encounters finished; ``done`` holds result rows
-    already computed (skipped here) and ``on_chunk`` receives all rows so far after each chunk
-    of five. Options go to :func:`run_encounter`.
+    Returns one row per terrain, encounter and layout (columns ``terrain``, ``encounter``,
+    ``layout``, the encounter's parameters and its result). ``progress`` is called with the number
+    of encounters finished; ``done`` holds result rows already computed ({(terrain, i): rows},
+    skipped here) and ``on_chunk`` receives all rows so far after each chunk. Options go to
+    :func:`~skyradar.experiments.encounter_chain.run_encounter`.
     """
     workers = check_workers(workers) or min(2, os.cpu_count() or 1)  # 10**20 spawned until memory ran out
-    results: dict[int, dict] = dict(done or {})
-    todo = [(i, p) for i, p in enumerate(params.to_dict("records")) if i not in results]
-    chunks = [todo[k : k + 5] for k in range(0, len(todo), 5)]
+    results: dict[tuple[str, int], list[dict]] = dict(done or {})
+    records = params.to_dict("records")
+    todo = [(tr, i, p) for tr in terrains for i, p in enumerate(records) if (tr, i) not in results]
+    chunks = [todo[k : k + _CHUNK] for k in range(0, len(todo), _CHUNK)]
     kw = {"seed": seed, "options": options}
 
-    def finished(rows: list[tuple[int, dict]]) -> None:
-        results.update(dict(rows))
+    def finished(rows: list[tuple[str, int, list[dict]]]) -> None:
+        results.update({(tr, i): r for tr, i, r in rows})
         if on_chunk:
             on_chunk(results)
         if progress:
@@ -166,50 +104,70 @@ def run_encounters(
                 for f in futures:
                     f.cancel()
                 raise
-    return pd.DataFrame([results[i] for i in range(len(params))])
+    return _long_table(params, results, terrains)
 
 
-def _partial_store(out_dir: Path, key: dict) -> tuple[dict[int, dict], Callable[[dict[int, dict]], None]]:
+def _long_table(params: pd.DataFrame, results: dict, terrains) -> pd.DataFrame:
+    rows = []
+    for tr in terrains:
+        for i, p in enumerate(params.to_dict("records")):
+            rows += [{"terrain": tr, "encounter": i, **p, **r} for r in results[(tr, i)]]
+    return pd.DataFrame(rows)
+
+
+def _partial_store(out_dir: Path, key: dict) -> tuple[dict, Callable[[dict], None]]:
     """Rows of an interrupted run with the same settings, and a writer that keeps them up to date."""
     path, key_path = out_dir / _PARTIAL, out_dir / (_PARTIAL + ".json")
-    done: dict[int, dict] = {}
+    done: dict[tuple[str, int], list[dict]] = {}
     if path.exists() and key_path.exists() and json.loads(key_path.read_text()) == key:
         table = pd.read_parquet(path)
-        done = {int(i): row for i, row in zip(table.pop("encounter"), table.to_dict("records"), strict=True)}
+        for (tr, i), g in table.groupby(["terrain", "encounter"], sort=False):
+            done[(str(tr), int(i))] = g.drop(columns=["terrain", "encounter"]).to_dict("records")
     write_json_atomic(key_path, key)
 
-    def save(results: dict[int, dict]) -> None:
-        rows = pd.DataFrame(list(results.values()))
-        rows.insert(0, "encounter", list(results))
-        write_table(rows, path)
+    def save(results: dict) -> None:
+        rows = [{"terrain": tr, "encounter": i, **r} for (tr, i), rs in results.items() for r in rs]
+        write_table(pd.DataFrame(rows), path)
 
     return done, save
 
 
+def _check(n_encounters: int, terrains: tuple[str, ...], layouts: tuple[str, ...]) -> None:
+    if not 1 <= n_encounters <= MAX_ENCOUNTERS:  # 10**20 was a numpy "Maximum allowed size" traceback
+        raise InputError(f"--n: must be an integer >= 1 and <= {MAX_ENCOUNTERS}, got {n_encounters!r}")
+    if not terrains or any(t not in TERRAINS for t in terrains):
+        raise InputError(f"--terrain: must be among {', '.join(TERRAINS)}, got {','.join(terrains)!r}")
+    if not layouts or any(x not in LAYOUTS for x in layouts):
+        raise InputError(f"--layout: must be among {', '.join(LAYOUTS)}, got {','.join(layouts)!r}")
+
+
 def run(
     out_dir: Path,
-    n_encounters: int = 500,
+    n_encounters: int = DEFAULT_ENCOUNTERS,
     seed: int = 0,
-    frame_rate_hz: float = 4.7,
+    frame_rate_hz: float = FRAME_RATE_HZ,
     late_lead_s: float = 12.5,
     buffer: float = 1.5,
     workers: int | None = None,
     uncertainty: bool = True,
     progress: Callable[[int], None] | None = None,
-    terrain: str | None = None,
+    terrains: tuple[str, ...] = ("none",),
+    layouts: tuple[str, ...] = LAYOUTS,
+    navigation: str = "ga-typical",
 ) -> dict:
-    """Run the encounter set; write ``encounters.parquet``, ``encounters.csv``, ``summary.json`` and
-    ``encounters.png`` into ``out_dir``; return the summary.
+    """Run the encounter set; write ``encounters.parquet``/``.csv`` (one row per terrain, encounter
+    and layout), ``summary.json``, ``summary_rows.csv`` and the figures into ``out_dir``; return the
+    summary.
 
-    ``uncertainty=False`` turns off the widening of the volumes by the track covariance. A warning
-    with less lead than ``late_lead_s`` (default half the 25 s warning alerting time) is late.
-    ``terrain="flat"`` flies the set over flat ground (clutter, slower; see
-    :func:`~skyradar.experiments.encounter_set.encounter_scenario`). Finished encounters are kept
-    in ``encounters.partial.parquet`` while the run goes on; a run that was interrupted resumes
-    from them when started again with the same settings.
+    The summary's top-level keys are those of the first terrain and last layout (three-head when it
+    runs); ``rows`` holds every terrain and layout. ``uncertainty=False`` turns off the widening of
+    the volumes by the track covariance. A warning with less lead than ``late_lead_s`` (default half
+    the 25 s warning alerting time) is late. ``navigation`` is the scenarios' ``navigation:`` model.
+    Finished encounters are kept in ``encounters.partial.parquet`` while the run goes on; a run that
+    was interrupted resumes from them when started again with the same settings.
     """
-    if not 1 <= n_encounters <= MAX_ENCOUNTERS:  # 10**20 was a numpy "Maximum allowed size" traceback
-        raise InputError(f"--n: must be an integer >= 1 and <= {MAX_ENCOUNTERS}, got {n_encounters!r}")
+    terrains, layouts = tuple(terrains), tuple(x for x in LAYOUTS if x in layouts)
+    _check(n_encounters, terrains, tuple(layouts) or ("",))
     t0 = time.perf_counter()
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -217,21 +175,18 @@ def run(
     if not uncertainty:
         cfg = replace(cfg, z_h_pos=0.0, z_h_vel=0.0, z_v_pos=0.0, z_v_vel=0.0)
     enc = make_encounters(n_encounters, seed)
-    key = {"n": n_encounters, "seed": seed, "frame_rate_hz": frame_rate_hz, "buffer": buffer,
-           "uncertainty": uncertainty, "terrain": terrain, "version": _version()}  # fmt: skip
-    done, save = _partial_store(out_dir, key)
-    out = run_encounters(enc, seed, workers, progress, done, save, frame_rate_hz=frame_rate_hz, buffer=buffer,
-                         alert_config=cfg, terrain=terrain)  # fmt: skip
-    res = pd.concat([enc, out], axis=1)
-    summary = summarise(res, late_lead_s)
-    summary.update(chain="full", frames=int(res["frames"].sum()), frame_rate_hz=frame_rate_hz, buffer=buffer,
-                   uncertainty=uncertainty, seed=seed, terrain=terrain or "none",
-                   resumed_encounters=len(done),
-                   other_track_warnings=int(res["t_other_warning_s"].notna().sum()))  # fmt: skip
-    write_table(res, out_dir / "encounters.parquet")
-    write_csv_atomic(res, out_dir / "encounters.csv", index=False)
-    plot_encounters(res, out_dir / "encounters.png", buffer, cfg.levels[-1].alerting_time_s)
-    summary["runtime_s"] = round(time.perf_counter() - t0, 1)
+    settings = {"n": n_encounters, "seed": seed, "frame_rate_hz": frame_rate_hz, "buffer": buffer,
+                "uncertainty": uncertainty, "terrains": list(terrains), "layouts": list(layouts),
+                "navigation": navigation, "suppression": SUPPRESSION, "late_lead_s": late_lead_s}  # fmt: skip
+    done, save = _partial_store(out_dir, {**settings, "version": _version()})
+    res = run_encounters(enc, seed, workers, progress, done, save, terrains=terrains, layouts=layouts,
+                         frame_rate_hz=frame_rate_hz, buffer=buffer, alert_config=cfg,
+                         navigation=navigation)  # fmt: skip
+    summary = write_report(res, out_dir, settings, late_lead_s, cfg.levels[-1].alerting_time_s)
+    workers = check_workers(workers) or min(2, os.cpu_count() or 1)
+    summary.update(
+        resumed_encounters=len(done), workers=workers, runtime_s=round(time.perf_counter() - t0, 1)
+    )
     write_json_atomic(out_dir / "summary.json", summary)
     for name in (_PARTIAL, _PARTIAL + ".json"):
         (out_dir / name).unlink(missing_ok=True)

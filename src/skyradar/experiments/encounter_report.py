@@ -1,0 +1,107 @@
+"""Tables, figures and the summary of ``skyradar experiment encounters``.
+
+Writes ``encounters.parquet`` and ``encounters.csv`` (one row per terrain, encounter and layout),
+``summary_rows.csv`` (one row per terrain and layout), ``encounters.png`` (the first terrain's
+last layout), ``encounters_<terrain>_<layout>.png`` for every other row and ``causes.png`` (every
+conflict of each row: warned before its loss of well clear, or the cause it was not).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from skyradar.experiments.encounter_score import CAUSES, summarise_layout
+from skyradar.experiments.encounter_set import plot_encounters
+from skyradar.io.atomic import savefig_atomic, write_csv_atomic
+from skyradar.io.tables import write_table
+
+__all__ = ["summary_rows", "cost_ms_per_frame", "write_report", "plot_causes"]
+
+_STAGES = ("simulate", "process", "track", "alert")
+
+
+def summary_rows(res: pd.DataFrame, late_lead_s: float) -> list[dict[str, Any]]:
+    """One summary per terrain and layout, in the table's order."""
+    rows = []
+    for (terrain, layout), g in res.groupby(["terrain", "layout"], sort=False):
+        rows.append({"terrain": terrain, "layout": layout, **summarise_layout(g, late_lead_s)})
+    return rows
+
+
+def cost_ms_per_frame(res: pd.DataFrame) -> dict[str, float]:
+    """Mean wall time per frame of each stage, ms (simulate and process: every head of the run,
+    counted once per encounter; track and alert: per layout, named ``track_<layout>``).
+
+    Examples
+    --------
+    >>> res = pd.DataFrame({"terrain": "none", "encounter": [0, 0], "layout": ["single", "three-head"],
+    ...     "frames": 100, "simulate_s": 1.0, "process_s": 2.0, "track_s": [0.1, 0.3], "alert_s": 0.0})
+    >>> cost_ms_per_frame(res)["process"], cost_ms_per_frame(res)["track_three-head"]
+    (20.0, 3.0)
+    """
+    once = res.drop_duplicates(["terrain", "encounter"])
+    frames = float(once["frames"].sum())
+    out = {s: round(1000.0 * float(once[f"{s}_s"].sum()) / frames, 2) for s in _STAGES[:2]}
+    for layout, g in res.groupby("layout", sort=False):
+        for s in _STAGES[2:]:
+            out[f"{s}_{layout}"] = round(1000.0 * float(g[f"{s}_s"].sum()) / float(g["frames"].sum()), 2)
+    return out
+
+
+def plot_causes(rows: list[dict[str, Any]], path: Path) -> None:
+    """Stacked bars per terrain and layout: conflicts warned before LoWC, and the rest by cause."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(max(5.0, 1.3 * len(rows) + 2.0), 4.5))
+    x = np.arange(len(rows))
+    bottom = np.zeros(len(rows))
+    parts = [("warned before LoWC", "tab:blue", [r["warned_before_lowc"] for r in rows])]
+    colours = dict(zip(CAUSES, ("tab:red", "0.3", "0.55", "tab:brown", "0.8"), strict=True))
+    parts += [(c.replace("_", " "), colours[c], [r["unwarned_by_cause"][c] for r in rows]) for c in CAUSES]
+    for label, colour, values in parts:
+        ax.bar(x, values, bottom=bottom, color=colour, label=label)
+        bottom += np.asarray(values, float)
+    ax.set_xticks(x, [f"{r['terrain']}\n{r['layout']}" for r in rows], fontsize=8)
+    ax.set(ylabel="conflicts", title="every conflict: warned before LoWC, or why not")
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    fig.tight_layout()
+    savefig_atomic(fig, path, dpi=110)
+    plt.close(fig)
+
+
+def write_report(
+    res: pd.DataFrame, out_dir: Path, settings: dict, late_lead_s: float, warning_time_s: float
+) -> dict[str, Any]:
+    """Write the tables and figures of a finished run into ``out_dir``; return the summary (without
+    runtime): the first terrain's last layout at the top level, every row under ``rows``."""
+    rows = summary_rows(res, late_lead_s)
+    buffer = settings["buffer"]
+    write_table(res, out_dir / "encounters.parquet")
+    write_csv_atomic(res, out_dir / "encounters.csv", index=False)
+    flat = [{k: v for k, v in r.items() if not isinstance(v, dict)} for r in rows]
+    write_csv_atomic(pd.DataFrame(flat), out_dir / "summary_rows.csv", index=False)
+    first = res["terrain"].iloc[0]
+    primary = [r for r in rows if r["terrain"] == first][-1]
+    for r in rows:
+        g = res[(res["terrain"] == r["terrain"]) & (res["layout"] == r["layout"])]
+        name = "encounters.png" if r is primary else f"encounters_{r['terrain']}_{r['layout']}.png"
+        plot_encounters(g, out_dir / name, buffer, warning_time_s)
+    plot_causes(rows, out_dir / "causes.png")
+    once = res.drop_duplicates(["terrain", "encounter"])
+    mine = res[(res["terrain"] == first) & (res["layout"] == primary["layout"])]
+    return {
+        **primary,
+        "chain": "full",
+        **{k: v for k, v in settings.items() if k not in ("n",)},
+        "frames": int(once["frames"].sum()),
+        "cost_ms_per_frame": cost_ms_per_frame(res),
+        "other_track_warnings": int(mine["t_other_warning_s"].notna().sum()),
+        "rows": rows,
+    }

@@ -1,0 +1,123 @@
+"""Honest encounter scoring: every conflict, causes of the unwarned ones, clutter and fragments,
+the terrains of the set, and the command's bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from cli_helpers import assert_one_line_error, skyradar
+from skyradar.experiments.encounter_report import cost_ms_per_frame
+from skyradar.experiments.encounter_score import CAUSES, conflict_cause, summarise_layout
+from skyradar.experiments.encounter_set import make_encounters
+from skyradar.experiments.encounter_terrain import mirror_below_ground, own_altitude_m, parse_terrains
+
+
+def _status(**flags) -> pd.DataFrame:
+    n = 11
+    base = {"time_s": np.arange(n, dtype=float), "behind": np.zeros(n, bool), "in_beam": np.ones(n, bool),
+            "in_view": np.ones(n, bool), "observable": np.ones(n, bool)}  # fmt: skip
+    for name, frames in flags.items():
+        base[name] = base[name].copy()
+        base[name][frames] = not base[name][frames[0]]
+        base["observable"][frames] = False
+    return pd.DataFrame(base)
+
+
+@pytest.mark.parametrize(
+    ("flags", "cause"),
+    [({}, "missed"), ({"behind": [9]}, "behind"), ({"in_beam": [8]}, "outside_beams"),
+     ({"in_view": [4]}, "terrain_masked"), ({"observable": [10]}, "below_13db"),
+     ({"in_beam": [2], "behind": [9]}, "behind"), ({"in_view": [3], "in_beam": [5]}, "outside_beams")],
+)  # fmt: skip
+def test_conflict_cause_takes_the_first_cause_in_the_window_before_lowc(flags, cause):
+    assert conflict_cause(_status(**flags), t_lowc_s=10.0, observe_window_s=8.0) == cause
+
+
+def test_conflict_cause_ignores_frames_outside_the_window():
+    s = _status(behind=[0, 1])  # behind long before the window: the window is clean
+    assert conflict_cause(s, t_lowc_s=10.0, observe_window_s=8.0) == "missed"
+    assert conflict_cause(s, t_lowc_s=np.nan, observe_window_s=8.0) == ""
+
+
+def _results() -> pd.DataFrame:
+    # Six conflicts (two warned in time, one late after LoWC, three never), one may-alert, two must-not.
+    rows = [
+        (True, False, True, 100.0, 80.0, "missed", 1, 0, 0, 0, 0),
+        (True, False, False, 100.0, 90.0, "outside_beams", 2, 1, 0, 1, 0),
+        (True, False, True, 100.0, 105.0, "missed", 3, 0, 0, 0, 0),
+        (True, False, False, 100.0, np.nan, "behind", 0, 0, 0, 0, 0),
+        (True, False, False, 100.0, np.nan, "below_13db", 1, 2, 1, 2, 1),
+        (True, False, False, 100.0, np.nan, "terrain_masked", 0, 0, 0, 0, 0),
+        (False, True, False, np.nan, 70.0, "", 1, 0, 0, 0, 0),
+        (False, False, False, np.nan, np.nan, "", 1, 3, 0, 0, 0),
+        (False, False, False, np.nan, 60.0, "", 4, 0, 0, 0, 0),
+    ]
+    cols = ["conflict", "may_alert", "observable", "t_lowc_s", "t_warning_s", "cause", "intruder_tracks",
+            "clutter_tracks", "clutter_warning_tracks", "ground_tracks", "ground_warning_tracks"]  # fmt: skip
+    res = pd.DataFrame(rows, columns=cols)
+    res["flight_s"] = 40.0  # 9 x 40 s = 6 minutes
+    return res
+
+
+def test_summary_over_all_conflicts_by_cause_with_clutter_and_fragments():
+    s = summarise_layout(_results(), late_lead_s=12.5)
+    assert (s["conflicts"], s["warned_before_lowc"]) == (6, 2)
+    assert s["warned_before_lowc_fraction"] == pytest.approx(2 / 6)
+    # Unwarned (or warned after LoWC) conflicts by cause; "missed" is the observable one.
+    assert s["unwarned_by_cause"] == {"missed": 1, "behind": 1, "outside_beams": 0, "terrain_masked": 1,
+                                      "below_13db": 1}  # fmt: skip
+    assert set(s["unwarned_by_cause"]) == set(CAUSES)
+    assert s["missed_warnings"] == s["unwarned_by_cause"]["missed"] == 1
+    assert s["must_not_alert_encounters"] == 2 and s["false_warnings"] == 1
+    assert s["flight_minutes"] == pytest.approx(6.0)
+    assert (s["clutter_tracks"], s["clutter_tracks_per_min"]) == (6, pytest.approx(1.0))
+    assert (s["clutter_warnings"], s["encounters_with_clutter_warnings"]) == (1, 1)
+    assert (s["ground_tracks"], s["ground_tracks_per_min"], s["ground_track_warnings"]) == (3, 0.5, 1)
+    # Fragments over the encounters whose intruder has a track: 1, 2, 3, 1, 1, 1, 4.
+    assert s["intruder_tracked_encounters"] == 7
+    assert s["track_fragments_per_intruder"] == {"median": 1.0, "mean": pytest.approx(13 / 7), "max": 4}
+
+
+def test_cost_per_frame_counts_the_shared_simulation_once():
+    res = pd.DataFrame({"terrain": "none", "encounter": [0, 0, 1, 1], "layout": ["single", "three-head"] * 2,
+                        "frames": [100, 100, 300, 300], "simulate_s": [2.0, 2.0, 6.0, 6.0],
+                        "process_s": [1.0, 1.0, 3.0, 3.0], "track_s": [0.1, 0.4, 0.3, 1.2],
+                        "alert_s": 0.0})  # fmt: skip
+    c = cost_ms_per_frame(res)
+    assert (c["simulate"], c["process"]) == (20.0, 10.0)
+    assert (c["track_single"], c["track_three-head"]) == (1.0, 4.0)
+
+
+def test_terrain_names_altitude_and_mirror():
+    assert parse_terrains("none, flat-300,flat") == ["none", "flat-300", "flat-1000"]
+    ground = np.array([300.0, 420.0, 550.0])  # 250 m of relief fits the 400-700 m band
+    alt = own_altitude_m(ground)
+    assert alt - ground.max() >= 400.0 and alt - ground.min() <= 700.0
+    steep = np.array([0.0, 500.0])  # too steep for the band: clearance wins
+    assert own_altitude_m(steep) - steep.max() == 400.0
+    # 50 m above the ground below own-ship at 300 m AGL: flies the mirror image (550 m AGL).
+    assert mirror_below_ground(np.array([50.0]), np.array([0.0]), 300.0)
+    assert not mirror_below_ground(np.array([150.0]), np.array([0.0]), 300.0)
+
+
+def test_jacksboro_dem_covers_every_encounter_window_and_range_limit():
+    from skyradar.experiments.encounter_set import T_CPA_S, encounter_scenario
+    from skyradar.scene.scenario import Scenario
+
+    p = make_encounters(1, 0).iloc[0]
+    for seed in (0, 1, 2):
+        spec = encounter_scenario(p, T_CPA_S - 42.0, 44.0, 2.0, seed, "jacksboro")
+        built = Scenario.from_dict(spec).build()
+        own = built.ownship.sample(built.times_s)
+        (lat0, lon0), r = (own.lat_deg, own.lon_deg), built.radar.range_limit_m
+        for dn, de in ((r, 0.0), (-r, 0.0), (0.0, r), (0.0, -r)):  # the range limit around own-ship
+            dlat, dlon = np.degrees(dn / 6.371e6), np.degrees(de / (6.371e6 * np.cos(np.radians(lat0))))
+            assert np.isfinite(built.terrain.height_at(lat0 + dlat, lon0 + dlon)).all(), (seed, dn, de)
+
+
+def test_bad_terrain_gives_one_line(tmp_path):
+    r = skyradar("experiment", "encounters", "--terrain", "hills,moon", "--out", "o", cwd=tmp_path)
+    assert_one_line_error(r, "--terrain", "moon")
+    assert not (tmp_path / "o").exists()

@@ -18,8 +18,23 @@ def alert(
     tracks: Annotated[
         Path, typer.Argument(help="Tracks table (Parquet or CSV) with 3-D NED position and velocity.")
     ],
-    ownship: Annotated[Path, typer.Option("--ownship", help="Frames run (Zarr) holding the own-ship state.")],
+    ownship: Annotated[
+        Path,
+        typer.Option(
+            "--ownship",
+            help="Own-ship state: the frames run (Zarr) or a table (Parquet/CSV, e.g. `skyradar export`'s "
+            "ownship.parquet); its navigation solution (nav_*) is used, never the truth.",
+        ),
+    ],
     output: Annotated[Path, typer.Option("-o", "--output", help="Alerts table to write (Parquet).")],
+    config: Annotated[
+        str,
+        typer.Option(
+            "--config",
+            help="Alert settings: radar (the README's results; default), default (DAIDALUS DO-365B: "
+            "2 of 4 frames, no track-quality gate) or FILE.yaml (fields of skyradar.daa.alert_config).",
+        ),
+    ] = "radar",
     no_advice: Annotated[
         bool, typer.Option("--no-advice", help="Skip the resolution bands and manoeuvre.")
     ] = False,
@@ -29,23 +44,28 @@ def alert(
     """Turn tracks into DO-365-style alert levels, FLARM-style alarms and resolution advice.
 
     Levels: 0 none, 1 preventive, 2 corrective, 3 warning (non-cooperative well clear: 2200 ft,
-    450 ft; alerting times 55/55/25 s; 2-of-4 persistence, 5 s hysteresis).
+    450 ft; alerting times 55/55/25 s; with --config radar 2 of 4 one-second periods, 5 s
+    hysteresis, no alert from a track whose velocity is known worse than 6 m/s).
     """
+    from skyradar.daa.alert_config import alert_config
     from skyradar.daa.pipeline import TRACK_COLUMNS, alert_summary, alerts_for_run
-    from skyradar.io.frames import open_frames
     from skyradar.io.outputs import check_output
+    from skyradar.io.ownship_input import open_ownship
     from skyradar.io.tables import read_table, write_table
 
-    check_output(output, [tracks, ownship], overwrite, kind="table")
+    settings = alert_config(config)  # a bad --config is named before anything is read
+    config_file = None if config in ("radar", "default") else Path(config)
+    check_output(output, [tracks, ownship, config_file], overwrite, kind="table")
     table = read_table(tracks, required=TRACK_COLUMNS, sort_by="time_s")
-    run_ds = open_frames(ownship)
+    run_ds = open_ownship(ownship)
     alerts = alerts_for_run(
-        run_ds, table, with_advice=not no_advice, run_name=str(ownship), tracks_name=str(tracks)
-    )
+        run_ds, table, settings, with_advice=not no_advice, run_name=str(ownship),
+        tracks_name=str(tracks),
+    )  # fmt: skip
     write_table(alerts, output)
     summary = alert_summary(alerts)
     levels = {key: summary.pop(key) for key in ("rows_level_1", "rows_level_2", "rows_level_3")}
-    emit_result(summary | {"output": str(output)} | levels, as_json, "alerts")
+    emit_result(summary | {"output": str(output), "config": config} | levels, as_json, "alerts")
 
 
 @app.command()

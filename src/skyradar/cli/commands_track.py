@@ -43,16 +43,50 @@ _ModelOpt = Annotated[
     str, typer.Option("--model", help="'radar' (aliasing-aware, coupled) or 'traditional' (image tracker).")
 ]
 _OriginOpt = Annotated[
-    str | None, typer.Option("--origin", help="Scenario origin 'lat,lon,alt' for the tracks' lat/lon/alt.")
+    str | None,
+    typer.Option(
+        "--origin",
+        help="Override the origin 'lat,lon,alt' (default: --ownship's store, else the detections' run).",
+    ),
 ]
 _OwnshipOpt = Annotated[
     Path | None,
     typer.Option(
         "--ownship",
-        help="Own-ship table (time_s, own_north_m..own_vd_mps, NED): the radial velocity then "
-        "updates the 3-D velocity and the DoA error is split along/across the line of sight.",
+        help="Own-ship state: the frames run (Zarr) or a table (Parquet/CSV, e.g. `skyradar export`'s "
+        "ownship.parquet; time_s, nav_* or own_*): its navigation solution (nav_*) is used, never the "
+        "truth. The radial velocity then updates the 3-D velocity and the DoA error is split along/across "
+        "the line of sight.",
     ),
 ]
+
+
+def _ownship_and_origin(ownship: Path | None, table, origin: str | None):
+    """(own-ship navigation table or None, origin or None, where the origin came from)."""
+    import json
+
+    import pandas as pd
+
+    from skyradar.io.navigation import navigation_state
+    from skyradar.io.ownship_input import open_ownship
+    from skyradar.io.run_origin import scenario_origin
+    from skyradar.track.io import validate_ownship
+    from skyradar.track.track_table import OWNSHIP_COLUMNS
+
+    own, found, where = None, None, None
+    if ownship is not None:
+        run = open_ownship(ownship)
+        own = navigation_state(run, f"--ownship {ownship}")
+        if own is None:  # no own-ship variable at all: validate_ownship names the missing ones
+            own = pd.DataFrame({"time_s": run["time_s"].values if "time_s" in run else []})
+        own = validate_ownship(own, OWNSHIP_COLUMNS, f"--ownship {ownship}")
+        found, where = scenario_origin(run), f"--ownship {ownship}"
+    if found is None and table.attrs.get("ownship_signature"):  # `process` signs the run it read
+        sig = json.loads(table.attrs["ownship_signature"])
+        found, where = (tuple(sig["origin"]), f"run {sig.get('run')}") if sig.get("origin") else (None, None)
+    if origin is not None:
+        return own, _origin(origin), "--origin"
+    return own, found, where
 
 
 @app.command()
@@ -73,26 +107,27 @@ def track(
     east_m, down_m each track also gets a 3-D position, velocity and position covariance.
     Detections flagged is_ground or spur are left out.
     """
+    import json
+
     import numpy as np
 
     from skyradar.errors import InputError
     from skyradar.io.outputs import check_output
-    from skyradar.io.tables import read_table, write_table
-    from skyradar.track.io import radar_config_from_attrs, read_detections, validate_ownship
-    from skyradar.track.track_table import OWNSHIP_COLUMNS, track_air_detections
+    from skyradar.io.tables import write_table
+    from skyradar.track.io import radar_config_from_attrs, read_detections
+    from skyradar.track.track_table import track_air_detections
 
     if model not in ("radar", "traditional"):
         raise InputError(f"--model: must be 'radar' or 'traditional', got {model!r}")
     check_output(output, [detections, ownship], overwrite, kind="table")
-    origin_lla = _origin(origin)
+    _origin(origin)  # a bad --origin is named before any reading
     table = read_detections(detections)
     config = radar_config_from_attrs(table)
-    own = None
-    if ownship is not None:
-        own = read_table(ownship, required=list(OWNSHIP_COLUMNS), sort_by="time_s")
-        validate_ownship(own, OWNSHIP_COLUMNS, str(ownship))
+    own, origin_lla, origin_from = _ownship_and_origin(ownship, table, origin)
     tracks, n_used = track_air_detections(table, model, config, origin_lla, own)
     meta = {"radar_config": config.to_json(), "source": str(detections), "model": model}
+    if origin_lla is not None:
+        meta["origin_lla"] = json.dumps([float(v) for v in origin_lla])
     if table.attrs.get("ownship_signature"):  # carried on for `alert` (see skyradar.daa.provenance)
         meta["ownship_signature"] = table.attrs["ownship_signature"]
     write_table(tracks, output, metadata=meta)
@@ -105,7 +140,7 @@ def track(
         )
     n_frames = int(np.unique(table["time_s"].to_numpy(float)).size)
     result = {"frames": n_frames, "detections": n_used, "tracks": int(tracks["track_id"].nunique())}
-    result |= {"rows": len(tracks), "model": model, "output": str(output)}
+    result |= {"rows": len(tracks), "model": model, "output": str(output), "origin_from": origin_from}
     emit_result(result, as_json, "tracks")
 
 

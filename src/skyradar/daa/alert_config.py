@@ -1,0 +1,139 @@
+"""Alerting settings by name or from a YAML file (``skyradar alert --config radar|default|FILE.yaml``).
+
+``radar`` is :data:`~skyradar.daa.alerting.RADAR_ALERT_CONFIG`, the settings every DAA result of
+this project uses (``experiment encounters``, ``demo``) and ``alert``'s default; ``default`` is
+:class:`~skyradar.daa.alerting.AlertConfig` as DAIDALUS' DO-365B configuration has it (2 of 4
+frames, no track-quality gate). A file holds :class:`AlertConfig` fields, starting from ``base``
+(``radar`` unless given)::
+
+    base: radar                  # or default
+    m: 3
+    n: 5
+    period_s: 1.0                # null: M of N frames
+    persistence_s: 4.0
+    hysteresis_s: 5.0
+    z_h_pos: 1.5                 # also z_h_vel, z_v_pos, z_v_vel
+    min_track_age_s: 2.0
+    max_velocity_sigma_mps: 6.0  # null: no gate
+    flarm_thresholds_s: [18, 13, 8]
+    levels:                      # preventive, corrective, warning
+      - {name: preventive, dthr_m: 670.56, zthr_m: 213.36, alerting_time_s: 55}
+      - {name: corrective, dthr_m: 670.56, zthr_m: 137.16, alerting_time_s: 55}
+      - {name: warning, dthr_m: 670.56, zthr_m: 137.16, alerting_time_s: 25}
+    collision_volume: {dthr_m: 152.4, zthr_m: 30.48}
+
+Every field is checked; a wrong one is refused in one line naming the file, the field and the value.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+from typing import Any
+
+from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig, AlertLevel
+from skyradar.daa.conflict import WellClearVolume
+from skyradar.errors import InputError
+
+__all__ = ["ALERT_CONFIGS", "alert_config"]
+
+ALERT_CONFIGS = {"radar": RADAR_ALERT_CONFIG, "default": AlertConfig()}
+_INTS = ("m", "n")
+_FLOATS = ("persistence_s", "hysteresis_s", "z_h_pos", "z_h_vel", "z_v_pos", "z_v_vel", "min_track_age_s")
+_OPTIONAL = ("period_s", "max_velocity_sigma_mps")
+_VOLUME_KEYS = ("dthr_m", "zthr_m", "tthr_s", "tcoa_s")
+
+
+def _number(label: str, value: Any, integer: bool = False, low: float = 0.0) -> float:
+    ok = isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+    ok = ok and (float(value).is_integer() if integer else True) and value >= low
+    if not ok:
+        kind = "an integer" if integer else "a finite number"
+        raise InputError(f"{label}: must be {kind} >= {low:g}, got {value!r}")
+    return int(value) if integer else float(value)
+
+
+def _volume(label: str, value: Any) -> WellClearVolume:
+    if (
+        not isinstance(value, dict)
+        or not {"dthr_m", "zthr_m"} <= set(value)
+        or set(value) - set(_VOLUME_KEYS)
+    ):
+        raise InputError(f"{label}: must be a mapping of dthr_m, zthr_m (and tthr_s, tcoa_s), got {value!r}")
+    return WellClearVolume(**{k: _number(f"{label}.{k}", v) for k, v in value.items()})
+
+
+def _levels(label: str, value: Any) -> tuple[AlertLevel, ...]:
+    if not isinstance(value, list) or not value:
+        raise InputError(
+            f"{label}: must be a list of levels (preventive, corrective, warning), got {value!r}"
+        )
+    levels = []
+    for i, item in enumerate(value):
+        where = f"{label}.{i}"
+        if not isinstance(item, dict) or not {"name", "alerting_time_s"} <= set(item):
+            raise InputError(f"{where}: must have name, dthr_m, zthr_m and alerting_time_s, got {item!r}")
+        volume = {k: v for k, v in item.items() if k not in ("name", "alerting_time_s")}
+        time_s = _number(f"{where}.alerting_time_s", item["alerting_time_s"])
+        levels.append(AlertLevel(str(item["name"]), _volume(where, volume), time_s))
+    return tuple(levels)
+
+
+def _fields(label: str, data: dict) -> dict:
+    known = {f.name for f in dataclasses.fields(AlertConfig)}
+    changes: dict[str, Any] = {}
+    for key, value in data.items():
+        where = f"{label}: field '{key}'"
+        if key not in known:
+            raise InputError(f"{where} is not an alert setting (known: base, {', '.join(sorted(known))})")
+        if key in _INTS:
+            changes[key] = _number(where, value, integer=True, low=1)
+        elif key in _FLOATS:
+            changes[key] = _number(where, value)
+        elif key in _OPTIONAL:
+            changes[key] = None if value is None else _number(where, value)
+        elif key == "flarm_thresholds_s":
+            if not isinstance(value, list) or len(value) != 3:
+                raise InputError(f"{where}: must be 3 times to impact in s, got {value!r}")
+            changes[key] = tuple(_number(f"{where}.{i}", v) for i, v in enumerate(value))
+        elif key == "levels":
+            changes[key] = _levels(where, value)
+        else:  # collision_volume
+            changes[key] = _volume(where, value)
+    return changes
+
+
+def alert_config(value: str | Path) -> AlertConfig:
+    """The alerting settings ``value`` names: ``radar``, ``default``, or a YAML file of fields.
+
+    Examples
+    --------
+    >>> alert_config("radar") is RADAR_ALERT_CONFIG, alert_config("default") == AlertConfig()
+    (True, True)
+    >>> alert_config("fast")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: --config fast: not radar, default or an existing .yaml file
+    """
+    if str(value) in ALERT_CONFIGS:
+        return ALERT_CONFIGS[str(value)]
+    path = Path(value)
+    if path.suffix.lower() not in (".yaml", ".yml") or not path.is_file():
+        raise InputError(f"--config {value}: not radar, default or an existing .yaml file")
+    import yaml
+
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
+    except (yaml.YAMLError, UnicodeDecodeError) as exc:
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise InputError(f"{path}: not valid YAML ({first})") from None
+    if not isinstance(data, dict):
+        raise InputError(f"{path}: must be a mapping of alert settings, got {type(data).__name__}")
+    base = data.pop("base", "radar")
+    if base not in ALERT_CONFIGS:
+        raise InputError(f"{path}: field 'base' must be radar or default, got {base!r}")
+    try:
+        return dataclasses.replace(ALERT_CONFIGS[base], **_fields(str(path), data))
+    except ValueError as exc:  # AlertConfig's own checks (1 <= m <= n, period_s > 0)
+        raise InputError(f"{path}: {exc}") from None

@@ -35,10 +35,11 @@ from skyradar.errors import InputError
 from skyradar.geo import rotation_matrix
 from skyradar.io.checks import check_finite_frames, check_frame_times
 from skyradar.io.frames_model import frame_times_s
-from skyradar.sim.navigation import AhrsModel, ahrs_attitude
+from skyradar.io.navigation import navigation_state
 from skyradar.nav.inversion import StateFit, fit_robust, fit_thesis
 from skyradar.nav.kalman_state import KalmanSettings, filter_states
 from skyradar.nav.ridge import Ridge, extract_ridge
+from skyradar.sim.navigation import AhrsModel, ahrs_attitude
 
 __all__ = [
     "METHODS",
@@ -158,11 +159,16 @@ def filter_table(
 
 
 def _attitudes(ds: xr.Dataset, times: np.ndarray, ahrs: AhrsModel | None, seed: int) -> np.ndarray:
-    """(n, 3) yaw, pitch, roll: the run's own_*_rad (level north when absent), through ``ahrs`` if given."""
+    """(n, 3) yaw, pitch, roll (level north when absent).
+
+    Without ``ahrs``: the run's navigation attitude (nav_*_rad, the AHRS the run simulated; own_*
+    only in runs written without navigation). With ``ahrs`` (the thesis comparison): the truth
+    own_*_rad through that model's seeded errors.
+    """
     names = ("own_yaw_rad", "own_pitch_rad", "own_roll_rad")
-    attitude = np.column_stack(
-        [ds[n].to_numpy().astype(float) if n in ds else np.zeros(times.size) for n in names]
-    )
+    state = ds if ahrs is not None else navigation_state(ds)
+    columns = [np.asarray(state[n], float) if state is not None and n in state else None for n in names]
+    attitude = np.column_stack([np.zeros(times.size) if c is None else c for c in columns])
     return attitude if ahrs is None else ahrs_attitude(attitude, times, ahrs, seed=seed)
 
 
@@ -240,8 +246,10 @@ def estimate_run(
         settings = KalmanSettings(terrain_psd=400.0) if method == "terrain" else KalmanSettings()
     reference = None
     if gps_gate:
-        if "own_height_agl_m" not in ds:
+        # The GPS gate compares with the GNSS height above the terrain: the navigation's, not the truth.
+        nav = navigation_state(ds, source)
+        if nav is None or "own_height_agl_m" not in nav:
             raise InputError(f"{source}: field 'own_height_agl_m' is needed for the GPS gate but missing")
-        reference = ds["own_height_agl_m"].to_numpy().astype(float)
+        reference = nav["own_height_agl_m"].to_numpy(float)
         settings = KalmanSettings(**{**settings.__dict__, "gps_gate_m": 150.0})
     return filter_table(table, settings, reference)

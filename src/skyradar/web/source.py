@@ -27,6 +27,7 @@ from skyradar.errors import InputError
 from skyradar.io import cint16
 from skyradar.io.frames import FrameStoreWriter, open_frames, radar_config_of
 from skyradar.io.frames_model import frame_times_s
+from skyradar.io.navigation import navigation_state
 from skyradar.io.tables import jsonable, read_table
 from skyradar.process.power import power_image
 
@@ -116,8 +117,11 @@ class RunSource:
         self.ds, self._opened = ds, target
         self.config = radar_config_of(ds, str(target))
         self.times = frame_times_s(ds)
-        # Truth variables are small and written at creation: keep them in memory.
-        self._own = {k: np.asarray(ds[k].values, float) for k in ds.data_vars if k.startswith("own_")}
+        # The own-ship state the pilot's display shows is the navigation solution (nav_*), never the
+        # simulator's truth; it is small and written at creation: keep it in memory.
+        state = navigation_state(ds, str(target))
+        own = [] if state is None else [k for k in state if k.startswith("own_")]
+        self._own = {k: state[k].to_numpy(float) for k in own}
         self._compute_alerts()
 
     def _ready_frames(self) -> int:

@@ -109,5 +109,10 @@ def test_make_encounter_command(tmp_path):
     assert "a.csv.gz: cleaned: timestamp in epoch ms, sorted by time (200 step(s) back)" in result.stderr
     built = load_scenario(tmp_path / "enc.yaml").build()
     assert (built.times_s[0], len(built.intruders)) == (pytest.approx(40.0), 1)
-    again = skyradar(*args, cwd=tmp_path)  # never overwrites without --overwrite
-    assert_one_line_error(again, "enc.yaml", "--overwrite")
+    # A file that cannot be repaired (timestamps between seconds and milliseconds) is refused in one
+    # line with the reason, and the scenario written before is left as it was.
+    rows[1].assign(timestamp=lambda d: d["timestamp"] / 100).to_json(tmp_path / "bad.json", orient="records")
+    before = (tmp_path / "enc.yaml").read_text()
+    again = skyradar("make-encounter", "bad.json", "b.json", "-o", "enc.yaml", "--overwrite", cwd=tmp_path)
+    assert_one_line_error(again, "bad.json: field 'timestamp' runs from", "cannot tell the unit")
+    assert (tmp_path / "enc.yaml").read_text() == before

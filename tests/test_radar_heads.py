@@ -9,6 +9,7 @@ import pytest
 from cli_helpers import assert_one_line_error, skyradar
 from skyradar.config import Mount
 from skyradar.errors import InputError
+from skyradar.experiments.daa_chain import label_tracks, run_chain
 from skyradar.geo import rotation_matrix
 from skyradar.io.frames import open_frames
 from skyradar.io.frames_heads import store_heads
@@ -210,3 +211,53 @@ def test_without_fusion_the_overlap_gives_duplicate_tracks(crossing):
 def test_example_yaml_lists_the_three_head_layout():
     path = example_scenario("three_heads_crossing")
     assert load_yaml(path.read_text(), path)["radars"] == THREE_HEAD_RADARS
+
+
+@pytest.mark.slow
+def test_full_chain_handover_left_head_to_nose_keeps_one_track_id():
+    # The acceptance point on the whole chain (simulate -> process -> fused track), nose and left heads
+    # of three_heads_crossing: 470 frames x 2 heads, a few minutes.
+    built = load_scenario(example_scenario("three_heads_crossing")).build()
+    out = run_chain(built, heads=["nose", "left"], with_advice=False)
+    labels = label_tracks(out["tracks"], out["truth"])
+    mine = [tid for tid, name in labels.items() if name == "crossing-left"]
+    assert len(mine) == 1
+    det = out["detections"]
+    air = det[~(det["is_ground"].astype(bool) | det["spur"].astype(bool))].reset_index(drop=True)
+    one = out["tracks"][out["tracks"]["track_id"] == mine[0]]
+    used = air.iloc[one["detection_row"][one["detection_row"] >= 0].to_numpy()]
+    first = used.groupby("radar")["time_s"].min()
+    assert first["left"] < 1.0 and first["nose"] > first["left"]  # the left head first, then the nose
+    assert one["time_s"].max() > built.times_s[-1] - 1.0  # to the end, as the nose's (and left's) track
+
+
+@pytest.mark.parametrize("precision", ["complex64", "cint16"])
+def test_multi_head_store_resumes_and_keeps_each_head(tmp_path, precision):
+    import dask.array as da
+
+    from skyradar.config import RadarConfig
+    from skyradar.io.frames import FrameStoreWriter, frames_dataset
+
+    cfg = RadarConfig.prototype_2022(range_limit_m=300.0, n_doppler=8)
+    shape = (3, cfg.n_range, cfg.n_doppler, cfg.n_rx)
+    times = np.arange(3) * 0.1
+    templates = {h: frames_dataset(da.zeros(shape, dtype=np.complex64, chunks=(2, -1, -1, -1)), times, cfg)
+                 for h in ("nose", "tail")}  # fmt: skip
+    rng = np.random.default_rng(1)
+    cubes = {
+        h: (rng.normal(size=shape) + 1j * rng.normal(size=shape)).astype(np.complex64) for h in templates
+    }
+    path = tmp_path / "run.zarr"
+    first = FrameStoreWriter(path, templates, 2, "job", precision=precision)
+    first.write_chunk(0, {h: c[:2] for h, c in cubes.items()})  # then "interrupted"
+    again = FrameStoreWriter(path, templates, 2, "job", precision=precision)
+    assert again.pending_chunks() == [1]  # resumed, not restarted
+    again.write_chunk(1, {h: c[2:] for h, c in cubes.items()})
+    again.close()
+    for h, cube in cubes.items():  # each head reads back as that head's frames written alone
+        alone = FrameStoreWriter(tmp_path / f"{h}.zarr", templates[h], 2, "job", precision=precision)
+        alone.write_chunk(0, cube[:2])
+        alone.write_chunk(1, cube[2:])
+        want = open_frames(alone.close()).iq.values
+        np.testing.assert_array_equal(open_frames(path, head=h).iq.values, want)
+        assert precision == "cint16" or np.array_equal(want, cube)

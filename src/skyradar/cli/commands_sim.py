@@ -90,8 +90,9 @@ def simulate(
     check_output(output, [scenario], overwrite, kind="frames store")  # before any work
     loaded = load_scenario(scenario)
     # Before the build: a huge run is refused in a second, not after minutes of truth geometry.
-    check_store_space(output, loaded.radar_config(), loaded.frame_times().size, chunk_frames, compress,
-                      precision)  # fmt: skip
+    n_heads = len(loaded.model.radars or [None])  # several radar heads: a group of frames each
+    check_store_space(output, loaded.radar_config(), n_heads * loaded.frame_times().size,
+                      n_heads * chunk_frames, compress, precision)  # fmt: skip
     built = loaded.build()
     n = built.times_s.size
     with frame_progress(n, f"simulate {built.name}") as bar:
@@ -100,7 +101,8 @@ def simulate(
             built, output, chunk_frames, scheduler, workers, progress=lambda k: bar.advance(task, k),
             overwrite=overwrite, compressor=compress, precision=precision,
         )  # fmt: skip
-    console.print(f"wrote {n} frames to {path}")
+    heads = f" of {len(built.heads)} radar heads ({', '.join(h.name for h in built.heads)})"
+    console.print(f"wrote {n} frames{heads if len(built.heads) > 1 else ''} to {path}")
 
 
 @app.command()

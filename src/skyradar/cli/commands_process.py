@@ -103,6 +103,7 @@ def process(
     from skyradar.daa.provenance import ownship_signature
     from skyradar.io.frames import open_frames, radar_config_of
     from skyradar.io.frames_heads import store_heads
+    from skyradar.io.navigation import navigation_source
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_table
     from skyradar.process.detect_run import detect_run_heads, detection_summary
@@ -129,8 +130,12 @@ def process(
     if len(configs) > 1:  # each head's RadarConfig (mount, lever arm); radar_config is the first's
         meta["radar_heads"] = json.dumps({name: c.to_dict() for name, c in configs.items()})
     meta.update({"ownship_signature": sig} if (sig := ownship_signature(ds, str(run))) else {})
+    # Which own-ship state placed the detections: nav_* (GNSS/AHRS with errors), or an old store's truth.
+    meta["navigation"] = navigation_source(ds) or "none"
     write_table(table, output, metadata=meta)
-    emit_result(detection_summary(table, ds.sizes["time"]) | {"output": str(output)}, as_json, "detections")
+    result = detection_summary(table, ds.sizes["time"]) | {"navigation": meta["navigation"]}
+    result["output"] = str(output)
+    emit_result(result, as_json, "detections")
 
 
 def _terrain_window(terrain: str | None, ds, config, run: Path):

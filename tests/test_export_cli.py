@@ -26,11 +26,16 @@ def _write_run(path, n_frames: int = 8):
     return ds
 
 
-def test_export_writes_navigation_truth_and_intruders(tmp_path):
+def test_export_writes_navigation_truth_and_intruders(tmp_path, monkeypatch, capsys):
+    import sys
+
+    from skyradar.cli import main
+
     ds = _write_run(tmp_path / "run.zarr")
-    result = skyradar("export", "run.zarr", "-o", "tables", "--json", cwd=tmp_path)
-    assert result.returncode == 0, result.stderr
-    out = json.loads(result.stdout.strip().splitlines()[-1])
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", ["skyradar", "export", "run.zarr", "-o", "tables", "--json"])
+    main()  # the entry point, in this process (the bad input below goes through a subprocess)
+    out = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert (out["ownship_rows"], out["intruder_rows"], out["targets"], out["navigation"]) == (8, 16, 2, True)
     own = pd.read_parquet(tmp_path / "tables" / "ownship.parquet")
     np.testing.assert_array_equal(own["nav_north_m"], ds["own_north_m"].values + 2.5)  # navigation

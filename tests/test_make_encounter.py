@@ -88,7 +88,23 @@ def test_bad_requests_name_the_field():
         encounter_from_tracks(a, a, 50.0, -1.0)
 
 
-def test_make_encounter_command(tmp_path):
+def _cli(monkeypatch, capsys, *args):
+    """``skyradar ARGS`` through :func:`skyradar.cli.main` in this process (exit code, stdout, stderr)."""
+    import sys
+
+    from skyradar.cli import main
+
+    monkeypatch.setattr(sys, "argv", ["skyradar", *args])
+    code = 0
+    try:
+        main()
+    except SystemExit as exc:
+        code = exc.code or 0
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_make_encounter_command(tmp_path, monkeypatch, capsys, caplog):
     rows = []
     for heading, origin in ((30.0, MUNICH), (100.0, LISBON)):
         traj = straight([0, 0, -1000], heading, 50.0, 200.0, origin=origin, rate_hz=1.0)
@@ -98,15 +114,17 @@ def test_make_encounter_command(tmp_path):
         rows.append(df)
     rows[0].iloc[::-1].to_csv(tmp_path / "a.csv.gz", index=False)  # reversed, epoch ms: cleaned
     rows[1].to_json(tmp_path / "b.json", orient="records")
+    monkeypatch.chdir(tmp_path)
     args = ("make-encounter", "a.csv.gz", "b.json", "-o", "enc.yaml", "--miss-m", "300", "--t-cpa", "100")
-    result = skyradar(*args, "--vertical-miss-m", "-60", "--json", cwd=tmp_path)
-    assert result.returncode == 0, result.stderr
-    out = json.loads(result.stdout.strip().splitlines()[-1])
+    code, stdout, stderr = _cli(monkeypatch, capsys, *args, "--vertical-miss-m", "-60", "--json")
+    assert code == 0, stderr
+    out = json.loads(stdout.strip().splitlines()[-1])
     assert out["t_cpa_s"] == pytest.approx(100.0, abs=1e-3) and out["horizontal_miss_m"] == pytest.approx(
         300.0
     )
     assert out["vertical_miss_m"] == pytest.approx(-60.0, abs=0.05)
-    assert "a.csv.gz: cleaned: timestamp in epoch ms, sorted by time (200 step(s) back)" in result.stderr
+    notes = [r.getMessage() for r in caplog.records if r.name == "skyradar.scene.adsb"]  # stderr in a shell
+    assert "a.csv.gz: cleaned: timestamp in epoch ms, sorted by time (200 step(s) back)" in notes[0]
     built = load_scenario(tmp_path / "enc.yaml").build()
     assert (built.times_s[0], len(built.intruders)) == (pytest.approx(40.0), 1)
     # A file that cannot be repaired (timestamps between seconds and milliseconds) is refused in one

@@ -133,13 +133,14 @@ class MotionModel:
         F[0, 2] = F[1, 3] = F[2, 3] = dt_s
         return F
 
-    def process_noise_unresolved(self, dt_s: float) -> np.ndarray:
+    def process_noise_unresolved(self, dt_s: float | np.ndarray) -> np.ndarray:
         """White jerk into ``a``, integrated into ``V_R`` and ``dR/dt`` alike, plus a small
-        independent white acceleration on ``(R, dR/dt)``, 4x4."""
-        dt = float(dt_s)
+        independent white acceleration on ``(R, dR/dt)``, shape ``dt_s.shape + (4, 4)``."""
+        dt = np.asarray(dt_s, float)
         Q = self.q_velocity_mps3**2 * _jerk_chain_noise(dt)
         qa = (0.25 * self.q_range_mps2) ** 2
-        Q[np.ix_([0, 2], [0, 2])] += qa * np.array([[dt**3 / 3, dt**2 / 2], [dt**2 / 2, dt]])
+        for (i, j), value in (((0, 0), dt**3 / 3), ((0, 2), dt**2 / 2), ((2, 0), dt**2 / 2), ((2, 2), dt)):
+            Q[..., i, j] += qa * value
         return Q
 
     @property
@@ -194,8 +195,8 @@ def radar_model(doppler_width_mps: float, **noise: float) -> MotionModel:
     return MotionModel("radar", True, True, True, float(doppler_width_mps), **noise)
 
 
-def _jerk_chain_noise(dt: float) -> np.ndarray:
-    """Covariance added over ``dt`` by unit white jerk to (R, V_R, dR/dt, a), 4x4.
+def _jerk_chain_noise(dt: np.ndarray) -> np.ndarray:
+    """Covariance added over ``dt`` by unit white jerk to (R, V_R, dR/dt, a), ``dt.shape + (4, 4)``.
 
     An impulse of jerk ``s`` before the end leaves ``a`` +1, both velocities +s and range +s^2/2;
     the entries are the integrals of the products of those responses over ``[0, dt]``.
@@ -210,8 +211,8 @@ def _jerk_chain_noise(dt: float) -> np.ndarray:
         (a, a): dt,
     }
     kind = [p, v, v, a]
-    Q = np.empty((4, 4))
+    Q = np.empty(np.shape(dt) + (4, 4))
     for i in range(4):
         for j in range(4):
-            Q[i, j] = powers[(min(kind[i], kind[j]), max(kind[i], kind[j]))]
+            Q[..., i, j] = powers[(min(kind[i], kind[j]), max(kind[i], kind[j]))]
     return Q

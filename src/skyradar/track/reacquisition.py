@@ -23,6 +23,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from skyradar.track.association import pair_costs
 from skyradar.track.kalman import predict, wrap
 from skyradar.track.models import MotionModel
 
@@ -134,12 +135,16 @@ class LostTracks:
         H = self.model.measurement_matrix
         z_new = x @ H.T
         S_new = H @ P @ H.T
-        y = z_new[:, None, :] - z_lost[None, :, :]
+        # The two estimates are independent: the difference's covariance is the sum of theirs. Pairs
+        # outside the gate's range extent are not scored.
+        dr = z_new[:, None, 0] - z_lost[None, :, 0]
+        a, b = np.nonzero(dr**2 < self.gate * (S_new[:, None, 0, 0] + S_lost[None, :, 0, 0]))
+        y = np.column_stack([dr[a, b], z_new[a, 1] - z_lost[b, 1]])
         if self.model.wrap_doppler:
-            y[..., 1] = wrap(y[..., 1], self.model.doppler_width_mps)
-        S = S_new[:, None] + S_lost[None, :] + self.model.measurement_noise
-        d2 = np.einsum("abi,abi->ab", y, np.linalg.solve(S, y[..., None])[..., 0])
-        cost = np.where(d2 < self.gate, d2, 1e12)
+            y[:, 1] = wrap(y[:, 1], self.model.doppler_width_mps)
+        cost = np.full((k, self.ids.size), 1e12)
+        d2 = pair_costs(y, S_new[a] + S_lost[b], "mahalanobis", (1.0, 1.0))
+        cost[a, b] = np.where(d2 < self.gate, d2, 1e12)
         r, c = linear_sum_assignment(cost)
         ok = cost[r, c] < self.gate
         r, c = r[ok], c[ok]
@@ -155,33 +160,31 @@ class LostTracks:
     def _predicted_observation(self, time_s: float) -> tuple[np.ndarray, np.ndarray]:
         """Observed (range, radial velocity) of every lost track at ``time_s`` and its covariance."""
         m, H = self._gentle, self.model.measurement_matrix
-        z = np.empty((self.ids.size, 2))
-        S = np.empty((self.ids.size, 2, 2))
-        for i in range(self.ids.size):
-            dt = float(time_s - self.time_s[i])
-            resolved = self.resolved[i] or not self.model.dealias
-            F = m.transition(np.array(dt)) if resolved else m.transition_unresolved(dt)
-            Q = m.process_noise(np.array(dt)) if resolved else m.process_noise_unresolved(dt)
-            P = self.P[i : i + 1].copy()
-            if self.model.coupled:
-                F = manoeuvre_transition(dt, self.tau_s, resolved)
-                P[:, 3, 3] += self.sigma_accel_mps2**2
-            xp, Pp = predict(self.x[i : i + 1], P, F, Q)
-            z[i] = H @ xp[0]
-            S[i] = H @ Pp[0] @ H.T
-        return z, S
+        dt = time_s - self.time_s
+        resolved = self.resolved | (not self.model.dealias)
+        P = self.P.copy()
+        if self.model.coupled:
+            F = manoeuvre_transition(dt, self.tau_s, resolved)
+            P[:, 3, 3] += self.sigma_accel_mps2**2
+        else:
+            F = m.transition(dt)
+        Q = np.where(resolved[:, None, None], m.process_noise(dt), m.process_noise_unresolved(dt))
+        xp, Pp = predict(self.x, P, F, Q)
+        return xp @ H.T, H @ Pp @ H.T
 
     def _take(self, keep: np.ndarray) -> None:
         self.ids, self.x, self.P = self.ids[keep], self.x[keep], self.P[keep]
         self.resolved, self.time_s = self.resolved[keep], self.time_s[keep]
 
 
-def manoeuvre_transition(dt_s: float, tau_s: float, resolved: bool = True) -> np.ndarray:
+def manoeuvre_transition(
+    dt_s: float | np.ndarray, tau_s: float, resolved: bool | np.ndarray = True
+) -> np.ndarray:
     """Radar-model transition over ``dt_s`` with the radial acceleration decaying as ``exp(-t / tau)``.
 
     The acceleration adds ``g1 = tau (1 - exp(-dt / tau))`` to the velocities and
     ``g2 = tau (dt - g1)`` to the range; range follows ``V_R`` once the alias is resolved, the
-    range-rate state before.
+    range-rate state before. Arrays of ``dt_s`` and ``resolved`` give ``dt_s.shape + (4, 4)``.
 
     Examples
     --------
@@ -189,13 +192,16 @@ def manoeuvre_transition(dt_s: float, tau_s: float, resolved: bool = True) -> np
     >>> F[0].round(3).tolist(), F[1].round(3).tolist()
     ([1.0, 2.0, 0.0, 2.0], [0.0, 1.0, 0.0, 2.0])
     """
-    x = dt_s / tau_s
+    dt = np.asarray(dt_s, float)
+    x = dt / tau_s
+    res = np.broadcast_to(np.asarray(resolved, bool), dt.shape)
+    F = np.broadcast_to(np.eye(4), dt.shape + (4, 4)).copy()
+    F[..., 0, 1] = np.where(res, dt, 0.0)
+    F[..., 0, 2] = np.where(res, 0.0, dt)
     g1 = -tau_s * np.expm1(-x)
-    g2 = tau_s * tau_s * (x + np.expm1(-x))
-    decay = np.exp(-x)
-    F = np.eye(4)
-    F[0, 1 if resolved else 2] = dt_s
-    F[0, 3], F[1, 3], F[2, 3], F[3, 3] = g2, g1, g1, decay
+    F[..., 0, 3] = tau_s * tau_s * (x + np.expm1(-x))
+    F[..., 1, 3] = F[..., 2, 3] = g1
+    F[..., 3, 3] = np.exp(-x)
     return F
 
 

@@ -165,7 +165,9 @@ def _run_tracker(tracker: RangeDopplerTracker, m3, detections: pd.DataFrame, gri
         out = tracker.step(float(time_s), z_all[a:b])
         frame = frames_col[a] if (frames_col is not None and b > a) else k
         row = _frame_rows(tracker, out, time_s, frame, a)
+        row["reacquired"] = out.reacquired
         if m3.active:
+            m3.t3.rename(out.reacquired[:, 0], out.reacquired[:, 1])
             x, P = m3.step(tracker, out, k, a, b)
             rows = np.searchsorted(out.alive_ids, out.track_id)
             row["x3"], row["P3"] = x[rows], P[rows]
@@ -325,8 +327,23 @@ def _assemble(
     cols["confirmed"] = cat("confirmed")
     cols["n_updates"] = cat("n_updates")
     cols["misses"] = cat("misses")
-    df = pd.DataFrame(cols, columns=TRACK_COLUMNS)
+    df = _relabel_reacquired(pd.DataFrame(cols, columns=TRACK_COLUMNS), cat("reacquired").reshape(-1, 2))
     # Tentative rows are kept only for tracks that were confirmed at some point: their early
     # updates belong to a real track, the rest is clutter that never became one.
     real = np.unique(df["track_id"].to_numpy()[df["confirmed"].to_numpy()])
     return df[np.isin(df["track_id"].to_numpy(), real)].reset_index(drop=True)
+
+
+def _relabel_reacquired(df: pd.DataFrame, pairs: np.ndarray) -> pd.DataFrame:
+    """Rows of a track before it reacquired a lost id (its tentative start) take that id too.
+
+    Where the lost track still had a (coasting) row at the same time, the row with a detection wins.
+    """
+    if pairs.size == 0:
+        return df
+    ids = df["track_id"].to_numpy()
+    lookup = dict(zip(pairs[:, 0].tolist(), pairs[:, 1].tolist(), strict=True))
+    df["track_id"] = np.array([lookup.get(i, i) for i in ids.tolist()], np.int64)
+    by_detection = df.assign(_nodet=df["detection_row"].to_numpy() < 0).sort_values("_nodet", kind="stable")
+    kept = by_detection.drop_duplicates(["time_s", "track_id"]).index
+    return df.loc[np.sort(kept)].reset_index(drop=True)

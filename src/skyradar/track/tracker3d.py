@@ -230,6 +230,29 @@ class Tracker3D:
         out_P[found] = self.P[pos[found]]
         return out_x, out_P
 
+    def rename(self, old_ids: np.ndarray, new_ids: np.ndarray) -> None:
+        """Give the filters of ``old_ids`` the ids ``new_ids`` (a track that reacquired a lost id).
+
+        A filter still held under a new id is replaced: the renamed one follows the current
+        detections.
+
+        Examples
+        --------
+        >>> t3 = Tracker3D()
+        >>> _ = t3.step(0.0, np.array([3, 9]), np.zeros((2, 3)), np.full(2, 400.0))
+        >>> t3.rename(np.array([9]), np.array([1]))
+        >>> t3.ids.tolist()
+        [1, 3]
+        """
+        old_ids, new_ids = np.asarray(old_ids, np.int64), np.asarray(new_ids, np.int64)
+        pos, found = _lookup(self.ids, old_ids)
+        keep = ~np.isin(self.ids, new_ids[found])
+        self.ids = self.ids.copy()
+        self.ids[pos[found]] = new_ids[found]
+        keep[pos[found]] = True
+        order = np.flatnonzero(keep)[np.argsort(self.ids[keep], kind="stable")]
+        self.ids, self.x, self.P, self.rejects = (a[order] for a in (self.ids, self.x, self.P, self.rejects))
+
     def _update_positions(
         self, sel: np.ndarray, pos: np.ndarray, positions_m: np.ndarray, cov: np.ndarray
     ) -> None:

@@ -121,13 +121,13 @@ def alert_config(value: str | Path) -> AlertConfig:
     path = Path(value)
     if path.suffix.lower() not in (".yaml", ".yml") or not path.is_file():
         raise InputError(f"--config {value}: not radar, default or an existing .yaml file")
-    import yaml
+    from skyradar.io.safe_yaml import load_yaml
 
     try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
-    except (yaml.YAMLError, UnicodeDecodeError) as exc:
-        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise InputError(f"{path}: not valid YAML ({first})") from None
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot read as UTF-8 text ({type(exc).__name__})") from None
+    data = load_yaml(text, path) or {}  # aliases bounded, duplicate keys refused, like scenarios
     if not isinstance(data, dict):
         raise InputError(f"{path}: must be a mapping of alert settings, got {type(data).__name__}")
     base = data.pop("base", "radar")

@@ -199,3 +199,23 @@ def test_scenario_frames_carry_navigation_beside_truth_and_a_bad_model_is_one_li
     path.write_text(text + "navigation: {model: ga-typical, heading_bias_deg: -2}\n")
     assert_one_line_error(skyradar("simulate", str(path), "--output", str(tmp_path / "r.zarr"), cwd=tmp_path),
                           "navigation.heading_bias_deg", "-2")  # fmt: skip
+
+
+def test_radar_height_replaces_the_gnss_height_where_the_estimator_was_trusted():
+    import pandas as pd
+
+    from skyradar.nav.radar_height import with_radar_height
+    from skyradar.process.pipeline import _own_state
+
+    ds = _scene(n_frames=4)
+    t = np.arange(4) / 9.4  # _scene's frame times
+    # Estimates a few ms off the frame times (nearest within half a frame), one not trusted, one unsorted.
+    state = pd.DataFrame({"time_s": t[[3, 0, 1, 2]] + 0.004, "h_m": [603.0, 590.0, 591.0, 592.0],
+                          "used_by_filter": [True, True, True, False]})  # fmt: skip
+    out = with_radar_height(ds, state)
+    gnss = ds["nav_height_agl_m"].values
+    np.testing.assert_array_equal(out["nav_height_agl_m"].values, [590.0, 591.0, gnss[2], 603.0])
+    np.testing.assert_array_equal(out["own_height_agl_m"].values, ds["own_height_agl_m"].values)
+    np.testing.assert_array_equal(_own_state(out)["own_height_agl_m"], [590.0, 591.0, gnss[2], 603.0])
+    with pytest.raises(InputError, match="h_m"):
+        with_radar_height(ds, state.drop(columns="h_m"))

@@ -7,10 +7,10 @@ from typing import Annotated
 
 import typer
 
-from skyradar.cli.app import NON_NEGATIVE, JsonOption, app, emit_result, experiment_app, number_in
+from skyradar.cli.app import JsonOption, app, emit_result
 from skyradar.io.outputs import OVERWRITE_HELP
 
-__all__ = ["alert", "serve", "experiment_encounters"]
+__all__ = ["alert", "serve"]  # experiment encounters: skyradar.cli.commands_encounters
 
 
 @app.command()
@@ -122,59 +122,3 @@ def serve(
     asgi = LoopbackHostOnly(web_app) if local else web_app
     server = uvicorn.Server(uvicorn.Config(asgi, host=host, port=port, log_level="warning"))
     server.run(sockets=[sock])
-
-
-@experiment_app.command("encounters")
-def experiment_encounters(
-    out: Annotated[Path, typer.Option("--out", help="Output directory.")] = Path("out/encounters"),
-    n: Annotated[
-        int,
-        typer.Option("--n", callback=number_in(1, 100_000), help="Number of encounters (at most 100000)."),
-    ] = 500,
-    seed: Annotated[int, typer.Option("--seed", callback=NON_NEGATIVE, help="Random seed.")] = 0,
-    workers: Annotated[
-        int | None, typer.Option(min=1, help="Worker processes (default: up to 2, one per core).")
-    ] = None,
-    frame_rate: Annotated[
-        float, typer.Option(callback=number_in(0.5, 100.0), help="Radar frame rate, frames/s.")
-    ] = 4.7,
-    buffer: Annotated[
-        float,
-        typer.Option(
-            callback=number_in(1.0, 100.0), help="May-alert zone: this many times the well-clear volume."
-        ),
-    ] = 1.5,
-    no_uncertainty: Annotated[
-        bool, typer.Option("--no-uncertainty", help="Do not widen the volumes by the track covariance.")
-    ] = False,
-    terrain: Annotated[
-        str,
-        typer.Option(help="'none' (clear sky) or 'flat' (flat ground 1000 m below: clutter; slower)."),
-    ] = "none",
-    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
-    as_json: JsonOption = False,
-) -> None:
-    """Encounter set (head-on, crossing, converging, overtaking, climbing; conflicts and near misses),
-    each through the full chain (simulate, detect + DoA, track, alert): missed, late and false
-    warnings, and the warning lead.
-    """
-    from skyradar.cli.commands_sim import frame_progress
-    from skyradar.errors import InputError
-    from skyradar.experiments.encounters import run
-    from skyradar.io.outputs import check_output, mark_folder
-    from skyradar.parallel import check_workers
-
-    check_workers(workers)
-    if terrain not in ("none", "flat"):
-        raise InputError(f"experiment encounters: option '--terrain' must be none or flat, got {terrain!r}")
-
-    check_output(out, (), overwrite, kind="folder", option="--out")
-    mark_folder(out)
-    with frame_progress(n, "encounters") as bar:
-        task = bar.add_task("encounters", total=n)
-        result = run(
-            out, n_encounters=n, seed=seed, frame_rate_hz=frame_rate, buffer=buffer, workers=workers,
-            uncertainty=not no_uncertainty, progress=lambda k: bar.update(task, completed=k),
-            terrain=None if terrain == "none" else terrain,
-        )  # fmt: skip
-    emit_result(result, as_json, "encounters")

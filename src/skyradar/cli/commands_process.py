@@ -329,7 +329,7 @@ def bench_process(
     seconds: BenchSecondsOption = 2.0,
     as_json: JsonOption = False,
 ) -> None:
-    """Detection + DoA frames per second on prototype-size cubes (333 x 250 x 4), ours vs a baseline."""
+    """Detection + DoA frames per second (333 x 250 x 4), ours vs a baseline; suppressed_*: terrain cubes."""
     from skyradar.benchmarks.process import run as run_bench
 
     emit_result(run_bench(min_time_s=seconds), as_json, "bench process")

@@ -26,6 +26,7 @@ from typing import Literal
 
 import cv2
 import numpy as np
+from numba import njit
 from scipy import integrate, ndimage, optimize, stats
 
 from skyradar.errors import InputError
@@ -230,6 +231,25 @@ def _ca_factor_table(pfa: float, n_max: int, n_integrated: int) -> np.ndarray:
     return np.r_[np.inf, stats.f.isf(pfa, 2 * n_integrated, 2 * n * n_integrated)].astype(np.float32)
 
 
+@njit(cache=True)
+def _floor_decide(power, total, clean, count, skip, big_l, table, floor, n_train, min_train, hits, noise):
+    # Per pixel: plain CA for excluded cells, CA over the cells left (or the floor) for the others.
+    n_r, n_d = power.shape
+    for i in range(n_r):
+        for j in range(n_d):
+            if skip[i, j]:
+                n, est = n_train, total[i, j] / n_train
+            else:
+                n = min(int(count[i, j] + 0.5), n_train)
+                if n >= min_train:
+                    est = clean[i, j] / count[i, j]
+                else:
+                    n, est = 0, floor
+            est = max(est, floor)
+            noise[i, j] = est
+            hits[i, j] = power[i, j] > table[big_l[i, j], n] * est
+
+
 @lru_cache(maxsize=16)
 def _floor_tables(pfa: float, n_max: int) -> np.ndarray:
     """``alpha[L, n]``: CA factor, Gamma(L, 1/L) cell, ``n`` training cells; ``n = 0``: known floor."""
@@ -280,21 +300,18 @@ def cfar_2d_floor(
         raise InputError(f"cfar: field 'pfa' must be in (0, 1), got {pfa}")
     n_train = (2 * hr + 1) * (2 * hd + 1) - (2 * gr + 1) * (2 * gd + 1)
     table = _floor_tables(float(pfa), n_train)
-    floor = np.float32(noise_floor_w)
     p_pad = _pad(power, hr, hd)
     total = _box_sum(p_pad, hr, hd, hr, hd, power.shape) - _box_sum(p_pad, gr, gd, hr, hd, power.shape)
-    noise = np.maximum(total / np.float32(n_train), floor)  # plain CA, for cells in the excluded set
-    n_cells = np.full(power.shape, n_train, np.int64)
-    if train_exclude is not None:
-        valid = (~train_exclude).astype(np.float32)
-        v_pad, p_pad = _pad(valid, hr, hd), _pad(power * valid, hr, hd)
+    if train_exclude is None:
+        skip, count, clean = np.zeros(power.shape, np.bool_), np.full(power.shape, np.float32(n_train)), total
+    else:
+        skip = np.ascontiguousarray(train_exclude, np.bool_)
+        valid = (~skip).astype(np.float32)
+        v_pad, c_pad = _pad(valid, hr, hd), _pad(power * valid, hr, hd)
         count = _box_sum(v_pad, hr, hd, hr, hd, power.shape) - _box_sum(v_pad, gr, gd, hr, hd, power.shape)
-        clean = _box_sum(p_pad, hr, hd, hr, hd, power.shape) - _box_sum(p_pad, gr, gd, hr, hd, power.shape)
-        counted = np.clip(np.rint(count).astype(np.int64), 0, n_train)
-        enough = counted >= min_train
-        own = np.where(enough, np.maximum(clean / np.maximum(count, 1.0), floor), floor)
-        noise = np.where(train_exclude, noise, own)
-        n_cells = np.where(train_exclude, n_cells, np.where(enough, counted, 0))
-    big_l = np.clip(np.asarray(channels, np.int64), 1, 8)
-    alpha = table[big_l, n_cells]
-    return power > alpha * noise, noise.astype(np.float32)
+        clean = _box_sum(c_pad, hr, hd, hr, hd, power.shape) - _box_sum(c_pad, gr, gd, hr, hd, power.shape)
+    hits, noise = np.empty(power.shape, np.bool_), np.empty(power.shape, np.float32)
+    big_l = np.ascontiguousarray(np.clip(channels, 1, 8), np.int8)
+    floor = np.float32(noise_floor_w)
+    _floor_decide(power, total, clean, count, skip, big_l, table, floor, n_train, min_train, hits, noise)
+    return hits, noise

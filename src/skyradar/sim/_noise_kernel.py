@@ -26,7 +26,7 @@ from llvmlite import ir
 from numba import float32, int32, int64, njit, prange, types, uint64
 from numba.extending import intrinsic
 
-__all__ = ["frame_key", "finalize_frame", "gaussian_noise"]
+__all__ = ["frame_key", "finalize_frame", "gaussian_noise", "mix64", "complex_normal"]
 
 _GAMMA = np.uint64(0x9E3779B97F4A7C15)
 _F0, _F1, _F2, _HALF = np.float32(0.0), np.float32(1.0), np.float32(2.0), np.float32(0.5)
@@ -116,6 +116,10 @@ def _complex_normal(z, sigma):
     r = sigma * math.sqrt(max(float32(-2.0) * log_f32(u1), _F0))
     c, s = cis_count_f32(z & uint64(0xFFFFFFFF))
     return r * c, r * s
+
+
+mix64 = _mix  # SplitMix64's finaliser, for other counter-based draws (terrain speckle)
+complex_normal = _complex_normal
 
 
 @njit(fastmath=_FASTMATH, error_model="numpy", cache=True)

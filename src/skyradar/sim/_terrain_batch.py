@@ -19,18 +19,25 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit, uint64
 
 from skyradar.sim._elementary import cis_cycles_f32, fast_atan2
+from skyradar.sim._noise_kernel import complex_normal, mix64
 
-__all__ = ["CELL_FIELDS", "cell_geometry", "cell_geometry_scalar", "item_returns", "scatter_items"]
+__all__ = [
+    "CELL_FIELDS", "cell_geometry", "cell_geometry_scalar", "item_returns", "number_items", "scatter_items",
+]  # fmt: skip
 
 # Rows of the per-thread scratch array (one column per sub-facet of the batch).
 _X, _Y, _Z, _R0, _AREA, _COS_INC, _RTX, _RSUM, _RNG, _VR, _VALID, _KR, _KD, _AMP, _N, _E, _D = range(17)
 _TMP0, _TMP1 = 17, 18  # per-loop temporaries (table positions, horizon index and slope)
-CELL_FIELDS = 19
+_ID = 19  # the sub-facet's number in the frame (cell * sub-facets per cell + m): its speckle draw
+CELL_FIELDS = 20
 
 _OPTS = {"error_model": "numpy", "fastmath": True}
+_GAMMA = uint64(0x9E3779B97F4A7C15)
+_SQRT_HALF = np.float32(math.sqrt(0.5))
 
 
 @njit(**_OPTS)
@@ -274,14 +281,35 @@ def _weight_rows(re_q, im_q, amp):
         im_q[m] = im_q[m] * amp[m]
 
 
+@njit(inline="always")
+def number_items(s, k, first, n):
+    """Number items ``k .. k + n - 1`` of the batch ``first, first + 1, ...`` (their speckle draws)."""
+    for m in range(n):
+        s[_ID, k + m] = first + m
+
+
 @njit(error_model="numpy")
-def scatter_items(out, sparse, blk, s, cos_sin, n_items):
-    """Add the valid items into the thread's cube (or its sparse list)."""
+def _speckle_rows(re_q, im_q, ids, speckle_key):
+    # Each sub-facet's complex reflectivity: a unit-power circular Gaussian drawn from its number
+    # (the same for every receiver: one scatterer), by the noise kernel's counter-based generator.
+    for m in range(ids.shape[0]):
+        z = mix64(speckle_key + (uint64(ids[m]) + uint64(1)) * _GAMMA)
+        g_re, g_im = complex_normal(z, _SQRT_HALF)
+        re, im = re_q[m], im_q[m]
+        re_q[m] = re * g_re - im * g_im
+        im_q[m] = re * g_im + im * g_re
+
+
+@njit(error_model="numpy")
+def scatter_items(out, sparse, blk, s, cos_sin, n_items, speckle_key):
+    """Add the valid items into the thread's cube (or its sparse list); speckle when the key is not 0."""
     idx, val, count = sparse
     n_rx = cos_sin.shape[1]
     amp = s[_AMP][:n_items]
     for q in range(n_rx):
         _weight_rows(cos_sin[0, q][:n_items], cos_sin[1, q][:n_items], amp)
+        if speckle_key != 0:
+            _speckle_rows(cos_sin[0, q][:n_items], cos_sin[1, q][:n_items], s[_ID][:n_items], speckle_key)
     for m in range(n_items):
         if s[_VALID, m] == 0.0:
             continue

@@ -22,6 +22,7 @@ from skyradar.sim._terrain_batch import (
     cell_geometry,
     cell_geometry_scalar,
     item_returns,
+    number_items,
     scatter_items,
 )
 
@@ -226,7 +227,7 @@ def rotate_points(points, rot, out):
 def terrain_returns(
     p_ned, p_ant, up_ant, tx, rx, v_ground_ant, nsub_r, nsub_c, wavelength, d_range, d_vel, coupling,
     power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m, use_horizon, n_blocks, out,
-    sparse, mode,
+    sparse, mode, speckle_key,
 ):  # fmt: skip
     """Accumulate terrain returns into ``out`` of shape (n_blocks, n_range, n_doppler, n_rx).
 
@@ -240,7 +241,9 @@ def terrain_returns(
     and cap > 0 contributions are recorded there instead of added to ``out`` (see
     :func:`add_sparse`). ``mode`` 1 runs the vectorised batches of ``_terrain_batch``, 0 the
     scalar loop below, one sub-facet at a time (the same physics term for term: the reference
-    the batches are tested against). ``fastmath`` is safe here: every input is finite.
+    the batches are tested against). ``speckle_key`` not 0 multiplies every sub-facet by its own
+    unit-power complex Gaussian drawn from that key and its number (batched mode only).
+    ``fastmath`` is safe here: every input is finite.
     """
     ny, nx = p_ned.shape[0], p_ned.shape[1]
     n_range, n_dopp = out.shape[1], out.shape[2]
@@ -272,6 +275,7 @@ def terrain_returns(
                             cell_geometry(scratch, k, ta, tn, us, ws, up_ant, use_horizon)
                         else:
                             cell_geometry_scalar(scratch, k, ta, tn, us, ws, up_ant, use_horizon)
+                        number_items(scratch, k, float((i * (nx - 1) + j) * n_sub), n_sub)
                         k += n_sub
                     # The batch is full, or the block's last cell is done: into the cube.
                     if k > 0 and (k + n_sub > cap or (j == nx - 2 and i + n_blocks >= ny - 1)):
@@ -280,7 +284,7 @@ def terrain_returns(
                             coupling, n_range, n_dopp, inv_wl, power_const, n_sub, gain2, gain2_step,
                             refl_table, horizon, az_bin_rad, h_bin_m, use_horizon,
                         )  # fmt: skip
-                        scatter_items(out, sparse, blk, scratch, cos_sin, k)
+                        scatter_items(out, sparse, blk, scratch, cos_sin, k, speckle_key)
                         k = 0
                     continue
                 if skip:

@@ -10,7 +10,9 @@ The thesis' method (seed-brief.md ch2) made exact where it simplified:
 - occlusion of terrain hidden behind terrain (line of sight along range per azimuth);
 - two-way antenna gain, radar equation, exact two-way path phase per receive antenna;
 - Doppler with aliasing wrap and the sawtooth range-Doppler coupling;
-- one-pass scatter-add and calibrated thermal noise (k T B_n F per pixel, so SNR is physical).
+- one-pass scatter-add and calibrated thermal noise (k T B_n F per pixel, so SNR is physical);
+- optionally (issue 12.1): the range and Doppler windows' point-spread (:mod:`skyradar.sim.psf`),
+  speckle on terrain and Swerling 1 fluctuation of the targets.
 
 Pixel units: |pixel|^2 is received power in W for a scatterer centred in that pixel.
 """
@@ -27,6 +29,7 @@ from skyradar.errors import InputError
 from skyradar.geo import ned_rotation_to, ned_to_geodetic, rotation_matrix
 from skyradar.sim._horizon_kernel import horizon_map
 from skyradar.sim._noise_kernel import finalize_frame, frame_key
+from skyradar.sim._tables import REFLECTIVITY_MODELS, reflectivity_table, two_way_gain_table
 from skyradar.sim._terrain_kernel import (
     add_sparse,
     relative_points,
@@ -34,7 +37,8 @@ from skyradar.sim._terrain_kernel import (
     terrain_returns,
 )
 from skyradar.sim.geometry import AntennaGeometry, PlatformState, PointTarget, TerrainView
-from skyradar.sim.targets import add_targets, line_of_sight, target_geometry
+from skyradar.sim.psf import apply_psf, enbw, frame_options, psf_kernels, speckle_key
+from skyradar.sim.targets import add_targets, line_of_sight, swerling1_power, target_geometry
 
 __all__ = [
     "PlatformState",
@@ -43,13 +47,11 @@ __all__ = [
     "TerrainView",
     "ImageSimulator",
     "REFLECTIVITY_MODELS",
+    "two_way_gain_table",
 ]
+_NO_SPECKLE = np.uint64(0)
 
-REFLECTIVITY_MODELS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
-    "cosine": np.cos,  # the thesis: 1 straight below, 0 at grazing
-    "lambert": lambda theta: np.cos(theta) ** 2,
-    "constant": lambda theta: np.ones_like(theta),
-}
+_reflectivity_table = reflectivity_table  # the old private name (benchmarks.sim)
 
 
 class ImageSimulator:
@@ -80,6 +82,14 @@ class ImageSimulator:
         Shift apparent range by ``v * fc / (B * PRF)`` as a sawtooth chirp does.
     ground_reflectivity_db : float
         Extra gain applied to terrain returns (e.g. -10 for the weaker ground seen in flight).
+    psf : bool
+        Frames as the Hann x Hann windowed FFTs give them (:mod:`skyradar.sim.psf`): terrain and
+        noise convolved with the bin-averaged window kernel, targets spread by the exact window
+        response at their fractional position. Noise per pixel becomes ``noise_power_w * ENBW``.
+    speckle : bool
+        Each terrain sub-facet times a unit-power complex Gaussian, new every frame.
+    swerling : {0, 1}
+        Target RCS constant (0) or exponential, independent per frame and target (1).
 
     Examples
     --------
@@ -105,6 +115,9 @@ class ImageSimulator:
         flat_earth: bool = False,
         range_doppler_coupling: bool = True,
         ground_reflectivity_db: float = 0.0,
+        psf: bool = False,
+        speckle: bool = False,
+        swerling: int = 0,
     ) -> None:
         self.config = config
         self.terrain = terrain
@@ -118,7 +131,9 @@ class ImageSimulator:
         self.flat_earth = bool(flat_earth)
         self.coupling_s = config.range_doppler_coupling_s if range_doppler_coupling else 0.0
         self.ground_gain = 10.0 ** (ground_reflectivity_db / 10.0)
-        self._refl_table = _reflectivity_table(reflectivity)
+        self._refl_table = reflectivity_table(reflectivity)
+        self.psf, self.speckle, self.swerling = frame_options(psf, speckle, swerling)
+        self._psf = psf_kernels(config) if self.psf else None
         self._gain2, self._gain2_step = two_way_gain_table(config)
         self._grid_ned = None
         self._blocks: np.ndarray | None = None
@@ -176,22 +191,48 @@ class ImageSimulator:
         geom = self.geometry(platform)
         view = self._terrain_view(geom, self._scratch)
         frame = self._output(out)
-        sigma = np.sqrt(cfg.noise_power_w / 2.0) if self.noise else 0.0
+        sigma = np.sqrt(self.noise_per_pixel_w / 2.0) if self.noise else 0.0
         key = frame_key(self.seed, int(frame_index))
+        speckle = speckle_key(key) if self.speckle else _NO_SPECKLE
+        # With the point-spread, terrain lands on a grid of sub-bins spread into the frame after.
+        psf = self._psf is not None and view is not None
+        grid = _array(self._scratch, "grid", self._grid_shape, np.complex64) if psf else frame
         if view is None:
             finalize_frame(self._no_blocks(), sigma, key, frame)
         elif self._sparse_suits(view):
             sparse = self._sparse_buffers(view, self._scratch)
-            self._accumulate_terrain(geom, view, self._no_blocks(), sparse, self._scratch)
-            finalize_frame(self._no_blocks(), sigma, key, frame)
-            add_sparse(frame.reshape(-1, cfg.n_rx), *sparse)
+            self._accumulate_terrain(geom, view, self._no_blocks(), sparse, self._scratch, speckle)
+            finalize_frame(self._no_blocks(), 0.0 if psf else sigma, key, grid)
+            add_sparse(grid.reshape(-1, cfg.n_rx), *sparse)
         else:
             blocks = self._accumulation_blocks()
-            self._accumulate_terrain(geom, view, blocks, _NO_SPARSE, self._scratch)
-            finalize_frame(blocks, sigma, key, frame)
+            self._accumulate_terrain(geom, view, blocks, _NO_SPARSE, self._scratch, speckle)
+            finalize_frame(blocks, 0.0 if psf else sigma, key, grid)
+        if psf:
+            self._spread(grid, frame, sigma, key)
         if targets:
-            add_targets(frame, cfg, geom, targets, self.coupling_s, line_of_sight(view, geom, targets))
+            clear, reach = line_of_sight(view, geom, targets), None if self._psf is None else self._psf.reach
+            factor = swerling1_power(self.seed, frame_index, len(targets)) if self.swerling else None
+            add_targets(frame, cfg, geom, targets, self.coupling_s, clear, factor, reach)
         return frame
+
+    def _spread(self, grid: np.ndarray, frame: np.ndarray, sigma: float, key: np.uint64) -> None:
+        # The windows' point-spread, then the noise, white at its windowed power.
+        block = _array(self._scratch, "spread", (1, *frame.shape), np.complex64)
+        work = _array(self._scratch, "spread_work", (grid.shape[0] * frame[0].size,), np.complex64)
+        apply_psf(grid, self._psf, block[0], work)
+        finalize_frame(block, sigma, key, frame)
+
+    @property
+    def _grid_shape(self) -> tuple[int, int, int]:
+        # Accumulation grid: the frame's bins, or sub-bins with the point-spread.
+        n = 1 if self._psf is None else self._psf.oversample
+        return n * self.config.n_range, n * self.config.n_doppler, self.config.n_rx
+
+    @property
+    def noise_per_pixel_w(self) -> float:
+        """Thermal noise power per pixel of the frames, W (times the windows' ENBW with ``psf``)."""
+        return self.config.noise_power_w * enbw(self._psf)
 
     def _output(self, out: np.ndarray | None) -> np.ndarray:
         cfg = self.config
@@ -225,25 +266,28 @@ class ImageSimulator:
 
     def terrain_cube(self, geom: AntennaGeometry, view: TerrainView | None = None) -> np.ndarray:
         """Terrain returns only, (n_range, n_doppler, n_rx) complex64, without noise."""
+        cfg = self.config
         blocks = self._accumulation_blocks()
         view = view if view is not None else self.terrain_view(geom)
         if view is not None:
             self._accumulate_terrain(geom, view, blocks, _NO_SPARSE)
         out = np.empty(blocks.shape[1:], np.complex64)
         finalize_frame(blocks, 0.0, np.uint64(0), out)
-        return out
+        if self._psf is None:
+            return out
+        frame = np.empty((cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
+        self._spread(out, frame, 0.0, np.uint64(0))
+        return frame
 
     def _accumulation_blocks(self) -> np.ndarray:
         # One complex64 cube per thread, kept between frames: the final pass reads and clears it.
-        cfg = self.config
-        shape = (get_num_threads(), cfg.n_range, cfg.n_doppler, cfg.n_rx)
+        shape = (get_num_threads(), *self._grid_shape)
         if self._blocks is None or self._blocks.shape != shape:
             self._blocks = np.zeros(shape, np.complex64)
         return self._blocks
 
     def _no_blocks(self) -> np.ndarray:
-        cfg = self.config
-        return np.empty((0, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
+        return np.empty((0, *self._grid_shape), np.complex64)
 
     def _sparse_suits(self, view: TerrainView) -> bool:
         # Few facets (DEM spacing): a list of contributions beats clearing per-thread cubes.
@@ -271,18 +315,20 @@ class ImageSimulator:
         blocks: np.ndarray,
         sparse,
         scratch: dict | None = None,
+        speckle: np.uint64 = _NO_SPECKLE,
     ) -> None:
         cfg = self.config
+        n = 1 if self._psf is None else self._psf.oversample  # sub-bins per bin
         rot = geom.rot_ned_to_ant
         p_ant = rotate_points(view.p_ned, rot, _array(scratch, "p_ant", view.p_ned.shape, np.float64))
         power_const = cfg.pe_w * cfg.wavelength_m**2 / (4 * np.pi) ** 3 * self.ground_gain
         v_ground = rot @ (-geom.velocity_ned_mps)
         terrain_returns(
             view.p_ned, p_ant, -rot[:, 2], cfg.tx_position_m, cfg.rx_positions_m, v_ground,
-            self._nsub[0], self._nsub[1], cfg.wavelength_m, cfg.range_resolution_m,
-            cfg.doppler_resolution_mps, self.coupling_s, power_const, self._gain2, self._gain2_step,
+            self._nsub[0], self._nsub[1], cfg.wavelength_m, cfg.range_resolution_m / n,
+            cfg.doppler_resolution_mps / n, self.coupling_s, power_const, self._gain2, self._gain2_step,
             self._refl_table, view.horizon, view.az_bin_rad, view.h_bin_m, self.occlusion,
-            blocks.shape[0] or sparse[0].shape[0], blocks, sparse, self._kernel_mode,
+            blocks.shape[0] or sparse[0].shape[0], blocks, sparse, self._kernel_mode, speckle,
         )  # fmt: skip
 
     def _horizon(
@@ -329,35 +375,7 @@ class ImageSimulator:
         """Range, radial velocity, antenna-frame angles, expected SNR and visibility per target."""
         geom = self.geometry(platform)
         clear = line_of_sight(self.terrain_view(geom), geom, targets)
-        return target_geometry(self.config, geom, targets, self.coupling_s, clear)
-
-
-def two_way_gain_table(config: RadarConfig, n: int = 513) -> tuple[np.ndarray, float]:
-    """Two-way linear gain G^2 on a grid of antenna-frame direction cosines (u_y, u_z) in [-1, 1]^2.
-
-    Looking up by direction cosine spares the compiled kernel an atan2, an asin and a power per
-    facet; 513 points give 0.22 deg steps at boresight, interpolated bilinearly, and the float32
-    table (1 MB) stays in cache.
-    """
-    c = np.linspace(-1.0, 1.0, n)
-    uy, uz = np.meshgrid(c, c, indexing="ij")
-    ux = np.sqrt(np.clip(1.0 - uy**2 - uz**2, 0.0, None))
-    gain_db = config.antenna.gain_db(np.arctan2(uy, ux), np.arcsin(-uz))
-    return (10.0 ** (gain_db / 5.0)).astype(np.float32), float(c[1] - c[0])
-
-
-def _reflectivity_table(reflectivity: str | Callable[[np.ndarray], np.ndarray], n: int = 4097) -> np.ndarray:
-    if isinstance(reflectivity, str):
-        if reflectivity not in REFLECTIVITY_MODELS:
-            raise InputError(
-                f"simulation.reflectivity {reflectivity!r} unknown; choose {sorted(REFLECTIVITY_MODELS)}"
-            )
-        reflectivity = REFLECTIVITY_MODELS[reflectivity]
-    # Tabulated on a uniform grid of cos(incidence) for the compiled kernel.
-    table = np.asarray(reflectivity(np.arccos(np.linspace(0.0, 1.0, n))), dtype=float)
-    if table.shape != (n,) or not np.all(np.isfinite(table)) or np.any(table < 0):
-        raise InputError("simulation.reflectivity: the function must return finite non-negative factors")
-    return table
+        return target_geometry(self.config, geom, targets, self.coupling_s, clear, self.noise_per_pixel_w)
 
 
 def _array(scratch: dict | None, name: str, shape: tuple[int, ...], dtype) -> np.ndarray:

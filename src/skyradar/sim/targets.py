@@ -14,9 +14,24 @@ import numpy as np
 from skyradar.config import RadarConfig
 from skyradar.geo import direction_angles
 from skyradar.sim.geometry import AntennaGeometry, PointTarget, TerrainView
+from skyradar.sim.psf import PSF_WINDOW, target_psf_taps
 from skyradar.units import nearest_bin
 
-__all__ = ["line_of_sight", "target_geometry", "add_targets"]
+__all__ = ["line_of_sight", "target_geometry", "add_targets", "swerling1_power"]
+
+
+def swerling1_power(seed: int, frame_index: int, n_targets: int) -> np.ndarray:
+    """Swerling 1 power factors: exponential of mean 1, independent per frame and target.
+
+    Drawn from the stream ``(seed, frame_index)`` so any frame is reproducible alone.
+
+    Examples
+    --------
+    >>> f = swerling1_power(0, 3, 100_000)
+    >>> round(float(f.mean()), 2), round(float(np.mean(f < np.log(2))), 2)  # mean 1, median ln 2
+    (1.0, 0.5)
+    """
+    return np.random.default_rng([int(seed), int(frame_index), 0x5357]).standard_exponential(int(n_targets))
 
 
 def line_of_sight(
@@ -39,7 +54,12 @@ def target_geometry(
     targets: Sequence[PointTarget],
     coupling_s: float,
     clear: np.ndarray,
+    noise_w: float | None = None,
 ):
+    """Per-target geometry, bins and expected power; ``snr_db`` against ``noise_w`` per pixel.
+
+    ``noise_w`` defaults to ``cfg.noise_power_w`` (frames without the window point-spread).
+    """
     pos = np.array([t.position_ned_m for t in targets], float).reshape(-1, 3)
     vel = np.array([t.velocity_ned_mps for t in targets], float).reshape(-1, 3)
     rcs = np.array([t.rcs_m2 for t in targets], float)
@@ -63,7 +83,8 @@ def target_geometry(
         "azimuth_rad": az,
         "elevation_rad": el,
         "power_w": power_w,
-        "snr_db": 10 * np.log10(np.maximum(power_w, 1e-300) / cfg.noise_power_w),
+        "snr_db": 10 * np.log10(np.maximum(power_w, 1e-300) / (noise_w or cfg.noise_power_w)),
+        "range_position_bins": (half_path + coupling_s * v_r) / cfg.range_resolution_m,
         "range_bin": k,
         "doppler_bin": j,
         "visible": in_view,
@@ -72,16 +93,44 @@ def target_geometry(
 
 
 def add_targets(
-    cube: np.ndarray, cfg: RadarConfig, geom, targets, coupling_s: float, clear: np.ndarray
+    cube: np.ndarray,
+    cfg: RadarConfig,
+    geom,
+    targets,
+    coupling_s: float,
+    clear: np.ndarray,
+    power_factor: np.ndarray | None = None,
+    psf_reach: tuple[int, int] | None = None,
 ) -> None:
+    """Add the targets' returns to ``cube``: one pixel each, or the windows' exact point-spread.
+
+    ``power_factor`` (per target) scales the received power (Swerling fluctuation);
+    ``psf_reach`` (range, Doppler bins) spreads each target over the windows' response at its
+    fractional (range, Doppler) position (:mod:`skyradar.sim.psf`).
+    """
     g = target_geometry(cfg, geom, targets, coupling_s, clear)
     keep = g["visible"]
     if not np.any(keep):
         return
-    amp = np.sqrt(g["power_w"][keep])[:, None]
+    power = g["power_w"] if power_factor is None else g["power_w"] * np.asarray(power_factor, float)
+    amp = np.sqrt(power[keep])[:, None]
     phase = 2 * np.pi * np.mod(g["path_m"][keep] / cfg.wavelength_m, 1.0)
     values = amp * np.exp(1j * phase)
+    if psf_reach is not None:
+        _add_spread(cube, cfg, g, keep, values, psf_reach)
+        return
     for q in range(cfg.n_rx):
         np.add.at(
             cube[..., q], (g["range_bin"][keep], g["doppler_bin"][keep]), values[:, q].astype(cube.dtype)
         )
+
+
+def _add_spread(cube, cfg: RadarConfig, g, keep, values, reach: tuple[int, int]) -> None:
+    # Range position as the bins' own (with the coupling shift), Doppler as doppler_bin's.
+    x_range = g["range_position_bins"][keep]
+    x_doppler = g["radial_velocity_mps"][keep] / cfg.doppler_resolution_mps + cfg.n_doppler // 2
+    for t in range(values.shape[0]):
+        kr, wr = target_psf_taps(PSF_WINDOW, cfg.samples_per_chirp, x_range[t], reach[0], cfg.n_range, False)
+        kd, wd = target_psf_taps(PSF_WINDOW, cfg.n_doppler, x_doppler[t], reach[1], cfg.n_doppler, True)
+        spread = np.multiply.outer(np.multiply.outer(wr, wd), values[t])
+        cube[np.ix_(kr, kd)] += spread.astype(cube.dtype)

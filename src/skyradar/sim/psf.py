@@ -1,0 +1,259 @@
+"""Point-spread of the range and Doppler FFT windows for image-domain frames.
+
+The raw ADC chain (:mod:`skyradar.sim.raw` then ``process.rangedoppler.range_doppler``) windows each
+chirp and each slow-time row before its FFT, so a scatterer at fractional bin position ``x`` shows
+in bin ``k`` with the window's response ``W(k - x)``: a main lobe two bins wide (Hann), sidelobes
+(-31 dB for Hann) and a straddle loss up to 1.4 dB per axis for a scatterer half-way between bins.
+Here ``W(u) = sum_n w[n] exp(-2j pi u (n - N/2) / N) / sum_n w[n]``: the zero-phase DTFT of the
+periodic window, 1 at ``u = 0``, so pixel units stay "an on-bin scatterer's pixel power is its
+received power" (the raw chain's pixel divided by the windows' coherent gain).
+
+Two uses:
+
+- point targets (few per frame) get ``W`` exactly at their fractional (range, Doppler) position
+  (:func:`target_psf_taps`);
+- terrain (millions of facets per frame) is accumulated at its nearest bin, then the whole frame
+  (with its noise) is convolved with the *bin-averaged* kernel ``h[m]``, ``|h[m]|^2 =
+  mean over d in [-1/2, 1/2) of |W(m + d)|^2`` (:func:`binned_kernel`, :func:`apply_psf`).
+  With facets no coarser than half a bin their positions inside a bin are spread evenly, so the
+  expected power of every cell (over speckle) is the raw chain's ``sum_i P_i |W(k - x_i)|^2`` up
+  to that averaging (``tests/test_sim_psf.py`` measures the difference against the raw chain),
+  at the cost of one separable convolution per frame instead of a kernel per facet. Noise
+  convolved with ``h`` gets the windowed noise power ``sum |h|^2 = ENBW`` (1.5 per axis for Hann)
+  as the raw chain's does.
+
+The Doppler axis is circular (aliasing); the range axis ends at the cube's edges (clutter beyond
+the last range bin, which the simulator does not accumulate, would leak in a few bins in the raw
+chain).
+
+Windows are scipy's periodic (``fftbins=True``) windows, the convention of
+``skyradar.process.windows.get_window`` (tested equal there; ``sim`` may not import ``process``).
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from typing import NamedTuple
+
+import numpy as np
+import scipy.signal
+from numba import njit, prange
+
+from skyradar.errors import InputError
+
+__all__ = [
+    "PSF_WINDOW", "PSFKernels", "window_response", "binned_kernel", "psf_kernels", "enbw", "apply_psf",
+    "target_psf_taps", "frame_options", "speckle_key",
+]  # fmt: skip
+
+PSF_WINDOW = "hann"  # the default range and Doppler windows of process/range_doppler
+_TAIL = 1e-6  # kernel truncated where the power left out is below -60 dB of the whole
+_K_MAX = 16
+OVERSAMPLE = 2  # terrain lands on half-bins: the kernel then averages over half a bin, not a whole one
+_SPECKLE_STREAM = 0x5D5EC1E5A1B2C3D4  # XORed into the frame's noise key: speckle's own stream
+
+
+@lru_cache(maxsize=16)
+def _window(name: str, n: int) -> np.ndarray:
+    try:
+        return scipy.signal.get_window(name, int(n), fftbins=True).astype(float)
+    except ValueError:
+        raise InputError(f"simulation: unknown PSF window {name!r} (a scipy.signal window name)") from None
+
+
+def window_response(name: str, n: int, offset_bins: np.ndarray) -> np.ndarray:
+    """Zero-phase DTFT of the periodic window at ``offset_bins`` (bins), normalised to 1 at 0.
+
+    Parameters
+    ----------
+    name : str
+        scipy window name (``'hann'``, ``'hamming'``, ``'boxcar'``...).
+    n : int
+        Window length (samples per chirp for range, chirps per frame for Doppler).
+    offset_bins : ndarray
+        Bin offsets ``k - x`` between an output bin and the scatterer.
+
+    Examples
+    --------
+    >>> w = window_response("hann", 256, np.array([0.0, 0.5, 1.0, 2.0]))
+    >>> np.round(20 * np.log10(np.abs(w[:2])), 2).tolist(), np.round(w.real[2:], 3).tolist()
+    ([0.0, -1.42], [0.5, 0.0])
+    """
+    w = _window(name, n)
+    u = np.asarray(offset_bins, float)
+    centred = np.arange(n) - n / 2.0
+    phase = np.exp(-2j * np.pi * np.multiply.outer(u, centred) / n)
+    return phase @ w / w.sum()
+
+
+@lru_cache(maxsize=16)
+def binned_kernel(name: str, n: int, oversample: int = 1) -> np.ndarray:
+    """Window kernel averaged over sub-bins of ``1 / oversample`` bin, float32.
+
+    Entry ``s`` (s = -S..S, S = oversample * K + oversample - 1) is the root of the mean of
+    ``|W(s / oversample + d)|^2`` over ``d`` in one sub-bin, with the sign of its mean real part.
+    ``K`` is the smallest reach in bins whose left-out power is below -60 dB of the total (at
+    most 16, and less than half the window length). ``sum(h^2) / oversample`` is the window's
+    ENBW.
+
+    Examples
+    --------
+    >>> h = binned_kernel("hann", 250)
+    >>> len(h) // 2, round(float(np.sum(h.astype(float) ** 2)), 3)  # reach, ENBW of Hann
+    (7, 1.5)
+    >>> h2 = binned_kernel("hann", 250, 2)
+    >>> len(h2) // 2, round(float(np.sum(h2.astype(float) ** 2)) / 2, 2)
+    (13, 1.5)
+    """
+    d = ((np.arange(64) + 0.5) / 64 - 0.5) / oversample
+    # The response repeats every n bins: the kernel stays within half a period.
+    half = max(0, min(_K_MAX + 4, (n - 1) // 2 - 1))
+    m = np.arange(-half * oversample, half * oversample + 1) / oversample
+    resp = window_response(name, n, (m[:, None] + d[None, :]).ravel()).reshape(m.size, d.size)
+    power = np.mean(np.abs(resp) ** 2, axis=1)
+    total = power.sum()
+    reach = min(_K_MAX, half - 1)
+    for k in range(reach + 1):
+        if power[np.abs(m) > k + 0.5].sum() <= _TAIL * total:
+            reach = k
+            break
+    keep = np.abs(m) <= reach + 1 - 1.0 / oversample + 1e-9
+    sign = np.where(resp.real.mean(axis=1) < 0.0, -1.0, 1.0)
+    return (sign * np.sqrt(power))[keep].astype(np.float32)
+
+
+@njit(parallel=True, cache=True, error_model="numpy", fastmath=True)
+def _psf_kernel(fine, tmp, out, h_range, h_doppler, step):  # pragma: no cover - compiled
+    # Float32 views: fine (L n_r, L n_d * w), tmp (L n_r, n_d * w), out (n_r, n_d * w) with
+    # w = 2 n_rx floats per bin. out[k, j] = sum over fine (m, l) of
+    # fine[m, l] h_range[L k - m] h_doppler[L j - l]: a real kernel acts on the real and
+    # imaginary parts alike, so the inner loops are plain vector multiply-adds over w floats.
+    n_fine_d = fine.shape[1] // step
+    n_d = tmp.shape[1] // step
+    os = n_fine_d // n_d
+    sr, sd = h_range.shape[0] // 2, h_doppler.shape[0] // 2
+    for m in prange(fine.shape[0]):  # Doppler: circular
+        src, dst = fine[m], tmp[m]
+        dst[:] = 0
+        for j in range(n_d):
+            o = j * step
+            for s in range(-sd, sd + 1):
+                l = os * j - s
+                l = l + n_fine_d if l < 0 else (l - n_fine_d if l >= n_fine_d else l)
+                g, i = h_doppler[s + sd], l * step
+                for c in range(step):
+                    dst[o + c] += g * src[i + c]
+    for k in prange(out.shape[0]):  # range: zero beyond the cube
+        dst = out[k]
+        dst[:] = 0
+        for s in range(-sr, sr + 1):
+            m = os * k - s
+            if m < 0 or m >= fine.shape[0]:
+                continue
+            g, src = h_range[s + sr], tmp[m]
+            for c in range(dst.shape[0]):
+                dst[c] += g * src[c]
+
+
+def apply_psf(fine: np.ndarray, kernels: PSFKernels, out: np.ndarray, scratch: np.ndarray) -> None:
+    """``out`` (n_range, n_doppler, n_rx) from the oversampled grid ``fine`` and the kernels.
+
+    ``fine`` is (L n_range, L n_doppler, n_rx) complex64 with ``L = kernels.oversample``: each
+    scatterer added at its nearest sub-bin. ``scratch`` is complex64 with at least
+    ``L n_range * n_doppler * n_rx`` elements (overwritten).
+
+    Examples
+    --------
+    >>> k = PSFKernels(binned_kernel("hann", 64, 2), binned_kernel("hann", 64, 2), 2)
+    >>> fine, out = np.zeros((40, 128, 1), np.complex64), np.zeros((20, 64, 1), np.complex64)
+    >>> fine[20, 0, 0] = 1.0  # on bin (10, 0)
+    >>> apply_psf(fine, k, out, np.empty(40 * 64, np.complex64))
+    >>> round(float(np.sum(np.abs(out) ** 2)), 2), bool(abs(out[10, 63, 0]) > 0)  # ~ENBW^2; wraps
+    (2.25, True)
+    """
+    n_r, n_d, n_rx = out.shape
+    step = 2 * n_rx
+    tmp = scratch.reshape(-1)[: fine.shape[0] * n_d * n_rx].view(np.float32)
+    tmp = tmp.reshape(fine.shape[0], n_d * step)
+    _psf_kernel(
+        fine.view(np.float32).reshape(fine.shape[0], -1), tmp, out.view(np.float32).reshape(n_r, n_d * step),
+        kernels.h_range, kernels.h_doppler, step,
+    )  # fmt: skip
+
+
+def target_psf_taps(
+    name: str, n: int, position_bins: float, reach: int, n_bins: int, circular: bool
+) -> tuple[np.ndarray, np.ndarray]:
+    """Bins and exact window responses of a point at fractional ``position_bins`` on one axis.
+
+    Bins ``round(position) - reach .. + reach``, wrapped when ``circular`` (Doppler), else
+    those inside ``[0, n_bins)`` (range).
+
+    Examples
+    --------
+    >>> bins, w = target_psf_taps("hann", 250, 249.5, 2, 250, True)
+    >>> bins.tolist(), np.round(np.abs(w), 2).tolist()
+    ([248, 249, 0, 1, 2], [0.17, 0.85, 0.85, 0.17, 0.02])
+    """
+    centre = int(np.floor(position_bins + 0.5))
+    bins = np.arange(centre - reach, centre + reach + 1)
+    response = window_response(name, n, bins - position_bins)
+    if circular:
+        return bins % n_bins, response
+    inside = (bins >= 0) & (bins < n_bins)
+    return bins[inside], response[inside]
+
+
+class PSFKernels(NamedTuple):
+    """The sub-bin averaged range and Doppler kernels of one radar's frames (float32, odd lengths)."""
+
+    h_range: np.ndarray
+    h_doppler: np.ndarray
+    oversample: int = 1
+
+    @property
+    def reach(self) -> tuple[int, int]:
+        """Half-widths (range, Doppler), whole bins."""
+        return len(self.h_range) // 2 // self.oversample, len(self.h_doppler) // 2 // self.oversample
+
+
+def psf_kernels(config, window: str = PSF_WINDOW, oversample: int = OVERSAMPLE) -> PSFKernels:
+    """Kernels for ``config``: range over ``samples_per_chirp``, Doppler over ``n_doppler``.
+
+    Examples
+    --------
+    >>> from skyradar.config import RadarConfig
+    >>> psf_kernels(RadarConfig.prototype_2022()).reach
+    (6, 6)
+    """
+    return PSFKernels(
+        binned_kernel(window, config.samples_per_chirp, oversample),
+        binned_kernel(window, config.n_doppler, oversample),
+        oversample,
+    )
+
+
+def enbw(kernels: PSFKernels | None) -> float:
+    """Noise power gain of the two kernels (the windows' ENBW product; 1 for none).
+
+    Examples
+    --------
+    >>> round(enbw(PSFKernels(binned_kernel("hann", 64), binned_kernel("hann", 64))), 2)
+    2.25
+    """
+    if kernels is None:
+        return 1.0
+    h_r, h_d = kernels.h_range.astype(float), kernels.h_doppler.astype(float)
+    return float(np.sum(h_r**2) * np.sum(h_d**2)) / kernels.oversample**2
+
+
+def frame_options(psf, speckle, swerling) -> tuple[bool, bool, int]:
+    """Checked ``psf``, ``speckle`` and ``swerling`` simulation options."""
+    if swerling not in (0, 1) or isinstance(swerling, bool):
+        raise InputError(f"simulation.swerling must be 0 or 1, got {swerling!r}")
+    return bool(psf), bool(speckle), int(swerling)
+
+
+def speckle_key(noise_key: np.uint64) -> np.uint64:
+    """The frame's speckle stream key, derived from its noise key (never 0: 0 means no speckle)."""
+    return np.uint64(int(noise_key) ^ _SPECKLE_STREAM) or np.uint64(1)

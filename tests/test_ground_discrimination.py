@@ -11,7 +11,7 @@ from cli_helpers import assert_one_line_error, skyradar
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.experiments.ground_scenes import SCENES, score_scene, simulate_scene
-from skyradar.io.frames import open_frames
+from skyradar.io.frames import FrameStoreWriter, open_frames
 from skyradar.process.doa import direction_from_angles, estimate_directions, steering_vector
 from skyradar.process.ground import (
     classify_ground,
@@ -125,6 +125,13 @@ def runs(tmp_path_factory):
     hills = {"type": "fractal", "local_sd_m": 60.0, "size_m": 3000.0, "spacing_m": 60.0, "seed": 3}
     built = Scenario.from_dict({**BASE, "terrain": hills}, source=base / "h.yaml").build()
     simulate_to_zarr(built, base / "hills.zarr", chunk_frames=5)
+    # The same clear-sky frames with no own-ship state at all (neither navigation nor truth).
+    ds = open_frames(base / "run.zarr")
+    bare = ds.drop_vars([v for v in ds.data_vars if v.startswith(("own_", "nav_"))]).load()
+    writer = FrameStoreWriter(base / "bare.zarr", bare.assign(iq=bare["iq"].chunk({"time": 3})), 3, "bare")
+    for k in writer.pending_chunks():
+        writer.write_chunk(k, bare["iq"].values[writer.chunk_slice(k)])
+    writer.close()
     return base, built
 
 
@@ -157,4 +164,7 @@ def test_process_terrain_bad_names_and_a_dem_off_the_flight_give_one_line(runs):
     # The Jacksboro DEM is in Tennessee; this run flies at 52.5 N.
     result = skyradar(*args, "jacksboro", cwd=base)
     assert_one_line_error(result, "jacksboro_fault_dem.npz", "lat 52.5", "does not cover the flight")
+    # Ground discrimination with a terrain needs the own-ship state (navigation): one line without it.
+    result = skyradar("process", "bare.zarr", "-o", "det.parquet", "--terrain", "flat", cwd=base)
+    assert_one_line_error(result, "bare.zarr", "--terrain", "own-ship position", "nav_lat_deg")
     assert not (base / "det.parquet").exists()

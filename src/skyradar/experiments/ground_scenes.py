@@ -11,7 +11,9 @@ clutter (the thermal false alarms at the CFAR's 2e-8 are a handful per run). Sco
 * ``ground_flagged``: fraction of ground clutter detections flagged ``is_ground`` (want high);
 * ``aircraft_flagged``: fraction of aircraft detections flagged ``is_ground`` (want 0), per aircraft.
 
-Run ``python -m skyradar.experiments.ground_scenes`` for the table of every scene.
+Run ``python -m skyradar.experiments.ground_scenes [n_frames] [n_seeds] [suppression]`` for the
+table of every scene (defaults 20 frames 1 s apart, seeds 0 and 1, no suppression); the JSON of the
+table is the last line.
 
 Examples
 --------
@@ -160,15 +162,18 @@ def score_scene(table: pd.DataFrame, truth: pd.DataFrame, n_doppler: int) -> dic
 
 
 def ground_scores(
-    names=tuple(SCENES), n_frames: int = 8, seeds=(0,), aheads_m=(1500.0, 3000.0)
+    names=tuple(SCENES), n_frames: int = 8, seeds=(0,), aheads_m=(1500.0, 3000.0), suppression: str = "none"
 ) -> pd.DataFrame:
-    """One row of :func:`score_scene` per scene name, pooled over seeds and aircraft distances."""
+    """One row of :func:`score_scene` per scene name, pooled over seeds and aircraft distances.
+
+    ``suppression`` is passed to :func:`process_frames` (ground clutter suppression before detection).
+    """
     rows = []
     for name in names:
         tables, truths = [], []
         for run, (seed, ahead) in enumerate((s, a) for s in seeds for a in aheads_m):
             ds, truth, terrain = simulate_scene(SCENES[name], n_frames, 20.0 / n_frames, seed, ahead)
-            table = process_frames(ds, terrain=terrain)
+            table = process_frames(ds, terrain=terrain, suppression=suppression)
             tables.append(table.assign(frame=table.frame + run * n_frames))
             truths.append(truth.assign(frame=truth.frame + run * n_frames))
         scores = score_scene(pd.concat(tables), pd.concat(truths), ds.sizes["doppler"])
@@ -181,6 +186,7 @@ if __name__ == "__main__":  # pragma: no cover - a measurement, not a library pa
 
     frames = int(sys.argv[1]) if len(sys.argv) > 1 else 20
     n_seeds = int(sys.argv[2]) if len(sys.argv) > 2 else 2
-    scores = ground_scores(n_frames=frames, seeds=tuple(range(n_seeds)))
+    suppression = sys.argv[3] if len(sys.argv) > 3 else "none"
+    scores = ground_scores(n_frames=frames, seeds=tuple(range(n_seeds)), suppression=suppression)
     print(scores.to_string(index=False, float_format=lambda v: f"{v:.3f}"))
     print(json.dumps(scores.to_dict(orient="records")))

@@ -56,6 +56,8 @@ __all__ = [
 
 
 _ONE_DEG = float(np.radians(1.0))
+_CHI2_2DOF_3SD = 11.829  # chi-square quantile of 2 degrees of freedom at 0.9973 (3 sd in one)
+_ENDFIRE_COSINE = float(np.sin(np.radians(45.0)))
 # DoA error floor beyond the Cramer-Rao bound (attitude and calibration errors), and the surface's
 # own height uncertainty (DEM error, relief inside a range cell, navigation altitude error).
 ANGLE_FLOOR_RAD = float(np.radians(0.3))
@@ -245,20 +247,23 @@ def classify_ground(
     h = np.asarray(height_agl_m, float)
     sd = rng * np.asarray(angle_sd_rad, float) if height_sd is None else np.asarray(height_sd, float)
     u = np.asarray(direction_ned, float)
-    static = np.zeros(rng.shape, bool)
+    z_v = np.full(rng.shape, np.inf)  # Doppler distance from a static point in that direction, in sd
     if own_velocity_ned_mps is not None and np.all(np.isfinite(own_velocity_ned_mps)):
         speed = float(np.linalg.norm(own_velocity_ned_mps))
         expected = static_radial_velocity_mps(u, own_velocity_ned_mps)
         spread = speed * np.asarray(angle_sd_rad, float) if doppler_sd is None else np.asarray(doppler_sd)
-        tol = 1.5 * config.doppler_resolution_mps + 3.0 * spread
-        static = np.isfinite(expected) & doppler_matches_static(radial_velocity_mps, expected, config, tol)
+        width = 2.0 * config.v_lim_mps
+        diff = (np.asarray(radial_velocity_mps, float) - expected + width / 2.0) % width - width / 2.0
+        z_v = np.nan_to_num(np.abs(diff) / np.hypot(0.5 * config.doppler_resolution_mps, spread), nan=np.inf)
     with np.errstate(invalid="ignore"):
-        on_surface = h <= 3.0 * sd
-        conclusive = 3.0 * sd <= height_margin_m
         leak = leakage_bins * config.range_resolution_m * np.abs(np.nan_to_num(u[:, 2]))
-        along_ray = h <= 3.0 * sd + leak
+        # Position and Doppler tested jointly: both within 3 sd together (chi-square, 2 dof, 99.73 %),
+        # the position allowed to fall short of the surface by the range leakage.
+        z_h = np.maximum(h - leak, 0.0) / sd
+        joint = z_h**2 + z_v**2 <= _CHI2_2DOF_3SD
+        conclusive = (h <= 3.0 * sd) & (3.0 * sd <= height_margin_m)
         below = h < -3.0 * sd
-    return np.isfinite(h) & ((on_surface & (static | conclusive)) | (static & along_ray) | below)
+    return np.isfinite(h) & (joint | conclusive | below)
 
 
 def ground_in_elevation(
@@ -334,27 +339,48 @@ def flag_ground(
     ground) are ground only when the ground can produce their range and Doppler
     (:func:`in_ground_band`) AND their elevation points at the surface for some azimuth
     (:func:`ground_in_elevation`): an aircraft mixed with ground pulls the elevation up and is kept.
+    Near the end-fire of a baseline (direction cosine above sin 45 deg) the mirrored direction is
+    tested too: the phase step is near +-pi there, and the ground straight below (the altitude
+    return) is otherwise read as a direction above the aircraft.
     """
     from skyradar.process.calibration import in_field_of_view
     from skyradar.process.doa import doa_crlb
 
     rng = np.asarray(out["range_m"], float)
+    if rng.size == 0:
+        return np.zeros(0, bool)
     sd_az, sd_el = doa_crlb(out["snr_db"], out["azimuth_rad"], out["elevation_rad"], config)
     sd_az, sd_el = (np.clip(np.nan_to_num(s, nan=0.2), ANGLE_FLOOR_RAD, 0.2) for s in (sd_az, sd_el))
     points = np.stack([out["north_m"], out["east_m"], out["down_m"]], axis=1)
-    sd_h = height_sd_m(rng, sd_az, sd_el, out["u_ant"], ant_to_ned, config, SURFACE_SD_M)
-    vel, sigma = own_velocity_ned_mps, np.maximum(sd_az, sd_el)
-    sd_v = static_doppler_sd_mps(out["u_ant"], sd_az, sd_el, ant_to_ned, vel)
-    v_r = out["radial_velocity_mps"]
-    h = height_fn(points)
-    ground = classify_ground(rng, v_r, u_ned, config, vel, h, sigma, height_sd=sd_h, doppler_sd=sd_v)
+    antenna = points[0] - rng[0] * u_ned[0]
+    v_r, u_ant = out["radial_velocity_mps"], np.asarray(out["u_ant"], float)
+    args = (antenna, ant_to_ned, height_fn, own_velocity_ned_mps, config)
+    ground = _ground_along(u_ant, rng, v_r, sd_az, sd_el, *args)
+    # Near the end-fire of a baseline the phase step is close to +-pi and noise flips its sign: the
+    # mirrored direction is as plausible (the ground straight below read as straight above).
+    mirror = u_ant.copy()
+    mirror[:, 1:] *= np.where(np.abs(u_ant[:, 1:]) > _ENDFIRE_COSINE, -1.0, 1.0)
+    amb = np.any(mirror != u_ant, axis=1)
+    mirrored = np.zeros(rng.shape, bool)
+    if amb.any():
+        mirrored[amb] = _ground_along(mirror[amb], rng[amb], v_r[amb], sd_az[amb], sd_el[amb], *args)
+    ground |= mirrored
     unreliable = ~in_field_of_view(out["azimuth_rad"], out["elevation_rad"], config, 12.0)
     unreliable |= out["coherence"] < 0.5
-    sel = unreliable & in_ground_band(rng, v_r, vel, own_height_agl_m, config)
-    hit = np.zeros(rng.shape, bool)
+    sel = unreliable & in_ground_band(rng, v_r, own_velocity_ned_mps, own_height_agl_m, config)
+    hit = sel & mirrored
     if sel.any():
-        antenna = points[0] - rng[0] * u_ned[0]
         margin = 3.0 * np.hypot(rng[sel] * sd_el[sel], SURFACE_SD_M)
         el = out["elevation_rad"][sel]
-        hit[sel] = ground_in_elevation(rng[sel], el, height_fn, antenna, ant_to_ned, margin)
+        hit[sel] |= ground_in_elevation(rng[sel], el, height_fn, antenna, ant_to_ned, margin)
     return np.where(unreliable, hit, ground)
+
+
+def _ground_along(u_ant, rng, v_r, sd_az, sd_el, antenna, ant_to_ned, height_fn, vel, config) -> np.ndarray:
+    """:func:`classify_ground` of detections at ``rng`` along antenna-frame directions ``u_ant``."""
+    u_ned = u_ant @ np.asarray(ant_to_ned, float).T
+    h = height_fn(antenna + rng[:, None] * u_ned)
+    sd_h = height_sd_m(rng, sd_az, sd_el, u_ant, ant_to_ned, config, SURFACE_SD_M)
+    sd_v = static_doppler_sd_mps(u_ant, sd_az, sd_el, ant_to_ned, vel)
+    sigma = np.maximum(sd_az, sd_el)
+    return classify_ground(rng, v_r, u_ned, config, vel, h, sigma, height_sd=sd_h, doppler_sd=sd_v)

@@ -106,9 +106,9 @@ def check_dem_covers(
 def dem_for_run(path: str | Path, ds: Any, range_limit_m: float, source: str) -> Terrain:
     """Read the DEM ``path`` for a frames run ``ds``: the window its own-ship can see, checked to cover it.
 
-    The own-ship positions come from the run's ``own_lat_deg``/``own_lon_deg`` or, failing
-    those, from its NED track and stored origin. A run without either cannot place a DEM:
-    :class:`InputError` naming ``source``.
+    The own-ship positions come from the run's navigation (``nav_lat_deg``/``nav_lon_deg``, or
+    its NED track and stored origin; ``own_*`` in runs written before navigation). A run without
+    either cannot place a DEM: :class:`InputError` naming ``source``.
     """
     from skyradar.scene.dem_readers import read_dem
 
@@ -124,23 +124,23 @@ def dem_for_run(path: str | Path, ds: Any, range_limit_m: float, source: str) ->
 
 
 def _run_track(ds: Any, source: str) -> tuple[np.ndarray, np.ndarray, tuple[float, ...] | None]:
+    """Own-ship latitude/longitude per frame as the aircraft knows them (navigation), and the origin."""
     from skyradar.geo import ned_to_geodetic
+    from skyradar.io.navigation import navigation_state
     from skyradar.io.run_origin import scenario_origin
 
     origin = scenario_origin(ds)
-    if "own_lat_deg" in ds and "own_lon_deg" in ds:
-        return (
-            np.asarray(ds["own_lat_deg"].values, float),
-            np.asarray(ds["own_lon_deg"].values, float),
-            origin,
-        )
+    nav = navigation_state(ds, source)
+    if nav is not None and "own_lat_deg" in nav and "own_lon_deg" in nav:
+        return nav["own_lat_deg"].to_numpy(float), nav["own_lon_deg"].to_numpy(float), origin
     names = ("own_north_m", "own_east_m", "own_down_m")
-    if origin is None or not all(n in ds for n in names):
+    if origin is None or nav is None or not all(n in nav for n in names):
         raise InputError(
-            f"{source}: option '--terrain' needs the run's own-ship position (variables own_lat_deg, "
-            "own_lon_deg, or own_north_m.. and an origin) to place the DEM; this run has none"
+            f"{source}: option '--terrain' needs the run's own-ship position (navigation variables "
+            "nav_lat_deg, nav_lon_deg, or nav_north_m.. and an origin; own_* in older runs) to place "
+            "the terrain and judge ground; this run has none"
         )
-    ned = np.stack([np.asarray(ds[n].values, float) for n in names], axis=-1)
+    ned = np.stack([nav[n].to_numpy(float) for n in names], axis=-1)
     lat, lon, _ = ned_to_geodetic(ned, *origin)
     return np.atleast_1d(lat), np.atleast_1d(lon), origin
 

@@ -60,8 +60,10 @@ def _read(path, caplog):
 
 
 def test_pandas_default_json_gz_in_epoch_milliseconds(tmp_path, reference, caplog):
-    df = _rows().assign(timestamp=lambda d: pd.to_datetime(d["timestamp"], unit="s"))
-    df.to_json(tmp_path / "f.json.gz", date_format="epoch")  # pandas defaults: orient columns, ms, gzip
+    # What pandas' to_json() wrote for datetimes by default (orient="columns", epoch ms), gzipped;
+    # written as integer ms here since pandas 3 deprecates the epoch date format itself.
+    df = _rows().assign(timestamp=lambda d: (d["timestamp"] * 1000).astype("int64"))
+    df.to_json(tmp_path / "f.json.gz")
     traj, line = _read(tmp_path / "f.json.gz", caplog)
     _same(traj, reference)
     assert "timestamp in epoch ms" in line
@@ -185,3 +187,33 @@ def test_several_aircraft_one_line_per_file(tmp_path, caplog):
     assert sorted(tracks) == ["008123", "3c6444"]
     (line,) = [r.getMessage() for r in caplog.records]
     assert "3c6444: sorted by time" in line and "008123: sorted by time" in line
+
+
+def test_readsb_trace_json(tmp_path, reference, caplog):
+    """readsb / ADS-B Exchange trace_full_*.json: offsets from a base time, "ground" altitudes."""
+    import json
+
+    df = _rows()
+    trace = [
+        [
+            float(r.timestamp - T0),
+            r.latitude,
+            r.longitude,
+            r.altitude,
+            107.0,
+            70.0,
+            0,
+            394.0,
+            None,
+            "adsb_icao",
+        ]
+        for r in df.itertuples()
+    ]
+    trace[3][8] = {"type": "adsb_icao", "flight": "DLH4AB  "}
+    trace.append([11.5, 47.1, 11.1, "ground", None, None, 0, None, None, "adsb_icao"])
+    (tmp_path / "trace_full_3c6444.json").write_text(
+        json.dumps({"icao": "3c6444", "timestamp": T0, "trace": trace})
+    )
+    traj, line = _read(tmp_path / "trace_full_3c6444.json", caplog)
+    _same(traj, reference)
+    assert traj.name == "DLH4AB" and "dropped 1 row(s) without a position" in line

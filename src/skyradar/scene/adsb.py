@@ -40,7 +40,7 @@ import pandas as pd
 
 from skyradar.errors import InputError
 from skyradar.geo import geodetic_to_ned
-from skyradar.scene.adsb_clean import altitude_m, clean_rows, time_seconds
+from skyradar.scene.adsb_clean import altitude_m, clean_rows, readsb_trace, time_seconds
 
 __all__ = ["FT_M", "KT_MPS", "FPM_MPS", "read_track_table", "read_trajectory", "read_trajectories"]
 
@@ -92,6 +92,8 @@ def _read_json(path: Path, lines: bool) -> pd.DataFrame:
     with (opener or open)(path, "rt", encoding="utf-8") as fh:
         text = fh.read()
     data = [json.loads(line) for line in text.splitlines() if line.strip()] if lines else json.loads(text)
+    if isinstance(data, dict) and isinstance(data.get("trace"), list) and "timestamp" in data:
+        return readsb_trace(data)  # readsb / ADS-B Exchange trace_full_*.json
     if isinstance(data, dict) and isinstance(data.get("data"), list):
         if isinstance(data.get("columns"), list):  # pandas orient="split"
             return pd.DataFrame(data["data"], columns=data["columns"])

@@ -238,3 +238,42 @@ def glitch_rows(pos: np.ndarray, t: np.ndarray, max_speed_mps: float) -> np.ndar
             if i == anchor or _consistent(pos, t, last, i, max_speed_mps):
                 bad[i], last = False, i
     return bad
+
+
+def readsb_trace(data: dict) -> pd.DataFrame:
+    """A readsb / ADS-B Exchange ``trace_full_*.json`` file as rows in the ``traffic`` convention.
+
+    The file is ``{"icao": ..., "timestamp": unix s, "trace": [[dt_s, lat, lon, alt_baro_ft or
+    "ground", gs_kt, track_deg, flags, vrate_fpm, details or null, source, alt_geom_ft, ...], ...]}``
+    (readsb's README-json). ``"ground"`` altitudes become missing (filled from ``alt_geom`` or
+    dropped by :func:`clean_rows`).
+
+    Examples
+    --------
+    >>> point = [0.0, 16.7, -88.0, 32000, 478.6, 327.8, 1, 0, None, "adsb_icao", 33825]
+    >>> rows = readsb_trace({"icao": "ac671b", "timestamp": 100.0, "trace": [point]})
+    >>> rows[["timestamp", "altitude", "geoaltitude", "icao24"]].values.tolist()
+    [[100.0, 32000.0, 33825.0, 'ac671b']]
+    """
+    points = [p for p in data["trace"] if isinstance(p, list) and len(p) >= 8]
+    if not points:
+        raise InputError(
+            "readsb trace: field 'trace' has no points [dt, lat, lon, alt, gs, track, flags, vrate...]"
+        )
+
+    def column(k: int) -> list:
+        def number(v) -> bool:
+            return isinstance(v, int | float) and not isinstance(v, bool)
+
+        return [p[k] if len(p) > k and number(p[k]) else np.nan for p in points]
+
+    rows = pd.DataFrame({
+        "timestamp": float(data["timestamp"]) + np.asarray(column(0), float), "latitude": column(1),
+        "longitude": column(2), "altitude": column(3), "groundspeed": column(4), "track": column(5),
+        "vertical_rate": column(7), "geoaltitude": column(10),
+    }, dtype=float)  # fmt: skip
+    rows["icao24"] = str(data.get("icao", "trace"))
+    flights = [p[8].get("flight") for p in points if isinstance(p[8], dict) and p[8].get("flight")]
+    if flights:
+        rows["callsign"] = str(flights[0]).strip()
+    return rows

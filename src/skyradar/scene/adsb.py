@@ -185,10 +185,13 @@ def _drop_glitches(path, rows, t, lat, lon, alt, alt_field: str, label: str, not
         keep[ok[glitch_rows(pos, t[ok], MAX_SPEED_MPS)]] = False
     dropped = int(len(t) - keep.sum())
     if dropped > GLITCH_BUDGET * len(t) or keep.sum() < 2:
-        _check_ranges(path, rows, lat, lon, alt, alt_field, label)  # the first bad value, named
-        pos = geodetic_to_ned(lat, lon, alt, lat[0], lon[0], alt[0])
-        _check_speed(path, rows, t, pos, label)
-        raise InputError(f"{path}: fewer than 2 plausible fixes{label}")
+        share = f"; {dropped} of {len(t)} fixes implausible (at most {GLITCH_BUDGET:.0%} drop as glitches)"
+        try:  # name the first bad value
+            _check_ranges(path, rows, lat, lon, alt, alt_field, label)
+            _check_speed(path, rows, t, geodetic_to_ned(lat, lon, alt, lat[0], lon[0], alt[0]), label)
+        except InputError as exc:
+            raise InputError(f"{exc}{share}") from None
+        raise InputError(f"{path}: fewer than 2 plausible fixes{label}{share}")
     if dropped:
         out = int((~in_range).sum())
         notes.append(f"dropped {dropped} glitch fix(es) ({out} out of range, {dropped - out} out of reach)")

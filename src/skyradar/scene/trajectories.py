@@ -214,7 +214,12 @@ class Trajectory:
         return (t >= self.time_s[0] - _TIME_TOLERANCE_S) & (t <= self.time_s[-1] + _TIME_TOLERANCE_S)
 
     def sample(self, times_s: np.ndarray | float) -> TrajectorySample:
-        """States at ``times_s`` (s): Hermite position, linear velocity, angle-aware attitude.
+        """States at ``times_s`` (s): Hermite position, its derivative as velocity, angle-aware attitude.
+
+        The velocity is the derivative of the position spline, not an interpolation of the sampled
+        velocities: between sparse samples (ADS-B gives a state every 5-12 s) a turning aircraft's
+        interpolated velocity differs from the motion of its position by metres per second, and a
+        simulated radar would then see a Doppler that disagrees with the range rate.
 
         Raises :class:`InputError` naming the trajectory when a time is outside its span.
         """
@@ -230,7 +235,7 @@ class Trajectory:
             )
         t = np.clip(t, self.time_s[0], self.time_s[-1])
         pos = self._spline(t)
-        vel = np.stack([np.interp(t, self.time_s, self.velocity_ned_mps[:, k]) for k in range(3)], axis=-1)
+        vel = self._spline(t, 1)
         att = np.stack([np.interp(t, self.time_s, self._unwrapped_attitude[:, k]) for k in range(3)], axis=-1)
         att[:, [0, 2]] = _wrap_pi(att[:, [0, 2]])
         lat, lon, alt = ned_to_geodetic(pos, *self.origin)

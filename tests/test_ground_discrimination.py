@@ -157,14 +157,19 @@ def test_terrain_by_name_refuses_what_it_cannot_place(runs):
         terrain_for_run("jacksboro", bare, 600.0, "run.zarr")
 
 
-def test_process_terrain_bad_names_and_a_dem_off_the_flight_give_one_line(runs):
+def test_process_terrain_bad_name_and_missing_own_ship_give_one_line(runs):
     base, _ = runs
     args = ["process", "run.zarr", "-o", "det.parquet", "--terrain"]
     assert_one_line_error(skyradar(*args, "moon", cwd=base), "--terrain", "moon", "flat, fractal, jacksboro")
-    # The Jacksboro DEM is in Tennessee; this run flies at 52.5 N.
-    result = skyradar(*args, "jacksboro", cwd=base)
-    assert_one_line_error(result, "jacksboro_fault_dem.npz", "lat 52.5", "does not cover the flight")
     # Ground discrimination with a terrain needs the own-ship state (navigation): one line without it.
     result = skyradar("process", "bare.zarr", "-o", "det.parquet", "--terrain", "flat", cwd=base)
     assert_one_line_error(result, "bare.zarr", "--terrain", "own-ship position", "nav_lat_deg")
     assert not (base / "det.parquet").exists()
+
+
+def test_jacksboro_by_name_refuses_a_run_that_is_not_over_it(runs):
+    # The Jacksboro DEM is in Tennessee; this run flies at 52.5 N (a file DEM off the flight is
+    # refused through the real `skyradar process` in test_silent_inputs: the same check).
+    base, _ = runs
+    with pytest.raises(InputError, match=r"jacksboro_fault_dem.npz: .* lat 52.5.* does not cover the flight"):
+        terrain_for_run("jacksboro", open_frames(base / "run.zarr"), 600.0, "run.zarr")

@@ -289,15 +289,21 @@ def number_items(s, k, first, n):
 
 
 @njit(error_model="numpy")
-def _speckle_rows(re_q, im_q, ids, speckle_key):
+def _speckle_draws(g_re, g_im, ids, speckle_key):
     # Each sub-facet's complex reflectivity: a unit-power circular Gaussian drawn from its number
-    # (the same for every receiver: one scatterer), by the noise kernel's counter-based generator.
+    # by the noise kernel's counter-based generator (branch-free: the loop vectorises).
     for m in range(ids.shape[0]):
         z = mix64(speckle_key + (uint64(ids[m]) + uint64(1)) * _GAMMA)
-        g_re, g_im = complex_normal(z, _SQRT_HALF)
+        g_re[m], g_im[m] = complex_normal(z, _SQRT_HALF)
+
+
+@njit(**_OPTS)
+def _speckle_rows(re_q, im_q, g_re, g_im):
+    # The same draw for every receiver: one scatterer.
+    for m in range(re_q.shape[0]):
         re, im = re_q[m], im_q[m]
-        re_q[m] = re * g_re - im * g_im
-        im_q[m] = re * g_im + im * g_re
+        re_q[m] = re * g_re[m] - im * g_im[m]
+        im_q[m] = re * g_im[m] + im * g_re[m]
 
 
 @njit(error_model="numpy")
@@ -306,10 +312,13 @@ def scatter_items(out, sparse, blk, s, cos_sin, n_items, speckle_key):
     idx, val, count = sparse
     n_rx = cos_sin.shape[1]
     amp = s[_AMP][:n_items]
+    g_re, g_im = s[_TMP0][:n_items], s[_TMP1][:n_items]  # free once item_returns is done
+    if speckle_key != 0:
+        _speckle_draws(g_re, g_im, s[_ID][:n_items], speckle_key)
     for q in range(n_rx):
         _weight_rows(cos_sin[0, q][:n_items], cos_sin[1, q][:n_items], amp)
         if speckle_key != 0:
-            _speckle_rows(cos_sin[0, q][:n_items], cos_sin[1, q][:n_items], s[_ID][:n_items], speckle_key)
+            _speckle_rows(cos_sin[0, q][:n_items], cos_sin[1, q][:n_items], g_re, g_im)
     for m in range(n_items):
         if s[_VALID, m] == 0.0:
             continue

@@ -15,6 +15,7 @@ from skyradar.process.clutter_frames import frame_subspace
 from skyradar.process.clutter_suppress import null_count, projected_power, suppress_clutter
 from skyradar.process.ground import in_ground_band
 from skyradar.process.pipeline import _own_state, process_frames
+from skyradar.process.power import power_image
 from skyradar.scene.synthetic_terrain import flat_terrain
 from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
 
@@ -131,7 +132,11 @@ def test_fused_kernel_matches_the_numpy_reference(clutter_frame, subspace):
     assert (out.unsuppressed != unsuppressed).mean() < 1e-4
     reference = projected_power(cube / CFG.rx_calibration, subspace.vectors, nulls)
     # |z|^2 - |E^H z|^2 in float32 under 50 dB of clutter: differences stay far below the noise.
-    np.testing.assert_allclose(out.power, reference, rtol=2e-3, atol=0.1 * CFG.noise_power_w)
+    same = out.nulls == nulls
+    raw = power_image(cube, CFG.rx_calibration)
+    # float32 rounding of |z|^2 - |E^H z|^2 grows with the cell's raw power (up to 55 dB of clutter).
+    tolerance = 2e-3 * reference + 1e-5 * raw + 1e-3 * CFG.noise_power_w
+    assert np.all(np.abs(out.power - reference)[same] <= tolerance[same])
 
 
 @pytest.mark.slow

@@ -71,7 +71,7 @@ def doppler_metrics(
     >>> v = np.linspace(-40, 40, 81)
     >>> m = doppler_metrics(np.where(np.abs(v + 30) < 4, -20.0, 0.0), v, -30.0, 40.0)
     >>> m["mdv_mps"], round(m["usable_doppler_fraction"], 3)
-    (4.0, 0.901)
+    (4.0, 0.914)
     """
     usable = np.asarray(loss_db) >= LOSS_THRESHOLD_DB
     sep = np.abs((np.asarray(velocity_mps) - v_mbc_mps + v_lim_mps) % (2 * v_lim_mps) - v_lim_mps)

@@ -1,16 +1,18 @@
 """Clutter suppression inside the frames pipeline: per-frame geometry (cached) and DoA after projection.
 
 :func:`frame_subspace` turns one frame's navigation state (the own-ship dict of
-:mod:`skyradar.process.pipeline`: velocity, attitude, height above ground, optional terrain) into
-the predicted clutter subspace. Over flat ground the prediction depends on the velocity in the
-body frame, pitch, roll and height only, so it is cached on those (rounded to 0.05 m/s, 0.05 deg
-and 1 m): a straight level flight computes it once. With a terrain it depends on the position
-too (rounded to 30 m).
+:mod:`skyradar.process.pipeline`: velocity, attitude, height above ground) into the predicted
+clutter subspace over flat ground at the own-ship's height above the ground below it (from the
+navigation, else from the terrain under the own-ship). It depends on the velocity in a
+heading-free frame, pitch, roll and height only, so it is cached on those, quantised (0.25 m/s,
+1 deg, 0.25 % of the height): a straight flight computes it once; each new geometry costs about
+1-3 s. The terrain-following prediction (:func:`skyradar.process.clutter.clutter_subspace` with
+``depth_fn``) is not used per frame: it would cost that for every few metres flown.
 
 :func:`directions_after_projection` estimates the direction of a detection whose cell was
 projected: the unit vector maximising ``|s^H P z|^2 / (s^H P s)`` (the projected matched filter)
-on a 2 deg grid over the field of view, refined on a 0.05 deg grid (+-1.5 deg); the plain phase estimate of
-the unsuppressed snapshot would follow the clutter that dominates the cell. With two nulls
+on a 2 deg grid over the field of view, refined on a 0.05 deg grid (+-1.5 deg); the plain phase
+estimate of the unsuppressed snapshot would follow the clutter that dominates the cell. With two nulls
 elevation is often unobservable (see the function).
 
 Examples
@@ -54,6 +56,7 @@ __all__ = [
 
 SUPPRESSIONS = ("none", "knowledge-aided", "auto")
 _CACHE: OrderedDict[tuple, ClutterSubspace] = OrderedDict()
+_V_STEP, _ANGLE_STEP_DEG, _HEIGHT_STEP = 0.25, 1.0, 0.0025
 
 
 def _depth_fn(terrain: Any, lat_deg: float, lon_deg: float, alt_m: float):
@@ -76,31 +79,32 @@ def frame_subspace(
     yaw, pitch, roll = (float(own[k][i]) for k in ("own_yaw_rad", "own_pitch_rad", "own_roll_rad"))
     v_ned = np.array([own[k][i] for k in ("own_vn_mps", "own_ve_mps", "own_vd_mps")], float)
     height = float(own["own_height_agl_m"][i])
-    geo = bool(own["has_geo"]) and terrain is not None
-    if not np.isfinite(height) and not geo:
+    if not np.isfinite(height) and not (bool(own["has_geo"]) and terrain is not None):
         return None
-    if geo:
+    if not np.isfinite(height):  # only a DEM: the terrain height under the own-ship
         lat, lon, alt = (float(own[k][i]) for k in ("own_lat_deg", "own_lon_deg", "own_alt_m"))
-        key = ("terrain", id(terrain), round(lat * 3600), round(lon * 3600), round(alt), round(yaw, 3))
-        depth_fn = _depth_fn(terrain, lat, lon, alt)
-        height = float(depth_fn(np.zeros(1), np.zeros(1))[0])
-        body_to_ned = rotation_matrix(yaw, pitch, roll)
-    else:
-        # Flat ground is the same in every direction: work in a heading-free frame.
-        body_to_ned = rotation_matrix(0.0, pitch, roll)
-        v_ned = rotation_matrix(yaw, 0.0, 0.0).T @ v_ned
-        depth_fn = None
-        key = ("flat", *np.round(v_ned / 0.05).astype(int), round(np.degrees(pitch) / 0.05),
-               round(np.degrees(roll) / 0.05), round(height))  # fmt: skip
-    key = (*key, id(config))
+        height = float(_depth_fn(terrain, lat, lon, alt)(np.zeros(1), np.zeros(1))[0])
+    if not height > 0:
+        return None
+    # Flat ground at that height is the same in every direction: a heading-free frame, and the
+    # geometry quantised (0.25 m/s, 1 deg, 0.25 % of the height) so that navigation noise and slow
+    # climbs reuse one prediction; it is computed AT the quantised values, so the result does not
+    # depend on which frame filled the cache (chunked and whole-run processing agree).
+    v_q = np.round(rotation_matrix(yaw, 0.0, 0.0).T @ v_ned / _V_STEP) * _V_STEP
+    pitch_q, roll_q = (
+        np.radians(round(np.degrees(a) / _ANGLE_STEP_DEG) * _ANGLE_STEP_DEG) for a in (pitch, roll)
+    )
+    height_q = float(np.exp(np.round(np.log(height) / _HEIGHT_STEP) * _HEIGHT_STEP))
+    key = (*np.round(v_q / _V_STEP).astype(int), round(np.degrees(pitch_q)), round(np.degrees(roll_q)),
+           round(height_q, 3), id(config))  # fmt: skip
     hit = _CACHE.get(key)
     if hit is not None:
         _CACHE.move_to_end(key)
         return hit
-    ant_to_ned = body_to_ned @ config.mount.rotation
-    sub = clutter_subspace(config, v_ned, ant_to_ned, height, depth_fn, n_azimuth=720)
+    ant_to_ned = rotation_matrix(0.0, pitch_q, roll_q) @ config.mount.rotation
+    sub = clutter_subspace(config, v_q, ant_to_ned, height_q, None, n_azimuth=720)
     _CACHE[key] = sub
-    while len(_CACHE) > 4:
+    while len(_CACHE) > 8:  # about 7 MB each
         _CACHE.popitem(last=False)
     return sub
 

@@ -4,8 +4,9 @@ For each range-Doppler cell the four calibrated channels ``z`` are projected ort
 ``m`` strongest eigenvectors ``E`` of the predicted clutter covariance
 (:func:`skyradar.process.clutter.clutter_subspace`): ``y = (I - E E^H) z``. How many directions
 are nulled follows the measured clutter: where the clutter-to-noise ratio ``c`` of the cell's
-neighbourhood (largest of the unsuppressed power image 2-3 Doppler bins either side) exceeds ``gate``
-(default 3, 4.8 dB: the largest of 15 noise pixels of a 4-channel mean stays under 4 times the
+neighbourhood (largest of the unsuppressed power image 2-3 Doppler bins either side, or of the
+cell itself unless it is a point-like peak 6 dB above that quiet neighbourhood) exceeds ``gate``
+(default 3, 4.8 dB: the largest of 12 noise pixels of a 4-channel mean stays under 4 times the
 noise in about 99.8 % of windows), the fewest eigenvectors that leave at most a quarter of the
 noise of predicted clutter, at most ``max_nulls``. Clean cells keep all channels (no loss in clear sky).
 
@@ -146,7 +147,12 @@ def suppress_clutter(
     if cube.shape != subspace.predicted.shape + (config.n_rx,):
         raise InputError(f"suppression: frame shape {cube.shape} does not fit the clutter prediction")
     raw = power_image(cube, config.rx_calibration)
-    cnr = _local_cnr(raw, config.noise_power_w)
+    ring = _local_cnr(raw, config.noise_power_w)
+    own = raw * np.float32(1.0 / config.noise_power_w) - np.float32(1.0)
+    # A cell brighter than gate counts as clutter too, unless it stands 6 dB above everything 2-3
+    # Doppler bins away while they are quiet: that is a point target, not ground.
+    peak = (ring <= gate) & (own + 1.0 > 4.0 * (ring + 1.0))
+    cnr = np.where(peak, ring, np.maximum(ring, own)).astype(np.float32)
     if not 0 <= max_nulls < config.n_rx:
         raise InputError(f"suppression: field 'max_nulls' must be in [0, {config.n_rx - 1}], got {max_nulls}")
     power, nulls = np.empty(raw.shape, np.float32), np.empty(raw.shape, np.int8)

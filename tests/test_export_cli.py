@@ -51,8 +51,8 @@ def test_export_writes_navigation_truth_and_intruders(tmp_path, monkeypatch, cap
 def test_intruder_table_adds_each_heads_view():
     ds = sample_run_dataset(n_frames=3)
     left = ds.assign(tgt_visible=~ds["tgt_visible"])
-    table = intruder_table(ds, {"left": left, "same": ds})
-    assert "tgt_visible@left" in table and "tgt_visible@same" not in table  # only what differs
+    table = intruder_table(ds, {"nose": ds, "left": left})
+    assert {"tgt_visible@nose", "tgt_visible@left"} <= set(table) and "tgt_north_m@left" not in table
     np.testing.assert_array_equal(table["tgt_visible@left"], ~table["tgt_visible"])
     assert table[["time_s", "target_index"]].values.tolist()[:3] == [[0.0, 0], [0.0, 1], [1.0, 0]]
 

@@ -19,7 +19,8 @@ def export(
     output: Annotated[
         Path,
         typer.Option(
-            "-o", "--output",
+            "-o",
+            "--output",
             help="Folder (gets ownship.parquet, intruders.parquet) or NAME.parquet (+NAME.intruders.parquet)",
         ),
     ],  # fmt: skip
@@ -45,7 +46,8 @@ def export(
         check_output(path, [run], overwrite, kind="table")
     ds = open_frames(run)
     heads = store_heads(run) or []
-    own, intr = ownship_table(ds), intruder_table(ds, {h: open_frames(run, head=h) for h in heads[1:]})
+    views = {h: ds if i == 0 else open_frames(run, head=h) for i, h in enumerate(heads)}
+    own, intr = ownship_table(ds), intruder_table(ds, views)
     if own.shape[1] <= 2 and intr.empty:
         raise InputError(f"{run}: no own-ship (nav_*, own_*) or intruder (tgt_*) state to export")
     origin = scenario_origin(ds)

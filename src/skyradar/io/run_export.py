@@ -4,7 +4,8 @@ The own-ship table holds, per frame, the navigation solution the chain used (``n
 AHRS with errors) beside the simulator's truth (``own_*``), so that anyone can measure what a
 navigation error did. The intruder table holds the intruder truth (``tgt_*``) in long form, one
 row per frame and intruder; a store of several radar heads adds each head's own view
-(``tgt_visible``, ``tgt_snr_db``... that depend on the head) as ``<variable>@<head>`` columns.
+(``tgt_visible``, ``tgt_snr_db``... whatever differs between heads) as ``<variable>@<head>``
+columns; the unsuffixed columns are the first head's.
 Both carry ``time_s`` (s since the run's start) and ``utc`` (the instant, from ``start_time``).
 """
 
@@ -48,8 +49,8 @@ def ownship_table(ds: xr.Dataset) -> pd.DataFrame:
 def intruder_table(ds: xr.Dataset, head_views: dict[str, xr.Dataset] | None = None) -> pd.DataFrame:
     """Intruder truth (``tgt_*``) in long form: one row per frame and intruder.
 
-    ``head_views`` (head name to that head's Dataset) adds the head-dependent variables of each
-    head as ``<variable>@<head>`` columns.
+    ``head_views`` (head name to that head's Dataset, every head) adds the variables that differ
+    between heads as ``<variable>@<head>`` columns for every head.
 
     Examples
     --------
@@ -69,9 +70,16 @@ def intruder_table(ds: xr.Dataset, head_views: dict[str, xr.Dataset] | None = No
     cols["target_index"] = np.tile(np.arange(n_tgt), n_t)
     for name in names:
         cols[name] = np.asarray(ds[name].values).ravel()
-    for head, view in (head_views or {}).items():
-        for name in names:
-            if name in view and not np.array_equal(view[name].values, ds[name].values, equal_nan=True):
+    views = head_views or {}
+
+    def differs(name: str, view: xr.Dataset) -> bool:
+        return name in view and not np.array_equal(view[name].values, ds[name].values, equal_nan=True)
+
+    # The variables some head sees otherwise (azimuth, SNR, visibility...), for every head.
+    per_head = [n for n in names if any(differs(n, v) for v in views.values())]
+    for head, view in views.items():
+        for name in per_head:
+            if name in view:
                 cols[f"{name}@{head}"] = np.asarray(view[name].values).ravel()
     return pd.DataFrame(cols)
 

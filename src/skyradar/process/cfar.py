@@ -232,17 +232,27 @@ def _ca_factor_table(pfa: float, n_max: int, n_integrated: int) -> np.ndarray:
 
 
 @njit(cache=True)
-def _floor_decide(power, total, clean, count, skip, big_l, table, floor, n_train, min_train, hits, noise):
+def _ring(sat, i, j, hr, hd, gr, gd):  # pragma: no cover - compiled
+    # Sum over the (2hr+1) x (2hd+1) window at padded (i + hr, j + hd) minus its guard block.
+    outer = sat[i + 2 * hr + 1, j + 2 * hd + 1] - sat[i, j + 2 * hd + 1] - sat[i + 2 * hr + 1, j] + sat[i, j]
+    a, b, c, d = i + hr - gr, i + hr + gr + 1, j + hd - gd, j + hd + gd + 1
+    return outer - (sat[b, d] - sat[a, d] - sat[b, c] + sat[a, c])
+
+
+@njit(cache=True)
+def _floor_decide(power, sat_p, sat_c, sat_v, half, skip, big_l, table, floor, n_train, min_train, hits, noise):  # noqa: E501 - compiled kernel signature
     # Per pixel: plain CA for excluded cells, CA over the cells left (or the floor) for the others.
+    hr, hd, gr, gd = half
     n_r, n_d = power.shape
     for i in range(n_r):
         for j in range(n_d):
             if skip[i, j]:
-                n, est = n_train, total[i, j] / n_train
+                n, est = n_train, _ring(sat_p, i, j, hr, hd, gr, gd) / n_train
             else:
-                n = min(int(count[i, j] + 0.5), n_train)
+                count = _ring(sat_v, i, j, hr, hd, gr, gd)
+                n = min(int(count + 0.5), n_train)
                 if n >= min_train:
-                    est = clean[i, j] / count[i, j]
+                    est = _ring(sat_c, i, j, hr, hd, gr, gd) / count
                 else:
                     n, est = 0, floor
             est = max(est, floor)
@@ -300,18 +310,15 @@ def cfar_2d_floor(
         raise InputError(f"cfar: field 'pfa' must be in (0, 1), got {pfa}")
     n_train = (2 * hr + 1) * (2 * hd + 1) - (2 * gr + 1) * (2 * gd + 1)
     table = _floor_tables(float(pfa), n_train)
-    p_pad = _pad(power, hr, hd)
-    total = _box_sum(p_pad, hr, hd, hr, hd, power.shape) - _box_sum(p_pad, gr, gd, hr, hd, power.shape)
-    if train_exclude is None:
-        skip, count, clean = np.zeros(power.shape, np.bool_), np.full(power.shape, np.float32(n_train)), total
-    else:
-        skip = np.ascontiguousarray(train_exclude, np.bool_)
-        valid = (~skip).astype(np.float32)
-        v_pad, c_pad = _pad(valid, hr, hd), _pad(power * valid, hr, hd)
-        count = _box_sum(v_pad, hr, hd, hr, hd, power.shape) - _box_sum(v_pad, gr, gd, hr, hd, power.shape)
-        clean = _box_sum(c_pad, hr, hd, hr, hd, power.shape) - _box_sum(c_pad, gr, gd, hr, hd, power.shape)
+    skip = np.zeros(power.shape, np.bool_) if train_exclude is None else np.asarray(train_exclude, np.bool_)
+    valid = (~skip).astype(np.float32)
+    # Summed-area tables (float64) of the padded images: every window sum is four lookups.
+    sat_p, sat_c, sat_v = (
+        cv2.integral(_pad(x, hr, hd), sdepth=cv2.CV_64F) for x in (power, power * valid, valid)
+    )
     hits, noise = np.empty(power.shape, np.bool_), np.empty(power.shape, np.float32)
     big_l = np.ascontiguousarray(np.clip(channels, 1, 8), np.int8)
     floor = np.float32(noise_floor_w)
-    _floor_decide(power, total, clean, count, skip, big_l, table, floor, n_train, min_train, hits, noise)
+    _floor_decide(power, sat_p, sat_c, sat_v, (hr, hd, gr, gd), skip, big_l, table, floor, n_train, min_train,
+                  hits, noise)  # fmt: skip
     return hits, noise

@@ -50,7 +50,10 @@ def baseline_suppressed(cube: np.ndarray, sub: ClutterSubspace, config: RadarCon
     raw = np.linalg.norm(z, axis=-1) ** 2 / config.n_rx
     ring = np.ones((3, 7), bool)
     ring[:, 2:5] = False
-    cnr = np.maximum(ndimage.maximum_filter(raw / noise, footprint=ring, mode="wrap") - 1.0, 0.0)
+    ring_cnr = np.maximum(ndimage.maximum_filter(raw / noise, footprint=ring, mode="wrap") - 1.0, 0.0)
+    own = raw / noise - 1.0
+    peak = (ring_cnr <= 3.0) & (own + 1.0 > 4.0 * (ring_cnr + 1.0))  # a point target is not clutter
+    cnr = np.where(peak, ring_cnr, np.maximum(ring_cnr, own))
     nulls, unsuppressed = null_count(sub.fractions, cnr)
     keep = np.arange(config.n_rx) < nulls[..., None]
     e = sub.vectors * keep[..., None, :]

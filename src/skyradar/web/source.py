@@ -21,6 +21,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from skyradar.daa.alerting import RADAR_ALERT_CONFIG
 from skyradar.daa.pipeline import alerts_for_run
 from skyradar.daa.run_tables import has_ownship
 from skyradar.errors import InputError
@@ -154,7 +155,8 @@ class RunSource:
         self.traffic_source = "truth" if tracks is None else "tracks"
         # Tracks without the run's own-ship state cannot be alerted: alerts_for_run says so.
         names = {"run_name": str(self._opened), "tracks_name": str(self.tracks_path)}
-        self.alerts = alerts_for_run(self.ds, tracks, **names)
+        # The same settings as `skyradar alert` (its default --config radar) and every DAA result.
+        self.alerts = alerts_for_run(self.ds, tracks, RADAR_ALERT_CONFIG, **names)
 
     def info(self) -> dict[str, Any]:
         """Run summary for the page."""

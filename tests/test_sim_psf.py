@@ -131,7 +131,8 @@ def test_without_the_point_spread_the_clutter_does_not_agree():
 
 @pytest.mark.slow
 def test_image_and_raw_clutter_agree_on_a_hilly_patch():
-    hills = fractal_terrain(52.0 + 400.0 / 111_250.0, 4.36, 20.0, size_m=400.0, spacing_m=7.5, seed=2)
+    north = 52.0 + 400.0 / 111_250.0
+    hills = fractal_terrain(north, 4.36, 15.0, size_m=300.0, spacing_m=7.5, seed=2, cell_m=(150.0, 150.0))
     mean_db, n_cells = clutter_agreement_db(hills, n_frames=1000)
     assert n_cells > 300
     assert mean_db < 1.0, mean_db

@@ -11,7 +11,8 @@ noise in about 99.8 % of windows), the fewest eigenvectors that leave at most a 
 noise of predicted clutter, at most ``max_nulls``. Clean cells keep all channels (no loss in clear sky).
 
 Calibration: ``y`` spans ``L = n_rx - m`` orthonormal dimensions, so the detection image
-``|y|^2 / L`` keeps the thermal noise mean ``noise_power_w`` and a Gamma(L, 1/L) law per pixel;
+``|y|^2 / L`` keeps the thermal noise mean per pixel (measured per frame where no ground can be,
+:func:`measured_floor`) and a Gamma(L, 1/L) law per pixel;
 the CFAR threshold uses each pixel's ``L`` (:func:`skyradar.process.cfar.cfar_2d` accepts an array
 ``n_integrated``). A target from ``s`` keeps ``|P s|^2 / L`` of its per-channel power: close to 1
 away from the nulls. Cells whose predicted clutter left outside the nulls still exceeds the noise
@@ -39,13 +40,21 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 from numba import njit
+from scipy import stats
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.process.clutter import ClutterSubspace
 from skyradar.process.power import power_image
 
-__all__ = ["Suppressed", "suppress_clutter", "null_count", "projected_power", "projected_snapshots"]
+__all__ = [
+    "Suppressed",
+    "suppress_clutter",
+    "null_count",
+    "measured_floor",
+    "projected_power",
+    "projected_snapshots",
+]
 
 
 @dataclass(frozen=True)
@@ -54,7 +63,8 @@ class Suppressed:
 
     power : float32, W, thermal noise mean ``noise_power_w``; channels : int8, ``L`` per pixel;
     unsuppressed : bool, predicted clutter left above the noise; nulls : int8, ``n_rx - L``;
-    clutter_to_noise : float32, measured neighbourhood clutter-to-noise ratio (linear).
+    clutter_to_noise : float32, measured neighbourhood clutter-to-noise ratio (linear);
+    noise_floor_w : the frame's measured thermal noise per pixel (:func:`measured_floor`).
     """
 
     power: np.ndarray
@@ -62,6 +72,26 @@ class Suppressed:
     unsuppressed: np.ndarray
     nulls: np.ndarray
     clutter_to_noise: np.ndarray
+    noise_floor_w: float
+
+
+# Median of Gamma(L, 1/L) (the channel mean of L unit-noise channels), L = 1..8.
+_GAMMA_MEDIAN = np.array([np.nan, *(stats.gamma(n, scale=1.0 / n).median() for n in range(1, 9))])
+
+
+def measured_floor(raw: np.ndarray, predicted: np.ndarray, nominal_w: float, n_rx: int = 4) -> float:
+    """Thermal noise per pixel of one frame, W, measured where no ground can be.
+
+    The median of the channel-mean image over the cells no ground direction reaches (nearer than
+    the height, Doppler outside the ground band), divided by the median of Gamma(L, 1/L): robust to
+    a few targets. The window point-spread of a real (or ``psf``-simulated) chain raises the noise
+    per pixel above ``nominal_w`` (``RadarConfig.noise_power_w``, +3.5 dB for Hann x Hann), so the
+    floor is measured, not assumed; with fewer than 2000 such cells ``nominal_w`` is used.
+    """
+    free = raw[~predicted]
+    if free.size < 2000:
+        return float(nominal_w)
+    return float(np.median(free) / _GAMMA_MEDIAN[min(max(n_rx, 1), 8)])
 
 
 def _local_cnr(power: np.ndarray, noise_power_w: float) -> np.ndarray:
@@ -147,8 +177,9 @@ def suppress_clutter(
     if cube.shape != subspace.predicted.shape + (config.n_rx,):
         raise InputError(f"suppression: frame shape {cube.shape} does not fit the clutter prediction")
     raw = power_image(cube, config.rx_calibration)
-    ring = _local_cnr(raw, config.noise_power_w)
-    own = raw * np.float32(1.0 / config.noise_power_w) - np.float32(1.0)
+    floor = measured_floor(raw, subspace.predicted, config.noise_power_w)
+    ring = _local_cnr(raw, floor)
+    own = raw * np.float32(1.0 / floor) - np.float32(1.0)
     # A cell brighter than gate counts as clutter too, unless it stands 6 dB above everything 2-3
     # Doppler bins away while they are quiet: that is a point target, not ground.
     peak = (ring <= gate) & (own + 1.0 > 4.0 * (ring + 1.0))
@@ -162,14 +193,16 @@ def suppress_clutter(
     rule = (np.int64(max_nulls), np.float32(gate), np.float32(_RESIDUAL))
     _fused(z, raw, inv_gain, subspace.fractions, subspace.vectors, cnr, *rule, power, nulls, unsuppressed)
     channels = (config.n_rx - nulls).astype(np.int8)
-    return Suppressed(power, channels, unsuppressed, nulls, cnr)
+    return Suppressed(power, channels, unsuppressed, nulls, cnr, floor)
 
 
 _RESIDUAL = 0.25  # predicted clutter left after the nulls, in units of the noise (null_count's default)
 
 
 @njit(cache=True, fastmath=True)
-def _fused(cube, raw, inv_gain, fractions, vectors, cnr, max_nulls, gate, residual, power, nulls, unsuppressed):  # noqa: E501
+def _fused(
+    cube, raw, inv_gain, fractions, vectors, cnr, max_nulls, gate, residual, power, nulls, unsuppressed
+):  # noqa: E501
     # null_count and projected_power in one pass over the cells (same rules; tests compare them).
     n_r, n_d, n_k = cube.shape
     z = np.empty(n_k, np.complex64)

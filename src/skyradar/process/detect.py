@@ -238,11 +238,11 @@ def _shi_tomasi_blobs(power: np.ndarray, noise_power_w: float, min_snr_db: float
     return blob_peaks(grow | seeds, power, seeds)
 
 
-def _suppressed_cfar(power, config, channels, exclude, train_exclude, guard, train, pfa):
+def _suppressed_cfar(power, floor_w, channels, exclude, train_exclude, guard, train, pfa):
     """CA-CFAR of a clutter-suppressed image: spur pixels out of everything, clutter out of training."""
     skip = exclude if train_exclude is None else train_exclude
     skip = skip if exclude is None or train_exclude is None else exclude | train_exclude
-    hits, noise_map = cfar_2d_floor(power, channels, config.noise_power_w, skip, guard, train, pfa)
+    hits, noise_map = cfar_2d_floor(power, channels, floor_w, skip, guard, train, pfa)
     return (hits if exclude is None else hits & ~exclude), noise_map
 
 
@@ -258,6 +258,7 @@ def detect(
     exclude: np.ndarray | None = None,
     channels: np.ndarray | None = None,
     train_exclude: np.ndarray | None = None,
+    noise_floor_w: float | None = None,
 ) -> Detections:
     """Detect objects in a channel-integrated power image: one detection per blob.
 
@@ -276,10 +277,9 @@ def detect(
         SNR against the CFAR noise estimate (True) or against ``config.noise_power_w``.
     exclude : ndarray of bool, optional
         Pixels never detected and left out of CFAR training (e.g. ``SpurMap.mask``).
-    channels, train_exclude : ndarray, optional
-        A clutter-suppressed image (:mod:`skyradar.process.clutter_suppress`): channels left per
-        pixel and pixels kept out of CFAR training only; CA-CFAR then uses
-        :func:`skyradar.process.cfar.cfar_2d_floor` (calibrated noise floor).
+    channels, train_exclude, noise_floor_w : optional
+        A clutter-suppressed image's channels per pixel, pixels kept out of CFAR training only and
+        noise floor (default ``config.noise_power_w``): :func:`skyradar.process.cfar.cfar_2d_floor`.
     """
     power = np.asarray(power, dtype=np.float32)
     if power.shape != (config.n_range, config.n_doppler):
@@ -288,7 +288,8 @@ def detect(
             f"{(config.n_range, config.n_doppler)}"
         )
     if channels is not None and method == "cfar":
-        hits, noise_map = _suppressed_cfar(power, config, channels, exclude, train_exclude, guard, train, pfa)
+        floor = config.noise_power_w if noise_floor_w is None else noise_floor_w
+        hits, noise_map = _suppressed_cfar(power, floor, channels, exclude, train_exclude, guard, train, pfa)
         r, d = blob_peaks(hits, power)
         noise = noise_map[r, d] if use_cfar_noise else np.full(r.size, config.noise_power_w, np.float32)
     elif method in ("cfar", "os-cfar"):

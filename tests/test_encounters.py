@@ -24,6 +24,9 @@ from skyradar.scene.scenario import Scenario
 D_NC, Z_NC = 2200 * FT, 450 * FT
 NO_FRAMES = pd.DataFrame({"time_s": [], "observable": []})
 HALF_FOV_DEG, RANGE_LIMIT_M, OBSERVE_WINDOW_S = 35.0, 5000.0, 12.5  # run_encounter's defaults, 2022 prototype
+# These tests are about geometry and scoring, not the simulator: its costly realism (window PSF, speckle,
+# Swerling 1) stays off, and frames come at 4.7 Hz, to keep them within the test budget.
+LIGHT = {"psf": False, "speckle": False, "swerling": 0}
 
 
 def _closed_form_rel(p: pd.Series, t: np.ndarray) -> np.ndarray:
@@ -152,13 +155,13 @@ def test_summary_counts():
 def test_full_chain_warns_head_on_collision_and_stays_quiet_when_far():
     from skyradar.experiments.encounters import run_encounter
 
-    (hit,) = run_encounter(_row(), seed=1, frame_rate_hz=4.7)
+    (hit,) = run_encounter(_row(), seed=1, frame_rate_hz=4.7, simulation=LIGHT)
     assert hit["conflict"] and hit["observable"]
     assert hit["t_lowc_s"] == pytest.approx(T_CPA_S - D_NC / 100.0, abs=0.06)
     # Warned well ahead of the loss of well clear, by a track that follows the intruder.
     assert 12.5 <= hit["t_lowc_s"] - hit["t_warning_s"] <= 30.0
     assert hit["tracks"] >= 1 and hit["frames"] > 150
-    (far,) = run_encounter(_row(h=2.5 * D_NC), seed=1, frame_rate_hz=4.7)
+    (far,) = run_encounter(_row(h=2.5 * D_NC), seed=1, frame_rate_hz=4.7, simulation=LIGHT)
     assert not far["conflict"] and not far["may_alert"]
     assert np.isnan(far["t_warning_s"]) and np.isnan(far["t_other_warning_s"])
 
@@ -192,7 +195,8 @@ def test_experiment_counts_match_the_geometry_and_warns_every_observable_conflic
     # This set: three conflicts (head-on, crossing, overtaking), all in view; one clear converging.
     assert (conflict.sum(), observable.sum(), may_alert.sum()) == (3, 3, 0)
 
-    s = run(tmp_path, n_encounters=4, seed=2, workers=2, frame_rate_hz=4.7, layouts=("single",))
+    s = run(tmp_path, n_encounters=4, seed=2, workers=2, frame_rate_hz=4.7, layouts=("single",),
+            simulation=LIGHT)
     assert s["encounters"] == 4 and s["chain"] == "full" and s["frames"] > 4 * 50
     assert (s["terrain"], s["layout"], len(s["rows"])) == ("none", "single", 1)
     assert s["warned_before_lowc"] == conflict.sum() and s["unwarned_by_cause"]["missed"] == 0
@@ -216,7 +220,7 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
 
     settings = {"n": 2, "seed": 5, "frame_rate_hz": 4.7, "buffer": 1.5, "uncertainty": True,
                 "terrains": ["none"], "layouts": ["single"], "navigation": "ga-typical",
-                "suppression": "auto", "late_lead_s": 12.5}  # fmt: skip
+                "suppression": "auto", "late_lead_s": 12.5, "simulation": LIGHT}  # fmt: skip
     key = {**settings, "version": E._version()}
     _, save = E._partial_store(tmp_path, key)
     fake = {"t_lowc_s": np.nan, "t_cpa_s": 120.0, "conflict": False, "may_alert": False,
@@ -228,7 +232,8 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
             "flight_s": 1.5, "mirrored": False, "vertical_miss_flown_m": 0.0, "own_altitude_m": 1000.0,
             "simulate_s": 0.0, "process_s": 0.0, "track_s": 0.0, "alert_s": 0.0}  # fmt: skip
     save({("none", 0): [fake]})  # as left by a run interrupted after its first encounter
-    s = E.run(tmp_path, n_encounters=2, seed=5, workers=1, frame_rate_hz=4.7, layouts=("single",))
+    s = E.run(tmp_path, n_encounters=2, seed=5, workers=1, frame_rate_hz=4.7, layouts=("single",),
+              simulation=LIGHT)
     assert s["resumed_encounters"] == 1
     table = pd.read_parquet(tmp_path / "encounters.parquet")
     assert table.loc[0, "frames"] == 7 and table.loc[1, "frames"] > 50  # row 0 kept, row 1 computed
@@ -252,3 +257,20 @@ def test_flat_terrain_variant_puts_ground_under_the_whole_window():
     assert low.ownship.sample(low.times_s).position_ned_m[:, 2] == pytest.approx(-300.0)
     with pytest.raises(InputError, match="terrain"):
         encounter_scenario(_row(), 0.0, 1.0, 4.7, 0, terrain="moon")
+
+
+def test_one_simulation_scores_the_nose_head_and_the_three_head_layout():
+    from skyradar.experiments.encounters import run_encounter
+
+    # A converging intruder from 50-52 deg off the nose: outside the nose's +-35 deg beam, inside the
+    # right wingtip head's (yawed 75 deg).
+    p = make_encounters(30, seed=0).iloc[2]
+    single, three = run_encounter(p, seed=2, frame_rate_hz=4.7, layouts=("single", "three-head"),
+                                  simulation=LIGHT)  # fmt: skip
+    assert (single["layout"], three["layout"]) == ("single", "three-head")
+    assert single["frames"] == three["frames"] and single["simulate_s"] == three["simulate_s"]  # shared
+    assert single["conflict"] and three["conflict"] and single["t_lowc_s"] == three["t_lowc_s"]
+    assert not single["observable"] and single["cause"] == "outside_beams"
+    assert three["observable"] and three["cause"] == "missed"  # the cause it would have; it was warned
+    assert three["t_warning_s"] < three["t_lowc_s"] and three["detections"] > single["detections"]
+    assert three["intruder_tracks"] == 1 and three["clutter_tracks"] == 0

@@ -37,8 +37,8 @@ _N = Annotated[
     typer.Option(
         "--n",
         callback=number_in(1, 100_000),
-        help="Encounters per terrain (at most 100000; default 40: clear sky, both layouts, 2 workers "
-        "in under 5 minutes on 2 cores; over terrain use about 10).",
+        help="Encounters per terrain (at most 100000; default 20: clear sky, both layouts, 2 workers "
+        "in under 5 minutes on 2 cores; over terrain use fewer).",
     ),
 ]
 _FRAME_RATE = Annotated[

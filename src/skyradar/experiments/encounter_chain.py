@@ -106,7 +106,7 @@ def _score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[
     return row
 
 
-def _scenario(p, seed, frame_rate_hz, lookback_s, terrain, layouts, navigation) -> tuple[Any, dict, dict]:
+def _scenario(p, seed, frame_rate_hz, lookback_s, terrain, layouts, navigation, simulation) -> tuple:
     """The built scenario of one encounter, its dense relative truth and the row's shared columns."""
     from skyradar.scene.examples import THREE_HEAD_RADARS
 
@@ -150,6 +150,7 @@ def run_encounter(
     terrain: str | None = None,
     layouts: tuple[str, ...] = ("single",),
     navigation: str | dict | None = None,
+    simulation: dict[str, Any] | None = None,
 ) -> list[dict[str, Any]]:
     """One encounter row through the full chain; one result row per layout (times in s, NaN when none).
 
@@ -157,11 +158,14 @@ def run_encounter(
     ``"three-head"``: :data:`~skyradar.scene.examples.THREE_HEAD_RADARS`) tracks and alerts its
     heads' detections. ``t_warning_s`` is the first warning (level 3) of a track that follows the
     intruder; ``t_other_warning_s`` the first warning of any other track (clutter or noise).
+    ``simulation`` overrides the scenario's simulator options
+    (:func:`~skyradar.experiments.encounter_set.encounter_scenario`).
     """
     from skyradar.experiments.daa_chain import track_and_alert
 
     cfg = alert_config or RADAR_ALERT_CONFIG
-    built, truth, shared = _scenario(p, seed, frame_rate_hz, lookback_s, terrain, layouts, navigation)
+    spec_args = (p, seed, frame_rate_hz, lookback_s, terrain, layouts, navigation, simulation)
+    built, truth, shared = _scenario(*spec_args)
     chain = run_chain(built, cfg, with_advice=False, process_options={"suppression": SUPPRESSION})
     shared.update({f"{k}_s": float(v) for k, v in chain["timings_s"].items() if k in ("simulate", "process")})
     opts = {

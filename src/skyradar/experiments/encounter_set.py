@@ -1,6 +1,7 @@
 """The encounter set of ``skyradar experiment encounters``: geometries, scenarios and scoring.
 
-Own-ship flies north, level, at ``OWN_SPEED_MPS`` and ``OWN_ALTITUDE_M`` with the forward mount;
+Own-ship flies north, level, at ``OWN_SPEED_MPS`` and ``OWN_ALTITUDE_M`` (or the terrain's height,
+:mod:`skyradar.experiments.encounter_terrain`) with the forward mount or the scenario's ``radars:``;
 each intruder flies straight and reaches its closest point of approach (CPA) at
 :data:`T_CPA_S`. Kinds: ``head-on``, ``crossing`` (60-120 deg from either side), ``converging``
 (20-60 deg), ``overtaking`` (own-ship overtakes a slower aircraft ahead: a forward radar cannot see
@@ -115,6 +116,7 @@ def encounter_scenario(
     navigation: str | dict | None = None,
     own_altitude_m: float | None = None,
     terrain_seed: int | None = None,
+    simulation: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Scenario dict (:meth:`skyradar.scene.scenario.Scenario.from_dict`) of one encounter row.
 
@@ -129,7 +131,8 @@ def encounter_scenario(
     and Jacksboro it is chosen from the ground under the track). ``radars`` is the scenario's
     ``radars:`` list (None: one forward head) and ``navigation`` its ``navigation:`` key (None:
     the scenario default). ``terrain_seed`` (default ``seed``) picks the hills surface and the
-    point over Jacksboro.
+    point over Jacksboro. ``simulation`` overrides keys of the scenario's ``simulation:`` section
+    (tests that are about scoring, not the simulator, turn the costly realism off with it).
     """
     from skyradar.experiments.encounter_terrain import site
 
@@ -146,7 +149,8 @@ def encounter_scenario(
         "start_s": float(start_s),
         "duration_s": float(duration_s),
         # The simulator's realistic options (sim.image): window point-spread, terrain speckle, Swerling 1.
-        "simulation": {"noise": True, "seed": int(seed), "psf": True, "speckle": True, "swerling": 1},
+        "simulation": {"noise": True, "seed": int(seed), "psf": True, "speckle": True, "swerling": 1,
+                       **(simulation or {})},
     }  # fmt: skip
     if radars is None:
         scenario["mount"] = "forward"

@@ -40,7 +40,7 @@ from skyradar.parallel import check_workers
 __all__ = ["run_encounter", "run_encounters", "run", "MAX_ENCOUNTERS", "DEFAULT_ENCOUNTERS"]
 
 MAX_ENCOUNTERS = 100_000  # 200 times the thesis-sized set; more is a typo, not a plan
-DEFAULT_ENCOUNTERS = 40  # clear sky, both layouts, 2 workers: within 5 minutes on 2 cores
+DEFAULT_ENCOUNTERS = 20  # clear sky, both layouts (23 CPU-s each), 2 workers: within 5 minutes on 2 cores
 _PARTIAL = "encounters.partial.parquet"
 _CHUNK = 4  # encounters per worker task
 
@@ -154,6 +154,7 @@ def run(
     terrains: tuple[str, ...] = ("none",),
     layouts: tuple[str, ...] = LAYOUTS,
     navigation: str = "ga-typical",
+    simulation: dict[str, Any] | None = None,
 ) -> dict:
     """Run the encounter set; write ``encounters.parquet``/``.csv`` (one row per terrain, encounter
     and layout), ``summary.json``, ``summary_rows.csv`` and the figures into ``out_dir``; return the
@@ -162,7 +163,8 @@ def run(
     The summary's top-level keys are those of the first terrain and last layout (three-head when it
     runs); ``rows`` holds every terrain and layout. ``uncertainty=False`` turns off the widening of
     the volumes by the track covariance. A warning with less lead than ``late_lead_s`` (default half
-    the 25 s warning alerting time) is late. ``navigation`` is the scenarios' ``navigation:`` model.
+    the 25 s warning alerting time) is late. ``navigation`` is the scenarios' ``navigation:`` model;
+    ``simulation`` overrides their simulator options (default: PSF, speckle, Swerling 1).
     Finished encounters are kept in ``encounters.partial.parquet`` while the run goes on; a run that
     was interrupted resumes from them when started again with the same settings.
     """
@@ -177,11 +179,12 @@ def run(
     enc = make_encounters(n_encounters, seed)
     settings = {"n": n_encounters, "seed": seed, "frame_rate_hz": frame_rate_hz, "buffer": buffer,
                 "uncertainty": uncertainty, "terrains": list(terrains), "layouts": list(layouts),
-                "navigation": navigation, "suppression": SUPPRESSION, "late_lead_s": late_lead_s}  # fmt: skip
+                "navigation": navigation, "suppression": SUPPRESSION, "late_lead_s": late_lead_s,
+                "simulation": simulation or {}}  # fmt: skip
     done, save = _partial_store(out_dir, {**settings, "version": _version()})
     res = run_encounters(enc, seed, workers, progress, done, save, terrains=terrains, layouts=layouts,
                          frame_rate_hz=frame_rate_hz, buffer=buffer, alert_config=cfg,
-                         navigation=navigation)  # fmt: skip
+                         navigation=navigation, simulation=simulation)  # fmt: skip
     summary = write_report(res, out_dir, settings, late_lead_s, cfg.levels[-1].alerting_time_s)
     workers = check_workers(workers) or min(2, os.cpu_count() or 1)
     summary.update(

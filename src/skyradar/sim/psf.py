@@ -132,23 +132,39 @@ def _psf_kernel(fine, tmp, out, h_range, h_doppler, step):  # pragma: no cover -
     n_d = tmp.shape[1] // step
     os = n_fine_d // n_d
     sr, sd = h_range.shape[0] // 2, h_doppler.shape[0] // 2
+    width = n_d * step
+    filled = np.zeros(fine.shape[0], np.bool_)  # rows with any return (ground below is empty)
     for m in prange(fine.shape[0]):  # Doppler: circular
         src, dst = fine[m], tmp[m]
-        dst[:] = 0
+        for x in range(src.shape[0]):
+            if src[x] != 0.0:
+                filled[m] = True
+                break
+        if not filled[m]:
+            continue
+        # The row's sub-bin phases, each a plain row of bins: fine bin L j + p is phases[p, j].
+        phases = np.empty((os, width), np.float32)
         for j in range(n_d):
-            o = j * step
-            for s in range(-sd, sd + 1):
-                l = os * j - s
-                l = l + n_fine_d if l < 0 else (l - n_fine_d if l >= n_fine_d else l)
-                g, i = h_doppler[s + sd], l * step
+            for p in range(os):
                 for c in range(step):
-                    dst[o + c] += g * src[i + c]
+                    phases[p, j * step + c] = src[(os * j + p) * step + c]
+        dst[:] = 0
+        for s in range(-sd, sd + 1):
+            # Fine bin L j - s is phase (-s) mod L of bin j - shift: one shifted run of the row
+            # (two at the wrap) per tap.
+            p = (-s) % os
+            shift = ((s + p) // os) % n_d * step
+            g, row = h_doppler[s + sd], phases[p]
+            for x in range(shift, width):
+                dst[x] += g * row[x - shift]
+            for x in range(shift):
+                dst[x] += g * row[x + width - shift]
     for k in prange(out.shape[0]):  # range: zero beyond the cube
         dst = out[k]
         dst[:] = 0
         for s in range(-sr, sr + 1):
             m = os * k - s
-            if m < 0 or m >= fine.shape[0]:
+            if m < 0 or m >= fine.shape[0] or not filled[m]:
                 continue
             g, src = h_range[s + sr], tmp[m]
             for c in range(dst.shape[0]):

@@ -64,12 +64,17 @@ def plot_causes(rows: list[dict[str, Any]], path: Path) -> None:
     bottom = np.zeros(len(rows))
     parts = [("warned before LoWC", "tab:blue", [r["warned_before_lowc"] for r in rows])]
     colours = dict(zip(CAUSES, ("tab:red", "0.3", "0.55", "tab:brown", "0.8"), strict=True))
-    parts += [(c.replace("_", " "), colours[c], [r["unwarned_by_cause"][c] for r in rows]) for c in CAUSES]
+    names = {"missed": "missed (observable)", "below_13db": "below 13 dB SNR"}
+    parts += [
+        (names.get(c, c.replace("_", " ")), colours[c], [r["unwarned_by_cause"][c] for r in rows])
+        for c in CAUSES
+    ]
     for label, colour, values in parts:
         ax.bar(x, values, bottom=bottom, color=colour, label=label)
         bottom += np.asarray(values, float)
     ax.set_xticks(x, [f"{r['terrain']}\n{r['layout']}" for r in rows], fontsize=8)
-    ax.set(ylabel="conflicts", title="every conflict: warned before LoWC, or why not")
+    ax.set(ylabel="conflicts")
+    fig.suptitle("every conflict: warned before LoWC, or why not", fontsize=10)
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     fig.tight_layout()
     savefig_atomic(fig, path, dpi=110)

@@ -221,3 +221,17 @@ def test_gliders_and_fast_intruder_one_track_each(bank_deg):
         n_spans = np.unique(spans[spans[:, j] >= 0, j]).size
         assert _ids_on(tracks, det, j).size <= n_spans + 1, j
     assert m["fragmentation"] <= 1
+
+
+def test_track_closed_before_gating_after_a_gap_without_frames():
+    """Deletion: with frames only at detection times (as `skyradar track` steps), a track 10 s
+    without an update met the next frame with a gate over half the image and took another
+    aircraft's detection, which then carried the first aircraft's id."""
+    t = np.arange(0.0, 20.0, 1 / RATE_HZ)
+    r = np.column_stack([2000.0 - 30.0 * t, 1800.0 + 10.0 * (t - 13.0)])
+    v = np.column_stack([np.full(t.size, -30.0), np.full(t.size, 10.0)])
+    vis = np.column_stack([t < 3.0, t > 13.0])
+    det = synthetic_detections(t, r, v, visible=vis, config=CFG, sigma_range_m=4.4, coupling=False, seed=2)
+    tracks = track_detections(det, "radar", CFG)  # no frame_times_s: frames are the detections' times
+    a, b = _ids_on(tracks, det, 0), _ids_on(tracks, det, 1)
+    assert a.size == b.size == 1 and a[0] != b[0]

@@ -103,6 +103,11 @@ class LostTracks:
         self.resolved = np.concatenate([self.resolved, np.asarray(resolved, bool)])
         self.time_s = np.concatenate([self.time_s, np.broadcast_to(np.asarray(time_s, float), (len(ids),))])
 
+    def add_anchored(self, tracks: dict[str, np.ndarray], mask: np.ndarray) -> None:
+        """Keep the tracker's tracks ``mask`` (struct of arrays) at their anchors (:func:`set_anchor`)."""
+        self.add(tracks["ids"][mask], tracks["anchor_x"][mask], tracks["anchor_P"][mask],
+                 tracks["anchor_resolved"][mask], tracks["anchor_t"][mask])  # fmt: skip
+
     def expire(self, time_s: float) -> None:
         """Forget lost tracks closed more than ``max_age_s`` before ``time_s``."""
         keep = time_s - self.time_s <= self.max_age_s

@@ -84,10 +84,9 @@ class RangeDopplerTracker:
         self.associator = associator
         self.initiator = initiator or MOfN(self.config.confirm_m, self.config.confirm_n)
         self.deleter = deleter or MissDeleter(self.config.max_misses, self.config.max_coast_s)
-        self.reacquirer = reacquirer or LostTracks(
-            model, self.config.reacquire_s, self.config.reacquire_jerk_mps3, self.config.gate,
-            self.config.resolve_fraction * model.doppler_width_mps,
-        )  # fmt: skip
+        c = self.config
+        self.reacquirer = reacquirer or LostTracks(model, c.reacquire_s, c.reacquire_jerk_mps3, c.gate,
+                                                   c.resolve_fraction * model.doppler_width_mps)  # fmt: skip
         self._reacquired = np.zeros((0, 2), np.int64)
         self.time_s: float | None = None
         self._next_id = 0
@@ -145,6 +144,7 @@ class RangeDopplerTracker:
             else:
                 tr["x"], tr["P"] = predict(tr["x"], tr["P"], F, Q)
         self.time_s = float(time_s)
+        self._close_stale()
         assoc = self._associate(z)
         assigned = np.full(tr["ids"].size, -1)
         assigned[assoc.track_index] = assoc.detection_index
@@ -325,9 +325,7 @@ class RangeDopplerTracker:
             tr["confirmed"] & self.deleter.delete(tr["misses"], self.time_s - tr["t_update"])
         )
         # Closed tracks that were ever confirmed are kept as lost, at their last solid update.
-        lost = dead & tr["was_confirmed"]
-        self.reacquirer.add(tr["ids"][lost], tr["anchor_x"][lost], tr["anchor_P"][lost],
-                            tr["anchor_resolved"][lost], tr["anchor_t"][lost])  # fmt: skip
+        self.reacquirer.add_anchored(tr, dead & tr["was_confirmed"])
         self._reacquire(np.flatnonzero(tentative & tr["confirmed"] & ~tr["was_confirmed"] & ~dead))
         tr["was_confirmed"] |= tr["confirmed"]
         alive = np.flatnonzero(~dead)
@@ -337,6 +335,18 @@ class RangeDopplerTracker:
             for name in _FIELDS:
                 tr[name] = tr[name][alive]
         return alive
+
+    def _close_stale(self) -> None:
+        """Close tracks not updated for longer than the coasting time before they gate: without
+        frames between detections (``skyradar track`` steps on detection times) such a track meets
+        the next frame with a gate over much of the image and takes whatever is there."""
+        tr = self.tracks
+        stale = self.time_s - tr["t_update"] > self.deleter.max_coast_s
+        if not np.any(stale):
+            return
+        self.reacquirer.add_anchored(tr, stale & tr["was_confirmed"])
+        for name in _FIELDS:
+            tr[name] = tr[name][~stale]
 
     def _reacquire(self, rows: np.ndarray) -> None:
         """Give newly confirmed tracks ``rows`` the id (and the resolved alias) of a lost track."""

@@ -42,7 +42,7 @@ __all__ = ["run_encounter", "run_encounters", "run", "MAX_ENCOUNTERS", "DEFAULT_
 MAX_ENCOUNTERS = 100_000  # 200 times the thesis-sized set; more is a typo, not a plan
 DEFAULT_ENCOUNTERS = 20  # clear sky, both layouts (23 CPU-s each), 2 workers: within 5 minutes on 2 cores
 _PARTIAL = "encounters.partial.parquet"
-_CHUNK = 4  # encounters per worker task
+_CHUNK = 4  # encounters per worker task at most (each writes the partial table once)
 
 
 def _init_worker() -> None:
@@ -80,7 +80,8 @@ def run_encounters(
     results: dict[tuple[str, int], list[dict]] = dict(done or {})
     records = params.to_dict("records")
     todo = [(tr, i, p) for tr in terrains for i, p in enumerate(records) if (tr, i) not in results]
-    chunks = [todo[k : k + _CHUNK] for k in range(0, len(todo), _CHUNK)]
+    size = max(1, min(_CHUNK, len(todo) // (2 * workers)))  # small runs: every worker gets some
+    chunks = [todo[k : k + size] for k in range(0, len(todo), size)]
     kw = {"seed": seed, "options": options}
 
     def finished(rows: list[tuple[str, int, list[dict]]]) -> None:

@@ -280,7 +280,7 @@ def test_nonsense_scenario_is_refused(tmp_path, change, needles):
         # 104 deg of latitude in 1 s (a sign error in one ADS-B message)
         (["0,52,4,1000", "1,-52,4,1000", "2,-52,4,1000"], ["track.csv", "row 1", "latitude", "Mach 3"]),
         # -100000 ft
-        (["0,52,4,1000", "10,52.001,4,-100000"], ["track.csv", "row 1", "'altitude'", "-100000"]),
+        (["0,52,4,1000", "10,52.001,4,-100000"], ["track.csv", "row 1", "'altitude'", "-30480 m"]),
     ],
 )
 def test_implausible_trajectory_file_is_refused(tmp_path, rows, needles):

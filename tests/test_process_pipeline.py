@@ -131,7 +131,8 @@ def test_cli_process_writes_the_table_and_reports_bad_input(tmp_path, monkeypatc
     out = tmp_path / "det.parquet"
     assert run_cli(monkeypatch, "process", tmp_path / "run.zarr", "-o", out, "--json") == 0
     table = pd.read_parquet(out)
-    assert list(table.columns) == DETECTION_COLUMNS and len(table) == 4
+    assert list(table.columns) == [*DETECTION_COLUMNS, "radar"] and len(table) == 4
+    assert set(table["radar"]) == {"radar"}  # one head: its default name
     assert '"detections": 4' in capsys.readouterr().out.strip().splitlines()[-1]
     # A spur map learned from the same frames masks both objects.
     assert (

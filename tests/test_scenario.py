@@ -31,6 +31,9 @@ SIM_KEYS = {
     "flat_earth",
     "range_doppler_coupling",
     "seed",
+    "psf",
+    "speckle",
+    "swerling",
 }
 
 

@@ -38,6 +38,8 @@ def table_as_run(table: pd.DataFrame, source: str) -> xr.Dataset:
     """
     if "time_s" not in table.columns:
         raise InputError(f"{source}: missing required field 'time_s'; columns are {list(table.columns)}")
+    if len(table) == 0:  # an empty CSV's columns come back untyped: say so, not "missing column"
+        raise InputError(f"{source}: no rows")
     t = pd.to_numeric(table["time_s"], errors="coerce").to_numpy(float)
     bad = np.flatnonzero(~np.isfinite(t))
     if bad.size:

@@ -40,12 +40,12 @@ from skyradar.errors import InputError
 from skyradar.experiments.ch5_flight import Flight, terrain_following_flight
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
-from skyradar.sim.navigation import AhrsModel, ahrs_attitude
 from skyradar.nav.flight_state import estimate_frame, filter_table, mount_height_offset_m
 from skyradar.nav.kalman_state import KalmanSettings
 from skyradar.nav.ridge import extract_ridge
 from skyradar.nav.terrain_aware import TerrainAwareEstimator
 from skyradar.scene.scenario import MAX_FRAMES
+from skyradar.sim.navigation import AhrsModel, ahrs_attitude
 
 __all__ = ["ACCEPTANCE", "TERRAINS", "THESIS_TABLE", "TYPICAL_AHRS", "check_run_options", "run"]
 

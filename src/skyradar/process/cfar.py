@@ -240,7 +240,9 @@ def _ring(sat, i, j, hr, hd, gr, gd):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _floor_decide(power, sat_p, sat_c, sat_v, half, skip, big_l, table, floor, n_train, min_train, hits, noise):  # noqa: E501 - compiled kernel signature
+def _floor_decide(
+    power, sat_p, sat_c, sat_v, half, skip, big_l, table, floor, n_train, min_train, hits, noise
+):
     # Per pixel: plain CA for excluded cells, CA over the cells left (or the floor) for the others.
     hr, hd, gr, gd = half
     n_r, n_d = power.shape

@@ -27,7 +27,7 @@ from typing import Literal
 import cv2
 import numpy as np
 from numba import njit
-from scipy import integrate, ndimage, optimize, stats
+from scipy import ndimage  # stats, integrate, optimize: imported where used (scipy.stats alone ~0.5 s)
 
 from skyradar.errors import InputError
 
@@ -36,6 +36,8 @@ __all__ = ["cfar_factor", "cfar_2d", "cfar_2d_floor"]
 
 @lru_cache(maxsize=64)
 def _os_factor(pfa: float, n_train: int, rank: int, n_int: int) -> float:
+    from scipy import integrate, optimize, stats
+
     cut = stats.gamma(n_int, scale=1.0 / n_int)
     order = stats.beta(rank, n_train - rank + 1)
 
@@ -69,6 +71,8 @@ def cfar_factor(
     >>> round(cfar_factor(1e-6, 16), 3) == round(16 * (1e-6 ** (-1 / 16) - 1), 3)  # classic CA formula
     True
     """
+    from scipy import stats
+
     if not 0.0 < pfa < 1.0:
         raise InputError(f"cfar: field 'pfa' must be in (0, 1), got {pfa}")
     if n_train < 1:
@@ -227,6 +231,8 @@ def _os(power, exclude, guard: tuple[int, int], train: tuple[int, int], k: int, 
 
 @lru_cache(maxsize=16)
 def _ca_factor_table(pfa: float, n_max: int, n_integrated: int) -> np.ndarray:
+    from scipy import stats
+
     n = np.arange(1, n_max + 1)
     return np.r_[np.inf, stats.f.isf(pfa, 2 * n_integrated, 2 * n * n_integrated)].astype(np.float32)
 
@@ -265,6 +271,8 @@ def _floor_decide(
 @lru_cache(maxsize=16)
 def _floor_tables(pfa: float, n_max: int) -> np.ndarray:
     """``alpha[L, n]``: CA factor, Gamma(L, 1/L) cell, ``n`` training cells; ``n = 0``: known floor."""
+    from scipy import stats
+
     n = np.arange(1, n_max + 1)
     rows = [np.full(n_max + 1, np.inf)]
     for big_l in range(1, 9):

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 from numba import njit
-from scipy import stats
+from scipy.special import gammaincinv
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
@@ -76,7 +76,9 @@ class Suppressed:
 
 
 # Median of Gamma(L, 1/L) (the channel mean of L unit-noise channels), L = 1..8.
-_GAMMA_MEDIAN = np.array([np.nan, *(stats.gamma(n, scale=1.0 / n).median() for n in range(1, 9))])
+# Median of the mean of n unit-mean exponentials (Gamma(n, 1/n)); scipy.special, not scipy.stats, keeps
+# `import skyradar.process` light for every command that only reads a table.
+_GAMMA_MEDIAN = np.array([np.nan, *(gammaincinv(n, 0.5) / n for n in range(1, 9))])
 
 
 def measured_floor(raw: np.ndarray, predicted: np.ndarray, nominal_w: float, n_rx: int = 4) -> float:

@@ -195,8 +195,9 @@ def test_experiment_counts_match_the_geometry_and_warns_every_observable_conflic
     # This set: three conflicts (head-on, crossing, overtaking), all in view; one clear converging.
     assert (conflict.sum(), observable.sum(), may_alert.sum()) == (3, 3, 0)
 
-    s = run(tmp_path, n_encounters=4, seed=2, workers=2, frame_rate_hz=4.7, layouts=("single",),
-            simulation=LIGHT)
+    s = run(
+        tmp_path, n_encounters=4, seed=2, workers=2, frame_rate_hz=4.7, layouts=("single",), simulation=LIGHT
+    )
     assert s["encounters"] == 4 and s["chain"] == "full" and s["frames"] > 4 * 50
     assert (s["terrain"], s["layout"], len(s["rows"])) == ("none", "single", 1)
     assert s["warned_before_lowc"] == conflict.sum() and s["unwarned_by_cause"]["missed"] == 0
@@ -232,8 +233,9 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
             "flight_s": 1.5, "mirrored": False, "vertical_miss_flown_m": 0.0, "own_altitude_m": 1000.0,
             "simulate_s": 0.0, "process_s": 0.0, "track_s": 0.0, "alert_s": 0.0}  # fmt: skip
     save({("none", 0): [fake]})  # as left by a run interrupted after its first encounter
-    s = E.run(tmp_path, n_encounters=2, seed=5, workers=1, frame_rate_hz=4.7, layouts=("single",),
-              simulation=LIGHT)
+    s = E.run(
+        tmp_path, n_encounters=2, seed=5, workers=1, frame_rate_hz=4.7, layouts=("single",), simulation=LIGHT
+    )
     assert s["resumed_encounters"] == 1
     table = pd.read_parquet(tmp_path / "encounters.parquet")
     assert table.loc[0, "frames"] == 7 and table.loc[1, "frames"] > 50  # row 0 kept, row 1 computed

@@ -34,6 +34,16 @@ from skyradar.errors import InputError
 __all__ = ["cfar_factor", "cfar_2d", "cfar_2d_floor"]
 
 
+def _window(shape: tuple[int, ...], guard, train) -> tuple[int, int, int, int, int, int]:
+    """Guard and training half-widths (range, Doppler) and their sums, checked against the image shape."""
+    gr, gd = (int(v) for v in guard)
+    tr, td = (int(v) for v in train)
+    hr, hd = gr + tr, gd + td
+    if min(gr, gd, tr, td) < 0 or hd >= shape[1] // 2 or hr >= shape[0] // 2:
+        raise InputError(f"cfar: guard {guard} / train {train} do not fit an image of shape {shape}")
+    return gr, gd, tr, td, hr, hd
+
+
 @lru_cache(maxsize=64)
 def _os_factor(pfa: float, n_train: int, rank: int, n_int: int) -> float:
     from scipy import integrate, optimize, stats
@@ -197,11 +207,7 @@ def cfar_2d(
         Noise estimate per pixel, W.
     """
     power = np.asarray(power, dtype=np.float32)
-    gr, gd = (int(v) for v in guard)
-    tr, td = (int(v) for v in train)
-    hr, hd = gr + tr, gd + td
-    if min(gr, gd, tr, td) < 0 or hd >= power.shape[1] // 2 or hr >= power.shape[0] // 2:
-        raise InputError(f"cfar: guard {guard} / train {train} do not fit an image of shape {power.shape}")
+    gr, gd, tr, td, hr, hd = _window(power.shape, guard, train)
     n_train = (2 * hr + 1) * (2 * hd + 1) - (2 * gr + 1) * (2 * gd + 1)
     if not 0.0 < pfa < 1.0:  # the CA table below skips cfar_factor's check (pfa 5 gave NaN thresholds)
         raise InputError(f"cfar: field 'pfa' must be in (0, 1), got {pfa}")
@@ -311,11 +317,7 @@ def cfar_2d_floor(
     (True, True)
     """
     power = np.asarray(power, dtype=np.float32)
-    gr, gd = (int(v) for v in guard)
-    tr, td = (int(v) for v in train)
-    hr, hd = gr + tr, gd + td
-    if min(gr, gd, tr, td) < 0 or hd >= power.shape[1] // 2 or hr >= power.shape[0] // 2:
-        raise InputError(f"cfar: guard {guard} / train {train} do not fit an image of shape {power.shape}")
+    gr, gd, tr, td, hr, hd = _window(power.shape, guard, train)
     if not 0.0 < pfa < 1.0:
         raise InputError(f"cfar: field 'pfa' must be in (0, 1), got {pfa}")
     n_train = (2 * hr + 1) * (2 * hd + 1) - (2 * gr + 1) * (2 * gd + 1)

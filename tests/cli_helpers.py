@@ -9,7 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-__all__ = ["skyradar", "assert_one_line_error"]
+__all__ = ["skyradar", "skyradar_in_process", "assert_one_line_error"]
 
 
 def skyradar(*args: str, cwd: Path, timeout: float = 300) -> subprocess.CompletedProcess:
@@ -17,6 +17,23 @@ def skyradar(*args: str, cwd: Path, timeout: float = 300) -> subprocess.Complete
     return subprocess.run(
         [sys.executable, "-m", "skyradar", *args], cwd=cwd, capture_output=True, text=True, timeout=timeout
     )
+
+
+def skyradar_in_process(monkeypatch, capsys, *args: str) -> tuple[int, str, str]:
+    """``skyradar ARGS`` through :func:`skyradar.cli.main` in this process: (exit code, stdout, stderr).
+
+    For main paths whose cost is the work, not the start-up; bad input goes through :func:`skyradar`.
+    """
+    from skyradar.cli import main
+
+    monkeypatch.setattr(sys, "argv", ["skyradar", *map(str, args)])
+    code = 0
+    try:
+        main()
+    except SystemExit as exc:
+        code = int(exc.code or 0)
+    out = capsys.readouterr()
+    return code, out.out, out.err
 
 
 def assert_one_line_error(result: subprocess.CompletedProcess, *needles: str) -> None:

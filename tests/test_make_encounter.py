@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cli_helpers import assert_one_line_error, skyradar
+from cli_helpers import assert_one_line_error, skyradar, skyradar_in_process
 from skyradar.errors import InputError
 from skyradar.scene.adsb import read_trajectory
 from skyradar.scene.encounter_from_tracks import encounter_from_tracks, trajectory_table
@@ -88,22 +88,6 @@ def test_bad_requests_name_the_field():
         encounter_from_tracks(a, a, 50.0, -1.0)
 
 
-def _cli(monkeypatch, capsys, *args):
-    """``skyradar ARGS`` through :func:`skyradar.cli.main` in this process (exit code, stdout, stderr)."""
-    import sys
-
-    from skyradar.cli import main
-
-    monkeypatch.setattr(sys, "argv", ["skyradar", *args])
-    code = 0
-    try:
-        main()
-    except SystemExit as exc:
-        code = exc.code or 0
-    out = capsys.readouterr()
-    return code, out.out, out.err
-
-
 def test_make_encounter_command(tmp_path, monkeypatch, capsys, caplog):
     rows = []
     for heading, origin in ((30.0, MUNICH), (100.0, LISBON)):
@@ -116,7 +100,9 @@ def test_make_encounter_command(tmp_path, monkeypatch, capsys, caplog):
     rows[1].to_json(tmp_path / "b.json", orient="records")
     monkeypatch.chdir(tmp_path)
     args = ("make-encounter", "a.csv.gz", "b.json", "-o", "enc.yaml", "--miss-m", "300", "--t-cpa", "100")
-    code, stdout, stderr = _cli(monkeypatch, capsys, *args, "--vertical-miss-m", "-60", "--json")
+    code, stdout, stderr = skyradar_in_process(
+        monkeypatch, capsys, *args, "--vertical-miss-m", "-60", "--json"
+    )
     assert code == 0, stderr
     out = json.loads(stdout.strip().splitlines()[-1])
     assert out["t_cpa_s"] == pytest.approx(100.0, abs=1e-3) and out["horizontal_miss_m"] == pytest.approx(

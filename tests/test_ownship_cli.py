@@ -5,14 +5,12 @@ the store; `alert --config radar|default|FILE.yaml`."""
 from __future__ import annotations
 
 import json
-import sys
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from cli_helpers import assert_one_line_error, skyradar
-from skyradar.cli import main
+from cli_helpers import assert_one_line_error, skyradar, skyradar_in_process
 from skyradar.daa.alert_config import alert_config
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig
 from skyradar.errors import InputError
@@ -22,17 +20,6 @@ from skyradar.web.sample import sample_run_dataset
 
 NAV_BIAS_M = 400.0  # navigation north error: big enough to move the warnings
 _STATE = ("north_m", "east_m", "down_m", "vn_mps", "ve_mps", "vd_mps")
-
-
-def _cli(monkeypatch, capsys, *args):
-    monkeypatch.setattr(sys, "argv", ["skyradar", *args])
-    code = 0
-    try:
-        main()
-    except SystemExit as exc:
-        code = exc.code or 0
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 def _write_run(path, bias_m: float):
@@ -65,18 +52,20 @@ def test_run_and_table_give_the_same_tracks_and_alerts_from_navigation(tmp_path,
     _write_run(tmp_path / "true_nav.zarr", 0.0)
     _detections(ds).to_parquet(tmp_path / "det.parquet")
     assert (
-        _cli(monkeypatch, capsys, "export", str(tmp_path / "run.zarr"), "-o", str(tmp_path / "tables"))[0]
+        skyradar_in_process(
+            monkeypatch, capsys, "export", str(tmp_path / "run.zarr"), "-o", str(tmp_path / "tables")
+        )[0]
         == 0
     )
     table = tmp_path / "tables" / "ownship.parquet"
     results = {}
     for name, own in (("run", tmp_path / "run.zarr"), ("table", table), ("true", tmp_path / "true_nav.zarr")):
         trk, alerts = tmp_path / f"trk_{name}.parquet", tmp_path / f"al_{name}.parquet"
-        code, out, err = _cli(monkeypatch, capsys, "track", str(tmp_path / "det.parquet"),
+        code, out, err = skyradar_in_process(monkeypatch, capsys, "track", str(tmp_path / "det.parquet"),
                               "--ownship", str(own), "-o", str(trk), "--json")  # fmt: skip
         assert code == 0, err
         results[name] = json.loads(out.strip().splitlines()[-1])
-        code, out, err = _cli(monkeypatch, capsys, "alert", str(trk), "--ownship", str(own),
+        code, out, err = skyradar_in_process(monkeypatch, capsys, "alert", str(trk), "--ownship", str(own),
                               "-o", str(alerts), "--json")  # fmt: skip
         assert code == 0, err
         results[name] |= json.loads(out.strip().splitlines()[-1])

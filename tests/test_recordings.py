@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import yaml
 
-from skyradar import cli
+from cli_helpers import skyradar_in_process
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.io.recording_writer import write_recording
@@ -180,17 +180,6 @@ def test_writer_rejects_bad_input_and_leaves_nothing(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
-def run_cli(monkeypatch, capsys, *args: str) -> tuple[int, str, str]:
-    monkeypatch.setattr("sys.argv", ["skyradar", *args])
-    code = 0
-    try:
-        cli.main()
-    except SystemExit as exc:
-        code = int(exc.code or 0)
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
 def test_rd_command_writes_frames_and_resumes(tmp_path, monkeypatch, capsys):
     from skyradar.io.frames import open_frames
     from skyradar.process.rangedoppler import range_doppler
@@ -198,7 +187,7 @@ def test_rd_command_writes_frames_and_resumes(tmp_path, monkeypatch, capsys):
     data = frames(3)
     sidecar = write_recording(tmp_path / "rec.bin", data, CFG, dtype="complex64")
     out = tmp_path / "run.zarr"
-    code, stdout, err = run_cli(
+    code, stdout, err = skyradar_in_process(
         monkeypatch, capsys, "rd", str(sidecar), "-o", str(out), "--chunk-frames", "2", "--json"
     )
     assert code == 0, err
@@ -215,7 +204,7 @@ def test_rd_command_bad_recording_leaves_no_output(tmp_path, monkeypatch, capsys
     with open(tmp_path / "rec.bin", "r+b") as fh:
         fh.truncate(1000)
     out = tmp_path / "run.zarr"
-    code, _, err = run_cli(monkeypatch, capsys, "rd", str(sidecar), "-o", str(out))
+    code, _, err = skyradar_in_process(monkeypatch, capsys, "rd", str(sidecar), "-o", str(out))
     assert code == 2
     assert err.startswith("error: ") and "truncated" in err and len(err.strip().splitlines()) == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["rec.bin", "rec.json"]
@@ -236,10 +225,10 @@ def test_rd_command_resumes_after_interruption(tmp_path, monkeypatch, capsys):
         return original(self, adc, **kw)
 
     monkeypatch.setattr(RangeDopplerProcessor, "__call__", interrupted)
-    run_cli(monkeypatch, capsys, "rd", str(sidecar), "-o", str(out), "--chunk-frames", "2")
+    skyradar_in_process(monkeypatch, capsys, "rd", str(sidecar), "-o", str(out), "--chunk-frames", "2")
     assert not out.exists() and (tmp_path / "run.zarr.partial").exists()
     monkeypatch.setattr(RangeDopplerProcessor, "__call__", original)
-    code, stdout, err = run_cli(
+    code, stdout, err = skyradar_in_process(
         monkeypatch, capsys, "rd", str(sidecar), "-o", str(out), "--chunk-frames", "2", "--json"
     )
     assert code == 0, err

@@ -1,27 +1,15 @@
 """`skyradar track` and `skyradar evaluate` end to end, and their bad-input errors."""
 
 import json
-import sys
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from skyradar.cli import main
+from cli_helpers import skyradar_in_process
 from skyradar.config import RadarConfig
 from skyradar.io.frames import frames_dataset
 from skyradar.track.simulated_detections import synthetic_detections
-
-
-def _cli(monkeypatch, capsys, *args):
-    monkeypatch.setattr(sys, "argv", ["skyradar", *args])
-    code = 0
-    try:
-        main()
-    except SystemExit as exc:
-        code = exc.code or 0
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 def _scene(cfg, n=120, dt=0.106):
@@ -42,12 +30,12 @@ def test_track_then_evaluate_against_run_truth(tmp_path, monkeypatch, capsys):
     iq = np.zeros((t.size, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
     targets = {"tgt_range_m": R, "tgt_radial_velocity_mps": V, "tgt_visible": vis}
     frames_dataset(iq, t, cfg, targets=targets).to_zarr(tmp_path / "run.zarr", consolidated=False)
-    code, out, err = _cli(
+    code, out, err = skyradar_in_process(
         monkeypatch, capsys, "track", str(det_path), "-o", str(tmp_path / "trk.parquet"), "--json"
     )
     assert code == 0, err
     assert json.loads(out.strip().splitlines()[-1])["tracks"] >= 2
-    code, out, err = _cli(
+    code, out, err = skyradar_in_process(
         monkeypatch, capsys, "evaluate", str(tmp_path / "run.zarr"), str(tmp_path / "trk.parquet"), "--json"
     )
     assert code == 0, err
@@ -61,7 +49,9 @@ def test_track_then_evaluate_against_run_truth(tmp_path, monkeypatch, capsys):
 def test_track_bad_inputs_give_one_line_errors(tmp_path, monkeypatch, capsys):
     bad = tmp_path / "bad.parquet"
     pd.DataFrame({"time_s": [0.0, 0.1], "range_m": [1.0, 2.0]}).to_parquet(bad)
-    code, _, err = _cli(monkeypatch, capsys, "track", str(bad), "-o", str(tmp_path / "x.parquet"))
+    code, _, err = skyradar_in_process(
+        monkeypatch, capsys, "track", str(bad), "-o", str(tmp_path / "x.parquet")
+    )
     assert code == 2
     assert err.startswith("error: ") and "radial_velocity_mps" in err and str(bad) in err
     assert len(err.strip().splitlines()) == 1
@@ -69,9 +59,11 @@ def test_track_bad_inputs_give_one_line_errors(tmp_path, monkeypatch, capsys):
     pd.DataFrame({"time_s": [0.0, 0.2, 0.1], "range_m": [1.0] * 3, "radial_velocity_mps": [0.0] * 3}).to_csv(
         back
     )
-    code, _, err = _cli(monkeypatch, capsys, "track", str(back), "-o", str(tmp_path / "x.parquet"))
+    code, _, err = skyradar_in_process(
+        monkeypatch, capsys, "track", str(back), "-o", str(tmp_path / "x.parquet")
+    )
     assert code == 2 and "'time_s' goes backwards at row 2 (0.2 -> 0.1)" in err
-    code, _, err = _cli(
+    code, _, err = skyradar_in_process(
         monkeypatch, capsys, "track", str(back), "-o", str(tmp_path / "x.parquet"), "--model", "kf"
     )
     assert code == 2 and "--model" in err
@@ -87,5 +79,5 @@ def test_evaluate_without_truth_is_clear_error(tmp_path, monkeypatch, capsys, mi
     pd.DataFrame({"time_s": [0.0], "track_id": [0], "range_m": [1.0], "radial_velocity_mps": [0.0],
                   "innovation_range_m": [0.0],
                   "innovation_radial_velocity_mps": [0.0]}).to_parquet(trk)  # fmt: skip
-    code, _, err = _cli(monkeypatch, capsys, "evaluate", str(tmp_path / "run.zarr"), str(trk))
+    code, _, err = skyradar_in_process(monkeypatch, capsys, "evaluate", str(tmp_path / "run.zarr"), str(trk))
     assert code == 2 and missing in err and "run.zarr" in err

@@ -37,7 +37,7 @@ from numba import njit
 from skyradar.config import RadarConfig
 from skyradar.process.doa import steering_vector
 
-__all__ = ["ClutterSubspace", "clutter_subspace", "hann_psf_power"]
+__all__ = ["ClutterSubspace", "clutter_subspace"]
 
 
 @dataclass(frozen=True)
@@ -59,20 +59,6 @@ class ClutterSubspace:
     predicted: np.ndarray
 
 
-def hann_psf_power(offset_bins: np.ndarray | float) -> np.ndarray:
-    """Power response of a Hann-windowed DFT to a tone ``offset_bins`` from a bin centre (1 at 0).
-
-    The amplitude is ``sinc(d) / (1 - d^2)`` (0.5 at one bin, 0 from two bins on in the main lobe).
-
-    >>> hann_psf_power(np.array([0.0, 0.5, 1.0, 2.0])).round(3).tolist()
-    [1.0, 0.72, 0.25, 0.0]
-    """
-    d = np.asarray(offset_bins, float)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        amp = np.where(np.abs(np.abs(d) - 1.0) < 1e-9, 0.5, np.sinc(d) / (1.0 - d * d))
-    return amp**2
-
-
 @njit(cache=True)
 def _accumulate(r_pos, d_pos, steer, weight, n_r, n_d, cov):  # pragma: no cover - compiled
     n_s, n_k = steer.shape
@@ -84,6 +70,8 @@ def _accumulate(r_pos, d_pos, steer, weight, n_r, n_d, cov):  # pragma: no cover
             if r < 0 or r >= n_r:
                 continue
             x = r_pos[s] - r
+            # Hann main lobe in the long-window limit, sinc(x) / (1 - x^2) (0.5 at one bin); the exact
+            # finite-window response is skyradar.sim.psf.window_response, which process may not import.
             wr = 0.5 if abs(abs(x) - 1.0) < 1e-9 else np.sinc(x) / (1.0 - x * x)
             for dd in range(-2, 3):
                 y = d_pos[s] - (d0 + dd)

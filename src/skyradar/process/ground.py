@@ -297,7 +297,7 @@ def ground_in_elevation(
 
 
 def surface_height_fn(
-    flat_down_m: float, terrain: Any, geodetic: Callable[[np.ndarray], tuple]
+    flat_down_m: float, terrain: Any, geodetic: Callable[[np.ndarray], tuple] | None
 ) -> Callable[[np.ndarray], np.ndarray]:
     """Height above the surface of NED points (..., 3): the DEM, else a flat ground at ``flat_down_m``.
 

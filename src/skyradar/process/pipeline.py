@@ -157,17 +157,24 @@ def _to_world(
     """NED position, geodetic position and NED unit direction of one frame's detections."""
     pos = np.array([own["own_north_m"][i], own["own_east_m"][i], own["own_down_m"][i]])
     body_to_ned = _body_to_ned(own, i, origin)
-    has_geo = bool(own["has_geo"])
     body = np.stack([out["x_body_m"], out["y_body_m"], out["z_body_m"]], axis=1)
     ned = pos + body @ body_to_ned.T
     u_ned = out["u_ant"] @ (body_to_ned @ config.mount.rotation).T
-    if origin is not None:
-        geo = ned_to_geodetic(ned, *origin)
-    elif has_geo:
-        geo = ned_to_geodetic(ned - pos, own["own_lat_deg"][i], own["own_lon_deg"][i], own["own_alt_m"][i])
-    else:
-        geo = tuple(np.full(len(ned), np.nan) for _ in range(3))
+    geodetic = _geodetic_fn(own, i, origin)
+    geo = geodetic(ned) if geodetic is not None else tuple(np.full(len(ned), np.nan) for _ in range(3))
     return ned, geo, u_ned
+
+
+def _geodetic_fn(own: dict[str, np.ndarray], i: int, origin: tuple | None) -> Callable | None:
+    """NED points -> (lat, lon, alt) for frame ``i``: from the scenario origin, else relative to the
+    own-ship's geodetic fix (about 2 m off at 5 km); None with neither."""
+    if origin is not None:
+        return lambda points: ned_to_geodetic(points, *origin)
+    if not bool(own["has_geo"]):
+        return None
+    pos = np.array([own["own_north_m"][i], own["own_east_m"][i], own["own_down_m"][i]])
+    fix = (float(own["own_lat_deg"][i]), float(own["own_lon_deg"][i]), float(own["own_alt_m"][i]))
+    return lambda points: ned_to_geodetic(points - pos, *fix)
 
 
 def _ground_flags(
@@ -190,14 +197,8 @@ def _ground_flags(
         return np.zeros(n, bool)
     own_agl = float(own["own_height_agl_m"][i])
     pos = np.array([own["own_north_m"][i], own["own_east_m"][i], own["own_down_m"][i]])
-    geo_ref = (float(own["own_lat_deg"][i]), float(own["own_lon_deg"][i]), float(own["own_alt_m"][i]))
-    located = origin is not None or bool(own["has_geo"])
-
-    def geodetic(points: np.ndarray):
-        if origin is not None:
-            return ned_to_geodetic(points, *origin)
-        return ned_to_geodetic(points - pos, *geo_ref)
-
+    geodetic = _geodetic_fn(own, i, origin)
+    located = geodetic is not None
     if terrain is not None and located and not np.isfinite(own_agl):
         own_agl = float(height_above_ground_m(*geodetic(pos[None]), terrain)[0])
     if not np.isfinite(own_agl):

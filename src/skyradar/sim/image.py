@@ -207,7 +207,10 @@ class ImageSimulator:
         else:
             blocks = self._accumulation_blocks()
             self._accumulate_terrain(geom, view, blocks, _NO_SPARSE, self._scratch, speckle)
-            finalize_frame(blocks, 0.0 if psf else sigma, key, grid)
+            if psf:  # the spreading sums (and clears) the per-thread blocks itself
+                grid = blocks
+            else:
+                finalize_frame(blocks, sigma, key, grid)
         if psf:
             self._spread(grid, frame, sigma, key)
         if targets:
@@ -217,10 +220,11 @@ class ImageSimulator:
         return frame
 
     def _spread(self, grid: np.ndarray, frame: np.ndarray, sigma: float, key: np.uint64) -> None:
-        # The windows' point-spread, then the noise, white at its windowed power.
+        # The windows' point-spread, then the noise, white at its windowed power. ``grid``: the
+        # oversampled grid, or the per-thread blocks (summed, and cleared for the next frame).
         block = _array(self._scratch, "spread", (1, *frame.shape), np.complex64)
-        work = _array(self._scratch, "spread_work", (grid.shape[0] * frame[0].size,), np.complex64)
-        apply_psf(grid, self._psf, block[0], work)
+        work = _array(self._scratch, "spread_work", (self._grid_shape[0] * frame[0].size,), np.complex64)
+        apply_psf(grid, self._psf, block[0], work, clear=True)
         finalize_frame(block, sigma, key, frame)
 
     @property

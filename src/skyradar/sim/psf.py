@@ -149,32 +149,50 @@ def binned_kernel(name: str, n: int, oversample: int = 1) -> np.ndarray:
     return (sign * np.sqrt(power))[keep].astype(np.float32)
 
 
+@njit(inline="always")
+def _axpy(dst, g, src):
+    # dst += g * src over equal-length views, indexed by a plain range(n): numba then knows no
+    # index is negative, drops its wrap-around check and LLVM vectorises the loop (an index
+    # like x - shift kept it scalar: 5x slower).
+    for x in range(dst.shape[0]):
+        dst[x] += g * src[x]
+
+
 @njit(parallel=True, cache=True, error_model="numpy", fastmath=True)
-def _psf_kernel(fine, tmp, out, h_range, h_doppler, step):  # pragma: no cover - compiled
-    # Float32 views: fine (L n_r, L n_d * w), tmp (L n_r, n_d * w), out (n_r, n_d * w) with
-    # w = 2 n_rx floats per bin. out[k, j] = sum over fine (m, l) of
-    # fine[m, l] h_range[L k - m] h_doppler[L j - l]: a real kernel acts on the real and
-    # imaginary parts alike, so the inner loops are plain vector multiply-adds over w floats.
-    n_fine_d = fine.shape[1] // step
+def _psf_kernel(fine, tmp, out, h_range, h_doppler, step, clear):  # pragma: no cover - compiled
+    # Float32 views: fine (n_blocks, L n_r, L n_d * w), summed over its blocks (the simulator's
+    # per-thread accumulation cubes, cleared on the way when ``clear``: no separate pass over
+    # them), tmp (L n_r, n_d * w), out (n_r, n_d * w) with w = 2 n_rx floats per bin.
+    # out[k, j] = sum over fine (m, l) of fine[m, l] h_range[L k - m] h_doppler[L j - l]: a real
+    # kernel acts on the real and imaginary parts alike, so the inner loops are plain vector
+    # multiply-adds over w floats.
+    n_blocks, n_fine_r = fine.shape[0], fine.shape[1]
+    n_fine_d = fine.shape[2] // step
     n_d = tmp.shape[1] // step
     os = n_fine_d // n_d
     sr, sd = h_range.shape[0] // 2, h_doppler.shape[0] // 2
     width = n_d * step
-    filled = np.zeros(fine.shape[0], np.bool_)  # rows with any return (ground below is empty)
-    for m in prange(fine.shape[0]):  # Doppler: circular
-        src, dst = fine[m], tmp[m]
-        for x in range(src.shape[0]):
-            if src[x] != 0.0:
-                filled[m] = True
-                break
+    filled = np.zeros(n_fine_r, np.bool_)  # rows with any return (ground below is empty)
+    for m in prange(n_fine_r):  # Doppler: circular
+        dst = tmp[m]
+        for b in range(n_blocks):
+            src = fine[b, m]
+            for x in range(src.shape[0]):
+                if src[x] != 0.0:
+                    filled[m] = True
+                    break
         if not filled[m]:
             continue
         # The row's sub-bin phases, each a plain row of bins: fine bin L j + p is phases[p, j].
-        phases = np.empty((os, width), np.float32)
-        for j in range(n_d):
-            for p in range(os):
-                for c in range(step):
-                    phases[p, j * step + c] = src[(os * j + p) * step + c]
+        phases = np.zeros((os, width), np.float32)
+        for b in range(n_blocks):
+            src = fine[b, m]
+            for j in range(n_d):
+                for p in range(os):
+                    lo = (os * j + p) * step
+                    _axpy(phases[p, j * step : (j + 1) * step], 1.0, src[lo : lo + step])
+            if clear:
+                src[:] = 0
         dst[:] = 0
         for s in range(-sd, sd + 1):
             # Fine bin L j - s is phase (-s) mod L of bin j - shift: one shifted run of the row
@@ -182,27 +200,26 @@ def _psf_kernel(fine, tmp, out, h_range, h_doppler, step):  # pragma: no cover -
             p = (-s) % os
             shift = ((s + p) // os) % n_d * step
             g, row = h_doppler[s + sd], phases[p]
-            for x in range(shift, width):
-                dst[x] += g * row[x - shift]
-            for x in range(shift):
-                dst[x] += g * row[x + width - shift]
+            _axpy(dst[shift:], g, row[: width - shift])
+            _axpy(dst[:shift], g, row[width - shift :])
     for k in prange(out.shape[0]):  # range: zero beyond the cube
         dst = out[k]
         dst[:] = 0
         for s in range(-sr, sr + 1):
             m = os * k - s
-            if m < 0 or m >= fine.shape[0] or not filled[m]:
+            if m < 0 or m >= n_fine_r or not filled[m]:
                 continue
-            g, src = h_range[s + sr], tmp[m]
-            for c in range(dst.shape[0]):
-                dst[c] += g * src[c]
+            _axpy(dst, h_range[s + sr], tmp[m])
 
 
-def apply_psf(fine: np.ndarray, kernels: PSFKernels, out: np.ndarray, scratch: np.ndarray) -> None:
+def apply_psf(
+    fine: np.ndarray, kernels: PSFKernels, out: np.ndarray, scratch: np.ndarray, clear: bool = False
+) -> None:
     """``out`` (n_range, n_doppler, n_rx) from the oversampled grid ``fine`` and the kernels.
 
     ``fine`` is (L n_range, L n_doppler, n_rx) complex64 with ``L = kernels.oversample``: each
-    scatterer added at its nearest sub-bin. ``scratch`` is complex64 with at least
+    scatterer added at its nearest sub-bin; or (n_blocks, L n_range, L n_doppler, n_rx): blocks
+    summed first (and set to 0 when ``clear``). ``scratch`` is complex64 with at least
     ``L n_range * n_doppler * n_rx`` elements (overwritten).
 
     Examples
@@ -216,11 +233,13 @@ def apply_psf(fine: np.ndarray, kernels: PSFKernels, out: np.ndarray, scratch: n
     """
     n_r, n_d, n_rx = out.shape
     step = 2 * n_rx
-    tmp = scratch.reshape(-1)[: fine.shape[0] * n_d * n_rx].view(np.float32)
-    tmp = tmp.reshape(fine.shape[0], n_d * step)
+    blocks = fine if fine.ndim == 4 else fine[None]
+    n_fine_r = blocks.shape[1]
+    tmp = scratch.reshape(-1)[: n_fine_r * n_d * n_rx].view(np.float32)
+    tmp = tmp.reshape(n_fine_r, n_d * step)
     _psf_kernel(
-        fine.view(np.float32).reshape(fine.shape[0], -1), tmp, out.view(np.float32).reshape(n_r, n_d * step),
-        kernels.h_range, kernels.h_doppler, step,
+        blocks.view(np.float32).reshape(blocks.shape[0], n_fine_r, -1), tmp,
+        out.view(np.float32).reshape(n_r, n_d * step), kernels.h_range, kernels.h_doppler, step, bool(clear),
     )  # fmt: skip
 
 

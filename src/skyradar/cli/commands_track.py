@@ -14,10 +14,12 @@ from skyradar.cli.app import (
     JsonOption,
     app,
     bench_app,
+    check_choice,
     check_number,
     console,
     emit_result,
     experiment_app,
+    number_in,
 )
 from skyradar.io.outputs import OVERWRITE_HELP
 
@@ -38,6 +40,8 @@ def _origin(text: str | None) -> tuple[float, float, float] | None:
     check_number("--origin: field 'alt_m'", alt, -500.0, 30_000.0)
     return lat, lon, alt
 
+
+_FINITE_DB = number_in(-100.0, 100.0)  # an SNR in dB: finite, and a typo like 1e9 is refused
 
 _ModelOpt = Annotated[
     str, typer.Option("--model", help="'radar' (aliasing-aware, coupled) or 'traditional' (image tracker).")
@@ -105,7 +109,9 @@ def track(
 
     Needs columns time_s, range_m, radial_velocity_mps (time never decreasing); with north_m,
     east_m, down_m each track also gets a 3-D position, velocity and position covariance.
-    Detections flagged is_ground or spur are left out.
+    Detections flagged is_ground or spur are left out. The tracker steps on every frame (the
+    --ownship run's times, else the detections' frame column), so a track keeps its rows while it
+    coasts through frames without a detection (column coasted).
     """
     import json
 
@@ -124,7 +130,9 @@ def track(
     table = read_detections(detections)
     config = radar_config_from_attrs(table)
     own, origin_lla, origin_from = _ownship_and_origin(ownship, table, origin)
-    tracks, n_used = track_air_detections(table, model, config, origin_lla, own)
+    # The own-ship state of a run has every frame's time: the tracker steps on frames without detections.
+    run_times = None if own is None else own["time_s"].to_numpy(float)
+    tracks, n_used = track_air_detections(table, model, config, origin_lla, own, run_times)
     meta = {"radar_config": config.to_json(), "source": str(detections), "model": model}
     if origin_lla is not None:
         meta["origin_lla"] = json.dumps([float(v) for v in origin_lla])
@@ -154,15 +162,40 @@ def evaluate(
     gospa_c_px: Annotated[
         float, typer.Option("--gospa-c", callback=POSITIVE, help="GOSPA cut-off distance, pixels.")
     ] = 10.0,
+    truth: Annotated[
+        str,
+        typer.Option(
+            "--truth",
+            help="'detectable': frames in a beam with expected SNR >= --min-snr-db; 'beam': every "
+            "in-beam frame.",
+        ),
+    ] = "detectable",
+    min_snr_db: Annotated[
+        float | None,
+        typer.Option(
+            "--min-snr-db",
+            callback=_FINITE_DB,
+            help="Detection threshold of the truth (default: the CA-CFAR's 50 % detection SNR, 7.5 dB "
+            "for the prototype).",
+        ),
+    ] = None,
+    coasting: Annotated[
+        bool,
+        typer.Option(
+            "--coasting/--confirmed-only",
+            help="Match a confirmed track's coasted (predicted) rows too, until it is closed.",
+        ),
+    ] = True,
     as_json: JsonOption = False,
 ) -> None:
-    """Score tracks against the run's truth: track and truth counts, fragmentation, identity
-    switches, completeness, GOSPA mean, innovation mean and 95th percentile (pixels and SI)."""
+    """Score tracks against the run's truth: track and truth counts, tracks per target, fragmentation,
+    identity switches, completeness, GOSPA mean, innovation mean and 95th percentile (pixels and SI).
+    The truth is what the radar could see (in a beam and at the detection SNR), from the scenario
+    alone; several radar heads are combined."""
     from skyradar.io.tables import read_table
-    from skyradar.track.io import truth_from_frames
-    from skyradar.track.metrics import track_metrics
+    from skyradar.track.evaluate import TRUTH_MODES, evaluate_run
 
-    truth, config = truth_from_frames(run)
+    check_choice("--truth", truth, TRUTH_MODES)  # before any reading
     table = read_table(
         tracks,
         required=["time_s", "track_id", "range_m", "radial_velocity_mps", "innovation_range_m",
@@ -170,8 +203,7 @@ def evaluate(
         sort_by="time_s",
         finite=["time_s", "track_id", "range_m", "radial_velocity_mps"],  # NaN was a scipy traceback
     )  # fmt: skip
-    pixel = (config.range_resolution_m, config.doppler_resolution_mps)
-    result = track_metrics(table, truth, pixel, 2.0 * config.v_lim_mps, threshold_px, gospa_c_px)
+    result = evaluate_run(run, table, threshold_px, gospa_c_px, truth, min_snr_db, coasting)
     emit_result(result, as_json, "track evaluation")
 
 

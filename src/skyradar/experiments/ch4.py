@@ -31,20 +31,19 @@ per-scenario detection and track tables, and three figures.
 
 from __future__ import annotations
 
-import inspect
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from scipy import optimize, stats
 
 from skyradar.config import RadarConfig
 from skyradar.experiments.ch4_flights import EPBC, SCENARIOS, Traffic, build_traffic
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.parallel import check_workers
+from skyradar.track.detectable import detection_threshold_snr_db
 from skyradar.track.io import Truth
 from skyradar.track.metrics import track_metrics, truth_segments
 from skyradar.track.simulated_detections import synthetic_detections
@@ -67,35 +66,6 @@ THESIS = {
     "zulu": {"innov_mean": (2.7, 2.5), "innov_p95": (10.5, 7.1), "tracks": (42, 9), "truth": 9},
     "free": {"innov_mean": (4.3, 3.6), "innov_p95": (14.4, 10.7), "tracks": (54, 13), "truth": 12},
 }
-
-
-def detection_threshold_snr_db(config: RadarConfig, probability: float = 0.5) -> float:
-    """Expected per-channel SNR (dB) at which ``process_cube``'s CA-CFAR detects with ``probability``.
-
-    The detector compares the mean of ``n_rx`` channels' power with ``alpha`` times the mean of
-    ``N`` training cells (the ``pfa``, ``guard`` and ``train`` defaults of
-    :func:`skyradar.process.detect.detect`). For a steady target of SNR ``s`` per channel the ratio
-    is noncentral F with (2 n_rx, 2 N n_rx) degrees of freedom and noncentrality 2 n_rx s, which
-    gives the detection probability exactly (a target filling one pixel, as the simulator puts it).
-
-    Examples
-    --------
-    >>> round(detection_threshold_snr_db(RadarConfig.prototype_2022()), 1)
-    7.5
-    """
-    from skyradar.process.cfar import cfar_factor
-    from skyradar.process.detect import detect
-
-    defaults = {k: v.default for k, v in inspect.signature(detect).parameters.items()}
-    (gr, gd), (tr, td) = defaults["guard"], defaults["train"]
-    n_train = (2 * (gr + tr) + 1) * (2 * (gd + td) + 1) - (2 * gr + 1) * (2 * gd + 1)
-    n = config.n_rx
-    alpha = cfar_factor(defaults["pfa"], n_train, n)
-
-    def miss(snr_db: float) -> float:
-        return float(stats.ncf.sf(alpha, 2 * n, 2 * n_train * n, 2 * n * 10 ** (snr_db / 10))) - probability
-
-    return float(optimize.brentq(miss, -20.0, 40.0, xtol=1e-6))
 
 
 def scenario_visibility(truth: dict, snr_threshold_db: float) -> np.ndarray:

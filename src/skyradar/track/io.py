@@ -98,6 +98,8 @@ class Truth:
     range_m, radial_velocity_mps : ndarray, shape (n_time, n_target)
     visible : ndarray of bool, shape (n_time, n_target)
     names : list of str
+    snr_db : ndarray, shape (n_time, n_target), or None
+        Expected SNR (radar equation, no noise), when the run has it.
     """
 
     def __init__(
@@ -107,31 +109,53 @@ class Truth:
         radial_velocity_mps: np.ndarray,
         visible: np.ndarray,
         names: list[str] | None = None,
+        snr_db: np.ndarray | None = None,
     ) -> None:
         self.time_s = np.asarray(time_s, float)
         self.range_m = np.asarray(range_m, float)
         self.radial_velocity_mps = np.asarray(radial_velocity_mps, float)
         self.visible = np.asarray(visible, bool)
+        self.snr_db = None if snr_db is None else np.asarray(snr_db, float)
         n = self.range_m.shape[1] if self.range_m.ndim == 2 else 0
         self.names = list(names) if names is not None else [f"T{i}" for i in range(n)]
 
 
 def truth_from_frames(path: str | Path) -> tuple[Truth, RadarConfig]:
-    """Intruder truth and radar config from a simulated frames store (Zarr)."""
-    from skyradar.io.frames import open_frames, radar_config_of
+    """Intruder truth and radar config from a simulated frames store (Zarr).
 
-    ds = open_frames(path)
+    With several radar heads, a target is visible in a frame when it is in any head's beam, and
+    its range, radial velocity and SNR are those of the head that sees it strongest (the fused
+    tracker refers every head's range to the aircraft's reference point, lever arms of metres
+    apart); the radar config is the first head's.
+    """
+    from skyradar.io.frames import open_frames
+    from skyradar.io.frames_heads import store_heads
+
+    heads = store_heads(path) or [None]
+    sets = [_head_truth(open_frames(path, head=h) if h else open_frames(path), path) for h in heads]
+    best = np.argmax(np.stack([np.where(s["tgt_visible"], np.nan_to_num(s["tgt_snr_db"], nan=-np.inf),
+                                        -np.inf) for s in sets]), axis=0)  # fmt: skip
+    pick = {k: np.choose(best, [s[k] for s in sets]) for k in sets[0] if k.startswith("tgt_")}
+    pick["tgt_visible"] = np.any([s["tgt_visible"] for s in sets], axis=0)
+    first = sets[0]
+    truth = Truth(first["time_s"], pick["tgt_range_m"], pick["tgt_radial_velocity_mps"],
+                  pick["tgt_visible"], first["names"], pick["tgt_snr_db"])  # fmt: skip
+    return truth, first["config"]
+
+
+def _head_truth(ds, path) -> dict:
+    """One head's truth arrays (``tgt_snr_db`` NaN when the run has none), times, names, config."""
+    from skyradar.io.frames import radar_config_of
+
     needed = ["tgt_range_m", "tgt_radial_velocity_mps", "tgt_visible"]
     missing = [v for v in needed if v not in ds]
     if missing:
         raise InputError(
             f"{path}: no intruder truth (missing variable(s) {missing}); evaluate needs a simulated run"
         )
-    truth = Truth(
-        frame_times_s(ds),
-        ds["tgt_range_m"].values,
-        ds["tgt_radial_velocity_mps"].values,
-        ds["tgt_visible"].values.astype(bool),
-        [str(n) for n in ds["target"].values],
-    )
-    return truth, radar_config_of(ds, str(path))
+    out = {v: ds[v].values for v in needed}
+    out["tgt_visible"] = out["tgt_visible"].astype(bool)
+    shape = out["tgt_visible"].shape
+    out["tgt_snr_db"] = ds["tgt_snr_db"].values if "tgt_snr_db" in ds else np.full(shape, np.nan)
+    names = [str(n) for n in ds["target"].values]
+    return out | {"time_s": frame_times_s(ds), "names": names, "config": radar_config_of(ds, str(path))}

@@ -36,6 +36,7 @@ __all__ = [
     "truth_segments",
     "detected_truth",
     "match_tracks",
+    "existing_rows",
     "track_metrics",
 ]
 
@@ -287,6 +288,31 @@ def _match_frame(
     return out
 
 
+def existing_rows(tracks: pd.DataFrame) -> np.ndarray:
+    """Rows at or after each track's first ``confirmed`` row (in time order): where the track exists.
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({"time_s": [0, 1, 2, 3], "track_id": [1, 1, 1, 1], "confirmed": [0, 1, 0, 1]})
+    >>> existing_rows(df).tolist()
+    [False, True, True, True]
+    """
+    order = np.argsort(tracks["time_s"].to_numpy(float), kind="stable")
+    conf = pd.Series(tracks["confirmed"].to_numpy(bool)[order].astype(np.int8))
+    seen = conf.groupby(tracks["track_id"].to_numpy()[order]).cummax().to_numpy(bool)
+    out = np.zeros(len(tracks), bool)
+    out[order] = seen
+    return out
+
+
+def _scored_rows(tracks: pd.DataFrame, coasting: bool) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(rows to match, confirmed rows): all rows without a ``confirmed`` column."""
+    if "confirmed" not in tracks.columns:
+        return tracks, tracks
+    confirmed_rows = tracks[tracks["confirmed"].to_numpy(bool)]
+    return (tracks[existing_rows(tracks)] if coasting else confirmed_rows), confirmed_rows
+
+
 def _segment_counts(matched: np.ndarray, labels: np.ndarray) -> tuple[int, int, float, int]:
     """Fragmentation, identity switches, completeness and missed segments from per-frame matches."""
     frag = switches = missed = 0
@@ -315,6 +341,7 @@ def track_metrics(
     min_duration_s: float = 2.0,
     confirm: tuple[int, int] = (1, 1),
     counted: np.ndarray | None = None,
+    coasting: bool = False,
 ) -> dict[str, float]:
     """All track metrics of this module in one dict (see the module docstring).
 
@@ -324,21 +351,25 @@ def track_metrics(
     counted truth segments, e.g. those with enough expected SNR; tracks are still matched against
     every visible truth, so a track on an aircraft too faint to be counted is not a false track;
     GOSPA is taken against the counted truths only (one too faint is not a missed target).
+    With ``coasting`` a track is matched on every row from its first confirmed one on (coasted
+    predictions included: the track exists there, as in Stone Soup's SIAP completeness), not only
+    on ``confirmed`` rows (``completeness_confirmed``). ``tracks_per_target``: distinct tracks
+    matched to each target over the run.
     """
     if counted is None:
         counted = truth.visible
     counted = np.asarray(counted, bool) & truth.visible
     counted_truth = Truth(truth.time_s, truth.range_m, truth.radial_velocity_mps, counted)
     labels = truth_segments(counted_truth, gap_s, min_duration_s, confirm)
-    all_rows = tracks
-    if "confirmed" in tracks.columns:
-        tracks = tracks[tracks["confirmed"].to_numpy(bool)]
-    matched, gospa_d = match_tracks(tracks, truth, pixel_size, doppler_width_mps, threshold_px, gospa_c_px)
+    all_rows, (tracks, confirmed_rows) = tracks, _scored_rows(tracks, coasting)
+    args = (pixel_size, doppler_width_mps, threshold_px, gospa_c_px)
+    matched, gospa_d = match_tracks(tracks, truth, *args)
     if not np.array_equal(counted, truth.visible):
-        gospa_d = match_tracks(
-            tracks, counted_truth, pixel_size, doppler_width_mps, threshold_px, gospa_c_px
-        )[1]
+        gospa_d = match_tracks(tracks, counted_truth, *args)[1]
     frag, switches, completeness, missed = _segment_counts(matched, labels)
+    completeness_confirmed = completeness
+    if coasting and len(confirmed_rows) != len(tracks):
+        completeness_confirmed = _segment_counts(match_tracks(confirmed_rows, truth, *args)[0], labels)[2]
     ids = np.unique(tracks["track_id"].to_numpy(np.int64))
     true_ids = np.unique(matched[matched >= 0])
     innov_cols = ["innovation_range_m", "innovation_radial_velocity_mps"]
@@ -352,6 +383,8 @@ def track_metrics(
         "id_switches": int(switches),
         "completeness": completeness,
         "missed_truth_tracks": int(missed),
+        "completeness_confirmed": completeness_confirmed,
+        "tracks_per_target": [int(np.unique(m[m >= 0]).size) for m in matched.T],
         "gospa_mean": float(gospa_d.mean()) if gospa_d.size else float("nan"),
         **innovation_stats(innov, pixel_size),
         "innov_mean_px_confirmed": confirmed_only["innov_mean_px"],

@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 
 from skyradar.config import RadarConfig
+from skyradar.track.frame_grid import frame_grid, frame_numbers
 from skyradar.track.fusion import fuse_heads, restore_detection_rows
 from skyradar.track.io import validate_detections, validate_ownship
 from skyradar.track.measure3d import angle_sigma_rad, position_covariance
@@ -29,7 +30,7 @@ TRACK_COLUMNS = [
     "lat_deg", "lon_deg", "alt_m",
     *[f"cov_pp_{i}{j}" for i in range(3) for j in range(3)],
     *[f"cov_vv_{i}{j}" for i in range(3) for j in range(3)],
-    *[f"cov_pv_{i}{j}" for i in range(3) for j in range(3)], "confirmed", "n_updates", "misses",
+    *[f"cov_pv_{i}{j}" for i in range(3) for j in range(3)], "confirmed", "n_updates", "misses", "coasted",
 ]  # fmt: skip
 _NED = ("north_m", "east_m", "down_m")
 OWNSHIP_COLUMNS = (
@@ -58,7 +59,8 @@ def empty_tracks() -> pd.DataFrame:
 
     # Integer row indices stay integer so that callers can index with them even when empty.
     def dtype(column: str) -> type:
-        return np.int64 if column in _INTEGER_COLUMNS else bool if column == "confirmed" else float
+        flags = ("confirmed", "coasted")
+        return np.int64 if column in _INTEGER_COLUMNS else bool if column in flags else float
 
     return pd.DataFrame({c: pd.Series(dtype=dtype(c)) for c in TRACK_COLUMNS}, columns=TRACK_COLUMNS)
 
@@ -106,10 +108,10 @@ def track_detections(
 ) -> pd.DataFrame:
     """Track a detections table; one output row per track per frame.
 
-    Rows of a track before its confirmation are kept (``confirmed`` False) for tracks that were
-    confirmed later; tentative tracks that never were are dropped. ``confirmed`` is also False on
-    rows where a confirmed track has coasted ``confirm_n`` frames or more without a detection (its
-    state is then an extrapolation; ``misses`` gives the count).
+    Rows of a track before its confirmation are kept (``confirmed`` False) for tracks confirmed
+    later; tentative tracks that never were are dropped. ``confirmed`` is also False on rows where a
+    confirmed track has coasted ``confirm_n`` frames or more (``misses``). ``coasted`` marks rows
+    without a detection of a track confirmed earlier (a prediction; the track exists until closed).
 
     Parameters
     ----------
@@ -159,12 +161,11 @@ def track_detections(
 def _run_tracker(tracker: RangeDopplerTracker, m3, detections: pd.DataFrame, grid, lo, hi) -> list[dict]:
     """Step the tracker (and the 3-D tracks) frame by frame; one dict of column arrays per frame."""
     z_all = detections[["range_m", "radial_velocity_mps"]].to_numpy(float)
-    frames_col = detections["frame"].to_numpy() if "frame" in detections.columns else None
+    frames = frame_numbers(grid, detections)
     chunks: list[dict[str, np.ndarray]] = []
     for k, (time_s, a, b) in enumerate(zip(grid, lo, hi, strict=True)):
         out = tracker.step(float(time_s), z_all[a:b])
-        frame = frames_col[a] if (frames_col is not None and b > a) else k
-        row = _frame_rows(tracker, out, time_s, frame, a)
+        row = _frame_rows(tracker, out, time_s, frames[k], a)
         row["reacquired"] = out.reacquired
         if m3.active:
             m3.t3.rename(out.reacquired[:, 0], out.reacquired[:, 1])
@@ -178,7 +179,8 @@ def _run_tracker(tracker: RangeDopplerTracker, m3, detections: pd.DataFrame, gri
 def _frame_rows(tracker: RangeDopplerTracker, out, time_s: float, frame: int, first_row: int) -> dict:
     """One frame's track rows (``out`` from :meth:`RangeDopplerTracker.step`) as column arrays."""
     n = out.track_id.size
-    misses = tracker.tracks["misses"][np.searchsorted(out.alive_ids, out.track_id)]
+    rows = np.searchsorted(out.alive_ids, out.track_id)
+    misses = tracker.tracks["misses"][rows]
     return {
         "time_s": np.full(n, time_s),
         "frame": np.full(n, frame, np.int64),
@@ -191,6 +193,8 @@ def _frame_rows(tracker: RangeDopplerTracker, out, time_s: float, frame: int, fi
         # A confirmed track coasting confirm_n frames is an extrapolation, no longer confirmed.
         "confirmed": out.confirmed & (misses < tracker.initiator.n),
         "misses": misses,
+        # A prediction only: the track was confirmed before and no detection was assigned to it now.
+        "coasted": (out.detection_index < 0) & tracker.tracks["was_confirmed"][rows],
     }
 
 
@@ -200,12 +204,15 @@ def track_air_detections(
     config: RadarConfig | None = None,
     origin: tuple[float, float, float] | None = None,
     ownship: pd.DataFrame | None = None,
+    run_times_s: np.ndarray | None = None,
 ) -> tuple[pd.DataFrame, int]:
     """Tracks of a ``skyradar process`` table without its ground and spur detections.
 
-    Every frame of the table counts (a frame whose detections are all ground is a miss), and
-    ``detection_row`` refers to the rows of ``detections``. Returns the tracks and the number of
-    detections tracked.
+    The tracker steps on every frame (:func:`skyradar.track.frame_grid.frame_grid`: the run's
+    times ``run_times_s`` when given, else the frames of the ``frame`` column, including frames
+    without any detection), so a frame without an air detection is a miss and coasting tracks keep
+    their rows. ``detection_row`` refers to the rows of ``detections``. Returns the tracks and the
+    number of detections tracked.
 
     Examples
     --------
@@ -216,7 +223,7 @@ def track_air_detections(
     >>> n_used, int(tracks.detection_row.max())
     (8, 7)
     """
-    frame_times = np.unique(detections["time_s"].to_numpy(float))
+    frame_times = frame_grid(detections, run_times_s)
     keep = np.ones(len(detections), bool)
     for flag in ("is_ground", "spur"):
         if flag in detections.columns:
@@ -327,6 +334,7 @@ def _assemble(
     cols["confirmed"] = cat("confirmed")
     cols["n_updates"] = cat("n_updates")
     cols["misses"] = cat("misses")
+    cols["coasted"] = cat("coasted")
     df = _relabel_reacquired(pd.DataFrame(cols, columns=TRACK_COLUMNS), cat("reacquired").reshape(-1, 2))
     # Tentative rows are kept only for tracks that were confirmed at some point: their early
     # updates belong to a real track, the rest is clutter that never became one.

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numba import njit
@@ -57,6 +58,22 @@ class ClutterSubspace:
     vectors: np.ndarray
     fractions: np.ndarray
     predicted: np.ndarray
+
+    @cached_property
+    def null_rows(self) -> np.ndarray:
+        """``E^H`` of the first ``n_rx - 1`` eigenvectors, (n_range, n_doppler, n_rx - 1, n_rx), complex64.
+
+        The rows a projection takes inner products with, contiguous per cell: the suppression
+        kernel reads 32 bytes per null instead of a strided column of ``vectors`` (computed once
+        per prediction, reused by every frame that shares the geometry).
+        """
+        rows = np.conj(np.swapaxes(self.vectors[..., :-1], -1, -2))
+        return np.ascontiguousarray(rows, np.complex64)
+
+    @cached_property
+    def free_cells(self) -> np.ndarray:
+        """Flat indices of the cells no ground direction reaches (where the noise floor is measured)."""
+        return np.flatnonzero(~self.predicted)
 
 
 @njit(cache=True)

@@ -9,11 +9,10 @@ heading-free frame, pitch, roll and height only, so it is cached on those, quant
 1-3 s. The terrain-following prediction (:func:`skyradar.process.clutter.clutter_subspace` with
 ``depth_fn``) is not used per frame: it would cost that for every few metres flown.
 
-:func:`directions_after_projection` estimates the direction of a detection whose cell was
-projected: the unit vector maximising ``|s^H P z|^2 / (s^H P s)`` (the projected matched filter)
-on a 2 deg grid over the field of view, refined on a 0.05 deg grid (+-1.5 deg); the plain phase
-estimate of the unsuppressed snapshot would follow the clutter that dominates the cell. With two nulls
-elevation is often unobservable (see the function).
+:func:`directions_after_projection` (home: :mod:`skyradar.process.clutter_doa`) estimates the
+direction of a detection whose cell was projected: the projected matched filter's best direction;
+the plain phase estimate of the unsuppressed snapshot would follow the clutter that dominates the
+cell. With two nulls elevation is often unobservable (see that module).
 
 Examples
 --------
@@ -37,14 +36,10 @@ from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.geo import rotation_matrix
 from skyradar.process.clutter import ClutterSubspace, clutter_subspace
+from skyradar.process.clutter_doa import directions_after_projection
 from skyradar.process.clutter_suppress import projected_snapshots, suppress_clutter
 from skyradar.process.detect import Detections, detect
-from skyradar.process.doa import (
-    direction_coherence,
-    direction_from_angles,
-    estimate_directions,
-    steering_vector,
-)
+from skyradar.process.doa import direction_coherence, estimate_directions, steering_vector
 
 __all__ = [
     "frame_subspace",
@@ -109,58 +104,7 @@ def frame_subspace(
     return sub
 
 
-def _grid(az_deg: np.ndarray, el_deg: np.ndarray) -> tuple[np.ndarray, tuple[int, int]]:
-    a, e = np.meshgrid(np.radians(az_deg), np.radians(el_deg), indexing="ij")
-    return direction_from_angles(a.ravel(), e.ravel()), a.shape
-
-
-_COARSE: dict[int, tuple[RadarConfig, np.ndarray, np.ndarray, tuple[int, int]]] = {}
 _PLANE_WAVE = 0.9  # unsuppressed coherence above which the plain DoA is kept in a projected cell
-_OBSERVABLE_DB = 1.0  # normalised score contrast along elevation below which elevation is unobservable
-
-
-def _coarse(config: RadarConfig) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
-    hit = _COARSE.get(id(config))
-    if hit is None or hit[0] is not config:
-        u, shape = _grid(np.arange(-70.0, 70.5, 2.0), np.arange(-70.0, 70.5, 2.0))
-        hit = (config, u, steering_vector(u, config), shape)
-        _COARSE.clear()
-        _COARSE[id(config)] = hit
-    return hit[1], hit[2], hit[3]
-
-
-def directions_after_projection(pixels: np.ndarray, proj: np.ndarray, config: RadarConfig) -> np.ndarray:
-    """Antenna-frame unit vectors (n, 3) of calibrated snapshots (n, n_rx) seen through ``proj``.
-
-    Where the nulls take the elevation dimension (a pair of clutter directions left and right at
-    one elevation spans both azimuth phases: the projected matched filter is flat in elevation
-    within ``_OBSERVABLE_DB``), elevation is unobservable in that cell and the detection is
-    placed in the antenna's horizontal plane (elevation 0, co-altitude for a level forward
-    radar): a prior, not a measurement; the azimuth is still measured.
-    """
-    out = np.zeros((len(pixels), 3))
-    u_c, s_c, shape = _coarse(config)
-    fine_off = np.arange(-1.5, 1.525, 0.05)
-    for n, (z, p) in enumerate(zip(pixels, proj, strict=True)):
-        score = _score(s_c, z, p).reshape(shape)
-        ia, ie = np.unravel_index(np.argmax(score), shape)
-        along_el = score[ia]
-        best = u_c[np.ravel_multi_index((ia, ie), shape)]
-        az, el = np.degrees(np.arctan2(best[1], best[0])), np.degrees(np.arcsin(-best[2]))
-        if 10 * np.log10(along_el.max() / max(np.median(along_el), 1e-300)) < _OBSERVABLE_DB:
-            fine, _ = _grid(az + fine_off, np.zeros(1))
-        else:
-            fine, _ = _grid(az + fine_off, el + fine_off)
-        out[n] = fine[np.argmax(_score(steering_vector(fine, config), z, p))]
-    return out
-
-
-def _score(steer: np.ndarray, z: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """Projected matched filter ``|s^H P z|^2 / (s^H P s)`` for rows ``s`` of ``steer``."""
-    # einsum, not @: these thin complex products are 10x slower through BLAS on a busy machine.
-    ps = np.einsum("nk,lk->nl", steer, p)  # rows: (P s)^T, P Hermitian
-    num = np.abs(np.einsum("nk,k->n", np.conj(ps), z.astype(ps.dtype))) ** 2
-    return num / np.maximum(np.einsum("nk,nk->n", ps, np.conj(ps)).real, 1e-9)
 
 
 def detect_suppressed(

@@ -37,7 +37,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 from numba import njit
 from scipy.special import gammaincinv
@@ -81,7 +80,9 @@ class Suppressed:
 _GAMMA_MEDIAN = np.array([np.nan, *(gammaincinv(n, 0.5) / n for n in range(1, 9))])
 
 
-def measured_floor(raw: np.ndarray, predicted: np.ndarray, nominal_w: float, n_rx: int = 4) -> float:
+def measured_floor(
+    raw: np.ndarray, predicted: np.ndarray, nominal_w: float, n_rx: int = 4, free: np.ndarray | None = None
+) -> float:
     """Thermal noise per pixel of one frame, W, measured where no ground can be.
 
     The median of the channel-mean image over the cells no ground direction reaches (nearer than
@@ -89,26 +90,12 @@ def measured_floor(raw: np.ndarray, predicted: np.ndarray, nominal_w: float, n_r
     a few targets. The window point-spread of a real (or ``psf``-simulated) chain raises the noise
     per pixel above ``nominal_w`` (``RadarConfig.noise_power_w``, +3.5 dB for Hann x Hann), so the
     floor is measured, not assumed; with fewer than 2000 such cells ``nominal_w`` is used.
+    ``free`` (flat indices of ``~predicted``, :attr:`ClutterSubspace.free_cells`) saves the mask.
     """
-    free = raw[~predicted]
-    if free.size < 2000:
+    values = raw.ravel()[free] if free is not None else raw[~predicted]
+    if values.size < 2000:
         return float(nominal_w)
-    return float(np.median(free) / _GAMMA_MEDIAN[min(max(n_rx, 1), 8)])
-
-
-def _local_cnr(power: np.ndarray, noise_power_w: float) -> np.ndarray:
-    """Largest clutter-to-noise ratio 2-3 Doppler bins either side (wrapping), over 3 range bins.
-
-    The maximum, not the mean: simulated and real ground fills the image as a comb of bright
-    pixels (facets, speckle). The cell itself and its first Doppler neighbours are left out: a
-    point target's Hann main lobe ends two bins away, ground spreads along Doppler, so a target
-    in clear sky does not make its own cell look cluttered.
-    """
-    padded = np.concatenate([power[:, -3:], power, power[:, :3]], axis=1).astype(np.float32, copy=False)
-    ring = np.ones((3, 7), np.uint8)
-    ring[:, 2:5] = 0
-    top = cv2.dilate(padded, ring)[:, 3:-3]
-    return np.maximum(top * np.float32(1.0 / noise_power_w) - np.float32(1.0), np.float32(0.0))
+    return float(np.median(values) / _GAMMA_MEDIAN[min(max(n_rx, 1), 8)])
 
 
 def null_count(
@@ -178,22 +165,16 @@ def suppress_clutter(
     cube = np.asarray(cube)
     if cube.shape != subspace.predicted.shape + (config.n_rx,):
         raise InputError(f"suppression: frame shape {cube.shape} does not fit the clutter prediction")
-    raw = power_image(cube, config.rx_calibration)
-    floor = measured_floor(raw, subspace.predicted, config.noise_power_w)
-    ring = _local_cnr(raw, floor)
-    own = raw * np.float32(1.0 / floor) - np.float32(1.0)
-    # A cell brighter than gate counts as clutter too, unless it stands 6 dB above everything 2-3
-    # Doppler bins away while they are quiet: that is a point target, not ground.
-    peak = (ring <= gate) & (own + 1.0 > 4.0 * (ring + 1.0))
-    cnr = np.where(peak, ring, np.maximum(ring, own)).astype(np.float32)
     if not 0 <= max_nulls < config.n_rx:
         raise InputError(f"suppression: field 'max_nulls' must be in [0, {config.n_rx - 1}], got {max_nulls}")
+    raw = power_image(cube, config.rx_calibration)
+    floor = measured_floor(raw, subspace.predicted, config.noise_power_w, config.n_rx, subspace.free_cells)
     power, nulls = np.empty(raw.shape, np.float32), np.empty(raw.shape, np.int8)
-    unsuppressed = np.empty(raw.shape, np.bool_)
+    unsuppressed, cnr = np.empty(raw.shape, np.bool_), np.empty(raw.shape, np.float32)
     inv_gain = (1.0 / np.asarray(config.rx_calibration)).astype(np.complex64)
     z = np.ascontiguousarray(cube, np.complex64)
-    rule = (np.int64(max_nulls), np.float32(gate), np.float32(_RESIDUAL))
-    _fused(z, raw, inv_gain, subspace.fractions, subspace.vectors, cnr, *rule, power, nulls, unsuppressed)
+    rule = (np.float32(1.0 / floor), np.int64(max_nulls), np.float32(gate), np.float32(_RESIDUAL))
+    _fused(z, raw, inv_gain, subspace.fractions, subspace.null_rows, *rule, power, nulls, unsuppressed, cnr)
     channels = (config.n_rx - nulls).astype(np.int8)
     return Suppressed(power, channels, unsuppressed, nulls, cnr, floor)
 
@@ -201,21 +182,55 @@ def suppress_clutter(
 _RESIDUAL = 0.25  # predicted clutter left after the nulls, in units of the noise (null_count's default)
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True)
+def _ring_max(raw, top):  # pragma: no cover - compiled
+    # Largest pixel over 3 range rows (range edges: the rows there are) at Doppler offsets -3, -2,
+    # +2, +3 (wrapping), separably (column maxima first). The maximum, not the mean: simulated and
+    # real ground fills the image as a comb of bright pixels (facets, speckle). The cell itself and
+    # its first Doppler neighbours are left out: a point target's Hann main lobe ends two bins
+    # away, ground spreads along Doppler, so a target in clear sky does not make its own cell look
+    # cluttered.
+    n_r, n_d = raw.shape
+    col = np.empty((n_r, n_d), np.float32)
+    for r in range(n_r):
+        for d in range(n_d):
+            m = raw[r, d]
+            if r > 0:
+                m = max(m, raw[r - 1, d])
+            if r < n_r - 1:
+                m = max(m, raw[r + 1, d])
+            col[r, d] = m
+    for r in range(n_r):
+        for d in range(n_d):
+            a = max(col[r, (d - 3) % n_d], col[r, (d - 2) % n_d])
+            top[r, d] = max(a, max(col[r, (d + 2) % n_d], col[r, (d + 3) % n_d]))
+    return top
+
+
+@njit(cache=True)
 def _fused(
-    cube, raw, inv_gain, fractions, vectors, cnr, max_nulls, gate, residual, power, nulls, unsuppressed
-):  # noqa: E501
-    # null_count and projected_power in one pass over the cells (same rules; tests compare them).
+    cube, raw, inv_gain, fractions, rows, inv_floor, max_nulls, gate, residual,  # inputs
+    power, nulls, unsuppressed, cnr,  # outputs
+):  # pragma: no cover - compiled  # fmt: skip
+    # The clutter level (ring and peak rule), null_count and projected_power in one pass over the
+    # cells (same rules as those functions; tests compare them). Only the m <= max_nulls rows of
+    # E^H a cell needs are read, contiguously (ClutterSubspace.null_rows).
     n_r, n_d, n_k = cube.shape
+    one, zero, four = np.float32(1.0), np.float32(0.0), np.float32(4.0)
+    top = _ring_max(raw, np.empty((n_r, n_d), np.float32))
     z = np.empty(n_k, np.complex64)
     for r in range(n_r):
         for d in range(n_d):
-            c = cnr[r, d]
+            ring = max(top[r, d] * inv_floor - one, zero)
+            own = raw[r, d] * inv_floor - one
+            # A cell brighter than gate counts as clutter too, unless it stands 6 dB above everything
+            # 2-3 Doppler bins away while they are quiet: that is a point target, not ground.
+            c = ring if (ring <= gate and own + one > four * (ring + one)) else max(ring, own)
+            cnr[r, d] = c
             m = 0
             left = c
             if c > gate and fractions[r, d, 0] > 0:
                 cum = 0.0
-                m = 1
                 for i in range(max_nulls):
                     cum += fractions[r, d, i]
                     left = c * max(1.0 - cum, 0.0)
@@ -229,7 +244,7 @@ def _fused(
             for i in range(m):
                 acc = 0j
                 for k in range(n_k):
-                    acc += np.conj(vectors[r, d, k, i]) * z[k]
+                    acc += rows[r, d, i, k] * z[k]
                 total -= acc.real * acc.real + acc.imag * acc.imag
             nulls[r, d] = m
             unsuppressed[r, d] = left > 1.0

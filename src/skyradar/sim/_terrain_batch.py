@@ -61,6 +61,12 @@ def _normal(u, w, e1, e2, e3, up):
 
 
 @njit(**_OPTS)
+def _scale_row(x, factor):
+    for m in range(x.shape[0]):
+        x[m] *= factor
+
+
+@njit(**_OPTS)
 def _area_row(area, us, ws, e1, e2, e3, up):
     for m in range(area.shape[0]):
         nx, ny, nz = _normal(us[m], ws[m], e1, e2, e3, up)
@@ -169,9 +175,9 @@ def _gain_refl_rows(gain_, refl_, fy_, fz_, cos_inc, gain2, refl_table):
 
 
 @njit(**_OPTS)
-def _amplitude_row(amp, gain_, refl_, area, rng_, power_const, n_sub_total):
+def _amplitude_row(amp, gain_, refl_, area, rng_, power_const):
     for m in range(amp.shape[0]):
-        power = power_const * gain_[m] * refl_[m] * area[m] / n_sub_total
+        power = power_const * gain_[m] * refl_[m] * area[m]
         amp[m] = math.sqrt(max(power, 0.0)) / (rng_[m] * rng_[m])
 
 
@@ -201,6 +207,7 @@ def cell_geometry(s, k, ta, tn, us, ws, up, use_horizon):
     area = s[_AREA][k : k + n]
     _area_row(area, us, ws, e1, e2, e3, upt)
     _cos_inc_row(s[_COS_INC][k : k + n], us, ws, x_, y_, z_, r0_, area, e1, e2, e3, upt)
+    _scale_row(area, 1.0 / n)  # area per unit (u, w) -> the sub-facet's area
     if use_horizon:
         for c, row in ((0, s[_N][k : k + n]), (1, s[_E][k : k + n]), (2, s[_D][k : k + n])):
             _patch_row(row, us, ws, tn[0, c], tn[1, c], tn[2, c], tn[3, c])
@@ -222,7 +229,7 @@ def cell_geometry_scalar(s, k, ta, tn, us, ws, up, use_horizon):
         r0 = math.sqrt(x * x + y * y + z * z)
         nx, ny, nz = _normal(u, w, e1, e2, e3, upt)
         area = math.sqrt(nx * nx + ny * ny + nz * nz)
-        s[_X, i], s[_Y, i], s[_Z, i], s[_R0, i], s[_AREA, i] = x, y, z, r0, area
+        s[_X, i], s[_Y, i], s[_Z, i], s[_R0, i], s[_AREA, i] = x, y, z, r0, area / us.shape[0]
         s[_COS_INC, i] = -(nx * x + ny * y + nz * z) / (area * r0 + 1e-300)
         if use_horizon:
             s[_N, i], s[_E, i], s[_D, i] = _point(tn, u, w, 0), _point(tn, u, w, 1), _point(tn, u, w, 2)
@@ -235,13 +242,13 @@ def _point(t, u, w, c):
 
 @njit(error_model="numpy")
 def item_returns(s, n, tx, rx, r_rx, cos_sin, v_ground, r_max, d_range, d_vel, coupling, n_range, n_dopp,
-                 inv_wavelength, power_const, n_sub_cell, gain2, gain2_step, refl_table, horizon, az_bin_rad,
+                 inv_wavelength, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad,
                  h_bin_m, use_horizon):  # fmt: skip
     """Validity, pixel (range, Doppler) as floats, amplitude and per-receiver (cos, sin) of items.
 
     Reads the geometry rows of the first ``n`` items of ``s``; writes their _VALID, _KR, _KD,
-    _AMP rows and ``cos_sin`` (2, n_rx, >= n); ``r_rx`` (n_rx, >= n) is scratch. Power is per
-    sub-facet of a cell of ``n_sub_cell``.
+    _AMP rows and ``cos_sin`` (2, n_rx, >= n); ``r_rx`` (n_rx, >= n) is scratch. The _AREA row
+    holds each sub-facet's own area.
     """
     x_, y_, z_, r0_ = s[_X][:n], s[_Y][:n], s[_Z][:n], s[_R0][:n]
     r_tx, rsum, rng_, v_r_ = s[_RTX][:n], s[_RSUM][:n], s[_RNG][:n], s[_VR][:n]
@@ -268,7 +275,7 @@ def item_returns(s, n, tx, rx, r_rx, cos_sin, v_ground, r_max, d_range, d_vel, c
     # The gain and reflectivity factors land in the _N and _E rows, free after the horizon test.
     gain_, refl_ = s[_N][:n], s[_E][:n]
     _gain_refl_rows(gain_, refl_, tmp0, tmp1, cos_inc, gain2, refl_table)
-    _amplitude_row(s[_AMP][:n], gain_, refl_, s[_AREA][:n], rng_, power_const, float(n_sub_cell))
+    _amplitude_row(s[_AMP][:n], gain_, refl_, s[_AREA][:n], rng_, power_const)
     for q in range(rx.shape[0]):
         _phase_rows(cos_sin[0, q][:n], cos_sin[1, q][:n], r_tx, r_rx[q][:n], inv_wavelength)
 

@@ -25,9 +25,11 @@ from skyradar.sim._terrain_batch import (
     number_items,
     scatter_items,
 )
+from skyradar.sim.facets import cell_counts
 
 __all__ = [
     "add_sparse",
+    "cell_count_grid",
     "cis_cycles",
     "fast_atan2",
     "relative_points",
@@ -223,9 +225,27 @@ def rotate_points(points, rot, out):
     return out
 
 
+@njit(cache=True, error_model="numpy")
+def cell_count_grid(p_ant, v_ground_ant, counts, adapt, r_max):
+    """Sub-facets per axis (ny - 1, nx - 1, 2) that ``terrain_returns`` cuts each cell into (0: culled)."""
+    out = np.zeros((p_ant.shape[0] - 1, p_ant.shape[1] - 1, 2), np.int64)
+    n0, n1, n2, n3 = counts[0], counts[1], counts[2], counts[3]
+    for i in range(p_ant.shape[0] - 1):
+        for j in range(p_ant.shape[1] - 1):
+            if not (_cell_behind(p_ant, i, j) or _cell_beyond(p_ant, i, j, r_max)):
+                out[i, j] = cell_counts(p_ant, i, j, v_ground_ant, n0, n1, n2, n3, adapt)
+    return out
+
+
+@njit(inline="always")
+def _sub_centres(us, ws, nu, nw):
+    for m in range(nu * nw):
+        us[m], ws[m] = (m // nw + 0.5) / nu, (m % nw + 0.5) / nw
+
+
 @njit(parallel=True, cache=True, fastmath=True, error_model="numpy")
 def terrain_returns(
-    p_ned, p_ant, up_ant, tx, rx, v_ground_ant, nsub_r, nsub_c, wavelength, d_range, d_vel, coupling,
+    p_ned, p_ant, up_ant, tx, rx, v_ground_ant, counts, adapt, wavelength, d_range, d_vel, coupling,
     power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m, use_horizon, n_blocks, out,
     sparse, mode, speckle_key,
 ):  # fmt: skip
@@ -235,65 +255,76 @@ def terrain_returns(
     antenna phase centre in NED and in the antenna frame (m); ``up_ant`` is the local up
     direction in the antenna frame; ``tx``/``rx`` are antenna positions in the antenna frame;
     ``v_ground_ant`` is the velocity of the static ground relative to the radar in the antenna
-    frame. ``power_const`` is Pe * lambda^2 / (4 pi)^3. ``gain2`` is the two-way linear gain
-    G^2 on a regular grid of antenna-frame direction cosines (u_y, u_z) over [-1, 1]^2 with
-    spacing ``gain2_step``. ``sparse`` is (idx, val, count): with ``idx`` of shape (n_blocks, cap)
-    and cap > 0 contributions are recorded there instead of added to ``out`` (see
-    :func:`add_sparse`). ``mode`` 1 runs the vectorised batches of ``_terrain_batch``, 0 the
-    scalar loop below, one sub-facet at a time (the same physics term for term: the reference
-    the batches are tested against). ``speckle_key`` not 0 multiplies every sub-facet by its own
-    unit-power complex Gaussian drawn from that key and its number (batched mode only).
-    ``fastmath`` is safe here: every input is finite.
+    frame. ``counts`` (n_min_r, n_min_c, n_max_r, n_max_c) and ``adapt`` are the sub-facet rule
+    (:class:`skyradar.sim.facets.FacetRule`). ``power_const`` is Pe * lambda^2 / (4 pi)^3.
+    ``gain2`` is the two-way linear gain G^2 on a regular grid of antenna-frame direction
+    cosines (u_y, u_z) over [-1, 1]^2 with spacing ``gain2_step``. ``sparse`` is (idx, val,
+    count): with ``idx`` of shape (n_blocks, cap) and cap > 0 contributions are recorded there
+    instead of added to ``out`` (see :func:`add_sparse`). ``mode`` 1 runs the vectorised
+    batches of ``_terrain_batch``, 0 the scalar loop below, one sub-facet at a time (the same
+    physics term for term: the reference the batches are tested against). ``speckle_key`` not
+    0 multiplies every sub-facet by its own unit-power complex Gaussian drawn from that key and
+    its number (batched mode only). ``fastmath`` is safe here: every input is finite.
     """
     ny, nx = p_ned.shape[0], p_ned.shape[1]
     n_range, n_dopp = out.shape[1], out.shape[2]
     r_max = d_range * (n_range + 2)
-    n_sub = nsub_r * nsub_c
-    batched = mode == 1
-    # Cells are gathered into batches of up to 512 sub-facets (one cell at least), by row.
-    per_cell = n_sub >= 8  # then the cell's own geometry loops are long enough to vectorise
-    cap = max(n_sub, 512) if batched else 0
-    us, ws = np.empty(n_sub), np.empty(n_sub)
-    for m in range(n_sub):
-        us[m], ws[m] = (m // nsub_c + 0.5) / nsub_r, (m % nsub_c + 0.5) / nsub_c
+    n_min_r, n_min_c, n_max_r, n_max_c = counts
+    n_cell_max = n_max_r * n_max_c
+    # Cells are gathered into batches of up to max(512, one cell) sub-facets, by row.
+    cap = max(n_cell_max, 512) if mode == 1 else 0
     inv_wl = 1.0 / wavelength
     for blk in prange(n_blocks):
         ta, tn, r_rx = np.empty((4, 3)), np.empty((4, 3)), np.empty(rx.shape[0])
+        us, ws = np.empty(n_cell_max), np.empty(n_cell_max)
         scratch = np.zeros((CELL_FIELDS, cap))
         r_rx_sub, cos_sin = np.empty((rx.shape[0], cap)), np.empty((2, rx.shape[0], cap), np.float32)
         k = 0  # items in the batch
         for i in range(blk, ny - 1, n_blocks):  # interleaved rows: blocks share the work evenly
             for j in range(nx - 1):
-                skip = _cell_behind(p_ant, i, j) or _cell_beyond(p_ant, i, j, r_max)
-                if not skip:
-                    _corner_terms(p_ant, i, j, ta)
-                    if use_horizon:
-                        _corner_terms(p_ned, i, j, tn)
-                if batched:
-                    if not skip:
-                        if per_cell:
-                            cell_geometry(scratch, k, ta, tn, us, ws, up_ant, use_horizon)
-                        else:
-                            cell_geometry_scalar(scratch, k, ta, tn, us, ws, up_ant, use_horizon)
-                        number_items(scratch, k, float((i * (nx - 1) + j) * n_sub), n_sub)
-                        k += n_sub
-                    # The batch is full, or the block's last cell is done: into the cube.
-                    if k > 0 and (k + n_sub > cap or (j == nx - 2 and i + n_blocks >= ny - 1)):
-                        item_returns(
-                            scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel,
-                            coupling, n_range, n_dopp, inv_wl, power_const, n_sub, gain2, gain2_step,
-                            refl_table, horizon, az_bin_rad, h_bin_m, use_horizon,
-                        )  # fmt: skip
-                        scatter_items(out, sparse, blk, scratch, cos_sin, k, speckle_key)
-                        k = 0
+                if _cell_behind(p_ant, i, j) or _cell_beyond(p_ant, i, j, r_max):
                     continue
-                if skip:
+                nu, nw = cell_counts(p_ant, i, j, v_ground_ant, n_min_r, n_min_c, n_max_r, n_max_c, adapt)
+                n_sub = nu * nw
+                _sub_centres(us, ws, nu, nw)
+                _corner_terms(p_ant, i, j, ta)
+                if use_horizon:
+                    _corner_terms(p_ned, i, j, tn)
+                if mode != 1:
+                    _reference_cell(
+                        ta, tn, up_ant, tx, rx, r_rx, v_ground_ant, nu, nw, wavelength, d_range, d_vel,
+                        coupling, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m,
+                        use_horizon, r_max, out, sparse, blk,
+                    )  # fmt: skip
                     continue
-                _reference_cell(
-                    ta, tn, up_ant, tx, rx, r_rx, v_ground_ant, nsub_r, nsub_c, wavelength, d_range, d_vel,
-                    coupling, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m,
-                    use_horizon, r_max, out, sparse, blk,
-                )  # fmt: skip
+                if k + n_sub > cap:  # the batch is full: into the cube first
+                    _flush(scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel,
+                           coupling, n_range, n_dopp, inv_wl, power_const, gain2, gain2_step, refl_table,
+                           horizon, az_bin_rad, h_bin_m, use_horizon, out, sparse, blk,
+                           speckle_key)  # fmt: skip
+                    k = 0
+                if n_sub >= 8:  # then the cell's own geometry loops are long enough to vectorise
+                    cell_geometry(scratch, k, ta, tn, us[:n_sub], ws[:n_sub], up_ant, use_horizon)
+                else:
+                    cell_geometry_scalar(scratch, k, ta, tn, us[:n_sub], ws[:n_sub], up_ant, use_horizon)
+                number_items(scratch, k, float((i * (nx - 1) + j) * n_cell_max), n_sub)
+                k += n_sub
+        if k > 0:  # the block's last batch
+            _flush(scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel, coupling,
+                   n_range, n_dopp, inv_wl, power_const, gain2, gain2_step, refl_table, horizon,
+                   az_bin_rad, h_bin_m, use_horizon, out, sparse, blk, speckle_key)  # fmt: skip
+
+
+@njit(inline="always")
+def _flush(scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel, coupling, n_range,
+           n_dopp, inv_wl, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m,
+           use_horizon, out, sparse, blk, speckle_key):  # fmt: skip
+    item_returns(
+        scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel, coupling, n_range,
+        n_dopp, inv_wl, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m,
+        use_horizon,
+    )  # fmt: skip
+    scatter_items(out, sparse, blk, scratch, cos_sin, k, speckle_key)
 
 
 @njit(inline="always")

@@ -36,6 +36,7 @@ from skyradar.sim._terrain_kernel import (
     rotate_points,
     terrain_returns,
 )
+from skyradar.sim.facets import facet_rule
 from skyradar.sim.geometry import AntennaGeometry, PlatformState, PointTarget, TerrainView
 from skyradar.sim.psf import apply_psf, enbw, frame_options, psf_kernels, speckle_key
 from skyradar.sim.targets import add_targets, line_of_sight, swerling1_power, target_geometry
@@ -90,6 +91,9 @@ class ImageSimulator:
         Each terrain sub-facet times a unit-power complex Gaussian, new every frame.
     swerling : {0, 1}
         Target RCS constant (0) or exponential, independent per frame and target (1).
+    adaptive_facets : bool, optional
+        Cut each DEM cell by its own range and Doppler extent (:mod:`skyradar.sim.facets`)
+        instead of by ground size. Default: on with ``psf``, off without it.
 
     Examples
     --------
@@ -118,6 +122,7 @@ class ImageSimulator:
         psf: bool = False,
         speckle: bool = False,
         swerling: int = 0,
+        adaptive_facets: bool | None = None,
     ) -> None:
         self.config = config
         self.terrain = terrain
@@ -152,6 +157,8 @@ class ImageSimulator:
                 max(1, int(np.ceil(dx / self.facet_size_m))),
             )
             self._facet_m = max(dy / self._nsub[0], dx / self._nsub[1])
+            adaptive = self.psf if adaptive_facets is None else bool(adaptive_facets)
+            self._facets = facet_rule(config, self._spacing_m, self.facet_size_m, adaptive)
 
     # ---- geometry ---------------------------------------------------------------------------
     def geometry(self, platform: PlatformState) -> AntennaGeometry:
@@ -296,16 +303,14 @@ class ImageSimulator:
     def _sparse_suits(self, view: TerrainView) -> bool:
         # Few facets (DEM spacing): a list of contributions beats clearing per-thread cubes.
         ny, nx = view.p_ned.shape[:2]
-        return (ny - 1) * (nx - 1) * self._nsub[0] * self._nsub[
-            1
-        ] <= self.config.n_range * self.config.n_doppler
+        return (ny - 1) * (nx - 1) * self._facets.per_cell_max <= self.config.n_range * self.config.n_doppler
 
     def _sparse_buffers(
         self, view: TerrainView, scratch: dict | None = None
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         n_blocks = get_num_threads()
         ny, nx = view.p_ned.shape[:2]
-        cap = -(-(ny - 1) // n_blocks) * (nx - 1) * self._nsub[0] * self._nsub[1]
+        cap = -(-(ny - 1) // n_blocks) * (nx - 1) * self._facets.per_cell_max
         return (
             _array(scratch, "sparse_idx", (n_blocks, cap), np.int64),
             _array(scratch, "sparse_val", (n_blocks, cap, self.config.n_rx), np.complex64),
@@ -329,7 +334,7 @@ class ImageSimulator:
         v_ground = rot @ (-geom.velocity_ned_mps)
         terrain_returns(
             view.p_ned, p_ant, -rot[:, 2], cfg.tx_position_m, cfg.rx_positions_m, v_ground,
-            self._nsub[0], self._nsub[1], cfg.wavelength_m, cfg.range_resolution_m / n,
+            self._facets.counts, self._facets.adapt, cfg.wavelength_m, cfg.range_resolution_m / n,
             cfg.doppler_resolution_mps / n, self.coupling_s, power_const, self._gain2, self._gain2_step,
             self._refl_table, view.horizon, view.az_bin_rad, view.h_bin_m, self.occlusion,
             blocks.shape[0] or sparse[0].shape[0], blocks, sparse, self._kernel_mode, speckle,

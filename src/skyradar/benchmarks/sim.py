@@ -40,6 +40,7 @@ import numpy as np
 
 from skyradar.config import RadarConfig
 from skyradar.geo import geodetic_to_ned
+from skyradar.sim._terrain_kernel import cell_count_grid
 from skyradar.sim.geometry import AntennaGeometry
 from skyradar.sim.image import ImageSimulator, PlatformState, _reflectivity_table, two_way_gain_table
 from skyradar.units import nearest_bin
@@ -242,15 +243,21 @@ def benchmark_tile(directory: Path, seed: int = 0):
 
 def _time_frames(fn, n_frames: int, min_seconds: float) -> float:
     """Frames/s from the median frame time after one warm-up frame (numba compile, caches)."""
+    return _time_frames_cpu(fn, n_frames, min_seconds)[0]
+
+
+def _time_frames_cpu(fn, n_frames: int, min_seconds: float) -> tuple[float, float]:
+    """Frames/s (median wall time) and the median CPU-ms per frame, all threads (process time)."""
     fn(0)
-    times, start = [], time.perf_counter()
+    times, cpu, start = [], [], time.perf_counter()
     while len(times) < n_frames or time.perf_counter() - start < min_seconds:
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         fn(len(times) + 1)
         times.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
         if time.perf_counter() - start > 10 * max(min_seconds, 1.0):
             break
-    return 1.0 / float(np.median(times))
+    return 1.0 / float(np.median(times)), 1e3 * float(np.median(cpu))
 
 
 def _baseline_fps(config, terrain, origin, geometry, n_frames, baseline_frames, min_seconds) -> tuple:
@@ -269,6 +276,17 @@ def _baseline_fps(config, terrain, origin, geometry, n_frames, baseline_frames, 
         lambda i: numpy_baseline_frame(terrain, grid, geometry(i), physics, rng), n_frames, min_seconds
     )
     return fps_thesis, fps_numpy
+
+
+def _sub_facets(sim: ImageSimulator, platform: PlatformState) -> int:
+    """Sub-facets the simulator cuts the terrain in view into for one frame (cells culled whole: 0)."""
+    geom = sim.geometry(platform)
+    p_ant = np.ascontiguousarray(sim.terrain_view(geom).p_ned @ geom.rot_ned_to_ant.T)
+    v_ground = geom.rot_ned_to_ant @ -geom.velocity_ned_mps
+    rule, cfg = sim._facets, sim.config
+    r_max = cfg.range_resolution_m * (cfg.n_range + 2)  # the kernel's
+    counts = cell_count_grid(p_ant, v_ground, np.array(rule.counts), rule.adapt, r_max)
+    return int(np.prod(counts, axis=-1).sum())
 
 
 def run(n_frames: int = 40, baseline_frames: int = 6, min_seconds: float = 2.0) -> dict[str, Any]:
@@ -292,16 +310,24 @@ def run(n_frames: int = 40, baseline_frames: int = 6, min_seconds: float = 2.0) 
     def ours_fps(sim: ImageSimulator, n: int) -> float:
         return _time_frames(lambda i: sim.frame(platform(i), frame_index=i, out=buffer), n, min_seconds)
 
+    def ours_cpu(sim: ImageSimulator, n: int) -> tuple[float, float]:
+        return _time_frames_cpu(lambda i: sim.frame(platform(i), frame_index=i, out=buffer), n, min_seconds)
+
     same = ImageSimulator(
         config, terrain, origin, facet_size_m=float("inf"), occlusion=False, flat_earth=True
     )
     full = ImageSimulator(config, terrain, origin, facet_size_m=float("inf"), seed=1)
     fine = ImageSimulator(config, terrain, origin, seed=1)
-    # Clutter as the radar sees it (issue 12.1): the windows' point-spread and speckle on.
+    # Clutter as the radar sees it (issue 12.1): the windows' point-spread and speckle on, cells
+    # cut by their range and Doppler extent (the default with psf), and by ground size as before.
     fine_psf = ImageSimulator(config, terrain, origin, seed=1, psf=True, speckle=True)
+    uniform_psf = ImageSimulator(
+        config, terrain, origin, seed=1, psf=True, speckle=True, adaptive_facets=False
+    )
     fps, fps_full = ours_fps(same, n_frames), ours_fps(full, n_frames)
     fps_fine = ours_fps(fine, max(3, n_frames // 4))
-    fps_fine_psf = ours_fps(fine_psf, max(3, n_frames // 4))
+    fps_fine_psf, cpu_fine_psf = ours_cpu(fine_psf, max(3, n_frames // 4))
+    fps_uniform_psf, cpu_uniform_psf = ours_cpu(uniform_psf, max(3, n_frames // 4))
 
     ours_geometry = (config, terrain, origin, lambda i: same.geometry(platform(i)))
     fps_thesis, fps_numpy = _baseline_fps(*ours_geometry, n_frames, baseline_frames, min_seconds)
@@ -321,7 +347,15 @@ def run(n_frames: int = 40, baseline_frames: int = 6, min_seconds: float = 2.0) 
         "frames_per_s_fine_psf": fps_fine_psf,
         "fine_psf_vs_fine": fps_fine_psf / fps_fine,
         "fine_psf_x_field_rate": fps_fine_psf / FIELD_RATE_HZ,
-        "fine_psf": "facets <= dR/2, exact geodesy, occlusion, Hann x Hann point-spread, speckle (ours only)",
+        "fine_psf_cpu_ms_per_frame": cpu_fine_psf,
+        "fine_psf": "sub-facets <= dR/2 in range and <= half a Doppler bin (cut per cell by its extent), "
+        "exact geodesy, occlusion, Hann x Hann point-spread, speckle (ours only)",
+        "sub_facets_per_frame_fine_psf": _sub_facets(fine_psf, platform(0)),
+        "frames_per_s_fine_psf_uniform": fps_uniform_psf,
+        "fine_psf_uniform_cpu_ms_per_frame": cpu_uniform_psf,
+        "sub_facets_per_frame_fine_psf_uniform": _sub_facets(uniform_psf, platform(0)),
+        "fine_psf_vs_uniform": fps_fine_psf / fps_uniform_psf,
+        "fine_psf_uniform": "as fine_psf, every cell cut into facets <= dR/2 on the ground (the rule before)",
         "full_physics": "exact WGS84 geodesy and occlusion (ours only; no baseline ratio)",
         "thesis_code_frames_per_s": THESIS_FRAMES_PER_S,
         "speedup_vs_thesis_code": fps / THESIS_FRAMES_PER_S,

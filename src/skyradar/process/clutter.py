@@ -59,16 +59,21 @@ class ClutterSubspace:
     fractions: np.ndarray
     predicted: np.ndarray
 
-    @cached_property
-    def null_rows(self) -> np.ndarray:
-        """``E^H`` of the first ``n_rx - 1`` eigenvectors, (n_range, n_doppler, n_rx - 1, n_rx), complex64.
+    def null_rows(self, inv_gain: np.ndarray) -> np.ndarray:
+        """``E^H diag(inv_gain)``, first ``n_rx - 1`` eigenvectors: (n_range, n_doppler, n_rx - 1, n_rx).
 
-        The rows a projection takes inner products with, contiguous per cell: the suppression
-        kernel reads 32 bytes per null instead of a strided column of ``vectors`` (computed once
-        per prediction, reused by every frame that shares the geometry).
+        The rows a projection of an uncalibrated snapshot takes inner products with (the channel
+        calibration folded in), contiguous per cell, complex64: the suppression kernel reads 32
+        bytes per null instead of a strided column of ``vectors``. Computed once per prediction
+        and calibration, reused by every frame that shares them.
         """
-        rows = np.conj(np.swapaxes(self.vectors[..., :-1], -1, -2))
-        return np.ascontiguousarray(rows, np.complex64)
+        key = np.asarray(inv_gain, np.complex64).tobytes()
+        cache = self.__dict__.setdefault("_null_rows", {})
+        if key not in cache:
+            rows = np.conj(np.swapaxes(self.vectors[..., :-1], -1, -2)) * np.asarray(inv_gain, np.complex64)
+            cache.clear()  # one calibration per radar head: keep the latest only
+            cache[key] = np.ascontiguousarray(rows, np.complex64)
+        return cache[key]
 
     @cached_property
     def free_cells(self) -> np.ndarray:

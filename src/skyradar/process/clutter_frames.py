@@ -4,10 +4,11 @@
 :mod:`skyradar.process.pipeline`: velocity, attitude, height above ground) into the predicted
 clutter subspace over flat ground at the own-ship's height above the ground below it (from the
 navigation, else from the terrain under the own-ship). It depends on the velocity in a
-heading-free frame, pitch, roll and height only, so it is cached on those, quantised (0.25 m/s,
-1 deg, 0.25 % of the height): a straight flight computes it once; each new geometry costs about
-1-3 s. The terrain-following prediction (:func:`skyradar.process.clutter.clutter_subspace` with
-``depth_fn``) is not used per frame: it would cost that for every few metres flown.
+heading-free frame, pitch, roll and height only, so it is cached on those, and reused while the
+navigated geometry stays within a stated tolerance (see the function): a straight flight computes
+it once; each new geometry costs about 1-3 s. The terrain-following prediction
+(:func:`skyradar.process.clutter.clutter_subspace` with ``depth_fn``) is not used per frame: it
+would cost that for every few metres flown.
 
 :func:`directions_after_projection` (home: :mod:`skyradar.process.clutter_doa`) estimates the
 direction of a detection whose cell was projected: the projected matched filter's best direction;
@@ -50,8 +51,9 @@ __all__ = [
 ]
 
 SUPPRESSIONS = ("none", "knowledge-aided", "auto")
-_CACHE: OrderedDict[tuple, ClutterSubspace] = OrderedDict()
+_CACHE: OrderedDict[tuple, tuple[np.ndarray, ClutterSubspace]] = OrderedDict()
 _V_STEP, _ANGLE_STEP_DEG, _HEIGHT_STEP = 0.25, 1.0, 0.0025
+V_TOLERANCE_MPS, ANGLE_TOLERANCE_DEG, HEIGHT_TOLERANCE = 0.35, 1.0, 0.02  # reuse of a cached prediction
 
 
 def _depth_fn(terrain: Any, lat_deg: float, lon_deg: float, alt_m: float):
@@ -67,10 +69,8 @@ def _depth_fn(terrain: Any, lat_deg: float, lon_deg: float, alt_m: float):
     return depth
 
 
-def frame_subspace(
-    own: dict[str, np.ndarray], i: int, config: RadarConfig, terrain: Any = None
-) -> ClutterSubspace | None:
-    """Predicted clutter subspace of frame ``i`` (None when the height above ground is unknown)."""
+def _frame_geometry(own: dict[str, np.ndarray], i: int, terrain: Any) -> np.ndarray | None:
+    """Velocity in a heading-free frame (3), pitch, roll and height above ground of frame ``i``."""
     yaw, pitch, roll = (float(own[k][i]) for k in ("own_yaw_rad", "own_pitch_rad", "own_roll_rad"))
     v_ned = np.array([own[k][i] for k in ("own_vn_mps", "own_ve_mps", "own_vd_mps")], float)
     height = float(own["own_height_agl_m"][i])
@@ -81,24 +81,54 @@ def frame_subspace(
         height = float(_depth_fn(terrain, lat, lon, alt)(np.zeros(1), np.zeros(1))[0])
     if not height > 0:
         return None
-    # Flat ground at that height is the same in every direction: a heading-free frame, and the
-    # geometry quantised (0.25 m/s, 1 deg, 0.25 % of the height) so that navigation noise and slow
-    # climbs reuse one prediction; it is computed AT the quantised values, so the result does not
-    # depend on which frame filled the cache (chunked and whole-run processing agree).
-    v_q = np.round(rotation_matrix(yaw, 0.0, 0.0).T @ v_ned / _V_STEP) * _V_STEP
-    pitch_q, roll_q = (
-        np.radians(round(np.degrees(a) / _ANGLE_STEP_DEG) * _ANGLE_STEP_DEG) for a in (pitch, roll)
+    # Flat ground at that height is the same in every direction: a heading-free frame.
+    return np.array([*(rotation_matrix(yaw, 0.0, 0.0).T @ v_ned), pitch, roll, height])
+
+
+def _within_tolerance(state: np.ndarray, at: np.ndarray) -> bool:
+    """Whether a prediction computed at ``at`` serves a frame at ``state`` (see :func:`frame_subspace`)."""
+    return bool(
+        np.all(np.abs(state[:3] - at[:3]) <= V_TOLERANCE_MPS)
+        and np.all(np.abs(state[3:5] - at[3:5]) <= np.radians(ANGLE_TOLERANCE_DEG))
+        and abs(np.log(state[5] / at[5])) <= HEIGHT_TOLERANCE
     )
-    height_q = float(np.exp(np.round(np.log(height) / _HEIGHT_STEP) * _HEIGHT_STEP))
+
+
+def frame_subspace(
+    own: dict[str, np.ndarray], i: int, config: RadarConfig, terrain: Any = None
+) -> ClutterSubspace | None:
+    """Predicted clutter subspace of frame ``i`` (None when the height above ground is unknown).
+
+    The prediction (about 1 s of CPU) is computed at the geometry quantised (0.25 m/s, 1 deg,
+    0.25 % of the height) and reused for every frame whose navigated geometry lies within
+    ``V_TOLERANCE_MPS`` per velocity axis (about one Doppler bin), ``ANGLE_TOLERANCE_DEG`` of
+    pitch and roll and ``HEIGHT_TOLERANCE`` of the height of a cached one (the most recently
+    used first): without the tolerance the GNSS noise of ``ga-typical`` navigation (0.2 m/s
+    vertical) crossed a quantisation step on most frames and each frame paid for a new
+    prediction. Which cached prediction serves a frame can depend on the frames before it, so
+    chunked and whole-run processing may use predictions that differ by at most the tolerance.
+    """
+    state = _frame_geometry(own, i, terrain)
+    if state is None:
+        return None
+    v_q = np.round(state[:3] / _V_STEP) * _V_STEP
+    step = _ANGLE_STEP_DEG
+    pitch_q, roll_q = (np.radians(round(np.degrees(a) / step) * step) for a in state[3:5])
+    height_q = float(np.exp(np.round(np.log(state[5]) / _HEIGHT_STEP) * _HEIGHT_STEP))
     key = (*np.round(v_q / _V_STEP).astype(int), round(np.degrees(pitch_q)), round(np.degrees(roll_q)),
            round(height_q, 3), id(config))  # fmt: skip
     hit = _CACHE.get(key)
+    if hit is None:
+        for other in reversed(_CACHE):
+            if other[-1] == id(config) and _within_tolerance(state, _CACHE[other][0]):
+                key, hit = other, _CACHE[other]
+                break
     if hit is not None:
         _CACHE.move_to_end(key)
-        return hit
+        return hit[1]
     ant_to_ned = rotation_matrix(0.0, pitch_q, roll_q) @ config.mount.rotation
     sub = clutter_subspace(config, v_q, ant_to_ned, height_q, None, n_azimuth=720)
-    _CACHE[key] = sub
+    _CACHE[key] = (np.array([*v_q, pitch_q, roll_q, height_q]), sub)
     while len(_CACHE) > 8:  # about 7 MB each
         _CACHE.popitem(last=False)
     return sub

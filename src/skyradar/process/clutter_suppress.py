@@ -174,7 +174,7 @@ def suppress_clutter(
     inv_gain = (1.0 / np.asarray(config.rx_calibration)).astype(np.complex64)
     z = np.ascontiguousarray(cube, np.complex64)
     rule = (np.float32(1.0 / floor), np.int64(max_nulls), np.float32(gate), np.float32(_RESIDUAL))
-    _fused(z, raw, inv_gain, subspace.fractions, subspace.null_rows, *rule, power, nulls, unsuppressed, cnr)
+    _fused(z, raw, subspace.null_rows(inv_gain), subspace.fractions, *rule, power, nulls, unsuppressed, cnr)
     channels = (config.n_rx - nulls).astype(np.int8)
     return Suppressed(power, channels, unsuppressed, nulls, cnr, floor)
 
@@ -185,40 +185,42 @@ _RESIDUAL = 0.25  # predicted clutter left after the nulls, in units of the nois
 @njit(cache=True)
 def _ring_max(raw, top):  # pragma: no cover - compiled
     # Largest pixel over 3 range rows (range edges: the rows there are) at Doppler offsets -3, -2,
-    # +2, +3 (wrapping), separably (column maxima first). The maximum, not the mean: simulated and
-    # real ground fills the image as a comb of bright pixels (facets, speckle). The cell itself and
-    # its first Doppler neighbours are left out: a point target's Hann main lobe ends two bins
-    # away, ground spreads along Doppler, so a target in clear sky does not make its own cell look
-    # cluttered.
+    # +2, +3 (wrapping), separably: column maxima into a Doppler-wrapped scratch row first. The
+    # maximum, not the mean: simulated and real ground fills the image as a comb of bright pixels
+    # (facets, speckle). The cell itself and its first Doppler neighbours are left out: a point
+    # target's Hann main lobe ends two bins away, ground spreads along Doppler, so a target in
+    # clear sky does not make its own cell look cluttered.
     n_r, n_d = raw.shape
-    col = np.empty((n_r, n_d), np.float32)
+    col = np.empty(n_d + 6, np.float32)
     for r in range(n_r):
+        lo, hi = max(r - 1, 0), min(r + 1, n_r - 1)
         for d in range(n_d):
-            m = raw[r, d]
-            if r > 0:
-                m = max(m, raw[r - 1, d])
-            if r < n_r - 1:
-                m = max(m, raw[r + 1, d])
-            col[r, d] = m
-    for r in range(n_r):
+            m = raw[lo, d]
+            for rr in range(lo + 1, hi + 1):
+                v = raw[rr, d]
+                m = v if v > m else m
+            col[d + 3] = m
+        for d in range(3):
+            col[d] = col[n_d + d]
+            col[n_d + 3 + d] = col[3 + d]
         for d in range(n_d):
-            a = max(col[r, (d - 3) % n_d], col[r, (d - 2) % n_d])
-            top[r, d] = max(a, max(col[r, (d + 2) % n_d], col[r, (d + 3) % n_d]))
+            a = col[d] if col[d] > col[d + 1] else col[d + 1]
+            b = col[d + 5] if col[d + 5] > col[d + 6] else col[d + 6]
+            top[r, d] = a if a > b else b
     return top
 
 
 @njit(cache=True)
 def _fused(
-    cube, raw, inv_gain, fractions, rows, inv_floor, max_nulls, gate, residual,  # inputs
+    cube, raw, rows, fractions, inv_floor, max_nulls, gate, residual,  # inputs
     power, nulls, unsuppressed, cnr,  # outputs
 ):  # pragma: no cover - compiled  # fmt: skip
-    # The clutter level (ring and peak rule), null_count and projected_power in one pass over the
-    # cells (same rules as those functions; tests compare them). Only the m <= max_nulls rows of
-    # E^H a cell needs are read, contiguously (ClutterSubspace.null_rows).
+    # The clutter level (ring and peak rule) and null_count in one pass over the cells, then
+    # projected_power where nulls were placed (same rules as those functions; tests compare them).
+    # Two branch-light loops run faster than one that mixes them.
     n_r, n_d, n_k = cube.shape
     one, zero, four = np.float32(1.0), np.float32(0.0), np.float32(4.0)
     top = _ring_max(raw, np.empty((n_r, n_d), np.float32))
-    z = np.empty(n_k, np.complex64)
     for r in range(n_r):
         for d in range(n_d):
             ring = max(top[r, d] * inv_floor - one, zero)
@@ -230,25 +232,35 @@ def _fused(
             m = 0
             left = c
             if c > gate and fractions[r, d, 0] > 0:
-                cum = 0.0
+                cum = zero
                 for i in range(max_nulls):
                     cum += fractions[r, d, i]
-                    left = c * max(1.0 - cum, 0.0)
+                    left = c * max(one - cum, zero)
                     m = i + 1
                     if left <= residual:
                         break
-            total = raw[r, d] * n_k  # |z|^2 of the calibrated snapshot (raw is its channel mean)
-            if m > 0:
-                for k in range(n_k):
-                    z[k] = cube[r, d, k] * inv_gain[k]
-            for i in range(m):
-                acc = 0j
-                for k in range(n_k):
-                    acc += rows[r, d, i, k] * z[k]
-                total -= acc.real * acc.real + acc.imag * acc.imag
             nulls[r, d] = m
-            unsuppressed[r, d] = left > 1.0
-            power[r, d] = max(total, 0.0) / (n_k - m)
+            unsuppressed[r, d] = left > one
+    _project_rows(cube, raw, rows, nulls, power)
+
+
+@njit(cache=True)
+def _project_rows(cube, raw, rows, nulls, power):  # pragma: no cover - compiled
+    # |P z|^2 / L = (|z|^2 - sum_i |e_i^H z|^2) / L, z = cube / gain: rows hold e_i^H diag(1 / gain).
+    n_r, n_d, n_k = cube.shape
+    for r in range(n_r):
+        for d in range(n_d):
+            m = nulls[r, d]
+            if m == 0:
+                power[r, d] = raw[r, d]
+                continue
+            total = raw[r, d] * n_k  # |z|^2 of the calibrated snapshot (raw is its channel mean)
+            for i in range(m):
+                acc = np.complex64(0)
+                for k in range(n_k):
+                    acc += rows[r, d, i, k] * cube[r, d, k]
+                total -= acc.real * acc.real + acc.imag * acc.imag
+            power[r, d] = max(total, np.float32(0.0)) / (n_k - m)
 
 
 def projected_power(calibrated: np.ndarray, vectors: np.ndarray, nulls: np.ndarray) -> np.ndarray:

@@ -242,7 +242,8 @@ def _suppressed_cfar(power, floor_w, channels, exclude, train_exclude, guard, tr
     """CA-CFAR of a clutter-suppressed image: spur pixels out of everything, clutter out of training."""
     skip = exclude if train_exclude is None else train_exclude
     skip = skip if exclude is None or train_exclude is None else exclude | train_exclude
-    hits, noise_map = cfar_2d_floor(power, channels, floor_w, skip, guard, train, pfa)
+    # Noise estimates only where a hit is possible: the peaks read it, nothing else does.
+    hits, noise_map = cfar_2d_floor(power, channels, floor_w, skip, guard, train, pfa, noise_map=False)
     return (hits if exclude is None else hits & ~exclude), noise_map
 
 

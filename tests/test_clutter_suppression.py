@@ -156,5 +156,6 @@ def test_experiment_clutter_writes_figures_table_and_json(tmp_path):
     assert result.returncode == 0, result.stderr
     summary = json.loads(result.stdout.strip().splitlines()[-1])
     assert summary["h1000_frames"] == 2 and "h300_usable_doppler_fraction_suppressed" in summary
+    assert {"h1000_if_db_lost_cells_median", "h300_if_db_lost_cells_min"} <= set(summary)
     for name in ("sinr_loss.png", "intruder.png", "frames.csv", "sinr_loss.csv", "summary.json"):
         assert (tmp_path / "c" / name).exists()

@@ -1,0 +1,101 @@
+"""The fast paths of clutter suppression (issue 12 point 2) against the straightforward versions."""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+
+import numpy as np
+
+from skyradar.config import RadarConfig
+from skyradar.process import clutter_frames
+from skyradar.process.cfar import cfar_2d_floor
+from skyradar.process.clutter_doa import directions_after_projection
+from skyradar.process.doa import direction_from_angles, steering_vector
+
+CFG = RadarConfig.prototype_2022()
+
+
+def _lattice_best(z: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, float]:
+    """Exhaustive search: 2 deg grid, then every point of the 0.05 deg lattice within +-1.5 deg
+    (elevation 0 where the score along elevation is flat within 1 dB: unobservable)."""
+
+    def score(az_deg: np.ndarray, el_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        a, e = np.meshgrid(np.radians(az_deg), np.radians(el_deg), indexing="ij")
+        u = direction_from_angles(a.ravel(), e.ravel())
+        ps = steering_vector(u, CFG) @ p.T  # rows (P s)^T
+        num = np.abs(np.conj(ps) @ z) ** 2
+        return u, num / np.sum(np.abs(ps) ** 2, axis=1)
+
+    coarse = np.arange(-70.0, 70.5, 2.0)
+    _, s = score(coarse, coarse)
+    s = s.reshape(coarse.size, coarse.size)
+    ia, ie = np.unravel_index(np.argmax(s), s.shape)
+    fine = np.arange(-1.5, 1.525, 0.05)
+    flat = 10 * np.log10(s[ia].max() / np.median(s[ia])) < 1.0
+    u, s = score(coarse[ia] + fine, np.zeros(1) if flat else coarse[ie] + fine)
+    return u[np.argmax(s)], float(s.max())
+
+
+def test_coarse_to_fine_direction_search_finds_the_exhaustive_lattice_best():
+    rng = np.random.default_rng(0)
+    for _ in range(25):
+        u_true = direction_from_angles(rng.uniform(-1.0, 1.0), rng.uniform(-0.8, 0.8))
+        noise = rng.standard_normal(4) + 1j * rng.standard_normal(4)
+        z = steering_vector(u_true, CFG) * rng.uniform(3.0, 10.0) + noise
+        m = int(rng.integers(0, 3))
+        e = np.linalg.qr(rng.standard_normal((4, 4)) + 1j * rng.standard_normal((4, 4)))[0][:, :m]
+        p = np.eye(4) - e @ e.conj().T
+        u_ref, best = _lattice_best(z, p)
+        u = directions_after_projection(z[None], p[None], CFG)[0]
+        ps = p @ steering_vector(u, CFG)
+        got = abs(np.vdot(ps, z)) ** 2 / np.vdot(ps, ps).real
+        assert got >= best * (1 - 1e-5)
+        assert np.degrees(np.arccos(min(1.0, float(u @ u_ref)))) < 0.1
+
+
+def test_sparse_cfar_after_suppression_gives_the_full_maps_hits():
+    rng = np.random.default_rng(2)
+    shape = (200, 160)
+    channels = rng.choice(np.array([2, 3, 4], np.int8), size=shape)
+    power = (rng.gamma(channels, 1.0 / channels)).astype(np.float32)
+    skip = np.zeros(shape, bool)
+    skip[40:50, 30:55] = True  # unsuppressed clutter: bright, out of the training of the others
+    power[skip] *= 300.0
+    for r, d, snr in ((50, 95, 40.0), (120, 20, 25.0), (121, 22, 18.0), (5, 158, 30.0), (199, 0, 30.0)):
+        power[r, d] += snr  # targets beside the clutter, in clutter-free noise, at the edges
+    for pfa in (2e-8, 1e-4):
+        full_hits, full_noise = cfar_2d_floor(power, channels, 1.0, skip, pfa=pfa)
+        hits, noise = cfar_2d_floor(power, channels, 1.0, skip, pfa=pfa, noise_map=False)
+        assert full_hits.sum() >= 5 and np.array_equal(hits, full_hits)
+        known = np.isfinite(noise)
+        assert known[hits].all() and known.mean() < 0.01
+        np.testing.assert_allclose(noise[known], full_noise[known], rtol=1e-5)
+
+
+def test_frame_subspace_is_reused_within_the_tolerance_and_recomputed_beyond(monkeypatch):
+    calls = []
+
+    def fake_subspace(config, v, ant_to_ned, height, depth_fn, n_azimuth):
+        calls.append((tuple(v), height))
+        return object()
+
+    monkeypatch.setattr(clutter_frames, "clutter_subspace", fake_subspace)
+    monkeypatch.setattr(clutter_frames, "_CACHE", OrderedDict())
+    one = np.ones(1)
+
+    def own(vd: float, height: float, pitch_deg: float = 0.0) -> dict:
+        state = {"own_vn_mps": 50 * one, "own_ve_mps": 0 * one, "own_vd_mps": vd * one,
+                 "own_yaw_rad": 0.3 * one, "own_pitch_rad": np.radians(pitch_deg) * one}  # fmt: skip
+        state["own_roll_rad"] = 0 * one
+        return state | {"own_height_agl_m": height * one, "has_geo": np.array(False)}
+
+    first = clutter_frames.frame_subspace(own(0.0, 1000.0), 0, CFG)
+    # GNSS-like jitter (vertical velocity, height, attitude) inside the tolerance: the same prediction.
+    for vd, h, pitch in ((0.3, 1000.0, 0.0), (-0.2, 1015.0, 0.6), (0.1, 990.0, -0.9)):
+        assert clutter_frames.frame_subspace(own(vd, h, pitch), 0, CFG) is first
+    assert len(calls) == 1
+    assert clutter_frames.frame_subspace(own(0.0, 1050.0), 0, CFG) is not first  # 5 % higher
+    assert clutter_frames.frame_subspace(own(1.0, 1000.0), 0, CFG) is not first  # climbing 1 m/s
+    assert len(calls) == 3
+    assert clutter_frames.frame_subspace(own(0.05, 1003.0), 0, CFG) is first  # back: still cached
+    assert len(calls) == 3

@@ -37,7 +37,6 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
-import numpy as np
 from numba import njit
 
 from skyradar.config import RadarConfig
@@ -98,29 +97,29 @@ def cell_counts(p_ant, i, j, vg, n_min_r, n_min_c, n_max_r, n_max_c, adapt):
     target_r, target_v = adapt[0], adapt[1]
     if target_r <= 0.0:
         return n_min_r, n_min_c
-    r = np.empty((2, 2))
-    v = np.empty((2, 2))
-    for a in range(2):
-        for b in range(2):
-            x, y, z = p_ant[i + a, j + b, 0], p_ant[i + a, j + b, 1], p_ant[i + a, j + b, 2]
-            r[a, b] = math.sqrt(x * x + y * y + z * z)
-            v[a, b] = (vg[0] * x + vg[1] * y + vg[2] * z) / max(r[a, b], 1e-9)
+    # Corner ranges and radial velocities as scalars: a small array here would be a heap
+    # allocation per cell.
+    r00, v00 = _range_velocity(p_ant, i, j, vg)
+    r01, v01 = _range_velocity(p_ant, i, j + 1, vg)
+    r10, v10 = _range_velocity(p_ant, i + 1, j, vg)
+    r11, v11 = _range_velocity(p_ant, i + 1, j + 1, vg)
     l_u = max(_dist(p_ant, i, j, i + 1, j), _dist(p_ant, i, j + 1, i + 1, j + 1))
     l_w = max(_dist(p_ant, i, j, i, j + 1), _dist(p_ant, i + 1, j, i + 1, j + 1))
-    r_min = max(min(min(r[0, 0], r[0, 1]), min(r[1, 0], r[1, 1])) - (l_u + l_w), 1e-3)
+    r_min = max(min(min(r00, r01), min(r10, r11)) - (l_u + l_w), 1e-3)
     h_r = 1.0 / r_min
     h_v = math.sqrt(5.0) * math.sqrt(vg[0] * vg[0] + vg[1] * vg[1] + vg[2] * vg[2]) / (r_min * r_min)
-    dr_u, dv_u = (
-        max(abs(r[1, 0] - r[0, 0]), abs(r[1, 1] - r[0, 1])),
-        max(abs(v[1, 0] - v[0, 0]), abs(v[1, 1] - v[0, 1])),
-    )
-    dr_w, dv_w = (
-        max(abs(r[0, 1] - r[0, 0]), abs(r[1, 1] - r[1, 0])),
-        max(abs(v[0, 1] - v[0, 0]), abs(v[1, 1] - v[1, 0])),
-    )
+    dr_u, dv_u = max(abs(r10 - r00), abs(r11 - r01)), max(abs(v10 - v00), abs(v11 - v01))
+    dr_w, dv_w = max(abs(r01 - r00), abs(r11 - r10)), max(abs(v01 - v00), abs(v11 - v10))
     n_u = _axis_count(dr_u, dv_u, l_u, h_r, h_v, target_r, target_v)
     n_w = _axis_count(dr_w, dv_w, l_w, h_r, h_v, target_r, target_v)
     return min(max(n_u, n_min_r), n_max_r), min(max(n_w, n_min_c), n_max_c)
+
+
+@njit(inline="always")
+def _range_velocity(p, i, j, vg):
+    x, y, z = p[i, j, 0], p[i, j, 1], p[i, j, 2]
+    r = math.sqrt(x * x + y * y + z * z)
+    return r, (vg[0] * x + vg[1] * y + vg[2] * z) / max(r, 1e-9)
 
 
 @njit(inline="always")

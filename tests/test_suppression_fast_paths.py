@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections import OrderedDict
 
 import numpy as np
+import pytest
 
 from skyradar.config import RadarConfig
 from skyradar.process import clutter_frames
@@ -53,13 +54,14 @@ def test_coarse_to_fine_direction_search_finds_the_exhaustive_lattice_best():
         assert np.degrees(np.arccos(min(1.0, float(u @ u_ref)))) < 0.1
 
 
-def test_sparse_cfar_after_suppression_gives_the_full_maps_hits():
+@pytest.mark.parametrize("clutter_rows", [10, 60])  # under and over 1 % of pixels that could be hits
+def test_sparse_cfar_after_suppression_gives_the_full_maps_hits(clutter_rows):
     rng = np.random.default_rng(2)
     shape = (200, 160)
     channels = rng.choice(np.array([2, 3, 4], np.int8), size=shape)
     power = (rng.gamma(channels, 1.0 / channels)).astype(np.float32)
     skip = np.zeros(shape, bool)
-    skip[40:50, 30:55] = True  # unsuppressed clutter: bright, out of the training of the others
+    skip[40 : 40 + clutter_rows, 30:55] = True  # unsuppressed clutter: bright, out of the others' training
     power[skip] *= 300.0
     for r, d, snr in ((50, 95, 40.0), (120, 20, 25.0), (121, 22, 18.0), (5, 158, 30.0), (199, 0, 30.0)):
         power[r, d] += snr  # targets beside the clutter, in clutter-free noise, at the edges
@@ -68,7 +70,7 @@ def test_sparse_cfar_after_suppression_gives_the_full_maps_hits():
         hits, noise = cfar_2d_floor(power, channels, 1.0, skip, pfa=pfa, noise_map=False)
         assert full_hits.sum() >= 5 and np.array_equal(hits, full_hits)
         known = np.isfinite(noise)
-        assert known[hits].all() and known.mean() < 0.01
+        assert known[hits].all() and known.mean() < 0.1
         np.testing.assert_allclose(noise[known], full_noise[known], rtol=1e-5)
 
 

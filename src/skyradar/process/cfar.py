@@ -253,13 +253,16 @@ def _ring(sat, i, j, hr, hd, gr, gd):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _floor_decide(
-    power, sat_p, sat_c, sat_v, half, skip, big_l, table, floor, n_train, min_train, hits, noise
-):
+    power, sat_p, sat_c, sat_v, half, skip, big_l, table, floor, n_train, min_train, hits, noise, only
+):  # pragma: no cover - compiled
     # Per pixel: plain CA for excluded cells, CA over the cells left (or the floor) for the others.
+    # With `only` true, pixels whose `hits` is already False (no hit possible) are left as they are.
     hr, hd, gr, gd = half
     n_r, n_d = power.shape
     for i in range(n_r):
         for j in range(n_d):
+            if only and not hits[i, j]:
+                continue
             if skip[i, j]:
                 n, est = n_train, _ring(sat_p, i, j, hr, hd, gr, gd) / n_train
             else:
@@ -279,8 +282,8 @@ def _floor_sparse(power, skip, big_l, table, floor, half, n_train, min_n, hits, 
     # _floor_decide with window sums taken only where a hit is possible: the smallest threshold any
     # pixel can have is the known-floor factor times the floor (every F-based factor is larger and
     # no estimate goes below the floor), and after suppression almost every pixel is below it.
-    # Returns False (nothing decided) when more than 1 % of the pixels could be hits: then the
-    # summed-area tables of cfar_2d_floor are cheaper than direct window sums.
+    # Returns False when more than 1 % of the pixels could be hits (`hits` then holds that mask and
+    # nothing is decided): summed-area tables are cheaper than direct window sums for so many.
     hr, hd, gr, gd = half
     n_r, n_d = power.shape
     n_cand = 0
@@ -378,16 +381,18 @@ def cfar_2d_floor(
     big_l = np.ascontiguousarray(np.clip(channels, 1, 8), np.int8)
     floor = np.float32(noise_floor_w)
     hits = np.empty(power.shape, np.bool_)
-    if not noise_map:
+    only = not noise_map
+    if only:
         noise = np.full(power.shape, np.nan, np.float32)
         if _floor_sparse(power, skip, big_l, table, floor, (hr, hd, gr, gd), n_train, min_train, hits, noise):
             return hits, noise
+    else:
+        noise = np.empty(power.shape, np.float32)
     valid = (~skip).astype(np.float32)
     # Summed-area tables (float64) of the padded images: every window sum is four lookups.
     sat_p, sat_c, sat_v = (
         cv2.integral(_pad(x, hr, hd), sdepth=cv2.CV_64F) for x in (power, power * valid, valid)
     )
-    noise = np.empty(power.shape, np.float32)
     _floor_decide(power, sat_p, sat_c, sat_v, (hr, hd, gr, gd), skip, big_l, table, floor, n_train, min_train,
-                  hits, noise)  # fmt: skip
+                  hits, noise, only)  # fmt: skip
     return hits, noise

@@ -103,3 +103,30 @@ def test_adaptive_cells_in_the_vectorised_batches_match_the_scalar_reference():
     reference, batched = cubes
     assert np.abs(reference).max() > 1e3 * np.sqrt(cfg.noise_power_w)
     np.testing.assert_allclose(batched, reference, rtol=0, atol=1e-6 * np.abs(reference).max())
+
+
+def test_level_terrain_skips_the_horizon_and_keeps_the_frame():
+    # A level surface is convex: nothing in range is hidden (its horizon is 25 km away at 50 m).
+    from skyradar.scene.synthetic_terrain import flat_terrain
+
+    cfg = RadarConfig.prototype_2022(range_limit_m=2000.0)
+    level = flat_terrain(ORIGIN[0], ORIGIN[1], 0.0, size_m=6000.0)
+    own = PlatformState(
+        np.array([500.0, -800.0, -300.0]), np.array([50.0, 0.0, 0.0]), np.array([0.3, 0.05, 0.4])
+    )
+    sim = ImageSimulator(cfg, level, ORIGIN, noise=False)
+    assert sim.terrain_view(sim.geometry(own)).horizon.shape == (1, 1)
+    skipped = np.abs(sim.frame(own)) ** 2
+    sim._level = False  # the full horizon, as for any other terrain
+    assert sim.terrain_view(sim.geometry(own)).horizon.shape[0] > 100
+    full = np.abs(sim.frame(own)) ** 2
+    assert skipped.sum() > 0 and abs(full.sum() / skipped.sum() - 1.0) < 1e-4
+    np.testing.assert_allclose(
+        full.sum(axis=(1, 2)), skipped.sum(axis=(1, 2)), rtol=1e-3, atol=1e-6 * full.max()
+    )
+    # Hills keep their horizon; so does level ground less than 50 m below the antenna.
+    hills = ImageSimulator(cfg, fractal_terrain(ORIGIN[0], ORIGIN[1], 20.0, size_m=6000.0, seed=1), ORIGIN)
+    assert hills.terrain_view(hills.geometry(own)).horizon.shape[0] > 100
+    low = PlatformState(np.array([0.0, 0.0, -30.0]), np.array([50.0, 0.0, 0.0]), np.zeros(3))
+    fresh = ImageSimulator(cfg, level, ORIGIN, noise=False)
+    assert fresh.terrain_view(fresh.geometry(low)).horizon.shape[0] > 100

@@ -51,6 +51,7 @@ __all__ = [
     "two_way_gain_table",
 ]
 _NO_SPECKLE = np.uint64(0)
+_LEVEL_CLEAR_M = 50.0  # antenna height above level terrain from which nothing in range is hidden
 
 _reflectivity_table = reflectivity_table  # the old private name (benchmarks.sim)
 
@@ -157,6 +158,7 @@ class ImageSimulator:
                 max(1, int(np.ceil(dx / self.facet_size_m))),
             )
             self._facet_m = max(dy / self._nsub[0], dx / self._nsub[1])
+            self._level = bool(np.ptp(terrain.elevation_m) == 0.0)  # see _horizon
             adaptive = self.psf if adaptive_facets is None else bool(adaptive_facets)
             self._facets = facet_rule(config, self._spacing_m, self.facet_size_m, adaptive)
 
@@ -343,10 +345,17 @@ class ImageSimulator:
     def _horizon(
         self, p_ned: np.ndarray, geom: AntennaGeometry, n_blocks: int
     ) -> tuple[np.ndarray, float, float]:
-        """Polar horizon for the occlusion test, with its azimuth and horizontal-range bin sizes."""
-        if not self.occlusion:
-            return np.full((1, 1), -np.inf, np.float32), 1.0, 1.0
+        """Polar horizon for the occlusion test, with its azimuth and horizontal-range bin sizes.
+
+        Level terrain (one height everywhere) is a convex surface: it hides nothing closer than
+        its geometric horizon, sqrt(2 R_earth h), 25 km at h = 50 m. With the antenna more than
+        ``_LEVEL_CLEAR_M`` above every point of the crop (a lower bound of its height) and the
+        range limit below that, the horizon is skipped: the same frames, without its cost.
+        """
         r_lim = self.config.range_limit_m + self.config.range_resolution_m
+        level = self._level and r_lim < 20e3 and float(p_ned[..., 2].min()) > _LEVEL_CLEAR_M
+        if not self.occlusion or level:
+            return np.full((1, 1), -np.inf, np.float32), 1.0, 1.0
         # The horizon follows the terrain's shape, which the DEM resolves at its own spacing:
         # 2 x 2 samples per DEM cell and bins of half the spacing, not every sub-facet.
         h_nsub = (min(self._nsub[0], 2), min(self._nsub[1], 2))
@@ -357,17 +366,7 @@ class ImageSimulator:
         # Each horizon sample stands for a patch this wide (see horizon_map).
         sample_m = max(self._spacing_m[0] / h_nsub[0], self._spacing_m[1] / h_nsub[1])
         horizon = horizon_map(
-            p_ned,
-            geom.rot_ned_to_ant,
-            h_nsub[0],
-            h_nsub[1],
-            r_lim,
-            az_bin,
-            h_bin,
-            n_az,
-            n_h,
-            n_blocks,
-            sample_m,
+            p_ned, geom.rot_ned_to_ant, *h_nsub, r_lim, az_bin, h_bin, n_az, n_h, n_blocks, sample_m
         )
         return horizon, az_bin, h_bin
 

@@ -289,6 +289,34 @@ def _sub_facets(sim: ImageSimulator, platform: PlatformState) -> int:
     return int(np.prod(counts, axis=-1).sum())
 
 
+def _psf_keys(config, terrain, origin, platform, ours, n: int, fps_fine: float) -> dict[str, Any]:
+    """Issue 12.1's keys: fine facets with the windows' point-spread and speckle, by both facet rules.
+
+    ``ours(sim, n)`` times a simulator: (frames/s, CPU-ms per frame).
+    """
+    # Cells cut by their range and Doppler extent (the default with psf), and by ground size as before.
+    fine_psf = ImageSimulator(config, terrain, origin, seed=1, psf=True, speckle=True)
+    uniform_psf = ImageSimulator(
+        config, terrain, origin, seed=1, psf=True, speckle=True, adaptive_facets=False
+    )
+    fps_fine_psf, cpu_fine_psf = ours(fine_psf, n)
+    fps_uniform_psf, cpu_uniform_psf = ours(uniform_psf, n)
+    return {
+        "frames_per_s_fine_psf": fps_fine_psf,
+        "fine_psf_vs_fine": fps_fine_psf / fps_fine,
+        "fine_psf_x_field_rate": fps_fine_psf / FIELD_RATE_HZ,
+        "fine_psf_cpu_ms_per_frame": cpu_fine_psf,
+        "fine_psf": "sub-facets <= dR/2 in range and <= half a Doppler bin (cut per cell by its extent), "
+        "exact geodesy, occlusion, Hann x Hann point-spread, speckle (ours only)",
+        "sub_facets_per_frame_fine_psf": _sub_facets(fine_psf, platform(0)),
+        "frames_per_s_fine_psf_uniform": fps_uniform_psf,
+        "fine_psf_uniform_cpu_ms_per_frame": cpu_uniform_psf,
+        "sub_facets_per_frame_fine_psf_uniform": _sub_facets(uniform_psf, platform(0)),
+        "fine_psf_vs_uniform": fps_fine_psf / fps_uniform_psf,
+        "fine_psf_uniform": "as fine_psf, every cell cut into facets <= dR/2 on the ground (the rule before)",
+    }
+
+
 def run(n_frames: int = 40, baseline_frames: int = 6, min_seconds: float = 2.0) -> dict[str, Any]:
     """Frames/s of the simulator and of both baselines on the synthetic tile, in one run."""
     load_before = os.getloadavg()[0]
@@ -307,9 +335,6 @@ def run(n_frames: int = 40, baseline_frames: int = 6, min_seconds: float = 2.0) 
     # Into one preallocated frame, as simulate_frames writes into its stack of frames.
     buffer = np.empty((config.n_range, config.n_doppler, config.n_rx), np.complex64)
 
-    def ours_fps(sim: ImageSimulator, n: int) -> float:
-        return _time_frames(lambda i: sim.frame(platform(i), frame_index=i, out=buffer), n, min_seconds)
-
     def ours_cpu(sim: ImageSimulator, n: int) -> tuple[float, float]:
         return _time_frames_cpu(lambda i: sim.frame(platform(i), frame_index=i, out=buffer), n, min_seconds)
 
@@ -318,16 +343,9 @@ def run(n_frames: int = 40, baseline_frames: int = 6, min_seconds: float = 2.0) 
     )
     full = ImageSimulator(config, terrain, origin, facet_size_m=float("inf"), seed=1)
     fine = ImageSimulator(config, terrain, origin, seed=1)
-    # Clutter as the radar sees it (issue 12.1): the windows' point-spread and speckle on, cells
-    # cut by their range and Doppler extent (the default with psf), and by ground size as before.
-    fine_psf = ImageSimulator(config, terrain, origin, seed=1, psf=True, speckle=True)
-    uniform_psf = ImageSimulator(
-        config, terrain, origin, seed=1, psf=True, speckle=True, adaptive_facets=False
-    )
-    fps, fps_full = ours_fps(same, n_frames), ours_fps(full, n_frames)
-    fps_fine = ours_fps(fine, max(3, n_frames // 4))
-    fps_fine_psf, cpu_fine_psf = ours_cpu(fine_psf, max(3, n_frames // 4))
-    fps_uniform_psf, cpu_uniform_psf = ours_cpu(uniform_psf, max(3, n_frames // 4))
+    fps, fps_full = ours_cpu(same, n_frames)[0], ours_cpu(full, n_frames)[0]
+    fps_fine = ours_cpu(fine, max(3, n_frames // 4))[0]
+    psf_keys = _psf_keys(config, terrain, origin, platform, ours_cpu, max(3, n_frames // 4), fps_fine)
 
     ours_geometry = (config, terrain, origin, lambda i: same.geometry(platform(i)))
     fps_thesis, fps_numpy = _baseline_fps(*ours_geometry, n_frames, baseline_frames, min_seconds)
@@ -344,18 +362,7 @@ def run(n_frames: int = 40, baseline_frames: int = 6, min_seconds: float = 2.0) 
         "frames_per_s_full_physics": fps_full,
         "facet_size_fine_m": round(fine._facet_m, 3),
         "frames_per_s_fine": fps_fine,
-        "frames_per_s_fine_psf": fps_fine_psf,
-        "fine_psf_vs_fine": fps_fine_psf / fps_fine,
-        "fine_psf_x_field_rate": fps_fine_psf / FIELD_RATE_HZ,
-        "fine_psf_cpu_ms_per_frame": cpu_fine_psf,
-        "fine_psf": "sub-facets <= dR/2 in range and <= half a Doppler bin (cut per cell by its extent), "
-        "exact geodesy, occlusion, Hann x Hann point-spread, speckle (ours only)",
-        "sub_facets_per_frame_fine_psf": _sub_facets(fine_psf, platform(0)),
-        "frames_per_s_fine_psf_uniform": fps_uniform_psf,
-        "fine_psf_uniform_cpu_ms_per_frame": cpu_uniform_psf,
-        "sub_facets_per_frame_fine_psf_uniform": _sub_facets(uniform_psf, platform(0)),
-        "fine_psf_vs_uniform": fps_fine_psf / fps_uniform_psf,
-        "fine_psf_uniform": "as fine_psf, every cell cut into facets <= dR/2 on the ground (the rule before)",
+        **psf_keys,
         "full_physics": "exact WGS84 geodesy and occlusion (ours only; no baseline ratio)",
         "thesis_code_frames_per_s": THESIS_FRAMES_PER_S,
         "speedup_vs_thesis_code": fps / THESIS_FRAMES_PER_S,

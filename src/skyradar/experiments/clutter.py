@@ -106,6 +106,10 @@ def _window(k: int, j: int, config: RadarConfig) -> tuple[np.ndarray, np.ndarray
     return r, (j + dd[train]) % config.n_doppler
 
 
+def _median_db(x: np.ndarray) -> float:
+    return float(np.median(_db(x))) if x.size else float("nan")
+
+
 def _attenuation_db(before: np.ndarray, after: np.ndarray) -> float:
     """Clutter power before over after the projection (NaN for no cells)."""
     return float(_db(before.sum() / max(after.sum(), 1e-300))) if before.size else float("nan")
@@ -136,6 +140,7 @@ def _frame_measures(i, full, clutter, target, sub, config, tables) -> dict[str, 
         "target_gain_db": float(_db(gain)),
         "window_bright_cells": int(bright.sum()),
         "window_bright_if_db": float(np.median(cell_if[bright])) if bright.any() else float("nan"),
+        "window_bright_cnr_db": _median_db(c_in[wr, wd][bright] / noise),
         "window_bright_attenuation_db": _attenuation_db(c_in[wr, wd][bright], c_out[wr, wd][bright]),
         "nulls": int(sup.nulls[k, j]),
         "hit_clear": _hit(tables["clear"], i, k, j, config),
@@ -218,6 +223,9 @@ def _case_summary(height_m: float, frames: pd.DataFrame, curves: pd.DataFrame, t
         f"{key}_if_db_lost_cells_median": _stat(lost.window_bright_if_db, "median"),
         f"{key}_if_db_lost_cells_min": _stat(lost.window_bright_if_db, "min"),
         f"{key}_lost_cells_per_frame_median": _stat(lost.window_bright_cells, "median"),
+        # What bounds it: IF = g (C + N) / (C_out + N) <= g (CNR + 1) once the clutter is nulled.
+        f"{key}_lost_cells_cnr_db_median": _stat(lost.window_bright_cnr_db, "median"),
+        f"{key}_lost_target_gain_db_median": _stat(lost.target_gain_db, "median"),
         f"{key}_lost_bright_cell_if_db_median": _stat(lost.window_bright_if_db, "median"),
         f"{key}_lost_bright_cell_if_db_min": _stat(lost.window_bright_if_db, "min"),
         f"{key}_lost_bright_attenuation_db_median": _stat(lost.window_bright_attenuation_db, "median"),

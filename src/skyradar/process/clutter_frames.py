@@ -53,7 +53,7 @@ __all__ = [
 SUPPRESSIONS = ("none", "knowledge-aided", "auto")
 _CACHE: OrderedDict[tuple, tuple[np.ndarray, ClutterSubspace]] = OrderedDict()
 _V_STEP, _ANGLE_STEP_DEG, _HEIGHT_STEP = 0.25, 1.0, 0.0025
-V_TOLERANCE_MPS, ANGLE_TOLERANCE_DEG, HEIGHT_TOLERANCE = 0.35, 1.0, 0.02  # reuse of a cached prediction
+V_TOLERANCE_MPS, ANGLE_TOLERANCE_DEG, HEIGHT_TOLERANCE = 0.35, 0.5, 0.01  # reuse of a cached prediction
 
 
 def _depth_fn(terrain: Any, lat_deg: float, lon_deg: float, alt_m: float):
@@ -105,8 +105,12 @@ def frame_subspace(
     pitch and roll and ``HEIGHT_TOLERANCE`` of the height of a cached one (the most recently
     used first): without the tolerance the GNSS noise of ``ga-typical`` navigation (0.2 m/s
     vertical) crossed a quantisation step on most frames and each frame paid for a new
-    prediction. Which cached prediction serves a frame can depend on the frames before it, so
-    chunked and whole-run processing may use predictions that differ by at most the tolerance.
+    prediction. Measured on the ``experiment clutter`` scene at 1000 m, a prediction off by the
+    whole tolerance in every quantity at once (0.35 m/s down, 0.5 deg pitch, 1 % height, either
+    sign) lowers the improvement factor in the intruder's lost cells from 27.3 to 26.3-26.6 dB
+    (2 deg and 2 % cost 2.4 dB: the tolerances were halved). Which cached prediction serves a
+    frame can depend on the frames before it, so chunked and whole-run processing may use
+    predictions that differ by at most the tolerance.
     """
     state = _frame_geometry(own, i, terrain)
     if state is None:

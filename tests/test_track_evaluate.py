@@ -174,3 +174,25 @@ def test_evaluate_bad_options_one_line(tmp_path):
     for args, needle in ((["--truth", "seen"], "--truth"), (["--min-snr-db", "nan"], "--min-snr-db")):
         result = skyradar("evaluate", "run.zarr", "trk.parquet", *args, cwd=tmp_path)
         assert_one_line_error(result, needle)
+
+
+def test_truth_of_several_heads_is_their_union(tmp_path):
+    """Several heads: a target is truth where any head sees it, with the strongest head's values."""
+    from skyradar.io.frames_heads import write_heads_root
+    from skyradar.track.io import truth_from_frames
+
+    cfg = RadarConfig.prototype_2022(range_limit_m=600.0, n_doppler=8)
+    t = np.arange(6) * 0.1
+    iq = np.zeros((t.size, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
+    first = (t < 0.3)[:, None]
+    write_heads_root(tmp_path / "run.zarr", {}, ["left", "nose"])
+    for name, vis, r, snr in (("left", first, 100.0, 9.0), ("nose", ~first, 101.0, 12.0)):
+        targets = {"tgt_range_m": np.full((t.size, 1), r), "tgt_radial_velocity_mps": np.zeros((t.size, 1)),
+                   "tgt_visible": vis, "tgt_snr_db": np.where(vis, snr, -30.0)}  # fmt: skip
+        frames_dataset(iq, t, cfg, targets=targets).to_zarr(
+            tmp_path / "run.zarr", group=name, consolidated=False
+        )
+    truth, _ = truth_from_frames(tmp_path / "run.zarr")
+    assert truth.visible[:, 0].all()
+    assert truth.range_m[:, 0].tolist() == [100.0] * 3 + [101.0] * 3
+    assert truth.snr_db[:, 0].tolist() == [9.0] * 3 + [12.0] * 3

@@ -204,6 +204,9 @@ def evaluate(
         finite=["time_s", "track_id", "range_m", "radial_velocity_mps"],  # NaN was a scipy traceback
     )  # fmt: skip
     result = evaluate_run(run, table, threshold_px, gospa_c_px, truth, min_snr_db, coasting)
+    # The table shows no lists: one readable row for the per-target counts (1 = one track per aircraft).
+    pairs = zip(result["targets"], result["tracks_per_target"], strict=True)
+    result["tracks_by_target"] = ", ".join(f"{name} {n}" for name, n in pairs)
     emit_result(result, as_json, "track evaluation")
 
 

@@ -78,6 +78,8 @@ def summary_rows(result: dict[str, Any], heights_m) -> list[dict[str, Any]]:
             "frames": result[f"{key}_frames"],
             "if_db_lost_cells_median": result[f"{key}_if_db_lost_cells_median"],
             "if_db_lost_cells_min": result[f"{key}_if_db_lost_cells_min"],
+            "lost_frames_with_cells": result[f"{key}_lost_frames_with_cells"],
+            "target_gain_db_lost_cells": result[f"{key}_lost_cells_target_gain_db_median"],
             "if_db_where_lost_median": result[f"{key}_lost_window_if_db_median"],
             "if_db_where_lost_min": result[f"{key}_lost_window_if_db_min"],
             "mdv_mps_none": result[f"{key}_mdv_mps_none"],

@@ -42,7 +42,8 @@ __all__ = ["run_encounter", "run_encounters", "run", "MAX_ENCOUNTERS", "DEFAULT_
 MAX_ENCOUNTERS = 100_000  # 200 times the thesis-sized set; more is a typo, not a plan
 DEFAULT_ENCOUNTERS = 20  # clear sky, both layouts (23 CPU-s each), 2 workers: within 5 minutes on 2 cores
 _PARTIAL = "encounters.partial.parquet"
-_CHUNK = 4  # encounters per worker task at most (each writes the partial table once)
+_CHUNK = 1  # encounters per worker task (each writes the partial table once): over terrain one costs
+# minutes, so an interrupted run loses at most the encounters in flight
 
 
 def _init_worker() -> None:
@@ -96,16 +97,26 @@ def run_encounters(
             finished(_run_rows(c, kw))
     elif chunks:
         ctx = get_context("spawn")  # numba's thread pools do not survive fork
-        with ProcessPoolExecutor(workers, mp_context=ctx, initializer=_init_worker) as pool:
+        pool = ProcessPoolExecutor(workers, mp_context=ctx, initializer=_init_worker)
+        try:
             futures = [pool.submit(_run_rows, c, kw) for c in chunks]
-            try:
-                for fut in as_completed(futures):
-                    finished(fut.result())
-            except KeyboardInterrupt:
-                for f in futures:
-                    f.cancel()
-                raise
+            for fut in as_completed(futures):
+                finished(fut.result())
+        except BaseException:  # Ctrl-C: stop now; what finished is saved by on_chunk
+            _stop(pool)
+            raise
+        pool.shutdown()
     return _long_table(params, results, terrains)
+
+
+def _stop(pool: ProcessPoolExecutor) -> None:
+    """Cancel queued chunks and end the running workers (they ignore SIGINT and run for minutes)."""
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in procs:
+        proc.terminate()
+    for proc in procs:
+        proc.join(timeout=5)
 
 
 def _long_table(params: pd.DataFrame, results: dict, terrains) -> pd.DataFrame:

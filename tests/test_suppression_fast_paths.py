@@ -101,3 +101,16 @@ def test_frame_subspace_is_reused_within_the_tolerance_and_recomputed_beyond(mon
     assert len(calls) == 3
     assert clutter_frames.frame_subspace(own(0.05, 1003.0), 0, CFG) is first  # back: still cached
     assert len(calls) == 3
+
+
+def test_measured_floor_is_the_median_of_the_ground_free_cells():
+    from skyradar.process.clutter_suppress import _GAMMA_MEDIAN, measured_floor
+
+    rng = np.random.default_rng(4)
+    for n in (4000, 4001):  # even and odd counts
+        raw = rng.gamma(4.0, 0.25, (n, 3)).astype(np.float32)
+        predicted = np.zeros(raw.shape, bool)
+        predicted[:, 1] = True
+        expected = np.median(raw[:, [0, 2]]) / _GAMMA_MEDIAN[4]
+        assert measured_floor(raw, predicted, 1.0) == expected
+        assert measured_floor(raw, predicted, 1.0, free=np.flatnonzero(~predicted)) == expected

@@ -195,6 +195,9 @@ def blob_peaks(
     return peaks[order, 0], peaks[order, 1]
 
 
+_TINY32 = np.float32(np.finfo(np.float32).tiny)
+
+
 def refine_peaks(power: np.ndarray, r: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Sub-pixel peak position: a parabola through the dB values of the peak and its neighbours.
 
@@ -202,7 +205,7 @@ def refine_peaks(power: np.ndarray, r: np.ndarray, d: np.ndarray) -> tuple[np.nd
     Range edges get no offset; Doppler neighbours wrap.
     """
     n_r, n_d = power.shape
-    floor = np.float32(np.finfo(np.float32).tiny)
+    floor = _TINY32
     db = lambda i, j: np.log(np.maximum(power[i, j], floor))  # noqa: E731 - local shorthand
     c = db(r, d)
     rm, rp = np.clip(r - 1, 0, n_r - 1), np.clip(r + 1, 0, n_r - 1)

@@ -39,7 +39,6 @@ from typing import Any
 import numpy as np
 
 from skyradar.config import RadarConfig
-from skyradar.process.ground_fit import surface_fit_chi2
 
 __all__ = [
     "static_radial_velocity_mps",
@@ -384,11 +383,4 @@ def _ground_along(u_ant, rng, v_r, sd_az, sd_el, antenna, ant_to_ned, height_fn,
     sd_h = height_sd_m(rng, sd_az, sd_el, u_ant, ant_to_ned, config, SURFACE_SD_M)
     sd_v = static_doppler_sd_mps(u_ant, sd_az, sd_el, ant_to_ned, vel)
     sigma = np.maximum(sd_az, sd_el)
-    ground = classify_ground(rng, v_r, u_ned, config, vel, h, sigma, height_sd=sd_h, doppler_sd=sd_v)
-    with np.errstate(invalid="ignore"):  # below the surface, or on it with a precise position: decided
-        check = ground & ~((h < -3.0 * sd_h) | ((h <= 3.0 * sd_h) & (3.0 * sd_h <= 30.0)))
-    if check.any():  # one DoA error moves both height and static Doppler: fit ONE ground direction
-        chi2 = surface_fit_chi2(u_ant[check], rng[check], v_r[check], sd_az[check], sd_el[check], antenna,
-                                ant_to_ned, height_fn, vel, config, SURFACE_SD_M)  # fmt: skip
-        ground[check] = chi2 <= _CHI2_2DOF_3SD
-    return ground
+    return classify_ground(rng, v_r, u_ned, config, vel, h, sigma, height_sd=sd_h, doppler_sd=sd_v)

@@ -382,17 +382,15 @@ def cfar_2d_floor(
     floor = np.float32(noise_floor_w)
     hits = np.empty(power.shape, np.bool_)
     only = not noise_map
-    if only:
-        noise = np.full(power.shape, np.nan, np.float32)
-        if _floor_sparse(power, skip, big_l, table, floor, (hr, hd, gr, gd), n_train, min_train, hits, noise):
-            return hits, noise
-    else:
-        noise = np.empty(power.shape, np.float32)
+    noise = np.full(power.shape, np.nan, np.float32) if only else np.empty(power.shape, np.float32)
+    half = (hr, hd, gr, gd)
+    if only and _floor_sparse(power, skip, big_l, table, floor, half, n_train, min_train, hits, noise):
+        return hits, noise
     valid = (~skip).astype(np.float32)
     # Summed-area tables (float64) of the padded images: every window sum is four lookups.
     sat_p, sat_c, sat_v = (
         cv2.integral(_pad(x, hr, hd), sdepth=cv2.CV_64F) for x in (power, power * valid, valid)
     )
-    _floor_decide(power, sat_p, sat_c, sat_v, (hr, hd, gr, gd), skip, big_l, table, floor, n_train, min_train,
+    _floor_decide(power, sat_p, sat_c, sat_v, half, skip, big_l, table, floor, n_train, min_train,
                   hits, noise, only)  # fmt: skip
     return hits, noise

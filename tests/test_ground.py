@@ -108,3 +108,43 @@ def test_ground_band_is_the_clutter_region_of_a_level_flight():
     assert in_ground_band(np.array([2000.0]), np.array([30.0]), climbing, 1000.0, CFG, 0.0).all()
     # Fast flight: the band covers the whole aliased Doppler axis.
     assert in_ground_band(np.array([3000.0]), np.array([10.0]), np.array([90.0, 0, 0]), 500.0, CFG, 0.0).all()
+
+
+def _ridge_frame(elevation_deg: float) -> dict:
+    """One unreliable detection at 500 m, azimuth 60 deg, level flight north at 50 m/s, 550 m AGL."""
+    az, el = np.radians(60.0), np.radians(elevation_deg)
+    u = np.array([[np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)]])
+    p = 500.0 * u
+    return {
+        "range_m": np.array([500.0]),
+        "snr_db": np.array([20.0]),
+        "azimuth_rad": np.array([az]),
+        "elevation_rad": np.array([el]),
+        "north_m": p[:, 0],
+        "east_m": p[:, 1],
+        "down_m": p[:, 2],
+        "radial_velocity_mps": -u[:, 0] * 50.0,  # a static point's
+        "u_ant": u,
+        "coherence": np.array([0.3]),  # ground left and right in one cell: the direction is unreliable
+    }
+
+
+def test_ridge_beside_the_track_nearer_than_the_ground_below_is_ground():
+    # Flat ground 550 m below, and a ridge east of 300 m whose top is 263 m higher: its returns come
+    # at 500 m, nearer than the ground below. With a fixed 30 m margin they were "unreachable" and
+    # kept as air (confirmed ground tracks over Jacksboro); the band now widens by the sampled rise.
+    from skyradar.process.ground import flag_ground
+
+    ridge_top_down_m = 500.0 * np.sin(np.radians(35.0))
+
+    def height_fn(points):
+        points = np.asarray(points, float)
+        surface = np.where(points[..., 1] > 300.0, ridge_top_down_m, 550.0)
+        return surface - points[..., 2]
+
+    args = (np.array([50.0, 0.0, 0.0]), np.eye(3), height_fn, 550.0, CFG)
+    on_ridge = _ridge_frame(-35.0)
+    assert flag_ground(on_ridge, on_ridge["u_ant"], *args).tolist() == [True]
+    # An aircraft at the same range and Doppler, 250 m above the ridge's surface, stays air.
+    above = _ridge_frame(-5.0)
+    assert flag_ground(above, above["u_ant"], *args).tolist() == [False]

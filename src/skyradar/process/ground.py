@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from skyradar.config import RadarConfig
+from skyradar.process.terrain_rise import terrain_rise_m
 
 __all__ = [
     "static_radial_velocity_mps",
@@ -62,6 +63,7 @@ _ENDFIRE_COSINE = float(np.sin(np.radians(45.0)))
 # own height uncertainty (DEM error, relief inside a range cell, navigation altitude error).
 ANGLE_FLOOR_RAD = float(np.radians(0.3))
 SURFACE_SD_M = 10.0
+TERRAIN_MARGIN_M = 30.0  # ground this much above the ground below is in the band anywhere
 
 
 def static_radial_velocity_mps(direction_ned: np.ndarray, own_velocity_ned_mps: np.ndarray) -> np.ndarray:
@@ -89,7 +91,7 @@ def in_ground_band(
     own_height_agl_m: float,
     config: RadarConfig,
     tolerance_mps: float | None = None,
-    terrain_margin_m: float = 30.0,
+    terrain_margin_m: np.ndarray | float = 30.0,
 ) -> np.ndarray:
     """True where some static point of the ground at this range can have this (aliased) radial velocity.
 
@@ -367,7 +369,13 @@ def flag_ground(
     ground |= mirrored
     unreliable = ~in_field_of_view(out["azimuth_rad"], out["elevation_rad"], config, 12.0)
     unreliable |= out["coherence"] < 0.5
-    sel = unreliable & in_ground_band(rng, v_r, own_velocity_ned_mps, own_height_agl_m, config)
+    # Over relief, ground beside the track can be nearer than the ground below: widen the band by
+    # the terrain's rise around the radar (zero over flat ground, where the fixed margin stays).
+    margin_m = np.full(rng.shape, TERRAIN_MARGIN_M)
+    if unreliable.any():
+        margin_m[unreliable] += terrain_rise_m(height_fn, antenna, rng[unreliable])
+    band = in_ground_band(rng, v_r, own_velocity_ned_mps, own_height_agl_m, config, terrain_margin_m=margin_m)
+    sel = unreliable & band
     hit = sel & mirrored
     if sel.any():
         margin = 3.0 * np.hypot(rng[sel] * sd_el[sel], SURFACE_SD_M)

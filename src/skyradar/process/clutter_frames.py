@@ -13,17 +13,7 @@ would cost that for every few metres flown.
 :func:`directions_after_projection` (home: :mod:`skyradar.process.clutter_doa`) estimates the
 direction of a detection whose cell was projected: the projected matched filter's best direction;
 the plain phase estimate of the unsuppressed snapshot would follow the clutter that dominates the
-cell. With two nulls elevation is often unobservable (see that module).
-
-Examples
---------
->>> from skyradar.config import RadarConfig
->>> from skyradar.process.doa import direction_from_angles, steering_vector
->>> cfg = RadarConfig.prototype_2022()
->>> z = steering_vector(direction_from_angles(0.2, -0.1), cfg)[None]
->>> u = directions_after_projection(z, np.eye(4)[None], cfg)
->>> np.degrees(np.arctan2(u[0, 1], u[0, 0])).round(1), np.degrees(np.arcsin(-u[0, 2])).round(1)
-(np.float64(11.5), np.float64(-5.7))
+cell. With two nulls elevation is often unobservable (see that module, whose example shows it).
 """
 
 from __future__ import annotations

@@ -132,9 +132,11 @@ def test_ctrl_c_keeps_finished_chunks_and_rerun_resumes(tmp_path):
     import signal
     import time
 
-    # 24 frames in 6 chunks, with the default facets (<= dR/2) over 6 km (about 0.3 s a frame): seconds
-    # of work left when the first chunk is done, so the interrupt always lands mid-run.
-    heavy = {**BASE, "duration_s": 4.8, "terrain": {"type": "flat", "size_m": 6000, "spacing_m": 30}}
+    # 48 frames in 12 chunks, with the default facets (<= dR/2) over 6 km of hills (level ground skips
+    # the horizon and was fast enough to finish before the interrupt): seconds of work left when the
+    # first chunk is done, so the interrupt always lands mid-run.
+    hills = {"type": "fractal", "local_sd_m": 30.0, "size_m": 6000, "spacing_m": 30, "seed": 1}
+    heavy = {**BASE, "duration_s": 9.6, "terrain": hills}
     scenario = _write(tmp_path, {**heavy, "simulation": {}})
     command = [
         sys.executable,
@@ -162,7 +164,7 @@ def test_ctrl_c_keeps_finished_chunks_and_rerun_resumes(tmp_path):
     result = _skyradar("simulate", str(scenario), "-o", "run.zarr", "--chunk-frames", "4", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     ds = open_frames(tmp_path / "run.zarr")
-    assert ds.iq.shape[0] == 24
+    assert ds.iq.shape[0] == 48
     np.testing.assert_array_equal(ds.iq.values[:4], first_chunk)
 
 

@@ -149,7 +149,16 @@ def test_ctrl_c_keeps_finished_chunks_and_rerun_resumes(tmp_path):
         "--chunk-frames",
         "4",
     ]
-    proc = subprocess.Popen(command, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # A shell without job control starts background jobs with SIGINT ignored, and Python then installs
+    # no KeyboardInterrupt handler: give the command the default disposition a terminal's Ctrl-C meets.
+    proc = subprocess.Popen(
+        command,
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     marks = tmp_path / "run.zarr.partial.done"
     deadline = time.time() + 240
     while not (marks / "0").exists() and time.time() < deadline and proc.poll() is None:

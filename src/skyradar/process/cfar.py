@@ -31,17 +31,23 @@ from scipy import ndimage  # stats, integrate, optimize: imported where used (sc
 
 from skyradar.errors import InputError
 
-__all__ = ["cfar_factor", "cfar_2d", "cfar_2d_floor"]
+__all__ = ["cfar_factor", "cfar_2d", "cfar_2d_floor", "training_cells"]
 
 
-def _window(shape: tuple[int, ...], guard, train) -> tuple[int, int, int, int, int, int]:
-    """Guard and training half-widths (range, Doppler) and their sums, checked against the image shape."""
+def training_cells(guard: tuple[int, int], train: tuple[int, int]) -> int:
+    """Training cells of a 2-D CA-CFAR window, the window less its guard block (guard 2x2, train 4x8: 248)."""
+    (gr, gd), (tr, td) = guard, train
+    return (2 * (gr + tr) + 1) * (2 * (gd + td) + 1) - (2 * gr + 1) * (2 * gd + 1)
+
+
+def _window(shape: tuple[int, ...], guard, train) -> tuple[int, ...]:
+    """Guard and training half-widths, their sums and the training cells, checked against the shape."""
     gr, gd = (int(v) for v in guard)
     tr, td = (int(v) for v in train)
     hr, hd = gr + tr, gd + td
     if min(gr, gd, tr, td) < 0 or hd >= shape[1] // 2 or hr >= shape[0] // 2:
         raise InputError(f"cfar: guard {guard} / train {train} do not fit an image of shape {shape}")
-    return gr, gd, tr, td, hr, hd
+    return gr, gd, tr, td, hr, hd, training_cells((gr, gd), (tr, td))
 
 
 @lru_cache(maxsize=64)
@@ -207,8 +213,7 @@ def cfar_2d(
         Noise estimate per pixel, W.
     """
     power = np.asarray(power, dtype=np.float32)
-    gr, gd, tr, td, hr, hd = _window(power.shape, guard, train)
-    n_train = (2 * hr + 1) * (2 * hd + 1) - (2 * gr + 1) * (2 * gd + 1)
+    gr, gd, tr, td, hr, hd, n_train = _window(power.shape, guard, train)
     if not 0.0 < pfa < 1.0:  # the CA table below skips cfar_factor's check (pfa 5 gave NaN thresholds)
         raise InputError(f"cfar: field 'pfa' must be in (0, 1), got {pfa}")
     if kind == "ca":
@@ -372,10 +377,9 @@ def cfar_2d_floor(
     (True, True)
     """
     power = np.asarray(power, dtype=np.float32)
-    gr, gd, tr, td, hr, hd = _window(power.shape, guard, train)
+    gr, gd, tr, td, hr, hd, n_train = _window(power.shape, guard, train)
     if not 0.0 < pfa < 1.0:
         raise InputError(f"cfar: field 'pfa' must be in (0, 1), got {pfa}")
-    n_train = (2 * hr + 1) * (2 * hd + 1) - (2 * gr + 1) * (2 * gd + 1)
     table = _floor_tables(float(pfa), n_train)
     skip = np.zeros(power.shape, np.bool_) if train_exclude is None else np.asarray(train_exclude, np.bool_)
     big_l = np.ascontiguousarray(np.clip(channels, 1, 8), np.int8)

@@ -35,12 +35,11 @@ def detection_threshold_snr_db(config: RadarConfig, probability: float = 0.5) ->
     >>> round(detection_threshold_snr_db(RadarConfig.prototype_2022()), 1)
     7.5
     """
-    from skyradar.process.cfar import cfar_factor
+    from skyradar.process.cfar import cfar_factor, training_cells
     from skyradar.process.detect import detect
 
     defaults = {k: v.default for k, v in inspect.signature(detect).parameters.items()}
-    (gr, gd), (tr, td) = defaults["guard"], defaults["train"]
-    n_train = (2 * (gr + tr) + 1) * (2 * (gd + td) + 1) - (2 * gr + 1) * (2 * gd + 1)
+    n_train = training_cells(defaults["guard"], defaults["train"])
     n = config.n_rx
     alpha = cfar_factor(defaults["pfa"], n_train, n)
 

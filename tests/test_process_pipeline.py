@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 import pandas as pd
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from cli_helpers import skyradar_in_process as run_cli
 from skyradar.benchmarks.process import synthetic_frame
 from skyradar.config import Mount, RadarConfig
 from skyradar.errors import InputError
@@ -114,41 +113,26 @@ def test_bad_input():
         process_frames(ds, SpurMap(np.zeros((5, 5)), 0.5, 1))
 
 
-def run_cli(monkeypatch, *args) -> int:
-    from skyradar.cli import main
-
-    monkeypatch.setattr(sys, "argv", ["skyradar", *map(str, args)])
-    try:
-        main()
-    except SystemExit as exc:
-        return int(exc.code or 0)
-    return 0
-
-
 def test_cli_process_writes_the_table_and_reports_bad_input(tmp_path, monkeypatch, capsys):
     ds, _ = scene(n_frames=2)
     ds.to_zarr(tmp_path / "run.zarr", consolidated=False)
     out = tmp_path / "det.parquet"
-    assert run_cli(monkeypatch, "process", tmp_path / "run.zarr", "-o", out, "--json") == 0
+    code, stdout, _ = run_cli(monkeypatch, capsys, "process", tmp_path / "run.zarr", "-o", out, "--json")
+    assert code == 0
     table = pd.read_parquet(out)
     assert list(table.columns) == [*DETECTION_COLUMNS, "radar"] and len(table) == 4
     assert set(table["radar"]) == {"radar"}  # one head: its default name
-    assert '"detections": 4' in capsys.readouterr().out.strip().splitlines()[-1]
+    assert '"detections": 4' in stdout.strip().splitlines()[-1]
     # A spur map learned from the same frames masks both objects.
-    assert (
-        run_cli(monkeypatch, "spur-map", tmp_path / "run.zarr", "-o", tmp_path / "s.npz", "--threshold", 0.4)
-        == 0
-    )
-    assert (
-        run_cli(monkeypatch, "process", tmp_path / "run.zarr", "-o", out, "--spur-map", tmp_path / "s.npz")
-        == 0
-    )
+    spur_map = ("spur-map", tmp_path / "run.zarr", "-o", tmp_path / "s.npz", "--threshold", 0.4)
+    assert run_cli(monkeypatch, capsys, *spur_map)[0] == 0
+    masked = ("process", tmp_path / "run.zarr", "-o", out, "--spur-map", tmp_path / "s.npz")
+    assert run_cli(monkeypatch, capsys, *masked)[0] == 0
     assert len(pd.read_parquet(out)) == 0
-    capsys.readouterr()
     ds.isel(rx=slice(0, 3)).to_zarr(tmp_path / "bad.zarr", consolidated=False)
-    assert run_cli(monkeypatch, "process", tmp_path / "bad.zarr", "-o", out) == 2
-    assert capsys.readouterr().err.startswith("error: ")
-    assert run_cli(monkeypatch, "process", tmp_path / "missing.zarr", "-o", out) == 2
+    code, _, stderr = run_cli(monkeypatch, capsys, "process", tmp_path / "bad.zarr", "-o", out)
+    assert code == 2 and stderr.startswith("error: ")
+    assert run_cli(monkeypatch, capsys, "process", tmp_path / "missing.zarr", "-o", out)[0] == 2
 
 
 CH3_KEYS = ("az_sd_deg", "el_sd_deg", "az_crlb_deg", "el_crlb_deg", "dist_mean_m", "calib_phase_err_deg",
@@ -177,31 +161,22 @@ def test_cli_calibrate_then_process_with_the_calibrated_config(tmp_path, monkeyp
     cubes = np.stack([synthetic_frame(cfg, [building, aircraft], rng, rx_gain=offsets)[0] for _ in range(4)])
     frames_dataset(cubes, np.arange(4) * 0.1, cfg).to_zarr(tmp_path / "run.zarr", consolidated=False)
     args = ["--range", 438, "--azimuth", 5, "--elevation", -1]
-    assert run_cli(monkeypatch, "calibrate", tmp_path / "run.zarr", "-o", tmp_path / "radar.json", *args) == 0
+    calibrate = ("calibrate", tmp_path / "run.zarr", "-o", tmp_path / "radar.json", *args)
+    assert run_cli(monkeypatch, capsys, *calibrate)[0] == 0
     cal = RadarConfig.from_json((tmp_path / "radar.json").read_text())
     assert calibration_phase_error_deg(cal.rx_calibration, offsets) <= 1.0
     out = tmp_path / "det.parquet"
-    assert (
-        run_cli(
-            monkeypatch,
-            "process",
-            tmp_path / "run.zarr",
-            "-o",
-            out,
-            "--radar-config",
-            tmp_path / "radar.json",
-        )
-        == 0
-    )
+    calibrated = ("process", tmp_path / "run.zarr", "-o", out, "--radar-config", tmp_path / "radar.json")
+    assert run_cli(monkeypatch, capsys, *calibrated)[0] == 0
     table = pd.read_parquet(out)
     plane = table[np.abs(table.range_m - 1500.0) < 10]
     assert len(plane) == 4
     assert np.degrees(np.abs(plane.azimuth_rad + np.radians(12.0))).max() < 1.0
     assert np.degrees(np.abs(plane.elevation_rad - np.radians(8.0))).max() < 1.0
-    capsys.readouterr()
     wide = ["--range", 438, "--azimuth", 80, "--elevation", 0]
-    assert run_cli(monkeypatch, "calibrate", tmp_path / "run.zarr", "-o", tmp_path / "x.json", *wide) == 2
-    assert "field of view" in capsys.readouterr().err
+    x_json = tmp_path / "x.json"
+    code, _, stderr = run_cli(monkeypatch, capsys, "calibrate", tmp_path / "run.zarr", "-o", x_json, *wide)
+    assert code == 2 and "field of view" in stderr
 
 
 def test_simulated_flight_over_flat_ground_separates_terrain_from_the_intruder():

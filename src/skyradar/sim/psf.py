@@ -150,12 +150,62 @@ def binned_kernel(name: str, n: int, oversample: int = 1) -> np.ndarray:
 
 
 @njit(inline="always")
-def _axpy(dst, g, src):
-    # dst += g * src over equal-length views, indexed by a plain range(n): numba then knows no
-    # index is negative, drops its wrap-around check and LLVM vectorises the loop (an index
-    # like x - shift kept it scalar: 5x slower).
+def _set4(dst, g0, s0, g1, s1, g2, s2, g3, s3):
     for x in range(dst.shape[0]):
-        dst[x] += g * src[x]
+        dst[x] = g0 * s0[x] + g1 * s1[x] + g2 * s2[x] + g3 * s3[x]
+
+
+@njit(inline="always")
+def _add4(dst, g0, s0, g1, s1, g2, s2, g3, s3):
+    # Four taps per pass: one load and store of ``dst`` per four multiply-adds, not per one (the
+    # passes were bound by those loads and stores). A plain range(n) index: no wrap-around
+    # check, and LLVM vectorises the loop.
+    for x in range(dst.shape[0]):
+        dst[x] += g0 * s0[x] + g1 * s1[x] + g2 * s2[x] + g3 * s3[x]
+
+
+@njit(inline="always")
+def _taps_into(dst, gains, rows, n):
+    """``dst = sum(gains[t] * rows[t] for t < n)``; ``n`` a multiple of 4 (padding has gain 0)."""
+    _set4(dst, gains[0], rows[0], gains[1], rows[1], gains[2], rows[2], gains[3], rows[3])
+    for t in range(4, n, 4):
+        _add4(dst, gains[t], rows[t], gains[t + 1], rows[t + 1], gains[t + 2], rows[t + 2], gains[t + 3],
+              rows[t + 3])  # fmt: skip
+
+
+@njit(inline="always")
+def _row_filled(fine, m):
+    for b in range(fine.shape[0]):
+        src = fine[b, m]
+        for x in range(src.shape[0]):
+            if src[x] != 0.0:
+                return True
+    return False
+
+
+@njit(inline="always")
+def _phase_rows(fine, m, ext, n_d, step, pad, clear):
+    # Fine bin L j + p of row m (summed over the blocks, which are cleared on the way when
+    # ``clear``) into ext[p, (pad + j) step ...], then ``pad`` bins copied circularly either side:
+    # every Doppler tap then reads one contiguous run.
+    os = ext.shape[0]
+    for b in range(fine.shape[0]):
+        src = fine[b, m]
+        for j in range(n_d):
+            for p in range(os):
+                dst = ext[p, (pad + j) * step : (pad + j + 1) * step]
+                part = src[(os * j + p) * step : (os * j + p + 1) * step]
+                if b == 0:
+                    dst[:] = part
+                else:
+                    for c in range(step):
+                        dst[c] += part[c]
+        if clear:
+            src[:] = 0
+    for p in range(os):
+        e = ext[p]
+        e[: pad * step] = e[n_d * step : (n_d + pad) * step]
+        e[(pad + n_d) * step :] = e[pad * step : 2 * pad * step]
 
 
 @njit(parallel=True, cache=True, error_model="numpy", fastmath=True)
@@ -165,51 +215,36 @@ def _psf_kernel(fine, tmp, out, h_range, h_doppler, step, clear):  # pragma: no 
     # them), tmp (L n_r, n_d * w), out (n_r, n_d * w) with w = 2 n_rx floats per bin.
     # out[k, j] = sum over fine (m, l) of fine[m, l] h_range[L k - m] h_doppler[L j - l]: a real
     # kernel acts on the real and imaginary parts alike, so the inner loops are plain vector
-    # multiply-adds over w floats.
-    n_blocks, n_fine_r = fine.shape[0], fine.shape[1]
-    n_fine_d = fine.shape[2] // step
-    n_d = tmp.shape[1] // step
-    os = n_fine_d // n_d
+    # multiply-adds over whole rows, four taps at a time.
+    n_fine_r, n_d = fine.shape[1], tmp.shape[1] // step
+    os = fine.shape[2] // step // n_d
     sr, sd = h_range.shape[0] // 2, h_doppler.shape[0] // 2
-    width = n_d * step
+    width, pad = n_d * step, (sd + os - 1) // os + 1
     filled = np.zeros(n_fine_r, np.bool_)  # rows with any return (ground below is empty)
     for m in prange(n_fine_r):  # Doppler: circular
-        dst = tmp[m]
-        for b in range(n_blocks):
-            src = fine[b, m]
-            for x in range(src.shape[0]):
-                if src[x] != 0.0:
-                    filled[m] = True
-                    break
+        filled[m] = _row_filled(fine, m)
         if not filled[m]:
             continue
-        # The row's sub-bin phases, each a plain row of bins: fine bin L j + p is phases[p, j].
-        phases = np.zeros((os, width), np.float32)
-        for b in range(n_blocks):
-            src = fine[b, m]
-            for j in range(n_d):
-                for p in range(os):
-                    lo = (os * j + p) * step
-                    _axpy(phases[p, j * step : (j + 1) * step], 1.0, src[lo : lo + step])
-            if clear:
-                src[:] = 0
-        dst[:] = 0
-        for s in range(-sd, sd + 1):
-            # Fine bin L j - s is phase (-s) mod L of bin j - shift: one shifted run of the row
-            # (two at the wrap) per tap.
-            p = (-s) % os
-            shift = ((s + p) // os) % n_d * step
-            g, row = h_doppler[s + sd], phases[p]
-            _axpy(dst[shift:], g, row[: width - shift])
-            _axpy(dst[:shift], g, row[width - shift :])
+        ext = np.empty((os, (n_d + 2 * pad) * step), np.float32)
+        _phase_rows(fine, m, ext, n_d, step, pad, clear)
+        # Fine bin L j - s is phase p = (-s) mod L of bin j - t, t = (s + p) / L.
+        gains, rows = np.zeros((2 * sd + 4) // 4 * 4, np.float32), [ext[0, :width]] * ((2 * sd + 4) // 4 * 4)
+        for i in range(2 * sd + 1):
+            p = (sd - i) % os
+            t = (i - sd + p) // os
+            gains[i], rows[i] = h_doppler[i], ext[p, (pad - t) * step : (pad - t) * step + width]
+        _taps_into(tmp[m], gains, rows, gains.shape[0])
+    n_taps = (2 * sr + 4) // 4 * 4
     for k in prange(out.shape[0]):  # range: zero beyond the cube
-        dst = out[k]
-        dst[:] = 0
+        gains, rows, n = np.zeros(n_taps, np.float32), [tmp[0]] * n_taps, 0
         for s in range(-sr, sr + 1):
             m = os * k - s
-            if m < 0 or m >= n_fine_r or not filled[m]:
-                continue
-            _axpy(dst, h_range[s + sr], tmp[m])
+            if 0 <= m < n_fine_r and filled[m]:
+                gains[n], rows[n], n = h_range[s + sr], tmp[m], n + 1
+        if n == 0:
+            out[k, :] = 0
+        else:
+            _taps_into(out[k], gains, rows, (n + 3) // 4 * 4)
 
 
 def apply_psf(

@@ -243,8 +243,10 @@ def _psf_kernel(fine, tmp, out, h_range, h_doppler, step, clear):  # pragma: no 
                 gains[n], rows[n], n = h_range[s + sr], tmp[m], n + 1
         if n == 0:
             out[k, :] = 0
-        else:
-            _taps_into(out[k], gains, rows, (n + 3) // 4 * 4)
+            continue
+        for t in range(n, n_taps):  # padding taps (gain 0) read a written row: 0 * garbage may be NaN
+            rows[t] = rows[0]
+        _taps_into(out[k], gains, rows, (n + 3) // 4 * 4)
 
 
 def apply_psf(

@@ -148,3 +148,27 @@ def test_ridge_beside_the_track_nearer_than_the_ground_below_is_ground():
     # An aircraft at the same range and Doppler, 250 m above the ridge's surface, stays air.
     above = _ridge_frame(-5.0)
     assert flag_ground(above, above["u_ant"], *args).tolist() == [False]
+
+
+def test_altitude_return_read_straight_up_is_ground():
+    # Over flat ground 300 m below, the ground just ahead of the nadir leaks into the range bin one
+    # short of the height (window sidelobes, straddle) at a few m/s of closing Doppler; the DoA of
+    # that far sidelobe is the end-fire of both baselines, read straight UP. Its mirror points at
+    # the ground below, where the linearised Doppler error vanishes: the encounter chain confirmed
+    # such returns as tracks over flat-300, flat-1000 and Jacksboro before this rule.
+    from skyradar.process.ground import flag_ground
+
+    el, az = np.radians(88.0), np.radians(90.0)
+    u = np.array([[np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)]] * 3)
+    rng = np.array([286.0, 200.0, 286.0])  # altitude return; nearer than the ground; closing fast
+    p = rng[:, None] * u
+    frame = {"range_m": rng, "snr_db": np.full(3, 13.0), "azimuth_rad": np.full(3, az),
+             "elevation_rad": np.full(3, el), "north_m": p[:, 0], "east_m": p[:, 1], "down_m": p[:, 2],
+             "radial_velocity_mps": np.array([-4.4, -4.4, -30.0]), "u_ant": u,
+             "coherence": np.full(3, 0.9)}  # fmt: skip
+
+    def height_fn(points):
+        return 300.0 - np.asarray(points, float)[..., 2]
+
+    flags = flag_ground(frame, u, np.array([50.0, 0.0, 0.0]), np.eye(3), height_fn, 300.0, CFG)
+    assert flags.tolist() == [True, False, False]

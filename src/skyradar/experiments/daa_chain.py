@@ -29,6 +29,7 @@ from skyradar.process.detect_run import merge_head_tables
 from skyradar.process.pipeline import process_frames
 from skyradar.scene.radar_heads import select_heads
 from skyradar.sim.scenario_frames import make_simulator, scenario_truth, simulate_frames
+from skyradar.track.ground_tracks import GroundTrackTest, terrain_surface
 from skyradar.track.track_table import track_detections
 
 __all__ = ["run_chain", "track_and_alert", "label_tracks"]
@@ -149,6 +150,7 @@ def track_and_alert(
     tracks = track_detections(
         detections[keep].reset_index(drop=True), "radar", chosen[0].config,
         frame_times_s=built.times_s, origin=built.origin, ownship=own,
+        ground_test=GroundTrackTest(surface_down=_surface(built, own)),
     )  # fmt: skip
     timings = {"track": time.perf_counter() - t0}
     t0 = time.perf_counter()
@@ -156,6 +158,15 @@ def track_and_alert(
     timings["alert"] = time.perf_counter() - t0
     return {"tracks": tracks, "alerts": alerts, "ownship": own, "detections": detections[mine],
             "timings_s": timings}  # fmt: skip
+
+
+def _surface(built, own: pd.DataFrame):
+    """The scenario's ground for the track-level ground test (None: the own-ship's height above ground)."""
+    if built.terrain is None or not hasattr(built.terrain, "height_at"):
+        return None
+    ground = (own["own_down_m"] + own.get("own_height_agl_m", np.nan)).to_numpy(float)
+    flat = float(np.nanmedian(ground)) if np.isfinite(ground).any() else np.nan
+    return terrain_surface(built.terrain, built.origin, flat)
 
 
 def label_tracks(tracks: pd.DataFrame, truth: xr.Dataset, max_distance_m: float = _MATCH_M) -> dict[int, str]:

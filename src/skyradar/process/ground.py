@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from skyradar.config import RadarConfig
+from skyradar.process.ground_elevation import ground_in_elevation
 from skyradar.process.terrain_rise import terrain_rise_m
 
 __all__ = [
@@ -64,6 +65,7 @@ _ENDFIRE_COSINE = float(np.sin(np.radians(45.0)))
 ANGLE_FLOOR_RAD = float(np.radians(0.3))
 SURFACE_SD_M = 10.0
 TERRAIN_MARGIN_M = 30.0  # ground this much above the ground below is in the band anywhere
+_ALTITUDE_LEAK_BINS = 2.0  # range bins the altitude return leaks (window sidelobes, straddle)
 
 
 def static_radial_velocity_mps(direction_ned: np.ndarray, own_velocity_ned_mps: np.ndarray) -> np.ndarray:
@@ -268,36 +270,6 @@ def classify_ground(
     return np.isfinite(h) & (joint | conclusive | below)
 
 
-def ground_in_elevation(
-    range_m: np.ndarray,
-    elevation_rad: np.ndarray,
-    height_fn: Callable[[np.ndarray], np.ndarray],
-    antenna_ned_m: np.ndarray,
-    ant_to_ned: np.ndarray,
-    margin_m: np.ndarray | float,
-    max_azimuth_rad: float = np.radians(70.0),
-    n_azimuth: int = 29,
-) -> np.ndarray:
-    """True where some azimuth within ``+-max_azimuth_rad`` puts ``(range, elevation)`` on the surface.
-
-    For pixels whose azimuth means nothing (ground to the left and right of the track in one
-    range-Doppler cell). Returns from the same antenna elevation add up with the same phase step
-    across the vertical baseline, so the elevation of such a mixture is still that of the
-    ground; an aircraft mixed with ground pulls it towards the aircraft. ``height_fn`` maps NED
-    points (m, shape (..., 3)) to heights above the surface (NaN: unknown, not ground).
-    """
-    az = np.linspace(-max_azimuth_rad, max_azimuth_rad, n_azimuth)
-    el = np.asarray(elevation_rad, float)[:, None]
-    u_ant = np.stack(np.broadcast_arrays(np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)), -1)
-    points = np.asarray(antenna_ned_m, float) + np.asarray(range_m, float)[:, None, None] * (
-        u_ant @ np.asarray(ant_to_ned, float).T
-    )
-    h = height_fn(points)
-    margin = np.broadcast_to(np.asarray(margin_m, float), el.shape[:1])[:, None]
-    with np.errstate(invalid="ignore"):
-        return np.any(np.abs(h) <= margin, axis=1)
-
-
 def surface_height_fn(
     flat_down_m: float, terrain: Any, geodetic: Callable[[np.ndarray], tuple] | None
 ) -> Callable[[np.ndarray], np.ndarray]:
@@ -343,7 +315,8 @@ def flag_ground(
     (:func:`ground_in_elevation`): an aircraft mixed with ground pulls the elevation up and is kept.
     Near the end-fire of a baseline (direction cosine above sin 45 deg) the mirrored direction is
     tested too: the phase step is near +-pi there, and the ground straight below (the altitude
-    return) is otherwise read as a direction above the aircraft.
+    return) is otherwise read as a direction above the aircraft; read so, it is ground when its
+    range and Doppler are the ground's within the DoA's cone around the nadir.
     """
     from skyradar.process.calibration import in_field_of_view
     from skyradar.process.doa import doa_crlb
@@ -358,15 +331,6 @@ def flag_ground(
     v_r, u_ant = out["radial_velocity_mps"], np.asarray(out["u_ant"], float)
     args = (antenna, ant_to_ned, height_fn, own_velocity_ned_mps, config)
     ground = _ground_along(u_ant, rng, v_r, sd_az, sd_el, *args)
-    # Near the end-fire of a baseline the phase step is close to +-pi and noise flips its sign: the
-    # mirrored direction is as plausible (the ground straight below read as straight above).
-    mirror = u_ant.copy()
-    mirror[:, 1:] *= np.where(np.abs(u_ant[:, 1:]) > _ENDFIRE_COSINE, -1.0, 1.0)
-    amb = np.any(mirror != u_ant, axis=1)
-    mirrored = np.zeros(rng.shape, bool)
-    if amb.any():
-        mirrored[amb] = _ground_along(mirror[amb], rng[amb], v_r[amb], sd_az[amb], sd_el[amb], *args)
-    ground |= mirrored
     unreliable = ~in_field_of_view(out["azimuth_rad"], out["elevation_rad"], config, 12.0)
     unreliable |= out["coherence"] < 0.5
     # Over relief, ground beside the track can be nearer than the ground below: widen the band by
@@ -375,6 +339,8 @@ def flag_ground(
     if unreliable.any():
         margin_m[unreliable] += terrain_rise_m(height_fn, antenna, rng[unreliable])
     band = in_ground_band(rng, v_r, own_velocity_ned_mps, own_height_agl_m, config, terrain_margin_m=margin_m)
+    mirrored = _mirrored_ground(u_ant, rng, v_r, sd_az, sd_el, band, own_height_agl_m, args)
+    ground |= mirrored
     sel = unreliable & band
     hit = sel & mirrored
     if sel.any():
@@ -382,6 +348,32 @@ def flag_ground(
         el = out["elevation_rad"][sel]
         hit[sel] |= ground_in_elevation(rng[sel], el, height_fn, antenna, ant_to_ned, margin)
     return np.where(unreliable, hit, ground)
+
+
+def _mirrored_ground(u_ant, rng, v_r, sd_az, sd_el, band, own_agl_m, args) -> np.ndarray:
+    """Ground read through the mirrored direction of detections near the end-fire of a baseline.
+
+    The phase step is close to +-pi there and noise flips its sign, so the mirrored direction is
+    as plausible: the ground straight below read as straight above. The return of the ground below
+    (the altitude return, the strongest of all: normal incidence at the shortest range) is ground
+    when its range and Doppler are in the ground band and its range is one that ground within the
+    DoA's 3-sd cone around that direction can have: at the pole the linearised Doppler error of
+    :func:`classify_ground` vanishes, though every direction of that cone is as likely.
+    """
+    antenna, ant_to_ned, _, _, config = args
+    mirror = u_ant.copy()
+    mirror[:, 1:] *= np.where(np.abs(u_ant[:, 1:]) > _ENDFIRE_COSINE, -1.0, 1.0)
+    amb = np.any(mirror != u_ant, axis=1)
+    mirrored = np.zeros(rng.shape, bool)
+    if not amb.any():
+        return mirrored
+    mirrored[amb] = _ground_along(mirror[amb], rng[amb], v_r[amb], sd_az[amb], sd_el[amb], *args)
+    cone_cos = np.cos(3.0 * np.maximum(sd_az, sd_el))
+    leak = _ALTITUDE_LEAK_BINS * config.range_resolution_m
+    down = (mirror @ np.asarray(ant_to_ned, float).T)[:, 2]
+    with np.errstate(invalid="ignore"):
+        altitude = amb & band & (down >= cone_cos) & (rng * cone_cos <= own_agl_m + leak)
+    return mirrored | altitude
 
 
 def _ground_along(u_ant, rng, v_r, sd_az, sd_el, antenna, ant_to_ned, height_fn, vel, config) -> np.ndarray:

@@ -8,6 +8,7 @@ import pandas as pd
 from skyradar.config import RadarConfig
 from skyradar.track.frame_grid import frame_grid, frame_numbers
 from skyradar.track.fusion import fuse_heads, restore_detection_rows
+from skyradar.track.ground_tracks import GroundTrackTest, hold_ground_tracks
 from skyradar.track.io import validate_detections, validate_ownship
 from skyradar.track.measure3d import angle_sigma_rad, position_covariance
 from skyradar.track.models import MotionModel, radar_model, traditional_model
@@ -105,6 +106,7 @@ def track_detections(
     origin: tuple[float, float, float] | None = None,
     position_sigma_rad: float | None = None,
     ownship: pd.DataFrame | None = None,
+    ground_test: GroundTrackTest | bool = True,
 ) -> pd.DataFrame:
     """Track a detections table; one output row per track per frame.
 
@@ -127,12 +129,13 @@ def track_detections(
     origin : (lat_deg, lon_deg, alt_m), optional
         Scenario origin for the tracks' lat/lon/alt; NaN without it.
     position_sigma_rad : float, optional
-        Fixed angular accuracy of DoA positions instead of the bound (default 0.04 rad when the
-        table has no ``snr_db``).
+        Fixed angular accuracy of DoA positions (default: the bound; 0.04 rad without ``snr_db``).
     ownship : DataFrame, optional
         :data:`OWNSHIP_COLUMNS` (NED, interpolated to the frame times). With it the DoA position
         error is split along/across the line of sight and the de-aliased radial velocity updates
         the 3-D velocity (:mod:`skyradar.track.tracker3d`).
+    ground_test : GroundTrackTest or bool
+        Hold back tracks the ground explains (:mod:`skyradar.track.ground_tracks`); False: off.
 
     Returns
     -------
@@ -149,13 +152,26 @@ def track_detections(
     """
     config = config or RadarConfig.prototype_2022()
     detections, head_rows = fuse_heads(validate_detections(detections), config)  # heads -> one stream
-    motion = make_model(model, config) if isinstance(model, str) else model
-    pixel = (config.range_resolution_m, config.doppler_resolution_mps)
-    tracker = RangeDopplerTracker(motion, tracker_config, pixel, report_tentative=True)
+    motion, tracker = _make_tracker(model, config, tracker_config)
     grid, lo, hi = _frame_slices(detections["time_s"].to_numpy(float), frame_times_s)
     m3 = _Measure3D(detections, config, motion, position_sigma_rad, ownship, grid)
     tracks = _assemble(_run_tracker(tracker, m3, detections, grid, lo, hi), origin, m3.active)
-    return restore_detection_rows(tracks, head_rows)
+    return restore_detection_rows(_held(tracks, detections, ownship, config, ground_test), head_rows)
+
+
+def _make_tracker(model, config: RadarConfig, tracker_config) -> tuple[MotionModel, RangeDopplerTracker]:
+    motion = make_model(model, config) if isinstance(model, str) else model
+    pixel = (config.range_resolution_m, config.doppler_resolution_mps)
+    return motion, RangeDopplerTracker(motion, tracker_config, pixel, report_tentative=True)
+
+
+def _held(tracks, detections, ownship, config: RadarConfig, ground_test) -> pd.DataFrame:
+    """:func:`~skyradar.track.ground_tracks.hold_ground_tracks` with ``ground_test``'s settings."""
+    if ground_test is False:
+        return tracks
+    test = ground_test if isinstance(ground_test, GroundTrackTest) else GroundTrackTest()
+    width, coupling = 2.0 * config.v_lim_mps, config.range_doppler_coupling_s
+    return hold_ground_tracks(tracks, detections, ownship, width, coupling, test.surface_down, test)
 
 
 def _run_tracker(tracker: RangeDopplerTracker, m3, detections: pd.DataFrame, grid, lo, hi) -> list[dict]:

@@ -1,0 +1,46 @@
+"""Ground tested by elevation alone, for pixels whose azimuth means nothing.
+
+A range-Doppler cell can sum ground to the left and right of the track (the same static Doppler
+on both sides): one plane wave explains such a pixel badly and its azimuth is meaningless, but
+returns from the same antenna elevation add up with the same phase step across the vertical
+baseline, so its elevation is still that of the ground. :func:`ground_in_elevation` asks whether
+some azimuth puts the pixel on the surface (used by :func:`skyradar.process.ground.flag_ground`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+__all__ = ["ground_in_elevation"]
+
+
+def ground_in_elevation(
+    range_m: np.ndarray,
+    elevation_rad: np.ndarray,
+    height_fn: Callable[[np.ndarray], np.ndarray],
+    antenna_ned_m: np.ndarray,
+    ant_to_ned: np.ndarray,
+    margin_m: np.ndarray | float,
+    max_azimuth_rad: float = np.radians(70.0),
+    n_azimuth: int = 29,
+) -> np.ndarray:
+    """True where some azimuth within ``+-max_azimuth_rad`` puts ``(range, elevation)`` on the surface.
+
+    For pixels whose azimuth means nothing (ground to the left and right of the track in one
+    range-Doppler cell). Returns from the same antenna elevation add up with the same phase step
+    across the vertical baseline, so the elevation of such a mixture is still that of the
+    ground; an aircraft mixed with ground pulls it towards the aircraft. ``height_fn`` maps NED
+    points (m, shape (..., 3)) to heights above the surface (NaN: unknown, not ground).
+    """
+    az = np.linspace(-max_azimuth_rad, max_azimuth_rad, n_azimuth)
+    el = np.asarray(elevation_rad, float)[:, None]
+    u_ant = np.stack(np.broadcast_arrays(np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)), -1)
+    points = np.asarray(antenna_ned_m, float) + np.asarray(range_m, float)[:, None, None] * (
+        u_ant @ np.asarray(ant_to_ned, float).T
+    )
+    h = height_fn(points)
+    margin = np.broadcast_to(np.asarray(margin_m, float), el.shape[:1])[:, None]
+    with np.errstate(invalid="ignore"):
+        return np.any(np.abs(h) <= margin, axis=1)

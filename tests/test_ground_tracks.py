@@ -1,0 +1,125 @@
+"""Track-level ground test (skyradar.track.ground_tracks) and the altitude return's ground flag.
+
+Over flat ground, a static point's range and Doppler history is fixed by the own-ship's motion;
+the tracks the encounter chain confirmed over terrain were such points with a wrong direction
+(sidelobe ground, ground left and right of the track in one cell) or residual clutter hopping
+between cells. Aircraft (slow, circling, crossing) must stay confirmed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from skyradar.config import RadarConfig
+from skyradar.track.ground_tracks import (
+    fits_static_ground,
+    flat_surface,
+    range_doppler_consistent,
+    static_point_measurements,
+)
+from skyradar.track.track_table import track_detections
+
+CFG = RadarConfig.prototype_2022()
+WIDTH = 2.0 * CFG.v_lim_mps
+C = CFG.range_doppler_coupling_s
+AGL_M = 500.0
+SPEED_MPS = 50.0
+T = np.arange(0.0, 8.0, 1.0 / 9.4)
+
+
+def _own(t: np.ndarray = T) -> pd.DataFrame:
+    """Own-ship flying north, level, 500 m above a level ground."""
+    zero = 0.0 * t
+    return pd.DataFrame({"time_s": t, "own_north_m": SPEED_MPS * t, "own_east_m": zero, "own_down_m": zero,
+                         "own_vn_mps": SPEED_MPS + zero, "own_ve_mps": zero, "own_vd_mps": zero,
+                         "own_height_agl_m": AGL_M + zero})  # fmt: skip
+
+
+def _detections(target_ned: np.ndarray, seed: int = 0, t: np.ndarray = T, up_m: float = 0.0) -> pd.DataFrame:
+    """Detections of a target (positions (k, 3) at ``t``), with range and Doppler noise; its DoA
+    position is moved ``up_m`` up (a wrong direction)."""
+    rng = np.random.default_rng(seed)
+    own = _own(t)
+    own_p = own[["own_north_m", "own_east_m", "own_down_m"]].to_numpy()
+    d = target_ned - own_p
+    r = np.linalg.norm(d, axis=1)
+    v_target = np.gradient(target_ned, t, axis=0)
+    v = np.sum(d * (v_target - [SPEED_MPS, 0, 0]), axis=1) / r
+    v_meas = v + rng.normal(0, 0.12, t.size)
+    return pd.DataFrame({"time_s": t, "range_m": r + C * v + rng.normal(0, 4.0, t.size),
+                         "radial_velocity_mps": (v_meas + WIDTH / 2) % WIDTH - WIDTH / 2,
+                         "north_m": target_ned[:, 0], "east_m": target_ned[:, 1],
+                         "down_m": target_ned[:, 2] - up_m, "snr_db": 20.0 + 0 * t})  # fmt: skip
+
+
+def _confirmed_from(tracks: pd.DataFrame) -> float:
+    return float(tracks.loc[tracks["confirmed"], "time_s"].min()) if tracks["confirmed"].any() else np.inf
+
+
+def test_static_ground_point_with_a_wrong_direction_is_not_confirmed():
+    # A point on the ground, its DoA 300 m up (a sidelobe): before the ground test it was a
+    # confirmed track with a 3-D position in the air.
+    ground = np.tile([2500.0, 900.0, AGL_M], (T.size, 1))
+    det = _detections(ground, up_m=300.0)
+    assert _confirmed_from(track_detections(det, ownship=_own(), ground_test=False)) < 1.0
+    assert len(track_detections(det, ownship=_own())) == 0
+
+
+def test_aircraft_in_the_ground_band_stay_confirmed():
+    # Inside the ground's range-Doppler band (|V| < own speed, range > height): a glider circling
+    # (r = 80 m, 25 m/s) 350 m above the ground, a slow aircraft crossing at 30 m/s, one the
+    # own-ship overtakes (|w| = 20 m/s: its Doppler drifts like a static point's only after ~1.5 s).
+    # Each is confirmed within 2.5 s of its first detection (0.3 s without the ground test).
+    phase = 25.0 / 80.0 * T
+    circling = np.column_stack([1800 + 80 * np.cos(phase), 300 + 80 * np.sin(phase), AGL_M - 350 + 0 * T])
+    crossing = np.column_stack([2000 + 0 * T, -600 + 30 * T, AGL_M - 450 + 0 * T])
+    overtaken = np.column_stack([1500 + 30 * T, 400 + 0 * T, AGL_M - 300 + 0 * T])
+    for seed, target in enumerate((circling, crossing, overtaken)):
+        tracks = track_detections(_detections(target, seed), ownship=_own())
+        assert tracks["track_id"].nunique() == 1
+        assert _confirmed_from(tracks) <= T[0] + 2.5
+
+
+def test_relative_speed_equal_to_own_speed_fits_ground_only_if_its_miss_distance_reaches_it():
+    # |w| = |v_own|: the history is a static point's at the miss distance from the line of flight;
+    # 200 m (a conflict) cannot be ground 500 m below, 2 km can.
+    w = SPEED_MPS * np.array([-np.cos(0.3), np.sin(0.3), 0.0])  # relative velocity, |w| = own speed
+    own = _own()
+    own_p = own[["own_north_m", "own_east_m", "own_down_m"]].to_numpy()
+    own_v = own[["own_vn_mps", "own_ve_mps", "own_vd_mps"]].to_numpy()
+    surface = flat_surface(AGL_M)
+    for miss_m, is_ground in ((200.0, False), (2000.0, True)):
+        across = np.cross(w / SPEED_MPS, [0.0, 0.0, 1.0])
+        rel = 2500.0 * -w / SPEED_MPS + miss_m * across / np.linalg.norm(across) + w * T[:, None]
+        rho = np.linalg.norm(rel, axis=1)
+        v = np.sum(rel * w, axis=1) / rho
+        ok = fits_static_ground(rho + C * v, v, own_p, own_v, surface, WIDTH, C)
+        assert ok == is_ground, miss_m
+
+
+def test_static_point_model_and_fit_reject_a_moving_target():
+    own = _own()
+    own_p = own[["own_north_m", "own_east_m", "own_down_m"]].to_numpy()
+    own_v = own[["own_vn_mps", "own_ve_mps", "own_vd_mps"]].to_numpy()
+    point = np.array([2500.0, -700.0, AGL_M])
+    rho, v = static_point_measurements(point, own_p, own_v, C)
+    # dr/dt of the model equals the finite difference of its ranges
+    r = rho - C * v
+    assert np.allclose(np.gradient(r, T)[2:-2], v[2:-2], atol=0.05)
+    assert fits_static_ground(rho, v, own_p, own_v, flat_surface(AGL_M), WIDTH, C)
+    # a point 400 m up and 200 m beside the line of flight: its ring around that line (the points
+    # with the same history) does not reach the ground
+    up = static_point_measurements(np.array([2500.0, -200.0, AGL_M - 400.0]), own_p, own_v, C)
+    assert not fits_static_ground(up[0], up[1], own_p, own_v, flat_surface(AGL_M), WIDTH, C)
+
+
+def test_residual_clutter_hopping_between_cells_is_not_an_object():
+    # Ranges that jump hundreds of metres while the Doppler stays at the clutter edge.
+    rng = np.random.default_rng(3)
+    t = T[:12]
+    hops = 3000.0 + np.cumsum(rng.choice([-150.0, 0.0, 60.0, 240.0], t.size))
+    assert not range_doppler_consistent(t, hops, np.full(t.size, 34.0), WIDTH, C)
+    v = 34.0 + rng.normal(0, 0.2, t.size)
+    det = pd.DataFrame({"time_s": t, "range_m": hops, "radial_velocity_mps": v})
+    assert len(track_detections(det, ownship=_own(t))) == 0

@@ -26,7 +26,10 @@ from llvmlite import ir
 from numba import float32, int32, int64, njit, prange, types, uint64
 from numba.extending import intrinsic
 
-__all__ = ["frame_key", "finalize_frame", "gaussian_noise", "mix64", "complex_normal"]
+__all__ = [
+    "frame_key", "finalize_frame", "gaussian_noise", "mix64", "complex_normal", "polar_normal",
+    "cis_count_f32",
+]  # fmt: skip
 
 _GAMMA = np.uint64(0x9E3779B97F4A7C15)
 _F0, _F1, _F2, _HALF = np.float32(0.0), np.float32(1.0), np.float32(2.0), np.float32(0.5)
@@ -110,11 +113,22 @@ def cis_count_f32(count):
 
 
 @njit(inline="always")
+def polar_normal(z, sigma):
+    """Box-Muller's polar form of one 64-bit random word: radius (float32) and angle count.
+
+    The complex Gaussian of :func:`complex_normal` is ``radius * cis_count_f32(count)``; a
+    caller that multiplies it by another phase adds that phase's count instead (one sine and
+    cosine, not two and a complex product).
+    """
+    u1 = (float32(int64(z >> uint64(33))) + _HALF) * _INV_2_31  # (0, 1], 31 bits
+    return sigma * math.sqrt(max(float32(-2.0) * log_f32(u1), _F0)), z & uint64(0xFFFFFFFF)
+
+
+@njit(inline="always")
 def _complex_normal(z, sigma):
     """Box-Muller on one 64-bit random word: (re, im), each N(0, sigma^2), float32."""
-    u1 = (float32(int64(z >> uint64(33))) + _HALF) * _INV_2_31  # (0, 1], 31 bits
-    r = sigma * math.sqrt(max(float32(-2.0) * log_f32(u1), _F0))
-    c, s = cis_count_f32(z & uint64(0xFFFFFFFF))
+    r, count = polar_normal(z, sigma)
+    c, s = cis_count_f32(count)
     return r * c, r * s
 
 

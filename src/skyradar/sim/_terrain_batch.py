@@ -7,8 +7,10 @@ quantities are computed in short branch-free loops over those rows, which LLVM t
 code (square roots and floors included; the antenna-gain and reflectivity table look-ups stay
 scalar, LLVM emits no gathers here). Culling becomes a validity flag and only the scatter into
 the pixels stays scalar. The formulas are the scalar kernel's, term for term, except that the
-path-phase polynomials run in float32 (error 1e-7, the precision of the complex64 pixels);
-``tests/test_sim_kernel.py`` checks both paths give the same cube.
+path phase is reduced exactly as an integer count of 2^-32 turns and its polynomials run in
+float32 (error 1e-7, the precision of the complex64 pixels); ``tests/test_sim_kernel.py`` checks
+both paths give the same cube. With speckle, each sub-facet's draw joins its phase as another
+count and its radius joins the amplitude: one sine and cosine per receiver, no complex product.
 
 Why so many small loops: LLVM vectorises a loop over arrays it cannot prove distinct only
 behind a few run-time overlap checks (8 by default), so each loop writes one or two rows and
@@ -20,10 +22,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, uint64
+from numba import int64, njit, uint64
 
-from skyradar.sim._elementary import cis_cycles_f32, fast_atan2
-from skyradar.sim._noise_kernel import complex_normal, mix64
+from skyradar.sim._elementary import fast_atan2
+from skyradar.sim._noise_kernel import cis_count_f32, mix64, polar_normal
 
 __all__ = [
     "CELL_FIELDS", "cell_geometry", "cell_geometry_scalar", "item_returns", "number_items", "scatter_items",
@@ -181,11 +183,26 @@ def _amplitude_row(amp, gain_, refl_, area, rng_, power_const):
         amp[m] = math.sqrt(max(power, 0.0)) / (rng_[m] * rng_[m])
 
 
+@njit(error_model="numpy")
+def _speckle_rows(amp, turn, ids, speckle_key):
+    # Each sub-facet's complex reflectivity, a unit-power circular Gaussian drawn from its number
+    # by the noise kernel's counter-based generator, in polar form: its radius scales the
+    # amplitude, its angle (a count of 2^-32 turns) is added to every receiver's path phase.
+    for m in range(amp.shape[0]):
+        radius, count = polar_normal(mix64(speckle_key + (uint64(ids[m]) + uint64(1)) * _GAMMA), _SQRT_HALF)
+        amp[m] *= radius
+        turn[m] = float(count)
+
+
 @njit(**_OPTS)
-def _phase_rows(cos_q, sin_q, r_tx, r_rx, inv_wavelength):
-    for m in range(cos_q.shape[0]):
-        c, s = cis_cycles_f32((r_tx[m] + r_rx[m]) * inv_wavelength)
-        cos_q[m], sin_q[m] = c, s
+def _phase_rows(re_q, im_q, r_tx, r_rx, amp, turn, counts_per_m):
+    # amp * exp(2 pi i (path / wavelength + turn / 2^32)). The path phase as an integer count of
+    # 2^-32 turns (exact below 2^53 counts: paths up to 30 km), so the reduction to one turn is
+    # an integer mask, not float64 floors. The float64 products round once to float32.
+    for m in range(re_q.shape[0]):
+        count = uint64(int64((r_tx[m] + r_rx[m]) * counts_per_m)) + uint64(int64(turn[m]))
+        c, s = cis_count_f32(count)
+        re_q[m], im_q[m] = c * amp[m], s * amp[m]
 
 
 @njit(error_model="numpy")
@@ -243,11 +260,12 @@ def _point(t, u, w, c):
 @njit(error_model="numpy")
 def item_returns(s, n, tx, rx, r_rx, cos_sin, v_ground, r_max, d_range, d_vel, coupling, n_range, n_dopp,
                  inv_wavelength, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad,
-                 h_bin_m, use_horizon):  # fmt: skip
-    """Validity, pixel (range, Doppler) as floats, amplitude and per-receiver (cos, sin) of items.
+                 h_bin_m, use_horizon, speckle_key):  # fmt: skip
+    """Validity, pixel (range, Doppler) as floats and per-receiver complex value of items.
 
     Reads the geometry rows of the first ``n`` items of ``s``; writes their _VALID, _KR, _KD,
-    _AMP rows and ``cos_sin`` (2, n_rx, >= n); ``r_rx`` (n_rx, >= n) is scratch. The _AREA row
+    _AMP rows and ``cos_sin`` (2, n_rx, >= n): real and imaginary part of each receiver's value,
+    with speckle when ``speckle_key`` is not 0; ``r_rx`` (n_rx, >= n) is scratch. The _AREA row
     holds each sub-facet's own area.
     """
     x_, y_, z_, r0_ = s[_X][:n], s[_Y][:n], s[_Z][:n], s[_R0][:n]
@@ -275,17 +293,15 @@ def item_returns(s, n, tx, rx, r_rx, cos_sin, v_ground, r_max, d_range, d_vel, c
     # The gain and reflectivity factors land in the _N and _E rows, free after the horizon test.
     gain_, refl_ = s[_N][:n], s[_E][:n]
     _gain_refl_rows(gain_, refl_, tmp0, tmp1, cos_inc, gain2, refl_table)
-    _amplitude_row(s[_AMP][:n], gain_, refl_, s[_AREA][:n], rng_, power_const)
+    amp, turn = s[_AMP][:n], tmp0
+    _amplitude_row(amp, gain_, refl_, s[_AREA][:n], rng_, power_const)
+    if speckle_key != 0:
+        _speckle_rows(amp, turn, s[_ID][:n], speckle_key)
+    else:
+        turn[:] = 0.0
+    counts_per_m = inv_wavelength * 2.0**32
     for q in range(rx.shape[0]):
-        _phase_rows(cos_sin[0, q][:n], cos_sin[1, q][:n], r_tx, r_rx[q][:n], inv_wavelength)
-
-
-@njit(**_OPTS)
-def _weight_rows(re_q, im_q, amp):
-    # In place: the float64 product rounds once to float32, as complex64 pixels would.
-    for m in range(re_q.shape[0]):
-        re_q[m] = re_q[m] * amp[m]
-        im_q[m] = im_q[m] * amp[m]
+        _phase_rows(cos_sin[0, q][:n], cos_sin[1, q][:n], r_tx, r_rx[q][:n], amp, turn, counts_per_m)
 
 
 @njit(inline="always")
@@ -296,36 +312,10 @@ def number_items(s, k, first, n):
 
 
 @njit(error_model="numpy")
-def _speckle_draws(g_re, g_im, ids, speckle_key):
-    # Each sub-facet's complex reflectivity: a unit-power circular Gaussian drawn from its number
-    # by the noise kernel's counter-based generator (branch-free: the loop vectorises).
-    for m in range(ids.shape[0]):
-        z = mix64(speckle_key + (uint64(ids[m]) + uint64(1)) * _GAMMA)
-        g_re[m], g_im[m] = complex_normal(z, _SQRT_HALF)
-
-
-@njit(**_OPTS)
-def _speckle_rows(re_q, im_q, g_re, g_im):
-    # The same draw for every receiver: one scatterer.
-    for m in range(re_q.shape[0]):
-        re, im = re_q[m], im_q[m]
-        re_q[m] = re * g_re[m] - im * g_im[m]
-        im_q[m] = re * g_im[m] + im * g_re[m]
-
-
-@njit(error_model="numpy")
-def scatter_items(out, sparse, blk, s, cos_sin, n_items, speckle_key):
-    """Add the valid items into the thread's cube (or its sparse list); speckle when the key is not 0."""
+def scatter_items(out, sparse, blk, s, cos_sin, n_items):
+    """Add the valid items into the thread's cube (or its sparse list)."""
     idx, val, count = sparse
     n_rx = cos_sin.shape[1]
-    amp = s[_AMP][:n_items]
-    g_re, g_im = s[_TMP0][:n_items], s[_TMP1][:n_items]  # free once item_returns is done
-    if speckle_key != 0:
-        _speckle_draws(g_re, g_im, s[_ID][:n_items], speckle_key)
-    for q in range(n_rx):
-        _weight_rows(cos_sin[0, q][:n_items], cos_sin[1, q][:n_items], amp)
-        if speckle_key != 0:
-            _speckle_rows(cos_sin[0, q][:n_items], cos_sin[1, q][:n_items], g_re, g_im)
     for m in range(n_items):
         if s[_VALID, m] == 0.0:
             continue

@@ -327,9 +327,9 @@ def _flush(scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, 
     item_returns(
         scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel, coupling, n_range,
         n_dopp, inv_wl, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m,
-        use_horizon,
+        use_horizon, speckle_key,
     )  # fmt: skip
-    scatter_items(out, sparse, blk, scratch, cos_sin, k, speckle_key)
+    scatter_items(out, sparse, blk, scratch, cos_sin, k)
 
 
 @njit(inline="always")

@@ -27,7 +27,6 @@ from numba import get_num_threads
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.geo import ned_rotation_to, ned_to_geodetic, rotation_matrix
-from skyradar.sim._horizon_kernel import horizon_map
 from skyradar.sim._noise_kernel import finalize_frame, frame_key
 from skyradar.sim._tables import REFLECTIVITY_MODELS, reflectivity_table, two_way_gain_table
 from skyradar.sim._terrain_kernel import (
@@ -38,6 +37,7 @@ from skyradar.sim._terrain_kernel import (
 )
 from skyradar.sim.facets import facet_rule
 from skyradar.sim.geometry import AntennaGeometry, PlatformState, PointTarget, TerrainView
+from skyradar.sim.horizon import horizon_grid, needs_horizon, target_clear, terrain_horizon
 from skyradar.sim.psf import apply_psf, enbw, frame_options, psf_kernels, speckle_key
 from skyradar.sim.targets import add_targets, line_of_sight, swerling1_power, target_geometry
 
@@ -51,7 +51,6 @@ __all__ = [
     "two_way_gain_table",
 ]
 _NO_SPECKLE = np.uint64(0)
-_LEVEL_CLEAR_M = 50.0  # antenna height above level terrain from which nothing in range is hidden
 
 _reflectivity_table = reflectivity_table  # the old private name (benchmarks.sim)
 
@@ -158,7 +157,8 @@ class ImageSimulator:
                 max(1, int(np.ceil(dx / self.facet_size_m))),
             )
             self._facet_m = max(dy / self._nsub[0], dx / self._nsub[1])
-            self._level = bool(np.ptp(terrain.elevation_m) == 0.0)  # see _horizon
+            self._level = bool(np.ptp(terrain.elevation_m) == 0.0)  # see horizon.needs_horizon
+            self._horizon_grid = horizon_grid(config, self._spacing_m, self._nsub, self._facet_m)
             adaptive = self.psf if adaptive_facets is None else bool(adaptive_facets)
             self._facets = facet_rule(config, self._spacing_m, self.facet_size_m, adaptive)
 
@@ -266,6 +266,17 @@ class ImageSimulator:
     def _terrain_view(self, geom: AntennaGeometry, scratch: dict | None) -> TerrainView | None:
         # With ``scratch`` the points land in an array reused by the next frame: only for a
         # view that does not outlive the frame.
+        p_ned = self._terrain_points(geom, scratch)
+        if p_ned is None:
+            return None
+        if not needs_horizon(self._horizon_grid, p_ned, self._level, self.occlusion):
+            return TerrainView(p_ned, np.full((1, 1), -np.inf, np.float32), 1.0, 1.0)
+        grid = self._horizon_grid
+        horizon = terrain_horizon(grid, p_ned, geom.rot_ned_to_ant, get_num_threads())
+        return TerrainView(p_ned, horizon, grid.az_bin_rad, grid.h_bin_m)
+
+    def _terrain_points(self, geom: AntennaGeometry, scratch: dict | None) -> np.ndarray | None:
+        # The DEM cropped around the antenna, relative to it (NED, m); None: no terrain in range.
         if self.terrain is None:
             return None
         crop = self._crop(geom)
@@ -274,8 +285,7 @@ class ImageSimulator:
         rows, cols = crop
         p_ned = _array(scratch, "p_ned", (rows.stop - rows.start, cols.stop - cols.start, 3), np.float64)
         origin = np.asarray(geom.origin_ned_m, float)
-        relative_points(self._grid_ned, rows.start, rows.stop, cols.start, cols.stop, origin, p_ned)
-        return TerrainView(p_ned, *self._horizon(p_ned, geom, get_num_threads()))
+        return relative_points(self._grid_ned, rows.start, rows.stop, cols.start, cols.stop, origin, p_ned)
 
     def terrain_cube(self, geom: AntennaGeometry, view: TerrainView | None = None) -> np.ndarray:
         """Terrain returns only, (n_range, n_doppler, n_rx) complex64, without noise."""
@@ -342,34 +352,6 @@ class ImageSimulator:
             blocks.shape[0] or sparse[0].shape[0], blocks, sparse, self._kernel_mode, speckle,
         )  # fmt: skip
 
-    def _horizon(
-        self, p_ned: np.ndarray, geom: AntennaGeometry, n_blocks: int
-    ) -> tuple[np.ndarray, float, float]:
-        """Polar horizon for the occlusion test, with its azimuth and horizontal-range bin sizes.
-
-        Level terrain (one height everywhere) is a convex surface: it hides nothing closer than
-        its geometric horizon, sqrt(2 R_earth h), 25 km at h = 50 m. With the antenna more than
-        ``_LEVEL_CLEAR_M`` above every point of the crop (a lower bound of its height) and the
-        range limit below that, the horizon is skipped: the same frames, without its cost.
-        """
-        r_lim = self.config.range_limit_m + self.config.range_resolution_m
-        level = self._level and r_lim < 20e3 and float(p_ned[..., 2].min()) > _LEVEL_CLEAR_M
-        if not self.occlusion or level:
-            return np.full((1, 1), -np.inf, np.float32), 1.0, 1.0
-        # The horizon follows the terrain's shape, which the DEM resolves at its own spacing:
-        # 2 x 2 samples per DEM cell and bins of half the spacing, not every sub-facet.
-        h_nsub = (min(self._nsub[0], 2), min(self._nsub[1], 2))
-        h_bin = max(self._facet_m, min(self._spacing_m) / 2.0)
-        n_az = int(np.ceil(2 * np.pi * (r_lim / 2.0) / h_bin))
-        n_h = int(np.ceil(r_lim / h_bin)) + 1
-        az_bin = 2 * np.pi / n_az
-        # Each horizon sample stands for a patch this wide (see horizon_map).
-        sample_m = max(self._spacing_m[0] / h_nsub[0], self._spacing_m[1] / h_nsub[1])
-        horizon = horizon_map(
-            p_ned, geom.rot_ned_to_ant, *h_nsub, r_lim, az_bin, h_bin, n_az, n_h, n_blocks, sample_m
-        )
-        return horizon, az_bin, h_bin
-
     def _crop(self, geom: AntennaGeometry) -> tuple[slice, slice] | None:
         # Crop around the platform; the mount offset (metres) is added to the reach.
         reach = self.config.range_limit_m + 2 * self._facet_m + float(np.linalg.norm(self._mount_position_m))
@@ -382,8 +364,17 @@ class ImageSimulator:
     def target_truth(self, platform: PlatformState, targets: Sequence[PointTarget]) -> dict[str, np.ndarray]:
         """Range, radial velocity, antenna-frame angles, expected SNR and visibility per target."""
         geom = self.geometry(platform)
-        clear = line_of_sight(self.terrain_view(geom), geom, targets)
-        return target_geometry(self.config, geom, targets, self.coupling_s, clear, self.noise_per_pixel_w)
+        return target_geometry(self.config, geom, targets, self.coupling_s, self._clear(geom, targets),
+                               self.noise_per_pixel_w)  # fmt: skip
+
+    def _clear(self, geom: AntennaGeometry, targets: Sequence[PointTarget]) -> np.ndarray:
+        # The frame's line-of-sight test (line_of_sight on the terrain view) from the horizon's
+        # entries at the targets only: a frame's truth without its whole horizon map.
+        p_ned = self._terrain_points(geom, self._scratch)
+        if p_ned is None or not needs_horizon(self._horizon_grid, p_ned, self._level, self.occlusion):
+            return np.ones(len(targets), bool)
+        rel = np.array([t.position_ned_m for t in targets], float).reshape(-1, 3) - geom.origin_ned_m
+        return target_clear(self._horizon_grid, p_ned, geom.rot_ned_to_ant, rel)
 
 
 def _array(scratch: dict | None, name: str, shape: tuple[int, ...], dtype) -> np.ndarray:

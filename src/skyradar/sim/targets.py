@@ -14,6 +14,7 @@ import numpy as np
 from skyradar.config import RadarConfig
 from skyradar.geo import direction_angles
 from skyradar.sim.geometry import AntennaGeometry, PointTarget, TerrainView
+from skyradar.sim.horizon import target_bins
 from skyradar.sim.psf import PSF_WINDOW, target_psf_taps
 from skyradar.units import nearest_bin
 
@@ -41,11 +42,8 @@ def line_of_sight(
     rel = np.array([t.position_ned_m for t in targets], float).reshape(-1, 3) - geom.origin_ned_m
     if view is None:
         return np.ones(len(rel), bool)
-    n_az, n_h = view.horizon.shape
-    h = np.hypot(rel[:, 0], rel[:, 1])
-    a = ((np.arctan2(rel[:, 1], rel[:, 0]) + np.pi) / view.az_bin_rad).astype(int) % n_az
-    k = np.minimum((h / view.h_bin_m).astype(int), n_h - 1)
-    return -rel[:, 2] / np.maximum(h, 1e-9) >= view.horizon[a, k]
+    a, k, slope = target_bins(rel, view.az_bin_rad, view.h_bin_m, *view.horizon.shape)
+    return slope >= view.horizon[a, k]
 
 
 def target_geometry(

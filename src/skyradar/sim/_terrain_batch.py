@@ -316,17 +316,39 @@ def scatter_items(out, sparse, blk, s, cos_sin, n_items):
     """Add the valid items into the thread's cube (or its sparse list)."""
     idx, val, count = sparse
     n_rx = cos_sin.shape[1]
+    if idx.shape[1] == 0:
+        _scatter_dense(out[blk].view(np.float32), s, cos_sin, n_items)
+        return
     for m in range(n_items):
         if s[_VALID, m] == 0.0:
             continue
-        kr, kd = int(s[_KR, m]), int(s[_KD, m])
-        if idx.shape[1] > 0:
-            n = count[blk]
-            idx[blk, n] = kr * out.shape[2] + kd
-            count[blk] = n + 1
-            for q in range(n_rx):
-                val[blk, n, q] = complex(cos_sin[0, q, m], cos_sin[1, q, m])
+        n = count[blk]
+        idx[blk, n] = int(s[_KR, m]) * out.shape[2] + int(s[_KD, m])
+        count[blk] = n + 1
+        for q in range(n_rx):
+            val[blk, n, q] = complex(cos_sin[0, q, m], cos_sin[1, q, m])
+
+
+@njit(inline="always")
+def _scatter_dense(cube, s, cos_sin, n_items):
+    # ``cube``: the thread's block as float32 (n_range, n_doppler, 2 n_rx). Unsigned pixel
+    # indices (>= 0 for valid items): numba then skips its wrap-around check. Four receivers
+    # (the usual 2 x 2 array) written out: their eight floats are one contiguous update.
+    n_rx = cos_sin.shape[1]
+    for m in range(n_items):
+        if s[_VALID, m] == 0.0:
+            continue
+        px = cube[uint64(s[_KR, m]), uint64(s[_KD, m])]
+        if n_rx == 4:
+            px[0] += cos_sin[0, 0, m]
+            px[1] += cos_sin[1, 0, m]
+            px[2] += cos_sin[0, 1, m]
+            px[3] += cos_sin[1, 1, m]
+            px[4] += cos_sin[0, 2, m]
+            px[5] += cos_sin[1, 2, m]
+            px[6] += cos_sin[0, 3, m]
+            px[7] += cos_sin[1, 3, m]
         else:
-            pixel = out[blk, uint64(kr), uint64(kd)]
             for q in range(n_rx):
-                pixel[q] += complex(cos_sin[0, q, m], cos_sin[1, q, m])
+                px[2 * q] += cos_sin[0, q, m]
+                px[2 * q + 1] += cos_sin[1, q, m]

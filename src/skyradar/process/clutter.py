@@ -17,6 +17,13 @@ radar", MIT Lincoln Laboratory TR-1015, 1994, section 2 for the clutter ridge).
 A terrain (``depth_fn(north_offset_m, east_offset_m) -> ground depth below the radar, m``) replaces
 the flat ground: the depression of each ring sample is iterated to the terrain height under it.
 
+Cost (one prediction of the prototype, 720 ring samples per range bin, ~213k samples): each
+sample's outer product is formed once (its Hermitian upper triangle, ``n_rx**2`` reals) and added
+to its 3 x 5 point-spread taps; a cell's eigen-pairs (compiled cyclic Jacobi,
+:func:`hermitian_eigh`) are computed only when a frame's measured clutter gates it
+(:meth:`ClutterSubspace.ensure`), 30-45 % of the cells over terrain. Checked against the
+straightforward numpy sum and ``numpy.linalg.eigh`` in ``tests/test_clutter_prediction_cost.py``.
+
 Examples
 --------
 >>> from skyradar.config import RadarConfig
@@ -29,7 +36,6 @@ Examples
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
@@ -38,42 +44,62 @@ from numba import njit
 from skyradar.config import RadarConfig
 from skyradar.process.doa import steering_vector
 
-__all__ = ["ClutterSubspace", "clutter_subspace"]
+__all__ = ["ClutterSubspace", "clutter_subspace", "hermitian_eigh", "decompose_cell", "cell_scratch"]
 
 
-@dataclass(frozen=True)
 class ClutterSubspace:
     """Predicted clutter of one frame geometry, per range-Doppler cell.
 
+    Built by :func:`clutter_subspace` from the packed predicted covariance of every cell; a cell's
+    eigen-decomposition is computed when first needed (:meth:`ensure`, or inside the suppression
+    kernel for the cells the measured clutter gates), so a prediction costs only the cells used.
+
     Attributes
     ----------
-    vectors : ndarray, shape (n_range, n_doppler, n_rx, n_rx), complex64
-        Eigenvectors of the predicted clutter covariance, columns by decreasing eigenvalue.
-    fractions : ndarray, shape (n_range, n_doppler, n_rx), float32
-        Eigenvalues divided by their sum (0 where no clutter is predicted), decreasing.
+    covariance : ndarray, shape (n_range, n_doppler, n_rx * n_rx), float64
+        Predicted clutter covariance per cell, packed: the ``n_rx`` real diagonal entries, then the
+        upper triangle's (re, im) pairs row by row (unnormalised).
     predicted : ndarray of bool, shape (n_range, n_doppler)
         Cells some ground direction reaches (main lobe of the point-spread included).
+    vectors : ndarray, shape (n_range, n_doppler, n_rx, n_rx), complex64
+        Eigenvectors of the trace-normalised covariance, columns by decreasing eigenvalue
+        (identity where no clutter is predicted). Every cell is decomposed on first access.
+    fractions : ndarray, shape (n_range, n_doppler, n_rx), float32
+        Eigenvalues divided by their sum (0 where no clutter is predicted), decreasing.
     """
 
-    vectors: np.ndarray
-    fractions: np.ndarray
-    predicted: np.ndarray
+    def __init__(self, covariance: np.ndarray, n_rx: int):
+        n_r, n_d = covariance.shape[:2]
+        self.covariance = covariance
+        self.predicted = np.einsum("rdk->rd", covariance[..., :n_rx]) > 0
+        self.done = np.zeros((n_r, n_d), np.bool_)  # cells decomposed so far
+        self._vectors = np.empty((n_r, n_d, n_rx, n_rx), np.complex64)
+        self._fractions = np.zeros((n_r, n_d, n_rx), np.float32)
 
-    def null_rows(self, inv_gain: np.ndarray) -> np.ndarray:
-        """``E^H diag(inv_gain)``, first ``n_rx - 1`` eigenvectors: (n_range, n_doppler, n_rx - 1, n_rx).
+    def ensure(self, range_index: np.ndarray | None = None, doppler_index: np.ndarray | None = None) -> None:
+        """Decompose the given cells (default: all) that are not decomposed yet."""
+        if range_index is None:
+            rr, dd = np.nonzero(~self.done)
+        else:
+            rr, dd = np.broadcast_arrays(
+                np.asarray(range_index, np.int64), np.asarray(doppler_index, np.int64)
+            )
+        _decompose(self.covariance, self.done, self._vectors, self._fractions, rr.ravel(), dd.ravel())
 
-        The rows a projection of an uncalibrated snapshot takes inner products with (the channel
-        calibration folded in), contiguous per cell, complex64: the suppression kernel reads 32
-        bytes per null instead of a strided column of ``vectors``. Computed once per prediction
-        and calibration, reused by every frame that shares them.
-        """
-        key = np.asarray(inv_gain, np.complex64).tobytes()
-        cache = self.__dict__.setdefault("_null_rows", {})
-        if key not in cache:
-            rows = np.conj(np.swapaxes(self.vectors[..., :-1], -1, -2)) * np.asarray(inv_gain, np.complex64)
-            cache.clear()  # one calibration per radar head: keep the latest only
-            cache[key] = np.ascontiguousarray(rows, np.complex64)
-        return cache[key]
+    def cell_vectors(self, range_index: np.ndarray, doppler_index: np.ndarray) -> np.ndarray:
+        """Eigenvectors (n, n_rx, n_rx) of the given cells only (decomposing just those)."""
+        self.ensure(range_index, doppler_index)
+        return self._vectors[range_index, doppler_index]
+
+    @property
+    def vectors(self) -> np.ndarray:
+        self.ensure()
+        return self._vectors
+
+    @property
+    def fractions(self) -> np.ndarray:
+        self.ensure()
+        return self._fractions
 
     @cached_property
     def free_cells(self) -> np.ndarray:
@@ -82,11 +108,28 @@ class ClutterSubspace:
 
 
 @njit(cache=True)
-def _accumulate(r_pos, d_pos, steer, weight, n_r, n_d, cov):  # pragma: no cover - compiled
+def _accumulate(r_pos, d_pos, steer, weight, n_r, n_d, acc):  # pragma: no cover - compiled
+    # acc[r, d]: the cell's Hermitian covariance packed as n_k real diagonal entries, then the upper
+    # triangle's (re, im) pairs row by row. The outer product is formed once per ring sample and
+    # added to its 3 x 5 point-spread taps (16 reals per tap, not 16 complex products).
     n_s, n_k = steer.shape
+    n_p = n_k * (n_k - 1) // 2
+    prod = np.empty(n_k + 2 * n_p)
+    wd = np.empty(5)
     for s in range(n_s):
+        for i in range(n_k):
+            prod[i] = steer[s, i].real ** 2 + steer[s, i].imag ** 2
+        p = n_k
+        for i in range(n_k):
+            for j in range(i + 1, n_k):
+                c = steer[s, i] * np.conj(steer[s, j])
+                prod[p], prod[p + 1] = c.real, c.imag
+                p += 2
         r0 = int(np.floor(r_pos[s] + 0.5))
         d0 = int(np.floor(d_pos[s] + 0.5))
+        for dd in range(-2, 3):
+            y = d_pos[s] - (d0 + dd)
+            wd[dd + 2] = 0.5 if abs(abs(y) - 1.0) < 1e-9 else np.sinc(y) / (1.0 - y * y)
         for dr in range(-1, 2):
             r = r0 + dr
             if r < 0 or r >= n_r:
@@ -96,16 +139,153 @@ def _accumulate(r_pos, d_pos, steer, weight, n_r, n_d, cov):  # pragma: no cover
             # finite-window response is skyradar.sim.psf.window_response, which process may not import.
             wr = 0.5 if abs(abs(x) - 1.0) < 1e-9 else np.sinc(x) / (1.0 - x * x)
             for dd in range(-2, 3):
-                y = d_pos[s] - (d0 + dd)
-                wd = 0.5 if abs(abs(y) - 1.0) < 1e-9 else np.sinc(y) / (1.0 - y * y)
-                w = weight[s] * (wr * wd) ** 2
+                w = weight[s] * (wr * wd[dd + 2]) ** 2
                 if w <= 0.0:
                     continue
                 d = (d0 + dd) % n_d
-                for i in range(n_k):
-                    for j in range(n_k):
-                        cov[r, d, i, j] += w * steer[s, i] * np.conj(steer[s, j])
-    return cov
+                for q in range(prod.size):
+                    acc[r, d, q] += w * prod[q]
+    return acc
+
+
+@njit(cache=True)
+def _unpack(acc_cell, n_k, a):  # pragma: no cover - compiled
+    # The packed cell (see _accumulate) as a full Hermitian matrix divided by its trace; the trace.
+    total = 0.0
+    for i in range(n_k):
+        total += acc_cell[i]
+    if not total > 0.0:
+        return 0.0
+    p = n_k
+    for i in range(n_k):
+        a[i, i] = acc_cell[i] / total
+        for j in range(i + 1, n_k):
+            a[i, j] = complex(acc_cell[p], acc_cell[p + 1]) / total
+            a[j, i] = np.conj(a[i, j])
+            p += 2
+    return total
+
+
+@njit(cache=True)
+def _jacobi_rotate(a, v, p, q):  # pragma: no cover - compiled
+    # One complex Jacobi rotation J zeroing a[p, q]: a <- J^H a J, v <- v J. A phase turns the pair
+    # real, then the real rotation of Numerical Recipes (section 11.1): t = tan(theta), smaller root.
+    # J = diag(1, conj(phase)) R on (p, q); a stays Hermitian, so only column p, q are computed
+    # and mirrored, and the diagonal pair moves by -+ t |a_pq|.
+    n = a.shape[0]
+    mag = abs(a[p, q])
+    if mag == 0.0:
+        return
+    ph = np.conj(a[p, q] / mag)
+    theta = (a[q, q].real - a[p, p].real) / (2.0 * mag)
+    t = (1.0 if theta >= 0 else -1.0) / (abs(theta) + np.sqrt(theta * theta + 1.0))
+    c = 1.0 / np.sqrt(t * t + 1.0)
+    s = t * c
+    for k in range(n):
+        vkp, vkq = v[k, p], v[k, q] * ph
+        v[k, p], v[k, q] = c * vkp - s * vkq, s * vkp + c * vkq
+        if k in (p, q):
+            continue
+        akp, akq = a[k, p], a[k, q] * ph
+        a[k, p], a[k, q] = c * akp - s * akq, s * akp + c * akq
+        a[p, k], a[q, k] = np.conj(a[k, p]), np.conj(a[k, q])
+    a[p, p], a[q, q] = a[p, p].real - t * mag, a[q, q].real + t * mag
+    a[p, q], a[q, p] = 0j, 0j
+
+
+@njit(cache=True)
+def hermitian_eigh(a, v, lam, order, tol=1e-7, max_sweeps=12, warm=False):  # pragma: no cover - compiled
+    """Eigen-pairs of a small Hermitian matrix ``a`` (overwritten) by cyclic Jacobi sweeps.
+
+    ``v`` receives the eigenvectors as columns, ``lam`` the eigenvalues in the same order and
+    ``order`` the column indices by decreasing eigenvalue. ``warm``: ``a`` was already turned into
+    the unitary basis ``v`` holds (``v^H a v``), whose rotations continue from there. Sweeps stop
+    when the off-diagonal power falls below ``tol**2`` times the diagonal's (quadratic convergence:
+    3-5 sweeps at n = 4 from the identity).
+
+    >>> a = np.array([[2.0, 1j], [-1j, 2.0]])
+    >>> v, lam, order = np.empty((2, 2), complex), np.empty(2), np.empty(2, np.int64)
+    >>> hermitian_eigh(a, v, lam, order)
+    >>> lam[order].round(9).tolist(), bool(np.allclose(v.conj().T @ v, np.eye(2)))
+    ([3.0, 1.0], True)
+    """
+    n = a.shape[0]
+    for i in range(n):
+        for j in range(n):
+            if not warm:
+                v[i, j] = 1.0 if i == j else 0.0
+    scale = 0.0
+    for i in range(n):
+        scale += a[i, i].real ** 2
+    for _ in range(max_sweeps):
+        off = 0.0
+        for i in range(n):
+            for j in range(i + 1, n):
+                off += a[i, j].real ** 2 + a[i, j].imag ** 2
+        if off <= tol * tol * scale:
+            break
+        for p in range(n):
+            for q in range(p + 1, n):
+                _jacobi_rotate(a, v, p, q)
+    for i in range(n):
+        lam[i] = a[i, i].real
+        order[i] = i
+    for i in range(1, n):  # insertion sort, decreasing
+        k, j = order[i], i
+        while j > 0 and lam[order[j - 1]] < lam[k]:
+            order[j] = order[j - 1]
+            j -= 1
+        order[j] = k
+
+
+@njit(cache=True)
+def decompose_cell(acc, done, vectors, fractions, r, d, scratch):  # pragma: no cover - compiled
+    """Eigen-pairs of cell (r, d)'s trace-normalised packed covariance into ``vectors``/``fractions``
+    (decreasing; identity and 0 where no clutter is predicted). ``scratch`` (:func:`cell_scratch`) carries
+    the last decomposed cell's eigenvectors: the rotations start from them (a neighbouring cell's
+    basis nearly diagonalises this one: 2 sweeps instead of 4)."""
+    a, v, w, lam, order, warm = scratch
+    n_k = vectors.shape[2]
+    done[r, d] = True
+    if not _unpack(acc[r, d], n_k, a) > 0.0:
+        for i in range(n_k):
+            for j in range(n_k):
+                vectors[r, d, i, j] = 1.0 if i == j else 0.0
+            fractions[r, d, i] = 0.0
+        return
+    if warm[0]:
+        for i in range(n_k):  # w = a v, then a = v^H w
+            for j in range(n_k):
+                t = 0j
+                for k in range(n_k):
+                    t += a[i, k] * v[k, j]
+                w[i, j] = t
+        for i in range(n_k):
+            for j in range(n_k):
+                t = 0j
+                for k in range(n_k):
+                    t += np.conj(v[k, i]) * w[k, j]
+                a[i, j] = t
+    hermitian_eigh(a, v, lam, order, 1e-7, 12, warm[0])
+    warm[0] = True
+    for c in range(n_k):
+        fractions[r, d, c] = max(lam[order[c]], 0.0)
+        for i in range(n_k):
+            vectors[r, d, i, c] = v[i, order[c]]
+
+
+@njit(cache=True)
+def cell_scratch(n_k):  # pragma: no cover - compiled
+    c = np.empty((n_k, n_k), np.complex128)
+    return c, c.copy(), c.copy(), np.empty(n_k), np.empty(n_k, np.int64), np.zeros(1, np.bool_)
+
+
+@njit(cache=True)
+def _decompose(acc, done, vectors, fractions, rr, dd):  # pragma: no cover - compiled
+    scratch = cell_scratch(vectors.shape[2])
+    for c in range(rr.size):
+        if not done[rr[c], dd[c]]:
+            decompose_cell(acc, done, vectors, fractions, rr[c], dd[c], scratch)
 
 
 def _ring_directions(
@@ -165,14 +345,5 @@ def clutter_subspace(
     weight = gain2 * grazing
     steer = steering_vector(u_ant, config)
     n_r, n_d, n_k = config.n_range, config.n_doppler, config.n_rx
-    cov = _accumulate(r_pos, d_pos, steer, weight, n_r, n_d, np.zeros((n_r, n_d, n_k, n_k), np.complex128))
-    total = np.einsum("rdii->rd", cov).real
-    predicted = total > 0
-    vectors = np.zeros((n_r, n_d, n_k, n_k), np.complex64)
-    vectors[...] = np.eye(n_k)
-    fractions = np.zeros((n_r, n_d, n_k), np.float32)
-    if predicted.any():
-        lam, vec = np.linalg.eigh((cov[predicted] / total[predicted, None, None]).astype(np.complex64))
-        vectors[predicted] = vec[..., ::-1]
-        fractions[predicted] = np.clip(lam[..., ::-1], 0.0, None)
-    return ClutterSubspace(vectors, fractions, predicted)
+    acc = _accumulate(r_pos, d_pos, steer, weight, n_r, n_d, np.zeros((n_r, n_d, n_k * n_k)))
+    return ClutterSubspace(acc, n_k)

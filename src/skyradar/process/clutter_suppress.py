@@ -43,7 +43,7 @@ from scipy.special import gammaincinv
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
-from skyradar.process.clutter import ClutterSubspace
+from skyradar.process.clutter import ClutterSubspace, cell_scratch, decompose_cell
 from skyradar.process.power import power_image
 
 __all__ = [
@@ -177,7 +177,8 @@ def suppress_clutter(
     inv_gain = (1.0 / np.asarray(config.rx_calibration)).astype(np.complex64)
     z = np.ascontiguousarray(cube, np.complex64)
     rule = (np.float32(1.0 / floor), np.int64(max_nulls), np.float32(gate), np.float32(_RESIDUAL))
-    _fused(z, raw, subspace.null_rows(inv_gain), subspace.fractions, *rule, power, nulls, unsuppressed, cnr)
+    cells = (subspace.covariance, subspace.predicted, subspace.done, subspace._vectors, subspace._fractions)
+    _fused(z, raw, *cells, inv_gain, *rule, power, nulls, unsuppressed, cnr)
     channels = (config.n_rx - nulls).astype(np.int8)
     return Suppressed(power, channels, unsuppressed, nulls, cnr, floor)
 
@@ -215,14 +216,17 @@ def _ring_max(raw, top):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _fused(
-    cube, raw, rows, fractions, inv_floor, max_nulls, gate, residual,  # inputs
+    cube, raw, acc, predicted, done, vectors, fractions, inv_gain,  # inputs (done, vectors, fractions filled)
+    inv_floor, max_nulls, gate, residual,  # the rule
     power, nulls, unsuppressed, cnr,  # outputs
 ):  # pragma: no cover - compiled  # fmt: skip
     # The clutter level (ring and peak rule) and null_count in one pass over the cells, then
     # projected_power where nulls were placed (same rules as those functions; tests compare them).
-    # Two branch-light loops run faster than one that mixes them.
+    # Two branch-light loops run faster than one that mixes them. A gated cell's eigen-pairs are
+    # computed here the first time any frame needs them (most predicted cells never are).
     n_r, n_d, n_k = cube.shape
     one, zero, four = np.float32(1.0), np.float32(0.0), np.float32(4.0)
+    scratch = cell_scratch(n_k)
     top = _ring_max(raw, np.empty((n_r, n_d), np.float32))
     for r in range(n_r):
         for d in range(n_d):
@@ -234,7 +238,9 @@ def _fused(
             cnr[r, d] = c
             m = 0
             left = c
-            if c > gate and fractions[r, d, 0] > 0:
+            if c > gate and predicted[r, d]:
+                if not done[r, d]:
+                    decompose_cell(acc, done, vectors, fractions, r, d, scratch)
                 cum = zero
                 for i in range(max_nulls):
                     cum += fractions[r, d, i]
@@ -244,12 +250,12 @@ def _fused(
                         break
             nulls[r, d] = m
             unsuppressed[r, d] = left > one
-    _project_rows(cube, raw, rows, nulls, power)
+    _project_rows(cube, raw, vectors, inv_gain, nulls, power)
 
 
 @njit(cache=True)
-def _project_rows(cube, raw, rows, nulls, power):  # pragma: no cover - compiled
-    # |P z|^2 / L = (|z|^2 - sum_i |e_i^H z|^2) / L, z = cube / gain: rows hold e_i^H diag(1 / gain).
+def _project_rows(cube, raw, vectors, inv_gain, nulls, power):  # pragma: no cover - compiled
+    # |P z|^2 / L = (|z|^2 - sum_i |e_i^H z|^2) / L, z = cube / gain.
     n_r, n_d, n_k = cube.shape
     for r in range(n_r):
         for d in range(n_d):
@@ -261,7 +267,7 @@ def _project_rows(cube, raw, rows, nulls, power):  # pragma: no cover - compiled
             for i in range(m):
                 acc = np.complex64(0)
                 for k in range(n_k):
-                    acc += rows[r, d, i, k] * cube[r, d, k]
+                    acc += np.conj(vectors[r, d, k, i]) * inv_gain[k] * cube[r, d, k]
                 total -= acc.real * acc.real + acc.imag * acc.imag
             power[r, d] = max(total, np.float32(0.0)) / (n_k - m)
 

@@ -42,7 +42,6 @@ import numpy as np
 from numba import njit
 
 from skyradar.config import RadarConfig
-from skyradar.process.doa import steering_vector
 
 __all__ = ["ClutterSubspace", "clutter_subspace", "hermitian_eigh", "decompose_cell", "cell_scratch"]
 
@@ -108,21 +107,26 @@ class ClutterSubspace:
 
 
 @njit(cache=True)
-def _accumulate(r_pos, d_pos, steer, weight, n_r, n_d, acc):  # pragma: no cover - compiled
+def _accumulate(r_pos, d_pos, u_ant, rx, wavenumber, weight, n_r, n_d, acc):  # pragma: no cover - compiled
     # acc[r, d]: the cell's Hermitian covariance packed as n_k real diagonal entries, then the upper
-    # triangle's (re, im) pairs row by row. The outer product is formed once per ring sample and
-    # added to its 3 x 5 point-spread taps (16 reals per tap, not 16 complex products).
-    n_s, n_k = steer.shape
+    # triangle's (re, im) pairs row by row. Each ring sample's receive steering vector (as
+    # skyradar.process.doa.steering_vector: s_k = exp(-i k u . r_k), unit modulus, so the diagonal
+    # is 1) and outer product s s^H are formed once and added to its 3 x 5 point-spread taps (16
+    # reals per tap); compiled, the steering costs less than numpy's complex exp and temporaries.
+    n_s = r_pos.size
+    n_k = rx.shape[0]
     n_p = n_k * (n_k - 1) // 2
-    prod = np.empty(n_k + 2 * n_p)
+    prod = np.ones(n_k + 2 * n_p)
+    steer = np.empty(n_k, np.complex128)
     wd = np.empty(5)
     for s in range(n_s):
-        for i in range(n_k):
-            prod[i] = steer[s, i].real ** 2 + steer[s, i].imag ** 2
+        for k in range(n_k):
+            phase = -wavenumber * (u_ant[s, 0] * rx[k, 0] + u_ant[s, 1] * rx[k, 1] + u_ant[s, 2] * rx[k, 2])
+            steer[k] = complex(np.cos(phase), np.sin(phase))
         p = n_k
         for i in range(n_k):
             for j in range(i + 1, n_k):
-                c = steer[s, i] * np.conj(steer[s, j])
+                c = steer[i] * np.conj(steer[j])
                 prod[p], prod[p + 1] = c.real, c.imag
                 p += 2
         r0 = int(np.floor(r_pos[s] + 0.5))
@@ -343,7 +347,7 @@ def clutter_subspace(
     gain2 = 10.0 ** (2.0 * config.antenna.gain_db(az, el) / 10.0)
     grazing = u_ned[:, 2]  # sin(grazing) over flat ground: constant-gamma reflectivity
     weight = gain2 * grazing
-    steer = steering_vector(u_ant, config)
+    rx, wavenumber = np.ascontiguousarray(config.rx_positions_m, float), 2.0 * np.pi / config.wavelength_m
     n_r, n_d, n_k = config.n_range, config.n_doppler, config.n_rx
-    acc = _accumulate(r_pos, d_pos, steer, weight, n_r, n_d, np.zeros((n_r, n_d, n_k * n_k)))
+    acc = _accumulate(r_pos, d_pos, u_ant, rx, wavenumber, weight, n_r, n_d, np.zeros((n_r, n_d, n_k * n_k)))
     return ClutterSubspace(acc, n_k)

@@ -43,6 +43,7 @@ __all__ = [
 
 SUPPRESSIONS = ("none", "knowledge-aided", "auto")
 _CACHE: OrderedDict[tuple, tuple[np.ndarray, ClutterSubspace]] = OrderedDict()
+_CACHE_SIZE = 8  # predictions kept: about 20 MB each (packed covariance, eigenvectors as cells need them)
 _V_STEP, _ANGLE_STEP_DEG, _HEIGHT_STEP = 0.25, 1.0, 0.0025
 V_TOLERANCE_MPS, ANGLE_TOLERANCE_DEG, HEIGHT_TOLERANCE = 0.35, 0.5, 0.01  # reuse of a cached prediction
 
@@ -147,7 +148,7 @@ def frame_subspace(
     ant_to_ned = rotation_matrix(0.0, pitch_q, roll_q) @ config.mount.rotation
     sub = clutter_subspace(config, v_q, ant_to_ned, height_q, None, n_azimuth=720)
     _CACHE[key] = (np.array([*v_q, pitch_q, roll_q, height_q]), sub)
-    while len(_CACHE) > 8:  # about 20 MB each (packed covariance, eigenvectors as cells need them)
+    while len(_CACHE) > _CACHE_SIZE:
         _CACHE.popitem(last=False)
     return sub
 

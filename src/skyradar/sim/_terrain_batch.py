@@ -35,7 +35,8 @@ __all__ = [
 _X, _Y, _Z, _R0, _AREA, _COS_INC, _RTX, _RSUM, _RNG, _VR, _VALID, _KR, _KD, _AMP, _N, _E, _D = range(17)
 _TMP0, _TMP1 = 17, 18  # per-loop temporaries (table positions, horizon index and slope)
 _ID = 19  # the sub-facet's number in the frame (cell * sub-facets per cell + m): its speckle draw
-CELL_FIELDS = 20
+_TMP2, _TMP3 = 20, 21  # more temporaries (table look-ups)
+CELL_FIELDS = 22
 
 _OPTS = {"error_model": "numpy", "fastmath": True}
 _GAMMA = uint64(0x9E3779B97F4A7C15)
@@ -153,27 +154,34 @@ def _direction_rows(fy_, fz_, y_, z_, r0_, gain2_step):
         fz_[m] = (z_[m] / r0_[m] + 1.0) / gain2_step
 
 
-@njit(error_model="numpy", fastmath=True)
-def _gain_refl_rows(gain_, refl_, fy_, fz_, cos_inc, gain2, refl_table):
-    # Scalar: table look-ups (the scalar kernel's _table2 and _table, same clamping).
-    n = gain2.shape[0] - 1
-    n_refl = refl_table.shape[0]
-    refl_step = 1.0 / (n_refl - 1)
-    for m in range(gain_.shape[0]):
+@njit(**_OPTS)
+def _table_rows(iy_, ty_, iz_, tz_, ir_, tr_, fy_, fz_, cos_inc, n_gain, n_refl, refl_step):
+    # Cells and weights of the gain and reflectivity look-ups (the scalar kernel's _table2 and
+    # _table, same clamping), branch-free: the loop vectorises; only the loads stay scalar.
+    for m in range(iy_.shape[0]):
         fy, fz = fy_[m], fz_[m]
-        iy = min(max(int(fy), 0), n - 1)
-        iz = min(max(int(fz), 0), n - 1)
-        ty = min(max(fy - iy, 0.0), 1.0)
-        tz = min(max(fz - iz, 0.0), 1.0)
-        row0, row1 = gain2[uint64(iy)], gain2[uint64(iy + 1)]
-        uz0, uz1 = uint64(iz), uint64(iz + 1)
-        gain_[m] = (1 - ty) * ((1 - tz) * row0[uz0] + tz * row0[uz1]) + ty * (
-            (1 - tz) * row1[uz0] + tz * row1[uz1]
-        )
+        iy = min(max(math.floor(fy), 0.0), n_gain - 1.0)
+        iz = min(max(math.floor(fz), 0.0), n_gain - 1.0)
+        iy_[m], ty_[m] = iy, min(max(fy - iy, 0.0), 1.0)
+        iz_[m], tz_[m] = iz, min(max(fz - iz, 0.0), 1.0)
+    for m in range(ir_.shape[0]):
         f = min(max(cos_inc[m] / refl_step, 0.0), n_refl - 1.0)
-        i = min(int(f), n_refl - 2)
-        t = f - i
-        refl_[m] = refl_table[uint64(i)] * (1.0 - t) + refl_table[uint64(i + 1)] * t
+        i = min(math.floor(f), n_refl - 2.0)
+        ir_[m], tr_[m] = i, f - i
+
+
+@njit(error_model="numpy", fastmath=True)
+def _lookup_rows(gain_, refl_, iy_, ty_, iz_, tz_, ir_, tr_, gain2, refl_table):
+    # Scalar: LLVM will not emit gathers here. Unsigned indices: no wrap-around checks.
+    one = uint64(1)
+    for m in range(gain_.shape[0]):
+        iy, iz, ty, tz = uint64(iy_[m]), uint64(iz_[m]), ty_[m], tz_[m]
+        row0, row1 = gain2[iy], gain2[iy + one]
+        gain_[m] = (1 - ty) * ((1 - tz) * row0[iz] + tz * row0[iz + one]) + ty * (
+            (1 - tz) * row1[iz] + tz * row1[iz + one]
+        )
+        i, t = uint64(ir_[m]), tr_[m]
+        refl_[m] = refl_table[i] * (1.0 - t) + refl_table[i + one] * t
 
 
 @njit(**_OPTS)
@@ -290,9 +298,13 @@ def item_returns(s, n, tx, rx, r_rx, cos_sin, v_ground, r_max, d_range, d_vel, c
         _horizon_rows(tmp0, tmp1, n_, e_, d_, az_bin_rad, h_bin_m, float(n_az), float(n_h))
         _visible_row(valid, tmp0, tmp1, horizon.reshape(n_az * n_h))
     _direction_rows(tmp0, tmp1, y_, z_, r0_, gain2_step)
-    # The gain and reflectivity factors land in the _N and _E rows, free after the horizon test.
-    gain_, refl_ = s[_N][:n], s[_E][:n]
-    _gain_refl_rows(gain_, refl_, tmp0, tmp1, cos_inc, gain2, refl_table)
+    # Look-up cells and weights into rows free by now (horizon, Doppler and range sums done).
+    iy_, ty_, iz_, tz_, ir_, tr_ = s[_N][:n], s[_E][:n], s[_D][:n], rsum, v_r_, s[_TMP2][:n]
+    n_refl = refl_table.shape[0]
+    _table_rows(iy_, ty_, iz_, tz_, ir_, tr_, tmp0, tmp1, cos_inc, float(gain2.shape[0] - 1), float(n_refl),
+                1.0 / (n_refl - 1))  # fmt: skip
+    gain_, refl_ = s[_TMP3][:n], tmp1
+    _lookup_rows(gain_, refl_, iy_, ty_, iz_, tz_, ir_, tr_, gain2, refl_table)
     amp, turn = s[_AMP][:n], tmp0
     _amplitude_row(amp, gain_, refl_, s[_AREA][:n], rng_, power_const)
     if speckle_key != 0:

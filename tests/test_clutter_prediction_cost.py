@@ -13,7 +13,7 @@ import numpy as np
 from skyradar.config import RadarConfig
 from skyradar.geo import rotation_matrix
 from skyradar.process import clutter_frames
-from skyradar.process.clutter import _ring_directions, clutter_subspace, hermitian_eigh
+from skyradar.process.clutter import clutter_subspace, hermitian_eigh
 from skyradar.process.doa import steering_vector
 
 CFG = RadarConfig.prototype_2022()
@@ -21,7 +21,13 @@ CFG = RadarConfig.prototype_2022()
 
 def _reference(velocity: np.ndarray, ant_to_ned: np.ndarray, height_m: float, n_azimuth: int):
     """The predicted covariance with every (sample, tap) outer product added by numpy, then eigh."""
-    u_ned, slant = _ring_directions(CFG, height_m, n_azimuth, None)
+    # Flat ground: every range bin's ring beyond the height, depression asin(h / R), all azimuths.
+    rng = CFG.range_axis_m[CFG.range_axis_m > height_m]
+    r_grid, phi = np.meshgrid(rng, np.linspace(-np.pi, np.pi, n_azimuth, endpoint=False), indexing="ij")
+    down = height_m / r_grid.ravel()
+    horizontal = np.sqrt(1.0 - down**2)
+    u_ned = np.stack([horizontal * np.cos(phi.ravel()), horizontal * np.sin(phi.ravel()), down], axis=1)
+    slant = r_grid.ravel()
     radial = -(u_ned @ velocity)
     r_pos = (slant + radial * CFG.range_doppler_coupling_s) / CFG.range_resolution_m
     d_pos = radial / CFG.doppler_resolution_mps + CFG.n_doppler // 2

@@ -292,23 +292,49 @@ def _decompose(acc, done, vectors, fractions, rr, dd):  # pragma: no cover - com
             decompose_cell(acc, done, vectors, fractions, rr[c], dd[c], scratch)
 
 
-def _ring_directions(
+def _ring_depths(
     config: RadarConfig, height_agl_m: float, n_azimuth: int, depth_fn: Callable | None
-) -> tuple[np.ndarray, np.ndarray]:
-    """NED unit vectors (n, 3) and slant ranges (n,) of ground points on each range bin's ring."""
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Range of each range bin's ring (n_r,), ring azimuths (n_az,), ground depth per sample (n_r, n_az)."""
     rng = config.range_axis_m[config.range_axis_m > 0]
     phi = np.linspace(-np.pi, np.pi, n_azimuth, endpoint=False)
-    r_grid, p_grid = np.meshgrid(rng, phi, indexing="ij")
-    depth = np.full(r_grid.shape, float(height_agl_m))
+    depth = np.full((rng.size, phi.size), float(height_agl_m))
     for _ in range(3 if depth_fn is not None else 0):
         # The ground under a ring sample sets its depression, which moves the sample: iterate.
-        horizontal = np.sqrt(np.maximum(r_grid**2 - depth**2, 0.0))
-        depth = np.asarray(depth_fn(horizontal * np.cos(p_grid), horizontal * np.sin(p_grid)), float)
-    seen = (depth > 0) & (depth < r_grid)
-    ud = np.where(seen, depth / r_grid, 0.0)
-    uh = np.sqrt(1.0 - ud**2)
-    u = np.stack([uh * np.cos(p_grid), uh * np.sin(p_grid), ud], axis=-1)
-    return u[seen], r_grid[seen]
+        horizontal = np.sqrt(np.maximum(rng[:, None] ** 2 - depth**2, 0.0))
+        depth = np.asarray(depth_fn(horizontal * np.cos(phi), horizontal * np.sin(phi)), float)
+    return rng, phi, depth
+
+
+@njit(cache=True)
+def _ring_samples(rng, phi, depth, v, rot, coupling_s, d_range, d_velocity, zero_bin):  # pragma: no cover
+    # Every ring sample with ground in view (0 < depth < range): NED direction u (depression
+    # asin(depth / R)), its radial velocity -v . u, fractional range and Doppler bins (with the
+    # chirp's range-Doppler coupling), antenna-frame direction rot^T u and its angles, sin(grazing).
+    n = 0
+    for i in range(rng.size):
+        for j in range(phi.size):
+            n += 1 if 0.0 < depth[i, j] < rng[i] else 0
+    u_ant, az, el = np.empty((n, 3)), np.empty(n), np.empty(n)
+    r_pos, d_pos, grazing = np.empty(n), np.empty(n), np.empty(n)
+    s = 0
+    for i in range(rng.size):
+        for j in range(phi.size):
+            if not 0.0 < depth[i, j] < rng[i]:
+                continue
+            ud = depth[i, j] / rng[i]
+            uh = np.sqrt(1.0 - ud * ud)
+            u0, u1 = uh * np.cos(phi[j]), uh * np.sin(phi[j])
+            radial = -(u0 * v[0] + u1 * v[1] + ud * v[2])
+            r_pos[s] = (rng[i] + radial * coupling_s) / d_range
+            d_pos[s] = radial / d_velocity + zero_bin
+            for k in range(3):
+                u_ant[s, k] = u0 * rot[0, k] + u1 * rot[1, k] + ud * rot[2, k]
+            az[s] = np.arctan2(u_ant[s, 1], u_ant[s, 0])
+            el[s] = np.arcsin(min(max(-u_ant[s, 2], -1.0), 1.0))
+            grazing[s] = ud  # sin(grazing) over flat ground: constant-gamma reflectivity
+            s += 1
+    return u_ant, az, el, r_pos, d_pos, grazing
 
 
 def clutter_subspace(
@@ -336,17 +362,14 @@ def clutter_subspace(
     n_azimuth : int
         Ring samples per range bin (1440: 0.25 deg, under a Doppler bin at 70 m/s).
     """
-    u_ned, slant = _ring_directions(config, height_agl_m, int(n_azimuth), depth_fn)
-    v = np.asarray(velocity_ned_mps, float)
-    radial = -(u_ned @ v)
-    r_pos = (slant + radial * config.range_doppler_coupling_s) / config.range_resolution_m
-    d_pos = radial / config.doppler_resolution_mps + config.n_doppler // 2
-    u_ant = u_ned @ np.asarray(ant_to_ned, float)  # rows: R^T u for each NED vector u
-    az = np.arctan2(u_ant[:, 1], u_ant[:, 0])
-    el = np.arcsin(np.clip(-u_ant[:, 2], -1.0, 1.0))
-    gain2 = 10.0 ** (2.0 * config.antenna.gain_db(az, el) / 10.0)
-    grazing = u_ned[:, 2]  # sin(grazing) over flat ground: constant-gamma reflectivity
-    weight = gain2 * grazing
+    rng, phi, depth = _ring_depths(config, height_agl_m, int(n_azimuth), depth_fn)
+    rot = np.ascontiguousarray(ant_to_ned, float)  # u_ant = rot^T u for each NED vector u
+    v = np.ascontiguousarray(velocity_ned_mps, float)
+    geometry = (config.range_doppler_coupling_s, config.range_resolution_m, config.doppler_resolution_mps)
+    u_ant, az, el, r_pos, d_pos, grazing = _ring_samples(
+        rng, phi, depth, v, rot, *geometry, float(config.n_doppler // 2)
+    )
+    weight = 10.0 ** (2.0 * config.antenna.gain_db(az, el) / 10.0) * grazing
     rx, wavenumber = np.ascontiguousarray(config.rx_positions_m, float), 2.0 * np.pi / config.wavelength_m
     n_r, n_d, n_k = config.n_range, config.n_doppler, config.n_rx
     acc = _accumulate(r_pos, d_pos, u_ant, rx, wavenumber, weight, n_r, n_d, np.zeros((n_r, n_d, n_k * n_k)))

@@ -123,3 +123,55 @@ def test_residual_clutter_hopping_between_cells_is_not_an_object():
     v = 34.0 + rng.normal(0, 0.2, t.size)
     det = pd.DataFrame({"time_s": t, "range_m": hops, "radial_velocity_mps": v})
     assert len(track_detections(det, ownship=_own(t))) == 0
+
+
+def test_history_starts_again_after_a_reacquisition_gap():
+    # Over hills a track was reacquired across a 3 s gap: residual clutter before it and a static
+    # ground point after it, joined into one "object" receding at ~115 m/s (alias +1). After the
+    # gap the ground point alone must be judged, so its rows stay unconfirmed.
+    from skyradar.track.ground_tracks import GroundTrackTest, hold_ground_tracks
+
+    own = _own()
+    t2 = T[46:49]  # three detections after a 2.9 s gap
+    own_p = own[["own_north_m", "own_east_m", "own_down_m"]].to_numpy()[46:49]
+    own_v = own[["own_vn_mps", "own_ve_mps", "own_vd_mps"]].to_numpy()[46:49]
+    rho2, v2 = static_point_measurements(np.array([2300.0, 1450.0, AGL_M]), own_p, own_v, C)
+    t1 = T[:19]  # 1.8 s: long enough for its range rate to rule out a static point
+    rho1 = rho2[0] - 115.0 * (t2[0] - t1)
+    v1 = np.full(t1.size, 115.0 - WIDTH)
+    det = pd.DataFrame({"time_s": np.r_[t1, t2], "range_m": np.r_[rho1, rho2],
+                        "radial_velocity_mps": np.r_[v1, (v2 + WIDTH / 2) % WIDTH - WIDTH / 2]})  # fmt: skip
+    tracks = pd.DataFrame({"time_s": det["time_s"], "track_id": 7, "detection_row": np.arange(len(det)),
+                           "confirmed": True})  # fmt: skip
+    after_gap = det["time_s"].to_numpy() > 3.0
+    for gap_s, held_after in ((np.inf, False), (2.0, True)):
+        out = hold_ground_tracks(tracks, det, own, WIDTH, C, None, GroundTrackTest(rejudge_gap_s=gap_s))
+        assert out.loc[out["time_s"] < 2.0, "confirmed"].iloc[-1]  # before the gap: an object off the ground
+        assert (~out.loc[after_gap, "confirmed"]).all() == held_after, gap_s
+
+
+def test_converging_aircraft_fits_a_static_point_but_its_direction_keeps_it():
+    # Flat-300 encounter 2 of the terrain set (converging at 60 deg, 42 m/s, 550 m miss, co-altitude)
+    # has |w| = 46.5 m/s against the own-ship's 50 m/s, so its range and Doppler fit a static point
+    # for seconds (its miss distance reaches the ground 300 m below). Held until they did not, it
+    # was warned 0.5 s after its loss of well clear. A direction of arrival that puts it in the
+    # air, consistently, keeps it confirmed; without one it is held.
+    from skyradar.track.ground_tracks import GroundTrackTest
+
+    agl = 300.0
+    own = _own().assign(own_height_agl_m=agl)
+    # relative velocity 46.5 m/s from 20 deg right (a 17 m/s glider crossing from the right)
+    w = -46.5 * np.array([np.cos(np.radians(20.0)), np.sin(np.radians(20.0)), 0.0])
+    across = np.cross(w, [0.0, 0.0, 1.0])
+    rel = -2000.0 * w / np.linalg.norm(w) + 550.0 * across / np.linalg.norm(across) + w * T[:, None]
+    target = rel + own[["own_north_m", "own_east_m", "own_down_m"]].to_numpy()
+    det = _detections(target, seed=4)
+    rng = np.random.default_rng(5)
+    det["azimuth_rad"] = np.arctan2(rel[:, 1], rel[:, 0]) + rng.normal(0, 0.02, T.size)
+    det["elevation_rad"] = rng.normal(0, 0.02, T.size)
+    test = GroundTrackTest(surface_down=flat_surface(agl))
+    with_doa = track_detections(det, ownship=own, ground_test=test)
+    no_doa = det.drop(columns=["azimuth_rad", "elevation_rad"])
+    without = track_detections(no_doa, ownship=own, ground_test=test)
+    assert _confirmed_from(with_doa) < 1.5
+    assert _confirmed_from(without) > _confirmed_from(with_doa) + 1.0

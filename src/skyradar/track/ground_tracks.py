@@ -15,10 +15,15 @@ Why aircraft are kept: in straight flight the history of a point moving at relat
 ``w`` has ``d(r dr/dt)/dt = |w|^2``, a static point's ``|v|^2``; so an aircraft fits a static
 point only while its relative speed equals the own-ship's speed, and then that point lies at its
 miss distance from the own-ship's line of flight: it can be ground only when that miss distance
-reaches the terrain (a conflict's miss distance is smaller than the height above ground unless
-the own-ship is very low). A circling aircraft's ``w`` turns and fits no static point. The price
-is time: an aircraft inside the ground's range-Doppler band is held until its history departs
-from a static point's (seconds when ``|w|`` differs from the own-ship's speed by a few m/s).
+reaches the terrain. A circling aircraft's ``w`` turns and fits no static point. The price is
+time: an aircraft inside the ground's range-Doppler band is held until its history departs from
+a static point's (about 1.5 s for a 20 m/s relative-speed difference; a converging aircraft at
+46.5 m/s against the own-ship's 50 m/s, 550 m miss over ground 300 m below, was held 7 s and
+warned after its loss of well clear). So a direction of arrival that says, reliably and
+consistently, that the track flies above the ground overrules the static fit
+(:func:`doa_in_the_air`); sidelobe ground read as air with a consistent wrong direction then
+stays a track. An elevation that clutter suppression left unobservable (``process.clutter_doa``
+places it co-altitude) cannot rule out a co-altitude aircraft and counts as air.
 
 :func:`hold_ground_tracks` applies both tests causally (a row uses only the detections up to it)
 to a tracks table: rows of a track while the ground explains it, or while it is not an object,
@@ -34,7 +39,15 @@ import numpy as np
 import pandas as pd
 from scipy.stats import chi2
 
-_EARTH_RADIUS_M = 6_371_000.0
+from skyradar.track.static_point import (
+    _trimmed_sum,
+    fits_static_ground,
+    flat_surface,
+    static_point_measurements,
+    terrain_surface,
+)
+
+_DOA_COLUMNS = ("azimuth_rad", "elevation_rad", "north_m", "east_m", "down_m")
 _CLEAR_S = 3.0  # judged an object off the ground this long on end: not judged again
 
 __all__ = [
@@ -45,6 +58,7 @@ __all__ = [
     "hold_ground_tracks",
     "flat_surface",
     "terrain_surface",
+    "doa_in_the_air",
 ]
 
 
@@ -70,166 +84,26 @@ class GroundTrackTest:
     surface_down : callable, optional
         NE points (k, 2) -> ``down`` of the ground surface, m (:func:`terrain_surface`); default:
         a level ground at the own-ship's ``own_height_agl_m``.
+    rejudge_gap_s : float
+        A gap between two detections of a track longer than this (the tracker's coasting time)
+        starts its history again: across it the track was reacquired on a prediction, and the
+        detections before may come from another scatterer (residual clutter joined to residual
+        clutter made one "object" receding at 110 m/s over hills).
+    doa_sigma_rad, doa_field_rad : float
+        A direction of arrival this accurate (CRLB at 13-20 dB plus attitude errors) inside this
+        half-angle of boresight may overrule the static-ground fit (:func:`doa_in_the_air`).
     """
 
     sigma_range_m: float = 8.0
-    sigma_velocity_mps: float = 0.35
+    sigma_velocity_mps: float = 0.25
     tail: float = 1e-3
     trim: float = 0.1
     min_detections: int = 3
     max_history: int = 120
     surface_down: Callable[[np.ndarray], np.ndarray] | None = None
-
-
-def flat_surface(down_m: float) -> Callable[[np.ndarray], np.ndarray]:
-    """Surface function (NE points (k, 2) -> surface ``down`` (k,), m) of a level ground.
-
-    Examples
-    --------
-    >>> flat_surface(300.0)(np.zeros((2, 2))).tolist()
-    [300.0, 300.0]
-    """
-    return lambda ne: np.full(np.asarray(ne).shape[0], float(down_m))
-
-
-def static_point_measurements(
-    point_ned: np.ndarray, own_position_m: np.ndarray, own_velocity_mps: np.ndarray, coupling_s: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Apparent range ``r + c dr/dt`` (m) and radial velocity ``dr/dt`` (m/s) of static points.
-
-    ``point_ned`` (3,) or (k, 3), own-ship positions and velocities (k, 3), NED.
-
-    Examples
-    --------
-    >>> rho, v = static_point_measurements(np.array([1000.0, 0, 0]), np.zeros((1, 3)),
-    ...                                    np.array([[50.0, 0, 0]]), 0.2)
-    >>> float(rho[0]), float(v[0])
-    (990.0, -50.0)
-    """
-    d = np.asarray(point_ned, float) - np.asarray(own_position_m, float)
-    r = np.linalg.norm(d, axis=-1)
-    v = -np.sum(d * np.asarray(own_velocity_mps, float), axis=-1) / np.maximum(r, 1e-9)
-    return r + coupling_s * v, v
-
-
-def _wrap(x: np.ndarray, width: float) -> np.ndarray:
-    return (x + width / 2.0) % width - width / 2.0
-
-
-def _trimmed_sum(z2: np.ndarray, trim: float) -> tuple[float, int]:
-    """Sum of the smallest ``1 - trim`` of the squared normalised residuals, and how many."""
-    keep = z2.size - int(np.floor(trim * z2.size))
-    return float(np.sum(np.partition(z2, keep - 1)[:keep])), keep
-
-
-def _ring_candidates(rng, vel, own_p, own_v, width, coupling, surface_down, n_phi: int = 90) -> np.ndarray:
-    """NE points of the surface with one detection's range and (aliased) static Doppler, (m, 2).
-
-    A static point with radial velocity ``V`` lies on the cone ``-u . v = V`` around the velocity;
-    at range ``r`` that is a ring, which meets the surface where its height above it changes sign.
-    """
-    speed = float(np.linalg.norm(own_v))
-    if speed < 1.0:
-        return np.zeros((0, 2))
-    axis = own_v / speed
-    e1 = np.cross(axis, [0.0, 0.0, 1.0] if abs(axis[2]) < 0.9 else [1.0, 0.0, 0.0])
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(axis, e1)
-    phi = np.linspace(0.0, 2.0 * np.pi, n_phi, endpoint=False)
-    ring = np.cos(phi)[:, None] * e1 + np.sin(phi)[:, None] * e2
-    out = []
-    for k in range(-int(np.ceil(2 * speed / width)) - 1, int(np.ceil(2 * speed / width)) + 2):
-        v_true = vel + k * width
-        if abs(v_true) > speed:
-            continue
-        cos_a = -v_true / speed
-        points = own_p + (rng - coupling * v_true) * (cos_a * axis + np.sqrt(1.0 - cos_a**2) * ring)
-        above = surface_down(points[:, :2]) - points[:, 2]
-        nxt = np.roll(above, -1)
-        for i in np.flatnonzero(np.isfinite(above) & np.isfinite(nxt) & ((above > 0) != (nxt > 0))):
-            f = above[i] / (above[i] - nxt[i])
-            j = (i + 1) % n_phi
-            out.append(points[i, :2] + f * (points[j, :2] - points[i, :2]))
-    return np.array(out).reshape(-1, 2)
-
-
-def fits_static_ground(
-    range_m: np.ndarray,
-    radial_velocity_mps: np.ndarray,
-    own_position_m: np.ndarray,
-    own_velocity_mps: np.ndarray,
-    surface_down: Callable[[np.ndarray], np.ndarray],
-    width_mps: float,
-    coupling_s: float,
-    test: GroundTrackTest | None = None,
-) -> bool:
-    """Whether one static point on the surface explains a detection history (chi-square test).
-
-    ``range_m`` (apparent) and ``radial_velocity_mps`` (aliased, modulo ``width_mps``) of the
-    detections, the own-ship's NED position and velocity (k, 3) at their times, and the
-    surface's ``down`` at NE points (:func:`flat_surface`). The point starts where the newest,
-    the middle and the oldest detection's ring meets the surface (:func:`_ring_candidates`) and
-    moves on the surface by Gauss-Newton steps.
-
-    Examples
-    --------
-    >>> t = np.arange(30) * 0.1
-    >>> own = np.column_stack([50.0 * t, 0 * t, 0 * t]); vel = np.tile([50.0, 0, 0], (30, 1))
-    >>> P = np.array([2000.0, 800.0, 500.0])  # a point on flat ground 500 m below
-    >>> rho, v = static_point_measurements(P, own, vel, 0.19)
-    >>> fits_static_ground(rho, v, own, vel, flat_surface(500.0), 78.3, 0.19)
-    True
-    >>> fits_static_ground(rho - 2.0 * t * 10, v, own, vel, flat_surface(500.0), 78.3, 0.19)  # 20 m/s off
-    False
-    """
-    test = test or GroundTrackTest()
-    rng, vel = np.asarray(range_m, float), np.asarray(radial_velocity_mps, float)
-    own_p, own_v = np.asarray(own_position_m, float), np.asarray(own_velocity_mps, float)
-    n = rng.size
-    starts = [
-        _ring_candidates(rng[i], vel[i], own_p[i], own_v[i], width_mps, coupling_s, surface_down)
-        for i in sorted({n - 1, n // 2, 0})
-    ]
-    candidates = np.concatenate(starts) if starts else np.zeros((0, 2))
-    if candidates.size == 0:
-        return False
-    sig = np.array([test.sigma_range_m, test.sigma_velocity_mps])
-
-    def residuals(ne: np.ndarray) -> np.ndarray:  # (m, 2) candidates -> (m, 2n) normalised residuals
-        points = np.column_stack([ne, surface_down(ne)])
-        rho, v = static_point_measurements(points[:, None, :], own_p, own_v, coupling_s)
-        return np.concatenate([(rng - rho) / sig[0], _wrap(vel - v, width_mps) / sig[1]], axis=1)
-
-    cost, keep = _gauss_newton(residuals, candidates, n, test.trim)
-    return bool(np.any(cost <= chi2.isf(test.tail, 2 * keep - 2)))
-
-
-def _kept_rows(z2: np.ndarray, trim: float) -> np.ndarray:
-    """Rows (last axis) of the smallest ``1 - trim`` of the squared normalised residuals."""
-    keep = z2.shape[-1] - int(np.floor(trim * z2.shape[-1]))
-    return z2 <= np.partition(z2, keep - 1, axis=-1)[..., keep - 1 : keep]
-
-
-def _gauss_newton(residuals: Callable, ne: np.ndarray, n: int, trim: float, steps: int = 6) -> tuple:
-    """Trimmed least squares of static points' NE positions from several starts at once.
-
-    ``residuals(ne)`` maps (m, 2) starts to (m, 2n) normalised residuals (the ``n`` detections'
-    ranges, then their Doppler); the Jacobian is taken by 1 m differences (the surface may be a
-    DEM). Returns each start's trimmed chi-square (m,) and the number of detections kept.
-    """
-    ne = np.asarray(ne, float).copy()
-    for _ in range(steps):
-        e = residuals(ne)
-        w = np.tile(_kept_rows(e[:, :n] ** 2 + e[:, n:] ** 2, trim), 2) & np.isfinite(e)
-        e = np.where(w, e, 0.0)
-        J = np.stack([np.where(w, residuals(ne + d), 0.0) - e for d in np.eye(2)], axis=-1)  # (m, 2n, 2)
-        JTJ = np.einsum("mki,mkj->mij", J, J) + 1e-6 * np.eye(2)
-        step = np.linalg.solve(JTJ, -np.einsum("mki,mk->mi", J, e)[..., None])[..., 0]
-        ne += np.clip(np.nan_to_num(step), -500.0, 500.0)
-    e = residuals(ne)
-    z2 = np.where(np.isfinite(e[:, :n] + e[:, n:]), e[:, :n] ** 2 + e[:, n:] ** 2, np.inf)
-    keep = n - int(np.floor(trim * n))
-    return np.sum(np.partition(z2, keep - 1, axis=1)[:, :keep], axis=1), keep
+    rejudge_gap_s: float = 2.0
+    doa_sigma_rad: float = float(np.radians(2.0))
+    doa_field_rad: float = float(np.radians(45.0))
 
 
 def range_doppler_consistent(
@@ -270,30 +144,6 @@ def range_doppler_consistent(
     return False
 
 
-def terrain_surface(terrain, origin: tuple[float, float, float], flat_down_m: float) -> Callable:
-    """Surface function (NE points (k, 2) -> ``down`` of the surface, m) of a DEM seen from a
-    scenario ``origin`` (lat, lon, alt); a level ground at ``flat_down_m`` beyond the DEM.
-
-    The fit calls it thousands of times with a few points, so the NED-to-geodetic conversion is
-    linearised at the origin (degrees per metre north and east, and the Earth's curvature dropping
-    the surface by ``(n^2 + e^2) / 2R``): under 0.1 m off at 15 km.
-    """
-    from skyradar.geo import ned_to_geodetic
-
-    probe = np.array([[0.0, 0.0, 0.0], [1e3, 0.0, 0.0], [0.0, 1e3, 0.0]])
-    lat, lon, _ = (np.asarray(v, float) for v in ned_to_geodetic(probe, *origin))
-    per_m = np.array([(lat[1] - lat[0]) / 1e3, (lon[2] - lon[0]) / 1e3])
-
-    def surface_down(ne: np.ndarray) -> np.ndarray:
-        ne = np.asarray(ne, float).reshape(-1, 2)
-        curvature = np.sum(ne**2, axis=1) / (2.0 * _EARTH_RADIUS_M)
-        h = np.asarray(terrain.height_at(lat[0] + ne[:, 0] * per_m[0], lon[0] + ne[:, 1] * per_m[1]), float)
-        down = origin[2] - h + curvature
-        return np.where(np.isfinite(down), down, flat_down_m)
-
-    return surface_down
-
-
 def _own_state(ownship: pd.DataFrame, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Own-ship NED position and velocity (k, 3) interpolated at ``times``."""
     t = ownship["time_s"].to_numpy(float)
@@ -302,7 +152,49 @@ def _own_state(ownship: pd.DataFrame, times: np.ndarray) -> tuple[np.ndarray, np
     return np.column_stack(cols[0]), np.column_stack(cols[1])
 
 
-def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test) -> np.ndarray:
+def _doa_height(det: np.ndarray, surface_down, test: GroundTrackTest) -> list[np.ndarray]:
+    """Azimuth and elevation (antenna frame) of each detection and its DoA position's height
+    above the surface in standard deviations (range x ``doa_sigma_rad``, 10 m for the surface)."""
+    az, el = det[:, 3], det[:, 4]
+    if surface_down is None or not np.isfinite(det[:, 5:8]).any():
+        return [az, el, np.full(az.size, np.nan)]
+    with np.errstate(invalid="ignore"):
+        height = surface_down(np.nan_to_num(det[:, 5:7])) - det[:, 7]
+        return [az, el, height / np.hypot(det[:, 1] * test.doa_sigma_rad, 10.0)]
+
+
+def doa_in_the_air(
+    azimuth_rad, elevation_rad, height_sd, test: GroundTrackTest | None = None, n: int = 10
+) -> bool:
+    """Whether a track's recent directions of arrival say, reliably, that it flies above the ground.
+
+    Of its last ``n`` detections, at least half and five must lie inside the field
+    (``doa_field_rad`` of boresight), their azimuth and elevation must agree (robust spread within
+    3 ``doa_sigma_rad``: one direction, not residual clutter or ground beside the track scattered
+    over the beam) and their median height above the surface must be 3 sd or more
+    (``height_sd``: height / sd). Such a track keeps its confirmation even when a static ground
+    point also fits its range and Doppler: an aircraft whose speed relative to the own-ship equals
+    the own-ship's (a converging one at 60 deg, say) fits a static point as long as it flies straight.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> az, el = 0.3 + rng.normal(0, 0.02, 10), rng.normal(0, 0.02, 10)
+    >>> scattered = rng.uniform(-0.6, 0.6, 10)  # residual clutter over the beam
+    >>> doa_in_the_air(az, el, np.full(10, 6.0)), doa_in_the_air(scattered, el, np.full(10, 6.0))
+    (True, False)
+    """
+    test = test or GroundTrackTest()
+    az, el, z = (np.asarray(a, float)[-n:] for a in (azimuth_rad, elevation_rad, height_sd))
+    with np.errstate(invalid="ignore"):
+        inside = (np.abs(az) <= test.doa_field_rad) & (np.abs(el) <= test.doa_field_rad) & np.isfinite(z)
+    if inside.sum() < max(5, az.size // 2):
+        return False
+    spread = max(1.4826 * np.median(np.abs(a[inside] - np.median(a[inside]))) for a in (az, el))
+    return bool(spread <= 3.0 * test.doa_sigma_rad and np.median(z[inside]) >= 3.0)
+
+
+def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test, doa) -> np.ndarray:
     """Per detection of one track: held (ground, or not an object) on the detections up to it.
 
     Judged at every detection for the first 30, then at every fifth. A track judged an object
@@ -319,11 +211,30 @@ def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test
         if k < 30 or k % 5 == 0 or k == n - 1:
             sl = slice(max(0, k + 1 - test.max_history), k + 1)
             last = not range_doppler_consistent(t[sl], rng[sl], vel[sl], width, coupling, test)
-            if not last and surface_down is not None:
+            if not last and surface_down is not None and not doa_in_the_air(*(a[sl] for a in doa), test):
+                fit = (test.sigma_range_m, test.sigma_velocity_mps, test.tail, test.trim)
                 last = fits_static_ground(rng[sl], vel[sl], own_p[sl], own_v[sl], surface_down, width,
-                                          coupling, test)  # fmt: skip
+                                          coupling, *fit)  # fmt: skip
             clear_since = np.inf if last else min(clear_since, t[k])
         held[k] = last
+    return held
+
+
+def _track_held(det: np.ndarray, ownship, surface_down, width: float, coupling: float, test) -> np.ndarray:
+    """Held flag per detection of one track (``det``: time, range, radial velocity), its history
+    started again after every gap longer than ``test.rejudge_gap_s``."""
+    t, rng, vel = det[:, :3].T
+    own_p, own_v = _own_state(ownship, t) if ownship is not None else (None, None)
+    ground = surface_down if ownship is not None else None
+    doa = _doa_height(det, ground, test)
+    held = np.ones(t.size, bool)
+    cuts = np.flatnonzero(np.diff(t) > test.rejudge_gap_s) + 1
+    for a, b in zip(np.r_[0, cuts], np.r_[cuts, t.size], strict=True):
+        s = slice(a, b)
+        own = (None, None) if own_p is None else (own_p[s], own_v[s])
+        held[s] = _history_held(
+            t[s], rng[s], vel[s], *own, ground, width, coupling, test, [a[s] for a in doa]
+        )
     return held
 
 
@@ -352,19 +263,16 @@ def hold_ground_tracks(
         ground = (ownship["own_down_m"] + ownship["own_height_agl_m"]).to_numpy(float)
         if np.isfinite(ground).any():
             surface_down = flat_surface(float(np.nanmedian(ground)))
-    det_t = detections["time_s"].to_numpy(float)
-    det_r = detections["range_m"].to_numpy(float)
-    det_v = detections["radial_velocity_mps"].to_numpy(float)
+    names = ["time_s", "range_m", "radial_velocity_mps", *_DOA_COLUMNS]
+    nan = np.full(len(detections), np.nan)
+    det = np.column_stack([detections[c].to_numpy(float) if c in detections else nan for c in names])
     rows = tracks["detection_row"].to_numpy()
     held = np.ones(len(tracks), bool)
     for _, idx in tracks.groupby("track_id", sort=False).indices.items():
         has = idx[rows[idx] >= 0]
         if has.size == 0:
             continue
-        d = rows[has]
-        own_p, own_v = _own_state(ownship, det_t[d]) if ownship is not None else (None, None)
-        ground = surface_down if ownship is not None else None
-        h = _history_held(det_t[d], det_r[d], det_v[d], own_p, own_v, ground, width_mps, coupling_s, test)
+        h = _track_held(det[rows[has]], ownship, surface_down, width_mps, coupling_s, test)
         # Each row (coasting ones too) takes the decision of the newest detection at or before it.
         pos = np.searchsorted(has, idx, side="right") - 1
         held[idx] = np.where(pos >= 0, h[np.maximum(pos, 0)], True)

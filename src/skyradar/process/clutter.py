@@ -77,6 +77,11 @@ class ClutterSubspace:
         self.done = np.zeros((n_r, n_d), np.bool_)  # cells decomposed so far
         self._vectors = np.empty((n_r, n_d, n_rx, n_rx), np.complex64)
         self._fractions = np.zeros((n_r, n_d, n_rx), np.float32)
+        # e_i^H diag(1 / gain) of a cell's first n_rx - 1 eigenvectors, for the calibration `rows_key`:
+        # the suppression kernel's inner products with an uncalibrated snapshot, filled as it needs them.
+        self.rows = np.empty((n_r, n_d, n_rx - 1, n_rx), np.complex64)
+        self.rows_done = np.zeros((n_r, n_d), np.bool_)
+        self.rows_key = b""
 
     def ensure(self, range_index: np.ndarray | None = None, doppler_index: np.ndarray | None = None) -> None:
         """Decompose the given cells (default: all) that are not decomposed yet."""

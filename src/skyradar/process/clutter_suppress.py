@@ -177,8 +177,12 @@ def suppress_clutter(
     inv_gain = (1.0 / np.asarray(config.rx_calibration)).astype(np.complex64)
     z = np.ascontiguousarray(cube, np.complex64)
     rule = (np.float32(1.0 / floor), np.int64(max_nulls), np.float32(gate), np.float32(_RESIDUAL))
+    if subspace.rows_key != inv_gain.tobytes():  # another calibration: rows made for it from scratch
+        subspace.rows_done[:] = False
+        subspace.rows_key = inv_gain.tobytes()
     cells = (subspace.covariance, subspace.predicted, subspace.done, subspace._vectors, subspace._fractions)
-    _fused(z, raw, *cells, inv_gain, *rule, power, nulls, unsuppressed, cnr)
+    rows = (subspace.rows, subspace.rows_done, inv_gain)
+    _fused(z, raw, *cells, *rows, *rule, power, nulls, unsuppressed, cnr)
     channels = (config.n_rx - nulls).astype(np.int8)
     return Suppressed(power, channels, unsuppressed, nulls, cnr, floor)
 
@@ -216,7 +220,7 @@ def _ring_max(raw, top):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _fused(
-    cube, raw, acc, predicted, done, vectors, fractions, inv_gain,  # inputs (done, vectors, fractions filled)
+    cube, raw, acc, predicted, done, vectors, fractions, rows, rows_done, inv_gain,  # inputs; lazily filled
     inv_floor, max_nulls, gate, residual,  # the rule
     power, nulls, unsuppressed, cnr,  # outputs
 ):  # pragma: no cover - compiled  # fmt: skip
@@ -250,12 +254,13 @@ def _fused(
                         break
             nulls[r, d] = m
             unsuppressed[r, d] = left > one
-    _project_rows(cube, raw, vectors, inv_gain, nulls, power)
+    _project_rows(cube, raw, vectors, rows, rows_done, inv_gain, nulls, power)
 
 
 @njit(cache=True)
-def _project_rows(cube, raw, vectors, inv_gain, nulls, power):  # pragma: no cover - compiled
-    # |P z|^2 / L = (|z|^2 - sum_i |e_i^H z|^2) / L, z = cube / gain.
+def _project_rows(cube, raw, vectors, rows, rows_done, inv_gain, nulls, power):  # pragma: no cover - compiled
+    # |P z|^2 / L = (|z|^2 - sum_i |e_i^H z|^2) / L, z = cube / gain: rows hold e_i^H diag(1 / gain),
+    # contiguous per null, made the first time a cell is projected under this calibration.
     n_r, n_d, n_k = cube.shape
     for r in range(n_r):
         for d in range(n_d):
@@ -263,11 +268,16 @@ def _project_rows(cube, raw, vectors, inv_gain, nulls, power):  # pragma: no cov
             if m == 0:
                 power[r, d] = raw[r, d]
                 continue
+            if not rows_done[r, d]:
+                for i in range(n_k - 1):
+                    for k in range(n_k):
+                        rows[r, d, i, k] = np.conj(vectors[r, d, k, i]) * inv_gain[k]
+                rows_done[r, d] = True
             total = raw[r, d] * n_k  # |z|^2 of the calibrated snapshot (raw is its channel mean)
             for i in range(m):
                 acc = np.complex64(0)
                 for k in range(n_k):
-                    acc += np.conj(vectors[r, d, k, i]) * inv_gain[k] * cube[r, d, k]
+                    acc += rows[r, d, i, k] * cube[r, d, k]
                 total -= acc.real * acc.real + acc.imag * acc.imag
             power[r, d] = max(total, np.float32(0.0)) / (n_k - m)
 

@@ -89,17 +89,24 @@ def _raise_bins(best, pts, n_pts, r_lim, n_az):
 
 
 @njit(error_model="numpy")
+def _cell_samples(p_ned, i, j, nsub_r, nsub_c, pts, n):
+    """The nsub_r x nsub_c bilinear samples of cell (i, j) into ``pts`` from row ``n``; the next free row."""
+    for a in range(nsub_r):
+        u = (a + 0.5) / nsub_r
+        for b in range(nsub_c):
+            _bilinear(p_ned, i, j, u, (b + 0.5) / nsub_c, pts, n)
+            n += 1
+    return n
+
+
+@njit(error_model="numpy")
 def _row_samples(p_ned, rot_n2a, i, nsub_r, nsub_c, pts):
     """Samples of the cells of grid row ``i`` in front of the antenna plane into ``pts``."""
     n = 0
     for j in range(p_ned.shape[1] - 1):
         if not _cell_in_front(p_ned, rot_n2a, i, j):
             continue
-        for a in range(nsub_r):
-            u = (a + 0.5) / nsub_r
-            for b in range(nsub_c):
-                _bilinear(p_ned, i, j, u, (b + 0.5) / nsub_c, pts, n)
-                n += 1
+        n = _cell_samples(p_ned, i, j, nsub_r, nsub_c, pts, n)
     return n
 
 
@@ -163,11 +170,7 @@ def _strip_samples(p_ned, rot_n2a, i, nsub_r, nsub_c, dn, de, sample_m, az_bin_r
         gap, h_max = _line_gap(p_ned, i, j, dn, de)  # first: it leaves out most cells
         if gap > 0.5 * sample_m + 3.0 * h_max * az_bin_rad + 1.0 or not _cell_in_front(p_ned, rot_n2a, i, j):
             continue
-        for a in range(nsub_r):
-            u = (a + 0.5) / nsub_r
-            for b in range(nsub_c):
-                _bilinear(p_ned, i, j, u, (b + 0.5) / nsub_c, pts, n)
-                n += 1
+        n = _cell_samples(p_ned, i, j, nsub_r, nsub_c, pts, n)
     return n
 
 

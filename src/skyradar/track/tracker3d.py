@@ -13,6 +13,12 @@ with ``u`` the unit line of sight of the prediction (:func:`range_rate_update`).
 the tangential velocity comes from differencing positions that are tens of metres apart, and the
 radial one is no better. Positions that fall outside a chi-square gate of the prediction (DoA
 outliers at low SNR) are not used.
+
+The stated angle error is the bound at the detection's SNR; after clutter suppression a 2 x 2 array's
+directions scatter far more (tens of degrees over terrain), and a filter that trusts the bound takes
+its velocity from those directions (55-65 m/s off for 5 s on a converging aircraft 300 m above flat
+ground). So each filter scales its position noise by what its own innovations show (covariance
+matching): an exponential average of ``NIS / 3`` against the stated noise, never below 1.
 """
 
 from __future__ import annotations
@@ -138,6 +144,12 @@ class Tracker3D:
     max_rejects : int
         After this many consecutive gated-out positions the filter is restarted on the next one
         (the estimate, not the measurements, is then the likelier culprit).
+    noise_memory : float
+        Weight of each new position in a filter's average of ``NIS / 3`` (normalised innovation
+        squared against the stated position noise); that average, clipped to
+        ``[1, max_noise_scale]``, multiplies the position noise. 0: the stated noise, always.
+    max_noise_scale : float
+        Largest factor on the position noise (each NIS enters the average at most ``3 *`` this).
 
     Examples
     --------
@@ -156,6 +168,8 @@ class Tracker3D:
         max_rejects: int = 5,
         sigma_vertical_accel_mps2: float = 0.3,
         init_sigma_vertical_mps: float = 3.0,
+        noise_memory: float = 0.1,
+        max_noise_scale: float = 16.0,
     ) -> None:
         self.sigma_accel_mps2 = float(sigma_accel_mps2)
         self.init_sigma_velocity_mps = float(init_sigma_velocity_mps)
@@ -163,10 +177,13 @@ class Tracker3D:
         self.init_sigma_vertical_mps = float(init_sigma_vertical_mps)
         self.gate = float(gate)
         self.max_rejects = int(max_rejects)
+        self.noise_memory = float(noise_memory)
+        self.max_noise_scale = float(max_noise_scale)
         self.ids = np.zeros(0, np.int64)
         self.x = np.zeros((0, 6))
         self.P = np.zeros((0, 6, 6))
         self.rejects = np.zeros(0, np.int64)
+        self.noise_scale = np.zeros(0)
         self.time_s: float | None = None
 
     def step(
@@ -203,7 +220,7 @@ class Tracker3D:
         if cov.ndim == 1:
             cov = cov[:, None, None] * np.eye(3)
         keep = np.isin(self.ids, ids)
-        self.ids, self.x, self.P, self.rejects = (a[keep] for a in (self.ids, self.x, self.P, self.rejects))
+        self._keep(keep)
         if self.time_s is not None and self.ids.size and time_s > self.time_s:
             dt = time_s - self.time_s
             self.x, self.P = predict(
@@ -251,7 +268,7 @@ class Tracker3D:
         self.ids[pos[found]] = new_ids[found]
         keep[pos[found]] = True
         order = np.flatnonzero(keep)[np.argsort(self.ids[keep], kind="stable")]
-        self.ids, self.x, self.P, self.rejects = (a[order] for a in (self.ids, self.x, self.P, self.rejects))
+        self._keep(order)
 
     def _update_positions(
         self, sel: np.ndarray, pos: np.ndarray, positions_m: np.ndarray, cov: np.ndarray
@@ -261,17 +278,33 @@ class Tracker3D:
             return
         rows = pos[sel]
         y = positions_m[sel] - self.x[rows, :3]
-        S = self.P[rows, :3, :3] + cov[sel]
+        stated = cov[sel]
+        cov_sel = stated * self.noise_scale[rows, None, None]  # the noise this filter's innovations showed
+        S = self.P[rows, :3, :3] + cov_sel
         nis = np.einsum("ni,ni->n", y, np.linalg.solve(S, y[..., None])[..., 0])
+        self._match_noise(rows, y, self.P[rows, :3, :3] + stated)
         ok = nis < self.gate
         restart = ~ok & (self.rejects[rows] >= self.max_rejects)
         self.rejects[rows] = np.where(ok, 0, self.rejects[rows] + 1)
         up = rows[ok]
-        self.x[up], self.P[up] = update(self.x[up], self.P[up], y[ok], _H3, cov[sel][ok])
+        self.x[up], self.P[up] = update(self.x[up], self.P[up], y[ok], _H3, cov_sel[ok])
         if np.any(restart):
-            x0, P0 = self._initial(positions_m[sel][restart], cov[sel][restart])
+            x0, P0 = self._initial(positions_m[sel][restart], cov_sel[restart])
             r = rows[restart]
             self.x[r], self.P[r], self.rejects[r] = x0, P0, 0
+
+    def _match_noise(self, rows: np.ndarray, y: np.ndarray, S_stated: np.ndarray) -> None:
+        """Average ``NIS / 3`` of the filters ``rows`` against the stated noise into their noise scale."""
+        nis = np.einsum("ni,ni->n", y, np.linalg.solve(S_stated, y[..., None])[..., 0])
+        top = self.max_noise_scale
+        seen = np.minimum(np.nan_to_num(nis, nan=3.0 * top), 3.0 * top) / 3.0
+        mixed = (1.0 - self.noise_memory) * self.noise_scale[rows] + self.noise_memory * seen
+        self.noise_scale[rows] = np.clip(mixed, 1.0, top)
+
+    def _keep(self, index: np.ndarray) -> None:
+        """Keep (and order) the filters selected by ``index`` (boolean mask or rows)."""
+        arrays = (self.ids, self.x, self.P, self.rejects, self.noise_scale)
+        self.ids, self.x, self.P, self.rejects, self.noise_scale = (a[index] for a in arrays)
 
     def _initial(self, positions_m: np.ndarray, cov: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         x = np.hstack([positions_m, np.zeros((positions_m.shape[0], 3))])
@@ -291,6 +324,7 @@ class Tracker3D:
         self.x = np.concatenate([self.x, x])[order]
         self.P = np.concatenate([self.P, P])[order]
         self.rejects = np.concatenate([self.rejects, np.zeros(ids.size, np.int64)])[order]
+        self.noise_scale = np.concatenate([self.noise_scale, np.ones(ids.size)])[order]
 
 
 def _lookup(stored: np.ndarray, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -13,7 +13,9 @@ residual clutter hopping between cells fails this. Nor is it one object while it
 follow one smooth curve (:func:`doppler_smooth`): a point's radial velocity is measured to a few
 hundredths of a m/s (CRLB at 13 dB: 0.027 m/s) and changes by about 1 m/s^2; the scatterers of a
 ground patch that take turns in one track (over relief, at the alias edge, with scattered
-directions and no single static point fitting them) jump by a Doppler bin.
+directions and no single static point fitting them) jump by a Doppler bin. A track whose measured
+elevations put it on the surface (:func:`doa_on_the_ground`) needs five detections, not three,
+before these tests may release it: some alias fits three hopping ranges.
 
 Why aircraft are kept: in straight flight the history of a point moving at relative velocity
 ``w`` has ``d(r dr/dt)/dt = |w|^2``, a static point's ``|v|^2``; so an aircraft fits a static
@@ -64,6 +66,7 @@ __all__ = [
     "terrain_surface",
     "doa_in_the_air",
     "doppler_smooth",
+    "doa_on_the_ground",
 ]
 
 
@@ -101,6 +104,10 @@ class GroundTrackTest:
         Doppler error of one point target's detections about a smooth curve (the radial velocity
         as measured, without the own-ship's velocity error): a track whose Doppler scatters more
         is not one object (:func:`doppler_smooth`); None: that test is off.
+    ground_min_detections : int
+        Detections a track needs, instead of ``min_detections``, while its measured directions put
+        it on the surface (:func:`doa_on_the_ground`): three cannot tell residual clutter hopping
+        between cells (its ranges fit some alias) from an object.
     """
 
     sigma_range_m: float = 8.0
@@ -114,6 +121,7 @@ class GroundTrackTest:
     doa_sigma_rad: float = float(np.radians(2.0))
     doa_field_rad: float = float(np.radians(45.0))
     point_sigma_velocity_mps: float | None = 0.1
+    ground_min_detections: int = 5
 
 
 def range_doppler_consistent(
@@ -235,6 +243,28 @@ def doppler_smooth(
     return bool(_trimmed_sum(z2, test.trim)[0] <= chi2.isf(test.tail, max(keep - degree - 1, 1)))
 
 
+def doa_on_the_ground(azimuth_rad, elevation_rad, height_sd, n: int = 10, max_sd: float = 1.0) -> bool:
+    """Whether a track's recent measured directions of arrival put it on the surface.
+
+    Of its last ``n`` detections, those with a measured elevation (not ``process.clutter_doa``'s
+    placeholder 0, a prior) and a height above the surface (``height_sd``, in sd) count: at least
+    three, and their median height is below ``max_sd``. Azimuths may scatter (ground beside the
+    track in one cell). Not proof of ground: an aircraft in a ground cell can read the ground's
+    direction too (terrain set flat-300 encounter 2); so it only asks for more detections.
+
+    Examples
+    --------
+    >>> el = np.radians([-25.0, 0.0, -24.0, -26.0])
+    >>> doa_on_the_ground(np.zeros(4), el, np.array([0.4, 11.0, -0.3, 0.9]))
+    True
+    >>> doa_on_the_ground(np.zeros(4), el, np.array([7.0, 11.0, 12.0, 26.0]))
+    False
+    """
+    el, z = (np.asarray(a, float)[-n:] for a in (elevation_rad, height_sd))
+    measured = (el != 0.0) & np.isfinite(z)
+    return bool(measured.sum() >= 3 and np.median(z[measured]) < max_sd)
+
+
 def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test, doa) -> np.ndarray:
     """Per detection of one track: held (ground, or not an object) on the detections up to it.
 
@@ -254,6 +284,8 @@ def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test
             last = not range_doppler_consistent(t[sl], rng[sl], vel[sl], width, coupling, test)
             if not last and test.point_sigma_velocity_mps is not None:
                 last = not doppler_smooth(t[sl], vel[sl], width, test)
+            if not last and k + 1 < test.ground_min_detections:
+                last = doa_on_the_ground(*(a[sl] for a in doa))
             if not last and surface_down is not None and not doa_in_the_air(*(a[sl] for a in doa), test):
                 fit = (test.sigma_range_m, test.sigma_velocity_mps, test.tail, test.trim)
                 last = fits_static_ground(rng[sl], vel[sl], own_p[sl], own_v[sl], surface_down, width,

@@ -213,11 +213,11 @@ def test_doppler_of_a_point_is_smooth_that_of_a_clutter_patch_is_not():
     assert len(track_detections(det, ownship=_own(), ground_test=on)) == 0
 
 
-def test_short_track_whose_measured_directions_are_on_the_ground_needs_five_detections():
+def test_short_track_whose_measured_directions_are_on_the_ground_needs_more_detections():
     # Jacksboro encounter 2 (saved detections, times from 0): residual clutter at the alias edge,
     # three detections in 0.2 s whose ranges some alias fits, measured elevations -25 deg on the
     # surface, was confirmed at its third and kept to its fourth (a placeholder 0 deg elevation).
-    # With the directions on the surface it needs five detections; with them in the air, three.
+    # With the directions on the surface it needs ten detections; with them in the air, three.
     from skyradar.track.ground_tracks import GroundTrackTest, hold_ground_tracks
 
     t = np.array([0.0, 0.106, 0.213, 0.851])
@@ -231,7 +231,7 @@ def test_short_track_whose_measured_directions_are_on_the_ground_needs_five_dete
     for down_m, kept in ((AGL_M, False), (0.0, True)):  # on the surface / co-altitude
         d = det.assign(north_m=own["own_north_m"] + north, east_m=east, down_m=down_m)
         d.loc[3, "down_m"] = 0.0  # the placeholder elevation reads co-altitude
-        for ground_min, kept_here in ((5, kept), (0, True)):  # 0: the rule off
+        for ground_min, kept_here in ((10, kept), (0, True)):  # 0: the rule off
             test = GroundTrackTest(point_sigma_velocity_mps=None, ground_min_detections=ground_min)
             out = hold_ground_tracks(tracks, d, own, WIDTH, C, flat_surface(AGL_M), test)
             assert (len(out) > 0) == kept_here, (down_m, ground_min)

@@ -14,8 +14,9 @@ follow one smooth curve (:func:`doppler_smooth`): a point's radial velocity is m
 hundredths of a m/s (CRLB at 13 dB: 0.027 m/s) and changes by about 1 m/s^2; the scatterers of a
 ground patch that take turns in one track (over relief, at the alias edge, with scattered
 directions and no single static point fitting them) jump by a Doppler bin. A track whose measured
-elevations put it on the surface (:func:`doa_on_the_ground`) needs five detections, not three,
-before these tests may release it: some alias fits three hopping ranges.
+elevations put it on the surface (:func:`doa_on_the_ground`) needs ten detections, not three,
+before these tests may release it: some alias fits three hopping ranges, and the Doppler test
+needs its full window.
 
 Why aircraft are kept: in straight flight the history of a point moving at relative velocity
 ``w`` has ``d(r dr/dt)/dt = |w|^2``, a static point's ``|v|^2``; so an aircraft fits a static
@@ -107,7 +108,7 @@ class GroundTrackTest:
     ground_min_detections : int
         Detections a track needs, instead of ``min_detections``, while its measured directions put
         it on the surface (:func:`doa_on_the_ground`): three cannot tell residual clutter hopping
-        between cells (its ranges fit some alias) from an object.
+        between cells (its ranges fit some alias) from an object; ten fill the Doppler test's window.
     """
 
     sigma_range_m: float = 8.0
@@ -121,7 +122,7 @@ class GroundTrackTest:
     doa_sigma_rad: float = float(np.radians(2.0))
     doa_field_rad: float = float(np.radians(45.0))
     point_sigma_velocity_mps: float | None = 0.1
-    ground_min_detections: int = 5
+    ground_min_detections: int = 10
 
 
 def range_doppler_consistent(

@@ -19,7 +19,7 @@ import pandas as pd
 
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig
 from skyradar.experiments.daa_chain import label_tracks, run_chain
-from skyradar.experiments.encounter_score import conflict_cause, frame_status, track_counts
+from skyradar.experiments.encounter_score import frame_status, track_counts, unwarned_cause
 from skyradar.experiments.encounter_set import (
     encounter_scenario,
     event_times,
@@ -91,7 +91,7 @@ def _score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[
     status = frame_status(truths, opts["fov_deg"], opts["min_snr_db"])
     window = opts["observe_window_s"]
     row = score_encounter(t, rel, warn["time_s"].to_numpy(float)[mine], status, opts["buffer"], window)
-    row["cause"] = conflict_cause(status, row["t_lowc_s"], window)
+    row["cause"] = unwarned_cause(status, row["t_lowc_s"], row["t_warning_s"], window)
     other = warn["time_s"].to_numpy(float)[~mine]
     own_agl = (
         float(np.nanmedian(truths[0]["own_height_agl_m"].values)) if built.terrain is not None else np.nan

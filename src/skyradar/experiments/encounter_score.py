@@ -33,7 +33,7 @@ import pandas as pd
 
 from skyradar.experiments.encounter_set import summarise
 
-__all__ = ["CAUSES", "frame_status", "conflict_cause", "track_counts", "summarise_layout"]
+__all__ = ["CAUSES", "frame_status", "conflict_cause", "unwarned_cause", "track_counts", "summarise_layout"]
 
 CAUSES = ("missed", "behind", "outside_beams", "terrain_masked", "below_13db")
 
@@ -104,6 +104,22 @@ def conflict_cause(status: pd.DataFrame, t_lowc_s: float, observe_window_s: floa
         if flag.any():
             return cause
     return "below_13db"
+
+
+def unwarned_cause(status: pd.DataFrame, t_lowc_s: float, t_warning_s: float, observe_window_s: float) -> str:
+    """:func:`conflict_cause` of a conflict not warned before its LoWC; ``""`` for one warned in time
+    (the table's ``cause`` column says why a conflict went unwarned, not what would have caused it).
+
+    Examples
+    --------
+    >>> s = pd.DataFrame({"time_s": [0.0, 1.0], "behind": [False, False], "in_beam": [True, True],
+    ...                   "in_view": [True, True], "observable": [True, True]})
+    >>> [unwarned_cause(s, 1.0, t_warning, 5.0) for t_warning in (0.5, 1.5, np.nan)]
+    ['', 'missed', 'missed']
+    """
+    if t_warning_s < t_lowc_s:
+        return ""
+    return conflict_cause(status, t_lowc_s, observe_window_s)
 
 
 def track_counts(

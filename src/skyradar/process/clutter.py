@@ -98,6 +98,14 @@ class ClutterSubspace:
         self.ensure(range_index, doppler_index)
         return self._vectors[range_index, doppler_index]
 
+    def calibrated_rows(self, inv_gain: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``rows`` and ``rows_done`` for the calibration ``inv_gain``; a different one starts them afresh."""
+        key = np.asarray(inv_gain).tobytes()
+        if self.rows_key != key:
+            self.rows_done[:] = False
+            self.rows_key = key
+        return self.rows, self.rows_done
+
     @property
     def vectors(self) -> np.ndarray:
         self.ensure()
@@ -115,6 +123,15 @@ class ClutterSubspace:
 
 
 @njit(cache=True)
+def steering_into(u0, u1, u2, rx, wavenumber, out):  # pragma: no cover - compiled
+    """:func:`skyradar.process.doa.steering_vector` of one direction ``(u0, u1, u2)`` into ``out``
+    (n_rx,), compiled for the kernels that form steering vectors one direction at a time."""
+    for k in range(rx.shape[0]):
+        phase = -wavenumber * (u0 * rx[k, 0] + u1 * rx[k, 1] + u2 * rx[k, 2])
+        out[k] = complex(np.cos(phase), np.sin(phase))
+
+
+@njit(cache=True)
 def _accumulate(r_pos, d_pos, u_ant, rx, wavenumber, weight, n_r, n_d, acc):  # pragma: no cover - compiled
     # acc[r, d]: the cell's Hermitian covariance packed as n_k real diagonal entries, then the upper
     # triangle's (re, im) pairs row by row. Each ring sample's receive steering vector (as
@@ -128,9 +145,7 @@ def _accumulate(r_pos, d_pos, u_ant, rx, wavenumber, weight, n_r, n_d, acc):  # 
     steer = np.empty(n_k, np.complex128)
     wd = np.empty(5)
     for s in range(n_s):
-        for k in range(n_k):
-            phase = -wavenumber * (u_ant[s, 0] * rx[k, 0] + u_ant[s, 1] * rx[k, 1] + u_ant[s, 2] * rx[k, 2])
-            steer[k] = complex(np.cos(phase), np.sin(phase))
+        steering_into(u_ant[s, 0], u_ant[s, 1], u_ant[s, 2], rx, wavenumber, steer)
         p = n_k
         for i in range(n_k):
             for j in range(i + 1, n_k):

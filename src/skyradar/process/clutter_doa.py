@@ -34,6 +34,7 @@ import numpy as np
 from numba import njit
 
 from skyradar.config import RadarConfig
+from skyradar.process.clutter import steering_into
 from skyradar.process.doa import direction_from_angles, steering_vector
 
 __all__ = ["directions_after_projection", "projected_scores", "OBSERVABLE_DB"]
@@ -81,9 +82,7 @@ def _grid_best(az0, el0, i_lo, i_hi, j_lo, j_hi, step, step_rad, rx, wavenumber,
         for j in range(j_lo, j_hi + 1, step):
             el = el0 + j * step_rad
             u0, u1, u2 = np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)
-            for k in range(n_k):
-                phase = -wavenumber * (u0 * rx[k, 0] + u1 * rx[k, 1] + u2 * rx[k, 2])
-                s[k] = np.cos(phase) + 1j * np.sin(phase)
+            steering_into(u0, u1, u2, rx, wavenumber, s)
             score = _score(s, pz, p)
             if score > best:
                 best, bi, bj = score, i, j

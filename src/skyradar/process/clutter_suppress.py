@@ -177,11 +177,8 @@ def suppress_clutter(
     inv_gain = (1.0 / np.asarray(config.rx_calibration)).astype(np.complex64)
     z = np.ascontiguousarray(cube, np.complex64)
     rule = (np.float32(1.0 / floor), np.int64(max_nulls), np.float32(gate), np.float32(_RESIDUAL))
-    if subspace.rows_key != inv_gain.tobytes():  # another calibration: rows made for it from scratch
-        subspace.rows_done[:] = False
-        subspace.rows_key = inv_gain.tobytes()
     cells = (subspace.covariance, subspace.predicted, subspace.done, subspace._vectors, subspace._fractions)
-    rows = (subspace.rows, subspace.rows_done, inv_gain)
+    rows = (*subspace.calibrated_rows(inv_gain), inv_gain)
     _fused(z, raw, *cells, *rows, *rule, power, nulls, unsuppressed, cnr)
     channels = (config.n_rx - nulls).astype(np.int8)
     return Suppressed(power, channels, unsuppressed, nulls, cnr, floor)

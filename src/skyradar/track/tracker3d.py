@@ -123,6 +123,11 @@ def cv3d_process_noise(dt_s: float, sigma_accel_mps2) -> np.ndarray:
     return np.kron(block, np.diag(q))
 
 
+def _nis(y: np.ndarray, S: np.ndarray) -> np.ndarray:
+    """Normalised innovation squared ``y^T S^-1 y`` of each row."""
+    return np.einsum("ni,ni->n", y, np.linalg.solve(S, y[..., None])[..., 0])
+
+
 class Tracker3D:
     """One 3-D constant-velocity Kalman filter per range-Doppler track id.
 
@@ -281,7 +286,7 @@ class Tracker3D:
         stated = cov[sel]
         cov_sel = stated * self.noise_scale[rows, None, None]  # the noise this filter's innovations showed
         S = self.P[rows, :3, :3] + cov_sel
-        nis = np.einsum("ni,ni->n", y, np.linalg.solve(S, y[..., None])[..., 0])
+        nis = _nis(y, S)
         self._match_noise(rows, y, self.P[rows, :3, :3] + stated)
         ok = nis < self.gate
         restart = ~ok & (self.rejects[rows] >= self.max_rejects)
@@ -295,7 +300,7 @@ class Tracker3D:
 
     def _match_noise(self, rows: np.ndarray, y: np.ndarray, S_stated: np.ndarray) -> None:
         """Average ``NIS / 3`` of the filters ``rows`` against the stated noise into their noise scale."""
-        nis = np.einsum("ni,ni->n", y, np.linalg.solve(S_stated, y[..., None])[..., 0])
+        nis = _nis(y, S_stated)
         top = self.max_noise_scale
         seen = np.minimum(np.nan_to_num(nis, nan=3.0 * top), 3.0 * top) / 3.0
         mixed = (1.0 - self.noise_memory) * self.noise_scale[rows] + self.noise_memory * seen

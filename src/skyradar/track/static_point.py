@@ -13,6 +13,8 @@ from collections.abc import Callable
 import numpy as np
 from scipy.stats import chi2
 
+from skyradar.kalman import wrap
+
 __all__ = ["static_point_measurements", "fits_static_ground", "flat_surface", "terrain_surface"]
 
 _EARTH_RADIUS_M = 6_371_000.0
@@ -47,10 +49,6 @@ def static_point_measurements(
     r = np.linalg.norm(d, axis=-1)
     v = -np.sum(d * np.asarray(own_velocity_mps, float), axis=-1) / np.maximum(r, 1e-9)
     return r + coupling_s * v, v
-
-
-def _wrap(x: np.ndarray, width: float) -> np.ndarray:
-    return (x + width / 2.0) % width - width / 2.0
 
 
 def _trimmed_sum(z2: np.ndarray, trim: float) -> tuple[float, int]:
@@ -139,7 +137,7 @@ def fits_static_ground(
     def residuals(ne: np.ndarray) -> np.ndarray:  # (m, 2) candidates -> (m, 2n) normalised residuals
         points = np.column_stack([ne, surface_down(ne)])
         rho, v = static_point_measurements(points[:, None, :], own_p, own_v, coupling_s)
-        return np.concatenate([(rng - rho) / sig[0], _wrap(vel - v, width_mps) / sig[1]], axis=1)
+        return np.concatenate([(rng - rho) / sig[0], wrap(vel - v, width_mps) / sig[1]], axis=1)
 
     cost, keep = _gauss_newton(residuals, candidates, n, trim)
     return bool(np.any(cost <= chi2.isf(tail, 2 * keep - 2)))

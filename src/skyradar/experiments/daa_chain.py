@@ -29,7 +29,7 @@ from skyradar.process.detect_run import merge_head_tables
 from skyradar.process.pipeline import process_frames
 from skyradar.scene.radar_heads import select_heads
 from skyradar.sim.scenario_frames import make_simulator, scenario_truth, simulate_frames
-from skyradar.track.ground_tracks import GroundTrackTest, terrain_surface
+from skyradar.track.ground_tracks import GroundTrackTest, median_ground_down_m, terrain_surface
 from skyradar.track.track_table import track_detections
 
 __all__ = ["run_chain", "track_and_alert", "label_tracks"]
@@ -164,9 +164,7 @@ def _surface(built, own: pd.DataFrame):
     """The scenario's ground for the track-level ground test (None: the own-ship's height above ground)."""
     if built.terrain is None or not hasattr(built.terrain, "height_at"):
         return None
-    ground = (own["own_down_m"] + own.get("own_height_agl_m", np.nan)).to_numpy(float)
-    flat = float(np.nanmedian(ground)) if np.isfinite(ground).any() else np.nan
-    return terrain_surface(built.terrain, built.origin, flat)
+    return terrain_surface(built.terrain, built.origin, median_ground_down_m(own))
 
 
 def label_tracks(tracks: pd.DataFrame, truth: xr.Dataset, max_distance_m: float = _MATCH_M) -> dict[int, str]:

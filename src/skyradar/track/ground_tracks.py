@@ -68,6 +68,7 @@ __all__ = [
     "doa_in_the_air",
     "doppler_smooth",
     "doa_on_the_ground",
+    "median_ground_down_m",
 ]
 
 
@@ -314,6 +315,23 @@ def _track_held(det: np.ndarray, ownship, surface_down, width: float, coupling: 
     return held
 
 
+def median_ground_down_m(ownship: pd.DataFrame) -> float:
+    """Median ``down`` of the ground under the own-ship (``own_down_m + own_height_agl_m``), m.
+
+    NaN when the table has no height above ground.
+
+    Examples
+    --------
+    >>> own = pd.DataFrame({"own_down_m": [-500.0, -510.0], "own_height_agl_m": [800.0, 810.0]})
+    >>> median_ground_down_m(own)
+    300.0
+    """
+    if "own_height_agl_m" not in ownship:
+        return float("nan")
+    ground = (ownship["own_down_m"] + ownship["own_height_agl_m"]).to_numpy(float)
+    return float(np.nanmedian(ground)) if np.isfinite(ground).any() else float("nan")
+
+
 def hold_ground_tracks(
     tracks: pd.DataFrame,
     detections: pd.DataFrame,
@@ -335,10 +353,8 @@ def hold_ground_tracks(
     test = test or GroundTrackTest()
     if len(tracks) == 0:
         return tracks
-    if surface_down is None and ownship is not None and "own_height_agl_m" in ownship:
-        ground = (ownship["own_down_m"] + ownship["own_height_agl_m"]).to_numpy(float)
-        if np.isfinite(ground).any():
-            surface_down = flat_surface(float(np.nanmedian(ground)))
+    if surface_down is None and ownship is not None and np.isfinite(median_ground_down_m(ownship)):
+        surface_down = flat_surface(median_ground_down_m(ownship))
     names = ["time_s", "range_m", "radial_velocity_mps", *_DOA_COLUMNS]
     nan = np.full(len(detections), np.nan)
     det = np.column_stack([detections[c].to_numpy(float) if c in detections else nan for c in names])

@@ -93,7 +93,7 @@ def in_ground_band(
     own_height_agl_m: float,
     config: RadarConfig,
     tolerance_mps: float | None = None,
-    terrain_margin_m: np.ndarray | float = 30.0,
+    terrain_margin_m: np.ndarray | float = TERRAIN_MARGIN_M,
 ) -> np.ndarray:
     """True where some static point of the ground at this range can have this (aliased) radial velocity.
 

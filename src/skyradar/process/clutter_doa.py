@@ -37,7 +37,7 @@ from skyradar.config import RadarConfig
 from skyradar.process.clutter import steering_into
 from skyradar.process.doa import direction_from_angles, steering_vector
 
-__all__ = ["directions_after_projection", "projected_scores", "OBSERVABLE_DB"]
+__all__ = ["directions_after_projection", "projected_directions", "projected_scores", "OBSERVABLE_DB"]
 
 OBSERVABLE_DB = 1.0  # normalised score contrast along elevation below which elevation is unobservable
 _COARSE_DEG = np.arange(-70.0, 70.5, 2.0)
@@ -91,7 +91,8 @@ def _grid_best(az0, el0, i_lo, i_hi, j_lo, j_hi, step, step_rad, rx, wavenumber,
 
 @njit(cache=True)
 def _one_direction(steer_c, coarse_rad, rx, wavenumber, step_rad, half, z, p, min_db):  # pragma: no cover
-    # Coarse grid, elevation observability, then the 0.05 deg lattice coarse to fine: (az, el), rad.
+    # Coarse grid, elevation observability, then the 0.05 deg lattice coarse to fine:
+    # (az, el) in rad and whether the elevation was measured.
     n_c = coarse_rad.size
     score = _scores(steer_c, z, p, np.empty(steer_c.shape[0])).reshape((n_c, n_c))
     best = np.argmax(score)
@@ -101,12 +102,12 @@ def _one_direction(steer_c, coarse_rad, rx, wavenumber, step_rad, half, z, p, mi
     az0, el0 = coarse_rad[ia], coarse_rad[ie]
     if contrast < min_db:  # elevation 0; azimuth over the whole lattice row
         i, _ = _grid_best(az0, 0.0, -half, half, 0, 0, 1, step_rad, rx, wavenumber, z, p)
-        return az0 + i * step_rad, 0.0
+        return az0 + i * step_rad, 0.0, False
     i, j = _grid_best(az0, el0, -half, half, -half, half, _MID_STEP, step_rad, rx, wavenumber, z, p)
     lo_i, hi_i = max(i - _LAST_HALF, -half), min(i + _LAST_HALF, half)
     lo_j, hi_j = max(j - _LAST_HALF, -half), min(j + _LAST_HALF, half)
     i, j = _grid_best(az0, el0, lo_i, hi_i, lo_j, hi_j, 1, step_rad, rx, wavenumber, z, p)
-    return az0 + i * step_rad, el0 + j * step_rad
+    return az0 + i * step_rad, el0 + j * step_rad, True
 
 
 def _coarse(config: RadarConfig) -> np.ndarray:
@@ -128,12 +129,27 @@ def projected_scores(steer: np.ndarray, z: np.ndarray, p: np.ndarray) -> np.ndar
     return _scores(steer, *args, np.empty(len(steer)))
 
 
-def directions_after_projection(pixels: np.ndarray, proj: np.ndarray, config: RadarConfig) -> np.ndarray:
-    """Antenna-frame unit vectors (n, 3) of calibrated snapshots (n, n_rx) seen through ``proj``.
+def projected_directions(
+    pixels: np.ndarray, proj: np.ndarray, config: RadarConfig
+) -> tuple[np.ndarray, np.ndarray]:
+    """Antenna-frame unit vectors (n, 3) of calibrated snapshots (n, n_rx) seen through ``proj``,
+    and whether each one's elevation was measured (n,) bool.
 
-    ``proj`` holds each snapshot's projector ``P = I - E E^H``, shape (n, n_rx, n_rx).
+    ``proj`` holds each snapshot's projector ``P = I - E E^H``, shape (n, n_rx, n_rx). Where the
+    projection leaves elevation unobservable the vector has elevation 0 (a prior, see the module
+    docstring) and its flag is False.
 
-    Elevation 0 where the projection leaves it unobservable (see the module docstring).
+    Examples
+    --------
+    >>> from skyradar.process.doa import direction_from_angles, steering_vector
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> z = steering_vector(direction_from_angles(np.radians([10.0, 10.0]), np.radians([-5.0, -5.0])), cfg)
+    >>> u_nulls = direction_from_angles(np.radians([-20.0, 20.0]), np.radians([-20.0, -20.0]))
+    >>> e, _ = np.linalg.qr(steering_vector(u_nulls, cfg).T)  # two nulls at one elevation
+    >>> proj = np.stack([np.eye(4), np.eye(4) - e @ e.conj().T])
+    >>> u, measured = projected_directions(z, proj, cfg)
+    >>> measured.tolist(), np.degrees(np.arcsin(-u[:, 2])).round(1).tolist()
+    ([True, False], [-5.0, 0.0])
     """
     steer_c = _coarse(config)
     rx = np.ascontiguousarray(config.rx_positions_m, float)
@@ -141,7 +157,18 @@ def directions_after_projection(pixels: np.ndarray, proj: np.ndarray, config: Ra
     half = int(round(_FINE_HALF_DEG / _FINE_STEP_DEG))
     rule = (np.radians(_COARSE_DEG), rx, wavenumber, np.radians(_FINE_STEP_DEG), half)
     angles = np.zeros((len(pixels), 2))
+    measured = np.ones(len(pixels), bool)
     for n, (z, p) in enumerate(zip(pixels, proj, strict=True)):
         z, p = (np.ascontiguousarray(x, np.complex128) for x in (z, p))
-        angles[n] = _one_direction(steer_c, *rule, z, p, OBSERVABLE_DB)
-    return direction_from_angles(angles[:, 0], angles[:, 1])
+        *angles[n], measured[n] = _one_direction(steer_c, *rule, z, p, OBSERVABLE_DB)
+    return direction_from_angles(angles[:, 0], angles[:, 1]), measured
+
+
+def directions_after_projection(pixels: np.ndarray, proj: np.ndarray, config: RadarConfig) -> np.ndarray:
+    """Antenna-frame unit vectors (n, 3) of calibrated snapshots (n, n_rx) seen through ``proj``.
+
+    ``proj`` holds each snapshot's projector ``P = I - E E^H``, shape (n, n_rx, n_rx).
+
+    Elevation 0 where the projection leaves it unobservable (:func:`projected_directions` says where).
+    """
+    return projected_directions(pixels, proj, config)[0]

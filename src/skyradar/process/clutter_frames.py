@@ -28,7 +28,7 @@ from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.geo import rotation_matrix
 from skyradar.process.clutter import ClutterSubspace, clutter_subspace
-from skyradar.process.clutter_doa import directions_after_projection
+from skyradar.process.clutter_doa import directions_after_projection, projected_directions
 from skyradar.process.clutter_suppress import projected_snapshots, suppress_clutter
 from skyradar.process.detect import Detections, detect
 from skyradar.process.doa import direction_coherence, estimate_directions, steering_vector
@@ -163,8 +163,10 @@ def detect_suppressed(
     exclude: np.ndarray | None = None,
     method: str = "cfar",
     **detect_kwargs: Any,
-) -> tuple[Detections, np.ndarray, np.ndarray]:
-    """Detections, antenna-frame directions and coherence of one frame after clutter suppression.
+) -> tuple[Detections, np.ndarray, np.ndarray, np.ndarray]:
+    """Detections, antenna-frame directions, coherence and whether the elevation was measured
+    (bool; False where the nulls left it unobservable and the direction holds elevation 0, a prior)
+    of one frame after clutter suppression.
 
     Detection runs on the projected, renormalised image (CA-CFAR with each pixel's channel count,
     training outside unsuppressed clutter, :func:`skyradar.process.cfar.cfar_2d_floor`); cells
@@ -180,19 +182,20 @@ def detect_suppressed(
     pixels = cube[det.range_index, det.doppler_index]
     u = estimate_directions(pixels, config)
     coherence = direction_coherence(pixels, u, config)
+    elevation_measured = np.ones(len(pixels), bool)
     nulls = sup.nulls[det.range_index, det.doppler_index]
     projected = (nulls > 0) & (coherence < _PLANE_WAVE)  # one plane wave explains it: the target dominates
     if projected.any():
         z = pixels[projected] / config.rx_calibration
         vectors = clutter.cell_vectors(det.range_index[projected], det.doppler_index[projected])
         proj, y = projected_snapshots(z, vectors, nulls[projected])
-        u[projected] = directions_after_projection(z, proj, config)
+        u[projected], elevation_measured[projected] = projected_directions(z, proj, config)
         ps = steering_vector(u[projected], config)
         ps = np.einsum("nkl,nl->nk", proj, ps)
         num = np.abs(np.sum(np.conj(ps) * y, axis=1)) ** 2
         den = np.maximum(np.sum(np.abs(ps) ** 2, axis=1) * np.sum(np.abs(y) ** 2, axis=1), 1e-300)
         coherence[projected] = num / den  # the projected matched filter's fit, in [0, 1]
-    return det, u, coherence
+    return det, u, coherence, elevation_measured
 
 
 def frame_clutter(

@@ -91,12 +91,15 @@ def process_cube(
     masking = spur_map is not None and spur_mode == "mask"
     exclude = spur_map.mask if masking else None
     if clutter is not None:  # a ClutterSubspace: knowledge-aided suppression before detection
-        det, u, coherence = detect_suppressed(cube, config, clutter, exclude, method, **detect_kwargs)
+        det, u, coherence, elevation_measured = detect_suppressed(
+            cube, config, clutter, exclude, method, **detect_kwargs
+        )
     else:
         power = integrate_channels(cube, config.rx_calibration)
         det = detect(power, config, method=method, exclude=exclude, **detect_kwargs)
         u = estimate_directions(cube[det.range_index, det.doppler_index], config)
         coherence = direction_coherence(cube[det.range_index, det.doppler_index], u, config)
+        elevation_measured = np.ones(len(det), bool)
     range_m = det.range_m(config)
     body = antenna_to_body(range_m[:, None] * u, config)
     az, el = angles_from_direction(u)
@@ -114,6 +117,7 @@ def process_cube(
         "power_db": 10.0 * np.log10(np.maximum(det.power_w, 1e-300)),
         "azimuth_rad": az,
         "elevation_rad": el,
+        "elevation_measured": elevation_measured,
         "x_body_m": body[:, 0],
         "y_body_m": body[:, 1],
         "z_body_m": body[:, 2],

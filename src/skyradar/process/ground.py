@@ -347,7 +347,10 @@ def flag_ground(
         margin = 3.0 * np.hypot(rng[sel] * sd_el[sel], SURFACE_SD_M)
         el = out["elevation_rad"][sel]
         hit[sel] |= ground_in_elevation(rng[sel], el, height_fn, antenna, ant_to_ned, margin)
-    return np.where(unreliable, hit, ground)
+    # An elevation the nulls left unobservable is a prior (elevation 0), not a measurement: such a
+    # detection is ground here only by the mirror rule; its track's history decides the rest.
+    measured = np.asarray(out.get("elevation_measured", np.ones(rng.size, bool)), bool)
+    return np.where(measured, np.where(unreliable, hit, ground), mirrored)
 
 
 def _mirrored_ground(u_ant, rng, v_r, sd_az, sd_el, band, own_agl_m, args) -> np.ndarray:

@@ -57,8 +57,8 @@ __all__ = ["DETECTION_COLUMNS", "process_chunk", "process_cube", "process_frames
 
 DETECTION_COLUMNS = [
     "time_s", "frame", "range_m", "radial_velocity_mps", "range_bin", "doppler_bin", "snr_db", "power_db",
-    "azimuth_rad", "elevation_rad", "x_body_m", "y_body_m", "z_body_m", "north_m", "east_m", "down_m",
-    "lat_deg", "lon_deg", "alt_m", "is_ground", "spur",
+    "azimuth_rad", "elevation_rad", "elevation_measured", "x_body_m", "y_body_m", "z_body_m", "north_m",
+    "east_m", "down_m", "lat_deg", "lon_deg", "alt_m", "is_ground", "spur",
 ]  # fmt: skip
 _OWN = ("own_north_m", "own_east_m", "own_down_m", "own_vn_mps", "own_ve_mps", "own_vd_mps")
 _ATT = ("own_yaw_rad", "own_pitch_rad", "own_roll_rad", "own_height_agl_m")

@@ -54,7 +54,7 @@ from skyradar.track.static_point import (
     terrain_surface,
 )
 
-_DOA_COLUMNS = ("azimuth_rad", "elevation_rad", "north_m", "east_m", "down_m")
+_DOA_COLUMNS = ("azimuth_rad", "elevation_rad", "north_m", "east_m", "down_m", "elevation_measured")
 _CLEAR_S = 3.0  # judged an object off the ground this long on end: not judged again
 
 __all__ = [
@@ -173,14 +173,15 @@ def _own_state(ownship: pd.DataFrame, times: np.ndarray) -> tuple[np.ndarray, np
 
 
 def _doa_height(det: np.ndarray, surface_down, test: GroundTrackTest) -> list[np.ndarray]:
-    """Azimuth and elevation (antenna frame) of each detection and its DoA position's height
-    above the surface in standard deviations (range x ``doa_sigma_rad``, 10 m for the surface)."""
-    az, el = det[:, 3], det[:, 4]
+    """Azimuth and elevation (antenna frame) of each detection, its DoA position's height above
+    the surface in standard deviations (range x ``doa_sigma_rad``, 10 m for the surface) and
+    whether its elevation was measured (tables without ``elevation_measured``: all were)."""
+    az, el, measured = det[:, 3], det[:, 4], det[:, 8] != 0.0  # NaN (no column): measured
     if surface_down is None or not np.isfinite(det[:, 5:8]).any():
-        return [az, el, np.full(az.size, np.nan)]
+        return [az, el, np.full(az.size, np.nan), measured]
     with np.errstate(invalid="ignore"):
         height = surface_down(np.nan_to_num(det[:, 5:7])) - det[:, 7]
-        return [az, el, height / np.hypot(det[:, 1] * test.doa_sigma_rad, 10.0)]
+        return [az, el, height / np.hypot(det[:, 1] * test.doa_sigma_rad, 10.0), measured]
 
 
 def doa_in_the_air(
@@ -215,8 +216,11 @@ def doa_in_the_air(
 
 
 def doppler_smooth(
-    time_s: np.ndarray, radial_velocity_mps: np.ndarray, width_mps: float,
-    test: GroundTrackTest | None = None, n: int = 10,
+    time_s: np.ndarray,
+    radial_velocity_mps: np.ndarray,
+    width_mps: float,
+    test: GroundTrackTest | None = None,
+    n: int = 10,
 ) -> bool:
     """Whether a track's last ``n`` radial velocities follow one smooth curve (one point, not a patch).
 
@@ -245,25 +249,26 @@ def doppler_smooth(
     return bool(_trimmed_sum(z2, test.trim)[0] <= chi2.isf(test.tail, max(keep - degree - 1, 1)))
 
 
-def doa_on_the_ground(azimuth_rad, elevation_rad, height_sd, n: int = 10, max_sd: float = 1.0) -> bool:
+def doa_on_the_ground(elevation_measured, height_sd, n: int = 10, max_sd: float = 1.0) -> bool:
     """Whether a track's recent measured directions of arrival put it on the surface.
 
-    Of its last ``n`` detections, those with a measured elevation (not ``process.clutter_doa``'s
-    placeholder 0, a prior) and a height above the surface (``height_sd``, in sd) count: at least
+    Of its last ``n`` detections, those with a measured elevation (``elevation_measured``; not
+    ``process.clutter_doa``'s prior of elevation 0) and a height above the surface (``height_sd``,
+    in sd) count: at least
     three, and their median height is below ``max_sd``. Azimuths may scatter (ground beside the
     track in one cell). Not proof of ground: an aircraft in a ground cell can read the ground's
     direction too (terrain set flat-300 encounter 2); so it only asks for more detections.
 
     Examples
     --------
-    >>> el = np.radians([-25.0, 0.0, -24.0, -26.0])
-    >>> doa_on_the_ground(np.zeros(4), el, np.array([0.4, 11.0, -0.3, 0.9]))
+    >>> measured = np.array([True, False, True, True])  # the second: elevation 0 as a prior
+    >>> doa_on_the_ground(measured, np.array([0.4, 11.0, -0.3, 0.9]))
     True
-    >>> doa_on_the_ground(np.zeros(4), el, np.array([7.0, 11.0, 12.0, 26.0]))
+    >>> doa_on_the_ground(measured, np.array([7.0, 11.0, 12.0, 26.0]))
     False
     """
-    el, z = (np.asarray(a, float)[-n:] for a in (elevation_rad, height_sd))
-    measured = (el != 0.0) & np.isfinite(z)
+    z = np.asarray(height_sd, float)[-n:]
+    measured = np.asarray(elevation_measured, bool)[-n:] & np.isfinite(z)
     return bool(measured.sum() >= 3 and np.median(z[measured]) < max_sd)
 
 
@@ -287,8 +292,8 @@ def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test
             if not last and test.point_sigma_velocity_mps is not None:
                 last = not doppler_smooth(t[sl], vel[sl], width, test)
             if not last and k + 1 < test.ground_min_detections:
-                last = doa_on_the_ground(*(a[sl] for a in doa))
-            if not last and surface_down is not None and not doa_in_the_air(*(a[sl] for a in doa), test):
+                last = doa_on_the_ground(doa[3][sl], doa[2][sl])
+            if not last and surface_down is not None and not doa_in_the_air(*(a[sl] for a in doa[:3]), test):
                 fit = (test.sigma_range_m, test.sigma_velocity_mps, test.tail, test.trim)
                 last = fits_static_ground(rng[sl], vel[sl], own_p[sl], own_v[sl], surface_down, width,
                                           coupling, *fit)  # fmt: skip

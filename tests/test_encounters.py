@@ -278,3 +278,18 @@ def test_one_simulation_scores_the_nose_head_and_the_three_head_layout():
     assert three["observable"] and three["cause"] == ""
     assert three["t_warning_s"] < three["t_lowc_s"] and three["detections"] > single["detections"]
     assert three["intruder_tracks"] == 1 and three["clutter_tracks"] == 0
+
+
+def test_a_run_resumes_only_on_the_same_code(tmp_path, monkeypatch):
+    import skyradar
+    from skyradar.experiments import encounters as E
+
+    package = tmp_path / "pkg"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "chain.py").write_text("GATE = 16.0\n")
+    monkeypatch.setattr(skyradar, "__file__", str(package / "__init__.py"))
+    before = E._version()
+    assert E._version() == before
+    (package / "chain.py").write_text("GATE = 9.0\n")  # the chain changed between two sessions
+    assert E._version() != before

@@ -16,6 +16,7 @@ The encounters are independent, so they run in ``workers`` processes (one numba 
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import time
@@ -219,6 +220,14 @@ def run(
 
 
 def _version() -> str:
+    """The package version and a digest of its source: a run resumes only on the same code (a
+    set of hundreds of encounters can span days of development at one version number)."""
     from importlib.metadata import version
 
-    return version("skyradar")
+    import skyradar
+
+    digest = hashlib.sha256()
+    root = Path(skyradar.__file__).parent
+    for path in sorted(root.rglob("*.py")):
+        digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes())
+    return f"{version('skyradar')}+{digest.hexdigest()[:16]}"

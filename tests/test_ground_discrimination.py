@@ -173,3 +173,29 @@ def test_jacksboro_by_name_refuses_a_run_that_is_not_over_it(runs):
     base, _ = runs
     with pytest.raises(InputError, match=r"jacksboro_fault_dem.npz: .* lat 52.5.* does not cover the flight"):
         terrain_for_run("jacksboro", open_frames(base / "run.zarr"), 600.0, "run.zarr")
+
+
+def test_track_takes_the_run_terrain_for_its_ground_test_and_names_bad_terrain(runs):
+    from skyradar.cli.commands_track import _ground_test
+    from skyradar.io.navigation import navigation_state
+    from skyradar.io.run_origin import scenario_origin
+    from skyradar.track.ground_tracks import GroundTrackTest
+
+    base, built = runs
+    ds = open_frames(base / "hills.zarr")
+    own, origin = navigation_state(ds, "hills.zarr"), scenario_origin(ds)
+    test = _ground_test(None, ds, base / "hills.zarr", own, origin, built.radar)
+    assert isinstance(test, GroundTrackTest)  # the recorded fractal hills, not level ground
+    lat, lon = np.array([origin[0]]), np.array([origin[1]])
+    ground = float(built.terrain.height_at(lat, lon)[0])
+    assert test.surface_down(np.zeros((1, 2)))[0] == pytest.approx(origin[2] - ground, abs=0.5)
+    assert _ground_test("none", ds, base / "hills.zarr", own, origin, built.radar) is True
+    assert _ground_test(None, None, None, None, None, built.radar) is True  # no own-ship: level ground
+    det = base / "det_track.csv"
+    det.write_text("time_s,range_m,radial_velocity_mps\n0.0,1000.0,-20.0\n0.1,998.0,-20.0\n")
+    args = ["track", str(det), "-o", str(base / "t.parquet")]
+    result = skyradar(*args, "--terrain", "flat", cwd=base)
+    assert_one_line_error(result, "--terrain", "flat", "--ownship")
+    result = skyradar(*args, "--ownship", "hills.zarr", "--terrain", "moon", cwd=base)
+    assert_one_line_error(result, "--terrain", "moon", "flat, fractal, jacksboro")
+    assert not (base / "t.parquet").exists()

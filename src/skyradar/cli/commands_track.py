@@ -65,6 +65,16 @@ _OwnshipOpt = Annotated[
 ]
 
 
+_TerrainOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--terrain",
+        help="Ground for the track-level ground test: a DEM file (.hgt/.tif/.npz) or flat, fractal, "
+        "jacksboro, none (default: the terrain the --ownship run records, if any).",
+    ),
+]
+
+
 def _ownship_and_origin(ownship: Path | None, table, origin: str | None):
     """(own-ship navigation table or None, origin or None, where the origin came from)."""
     import json
@@ -77,7 +87,7 @@ def _ownship_and_origin(ownship: Path | None, table, origin: str | None):
     from skyradar.track.io import validate_ownship
     from skyradar.track.track_table import OWNSHIP_COLUMNS
 
-    own, found, where = None, None, None
+    own, found, where, run = None, None, None, None
     if ownship is not None:
         run = open_ownship(ownship)
         own = navigation_state(run, f"--ownship {ownship}")
@@ -89,8 +99,24 @@ def _ownship_and_origin(ownship: Path | None, table, origin: str | None):
         sig = json.loads(table.attrs["ownship_signature"])
         found, where = (tuple(sig["origin"]), f"run {sig.get('run')}") if sig.get("origin") else (None, None)
     if origin is not None:
-        return own, _origin(origin), "--origin"
-    return own, found, where
+        return own, _origin(origin), "--origin", run
+    return own, found, where, run
+
+
+def _ground_test(terrain: str | None, run, ownship: Path | None, own, origin_lla, config):
+    """The track-level ground test over ``--terrain`` (default: the terrain the run records)."""
+    from skyradar.cli.commands_process import _terrain_window
+    from skyradar.errors import InputError
+    from skyradar.track.ground_tracks import GroundTrackTest, median_ground_down_m, terrain_surface
+
+    if run is None:
+        if terrain is not None and terrain.strip().lower() != "none":
+            raise InputError(f"--terrain {terrain}: needs --ownship (the run or own-ship table) to place it")
+        return True
+    dem = _terrain_window(terrain, run, config, ownship)
+    if dem is None or not hasattr(dem, "height_at") or origin_lla is None:
+        return True  # level ground at the own-ship's height above ground, where it has one
+    return GroundTrackTest(surface_down=terrain_surface(dem, origin_lla, median_ground_down_m(own)))
 
 
 @app.command()
@@ -102,6 +128,7 @@ def track(
     model: _ModelOpt = "radar",
     origin: _OriginOpt = None,
     ownship: _OwnshipOpt = None,
+    terrain: _TerrainOpt = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -111,7 +138,8 @@ def track(
     east_m, down_m each track also gets a 3-D position, velocity and position covariance.
     Detections flagged is_ground or spur are left out. The tracker steps on every frame (the
     --ownship run's times, else the detections' frame column), so a track keeps its rows while it
-    coasts through frames without a detection (column coasted).
+    coasts through frames without a detection (column coasted). A track stays unconfirmed while
+    one static point on the ground explains it (the --terrain surface, else level ground).
     """
     import json
 
@@ -129,10 +157,11 @@ def track(
     _origin(origin)  # a bad --origin is named before any reading
     table = read_detections(detections)
     config = radar_config_from_attrs(table)
-    own, origin_lla, origin_from = _ownship_and_origin(ownship, table, origin)
+    own, origin_lla, origin_from, run = _ownship_and_origin(ownship, table, origin)
+    ground_test = _ground_test(terrain, run, ownship, own, origin_lla, config)
     # The own-ship state of a run has every frame's time: the tracker steps on frames without detections.
     run_times = None if own is None else own["time_s"].to_numpy(float)
-    tracks, n_used = track_air_detections(table, model, config, origin_lla, own, run_times)
+    tracks, n_used = track_air_detections(table, model, config, origin_lla, own, run_times, ground_test)
     meta = {"radar_config": config.to_json(), "source": str(detections), "model": model}
     if origin_lla is not None:
         meta["origin_lla"] = json.dumps([float(v) for v in origin_lla])

@@ -221,14 +221,15 @@ def track_air_detections(
     origin: tuple[float, float, float] | None = None,
     ownship: pd.DataFrame | None = None,
     run_times_s: np.ndarray | None = None,
+    ground_test: GroundTrackTest | bool = True,
 ) -> tuple[pd.DataFrame, int]:
     """Tracks of a ``skyradar process`` table without its ground and spur detections.
 
     The tracker steps on every frame (:func:`skyradar.track.frame_grid.frame_grid`: the run's
     times ``run_times_s`` when given, else the frames of the ``frame`` column, including frames
     without any detection), so a frame without an air detection is a miss and coasting tracks keep
-    their rows. ``detection_row`` refers to the rows of ``detections``. Returns the tracks and the
-    number of detections tracked.
+    their rows. ``detection_row`` refers to the rows of ``detections``. ``ground_test``: as in
+    :func:`track_detections`. Returns the tracks and the number of detections tracked.
 
     Examples
     --------
@@ -245,7 +246,9 @@ def track_air_detections(
         if flag in detections.columns:
             keep &= ~detections[flag].fillna(False).to_numpy(bool)
     air = detections[keep].reset_index(drop=True)
-    tracks = track_detections(air, model, config, frame_times_s=frame_times, origin=origin, ownship=ownship)
+    tracks = track_detections(
+        air, model, config, frame_times_s=frame_times, origin=origin, ownship=ownship, ground_test=ground_test
+    )
     rows = tracks["detection_row"].to_numpy()
     tracks["detection_row"] = np.where(rows >= 0, np.flatnonzero(keep)[np.maximum(rows, 0)], -1)
     return tracks, int(keep.sum())

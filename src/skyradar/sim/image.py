@@ -29,12 +29,8 @@ from skyradar.errors import InputError
 from skyradar.geo import ned_rotation_to, ned_to_geodetic, rotation_matrix
 from skyradar.sim._noise_kernel import finalize_frame, frame_key
 from skyradar.sim._tables import REFLECTIVITY_MODELS, reflectivity_table, two_way_gain_table
-from skyradar.sim._terrain_kernel import (
-    add_sparse,
-    relative_points,
-    rotate_points,
-    terrain_returns,
-)
+from skyradar.sim._terrain_bands import banded_returns
+from skyradar.sim._terrain_kernel import add_sparse, relative_points, rotate_points, terrain_returns
 from skyradar.sim.facets import facet_rule
 from skyradar.sim.geometry import AntennaGeometry, PlatformState, PointTarget, TerrainView
 from skyradar.sim.horizon import horizon_grid, needs_horizon, target_clear, terrain_horizon
@@ -303,8 +299,9 @@ class ImageSimulator:
         return frame
 
     def _accumulation_blocks(self) -> np.ndarray:
-        # One complex64 cube per thread, kept between frames: the final pass reads and clears it.
-        shape = (get_num_threads(), *self._grid_shape)
+        # One complex64 cube, kept between frames: the final pass reads and clears it. Shared by
+        # the threads' range bands (_terrain_bands); one per thread for the scalar reference.
+        shape = (get_num_threads() if self._kernel_mode != 1 else 1, *self._grid_shape)
         if self._blocks is None or self._blocks.shape != shape:
             self._blocks = np.zeros(shape, np.complex64)
         return self._blocks
@@ -344,6 +341,15 @@ class ImageSimulator:
         p_ant = rotate_points(view.p_ned, rot, _array(scratch, "p_ant", view.p_ned.shape, np.float64))
         power_const = cfg.pe_w * cfg.wavelength_m**2 / (4 * np.pi) ** 3 * self.ground_gain
         v_ground = rot @ (-geom.velocity_ned_mps)
+        if self._kernel_mode == 1 and sparse[0].shape[1] == 0:  # dense: threads own range bands
+            cells = _array(scratch, "cells", (*(d - 1 for d in p_ant.shape[:2]), 4), np.int64)
+            banded_returns(
+                view.p_ned, p_ant, -rot[:, 2], cfg.tx_position_m, cfg.rx_positions_m, v_ground, self._facets,
+                cfg.wavelength_m, cfg.range_resolution_m / n, cfg.doppler_resolution_mps / n, self.coupling_s,
+                power_const, self._gain2, self._gain2_step, self._refl_table, view, self.occlusion,
+                get_num_threads(), blocks, speckle, cells,
+            )  # fmt: skip
+            return
         terrain_returns(
             view.p_ned, p_ant, -rot[:, 2], cfg.tx_position_m, cfg.rx_positions_m, v_ground,
             self._facets.counts, self._facets.adapt, cfg.wavelength_m, cfg.range_resolution_m / n,

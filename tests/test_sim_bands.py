@@ -1,0 +1,71 @@
+"""Terrain returns into one grid by range bands (_terrain_bands) against the per-thread-cube kernel."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from skyradar.config import RadarConfig
+from skyradar.scene.synthetic_terrain import fractal_terrain
+from skyradar.sim._terrain_bands import band_edges, banded_returns
+from skyradar.sim._terrain_kernel import rotate_points, terrain_returns
+from skyradar.sim.image import ImageSimulator, PlatformState
+
+ORIGIN = (47.0, 8.0, 0.0)
+_NO_SPARSE = (np.empty((1, 0), np.int64), np.empty((1, 0, 1), np.complex64), np.zeros(1, np.int64))
+
+
+def _setup():
+    cfg = RadarConfig.prototype_2022(range_limit_m=1500.0)
+    hills = fractal_terrain(ORIGIN[0], ORIGIN[1], 40.0, size_m=3400.0, spacing_m=60.0, seed=5)
+    sim = ImageSimulator(cfg, hills, ORIGIN, psf=True, speckle=True, seed=3)
+    # Banked and climbing, fast: range-Doppler coupling and a tilted footprint.
+    own = PlatformState(np.array([0.0, 0.0, -400.0]), np.array([60.0, 8.0, -3.0]), np.array([0.2, -0.1, 0.3]))
+    geom = sim.geometry(own)
+    view = sim.terrain_view(geom)
+    rot = geom.rot_ned_to_ant
+    p_ant = rotate_points(view.p_ned, rot, np.empty(view.p_ned.shape))
+    n = sim._psf.oversample
+    const = cfg.pe_w * cfg.wavelength_m**2 / (4 * np.pi) ** 3
+    common = (cfg.wavelength_m, cfg.range_resolution_m / n, cfg.doppler_resolution_mps / n, sim.coupling_s)
+    common += (const, sim._gain2, sim._gain2_step, sim._refl_table)
+    v_ground = rot @ -geom.velocity_ned_mps
+    head = (view.p_ned, p_ant, -rot[:, 2], cfg.tx_position_m, cfg.rx_positions_m, v_ground)
+    return sim, view, head, common
+
+
+@pytest.mark.parametrize("n_bands", [1, 3, 8])
+def test_bands_give_the_per_thread_cubes_sum(n_bands):
+    sim, view, head, common = _setup()
+    key = np.uint64(99)
+    blocks = np.zeros((2, *sim._grid_shape), np.complex64)
+    terrain_returns(
+        *head, sim._facets.counts, sim._facets.adapt, *common, view.horizon, view.az_bin_rad, view.h_bin_m,
+        True, 2, blocks, _NO_SPARSE, 1, key,
+    )  # fmt: skip
+    reference = blocks.sum(axis=0)
+    grid = np.zeros((1, *sim._grid_shape), np.complex64)
+    edges = banded_returns(*head, sim._facets, *common, view, True, n_bands, grid, key)
+    assert edges[0] == 0 and edges[-1] == sim._grid_shape[0] and np.all(np.diff(edges) >= 0)
+    if n_bands > 1:  # the split is not trivial: several bands hold returns
+        filled = np.flatnonzero(np.abs(reference).sum(axis=(1, 2)))
+        assert len(np.unique(np.searchsorted(edges, filled, side="right"))) >= min(n_bands, 3)
+    # Every sub-facet once (same pixels, same values) up to the order of float32 additions.
+    assert np.array_equal(grid[0] != 0, reference != 0)
+    np.testing.assert_allclose(grid[0], reference, rtol=0, atol=1e-5 * np.abs(reference).max())
+
+
+def test_band_edges_split_the_work_evenly():
+    rng = np.random.default_rng(0)
+    cells = np.zeros((30, 40, 4), np.int64)
+    cells[..., 0], cells[..., 1] = rng.integers(0, 9, (30, 40)), rng.integers(1, 9, (30, 40))
+    cells[..., 2] = rng.integers(0, 600, (30, 40))
+    cells[..., 3] = cells[..., 2] + 3
+    edges = band_edges(cells, 666, 4)
+    mid = np.clip((cells[..., 2] + cells[..., 3]) // 2, 0, 666)
+    work = cells[..., 0] * cells[..., 1]
+    per_band = [work[(mid >= lo) & (mid < hi)].sum() for lo, hi in zip(edges[:-1], edges[1:], strict=True)]
+    assert sum(per_band) == work.sum()
+    # Each band within one range bin's worth of work of an even share.
+    most_in_a_bin = max(work[mid == k].sum() for k in range(667))
+    assert max(abs(b - work.sum() / 4) for b in per_band) <= most_in_a_bin

@@ -235,3 +235,28 @@ def test_short_track_whose_measured_directions_are_on_the_ground_needs_more_dete
             test = GroundTrackTest(point_sigma_velocity_mps=None, ground_min_detections=ground_min)
             out = hold_ground_tracks(tracks, d, own, WIDTH, C, flat_surface(AGL_M), test)
             assert (len(out) > 0) == kept_here, (down_m, ground_min)
+
+
+def test_track_without_a_measured_direction_needs_more_detections():
+    # Hills, own-ship in a 35 deg banked circle ~500 m above (skyradar simulate/process/track, 40 s):
+    # residual clutter 660 m away, ground left and right in every cell (azimuth +-60-70 deg, no
+    # elevation measured), confirmed at its third detection in 0.32 s. With no measured direction
+    # it needs ten detections; an object with measured directions still three.
+    from skyradar.track.ground_tracks import GroundTrackTest, hold_ground_tracks
+
+    t = np.array([15.745, 15.957, 16.064, 16.277]) - 15.745
+    det = pd.DataFrame({"time_s": t, "range_m": [664.42, 660.32, 646.97, 629.10],
+                        "radial_velocity_mps": [-16.03, -13.51, -11.83, -8.82],
+                        "azimuth_rad": [-1.073, 1.248, -1.108, 1.248], "elevation_rad": 0.0 * t,
+                        "north_m": 660.0 + 0 * t, "east_m": 0 * t, "down_m": 0 * t})  # fmt: skip
+    tracks = pd.DataFrame({"time_s": t, "track_id": 3, "detection_row": np.arange(4), "confirmed": True})
+    test = GroundTrackTest(point_sigma_velocity_mps=None)
+    for measured, kept in ((False, False), (True, True)):
+        d = det.assign(elevation_measured=measured)
+        out = hold_ground_tracks(tracks, d, _own(t), WIDTH, C, flat_surface(AGL_M), test)
+        assert (len(out) > 0) == kept, measured
+    # Ten detections of a point target without a measured direction: released at the tenth.
+    aircraft = np.column_stack([1500.0 - 40.0 * T, 0 * T, 0 * T])  # head-on, co-altitude
+    d = _detections(aircraft).assign(elevation_measured=False)
+    out = track_detections(d, ownship=_own(), ground_test=GroundTrackTest(surface_down=flat_surface(AGL_M)))
+    assert 9 / 9.4 <= _confirmed_from(out) <= 2.0

@@ -68,6 +68,7 @@ __all__ = [
     "doa_in_the_air",
     "doppler_smooth",
     "doa_on_the_ground",
+    "direction_measured",
     "median_ground_down_m",
 ]
 
@@ -108,8 +109,10 @@ class GroundTrackTest:
         is not one object (:func:`doppler_smooth`); None: that test is off.
     ground_min_detections : int
         Detections a track needs, instead of ``min_detections``, while its measured directions put
-        it on the surface (:func:`doa_on_the_ground`): three cannot tell residual clutter hopping
-        between cells (its ranges fit some alias) from an object; ten fill the Doppler test's window.
+        it on the surface (:func:`doa_on_the_ground`) or while it has no measured direction (fewer
+        than three measured elevations of its last ten: ground left and right of it in every cell):
+        three cannot tell residual clutter hopping between cells (its ranges fit some alias) from
+        an object; ten fill the Doppler test's window.
     """
 
     sigma_range_m: float = 8.0
@@ -249,6 +252,17 @@ def doppler_smooth(
     return bool(_trimmed_sum(z2, test.trim)[0] <= chi2.isf(test.tail, max(keep - degree - 1, 1)))
 
 
+def direction_measured(elevation_measured, n: int = 10, least: int = 3) -> bool:
+    """Whether at least ``least`` of a track's last ``n`` detections have a measured elevation.
+
+    Examples
+    --------
+    >>> direction_measured(np.array([True, False, True, True])), direction_measured(np.zeros(9, bool))
+    (True, False)
+    """
+    return bool(np.count_nonzero(np.asarray(elevation_measured, bool)[-n:]) >= least)
+
+
 def doa_on_the_ground(elevation_measured, height_sd, n: int = 10, max_sd: float = 1.0) -> bool:
     """Whether a track's recent measured directions of arrival put it on the surface.
 
@@ -292,7 +306,8 @@ def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test
             if not last and test.point_sigma_velocity_mps is not None:
                 last = not doppler_smooth(t[sl], vel[sl], width, test)
             if not last and k + 1 < test.ground_min_detections:
-                last = doa_on_the_ground(doa[3][sl], doa[2][sl])
+                measured = doa[3][sl]
+                last = not direction_measured(measured) or doa_on_the_ground(measured, doa[2][sl])
             if not last and surface_down is not None and not doa_in_the_air(*(a[sl] for a in doa[:3]), test):
                 fit = (test.sigma_range_m, test.sigma_velocity_mps, test.tail, test.trim)
                 last = fits_static_ground(rng[sl], vel[sl], own_p[sl], own_v[sl], surface_down, width,

@@ -125,7 +125,7 @@ def test_knowledge_aided_without_own_ship_state_is_one_clear_error(tmp_path):
 
 def test_fused_kernel_matches_the_numpy_reference(clutter_frame, subspace):
     cube = np.asarray(clutter_frame.iq.values[0])
-    out = suppress_clutter(cube, subspace, CFG)
+    out = suppress_clutter(cube, subspace, CFG, adaptive=False)  # the predicted pass alone
     nulls, unsuppressed = null_count(subspace.fractions, out.clutter_to_noise)
     # float32 sums in the kernel: a cell whose residual is within rounding of the limit may flip.
     assert (out.nulls != nulls).mean() < 1e-4

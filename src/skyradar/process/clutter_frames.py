@@ -187,7 +187,7 @@ def detect_suppressed(
     projected = (nulls > 0) & (coherence < _PLANE_WAVE)  # one plane wave explains it: the target dominates
     if projected.any():
         z = pixels[projected] / config.rx_calibration
-        vectors = clutter.cell_vectors(det.range_index[projected], det.doppler_index[projected])
+        vectors = sup.cell_vectors(clutter, det.range_index[projected], det.doppler_index[projected])
         proj, y = projected_snapshots(z, vectors, nulls[projected])
         u[projected], elevation_measured[projected] = projected_directions(z, proj, config)
         ps = steering_vector(u[projected], config)

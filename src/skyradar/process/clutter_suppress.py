@@ -19,6 +19,11 @@ away from the nulls. Cells whose predicted clutter left outside the nulls still 
 (``c * sum(remaining fractions) > 1``) are returned as ``unsuppressed`` for the CFAR to keep out of
 its training cells.
 
+Where the prediction is wrong (relief: the ground is not flat at the height below), the cells whose
+neighbours still hold clutter after the predicted nulls take nulls trained on those neighbours
+instead (:mod:`skyradar.process.clutter_adaptive`, ``adaptive=True``, the default): same ``L``,
+same noise law, ``Suppressed.adaptive`` says which cells.
+
 Examples
 --------
 >>> from skyradar.config import RadarConfig
@@ -44,6 +49,7 @@ from scipy.special import gammaincinv
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.process.clutter import ClutterSubspace, cell_scratch, decompose_cell
+from skyradar.process.clutter_adaptive import adaptive_nulls
 from skyradar.process.power import power_image
 
 __all__ = [
@@ -63,7 +69,10 @@ class Suppressed:
     power : float32, W, thermal noise mean ``noise_power_w``; channels : int8, ``L`` per pixel;
     unsuppressed : bool, predicted clutter left above the noise; nulls : int8, ``n_rx - L``;
     clutter_to_noise : float32, measured neighbourhood clutter-to-noise ratio (linear);
-    noise_floor_w : the frame's measured thermal noise per pixel (:func:`measured_floor`).
+    noise_floor_w : the frame's measured thermal noise per pixel (:func:`measured_floor`);
+    adaptive : bool, cells whose nulls were trained on their neighbours
+    (:mod:`skyradar.process.clutter_adaptive`), ``adaptive_vectors`` their eigenvectors
+    (n_range, n_doppler, n_rx, n_rx), valid where ``adaptive``.
     """
 
     power: np.ndarray
@@ -72,6 +81,17 @@ class Suppressed:
     nulls: np.ndarray
     clutter_to_noise: np.ndarray
     noise_floor_w: float
+    adaptive: np.ndarray | None = None
+    adaptive_vectors: np.ndarray | None = None
+
+    def cell_vectors(self, subspace: ClutterSubspace, range_index, doppler_index) -> np.ndarray:
+        """Eigenvectors (n, n_rx, n_rx) whose first ``nulls`` columns were nulled in the given cells:
+        the adaptive ones where the cell was adaptive, else the prediction's."""
+        vectors = subspace.cell_vectors(range_index, doppler_index)
+        if self.adaptive is not None:
+            own = self.adaptive[range_index, doppler_index]
+            vectors[own] = self.adaptive_vectors[range_index[own], doppler_index[own]]
+        return vectors
 
 
 # Median of Gamma(L, 1/L) (the channel mean of L unit-noise channels), L = 1..8.
@@ -150,6 +170,7 @@ def suppress_clutter(
     config: RadarConfig,
     max_nulls: int = 2,
     gate: float = 3.0,
+    adaptive: bool = True,
 ) -> Suppressed:
     """Project every cell of a (n_range, n_doppler, n_rx) frame off its predicted clutter directions.
 
@@ -164,6 +185,9 @@ def suppress_clutter(
     gate : float
         A direction is nulled when the measured clutter-to-noise ratio times its eigenvalue
         fraction exceeds this.
+    adaptive : bool
+        Where the predicted nulls leave clutter over a cell's neighbours, null the directions
+        trained on them instead (:func:`skyradar.process.clutter_adaptive.adaptive_nulls`).
     """
     cube = np.asarray(cube)
     if cube.shape != subspace.predicted.shape + (config.n_rx,):
@@ -180,8 +204,11 @@ def suppress_clutter(
     cells = (subspace.covariance, subspace.predicted, subspace.done, subspace._vectors, subspace._fractions)
     rows = (*subspace.calibrated_rows(inv_gain), inv_gain)
     _fused(z, raw, *cells, *rows, *rule, power, nulls, unsuppressed, cnr)
+    trained = (None, None)
+    if adaptive:
+        trained = adaptive_nulls(z, inv_gain, cnr, floor, power, nulls, unsuppressed, max_nulls, gate)
     channels = (config.n_rx - nulls).astype(np.int8)
-    return Suppressed(power, channels, unsuppressed, nulls, cnr, floor)
+    return Suppressed(power, channels, unsuppressed, nulls, cnr, floor, *trained)
 
 
 _RESIDUAL = 0.25  # predicted clutter left after the nulls, in units of the noise (null_count's default)

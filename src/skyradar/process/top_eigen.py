@@ -1,0 +1,142 @@
+"""The few strongest eigen-pairs of a small Hermitian matrix, warm-started: subspace iteration.
+
+Adaptive nulls (:mod:`skyradar.process.clutter_adaptive`) need, per cell, the ``m <= 2`` strongest
+eigen-pairs of a 4 x 4 sample covariance, for some 20 000 cells of a frame over relief. Neighbouring
+cells' covariances share most of their training samples, so the previous cell's eigenvectors
+are an excellent start: a Rayleigh-Ritz subspace iteration (Saad, "Numerical methods for large
+eigenvalue problems", 2nd ed., SIAM 2011, section 5.1) converges at the rate
+``lam_(m+1) / lam_m`` per step, 2-4 steps over clutter, where the next eigenvalue is 15-30 dB
+weaker; about 0.5 us a step against 3 us for the full cyclic Jacobi of
+:func:`skyradar.process.clutter.hermitian_eigh` from the identity, which remains the fallback.
+
+Examples
+--------
+>>> a = np.diag([9.0, 4.0, 1.0, 1.0]).astype(complex)
+>>> v, lam = np.eye(4, 2, -1).astype(complex), np.empty(2)  # a start orthogonal to the strongest
+>>> steps = top_eigenpairs(a, v, lam, 0.0)
+>>> lam.round(6).tolist(), np.abs(v).round(6).tolist()
+([9.0, 4.0], [[1.0, 0.0], [0.0, 1.0], [0.0, 0.0], [0.0, 0.0]])
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from skyradar.process.clutter import hermitian_eigh
+
+__all__ = ["top_eigenpairs", "eigen_scratch"]
+
+
+@njit(cache=True)
+def eigen_scratch(n, m):  # pragma: no cover - compiled
+    """Work arrays of :func:`top_eigenpairs` for an ``n`` x ``n`` matrix and ``m`` pairs."""
+    nm, mm = np.empty((n, m), np.complex128), np.empty((m, m), np.complex128)
+    nn = np.empty((n, n), np.complex128)
+    ritz = (mm, mm.copy(), np.empty(m, np.int64), np.empty(m))
+    return (nm, nm.copy(), nm.copy(), *ritz, nn, nn.copy(), np.empty(n), np.empty(n, np.int64))
+
+
+@njit(cache=True)
+def _ritz(a, v, w, vu, wu, h, u, order, mu, lam):  # pragma: no cover - compiled
+    # w = a v; the m x m problem h = v^H w solved by Jacobi; the Ritz pairs (lam, vu), wu = a vu.
+    n, m = v.shape
+    for c in range(m):
+        for i in range(n):
+            t = 0j
+            for k in range(n):
+                t += a[i, k] * v[k, c]
+            w[i, c] = t
+    for b in range(m):
+        for c in range(m):
+            t = 0j
+            for i in range(n):
+                t += np.conj(v[i, b]) * w[i, c]
+            h[b, c] = t
+    hermitian_eigh(h, u, mu, order)
+    for c in range(m):
+        lam[c] = mu[order[c]]
+        for i in range(n):
+            t, x = 0j, 0j
+            for b in range(m):
+                t += v[i, b] * u[b, order[c]]
+                x += w[i, b] * u[b, order[c]]
+            vu[i, c], wu[i, c] = t, x
+
+
+@njit(cache=True)
+def _orthonormal_into(v, wu):  # pragma: no cover - compiled
+    # Modified Gram-Schmidt of the columns of wu into v (a degenerate column becomes a unit vector).
+    n, m = v.shape
+    for c in range(m):
+        for b in range(c):
+            t = 0j
+            for i in range(n):
+                t += np.conj(v[i, b]) * wu[i, c]
+            for i in range(n):
+                wu[i, c] -= t * v[i, b]
+        norm = 0.0
+        for i in range(n):
+            norm += wu[i, c].real ** 2 + wu[i, c].imag ** 2
+        norm = np.sqrt(norm)
+        for i in range(n):
+            v[i, c] = wu[i, c] / norm if norm > 0 else (1.0 if i == c else 0.0)
+
+
+@njit(cache=True)
+def _converged(vu, wu, lam, relevant, tol):  # pragma: no cover - compiled
+    n, m = vu.shape
+    for c in range(m):
+        if lam[c] > relevant:
+            res = 0.0
+            for i in range(n):
+                res += abs(wu[i, c] - lam[c] * vu[i, c]) ** 2
+            if res > (tol * lam[c]) ** 2:
+                return False
+    return True
+
+
+@njit(cache=True)
+def _strongest(a, lam, relevant):  # pragma: no cover - compiled
+    # Whether no eigenvalue outside those found can exceed the weakest found one (or `relevant`):
+    # the squares of those not found sum to the squared Frobenius norm less the found ones'.
+    rest = 0.0
+    for i in range(a.shape[0]):
+        for k in range(a.shape[1]):
+            rest += a[i, k].real ** 2 + a[i, k].imag ** 2
+    for c in range(lam.size):
+        rest -= lam[c] * lam[c]
+    return rest < max(lam[lam.size - 1], relevant) ** 2
+
+
+@njit(cache=True)
+def top_eigenpairs(a, v, lam, relevant, tol=1e-5, max_iter=50, scratch=None):  # pragma: no cover - compiled
+    """The ``v.shape[1]`` strongest eigen-pairs of a Hermitian ``a`` by subspace iteration from ``v``.
+
+    ``v`` (n, m) holds the start (orthonormal columns) and receives the eigenvectors, ``lam`` (m,)
+    the eigenvalues, decreasing. Each step is a Rayleigh-Ritz step, so the columns converge at the
+    rate of the subspace. It stops when every column whose eigenvalue exceeds ``relevant`` has a
+    residual ``|a v - lam v|`` below ``tol`` times its eigenvalue (weaker columns are not nulled
+    and need not converge), and the pairs found are the strongest (of those above ``relevant``):
+    the eigenvalues not found cannot exceed the weakest found one. Otherwise (no convergence in
+    ``max_iter`` steps: nearly equal eigenvalues; or a start nearly orthogonal to a strong
+    direction) the pairs come from the full Jacobi sweeps. Returns the steps taken, plus
+    ``max_iter`` when the sweeps were needed. ``scratch``: :func:`eigen_scratch` (n, m).
+    """
+    n, m = v.shape
+    w, vu, wu, h, u, order, mu, full, fv, fl, full_order = eigen_scratch(n, m) if scratch is None else scratch
+    for step in range(1, max_iter + 1):
+        _ritz(a, v, w, vu, wu, h, u, order, mu, lam)
+        if _converged(vu, wu, lam, relevant, tol):
+            v[:, :] = vu
+            if _strongest(a, lam, relevant):
+                return step
+            break
+        _orthonormal_into(v, wu)
+    full[:, :] = a
+    hermitian_eigh(full, fv, fl, full_order, 1e-12, 30)
+    for c in range(m):
+        lam[c] = fl[full_order[c]]
+        for i in range(n):
+            v[i, c] = fv[i, full_order[c]]
+    return max_iter + 1

@@ -227,7 +227,7 @@ def _adapt(cube, inv_gain, cand, ring_mean, inv_floor, max_nulls, edge, window, 
         for i in range(n_k):
             for j in range(n_k):
                 a[i, j] *= inv_floor  # in floors
-        top_eigenpairs(a, v, lam, edge, 1e-5, 50, scratch)
+        top_eigenpairs(a, v, lam, edge, 1e-4, 50, scratch)  # a in floors: 1e-4 of the noise left a null
         m = 0
         for i in range(max_nulls):
             if lam[i] > edge:

@@ -91,7 +91,7 @@ def _converged(vu, wu, lam, relevant, tol):  # pragma: no cover - compiled
             res = 0.0
             for i in range(n):
                 res += abs(wu[i, c] - lam[c] * vu[i, c]) ** 2
-            if res > (tol * lam[c]) ** 2:
+            if res > tol * lam[c]:
                 return False
     return True
 
@@ -110,14 +110,16 @@ def _strongest(a, lam, relevant):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def top_eigenpairs(a, v, lam, relevant, tol=1e-5, max_iter=50, scratch=None):  # pragma: no cover - compiled
+def top_eigenpairs(a, v, lam, relevant, tol=1e-4, max_iter=50, scratch=None):  # pragma: no cover - compiled
     """The ``v.shape[1]`` strongest eigen-pairs of a Hermitian ``a`` by subspace iteration from ``v``.
 
     ``v`` (n, m) holds the start (orthonormal columns) and receives the eigenvectors, ``lam`` (m,)
     the eigenvalues, decreasing. Each step is a Rayleigh-Ritz step, so the columns converge at the
     rate of the subspace. It stops when every column whose eigenvalue exceeds ``relevant`` has a
-    residual ``|a v - lam v|`` below ``tol`` times its eigenvalue (weaker columns are not nulled
-    and need not converge), and the pairs found are the strongest (of those above ``relevant``):
+    squared residual ``|a v - lam v|^2`` below ``tol`` times its eigenvalue (weaker columns are not
+    nulled and need not converge): nulling such a vector leaves about ``|residual|^2 / lam``
+    (``tol``, in the units of ``a``: 1e-4 of the noise for a covariance in noise units) of its
+    direction's power, and the pairs found are the strongest (of those above ``relevant``):
     the eigenvalues not found cannot exceed the weakest found one. Otherwise (no convergence in
     ``max_iter`` steps: nearly equal eigenvalues; or a start nearly orthogonal to a strong
     direction) the pairs come from the full Jacobi sweeps. Returns the steps taken, plus

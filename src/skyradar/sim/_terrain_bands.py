@@ -4,18 +4,20 @@
 interleaves DEM rows between them: with two threads that is two 10.6 MB cubes to scatter into,
 sum, and clear every frame, and the point-spread pass then reads both. Here the threads own
 disjoint bands of range bins of one grid instead, so no two threads ever add into one pixel and
-there is nothing to sum:
-
-1. a parallel pass over the DEM cells culls them, cuts them (the same ``cell_counts`` rule) and
-   bounds the range bins their sub-facets can land in;
-2. the band edges split the frame's sub-facets evenly (by each cell's middle bin);
-3. each band runs the vectorised batches of ``_terrain_batch`` over the cells that can reach it
-   (a cell straddling an edge is computed by both bands) and adds only the sub-facets whose
-   range bin is its own.
+there is nothing to sum. Each band walks all DEM cells in order, culls them as
+``terrain_returns`` does, bounds the range bins a cell's sub-facets can land in, and runs the
+vectorised batches of ``_terrain_batch`` over the cells that can reach it (a cell straddling a
+band edge is computed by both bands), adding only the sub-facets whose range bin is its own.
 
 Every sub-facet is computed by the same formulas and numbered as in ``terrain_returns`` (its
 speckle draw is the same), so the grid equals the interleaved kernel's up to the order of the
-float32 additions per pixel (``tests/test_sim_bands.py``).
+float32 additions per pixel (``tests/test_sim_bands.py``), whatever the edges or the number of
+threads.
+
+Load balance: the edges split the sub-facets of the frame before evenly (each band counts the
+sub-facets of the cells whose middle bin is its own: :func:`band_edges`); frames a tenth of a
+second apart see nearly the same terrain. Edges only move work between threads: any edges give
+the same grid, to float32 rounding.
 
 Why the bound holds: a point of a cell's bilinear patch is a convex combination of its four
 corners, so its distance from the antenna is at most the largest corner distance and at least
@@ -63,53 +65,32 @@ def _cell_bins(p_ant, i, j, d_range, margin_m):
     return lo, hi
 
 
-@njit(parallel=True, cache=True, error_model="numpy")
-def _plan(p_ant, v_ground_ant, counts, adapt, r_max, d_range, margin_m, cells):
-    """Per cell (ny - 1, nx - 1, 4): sub-facets per axis (0: culled), lowest and highest range bin."""
-    n_min_r, n_min_c, n_max_r, n_max_c = counts
-    for i in prange(p_ant.shape[0] - 1):
-        for j in range(p_ant.shape[1] - 1):
-            cell = cells[i, j]
-            if _cell_behind(p_ant, i, j) or _cell_beyond(p_ant, i, j, r_max):
-                cell[0] = 0
-                continue
-            nu, nw = cell_counts(p_ant, i, j, v_ground_ant, n_min_r, n_min_c, n_max_r, n_max_c, adapt)
-            lo, hi = _cell_bins(p_ant, i, j, d_range, margin_m)
-            cell[0], cell[1], cell[2], cell[3] = nu, nw, lo, hi
-
-
 @njit(cache=True, error_model="numpy")
-def band_edges(cells, n_range, n_bands):
-    """Range-bin edges (n_bands + 1) splitting the planned sub-facets evenly, by each cell's middle bin.
+def band_edges(work, n_bands):
+    """Range-bin edges (n_bands + 1) splitting the histogram ``work`` (sub-facets per bin) evenly.
 
     Examples
     --------
-    >>> cells = np.zeros((1, 4, 4), np.int64)
-    >>> cells[0, :, :2] = 2  # four cells of 2 x 2 sub-facets
-    >>> cells[0, :, 2] = [0, 10, 20, 30]
-    >>> cells[0, :, 3] = cells[0, :, 2] + 2
-    >>> band_edges(cells, 40, 2).tolist()
+    >>> work = np.zeros(41)
+    >>> work[[1, 11, 21, 31]] = 4.0  # four cells of 2 x 2 sub-facets
+    >>> band_edges(work, 2).tolist()
     [0, 12, 40]
     """
-    work = np.zeros(n_range + 1)
-    total = 0.0
-    for i in range(cells.shape[0]):
-        for j in range(cells.shape[1]):
-            c = cells[i, j]
-            if c[0] == 0:
-                continue
-            mid = min(max((c[2] + c[3]) // 2, 0), n_range)
-            work[mid] += c[0] * c[1]
-            total += c[0] * c[1]
+    n_range = work.shape[0] - 1
+    total = work.sum()
     edges = np.empty(n_bands + 1, np.int64)
     edges[0], edges[n_bands] = 0, n_range
     b, acc = 1, 0.0
+    if total <= 0.0:  # nothing seen yet: equal bands
+        for b in range(1, n_bands):
+            edges[b] = n_range * b // n_bands
+        return edges
     for k in range(n_range + 1):
         acc += work[k]
         while b < n_bands and acc >= total * b / n_bands:
-            edges[b] = k + 1
+            edges[b] = min(k + 1, n_range)
             b += 1
-    while b < n_bands:  # no work left: empty bands at the far end
+    while b < n_bands:
         edges[b] = n_range
         b += 1
     return edges
@@ -140,13 +121,15 @@ def _flush(scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, 
 
 @njit(parallel=True, cache=True, fastmath=True, error_model="numpy")
 def _band_pass(
-    p_ned, p_ant, up_ant, tx, rx, v_ground_ant, cells, edges, n_cell_max, wavelength, d_range, d_vel,
-    coupling, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m, use_horizon, out,
-    speckle_key,
+    p_ned, p_ant, up_ant, tx, rx, v_ground_ant, counts, adapt, margin_m, edges, work, wavelength, d_range,
+    d_vel, coupling, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m, use_horizon,
+    out, speckle_key,
 ):  # fmt: skip
     ny, nx = p_ned.shape[0], p_ned.shape[1]
     n_range, n_dopp = out.shape[1], out.shape[2]
     r_max = d_range * (n_range + 2)
+    n_min_r, n_min_c, n_max_r, n_max_c = counts
+    n_cell_max = n_max_r * n_max_c
     cap = max(n_cell_max, 512)
     inv_wl = 1.0 / wavelength
     n_bands = edges.shape[0] - 1
@@ -157,14 +140,20 @@ def _band_pass(
         us, ws = np.empty(n_cell_max), np.empty(n_cell_max)
         scratch = np.zeros((CELL_FIELDS, cap))
         r_rx_sub, cos_sin = np.empty((rx.shape[0], cap)), np.empty((2, rx.shape[0], cap), np.float32)
+        work[band, :] = 0.0
         k = 0
         for i in range(ny - 1):
             for j in range(nx - 1):
-                c = cells[i, j]
-                if c[0] == 0 or c[3] < lo or c[2] >= hi:
+                if _cell_behind(p_ant, i, j) or _cell_beyond(p_ant, i, j, r_max):
                     continue
-                nu, nw = c[0], c[1]
+                c_lo, c_hi = _cell_bins(p_ant, i, j, d_range, margin_m)
+                if c_hi < lo or c_lo >= hi:
+                    continue
+                nu, nw = cell_counts(p_ant, i, j, v_ground_ant, n_min_r, n_min_c, n_max_r, n_max_c, adapt)
                 n_sub = nu * nw
+                mid = min(max((c_lo + c_hi) // 2, 0), n_range)
+                if lo <= mid < hi or (band == n_bands - 1 and mid == n_range):
+                    work[band, mid] += n_sub
                 if k + n_sub > cap:
                     _flush(scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel,
                            coupling, n_range, n_dopp, inv_wl, power_const, gain2, gain2_step, refl_table,
@@ -205,32 +194,29 @@ def banded_returns(
     refl_table: np.ndarray,
     view,
     use_horizon: bool,
-    n_bands: int,
     out: np.ndarray,
     speckle_key: np.uint64,
-    cells: np.ndarray | None = None,
+    edges: np.ndarray,
 ) -> np.ndarray:
-    """Add terrain returns into ``out`` (1, n_range, n_doppler, n_rx), ``n_bands`` threads' bands.
+    """Add terrain returns into ``out`` (1, n_range, n_doppler, n_rx), one thread per band of ``edges``.
 
     The arguments are ``terrain_returns``' (``rule`` a :class:`~skyradar.sim.facets.FacetRule`,
     ``view`` the frame's :class:`~skyradar.sim.geometry.TerrainView`), always in its vectorised
-    mode into a dense grid. ``cells`` (ny - 1, nx - 1, 4) int64 is the per-cell plan's storage
-    (None: a fresh one). Returns the band edges (range bins).
+    mode into a dense grid. ``edges`` (n_bands + 1) int64 are the range-bin band edges, from 0 to
+    n_range (:func:`band_edges`; any give the same grid to float32 rounding). Returns the edges
+    that balance this frame's sub-facets: the next frame's.
     """
-    ny, nx = p_ant.shape[:2]
-    if cells is None or cells.shape != (ny - 1, nx - 1, 4):
-        cells = np.empty((ny - 1, nx - 1, 4), np.int64)
     n_range = out.shape[1]
-    r_max = d_range * (n_range + 2)
+    if edges[0] != 0 or edges[-1] != n_range or np.any(np.diff(edges) < 0):
+        raise ValueError(f"banded_returns: edges must rise from 0 to {n_range}, got {edges}")
     antennas = np.vstack([np.reshape(tx, (1, 3)), rx])
     reach_m = float(np.max(np.linalg.norm(antennas, axis=1)))
     margin_m = abs(coupling) * float(np.linalg.norm(v_ground_ant)) + reach_m
-    counts = np.asarray(rule.counts, np.int64)
-    _plan(p_ant, v_ground_ant, counts, np.asarray(rule.adapt, float), r_max, d_range, margin_m, cells)
-    edges = band_edges(cells, n_range, max(1, int(n_bands)))
+    work = np.empty((edges.size - 1, n_range + 1))
     _band_pass(
-        p_ned, p_ant, up_ant, tx, rx, v_ground_ant, cells, edges, rule.per_cell_max, wavelength, d_range,
-        d_vel, coupling, power_const, gain2, gain2_step, refl_table, view.horizon, view.az_bin_rad,
-        view.h_bin_m, use_horizon, out, speckle_key,
+        p_ned, p_ant, up_ant, tx, rx, v_ground_ant, np.asarray(rule.counts, np.int64),
+        np.asarray(rule.adapt, float), margin_m, edges, work, wavelength, d_range, d_vel, coupling,
+        power_const, gain2, gain2_step, refl_table, view.horizon, view.az_bin_rad, view.h_bin_m, use_horizon,
+        out, speckle_key,
     )  # fmt: skip
-    return edges
+    return band_edges(work.sum(axis=0), edges.size - 1)

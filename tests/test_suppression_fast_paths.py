@@ -93,10 +93,10 @@ def test_frame_subspace_is_reused_within_the_tolerance_and_recomputed_beyond(mon
 
     first = clutter_frames.frame_subspace(own(0.0, 1000.0), 0, CFG)
     # GNSS-like jitter (vertical velocity, height, attitude) inside the tolerance: the same prediction.
-    for vd, h, pitch in ((0.3, 1000.0, 0.0), (-0.2, 1008.0, 0.3), (0.1, 993.0, -0.4)):
-        assert clutter_frames.frame_subspace(own(vd, h, pitch), 0, CFG) is first
+    for vd, h, pitch in ((0.3, 1000.0, 0.0), (-0.2, 1008.0, 0.3), (0.1, 993.0, -0.4), (0.0, 1040.0, 0.0)):
+        assert clutter_frames.frame_subspace(own(vd, h, pitch), 0, CFG) is first  # 4 % higher too
     assert len(calls) == 1
-    assert clutter_frames.frame_subspace(own(0.0, 1050.0), 0, CFG) is not first  # 5 % higher
+    assert clutter_frames.frame_subspace(own(0.0, 1070.0), 0, CFG) is not first  # 7 % higher
     assert clutter_frames.frame_subspace(own(1.0, 1000.0), 0, CFG) is not first  # climbing 1 m/s
     assert len(calls) == 3
     assert clutter_frames.frame_subspace(own(0.05, 1003.0), 0, CFG) is first  # back: still cached

@@ -130,8 +130,9 @@ def _frame_measures(i, full, clutter, target, sub, config, tables) -> dict[str, 
     k, j = np.unravel_index(np.argmax(t_raw), t_raw.shape)
     sup = suppress_clutter(full, sub, config)  # the nulls the processing chose on the real frame
     c_in = power_image(clutter, config.rx_calibration)
-    c_out = projected_power(clutter / config.rx_calibration, sub.vectors, sup.nulls)
-    t_out = projected_power(target / config.rx_calibration, sub.vectors, sup.nulls)
+    vectors = sup.applied_vectors(sub)  # adaptive cells' own nulls where the prediction was not kept
+    c_out = projected_power(clutter / config.rx_calibration, vectors, sup.nulls)
+    t_out = projected_power(target / config.rx_calibration, vectors, sup.nulls)
     gain = float(t_out[k, j] / max(t_raw[k, j], 1e-300))
     wr, wd = _window(k, j, config)
     cell_if = _db(gain * (c_in[wr, wd] + noise) / (c_out[wr, wd] + noise))
@@ -162,10 +163,11 @@ def _curves(clutter_cubes, full_cubes, sub, config, height_m) -> pd.DataFrame:
     c_out = np.zeros(config.n_doppler)
     gain = np.zeros(config.n_doppler)
     for clutter, full in zip(clutter_cubes, full_cubes, strict=True):
-        nulls = suppress_clutter(full, sub, config).nulls
+        sup = suppress_clutter(full, sub, config)
+        nulls, vectors = sup.nulls, sup.applied_vectors(sub)
         c_in += power_image(clutter, config.rx_calibration)[rows].mean(axis=0)
-        c_out += projected_power(clutter / config.rx_calibration, sub.vectors, nulls)[rows].mean(axis=0)
-        gain += projected_power(boresight, sub.vectors, nulls)[rows].mean(axis=0)
+        c_out += projected_power(clutter / config.rx_calibration, vectors, nulls)[rows].mean(axis=0)
+        gain += projected_power(boresight, vectors, nulls)[rows].mean(axis=0)
     c_in, c_out, gain = (x / len(full_cubes) for x in (c_in, c_out, gain))
     return pd.DataFrame({
         "height_m": height_m, "radial_velocity_mps": config.doppler_axis_mps,

@@ -93,6 +93,12 @@ class Suppressed:
             vectors[own] = self.adaptive_vectors[range_index[own], doppler_index[own]]
         return vectors
 
+    def applied_vectors(self, subspace: ClutterSubspace) -> np.ndarray:
+        """:meth:`cell_vectors` of every cell (n_range, n_doppler, n_rx, n_rx)."""
+        if self.adaptive is None or not self.adaptive.any():
+            return subspace.vectors
+        return np.where(self.adaptive[..., None, None], self.adaptive_vectors, subspace.vectors)
+
 
 # Median of Gamma(L, 1/L) (the channel mean of L unit-noise channels), L = 1..8.
 # Median of the mean of n unit-mean exponentials (Gamma(n, 1/n)); scipy.special, not scipy.stats, keeps

@@ -196,3 +196,12 @@ def test_clear_sky_with_a_strong_target_is_bit_identical(flat_prediction):
     assert found_on and found_off and not on.adaptive.any()
     for name in ("power", "nulls", "unsuppressed", "channels"):
         np.testing.assert_array_equal(getattr(on, name), getattr(off, name))
+
+
+@pytest.mark.slow
+def test_relief_benchmark_agrees_with_its_numpy_baseline():
+    from skyradar.benchmarks.process_adaptive import run_adaptive
+
+    result = run_adaptive(n_cubes=1)
+    assert result["relief_adaptive_cells_per_frame"] > 1000  # the flat prediction misses the hills
+    assert result["relief_adaptive_same_nulls"] > 0.999

@@ -7,7 +7,9 @@ same run on the same cubes: the textbook numpy/scipy version (``np.abs(.)**2`` m
 ``np.linalg.lstsq`` DoA per detection).
 
 Also, on terrain cubes with knowledge-aided clutter suppression on, ours against a numpy
-baseline of the same steps (``suppressed_*`` keys, :mod:`skyradar.benchmarks.process_clutter`).
+baseline of the same steps (``suppressed_*`` keys, :mod:`skyradar.benchmarks.process_clutter`),
+and over relief the adaptive nulls against a numpy version of the same rule (``relief_*`` keys,
+:mod:`skyradar.benchmarks.process_adaptive`).
 
 Also home of :func:`synthetic_frame`, the reference cube generator used by the tests: point
 targets placed with the exact two-way phase formula plus complex Gaussian noise.
@@ -147,7 +149,10 @@ def run(n_cubes: int = 8, n_targets: int = 5, min_time_s: float = 2.0, seed: int
     from skyradar.benchmarks.process_clutter import run_suppressed  # the simulator only when benchmarking
 
     suppressed = run_suppressed(min_time_s=min_time_s, seed=seed)
-    return suppressed | {
+    # Over relief, the adaptive nulls against their numpy baseline (skyradar.benchmarks.process_adaptive).
+    from skyradar.benchmarks.process_adaptive import run_adaptive
+
+    return suppressed | run_adaptive(seed=seed) | {
         "frames_per_s": float(ours),
         "baseline_frames_per_s": float(base),
         "speedup": float(ours / base),

@@ -72,6 +72,8 @@ def test_bench_sim_json_names_synthetic_terrain_and_both_ratios(tmp_path):
     fps = data["frames_per_s"]
     assert data["speedup_vs_numpy_baseline"] == pytest.approx(fps / data["numpy_baseline_frames_per_s"])
     assert data["speedup_vs_thesis_baseline"] == pytest.approx(fps / data["thesis_baseline_frames_per_s"])
+    one = data["fine_psf_one_thread_cpu_ms_per_frame"]
+    assert data["fine_psf_thread_cpu_overhead"] == pytest.approx(data["fine_psf_cpu_ms_per_frame"] / one)
     wide = {**os.environ, "COLUMNS": "200"}  # the help text unwrapped
     help_text = subprocess.run(
         [sys.executable, "-m", "skyradar", "bench", "sim", "--help"],

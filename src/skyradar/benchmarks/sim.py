@@ -301,11 +301,21 @@ def _psf_keys(config, terrain, origin, platform, ours, n: int, fps_fine: float) 
     )
     fps_fine_psf, cpu_fine_psf = ours(fine_psf, n)
     fps_uniform_psf, cpu_uniform_psf = ours(uniform_psf, n)
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)  # the work of a frame, without waits for other threads (or other jobs)
+    try:
+        fps_one, cpu_one = ours(fine_psf, n)
+    finally:
+        numba.set_num_threads(threads)
     return {
         "frames_per_s_fine_psf": fps_fine_psf,
         "fine_psf_vs_fine": fps_fine_psf / fps_fine,
         "fine_psf_x_field_rate": fps_fine_psf / FIELD_RATE_HZ,
         "fine_psf_cpu_ms_per_frame": cpu_fine_psf,
+        "frames_per_s_fine_psf_one_thread": fps_one,
+        "fine_psf_one_thread_cpu_ms_per_frame": cpu_one,
+        # CPU time all threads spend on a frame over one thread's: the cost of splitting it.
+        "fine_psf_thread_cpu_overhead": cpu_fine_psf / cpu_one,
         "fine_psf": "sub-facets <= dR/2 in range and <= half a Doppler bin (cut per cell by its extent), "
         "exact geodesy, occlusion, Hann x Hann point-spread, speckle (ours only)",
         "sub_facets_per_frame_fine_psf": _sub_facets(fine_psf, platform(0)),

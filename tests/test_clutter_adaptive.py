@@ -8,7 +8,7 @@ from scipy import stats
 
 from skyradar.config import RadarConfig
 from skyradar.process.clutter_adaptive import ADAPTIVE_WINDOW, adaptive_nulls
-from skyradar.process.clutter_frames import frame_subspace
+from skyradar.process.clutter_frames import detect_suppressed, frame_subspace
 from skyradar.process.clutter_suppress import suppress_clutter
 from skyradar.process.detect import detect
 from skyradar.process.doa import direction_from_angles, steering_vector
@@ -139,6 +139,11 @@ def test_target_in_clutter_the_prediction_misses_is_found_only_with_adaptive_nul
     vectors = out.cell_vectors(flat_prediction, np.array([pixel[0]]), np.array([pixel[1]]))
     e = vectors[0][:, :2]
     assert np.linalg.norm(e.conj().T @ _steer(-30, 12)) > 0.99 * np.linalg.norm(_steer(-30, 12))
+    # its direction through the ring's whitening: the target's (25 dB, 2 of 4 dimensions nulled), not
+    # the clutter's (25-30 deg away)
+    det, u, coherence, _ = detect_suppressed(cube, CFG, flat_prediction)
+    k = np.flatnonzero((det.range_index == pixel[0]) & (det.doppler_index == pixel[1]))[0]
+    assert np.degrees(np.arccos(u[k] @ direction_from_angles(0.0, 0.0))) < 10.0 and coherence[k] > 0.9
 
 
 def _lobe(rng, shape, pixel, snr, direction):

@@ -58,7 +58,7 @@ from numba import njit
 
 from skyradar.process.top_eigen import eigen_scratch, top_eigenpairs
 
-__all__ = ["adaptive_nulls", "ADAPTIVE_WINDOW", "ADAPTIVE_GATE", "EIGEN_EDGE", "RING_CLIP"]
+__all__ = ["adaptive_nulls", "ring_whitening", "ADAPTIVE_WINDOW", "ADAPTIVE_GATE", "EIGEN_EDGE", "RING_CLIP"]
 
 ADAPTIVE_WINDOW = (5, 5, 2, 2)  # half sizes (range, Doppler) of the training window, then of its guard
 ADAPTIVE_GATE = 2.0  # ring mean after the predicted nulls, in floors, above which the prediction failed
@@ -305,3 +305,32 @@ def adaptive_nulls(
         out = (power, nulls, unsuppressed, mask, vectors)
         _adapt(z, np.asarray(inv_gain, np.complex64), cand, ring_mean, *rule, *out)
     return mask, vectors
+
+
+@njit(cache=True)
+def _whitening(cube, inv_gain, rr, dd, window, inv_floor, out):  # pragma: no cover - compiled
+    n_k = cube.shape[2]
+    a = np.empty((n_k, n_k), np.complex128)
+    for c in range(rr.size):
+        _ring_direct(cube, inv_gain, rr[c], dd[c], window, a)
+        out[c] = np.linalg.inv(a * inv_floor)
+    return out
+
+
+def ring_whitening(
+    cube: np.ndarray, inv_gain: np.ndarray, range_index: np.ndarray, doppler_index: np.ndarray,
+    floor_w: float, window: tuple[int, int, int, int] = ADAPTIVE_WINDOW,
+) -> np.ndarray:  # fmt: skip
+    """``floor_w R^-1`` (n, n_rx, n_rx) of the given cells, ``R`` their ring's sample covariance.
+
+    The whitening an adaptive cell's direction is estimated through
+    (:func:`skyradar.process.clutter_frames.detect_suppressed`): the projected matched filter
+    ``|s^H W z|^2 / (s^H W s)`` with ``W = R^-1`` is the adaptive matched filter (Robey et al.,
+    IEEE Trans. AES 28(1), 1992), whose best ``s`` weighs every direction by the clutter the ring
+    holds there, also what the nulls left; the nulls' projector weighs the directions left equally.
+    """
+    rr, dd = (np.ascontiguousarray(x, np.int64) for x in (range_index, doppler_index))
+    out = np.empty((rr.size, cube.shape[2], cube.shape[2]), np.complex128)
+    z = np.ascontiguousarray(cube, np.complex64)
+    window = tuple(int(w) for w in window)
+    return _whitening(z, np.asarray(inv_gain, np.complex64), rr, dd, window, 1.0 / floor_w, out)

@@ -146,6 +146,22 @@ def test_target_in_clutter_the_prediction_misses_is_found_only_with_adaptive_nul
     assert np.degrees(np.arccos(u[k] @ direction_from_angles(0.0, 0.0))) < 10.0 and coherence[k] > 0.9
 
 
+def test_one_unpredicted_clutter_plane_wave_is_not_taken_for_the_target(flat_prediction):
+    rng = np.random.default_rng(8)
+    shape = (CFG.n_range, CFG.n_doppler, CFG.n_rx)
+    noise_w = CFG.noise_power_w
+    cnr = np.zeros(shape[:2])
+    cnr[120:200, 150:230] = 10**4  # one direction, 40 dB: the raw snapshot is one plane wave
+    cube = _gauss(rng, *shape) * np.sqrt(noise_w) + _clutter(rng, shape, [_steer(-20, -25)], cnr) * np.sqrt(
+        noise_w
+    )
+    pixel = (160, 190)
+    cube[pixel] += np.sqrt(10**2.5 * noise_w) * _steer(5, 0) * np.exp(1j * rng.uniform(0, 6.3))  # 25 dB
+    det, u, _, _ = detect_suppressed(cube.astype(np.complex64), CFG, flat_prediction)
+    k = np.flatnonzero((det.range_index == pixel[0]) & (det.doppler_index == pixel[1]))[0]
+    assert np.degrees(np.arccos(u[k] @ direction_from_angles(np.radians(5.0), 0.0))) < 10.0
+
+
 def _lobe(rng, shape, pixel, snr, direction):
     """A point target spread over its Hann main lobe (+-1 range bin, +-2 Doppler bins, straddled)."""
     cube = np.zeros(shape, complex)

@@ -18,7 +18,7 @@ from skyradar.process.rangedoppler import range_doppler
 from skyradar.process.windows import get_window, window_gain_db
 from skyradar.scene.synthetic_terrain import flat_terrain, fractal_terrain
 from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
-from skyradar.sim.psf import _window, psf_kernels, window_response
+from skyradar.sim.psf import PSFKernels, _window, apply_psf, binned_kernel, psf_kernels, window_response
 from skyradar.sim.raw import received_power_w, simulate_adc
 
 ORIGIN = (52.0, 4.36, 0.0)
@@ -231,3 +231,28 @@ def test_apply_psf_is_the_separable_convolution_whatever_the_scratch_holds(n_blo
     apply_psf(fine, kernels, out, scratch, clear=True)
     np.testing.assert_allclose(out, expected, rtol=0, atol=1e-5 * np.abs(expected).max())
     assert not fine.any()  # cleared for the next frame
+
+
+def test_point_spread_of_blocks_is_that_of_their_sum_and_clears_them():
+    # Per-thread blocks are summed on the way (and cleared); a direct 2-D convolution is the truth.
+    rng = np.random.default_rng(4)
+    k = PSFKernels(binned_kernel("hann", 64, 2), binned_kernel("hann", 32, 2), 2)
+    blocks = np.zeros((2, 40, 64, 3), np.complex64)
+    blocks[:, 10:30] = rng.normal(size=(2, 20, 64, 3)) + 1j * rng.normal(size=(2, 20, 64, 3))
+    total = blocks.sum(axis=0)
+    out = np.empty((20, 32, 3), np.complex64)
+    apply_psf(blocks, k, out, np.empty(40 * 32 * 3, np.complex64), clear=True)
+    assert not blocks.any()
+    # out[r, d] = sum over fine (m, l) of total[m, l] h_r[2 r - m] h_d[2 d - l], Doppler circular.
+    h_r, h_d = k.h_range.astype(float), k.h_doppler.astype(float)
+    sr, sd = len(h_r) // 2, len(h_d) // 2
+    expected = np.zeros(out.shape, complex)
+    for r in range(20):
+        for m in range(max(0, 2 * r - sr), min(40, 2 * r + sr + 1)):
+            row = total[m].astype(complex)
+            for d in range(32):
+                lags = 2 * d - np.arange(64)
+                lags = (lags + 32) % 64 - 32  # circular: the nearest image of each fine bin
+                w = np.where(np.abs(lags) <= sd, h_d[np.clip(lags + sd, 0, 2 * sd)], 0.0)
+                expected[r, d] += h_r[2 * r - m + sr] * (w @ row)
+    np.testing.assert_allclose(out, expected, rtol=0, atol=1e-5 * np.abs(expected).max())

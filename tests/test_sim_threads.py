@@ -1,4 +1,4 @@
-"""skyradar.sim shortens libgomp's spin at barriers unless the user chose a value."""
+"""Importing skyradar shortens libgomp's spin at barriers unless the user chose a value."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-_PRINT = "import skyradar.sim, os; print(os.environ['GOMP_SPINCOUNT'])"
+_PRINT = "import skyradar, os; print(os.environ['GOMP_SPINCOUNT'])"
 
 
 @pytest.mark.parametrize(("given", "expected"), [(None, "10000"), ("250", "250")])

@@ -18,12 +18,7 @@ import numpy as np
 
 from skyradar.config import RadarConfig
 
-__all__ = ["angle_sigma_rad", "position_covariance", "UNMEASURED_ELEVATION_SIGMA_RAD"]
-
-# Elevation sd of a detection whose elevation clutter suppression left unobservable (a prior of
-# elevation 0, see process.clutter_doa): the width of the field an aircraft can be in, about
-# angle_sigma_rad's max_rad, so the 3-D tracker takes its height from its other detections.
-UNMEASURED_ELEVATION_SIGMA_RAD = 0.3
+__all__ = ["angle_sigma_rad", "position_covariance"]
 
 
 def angle_sigma_rad(
@@ -64,13 +59,8 @@ def position_covariance(
     own_position_m: np.ndarray,
     angle_sigma: np.ndarray,
     range_sigma_m: np.ndarray | float,
-    vertical_sigma: np.ndarray | None = None,
 ) -> np.ndarray:
     """Covariance of DoA positions, ``(R s)^2 (I - u u^T) + s_R^2 u u^T``, shape (k, 3, 3), m^2.
-
-    With ``vertical_sigma`` the across-sight axis in the vertical plane through the line of
-    sight takes ``(R s_v)^2`` instead (the horizontal one keeps ``s``): an elevation that was not
-    measured.
 
     Parameters
     ----------
@@ -82,18 +72,12 @@ def position_covariance(
         Per-axis angle standard deviation, rad.
     range_sigma_m : float or ndarray, shape (k,)
         Range standard deviation, m.
-    vertical_sigma : ndarray, shape (k,), optional
-        Angle standard deviation in the vertical plane, rad (default: ``angle_sigma``).
 
     Examples
     --------
     >>> C = position_covariance(np.array([[1000.0, 0, 0]]), np.zeros(3), np.array([0.01]), 5.0)
     >>> np.diag(C[0]).round(6).tolist()
     [25.0, 100.0, 100.0]
-    >>> p, s = np.array([[1000.0, 0, 0]]), np.array([0.01])
-    >>> C = position_covariance(p, np.zeros(3), s, 5.0, vertical_sigma=np.array([0.3]))
-    >>> np.diag(C[0]).round(6).tolist()
-    [25.0, 100.0, 90000.0]
     """
     d = np.asarray(positions_m, float) - np.asarray(own_position_m, float)
     r = np.linalg.norm(d, axis=1)
@@ -101,14 +85,4 @@ def position_covariance(
     uu = u[:, :, None] * u[:, None, :]
     across = (r * np.asarray(angle_sigma, float)) ** 2
     along = np.broadcast_to(np.asarray(range_sigma_m, float) ** 2, r.shape)
-    cov = across[:, None, None] * (np.eye(3) - uu) + along[:, None, None] * uu
-    if vertical_sigma is None:
-        return cov
-    # The across axis in the vertical plane: u x h, h = the horizontal one (NED z down; along
-    # the vertical itself any horizontal axis will do).
-    h = np.cross(np.array([0.0, 0.0, 1.0]), u)
-    h_norm = np.linalg.norm(h, axis=1)
-    h = np.where(h_norm[:, None] > 1e-9, h / np.maximum(h_norm, 1e-12)[:, None], np.array([0.0, 1.0, 0.0]))
-    e = np.cross(u, h)
-    extra = (r * np.asarray(vertical_sigma, float)) ** 2 - across
-    return cov + extra[:, None, None] * (e[:, :, None] * e[:, None, :])
+    return across[:, None, None] * (np.eye(3) - uu) + along[:, None, None] * uu

@@ -119,9 +119,8 @@ def frame_subspace(
     and height are not averaged. Measured on the ``experiment clutter`` scene at 1000 m, a
     prediction off by the whole tolerance in every quantity at once (0.35 m/s down, 0.5 deg
     pitch, 1 % height, either sign) lowers the improvement factor in the intruder's lost cells
-    from 27.3 to 26.3-26.6 dB (2 deg and 2 % cost 2.4 dB: the tolerances were halved); with 5 %
-    of height and the adaptive nulls, to 25.3 and 26.5 dB (median; least cell 23.0 and 20.5 dB),
-    the same 12 intruder hits of 20. Over relief
+    from 27.3 to 26.3-26.6 dB (2 deg and 2 % cost 2.4 dB); with 5 % of height and the adaptive
+    nulls, to 25.3 and 26.5 dB (least cell 23.0 and 20.5 dB), the same 12 intruder hits of 20. Over relief
     the height below jumps with every hill (15-22 predictions per 75 frames over ``hills``). Tried
     and measured on encounter windows: the median ground height within 5 km (6-13 predictions)
     lost intruder hits over hills (34 of 75 frames against 41), a height tolerance grown with

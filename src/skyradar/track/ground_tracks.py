@@ -30,7 +30,9 @@ warned after its loss of well clear). So a direction of arrival that says, relia
 consistently, that the track flies above the ground overrules the static fit
 (:func:`doa_in_the_air`); sidelobe ground read as air with a consistent wrong direction then
 stays a track. An elevation that clutter suppression left unobservable (``process.clutter_doa``
-places it co-altitude) cannot rule out a co-altitude aircraft and counts as air.
+places it co-altitude) is no evidence either way: it neither overrules the static fit (its prior
+elevation 0 with a steady azimuth looked like "one direction in the air" and released ground
+patches over hills) nor holds a track by itself.
 
 :func:`hold_ground_tracks` applies both tests causally (a row uses only the detections up to it)
 to a tracks table: rows of a track while the ground explains it, or while it is not an object,
@@ -46,6 +48,15 @@ import numpy as np
 import pandas as pd
 from scipy.stats import chi2
 
+from skyradar.track.ground_doa import (
+    DOA_COLUMNS,
+    DOA_FIELD_RAD,
+    DOA_SIGMA_RAD,
+    direction_measured,
+    doa_height_sd,
+    doa_in_the_air,
+    doa_on_the_ground,
+)
 from skyradar.track.static_point import (
     _trimmed_sum,
     fits_static_ground,
@@ -54,7 +65,6 @@ from skyradar.track.static_point import (
     terrain_surface,
 )
 
-_DOA_COLUMNS = ("azimuth_rad", "elevation_rad", "north_m", "east_m", "down_m", "elevation_measured")
 _CLEAR_S = 3.0  # judged an object off the ground this long on end: not judged again
 
 __all__ = [
@@ -123,8 +133,8 @@ class GroundTrackTest:
     max_history: int = 120
     surface_down: Callable[[np.ndarray], np.ndarray] | None = None
     rejudge_gap_s: float = 2.0
-    doa_sigma_rad: float = float(np.radians(2.0))
-    doa_field_rad: float = float(np.radians(45.0))
+    doa_sigma_rad: float = DOA_SIGMA_RAD
+    doa_field_rad: float = DOA_FIELD_RAD
     point_sigma_velocity_mps: float | None = 0.1
     ground_min_detections: int = 10
 
@@ -175,49 +185,6 @@ def _own_state(ownship: pd.DataFrame, times: np.ndarray) -> tuple[np.ndarray, np
     return np.column_stack(cols[0]), np.column_stack(cols[1])
 
 
-def _doa_height(det: np.ndarray, surface_down, test: GroundTrackTest) -> list[np.ndarray]:
-    """Azimuth and elevation (antenna frame) of each detection, its DoA position's height above
-    the surface in standard deviations (range x ``doa_sigma_rad``, 10 m for the surface) and
-    whether its elevation was measured (tables without ``elevation_measured``: all were)."""
-    az, el, measured = det[:, 3], det[:, 4], det[:, 8] != 0.0  # NaN (no column): measured
-    if surface_down is None or not np.isfinite(det[:, 5:8]).any():
-        return [az, el, np.full(az.size, np.nan), measured]
-    with np.errstate(invalid="ignore"):
-        height = surface_down(np.nan_to_num(det[:, 5:7])) - det[:, 7]
-        return [az, el, height / np.hypot(det[:, 1] * test.doa_sigma_rad, 10.0), measured]
-
-
-def doa_in_the_air(
-    azimuth_rad, elevation_rad, height_sd, test: GroundTrackTest | None = None, n: int = 10
-) -> bool:
-    """Whether a track's recent directions of arrival say, reliably, that it flies above the ground.
-
-    Of its last ``n`` detections, at least half and five must lie inside the field
-    (``doa_field_rad`` of boresight), their azimuth and elevation must agree (robust spread within
-    3 ``doa_sigma_rad``: one direction, not residual clutter or ground beside the track scattered
-    over the beam) and their median height above the surface must be 3 sd or more
-    (``height_sd``: height / sd). Such a track keeps its confirmation even when a static ground
-    point also fits its range and Doppler: an aircraft whose speed relative to the own-ship equals
-    the own-ship's (a converging one at 60 deg, say) fits a static point as long as it flies straight.
-
-    Examples
-    --------
-    >>> rng = np.random.default_rng(0)
-    >>> az, el = 0.3 + rng.normal(0, 0.02, 10), rng.normal(0, 0.02, 10)
-    >>> scattered = rng.uniform(-0.6, 0.6, 10)  # residual clutter over the beam
-    >>> doa_in_the_air(az, el, np.full(10, 6.0)), doa_in_the_air(scattered, el, np.full(10, 6.0))
-    (True, False)
-    """
-    test = test or GroundTrackTest()
-    az, el, z = (np.asarray(a, float)[-n:] for a in (azimuth_rad, elevation_rad, height_sd))
-    with np.errstate(invalid="ignore"):
-        inside = (np.abs(az) <= test.doa_field_rad) & (np.abs(el) <= test.doa_field_rad) & np.isfinite(z)
-    if inside.sum() < max(5, az.size // 2):
-        return False
-    spread = max(1.4826 * np.median(np.abs(a[inside] - np.median(a[inside]))) for a in (az, el))
-    return bool(spread <= 3.0 * test.doa_sigma_rad and np.median(z[inside]) >= 3.0)
-
-
 def doppler_smooth(
     time_s: np.ndarray,
     radial_velocity_mps: np.ndarray,
@@ -252,40 +219,6 @@ def doppler_smooth(
     return bool(_trimmed_sum(z2, test.trim)[0] <= chi2.isf(test.tail, max(keep - degree - 1, 1)))
 
 
-def direction_measured(elevation_measured, n: int = 10, least: int = 3) -> bool:
-    """Whether at least ``least`` of a track's last ``n`` detections have a measured elevation.
-
-    Examples
-    --------
-    >>> direction_measured(np.array([True, False, True, True])), direction_measured(np.zeros(9, bool))
-    (True, False)
-    """
-    return bool(np.count_nonzero(np.asarray(elevation_measured, bool)[-n:]) >= least)
-
-
-def doa_on_the_ground(elevation_measured, height_sd, n: int = 10, max_sd: float = 1.0) -> bool:
-    """Whether a track's recent measured directions of arrival put it on the surface.
-
-    Of its last ``n`` detections, those with a measured elevation (``elevation_measured``; not
-    ``process.clutter_doa``'s prior of elevation 0) and a height above the surface (``height_sd``,
-    in sd) count: at least
-    three, and their median height is below ``max_sd``. Azimuths may scatter (ground beside the
-    track in one cell). Not proof of ground: an aircraft in a ground cell can read the ground's
-    direction too (terrain set flat-300 encounter 2); so it only asks for more detections.
-
-    Examples
-    --------
-    >>> measured = np.array([True, False, True, True])  # the second: elevation 0 as a prior
-    >>> doa_on_the_ground(measured, np.array([0.4, 11.0, -0.3, 0.9]))
-    True
-    >>> doa_on_the_ground(measured, np.array([7.0, 11.0, 12.0, 26.0]))
-    False
-    """
-    z = np.asarray(height_sd, float)[-n:]
-    measured = np.asarray(elevation_measured, bool)[-n:] & np.isfinite(z)
-    return bool(measured.sum() >= 3 and np.median(z[measured]) < max_sd)
-
-
 def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test, doa) -> np.ndarray:
     """Per detection of one track: held (ground, or not an object) on the detections up to it.
 
@@ -308,7 +241,10 @@ def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test
             if not last and k + 1 < test.ground_min_detections:
                 measured = doa[3][sl]
                 last = not direction_measured(measured) or doa_on_the_ground(measured, doa[2][sl])
-            if not last and surface_down is not None and not doa_in_the_air(*(a[sl] for a in doa[:3]), test):
+            in_air = not last and doa_in_the_air(
+                *(a[sl] for a in doa), test.doa_sigma_rad, test.doa_field_rad
+            )
+            if not last and surface_down is not None and not in_air:
                 fit = (test.sigma_range_m, test.sigma_velocity_mps, test.tail, test.trim)
                 last = fits_static_ground(rng[sl], vel[sl], own_p[sl], own_v[sl], surface_down, width,
                                           coupling, *fit)  # fmt: skip
@@ -323,7 +259,7 @@ def _track_held(det: np.ndarray, ownship, surface_down, width: float, coupling: 
     t, rng, vel = det[:, :3].T
     own_p, own_v = _own_state(ownship, t) if ownship is not None else (None, None)
     ground = surface_down if ownship is not None else None
-    doa = _doa_height(det, ground, test)
+    doa = doa_height_sd(det, ground, test.doa_sigma_rad)
     held = np.ones(t.size, bool)
     cuts = np.flatnonzero(np.diff(t) > test.rejudge_gap_s) + 1
     for a, b in zip(np.r_[0, cuts], np.r_[cuts, t.size], strict=True):
@@ -375,7 +311,7 @@ def hold_ground_tracks(
         return tracks
     if surface_down is None and ownship is not None and np.isfinite(median_ground_down_m(ownship)):
         surface_down = flat_surface(median_ground_down_m(ownship))
-    names = ["time_s", "range_m", "radial_velocity_mps", *_DOA_COLUMNS]
+    names = ["time_s", "range_m", "radial_velocity_mps", *DOA_COLUMNS]
     nan = np.full(len(detections), np.nan)
     det = np.column_stack([detections[c].to_numpy(float) if c in detections else nan for c in names])
     rows = tracks["detection_row"].to_numpy()

@@ -1,0 +1,119 @@
+"""Direction-of-arrival evidence for the track-level ground test (:mod:`skyradar.track.ground_tracks`).
+
+A detection's direction says where a track is only when its elevation was measured: after two
+clutter nulls the 2x2 array often cannot measure it and ``process.clutter_doa`` places the
+detection co-altitude (elevation 0) with ``elevation_measured`` False. Such a prior is no evidence
+of height either way, so each rule here counts measured elevations only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+DOA_COLUMNS = ("azimuth_rad", "elevation_rad", "north_m", "east_m", "down_m", "elevation_measured")
+DOA_SIGMA_RAD = float(np.radians(2.0))  # CRLB at 13-20 dB plus attitude errors
+DOA_FIELD_RAD = float(np.radians(45.0))  # half-angle of boresight inside which that holds
+
+__all__ = ["DOA_COLUMNS", "doa_height_sd", "doa_in_the_air", "direction_measured", "doa_on_the_ground"]
+
+
+def doa_height_sd(det: np.ndarray, surface_down, sigma_rad: float = DOA_SIGMA_RAD) -> list[np.ndarray]:
+    """Azimuth and elevation (antenna frame) of each detection, its DoA position's height above
+    the surface in standard deviations (range x ``sigma_rad``, 10 m for the surface) and
+    whether its elevation was measured (tables without ``elevation_measured``: all were).
+
+    ``det`` columns: time, range, radial velocity, then :data:`DOA_COLUMNS`; ``surface_down`` maps
+    NE points (k, 2) to the ground's ``down``, m.
+
+    Examples
+    --------
+    >>> det = np.array([[0.0, 1000.0, 5.0, 0.1, -0.5, 800.0, 0.0, 480.0, 1.0]])
+    >>> az, el, z, measured = doa_height_sd(det, lambda ne: np.full(len(ne), 500.0))
+    >>> round(float(z[0]), 2), bool(measured[0])  # 20 m above ground, sd hypot(35, 10) m
+    (0.55, True)
+    """
+    az, el, measured = det[:, 3], det[:, 4], det[:, 8] != 0.0  # NaN (no column): measured
+    if surface_down is None or not np.isfinite(det[:, 5:8]).any():
+        return [az, el, np.full(az.size, np.nan), measured]
+    with np.errstate(invalid="ignore"):
+        height = surface_down(np.nan_to_num(det[:, 5:7])) - det[:, 7]
+        return [az, el, height / np.hypot(det[:, 1] * sigma_rad, 10.0), measured]
+
+
+def doa_in_the_air(
+    azimuth_rad,
+    elevation_rad,
+    height_sd,
+    elevation_measured=None,
+    sigma_rad: float = DOA_SIGMA_RAD,
+    field_rad: float = DOA_FIELD_RAD,
+    n: int = 10,
+) -> bool:
+    """Whether a track's recent directions of arrival say, reliably, that it flies above the ground.
+
+    Of its last ``n`` detections, at least half and five must have a measured elevation
+    (``elevation_measured``, default all; ``process.clutter_doa``'s prior of elevation 0 says
+    nothing of the height) and lie inside the field
+    (``field_rad`` of boresight), their azimuth and elevation must agree (robust spread within
+    3 ``sigma_rad``: one direction, not residual clutter or ground beside the track scattered
+    over the beam) and their median height above the surface must be 3 sd or more
+    (``height_sd``: height / sd). Such a track keeps its confirmation even when a static ground
+    point also fits its range and Doppler: an aircraft whose speed relative to the own-ship equals
+    the own-ship's (a converging one at 60 deg, say) fits a static point as long as it flies straight.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> az, el = 0.3 + rng.normal(0, 0.02, 10), rng.normal(0, 0.02, 10)
+    >>> scattered = rng.uniform(-0.6, 0.6, 10)  # residual clutter over the beam
+    >>> doa_in_the_air(az, el, np.full(10, 6.0)), doa_in_the_air(scattered, el, np.full(10, 6.0))
+    (True, False)
+    >>> prior = np.zeros(10, bool)  # elevation 0 placed by the chain, not measured
+    >>> doa_in_the_air(az, np.zeros(10), np.full(10, 6.0), prior)
+    False
+    """
+    az, el, z = (np.asarray(a, float)[-n:] for a in (azimuth_rad, elevation_rad, height_sd))
+    measured = (
+        np.ones(az.size, bool) if elevation_measured is None else np.asarray(elevation_measured, bool)[-n:]
+    )
+    with np.errstate(invalid="ignore"):
+        inside = (np.abs(az) <= field_rad) & (np.abs(el) <= field_rad) & np.isfinite(z)
+        inside &= measured
+    if inside.sum() < max(5, az.size // 2):
+        return False
+    spread = max(1.4826 * np.median(np.abs(a[inside] - np.median(a[inside]))) for a in (az, el))
+    return bool(spread <= 3.0 * sigma_rad and np.median(z[inside]) >= 3.0)
+
+
+def direction_measured(elevation_measured, n: int = 10, least: int = 3) -> bool:
+    """Whether at least ``least`` of a track's last ``n`` detections have a measured elevation.
+
+    Examples
+    --------
+    >>> direction_measured(np.array([True, False, True, True])), direction_measured(np.zeros(9, bool))
+    (True, False)
+    """
+    return bool(np.count_nonzero(np.asarray(elevation_measured, bool)[-n:]) >= least)
+
+
+def doa_on_the_ground(elevation_measured, height_sd, n: int = 10, max_sd: float = 1.0) -> bool:
+    """Whether a track's recent measured directions of arrival put it on the surface.
+
+    Of its last ``n`` detections, those with a measured elevation (``elevation_measured``; not
+    ``process.clutter_doa``'s prior of elevation 0) and a height above the surface (``height_sd``,
+    in sd) count: at least
+    three, and their median height is below ``max_sd``. Azimuths may scatter (ground beside the
+    track in one cell). Not proof of ground: an aircraft in a ground cell can read the ground's
+    direction too (terrain set flat-300 encounter 2); so it only asks for more detections.
+
+    Examples
+    --------
+    >>> measured = np.array([True, False, True, True])  # the second: elevation 0 as a prior
+    >>> doa_on_the_ground(measured, np.array([0.4, 11.0, -0.3, 0.9]))
+    True
+    >>> doa_on_the_ground(measured, np.array([7.0, 11.0, 12.0, 26.0]))
+    False
+    """
+    z = np.asarray(height_sd, float)[-n:]
+    measured = np.asarray(elevation_measured, bool)[-n:] & np.isfinite(z)
+    return bool(measured.sum() >= 3 and np.median(z[measured]) < max_sd)

@@ -219,38 +219,63 @@ def doppler_smooth(
     return bool(_trimmed_sum(z2, test.trim)[0] <= chi2.isf(test.tail, max(keep - degree - 1, 1)))
 
 
+def _judge(sl, t, rng, vel, own_p, own_v, surface_down, width, coupling, test, doa) -> str:
+    """One judgement of a detection history ``sl``: why it is held (``""``: an object off the ground)."""
+    if not range_doppler_consistent(t[sl], rng[sl], vel[sl], width, coupling, test):
+        return "range"
+    if test.point_sigma_velocity_mps is not None and not doppler_smooth(t[sl], vel[sl], width, test):
+        return "rough"
+    if sl.stop - sl.start < test.ground_min_detections:
+        measured = doa[3][sl]
+        if not direction_measured(measured) or doa_on_the_ground(measured, doa[2][sl]):
+            return "direction"
+    if surface_down is None or doa_in_the_air(*(a[sl] for a in doa), test.doa_sigma_rad, test.doa_field_rad):
+        return ""
+    fit = (test.sigma_range_m, test.sigma_velocity_mps, test.tail, test.trim)
+    ground = fits_static_ground(rng[sl], vel[sl], own_p[sl], own_v[sl], surface_down, width, coupling, *fit)
+    return "ground" if ground else ""
+
+
 def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test, doa) -> np.ndarray:
     """Per detection of one track: held (ground, or not an object) on the detections up to it.
 
     Judged at every detection for the first 30, then at every fifth. A track judged an object
     off the ground for :data:`_CLEAR_S` on end is not judged again (it was confirmed all that
-    time already, so a later verdict could not undo its count; the fits cost time).
+    time already, so a later verdict could not undo its count; the fits cost time). A Doppler
+    that is not one smooth curve starts the history again after its largest step: the detections
+    before it came from another scatterer, more than the static fit's trim leaves out (hills,
+    200-encounter set, encounter 10), and the new history needs ``ground_min_detections``.
+    Once a static ground point has fitted it, a track is released only when two judgements
+    running say otherwise, and not before ``ground_min_detections``: the surface model and a
+    patch's scatterers make a fit fail now and then, and each was a confirmed ground row.
     """
     n = rng.size
     held = np.ones(n, bool)
-    last, clear_since = True, np.inf
+    last, clear_since, start, ground_seen, objects_running = True, np.inf, 0, False, 0
+    least = test.min_detections
     for k in range(test.min_detections - 1, n):
         if t[k] - clear_since >= _CLEAR_S:
             held[k:] = False
             break
-        if k < 30 or k % 5 == 0 or k == n - 1:
-            sl = slice(max(0, k + 1 - test.max_history), k + 1)
-            last = not range_doppler_consistent(t[sl], rng[sl], vel[sl], width, coupling, test)
-            if not last and test.point_sigma_velocity_mps is not None:
-                last = not doppler_smooth(t[sl], vel[sl], width, test)
-            if not last and k + 1 < test.ground_min_detections:
-                measured = doa[3][sl]
-                last = not direction_measured(measured) or doa_on_the_ground(measured, doa[2][sl])
-            in_air = not last and doa_in_the_air(
-                *(a[sl] for a in doa), test.doa_sigma_rad, test.doa_field_rad
-            )
-            if not last and surface_down is not None and not in_air:
-                fit = (test.sigma_range_m, test.sigma_velocity_mps, test.tail, test.trim)
-                last = fits_static_ground(rng[sl], vel[sl], own_p[sl], own_v[sl], surface_down, width,
-                                          coupling, *fit)  # fmt: skip
+        if k + 1 - start >= least and (k < 30 or k % 5 == 0 or k == n - 1):
+            sl = slice(max(start, k + 1 - test.max_history), k + 1)
+            reason = _judge(sl, t, rng, vel, own_p, own_v, surface_down, width, coupling, test, doa)
+            if reason == "rough":  # a fresh history, as long as the Doppler test's window
+                start, least = max(start, _largest_step(vel, width, sl)), test.ground_min_detections
+            if reason == "ground":  # ground once: as long a history as the Doppler test's to clear it
+                ground_seen, least = True, test.ground_min_detections
+            objects_running = objects_running + 1 if reason == "" else 0
+            last = reason != "" or (ground_seen and objects_running < 2) or k + 1 - start < least
             clear_since = np.inf if last else min(clear_since, t[k])
         held[k] = last
     return held
+
+
+def _largest_step(vel: np.ndarray, width: float, sl: slice) -> int:
+    """Index of the detection after the largest Doppler step in ``sl`` (the newest ten)."""
+    first = max(sl.start, sl.stop - 10)
+    v = np.unwrap(vel[first : sl.stop], period=width)
+    return first + 1 + int(np.argmax(np.abs(np.diff(v)))) if v.size > 1 else sl.start
 
 
 def _track_held(det: np.ndarray, ownship, surface_down, width: float, coupling: float, test) -> np.ndarray:

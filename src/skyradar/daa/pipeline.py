@@ -22,7 +22,7 @@ import pandas as pd
 import xarray as xr
 
 from skyradar.daa.advice import advice_columns
-from skyradar.daa.alerting import AlertConfig, filter_alert_levels, raw_alert_levels
+from skyradar.daa.alerting import AlertConfig, filter_alert_levels, raw_alert_levels, velocity_unconverged
 from skyradar.daa.conflict import traffic_indication
 from skyradar.daa.provenance import check_tracks_match_run
 from skyradar.daa.run_tables import ownship_from_frames, truth_tracks
@@ -43,7 +43,7 @@ def _issued_levels(df: pd.DataFrame, t: np.ndarray, raw: dict, cov_v, config: Al
     """Issued level per row; silences (in ``raw``) unconverged and too young tracks first."""
     if config.max_velocity_sigma_mps is not None and cov_v is not None:
         sigma_hv = np.sqrt(np.nan_to_num(cov_v[:, 0, 0] + cov_v[:, 1, 1], nan=np.inf))
-        unconverged = sigma_hv > config.max_velocity_sigma_mps
+        unconverged = velocity_unconverged(sigma_hv, raw["tcpa_s"], config)
         raw["level"][unconverged] = 0
         raw["flarm_level"][unconverged] = 0
     level = np.zeros(len(df), int)

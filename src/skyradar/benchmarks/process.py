@@ -152,16 +152,20 @@ def run(n_cubes: int = 8, n_targets: int = 5, min_time_s: float = 2.0, seed: int
     # Over relief, the adaptive nulls against their numpy baseline (skyradar.benchmarks.process_adaptive).
     from skyradar.benchmarks.process_adaptive import run_adaptive
 
-    return suppressed | run_adaptive(seed=seed) | {
-        "frames_per_s": float(ours),
-        "baseline_frames_per_s": float(base),
-        "speedup": float(ours / base),
-        "cpu_frames_per_s": float(ours_cpu),
-        "frames_per_s_with_spur_map": float(masked),
-        "baseline_cpu_frames_per_s": float(base_cpu),
-        "load_average_1min": float(os.getloadavg()[0]),
-        "cube_shape": [config.n_range, config.n_doppler, config.n_rx],
-        "targets_per_frame": n_targets,
-        "detections_per_frame": float(n_ours),
-        "baseline_detections_per_frame": float(n_base),
-    }
+    return (
+        suppressed
+        | run_adaptive(seed=seed)
+        | {
+            "frames_per_s": float(ours),
+            "baseline_frames_per_s": float(base),
+            "speedup": float(ours / base),
+            "cpu_frames_per_s": float(ours_cpu),
+            "frames_per_s_with_spur_map": float(masked),
+            "baseline_cpu_frames_per_s": float(base_cpu),
+            "load_average_1min": float(os.getloadavg()[0]),
+            "cube_shape": [config.n_range, config.n_doppler, config.n_rx],
+            "targets_per_frame": n_targets,
+            "detections_per_frame": float(n_ours),
+            "baseline_detections_per_frame": float(n_base),
+        }
+    )

@@ -145,8 +145,9 @@ def velocity_unconverged(sigma_hv_mps: np.ndarray, tcpa_s: np.ndarray, config: A
     warning's alerting time, so it is the plain velocity gate for a CPA that far or farther, and
     lets a track closing fast from short range (first seen late over clutter, its cross-range
     velocity still converging) warn: at 8 s to CPA a 10 m/s velocity error moves the miss by
-    80 m, an eighth of the 670 m volume. The time to CPA is floored at 5 s (and a diverging
-    track's, negative, counts as 5 s).
+    80 m, an eighth of the 670 m volume. The time to CPA is floored at 8 s (a diverging track's,
+    negative, counts as 8 s), so no track warns with a velocity sigma above about three times
+    ``max_velocity_sigma_mps``, however close its CPA: such a velocity says nothing about the miss.
 
     Examples
     --------
@@ -157,7 +158,7 @@ def velocity_unconverged(sigma_hv_mps: np.ndarray, tcpa_s: np.ndarray, config: A
     if config.max_velocity_sigma_mps is None:
         return np.zeros(np.shape(sigma_hv_mps), bool)
     warning_s = config.levels[-1].alerting_time_s
-    t = np.clip(np.nan_to_num(np.asarray(tcpa_s, float), nan=warning_s), 5.0, warning_s)
+    t = np.clip(np.nan_to_num(np.asarray(tcpa_s, float), nan=warning_s), 8.0, warning_s)
     return (
         np.nan_to_num(np.asarray(sigma_hv_mps, float), nan=np.inf) * t
         > config.max_velocity_sigma_mps * warning_s

@@ -66,6 +66,13 @@ def _set(column: str, value, rows=slice(0, 1)):
     return change
 
 
+def _add_flag(column: str, first_value):
+    def change(df):
+        df[column] = [first_value] + ["yes"] * (len(df) - 1)  # parquet: one type per column
+
+    return change
+
+
 @pytest.mark.parametrize(
     ("name", "change", "needles"),
     [
@@ -76,6 +83,12 @@ def _set(column: str, value, rows=slice(0, 1)):
         ("str_v.parquet", _set("vn_mps", "fast", slice(None)), ["str_v.parquet", "'vn_mps'", "fast"]),
         # An infinite position was dropped like a missing one: no alert and no word.
         ("inf_n.parquet", _set("north_m", np.inf, slice(None)), ["inf_n.parquet", "'north_m'", "inf"]),
+        # The altitude flag is read as a boolean; "maybe" must not become True.
+        (
+            "alt_flag.parquet",
+            _add_flag("altitude_measured", "maybe"),
+            ["alt_flag.parquet", "'altitude_measured'", "maybe"],
+        ),
     ],
 )
 def test_alert_refuses_corrupt_track_values(tiny_run, name, change, needles):

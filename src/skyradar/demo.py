@@ -64,10 +64,11 @@ def alert_timeline(alerts: pd.DataFrame, labels: dict[int, str]) -> pd.DataFrame
     """One row per change of a track's issued alert level (the first row of each track included).
 
     Columns ``time_s, track_id, intruder, level, level_name, range_m, bearing_deg, rel_alt_m,
-    time_to_impact_s, preferred_heading_deg, preferred_vs_mps``.
+    time_to_impact_s, preferred_heading_deg, preferred_vs_mps, altitude_measured`` (those the alerts
+    have).
     """
     cols = ["time_s", "track_id", "level", "range_m", "bearing_deg", "rel_alt_m", "time_to_impact_s"]
-    cols += [c for c in ("preferred_heading_deg", "preferred_vs_mps") if c in alerts]
+    cols += [c for c in ("preferred_heading_deg", "preferred_vs_mps", "altitude_measured") if c in alerts]
     a = alerts.sort_values(["track_id", "time_s"], kind="stable")
     change = a["level"].ne(a.groupby("track_id")["level"].shift())
     out = a.loc[change & (a["level"].gt(0) | a.groupby("track_id")["level"].shift().gt(0)), cols]

@@ -21,9 +21,9 @@ def format_timeline(timeline) -> str:
     lines = ["alert timeline (time, track, intruder, level, range, bearing, relative altitude, advice):"]
     for r in timeline.itertuples(index=False):
         heading = float(getattr(r, "preferred_heading_deg", float("nan")))
-        advice = ""
+        advice = "" if getattr(r, "altitude_measured", True) else " (not measured)"
         if r.level > 0 and math.isfinite(heading):
-            advice = f"  advice: heading {heading:.0f} deg, vs {r.preferred_vs_mps:+.1f} m/s"
+            advice += f"  advice: heading {heading:.0f} deg, vs {r.preferred_vs_mps:+.1f} m/s"
         lines.append(
             f"  t={r.time_s:6.1f} s  T{r.track_id:<4d} {r.intruder:<10s} {r.level} {r.level_name:<10s} "
             f"range {r.range_m:6.0f} m  bearing {r.bearing_deg:+5.0f} deg  "

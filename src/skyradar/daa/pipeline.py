@@ -7,7 +7,9 @@ Alerts table (output), one row per track per frame: ``time_s, track_id, level`` 
 1 preventive, 2 corrective, 3 warning), ``raw_level, flarm_level, t_in_s`` (predicted loss of well
 clear), ``time_to_impact_s, tcpa_s, hmd_m, vmd_m, range_m, bearing_deg`` (relative to the heading,
 positive right), ``sector`` (0..11 clockwise from dead ahead), ``layer`` (-2..2), ``rel_north_m,
-rel_east_m, rel_alt_m`` (positive above), ``climb_rate_mps`` (intruder, positive up), and the advice
+rel_east_m, rel_alt_m`` (positive above), ``climb_rate_mps`` (intruder, positive up),
+``altitude_measured`` (False: the track's height is a co-altitude prior, no elevation of it was
+measured; the tracks table's flag, True for tables without it), and the advice
 of that frame, repeated on every row of the frame (empty/NaN when no track alerts):
 ``heading_bands_deg, vs_bands_mps, terrain_vs_bands_mps`` (flattened conflict intervals
 ``[lo0, hi0, lo1, hi1, ...]``), ``preferred_heading_deg, preferred_vs_mps``.
@@ -71,8 +73,16 @@ def _alerts_table(df, t, level, raw, s, v_int, yaw_rad) -> pd.DataFrame:
             "rel_east_m": s[:, 1],
             "rel_alt_m": ind["rel_alt_m"],
             "climb_rate_mps": -v_int[:, 2],
+            # False: the track's height is the co-altitude prior, rel_alt_m is not a measurement.
+            "altitude_measured": _altitude_measured(df),
         }
     )
+
+
+def _altitude_measured(df: pd.DataFrame) -> np.ndarray:
+    if "altitude_measured" not in df:  # truth tracks and tables from before the flag
+        return np.ones(len(df), bool)
+    return df["altitude_measured"].to_numpy(bool)  # checked by clean_tracks
 
 
 def alerts_from_tracks(

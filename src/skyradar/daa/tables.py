@@ -49,18 +49,23 @@ def clean_tracks(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
         raise InputError(f"{source}: field 'track_id' is not a whole number at row {bad} ({ids[bad]!r})")
     # Track ids stay integers in the alerts, as the tracker wrote them.
     df = df.assign(**cols | {"track_id": ids.astype(np.int64)})
+    for name in ("confirmed", "altitude_measured"):
+        if name in df:
+            df = df.assign(**{name: _flag(df[name], name, source)})
     if "confirmed" in df:
-        flag = df["confirmed"]
-        if flag.dtype != bool and not flag.isin([0, 1]).all():
-            bad = int(np.flatnonzero(~flag.isin([0, 1]))[0])
-            raise InputError(
-                f"{source}: field 'confirmed' is not a boolean at row {bad} ({flag.iloc[bad]!r})"
-            )
-        df = df[flag.astype(bool).to_numpy()]
+        df = df[df["confirmed"].to_numpy()]
     ok = np.isfinite(df[TRACK_COLUMNS[2:]].to_numpy(float)).all(axis=1)
     clean = df[ok].sort_values(["time_s", "track_id"], kind="stable").reset_index(drop=True)
     clean.attrs["rows_skipped_no_state"] = int((~ok).sum())
     return clean
+
+
+def _flag(flag: pd.Series, name: str, source: str) -> np.ndarray:
+    """A boolean column (or 0/1) as bools, else InputError naming the first bad row."""
+    if flag.dtype != bool and not flag.isin([0, 1]).all():
+        bad = int(np.flatnonzero(~flag.isin([0, 1]))[0])
+        raise InputError(f"{source}: field '{name}' is not a boolean at row {bad} ({flag.iloc[bad]!r})")
+    return flag.astype(bool).to_numpy()
 
 
 def interp_ownship(own: pd.DataFrame, times: np.ndarray, source: str) -> dict[str, np.ndarray]:

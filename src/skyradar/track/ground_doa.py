@@ -1,4 +1,6 @@
-"""Direction-of-arrival evidence for the track-level ground test (:mod:`skyradar.track.ground_tracks`).
+"""Direction-of-arrival evidence of tracks: for the ground test and the altitude flag.
+
+The ground test is :mod:`skyradar.track.ground_tracks`.
 
 A detection's direction says where a track is only when its elevation was measured: after two
 clutter nulls the 2x2 array often cannot measure it and ``process.clutter_doa`` places the
@@ -9,12 +11,20 @@ of height either way, so each rule here counts measured elevations only.
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 
 DOA_COLUMNS = ("azimuth_rad", "elevation_rad", "north_m", "east_m", "down_m", "elevation_measured")
 DOA_SIGMA_RAD = float(np.radians(2.0))  # CRLB at 13-20 dB plus attitude errors
 DOA_FIELD_RAD = float(np.radians(45.0))  # half-angle of boresight inside which that holds
 
-__all__ = ["DOA_COLUMNS", "doa_height_sd", "doa_in_the_air", "direction_measured", "doa_on_the_ground"]
+__all__ = [
+    "DOA_COLUMNS",
+    "doa_height_sd",
+    "doa_in_the_air",
+    "direction_measured",
+    "doa_on_the_ground",
+    "altitude_measured",
+]
 
 
 def doa_height_sd(det: np.ndarray, surface_down, sigma_rad: float = DOA_SIGMA_RAD) -> list[np.ndarray]:
@@ -117,3 +127,36 @@ def doa_on_the_ground(elevation_measured, height_sd, n: int = 10, max_sd: float 
     z = np.asarray(height_sd, float)[-n:]
     measured = np.asarray(elevation_measured, bool)[-n:] & np.isfinite(z)
     return bool(measured.sum() >= 3 and np.median(z[measured]) < max_sd)
+
+
+def altitude_measured(
+    track_id: np.ndarray, detection_row: np.ndarray, detections: pd.DataFrame, n: int = 10, least: int = 3
+) -> np.ndarray:
+    """Per row of a tracks table: whether its altitude rests on measured elevations.
+
+    True where at least ``least`` of the track's last ``n`` detections up to that row (rows in
+    time order) had a measured elevation (:func:`direction_measured`'s rule). Where the nulls left
+    every elevation unmeasured, the track flies at ``process.clutter_doa``'s co-altitude prior: its
+    height is an assumption, and an alert on it says so. Detections without
+    ``elevation_measured``: measured when they carry a 3-D position, else not.
+
+    Examples
+    --------
+    >>> det = pd.DataFrame({"north_m": 0.0, "elevation_measured": [True, True, False, True]})
+    >>> altitude_measured(np.array([1, 1, 1, 1, 1]), np.array([0, 1, -1, 2, 3]), det, least=2).tolist()
+    [False, True, True, True, True]
+    """
+    ids, rows = np.asarray(track_id), np.asarray(detection_row)
+    if "elevation_measured" in detections.columns:
+        per_detection = detections["elevation_measured"].fillna(False).to_numpy(bool)
+    else:
+        per_detection = np.full(len(detections), "north_m" in detections.columns)
+    has = rows >= 0
+    measured = np.zeros(rows.size, bool)
+    measured[has] = per_detection[rows[has]]
+    out = np.zeros(rows.size, bool)
+    for idx in pd.Series(ids).groupby(ids, sort=False).indices.values():
+        seen = np.cumsum(has[idx])  # detections of the track up to each row
+        counted = np.concatenate([[0], np.cumsum(measured[idx][has[idx]])])
+        out[idx] = counted[seen] - counted[np.maximum(seen - n, 0)] >= least
+    return out

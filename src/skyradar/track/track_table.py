@@ -8,6 +8,7 @@ import pandas as pd
 from skyradar.config import RadarConfig
 from skyradar.track.frame_grid import frame_grid, frame_numbers
 from skyradar.track.fusion import fuse_heads, restore_detection_rows
+from skyradar.track.ground_doa import altitude_measured
 from skyradar.track.ground_tracks import GroundTrackTest, hold_ground_tracks
 from skyradar.track.io import validate_detections, validate_ownship
 from skyradar.track.measure3d import angle_sigma_rad, position_covariance
@@ -32,6 +33,7 @@ TRACK_COLUMNS = [
     *[f"cov_pp_{i}{j}" for i in range(3) for j in range(3)],
     *[f"cov_vv_{i}{j}" for i in range(3) for j in range(3)],
     *[f"cov_pv_{i}{j}" for i in range(3) for j in range(3)], "confirmed", "n_updates", "misses", "coasted",
+    "altitude_measured",
 ]  # fmt: skip
 _NED = ("north_m", "east_m", "down_m")
 OWNSHIP_COLUMNS = (
@@ -60,7 +62,7 @@ def empty_tracks() -> pd.DataFrame:
 
     # Integer row indices stay integer so that callers can index with them even when empty.
     def dtype(column: str) -> type:
-        flags = ("confirmed", "coasted")
+        flags = ("confirmed", "coasted", "altitude_measured")
         return np.int64 if column in _INTEGER_COLUMNS else bool if column in flags else float
 
     return pd.DataFrame({c: pd.Series(dtype=dtype(c)) for c in TRACK_COLUMNS}, columns=TRACK_COLUMNS)
@@ -114,6 +116,8 @@ def track_detections(
     later; tentative tracks that never were are dropped. ``confirmed`` is also False on rows where a
     confirmed track has coasted ``confirm_n`` frames or more (``misses``). ``coasted`` marks rows
     without a detection of a track confirmed earlier (a prediction; the track exists until closed).
+    ``altitude_measured`` is False while the track's height is the co-altitude prior
+    (:func:`~skyradar.track.ground_doa.altitude_measured`).
 
     Parameters
     ----------
@@ -156,7 +160,9 @@ def track_detections(
     grid, lo, hi = _frame_slices(detections["time_s"].to_numpy(float), frame_times_s)
     m3 = _Measure3D(detections, config, motion, position_sigma_rad, ownship, grid)
     tracks = _assemble(_run_tracker(tracker, m3, detections, grid, lo, hi), origin, m3.active)
-    return restore_detection_rows(_held(tracks, detections, ownship, config, ground_test), head_rows)
+    tracks = _held(tracks, detections, ownship, config, ground_test)
+    measured = altitude_measured(tracks["track_id"], tracks["detection_row"], detections)
+    return restore_detection_rows(tracks.assign(altitude_measured=measured), head_rows)
 
 
 def _make_tracker(model, config: RadarConfig, tracker_config) -> tuple[MotionModel, RangeDopplerTracker]:

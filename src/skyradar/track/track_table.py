@@ -116,8 +116,7 @@ def track_detections(
     later; tentative tracks that never were are dropped. ``confirmed`` is also False on rows where a
     confirmed track has coasted ``confirm_n`` frames or more (``misses``). ``coasted`` marks rows
     without a detection of a track confirmed earlier (a prediction; the track exists until closed).
-    ``altitude_measured`` is False while the track's height is the co-altitude prior
-    (:func:`~skyradar.track.ground_doa.altitude_measured`).
+    ``altitude_measured``: False while the height is the co-altitude prior (`track.ground_doa`).
 
     Parameters
     ----------
@@ -135,9 +134,8 @@ def track_detections(
     position_sigma_rad : float, optional
         Fixed angular accuracy of DoA positions (default: the bound; 0.04 rad without ``snr_db``).
     ownship : DataFrame, optional
-        :data:`OWNSHIP_COLUMNS` (NED, interpolated to the frame times). With it the DoA position
-        error is split along/across the line of sight and the de-aliased radial velocity updates
-        the 3-D velocity (:mod:`skyradar.track.tracker3d`).
+        :data:`OWNSHIP_COLUMNS` (NED, at the frame times): splits the DoA position error along and
+        across the line of sight; the de-aliased radial velocity updates the 3-D velocity.
     ground_test : GroundTrackTest or bool
         Hold back tracks the ground explains (:mod:`skyradar.track.ground_tracks`); False: off.
 
@@ -160,9 +158,7 @@ def track_detections(
     grid, lo, hi = _frame_slices(detections["time_s"].to_numpy(float), frame_times_s)
     m3 = _Measure3D(detections, config, motion, position_sigma_rad, ownship, grid)
     tracks = _assemble(_run_tracker(tracker, m3, detections, grid, lo, hi), origin, m3.active)
-    tracks = _held(tracks, detections, ownship, config, ground_test)
-    measured = altitude_measured(tracks["track_id"], tracks["detection_row"], detections)
-    return restore_detection_rows(tracks.assign(altitude_measured=measured), head_rows)
+    return restore_detection_rows(_held(tracks, detections, ownship, config, ground_test), head_rows)
 
 
 def _make_tracker(model, config: RadarConfig, tracker_config) -> tuple[MotionModel, RangeDopplerTracker]:
@@ -172,7 +168,10 @@ def _make_tracker(model, config: RadarConfig, tracker_config) -> tuple[MotionMod
 
 
 def _held(tracks, detections, ownship, config: RadarConfig, ground_test) -> pd.DataFrame:
-    """:func:`~skyradar.track.ground_tracks.hold_ground_tracks` with ``ground_test``'s settings."""
+    """:func:`~skyradar.track.ground_tracks.hold_ground_tracks` with ``ground_test``'s settings,
+    and the rows' ``altitude_measured`` flag."""
+    measured = altitude_measured(tracks["track_id"], tracks["detection_row"], detections)
+    tracks = tracks.assign(altitude_measured=measured)
     if ground_test is False:
         return tracks
     test = ground_test if isinstance(ground_test, GroundTrackTest) else GroundTrackTest()

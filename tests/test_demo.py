@@ -68,6 +68,26 @@ def test_label_tracks_follows_nearest_truth_and_flags_clutter():
     assert label_tracks(tracks, truth) == {7: "b", 8: "a", 9: "clutter"}
 
 
+def test_label_tracks_matches_a_prior_height_track_by_range_and_bearing():
+    # Intruder "a" 339 m above the own-ship (at the origin), closing from 700 m north; its track
+    # has no measured elevation and flies co-altitude at the same slant range and bearing.
+    t = np.arange(5.0)
+    north = 700.0 - 20.0 * t
+    dims = ("time", "target")
+    data = {"tgt_north_m": (dims, north[:, None]), "tgt_east_m": (dims, np.zeros((5, 1))),
+            "tgt_down_m": (dims, np.full((5, 1), -339.0))}  # fmt: skip
+    data |= {f"own_{axis}_m": ("time", np.zeros(5)) for axis in ("north", "east", "down")}
+    truth = xr.Dataset(data, coords={"time": t, "target": ["a"]})
+    slant = np.hypot(north, 339.0)
+    track = pd.DataFrame({"time_s": t, "track_id": 5, "north_m": slant, "east_m": 0.0, "down_m": 0.0})
+    assert label_tracks(track.assign(altitude_measured=False), truth) == {5: "a"}
+    # The same positions said to be measured are 340 m off: not the intruder's.
+    assert label_tracks(track.assign(altitude_measured=True), truth) == {5: "clutter"}
+    # A prior-height track elsewhere in bearing is still clutter.
+    aside = track.assign(north_m=0.0, east_m=slant, altitude_measured=False)
+    assert label_tracks(aside, truth) == {5: "clutter"}
+
+
 def test_alert_timeline_lists_each_level_change():
     alerts = pd.DataFrame({
         "time_s": [0, 1, 2, 3, 4, 0, 1, 2], "track_id": [1, 1, 1, 1, 1, 2, 2, 2],

@@ -9,7 +9,7 @@ import pytest
 
 from cli_helpers import assert_one_line_error, skyradar
 from skyradar.experiments.encounter_report import cost_ms_per_frame
-from skyradar.experiments.encounter_score import CAUSES, conflict_cause, summarise_layout
+from skyradar.experiments.encounter_score import CAUSES, conflict_cause, summarise_layout, track_counts
 from skyradar.experiments.encounter_set import make_encounters
 from skyradar.experiments.encounter_terrain import mirror_below_ground, own_altitude_m, parse_terrains
 
@@ -78,6 +78,28 @@ def test_summary_over_all_conflicts_by_cause_with_clutter_and_fragments():
     # Fragments over the encounters whose intruder has a track: 1, 2, 3, 1, 1, 1, 4.
     assert s["intruder_tracked_encounters"] == 7
     assert s["track_fragments_per_intruder"] == {"median": 1.0, "mean": pytest.approx(13 / 7), "max": 4}
+
+
+def test_clutter_tracks_on_the_surface_or_without_a_measured_altitude_are_ground_tracks():
+    from skyradar.scene.terrain import Terrain
+
+    flat = Terrain.projected(np.full((5, 5), 100.0), 52.0, 4.0, dy_m=1000.0, dx_m=1000.0)
+    rows = {  # track id: (altitude m, altitude measured); own-ship 500 m above the ground
+        1: (110.0, True),  # on the surface: ground
+        2: (590.0, True),  # in the air, measured: clutter only
+        3: (590.0, False),  # co-altitude prior on every row: its height says nothing
+        4: (600.0, True),  # the intruder
+    }
+    tracks = pd.DataFrame([
+        {"track_id": tid, "alt_m": alt, "lat_deg": 51.99, "lon_deg": 4.01, "altitude_measured": known}
+        for tid, (alt, known) in rows.items() for _ in range(3)
+    ])  # fmt: skip
+    labels = {1: "clutter", 2: "clutter", 3: "clutter", 4: "intruder"}
+    counts = track_counts(tracks, {3}, labels, flat, own_agl_m=500.0)
+    assert counts == {"intruder_tracks": 1, "clutter_tracks": 3, "clutter_warning_tracks": 1,
+                      "ground_tracks": 2, "ground_warning_tracks": 1}  # fmt: skip
+    without_flag = track_counts(tracks.drop(columns="altitude_measured"), {3}, labels, flat, own_agl_m=500.0)
+    assert without_flag["ground_tracks"] == 1
 
 
 def test_cost_per_frame_counts_the_shared_simulation_once():

@@ -170,6 +170,10 @@ def _surface(built, own: pd.DataFrame):
 def label_tracks(tracks: pd.DataFrame, truth: xr.Dataset, max_distance_m: float = _MATCH_M) -> dict[int, str]:
     """Name of the intruder each track follows (median 3-D distance to its truth), else ``'clutter'``.
 
+    On rows whose height is the co-altitude prior (``altitude_measured`` False) the distance is
+    taken in what the radar measured, slant range and bearing from the own-ship (``own_*`` in
+    ``truth``): such a track is its intruder's even when it flies 300 m above.
+
     Examples
     --------
     >>> t = xr.Dataset({"tgt_north_m": (("time", "target"), [[0.0]]), "tgt_east_m": (("time", "target"),
@@ -182,13 +186,32 @@ def label_tracks(tracks: pd.DataFrame, truth: xr.Dataset, max_distance_m: float 
     times = frame_times_s(truth)
     names = [str(x) for x in truth["target"].values]
     truth_pos = np.stack([truth[f"tgt_{a}_m"].values for a in ("north", "east", "down")], -1)
+    own = None
+    if all(f"own_{a}_m" in truth for a in ("north", "east", "down")):
+        own = np.stack([truth[f"own_{a}_m"].values for a in ("north", "east", "down")], -1)
     labels = {}
     for tid, g in tracks.groupby("track_id"):
         idx = np.clip(np.searchsorted(times, g["time_s"].to_numpy(float)), 0, times.size - 1)
-        err = g[["north_m", "east_m", "down_m"]].to_numpy(float)[:, None, :] - truth_pos[idx]
+        pos = g[["north_m", "east_m", "down_m"]].to_numpy(float)
         with np.errstate(all="ignore"):
-            dist = np.linalg.norm(err, axis=-1)
+            dist = np.linalg.norm(pos[:, None, :] - truth_pos[idx], axis=-1)
+            if own is not None and "altitude_measured" in g:
+                prior = ~g["altitude_measured"].to_numpy(bool)
+                dist[prior] = _range_bearing_distance_m(pos[prior], truth_pos[idx[prior]], own[idx[prior]])
             med = np.array([np.nanmedian(d) if np.isfinite(d).any() else np.inf for d in dist.T])
         best = int(np.argmin(med)) if med.size else -1
         labels[int(tid)] = names[best] if best >= 0 and med[best] < max_distance_m else "clutter"
     return labels
+
+
+def _range_bearing_distance_m(
+    track_pos: np.ndarray, truth_pos: np.ndarray, own_pos: np.ndarray
+) -> np.ndarray:
+    """Distance (m) in slant range and horizontal bearing from the own-ship: (k, 3) against (k, n, 3)."""
+    rel_track, rel_truth = track_pos - own_pos, truth_pos - own_pos[:, None, :]
+    d_range = np.linalg.norm(rel_track, axis=-1)[:, None] - np.linalg.norm(rel_truth, axis=-1)
+    bearing = np.arctan2(rel_track[:, 1], rel_track[:, 0])[:, None] - np.arctan2(
+        rel_truth[..., 1], rel_truth[..., 0]
+    )
+    across = np.linalg.norm(rel_truth[..., :2], axis=-1) * np.angle(np.exp(1j * bearing))
+    return np.hypot(d_range, across)

@@ -133,7 +133,9 @@ def track_counts(
 
     ``labels`` from :func:`~skyradar.experiments.daa_chain.label_tracks`; ``warned_ids`` the tracks
     with a warning; ``terrain`` (a :class:`~skyradar.scene.terrain.Terrain` or None) and own-ship's
-    median height above it decide which clutter tracks are ground tracks.
+    median height above it decide which clutter tracks are ground tracks: median height below half
+    the own-ship's, or no measured altitude on any row (``altitude_measured``: its height is the
+    co-altitude prior, so it says nothing, and in a terrain scene clutter is the ground's).
     """
     clutter = [tid for tid, name in labels.items() if name == "clutter"]
     ground: list[int] = []
@@ -145,6 +147,9 @@ def track_counts(
             )
         med = pd.Series(agl, index=rows.index).groupby(rows["track_id"]).median()
         ground = [int(tid) for tid, h in med.items() if not h >= 0.5 * own_agl_m]  # NaN: off the grid
+        if "altitude_measured" in rows:
+            prior_only = ~rows["altitude_measured"].astype(bool).groupby(rows["track_id"]).any()
+            ground = sorted(set(ground) | {int(tid) for tid in prior_only.index[prior_only.to_numpy()]})
     return {
         "intruder_tracks": sum(name != "clutter" for name in labels.values()),
         "clutter_tracks": len(clutter),

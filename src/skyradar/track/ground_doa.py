@@ -16,6 +16,9 @@ import pandas as pd
 DOA_COLUMNS = ("azimuth_rad", "elevation_rad", "north_m", "east_m", "down_m", "elevation_measured")
 DOA_SIGMA_RAD = float(np.radians(2.0))  # CRLB at 13-20 dB plus attitude errors
 DOA_FIELD_RAD = float(np.radians(45.0))  # half-angle of boresight inside which that holds
+# A direction (and the track's height) counts as measured when this many of its last detections had
+# a measured elevation: one rule for the ground test and the tracks' altitude flag.
+MEASURED_LEAST, MEASURED_WINDOW = 3, 10
 
 __all__ = [
     "DOA_COLUMNS",
@@ -95,7 +98,7 @@ def doa_in_the_air(
     return bool(spread <= 3.0 * sigma_rad and np.median(z[inside]) >= 3.0)
 
 
-def direction_measured(elevation_measured, n: int = 10, least: int = 3) -> bool:
+def direction_measured(elevation_measured, n: int = MEASURED_WINDOW, least: int = MEASURED_LEAST) -> bool:
     """Whether at least ``least`` of a track's last ``n`` detections have a measured elevation.
 
     Examples
@@ -130,7 +133,11 @@ def doa_on_the_ground(elevation_measured, height_sd, n: int = 10, max_sd: float 
 
 
 def altitude_measured(
-    track_id: np.ndarray, detection_row: np.ndarray, detections: pd.DataFrame, n: int = 10, least: int = 3
+    track_id: np.ndarray,
+    detection_row: np.ndarray,
+    detections: pd.DataFrame,
+    n: int = MEASURED_WINDOW,
+    least: int = MEASURED_LEAST,
 ) -> np.ndarray:
     """Per row of a tracks table: whether its altitude rests on measured elevations.
 

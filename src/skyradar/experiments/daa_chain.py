@@ -25,6 +25,7 @@ from skyradar.daa.run_tables import ownship_from_frames
 from skyradar.errors import InputError
 from skyradar.io.frames import frames_dataset
 from skyradar.io.frames_model import frame_times_s
+from skyradar.kalman import wrap
 from skyradar.process.detect_run import merge_head_tables
 from skyradar.process.pipeline import process_frames
 from skyradar.scene.radar_heads import select_heads
@@ -213,5 +214,5 @@ def _range_bearing_distance_m(
     bearing = np.arctan2(rel_track[:, 1], rel_track[:, 0])[:, None] - np.arctan2(
         rel_truth[..., 1], rel_truth[..., 0]
     )
-    across = np.linalg.norm(rel_truth[..., :2], axis=-1) * np.angle(np.exp(1j * bearing))
+    across = np.linalg.norm(rel_truth[..., :2], axis=-1) * wrap(bearing, 2.0 * np.pi)
     return np.hypot(d_range, across)

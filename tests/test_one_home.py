@@ -24,6 +24,10 @@ PATTERNS = {
     "Kalman (I-K)P update: use skyradar.kalman.update": re.compile(
         r"\(np\.eye\([^)]*\)\s*-\s*\w+(\s*@\s*\w+)?\)\s*@"
     ),
+    "angle wrap: use skyradar.units.wrap_angle": re.compile(
+        r"np\.angle\(\s*np\.exp\(\s*1j\s*\*\s*\([^()]*(\([^()]*\)[^()]*)*\)\s*\)\s*\)"
+        r"|\+\s*np\.pi\)\s*%\s*\(?\s*2(\.0)?\s*\*\s*np\.pi\)?\s*-\s*np\.pi"
+    ),
 }
 # (path relative to src/skyradar, pattern key prefix) -> why it may stay.
 ALLOWED = {
@@ -76,6 +80,8 @@ def test_the_check_finds_each_kind_of_paste(tmp_path):
         "k = int(round(r / cfg.range_resolution_m))\n"
         "j = (np.floor(v / cfg.doppler_resolution_mps + 0.5) + cfg.n_doppler // 2) % cfg.n_doppler\n"
         "x, p = x + g @ y, (np.eye(3) - g) @ p\n"
+        "d = np.angle(np.exp(1j * (a - b)))\n"
+        "e = (a - b + np.pi) % (2 * np.pi) - np.pi\n"
         "def clean(v):\n"
         "    if isinstance(v, dict):\n"
         "        return {k: clean(x) for k, x in v.items()}\n"
@@ -88,5 +94,7 @@ def test_the_check_finds_each_kind_of_paste(tmp_path):
         "bin rounding",
         "Doppler wrap",
         "Kalman (I-K)P update",
+        "angle wrap",
+        "angle wrap",
         "JSON sanitiser",
     ], kinds

@@ -5,12 +5,12 @@ import pandas as pd
 import pytest
 
 from skyradar.config import RadarConfig
-from skyradar.track.kalman import wrap
 from skyradar.track.measure3d import angle_sigma_rad, position_covariance
 from skyradar.track.models import radar_model
 from skyradar.track.track_table import OWNSHIP_COLUMNS, track_detections
 from skyradar.track.tracker import RangeDopplerTracker, TrackerConfig
 from skyradar.track.tracker3d import RadialObservation, range_rate_update
+from skyradar.units import wrap
 
 CFG = RadarConfig.prototype_2022()
 W = 2 * CFG.v_lim_mps

@@ -6,8 +6,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from skyradar.track.dealias import dealias_velocity, push_history, range_rate_fit
-from skyradar.track.kalman import innovation, predict, update, wrap
+from skyradar.track.kalman import innovation, predict, update
 from skyradar.track.models import MEASUREMENT_MATRIX, radar_model, traditional_model
+from skyradar.units import wrap
 
 W = 78.32
 finite = st.floats(-1e4, 1e4, allow_nan=False, allow_infinity=False)

@@ -11,20 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["wrap", "predict", "innovation_covariance", "update"]
-
-
-def wrap(values: np.ndarray, width: float | np.ndarray) -> np.ndarray:
-    """Wrap ``values`` into ``[-width/2, width/2)``: ``mod(v + W/2, W) - W/2``.
-
-    Examples
-    --------
-    >>> wrap(np.array([39.0, 40.0, -100.0]), 78.0).tolist()
-    [-39.0, -38.0, -22.0]
-    """
-    width = np.asarray(width, float)
-    # floor is faster than np.mod and gives the same result for finite inputs.
-    return values - width * np.floor((values + width / 2.0) / width)
+__all__ = ["predict", "innovation_covariance", "update"]
 
 
 def predict(x: np.ndarray, P: np.ndarray, F: np.ndarray, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["nearest_bin", "centred_bin", "centred_bin_value"]
+__all__ = ["nearest_bin", "centred_bin", "centred_bin_value", "wrap", "wrap_angle"]
 
 
 def nearest_bin(value: ArrayLike, step: float) -> np.ndarray:
@@ -67,3 +67,27 @@ def centred_bin_value(index: ArrayLike, step: float, n_bins: int) -> np.ndarray:
     [-2.0, 0.0, 1.5]
     """
     return (np.asarray(index, float) - n_bins // 2) * step
+
+
+def wrap(values: ArrayLike, width: float | np.ndarray) -> np.ndarray:
+    """Wrap ``values`` into ``[-width/2, width/2)``: ``mod(v + W/2, W) - W/2``.
+
+    Examples
+    --------
+    >>> wrap(np.array([39.0, 40.0, -100.0]), 78.0).tolist()
+    [-39.0, -38.0, -22.0]
+    """
+    values, width = np.asarray(values, float), np.asarray(width, float)
+    # floor is faster than np.mod and gives the same result for finite inputs.
+    return values - width * np.floor((values + width / 2.0) / width)
+
+
+def wrap_angle(angle_rad: ArrayLike) -> np.ndarray:
+    """An angle (or a difference of angles) wrapped into ``[-pi, pi)``, rad.
+
+    Examples
+    --------
+    >>> wrap_angle(np.radians([190.0, -190.0, 45.0])).round(4).tolist()
+    [-2.9671, 2.9671, 0.7854]
+    """
+    return wrap(angle_rad, 2.0 * np.pi)

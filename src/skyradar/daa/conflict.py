@@ -20,6 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from skyradar.units import wrap_angle
+
 __all__ = [
     "FT",
     "WellClearVolume",
@@ -341,8 +343,7 @@ def traffic_indication(
     (3, 200.0, 1)
     """
     s = np.asarray(s, float)
-    bearing = np.arctan2(s[..., 1], s[..., 0]) - np.asarray(heading_rad, float)
-    bearing = (bearing + np.pi) % (2 * np.pi) - np.pi
+    bearing = wrap_angle(np.arctan2(s[..., 1], s[..., 0]) - np.asarray(heading_rad, float))
     sector = np.floor(((np.degrees(bearing) + 15.0) % 360.0) / 30.0).astype(int) % 12
     rel_alt = -s[..., 2]
     elev = np.arctan2(rel_alt, np.hypot(s[..., 0], s[..., 1]))

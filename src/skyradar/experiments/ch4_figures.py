@@ -9,7 +9,7 @@ import numpy as np
 
 from skyradar.config import RadarConfig
 from skyradar.io.atomic import savefig_atomic
-from skyradar.track.kalman import wrap
+from skyradar.units import wrap
 
 __all__ = ["draw_figures"]
 

@@ -46,6 +46,7 @@ from skyradar.nav.ridge import extract_ridge
 from skyradar.nav.terrain_aware import TerrainAwareEstimator
 from skyradar.scene.scenario import MAX_FRAMES
 from skyradar.sim.navigation import AhrsModel, ahrs_attitude
+from skyradar.units import wrap_angle
 
 __all__ = ["ACCEPTANCE", "TERRAINS", "THESIS_TABLE", "TYPICAL_AHRS", "check_run_options", "run"]
 
@@ -192,7 +193,7 @@ def _errors(table: pd.DataFrame, flight: Flight, warmup_s: float, attitude: np.n
     # The attitude error the estimators were given (0 with the truth): an AHRS bias shows up as
     # a mean error, mainly V_Z ~ -V * pitch error for the terrain-aware method.
     diff = attitude - flight.attitude_rad
-    att_err = np.degrees((diff + np.pi) % (2.0 * np.pi) - np.pi)[keep]  # yaw across +-pi
+    att_err = np.degrees(wrap_angle(diff))[keep]  # yaw across +-pi
     for i, axis in enumerate(("yaw", "pitch", "roll")):
         out[f"{axis}_err_mean_deg"] = _stat(att_err[:, i], np.mean)
     # A method that estimates nothing must show it: the error statistics skip NaN frames, so the

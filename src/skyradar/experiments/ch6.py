@@ -47,6 +47,7 @@ from skyradar.nav.gpscheck.monitor import DEFAULT_SETTINGS, WING_UP, inconsisten
 from skyradar.nav.gpscheck.preprocess import METHODS, preprocess
 from skyradar.nav.gpscheck.projection import frame_power, ground_image, ground_in_view_fraction
 from skyradar.nav.gpscheck.search import search_offset
+from skyradar.units import wrap_angle
 
 __all__ = ["THESIS_TABLE", "SPOOF_CASES", "ACCEPTANCE", "run"]
 
@@ -141,7 +142,7 @@ def _score_frame(
         err = gps + np.array([off.d_north_m, off.d_east_m, np.radians(off.d_heading_deg)]) - truth
         rows.append({"frame": k, "kind": "search", "method": DEFAULT_METHOD, "case": case,
                      "position_error_m": float(np.hypot(err[0], err[1])),
-                     "heading_error_deg": float(abs(np.degrees((err[2] + np.pi) % (2 * np.pi) - np.pi))),
+                     "heading_error_deg": float(abs(np.degrees(wrap_angle(err[2])))),
                      "psr": off.psr, "statistic": inconsistency(off, DEFAULT_SETTINGS),
                      "decided": bool(fraction >= DEFAULT_SETTINGS.min_ground_fraction
                                      and off.psr >= DEFAULT_SETTINGS.min_psr)})  # fmt: skip

@@ -10,6 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from skyradar.units import wrap_angle
+
 __all__ = ["Leg", "Flight", "fly"]
 
 G_MPS2 = 9.80665
@@ -64,6 +66,6 @@ def fly(
     pick = np.arange(0, n_steps + 1, int(round(frame_interval_s / step_s)))
     position = np.column_stack([north, east, np.full(t.size, start_ned_m[2])])[pick]
     velocity = np.column_stack([vn, ve, np.zeros(t.size)])[pick]
-    yaw = (heading[pick] + np.pi) % (2 * np.pi) - np.pi
+    yaw = wrap_angle(heading[pick])
     attitude = np.column_stack([yaw, np.zeros(pick.size), bank[pick]])
     return Flight(t[pick], position, velocity, attitude)

@@ -25,13 +25,13 @@ from skyradar.daa.run_tables import ownship_from_frames
 from skyradar.errors import InputError
 from skyradar.io.frames import frames_dataset
 from skyradar.io.frames_model import frame_times_s
-from skyradar.kalman import wrap
 from skyradar.process.detect_run import merge_head_tables
 from skyradar.process.pipeline import process_frames
 from skyradar.scene.radar_heads import select_heads
 from skyradar.sim.scenario_frames import make_simulator, scenario_truth, simulate_frames
 from skyradar.track.ground_tracks import GroundTrackTest, median_ground_down_m, terrain_surface
 from skyradar.track.track_table import track_detections
+from skyradar.units import wrap
 
 __all__ = ["run_chain", "track_and_alert", "label_tracks"]
 

@@ -32,6 +32,7 @@ import numpy as np
 import pandas as pd
 
 from skyradar.experiments.encounter_set import summarise
+from skyradar.units import wrap_angle
 
 __all__ = ["CAUSES", "frame_status", "conflict_cause", "unwarned_cause", "track_counts", "summarise_layout"]
 
@@ -51,7 +52,7 @@ def frame_status(truths: list, fov_deg: float = 70.0, min_snr_db: float = 13.0) 
     first = truths[0]
     rel_n = first["tgt_north_m"].values[:, 0] - first["own_north_m"].values
     rel_e = first["tgt_east_m"].values[:, 0] - first["own_east_m"].values
-    bearing = np.angle(np.exp(1j * (np.arctan2(rel_e, rel_n) - first["own_yaw_rad"].values)))
+    bearing = wrap_angle(np.arctan2(rel_e, rel_n) - first["own_yaw_rad"].values)
     in_beam = np.zeros(rel_n.size, bool)
     in_view, observable = in_beam.copy(), in_beam.copy()
     for truth in truths:

@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from skyradar.units import wrap_angle
+
 __all__ = ["C_MPS", "bistatic_range_m", "ellipse_point", "receiver_range_willis", "in_blind_zone"]
 
 C_MPS = 299_792_458.0
@@ -96,5 +98,5 @@ def in_blind_zone(
     >>> in_blind_zone([100.0, 5000.0, 5000.0], [1.0, 1.0, 0.01], 0.0, 500.0, 0.05).tolist()
     [True, False, True]
     """
-    off = np.abs(np.angle(np.exp(1j * (np.asarray(azimuth_rad, dtype=float) - bearing_rad))))
+    off = np.abs(wrap_angle(np.asarray(azimuth_rad, dtype=float) - bearing_rad))
     return (np.asarray(bistatic_range, dtype=float) < min_bistatic_range_m) | (off < half_width_rad)

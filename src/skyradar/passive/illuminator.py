@@ -28,6 +28,7 @@ from dataclasses import asdict, dataclass, field, fields, replace
 import numpy as np
 
 from skyradar.errors import InputError
+from skyradar.units import wrap_angle
 
 __all__ = ["C_MPS", "Pulse", "Illuminator", "lfm_baseband"]
 
@@ -234,7 +235,7 @@ class Illuminator:
         Gaussian main lobe ``exp(-4 ln2 (d / bw)^2)``; beyond it the sidelobe envelope
         ``sidelobe * (d1 / d)^2`` (``d1`` where the main lobe meets ``sidelobe``), floored at ``backlobe``.
         """
-        d = np.abs(np.mod(np.asarray(delta_az_rad, dtype=float) + np.pi, 2 * np.pi) - np.pi)
+        d = np.abs(wrap_angle(delta_az_rad))
         bw = np.radians(self.beamwidth_az_deg)
         main = np.exp(-4.0 * np.log(2.0) * (d / bw) ** 2)
         sl, bl = 10.0 ** (self.sidelobe_db / 10.0), 10.0 ** (self.backlobe_db / 10.0)

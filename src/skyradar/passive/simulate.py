@@ -35,6 +35,7 @@ from skyradar.io.sigmf_io import SigmfWriter, sigmf_paths
 from skyradar.passive.budget import direct_path_power_w, echo_power_w
 from skyradar.passive.illuminator import C_MPS
 from skyradar.passive.scene import PassiveScene, bistatic_geometry
+from skyradar.units import wrap_angle
 
 __all__ = ["NOISE_BLOCK", "check_sample_rate", "simulate_chunk", "simulate_recording"]
 
@@ -162,7 +163,7 @@ class _Synthesiser:
             # Only reflectors within the sidelobe reach of the arc the beam sweeps here rise above the floor.
             sweep = ill.rotation_rate_rad_s * (t_emit[-1] - t_emit[0])
             centre = ill.beam_azimuth_rad(0.5 * (t_emit[0] + t_emit[-1]), scene.azimuth_at_t0_rad)
-            off = np.abs(np.mod(self.az - centre + np.pi, 2 * np.pi) - np.pi)
+            off = np.abs(wrap_angle(self.az - centre))
             near = np.nonzero(off <= 0.5 * sweep + ill.sidelobe_reach_rad + 1e-6)[0]
             excess = np.sqrt(ill.pattern_gain(self.az[near][None, :] - az_beam[:, None])) - self.floor
             i_pulse, i_near = np.nonzero(excess > 1e-12 * self.floor)

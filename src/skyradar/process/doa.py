@@ -49,6 +49,7 @@ import numpy as np
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
+from skyradar.units import wrap_angle
 
 __all__ = [
     "ArrayGeometry",
@@ -304,7 +305,7 @@ def estimate_directions(
     pred = a0 @ geo.design.T
     resid = np.angle(z * np.conj(z[:, :1])) - pred
     common = np.angle(np.sum(np.exp(1j * resid), axis=1, keepdims=True))
-    unwrapped = pred + common + np.angle(np.exp(1j * (resid - common)))
+    unwrapped = pred + common + wrap_angle(resid - common)
     a = unwrapped @ geo.solve.T
     if geo.normal is None:
         u = a / np.maximum(np.linalg.norm(a, axis=1, keepdims=True), 1e-300)

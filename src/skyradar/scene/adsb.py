@@ -41,6 +41,7 @@ import pandas as pd
 from skyradar.errors import InputError
 from skyradar.geo import geodetic_to_ned
 from skyradar.scene.adsb_clean import altitude_m, clean_rows, readsb_trace, time_seconds
+from skyradar.units import wrap_angle
 
 __all__ = ["FT_M", "KT_MPS", "FPM_MPS", "read_track_table", "read_trajectory", "read_trajectories"]
 
@@ -247,7 +248,7 @@ def _velocity_of_positions(vel: np.ndarray, derived: np.ndarray, notes: list[str
     aircraft at 10 g between fixes. Real ADS-B of a circling glider at 5-12 s is off by 5-8 m/s.
     """
     moving = np.linalg.norm(derived[:, :2], axis=1) > 5.0
-    off = np.angle(np.exp(1j * (np.arctan2(vel[:, 1], vel[:, 0]) - np.arctan2(derived[:, 1], derived[:, 0]))))
+    off = wrap_angle(np.arctan2(vel[:, 1], vel[:, 0]) - np.arctan2(derived[:, 1], derived[:, 0]))
     angle_deg = float(np.degrees(np.nanmedian(np.abs(off[moving])))) if moving.sum() >= 3 else 0.0
     if not angle_deg > 45.0:
         return vel

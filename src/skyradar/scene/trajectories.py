@@ -26,6 +26,7 @@ from scipy.interpolate import CubicHermiteSpline
 
 from skyradar.errors import InputError
 from skyradar.geo import geodetic_to_ned, ned_rotation_to, ned_to_geodetic
+from skyradar.units import wrap_angle
 
 __all__ = [
     "GRAVITY_MPS2",
@@ -237,7 +238,7 @@ class Trajectory:
         pos = self._spline(t)
         vel = self._spline(t, 1)
         att = np.stack([np.interp(t, self.time_s, self._unwrapped_attitude[:, k]) for k in range(3)], axis=-1)
-        att[:, [0, 2]] = _wrap_pi(att[:, [0, 2]])
+        att[:, [0, 2]] = wrap_angle(att[:, [0, 2]])
         lat, lon, alt = ned_to_geodetic(pos, *self.origin)
         return TrajectorySample(t, pos, vel, att, np.atleast_1d(lat), np.atleast_1d(lon), np.atleast_1d(alt))
 
@@ -261,10 +262,6 @@ class Trajectory:
         rot = ned_rotation_to(self.origin[0], self.origin[1], lat0, lon0)
         vel = self.velocity_ned_mps @ rot.T
         return replace(self, position_ned_m=pos, velocity_ned_mps=vel, origin=(lat0, lon0, alt0))
-
-
-def _wrap_pi(angle_rad: np.ndarray) -> np.ndarray:
-    return (np.asarray(angle_rad) + np.pi) % (2.0 * np.pi) - np.pi
 
 
 def _ecef_from_ned(lat_deg: np.ndarray, lon_deg: np.ndarray) -> np.ndarray:
@@ -356,7 +353,7 @@ def derive_attitude(
     speed = np.linalg.norm(v, axis=1)
     roll = np.arctan(speed * turn_rate / g_mps2)
     pitch = np.arctan2(-v[:, 2], ground)
-    return np.stack([_wrap_pi(track), pitch, roll], axis=-1)
+    return np.stack([wrap_angle(track), pitch, roll], axis=-1)
 
 
 _REEXPORTS = {

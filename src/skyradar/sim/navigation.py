@@ -26,6 +26,7 @@ import numpy as np
 from skyradar.errors import InputError
 from skyradar.geo import ned_to_geodetic
 from skyradar.scene.navigation_config import NavigationConfig, navigation_config
+from skyradar.units import wrap_angle
 
 __all__ = [
     "AhrsModel",
@@ -102,7 +103,7 @@ def _check(times: np.ndarray, attitude: np.ndarray, model: AhrsModel) -> None:
 
 def _wrap(yaw: np.ndarray) -> np.ndarray:
     # Wrap only what left [-pi, pi): the rest stays bit-exact (a zero model returns the truth).
-    return np.where((yaw < -np.pi) | (yaw >= np.pi), (yaw + np.pi) % (2.0 * np.pi) - np.pi, yaw)
+    return np.where((yaw < -np.pi) | (yaw >= np.pi), wrap_angle(yaw), yaw)
 
 
 def ahrs_attitude(

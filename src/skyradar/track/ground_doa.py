@@ -27,13 +27,14 @@ __all__ = [
     "direction_measured",
     "doa_on_the_ground",
     "altitude_measured",
+    "elevation_measured_flags",
 ]
 
 
 def doa_height_sd(det: np.ndarray, surface_down, sigma_rad: float = DOA_SIGMA_RAD) -> list[np.ndarray]:
     """Azimuth and elevation (antenna frame) of each detection, its DoA position's height above
     the surface in standard deviations (range x ``sigma_rad``, 10 m for the surface) and
-    whether its elevation was measured (tables without ``elevation_measured``: all were).
+    whether its elevation was measured (:func:`elevation_measured_flags` says how the column is read).
 
     ``det`` columns: time, range, radial velocity, then :data:`DOA_COLUMNS`; ``surface_down`` maps
     NE points (k, 2) to the ground's ``down``, m.
@@ -45,7 +46,7 @@ def doa_height_sd(det: np.ndarray, surface_down, sigma_rad: float = DOA_SIGMA_RA
     >>> round(float(z[0]), 2), bool(measured[0])  # 20 m above ground, sd hypot(35, 10) m
     (0.55, True)
     """
-    az, el, measured = det[:, 3], det[:, 4], det[:, 8] != 0.0  # NaN (no column): measured
+    az, el, measured = det[:, 3], det[:, 4], det[:, 8] == 1.0
     if surface_down is None or not np.isfinite(det[:, 5:8]).any():
         return [az, el, np.full(az.size, np.nan), measured]
     with np.errstate(invalid="ignore"):
@@ -144,8 +145,8 @@ def altitude_measured(
     True where at least ``least`` of the track's last ``n`` detections up to that row (rows in
     time order) had a measured elevation (:func:`direction_measured`'s rule). Where the nulls left
     every elevation unmeasured, the track flies at ``process.clutter_doa``'s co-altitude prior: its
-    height is an assumption, and an alert on it says so. Detections without
-    ``elevation_measured``: measured when they carry a 3-D position, else not.
+    height is an assumption, and an alert on it says so. Each detection's flag is read by
+    :func:`elevation_measured_flags`; a table without 3-D positions (``north_m``) measures no altitude.
 
     Examples
     --------
@@ -154,10 +155,7 @@ def altitude_measured(
     [False, True, True, True, True]
     """
     ids, rows = np.asarray(track_id), np.asarray(detection_row)
-    if "elevation_measured" in detections.columns:
-        per_detection = detections["elevation_measured"].fillna(False).to_numpy(bool)
-    else:
-        per_detection = np.full(len(detections), "north_m" in detections.columns)
+    per_detection = elevation_measured_flags(detections) & ("north_m" in detections.columns)
     has = rows >= 0
     measured = np.zeros(rows.size, bool)
     measured[has] = per_detection[rows[has]]
@@ -167,3 +165,23 @@ def altitude_measured(
         counted = np.concatenate([[0], np.cumsum(measured[idx][has[idx]])])
         out[idx] = counted[seen] - counted[np.maximum(seen - n, 0)] >= least
     return out
+
+
+def elevation_measured_flags(detections: pd.DataFrame) -> np.ndarray:
+    """Whether each detection's elevation was measured: the one reading of the column for every rule.
+
+    The ``elevation_measured`` column where the table has it, a missing value counting as not
+    measured; tables without the column were processed without clutter suppression (or written by
+    other tools): every elevation they hold was measured.
+
+    Examples
+    --------
+    >>> elevation_measured_flags(pd.DataFrame({"elevation_measured": [True, None, False]})).tolist()
+    [True, False, False]
+    >>> elevation_measured_flags(pd.DataFrame({"elevation_rad": [0.1, -0.2]})).tolist()
+    [True, True]
+    """
+    if "elevation_measured" in detections.columns:
+        flags = detections["elevation_measured"]
+        return flags.where(flags.notna(), False).to_numpy(bool)
+    return np.ones(len(detections), bool)

@@ -56,6 +56,7 @@ from skyradar.track.ground_doa import (
     doa_height_sd,
     doa_in_the_air,
     doa_on_the_ground,
+    elevation_measured_flags,
 )
 from skyradar.track.static_point import (
     _trimmed_sum,
@@ -336,9 +337,12 @@ def hold_ground_tracks(
         return tracks
     if surface_down is None and ownship is not None and np.isfinite(median_ground_down_m(ownship)):
         surface_down = flat_surface(median_ground_down_m(ownship))
-    names = ["time_s", "range_m", "radial_velocity_mps", *DOA_COLUMNS]
+    names = ["time_s", "range_m", "radial_velocity_mps", *DOA_COLUMNS[:-1]]
     nan = np.full(len(detections), np.nan)
-    det = np.column_stack([detections[c].to_numpy(float) if c in detections else nan for c in names])
+    det = np.column_stack(
+        [detections[c].to_numpy(float) if c in detections else nan for c in names]
+        + [elevation_measured_flags(detections).astype(float)]
+    )
     rows = tracks["detection_row"].to_numpy()
     held = np.ones(len(tracks), bool)
     for _, idx in tracks.groupby("track_id", sort=False).indices.items():

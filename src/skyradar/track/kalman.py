@@ -2,17 +2,18 @@
 
 The innovation is computed outside the update (:func:`innovation`) so the tracker can wrap it: the
 Doppler axis of a range-Doppler image is circular, and the shortest way round the image is the right
-residual (seed-brief.md ch4). ``predict``, ``update``, ``innovation_covariance`` and ``wrap`` are
-re-exported from :mod:`skyradar.kalman`, their one home.
+residual (seed-brief.md ch4; the wrap is :func:`skyradar.units.wrap`). ``predict``, ``update`` and
+``innovation_covariance`` are re-exported from :mod:`skyradar.kalman`, their one home.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from skyradar.kalman import innovation_covariance, predict, update, wrap
+from skyradar.kalman import innovation_covariance, predict, update
+from skyradar.units import wrap
 
-__all__ = ["wrap", "predict", "innovation", "innovation_covariance", "update"]
+__all__ = ["predict", "innovation", "innovation_covariance", "update"]
 
 
 def innovation(

@@ -27,7 +27,7 @@ import pandas as pd
 from scipy.optimize import linear_sum_assignment
 
 from skyradar.track.io import Truth
-from skyradar.track.kalman import wrap
+from skyradar.units import wrap
 
 __all__ = [
     "innovation_stats",

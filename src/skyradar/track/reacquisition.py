@@ -24,8 +24,9 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from skyradar.track.association import pair_costs
-from skyradar.track.kalman import predict, wrap
+from skyradar.track.kalman import predict
 from skyradar.track.models import MotionModel
+from skyradar.units import wrap
 
 __all__ = ["LostTracks", "anchor_fields", "set_anchor", "manoeuvre_transition"]
 

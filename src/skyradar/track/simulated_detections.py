@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from skyradar.config import RadarConfig
-from skyradar.track.kalman import wrap
+from skyradar.units import wrap
 
 __all__ = ["synthetic_detections"]
 

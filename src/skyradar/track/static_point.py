@@ -13,7 +13,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.stats import chi2
 
-from skyradar.kalman import wrap
+from skyradar.units import wrap
 
 __all__ = ["static_point_measurements", "fits_static_ground", "flat_surface", "terrain_surface"]
 

@@ -115,8 +115,7 @@ def track_detections(
     Rows of a track before its confirmation are kept (``confirmed`` False) for tracks confirmed
     later; tentative tracks that never were are dropped. ``confirmed`` is also False on rows where a
     confirmed track has coasted ``confirm_n`` frames or more (``misses``). ``coasted`` marks rows
-    without a detection of a track confirmed earlier (a prediction; the track exists until closed).
-    ``altitude_measured``: False while the height is the co-altitude prior (`track.ground_doa`).
+    without a detection (a prediction); ``altitude_measured`` is False on the co-altitude prior.
 
     Parameters
     ----------
@@ -157,8 +156,9 @@ def track_detections(
     motion, tracker = _make_tracker(model, config, tracker_config)
     grid, lo, hi = _frame_slices(detections["time_s"].to_numpy(float), frame_times_s)
     m3 = _Measure3D(detections, config, motion, position_sigma_rad, ownship, grid)
-    tracks = _assemble(_run_tracker(tracker, m3, detections, grid, lo, hi), origin, m3.active)
-    return restore_detection_rows(_held(tracks, detections, ownship, config, ground_test), head_rows)
+    t = _assemble(_run_tracker(tracker, m3, detections, grid, lo, hi), origin, m3.active)
+    t = t.assign(altitude_measured=altitude_measured(t.track_id, t.detection_row, detections))
+    return restore_detection_rows(_held(t, detections, ownship, config, ground_test), head_rows)
 
 
 def _make_tracker(model, config: RadarConfig, tracker_config) -> tuple[MotionModel, RangeDopplerTracker]:
@@ -168,10 +168,7 @@ def _make_tracker(model, config: RadarConfig, tracker_config) -> tuple[MotionMod
 
 
 def _held(tracks, detections, ownship, config: RadarConfig, ground_test) -> pd.DataFrame:
-    """:func:`~skyradar.track.ground_tracks.hold_ground_tracks` with ``ground_test``'s settings,
-    and the rows' ``altitude_measured`` flag."""
-    measured = altitude_measured(tracks["track_id"], tracks["detection_row"], detections)
-    tracks = tracks.assign(altitude_measured=measured)
+    """:func:`~skyradar.track.ground_tracks.hold_ground_tracks` with ``ground_test``'s settings."""
     if ground_test is False:
         return tracks
     test = ground_test if isinstance(ground_test, GroundTrackTest) else GroundTrackTest()

@@ -23,6 +23,7 @@ from numba import njit, prange
 
 from skyradar.errors import InputError
 from skyradar.scene.ground_grid import GroundGrid, PoseGrid, sample_at_poses
+from skyradar.units import wrap_angle
 
 __all__ = ["ssim_scores", "decoy_poses", "crop_to_mask", "score_poses", "DecoyResult", "decoy_test"]
 
@@ -272,7 +273,7 @@ def decoy_test(
     poses = np.vstack([true_pose[None], decoy_poses(true_pose, rng, n_decoys)])
     scores = score_poses(radar, radar_mask, map_world, grid, pose_grid, poses, map_pose_grid)
     best = int(np.nanargmax(scores))
-    d_heading = (poses[best, 2] - true_pose[2] + np.pi) % (2 * np.pi) - np.pi
+    d_heading = wrap_angle(poses[best, 2] - true_pose[2])
     return DecoyResult(
         heading_error_deg=float(abs(np.degrees(d_heading))),
         position_error_m=float(np.hypot(*(poses[best, :2] - true_pose[:2]))),

@@ -10,15 +10,15 @@ import pytest
 from skyradar.config import RadarConfig
 from skyradar.process import clutter_frames
 from skyradar.process.cfar import cfar_2d_floor
-from skyradar.process.clutter_doa import directions_after_projection
+from skyradar.process.clutter_doa import projected_directions
 from skyradar.process.doa import direction_from_angles, steering_vector
 
 CFG = RadarConfig.prototype_2022()
 
 
-def _lattice_best(z: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, float]:
-    """Exhaustive search: 2 deg grid, then every point of the 0.05 deg lattice within +-1.5 deg
-    (elevation 0 where the score along elevation is flat within 1 dB: unobservable)."""
+def _lattice_best(z: np.ndarray, p: np.ndarray, measured: bool) -> tuple[np.ndarray, float]:
+    """Exhaustive search: 2 deg grid, then every point of the 0.05 deg lattice within +-1.5 deg;
+    where the elevation is not measured, the lattice row at elevation 0 around that azimuth."""
 
     def score(az_deg: np.ndarray, el_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         a, e = np.meshgrid(np.radians(az_deg), np.radians(el_deg), indexing="ij")
@@ -29,11 +29,12 @@ def _lattice_best(z: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, float]:
 
     coarse = np.arange(-70.0, 70.5, 2.0)
     _, s = score(coarse, coarse)
-    s = s.reshape(coarse.size, coarse.size)
-    ia, ie = np.unravel_index(np.argmax(s), s.shape)
+    ia, ie = np.unravel_index(np.argmax(s), (coarse.size, coarse.size))
     fine = np.arange(-1.5, 1.525, 0.05)
-    flat = 10 * np.log10(s[ia].max() / np.median(s[ia])) < 1.0
-    u, s = score(coarse[ia] + fine, np.zeros(1) if flat else coarse[ie] + fine)
+    u, s = score(coarse[ia] + fine, coarse[ie] + fine)
+    if not measured:
+        az = np.degrees(np.arctan2(u[np.argmax(s), 1], u[np.argmax(s), 0]))
+        u, s = score(az + fine, np.zeros(1))
     return u[np.argmax(s)], float(s.max())
 
 
@@ -46,8 +47,9 @@ def test_coarse_to_fine_direction_search_finds_the_exhaustive_lattice_best():
         m = int(rng.integers(0, 3))
         e = np.linalg.qr(rng.standard_normal((4, 4)) + 1j * rng.standard_normal((4, 4)))[0][:, :m]
         p = np.eye(4) - e @ e.conj().T
-        u_ref, best = _lattice_best(z, p)
-        u = directions_after_projection(z[None], p[None], CFG)[0]
+        u, measured = projected_directions(z[None], p[None], CFG, 1.0)
+        u_ref, best = _lattice_best(z, p, bool(measured[0]))
+        u = u[0]
         ps = p @ steering_vector(u, CFG)
         got = abs(np.vdot(ps, z)) ** 2 / np.vdot(ps, ps).real
         assert got >= best * (1 - 1e-5)

@@ -11,11 +11,16 @@ lattice point as an exhaustive search of the 61 x 61 lattice; a test checks it o
 snapshots and projections. Both steps are compiled (numba), about 50 us per detection instead of
 the 2 ms the numpy version cost, the largest share of a suppressed frame in ``bench process``.
 
-Where the nulls take the elevation dimension (a pair of clutter directions left and right at one
-elevation spans both azimuth phases: the score is flat along elevation within ``OBSERVABLE_DB``),
-elevation is unobservable in that cell and the detection is placed in the antenna's horizontal
-plane (elevation 0, co-altitude for a level forward radar): a prior, not a measurement; the
-azimuth is still measured (a 0.05 deg search over +-1.5 deg of azimuth).
+Whether the elevation was measured follows its Cramer-Rao bound through the cell's projector or
+whitening at the detection's amplitude (:func:`elevation_sigma_rad`). Two nulls at one elevation
+(clutter left and right at one range and Doppler) take the whole elevation dimension of the 2x2
+array: the bound is infinite, and training over neighbouring Doppler bins does not help (the
+clutter ridge is continuous in Doppler: over 3 or 5 bins the bound is only 7-12 % below one bin's).
+Whitened by a ring's finite clutter (adaptive cells) the elevation keeps a bound that grows with
+the clutter-to-noise ratio, a few degrees at 20-25 dB. Above :data:`MAX_ELEVATION_SIGMA_RAD` the
+detection is placed in the antenna's horizontal plane (elevation 0, co-altitude for a level
+forward radar): a prior, not a measurement; the azimuth is still measured (a 0.05 deg search over
++-1.5 deg of azimuth at elevation 0).
 
 Examples
 --------
@@ -23,9 +28,9 @@ Examples
 >>> from skyradar.process.doa import direction_from_angles, steering_vector
 >>> cfg = RadarConfig.prototype_2022()
 >>> z = steering_vector(direction_from_angles(0.2, -0.1), cfg)[None]
->>> u = directions_after_projection(z, np.eye(4)[None], cfg)
+>>> u = directions_after_projection(z, np.eye(4)[None], cfg, cfg.noise_power_w)
 >>> np.degrees(np.arctan2(u[0, 1], u[0, 0])).round(1), np.degrees(np.arcsin(-u[0, 2])).round(1)
-(np.float64(11.5), np.float64(-5.7))
+(np.float64(11.5), np.float64(-5.8))
 """
 
 from __future__ import annotations
@@ -37,9 +42,12 @@ from skyradar.config import RadarConfig
 from skyradar.process.clutter import steering_into
 from skyradar.process.doa import direction_from_angles, steering_vector
 
-__all__ = ["directions_after_projection", "projected_directions", "projected_scores", "OBSERVABLE_DB"]
+__all__ = [
+    "directions_after_projection", "projected_directions", "projected_scores", "elevation_sigma_rad",
+    "MAX_ELEVATION_SIGMA_RAD",
+]  # fmt: skip
 
-OBSERVABLE_DB = 1.0  # normalised score contrast along elevation below which elevation is unobservable
+MAX_ELEVATION_SIGMA_RAD = float(np.radians(10.0))  # Cramer-Rao bound above which elevation is a prior
 _COARSE_DEG = np.arange(-70.0, 70.5, 2.0)
 _FINE_STEP_DEG, _FINE_HALF_DEG = 0.05, 1.5
 _MID_STEP, _MID_HALF, _LAST_HALF = 5, 6, 7  # in fine steps: 0.25 deg over +-1.5 deg, then +-0.35 deg
@@ -90,24 +98,24 @@ def _grid_best(az0, el0, i_lo, i_hi, j_lo, j_hi, step, step_rad, rx, wavenumber,
 
 
 @njit(cache=True)
-def _one_direction(steer_c, coarse_rad, rx, wavenumber, step_rad, half, z, p, min_db):  # pragma: no cover
-    # Coarse grid, elevation observability, then the 0.05 deg lattice coarse to fine:
-    # (az, el) in rad and whether the elevation was measured.
+def _one_direction(steer_c, coarse_rad, rx, wavenumber, step_rad, half, z, p):  # pragma: no cover
+    # Coarse grid, then the 0.05 deg lattice coarse to fine: (az, el) in rad.
     n_c = coarse_rad.size
-    score = _scores(steer_c, z, p, np.empty(steer_c.shape[0])).reshape((n_c, n_c))
+    score = _scores(steer_c, z, p, np.empty(steer_c.shape[0]))
     best = np.argmax(score)
-    ia, ie = best // n_c, best % n_c
-    along_el = score[ia]
-    contrast = 10.0 * np.log10(along_el.max() / max(np.median(along_el), 1e-300))
-    az0, el0 = coarse_rad[ia], coarse_rad[ie]
-    if contrast < min_db:  # elevation 0; azimuth over the whole lattice row
-        i, _ = _grid_best(az0, 0.0, -half, half, 0, 0, 1, step_rad, rx, wavenumber, z, p)
-        return az0 + i * step_rad, 0.0, False
+    az0, el0 = coarse_rad[best // n_c], coarse_rad[best % n_c]
     i, j = _grid_best(az0, el0, -half, half, -half, half, _MID_STEP, step_rad, rx, wavenumber, z, p)
     lo_i, hi_i = max(i - _LAST_HALF, -half), min(i + _LAST_HALF, half)
     lo_j, hi_j = max(j - _LAST_HALF, -half), min(j + _LAST_HALF, half)
     i, j = _grid_best(az0, el0, lo_i, hi_i, lo_j, hi_j, 1, step_rad, rx, wavenumber, z, p)
-    return az0 + i * step_rad, el0 + j * step_rad, True
+    return az0 + i * step_rad, el0 + j * step_rad
+
+
+@njit(cache=True)
+def _azimuth_at_zero(az0, rx, wavenumber, step_rad, half, z, p):  # pragma: no cover - compiled
+    # The 0.05 deg lattice row at elevation 0 within +-1.5 deg of az0: azimuth in rad.
+    i, _ = _grid_best(az0, 0.0, -half, half, 0, 0, 1, step_rad, rx, wavenumber, z, p)
+    return az0 + i * step_rad
 
 
 def _coarse(config: RadarConfig) -> np.ndarray:
@@ -129,25 +137,75 @@ def projected_scores(steer: np.ndarray, z: np.ndarray, p: np.ndarray) -> np.ndar
     return _scores(steer, *args, np.empty(len(steer)))
 
 
-def projected_directions(
-    pixels: np.ndarray, proj: np.ndarray, config: RadarConfig
-) -> tuple[np.ndarray, np.ndarray]:
-    """Antenna-frame unit vectors (n, 3) of calibrated snapshots (n, n_rx) seen through ``proj``,
-    and whether each one's elevation was measured (n,) bool.
+def elevation_sigma_rad(
+    u: np.ndarray, pixels: np.ndarray, proj: np.ndarray, config: RadarConfig, noise_floor_w: float
+) -> np.ndarray:
+    """Cramer-Rao bound on the elevation of each direction ``u`` (n, 3) seen through ``proj``, rad.
 
-    ``proj`` holds each snapshot's projector ``P = I - E E^H``, shape (n, n_rx, n_rx). Where the
-    projection leaves elevation unobservable the vector has elevation 0 (a prior, see the module
-    docstring) and its flag is False.
+    For a plane wave of unknown complex amplitude in Gaussian interference the Fisher information
+    of (elevation, azimuth) is ``2 |a|^2 / N0 Re(D^H W D - D^H W s s^H W D / s^H W s)`` (``D`` the
+    steering vector's derivatives, ``W`` the cell's projector ``P`` or whitening ``N0 R^-1``,
+    ``a = s^H W z / s^H W s`` the amplitude estimate, ``N0`` the noise floor, W); the bound is the
+    elevation entry of its inverse (azimuth a nuisance). Infinite where ``W`` leaves the elevation
+    no information (two nulls at one elevation: the 2x2 array's Kronecker structure).
 
     Examples
     --------
     >>> from skyradar.process.doa import direction_from_angles, steering_vector
     >>> cfg = RadarConfig.prototype_2022()
-    >>> z = steering_vector(direction_from_angles(np.radians([10.0, 10.0]), np.radians([-5.0, -5.0])), cfg)
+    >>> u = direction_from_angles(np.radians([10.0, 10.0]), np.radians([-5.0, -5.0]))
+    >>> z = 10.0 * steering_vector(u, cfg) * np.sqrt(cfg.noise_power_w)  # 20 dB per channel: doa_crlb's
+    >>> e, _ = np.linalg.qr(steering_vector(direction_from_angles(np.radians([-20.0, 20.0]), -0.35), cfg).T)
+    >>> proj = np.stack([np.eye(4), np.eye(4) - e @ e.conj().T])
+    >>> np.degrees(elevation_sigma_rad(u, z, proj, cfg, cfg.noise_power_w)).round(2).tolist()
+    [1.29, inf]
+    """
+    k = 2.0 * np.pi / config.wavelength_m
+    az, el = np.arctan2(u[:, 1], u[:, 0]), np.arcsin(np.clip(-u[:, 2], -1.0, 1.0))
+    du_del = np.stack([-np.sin(el) * np.cos(az), -np.sin(el) * np.sin(az), -np.cos(el)], -1)
+    du_daz = np.stack([-np.cos(el) * np.sin(az), np.cos(el) * np.cos(az), np.zeros_like(az)], -1)
+    s = steering_vector(u, config)
+    rx = np.asarray(config.rx_positions_m, float)
+    d = np.stack([-1j * k * (g @ rx.T) * s for g in (du_del, du_daz)], -1)  # (n, n_rx, 2)
+    ws, wd = np.einsum("nkl,nl->nk", proj, s), np.einsum("nkl,nlj->nkj", proj, d)
+    sws = np.einsum("nk,nk->n", s.conj(), ws).real
+    seen = sws > 1e-9 * np.einsum("nk,nk->n", s.conj(), s).real  # a direction the nulls took: inf
+    sws = np.where(seen, sws, 1.0)
+    amp2 = np.abs(np.einsum("nk,nk->n", ws.conj(), pixels) / sws) ** 2  # proj Hermitian
+    dws = np.einsum("nkj,nk->nj", d.conj(), ws)
+    info = (
+        np.einsum("nkj,nkl->njl", d.conj(), wd)
+        - dws[:, :, None] * dws.conj()[:, None, :] / sws[:, None, None]
+    )
+    fisher = 2.0 * amp2[:, None, None] / noise_floor_w * info.real
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # no information: inf
+        det = fisher[:, 0, 0] * fisher[:, 1, 1] - fisher[:, 0, 1] * fisher[:, 1, 0]
+        scale = np.maximum(np.abs(fisher[:, 0, 0] * fisher[:, 1, 1]), 1e-300)
+        var = np.where(seen & (det > 1e-9 * scale), fisher[:, 1, 1] / det, np.inf)
+        return np.sqrt(np.where(var > 0, var, np.inf))
+
+
+def projected_directions(
+    pixels: np.ndarray, proj: np.ndarray, config: RadarConfig, noise_floor_w: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Antenna-frame unit vectors (n, 3) of calibrated snapshots (n, n_rx) seen through ``proj``,
+    and whether each one's elevation was measured (n,) bool.
+
+    ``proj`` holds each snapshot's projector ``P = I - E E^H`` or whitening ``N0 R^-1``, shape
+    (n, n_rx, n_rx); ``noise_floor_w`` is ``N0``. Where the elevation's Cramer-Rao bound through
+    ``proj`` (:func:`elevation_sigma_rad`) exceeds :data:`MAX_ELEVATION_SIGMA_RAD` the vector has
+    elevation 0 (a prior, see the module docstring) and its flag is False.
+
+    Examples
+    --------
+    >>> from skyradar.process.doa import direction_from_angles, steering_vector
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> u = direction_from_angles(np.radians([10.0, 10.0]), np.radians([-5.0, -5.0]))
+    >>> z = 10.0 * steering_vector(u, cfg) * np.sqrt(cfg.noise_power_w)  # 20 dB per channel
     >>> u_nulls = direction_from_angles(np.radians([-20.0, 20.0]), np.radians([-20.0, -20.0]))
     >>> e, _ = np.linalg.qr(steering_vector(u_nulls, cfg).T)  # two nulls at one elevation
     >>> proj = np.stack([np.eye(4), np.eye(4) - e @ e.conj().T])
-    >>> u, measured = projected_directions(z, proj, cfg)
+    >>> u, measured = projected_directions(z, proj, cfg, cfg.noise_power_w)
     >>> measured.tolist(), np.degrees(np.arcsin(-u[:, 2])).round(1).tolist()
     ([True, False], [-5.0, 0.0])
     """
@@ -156,19 +214,24 @@ def projected_directions(
     wavenumber = 2.0 * np.pi / config.wavelength_m
     half = int(round(_FINE_HALF_DEG / _FINE_STEP_DEG))
     rule = (np.radians(_COARSE_DEG), rx, wavenumber, np.radians(_FINE_STEP_DEG), half)
-    angles = np.zeros((len(pixels), 2))
-    measured = np.ones(len(pixels), bool)
-    for n, (z, p) in enumerate(zip(pixels, proj, strict=True)):
-        z, p = (np.ascontiguousarray(x, np.complex128) for x in (z, p))
-        *angles[n], measured[n] = _one_direction(steer_c, *rule, z, p, OBSERVABLE_DB)
+    z_all = np.ascontiguousarray(pixels, np.complex128)
+    p_all = np.ascontiguousarray(proj, np.complex128)
+    angles = np.array([_one_direction(steer_c, *rule, z, p) for z, p in zip(z_all, p_all, strict=True)])
+    angles = angles.reshape(len(z_all), 2)
+    u = direction_from_angles(angles[:, 0], angles[:, 1])
+    measured = elevation_sigma_rad(u, z_all, p_all, config, noise_floor_w) <= MAX_ELEVATION_SIGMA_RAD
+    for n in np.flatnonzero(~measured):  # the co-altitude prior; azimuth measured along it
+        angles[n] = _azimuth_at_zero(angles[n, 0], *rule[1:], z_all[n], p_all[n]), 0.0
     return direction_from_angles(angles[:, 0], angles[:, 1]), measured
 
 
-def directions_after_projection(pixels: np.ndarray, proj: np.ndarray, config: RadarConfig) -> np.ndarray:
+def directions_after_projection(
+    pixels: np.ndarray, proj: np.ndarray, config: RadarConfig, noise_floor_w: float
+) -> np.ndarray:
     """Antenna-frame unit vectors (n, 3) of calibrated snapshots (n, n_rx) seen through ``proj``.
 
-    ``proj`` holds each snapshot's projector ``P = I - E E^H``, shape (n, n_rx, n_rx).
+    ``proj`` holds each snapshot's projector ``P = I - E E^H`` (or whitening), shape (n, n_rx, n_rx).
 
-    Elevation 0 where the projection leaves it unobservable (:func:`projected_directions` says where).
+    Elevation 0 where the projection leaves it unmeasured (:func:`projected_directions` says where).
     """
-    return projected_directions(pixels, proj, config)[0]
+    return projected_directions(pixels, proj, config, noise_floor_w)[0]

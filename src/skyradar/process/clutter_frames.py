@@ -209,7 +209,7 @@ def detect_suppressed(
         if own.any():  # adaptive cells: through their ring's whitening (the adaptive matched filter)
             inv_gain = 1.0 / np.asarray(config.rx_calibration)
             proj[own] = ring_whitening(cube, inv_gain, r[own], d[own], sup.noise_floor_w)
-        u[projected], elevation_measured[projected] = projected_directions(z, proj, config)
+        u[projected], elevation_measured[projected] = projected_directions(z, proj, config, sup.noise_floor_w)
         coherence[projected] = _fit(proj, z, y, steering_vector(u[projected], config), own)
     return det, u, coherence, elevation_measured
 

@@ -18,15 +18,7 @@ import numpy as np
 
 from skyradar.config import RadarConfig
 
-__all__ = [
-    "angle_sigma_rad", "position_covariance", "at_elevation", "predicted_elevation",
-    "FREE_ELEVATION_SIGMA_RAD",
-]  # fmt: skip
-
-# An elevation the clutter nulls left unmeasured: its point sits at the track's predicted elevation
-# (the co-altitude prior for a new track) with this vertical-angle sigma, so it neither pulls the track's
-# height nor holds it; range and azimuth still count in full.
-FREE_ELEVATION_SIGMA_RAD = 0.35
+__all__ = ["angle_sigma_rad", "position_covariance"]
 
 
 def angle_sigma_rad(
@@ -67,11 +59,8 @@ def position_covariance(
     own_position_m: np.ndarray,
     angle_sigma: np.ndarray,
     range_sigma_m: np.ndarray | float,
-    elevation_sigma: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Covariance of DoA positions, ``(R s)^2 (I - u u^T - e e^T) + (R s_e)^2 e e^T + s_R^2 u u^T``, m^2.
-
-    ``u`` is the line of sight and ``e`` the direction of increasing elevation across it (NED).
+    """Covariance of DoA positions, ``(R s)^2 (I - u u^T) + s_R^2 u u^T``, shape (k, 3, 3), m^2.
 
     Parameters
     ----------
@@ -83,21 +72,12 @@ def position_covariance(
         Per-axis angle standard deviation, rad.
     range_sigma_m : float or ndarray, shape (k,)
         Range standard deviation, m.
-    elevation_sigma : ndarray, shape (k,), optional
-        Elevation standard deviation, rad (default ``angle_sigma``).
-
-    Returns
-    -------
-    ndarray, shape (k, 3, 3)
 
     Examples
     --------
     >>> C = position_covariance(np.array([[1000.0, 0, 0]]), np.zeros(3), np.array([0.01]), 5.0)
     >>> np.diag(C[0]).round(6).tolist()
     [25.0, 100.0, 100.0]
-    >>> C = position_covariance(np.array([[1000.0, 0, 0]]), np.zeros(3), [0.01], 5.0, np.array([0.1]))
-    >>> np.diag(C[0]).round(6).tolist()  # north, east, down: the vertical one loosened
-    [25.0, 100.0, 10000.0]
     """
     d = np.asarray(positions_m, float) - np.asarray(own_position_m, float)
     r = np.linalg.norm(d, axis=1)
@@ -105,58 +85,4 @@ def position_covariance(
     uu = u[:, :, None] * u[:, None, :]
     across = (r * np.asarray(angle_sigma, float)) ** 2
     along = np.broadcast_to(np.asarray(range_sigma_m, float) ** 2, r.shape)
-    cov = across[:, None, None] * (np.eye(3) - uu) + along[:, None, None] * uu
-    if elevation_sigma is not None:
-        h = np.maximum(np.hypot(u[:, 0], u[:, 1]), 1e-9)
-        e = np.column_stack([u[:, 2] * u[:, 0] / h, u[:, 2] * u[:, 1] / h, -h])  # up the vertical plane
-        extra = (r * np.asarray(elevation_sigma, float)) ** 2 - across
-        cov += extra[:, None, None] * (e[:, :, None] * e[:, None, :])
-    return cov
-
-
-def at_elevation(
-    positions_m: np.ndarray, own_position_m: np.ndarray, elevation_rad: np.ndarray
-) -> np.ndarray:
-    """Positions moved to ``elevation_rad`` above the radar's horizontal (NED), same range and bearing.
-
-    Rows whose elevation is NaN are returned unmoved.
-
-    Examples
-    --------
-    >>> at_elevation(np.array([[1000.0, 0.0, 0.0]]), np.zeros(3), np.array([np.pi / 6])).round(1).tolist()
-    [[866.0, 0.0, -500.0]]
-    """
-    own = np.asarray(own_position_m, float)
-    d = np.asarray(positions_m, float) - own
-    r = np.linalg.norm(d, axis=1)
-    bearing = np.arctan2(d[:, 1], d[:, 0])
-    el = np.asarray(elevation_rad, float)
-    moved = own + r[:, None] * np.column_stack(
-        [np.cos(el) * np.cos(bearing), np.cos(el) * np.sin(bearing), -np.sin(el)]
-    )
-    return np.where(np.isfinite(el)[:, None], moved, positions_m)
-
-
-def predicted_elevation(
-    ids: np.ndarray, own_position_m: np.ndarray, time_s: float, last: tuple | None
-) -> np.ndarray:
-    """Each track's elevation above the radar's horizontal (NED) at ``time_s``, rad; NaN if unknown.
-
-    ``last`` is ``(ids, states, time_s)`` of the 3-D tracker's previous step (states (k, 6): NED
-    position and velocity), moved on at constant velocity.
-
-    Examples
-    --------
-    >>> last = (np.array([3, 5]), np.array([[1000.0, 0, -100.0, -50.0, 0, 0]] * 2), 0.0)
-    >>> np.degrees(predicted_elevation(np.array([5, 9]), np.zeros(3), 1.0, last)).round(2).tolist()
-    [6.01, nan]
-    """
-    el = np.full(np.size(ids), np.nan)
-    if last is None or np.size(last[0]) == 0:
-        return el
-    prev_ids, x, t = last
-    rows = np.searchsorted(prev_ids, ids).clip(0, prev_ids.size - 1)
-    ok = prev_ids[rows] == ids
-    d = x[rows[ok], :3] + x[rows[ok], 3:] * (time_s - t) - np.asarray(own_position_m, float)
-    el[ok] = np.arctan2(-d[:, 2], np.hypot(d[:, 0], d[:, 1]))
-    return el
+    return across[:, None, None] * (np.eye(3) - uu) + along[:, None, None] * uu

@@ -6,7 +6,7 @@ import numpy as np
 
 from skyradar.config import RadarConfig
 from skyradar.scene.synthetic_terrain import fractal_terrain
-from skyradar.sim._terrain_bands import band_edges, banded_returns
+from skyradar.sim._terrain_bands import _sampled_work, band_edges, banded_returns, frame_edges
 from skyradar.sim._terrain_kernel import rotate_points, terrain_returns
 from skyradar.sim.image import ImageSimulator, PlatformState
 
@@ -50,10 +50,12 @@ def test_bands_give_the_per_thread_cubes_sum_whatever_the_edges():
 
     def banded(edges):
         grid = np.zeros((1, *sim._grid_shape), np.complex64)
-        following = banded_returns(*head, sim._facets, *common, view, True, grid, key, edges)
-        return grid[0], following
+        used = banded_returns(*head, sim._facets, *common, view, True, grid, key, edges)
+        return grid[0], used
 
-    grid, balanced = banded(band_edges(np.zeros(n_range + 1), 3))  # equal bands; returns balanced ones
+    grid, _ = banded(band_edges(np.zeros(n_range + 1), 3))  # equal bands
+    margin_m = abs(sim.coupling_s) * np.linalg.norm(head[-1]) + np.max(np.linalg.norm(head[4], axis=1))
+    balanced = frame_edges(head[1], head[-1], sim._facets, common[1], n_range, margin_m, 3)
     # Every sub-facet once (same pixels, same values) up to the order of float32 additions...
     assert np.array_equal(grid != 0, reference != 0)
     np.testing.assert_allclose(grid, reference, rtol=0, atol=1e-5 * np.abs(reference).max())
@@ -78,3 +80,28 @@ def test_band_edges_split_the_work_evenly():
     # Each band within one range bin's worth of work of an even share.
     assert max(abs(b - work.sum() / 4) for b in per_band) <= work.max()
     assert band_edges(np.zeros(101), 4).tolist() == [0, 25, 50, 75, 100]  # nothing seen yet: equal
+
+
+def test_a_frame_is_the_same_bits_whatever_was_simulated_before():
+    # The default edges come from the frame itself: simulating other frames first changes nothing.
+    sim, view, head, common = _setup()
+    key = np.uint64(7)
+    first = np.zeros((1, *sim._grid_shape), np.complex64)
+    edges = banded_returns(*head, sim._facets, *common, view, True, first, key)
+    other = PlatformState(np.array([300.0, 50.0, -600.0]), np.array([50.0, 0.0, 0.0]), np.zeros(3))
+    sim.frame(other, frame_index=4)  # another geometry in between
+    again = np.zeros_like(first)
+    assert np.array_equal(banded_returns(*head, sim._facets, *common, view, True, again, key), edges)
+    assert np.array_equal(again, first)
+
+
+def test_frame_edges_balance_the_sub_facets_of_the_frame():
+    sim, view, head, common = _setup()
+    n_range = sim._grid_shape[0]
+    counts, adapt = np.asarray(sim._facets.counts, np.int64), np.asarray(sim._facets.adapt, float)
+    work = _sampled_work(head[1], head[-1], counts, adapt, 1.0, common[1], n_range, 1)  # every cell
+    edges = frame_edges(head[1], head[-1], sim._facets, common[1], n_range, 1.0, 4)  # every 4th
+    share = np.array([work[lo:hi].sum() for lo, hi in zip(edges[:-1], edges[1:], strict=True)])
+    share /= work[:n_range].sum()
+    assert edges[0] == 0 and edges[-1] == n_range and np.all(np.diff(edges) >= 0)
+    assert np.all(np.abs(share - 0.25) < 0.05), share  # sampled edges, exact work: even within 5 %

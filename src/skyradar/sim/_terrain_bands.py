@@ -14,10 +14,13 @@ speckle draw is the same), so the grid equals the interleaved kernel's up to the
 float32 additions per pixel (``tests/test_sim_bands.py``), whatever the edges or the number of
 threads.
 
-Load balance: the edges split the sub-facets of the frame before evenly (each band counts the
-sub-facets of the cells whose middle bin is its own: :func:`band_edges`); frames a tenth of a
-second apart see nearly the same terrain. Edges only move work between threads: any edges give
-the same grid, to float32 rounding.
+Load balance: the edges split this frame's sub-facets evenly (:func:`frame_edges` counts the
+sub-facets of every fourth cell along each DEM axis at its middle range bin, :func:`band_edges`
+cuts that histogram). They are a function of the frame alone: edges balanced on the frame before
+made a frame depend on the frames simulated before it (an item's value may round differently in
+a vector body and a loop's scalar remainder, and the edges move items between the two), so the
+same frame index did not give the same bits twice. Any edges give the same grid to float32
+rounding.
 
 Why the bound holds: a point of a cell's bilinear patch is a convex combination of its four
 corners, so its distance from the antenna is at most the largest corner distance and at least
@@ -31,7 +34,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import get_num_threads, njit, prange
 
 from skyradar.sim._terrain_batch import (
     _KR,
@@ -46,7 +49,7 @@ from skyradar.sim._terrain_batch import (
 from skyradar.sim._terrain_kernel import _cell_behind, _cell_beyond, _corner_terms, _sub_centres
 from skyradar.sim.facets import cell_counts
 
-__all__ = ["banded_returns", "band_edges"]
+__all__ = ["banded_returns", "band_edges", "frame_edges"]
 
 
 @njit(inline="always")
@@ -96,6 +99,56 @@ def band_edges(work, n_bands):
     return edges
 
 
+@njit(cache=True, error_model="numpy")
+def _sampled_work(p_ant, v_ground_ant, counts, adapt, margin_m, d_range, n_range, stride):
+    # Sub-facets per middle range bin of every stride-th cell along each axis, times stride^2.
+    ny, nx = p_ant.shape[0], p_ant.shape[1]
+    n_min_r, n_min_c, n_max_r, n_max_c = counts
+    r_max = d_range * (n_range + 2)
+    work = np.zeros(n_range + 1)
+    for i in range(0, ny - 1, stride):
+        for j in range(0, nx - 1, stride):
+            if _cell_behind(p_ant, i, j) or _cell_beyond(p_ant, i, j, r_max):
+                continue
+            c_lo, c_hi = _cell_bins(p_ant, i, j, d_range, margin_m)
+            nu, nw = cell_counts(p_ant, i, j, v_ground_ant, n_min_r, n_min_c, n_max_r, n_max_c, adapt)
+            work[min(max((c_lo + c_hi) // 2, 0), n_range)] += nu * nw * stride * stride
+    return work
+
+
+def frame_edges(
+    p_ant: np.ndarray,
+    v_ground_ant: np.ndarray,
+    rule,
+    d_range: float,
+    n_range: int,
+    margin_m: float,
+    n_bands: int,
+    stride: int = 4,
+) -> np.ndarray:
+    """Range-bin edges (n_bands + 1) that split this frame's sub-facets evenly between the bands.
+
+    ``p_ant`` (ny, nx, 3) are the DEM points in the antenna frame (m), ``v_ground_ant`` the
+    ground's velocity there (m/s), ``rule`` the :class:`~skyradar.sim.facets.FacetRule`,
+    ``d_range`` the bin size (m) of the ``n_range`` bins and ``margin_m`` the bound's margin (module
+    docstring). Every ``stride``-th cell along each axis is counted: the edges only balance the
+    threads (any edges give the same grid), and they depend on the frame alone.
+
+    Examples
+    --------
+    >>> from skyradar.sim.facets import FacetRule
+    >>> n, e = np.meshgrid(np.arange(0.0, 400.0, 20.0), np.arange(-200.0, 200.0, 20.0), indexing="ij")
+    >>> p_ant = np.stack([n + 10.0, e, np.full_like(n, 100.0)], -1)  # flat ground 100 m below
+    >>> edges = frame_edges(p_ant, np.zeros(3), FacetRule((1, 1), (1, 1), (0.0,) * 4), 3.0, 160, 0.1, 2)
+    >>> edges[0], edges[-1], bool(40 < edges[1] < 120)
+    (np.int64(0), np.int64(160), True)
+    """
+    counts = np.asarray(rule.counts, np.int64)
+    adapt = np.asarray(rule.adapt, float)
+    work = _sampled_work(p_ant, v_ground_ant, counts, adapt, margin_m, d_range, n_range, int(stride))
+    return band_edges(work, n_bands)
+
+
 @njit(inline="always")
 def _keep_band(s, k, lo, hi):
     # Items outside the band are another band's: not valid here.
@@ -121,7 +174,7 @@ def _flush(scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, 
 
 @njit(parallel=True, cache=True, fastmath=True, error_model="numpy")
 def _band_pass(
-    p_ned, p_ant, up_ant, tx, rx, v_ground_ant, counts, adapt, margin_m, edges, work, wavelength, d_range,
+    p_ned, p_ant, up_ant, tx, rx, v_ground_ant, counts, adapt, margin_m, edges, wavelength, d_range,
     d_vel, coupling, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m, use_horizon,
     out, speckle_key,
 ):  # fmt: skip
@@ -140,7 +193,6 @@ def _band_pass(
         us, ws = np.empty(n_cell_max), np.empty(n_cell_max)
         scratch = np.zeros((CELL_FIELDS, cap))
         r_rx_sub, cos_sin = np.empty((rx.shape[0], cap)), np.empty((2, rx.shape[0], cap), np.float32)
-        work[band, :] = 0.0
         k = 0
         for i in range(ny - 1):
             for j in range(nx - 1):
@@ -151,9 +203,6 @@ def _band_pass(
                     continue
                 nu, nw = cell_counts(p_ant, i, j, v_ground_ant, n_min_r, n_min_c, n_max_r, n_max_c, adapt)
                 n_sub = nu * nw
-                mid = min(max((c_lo + c_hi) // 2, 0), n_range)
-                if lo <= mid < hi or (band == n_bands - 1 and mid == n_range):
-                    work[band, mid] += n_sub
                 if k + n_sub > cap:
                     _flush(scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel,
                            coupling, n_range, n_dopp, inv_wl, power_const, gain2, gain2_step, refl_table,
@@ -196,27 +245,28 @@ def banded_returns(
     use_horizon: bool,
     out: np.ndarray,
     speckle_key: np.uint64,
-    edges: np.ndarray,
+    edges: np.ndarray | None = None,
 ) -> np.ndarray:
     """Add terrain returns into ``out`` (1, n_range, n_doppler, n_rx), one thread per band of ``edges``.
 
     The arguments are ``terrain_returns``' (``rule`` a :class:`~skyradar.sim.facets.FacetRule`,
     ``view`` the frame's :class:`~skyradar.sim.geometry.TerrainView`), always in its vectorised
     mode into a dense grid. ``edges`` (n_bands + 1) int64 are the range-bin band edges, from 0 to
-    n_range (:func:`band_edges`; any give the same grid to float32 rounding). Returns the edges
-    that balance this frame's sub-facets: the next frame's.
+    n_range; default: :func:`frame_edges` for numba's thread count (any edges give the same grid
+    to float32 rounding; the default ones depend on this frame alone). Returns the edges used.
     """
     n_range = out.shape[1]
-    if edges[0] != 0 or edges[-1] != n_range or np.any(np.diff(edges) < 0):
-        raise ValueError(f"banded_returns: edges must rise from 0 to {n_range}, got {edges}")
     antennas = np.vstack([np.reshape(tx, (1, 3)), rx])
     reach_m = float(np.max(np.linalg.norm(antennas, axis=1)))
     margin_m = abs(coupling) * float(np.linalg.norm(v_ground_ant)) + reach_m
-    work = np.empty((edges.size - 1, n_range + 1))
+    if edges is None:
+        edges = frame_edges(p_ant, v_ground_ant, rule, d_range, n_range, margin_m, get_num_threads())
+    if edges[0] != 0 or edges[-1] != n_range or np.any(np.diff(edges) < 0):
+        raise ValueError(f"banded_returns: edges must rise from 0 to {n_range}, got {edges}")
     _band_pass(
         p_ned, p_ant, up_ant, tx, rx, v_ground_ant, np.asarray(rule.counts, np.int64),
-        np.asarray(rule.adapt, float), margin_m, edges, work, wavelength, d_range, d_vel, coupling,
+        np.asarray(rule.adapt, float), margin_m, edges, wavelength, d_range, d_vel, coupling,
         power_const, gain2, gain2_step, refl_table, view.horizon, view.az_bin_rad, view.h_bin_m, use_horizon,
         out, speckle_key,
     )  # fmt: skip
-    return band_edges(work.sum(axis=0), edges.size - 1)
+    return edges

@@ -29,7 +29,7 @@ from skyradar.errors import InputError
 from skyradar.geo import ned_rotation_to, ned_to_geodetic, rotation_matrix
 from skyradar.sim._noise_kernel import finalize_frame, frame_key
 from skyradar.sim._tables import REFLECTIVITY_MODELS, reflectivity_table, two_way_gain_table
-from skyradar.sim._terrain_bands import band_edges, banded_returns
+from skyradar.sim._terrain_bands import banded_returns
 from skyradar.sim._terrain_kernel import add_sparse, relative_points, rotate_points, terrain_returns
 from skyradar.sim.facets import facet_rule
 from skyradar.sim.geometry import AntennaGeometry, PlatformState, PointTarget, TerrainView
@@ -138,7 +138,6 @@ class ImageSimulator:
         self._gain2, self._gain2_step = two_way_gain_table(config)
         self._grid_ned = None
         self._blocks: np.ndarray | None = None
-        self._band_edges: dict[int, np.ndarray] = {}  # per thread count: _terrain_bands
         # 1: the kernel's vectorised batches; 0: its scalar reference loop (tests compare them).
         self._kernel_mode = 1
         # Per-frame work arrays kept between frames (fresh ones cost page faults every frame).
@@ -343,13 +342,11 @@ class ImageSimulator:
         power_const = cfg.pe_w * cfg.wavelength_m**2 / (4 * np.pi) ** 3 * self.ground_gain
         v_ground = rot @ (-geom.velocity_ned_mps)
         if self._kernel_mode == 1 and sparse[0].shape[1] == 0:  # dense: threads own range bands
-            n_bands = get_num_threads()  # edges balanced on the frame before (equal at first)
-            edges = self._band_edges.get(n_bands, band_edges(np.zeros(blocks.shape[1] + 1), n_bands))
-            self._band_edges[n_bands] = banded_returns(
+            banded_returns(
                 view.p_ned, p_ant, -rot[:, 2], cfg.tx_position_m, cfg.rx_positions_m, v_ground, self._facets,
                 cfg.wavelength_m, cfg.range_resolution_m / n, cfg.doppler_resolution_mps / n, self.coupling_s,
                 power_const, self._gain2, self._gain2_step, self._refl_table, view, self.occlusion, blocks,
-                speckle, edges,
+                speckle,
             )  # fmt: skip
             return
         terrain_returns(

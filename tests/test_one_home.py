@@ -28,6 +28,9 @@ PATTERNS = {
         r"np\.angle\(\s*np\.exp\(\s*1j\s*\*\s*\([^()]*(\([^()]*\)[^()]*)*\)\s*\)\s*\)"
         r"|\+\s*np\.pi\)\s*%\s*\(?\s*2(\.0)?\s*\*\s*np\.pi\)?\s*-\s*np\.pi"
     ),
+    "interval wrap: use skyradar.units.wrap": re.compile(
+        r"\+\s*(?!np\.pi\b)([\w.]+)\s*\)\s*%\s*\(\s*2(\.0)?\s*\*\s*\1\s*\)\s*-\s*\1\b"
+    ),
 }
 # (path relative to src/skyradar, pattern key prefix) -> why it may stay.
 ALLOWED = {
@@ -82,6 +85,7 @@ def test_the_check_finds_each_kind_of_paste(tmp_path):
         "x, p = x + g @ y, (np.eye(3) - g) @ p\n"
         "d = np.angle(np.exp(1j * (a - b)))\n"
         "e = (a - b + np.pi) % (2 * np.pi) - np.pi\n"
+        "v = (v + config.v_lim_mps) % (2.0 * config.v_lim_mps) - config.v_lim_mps\n"
         "def clean(v):\n"
         "    if isinstance(v, dict):\n"
         "        return {k: clean(x) for k, x in v.items()}\n"
@@ -96,5 +100,6 @@ def test_the_check_finds_each_kind_of_paste(tmp_path):
         "Kalman (I-K)P update",
         "angle wrap",
         "angle wrap",
+        "interval wrap",
         "JSON sanitiser",
     ], kinds

@@ -60,6 +60,7 @@ from skyradar.process.clutter_suppress import projected_power, suppress_clutter
 from skyradar.process.doa import steering_vector
 from skyradar.process.pipeline import _own_state, process_frames
 from skyradar.process.power import power_image
+from skyradar.units import wrap
 
 __all__ = ["run", "doppler_metrics", "LOSS_THRESHOLD_DB"]
 
@@ -88,7 +89,7 @@ def doppler_metrics(
     (4.0, 0.914)
     """
     usable = np.asarray(loss_db) >= LOSS_THRESHOLD_DB
-    sep = np.abs((np.asarray(velocity_mps) - v_mbc_mps + v_lim_mps) % (2 * v_lim_mps) - v_lim_mps)
+    sep = np.abs(wrap(np.asarray(velocity_mps) - v_mbc_mps, 2.0 * v_lim_mps))
     return {
         "mdv_mps": float(sep[usable].min()) if usable.any() else float("nan"),
         "usable_doppler_fraction": float(usable.mean()),

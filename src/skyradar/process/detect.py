@@ -37,6 +37,7 @@ from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.process.cfar import cfar_2d, cfar_2d_floor, cfar_factor
 from skyradar.process.power import power_image
+from skyradar.units import wrap
 
 __all__ = [
     "Detections",
@@ -86,7 +87,7 @@ class Detections:
     def radial_velocity_mps(self, config: RadarConfig) -> np.ndarray:
         """Radial velocity (aliased into [-VLim, VLim)), m/s, positive receding."""
         v = config.radial_velocity_at_bin_mps(self.doppler_bin)
-        return (v + config.v_lim_mps) % (2.0 * config.v_lim_mps) - config.v_lim_mps
+        return wrap(v, 2.0 * config.v_lim_mps)
 
     def select(self, keep: np.ndarray) -> Detections:
         """The subset where ``keep`` is true (boolean or index array)."""

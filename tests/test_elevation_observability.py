@@ -138,3 +138,16 @@ def test_a_track_with_no_measured_elevation_stays_at_the_co_altitude_prior():
     tracks = track_detections(_level_track(np.zeros(150, bool), 300.0), ownship=_own(150), ground_test=False)
     last = tracks[tracks.confirmed].groupby("track_id").tail(1)
     assert len(last) == 1 and abs(last["down_m"].iloc[0]) < 30.0 and not last["altitude_measured"].iloc[0]
+
+
+def test_a_plain_doa_that_follows_the_predicted_clutter_has_no_elevation():
+    # Ground 15 dB over the intruder in its cell: the snapshot is one plane wave, the ground's, and the
+    # plain DoA points at it. Through the cell's nulls that direction carries (almost) nothing.
+    u_ground = direction_from_angles(np.array([0.3]), np.array([-0.35]))
+    u_target = direction_from_angles(np.array([-0.3]), np.array([0.1]))
+    s_g, s_t = steering_vector(u_ground, CFG), steering_vector(u_target, CFG)
+    z = np.sqrt(10**4.0 * N0) * s_g + np.sqrt(10**2.5 * N0) * s_t
+    e, _ = np.linalg.qr(s_g.T)  # one null, at the predicted ground direction
+    proj = (np.eye(4) - e @ e.conj().T)[None]
+    assert elevation_sigma_rad(u_ground, z, proj, CFG, N0)[0] > MAX_ELEVATION_SIGMA_RAD
+    assert elevation_sigma_rad(u_target, z, proj, CFG, N0)[0] < np.radians(3.0)  # the intruder's is kept

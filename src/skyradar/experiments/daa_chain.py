@@ -33,7 +33,7 @@ from skyradar.track.ground_tracks import GroundTrackTest, median_ground_down_m, 
 from skyradar.track.track_table import track_detections
 from skyradar.units import wrap
 
-__all__ = ["run_chain", "track_and_alert", "label_tracks"]
+__all__ = ["run_chain", "track_and_alert", "label_tracks", "confirmed_rows"]
 
 _MATCH_M = 300.0  # a track is an intruder's if its median distance to that truth is below this
 
@@ -171,6 +171,11 @@ def _surface(built, own: pd.DataFrame):
 def label_tracks(tracks: pd.DataFrame, truth: xr.Dataset, max_distance_m: float = _MATCH_M) -> dict[int, str]:
     """Name of the intruder each track follows (median 3-D distance to its truth), else ``'clutter'``.
 
+    Only a track's confirmed rows count when it has any: alerts come from those, and the rows
+    before them are the initiator's guesses, or a lost track's whose id the track reacquired (over
+    hills a ground track's 21 s of hops took an intruder's track to 'clutter', and its warning on
+    the intruder to a ground track's: :func:`confirmed_rows`).
+
     On rows whose height is the co-altitude prior (``altitude_measured`` False) the distance is
     taken in what the radar measured, slant range and bearing from the own-ship (``own_*`` in
     ``truth``): such a track is its intruder's even when it flies 300 m above.
@@ -191,7 +196,7 @@ def label_tracks(tracks: pd.DataFrame, truth: xr.Dataset, max_distance_m: float 
     if all(f"own_{a}_m" in truth for a in ("north", "east", "down")):
         own = np.stack([truth[f"own_{a}_m"].values for a in ("north", "east", "down")], -1)
     labels = {}
-    for tid, g in tracks.groupby("track_id"):
+    for tid, g in confirmed_rows(tracks).groupby("track_id"):
         idx = np.clip(np.searchsorted(times, g["time_s"].to_numpy(float)), 0, times.size - 1)
         pos = g[["north_m", "east_m", "down_m"]].to_numpy(float)
         with np.errstate(all="ignore"):
@@ -203,6 +208,22 @@ def label_tracks(tracks: pd.DataFrame, truth: xr.Dataset, max_distance_m: float 
         best = int(np.argmin(med)) if med.size else -1
         labels[int(tid)] = names[best] if best >= 0 and med[best] < max_distance_m else "clutter"
     return labels
+
+
+def confirmed_rows(tracks: pd.DataFrame) -> pd.DataFrame:
+    """The confirmed rows of each track in a tracks table; all rows of a track that has none.
+
+    Examples
+    --------
+    >>> tr = pd.DataFrame({"track_id": [1, 1, 1, 2], "confirmed": [False, True, True, False]})
+    >>> confirmed_rows(tr).index.tolist()
+    [1, 2, 3]
+    """
+    if "confirmed" not in tracks or tracks.empty:
+        return tracks
+    confirmed = tracks["confirmed"].to_numpy(bool)
+    has = pd.Series(confirmed).groupby(tracks["track_id"].to_numpy()).transform("any").to_numpy(bool)
+    return tracks[confirmed | ~has]
 
 
 def _range_bearing_distance_m(

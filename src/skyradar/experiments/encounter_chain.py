@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig
-from skyradar.experiments.daa_chain import label_tracks, run_chain
+from skyradar.experiments.daa_chain import confirmed_rows, label_tracks, run_chain
 from skyradar.experiments.encounter_score import frame_status, track_counts, unwarned_cause
 from skyradar.experiments.encounter_set import (
     encounter_scenario,
@@ -97,7 +97,7 @@ def _score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[
         float(np.nanmedian(truths[0]["own_height_agl_m"].values)) if built.terrain is not None else np.nan
     )
     warned = {int(i) for i in warn["track_id"]}
-    row.update(track_counts(tracks, warned, labels, built.terrain, own_agl))
+    row.update(track_counts(confirmed_rows(tracks), warned, labels, built.terrain, own_agl))
     row.update(
         t_other_warning_s=float(other.min()) if other.size else float("nan"),
         tracks=int(tracks["track_id"].nunique()),

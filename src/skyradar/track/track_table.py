@@ -114,9 +114,8 @@ def track_detections(
 
     Rows of a track before its confirmation are kept (``confirmed`` False) for tracks confirmed
     later; tentative tracks that never were are dropped. ``confirmed`` is also False on rows where a
-    confirmed track has coasted ``confirm_n`` frames or more (``misses``). ``coasted`` marks rows
-    without a detection of a track confirmed earlier (a prediction; the track exists until closed);
-    ``altitude_measured`` is False while the height is the co-altitude prior (``track.ground_doa``).
+    confirmed track has coasted ``confirm_n`` frames or more (``misses``). ``coasted``: a prediction
+    of a track confirmed earlier; ``altitude_measured`` is False on the co-altitude prior.
 
     Parameters
     ----------

@@ -13,6 +13,7 @@ from skyradar.track.ground_tracks import GroundTrackTest, hold_ground_tracks
 from skyradar.track.io import validate_detections, validate_ownship
 from skyradar.track.measure3d import angle_sigma_rad, position_covariance
 from skyradar.track.models import MotionModel, radar_model, traditional_model
+from skyradar.track.reacquired_ids import relabel_reacquired
 from skyradar.track.tracker import RangeDopplerTracker, TrackerConfig
 from skyradar.track.tracker3d import RadialObservation, Tracker3D
 
@@ -156,9 +157,18 @@ def track_detections(
     motion, tracker = _make_tracker(model, config, tracker_config)
     grid, lo, hi = _frame_slices(detections["time_s"].to_numpy(float), frame_times_s)
     m3 = _Measure3D(detections, config, motion, position_sigma_rad, ownship, grid)
-    t = _assemble(_run_tracker(tracker, m3, detections, grid, lo, hi), origin, m3.active)
+    chunks = _run_tracker(tracker, m3, detections, grid, lo, hi)
+    t = _table(chunks, origin, m3.active, detections, ownship, config, ground_test)
+    return restore_detection_rows(t, head_rows)
+
+
+def _table(
+    chunks, origin, has3d: bool, detections, ownship, config: RadarConfig, ground_test
+) -> pd.DataFrame:
+    """The tracks table: ids through reacquisition, ``altitude_measured``, then the ground hold."""
+    t = _reacquired_ids(_assemble(chunks, origin, has3d), chunks, detections, ownship, config, ground_test)
     t = t.assign(altitude_measured=altitude_measured(t.track_id, t.detection_row, detections))
-    return restore_detection_rows(_held(t, detections, ownship, config, ground_test), head_rows)
+    return _held(t, detections, ownship, config, ground_test)
 
 
 def _make_tracker(model, config: RadarConfig, tracker_config) -> tuple[MotionModel, RangeDopplerTracker]:
@@ -185,6 +195,7 @@ def _run_tracker(tracker: RangeDopplerTracker, m3, detections: pd.DataFrame, gri
         out = tracker.step(float(time_s), z_all[a:b])
         row = _frame_rows(tracker, out, time_s, frames[k], a)
         row["reacquired"] = out.reacquired
+        row["reacquired_t"] = np.full(len(out.reacquired), float(time_s))
         if m3.active:
             m3.t3.rename(out.reacquired[:, 0], out.reacquired[:, 1])
             x, P = m3.step(tracker, out, k, a, b)
@@ -360,23 +371,22 @@ def _assemble(
     cols["n_updates"] = cat("n_updates")
     cols["misses"] = cat("misses")
     cols["coasted"] = cat("coasted")
-    df = _relabel_reacquired(pd.DataFrame(cols, columns=TRACK_COLUMNS), cat("reacquired").reshape(-1, 2))
-    # Tentative rows are kept only for tracks that were confirmed at some point: their early
-    # updates belong to a real track, the rest is clutter that never became one.
+    return pd.DataFrame(cols, columns=TRACK_COLUMNS)
+
+
+def _reacquired_ids(
+    df: pd.DataFrame, chunks, detections, ownship, config: RadarConfig, ground_test
+) -> pd.DataFrame:
+    """Reacquisitions of lost tracks the ground test finds objects (:mod:`.reacquired_ids`), then
+    only tracks confirmed at some point: the tentative rows of the rest were clutter."""
+    if len(df) == 0:
+        return df
+    pairs = np.concatenate([c["reacquired"] for c in chunks]).reshape(-1, 2)
+    times = np.concatenate([c["reacquired_t"] for c in chunks])
+
+    def is_object(rows: pd.DataFrame) -> bool:
+        return len(_held(rows, detections, ownship, config, ground_test)) > 0
+
+    df = relabel_reacquired(df, pairs, times, is_object)
     real = np.unique(df["track_id"].to_numpy()[df["confirmed"].to_numpy()])
     return df[np.isin(df["track_id"].to_numpy(), real)].reset_index(drop=True)
-
-
-def _relabel_reacquired(df: pd.DataFrame, pairs: np.ndarray) -> pd.DataFrame:
-    """Rows of a track before it reacquired a lost id (its tentative start) take that id too.
-
-    Where the lost track still had a (coasting) row at the same time, the row with a detection wins.
-    """
-    if pairs.size == 0:
-        return df
-    ids = df["track_id"].to_numpy()
-    lookup = dict(zip(pairs[:, 0].tolist(), pairs[:, 1].tolist(), strict=True))
-    df["track_id"] = np.array([lookup.get(i, i) for i in ids.tolist()], np.int64)
-    by_detection = df.assign(_nodet=df["detection_row"].to_numpy() < 0).sort_values("_nodet", kind="stable")
-    kept = by_detection.drop_duplicates(["time_s", "track_id"]).index
-    return df.loc[np.sort(kept)].reset_index(drop=True)

@@ -59,8 +59,12 @@ def position_covariance(
     own_position_m: np.ndarray,
     angle_sigma: np.ndarray,
     range_sigma_m: np.ndarray | float,
+    elevation_sigma: np.ndarray | None = None,
 ) -> np.ndarray:
     """Covariance of DoA positions, ``(R s)^2 (I - u u^T) + s_R^2 u u^T``, shape (k, 3, 3), m^2.
+
+    With ``elevation_sigma`` the variance along ``e``, the direction of increasing elevation
+    across the line of sight, is ``(R s_e)^2`` instead of ``(R s)^2``.
 
     Parameters
     ----------
@@ -72,12 +76,17 @@ def position_covariance(
         Per-axis angle standard deviation, rad.
     range_sigma_m : float or ndarray, shape (k,)
         Range standard deviation, m.
+    elevation_sigma : ndarray, shape (k,), optional
+        Elevation standard deviation, rad (default ``angle_sigma``).
 
     Examples
     --------
     >>> C = position_covariance(np.array([[1000.0, 0, 0]]), np.zeros(3), np.array([0.01]), 5.0)
     >>> np.diag(C[0]).round(6).tolist()
     [25.0, 100.0, 100.0]
+    >>> C = position_covariance(np.array([[1000.0, 0, 0]]), np.zeros(3), [0.01], 5.0, np.array([0.1]))
+    >>> np.diag(C[0]).round(6).tolist()  # north, east, down: the vertical one loosened
+    [25.0, 100.0, 10000.0]
     """
     d = np.asarray(positions_m, float) - np.asarray(own_position_m, float)
     r = np.linalg.norm(d, axis=1)
@@ -85,4 +94,10 @@ def position_covariance(
     uu = u[:, :, None] * u[:, None, :]
     across = (r * np.asarray(angle_sigma, float)) ** 2
     along = np.broadcast_to(np.asarray(range_sigma_m, float) ** 2, r.shape)
-    return across[:, None, None] * (np.eye(3) - uu) + along[:, None, None] * uu
+    cov = across[:, None, None] * (np.eye(3) - uu) + along[:, None, None] * uu
+    if elevation_sigma is not None:
+        h = np.maximum(np.hypot(u[:, 0], u[:, 1]), 1e-9)
+        e = np.column_stack([u[:, 2] * u[:, 0] / h, u[:, 2] * u[:, 1] / h, -h])  # up, across the sight line
+        extra = (r * np.asarray(elevation_sigma, float)) ** 2 - across
+        cov += extra[:, None, None] * (e[:, :, None] * e[:, None, :])
+    return cov

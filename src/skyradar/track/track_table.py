@@ -6,16 +6,15 @@ import numpy as np
 import pandas as pd
 
 from skyradar.config import RadarConfig
+from skyradar.track.doa_feed import OWNSHIP_COLUMNS, Measure3D
 from skyradar.track.frame_grid import frame_grid, frame_numbers
 from skyradar.track.fusion import fuse_heads, restore_detection_rows
 from skyradar.track.ground_doa import altitude_measured
 from skyradar.track.ground_tracks import GroundTrackTest, hold_ground_tracks
-from skyradar.track.io import validate_detections, validate_ownship
-from skyradar.track.measure3d import angle_sigma_rad, position_covariance
+from skyradar.track.io import validate_detections
 from skyradar.track.models import MotionModel, radar_model, traditional_model
 from skyradar.track.reacquired_ids import relabel_reacquired
 from skyradar.track.tracker import RangeDopplerTracker, TrackerConfig
-from skyradar.track.tracker3d import RadialObservation, Tracker3D
 
 __all__ = [
     "make_model",
@@ -36,16 +35,6 @@ TRACK_COLUMNS = [
     *[f"cov_pv_{i}{j}" for i in range(3) for j in range(3)], "confirmed", "n_updates", "misses", "coasted",
     "altitude_measured",
 ]  # fmt: skip
-_NED = ("north_m", "east_m", "down_m")
-OWNSHIP_COLUMNS = (
-    "time_s",
-    "own_north_m",
-    "own_east_m",
-    "own_down_m",
-    "own_vn_mps",
-    "own_ve_mps",
-    "own_vd_mps",
-)
 
 
 _INTEGER_COLUMNS = ("frame", "track_id", "detection_row", "n_updates", "misses")
@@ -156,18 +145,22 @@ def track_detections(
     detections, head_rows = fuse_heads(validate_detections(detections), config)  # heads -> one stream
     motion, tracker = _make_tracker(model, config, tracker_config)
     grid, lo, hi = _frame_slices(detections["time_s"].to_numpy(float), frame_times_s)
-    m3 = _Measure3D(detections, config, motion, position_sigma_rad, ownship, grid)
+    m3 = Measure3D(detections, config, motion, position_sigma_rad, ownship, grid)
     chunks = _run_tracker(tracker, m3, detections, grid, lo, hi)
-    t = _table(chunks, origin, m3.active, detections, ownship, config, ground_test)
+    t = _table(chunks, origin, m3, detections, ownship, config, ground_test)
     return restore_detection_rows(t, head_rows)
 
 
-def _table(
-    chunks, origin, has3d: bool, detections, ownship, config: RadarConfig, ground_test
-) -> pd.DataFrame:
-    """The tracks table: ids through reacquisition, ``altitude_measured``, then the ground hold."""
-    t = _reacquired_ids(_assemble(chunks, origin, has3d), chunks, detections, ownship, config, ground_test)
-    t = t.assign(altitude_measured=altitude_measured(t.track_id, t.detection_row, detections))
+def _table(chunks, origin, m3, detections, ownship, config: RadarConfig, ground_test) -> pd.DataFrame:
+    """The tracks table: ids through reacquisition, ``altitude_measured`` (on the elevations the
+    3-D tracker trusted, :mod:`.elevation_trust`), then the ground hold."""
+    t = _reacquired_ids(
+        _assemble(chunks, origin, m3.active), chunks, detections, ownship, config, ground_test
+    )
+    read = (
+        detections.assign(elevation_measured=m3.trusted) if m3.active and m3.own is not None else detections
+    )
+    t = t.assign(altitude_measured=altitude_measured(t.track_id, t.detection_row, read))
     return _held(t, detections, ownship, config, ground_test)
 
 
@@ -265,73 +258,6 @@ def track_air_detections(
     rows = tracks["detection_row"].to_numpy()
     tracks["detection_row"] = np.where(rows >= 0, np.flatnonzero(keep)[np.maximum(rows, 0)], -1)
     return tracks, int(keep.sum())
-
-
-class _Measure3D:
-    """Feeds the 3-D tracker: DoA position, its covariance and the de-aliased radial velocity."""
-
-    def __init__(self, det, config, motion, sigma_rad, ownship, grid) -> None:
-        self.active = all(c in det.columns for c in _NED)
-        if not self.active:
-            return
-        self.t3 = Tracker3D()
-        self.ned = det[list(_NED)].to_numpy(float)
-        self.z = det[["range_m", "radial_velocity_mps"]].to_numpy(float)
-        self.motion, self.width = motion, motion.doppler_width_mps
-        if sigma_rad is None and "snr_db" in det.columns:
-            angles = [
-                det[c].to_numpy(float) if c in det.columns else None for c in ("azimuth_rad", "elevation_rad")
-            ]
-            self.sigma = angle_sigma_rad(det["snr_db"].to_numpy(float), config, *angles)
-        else:
-            self.sigma = np.full(len(det), 0.04 if sigma_rad is None else float(sigma_rad))
-        self.own = None
-        if ownship is not None:
-            validate_ownship(ownship, OWNSHIP_COLUMNS)
-            t = ownship["time_s"].to_numpy(float)
-            self.own = np.column_stack(
-                [np.interp(grid, t, ownship[c].to_numpy(float)) for c in OWNSHIP_COLUMNS[1:]]
-            )
-
-    def step(self, tracker, out, k: int, a: int, b: int) -> tuple[np.ndarray, np.ndarray]:
-        det = out.alive_detection
-        has = det >= 0
-        idx = det[has] + a
-        pos = np.full((det.size, 3), np.nan)
-        pos[has] = self.ned[idx]
-        state, resolved = tracker.tracks["x"], tracker.tracks["resolved"]
-        v_meas = np.full(det.size, np.nan)
-        v_meas[has] = self.z[idx, 1]
-        # The detection's radial velocity moved to the track's (de-aliased) alias.
-        v_track = v_meas + self.width * np.round((state[:, 1] - v_meas) / self.width)
-        v_unaliased = np.where(resolved, v_track, np.nan)
-        sigma = np.full(det.size, 0.04)
-        sigma[has] = self.sigma[idx]
-        c, sr = self.motion.coupling_s, self.motion.sigma_range_m
-        if self.own is None:
-            r = np.full(det.size, 1.0)
-            r[has] = self.z[idx, 0]
-            return self.t3.step(float(out.time_s), out.alive_ids, pos, np.maximum(r * sigma, 5.0) ** 2)
-        own_p, own_v = self.own[k, :3], self.own[k, 3:]
-        d = pos - own_p
-        rng = np.linalg.norm(d, axis=1, keepdims=True)
-        # The DoA point sits at the apparent range R + c V_R; move it to the true range.
-        pos = own_p + d * (1.0 - c * np.where(resolved, v_track, v_meas)[:, None] / rng)
-        range_sigma = np.where(resolved, sr, np.hypot(sr, 0.5 * c * self.width))
-        # Measured on the full chain (ch4 Free), DoA positions are off along the line of sight by
-        # 17-25 m RMS at high SNR and far more at low SNR (angle outliers), not by the range noise;
-        # trusting the range there slowed the 3-D velocity's convergence (median error 10 vs 6 m/s),
-        # so the along-sight error is never taken below the across-sight one.
-        across = np.linalg.norm(pos - own_p, axis=1) * sigma
-        cov = np.full((det.size, 3, 3), np.nan)
-        use = has & np.isfinite(sigma)
-        # An elevation the nulls left unmeasured (elevation_measured False) stays at its co-altitude
-        # prior with the stated noise: de-weighting it (0.3 rad vertical) let the measured
-        # elevations, pulled by clutter, carry a converging intruder's track off its altitude
-        # (flat ground 300 m below: warned 4.6 s before its loss of well clear with the prior, never without).
-        cov[use] = position_covariance(pos[use], own_p, sigma[use], np.maximum(range_sigma, across)[use])
-        radial = RadialObservation(own_p, own_v, v_unaliased, self.motion.sigma_velocity_mps)
-        return self.t3.step(float(out.time_s), out.alive_ids, pos, cov, radial)
 
 
 def _assemble(

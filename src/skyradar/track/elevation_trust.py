@@ -1,0 +1,178 @@
+"""Which measured elevations a track's height may rest on, and where the others put a detection.
+
+Clutter suppression (``process.clutter_frames``) measures a detection's elevation, or leaves it
+unmeasured where the nulls take the elevation dimension of the 2x2 array (``elevation_measured``
+False; the direction then holds the co-altitude prior). A *measured* elevation in a cell the
+ground also fills is not always the target's: where the ground is 15 dB over the target, the
+plain DoA of the cell is the ground's (flat ground 300 m below, ``--n 3`` encounter 2: the
+co-altitude intruder's "measured" elevations were -16 to -20 deg, the ground's depression at
+those ranges), and after whitening a mixture lands between the target and the ground (Jacksboro:
+-13 to -28 deg for the same intruder). Both errors pull *towards the ground*, so they are below
+the target's true elevation; none can put a reading above the own-ship's horizontal when the
+ground is below it. Hence the asymmetric rule (:func:`elevation_trusted`): inside the ground's
+range-Doppler band (:func:`in_ground_band`) an elevation counts only when it is measured and more
+than ``k`` standard deviations above the own-ship's horizontal; outside the band every measured
+elevation counts. The rest are *free*: the tracker places them at the track's predicted elevation
+(:func:`predicted_elevation`; the co-altitude prior, 0, for a new track) with a vertical-angle
+sigma of :data:`FREE_ELEVATION_SIGMA_RAD` (:func:`at_elevation`), so that they hold the track's
+height without pulling it, while range and azimuth count in full.
+
+What this buys (hills, 200-encounter set, encounter 23, an aircraft overtaken 339 m above): its
+elevations were measured on 30-70 % of the detections, at 27-45 deg, within a few degrees of the
+truth; the co-altitude prior of the others held the track 74 m above the own-ship and it was
+warned. What it costs: an intruder below the own-ship inside the ground's band keeps the
+co-altitude prior (its readings cannot be told from the ground's pull), so it is warned as if
+co-altitude: a false warning where it passes well below, never a missed one.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "FREE_ELEVATION_SIGMA_RAD", "in_ground_band", "elevation_trusted", "predicted_elevation", "at_elevation",
+]  # fmt: skip
+
+FREE_ELEVATION_SIGMA_RAD = 0.35  # vertical-angle sigma of a free detection (holds, does not pull)
+_GROUND_RANGE_FRACTION = 0.5  # ground may be in range from half the own-ship's height above it (relief)
+
+
+def in_ground_band(
+    range_m: np.ndarray,
+    radial_velocity_mps: np.ndarray,
+    own_speed_mps: float,
+    height_agl_m: float,
+    margin_mps: float = 5.0,
+) -> np.ndarray:
+    """Whether the ground can fill each detection's range-Doppler cell (bool per detection).
+
+    A static point's radial velocity is at most the own-ship's speed, and no ground lies closer
+    than the own-ship's height above it (half of it here: relief ahead rises above the ground
+    below). NaN ``height_agl_m`` (clear sky, no terrain): False everywhere.
+
+    Examples
+    --------
+    >>> rng, v = np.array([2000.0, 2000.0, 200.0]), np.array([-30.0, -90.0, -30.0])
+    >>> in_ground_band(rng, v, 50.0, 500.0).tolist()
+    [True, False, False]
+    """
+    if not np.isfinite(height_agl_m):
+        return np.zeros(np.shape(range_m), bool)
+    near = np.asarray(range_m, float) >= _GROUND_RANGE_FRACTION * height_agl_m
+    return near & (np.abs(np.asarray(radial_velocity_mps, float)) <= own_speed_mps + margin_mps)
+
+
+def elevation_trusted(
+    elevation_rad: np.ndarray, sigma_rad: np.ndarray, measured: np.ndarray, band: np.ndarray, k: float = 3.0
+) -> np.ndarray:
+    """Whether each detection's elevation may move its track's height (bool per detection).
+
+    ``elevation_rad`` is the DoA point's elevation above the own-ship's horizontal (NED), rad;
+    ``sigma_rad`` its standard deviation; ``measured`` the detection's ``elevation_measured``;
+    ``band`` :func:`in_ground_band`. See the module docstring for the rule.
+
+    Examples
+    --------
+    >>> el = np.radians([-20.0, 20.0, 2.0, -20.0])
+    >>> elevation_trusted(el, np.full(4, 0.02), np.array([True, True, True, False]),
+    ...                   np.array([True, True, True, False])).tolist()
+    [False, True, False, False]
+    """
+    above = np.asarray(elevation_rad, float) > k * np.asarray(sigma_rad, float)
+    return np.asarray(measured, bool) & (~np.asarray(band, bool) | above)
+
+
+def predicted_elevation(
+    ids: np.ndarray, own_position_m: np.ndarray, time_s: float, last: tuple | None
+) -> np.ndarray:
+    """Each track's elevation above the radar's horizontal (NED) at ``time_s``, rad; 0 if unknown.
+
+    ``last`` is ``(ids, states, time_s)`` of the 3-D tracker's previous step (states (k, 6): NED
+    position and velocity, ids sorted), moved on at constant velocity. A track it does not hold
+    (a new one) gets 0: the co-altitude prior.
+
+    Examples
+    --------
+    >>> last = (np.array([3, 5]), np.array([[1000.0, 0, -100.0, -50.0, 0, 0]] * 2), 0.0)
+    >>> np.degrees(predicted_elevation(np.array([5, 9]), np.zeros(3), 1.0, last)).round(2).tolist()
+    [6.01, 0.0]
+    """
+    el = np.zeros(np.size(ids))
+    if last is None or np.size(last[0]) == 0:
+        return el
+    prev_ids, x, t = last
+    rows = np.searchsorted(prev_ids, ids).clip(0, prev_ids.size - 1)
+    ok = prev_ids[rows] == ids
+    d = x[rows[ok], :3] + x[rows[ok], 3:] * (time_s - t) - np.asarray(own_position_m, float)
+    el[ok] = np.nan_to_num(np.arctan2(-d[:, 2], np.hypot(d[:, 0], d[:, 1])))
+    return el
+
+
+def at_elevation(
+    positions_m: np.ndarray, own_position_m: np.ndarray, elevation_rad: np.ndarray
+) -> np.ndarray:
+    """Positions moved to ``elevation_rad`` above the radar's horizontal (NED), same range and bearing.
+
+    Examples
+    --------
+    >>> at_elevation(np.array([[1000.0, 0.0, 0.0]]), np.zeros(3), np.array([np.pi / 6])).round(1).tolist()
+    [[866.0, 0.0, -500.0]]
+    """
+    own = np.asarray(own_position_m, float)
+    d = np.asarray(positions_m, float) - own
+    r = np.linalg.norm(d, axis=1)
+    bearing = np.arctan2(d[:, 1], d[:, 0])
+    el = np.asarray(elevation_rad, float)
+    return own + r[:, None] * np.column_stack(
+        [np.cos(el) * np.cos(bearing), np.cos(el) * np.sin(bearing), -np.sin(el)]
+    )
+
+
+def place_elevations(
+    positions_m: np.ndarray,
+    own_position_m: np.ndarray,
+    own_speed_mps: float,
+    sigma_rad: np.ndarray,
+    measured: np.ndarray,
+    radial_velocity_mps: np.ndarray,
+    height_agl_m: float,
+    predicted_rad: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """DoA positions with free elevations at the predicted one, their elevation sigma, and trust.
+
+    Parameters
+    ----------
+    positions_m : ndarray, shape (k, 3)
+        NED DoA positions, m.
+    own_position_m : ndarray, shape (3,)
+        Own-ship NED position, m; ``own_speed_mps`` its speed, m/s.
+    sigma_rad, measured, radial_velocity_mps : ndarray, shape (k,)
+        Angle sigma (rad), ``elevation_measured`` and radial velocity (m/s) of each detection.
+    height_agl_m : float
+        Own-ship's height above the ground, m (NaN: no ground known).
+    predicted_rad : ndarray, shape (k,)
+        Predicted elevation of each detection's track (:func:`predicted_elevation`), rad.
+
+    Returns
+    -------
+    positions_m, elevation_sigma_rad, trusted : ndarray
+        Free detections (not :func:`elevation_trusted`) moved to ``predicted_rad`` with
+        :data:`FREE_ELEVATION_SIGMA_RAD`; the trusted keep their position and ``sigma_rad``.
+
+    Examples
+    --------
+    >>> pos = np.array([[2000.0, 0.0, 700.0], [2000.0, 0.0, -700.0]])  # 19 deg below, 19 deg above
+    >>> p, s, ok = place_elevations(pos, np.zeros(3), 50.0, np.full(2, 0.02), np.ones(2, bool),
+    ...                             np.full(2, -30.0), 500.0, np.zeros(2))
+    >>> ok.tolist(), p[:, 2].round(1).tolist(), s.tolist()
+    ([False, True], [0.0, -700.0], [0.35, 0.02])
+    """
+    own = np.asarray(own_position_m, float)
+    d = np.asarray(positions_m, float) - own
+    elevation = np.arctan2(-d[:, 2], np.hypot(d[:, 0], d[:, 1]))
+    band = in_ground_band(np.linalg.norm(d, axis=1), radial_velocity_mps, own_speed_mps, height_agl_m)
+    trusted = elevation_trusted(elevation, sigma_rad, measured, band)
+    free = ~trusted & np.isfinite(d).all(axis=1)
+    out = np.array(positions_m, float)
+    out[free] = at_elevation(out[free], own, np.asarray(predicted_rad, float)[free])
+    return out, np.where(trusted, sigma_rad, FREE_ELEVATION_SIGMA_RAD), trusted

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from skyradar.track.elevation_trust import place_elevations, predicted_elevation
+from skyradar.track.elevation_trust import AboveVotes, place_elevations, predicted_elevation
 from skyradar.track.ground_doa import elevation_measured_flags
 from skyradar.track.io import validate_ownship
 from skyradar.track.measure3d import angle_sigma_rad, position_covariance
@@ -50,6 +50,7 @@ class Measure3D:
         else:
             self.sigma = np.full(len(det), 0.04 if sigma_rad is None else float(sigma_rad))
         self.own, self.agl, self.last = None, np.full(len(grid), np.nan), None
+        self.votes = AboveVotes()
         self.measured, self.trusted = elevation_measured_flags(det), np.zeros(len(det), bool)
         if ownship is not None:
             validate_ownship(ownship, OWNSHIP_COLUMNS)
@@ -98,7 +99,7 @@ class Measure3D:
         predicted = predicted_elevation(out.alive_ids, own_p, float(out.time_s), self.last)
         speed = float(np.linalg.norm(own_v))
         pos, el_sigma, trusted = place_elevations(
-            pos, own_p, speed, sigma, measured, v_best, self.agl[k], predicted
+            pos, own_p, speed, sigma, measured, v_best, self.agl[k], predicted, self.votes, out.alive_ids
         )
         self.trusted[idx] = trusted[has]
         cov = np.full((det.size, 3, 3), np.nan)

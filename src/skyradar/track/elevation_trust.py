@@ -104,7 +104,7 @@ class AboveVotes:
     warned. An aircraft that is above has nearly all its readings above (hills 23, 163, Jacksboro
     23: 93-99 %). So a track's in-band elevations count only while at least ``least`` of its last
     ``window`` measured in-band readings were above the threshold. 7 of 10: a co-altitude track
-    with 5 % of its readings 10-30 deg up in bursts of three stays within 40 m of its height (5 of
+    with 5 % of its readings 10-30 deg up in bursts of three stays within 60 m of its height (5 of
     10 let one of three draws climb 420 m); 14 of 20 resists more but an aircraft 340 m above
     then takes seconds longer to reach its height (``tests/test_elevation_trust.py``).
 

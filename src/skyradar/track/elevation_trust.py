@@ -35,7 +35,10 @@ __all__ = [
 ]  # fmt: skip
 
 FREE_ELEVATION_SIGMA_RAD = 0.35  # vertical-angle sigma of a free detection (holds, does not pull)
-BAND_ELEVATION_SIGMA_RAD = 0.05  # least elevation sigma of a trusted one inside the ground's band
+# Least elevation sigma of a trusted one inside the ground's band: readings measured through the nulls
+# scatter by degrees past their bound at the detection's SNR (Jacksboro, 200-set encounter 23: the first
+# readings, trusted at the bound, gated the others out and the track took 12 s to reach its height).
+BAND_ELEVATION_SIGMA_RAD = 0.05
 _GROUND_RANGE_FRACTION = 0.5  # ground may be in range from half the own-ship's height above it (relief)
 
 
@@ -220,10 +223,7 @@ def place_elevations(
     positions_m, elevation_sigma_rad, trusted : ndarray
         Free detections (not :func:`elevation_trusted`) moved to ``predicted_rad`` with
         :data:`FREE_ELEVATION_SIGMA_RAD`; the trusted keep their position and ``sigma_rad``, at
-        least :data:`BAND_ELEVATION_SIGMA_RAD` inside the band: an elevation measured through the
-        nulls scatters by degrees past its bound at the detection's SNR (Jacksboro, 200-set
-        encounter 23: the first readings, trusted at the bound, gated the others out and the track
-        took 12 s to reach its height).
+        least :data:`BAND_ELEVATION_SIGMA_RAD` inside the band (see its comment).
 
     Examples
     --------

@@ -17,7 +17,6 @@ from hypothesis import strategies as st
 
 from skyradar.config import RadarConfig
 from skyradar.track.elevation_trust import (
-    BAND_ELEVATION_SIGMA_RAD,
     FREE_ELEVATION_SIGMA_RAD,
     place_elevations,
 )
@@ -80,11 +79,11 @@ def test_elevations_scattered_past_their_bound_still_bring_the_track_to_its_heig
     # Jacksboro, 200-set encounter 23: elevations measured through the nulls scatter by degrees, far
     # past their Cramer-Rao bound at 25 dB (under 1 deg). Trusted at the bound, the first ones set the
     # track's height and gated the rest out (11 of 18 in its first 2 s); it reached its true height
-    # (339 m up) only after 12 s, and was warned meanwhile. At the band's 0.05 rad floor: within 60 m
-    # after 8 s.
+    # (339 m up) only after 12 s, and was warned meanwhile (its free readings then held the track's
+    # predicted height; at the co-altitude prior they weigh little against trusted ones).
     for seed in range(4):
         reading = np.where(np.random.default_rng(seed).random(N) < 0.5, "true", "prior")
-        det = _aircraft(340.0, 30.0, reading, noise_rad=0.06)
+        det = _aircraft(340.0, 30.0, reading, ahead_m=1200.0, noise_rad=0.06)
         tracks = track_detections(det, ownship=_own(), ground_test=False)
         after_8_s = tracks[tracks.confirmed & (tracks.time_s > 8.0)]
         assert len(after_8_s) > 100 and np.all(np.abs(-after_8_s["down_m"] - 340.0) < 60.0), seed
@@ -117,6 +116,18 @@ def test_outliers_above_do_not_lift_a_co_altitude_intruder():
         det = _lift(det, rows, rng.uniform(np.radians(10.0), np.radians(30.0), rows.size))
         confirmed = track_detections(det, ownship=_own(), ground_test=False).query("confirmed")
         assert len(confirmed) > 150 and np.all(np.abs(-confirmed["down_m"] + 39.0) < 60.0), seed
+
+
+def test_a_track_without_trusted_elevations_stays_co_altitude():
+    # Hills, 200-set encounter 88: overtaken 110 m below, every reading below the horizontal (none
+    # trusted). Placed at the track's predicted elevation they held nothing, the radial-velocity
+    # update lifted the track to 500 m up and the conflict was missed. At the co-altitude prior the
+    # track stays co-altitude: warned as if level with the own-ship.
+    for up_m in (-110.0, -40.0):
+        det = _aircraft(up_m, 35.0, np.full(N, "true"), noise_rad=0.05)
+        confirmed = track_detections(det, ownship=_own(), ground_test=False).query("confirmed")
+        assert len(confirmed) > 150 and np.all(np.abs(confirmed["down_m"]) < 60.0)
+        assert not confirmed["altitude_measured"].any()
 
 
 def test_ground_readings_of_a_co_altitude_intruder_do_not_carry_its_track_down():
@@ -156,23 +167,20 @@ def test_measured_elevations_below_count_outside_the_ground_band():
         min_size=1,
         max_size=8,
     ),  # fmt: skip
-    st.floats(-1.0, 1.0),
 )
-def test_free_detections_keep_range_and_bearing_and_trusted_ones_do_not_move(rows, predicted):
+def test_free_detections_keep_range_and_bearing_and_trusted_ones_do_not_move(rows):
     rng_m, bearing, el, measured, v = (np.array(c) for c in zip(*rows, strict=True))
     own = np.array([100.0, -50.0, -800.0])
     pos = own + rng_m[:, None] * np.column_stack(
         [np.cos(el) * np.cos(bearing), np.cos(el) * np.sin(bearing), -np.sin(el)]
     )
     sigma = np.full(len(rows), 0.02)
-    out, el_sigma, trusted = place_elevations(
-        pos, own, 50.0, sigma, measured, v, 600.0, np.full(len(rows), predicted)
-    )
+    out, el_sigma, trusted = place_elevations(pos, own, 50.0, sigma, measured, v, 600.0)
     d = out - own
     assert np.allclose(np.linalg.norm(d, axis=1), rng_m)
     horizontal = np.hypot(d[:, 0], d[:, 1]) > 1e-6 * rng_m
     assert np.allclose(np.cos(np.arctan2(d[:, 1], d[:, 0]) - bearing)[horizontal], 1.0)
     assert np.allclose(out[trusted], pos[trusted])
-    assert np.all((el_sigma[trusted] == 0.02) | (el_sigma[trusted] == BAND_ELEVATION_SIGMA_RAD))
-    assert np.allclose(np.arcsin(-d[~trusted, 2] / rng_m[~trusted]), predicted)
+    assert np.all(el_sigma[trusted] == 0.02)
+    assert np.allclose(d[~trusted, 2], 0.0, atol=1e-6 * rng_m.max())  # at the co-altitude prior
     assert np.all(el_sigma[~trusted] == FREE_ELEVATION_SIGMA_RAD) and not trusted[~measured].any()

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from skyradar.track.elevation_trust import AboveVotes, place_elevations, predicted_elevation
+from skyradar.track.elevation_trust import AboveVotes, place_elevations
 from skyradar.track.ground_doa import elevation_measured_flags
 from skyradar.track.io import validate_ownship
 from skyradar.track.measure3d import angle_sigma_rad, position_covariance
@@ -49,7 +49,7 @@ class Measure3D:
             self.sigma = angle_sigma_rad(det["snr_db"].to_numpy(float), config, *angles)
         else:
             self.sigma = np.full(len(det), 0.04 if sigma_rad is None else float(sigma_rad))
-        self.own, self.agl, self.last = None, np.full(len(grid), np.nan), None
+        self.own, self.agl = None, np.full(len(grid), np.nan)
         self.votes = AboveVotes()
         self.measured, self.trusted = elevation_measured_flags(det), np.zeros(len(det), bool)
         if ownship is not None:
@@ -92,14 +92,13 @@ class Measure3D:
         # trusting the range there slowed the 3-D velocity's convergence (median error 10 vs 6 m/s),
         # so the along-sight error is never taken below the across-sight one.
         across = np.linalg.norm(pos - own_p, axis=1) * sigma
-        # Elevations the ground may have pulled, or the nulls left unmeasured, hold the track's
-        # predicted height without moving it (skyradar.track.elevation_trust).
+        # Elevations the ground may have pulled, or the nulls left unmeasured, sit at the co-altitude
+        # prior with a loose vertical sigma (skyradar.track.elevation_trust).
         measured = np.zeros(det.size, bool)
         measured[has] = self.measured[idx]
-        predicted = predicted_elevation(out.alive_ids, own_p, float(out.time_s), self.last)
         speed = float(np.linalg.norm(own_v))
         pos, el_sigma, trusted = place_elevations(
-            pos, own_p, speed, sigma, measured, v_best, self.agl[k], predicted, self.votes, out.alive_ids
+            pos, own_p, speed, sigma, measured, v_best, self.agl[k], self.votes, out.alive_ids
         )
         self.trusted[idx] = trusted[has]
         cov = np.full((det.size, 3, 3), np.nan)
@@ -108,6 +107,4 @@ class Measure3D:
             pos[use], own_p, sigma[use], np.maximum(range_sigma, across)[use], el_sigma[use]
         )
         radial = RadialObservation(own_p, own_v, v_unaliased, self.motion.sigma_velocity_mps)
-        x, P = self.t3.step(float(out.time_s), out.alive_ids, pos, cov, radial)
-        self.last = (np.asarray(out.alive_ids), x, float(out.time_s))
-        return x, P
+        return self.t3.step(float(out.time_s), out.alive_ids, pos, cov, radial)

@@ -12,10 +12,14 @@ the target's true elevation; none can put a reading above the own-ship's horizon
 ground is below it. Hence the asymmetric rule (:func:`elevation_trusted`): inside the ground's
 range-Doppler band (:func:`in_ground_band`) an elevation counts only when it is measured and more
 than ``k`` standard deviations above the own-ship's horizontal; outside the band every measured
-elevation counts. The rest are *free*: the tracker places them at the track's predicted elevation
-(:func:`predicted_elevation`; the co-altitude prior, 0, for a new track) with a vertical-angle
-sigma of :data:`FREE_ELEVATION_SIGMA_RAD` (:func:`at_elevation`), so that they hold the track's
-height without pulling it, while range and azimuth count in full.
+elevation counts. The rest are *free*: the tracker places them at the co-altitude prior (elevation
+0 above the own-ship's horizontal, :func:`at_elevation`) with a vertical-angle sigma of
+:data:`FREE_ELEVATION_SIGMA_RAD`, while range and azimuth count in full. A track with no trusted
+elevation then stays co-altitude; one with trusted elevations follows them (a free reading weighs
+1/300 of a trusted one at 0.02 rad). Free readings placed at the track's
+*predicted* elevation instead held nothing: the radial-velocity update then moved the height
+unopposed (hills, 200-set encounter 88, 110 m below with no trusted reading: its track climbed to
+500 m up and a conflict was missed).
 
 What this buys (hills, 200-encounter set, encounter 23, an aircraft overtaken 339 m above): its
 elevations were measured on 30-70 % of the detections, at 27-45 deg, within a few degrees of the
@@ -31,13 +35,13 @@ import numpy as np
 
 __all__ = [
     "FREE_ELEVATION_SIGMA_RAD", "BAND_ELEVATION_SIGMA_RAD", "in_ground_band", "elevation_trusted",
-    "predicted_elevation", "at_elevation", "place_elevations", "AboveVotes",
+    "at_elevation", "place_elevations", "AboveVotes",
 ]  # fmt: skip
 
-FREE_ELEVATION_SIGMA_RAD = 0.35  # vertical-angle sigma of a free detection (holds, does not pull)
-# Least elevation sigma of a trusted one inside the ground's band: readings measured through the nulls
-# scatter by degrees past their bound at the detection's SNR (Jacksboro, 200-set encounter 23: the first
-# readings, trusted at the bound, gated the others out and the track took 12 s to reach its height).
+FREE_ELEVATION_SIGMA_RAD = 0.35  # vertical-angle sigma of a free detection, at the co-altitude prior
+# Least elevation scatter assumed inside the ground's band when a reading is judged above the horizontal
+# (3 of it: 8.6 deg): readings through the nulls scatter by degrees past their bound, with a heavy upper
+# tail (hills, 200-set encounter 48, 39 m below: 1.7 % of its measured elevations above 8.6 deg).
 BAND_ELEVATION_SIGMA_RAD = 0.05
 _GROUND_RANGE_FRACTION = 0.5  # ground may be in range from half the own-ship's height above it (relief)
 
@@ -142,32 +146,6 @@ class AboveVotes:
         return out
 
 
-def predicted_elevation(
-    ids: np.ndarray, own_position_m: np.ndarray, time_s: float, last: tuple | None
-) -> np.ndarray:
-    """Each track's elevation above the radar's horizontal (NED) at ``time_s``, rad; 0 if unknown.
-
-    ``last`` is ``(ids, states, time_s)`` of the 3-D tracker's previous step (states (k, 6): NED
-    position and velocity, ids sorted), moved on at constant velocity. A track it does not hold
-    (a new one) gets 0: the co-altitude prior.
-
-    Examples
-    --------
-    >>> last = (np.array([3, 5]), np.array([[1000.0, 0, -100.0, -50.0, 0, 0]] * 2), 0.0)
-    >>> np.degrees(predicted_elevation(np.array([5, 9]), np.zeros(3), 1.0, last)).round(2).tolist()
-    [6.01, 0.0]
-    """
-    el = np.zeros(np.size(ids))
-    if last is None or np.size(last[0]) == 0:
-        return el
-    prev_ids, x, t = last
-    rows = np.searchsorted(prev_ids, ids).clip(0, prev_ids.size - 1)
-    ok = prev_ids[rows] == ids
-    d = x[rows[ok], :3] + x[rows[ok], 3:] * (time_s - t) - np.asarray(own_position_m, float)
-    el[ok] = np.nan_to_num(np.arctan2(-d[:, 2], np.hypot(d[:, 0], d[:, 1])))
-    return el
-
-
 def at_elevation(
     positions_m: np.ndarray, own_position_m: np.ndarray, elevation_rad: np.ndarray
 ) -> np.ndarray:
@@ -196,11 +174,10 @@ def place_elevations(
     measured: np.ndarray,
     radial_velocity_mps: np.ndarray,
     height_agl_m: float,
-    predicted_rad: np.ndarray,
     votes: AboveVotes | None = None,
     ids: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """DoA positions with free elevations at the predicted one, their elevation sigma, and trust.
+    """DoA positions with free elevations at the co-altitude prior, their elevation sigma, and trust.
 
     Parameters
     ----------
@@ -212,8 +189,6 @@ def place_elevations(
         Angle sigma (rad), ``elevation_measured`` and radial velocity (m/s) of each detection.
     height_agl_m : float
         Own-ship's height above the ground, m (NaN: no ground known).
-    predicted_rad : ndarray, shape (k,)
-        Predicted elevation of each detection's track (:func:`predicted_elevation`), rad.
     votes, ids : AboveVotes and ndarray of int, shape (k,), optional
         The tracks' votes, updated here with this frame's in-band readings, and each row's track
         id; without them every track counts as voted above.
@@ -221,17 +196,16 @@ def place_elevations(
     Returns
     -------
     positions_m, elevation_sigma_rad, trusted : ndarray
-        Free detections (not :func:`elevation_trusted`) moved to ``predicted_rad`` with
-        :data:`FREE_ELEVATION_SIGMA_RAD`; the trusted keep their position and ``sigma_rad``, at
-        least :data:`BAND_ELEVATION_SIGMA_RAD` inside the band (see its comment).
+        Free detections (not :func:`elevation_trusted`) moved to elevation 0 with
+        :data:`FREE_ELEVATION_SIGMA_RAD`; the trusted keep their position and ``sigma_rad``.
 
     Examples
     --------
     >>> pos = np.array([[2000.0, 0.0, 700.0], [2000.0, 0.0, -700.0]])  # 19 deg below, 19 deg above
     >>> p, s, ok = place_elevations(pos, np.zeros(3), 50.0, np.full(2, 0.02), np.ones(2, bool),
-    ...                             np.full(2, -30.0), 500.0, np.zeros(2))
-    >>> ok.tolist(), p[:, 2].round(1).tolist(), s.tolist()  # in the band: the trusted one's sigma floored
-    ([False, True], [0.0, -700.0], [0.35, 0.05])
+    ...                             np.full(2, -30.0), 500.0)
+    >>> ok.tolist(), p[:, 2].round(1).tolist(), s.tolist()
+    ([False, True], [0.0, -700.0], [0.35, 0.02])
     """
     own = np.asarray(own_position_m, float)
     d = np.asarray(positions_m, float) - own
@@ -244,6 +218,5 @@ def place_elevations(
     trusted = elevation_trusted(elevation, sigma_rad, measured, band, track_above)
     free = ~trusted & np.isfinite(d).all(axis=1)
     out = np.array(positions_m, float)
-    out[free] = at_elevation(out[free], own, np.asarray(predicted_rad, float)[free])
-    trusted_sigma = np.where(band, np.maximum(sigma_rad, BAND_ELEVATION_SIGMA_RAD), sigma_rad)
-    return out, np.where(trusted, trusted_sigma, FREE_ELEVATION_SIGMA_RAD), trusted
+    out[free] = at_elevation(out[free], own, np.zeros(int(free.sum())))
+    return out, np.where(trusted, sigma_rad, FREE_ELEVATION_SIGMA_RAD), trusted

@@ -76,16 +76,15 @@ def elevation_trusted(
     sigma_rad: np.ndarray,
     measured: np.ndarray,
     band: np.ndarray,
-    track_above: np.ndarray | None = None,
     k: float = 3.0,
 ) -> np.ndarray:
     """Whether each detection's elevation may move its track's height (bool per detection).
 
     ``elevation_rad`` is the DoA point's elevation above the own-ship's horizontal (NED), rad;
     ``sigma_rad`` its standard deviation (taken at least :data:`BAND_ELEVATION_SIGMA_RAD` in the
-    band); ``measured`` the detection's ``elevation_measured``; ``band`` :func:`in_ground_band`;
-    ``track_above`` whether the detection's track is voted above the own-ship (:class:`AboveVotes`;
-    default: yes). See the module docstring for the rule.
+    band); ``measured`` the detection's ``elevation_measured``; ``band`` :func:`in_ground_band`.
+    The track's vote (:class:`AboveVotes`) is applied by :func:`place_elevations`. See the module
+    docstring for the rule.
 
     Examples
     --------
@@ -96,8 +95,6 @@ def elevation_trusted(
     """
     floor = np.where(band, BAND_ELEVATION_SIGMA_RAD, 0.0)
     above = np.asarray(elevation_rad, float) > k * np.maximum(np.asarray(sigma_rad, float), floor)
-    if track_above is not None:
-        above &= np.asarray(track_above, bool)
     return np.asarray(measured, bool) & (~np.asarray(band, bool) | above)
 
 
@@ -211,11 +208,9 @@ def place_elevations(
     d = np.asarray(positions_m, float) - own
     elevation = np.arctan2(-d[:, 2], np.hypot(d[:, 0], d[:, 1]))
     band = in_ground_band(np.linalg.norm(d, axis=1), radial_velocity_mps, own_speed_mps, height_agl_m)
-    track_above = None
-    if votes is not None:
-        above = elevation_trusted(elevation, sigma_rad, measured, band) & band
-        track_above = votes.update(ids, above, np.asarray(measured, bool) & band)
-    trusted = elevation_trusted(elevation, sigma_rad, measured, band, track_above)
+    trusted = elevation_trusted(elevation, sigma_rad, measured, band)
+    if votes is not None:  # in the band, only while the track is voted above
+        trusted &= ~band | votes.update(ids, trusted & band, np.asarray(measured, bool) & band)
     free = ~trusted & np.isfinite(d).all(axis=1)
     out = np.array(positions_m, float)
     out[free] = at_elevation(out[free], own, np.zeros(int(free.sum())))

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from skyradar.track.elevation_trust import AboveVotes, place_elevations
+from skyradar.track.elevation_trust import AboveVotes, BelowConsensus, place_elevations
 from skyradar.track.ground_doa import elevation_measured_flags
 from skyradar.track.io import validate_ownship
 from skyradar.track.measure3d import angle_sigma_rad, position_covariance
@@ -34,7 +34,7 @@ OWNSHIP_COLUMNS = (
 class Measure3D:
     """Feeds the 3-D tracker: DoA position, its covariance and the de-aliased radial velocity."""
 
-    def __init__(self, det, config, motion, sigma_rad, ownship, grid) -> None:
+    def __init__(self, det, config, motion, sigma_rad, ownship, grid, surface_down=None) -> None:
         self.active = all(c in det.columns for c in _NED)
         if not self.active:
             return
@@ -50,7 +50,7 @@ class Measure3D:
         else:
             self.sigma = np.full(len(det), 0.04 if sigma_rad is None else float(sigma_rad))
         self.own, self.agl = None, np.full(len(grid), np.nan)
-        self.votes = AboveVotes()
+        self.votes, self.below, self.surface_down = AboveVotes(), BelowConsensus(), surface_down
         self.measured, self.trusted = elevation_measured_flags(det), np.zeros(len(det), bool)
         if ownship is not None:
             validate_ownship(ownship, OWNSHIP_COLUMNS)
@@ -98,7 +98,17 @@ class Measure3D:
         measured[has] = self.measured[idx]
         speed = float(np.linalg.norm(own_v))
         pos, el_sigma, trusted = place_elevations(
-            pos, own_p, speed, sigma, measured, v_best, self.agl[k], self.votes, out.alive_ids
+            pos,
+            own_p,
+            speed,
+            sigma,
+            measured,
+            v_best,
+            self.agl[k],
+            self.votes,
+            out.alive_ids,
+            self.below,
+            self._clearance(pos, own_p[2] + self.agl[k]),
         )
         self.trusted[idx] = trusted[has]
         cov = np.full((det.size, 3, 3), np.nan)
@@ -108,3 +118,13 @@ class Measure3D:
         )
         radial = RadialObservation(own_p, own_v, v_unaliased, self.motion.sigma_velocity_mps)
         return self.t3.step(float(out.time_s), out.alive_ids, pos, cov, radial)
+
+    def _clearance(self, pos: np.ndarray, flat_down_m: float) -> np.ndarray:
+        """Height of each point above the terrain (``surface_down``), else above a level ground at
+        ``flat_down_m``, m; NaN where the point is unknown."""
+        if self.surface_down is None:
+            return flat_down_m - pos[:, 2]
+        out = np.full(len(pos), np.nan)
+        ok = np.isfinite(pos).all(axis=1)
+        out[ok] = np.asarray(self.surface_down(pos[ok, :2]), float) - pos[ok, 2]
+        return out

@@ -145,7 +145,8 @@ def track_detections(
     detections, head_rows = fuse_heads(validate_detections(detections), config)  # heads -> one stream
     motion, tracker = _make_tracker(model, config, tracker_config)
     grid, lo, hi = _frame_slices(detections["time_s"].to_numpy(float), frame_times_s)
-    m3 = Measure3D(detections, config, motion, position_sigma_rad, ownship, grid)
+    surface = ground_test.surface_down if isinstance(ground_test, GroundTrackTest) else None
+    m3 = Measure3D(detections, config, motion, position_sigma_rad, ownship, grid, surface)
     chunks = _run_tracker(tracker, m3, detections, grid, lo, hi)
     t = _table(chunks, origin, m3, detections, ownship, config, ground_test)
     return restore_detection_rows(t, head_rows)

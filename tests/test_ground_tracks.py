@@ -232,7 +232,9 @@ def test_short_track_whose_measured_directions_are_on_the_ground_needs_more_dete
         d = det.assign(north_m=own["own_north_m"] + north, east_m=east, down_m=down_m)
         d.loc[3, "down_m"] = 0.0  # the placeholder elevation reads co-altitude
         for ground_min, kept_here in ((10, kept), (0, True)):  # 0: the rule off
-            test = GroundTrackTest(point_sigma_velocity_mps=None, ground_min_detections=ground_min)
+            test = GroundTrackTest(
+                point_sigma_velocity_mps=None, ground_min_detections=ground_min, min_detections=3
+            )
             out = hold_ground_tracks(tracks, d, own, WIDTH, C, flat_surface(AGL_M), test)
             assert (len(out) > 0) == kept_here, (down_m, ground_min)
 
@@ -250,7 +252,7 @@ def test_track_without_a_measured_direction_needs_more_detections():
                         "azimuth_rad": [-1.073, 1.248, -1.108, 1.248], "elevation_rad": 0.0 * t,
                         "north_m": 660.0 + 0 * t, "east_m": 0 * t, "down_m": 0 * t})  # fmt: skip
     tracks = pd.DataFrame({"time_s": t, "track_id": 3, "detection_row": np.arange(4), "confirmed": True})
-    test = GroundTrackTest(point_sigma_velocity_mps=None)
+    test = GroundTrackTest(point_sigma_velocity_mps=None, min_detections=3)
     for measured, kept in ((False, False), (True, True)):
         d = det.assign(elevation_measured=measured)
         out = hold_ground_tracks(tracks, d, _own(t), WIDTH, C, flat_surface(AGL_M), test)
@@ -336,3 +338,49 @@ def test_a_doppler_step_starts_a_held_tracks_history_again():
     # the second patch alone: held too (the test is about the step, not the patch)
     alone = hold_ground_tracks(tracks.iloc[3:], det, own, WIDTH, C, flat_surface(AGL_M), test)
     assert len(alone) == 0
+
+
+def test_three_clutter_hits_a_range_line_fits_are_not_an_object():
+    # Hills, 200-set encounters 33 and 188: three detections of residual clutter (different
+    # scatterers at 1.45-1.53 km, ranges 80 m apart in 0.3 s that some Doppler alias fits) were
+    # judged an object at the third and stayed confirmed while coasting (0.5 s each, counted as
+    # ground tracks). Judged from the fifth detection they are held; an aircraft is released there.
+    from skyradar.track.ground_tracks import GroundTrackTest, hold_ground_tracks
+
+    t = np.array([95.4, 95.5, 95.7, 96.6]) - 95.4
+    det = pd.DataFrame({"time_s": t, "range_m": [1446.5, 1461.5, 1528.0, 1724.1],
+                        "radial_velocity_mps": [35.2, 35.1, 34.3, 31.6],
+                        "north_m": 1500.0 + 0 * t, "east_m": 0 * t, "down_m": 0 * t})  # fmt: skip
+    tracks = pd.DataFrame({"time_s": t, "track_id": 3, "detection_row": np.arange(4), "confirmed": True})
+    for least, kept in ((3, True), (GroundTrackTest().min_detections, False)):
+        test = GroundTrackTest(min_detections=least)
+        out = hold_ground_tracks(tracks, det, _own(t), WIDTH, C, flat_surface(AGL_M), test)
+        assert (len(out) > 0) == kept, least
+    # A head-on aircraft's confirmation (its Doppler test needs its own history) is not delayed.
+    aircraft = _detections(np.column_stack([1500.0 - 40.0 * T, 0 * T, 0 * T]))
+    tests = [GroundTrackTest(min_detections=m) for m in (3, GroundTrackTest().min_detections)]
+    first = [_confirmed_from(track_detections(aircraft, ownship=_own(), ground_test=g)) for g in tests]
+    assert first[1] == first[0] < 2.0
+
+
+def test_a_ground_track_is_released_only_by_verdicts_on_new_directions():
+    # Hills, 200-set encounters 6 and 28: a ground patch 2.7-3.1 km away, its static fit holding it,
+    # then three judgements running (9 of 10 directions shared) read "one direction in the air": the
+    # patch's azimuth off by 10 deg, over a valley. Released by two such verdicts, it was confirmed
+    # for 0.2 s. A release needs the verdicts to span five detections.
+    import skyradar.track.ground_tracks as gt
+
+    calls = iter(["ground"] * 10 + [""] * 3 + ["ground"] * 10)
+    t = np.arange(23) / 9.4
+    original = gt._judge
+    gt._judge = lambda *a, **k: next(calls)
+    try:
+        test = gt.GroundTrackTest(ground_min_detections=5)
+        held = gt._history_held(t, *([np.zeros(23)] * 4), None, WIDTH, C, test, [np.zeros(23)] * 4)
+        assert held.all()
+        calls = iter(["ground"] * 10 + [""] * 13)
+        held = gt._history_held(t, *([np.zeros(23)] * 4), None, WIDTH, C, test, [np.zeros(23)] * 4)
+        released = test.min_detections - 1 + 10 + gt._RELEASE_DETECTIONS  # first verdict at the 5th detection
+        assert held[:released].all() and not held[released:].any()
+    finally:
+        gt._judge = original

@@ -67,6 +67,11 @@ from skyradar.track.static_point import (
 )
 
 _CLEAR_S = 3.0  # judged an object off the ground this long on end: not judged again
+# Detections a run of "object" verdicts must span to release a track a static ground point fitted:
+# half the DoA test's window new. Successive judgements share 9 of 10 directions, so a run of three
+# was one chance window: a ground patch read a few degrees off its azimuth, over a valley (hills,
+# 200-set encounters 6 and 28: confirmed for 0.2 s each at 2.7-3.1 km).
+_RELEASE_DETECTIONS = 5
 
 __all__ = [
     "GroundTrackTest",
@@ -100,7 +105,9 @@ class GroundTrackTest:
         same clutter patch, a noise hit in the gate).
     min_detections : int
         Detections of a track in the table (its first one starts it and is not there) before it
-        can be judged; fewer: held.
+        can be judged; fewer: held. Five, not three: three hits of residual clutter on different
+        scatterers fit a range line through some Doppler alias (hills, 200-set encounters 33
+        and 188, each confirmed for 0.5 s); an aircraft's Doppler test needs more anyway.
     max_history : int
         The most recent detections a fit uses.
     surface_down : callable, optional
@@ -130,7 +137,7 @@ class GroundTrackTest:
     sigma_velocity_mps: float = 0.25
     tail: float = 1e-3
     trim: float = 0.1
-    min_detections: int = 3
+    min_detections: int = 5
     max_history: int = 120
     surface_down: Callable[[np.ndarray], np.ndarray] | None = None
     rejudge_gap_s: float = 2.0
@@ -246,13 +253,14 @@ def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test
     that is not one smooth curve starts the history again after its largest step: the detections
     before it came from another scatterer, more than the static fit's trim leaves out (hills,
     200-encounter set, encounter 10), and the new history needs ``ground_min_detections``.
-    Once a static ground point has fitted it, a track is released only when two judgements
-    running say otherwise, and not before ``ground_min_detections``: the surface model and a
-    patch's scatterers make a fit fail now and then, and each was a confirmed ground row.
+    Once a static ground point has fitted it, a track is released only when the judgements
+    running over :data:`_RELEASE_DETECTIONS` detections say otherwise, and not before
+    ``ground_min_detections``: the surface model and a patch's scatterers make a fit fail now and
+    then, and each was a confirmed ground row.
     """
     n = rng.size
     held = np.ones(n, bool)
-    last, clear_since, start, ground_seen, objects_running = True, np.inf, 0, False, 0
+    last, clear_since, start, ground_seen, object_since = True, np.inf, 0, False, n
     least = test.min_detections
     for k in range(test.min_detections - 1, n):
         if t[k] - clear_since >= _CLEAR_S:
@@ -265,8 +273,9 @@ def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test
                 start, least = max(start, _largest_step(vel, width, sl)), test.ground_min_detections
             if reason == "ground":  # ground once: as long a history as the Doppler test's to clear it
                 ground_seen, least = True, test.ground_min_detections
-            objects_running = objects_running + 1 if reason == "" else 0
-            last = reason != "" or (ground_seen and objects_running < 2) or k + 1 - start < least
+            object_since = min(object_since, k) if reason == "" else n
+            released = k - object_since >= _RELEASE_DETECTIONS
+            last = reason != "" or (ground_seen and not released) or k + 1 - start < least
             clear_since = np.inf if last else min(clear_since, t[k])
         held[k] = last
     return held

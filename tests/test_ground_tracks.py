@@ -173,6 +173,7 @@ def test_converging_aircraft_fits_a_static_point_but_its_direction_keeps_it():
     with_doa = track_detections(det, ownship=own, ground_test=test)
     no_doa = det.drop(columns=["azimuth_rad", "elevation_rad"])
     without = track_detections(no_doa, ownship=own, ground_test=test)
+    # 1.17 s when two running verdicts released it; a span of three detections costs a little.
     assert _confirmed_from(with_doa) < 1.5
     assert _confirmed_from(without) > _confirmed_from(with_doa) + 1.0
 
@@ -233,7 +234,7 @@ def test_short_track_whose_measured_directions_are_on_the_ground_needs_more_dete
         d.loc[3, "down_m"] = 0.0  # the placeholder elevation reads co-altitude
         for ground_min, kept_here in ((10, kept), (0, True)):  # 0: the rule off
             test = GroundTrackTest(
-                point_sigma_velocity_mps=None, ground_min_detections=ground_min, min_detections=3
+                point_sigma_velocity_mps=None, ground_min_detections=ground_min, release_detections=3
             )
             out = hold_ground_tracks(tracks, d, own, WIDTH, C, flat_surface(AGL_M), test)
             assert (len(out) > 0) == kept_here, (down_m, ground_min)
@@ -252,7 +253,7 @@ def test_track_without_a_measured_direction_needs_more_detections():
                         "azimuth_rad": [-1.073, 1.248, -1.108, 1.248], "elevation_rad": 0.0 * t,
                         "north_m": 660.0 + 0 * t, "east_m": 0 * t, "down_m": 0 * t})  # fmt: skip
     tracks = pd.DataFrame({"time_s": t, "track_id": 3, "detection_row": np.arange(4), "confirmed": True})
-    test = GroundTrackTest(point_sigma_velocity_mps=None, min_detections=3)
+    test = GroundTrackTest(point_sigma_velocity_mps=None, release_detections=3)
     for measured, kept in ((False, False), (True, True)):
         d = det.assign(elevation_measured=measured)
         out = hold_ground_tracks(tracks, d, _own(t), WIDTH, C, flat_surface(AGL_M), test)
@@ -352,13 +353,13 @@ def test_three_clutter_hits_a_range_line_fits_are_not_an_object():
                         "radial_velocity_mps": [35.2, 35.1, 34.3, 31.6],
                         "north_m": 1500.0 + 0 * t, "east_m": 0 * t, "down_m": 0 * t})  # fmt: skip
     tracks = pd.DataFrame({"time_s": t, "track_id": 3, "detection_row": np.arange(4), "confirmed": True})
-    for least, kept in ((3, True), (GroundTrackTest().min_detections, False)):
-        test = GroundTrackTest(min_detections=least)
+    for least, kept in ((3, True), (GroundTrackTest().release_detections, False)):
+        test = GroundTrackTest(release_detections=least)
         out = hold_ground_tracks(tracks, det, _own(t), WIDTH, C, flat_surface(AGL_M), test)
         assert (len(out) > 0) == kept, least
     # A head-on aircraft's confirmation (its Doppler test needs its own history) is not delayed.
     aircraft = _detections(np.column_stack([1500.0 - 40.0 * T, 0 * T, 0 * T]))
-    tests = [GroundTrackTest(min_detections=m) for m in (3, GroundTrackTest().min_detections)]
+    tests = [GroundTrackTest(release_detections=m) for m in (3, GroundTrackTest().release_detections)]
     first = [_confirmed_from(track_detections(aircraft, ownship=_own(), ground_test=g)) for g in tests]
     assert first[1] == first[0] < 2.0
 
@@ -367,7 +368,7 @@ def test_a_ground_track_is_released_only_by_verdicts_on_new_directions():
     # Hills, 200-set encounters 6 and 28: a ground patch 2.7-3.1 km away, its static fit holding it,
     # then three judgements running (9 of 10 directions shared) read "one direction in the air": the
     # patch's azimuth off by 10 deg, over a valley. Released by two such verdicts, it was confirmed
-    # for 0.2 s. A release needs the verdicts to span five detections.
+    # for 0.2 s. A release needs the verdicts to span three detections (four verdicts running).
     import skyradar.track.ground_tracks as gt
 
     calls = iter(["ground"] * 10 + [""] * 3 + ["ground"] * 10)
@@ -375,12 +376,12 @@ def test_a_ground_track_is_released_only_by_verdicts_on_new_directions():
     original = gt._judge
     gt._judge = lambda *a, **k: next(calls)
     try:
-        test = gt.GroundTrackTest(ground_min_detections=5)
+        test = gt.GroundTrackTest(ground_min_detections=3)  # judged at every detection from the third
         held = gt._history_held(t, *([np.zeros(23)] * 4), None, WIDTH, C, test, [np.zeros(23)] * 4)
         assert held.all()
         calls = iter(["ground"] * 10 + [""] * 13)
         held = gt._history_held(t, *([np.zeros(23)] * 4), None, WIDTH, C, test, [np.zeros(23)] * 4)
-        released = test.min_detections - 1 + 10 + gt._RELEASE_DETECTIONS  # first verdict at the 5th detection
+        released = test.min_detections - 1 + 10 + gt._RELEASE_DETECTIONS
         assert held[:released].all() and not held[released:].any()
     finally:
         gt._judge = original

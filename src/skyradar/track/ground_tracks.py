@@ -67,11 +67,12 @@ from skyradar.track.static_point import (
 )
 
 _CLEAR_S = 3.0  # judged an object off the ground this long on end: not judged again
-# Detections a run of "object" verdicts must span to release a track a static ground point fitted:
-# half the DoA test's window new. Successive judgements share 9 of 10 directions, so a run of three
-# was one chance window: a ground patch read a few degrees off its azimuth, over a valley (hills,
-# 200-set encounters 6 and 28: confirmed for 0.2 s each at 2.7-3.1 km).
-_RELEASE_DETECTIONS = 5
+# Detections a run of "object" verdicts must span to release a track a static ground point fitted.
+# Successive judgements share 9 of 10 directions, so a run of three was one chance window: a ground
+# patch read a few degrees off its azimuth, over a valley (hills, 200-set encounters 6 and 28:
+# confirmed for 0.2 s each at 2.7-3.1 km). Five cost a fast head-on intruder whose aliased Doppler
+# fits a static point 1.4 s of warning (encounter 15); three cost it 0.3 s.
+_RELEASE_DETECTIONS = 3
 
 __all__ = [
     "GroundTrackTest",
@@ -105,9 +106,13 @@ class GroundTrackTest:
         same clutter patch, a noise hit in the gate).
     min_detections : int
         Detections of a track in the table (its first one starts it and is not there) before it
-        can be judged; fewer: held. Five, not three: three hits of residual clutter on different
-        scatterers fit a range line through some Doppler alias (hills, 200-set encounters 33
-        and 188, each confirmed for 0.5 s); an aircraft's Doppler test needs more anyway.
+        can be judged; fewer: held.
+    release_detections : int
+        Detections before a track judged an object is released. Five, not three: three hits of
+        residual clutter on different scatterers fit a range line through some Doppler alias
+        (hills, 200-set encounters 33 and 188, each confirmed for 0.5 s). Judging still starts at
+        ``min_detections``, so a static fit seen at the third detection counts (the altitude
+        return of encounter 27 was judged an object first at its fifth).
     max_history : int
         The most recent detections a fit uses.
     surface_down : callable, optional
@@ -137,7 +142,8 @@ class GroundTrackTest:
     sigma_velocity_mps: float = 0.25
     tail: float = 1e-3
     trim: float = 0.1
-    min_detections: int = 5
+    min_detections: int = 3
+    release_detections: int = 5
     max_history: int = 120
     surface_down: Callable[[np.ndarray], np.ndarray] | None = None
     rejudge_gap_s: float = 2.0
@@ -275,7 +281,8 @@ def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test
                 ground_seen, least = True, test.ground_min_detections
             object_since = min(object_since, k) if reason == "" else n
             released = k - object_since >= _RELEASE_DETECTIONS
-            last = reason != "" or (ground_seen and not released) or k + 1 - start < least
+            early = k + 1 - start < max(least, test.release_detections)
+            last = reason != "" or (ground_seen and not released) or early
             clear_since = np.inf if last else min(clear_since, t[k])
         held[k] = last
     return held

@@ -139,7 +139,7 @@ def track_detections(
     >>> det = pd.DataFrame({"time_s": t, "range_m": 1000 - 50 * t, "radial_velocity_mps": np.full(10, 28.3)})
     >>> out = track_detections(det)
     >>> out.track_id.nunique(), len(out), int(out.confirmed.sum())
-    (1, 9, 7)
+    (1, 9, 5)
     """
     config = config or RadarConfig.prototype_2022()
     detections, head_rows = fuse_heads(validate_detections(detections), config)  # heads -> one stream

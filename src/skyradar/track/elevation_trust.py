@@ -252,22 +252,18 @@ def place_elevations(
 
     Parameters
     ----------
-    positions_m : ndarray, shape (k, 3)
-        NED DoA positions, m.
-    own_position_m : ndarray, shape (3,)
-        Own-ship NED position, m; ``own_speed_mps`` its speed, m/s.
+    positions_m, own_position_m : ndarray, shape (k, 3) and (3,)
+        NED DoA positions and the own-ship's, m; ``own_speed_mps`` its speed, m/s.
     sigma_rad, measured, radial_velocity_mps : ndarray, shape (k,)
         Angle sigma (rad), ``elevation_measured`` and radial velocity (m/s) of each detection.
     height_agl_m : float
         Own-ship's height above the ground, m (NaN: no ground known).
     votes, ids : AboveVotes and ndarray of int, shape (k,), optional
-        The tracks' votes, updated here with this frame's in-band readings, and each row's track
-        id; without them every track counts as voted above.
+        The tracks' votes (updated here) and each row's track id; without: all voted above.
     below, clearance_m : BelowConsensus and ndarray, shape (k,), optional
-        The tracks' consensus below the own-ship (needs ``ids``), updated here, and each DoA
-        point's height above the terrain, m: in-band readings below the horizontal within 3
-        bounds of their track's consensus are trusted, with a sigma of at least
-        :data:`BAND_ELEVATION_SIGMA_RAD`. Without them no in-band reading below counts.
+        The tracks' consensus below (updated here) and each DoA point's height above the terrain,
+        m: in-band readings below within 3 bounds of the consensus are trusted, at a sigma of at
+        least :data:`BAND_ELEVATION_SIGMA_RAD`. Without them no in-band reading below counts.
 
     Returns
     -------
@@ -291,11 +287,10 @@ def place_elevations(
     in_band = np.asarray(measured, bool) & band
     if votes is not None:  # in the band, only while the track is voted above
         trusted &= ~band | votes.update(ids, trusted & band, in_band)
-    sigma = np.asarray(sigma_rad, float)
+    sigma, held = np.asarray(sigma_rad, float), np.zeros(len(d), bool)
     if below is not None and clearance_m is not None:
         held = _held_below(elevation, np.linalg.norm(d, axis=1), sigma, in_band, clearance_m, below, ids)
-        trusted |= held
-        sigma = np.where(held, np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD), sigma)
+    trusted, sigma = trusted | held, np.where(held, np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD), sigma)
     free = ~trusted & np.isfinite(d).all(axis=1)
     out = np.array(positions_m, float)
     out[free] = at_elevation(out[free], own, np.zeros(int(free.sum())))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pandas as pd
 
@@ -145,11 +147,15 @@ def track_detections(
     detections, head_rows = fuse_heads(validate_detections(detections), config)  # heads -> one stream
     motion, tracker = _make_tracker(model, config, tracker_config)
     grid, lo, hi = _frame_slices(detections["time_s"].to_numpy(float), frame_times_s)
-    surface = ground_test.surface_down if isinstance(ground_test, GroundTrackTest) else None
-    m3 = Measure3D(detections, config, motion, position_sigma_rad, ownship, grid, surface)
+    m3 = Measure3D(detections, config, motion, position_sigma_rad, ownship, grid, _surface(ground_test))
     chunks = _run_tracker(tracker, m3, detections, grid, lo, hi)
     t = _table(chunks, origin, m3, detections, ownship, config, ground_test)
     return restore_detection_rows(t, head_rows)
+
+
+def _surface(ground_test) -> Callable | None:
+    """The terrain the ground test knows (NE -> down), for the 3-D feed's clearance of readings."""
+    return ground_test.surface_down if isinstance(ground_test, GroundTrackTest) else None
 
 
 def _table(chunks, origin, m3, detections, ownship, config: RadarConfig, ground_test) -> pd.DataFrame:

@@ -125,24 +125,33 @@ class AboveVotes:
     """
 
     def __init__(self, window: int = 10, least: int = 7) -> None:
-        self.window, self.least = int(window), int(least)
-        self._votes: dict[int, list[bool]] = {}
+        self.least, self._recent = int(least), _RecentReadings(window)
 
     def update(self, ids: np.ndarray, above: np.ndarray, counts: np.ndarray) -> np.ndarray:
         """Add this frame's vote ``above`` of each track ``ids`` where ``counts``; returns whether
         each track is voted above now (bool per id). Tracks not listed are forgotten."""
-        keep = {int(i) for i in np.asarray(ids).tolist()}
-        self._votes = {i: v for i, v in self._votes.items() if i in keep}
-        out = np.zeros(np.size(ids), bool)
-        rows = zip(
-            np.asarray(ids).tolist(), np.asarray(above).tolist(), np.asarray(counts).tolist(), strict=True
-        )
-        for n, (i, a, c) in enumerate(rows):
-            votes = self._votes.setdefault(int(i), [])
+        votes = self._recent.push(ids, np.asarray(above, bool).tolist(), counts)
+        return np.array([sum(v) >= self.least for v in votes], bool)
+
+
+class _RecentReadings:
+    """Each track's last ``window`` readings, kept from frame to frame; tracks not listed are forgotten."""
+
+    def __init__(self, window: int) -> None:
+        self.window, self._by_track = int(window), {}
+
+    def push(self, ids: np.ndarray, readings: list, counts: np.ndarray) -> list[list]:
+        """Add ``readings[n]`` to track ``ids[n]`` where ``counts[n]``; each listed track's readings."""
+        ids = [int(i) for i in np.asarray(ids).tolist()]
+        listed = set(ids)
+        self._by_track = {i: v for i, v in self._by_track.items() if i in listed}
+        out = []
+        for i, reading, c in zip(ids, readings, np.asarray(counts).tolist(), strict=True):
+            recent = self._by_track.setdefault(i, [])
             if c:
-                votes.append(bool(a))
-                del votes[: -self.window]
-            out[n] = sum(votes) >= self.least
+                recent.append(reading)
+                del recent[: -self.window]
+            out.append(recent)
         return out
 
 
@@ -177,7 +186,7 @@ class BelowConsensus:
 
     def __init__(self, window: int = 10, least: int = 7, spread: float = 1.5) -> None:
         self.window, self.least, self.spread = int(window), int(least), float(spread)
-        self._readings: dict[int, list[tuple[float, float, bool, float]]] = {}
+        self._recent = _RecentReadings(window)
 
     def update(
         self,
@@ -192,18 +201,10 @@ class BelowConsensus:
         whether ``below`` the threshold, clearance ``clear_m`` of the surface) of each track ``ids``
         where ``counts``; returns each track's consensus height, m (NaN: none). Tracks not listed
         are forgotten."""
-        keep = {int(i) for i in np.asarray(ids).tolist()}
-        self._readings = {i: v for i, v in self._readings.items() if i in keep}
-        out = np.full(np.size(ids), np.nan)
-        columns = (np.asarray(up_m, float), np.asarray(bound_m, float), np.asarray(below, bool),
+        columns = (np.asarray(up_m, float), np.asarray(bound_m, float), np.asarray(below, float),
                    np.asarray(clear_m, float))  # fmt: skip
-        for n, (i, c) in enumerate(zip(np.asarray(ids).tolist(), np.asarray(counts).tolist(), strict=True)):
-            readings = self._readings.setdefault(int(i), [])
-            if c:
-                readings.append(tuple(col[n].item() for col in columns))
-                del readings[: -self.window]
-            out[n] = self._consensus(np.array(readings, float).reshape(-1, 4))
-        return out
+        recent = self._recent.push(ids, np.column_stack(columns).tolist(), counts)
+        return np.array([self._consensus(np.array(r, float).reshape(-1, 4)) for r in recent], float)
 
     def _consensus(self, readings: np.ndarray) -> float:
         up, bound, below, clear = readings.T
@@ -281,15 +282,15 @@ def place_elevations(
     """
     own = np.asarray(own_position_m, float)
     d = np.asarray(positions_m, float) - own
-    elevation = np.arctan2(-d[:, 2], np.hypot(d[:, 0], d[:, 1]))
-    band = in_ground_band(np.linalg.norm(d, axis=1), radial_velocity_mps, own_speed_mps, height_agl_m)
+    elevation, range_m = np.arctan2(-d[:, 2], np.hypot(d[:, 0], d[:, 1])), np.linalg.norm(d, axis=1)
+    band = in_ground_band(range_m, radial_velocity_mps, own_speed_mps, height_agl_m)
     trusted = elevation_trusted(elevation, sigma_rad, measured, band)
     in_band = np.asarray(measured, bool) & band
     if votes is not None:  # in the band, only while the track is voted above
         trusted &= ~band | votes.update(ids, trusted & band, in_band)
     sigma, held = np.asarray(sigma_rad, float), np.zeros(len(d), bool)
     if below is not None and clearance_m is not None:
-        held = _held_below(elevation, np.linalg.norm(d, axis=1), sigma, in_band, clearance_m, below, ids)
+        held = _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids)
     trusted, sigma = trusted | held, np.where(held, np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD), sigma)
     free = ~trusted & np.isfinite(d).all(axis=1)
     out = np.array(positions_m, float)
@@ -299,7 +300,7 @@ def place_elevations(
 
 def _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids, k: float = 3.0) -> np.ndarray:
     """In-band readings below the horizontal that agree with their track's :class:`BelowConsensus`."""
-    up, loose = range_m * np.sin(elevation), k * range_m * np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD)
-    is_below = elevation < -k * np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD)
+    wide = k * np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD)
+    up, loose, is_below = range_m * np.sin(elevation), range_m * wide, elevation < -wide
     consensus = below.update(ids, up, range_m * sigma, is_below, in_band, np.asarray(clearance_m) - loose)
     return in_band & is_below & (np.abs(up - consensus) <= loose)

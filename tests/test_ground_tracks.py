@@ -364,24 +364,22 @@ def test_three_clutter_hits_a_range_line_fits_are_not_an_object():
     assert first[1] == first[0] < 2.0
 
 
-def test_a_ground_track_is_released_only_by_verdicts_on_new_directions():
+def test_a_ground_track_is_released_only_by_verdicts_on_new_directions(monkeypatch):
     # Hills, 200-set encounters 6 and 28: a ground patch 2.7-3.1 km away, its static fit holding it,
     # then three judgements running (9 of 10 directions shared) read "one direction in the air": the
     # patch's azimuth off by 10 deg, over a valley. Released by two such verdicts, it was confirmed
     # for 0.2 s. A release needs the verdicts to span three detections (four verdicts running).
     import skyradar.track.ground_tracks as gt
 
-    calls = iter(["ground"] * 10 + [""] * 3 + ["ground"] * 10)
     t = np.arange(23) / 9.4
-    original = gt._judge
-    gt._judge = lambda *a, **k: next(calls)
-    try:
-        test = gt.GroundTrackTest(ground_min_detections=3)  # judged at every detection from the third
-        held = gt._history_held(t, *([np.zeros(23)] * 4), None, WIDTH, C, test, [np.zeros(23)] * 4)
-        assert held.all()
-        calls = iter(["ground"] * 10 + [""] * 13)
-        held = gt._history_held(t, *([np.zeros(23)] * 4), None, WIDTH, C, test, [np.zeros(23)] * 4)
-        released = test.min_detections - 1 + 10 + gt._RELEASE_DETECTIONS
-        assert held[:released].all() and not held[released:].any()
-    finally:
-        gt._judge = original
+    test = gt.GroundTrackTest(ground_min_detections=3)  # judged at every detection from the third
+
+    def held_with(verdicts: list[str]) -> np.ndarray:
+        calls = iter(verdicts)
+        monkeypatch.setattr(gt, "_judge", lambda *a, **k: next(calls))
+        return gt._history_held(t, *([np.zeros(23)] * 4), None, WIDTH, C, test, [np.zeros(23)] * 4)
+
+    assert held_with(["ground"] * 10 + [""] * 3 + ["ground"] * 10).all()
+    held = held_with(["ground"] * 10 + [""] * 13)
+    released = test.min_detections - 1 + 10 + test.release_span_detections
+    assert held[:released].all() and not held[released:].any()

@@ -67,12 +67,6 @@ from skyradar.track.static_point import (
 )
 
 _CLEAR_S = 3.0  # judged an object off the ground this long on end: not judged again
-# Detections a run of "object" verdicts must span to release a track a static ground point fitted.
-# Successive judgements share 9 of 10 directions, so a run of three was one chance window: a ground
-# patch read a few degrees off its azimuth, over a valley (hills, 200-set encounters 6 and 28:
-# confirmed for 0.2 s each at 2.7-3.1 km). Five cost a fast head-on intruder whose aliased Doppler
-# fits a static point 1.4 s of warning (encounter 15); three cost it 0.3 s.
-_RELEASE_DETECTIONS = 3
 
 __all__ = [
     "GroundTrackTest",
@@ -113,6 +107,13 @@ class GroundTrackTest:
         (hills, 200-set encounters 33 and 188, each confirmed for 0.5 s). Judging still starts at
         ``min_detections``, so a static fit seen at the third detection counts (the altitude
         return of encounter 27 was judged an object first at its fifth).
+    release_span_detections : int
+        Detections a run of "object" verdicts must span to release a track a static ground point
+        fitted. Successive judgements share 9 of 10 directions, so a run of three was one chance
+        window: a ground patch read a few degrees off its azimuth, over a valley (hills, 200-set
+        encounters 6 and 28: confirmed for 0.2 s each at 2.7-3.1 km). Five cost a fast head-on
+        intruder whose aliased Doppler fits a static point 1.4 s of warning (encounter 15); three
+        cost it 0.3 s.
     max_history : int
         The most recent detections a fit uses.
     surface_down : callable, optional
@@ -144,6 +145,7 @@ class GroundTrackTest:
     trim: float = 0.1
     min_detections: int = 3
     release_detections: int = 5
+    release_span_detections: int = 3
     max_history: int = 120
     surface_down: Callable[[np.ndarray], np.ndarray] | None = None
     rejudge_gap_s: float = 2.0
@@ -260,7 +262,7 @@ def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test
     before it came from another scatterer, more than the static fit's trim leaves out (hills,
     200-encounter set, encounter 10), and the new history needs ``ground_min_detections``.
     Once a static ground point has fitted it, a track is released only when the judgements
-    running over :data:`_RELEASE_DETECTIONS` detections say otherwise, and not before
+    running over ``release_span_detections`` detections say otherwise, and not before
     ``ground_min_detections``: the surface model and a patch's scatterers make a fit fail now and
     then, and each was a confirmed ground row.
     """
@@ -280,7 +282,7 @@ def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test
             if reason == "ground":  # ground once: as long a history as the Doppler test's to clear it
                 ground_seen, least = True, test.ground_min_detections
             object_since = min(object_since, k) if reason == "" else n
-            released = k - object_since >= _RELEASE_DETECTIONS
+            released = k - object_since >= test.release_span_detections
             early = k + 1 - start < max(least, test.release_detections)
             last = reason != "" or (ground_seen and not released) or early
             clear_since = np.inf if last else min(clear_since, t[k])

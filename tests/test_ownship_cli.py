@@ -111,3 +111,21 @@ def test_alert_bad_config_through_the_real_entry_point(tmp_path):
     result = skyradar("alert", "trk.parquet", "--ownship", "run.zarr", "-o", "al.parquet",
                       "--config", "alerts.yaml", cwd=tmp_path)  # fmt: skip
     assert_one_line_error(result, "alerts.yaml: field 'z_h_pos'", "nan")
+
+
+def test_text_in_an_own_ship_column_is_one_line_through_the_real_entry_point(tmp_path):
+    # Non-numeric columns of an own-ship table were dropped silently: a text own_height_agl_m took
+    # the ground's range-Doppler band away (track.elevation_trust) without a word.
+    t = np.arange(5) / 9.4
+    pd.DataFrame({"time_s": t, "range_m": 1500.0 - 40 * t, "radial_velocity_mps": -40.0}).to_parquet(
+        tmp_path / "d.parquet"
+    )
+    own = {
+        c: 0.0 * t
+        for c in ("own_north_m", "own_east_m", "own_down_m", "own_vn_mps", "own_ve_mps", "own_vd_mps")
+    }
+    table = pd.DataFrame({"time_s": t, **own, "own_height_agl_m": ["500", "high", "500", "500", "500"]})
+    table.to_parquet(tmp_path / "own.parquet")
+    result = skyradar("track", "d.parquet", "-o", "t.parquet", "--ownship", "own.parquet", cwd=tmp_path)
+    assert_one_line_error(result, "own.parquet", "'own_height_agl_m'", "row 1", "'high'")
+    assert not (tmp_path / "t.parquet").exists()

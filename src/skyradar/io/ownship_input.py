@@ -48,6 +48,7 @@ def table_as_run(table: pd.DataFrame, source: str) -> xr.Dataset:
     if back.size:
         i = int(back[0]) + 1
         raise InputError(f"{source}: field 'time_s' is not increasing at row {i} ({t[i - 1]} -> {t[i]})")
+    _own_columns_numeric(table, source)
     data = {
         str(c): ("time", table[c].to_numpy(float))
         for c in table.columns
@@ -60,6 +61,19 @@ def table_as_run(table: pd.DataFrame, source: str) -> xr.Dataset:
     if origin is not None:  # `skyradar export` keeps the run's origin in the table's metadata
         ds.attrs["origin"] = json.dumps(list(origin) if not isinstance(origin, str) else json.loads(origin))
     return ds
+
+
+def _own_columns_numeric(table: pd.DataFrame, source: str) -> None:
+    """Refuse an own-ship or navigation column (``own_*``, ``nav_*``) holding text: dropped with the
+    other non-numeric columns, it would go unseen (a text ``own_height_agl_m`` turned the ground's
+    range-Doppler band off, and every elevation was trusted as in clear sky)."""
+    for c in table.columns:
+        if not str(c).startswith(("own_", "nav_")) or pd.api.types.is_bool_dtype(table[c]):
+            continue
+        bad = np.flatnonzero(pd.to_numeric(table[c], errors="coerce").isna() & table[c].notna())
+        if bad.size:
+            row = int(bad[0])
+            raise InputError(f"{source}: field {c!r} is not a number at row {row} ({table[c].iloc[row]!r})")
 
 
 def open_ownship(path: str | Path, option: str = "--ownship") -> xr.Dataset:

@@ -275,6 +275,49 @@ class Tracker3D:
         order = np.flatnonzero(keep)[np.argsort(self.ids[keep], kind="stable")]
         self._keep(order)
 
+    def reset_height(
+        self, ids: np.ndarray, own_state: np.ndarray, up_m: np.ndarray, sigma_m: np.ndarray
+    ) -> None:
+        """Restart the filters ``ids`` at ``up_m`` above the own-ship (m) with ``sigma_m`` (m).
+
+        For a height learnt at once rather than reading by reading (a track whose elevations
+        first agree, :mod:`skyradar.track.elevation_trust`): updated one scattered reading at a
+        time, the first reading accepted sets the height and the gate then keeps out the rest.
+        ``own_state`` is the own-ship's NED position and velocity (6,), m and m/s. The position
+        moves on its range sphere (same range and bearing): the range is measured to a metre,
+        and a height changed at a fixed horizontal position would contradict it. The horizontal
+        speed along the bearing is rescaled to keep the range rate, which is measured to a few
+        cm/s: kept as it was, the range-rate updates turned the difference into a vertical speed
+        (hills, 200-set encounter 123, 250 m below and level: 4 m/s of climb, and a false warning).
+        The vertical speed and its sigma are kept.
+
+        Examples
+        --------
+        >>> t3 = Tracker3D()
+        >>> _ = t3.step(0.0, np.array([7]), np.array([[1000.0, 0.0, 0.0]]), np.array([400.0]))
+        >>> t3.x[0, 3] = -20.0  # closing at 20 m/s, level
+        >>> t3.reset_height(np.array([7, 8]), np.zeros(6), np.array([500.0, 0.0]), np.array([50.0, 1.0]))
+        >>> t3.x[0].round(1).tolist(), float(np.sqrt(t3.P[0, 2, 2]))
+        ([866.0, 0.0, -500.0, -23.1, 0.0, 0.0], 50.0)
+        """
+        pos, found = _lookup(self.ids, np.asarray(ids, np.int64))
+        rows, own = pos[found], np.asarray(own_state, float)
+        d, v = self.x[rows, :3] - own[:3], self.x[rows, 3:] - own[3:]
+        r = np.linalg.norm(d, axis=1)
+        range_rate = np.einsum("ij,ij->i", d, v) / r
+        up = np.clip(np.asarray(up_m, float)[found], -0.999 * r, 0.999 * r)
+        bearing = np.arctan2(d[:, 1], d[:, 0])
+        along = np.column_stack([np.cos(bearing), np.sin(bearing)])
+        horizontal = np.sqrt(r**2 - up**2)
+        # range rate = (horizontal * along_speed - up * -vd) / r, with the vertical speed kept
+        along_speed = (r * range_rate - up * v[:, 2]) / horizontal
+        v_h = v[:, :2] + (along_speed - np.einsum("ij,ij->i", v[:, :2], along))[:, None] * along
+        self.x[rows, :2] = own[:2] + along * horizontal[:, None]
+        self.x[rows, 2] = own[2] - up
+        self.x[rows, 3:5] = own[3:5] + v_h
+        self.P[rows, 2, :], self.P[rows, :, 2] = 0.0, 0.0
+        self.P[rows, 2, 2] = np.asarray(sigma_m, float)[found] ** 2
+
     def _update_positions(
         self, sel: np.ndarray, pos: np.ndarray, positions_m: np.ndarray, cov: np.ndarray
     ) -> None:

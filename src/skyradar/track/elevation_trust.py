@@ -28,7 +28,7 @@ warned. Below the horizontal one reading cannot be told from the ground's pull, 
 readings can (:class:`BelowConsensus`): the ground's pull scatters from frame to frame or lies on
 the surface, an aircraft's readings agree, clear of it. Those that agree are trusted (hills,
 encounter 188, 281 m below: its false warning is gone). Once a track's readings agree on a height
-(above or below), its free readings sit at that height instead of the co-altitude prior, its
+above, its free readings sit at that height instead of the co-altitude prior, its
 trusted readings above at that height too (with the readings' spread as sigma), and the 3-D
 filter restarts its height there (``doa_feed``): read one at a time, the scattered readings of
 an aircraft above let the first one accepted set the height. What it still costs: an intruder below
@@ -316,8 +316,8 @@ def place_elevations(
         in-band readings above sit at their track's agreed height, at a sigma of at least the
         readings' spread; the other trusted keep their position and ``sigma_rad``.
     track_up_m, track_spread_m : ndarray, shape (k,)
-        Height above the own-ship each row's track agrees on (:class:`AboveVotes`, else
-        :class:`BelowConsensus`) and its spread, m; NaN: none.
+        Height above the own-ship each row's track agrees on (:class:`AboveVotes`) and its
+        spread, m; NaN: none.
 
     Examples
     --------
@@ -339,9 +339,10 @@ def place_elevations(
         track_up, spread = votes.update(ids, trusted & band, in_band, range_m * np.sin(elevation))
         trusted &= ~band | np.isfinite(track_up)
     if below is not None and clearance_m is not None:
-        held, below_up, below_sd = _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids)
-        none = ~np.isfinite(track_up)
-        track_up, spread = np.where(none, below_up, track_up), np.where(none, below_sd, spread)
+        # A consensus below only trusts its readings: readings a mixture pulls can agree too (flat
+        # ground 1000 m below, 200-set encounter 67: 103 m below, readings agreeing 700 m below;
+        # held there, its track was never warned). Above the horizontal the ground pulls none.
+        held = _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids)
     trusted, sigma = trusted | held, np.where(held, np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD), sigma)
     # In the band a track's height rests on what its readings agree on, not on each scattered one.
     agreed = trusted & band & ~held & np.isfinite(track_up)
@@ -354,11 +355,10 @@ def place_elevations(
     return out, np.where(trusted, sigma, FREE_ELEVATION_SIGMA_RAD), trusted, track_up, spread
 
 
-def _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids, k: float = 3.0) -> tuple:
-    """In-band readings below the horizontal that agree with their track's :class:`BelowConsensus`,
-    and that consensus (height and spread, m) per reading."""
+def _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids, k: float = 3.0) -> np.ndarray:
+    """In-band readings below the horizontal that agree with their track's :class:`BelowConsensus`."""
     wide = k * np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD)
     up, loose, is_below = range_m * np.sin(elevation), range_m * wide, elevation < -wide
     clear = np.asarray(clearance_m) - loose
-    consensus, spread = below.update(ids, up, range_m * sigma, is_below, in_band, clear)
-    return in_band & is_below & (np.abs(up - consensus) <= loose), consensus, spread
+    consensus, _ = below.update(ids, up, range_m * sigma, is_below, in_band, clear)
+    return in_band & is_below & (np.abs(up - consensus) <= loose)

@@ -283,47 +283,34 @@ def place_elevations(
     clearance_m: np.ndarray | None = None,
     last_up_m: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """DoA positions with free elevations at their track's height, their elevation sigma, trust,
-    and the height each track's in-band readings agree on.
+    """DoA positions with free elevations at their track's height, elevation sigma, trust, and height.
 
     Parameters
     ----------
-    positions_m, own_position_m : ndarray, shape (k, 3) and (3,)
-        NED DoA positions and the own-ship's, m; ``own_speed_mps`` its speed, m/s.
+    positions_m, own_position_m, own_speed_mps : ndarray (k, 3), ndarray (3,), float
+        NED DoA positions and the own-ship's, m; its speed, m/s.
     sigma_rad, measured, radial_velocity_mps : ndarray, shape (k,)
         Angle sigma (rad), ``elevation_measured`` and radial velocity (m/s) of each detection.
     height_agl_m : float
         Own-ship's height above the ground, m (NaN: no ground known).
     votes, ids : AboveVotes and ndarray of int, shape (k,), optional
-        The tracks' votes (updated here) and each row's track id; without: all voted above, each
-        reading at its own height.
+        The tracks' votes (updated here) and track ids; without: all voted, each reading on its own.
     below, clearance_m : BelowConsensus and ndarray, shape (k,), optional
-        The tracks' consensus below (updated here) and each DoA point's height above the terrain,
-        m: in-band readings below within 3 bounds of the consensus are trusted, at a sigma of at
-        least :data:`BAND_ELEVATION_SIGMA_RAD`. Without them no in-band reading below counts.
+        The tracks' consensus below (updated here) and each point's height above the terrain, m; in
+        the band, readings below count only within 3 bounds of it (sigma at least 0.05 rad).
     last_up_m : ndarray, shape (k,), optional
-        Height above the own-ship each row's track last agreed on, m (NaN: never). Free readings
-        of a track that agrees on none now sit there: a vote lost on a run of readings the ground
-        pulled let the co-altitude prior drag the track down (flat ground 300 m below, 200-set
-        encounter 138: 280 m above, down to 103 m in 20 s, and warned).
+        Height above the own-ship each row's track last agreed on, m (NaN: never).
 
     Returns
     -------
-    positions_m, elevation_sigma_rad, trusted : ndarray
-        Free detections (not :func:`elevation_trusted`) moved to their track's agreed height (now,
-        else ``last_up_m``), else to elevation 0 (the co-altitude prior), with
-        :data:`FREE_ELEVATION_SIGMA_RAD`. Trusted
-        in-band readings above sit at their track's agreed height, at a sigma of at least the
-        readings' spread; the other trusted keep their position and ``sigma_rad``.
-    track_up_m, track_spread_m : ndarray, shape (k,)
-        Height above the own-ship each row's track agrees on (:class:`AboveVotes`) and its
-        spread, m; NaN: none.
+    positions_m, elevation_sigma_rad, trusted, track_up_m, track_spread_m : ndarray
+        See :func:`_placed`; the height above the own-ship each row's track agrees on
+        (:class:`AboveVotes`) and its spread, m.
 
     Examples
     --------
     >>> pos = np.array([[2000.0, 0.0, 700.0], [2000.0, 0.0, -700.0]])  # 19 deg below, 19 deg above
-    >>> p, s, ok, up, _ = place_elevations(pos, np.zeros(3), 50.0, np.full(2, 0.02), np.ones(2, bool),
-    ...                                    np.full(2, -30.0), 500.0)
+    >>> p, s, ok, up, _ = place_elevations(pos, np.zeros(3), 50, np.full(2, 0.02), np.ones(2, bool), -30, 500)
     >>> ok.tolist(), p[:, 2].round(1).tolist(), s.tolist(), up.tolist()
     ([False, True], [0.0, -700.0], [0.35, 0.02], [nan, nan])
     """
@@ -334,29 +321,48 @@ def place_elevations(
     trusted = elevation_trusted(elevation, sigma_rad, measured, band)
     in_band = np.asarray(measured, bool) & band
     sigma, held = np.asarray(sigma_rad, float), np.zeros(len(d), bool)
-    track_up, spread = np.full(len(d), np.nan), np.full(len(d), np.nan)
-    if votes is not None:  # in the band, only while the track is voted above
-        track_up, spread = votes.update(ids, trusted & band, in_band, range_m * np.sin(elevation))
-        trusted &= ~band | np.isfinite(track_up)
+    trusted, track_up, spread = _voted(votes, ids, trusted, band, in_band, range_m * np.sin(elevation))
     if below is not None and clearance_m is not None:
-        # A consensus below only trusts its readings: readings a mixture pulls can agree too (flat
-        # ground 1000 m below, 200-set encounter 67: 103 m below, readings agreeing 700 m below;
-        # held there, its track was never warned). Above the horizontal the ground pulls none.
         held = _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids)
     trusted, sigma = trusted | held, np.where(held, np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD), sigma)
-    # In the band a track's height rests on what its readings agree on, not on each scattered one.
     agreed = trusted & band & ~held & np.isfinite(track_up)
-    sigma = np.where(agreed, np.fmax(sigma, np.fmax(BAND_ELEVATION_SIGMA_RAD, spread / range_m)), sigma)
-    moved = (~trusted | agreed) & np.isfinite(d).all(axis=1)
+    out, sigma = _placed(positions_m, own, range_m, sigma, trusted, agreed, track_up, spread, last_up_m)
+    return out, sigma, trusted, track_up, spread
+
+
+def _voted(votes, ids, trusted, band, in_band, up_m) -> tuple:
+    """Trust in the band only while the track is voted above; the tracks' agreed heights and spreads."""
+    if votes is None:
+        return trusted, *np.full((2, len(trusted)), np.nan)
+    track_up, spread = votes.update(ids, trusted & band, in_band, up_m)
+    return trusted & (~band | np.isfinite(track_up)), track_up, spread
+
+
+def _placed(positions_m, own, range_m, sigma, trusted, agreed, track_up, spread, last_up_m) -> tuple:
+    """Positions and elevation sigmas: ``agreed`` readings (trusted, in the band, the track voted
+    above) at their track's height ``track_up`` with a sigma of at least the readings' ``spread``
+    (in the band a track's height rests on what its readings agree on, not on each scattered one);
+    free ones at the track's height now, else at ``last_up_m`` (a vote lost on a run of readings the
+    ground pulled let the co-altitude prior drag the track down: flat ground 300 m below, 200-set
+    encounter 138, 280 m above, down to 103 m in 20 s, and warned), else at elevation 0 (the
+    co-altitude prior), with :data:`FREE_ELEVATION_SIGMA_RAD`."""
+    floor = np.fmax(BAND_ELEVATION_SIGMA_RAD, spread / range_m)
+    sigma = np.where(agreed, np.fmax(sigma, floor), sigma)
+    moved = (~trusted | agreed) & np.isfinite(positions_m).all(axis=1)
     out = np.array(positions_m, float)
     prior = track_up if last_up_m is None else np.where(np.isfinite(track_up), track_up, last_up_m)
     height = np.nan_to_num(prior[moved], nan=0.0)
     out[moved] = at_elevation(out[moved], own, np.arcsin(np.clip(height / range_m[moved], -1.0, 1.0)))
-    return out, np.where(trusted, sigma, FREE_ELEVATION_SIGMA_RAD), trusted, track_up, spread
+    return out, np.where(trusted, sigma, FREE_ELEVATION_SIGMA_RAD)
 
 
 def _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids, k: float = 3.0) -> np.ndarray:
-    """In-band readings below the horizontal that agree with their track's :class:`BelowConsensus`."""
+    """In-band readings below the horizontal that agree with their track's :class:`BelowConsensus`.
+
+    A consensus below only trusts its readings; it neither places free ones nor restarts the
+    track's height: readings a mixture pulls can agree too (flat ground 1000 m below, 200-set
+    encounter 67: 103 m below, readings agreeing 700 m below; held there, its track was never
+    warned). Above the horizontal the ground pulls none."""
     wide = k * np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD)
     up, loose, is_below = range_m * np.sin(elevation), range_m * wide, elevation < -wide
     clear = np.asarray(clearance_m) - loose

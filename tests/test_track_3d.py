@@ -3,13 +3,15 @@
 import numpy as np
 import pandas as pd
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from skyradar.config import RadarConfig
 from skyradar.track.measure3d import angle_sigma_rad, position_covariance
 from skyradar.track.models import radar_model
 from skyradar.track.track_table import OWNSHIP_COLUMNS, track_detections
 from skyradar.track.tracker import RangeDopplerTracker, TrackerConfig
-from skyradar.track.tracker3d import RadialObservation, range_rate_update
+from skyradar.track.tracker3d import RadialObservation, Tracker3D, range_rate_update
 from skyradar.units import wrap
 
 CFG = RadarConfig.prototype_2022()
@@ -121,3 +123,30 @@ def test_position_covariance_and_range_rate_update_shapes():
     u = np.array([1.0, 1.0, 0.0]) / np.sqrt(2.0)
     assert np.dot(u, x1[0, 3:] - obs.own_velocity_mps) == pytest.approx(-70.0, abs=1.0)
     assert np.all(np.linalg.eigvalsh(P1[0]) > 0)
+
+
+@settings(max_examples=80, deadline=None)
+@given(
+    st.tuples(st.floats(-3000, 3000), st.floats(-3000, 3000), st.floats(-800, 800)),
+    st.tuples(st.floats(-80, 80), st.floats(-80, 80), st.floats(-8, 8)),
+    st.floats(-0.9, 0.9),
+)
+def test_a_height_restart_keeps_range_bearing_range_rate_and_vertical_speed(rel, vel, up_fraction):
+    # Tracker3D.reset_height moves a filter on its range sphere: range (measured to a metre) and
+    # range rate (to a few cm/s) must not change, nor the bearing or the vertical speed.
+    rel, own = np.array(rel), np.array([10.0, -20.0, -500.0, 45.0, 5.0, 0.5])
+    r = np.linalg.norm(rel)
+    assume(np.hypot(rel[0], rel[1]) > 50.0)
+    t3 = Tracker3D()
+    t3.step(0.0, np.array([4]), (own[:3] + rel)[None], np.array([100.0]))
+    t3.x[0, 3:] = own[3:] + np.array(vel)
+    before = t3.x[0].copy()
+
+    def seen(x):
+        d, v = x[:3] - own[:3], x[3:] - own[3:]
+        return np.linalg.norm(d), np.arctan2(d[1], d[0]), d @ v / np.linalg.norm(d)
+
+    t3.reset_height(np.array([4]), own, np.array([up_fraction * r]), np.array([30.0]))
+    assert np.allclose(seen(t3.x[0]), seen(before), atol=1e-6)
+    assert np.isclose(own[2] - t3.x[0, 2], up_fraction * r) and t3.x[0, 5] == before[5]
+    assert np.isclose(np.sqrt(t3.P[0, 2, 2]), 30.0)

@@ -309,8 +309,8 @@ class Tracker3D:
         bearing = np.arctan2(d[:, 1], d[:, 0])
         along = np.column_stack([np.cos(bearing), np.sin(bearing)])
         horizontal = np.sqrt(r**2 - up**2)
-        # range rate = (horizontal * along_speed - up * -vd) / r, with the vertical speed kept
-        along_speed = (r * range_rate - up * v[:, 2]) / horizontal
+        # r * range rate = horizontal * along_speed - up * vd (NED: the point's down is -up), vd kept
+        along_speed = (r * range_rate + up * v[:, 2]) / horizontal
         v_h = v[:, :2] + (along_speed - np.einsum("ij,ij->i", v[:, :2], along))[:, None] * along
         self.x[rows, :2] = own[:2] + along * horizontal[:, None]
         self.x[rows, 2] = own[2] - up

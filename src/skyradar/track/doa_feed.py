@@ -11,12 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from skyradar.track.elevation_trust import (
-    BAND_ELEVATION_SIGMA_RAD,
-    AboveVotes,
-    BelowConsensus,
-    place_elevations,
-)
+from skyradar.track.elevation_trust import AboveVotes, BelowConsensus, place_elevations
 from skyradar.track.ground_doa import elevation_measured_flags
 from skyradar.track.io import validate_ownship
 from skyradar.track.measure3d import angle_sigma_rad, position_covariance
@@ -120,7 +115,7 @@ class Measure3D:
             np.array([self.agreed_up.get(int(i), np.nan) for i in out.alive_ids], float),
         )
         self.trusted[idx] = trusted[has]
-        self._restart_heights(out.alive_ids, self.own[k], pos, track_up, spread)
+        self._restart_heights(out.alive_ids, self.own[k], track_up, spread)
         cov = np.full((det.size, 3, 3), np.nan)
         use = has & np.isfinite(sigma)
         cov[use] = position_covariance(
@@ -129,7 +124,7 @@ class Measure3D:
         radial = RadialObservation(own_p, own_v, v_unaliased, self.motion.sigma_velocity_mps)
         return self.t3.step(float(out.time_s), out.alive_ids, pos, cov, radial)
 
-    def _restart_heights(self, ids, own_state, pos, track_up, spread) -> None:
+    def _restart_heights(self, ids, own_state, track_up, spread) -> None:
         """Restart the 3-D height of each track whose readings now agree on one and did not last frame.
 
         Its height so far is the co-altitude prior (or a first scattered reading): a gradual pull
@@ -142,9 +137,7 @@ class Measure3D:
         self.agreed_up = {i: u for i, u in self.agreed_up.items() if i in alive}
         self.agreed_up.update(zip(np.asarray(ids)[agreed].tolist(), track_up[agreed].tolist(), strict=True))
         if np.any(new):
-            r = np.linalg.norm(pos[new] - own_state[:3], axis=1)
-            sigma = np.fmax(spread[new], BAND_ELEVATION_SIGMA_RAD * r)
-            self.t3.reset_height(np.asarray(ids)[new], own_state, track_up[new], sigma)
+            self.t3.reset_height(np.asarray(ids)[new], own_state, track_up[new], spread[new])
 
     def _clearance(self, pos: np.ndarray, flat_down_m: float) -> np.ndarray:
         """Height of each point above the terrain (``surface_down``), else above a level ground at

@@ -305,7 +305,7 @@ def place_elevations(
     -------
     positions_m, elevation_sigma_rad, trusted, track_up_m, track_spread_m : ndarray
         See :func:`_placed`; the height above the own-ship each row's track agrees on
-        (:class:`AboveVotes`) and its spread, m.
+        (:class:`AboveVotes`) and its spread (at least :data:`BAND_ELEVATION_SIGMA_RAD` at its range), m.
 
     Examples
     --------
@@ -322,6 +322,7 @@ def place_elevations(
     in_band = np.asarray(measured, bool) & band
     sigma, held = np.asarray(sigma_rad, float), np.zeros(len(d), bool)
     trusted, track_up, spread = _voted(votes, ids, trusted, band, in_band, range_m * np.sin(elevation))
+    spread = np.where(np.isfinite(track_up), np.fmax(spread, BAND_ELEVATION_SIGMA_RAD * range_m), np.nan)
     if below is not None and clearance_m is not None:
         held = _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids)
     trusted, sigma = trusted | held, np.where(held, np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD), sigma)
@@ -340,14 +341,13 @@ def _voted(votes, ids, trusted, band, in_band, up_m) -> tuple:
 
 def _placed(positions_m, own, range_m, sigma, trusted, agreed, track_up, spread, last_up_m) -> tuple:
     """Positions and elevation sigmas: ``agreed`` readings (trusted, in the band, the track voted
-    above) at their track's height ``track_up`` with a sigma of at least the readings' ``spread``
+    above) at their track's height ``track_up`` with a sigma of at least its ``spread`` (m)
     (in the band a track's height rests on what its readings agree on, not on each scattered one);
     free ones at the track's height now, else at ``last_up_m`` (a vote lost on a run of readings the
     ground pulled let the co-altitude prior drag the track down: flat ground 300 m below, 200-set
     encounter 138, 280 m above, down to 103 m in 20 s, and warned), else at elevation 0 (the
     co-altitude prior), with :data:`FREE_ELEVATION_SIGMA_RAD`."""
-    floor = np.fmax(BAND_ELEVATION_SIGMA_RAD, spread / range_m)
-    sigma = np.where(agreed, np.fmax(sigma, floor), sigma)
+    sigma = np.where(agreed, np.fmax(sigma, spread / range_m), sigma)
     moved = (~trusted | agreed) & np.isfinite(positions_m).all(axis=1)
     out = np.array(positions_m, float)
     prior = track_up if last_up_m is None else np.where(np.isfinite(track_up), track_up, last_up_m)

@@ -49,6 +49,24 @@ def test_two_nulls_at_one_elevation_leave_no_elevation_and_finite_clutter_some()
     assert bounds[2] < MAX_ELEVATION_SIGMA_RAD < bounds[4]
 
 
+@settings(max_examples=60, deadline=None)
+@given(
+    st.floats(-0.95, 0.95), st.floats(-0.25, 0.25), st.floats(-1.2, -0.3), st.floats(0.3, 1.2),
+)  # fmt: skip
+def test_with_no_elevation_the_azimuth_keeps_the_measured_cone(az, el, el_null, az_null):
+    # Two nulls at one elevation leave the score a function of the horizontal direction cosine only:
+    # the prior's azimuth is the point of that cone at elevation 0 (closed form), wherever on the cone
+    # the 2-D search's best point fell (up to 28 deg high before: flat-1000 encounter 67's track).
+    u = direction_from_angles(np.array([az]), np.array([el]))
+    z = np.sqrt(10**2.0 * N0) * steering_vector(u, CFG)
+    s_c = steering_vector(direction_from_angles(np.array([az_null, -az_null]), np.full(2, el_null)), CFG)
+    e, _ = np.linalg.qr(s_c.T)
+    got, measured = projected_directions(z, (np.eye(4) - e @ e.conj().T)[None], CFG, N0)
+    on_cone = np.degrees(np.arcsin(np.cos(el) * np.sin(az)))
+    assert not measured[0] and got[0, 2] == 0.0
+    assert abs(np.degrees(np.arctan2(got[0, 1], got[0, 0])) - on_cone) < 0.1
+
+
 def test_a_direction_whitened_by_moderate_clutter_is_measured_near_the_truth():
     rng = np.random.default_rng(3)
     w = _ring_whitening(20.0)

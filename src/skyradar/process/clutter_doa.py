@@ -20,7 +20,9 @@ Whitened by a ring's finite clutter (adaptive cells) the elevation keeps a bound
 the clutter-to-noise ratio, a few degrees at 20-25 dB. Above :data:`MAX_ELEVATION_SIGMA_RAD` the
 detection is placed in the antenna's horizontal plane (elevation 0, co-altitude for a level
 forward radar): a prior, not a measurement; the azimuth is still measured (a 0.05 deg search over
-+-1.5 deg of azimuth at elevation 0).
++-1.5 deg of azimuth at elevation 0, around the point at elevation 0 of the cone of equal horizontal
+direction cosine through the 2-D search's best point: without elevation the score is flat along
+that cone, so the best point's own azimuth may be tens of degrees off).
 
 Examples
 --------
@@ -221,7 +223,10 @@ def projected_directions(
     u = direction_from_angles(angles[:, 0], angles[:, 1])
     measured = elevation_sigma_rad(u, z_all, p_all, config, noise_floor_w) <= MAX_ELEVATION_SIGMA_RAD
     for n in np.flatnonzero(~measured):  # the co-altitude prior; azimuth measured along it
-        angles[n] = _azimuth_at_zero(angles[n, 0], *rule[1:], z_all[n], p_all[n]), 0.0
+        # The score is flat along the cone of equal horizontal direction cosine, so the search's best
+        # point may lie anywhere on it: start at the cone's elevation-0 point, not at its azimuth.
+        on_cone = np.arcsin(np.clip(np.cos(angles[n, 1]) * np.sin(angles[n, 0]), -1.0, 1.0))
+        angles[n] = _azimuth_at_zero(on_cone, *rule[1:], z_all[n], p_all[n]), 0.0
     return direction_from_angles(angles[:, 0], angles[:, 1]), measured
 
 

@@ -18,7 +18,8 @@ CFG = RadarConfig.prototype_2022()
 
 def _lattice_best(z: np.ndarray, p: np.ndarray, measured: bool) -> tuple[np.ndarray, float]:
     """Exhaustive search: 2 deg grid, then every point of the 0.05 deg lattice within +-1.5 deg;
-    where the elevation is not measured, the lattice row at elevation 0 around that azimuth."""
+    where the elevation is not measured, the lattice row at elevation 0 around the azimuth with that
+    point's horizontal direction cosine."""
 
     def score(az_deg: np.ndarray, el_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         a, e = np.meshgrid(np.radians(az_deg), np.radians(el_deg), indexing="ij")
@@ -32,8 +33,8 @@ def _lattice_best(z: np.ndarray, p: np.ndarray, measured: bool) -> tuple[np.ndar
     ia, ie = np.unravel_index(np.argmax(s), (coarse.size, coarse.size))
     fine = np.arange(-1.5, 1.525, 0.05)
     u, s = score(coarse[ia] + fine, coarse[ie] + fine)
-    if not measured:
-        az = np.degrees(np.arctan2(u[np.argmax(s), 1], u[np.argmax(s), 0]))
+    if not measured:  # the cone through the best point (its horizontal direction cosine) at elevation 0
+        az = np.degrees(np.arcsin(u[np.argmax(s), 1]))
         u, s = score(az + fine, np.zeros(1))
     return u[np.argmax(s)], float(s.max())
 

@@ -31,14 +31,19 @@ def _frames(ground: bool, own_state: bool = True):
     terrain = flat_terrain(52.0, 5.0, 0.0, 5000.0, 30.0) if ground else None
     sim = ImageSimulator(CFG, terrain, origin=(52.0, 5.0, 0.0), seed=3)
     cube = sim.frame(OWN, [INTRUDER], 0)
-    one = np.ones(1)
-    ownship = {
-        "own_north_m": 0 * one, "own_east_m": 0 * one, "own_down_m": -HEIGHT_M * one,
+    ownship = _level_ownship(1, HEIGHT_M) if own_state else None
+    return frames_dataset(cube[None], np.zeros(1), CFG, ownship=ownship)
+
+
+def _level_ownship(n: int, height_m: float) -> dict[str, np.ndarray]:
+    """Own-ship variables of ``n`` frames flying north, level, at ``SPEED_MPS``, ``height_m`` up."""
+    one = np.ones(n)
+    return {
+        "own_north_m": 0 * one, "own_east_m": 0 * one, "own_down_m": -height_m * one,
         "own_vn_mps": SPEED_MPS * one, "own_ve_mps": 0 * one, "own_vd_mps": 0 * one,
         "own_yaw_rad": 0 * one, "own_pitch_rad": 0 * one, "own_roll_rad": 0 * one,
-        "own_height_agl_m": HEIGHT_M * one,
+        "own_height_agl_m": height_m * one,
     }  # fmt: skip
-    return frames_dataset(cube[None], np.zeros(1), CFG, ownship=ownship if own_state else None)
 
 
 def _intruder_hits(table) -> int:
@@ -174,13 +179,7 @@ def test_intruder_mixed_with_sidelobe_clutter_keeps_its_detections_and_elevation
     sim = ImageSimulator(CFG, flat_terrain(52.0, 5.0, 0.0, 5000.0, 30.0), origin=(52.0, 5.0, 0.0), seed=5)
     n = 8
     cubes = np.stack([sim.frame(own, [target], k) for k in range(n)])
-    one = np.ones(n)
-    ownship = {
-        "own_north_m": 0 * one, "own_east_m": 0 * one, "own_down_m": -height * one,
-        "own_vn_mps": SPEED_MPS * one, "own_ve_mps": 0 * one, "own_vd_mps": 0 * one,
-        "own_yaw_rad": 0 * one, "own_pitch_rad": 0 * one, "own_roll_rad": 0 * one,
-        "own_height_agl_m": height * one,
-    }  # fmt: skip
+    ownship = _level_ownship(n, height)
     table = process_frames(
         frames_dataset(cubes, np.arange(n) * 0.1, CFG, ownship=ownship), suppression="auto"
     )

@@ -71,7 +71,14 @@ class ClutterSubspace:
         Eigenvalues divided by their sum (0 where no clutter is predicted), decreasing.
     """
 
-    def __init__(self, covariance: np.ndarray, n_rx: int):
+    def __init__(
+        self,
+        covariance: np.ndarray,
+        n_rx: int,
+        velocity_ant_mps: np.ndarray | None = None,
+        down_ant: np.ndarray | None = None,
+        height_agl_m: float | None = None,
+    ):
         n_r, n_d = covariance.shape[:2]
         self.covariance = covariance
         self.predicted = np.einsum("rdk->rd", covariance[..., :n_rx]) > 0
@@ -83,11 +90,9 @@ class ClutterSubspace:
         self.rows = np.empty((n_r, n_d, n_rx - 1, n_rx), np.complex64)
         self.rows_done = np.zeros((n_r, n_d), np.bool_)
         self.rows_key = b""
-        # The geometry it was predicted for (set by clutter_subspace): antenna-frame velocity, m/s,
-        # the down axis in the antenna frame and the height above the ground below, m. None: unknown.
-        self.velocity_ant_mps: np.ndarray | None = None
-        self.down_ant: np.ndarray | None = None
-        self.height_agl_m: float | None = None
+        # The geometry it was predicted for: antenna-frame velocity, m/s, the down axis in the
+        # antenna frame and the height above the ground below, m. None: unknown.
+        self.velocity_ant_mps, self.down_ant, self.height_agl_m = velocity_ant_mps, down_ant, height_agl_m
 
     def ensure(self, range_index: np.ndarray | None = None, doppler_index: np.ndarray | None = None) -> None:
         """Decompose the given cells (default: all) that are not decomposed yet."""
@@ -319,6 +324,4 @@ def clutter_subspace(
     rx, wavenumber = np.ascontiguousarray(config.rx_positions_m, float), 2.0 * np.pi / config.wavelength_m
     n_r, n_d, n_k = config.n_range, config.n_doppler, config.n_rx
     acc = _accumulate(r_pos, d_pos, u_ant, rx, wavenumber, weight, n_r, n_d, np.zeros((n_r, n_d, n_k * n_k)))
-    sub = ClutterSubspace(acc, n_k)
-    sub.velocity_ant_mps, sub.down_ant, sub.height_agl_m = rot.T @ v, rot[2].copy(), float(height_agl_m)
-    return sub
+    return ClutterSubspace(acc, n_k, rot.T @ v, rot[2].copy(), float(height_agl_m))

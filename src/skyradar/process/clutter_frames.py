@@ -33,6 +33,8 @@ from skyradar.process.clutter_doa import directions_after_projection, projected_
 from skyradar.process.clutter_suppress import projected_snapshots, suppress_clutter
 from skyradar.process.detect import Detections, detect
 from skyradar.process.doa import direction_coherence, estimate_directions, steering_vector
+from skyradar.process.ground import static_radial_velocity_mps
+from skyradar.units import wrap
 
 __all__ = [
     "frame_subspace",
@@ -198,9 +200,7 @@ def plain_wave_is_mixed(
     --------
     >>> from skyradar.process.clutter import ClutterSubspace
     >>> cfg = RadarConfig.prototype_2022()
-    >>> sub = ClutterSubspace(np.zeros((1, 1, 16)), 4)
-    >>> sub.velocity_ant_mps, sub.down_ant = np.array([50.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
-    >>> sub.height_agl_m = 300.0
+    >>> sub = ClutterSubspace(np.zeros((1, 1, 16)), 4, np.array([50.0, 0, 0]), np.array([0, 0, 1.0]), 300.0)
     >>> u = np.array([[0.46, 0.87, 0.18], [0.46, 0.87, 0.18], [0.96, -0.25, 0.0]])
     >>> plain_wave_is_mixed(u, np.array([-36.9, -23.0, -36.9]), np.full(3, 1460.0),
     ...                     np.array([0.01, 0.01, 0.4]), sub, cfg).tolist()  # mixed, clutter, target
@@ -209,9 +209,8 @@ def plain_wave_is_mixed(
     if clutter.velocity_ant_mps is None or clutter.down_ant is None or clutter.height_agl_m is None:
         return np.zeros(len(u_ant), bool)
     u, rng, height = np.asarray(u_ant, float), np.asarray(range_m, float), clutter.height_agl_m
-    width = 2.0 * config.v_lim_mps
-    static = -u @ clutter.velocity_ant_mps
-    off = np.abs((np.asarray(radial_velocity_mps, float) - static + width / 2.0) % width - width / 2.0)
+    static = static_radial_velocity_mps(u, clutter.velocity_ant_mps)  # any frame: both antenna here
+    off = np.abs(wrap(np.asarray(radial_velocity_mps, float) - static, 2.0 * config.v_lim_mps))
     grounded = rng * (u @ clutter.down_ant) >= (1.0 - _GROUND_SLACK) * height  # it would be read as ground
     far = rng >= _NEAR_GROUND * height
     return far & grounded & (np.asarray(kept_fraction, float) < _CLUTTER_DOMINATES) & (off > _STATIC_FIT_MPS)

@@ -16,6 +16,7 @@ from skyradar.track.ground_doa import elevation_measured_flags
 from skyradar.track.io import validate_ownship
 from skyradar.track.measure3d import angle_sigma_rad, position_covariance
 from skyradar.track.tracker3d import RadialObservation, Tracker3D
+from skyradar.units import wrap
 
 __all__ = ["Measure3D", "OWNSHIP_COLUMNS"]
 
@@ -106,7 +107,7 @@ class Measure3D:
             speed,
             sigma,
             measured,
-            v_best,
+            wrap(v_best, self.width),  # the cell's alias: the ground's band is judged on it
             self.agl[k],
             self.votes,
             out.alive_ids,

@@ -65,12 +65,21 @@ def in_ground_band(
     A static point's radial velocity is at most the own-ship's speed, and no ground lies closer
     than the own-ship's height above it (half of it here: relief ahead rises above the ground
     below). NaN ``height_agl_m`` (clear sky, no terrain): False everywhere.
+    ``radial_velocity_mps`` is the cell's: the alias within ``+-V_lim`` (``units.wrap``), not the
+    de-aliased velocity. A head-on closure of -115 m/s sits in the cell of -36.7 m/s, which the
+    ground fills at 50 m/s (Jacksboro, 200-set encounter 15, 47 m below: judged on -115 m/s, its
+    readings pulled down by the ground there were trusted, its track was held 245-335 m below the
+    aircraft, and it was never warned). When the own-ship is faster than ``V_lim`` less the
+    margin, every cell beyond half its height above the ground is in the band.
 
     Examples
     --------
     >>> rng, v = np.array([2000.0, 2000.0, 200.0]), np.array([-30.0, -90.0, -30.0])
     >>> in_ground_band(rng, v, 50.0, 500.0).tolist()
     [True, False, False]
+    >>> cell = np.array([-30.0, -90.0 + 78.3, -30.0])  # -90 m/s aliases to -11.7 with V_lim 39.15 m/s
+    >>> in_ground_band(rng, cell, 50.0, 500.0).tolist()
+    [True, True, False]
     """
     if not np.isfinite(height_agl_m):
         return np.zeros(np.shape(range_m), bool)
@@ -290,7 +299,7 @@ def place_elevations(
     positions_m, own_position_m, own_speed_mps : ndarray (k, 3), ndarray (3,), float
         NED DoA positions and the own-ship's, m; its speed, m/s.
     sigma_rad, measured, radial_velocity_mps : ndarray, shape (k,)
-        Angle sigma (rad), ``elevation_measured`` and radial velocity (m/s) of each detection.
+        Angle sigma (rad), ``elevation_measured`` and the cell's radial velocity (m/s, an alias).
     height_agl_m : float
         Own-ship's height above the ground, m (NaN: no ground known).
     votes, ids : AboveVotes and ndarray of int, shape (k,), optional

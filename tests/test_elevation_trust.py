@@ -183,7 +183,7 @@ def test_measured_elevations_below_count_outside_the_ground_band():
     below_clear = _last(
         track_detections(_aircraft(-300.0, 30.0, reading), ownship=_own(np.nan), ground_test=False)
     )
-    fast_radar = RadarConfig.prototype_2022(prf_hz=4921.0 * 100.0 / CFG.v_lim_mps)
+    fast_radar = RadarConfig.prototype_2022(prf_hz=CFG.prf_hz * 100.0 / CFG.v_lim_mps)
     head_on = track_detections(
         _aircraft(-300.0, -30.0, reading, ahead_m=3000.0),
         config=fast_radar,

@@ -107,7 +107,7 @@ class Measure3D:
             speed,
             sigma,
             measured,
-            wrap(v_best, self.width),  # the cell's alias: the ground's band is judged on it
+            wrap(v_meas, self.width),  # the cell's velocity: the ground's band is judged on it
             self.agl[k],
             self.votes,
             out.alive_ids,

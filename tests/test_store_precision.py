@@ -205,7 +205,11 @@ def test_process_on_cint16_store_matches_complex64(tmp_path):
     air = matched[~matched.is_ground]
     for column in ("azimuth_rad", "elevation_rad"):
         assert np.abs(air[column] - air[f"{column}_q"]).max() <= 0.03
-    assert np.abs(matched.snr_db - matched.snr_db_q).max() <= 0.3
+    # The pixel's power is what quantisation touches. The SNR is against the CFAR's local noise
+    # estimate, whose training cells follow discrete decisions (a neighbour nulled or left out of
+    # training): one flip moved a ground cell's SNR by 10 dB at the same power (-133.205 dBW both).
+    assert np.abs(matched.power_db - matched.power_db_q).max() <= 0.1
+    assert np.median(np.abs(matched.snr_db - matched.snr_db_q)) <= 0.1
 
 
 def test_rd_writes_cint16_store_within_the_bound(tmp_path):

@@ -26,7 +26,7 @@ from skyradar.errors import InputError
 from skyradar.io.frames import frames_dataset
 from skyradar.io.frames_model import frame_times_s
 from skyradar.process.detect_run import merge_head_tables
-from skyradar.process.pipeline import process_frames
+from skyradar.process.pipeline import clutter_anchors, process_frames
 from skyradar.scene.radar_heads import select_heads
 from skyradar.sim.scenario_frames import make_simulator, scenario_truth, simulate_frames
 from skyradar.track.ground_tracks import GroundTrackTest, median_ground_down_m, terrain_surface
@@ -53,6 +53,8 @@ def _detect(built, heads, keep_frames, block_frames, timings, options) -> tuple[
     """Detections of every head in ``heads`` (merged, ``radar`` column), each head's truth, kept frames."""
     simulators = {h.name: make_simulator(built, h.name) for h in heads}
     truths = {name: _truth_dataset(built, sim) for name, sim in simulators.items()}
+    # Each block is suppressed with the whole run's clutter predictions (as `skyradar process` would).
+    anchors = {name: clutter_anchors(t, built.terrain, built.name) for name, t in truths.items()}
     n = built.times_s.size
     detections: dict[str, list] = {name: [] for name in simulators}
     rd: dict = {}
@@ -67,7 +69,8 @@ def _detect(built, heads, keep_frames, block_frames, timings, options) -> tuple[
             truth = truths[name]
             ds = truth.isel(time=slice(start, start + rows.size)).assign(iq=(truth["iq"].dims, iq))
             t0 = time.perf_counter()
-            det = process_frames(ds, terrain=built.terrain, source=built.name, **options)
+            block = None if anchors[name] is None else anchors[name][start : start + rows.size]
+            det = process_frames(ds, terrain=built.terrain, source=built.name, anchors=block, **options)
             det["frame"] += start
             detections[name].append(det)
             timings["process"] += time.perf_counter() - t0

@@ -4,8 +4,9 @@
 :mod:`skyradar.process.pipeline`: velocity, attitude, height above ground) into the predicted
 clutter subspace over flat ground at the own-ship's height above the ground below it (from the
 navigation, else from the terrain under the own-ship). It depends on the velocity in a
-heading-free frame, pitch, roll and height only, so it is cached on those, and reused while the
-navigated geometry stays within a stated tolerance (see the function): a straight flight computes
+heading-free frame, pitch, roll and height only, so it is computed at the frame's anchor
+(:mod:`skyradar.process.clutter_anchors`: reused while the navigated geometry stays within a
+stated tolerance, the same anchor however the run is chunked) and cached: a straight flight computes
 it once; each new geometry costs about 0.1-0.2 s of CPU (the sum over the ground rings, then the
 eigen-pairs of only the cells the frames' clutter gates, :mod:`skyradar.process.clutter`). The
 terrain-following prediction (:func:`skyradar.process.clutter.clutter_subspace` with
@@ -29,6 +30,7 @@ from skyradar.errors import InputError
 from skyradar.geo import rotation_matrix
 from skyradar.process.clutter import ClutterSubspace, clutter_subspace
 from skyradar.process.clutter_adaptive import ring_whitening
+from skyradar.process.clutter_anchors import anchor_key, prediction_anchors
 from skyradar.process.clutter_doa import directions_after_projection, projected_directions
 from skyradar.process.clutter_suppress import projected_snapshots, suppress_clutter
 from skyradar.process.detect import Detections, detect
@@ -46,119 +48,37 @@ __all__ = [
 ]
 
 SUPPRESSIONS = ("none", "knowledge-aided", "auto")
-_CACHE: OrderedDict[tuple, tuple[np.ndarray, ClutterSubspace]] = OrderedDict()
+_CACHE: OrderedDict[tuple, tuple[RadarConfig, ClutterSubspace]] = OrderedDict()
 _CACHE_SIZE = 8  # predictions kept: about 20 MB each (packed covariance, eigenvectors as cells need them)
-_V_STEP, _ANGLE_STEP_DEG, _HEIGHT_STEP = 0.25, 1.0, 0.0025
-V_TOLERANCE_MPS, ANGLE_TOLERANCE_DEG, HEIGHT_TOLERANCE = 0.35, 0.5, 0.05  # reuse of a cached prediction
-
-
-def _depth_fn(terrain: Any, lat_deg: float, lon_deg: float, alt_m: float):
-    """Ground depth below the radar at NED offsets, from a terrain's ``height_at(lat, lon)``."""
-    height_at = terrain.height_at if hasattr(terrain, "height_at") else terrain
-    m_lat = 111_132.954 - 559.822 * np.cos(2 * np.radians(lat_deg))  # metres per degree (WGS84 series)
-    m_lon = 111_412.84 * np.cos(np.radians(lat_deg))
-
-    def depth(dn: np.ndarray, de: np.ndarray) -> np.ndarray:
-        h = np.asarray(height_at(lat_deg + dn / m_lat, lon_deg + de / m_lon), float)
-        return alt_m - np.where(np.isfinite(h), h, alt_m - 1e9)  # outside the DEM: no ground
-
-    return depth
-
-
-_SMOOTH_FRAMES = 5  # velocity mean over this frame and the 4 before it (GNSS velocity noise is white)
-
-
-def _frame_geometry(own: dict[str, np.ndarray], i: int, terrain: Any) -> np.ndarray | None:
-    """Velocity in a heading-free frame (3, the mean of the last ``_SMOOTH_FRAMES`` frames), pitch,
-    roll and height above ground of frame ``i``."""
-    pitch, roll = (float(own[k][i]) for k in ("own_pitch_rad", "own_roll_rad"))
-    height = float(own["own_height_agl_m"][i])
-    if not np.isfinite(height) and not (bool(own["has_geo"]) and terrain is not None):
-        return None
-    if not np.isfinite(height):  # only a DEM: the terrain height under the own-ship
-        lat, lon, alt = (float(own[k][i]) for k in ("own_lat_deg", "own_lon_deg", "own_alt_m"))
-        height = float(_depth_fn(terrain, lat, lon, alt)(np.zeros(1), np.zeros(1))[0])
-    if not height > 0:
-        return None
-    # Flat ground is the same in every direction: each frame's velocity in its own heading-free frame
-    # (constant through a coordinated turn), averaged against the GNSS velocity noise.
-    v_free = np.mean(
-        [
-            rotation_matrix(float(own["own_yaw_rad"][j]), 0.0, 0.0).T
-            @ np.array([own[k][j] for k in ("own_vn_mps", "own_ve_mps", "own_vd_mps")], float)
-            for j in range(max(i - _SMOOTH_FRAMES + 1, 0), i + 1)
-        ],
-        axis=0,
-    )
-    return np.array([*v_free, pitch, roll, height])
-
-
-def _within_tolerance(state: np.ndarray, at: np.ndarray) -> bool:
-    """Whether a prediction computed at ``at`` serves a frame at ``state`` (see :func:`frame_subspace`)."""
-    return bool(
-        np.all(np.abs(state[:3] - at[:3]) <= V_TOLERANCE_MPS)
-        and np.all(np.abs(state[3:5] - at[3:5]) <= np.radians(ANGLE_TOLERANCE_DEG))
-        and abs(np.log(state[5] / at[5])) <= HEIGHT_TOLERANCE
-    )
 
 
 def frame_subspace(
-    own: dict[str, np.ndarray], i: int, config: RadarConfig, terrain: Any = None
+    own: dict[str, np.ndarray],
+    i: int,
+    config: RadarConfig,
+    terrain: Any = None,
+    anchors: np.ndarray | None = None,
 ) -> ClutterSubspace | None:
     """Predicted clutter subspace of frame ``i`` (None when the height above ground is unknown).
 
-    The prediction is computed at the geometry quantised (0.25 m/s, 1 deg, 0.25 % of the height)
-    and reused for every frame whose navigated geometry lies within ``V_TOLERANCE_MPS`` per
-    velocity axis (about one Doppler bin), ``ANGLE_TOLERANCE_DEG`` of pitch and roll and
-    ``HEIGHT_TOLERANCE`` of the height of a cached one (the most recently used first): without the
-    tolerance the GNSS noise of ``ga-typical`` navigation (0.2 m/s vertical) crossed a quantisation
-    step on most frames and each frame paid for a new prediction. The velocity is the mean over
-    this frame and the 4 before it (those in ``own``), each in its own heading-free frame: the
-    white GNSS velocity noise (0.1 m/s horizontal, 0.2 m/s vertical) and the heading noise
-    (0.2 deg, 0.2 m/s across the track at 60 m/s) still crossed the tolerance every few frames
-    (6-10 predictions per 75 frames over flat ground, 2-3 with the mean). In a steady 35 deg
-    banked turn the heading-free velocity is constant (one prediction, tested); the mean lags a
-    changing velocity by 0.2 s (0.2 m/s at a 1 m/s^2 change, within the tolerance), and pitch, roll
-    and height are not averaged. Measured on the ``experiment clutter`` scene at 1000 m, a
-    prediction off by the whole tolerance in every quantity at once (0.35 m/s down, 0.5 deg
-    pitch, 1 % height, either sign) lowers the improvement factor in the intruder's lost cells
-    from 27.3 to 26.3-26.6 dB (2 deg and 2 % cost 2.4 dB); with 5 % of height and the adaptive
-    nulls, to 25.3 and 26.5 dB (least cell 23.0 and 20.5 dB), the same 12 intruder hits of 20. Over relief
-    the height below jumps with every hill (15-22 predictions per 75 frames over ``hills``). Tried
-    and measured on encounter windows: the median ground height within 5 km (6-13 predictions)
-    lost intruder hits over hills (34 of 75 frames against 41), a height tolerance grown with
-    the relief's spread (3-11) lost them over Jacksboro (61-64 against 67-68), so the height stays
-    the one below. Its tolerance was 1 % until the adaptive nulls
-    (:mod:`skyradar.process.clutter_adaptive`) took over the cells where the flat-ground prediction
-    fails: with them, 5 % keeps every intruder hit of a hills and a Jacksboro encounter (56 of 132
-    and 23 of 79 sampled frames, the same as at 1 %) with 3 and 2 times fewer predictions (21
-    against 71, 18 against 37), a prediction being the largest per-frame cost over relief. Over
-    flat ground the height below only changes with the own-ship's altitude. Which cached
-    prediction serves a frame can depend on the frames before
-    it, so chunked and whole-run processing may use predictions that differ by at most the
-    tolerance.
+    Computed over flat ground at the frame's anchor (``anchors[i]``; without ``anchors``, walked
+    over the run's frames up to ``i`` by
+    :func:`~skyradar.process.clutter_anchors.prediction_anchors`) and kept for the next frames
+    that share it (the last 8 predictions, about 20 MB each).
     """
-    state = _frame_geometry(own, i, terrain)
-    if state is None:
+    if anchors is None:
+        anchors = prediction_anchors(own, terrain, stop=i + 1)
+    anchor = anchors[i]
+    if not np.all(np.isfinite(anchor)):
         return None
-    v_q = np.round(state[:3] / _V_STEP) * _V_STEP
-    step = _ANGLE_STEP_DEG
-    pitch_q, roll_q = (np.radians(round(np.degrees(a) / step) * step) for a in state[3:5])
-    height_q = float(np.exp(np.round(np.log(state[5]) / _HEIGHT_STEP) * _HEIGHT_STEP))
-    key = (*np.round(v_q / _V_STEP).astype(int), round(np.degrees(pitch_q)), round(np.degrees(roll_q)),
-           round(height_q, 3), id(config))  # fmt: skip
+    key = (*anchor_key(anchor), id(config))
     hit = _CACHE.get(key)
-    if hit is None:
-        for other in reversed(_CACHE):
-            if other[-1] == id(config) and _within_tolerance(state, _CACHE[other][0]):
-                key, hit = other, _CACHE[other]
-                break
-    if hit is not None:
+    if hit is not None and hit[0] is config:  # the entry holds its config: its id is not reused
         _CACHE.move_to_end(key)
         return hit[1]
-    ant_to_ned = rotation_matrix(0.0, pitch_q, roll_q) @ config.mount.rotation
-    sub = clutter_subspace(config, v_q, ant_to_ned, height_q, None, n_azimuth=720)
-    _CACHE[key] = (np.array([*v_q, pitch_q, roll_q, height_q]), sub)
+    ant_to_ned = rotation_matrix(0.0, float(anchor[3]), float(anchor[4])) @ config.mount.rotation
+    sub = clutter_subspace(config, anchor[:3], ant_to_ned, float(anchor[5]), None, n_azimuth=720)
+    _CACHE[key] = (config, sub)
     while len(_CACHE) > _CACHE_SIZE:
         _CACHE.popitem(last=False)
     return sub
@@ -302,12 +222,14 @@ def frame_clutter(
     config: RadarConfig,
     terrain: Any = None,
     source: str = "frames",
+    anchors: np.ndarray | None = None,
 ) -> ClutterSubspace | None:
     """The clutter subspace frame ``i`` is suppressed with under ``suppression``, or None.
 
     ``"none"``: never. ``"knowledge-aided"``: always; InputError when the run has no own-ship
     state (velocity, attitude and height above ground, or a terrain under a geodetic position).
-    ``"auto"``: knowledge-aided where that state exists, none elsewhere.
+    ``"auto"``: knowledge-aided where that state exists, none elsewhere. ``anchors``: the run's
+    :func:`~skyradar.process.clutter_anchors.prediction_anchors` (computed here when not given).
     """
     if suppression not in SUPPRESSIONS:
         raise InputError(
@@ -315,7 +237,7 @@ def frame_clutter(
         )
     if suppression == "none":
         return None
-    sub = None if own is None else frame_subspace(own, i, config, terrain)
+    sub = None if own is None else frame_subspace(own, i, config, terrain, anchors)
     if sub is None and suppression == "knowledge-aided":
         what = (
             "own-ship state (own_*/nav_* variables)"

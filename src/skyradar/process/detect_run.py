@@ -73,11 +73,7 @@ def detect_run(
 
 def _head_chunk(path: str, start: int, stop: int, *args: Any, head: str, **kwargs: Any) -> pd.DataFrame:
     # process_chunk for one head of a multi-head run (a Dask worker opens the run itself).
-    table = process_frames(
-        open_frames(path, head).isel(time=slice(start, stop)), *args, source=path, **kwargs
-    )
-    table["frame"] += start
-    return table
+    return process_frames(open_frames(path, head), *args, source=path, frames=slice(start, stop), **kwargs)
 
 
 def merge_head_tables(tables: dict[str, pd.DataFrame]) -> pd.DataFrame:

@@ -42,6 +42,7 @@ from skyradar.io.frames import radar_config_of
 from skyradar.io.frames_model import frame_times_s
 from skyradar.io.navigation import navigation_state
 from skyradar.io.run_origin import scenario_origin  # re-exported: it lived here before issue 16
+from skyradar.process.clutter_anchors import prediction_anchors
 from skyradar.process.clutter_frames import detect_suppressed, frame_clutter
 from skyradar.process.detect import detect, integrate_channels
 from skyradar.process.doa import (
@@ -53,7 +54,10 @@ from skyradar.process.doa import (
 from skyradar.process.ground import flag_ground, height_above_ground_m, surface_height_fn
 from skyradar.process.spurs import SpurMap
 
-__all__ = ["DETECTION_COLUMNS", "process_chunk", "process_cube", "process_frames", "scenario_origin"]
+__all__ = [
+    "DETECTION_COLUMNS", "clutter_anchors", "process_chunk", "process_cube", "process_frames",
+    "scenario_origin",
+]  # fmt: skip
 
 DETECTION_COLUMNS = [
     "time_s", "frame", "range_m", "radial_velocity_mps", "range_bin", "doppler_bin", "snr_db", "power_db",
@@ -213,16 +217,25 @@ def _ground_flags(
     return flag_ground(out, u_ned, vel, ant_to_ned, height_fn, own_agl, config)
 
 
+def clutter_anchors(ds: xr.Dataset, terrain: Any = None, source: str = "frames") -> np.ndarray | None:
+    """The clutter predictions' anchors of every frame of the run ``ds`` (None without own-ship state).
+
+    For a run processed in blocks (``process_frames(block, anchors=...)``): each block is then
+    suppressed as in the whole run (:mod:`skyradar.process.clutter_anchors`).
+    """
+    own = _own_state(ds, source)
+    return None if own is None else prediction_anchors(own, terrain)
+
+
 def process_chunk(path: str, start: int, stop: int, *args: Any, **kwargs: Any) -> pd.DataFrame:
     """:func:`process_frames` on frames ``start:stop`` of the run at ``path`` (frame numbers kept).
 
-    The unit of work for Dask workers: they open the run themselves.
+    The unit of work for Dask workers: they open the run themselves. The own-ship state and the
+    clutter predictions' anchors are the whole run's, so the rows equal the plain loop's.
     """
     from skyradar.io.frames import open_frames
 
-    table = process_frames(open_frames(path).isel(time=slice(start, stop)), *args, source=path, **kwargs)
-    table["frame"] += start
-    return table
+    return process_frames(open_frames(path), *args, source=path, frames=slice(start, stop), **kwargs)
 
 
 def _checked_config(ds: xr.Dataset, config: RadarConfig | None, spur_map, source: str) -> RadarConfig:
@@ -272,6 +285,8 @@ def process_frames(
     source: str = "frames",
     config: RadarConfig | None = None,
     suppression: str = "none",
+    frames: slice | None = None,
+    anchors: np.ndarray | None = None,
     **detect_kwargs: Any,
 ) -> pd.DataFrame:
     """Detections table of a frames Dataset (see the module docstring for the columns).
@@ -292,25 +307,33 @@ def process_frames(
     suppression : {"none", "knowledge-aided", "auto"}
         Ground clutter suppression before detection (:mod:`skyradar.process.clutter_frames`):
         "auto" suppresses where the own-ship state allows, "knowledge-aided" requires it.
+    frames : slice, optional
+        Only these frames of ``ds`` (a Dask chunk); their frame numbers, own-ship state and
+        clutter predictions are those of the whole run (the same rows as a whole-run call).
+    anchors : ndarray, shape (n_frames, 6), optional
+        The clutter predictions' anchors of ``ds``'s frames (:func:`clutter_anchors`) when ``ds``
+        is a block of a longer run; computed from ``ds`` when not given.
     """
     config = _checked_config(ds, config, spur_map, source)
-    n_frames = ds.sizes["time"]
+    first, stop, _ = (frames or slice(None)).indices(ds.sizes["time"])
     own, origin = _own_state(ds, source), scenario_origin(ds)
     times = frame_times_s(ds)
+    if anchors is None and own is not None and suppression in ("knowledge-aided", "auto"):
+        anchors = prediction_anchors(own, terrain, stop)  # walked from frame 0: chunking changes nothing
     rows: list[dict[str, np.ndarray]] = []
-    for start in range(0, n_frames, batch_frames):
-        block = np.asarray(ds["iq"].isel(time=slice(start, start + batch_frames)).values)
+    for start in range(first, stop, batch_frames):
+        block = np.asarray(ds["iq"].isel(time=slice(start, min(start + batch_frames, stop))).values)
         check_finite_frames(block, start, source)
         for offset, cube in enumerate(block):
             i = start + offset
             try:
-                clutter = frame_clutter(suppression, own, i, config, terrain, source)
+                clutter = frame_clutter(suppression, own, i, config, terrain, source, anchors)
                 out = process_cube(cube, config, spur_map, method, spur_mode, clutter, **detect_kwargs)
             except InputError as exc:  # e.g. CFAR windows that do not fit: say which run
                 raise InputError(f"{source}: {exc}") from None
             rows.append(_located(out, times[i], i, own, origin, config, terrain))
         if progress is not None:
-            progress(min(start + batch_frames, n_frames))
+            progress(min(start + batch_frames, stop) - first)
     table = pd.DataFrame({c: np.concatenate([r[c] for r in rows]) for c in DETECTION_COLUMNS})
     table.attrs["navigation_source"] = None if own is None else str(own["navigation_source"])
     return table

@@ -182,7 +182,7 @@ def elevation_sigma_rad(
     fisher = 2.0 * amp2[:, None, None] / noise_floor_w * info.real
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # no information: inf
         det = fisher[:, 0, 0] * fisher[:, 1, 1] - fisher[:, 0, 1] * fisher[:, 1, 0]
-        scale = np.maximum(np.abs(fisher[:, 0, 0] * fisher[:, 1, 1]), 1e-300)
+        scale = np.maximum((fisher[:, 0, 0] + fisher[:, 1, 1]) ** 2, 1e-300)  # rank 1: no elevation
         var = np.where(seen & (det > 1e-9 * scale), fisher[:, 1, 1] / det, np.inf)
         return np.sqrt(np.where(var > 0, var, np.inf))
 

@@ -76,3 +76,24 @@ def test_a_run_processed_after_another_gives_the_same_rows(run, whole):
     clutter_frames._CACHE.clear()
     process_frames(higher, suppression="auto")
     pd.testing.assert_frame_equal(process_frames(run, suppression="auto"), whole)
+
+
+def test_the_velocity_mean_is_the_last_five_frames_and_a_gap_spoils_only_those():
+    from skyradar.geo import rotation_matrix
+    from skyradar.process.clutter_anchors import frame_geometries
+
+    rng = np.random.default_rng(1)
+    n = 12
+    own = {"own_vn_mps": 50 + rng.normal(0, 0.2, n), "own_ve_mps": rng.normal(0, 0.2, n),
+           "own_vd_mps": rng.normal(0, 0.2, n), "own_yaw_rad": rng.uniform(-3, 3, n),
+           "own_pitch_rad": np.zeros(n), "own_roll_rad": np.zeros(n),
+           "own_height_agl_m": np.full(n, 400.0), "has_geo": np.array(False)}  # fmt: skip
+    got = frame_geometries(own)
+    for i in range(n):  # peer: each frame's velocity rotated into its heading-free frame, then averaged
+        rows = range(max(i - 4, 0), i + 1)
+        v = [rotation_matrix(own["own_yaw_rad"][j], 0.0, 0.0).T @ [own[k][j] for k in
+             ("own_vn_mps", "own_ve_mps", "own_vd_mps")] for j in rows]  # fmt: skip
+        np.testing.assert_allclose(got[i, :3], np.mean(v, axis=0), atol=1e-12)
+    own["own_vn_mps"][3] = np.nan  # a navigation gap
+    spoiled = ~np.isfinite(frame_geometries(own)).all(axis=1)
+    assert spoiled.tolist() == [i in range(3, 8) for i in range(n)]

@@ -74,9 +74,10 @@ def frame_geometries(own: dict[str, np.ndarray], terrain: Any = None, stop: int 
     # Flat ground is the same in every direction: each frame's velocity in its own heading-free frame
     # (constant through a coordinated turn), averaged against the GNSS velocity noise.
     free = np.column_stack([np.cos(yaw) * vn + np.sin(yaw) * ve, np.cos(yaw) * ve - np.sin(yaw) * vn, vd])
-    sums = np.vstack([np.zeros(3), np.cumsum(free, axis=0)])
-    first = np.maximum(np.arange(n) - _SMOOTH_FRAMES + 1, 0)
-    mean = (sums[1:] - sums[first]) / (np.arange(n) - first + 1)[:, None]
+    # Windows over zeros before the first frame (a NaN velocity spoils its own 5 windows, no more).
+    padded = np.vstack([np.zeros((_SMOOTH_FRAMES - 1, 3)), free])
+    windows = np.lib.stride_tricks.sliding_window_view(padded, _SMOOTH_FRAMES, axis=0)
+    mean = windows.sum(axis=-1) / np.minimum(np.arange(1, n + 1), _SMOOTH_FRAMES)[:, None]
     height = np.array(own["own_height_agl_m"][:n], float)
     unknown = ~np.isfinite(height)
     if unknown.any() and bool(own["has_geo"]) and terrain is not None:

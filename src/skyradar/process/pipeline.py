@@ -307,12 +307,9 @@ def process_frames(
     suppression : {"none", "knowledge-aided", "auto"}
         Ground clutter suppression before detection (:mod:`skyradar.process.clutter_frames`):
         "auto" suppresses where the own-ship state allows, "knowledge-aided" requires it.
-    frames : slice, optional
-        Only these frames of ``ds`` (a Dask chunk); their frame numbers, own-ship state and
-        clutter predictions are those of the whole run (the same rows as a whole-run call).
-    anchors : ndarray, shape (n_frames, 6), optional
-        The clutter predictions' anchors of ``ds``'s frames (:func:`clutter_anchors`) when ``ds``
-        is a block of a longer run; computed from ``ds`` when not given.
+    frames, anchors : slice and ndarray (n_frames, 6), optional
+        Only ``frames`` of ``ds`` (a Dask chunk: frame numbers, own-ship state and clutter
+        predictions stay the whole run's); ``anchors`` of a block of a longer run (:func:`clutter_anchors`).
     """
     config = _checked_config(ds, config, spur_map, source)
     first, stop, _ = (frames or slice(None)).indices(ds.sizes["time"])

@@ -35,6 +35,8 @@ from typing import Any
 
 import numpy as np
 
+from skyradar.process.ground import height_above_ground_m
+
 __all__ = [
     "frame_geometries",
     "prediction_anchors",
@@ -42,11 +44,12 @@ __all__ = [
     "V_TOLERANCE_MPS",
     "ANGLE_TOLERANCE_DEG",
     "HEIGHT_TOLERANCE",
+    "RECENT_ANCHORS",
 ]
 
 _V_STEP, _ANGLE_STEP_DEG, _HEIGHT_STEP = 0.25, 1.0, 0.0025  # the quantisation an anchor is computed at
 V_TOLERANCE_MPS, ANGLE_TOLERANCE_DEG, HEIGHT_TOLERANCE = 0.35, 0.5, 0.05  # reuse of an anchor
-_RECENT = 8  # anchors kept in the walk (as many predictions as the cache holds)
+RECENT_ANCHORS = 8  # anchors the walk keeps (clutter_frames caches as many predictions)
 _SMOOTH_FRAMES = 5  # velocity mean over this frame and the 4 before it (GNSS velocity noise is white)
 
 
@@ -89,10 +92,9 @@ def frame_geometries(own: dict[str, np.ndarray], terrain: Any = None, stop: int 
 
 def _height_over_terrain(own: dict[str, np.ndarray], terrain: Any, rows: np.ndarray) -> np.ndarray:
     """Own-ship altitude less the terrain height under it at ``rows``, m (1e9 outside the DEM)."""
-    height_at = terrain.height_at if hasattr(terrain, "height_at") else terrain
     lat, lon, alt = (np.asarray(own[k], float)[rows] for k in ("own_lat_deg", "own_lon_deg", "own_alt_m"))
-    ground = np.asarray(height_at(lat, lon), float)
-    return np.where(np.isfinite(ground), alt - ground, 1e9)
+    agl = height_above_ground_m(lat, lon, alt, terrain)
+    return np.where(np.isfinite(agl), agl, 1e9)
 
 
 def anchor_key(anchor: np.ndarray) -> tuple:
@@ -155,7 +157,7 @@ def prediction_anchors(
                     break
         if hit is None:
             recent[key] = hit = at
-            while len(recent) > _RECENT:
+            while len(recent) > RECENT_ANCHORS:
                 recent.popitem(last=False)
         recent.move_to_end(key)
         anchors[i] = hit

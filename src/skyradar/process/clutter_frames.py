@@ -30,7 +30,7 @@ from skyradar.errors import InputError
 from skyradar.geo import rotation_matrix
 from skyradar.process.clutter import ClutterSubspace, clutter_subspace
 from skyradar.process.clutter_adaptive import ring_whitening
-from skyradar.process.clutter_anchors import anchor_key, prediction_anchors
+from skyradar.process.clutter_anchors import RECENT_ANCHORS, anchor_key, prediction_anchors
 from skyradar.process.clutter_doa import directions_after_projection, projected_directions
 from skyradar.process.clutter_suppress import projected_snapshots, suppress_clutter
 from skyradar.process.detect import Detections, detect
@@ -49,7 +49,9 @@ __all__ = [
 
 SUPPRESSIONS = ("none", "knowledge-aided", "auto")
 _CACHE: OrderedDict[tuple, tuple[RadarConfig, ClutterSubspace]] = OrderedDict()
-_CACHE_SIZE = 8  # predictions kept: about 20 MB each (packed covariance, eigenvectors as cells need them)
+_CACHE_SIZE = (
+    RECENT_ANCHORS  # predictions kept: about 20 MB each (packed covariance, eigenvectors as cells need them)
+)
 
 
 def frame_subspace(

@@ -2,8 +2,7 @@
 
 Compiled (numba) helpers shared by the clutter prediction (:mod:`skyradar.process.clutter`) and the
 adaptive nulls' strongest pairs (:mod:`skyradar.process.top_eigen`): a cyclic complex Jacobi
-solver that can continue from a neighbouring cell's basis, and the change of basis ``v^H a v``
-that such a warm start and a Rayleigh-Ritz step both need.
+solver, and the change of basis ``v^H a v`` a Rayleigh-Ritz step needs.
 
 Examples
 --------
@@ -50,12 +49,13 @@ def _jacobi_rotate(a, v, p, q):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def hermitian_eigh(a, v, lam, order, tol=1e-7, max_sweeps=12, warm=False):  # pragma: no cover - compiled
+def hermitian_eigh(a, v, lam, order, tol=1e-7, max_sweeps=12):  # pragma: no cover - compiled
     """Eigen-pairs of a small Hermitian matrix ``a`` (overwritten) by cyclic Jacobi sweeps.
 
     ``v`` receives the eigenvectors as columns, ``lam`` the eigenvalues in the same order and
-    ``order`` the column indices by decreasing eigenvalue. ``warm``: ``a`` was already turned into
-    the unitary basis ``v`` holds (``v^H a v``), whose rotations continue from there. Sweeps stop
+    ``order`` the column indices by decreasing eigenvalue. The rotations start from the identity
+    (a warm start from a neighbouring cell's basis made the clutter prediction's eigen-pairs depend
+    on the order cells were needed in, :func:`skyradar.process.clutter.decompose_cell`). Sweeps stop
     when the off-diagonal power falls below ``tol**2`` times the diagonal's (quadratic convergence:
     3-5 sweeps at n = 4 from the identity).
 
@@ -68,8 +68,7 @@ def hermitian_eigh(a, v, lam, order, tol=1e-7, max_sweeps=12, warm=False):  # pr
     n = a.shape[0]
     for i in range(n):
         for j in range(n):
-            if not warm:
-                v[i, j] = 1.0 if i == j else 0.0
+            v[i, j] = 1.0 if i == j else 0.0
     scale = 0.0
     for i in range(n):
         scale += a[i, i].real ** 2

@@ -125,6 +125,14 @@ def test_knowledge_aided_without_own_ship_state_is_one_clear_error(tmp_path):
         "process", "run.zarr", "-o", "d.parquet", "--suppression", "knowledge-aided", cwd=tmp_path
     )
     assert_one_line_error(result, "run.zarr", "knowledge-aided", "own-ship state")
+    assert result.stderr.count("run.zarr") == 1, result.stderr  # named once, not "run.zarr: run.zarr:"
+    assert not (tmp_path / "d.parquet").exists()
+    # The same on a local Dask cluster: its workers do not print the failed task's traceback.
+    result = skyradar(
+        "process", "run.zarr", "-o", "d.parquet", "--suppression", "knowledge-aided", "--workers", "2",
+        cwd=tmp_path,
+    )  # fmt: skip
+    assert_one_line_error(result, "run.zarr", "knowledge-aided", "own-ship state")
     assert not (tmp_path / "d.parquet").exists()
 
 

@@ -6,6 +6,7 @@ count travels back to the client, and an interrupted run keeps every finished ch
 
 from __future__ import annotations
 
+import logging
 import os
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -71,9 +72,12 @@ def connect(scheduler: str | None, workers: int | None, timeout_s: float = 10.0)
                 f"--scheduler {scheduler}: no Dask scheduler answered within {timeout_s:.0f} s ({exc})"
             ) from exc
     check_workers(workers)
+    # A worker logs every failed task with its traceback (ERROR); the client re-raises the error
+    # itself (bad input: one line), so our own cluster's workers log only what is critical.
     cluster = LocalCluster(
-        n_workers=int(workers or 2), threads_per_worker=1, processes=True, dashboard_address=None
-    )
+        n_workers=int(workers or 2), threads_per_worker=1, processes=True, dashboard_address=None,
+        silence_logs=logging.CRITICAL,
+    )  # fmt: skip
     return Client(cluster)
 
 

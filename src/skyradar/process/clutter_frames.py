@@ -223,7 +223,6 @@ def frame_clutter(
     i: int,
     config: RadarConfig,
     terrain: Any = None,
-    source: str = "frames",
     anchors: np.ndarray | None = None,
 ) -> ClutterSubspace | None:
     """The clutter subspace frame ``i`` is suppressed with under ``suppression``, or None.
@@ -234,9 +233,7 @@ def frame_clutter(
     :func:`~skyradar.process.clutter_anchors.prediction_anchors` (computed here when not given).
     """
     if suppression not in SUPPRESSIONS:
-        raise InputError(
-            f"{source}: field 'suppression' must be one of {', '.join(SUPPRESSIONS)}, got {suppression!r}"
-        )
+        raise InputError(f"field 'suppression' must be one of {', '.join(SUPPRESSIONS)}, got {suppression!r}")
     if suppression == "none":
         return None
     sub = None if own is None else frame_subspace(own, i, config, terrain, anchors)
@@ -246,5 +243,5 @@ def frame_clutter(
             if own is None
             else "height above ground (own_height_agl_m or a terrain)"
         )
-        raise InputError(f"{source}: suppression 'knowledge-aided' needs the {what}; frame {i} has none")
+        raise InputError(f"suppression 'knowledge-aided' needs the {what}; frame {i} has none")
     return sub

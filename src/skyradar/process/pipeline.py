@@ -324,7 +324,7 @@ def process_frames(
         for offset, cube in enumerate(block):
             i = start + offset
             try:
-                clutter = frame_clutter(suppression, own, i, config, terrain, source, anchors)
+                clutter = frame_clutter(suppression, own, i, config, terrain, anchors)
                 out = process_cube(cube, config, spur_map, method, spur_mode, clutter, **detect_kwargs)
             except InputError as exc:  # e.g. CFAR windows that do not fit: say which run
                 raise InputError(f"{source}: {exc}") from None

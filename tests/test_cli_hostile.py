@@ -151,6 +151,7 @@ def test_huge_worker_count_is_refused_before_any_process_starts(tiny_run, comman
         # --duration 1e308 and --n 10**20 were numpy "Maximum allowed size exceeded" tracebacks.
         (["experiment", "ch5", "--duration", "1e308"], ["--duration", "1e+308"]),
         (["experiment", "encounters", "--n", str(10**20)], ["--n", str(10**20)]),
+        (["experiment", "encounters", "--rx-layout", "ring"], ["--rx-layout", "'ring'"]),
     ],
 )
 def test_experiment_sizes_are_bounded_before_the_output_folder(tmp_path, args, needles):

@@ -221,7 +221,8 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
 
     settings = {"n": 2, "seed": 5, "frame_rate_hz": 4.7, "buffer": 1.5, "uncertainty": True,
                 "terrains": ["none"], "layouts": ["single"], "navigation": "ga-typical",
-                "suppression": "auto", "late_lead_s": 12.5, "simulation": LIGHT}  # fmt: skip
+                "suppression": "auto", "late_lead_s": 12.5, "simulation": LIGHT,
+                "rx_layout": "square"}  # fmt: skip
     key = {**settings, "version": E._version()}
     _, save = E._partial_store(tmp_path, key)
     fake = {"t_lowc_s": np.nan, "t_cpa_s": 120.0, "conflict": False, "may_alert": False,
@@ -244,6 +245,7 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
     save({("none", 0): [fake]})
     assert E._partial_store(tmp_path, {**key, "seed": 6})[0] == {}
     assert E._partial_store(tmp_path, {**key, "navigation": "perfect"})[0] == {}
+    assert E._partial_store(tmp_path, {**key, "rx_layout": "kite"})[0] == {}
 
 
 def test_flat_terrain_variant_puts_ground_under_the_whole_window():
@@ -293,3 +295,12 @@ def test_a_run_resumes_only_on_the_same_code(tmp_path, monkeypatch):
     assert E._version() == before
     (package / "chain.py").write_text("GATE = 9.0\n")  # the chain changed between two sessions
     assert E._version() != before
+
+
+def test_run_encounter_builds_its_scenario_with_the_simulation_and_array_asked_for():
+    # simulation= was dropped on the way to the scenario: every "light" test ran the costly realism.
+    from skyradar.experiments.encounter_chain import _scenario
+
+    built, _, _ = _scenario(_row(), 0, 4.7, 40.0, None, ("single",), None, LIGHT, "kite")
+    assert {k: built.sim_options[k] for k in LIGHT} == LIGHT
+    assert built.heads[0].config.rx_positions_m[3, 2] > 0.02  # the kite's tail, m below the centre

@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike
 
 from skyradar.antenna import AntennaPattern, GainCut
 from skyradar.errors import InputError
+from skyradar.rx_layouts import rx_layout_m
 from skyradar.units import centred_bin, centred_bin_value, nearest_bin
 
 __all__ = ["SPEED_OF_LIGHT", "BOLTZMANN", "Mount", "RadarConfig"]
@@ -98,13 +99,6 @@ class Mount:
         )
 
 
-def _square_array(wavelength_m: float) -> np.ndarray:
-    # 2x2 square in the antenna's y-z plane, half-wavelength spacing: unambiguous phase
-    # differences over the whole hemisphere.
-    q = wavelength_m / 4.0
-    return np.array([[0.0, -q, -q], [0.0, q, -q], [0.0, -q, q], [0.0, q, q]])
-
-
 @dataclass(frozen=True)
 class RadarConfig:
     """FMCW radar hardware parameters and derived axes (SI units throughout).
@@ -125,9 +119,10 @@ class RadarConfig:
         Chirps per frame (= Doppler bins).
     range_limit_m : float
         Processed range (RLim), m.
-    rx_positions_m : ndarray, shape (n_rx, 3)
-        Receive antenna phase centres in the antenna frame, m. Default: 2x2 square,
-        half-wavelength spacing.
+    rx_positions_m : ndarray, shape (n_rx, 3), or str
+        Receive antenna phase centres in the antenna frame, m, or a layout name of
+        :func:`skyradar.rx_layouts.rx_layout_m` (``"square"``, ``"kite"``). Default: the 2x2
+        square, half-wavelength spacing.
     tx_position_m : ndarray, shape (3,)
         Transmit antenna phase centre in the antenna frame, m.
     noise_figure_db : float
@@ -155,7 +150,7 @@ class RadarConfig:
     bandwidth_hz: float = 10e6
     n_doppler: int = 250
     range_limit_m: float = 5000.0
-    rx_positions_m: np.ndarray | None = None
+    rx_positions_m: np.ndarray | str | None = None
     tx_position_m: np.ndarray | None = None
     noise_figure_db: float = 6.0
     temperature_k: float = 290.0
@@ -172,8 +167,8 @@ class RadarConfig:
             raise InputError(f"radar.n_doppler must be an integer >= 2, got {self.n_doppler!r}")
         if self.prf_hz >= self.fs_hz:
             raise InputError(f"radar.prf_hz ({self.prf_hz}) must be below fs_hz ({self.fs_hz})")
-        rx = _square_array(self.wavelength_m) if self.rx_positions_m is None else self.rx_positions_m
-        rx = np.array(rx, dtype=float)
+        rx = "square" if self.rx_positions_m is None else self.rx_positions_m
+        rx = rx_layout_m(rx, self.wavelength_m) if isinstance(rx, str) else np.array(rx, dtype=float)
         if rx.ndim != 2 or rx.shape[1] != 3 or rx.shape[0] < 1 or not np.all(np.isfinite(rx)):
             raise InputError(
                 f"radar.rx_positions_m must be an (n_rx, 3) array of finite metres, got shape {rx.shape}"

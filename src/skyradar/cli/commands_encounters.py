@@ -73,6 +73,15 @@ _NAVIGATION = Annotated[
     ),
 ]
 
+_RX_LAYOUT = Annotated[
+    str,
+    typer.Option(
+        "--rx-layout",
+        help="Receive array of every head (scenario 'radar.rx_layout:'): square (the prototype's 2x2) "
+        "or kite (no centre of symmetry: keeps the elevation of targets in flat-ground clutter).",
+    ),
+]
+
 
 @experiment_app.command("encounters")
 def experiment_encounters(
@@ -90,6 +99,7 @@ def experiment_encounters(
     terrain: _TERRAIN = "none",
     layout: _LAYOUT = "both",
     navigation: _NAVIGATION = "ga-typical",
+    rx_layout: _RX_LAYOUT = "square",
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -103,12 +113,14 @@ def experiment_encounters(
     from skyradar.experiments.encounters import DEFAULT_ENCOUNTERS, DEFAULT_TERRAIN_ENCOUNTERS, run
     from skyradar.io.outputs import check_output, mark_folder
     from skyradar.parallel import check_workers
+    from skyradar.rx_layouts import check_rx_layout
 
     check_workers(workers)
     terrains, layouts = parse_terrains(terrain), _layouts(layout)
     if n is None:  # over terrain an encounter costs minutes: the default keeps a run within 5 minutes
         n = DEFAULT_ENCOUNTERS if terrains == ["none"] else DEFAULT_TERRAIN_ENCOUNTERS
     _navigation(navigation)
+    check_rx_layout(rx_layout, "experiment encounters: option '--rx-layout'")
     check_output(out, (), overwrite, kind="folder", option="--out")
     mark_folder(out)
     total = n * len(terrains)
@@ -117,6 +129,6 @@ def experiment_encounters(
         result = run(
             out, n_encounters=n, seed=seed, frame_rate_hz=frame_rate, buffer=buffer, workers=workers,
             uncertainty=not no_uncertainty, progress=lambda k: bar.update(task, completed=k),
-            terrains=tuple(terrains), layouts=layouts, navigation=navigation,
+            terrains=tuple(terrains), layouts=layouts, navigation=navigation, rx_layout=rx_layout,
         )  # fmt: skip
     emit_result(result, as_json, "encounters")

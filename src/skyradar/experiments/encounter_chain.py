@@ -106,7 +106,9 @@ def _score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[
     return row
 
 
-def _scenario(p, seed, frame_rate_hz, lookback_s, terrain, layouts, navigation, simulation) -> tuple:
+def _scenario(
+    p, seed, frame_rate_hz, lookback_s, terrain, layouts, navigation, simulation, rx_layout
+) -> tuple:
     """The built scenario of one encounter, its dense relative truth and the row's shared columns."""
     from skyradar.scene.examples import THREE_HEAD_RADARS
 
@@ -124,6 +126,8 @@ def _scenario(p, seed, frame_rate_hz, lookback_s, terrain, layouts, navigation, 
         radars=radars,
         navigation=navigation,
         own_altitude_m=alt,
+        simulation=simulation,
+        rx_layout=rx_layout,
     )
     built = Scenario.from_dict(spec).build()
     shared = {
@@ -151,6 +155,7 @@ def run_encounter(
     layouts: tuple[str, ...] = ("single",),
     navigation: str | dict | None = None,
     simulation: dict[str, Any] | None = None,
+    rx_layout: str = "square",
 ) -> list[dict[str, Any]]:
     """One encounter row through the full chain; one result row per layout (times in s, NaN when none).
 
@@ -158,13 +163,13 @@ def run_encounter(
     ``"three-head"``: :data:`~skyradar.scene.examples.THREE_HEAD_RADARS`) tracks and alerts its
     heads' detections. ``t_warning_s`` is the first warning (level 3) of a track that follows the
     intruder; ``t_other_warning_s`` the first warning of any other track (clutter or noise).
-    ``simulation`` overrides the scenario's simulator options
-    (:func:`~skyradar.experiments.encounter_set.encounter_scenario`).
+    ``simulation`` overrides the scenario's simulator options and ``rx_layout`` names every head's
+    receive array (:func:`~skyradar.experiments.encounter_set.encounter_scenario`).
     """
     from skyradar.experiments.daa_chain import track_and_alert
 
     cfg = alert_config or RADAR_ALERT_CONFIG
-    spec_args = (p, seed, frame_rate_hz, lookback_s, terrain, layouts, navigation, simulation)
+    spec_args = (p, seed, frame_rate_hz, lookback_s, terrain, layouts, navigation, simulation, rx_layout)
     built, truth, shared = _scenario(*spec_args)
     chain = run_chain(built, cfg, with_advice=False, process_options={"suppression": SUPPRESSION})
     shared.update({f"{k}_s": float(v) for k, v in chain["timings_s"].items() if k in ("simulate", "process")})

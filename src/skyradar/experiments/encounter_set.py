@@ -117,6 +117,7 @@ def encounter_scenario(
     own_altitude_m: float | None = None,
     terrain_seed: int | None = None,
     simulation: dict[str, Any] | None = None,
+    rx_layout: str = "square",
 ) -> dict[str, Any]:
     """Scenario dict (:meth:`skyradar.scene.scenario.Scenario.from_dict`) of one encounter row.
 
@@ -133,6 +134,7 @@ def encounter_scenario(
     the scenario default). ``terrain_seed`` (default ``seed``) picks the hills surface and the
     point over Jacksboro. ``simulation`` overrides keys of the scenario's ``simulation:`` section
     (tests that are about scoring, not the simulator, turn the costly realism off with it).
+    ``rx_layout`` names every head's receive array (:mod:`skyradar.rx_layouts`).
     """
     from skyradar.experiments.encounter_terrain import site
 
@@ -158,6 +160,8 @@ def encounter_scenario(
         scenario["radars"] = [dict(r) for r in radars]
     if navigation is not None:
         scenario["navigation"] = navigation
+    if rx_layout != "square":  # the prototype's array is the scenario default
+        scenario["radar"] = {"rx_layout": rx_layout}
     if where["terrain"] is not None:
         scenario["terrain"] = where["terrain"]
     return scenario

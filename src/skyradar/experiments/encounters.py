@@ -37,6 +37,7 @@ from skyradar.experiments.encounter_set import make_encounters
 from skyradar.experiments.encounter_terrain import TERRAINS
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.parallel import check_workers
+from skyradar.rx_layouts import check_rx_layout
 
 __all__ = [
     "run_encounter",
@@ -178,6 +179,7 @@ def run(
     layouts: tuple[str, ...] = LAYOUTS,
     navigation: str = "ga-typical",
     simulation: dict[str, Any] | None = None,
+    rx_layout: str = "square",
 ) -> dict:
     """Run the encounter set; write ``encounters.parquet``/``.csv`` (one row per terrain, encounter
     and layout), ``summary.json``, ``summary_rows.csv`` and the figures into ``out_dir``; return the
@@ -187,12 +189,14 @@ def run(
     runs); ``rows`` holds every terrain and layout. ``uncertainty=False`` turns off the widening of
     the volumes by the track covariance. A warning with less lead than ``late_lead_s`` (default half
     the 25 s warning alerting time) is late. ``navigation`` is the scenarios' ``navigation:`` model;
-    ``simulation`` overrides their simulator options (default: PSF, speckle, Swerling 1).
+    ``simulation`` overrides their simulator options (default: PSF, speckle, Swerling 1) and
+    ``rx_layout`` names the receive array (:mod:`skyradar.rx_layouts`; default the prototype's square).
     Finished encounters are kept in ``encounters.partial.parquet`` while the run goes on; a run that
     was interrupted resumes from them when started again with the same settings.
     """
     terrains, layouts = tuple(terrains), tuple(x for x in LAYOUTS if x in layouts)
     _check(n_encounters, terrains, tuple(layouts) or ("",))
+    check_rx_layout(rx_layout, "--rx-layout:")
     t0 = time.perf_counter()
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -203,11 +207,11 @@ def run(
     settings = {"n": n_encounters, "seed": seed, "frame_rate_hz": frame_rate_hz, "buffer": buffer,
                 "uncertainty": uncertainty, "terrains": list(terrains), "layouts": list(layouts),
                 "navigation": navigation, "suppression": SUPPRESSION, "late_lead_s": late_lead_s,
-                "simulation": simulation or {}}  # fmt: skip
+                "simulation": simulation or {}, "rx_layout": rx_layout}  # fmt: skip
     done, save = _partial_store(out_dir, {**settings, "version": _version()})
     res = run_encounters(enc, seed, workers, progress, done, save, terrains=terrains, layouts=layouts,
                          frame_rate_hz=frame_rate_hz, buffer=buffer, alert_config=cfg,
-                         navigation=navigation, simulation=simulation)  # fmt: skip
+                         navigation=navigation, simulation=simulation, rx_layout=rx_layout)  # fmt: skip
     summary = write_report(res, out_dir, settings, late_lead_s, cfg.levels[-1].alerting_time_s)
     workers = check_workers(workers) or min(2, os.cpu_count() or 1)
     summary.update(

@@ -173,8 +173,7 @@ class Scenario:
     def _radar(self, head=None, mount: Mount | None = None, section: str = "radar") -> RadarConfig:
         """The top-level radar, or a head's (``head``: its RadarModel overrides, ``mount``)."""
         m = self.model
-        overrides = m.radar.model_dump(exclude_none=True, exclude={"antenna"})
-        overrides |= head.model_dump(exclude_none=True, exclude={"antenna"}) if head is not None else {}
+        overrides = m.radar.overrides() | (head.overrides() if head is not None else {})
         mount = self._mount(m.mount) if mount is None else mount
         antenna = head.antenna if head is not None and head.antenna is not None else m.radar.antenna
         if antenna is not None:

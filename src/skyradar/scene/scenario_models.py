@@ -138,10 +138,24 @@ class RadarModel(_Model):
     n_doppler: int | None = Field(None, ge=2)
     range_limit_m: Positive | None = None
     rx_positions_m: list[Vector3] | None = None
+    rx_layout: Literal["square", "kite"] | None = None  # skyradar.rx_layouts; or rx_positions_m
     tx_position_m: Vector3 | None = None
     noise_figure_db: Finite | None = None
     temperature_k: Positive | None = None
     antenna: AntennaModel | None = None
+
+    @model_validator(mode="after")
+    def _one_array(self) -> RadarModel:
+        if self.rx_positions_m is not None and self.rx_layout is not None:
+            raise ValueError("give rx_positions_m or rx_layout, not both")
+        return self
+
+    def overrides(self) -> dict[str, Any]:
+        """The RadarConfig fields set here (a layout name stands for its positions; antenna apart)."""
+        out = self.model_dump(exclude_none=True, exclude={"antenna", "rx_layout"})
+        if self.rx_layout is not None:
+            out["rx_positions_m"] = self.rx_layout
+        return out
 
 
 def _mount_shorthand(value: Any) -> Any:

@@ -1,0 +1,75 @@
+"""Named receive-array layouts: antenna phase centres in the antenna frame (y right, z down), m.
+
+``square`` is the thesis prototype's coplanar 2x2 at half-wavelength spacing. It is centrally
+symmetric, and that costs it the elevation of a target whose clutter is nulled at two azimuths of
+one elevation (an aircraft above or below level flight over flat ground shares its Doppler with
+ground on both sides): after the two nulls the array's Fisher information on (azimuth, elevation)
+has rank 1, for any rotation of the square about its boresight.
+
+``kite`` keeps four antennas and the upper half-wavelength pair but moves the lower two onto the
+vertical axis, one and two half-wavelengths below the upper pair: a triangle with a tail and no
+centre of symmetry, so the same two nulls leave the elevation measurable.
+Its vertical aperture of one wavelength is unambiguous through the two half-wavelength pairs
+(:mod:`skyradar.process.doa` unwraps the long baseline from them).
+
+Examples
+--------
+>>> rx_layout_m("square", 0.04).round(3).tolist()[0]
+[0.0, -0.01, -0.01]
+>>> rx_layout_m("kite", 0.04)[:, 2].round(3).tolist()  # down, m
+[-0.01, -0.01, 0.01, 0.03]
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from skyradar.errors import InputError
+
+__all__ = ["RX_LAYOUTS", "check_rx_layout", "rx_layout_m"]
+
+RX_LAYOUTS = ("square", "kite")
+
+
+def rx_layout_m(name: str, wavelength_m: float) -> np.ndarray:
+    """Receive antenna positions (4, 3), m, of a named layout for the wavelength ``wavelength_m`` (m).
+
+    Parameters
+    ----------
+    name : str
+        ``"square"`` (2x2, half-wavelength sides) or ``"kite"`` (see the module docstring).
+    wavelength_m : float
+        Carrier wavelength, m.
+
+    Returns
+    -------
+    ndarray, shape (4, 3)
+        Rows (0, right, down) in the antenna frame, m, centred on the boresight axis for the square.
+
+    Examples
+    --------
+    >>> rx_layout_m("kite", 0.04)[:, 1].round(3).tolist()  # right, m
+    [-0.01, 0.01, 0.0, 0.0]
+    >>> rx_layout_m("ring", 0.04)
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: radar.rx_positions_m: layout must be square or kite, got 'ring'
+    """
+    check_rx_layout(name, "radar.rx_positions_m: layout")
+    q = float(wavelength_m) / 4.0
+    if name == "square":
+        return np.array([[0.0, -q, -q], [0.0, q, -q], [0.0, -q, q], [0.0, q, q]])
+    return np.array([[0.0, -q, -q], [0.0, q, -q], [0.0, 0.0, q], [0.0, 0.0, 3.0 * q]])
+
+
+def check_rx_layout(name: str, label: str) -> str:
+    """``name`` if it is a layout of :data:`RX_LAYOUTS`, else InputError ``"{label} must be ..."``.
+
+    Examples
+    --------
+    >>> check_rx_layout("kite", "--rx-layout")
+    'kite'
+    """
+    if name not in RX_LAYOUTS:
+        raise InputError(f"{label} must be {' or '.join(RX_LAYOUTS)}, got {name!r}")
+    return name

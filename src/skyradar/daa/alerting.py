@@ -22,6 +22,7 @@ from skyradar.daa.conflict import (
     loss_of_well_clear_interval,
     widened_thresholds,
 )
+from skyradar.daa.range_miss import cannot_enter
 
 __all__ = [
     "LEVEL_NAMES",
@@ -165,9 +166,10 @@ def velocity_unconverged(sigma_hv_mps: np.ndarray, tcpa_s: np.ndarray, config: A
     )
 
 
-def _volume_levels(s, v, tcpa, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2):
+def _volume_levels(s, v, tcpa, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2, miss=None):
     """Highest level whose (widened) volume is lost within its alerting time, its entry time,
-    and the widened thresholds ``{level: (dthr_m, zthr_m)}`` of every level."""
+    and the widened thresholds ``{level: (dthr_m, zthr_m)}`` of every level. ``miss`` (miss
+    distance and sigma, m) clears the levels whose plain cylinder it passes outside."""
     level = np.zeros(len(s), int)
     t_in_out = np.full(len(s), np.nan)
     widened = {}
@@ -178,6 +180,8 @@ def _volume_levels(s, v, tcpa, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2):
         widened[k] = (dthr, zthr)
         t_in, _ = loss_of_well_clear_interval(s, v, lv.volume, lv.alerting_time_s, dthr, zthr)
         hit = np.isfinite(t_in)
+        if miss is not None and lv.volume.tthr_s == 0.0 and lv.volume.tcoa_s == 0.0:
+            hit &= ~cannot_enter(*miss, lv.volume.dthr_m, lv.volume.zthr_m)
         level = np.where(hit, k, level)
         t_in_out = np.where(hit, t_in, t_in_out)
     return level, t_in_out, widened
@@ -189,6 +193,7 @@ def raw_alert_levels(
     config: AlertConfig | None = None,
     cov_pos_m2: np.ndarray | None = None,
     cov_vel_m2ps2: np.ndarray | None = None,
+    miss: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> dict[str, np.ndarray]:
     """Per-encounter raw alert level and conflict geometry (no persistence).
 
@@ -199,6 +204,10 @@ def raw_alert_levels(
     config : AlertConfig, optional
     cov_pos_m2, cov_vel_m2ps2 : ndarray, shape (n, 3, 3), optional
         Relative position / velocity covariance; widens the volumes.
+    miss : (ndarray, ndarray), optional
+        3-D miss distance and its sigma per row, m (:func:`skyradar.daa.range_miss.range_miss_distance`,
+        NaN: unknown): a level whose volume (a cylinder without tau) the miss passes outside by 3
+        sigmas is not raised, whatever ``s`` and ``v`` predict.
 
     Returns
     -------
@@ -217,7 +226,7 @@ def raw_alert_levels(
     s = np.atleast_2d(np.asarray(s, float))
     v = np.atleast_2d(np.asarray(v, float))
     tcpa, hmd, vmd = cpa(s, v)
-    level, t_in_out, widened = _volume_levels(s, v, tcpa, config, cov_pos_m2, cov_vel_m2ps2)
+    level, t_in_out, widened = _volume_levels(s, v, tcpa, config, cov_pos_m2, cov_vel_m2ps2, miss)
     t_imp, _ = loss_of_well_clear_interval(s, v, config.collision_volume, config.flarm_thresholds_s[0])
     corrective = widened[min(2, len(config.levels))]
     return {

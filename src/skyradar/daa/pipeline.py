@@ -27,6 +27,7 @@ from skyradar.daa.advice import advice_columns
 from skyradar.daa.alerting import AlertConfig, filter_alert_levels, raw_alert_levels, velocity_unconverged
 from skyradar.daa.conflict import traffic_indication
 from skyradar.daa.provenance import check_tracks_match_run
+from skyradar.daa.range_miss import range_miss_distance
 from skyradar.daa.run_tables import ownship_from_frames, truth_tracks
 from skyradar.daa.tables import OWNSHIP_COLUMNS, TRACK_COLUMNS, clean_tracks, covariances, interp_ownship
 
@@ -85,6 +86,17 @@ def _altitude_measured(df: pd.DataFrame) -> np.ndarray:
     return df["altitude_measured"].to_numpy(bool)  # checked by clean_tracks
 
 
+def _unmeasured_miss(df: pd.DataFrame, t: np.ndarray, own_vel: np.ndarray) -> tuple | None:
+    """The range-only miss distance and sigma (:mod:`skyradar.daa.range_miss`) on rows whose height
+    is the co-altitude prior (NaN elsewhere: a measured height is the 3-D track's to judge)."""
+    if not {"range_m", "range_rate_mps", "altitude_measured"} <= set(df):
+        return None
+    miss, sigma = range_miss_distance(df["track_id"].to_numpy(), t, df["range_m"].to_numpy(float),
+                                      df["range_rate_mps"].to_numpy(float), own_vel)  # fmt: skip
+    measured = df["altitude_measured"].to_numpy(bool)
+    return np.where(measured, np.nan, miss), np.where(measured, np.nan, sigma)
+
+
 def alerts_from_tracks(
     tracks: pd.DataFrame,
     ownship: pd.DataFrame,
@@ -120,7 +132,7 @@ def alerts_from_tracks(
     v_int = df[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(float)
     s, v = df[["north_m", "east_m", "down_m"]].to_numpy(float) - own_pos, v_int - own_vel
     cov_p, cov_v = covariances(df)
-    raw = raw_alert_levels(s, v, config, cov_p, cov_v)
+    raw = raw_alert_levels(s, v, config, cov_p, cov_v, _unmeasured_miss(df, t, own_vel))
     level = _issued_levels(df, t, raw, cov_v, config)
     out = _alerts_table(df, t, level, raw, s, v_int, own["own_yaw_rad"])
     if with_advice:

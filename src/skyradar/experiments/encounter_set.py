@@ -133,8 +133,7 @@ def encounter_scenario(
     ``radars:`` list (None: one forward head) and ``navigation`` its ``navigation:`` key (None:
     the scenario default). ``terrain_seed`` (default ``seed``) picks the hills surface and the
     point over Jacksboro. ``simulation`` overrides keys of the scenario's ``simulation:`` section
-    (tests that are about scoring, not the simulator, turn the costly realism off with it).
-    ``rx_layout`` names every head's receive array (:mod:`skyradar.rx_layouts`).
+    (tests about scoring turn the costly realism off); ``rx_layout`` names every head's receive array.
     """
     from skyradar.experiments.encounter_terrain import site
 

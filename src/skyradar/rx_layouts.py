@@ -26,7 +26,7 @@ import numpy as np
 
 from skyradar.errors import InputError
 
-__all__ = ["RX_LAYOUTS", "check_rx_layout", "rx_layout_m"]
+__all__ = ["RX_LAYOUTS", "check_rx_layout", "rx_layout_m", "square_m"]
 
 RX_LAYOUTS = ("square", "kite")
 
@@ -56,10 +56,22 @@ def rx_layout_m(name: str, wavelength_m: float) -> np.ndarray:
     skyradar.errors.InputError: radar.rx_positions_m: layout must be square or kite, got 'ring'
     """
     check_rx_layout(name, "radar.rx_positions_m: layout")
-    q = float(wavelength_m) / 4.0
     if name == "square":
-        return np.array([[0.0, -q, -q], [0.0, q, -q], [0.0, -q, q], [0.0, q, q]])
+        return square_m(float(wavelength_m) / 2.0)
+    q = float(wavelength_m) / 4.0
     return np.array([[0.0, -q, -q], [0.0, q, -q], [0.0, 0.0, q], [0.0, 0.0, 3.0 * q]])
+
+
+def square_m(side_m: float) -> np.ndarray:
+    """Positions (4, 3), m, of a 2x2 square of side ``side_m`` (m) centred on the boresight axis.
+
+    Examples
+    --------
+    >>> square_m(0.02)[:, 1:].round(3).tolist()  # (right, down), m
+    [[-0.01, -0.01], [0.01, -0.01], [-0.01, 0.01], [0.01, 0.01]]
+    """
+    h = float(side_m) / 2.0
+    return np.array([[0.0, -h, -h], [0.0, h, -h], [0.0, -h, h], [0.0, h, h]])
 
 
 def check_rx_layout(name: str, label: str) -> str:

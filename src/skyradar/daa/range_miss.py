@@ -81,14 +81,15 @@ def range_miss_distance(
     order = np.argsort(ids, kind="stable")
     bounds = np.flatnonzero(np.diff(ids[order])) + 1
     for rows in np.split(order, bounds):
-        m, s = _fit_track(t[rows], r[rows], rdot[rows], own_v[rows], window_s, min_span_s, min_rows,
-                          own_accel_tol_mps)  # fmt: skip
+        m, s = _fit_track(t[rows], r[rows], r[rows] * rdot[rows], own_v[rows], window_s, min_span_s,
+                          min_rows, own_accel_tol_mps)  # fmt: skip
         miss[rows], sigma[rows] = m, s
     return miss, sigma
 
 
 @numba.njit(cache=True)
-def _fit_track(t, r, rdot, own_v, window_s, min_span_s, min_rows, own_tol):  # pragma: no cover - numba
+def _fit_track(t, r, y, own_v, window_s, min_span_s, min_rows, own_tol):  # pragma: no cover - numba
+    # y = r * rdot, a straight line in time of slope |u|^2 (module docstring).
     n = t.size
     miss, sigma = np.full(n, np.nan), np.full(n, np.nan)
     i0 = 0
@@ -98,29 +99,18 @@ def _fit_track(t, r, rdot, own_v, window_s, min_span_s, min_rows, own_tol):  # p
         k = j + 1 - i0
         if k < min_rows or t[j] - t[i0] < min_span_s:
             continue
-        steady = True
-        for i in range(i0, j + 1):
-            for c in range(3):
-                if abs(own_v[i, c] - own_v[j, c]) > own_tol or not np.isfinite(r[i] * rdot[i]):
-                    steady = False
-        if not steady:
-            continue
-        tm, ym = t[i0 : j + 1].mean(), (r[i0 : j + 1] * rdot[i0 : j + 1]).mean()
-        sxy, sxx = 0.0, 0.0
-        for i in range(i0, j + 1):
-            sxy += (t[i] - tm) * (r[i] * rdot[i] - ym)
-            sxx += (t[i] - tm) ** 2
-        u2 = sxy / sxx
+        tw, yw = t[i0 : j + 1], y[i0 : j + 1]
+        if np.abs(own_v[i0 : j + 1] - own_v[j]).max() > own_tol or not np.isfinite(yw).all():
+            continue  # the own-ship's velocity changed (a turn), or a row has no range rate
+        tc = tw - tw.mean()
+        u2 = (tc * (yw - yw.mean())).sum() / (tc * tc).sum()
         if not u2 > 0.0:
             continue
-        m2 = np.empty(k)
-        for i in range(i0, j + 1):
-            m2[i - i0] = r[i] ** 2 - (r[i] * rdot[i]) ** 2 / u2
+        m2 = r[i0 : j + 1] ** 2 - yw**2 / u2
         centre = np.median(m2)
-        spread = 1.4826 * np.median(np.abs(m2 - centre))
         if centre > 0.0:
             miss[j] = np.sqrt(centre)
-            sigma[j] = spread / (2.0 * miss[j])
+            sigma[j] = 1.4826 * np.median(np.abs(m2 - centre)) / (2.0 * miss[j])
     return miss, sigma
 
 

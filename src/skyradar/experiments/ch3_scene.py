@@ -13,6 +13,7 @@ import numpy as np
 from skyradar.config import Mount, RadarConfig
 from skyradar.errors import InputError
 from skyradar.process.calibration import reflector_position
+from skyradar.rx_layouts import square_m
 from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
 from skyradar.sim.impairments import ChannelErrorsConfig, NoiseConfig, channel_errors, thesis_flight_look
 
@@ -42,8 +43,7 @@ def square_array_m(spacing_wavelengths: float, wavelength_m: float) -> np.ndarra
         raise InputError(
             f"ch3: field 'rx_spacing_wavelengths' must be in (0, {MAX_SPACING:g}] wavelengths, got {s!r}"
         )
-    h = s * wavelength_m / 2.0
-    return np.array([[0.0, -h, -h], [0.0, h, -h], [0.0, -h, h], [0.0, h, h]])
+    return square_m(s * wavelength_m)
 
 
 def unambiguous_half_angle_deg(spacing_wavelengths: float) -> float:

@@ -49,6 +49,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
+from skyradar.rx_layouts import RX_LAYOUTS
 from skyradar.scene.impairment_config import ImpairmentConfig
 from skyradar.scene.navigation_config import NavigationConfig, with_preset
 
@@ -138,7 +139,7 @@ class RadarModel(_Model):
     n_doppler: int | None = Field(None, ge=2)
     range_limit_m: Positive | None = None
     rx_positions_m: list[Vector3] | None = None
-    rx_layout: Literal["square", "kite"] | None = None  # skyradar.rx_layouts; or rx_positions_m
+    rx_layout: Literal[RX_LAYOUTS] | None = None  # or rx_positions_m
     tx_position_m: Vector3 | None = None
     noise_figure_db: Finite | None = None
     temperature_k: Positive | None = None

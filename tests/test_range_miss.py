@@ -118,3 +118,29 @@ def test_a_real_conflict_is_still_warned_whatever_the_altitude_flag():
     for measured in (False, True):  # 100 m below, 300 m aside: inside the cylinder
         tracks, own = _tracks(100.0, 300.0, measured=measured)
         assert alerts_from_tracks(tracks, own, with_advice=False)["level"].max() == 3
+
+
+def test_range_and_horizontal_direction_cannot_split_below_from_descending_through():
+    # Flat ground 300 m below, 200-set encounter 123: overtaken 250 m below, 28 m aside, 29.5 m/s
+    # closing; its elevation is nulled with the ground (square array), so the track holds range,
+    # range rate and the horizontal direction cosine east / r. Rotating the relative path about the
+    # antenna's y axis (east, own-ship level and heading north) keeps all three; 10 deg of rotation
+    # is an intruder ahead near the own-ship's level descending at 5.1 m/s (1000 ft/min) that loses
+    # well clear 22 s before the closest approach.
+    t = np.arange(-40.0, 20.0, 1 / 9.4)
+    level = np.column_stack([-29.5 * t, np.full_like(t, -27.6), np.full_like(t, 250.2)])
+    turn = np.radians(-10.0)
+    about_east = np.array([[np.cos(turn), 0, -np.sin(turn)], [0, 1, 0], [np.sin(turn), 0, np.cos(turn)]])
+    descending = level @ about_east.T
+    v_level, v_desc = np.gradient(level, t, axis=0), np.gradient(descending, t, axis=0)
+    for a, b in zip(_range_rows(level, v_level), _range_rows(descending, v_desc), strict=True):
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(level[:, 1] / np.linalg.norm(level, axis=1),
+                               descending[:, 1] / np.linalg.norm(descending, axis=1), rtol=1e-12)  # fmt: skip
+    assert np.isclose(v_desc[0, 2], 29.5 * np.sin(-turn)) and v_desc[0, 2] < 5.2  # down, m/s
+    volume = {"dthr_m": 670.56, "zthr_m": 137.16}  # the warning cylinder (DO-365 non-cooperative)
+
+    def inside(rel):
+        return (np.hypot(rel[:, 0], rel[:, 1]) <= volume["dthr_m"]) & (np.abs(rel[:, 2]) <= volume["zthr_m"])
+
+    assert not inside(level).any() and inside(descending).any()

@@ -1,4 +1,4 @@
-"""Detect-and-avoid commands: ``skyradar alert`` and ``skyradar serve``."""
+"""Detect-and-avoid commands: ``skyradar alert``, ``skyradar serve`` and ``skyradar bench alert``."""
 
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ from typing import Annotated
 
 import typer
 
-from skyradar.cli.app import JsonOption, app, emit_result
+from skyradar.cli.app import COUNT, JsonOption, app, bench_app, emit_result
 from skyradar.io.outputs import OVERWRITE_HELP
 
-__all__ = ["alert", "serve"]  # experiment encounters: skyradar.cli.commands_encounters
+__all__ = ["alert", "serve", "bench_alert"]  # experiment encounters: skyradar.cli.commands_encounters
 
 
 @app.command()
@@ -122,3 +122,15 @@ def serve(
     asgi = LoopbackHostOnly(web_app) if local else web_app
     server = uvicorn.Server(uvicorn.Config(asgi, host=host, port=port, log_level="warning"))
     server.run(sockets=[sock])
+
+
+@bench_app.command("alert")
+def bench_alert(
+    tracks: Annotated[int, typer.Option("--tracks", callback=COUNT, help="Intruder tracks per frame.")] = 20,
+    frames: Annotated[int, typer.Option("--frames", callback=COUNT, help="Frames (9.4 Hz).")] = 600,
+    as_json: JsonOption = False,
+) -> None:
+    """Alerting frames per second (with advice), and the range-only miss distance against a numpy baseline."""
+    from skyradar.benchmarks.alert import run as run_bench
+
+    emit_result(run_bench(n_tracks=tracks, n_frames=frames), as_json, "bench alert")

@@ -14,6 +14,17 @@ A cylinder of horizontal radius ``D`` and half-height ``Z`` lies within ``sqrt(D
 axis' centre, so an encounter whose miss distance is beyond that corner cannot lose that well-clear
 volume, whatever the split between horizontal and vertical (:func:`cannot_enter`).
 
+Inside the corner no kinematic fit can split the miss for a centrally symmetric array (the 2x2
+square, :mod:`skyradar.rx_layouts`) whose elevation the nulls took: what is left per detection is
+the range, the range rate and the direction cosine along the antenna's y axis, and all three are
+unchanged when the whole relative path is rotated about that axis. A level aircraft passing 250 m
+below and one ahead near the own-ship's level descending at 5.1 m/s give the same rows, and the
+second loses well clear (flat ground 300 m below, 200-set encounter 123; the test
+``test_range_and_horizontal_direction_cannot_split_below_from_descending_through``). Entering the
+warning cylinder takes 2.2-5.9 m/s of vertical speed for the must-not-alert encounters still warned
+(123, 163, 188, 28): a bound on the intruder's vertical rate below that would be an assumption
+about traffic, not a measurement. The ``kite`` array measures those elevations.
+
 The fit is per track over a sliding window; it refuses (NaN) where it has too few rows, where the
 own-ship's velocity changed in the window (a turn bends the relative path), or where the rows do
 not agree on one miss distance (a manoeuvring intruder, a range-rate alias): the spread of the

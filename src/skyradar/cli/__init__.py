@@ -7,6 +7,7 @@ this module imports them and turns bad input into one line on stderr with exit c
 from __future__ import annotations
 
 import importlib
+import signal
 import sys
 from types import ModuleType
 
@@ -58,8 +59,16 @@ _EXITS = _classes("Exit", typer.Exit)
 _ABORTS = _classes("Abort", typer.Abort)
 
 
+def _interrupt(signum: int, frame: object) -> None:
+    # `kill` (SIGTERM) stops like Ctrl-C: a job's worker processes are ended (killed by the default
+    # action, `experiment encounters` left its spawned workers running for minutes) and what
+    # finished is kept for the rerun to resume.
+    raise KeyboardInterrupt
+
+
 def main() -> None:
     """Entry point of the ``skyradar`` script."""
+    signal.signal(signal.SIGTERM, _interrupt)
     try:
         code = app(standalone_mode=False)
     except InputError as exc:

@@ -18,10 +18,12 @@ from hypothesis import strategies as st
 from skyradar.config import RadarConfig
 from skyradar.track.elevation_trust import (
     FREE_ELEVATION_SIGMA_RAD,
+    AboveVotes,
     BelowConsensus,
     place_elevations,
 )
 from skyradar.track.track_table import track_detections
+from skyradar.track.tracker3d import Tracker3D
 
 CFG = RadarConfig.prototype_2022()
 SPEED_MPS, AGL_M, N = 50.0, 500.0, 190  # 20 s at 9.4 Hz
@@ -282,3 +284,33 @@ def test_free_detections_keep_range_and_bearing_and_trusted_ones_do_not_move(row
     assert np.all(el_sigma[trusted] == 0.02)
     assert np.allclose(d[~trusted, 2], 0.0, atol=1e-6 * rng_m.max())  # at the co-altitude prior
     assert np.all(el_sigma[~trusted] == FREE_ELEVATION_SIGMA_RAD) and not trusted[~measured].any()
+
+
+def _vertical_speed_z_scores(seed: int, per_feed_window: int) -> np.ndarray:
+    # A level aircraft 230 m above, overtaken in the ground's band (400-600 m away, 500 m above the
+    # ground): its elevations carry a slow clutter pull (0.04 rad over a 20 s period) and white noise.
+    rng = np.random.default_rng(seed)
+    phase, votes, t3, dt = rng.uniform(0.0, 2.0 * np.pi), AboveVotes(), Tracker3D(), 1 / 9.4
+    votes.window = per_feed_window  # 1: each fed height weighed as one reading (before)
+    z = []
+    for k in range(int(30 / dt)):
+        t = k * dt
+        own, rel = np.array([50.0 * t, 0.0, -500.0]), np.array([600.0 - 15.0 * t, 40.0, -230.0])
+        r = np.linalg.norm(rel)
+        el = np.arcsin(230.0 / r) + 0.04 * np.sin(2 * np.pi * t / 20.0 + phase) + rng.normal(0.0, 0.01)
+        az = np.arctan2(rel[1], rel[0])
+        pos = own + r * np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)])
+        one = np.array([True])
+        p, sigma, *_ = place_elevations(pos[None], own, 50.0, np.array([0.01]), one, np.array([-15.0]),
+                                        500.0, votes, np.array([1]))  # fmt: skip
+        x, P = t3.step(t, np.array([1]), p, np.diag([25.0, (r * 0.01) ** 2, (r * sigma[0]) ** 2])[None])
+        if t > 10.0:
+            z.append(abs(x[0, 5]) / np.sqrt(P[0, 5, 5]))
+    return np.array(z)
+
+
+def test_a_voted_height_fed_every_frame_does_not_make_a_drift_a_vertical_speed():
+    ours = np.concatenate([_vertical_speed_z_scores(seed, AboveVotes().window) for seed in range(4)])
+    before = np.concatenate([_vertical_speed_z_scores(seed, 1) for seed in range(4)])
+    assert (ours > 3.0).mean() < 0.02  # the level aircraft's vertical speed stays within its sigma
+    assert (before > 3.0).mean() > 0.1  # fed at one reading's weight, the drift became a speed

@@ -21,9 +21,9 @@ unchanged when the whole relative path is rotated about that axis. A level aircr
 below and one ahead near the own-ship's level descending at 5.1 m/s give the same rows, and the
 second loses well clear (flat ground 300 m below, 200-set encounter 123; the test
 ``test_range_and_horizontal_direction_cannot_split_below_from_descending_through``). Entering the
-warning cylinder takes 2.2-5.9 m/s of vertical speed for the must-not-alert encounters still warned
-(123, 163, 188, 28): a bound on the intruder's vertical rate below that would be an assumption
-about traffic, not a measurement. The ``kite`` array measures those elevations.
+warning cylinder takes 4.5-5.9 m/s of vertical speed for the flat-300 must-not-alert encounters
+still warned (123, 188, 28): a bound on the intruder's vertical rate below that would be an
+assumption about traffic, not a measurement. The ``kite`` array measures those elevations.
 
 The fit is per track over a sliding window; it refuses (NaN) where it has too few rows, where the
 own-ship's velocity changed in the window (a turn bends the relative path), or where the rows do

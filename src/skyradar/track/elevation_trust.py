@@ -336,15 +336,9 @@ def place_elevations(
     if below is not None and clearance_m is not None:
         held = _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids)
     trusted, sigma = trusted | held, np.where(held, np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD), sigma)
-    agreed = trusted & band & ~held & np.isfinite(track_up)
-    # The agreed height is fed every frame but is the median of the last `window` readings, and
-    # their spread measures their scatter within that second, not the slow pull of the clutter they
-    # share: fed at the spread, the filter took the median's drift for a vertical speed (hills, 200-set
-    # encounter 163, level 232 m above: 253 to 210 m over 12 s, -2.5 to -3 m/s at a sigma of 0.8-1.1,
-    # and a false warning after the closest approach). So `window` successive feeds weigh as one.
-    per_feed = spread * np.sqrt(votes.window if votes is not None else 1)
-    out, sigma = _placed(positions_m, own, range_m, sigma, trusted, agreed, track_up, per_feed, last_up_m)
-    return out, sigma, trusted, track_up, spread
+    agreed, window = trusted & band & ~held & np.isfinite(track_up), votes.window if votes else 1
+    placed = (positions_m, own, range_m, sigma, trusted, agreed, track_up, spread, last_up_m, window)
+    return *_placed(*placed), trusted, track_up, spread
 
 
 def _voted(votes, ids, trusted, band, in_band, up_m) -> tuple:
@@ -355,15 +349,20 @@ def _voted(votes, ids, trusted, band, in_band, up_m) -> tuple:
     return trusted & (~band | np.isfinite(track_up)), track_up, spread
 
 
-def _placed(positions_m, own, range_m, sigma, trusted, agreed, track_up, spread, last_up_m) -> tuple:
+def _placed(positions_m, own, range_m, sigma, trusted, agreed, track_up, spread, last_up_m, window) -> tuple:
     """Positions and elevation sigmas: ``agreed`` readings (trusted, in the band, the track voted
-    above) at their track's height ``track_up`` with a sigma of at least ``spread`` (m, per feed)
+    above) at their track's height ``track_up`` with a sigma of at least ``sqrt(window)`` times its
+    ``spread`` (m): the height is the median of the last ``window`` readings, fed every frame, and
+    their spread measures their scatter within that second, not the slow clutter pull they share;
+    fed at the spread, the filter took the median's drift for a vertical speed (hills, 200-set
+    encounter 163, level 232 m above: 253 to 210 m over 12 s, -2.5 to -3 m/s at a sigma of 0.8-1.1,
+    and a false warning after the closest approach), so ``window`` successive feeds weigh as one
     (in the band a track's height rests on what its readings agree on, not on each scattered one);
     free ones at the track's height now, else at ``last_up_m`` (a vote lost on a run of readings the
     ground pulled let the co-altitude prior drag the track down: flat ground 300 m below, 200-set
     encounter 138, 280 m above, down to 103 m in 20 s, and warned), else at elevation 0 (the
     co-altitude prior), with :data:`FREE_ELEVATION_SIGMA_RAD`."""
-    sigma = np.where(agreed, np.fmax(sigma, spread / range_m), sigma)
+    sigma = np.where(agreed, np.fmax(sigma, np.sqrt(window) * spread / range_m), sigma)
     moved = (~trusted | agreed) & np.isfinite(positions_m).all(axis=1)
     out = np.array(positions_m, float)
     prior = track_up if last_up_m is None else np.where(np.isfinite(track_up), track_up, last_up_m)

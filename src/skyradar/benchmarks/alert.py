@@ -24,7 +24,8 @@ import pandas as pd
 
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG
 from skyradar.daa.pipeline import alerts_from_tracks
-from skyradar.daa.range_miss import range_miss_distance
+from skyradar.daa.range_miss import miss_of_window, range_miss_distance
+from skyradar.daa.tables import interp_ownship
 from skyradar.errors import InputError
 
 __all__ = ["bench_tables", "range_miss_baseline", "run"]
@@ -85,7 +86,8 @@ def range_miss_baseline(
     own_accel_tol_mps: float = 1.0,
 ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`skyradar.daa.range_miss.range_miss_distance` the straightforward way: per row, select
-    the track's window and fit ``r rdot`` against time with :func:`numpy.polyfit`.
+    the track's window and fit ``r rdot`` against time with :func:`numpy.polyfit` (the miss from
+    the fitted slope: :func:`skyradar.daa.range_miss.miss_of_window`, as ours).
 
     Examples
     --------
@@ -113,19 +115,14 @@ def range_miss_baseline(
             u2 = np.polyfit(t[w] - t[w].mean(), y[w], 1)[0]
             if not u2 > 0.0:
                 continue
-            m2 = r[w] ** 2 - y[w] ** 2 / u2
-            centre = np.median(m2)
-            if centre > 0.0:
-                miss[j] = np.sqrt(centre)
-                sigma[j] = 1.4826 * np.median(np.abs(m2 - centre)) / (2.0 * miss[j])
+            miss[j], sigma[j] = miss_of_window(r[w], y[w], u2)
     return miss, sigma
 
 
 def _miss_inputs(tracks: pd.DataFrame, own: pd.DataFrame) -> tuple:
     t = tracks["time_s"].to_numpy(float)
-    own_v = np.column_stack(
-        [np.interp(t, own["time_s"], own[c]) for c in ("own_vn_mps", "own_ve_mps", "own_vd_mps")]
-    )
+    at = interp_ownship(own, t, "bench")
+    own_v = np.column_stack([at["own_vn_mps"], at["own_ve_mps"], at["own_vd_mps"]])
     return (tracks["track_id"].to_numpy(), t, tracks["range_m"].to_numpy(float),
             tracks["range_rate_mps"].to_numpy(float), own_v)  # fmt: skip
 

@@ -91,9 +91,11 @@ def _unmeasured_miss(df: pd.DataFrame, t: np.ndarray, own_vel: np.ndarray) -> tu
     is the co-altitude prior (NaN elsewhere: a measured height is the 3-D track's to judge)."""
     if not {"range_m", "range_rate_mps", "altitude_measured"} <= set(df):
         return None
-    miss, sigma = range_miss_distance(df["track_id"].to_numpy(), t, df["range_m"].to_numpy(float),
-                                      df["range_rate_mps"].to_numpy(float), own_vel)  # fmt: skip
-    measured = df["altitude_measured"].to_numpy(bool)
+    ids, measured = df["track_id"].to_numpy(), df["altitude_measured"].to_numpy(bool)
+    fit = np.isin(ids, ids[~measured])  # only tracks with such rows (the fit spans measured ones too)
+    miss, sigma = np.full((2, len(df)), np.nan)
+    r, rdot = df["range_m"].to_numpy(float)[fit], df["range_rate_mps"].to_numpy(float)[fit]
+    miss[fit], sigma[fit] = range_miss_distance(ids[fit], t[fit], r, rdot, own_vel[fit])
     return np.where(measured, np.nan, miss), np.where(measured, np.nan, sigma)
 
 

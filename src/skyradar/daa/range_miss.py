@@ -36,7 +36,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["range_miss_distance", "cannot_enter"]
+__all__ = ["range_miss_distance", "miss_of_window", "cannot_enter"]
 
 
 def range_miss_distance(
@@ -117,12 +117,28 @@ def _fit_track(t, r, y, own_v, window_s, min_span_s, min_rows, own_tol):  # prag
         u2 = (tc * (yw - yw.mean())).sum() / (tc * tc).sum()
         if not u2 > 0.0:
             continue
-        m2 = r[i0 : j + 1] ** 2 - yw**2 / u2
-        centre = np.median(m2)
-        if centre > 0.0:
-            miss[j] = np.sqrt(centre)
-            sigma[j] = 1.4826 * np.median(np.abs(m2 - centre)) / (2.0 * miss[j])
+        miss[j], sigma[j] = miss_of_window(r[i0 : j + 1], yw, u2)
     return miss, sigma
+
+
+@numba.njit(cache=True)
+def miss_of_window(r: np.ndarray, y: np.ndarray, u2: float) -> tuple[float, float]:  # pragma: no cover
+    """Miss distance and its sigma, m, from one window's ranges ``r`` (m), ``y = r rdot`` (m^2/s)
+    and the relative speed squared ``u2`` (m^2/s^2) fitted to them: the median of the rows'
+    ``r^2 - y^2 / u2`` and its spread (1.4826 median absolute deviation); NaN where it is not positive.
+
+    Examples
+    --------
+    >>> r = np.array([500.0, 1000.0])
+    >>> [round(float(x), 3) for x in miss_of_window(r, -60.0 * np.sqrt(r**2 - 400.0**2), 3600.0)]
+    [400.0, 0.0]
+    """
+    m2 = r**2 - y**2 / u2
+    centre = np.median(m2)
+    if not centre > 0.0:
+        return np.nan, np.nan
+    miss = np.sqrt(centre)
+    return miss, 1.4826 * np.median(np.abs(m2 - centre)) / (2.0 * miss)
 
 
 def cannot_enter(

@@ -49,9 +49,8 @@ __all__ = [
 
 SUPPRESSIONS = ("none", "knowledge-aided", "auto")
 _CACHE: OrderedDict[tuple, tuple[RadarConfig, ClutterSubspace]] = OrderedDict()
-_CACHE_SIZE = (
-    RECENT_ANCHORS  # predictions kept: about 20 MB each (packed covariance, eigenvectors as cells need them)
-)
+# Predictions kept, one per anchor the walk keeps: about 20 MB each (packed covariance, eigenvectors).
+_CACHE_SIZE = RECENT_ANCHORS
 
 
 def frame_subspace(

@@ -6,11 +6,17 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from skyradar.config import RadarConfig
-from skyradar.process.clutter_doa import MAX_ELEVATION_SIGMA_RAD, elevation_sigma_rad, projected_directions
+from skyradar.process.clutter_doa import (
+    MAX_ELEVATION_SIGMA_RAD,
+    angle_sigmas_rad,
+    elevation_sigma_rad,
+    projected_directions,
+)
 from skyradar.process.doa import direction_from_angles, doa_crlb, steering_vector
 from skyradar.track.track_table import track_detections
 
@@ -214,3 +220,29 @@ def test_an_array_without_centre_symmetry_keeps_its_elevation_through_two_nulls(
     nulled = elevation_sigma_rad(u, z, (np.eye(4) - e @ e.conj().T)[None], cfg, N0)[0]
     free = elevation_sigma_rad(u, z, np.eye(4)[None], cfg, N0)[0]
     assert free < nulled < 1.5 * free
+
+
+@pytest.mark.parametrize(
+    "az, el, az_ground, el_ground",
+    [(0.17, 0.52, 1.05, -0.35), (-0.084, 0.058, 0.9, -0.21), (0.3, -0.1, 0.5, -0.3), (-0.2, 0.0, 0.2, -0.25)],
+)
+def test_the_kite_pays_for_its_elevation_with_its_azimuth(az, el, az_ground, el_ground):
+    # Two nulls at one elevation, left and right: the square keeps its azimuth (the y pairs survive
+    # the elevation null) and loses the elevation; the kite, mirror-symmetric about its vertical
+    # axis, keeps the elevation and loses most of the azimuth: its only horizontal baseline is the
+    # upper pair, and the antisymmetric combination of the two nulls lies on that pair alone.
+    sigmas = {}
+    for layout in ("square", "kite"):
+        cfg = RadarConfig.prototype_2022(rx_positions_m=layout)
+        u = direction_from_angles(np.array([az]), np.array([el]))
+        z = np.sqrt(10**2.7 * N0) * steering_vector(u, cfg)
+        ground = steering_vector(
+            direction_from_angles(np.array([az_ground, -az_ground]), np.full(2, el_ground)), cfg
+        )
+        e, _ = np.linalg.qr(ground.T)
+        nulled = angle_sigmas_rad(u, z, (np.eye(4) - e @ e.conj().T)[None], cfg, N0)
+        free = angle_sigmas_rad(u, z, np.eye(4)[None], cfg, N0)
+        sigmas[layout] = [float(s[0]) for s in (*nulled, *free)]
+    (sq_el, sq_az, _, sq_az_free), (k_el, k_az, _, k_az_free) = sigmas["square"], sigmas["kite"]
+    assert np.isinf(sq_el) and sq_az < 4.0 * sq_az_free  # the square: azimuth kept, elevation gone
+    assert k_el <= MAX_ELEVATION_SIGMA_RAD and k_az > 5.0 * sq_az and k_az > 5.0 * k_az_free

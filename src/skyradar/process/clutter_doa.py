@@ -46,7 +46,7 @@ from skyradar.process.doa import direction_from_angles, steering_vector
 
 __all__ = [
     "directions_after_projection", "projected_directions", "projected_scores", "elevation_sigma_rad",
-    "MAX_ELEVATION_SIGMA_RAD",
+    "angle_sigmas_rad", "MAX_ELEVATION_SIGMA_RAD",
 ]  # fmt: skip
 
 MAX_ELEVATION_SIGMA_RAD = float(np.radians(10.0))  # Cramer-Rao bound above which elevation is a prior
@@ -139,17 +139,56 @@ def projected_scores(steer: np.ndarray, z: np.ndarray, p: np.ndarray) -> np.ndar
     return _scores(steer, *args, np.empty(len(steer)))
 
 
+def angle_sigmas_rad(
+    u: np.ndarray, pixels: np.ndarray, proj: np.ndarray, config: RadarConfig, noise_floor_w: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Cramer-Rao bounds on the elevation and the azimuth of each direction ``u`` (n, 3) seen through
+    ``proj``, rad (two arrays of n).
+
+    For a plane wave of unknown complex amplitude in Gaussian interference the Fisher information
+    of (elevation, azimuth) is ``2 |a|^2 / N0 Re(D^H W D - D^H W s s^H W D / s^H W s)`` (``D`` the
+    steering vector's derivatives, ``W`` the cell's projector ``P`` or whitening ``N0 R^-1``,
+    ``a = s^H W z / s^H W s`` the amplitude estimate, ``N0`` the noise floor, W). The elevation's
+    bound is a diagonal entry of its inverse (the azimuth a nuisance), infinite where ``W`` leaves
+    the elevation no information. The azimuth's is the same where the elevation is measured (bound
+    at most :data:`MAX_ELEVATION_SIGMA_RAD`); elsewhere the detection is placed at the elevation
+    prior (:func:`projected_directions`) and the azimuth's bound is the one given that elevation,
+    ``1 / sqrt(J_az,az)``. Two nulls at one elevation, left and right of boresight (ground on both
+    sides at one range and Doppler), take the 2x2 array's elevation (its Kronecker structure) and
+    the kite's azimuth (:mod:`skyradar.rx_layouts`: mirror-symmetric about its vertical axis, its
+    only horizontal baseline is the pair the antisymmetric null takes).
+
+    Examples
+    --------
+    >>> from skyradar.process.doa import direction_from_angles, steering_vector
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> u = direction_from_angles(np.radians([10.0, 10.0]), np.radians([-5.0, -5.0]))
+    >>> z = 10.0 * steering_vector(u, cfg) * np.sqrt(cfg.noise_power_w)  # 20 dB per channel: doa_crlb's
+    >>> e, _ = np.linalg.qr(steering_vector(direction_from_angles(np.radians([-20.0, 20.0]), -0.35), cfg).T)
+    >>> proj = np.stack([np.eye(4), np.eye(4) - e @ e.conj().T])
+    >>> el, az = angle_sigmas_rad(u, z, proj, cfg, cfg.noise_power_w)
+    >>> np.degrees(el).round(2).tolist(), np.degrees(az).round(2).tolist()
+    ([1.29, inf], [1.31, 3.36])
+    """
+    fisher, seen = _direction_fisher(u, pixels, proj, config, noise_floor_w)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # no information: inf
+        det = fisher[:, 0, 0] * fisher[:, 1, 1] - fisher[:, 0, 1] * fisher[:, 1, 0]
+        scale = np.maximum((fisher[:, 0, 0] + fisher[:, 1, 1]) ** 2, 1e-300)  # rank 1: one angle only
+        full = seen & (det > 1e-9 * scale)
+        var_el = np.where(full, fisher[:, 1, 1] / det, np.inf)
+        var_el = np.where(var_el > 0, var_el, np.inf)
+        given_el = np.where(seen & (fisher[:, 1, 1] > 0), 1.0 / fisher[:, 1, 1], np.inf)
+        var_az = np.where(var_el <= MAX_ELEVATION_SIGMA_RAD**2, fisher[:, 0, 0] / det, given_el)
+        return np.sqrt(var_el), np.sqrt(np.where(var_az > 0, var_az, np.inf))
+
+
 def elevation_sigma_rad(
     u: np.ndarray, pixels: np.ndarray, proj: np.ndarray, config: RadarConfig, noise_floor_w: float
 ) -> np.ndarray:
     """Cramer-Rao bound on the elevation of each direction ``u`` (n, 3) seen through ``proj``, rad.
 
-    For a plane wave of unknown complex amplitude in Gaussian interference the Fisher information
-    of (elevation, azimuth) is ``2 |a|^2 / N0 Re(D^H W D - D^H W s s^H W D / s^H W s)`` (``D`` the
-    steering vector's derivatives, ``W`` the cell's projector ``P`` or whitening ``N0 R^-1``,
-    ``a = s^H W z / s^H W s`` the amplitude estimate, ``N0`` the noise floor, W); the bound is the
-    elevation entry of its inverse (azimuth a nuisance). Infinite where ``W`` leaves the elevation
-    no information (two nulls at one elevation: the 2x2 array's Kronecker structure).
+    The first of :func:`angle_sigmas_rad`. Infinite where ``W`` leaves the elevation no information
+    (two nulls at one elevation: the 2x2 array's Kronecker structure).
 
     Examples
     --------
@@ -162,6 +201,13 @@ def elevation_sigma_rad(
     >>> np.degrees(elevation_sigma_rad(u, z, proj, cfg, cfg.noise_power_w)).round(2).tolist()
     [1.29, inf]
     """
+    return angle_sigmas_rad(u, pixels, proj, config, noise_floor_w)[0]
+
+
+def _direction_fisher(
+    u: np.ndarray, pixels: np.ndarray, proj: np.ndarray, config: RadarConfig, noise_floor_w: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Fisher information (n, 2, 2) of (elevation, azimuth) through ``proj``, and where ``u`` is seen."""
     k = 2.0 * np.pi / config.wavelength_m
     az, el = np.arctan2(u[:, 1], u[:, 0]), np.arcsin(np.clip(-u[:, 2], -1.0, 1.0))
     du_del = np.stack([-np.sin(el) * np.cos(az), -np.sin(el) * np.sin(az), -np.cos(el)], -1)
@@ -179,12 +225,7 @@ def elevation_sigma_rad(
         np.einsum("nkj,nkl->njl", d.conj(), wd)
         - dws[:, :, None] * dws.conj()[:, None, :] / sws[:, None, None]
     )
-    fisher = 2.0 * amp2[:, None, None] / noise_floor_w * info.real
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # no information: inf
-        det = fisher[:, 0, 0] * fisher[:, 1, 1] - fisher[:, 0, 1] * fisher[:, 1, 0]
-        scale = np.maximum((fisher[:, 0, 0] + fisher[:, 1, 1]) ** 2, 1e-300)  # rank 1: no elevation
-        var = np.where(seen & (det > 1e-9 * scale), fisher[:, 1, 1] / det, np.inf)
-        return np.sqrt(np.where(var > 0, var, np.inf))
+    return 2.0 * amp2[:, None, None] / noise_floor_w * info.real, seen
 
 
 def projected_directions(

@@ -34,6 +34,13 @@ def test_without_nulls_the_bound_is_the_arrays_crlb(az, el, snr_db):
     z = np.sqrt(10 ** (snr_db / 10) * N0) * steering_vector(u, CFG)
     got = elevation_sigma_rad(u, z, np.eye(4)[None], CFG, N0)[0]
     assert np.isclose(got, doa_crlb(snr_db, az, el, CFG)[1], rtol=1e-6)
+    # ... and so is the azimuth's, for each layout (doa_crlb takes the layout from the config).
+    for layout in ("square", "kite"):
+        cfg = RadarConfig.prototype_2022(rx_positions_m=layout)
+        z = np.sqrt(10 ** (snr_db / 10) * N0) * steering_vector(u, cfg)
+        sd_el, sd_az = angle_sigmas_rad(u, z, np.eye(4)[None], cfg, N0)
+        want_az, want_el = doa_crlb(snr_db, az, el, cfg)
+        assert np.isclose(sd_az[0], want_az, rtol=1e-6) and np.isclose(sd_el[0], want_el, rtol=1e-6)
 
 
 def _ring_whitening(cnr_db: float, el_c: float = -0.6, az_c: float = 1.2) -> np.ndarray:

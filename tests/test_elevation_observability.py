@@ -24,6 +24,12 @@ CFG = RadarConfig.prototype_2022()
 N0 = CFG.noise_power_w
 
 
+def _off(steering: np.ndarray) -> np.ndarray:
+    """Projector (1, n_rx, n_rx) off the span of the steering vectors ``steering`` (k, n_rx): the nulls."""
+    e, _ = np.linalg.qr(steering.T)
+    return (np.eye(steering.shape[1]) - e @ e.conj().T)[None]
+
+
 @settings(max_examples=40, deadline=None)
 @given(
     st.floats(-1.0, 1.0), st.floats(-0.7, 0.7), st.floats(5.0, 40.0),
@@ -54,8 +60,7 @@ def test_two_nulls_at_one_elevation_leave_no_elevation_and_finite_clutter_some()
     u = direction_from_angles(np.array([-0.5]), np.array([0.45]))
     z = np.sqrt(10**2.7 * N0) * steering_vector(u, CFG)  # 27 dB, as the hills intruder
     s_c = steering_vector(direction_from_angles(np.array([1.2, -1.2]), np.full(2, -0.6)), CFG)
-    e, _ = np.linalg.qr(s_c.T)
-    nulled = elevation_sigma_rad(u, z, (np.eye(4) - e @ e.conj().T)[None], CFG, N0)[0]
+    nulled = elevation_sigma_rad(u, z, _off(s_c), CFG, N0)[0]
     assert np.isinf(nulled)
     bounds = [elevation_sigma_rad(u, z, _ring_whitening(c)[None], CFG, N0)[0] for c in (0, 10, 20, 30, 40)]
     assert np.all(np.isfinite(bounds)) and np.all(np.diff(bounds) > 0)  # the more clutter, the less elevation
@@ -73,8 +78,7 @@ def test_with_no_elevation_the_azimuth_keeps_the_measured_cone(az, el, el_null, 
     u = direction_from_angles(np.array([az]), np.array([el]))
     z = np.sqrt(10**2.0 * N0) * steering_vector(u, CFG)
     s_c = steering_vector(direction_from_angles(np.array([az_null, -az_null]), np.full(2, el_null)), CFG)
-    e, _ = np.linalg.qr(s_c.T)
-    got, measured = projected_directions(z, (np.eye(4) - e @ e.conj().T)[None], CFG, N0)
+    got, measured = projected_directions(z, _off(s_c), CFG, N0)
     on_cone = np.degrees(np.arcsin(np.cos(el) * np.sin(az)))
     assert not measured[0] and got[0, 2] == 0.0
     assert abs(np.degrees(np.arctan2(got[0, 1], got[0, 0])) - on_cone) < 0.1
@@ -178,8 +182,7 @@ def test_a_plain_doa_that_follows_the_predicted_clutter_has_no_elevation():
     u_target = direction_from_angles(np.array([-0.3]), np.array([0.1]))
     s_g, s_t = steering_vector(u_ground, CFG), steering_vector(u_target, CFG)
     z = np.sqrt(10**4.0 * N0) * s_g + np.sqrt(10**2.5 * N0) * s_t
-    e, _ = np.linalg.qr(s_g.T)  # one null, at the predicted ground direction
-    proj = (np.eye(4) - e @ e.conj().T)[None]
+    proj = _off(s_g)  # one null, at the predicted ground direction
     assert elevation_sigma_rad(u_ground, z, proj, CFG, N0)[0] > MAX_ELEVATION_SIGMA_RAD
     assert elevation_sigma_rad(u_target, z, proj, CFG, N0)[0] < np.radians(3.0)  # the intruder's is kept
 
@@ -209,8 +212,7 @@ def test_no_rotation_of_the_square_array_keeps_an_elevation_through_two_ground_n
     ground = steering_vector(
         direction_from_angles(np.array([az_ground, -az_ground]), np.full(2, el_ground)), cfg
     )
-    e, _ = np.linalg.qr(ground.T)
-    assert np.isinf(elevation_sigma_rad(u, z, (np.eye(4) - e @ e.conj().T)[None], cfg, N0)[0])
+    assert np.isinf(elevation_sigma_rad(u, z, _off(ground), cfg, N0)[0])
     one = ground[:1].T / np.linalg.norm(ground[0])
     assert np.isfinite(elevation_sigma_rad(u, z, (np.eye(4) - one @ one.conj().T)[None], cfg, N0)[0])
 
@@ -223,8 +225,7 @@ def test_an_array_without_centre_symmetry_keeps_its_elevation_through_two_nulls(
     u = direction_from_angles(np.array([0.17]), np.array([0.52]))
     z = np.sqrt(10**2.7 * N0) * steering_vector(u, cfg)
     ground = steering_vector(direction_from_angles(np.array([1.05, -1.05]), np.full(2, -0.35)), cfg)
-    e, _ = np.linalg.qr(ground.T)
-    nulled = elevation_sigma_rad(u, z, (np.eye(4) - e @ e.conj().T)[None], cfg, N0)[0]
+    nulled = elevation_sigma_rad(u, z, _off(ground), cfg, N0)[0]
     free = elevation_sigma_rad(u, z, np.eye(4)[None], cfg, N0)[0]
     assert free < nulled < 1.5 * free
 
@@ -246,8 +247,7 @@ def test_the_kite_pays_for_its_elevation_with_its_azimuth(az, el, az_ground, el_
         ground = steering_vector(
             direction_from_angles(np.array([az_ground, -az_ground]), np.full(2, el_ground)), cfg
         )
-        e, _ = np.linalg.qr(ground.T)
-        nulled = angle_sigmas_rad(u, z, (np.eye(4) - e @ e.conj().T)[None], cfg, N0)
+        nulled = angle_sigmas_rad(u, z, _off(ground), cfg, N0)
         free = angle_sigmas_rad(u, z, np.eye(4)[None], cfg, N0)
         sigmas[layout] = [float(s[0]) for s in (*nulled, *free)]
     (sq_el, sq_az, _, sq_az_free), (k_el, k_az, _, k_az_free) = sigmas["square"], sigmas["kite"]

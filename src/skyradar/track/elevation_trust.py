@@ -336,7 +336,7 @@ def place_elevations(
     if below is not None and clearance_m is not None:
         held = _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids)
     trusted, sigma = trusted | held, np.where(held, np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD), sigma)
-    agreed, window = trusted & band & ~held & np.isfinite(track_up), votes.window if votes else 1
+    agreed, window = trusted & band & ~held & np.isfinite(track_up), votes.window if votes is not None else 1
     placed = (positions_m, own, range_m, sigma, trusted, agreed, track_up, spread, last_up_m, window)
     return *_placed(*placed), trusted, track_up, spread
 

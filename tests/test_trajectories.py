@@ -157,39 +157,43 @@ def test_derive_attitude_holds_heading_when_stopped():
 
 # ---- readers ------------------------------------------------------------------------------------
 def _opensky_rows():
+    """Four fixes 5 s apart of an aircraft at 100 kt on track 30 deg climbing at 300 ft/min: the
+    positions move as the reported velocity says (0.002 deg north and 0.00188 deg east per fix)."""
     return pd.DataFrame(
         {
             "timestamp": [1_700_000_000, 1_700_000_005, 1_700_000_010, 1_700_000_015],
             "icao24": ["4840d6"] * 4,
             "callsign": ["PHABC"] * 4,
-            "latitude": [52.0, 52.001, 52.002, 52.003],
-            "longitude": [4.36, 4.361, 4.362, 4.363],
+            "latitude": [52.0, 52.002, 52.004, 52.006],
+            "longitude": [4.36, 4.36188, 4.36376, 4.36564],
             "altitude": [1500.0, 1525.0, 1550.0, 1575.0],
-            "groundspeed": [100.0, 101.0, 102.0, 103.0],
-            "track": [30.0, 31.0, 32.0, 33.0],
-            "vertical_rate": [300.0, 300.0, -500.0, 0.0],
+            "groundspeed": [100.0] * 4,
+            "track": [30.0] * 4,
+            "vertical_rate": [300.0] * 4,
         }
     )
 
 
 def test_opensky_units_are_converted_exactly(tmp_path):
+    from skyradar.scene.adsb import _local_velocity
+
     df = _opensky_rows()
+    gs, trk = df["groundspeed"] * 1852.0 / 3600.0, np.radians(df["track"])
+    np.testing.assert_allclose(
+        _local_velocity(df),
+        np.column_stack([gs * np.cos(trk), gs * np.sin(trk), -df["vertical_rate"] * 0.3048 / 60]),
+    )
+    assert (FT_M, KT_MPS, FPM_MPS) == (0.3048, 1852.0 / 3600.0, 0.3048 / 60.0)
     path = tmp_path / "track.csv"
     df.to_csv(path, index=False)
     traj = read_trajectory(path)
     assert traj.name == "PHABC" and traj.epoch_s == 1_700_000_000.0
     assert traj.origin == (52.0, 4.36, 1500.0 * 0.3048)
-    np.testing.assert_allclose(traj.time_s, [0.0, 5.0, 10.0, 15.0])
-    # At the origin the local and scenario NED frames coincide: velocities are the raw conversion.
-    gs, trk = 100.0 * 1852.0 / 3600.0, np.radians(30.0)
-    np.testing.assert_allclose(
-        traj.velocity_ned_mps[0], [gs * np.cos(trk), gs * np.sin(trk), -300.0 * 0.3048 / 60.0]
-    )
-    assert (FT_M, KT_MPS, FPM_MPS) == (0.3048, 1852.0 / 3600.0, 0.3048 / 60.0)
-    s = traj.sample(traj.time_s)
-    np.testing.assert_allclose(s.alt_m, df["altitude"] * 0.3048, atol=1e-6)
-    np.testing.assert_allclose(s.lat_deg, df["latitude"], atol=1e-10)
-    np.testing.assert_allclose(np.degrees(s.attitude_rad[:, 0]), df["track"], atol=0.01)
+    assert (traj.start_s, traj.end_s) == (0.0, 15.0)
+    s = traj.sample(np.array([0.0, 5.0, 10.0, 15.0]))
+    np.testing.assert_allclose(s.alt_m, df["altitude"] * 0.3048, atol=0.5)
+    np.testing.assert_allclose(s.lat_deg, df["latitude"], atol=2e-5)  # 2 m
+    np.testing.assert_allclose(np.degrees(s.attitude_rad[:, 0]), df["track"], atol=0.5)
 
 
 def test_formats_agree_and_iso_timestamps(tmp_path):
@@ -205,8 +209,8 @@ def test_formats_agree_and_iso_timestamps(tmp_path):
     ref = read_trajectory(tmp_path / "a.csv")
     for name in ("a.parquet", "a.json", "iso.csv", "a.jsonl"):
         other = read_trajectory(tmp_path / name)
-        np.testing.assert_allclose(other.position_ned_m, ref.position_ned_m, atol=1e-9, err_msg=name)
-        np.testing.assert_allclose(other.velocity_ned_mps, ref.velocity_ned_mps, atol=1e-12, err_msg=name)
+        np.testing.assert_allclose(other.position_ned_m, ref.position_ned_m, atol=1e-6, err_msg=name)
+        np.testing.assert_allclose(other.velocity_ned_mps, ref.velocity_ned_mps, atol=1e-6, err_msg=name)
         np.testing.assert_allclose(other.time_s, ref.time_s, err_msg=name)
         assert other.epoch_s == ref.epoch_s
 
@@ -217,8 +221,13 @@ def test_si_columns_and_derived_velocities(tmp_path):
     base = pd.DataFrame({"time_s": s.time_s, "latitude": s.lat_deg, "longitude": s.lon_deg, "alt_m": s.alt_m})
     base.to_csv(tmp_path / "nov.csv", index=False)
     derived = read_trajectory(tmp_path / "nov.csv", origin=ORIGIN)
-    np.testing.assert_allclose(derived.position_ned_m, truth.position_ned_m, atol=1e-6)
-    np.testing.assert_allclose(derived.velocity_ned_mps, truth.velocity_ned_mps, atol=1e-6)
+    times = np.linspace(0.0, 20.0, 41)
+    np.testing.assert_allclose(
+        derived.sample(times).position_ned_m, truth.sample(times).position_ned_m, atol=0.05
+    )
+    np.testing.assert_allclose(
+        derived.sample(times).velocity_ned_mps, truth.sample(times).velocity_ned_mps, atol=0.05
+    )
     assert np.isnan(derived.epoch_s)
     # SI velocity columns are local NED at each aircraft: rotate the truth there first.
     from skyradar.scene.trajectories import origin_to_local_rotation
@@ -228,7 +237,9 @@ def test_si_columns_and_derived_velocities(tmp_path):
     )
     base.assign(vn=local[:, 0], ve=local[:, 1], vd=local[:, 2]).to_parquet(tmp_path / "si.parquet")
     given_v = read_trajectory(tmp_path / "si.parquet", origin=ORIGIN)
-    np.testing.assert_allclose(given_v.velocity_ned_mps, truth.velocity_ned_mps, atol=1e-9)
+    np.testing.assert_allclose(
+        given_v.sample(times).velocity_ned_mps, truth.sample(times).velocity_ned_mps, atol=0.05
+    )
 
 
 def test_opensky_impala_state_vectors(tmp_path):
@@ -261,11 +272,12 @@ def test_read_trajectories_groups_by_aircraft(tmp_path):
     tracks = read_trajectories(tmp_path / "many.csv")
     assert sorted(tracks) == ["008123", "4840d6"]
     assert tracks["4840d6"].origin == tracks["008123"].origin == (52.0, 4.36, 1500.0 * 0.3048)
-    np.testing.assert_allclose(tracks["008123"].time_s, [2.0, 7.0, 12.0, 17.0])  # shared clock
+    assert (tracks["008123"].start_s, tracks["008123"].end_s) == (2.0, 17.0)  # shared clock
     assert tracks["008123"].name == "DLH1"
     np.testing.assert_allclose(
         tracks["008123"].position_ned_m[0, 0],
         geodetic_to_ned(52.01, 4.36, 457.2, *tracks["4840d6"].origin)[0],
+        atol=0.1,
     )
     with pytest.raises(InputError, match="many.csv.*'icao24'.*read_trajectories"):
         read_trajectory(tmp_path / "many.csv")
@@ -281,7 +293,7 @@ def test_read_trajectories_groups_by_aircraft(tmp_path):
         # what cannot be is refused with the reason:
         (
             lambda d: d.assign(timestamp=[1000.0, 1001.0, 1001.0, 1002.0], latitude=[52, 52, 52.1, 52]),
-            r"track.csv: field 'timestamp' repeats at rows \[1, 2\] with positions 11132 m apart",
+            r"track.csv: field 'timestamp' repeats at rows \[1, 2\] with positions 1113[23] m apart",
         ),
         (
             lambda d: d.assign(longitude=[4.0, np.nan, np.nan, np.nan]),

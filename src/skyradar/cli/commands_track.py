@@ -236,6 +236,7 @@ def evaluate(
     # The table shows no lists: one readable row for the per-target counts (1 = one track per aircraft).
     pairs = zip(result["targets"], result["tracks_per_target"], strict=True)
     result["tracks_by_target"] = ", ".join(f"{name} {n}" for name, n in pairs)
+    result["held_rows_by_reason"] = ", ".join(f"{k} {v}" for k, v in result["held_rows"].items()) or "none"
     emit_result(result, as_json, "track evaluation")
 
 

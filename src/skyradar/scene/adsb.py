@@ -41,6 +41,7 @@ import pandas as pd
 from skyradar.errors import InputError
 from skyradar.geo import geodetic_to_ned
 from skyradar.scene.adsb_clean import altitude_m, clean_rows, readsb_trace, time_seconds
+from skyradar.scene.flyable import AIRCRAFT_CLASSES, KinematicLimits, flyable_path
 from skyradar.units import wrap_angle
 
 __all__ = ["FT_M", "KT_MPS", "FPM_MPS", "read_track_table", "read_trajectory", "read_trajectories"]
@@ -207,8 +208,9 @@ def _one_trajectory(
     time_zero_s: float | None,
     label: str = "",
     impala: bool = False,
+    limits: KinematicLimits = AIRCRAFT_CLASSES["ga"],
 ):
-    """(trajectory, repair notes) of one aircraft's rows."""
+    """(trajectory, repair notes) of one aircraft's rows: a flyable path through its fixes."""
     from skyradar.scene.trajectories import Trajectory, origin_to_local_rotation
 
     df, col, t, alt, alt_field, notes = clean_rows(path, df, impala, label)
@@ -226,34 +228,37 @@ def _one_trajectory(
     pos = geodetic_to_ned(lat, lon, alt, *origin)
     zero = float(t[0]) if time_zero_s is None else float(time_zero_s)
     t_rel = t - zero
-    derived = np.gradient(pos, t_rel, axis=0, edge_order=2 if t.size > 2 else 1)
     local = _local_velocity(df)
-    if local is None:
-        vel = derived
-    else:
+    vel = None
+    if local is not None:
         vel = np.einsum("nji,nj->ni", origin_to_local_rotation(lat, lon, origin[0], origin[1]), local)
-        missing = ~np.all(np.isfinite(vel), axis=1)
-        vel[missing] = derived[missing]
-        vel = _velocity_of_positions(vel, derived, notes)
+        derived = np.gradient(pos, t_rel, axis=0, edge_order=2 if t.size > 2 else 1)
+        if _velocity_off_course(vel, derived, notes):
+            vel = None
+    built = flyable_path(t_rel, pos, vel, limits, rows=df.index.to_numpy(), label=f"{path}{label}")
+    notes.extend(built.notes)
     epoch = zero if col == "timestamp" else float("nan")
-    traj = Trajectory.from_states(t_rel, pos, vel, origin=origin, name=name, epoch_s=epoch)
+    traj = Trajectory.from_states(
+        built.time_s, built.position_ned_m, built.velocity_ned_mps, origin=origin, name=name, epoch_s=epoch
+    )
     return traj, notes
 
 
-def _velocity_of_positions(vel: np.ndarray, derived: np.ndarray, notes: list[str]) -> np.ndarray:
-    """``vel`` (recorded), or ``derived`` (from the positions) when the recorded velocities do not
-    point along the positions' course: a median angle above 45 deg over the fixes moving faster than
-    5 m/s. Some published samples (the ``traffic`` package's calibration flights) carry a ground
-    track some 100 deg off their positions' course; a Hermite spline through both then swings the
-    aircraft at 10 g between fixes. Real ADS-B of a circling glider at 5-12 s is off by 5-8 m/s.
+def _velocity_off_course(vel: np.ndarray, derived: np.ndarray, notes: list[str]) -> bool:
+    """Whether the recorded velocities do not point along the positions' course: a median angle above
+    45 deg over the fixes moving faster than 5 m/s. Some published samples (the ``traffic`` package's
+    calibration flights) carry a ground track some 100 deg off their positions' course; those
+    velocities are not used. Real ADS-B of a circling glider at 5-12 s is off by 5-8 m/s, which the
+    smoother weighs against the positions.
     """
     moving = np.linalg.norm(derived[:, :2], axis=1) > 5.0
+    moving &= np.isfinite(vel).all(axis=1)
     off = wrap_angle(np.arctan2(vel[:, 1], vel[:, 0]) - np.arctan2(derived[:, 1], derived[:, 0]))
-    angle_deg = float(np.degrees(np.nanmedian(np.abs(off[moving])))) if moving.sum() >= 3 else 0.0
+    angle_deg = float(np.degrees(np.median(np.abs(off[moving])))) if moving.sum() >= 3 else 0.0
     if not angle_deg > 45.0:
-        return vel
-    notes.append(f"velocity columns {angle_deg:.0f} deg off the positions' course: taken from positions")
-    return derived
+        return False
+    notes.append(f"velocity columns {angle_deg:.0f} deg off the positions' course: not used")
+    return True
 
 
 def _report(path: Path, notes: dict[str, list[str]]) -> None:
@@ -268,10 +273,13 @@ def read_trajectory(
     origin: tuple[float, float, float] | None = None,
     name: str | None = None,
     time_zero_s: float | None = None,
+    aircraft_class: str = "ga",
 ):
     """Read one aircraft's track from a CSV, Parquet or JSON file (plain or .gz/.bz2/.xz).
 
-    The repairs of :mod:`skyradar.scene.adsb_clean` are applied and reported in one line.
+    The repairs of :mod:`skyradar.scene.adsb_clean` are applied, the path is built through the fixes
+    within the aircraft class's kinematic limits (:func:`skyradar.scene.flyable.flyable_path`), and
+    every repair is reported in one line.
 
     Parameters
     ----------
@@ -285,6 +293,9 @@ def read_trajectory(
     time_zero_s : float, optional
         Timestamp (unix s, or ``time_s`` value) that becomes ``time_s == 0``; default the
         first row's. Use one value for files recorded together to keep them in step.
+    aircraft_class : str
+        A key of :data:`skyradar.scene.flyable.AIRCRAFT_CLASSES` (``ga``, ``glider``, ``transport``,
+        ``any``): the limits the built path keeps to.
 
     Returns
     -------
@@ -296,7 +307,7 @@ def read_trajectory(
     >>> f = pathlib.Path(tempfile.mkdtemp()) / "track.csv"
     >>> _ = f.write_text("timestamp,latitude,longitude,altitude\\n0,52,4,1000\\n10,52.001,4,1000\\n")
     >>> traj = read_trajectory(f)
-    >>> round(float(traj.position_ned_m[1, 0]), 1), round(float(traj.origin[2]), 1)
+    >>> round(float(traj.sample([10.0]).position_ned_m[0, 0]), 1), round(float(traj.origin[2]), 1)
     (111.3, 304.8)
     """
     path = Path(path)
@@ -307,7 +318,8 @@ def read_trajectory(
             f"{path}: field 'icao24' has {len(ids)} aircraft ({', '.join(ids[:5])}...); use read_trajectories"
         )
     name = name or _default_name(df, path)
-    traj, notes = _one_trajectory(path, df, origin, name, time_zero_s, impala=impala)
+    limits = _limits(aircraft_class)
+    traj, notes = _one_trajectory(path, df, origin, name, time_zero_s, impala=impala, limits=limits)
     _report(path, {"": notes})
     return traj
 
@@ -334,7 +346,10 @@ def _shared_frame(path: Path, df: pd.DataFrame, impala: bool, origin, time_zero_
 
 
 def read_trajectories(
-    path: str | Path, origin: tuple[float, float, float] | None = None, time_zero_s: float | None = None
+    path: str | Path,
+    origin: tuple[float, float, float] | None = None,
+    time_zero_s: float | None = None,
+    aircraft_class: str = "ga",
 ) -> dict:
     """Read every aircraft in a file (grouped by ``icao24``) into one shared NED frame and clock.
 
@@ -347,12 +362,15 @@ def read_trajectories(
     dict of str to Trajectory
     """
     path = Path(path)
+    limits = _limits(aircraft_class)
     df, impala = _normalise(read_track_table(path))
     for name in ("latitude", "longitude"):
         if name not in df.columns:
             raise InputError(f"{path}: missing required field '{name}'; columns are {list(df.columns)}")
     if "icao24" not in df.columns:
-        traj, notes = _one_trajectory(path, df, origin, _default_name(df, path), time_zero_s, impala=impala)
+        traj, notes = _one_trajectory(
+            path, df, origin, _default_name(df, path), time_zero_s, impala=impala, limits=limits
+        )
         _report(path, {"": notes})
         return {path.stem: traj}
     if df["icao24"].isna().any():
@@ -364,10 +382,16 @@ def read_trajectories(
         key = str(icao)
         name = _default_name(group, path, key)
         out[key], notes[key] = _one_trajectory(
-            path, group, origin, name, time_zero_s, f" (icao24 {key})", impala
+            path, group, origin, name, time_zero_s, f" (icao24 {key})", impala, limits
         )
     _report(path, notes)
     return out
+
+
+def _limits(aircraft_class: str) -> KinematicLimits:
+    if aircraft_class not in AIRCRAFT_CLASSES:
+        raise InputError(f"aircraft class {aircraft_class!r} is not one of {sorted(AIRCRAFT_CLASSES)}")
+    return AIRCRAFT_CLASSES[aircraft_class]
 
 
 def _default_name(df: pd.DataFrame, path: Path, fallback: str | None = None) -> str:

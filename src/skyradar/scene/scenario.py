@@ -43,7 +43,13 @@ from skyradar.scene.scenario_models import (
     FractalTerrainModel,
     ScenarioModel,
 )
-from skyradar.scene.scenario_sources import check_plausible, encounter_flight, read_dem_near, read_flight
+from skyradar.scene.scenario_sources import (
+    check_flyable,
+    check_plausible,
+    encounter_flight,
+    read_dem_near,
+    read_flight,
+)
 from skyradar.scene.terrain_names import terrain_spec_attr
 from skyradar.scene.trajectories import Trajectory
 
@@ -251,13 +257,17 @@ class Scenario:
         m = self.model
         try:
             if isinstance(spec, FileFlight):
-                return read_flight(self._path(spec.path), spec.icao24, origin, spec.time_zero_s)
+                return read_flight(
+                    self._path(spec.path), spec.icao24, origin, spec.time_zero_s, spec.aircraft_class
+                )
             if isinstance(spec, EncounterFlight):
-                params = spec.model_dump(exclude={"type", "name", "rcs_m2", "time_offset_s"})
+                params = spec.model_dump(
+                    exclude={"type", "name", "rcs_m2", "time_offset_s", "aircraft_class"}
+                )
                 return encounter_flight(ownship, params, name)
             from skyradar.scene import flights
 
-            params = spec.model_dump(exclude={"type", "name", "rcs_m2", "time_offset_s"})
+            params = spec.model_dump(exclude={"type", "name", "rcs_m2", "time_offset_s", "aircraft_class"})
             params["duration_s"] = params["duration_s"] or m.duration_s
             params["start_time_s"] = m.start_s if params["start_time_s"] is None else params["start_time_s"]
             traj = getattr(flights, spec.type)(origin=origin, name=name, **params)
@@ -265,6 +275,13 @@ class Scenario:
             return traj
         except InputError as exc:
             raise self._fail(section, exc) from None
+
+    def _check_flyable(self, traj: Trajectory, spec, section: str, times: np.ndarray) -> None:
+        try:
+            check_flyable(traj, spec.aircraft_class, times)
+        except InputError as exc:
+            where = f" (file {spec.path})" if isinstance(spec, FileFlight) else ""
+            raise InputError(f"{self._label}: field '{section}'{where}: {exc}") from None
 
     def _origin(self) -> tuple[tuple[float, float, float] | None, Trajectory | None, Any]:
         """(origin, own-ship if read to find it, terrain if built to find it)."""
@@ -341,6 +358,7 @@ class Scenario:
                 f"{ownship.start_s:.6g}..{ownship.end_s:.6g} s but the frames need "
                 f"{times[0]:.6g}..{times[-1]:.6g} s (start_s, duration_s)"
             )
+        self._check_flyable(ownship, m.ownship, "ownship", times)
         terrain = self._dem_under_flight(terrain, origin, ownship.sample(times), radar)
         land_cover = self._land_cover(origin) if m.ground_map is not None else None
         if land_cover is not None:
@@ -361,6 +379,7 @@ class Scenario:
                     f"{traj.start_s:.6g}..{traj.end_s:.6g} s, outside every frame "
                     f"({times[0]:.6g}..{times[-1]:.6g} s) (got {spec.time_offset_s})"
                 )
+            self._check_flyable(traj, spec, f"intruders.{i}", times)
             if any(other.name == name for other in intruders):
                 raise InputError(f"{self._label}: field 'intruders.{i}.name': '{name}' is used twice")
             intruders.append(Intruder(name, traj, float(spec.rcs_m2)))

@@ -213,7 +213,13 @@ Terrain = Annotated[
 ]
 
 
+# The kinematic limits a flight keeps to (skyradar.scene.flyable.AIRCRAFT_CLASSES): a file's path is built
+# within them, and every flight is checked against them over the frames.
+AircraftClass = Literal["ga", "glider", "transport", "any"]
+
+
 class _Timed(_Model):
+    aircraft_class: AircraftClass = "ga"
     duration_s: Positive | None = None  # default: the scenario's duration_s
     start_time_s: Time | None = None  # default: the scenario's start_s
     rate_hz: Positive = 20.0
@@ -222,6 +228,7 @@ class _Timed(_Model):
 class FileFlight(_Model):
     type: Literal["file"]
     path: str
+    aircraft_class: AircraftClass = "ga"
     icao24: str | None = None
     # File timestamp (unix s, or time_s value) that becomes scenario time 0; default the file's
     # first. Give recordings made together the same value to keep them in step.
@@ -274,6 +281,7 @@ class EncounterFlight(_Model):
     intruder_climb_mps: Finite | None = None
     side: Literal["right", "left"] = "right"
     rate_hz: Positive = 20.0
+    aircraft_class: AircraftClass = "ga"
 
 
 def _flight_shorthand(value: Any) -> Any:

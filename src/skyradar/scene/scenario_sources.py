@@ -13,7 +13,7 @@ import numpy as np
 from skyradar.errors import InputError
 from skyradar.scene.trajectories import Trajectory
 
-__all__ = ["read_dem_near", "check_plausible", "read_flight", "encounter_flight"]
+__all__ = ["read_dem_near", "check_plausible", "check_flyable", "read_flight", "encounter_flight"]
 
 
 def read_dem_near(path: Path, bounds, origin) -> Any:
@@ -50,13 +50,39 @@ def check_plausible(traj: Trajectory) -> None:
         )
 
 
-def read_flight(path: Path, icao24: str | None, origin, time_zero_s: float | None) -> Trajectory:
-    """A flight file's trajectory; with ``icao24`` that aircraft's track of a multi-aircraft file."""
+def check_flyable(traj: Trajectory, aircraft_class: str, times_s: np.ndarray) -> None:
+    """Refuse a flight whose motion over the frames ``times_s`` is beyond its class's kinematic limits.
+
+    The flight is sampled at 20 Hz over the part of the frames it covers, and its speed and its
+    velocity changes over the class's window (:func:`skyradar.scene.flyable.kinematic_violation`)
+    are compared with the limits.
+    """
+    from skyradar.scene.flyable import AIRCRAFT_CLASSES, kinematic_violation
+
+    limits = AIRCRAFT_CLASSES[aircraft_class]
+    start = max(float(times_s[0]), traj.start_s)
+    end = min(float(times_s[-1]), traj.end_s)
+    if end <= start:
+        return
+    grid = np.union1d(np.arange(start, end, 0.05), [end])
+    found = kinematic_violation(grid, traj.sample(grid).velocity_ned_mps, limits)
+    if found is not None:
+        when, what = found
+        raise InputError(
+            f"'{traj.name}' at t = {when:.6g} s: {what}; no {limits.name} aircraft flies this "
+            "(set aircraft_class, or fix the path)"
+        )
+
+
+def read_flight(
+    path: Path, icao24: str | None, origin, time_zero_s: float | None, aircraft_class: str = "ga"
+) -> Trajectory:
+    """A flight file's flyable path; with ``icao24`` that aircraft's track of a multi-aircraft file."""
     from skyradar.scene.adsb import read_trajectories, read_trajectory
 
     if icao24 is None:
-        return read_trajectory(path, origin=origin, time_zero_s=time_zero_s)
-    tracks = read_trajectories(path, origin=origin, time_zero_s=time_zero_s)
+        return read_trajectory(path, origin=origin, time_zero_s=time_zero_s, aircraft_class=aircraft_class)
+    tracks = read_trajectories(path, origin=origin, time_zero_s=time_zero_s, aircraft_class=aircraft_class)
     if icao24 not in tracks:
         raise InputError(f"field 'icao24': {icao24!r} is not in {path} (has {sorted(tracks)[:10]})")
     return tracks[icao24]

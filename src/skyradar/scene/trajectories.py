@@ -247,6 +247,35 @@ class Trajectory:
         """The same flight ``dt_s`` seconds later."""
         return replace(self, time_s=self.time_s + float(dt_s), epoch_s=self.epoch_s - float(dt_s))
 
+    def between(self, start_s: float, end_s: float) -> Trajectory:
+        """The part of the flight from ``start_s`` to ``end_s`` (s), its samples there and both ends.
+
+        Examples
+        --------
+        >>> t = np.arange(0.0, 101.0, 10.0)
+        >>> traj = Trajectory.from_states(t, np.column_stack([50 * t, 0 * t, 0 * t - 500]))
+        >>> part = traj.between(15.0, 42.0)
+        >>> part.time_s.tolist(), float(part.sample([42.0]).position_ned_m[0, 0])
+        ([15.0, 20.0, 30.0, 40.0, 42.0], 2100.0)
+        """
+        start, end = max(float(start_s), self.start_s), min(float(end_s), self.end_s)
+        if not end > start:
+            raise InputError(
+                f"trajectory '{self.name}': [{start_s:g}, {end_s:g}] s is outside its span "
+                f"[{self.start_s:g}, {self.end_s:g}] s"
+            )
+        inner = (self.time_s > start) & (self.time_s < end)
+        times = np.concatenate([[start], self.time_s[inner], [end]])
+        s = self.sample(times)
+        att = np.vstack([s.attitude_rad[:1], self.attitude_rad[inner], s.attitude_rad[-1:]])
+        return replace(
+            self,
+            time_s=times,
+            position_ned_m=s.position_ned_m,
+            velocity_ned_mps=s.velocity_ned_mps,
+            attitude_rad=att,
+        )
+
     def renamed(self, name: str) -> Trajectory:
         return replace(self, name=name)
 

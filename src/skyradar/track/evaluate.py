@@ -55,8 +55,10 @@ def evaluate_run(
     Returns
     -------
     dict
-        :func:`~skyradar.track.metrics.track_metrics` plus ``truth`` (the mode used) and
-        ``truth_snr_threshold_db``. A run without ``tgt_snr_db`` is scored on the beam and says so.
+        :func:`~skyradar.track.metrics.track_metrics` plus ``truth`` (the mode used),
+        ``truth_snr_threshold_db`` and ``held_rows``: how many unconfirmed rows each reason of the
+        tracks' ``held_by`` column holds (:data:`skyradar.track.ground_tracks.HOLD_REASONS`). A run
+        without ``tgt_snr_db`` is scored on the beam and says so.
     """
     if truth not in TRUTH_MODES:
         raise InputError(f"--truth: must be one of {', '.join(TRUTH_MODES)}, got {truth!r}")
@@ -79,4 +81,13 @@ def evaluate_run(
         counted=counted,
         coasting=coasting,
     )
-    return result | {"truth": mode, "truth_snr_threshold_db": threshold, "targets": list(tr.names)}
+    held = {}
+    if "held_by" in tracks and len(tracks):
+        why = tracks["held_by"].fillna("").astype(str)
+        held = {str(k): int(v) for k, v in why[why != ""].value_counts().sort_index().items()}
+    return result | {
+        "truth": mode,
+        "truth_snr_threshold_db": threshold,
+        "targets": list(tr.names),
+        "held_rows": held,
+    }

@@ -68,7 +68,21 @@ from skyradar.track.static_point import (
 
 _CLEAR_S = 3.0  # judged an object off the ground this long on end: not judged again
 
+# Why a track row is not confirmed (the tracks table's ``held_by``; "" when it is confirmed).
+HOLD_REASONS: dict[str, str] = {
+    "": "confirmed",
+    "tentative": "the tracker's M-of-N confirmation is not met yet",
+    "coasting": "no detection for as many frames as confirmation takes: an extrapolation",
+    "young": "too few detections for the ground test to judge it",
+    "range": "its ranges contradict its Doppler (not one scatterer)",
+    "rough": "its Doppler is not one smooth curve (scatterers of a patch taking turns)",
+    "direction": "its measured elevations put it on the surface, or none is measured",
+    "ground": "one static point on the surface explains its range-Doppler history",
+    "ground-release": "a static ground point fitted it; judged an object for too short a span yet",
+}
+
 __all__ = [
+    "HOLD_REASONS",
     "GroundTrackTest",
     "static_point_measurements",
     "fits_static_ground",
@@ -253,26 +267,26 @@ def _judge(sl, t, rng, vel, own_p, own_v, surface_down, width, coupling, test, d
 
 
 def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test, doa) -> np.ndarray:
-    """Per detection of one track: held (ground, or not an object) on the detections up to it.
+    """Per detection of one track: why it is held on the detections up to it (``""``: not held).
 
     Judged at every detection for the first 30, then at every fifth. A track judged an object
     off the ground for :data:`_CLEAR_S` on end is not judged again (it was confirmed all that
     time already, so a later verdict could not undo its count; the fits cost time). A Doppler
     that is not one smooth curve starts the history again after its largest step: the detections
-    before it came from another scatterer, more than the static fit's trim leaves out (hills,
-    200-encounter set, encounter 10), and the new history needs ``ground_min_detections``.
-    Once a static ground point has fitted it, a track is released only when the judgements
-    running over ``release_span_detections`` detections say otherwise, and not before
-    ``ground_min_detections``: the surface model and a patch's scatterers make a fit fail now and
-    then, and each was a confirmed ground row.
+    before it came from another scatterer, more than the static fit's trim leaves out, and the
+    new history needs ``ground_min_detections``. Once a static ground point has fitted it, a
+    track is released only when the judgements running over ``release_span_detections``
+    detections say otherwise, and not before ``ground_min_detections``: the surface model and a
+    patch's scatterers make a fit fail now and then, and each was a confirmed ground row.
+    The reasons are those of :data:`HOLD_REASONS`.
     """
     n = rng.size
-    held = np.ones(n, bool)
-    last, clear_since, start, ground_seen, object_since = True, np.inf, 0, False, n
+    why = np.full(n, "young", dtype=object)
+    last, clear_since, start, ground_seen, object_since = "young", np.inf, 0, False, n
     least = test.min_detections
     for k in range(test.min_detections - 1, n):
         if t[k] - clear_since >= _CLEAR_S:
-            held[k:] = False
+            why[k:] = ""
             break
         if k + 1 - start >= least and (k < 30 or k % 5 == 0 or k == n - 1):
             sl = slice(max(start, k + 1 - test.max_history), k + 1)
@@ -284,10 +298,15 @@ def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test
             object_since = min(object_since, k) if reason == "" else n
             released = k - object_since >= test.release_span_detections
             early = k + 1 - start < max(least, test.release_detections)
-            last = reason != "" or (ground_seen and not released) or early
+            if reason:
+                last = reason
+            elif ground_seen and not released:
+                last = "ground-release"
+            else:
+                last = "young" if early else ""
             clear_since = np.inf if last else min(clear_since, t[k])
-        held[k] = last
-    return held
+        why[k] = last
+    return why
 
 
 def _largest_step(vel: np.ndarray, width: float, sl: slice) -> int:
@@ -298,21 +317,19 @@ def _largest_step(vel: np.ndarray, width: float, sl: slice) -> int:
 
 
 def _track_held(det: np.ndarray, ownship, surface_down, width: float, coupling: float, test) -> np.ndarray:
-    """Held flag per detection of one track (``det``: time, range, radial velocity), its history
-    started again after every gap longer than ``test.rejudge_gap_s``."""
+    """Why each detection of one track (``det``: time, range, radial velocity) holds it (``""``: not
+    held), its history started again after every gap longer than ``test.rejudge_gap_s``."""
     t, rng, vel = det[:, :3].T
     own_p, own_v = _own_state(ownship, t) if ownship is not None else (None, None)
     ground = surface_down if ownship is not None else None
     doa = doa_height_sd(det, ground, test.doa_sigma_rad)
-    held = np.ones(t.size, bool)
+    why = np.full(t.size, "young", dtype=object)
     cuts = np.flatnonzero(np.diff(t) > test.rejudge_gap_s) + 1
     for a, b in zip(np.r_[0, cuts], np.r_[cuts, t.size], strict=True):
         s = slice(a, b)
         own = (None, None) if own_p is None else (own_p[s], own_v[s])
-        held[s] = _history_held(
-            t[s], rng[s], vel[s], *own, ground, width, coupling, test, [a[s] for a in doa]
-        )
-    return held
+        why[s] = _history_held(t[s], rng[s], vel[s], *own, ground, width, coupling, test, [a[s] for a in doa])
+    return why
 
 
 def median_ground_down_m(ownship: pd.DataFrame) -> float:
@@ -347,8 +364,9 @@ def hold_ground_tracks(
     radial_velocity_mps``). ``ownship`` (``own_*`` NED columns, optionally ``own_height_agl_m``)
     gives the static points' history; without ``surface_down`` the surface is a level ground at
     the own-ship's height above ground, and without either only the range-Doppler test applies.
-    A row takes the decision of the track's newest detection at or before it; tracks left
-    without a confirmed row are dropped.
+    A row takes the decision of the track's newest detection at or before it, and says in
+    ``held_by`` why it is not confirmed (:data:`HOLD_REASONS`); tracks left without a confirmed row
+    are dropped.
     """
     test = test or GroundTrackTest()
     if len(tracks) == 0:
@@ -362,7 +380,7 @@ def hold_ground_tracks(
         + [elevation_measured_flags(detections).astype(float)]
     )
     rows = tracks["detection_row"].to_numpy()
-    held = np.ones(len(tracks), bool)
+    why = np.full(len(tracks), "young", dtype=object)
     for _, idx in tracks.groupby("track_id", sort=False).indices.items():
         has = idx[rows[idx] >= 0]
         if has.size == 0:
@@ -370,7 +388,9 @@ def hold_ground_tracks(
         h = _track_held(det[rows[has]], ownship, surface_down, width_mps, coupling_s, test)
         # Each row (coasting ones too) takes the decision of the newest detection at or before it.
         pos = np.searchsorted(has, idx, side="right") - 1
-        held[idx] = np.where(pos >= 0, h[np.maximum(pos, 0)], True)
-    out = tracks.assign(confirmed=tracks["confirmed"].to_numpy(bool) & ~held)
+        why[idx] = np.where(pos >= 0, h[np.maximum(pos, 0)], "young")
+    was = tracks["confirmed"].to_numpy(bool)
+    held_by = tracks["held_by"].to_numpy(object) if "held_by" in tracks else np.where(was, "", "tentative")
+    out = tracks.assign(confirmed=was & (why == ""), held_by=np.where(was, why, held_by).astype(str))
     real = np.unique(out["track_id"].to_numpy()[out["confirmed"].to_numpy()])
     return out[np.isin(out["track_id"].to_numpy(), real)].reset_index(drop=True)

@@ -34,8 +34,8 @@ TRACK_COLUMNS = [
     "lat_deg", "lon_deg", "alt_m",
     *[f"cov_pp_{i}{j}" for i in range(3) for j in range(3)],
     *[f"cov_vv_{i}{j}" for i in range(3) for j in range(3)],
-    *[f"cov_pv_{i}{j}" for i in range(3) for j in range(3)], "confirmed", "n_updates", "misses", "coasted",
-    "altitude_measured",
+    *[f"cov_pv_{i}{j}" for i in range(3) for j in range(3)], "confirmed", "held_by", "n_updates", "misses",
+    "coasted", "altitude_measured",
 ]  # fmt: skip
 
 
@@ -55,6 +55,8 @@ def empty_tracks() -> pd.DataFrame:
     # Integer row indices stay integer so that callers can index with them even when empty.
     def dtype(column: str) -> type:
         flags = ("confirmed", "coasted", "altitude_measured")
+        if column == "held_by":
+            return object
         return np.int64 if column in _INTEGER_COLUMNS else bool if column in flags else float
 
     return pd.DataFrame({c: pd.Series(dtype=dtype(c)) for c in TRACK_COLUMNS}, columns=TRACK_COLUMNS)
@@ -178,7 +180,11 @@ def _make_tracker(model, config: RadarConfig, tracker_config) -> tuple[MotionMod
 
 
 def _held(tracks, detections, ownship, config: RadarConfig, ground_test) -> pd.DataFrame:
-    """:func:`~skyradar.track.ground_tracks.hold_ground_tracks` with ``ground_test``'s settings."""
+    """:func:`~skyradar.track.ground_tracks.hold_ground_tracks` with ``ground_test``'s settings, and
+    ``held_by`` saying why each row is not confirmed (the tracker's reasons first)."""
+    coasting = tracks["coasted"].to_numpy(bool) if "coasted" in tracks else np.zeros(len(tracks), bool)
+    tracker_why = np.where(coasting, "coasting", "tentative")
+    tracks = tracks.assign(held_by=np.where(tracks["confirmed"].to_numpy(bool), "", tracker_why))
     if ground_test is False:
         return tracks
     test = ground_test if isinstance(ground_test, GroundTrackTest) else GroundTrackTest()

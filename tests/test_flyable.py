@@ -259,3 +259,43 @@ def test_scenario_file_flight_is_built_within_its_class(tmp_path):
     built = load_scenario(tmp_path / "s.yaml").build()
     s = built.ownship.sample(built.times_s)
     assert kinematic_violation(s.time_s, s.velocity_ned_mps, GA) is None
+
+
+def test_a_file_whose_track_is_off_flies_at_its_reported_ground_speed(tmp_path, caplog):
+    """Some recordings carry a track column far off their positions' course: its ground speed still
+    holds, and the path's own direction carries it (the fixes alone, jittered in time, swing it)."""
+    t, pos, vel = _flight(62.0, [(60.0, 0.0, 0.0), (40.0, 20.0, 0.0), (60.0, 0.0, 0.0)])
+    _fixes_file(
+        tmp_path / "off.csv", t, pos, vel, interval_s=5.0, jitter_s=1.5, noise_m=10.0, lag_s=0.0,
+        stale_share=0.0, rng=np.random.default_rng(6),
+    )  # fmt: skip
+    df = pd.read_csv(tmp_path / "off.csv")
+    df.assign(track=(df["track"] + 100.0) % 360.0).to_csv(tmp_path / "off.csv", index=False)
+    traj, line = _read(tmp_path / "off.csv", caplog)
+    assert "track 100 deg off the positions' course: only the ground speed used" in line
+    speed = np.linalg.norm(traj.sample(np.arange(15.0, 140.0)).velocity_ned_mps, axis=1)
+    assert np.abs(speed - 62.0).max() < 4.0  # the fixes between each other: 40-90 m/s
+
+
+def test_skyradar_flight_writes_the_path_and_its_figure(tmp_path):
+    t, pos, vel = _flight(55.0, [(40.0, 0.0, 0.0), (40.0, 30.0, 1.0)])
+    _fixes_file(
+        tmp_path / "fixes.csv", t, pos, vel, interval_s=1.0, jitter_s=0.3, noise_m=10.0, lag_s=0.5,
+        stale_share=0.05, rng=np.random.default_rng(7),
+    )  # fmt: skip
+    result = skyradar("flight", "fixes.csv", "-o", "path.csv", "--figure", "path.png", "--json", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    import json
+
+    summary = json.loads(result.stdout.strip().splitlines()[-1])
+    assert summary["horizontal_accel_max_mps2"] <= 10.0 and "stale fix(es)" in summary["repairs"]
+    assert (tmp_path / "path.png").stat().st_size > 10_000
+    built = read_trajectory(tmp_path / "path.csv")  # the table a scenario flies
+    assert built.duration_s == pytest.approx(summary["duration_s"], abs=0.01)
+    bad = skyradar("flight", "fixes.csv", "-o", "p2.csv", "--aircraft-class", "jet", cwd=tmp_path)
+    assert_one_line_error(bad, "--aircraft-class", "jet")
+    bad = skyradar("flight", "fixes.csv", "-o", "p2.txt", cwd=tmp_path)
+    assert_one_line_error(bad, "--output", "p2.txt")
+    assert not (tmp_path / "p2.csv").exists() and not (tmp_path / "p2.txt").exists()
+    again = skyradar("flight", "fixes.csv", "-o", "path.csv", cwd=tmp_path)  # never replaced unasked
+    assert again.returncode == 2 and "path.csv" in again.stderr

@@ -1,4 +1,5 @@
-"""Real traffic in: ``skyradar make-encounter`` (an encounter scenario from two recorded flights)."""
+"""Real traffic in: ``skyradar flight`` (the flyable path a recorded flight becomes) and
+``skyradar make-encounter`` (an encounter scenario from two recorded flights)."""
 
 from __future__ import annotations
 
@@ -17,9 +18,12 @@ from skyradar.cli.app import (
     console,
     emit_result,
 )
+from skyradar.errors import InputError
 from skyradar.io.outputs import OVERWRITE_HELP
 
-__all__ = ["make_encounter"]
+__all__ = ["flight", "make_encounter"]
+
+_CLASSES = ("ga", "glider", "transport", "any")
 
 _Icao = Annotated[str | None, typer.Option(help="Aircraft address to take from a file holding several.")]
 _Track = Annotated[Path, typer.Argument(help="Track file (ADS-B/GPS: CSV, JSON, Parquet; .gz too).")]
@@ -49,12 +53,87 @@ _Before = Annotated[
 _After = Annotated[float, typer.Option("--after-s", callback=POSITIVE, help="Scenario end, s after CPA.")]
 
 
-def _flight(path: Path, icao24: str | None):
-    """The file's flight with t = 0 s at its first fix."""
+def _flight(path: Path, icao24: str | None, aircraft_class: str):
+    """The file's flyable path with t = 0 s at its first fix."""
     from skyradar.scene.scenario_sources import read_flight
 
-    traj = read_flight(path, icao24, None, None)
+    traj = read_flight(path, icao24, None, None, aircraft_class)
     return traj.shifted(-traj.start_s)
+
+
+def _class_option(role: str) -> object:
+    return typer.Option(
+        f"--{role}-class" if role else "--aircraft-class",
+        help=f"Aircraft class whose kinematic limits the {role or 'built'} path keeps to: "
+        f"{', '.join(_CLASSES)}.",
+    )
+
+
+@app.command("flight")
+def flight(
+    track: _Track,
+    output: Annotated[
+        Path,
+        typer.Option("-o", "--output", help="The built path as a table (CSV or Parquet) a scenario flies."),
+    ],
+    figure: Annotated[
+        Path | None,
+        typer.Option("--figure", help="The built path drawn against the fixes (PNG, SVG or PDF)."),
+    ] = None,
+    aircraft_class: Annotated[str, _class_option("")] = "ga",
+    icao24: _Icao = None,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
+    as_json: JsonOption = False,
+) -> None:
+    """Build the flyable path of a recorded flight (ADS-B, GPS log) within its aircraft class's kinematic
+    limits, as every scenario does with a flight file, and write it with a figure against the fixes.
+    The one line on stderr names every fix repaired."""
+    import numpy as np
+
+    from skyradar.io.atomic import write_csv_atomic, write_with
+    from skyradar.io.outputs import check_output
+    from skyradar.scene.adsb import fit_flight
+    from skyradar.scene.encounter_from_tracks import trajectory_table
+    from skyradar.scene.flyable import hermite_accelerations
+
+    check_choice("--aircraft-class", aircraft_class, _CLASSES)
+    if output.suffix.lower() not in (".csv", ".parquet"):
+        raise InputError(f"--output: {output} must end in .csv or .parquet")
+    check_output(output, [track], overwrite, kind="file")
+    if figure is not None:
+        if figure.suffix.lower() not in (".png", ".svg", ".pdf"):
+            raise InputError(f"--figure: {figure} must end in .png, .svg or .pdf")
+        check_output(figure, [track], overwrite, kind="file", option="--figure")
+    fit = fit_flight(track, aircraft_class, icao24)
+    table = trajectory_table(fit.trajectory)
+    if output.suffix.lower() == ".csv":
+        write_csv_atomic(table, output, index=False)
+    else:
+        write_with(output, lambda tmp: table.to_parquet(tmp, index=False))
+    if figure is not None:
+        from skyradar.viz.flight import flight_fit_figure
+
+        flight_fit_figure(fit, figure)
+    traj = fit.trajectory
+    start, end = hermite_accelerations(traj.time_s, traj.position_ned_m, traj.velocity_ned_mps)
+    both = np.concatenate([start, end])
+    speed = np.linalg.norm(traj.velocity_ned_mps, axis=1)
+    result = {
+        "output": str(output),
+        "figure": None if figure is None else str(figure),
+        "name": traj.name,
+        "aircraft_class": aircraft_class,
+        "fixes": int(fit.fix_time_s.size),
+        "fixes_used": int(fit.path.kept.sum()),
+        "position_lag_s": fit.path.lag_s,
+        "duration_s": traj.duration_s,
+        "speed_min_mps": float(speed.min()),
+        "speed_max_mps": float(speed.max()),
+        "horizontal_accel_max_mps2": float(np.hypot(both[:, 0], both[:, 1]).max()),
+        "vertical_accel_max_mps2": float(np.abs(both[:, 2]).max()),
+        "repairs": "; ".join(fit.notes) or "none",
+    }
+    emit_result(result, as_json, "flight")
 
 
 def _side_files(output: Path) -> tuple[Path, Path]:
@@ -62,7 +141,9 @@ def _side_files(output: Path) -> tuple[Path, Path]:
     return output.with_name(f"{stem}.ownship.csv"), output.with_name(f"{stem}.intruder.csv")
 
 
-def _write(output: Path, own, intr, t_cpa: float, window_s: tuple[float, float], name: str) -> dict:
+def _write(
+    output: Path, own, intr, t_cpa: float, window_s: tuple[float, float], name: str, classes: tuple[str, str]
+) -> dict:
     """Write the scenario and its two tracks (atomically); the files written and the real CPA."""
     import yaml
 
@@ -71,6 +152,7 @@ def _write(output: Path, own, intr, t_cpa: float, window_s: tuple[float, float],
 
     own_csv, intr_csv = _side_files(output)
     scenario = encounter_scenario(own, intr, own_csv.name, intr_csv.name, t_cpa, *window_s, name=name)
+    scenario["ownship"]["aircraft_class"], scenario["intruders"][0]["aircraft_class"] = classes
     write_csv_atomic(trajectory_table(own), own_csv, index=False)
     write_csv_atomic(trajectory_table(intr), intr_csv, index=False)
     write_text_atomic(output, yaml.safe_dump(scenario, sort_keys=False))
@@ -96,6 +178,8 @@ def make_encounter(
     after_s: _After = 20.0,
     ownship_icao24: _Icao = None,
     intruder_icao24: _Icao = None,
+    ownship_class: Annotated[str, _class_option("ownship")] = "ga",
+    intruder_class: Annotated[str, _class_option("intruder")] = "ga",
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -107,14 +191,17 @@ def make_encounter(
     from skyradar.scene.encounter_from_tracks import encounter_from_tracks
 
     check_choice("--side", side, ("right", "left"))
+    check_choice("--ownship-class", ownship_class, _CLASSES)
+    check_choice("--intruder-class", intruder_class, _CLASSES)
     check_number("--vertical-miss-m", vertical_miss_m, -10_000.0, 10_000.0)
     check_number("--rotate-deg", rotate_deg, -360.0, 360.0)
     for path in (output, *_side_files(output)):
         check_output(path, [ownship, intruder], overwrite, kind="file")
-    a, b = _flight(ownship, ownship_icao24), _flight(intruder, intruder_icao24)
+    a, b = _flight(ownship, ownship_icao24, ownship_class), _flight(intruder, intruder_icao24, intruder_class)
     t_cpa = 0.5 * a.end_s if t_cpa is None else t_cpa
     own, intr = encounter_from_tracks(a, b, t_cpa, miss_m, vertical_miss_m, intruder_time, rotate_deg, side)
-    result = _write(output, own, intr, t_cpa, (before_s, after_s), f"{a.name} meets {b.name}")
+    classes = (ownship_class, intruder_class)
+    result = _write(output, own, intr, t_cpa, (before_s, after_s), f"{a.name} meets {b.name}", classes)
     t, h_m = result["t_cpa_s"], result["horizontal_miss_m"]
     if abs(t - t_cpa) > 0.1 or abs(h_m - miss_m) > 1.0:  # manoeuvring flights: say what they really do
         console.print(

@@ -33,7 +33,9 @@ import gzip
 import json
 import logging
 import lzma
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -41,10 +43,19 @@ import pandas as pd
 from skyradar.errors import InputError
 from skyradar.geo import geodetic_to_ned
 from skyradar.scene.adsb_clean import altitude_m, clean_rows, readsb_trace, time_seconds
-from skyradar.scene.flyable import AIRCRAFT_CLASSES, KinematicLimits, flyable_path
+from skyradar.scene.flyable import AIRCRAFT_CLASSES, FlyablePath, KinematicLimits, flyable_path
 from skyradar.units import wrap_angle
 
-__all__ = ["FT_M", "KT_MPS", "FPM_MPS", "read_track_table", "read_trajectory", "read_trajectories"]
+__all__ = [
+    "FT_M",
+    "KT_MPS",
+    "FPM_MPS",
+    "FlightFit",
+    "fit_flight",
+    "read_track_table",
+    "read_trajectory",
+    "read_trajectories",
+]
 
 FT_M = 0.3048  # international foot, m (exact)
 KT_MPS = 1852.0 / 3600.0  # knot, m/s (exact)
@@ -200,6 +211,38 @@ def _drop_glitches(path, rows, t, lat, lon, alt, alt_field: str, label: str, not
     return keep
 
 
+@dataclass(frozen=True)
+class FlightFit:
+    """A file's flight as built (:func:`fit_flight`), beside the fixes it was built from.
+
+    Attributes
+    ----------
+    trajectory : Trajectory
+        The flyable path.
+    fix_time_s : ndarray, shape (n,)
+        The fixes' times on the trajectory's clock, s (after the repairs of
+        :mod:`skyradar.scene.adsb_clean`, before those of the path).
+    fix_position_ned_m : ndarray, shape (n, 3)
+        The fixes' positions in the trajectory's NED frame, m.
+    fix_velocity_ned_mps : ndarray, shape (n, 3), or None
+        The velocities the file reports (ground speed, track, vertical rate), m/s, used or not;
+        None when the file has none.
+    path : FlyablePath
+        The smoother's result: which fixes it kept, the lag, the notes.
+    limits : KinematicLimits
+    notes : list of str
+        Every repair, as the one line logged for the file says.
+    """
+
+    trajectory: Any
+    fix_time_s: np.ndarray
+    fix_position_ned_m: np.ndarray
+    fix_velocity_ned_mps: np.ndarray | None
+    path: FlyablePath
+    limits: KinematicLimits
+    notes: list[str]
+
+
 def _one_trajectory(
     path: Path,
     df: pd.DataFrame,
@@ -229,19 +272,29 @@ def _one_trajectory(
     zero = float(t[0]) if time_zero_s is None else float(time_zero_s)
     t_rel = t - zero
     local = _local_velocity(df)
-    vel = None
+    vel = local_ned = ground_speed = None
     if local is not None:
         vel = np.einsum("nji,nj->ni", origin_to_local_rotation(lat, lon, origin[0], origin[1]), local)
+        local_ned = vel
         derived = np.gradient(pos, t_rel, axis=0, edge_order=2 if t.size > 2 else 1)
         if _velocity_off_course(vel, derived, notes):
-            vel = None
-    built = flyable_path(t_rel, pos, vel, limits, rows=df.index.to_numpy(), label=f"{path}{label}")
+            vel, ground_speed = None, np.hypot(local[:, 0], local[:, 1])
+    built = flyable_path(
+        t_rel,
+        pos,
+        vel,
+        limits,
+        rows=df.index.to_numpy(),
+        label=f"{path}{label}",
+        ground_speed_mps=ground_speed,
+    )
     notes.extend(built.notes)
     epoch = zero if col == "timestamp" else float("nan")
     traj = Trajectory.from_states(
         built.time_s, built.position_ned_m, built.velocity_ned_mps, origin=origin, name=name, epoch_s=epoch
     )
-    return traj, notes
+    fit = FlightFit(traj, t_rel, pos, local_ned, built, limits, notes)
+    return traj, notes, fit
 
 
 def _velocity_off_course(vel: np.ndarray, derived: np.ndarray, notes: list[str]) -> bool:
@@ -257,7 +310,7 @@ def _velocity_off_course(vel: np.ndarray, derived: np.ndarray, notes: list[str])
     angle_deg = float(np.degrees(np.median(np.abs(off[moving])))) if moving.sum() >= 3 else 0.0
     if not angle_deg > 45.0:
         return False
-    notes.append(f"velocity columns {angle_deg:.0f} deg off the positions' course: not used")
+    notes.append(f"track {angle_deg:.0f} deg off the positions' course: only the ground speed used")
     return True
 
 
@@ -319,9 +372,51 @@ def read_trajectory(
         )
     name = name or _default_name(df, path)
     limits = _limits(aircraft_class)
-    traj, notes = _one_trajectory(path, df, origin, name, time_zero_s, impala=impala, limits=limits)
+    traj, notes, _fit = _one_trajectory(path, df, origin, name, time_zero_s, impala=impala, limits=limits)
     _report(path, {"": notes})
     return traj
+
+
+def fit_flight(
+    path: str | Path,
+    aircraft_class: str = "ga",
+    icao24: str | None = None,
+    time_zero_s: float | None = None,
+) -> FlightFit:
+    """One aircraft's flight from a file, with the fixes it was built from (for figures and checks).
+
+    Parameters
+    ----------
+    path : str or Path
+        As :func:`read_trajectory` reads.
+    aircraft_class : str
+        A key of :data:`skyradar.scene.flyable.AIRCRAFT_CLASSES`.
+    icao24 : str, optional
+        The aircraft to take from a file holding several.
+    time_zero_s : float, optional
+        As :func:`read_trajectory`.
+
+    Returns
+    -------
+    FlightFit
+    """
+    path = Path(path)
+    limits = _limits(aircraft_class)
+    df, impala = _normalise(read_track_table(path))
+    if icao24 is not None:
+        if "icao24" not in df.columns or not (df["icao24"].astype(str) == icao24).any():
+            raise InputError(f"{path}: field 'icao24': {icao24!r} is not in the file")
+        df = df[df["icao24"].astype(str) == icao24]
+    elif "icao24" in df.columns and df["icao24"].nunique(dropna=True) > 1:
+        ids = sorted(str(v) for v in df["icao24"].dropna().unique())
+        raise InputError(
+            f"{path}: field 'icao24' has {len(ids)} aircraft ({', '.join(ids[:5])}...); name one"
+        )
+    _traj, notes, fit = _one_trajectory(
+        path, df, None, _default_name(df, path), time_zero_s, impala=impala, limits=limits
+    )
+    _report(path, {"": notes})
+    return fit
 
 
 def _shared_frame(path: Path, df: pd.DataFrame, impala: bool, origin, time_zero_s):
@@ -368,7 +463,7 @@ def read_trajectories(
         if name not in df.columns:
             raise InputError(f"{path}: missing required field '{name}'; columns are {list(df.columns)}")
     if "icao24" not in df.columns:
-        traj, notes = _one_trajectory(
+        traj, notes, _fit = _one_trajectory(
             path, df, origin, _default_name(df, path), time_zero_s, impala=impala, limits=limits
         )
         _report(path, {"": notes})
@@ -381,7 +476,7 @@ def read_trajectories(
     for icao, group in df.groupby("icao24", sort=False):
         key = str(icao)
         name = _default_name(group, path, key)
-        out[key], notes[key] = _one_trajectory(
+        out[key], notes[key], _fit = _one_trajectory(
             path, group, origin, name, time_zero_s, f" (icao24 {key})", impala, limits
         )
     _report(path, notes)

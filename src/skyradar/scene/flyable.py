@@ -431,6 +431,7 @@ def flyable_path(
     rows: np.ndarray | None = None,
     step_s: float = 0.5,
     label: str = "fixes",
+    ground_speed_mps: np.ndarray | None = None,
 ) -> FlyablePath:
     """A path within ``limits`` through recorded fixes (module docstring: the rules).
 
@@ -451,6 +452,9 @@ def flyable_path(
         Grid step of the built path, s; the fixes' own times are added to the grid.
     label : str
         Names the input in errors (a file path).
+    ground_speed_mps : ndarray, shape (n,), optional
+        Reported ground speeds, m/s, for a file whose track cannot be used (``velocity_ned_mps``
+        None): the path's own direction at each fix, refined with each pass, carries them.
 
     Returns
     -------
@@ -507,7 +511,10 @@ def flyable_path(
             f"dropped {int(out_of_reach.sum())} fix(es) out of reach at the {limits.name} class's "
             f"{limits.speed_mps:g} m/s ({_rows_phrase(rows[out_of_reach])})"
         )
-    has_vel = vel is not None and np.isfinite(vel).all(axis=1).sum() >= 3
+    heading_from_path = vel is None and ground_speed_mps is not None
+    if heading_from_path:
+        vel = np.full((t.size, 3), np.nan)  # horizontal filled from the path's direction below
+    has_vel = vel is not None and np.isfinite(vel[:, :2]).all(axis=1).sum() >= 3 or heading_from_path
     limit = np.array([limits.horizontal_accel_mps2, limits.horizontal_accel_mps2, limits.vertical_accel_mps2])
     # Acceleration spectral density: a velocity change of the class's full acceleration held over a
     # typical interval between fixes is one standard deviation, so the first fit follows a hard turn
@@ -528,10 +535,25 @@ def flyable_path(
         v = vel[vel_rows] if has_vel else None
         return grid, _smooth(grid, at_pos, pos[keep], at_vel, v, sigma_p, sigma_v, q), at_pos
 
-    lag_passes = _LAG_PASSES if has_vel else 0
+    lag_passes = _LAG_PASSES if has_vel and not heading_from_path else 0
     q0 = q.copy()
-    vel_ok = np.isfinite(vel).all(axis=1) if has_vel else np.zeros(t.size, bool)
+
+    def carry_ground_speed(grid: np.ndarray, states: np.ndarray) -> None:
+        """The reported ground speeds along the path's direction at each fix."""
+        at = np.clip(np.searchsorted(grid, t - lag), 0, grid.size - 1)
+        horizontal = states[at, :2, 1]
+        norm = np.linalg.norm(horizontal, axis=1, keepdims=True)
+        vel[:, :2] = np.where(
+            norm > _MOVING_MPS, ground_speed_mps[:, None] * horizontal / np.maximum(norm, 1e-9), np.nan
+        )
+
+    vel_ok = np.zeros(t.size, bool)
+    grid, states, _at = fit(q)  # positions only, or the reported velocities at the default noise
     for _pass in range(lag_passes + 4):
+        if heading_from_path:
+            carry_ground_speed(grid, states)
+        if has_vel:
+            vel_ok = np.isfinite(vel[:, :2]).all(axis=1)
         if _pass >= lag_passes:  # the noise that makes the kept fixes most likely
             rows_v = keep & vel_ok
             q, sigma_p, sigma_v = _noise_by_likelihood(

@@ -4,9 +4,9 @@ A collision-course intruder is detected from an own-ship that flies straight or 
 banked turn, shaken by turbulence (gusts of 1.5 m/s spread and 3 s correlation, smoothed by the
 aircraft's inertia over 0.5 s: accelerations of about 1 m/s^2, moderate turbulence), on a path
 with the residual jitter of the trajectory smoother (1.5 m of smooth position error), while the
-chain knows its own motion only through the ``ga-typical`` navigation (GNSS position and velocity errors, 0.2 s of latency,
-AHRS errors). The detections carry the errors the radar measures with (range 3 m, radial velocity
-0.05 m/s, direction 1 deg). Through the tracker's public entry point
+chain knows its own motion only through the ``ga-typical`` navigation (GNSS position and velocity
+errors, 0.2 s of latency, AHRS errors). The detections carry the errors the radar measures with
+(range 3 m, radial velocity 0.05 m/s, direction 1 deg). Through the tracker's public entry point
 (:func:`skyradar.track.track_table.track_air_detections`, which applies the M-of-N confirmation,
 association gates, the range-Doppler, Doppler-smoothness, direction and static-ground gates), the
 intruder must be confirmed within 1.5 s of its first detection and stay confirmed: a gate that

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from skyradar.cli.app import NON_NEGATIVE, JsonOption, emit_result, experiment_app, number_in
+from skyradar.cli.app import NON_NEGATIVE, JsonOption, check_choice, emit_result, experiment_app, number_in
 from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["experiment_encounters"]
@@ -100,6 +100,14 @@ def experiment_encounters(
     layout: _LAYOUT = "both",
     navigation: _NAVIGATION = "ga-typical",
     rx_layout: _RX_LAYOUT = "square",
+    family: Annotated[
+        str,
+        typer.Option(
+            "--family",
+            help="synthetic (parametric flights) or real-flights (recorded own-ship and intruder "
+            "flights of the 'flights' extra, moved to meet).",
+        ),
+    ] = "synthetic",
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -110,12 +118,17 @@ def experiment_encounters(
     """
     from skyradar.cli.commands_sim import frame_progress
     from skyradar.experiments.encounter_terrain import parse_terrains
-    from skyradar.experiments.encounters import DEFAULT_ENCOUNTERS, DEFAULT_TERRAIN_ENCOUNTERS, run
+    from skyradar.experiments.encounters import DEFAULT_ENCOUNTERS, DEFAULT_TERRAIN_ENCOUNTERS, FAMILIES, run
     from skyradar.io.outputs import check_output, mark_folder
     from skyradar.parallel import check_workers
     from skyradar.rx_layouts import check_rx_layout
 
     check_workers(workers)
+    check_choice("--family", family, FAMILIES)
+    if family == "real-flights":
+        from skyradar.scene.sample_flights import sample_flights
+
+        sample_flights("gliders")  # the 'flights' extra, before any output is made
     terrains, layouts = parse_terrains(terrain), _layouts(layout)
     if n is None:  # over terrain an encounter costs minutes: the default keeps a run within 5 minutes
         n = DEFAULT_ENCOUNTERS if terrains == ["none"] else DEFAULT_TERRAIN_ENCOUNTERS
@@ -130,5 +143,6 @@ def experiment_encounters(
             out, n_encounters=n, seed=seed, frame_rate_hz=frame_rate, buffer=buffer, workers=workers,
             uncertainty=not no_uncertainty, progress=lambda k: bar.update(task, completed=k),
             terrains=tuple(terrains), layouts=layouts, navigation=navigation, rx_layout=rx_layout,
+            family=family,
         )  # fmt: skip
     emit_result(result, as_json, "encounters")

@@ -29,7 +29,15 @@ from skyradar.experiments.encounter_set import (
 from skyradar.experiments.encounter_terrain import mirror_below_ground, own_altitude_m
 from skyradar.scene.scenario import Scenario
 
-__all__ = ["run_encounter", "FRAME_RATE_HZ", "LAYOUTS", "SUPPRESSION"]
+__all__ = [
+    "run_encounter",
+    "score_layout",
+    "layout_heads",
+    "warning_held",
+    "FRAME_RATE_HZ",
+    "LAYOUTS",
+    "SUPPRESSION",
+]
 
 FRAME_RATE_HZ = 9.4  # the prototype's frame rate
 LAYOUTS = ("single", "three-head")
@@ -77,12 +85,29 @@ def _fly_above_ground(
     return (None if alt == nominal else alt), p, rel
 
 
-def _layout_heads(built, layout: str) -> list[str]:
+def layout_heads(built, layout: str) -> list[str]:
+    """The head names of a layout: ``single`` the first (forward) head, ``three-head`` all."""
     names = [h.name for h in built.heads]
     return names[:1] if layout == "single" else names
 
 
-def _score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[str, Any]:
+def warning_held(warn_times_s: np.ndarray, status: pd.DataFrame, t_cpa_s: float) -> tuple[bool, float]:
+    """Whether a warning, once issued, stays on every frame to the closest approach (or to the last
+    frame the intruder is observable before it, when it leaves the beams first), and the longest
+    gap between its frames, s. (True, 0) when never issued."""
+    warn = np.unique(np.asarray(warn_times_s, float))
+    if warn.size == 0:
+        return True, 0.0
+    ft, ok = status["time_s"].to_numpy(float), status["observable"].to_numpy(bool)
+    frames = ft[(ft >= warn[0]) & (ft <= t_cpa_s) & ok]
+    end = float(frames.max()) if frames.size else warn[0]
+    frame_s = float(np.median(np.diff(ft))) if ft.size > 1 else 0.0
+    shown = np.concatenate([warn[warn <= end], [end]]) if end > warn[-1] else warn[warn <= end]
+    gap = float(np.diff(shown).max()) if shown.size > 1 else 0.0
+    return bool(gap <= 1.5 * frame_s + 1e-9), gap
+
+
+def score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[str, Any]:
     """One layout's result row from its tracks and alerts (``chain``) and its heads' truth."""
     tracks, alerts = chain["tracks"], chain["alerts"]
     labels = label_tracks(tracks, truths[0])
@@ -91,6 +116,9 @@ def _score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[
     status = frame_status(truths, opts["fov_deg"], opts["min_snr_db"])
     window = opts["observe_window_s"]
     row = score_encounter(t, rel, warn["time_s"].to_numpy(float)[mine], status, opts["buffer"], window)
+    row["warning_held"], row["warning_gap_max_s"] = warning_held(
+        warn["time_s"].to_numpy(float)[mine], status, row["t_cpa_s"]
+    )
     row["cause"] = unwarned_cause(status, row["t_lowc_s"], row["t_warning_s"], window)
     other = warn["time_s"].to_numpy(float)[~mine]
     own_agl = (
@@ -181,12 +209,12 @@ def run_encounter(
     }
     det, rows = chain["detections"], []
     for layout in layouts:
-        heads = _layout_heads(built, layout)
+        heads = layout_heads(built, layout)
         out = chain
         if len(heads) < len(built.heads):  # a subset of the simulated heads: track and alert again
             out = track_and_alert(det, built, heads, cfg, with_advice=False, truth=chain["truth"])
         truths = [chain["truth_by_head"][h] for h in heads]
-        row = _score_layout(out, truths, built, truth["t"], truth["rel"], opts)
+        row = score_layout(out, truths, built, truth["t"], truth["rel"], opts)
         mine = det["radar"].isin(heads).to_numpy(bool) if "radar" in det else np.ones(len(det), bool)
         row.update(
             layout=layout,

@@ -169,7 +169,10 @@ def summarise_layout(res: pd.DataFrame, late_lead_s: float) -> dict[str, Any]:
     minutes = float(res["flight_s"].sum()) / 60.0
     unwarned = res.loc[conflict & ~in_time, "cause"]
     frag = res.loc[res["intruder_tracks"] > 0, "intruder_tracks"]
+    warned = res["t_warning_s"].notna()
+    held = res["warning_held"].astype(bool) if "warning_held" in res else pd.Series(True, index=res.index)
     s.update(
+        warnings_not_held=int((warned & ~held).sum()),
         warned_before_lowc=int(in_time.sum()),
         warned_before_lowc_fraction=float(in_time.sum() / max(int(conflict.sum()), 1)),
         unwarned_by_cause={c: int((unwarned == c).sum()) for c in CAUSES},

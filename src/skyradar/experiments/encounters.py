@@ -46,6 +46,7 @@ __all__ = [
     "MAX_ENCOUNTERS",
     "DEFAULT_ENCOUNTERS",
     "DEFAULT_TERRAIN_ENCOUNTERS",
+    "FAMILIES",
 ]
 
 MAX_ENCOUNTERS = 100_000  # 200 times the thesis-sized set; more is a typo, not a plan
@@ -53,6 +54,7 @@ DEFAULT_ENCOUNTERS = 20  # clear sky, both layouts (23 CPU-s each), 2 workers: w
 # Over terrain one single-head encounter (395 frames, psf + speckle, suppression on) cost about 160 CPU-s
 # (flat-1000, measured 04:50 UTC at load 3.6 on 56 frames and scaled): 3 per terrain fit 5 minutes on 2 cores.
 DEFAULT_TERRAIN_ENCOUNTERS = 3
+FAMILIES = ("synthetic", "real-flights")
 _PARTIAL = "encounters.partial.parquet"
 _CHUNK = 1  # encounters per worker task (each writes the partial table once): over terrain one costs
 # minutes, so an interrupted run loses at most the encounters in flight
@@ -65,8 +67,12 @@ def _init_worker() -> None:
 
 
 def _run_rows(tasks: list[tuple[str, int, dict]], kw: dict) -> list[tuple[str, int, list[dict]]]:
+    if kw["family"] == "real-flights":
+        from skyradar.experiments.encounter_real import run_real_encounter as one
+    else:
+        one = run_encounter
     return [
-        (terrain, i, run_encounter(pd.Series(p), seed=kw["seed"] + i, terrain=terrain, **kw["options"]))
+        (terrain, i, one(pd.Series(p), seed=kw["seed"] + i, terrain=terrain, **kw["options"]))
         for terrain, i, p in tasks
     ]
 
@@ -79,6 +85,7 @@ def run_encounters(
     done: dict[tuple[str, int], list[dict]] | None = None,
     on_chunk: Callable[[dict], None] | None = None,
     terrains: tuple[str, ...] = ("none",),
+    family: str = "synthetic",
     **options: Any,
 ) -> pd.DataFrame:
     """All encounters (rows of ``params``) over every terrain, ``workers`` processes.
@@ -87,7 +94,8 @@ def run_encounters(
     ``layout``, the encounter's parameters and its result). ``progress`` is called with the number
     of encounters finished; ``done`` holds result rows already computed ({(terrain, i): rows},
     skipped here) and ``on_chunk`` receives all rows so far after each chunk. Options go to
-    :func:`~skyradar.experiments.encounter_chain.run_encounter`.
+    :func:`~skyradar.experiments.encounter_chain.run_encounter` (``family="real-flights"``:
+    :func:`~skyradar.experiments.encounter_real.run_real_encounter`).
     """
     workers = check_workers(workers) or min(2, os.cpu_count() or 1)  # 10**20 spawned until memory ran out
     results: dict[tuple[str, int], list[dict]] = dict(done or {})
@@ -95,7 +103,7 @@ def run_encounters(
     todo = [(tr, i, p) for tr in terrains for i, p in enumerate(records) if (tr, i) not in results]
     size = max(1, min(_CHUNK, len(todo) // (2 * workers)))  # small runs: every worker gets some
     chunks = [todo[k : k + size] for k in range(0, len(todo), size)]
-    kw = {"seed": seed, "options": options}
+    kw = {"seed": seed, "options": options, "family": family}
 
     def finished(rows: list[tuple[str, int, list[dict]]]) -> None:
         results.update({(tr, i): r for tr, i, r in rows})
@@ -180,6 +188,7 @@ def run(
     navigation: str = "ga-typical",
     simulation: dict[str, Any] | None = None,
     rx_layout: str = "square",
+    family: str = "synthetic",
 ) -> dict:
     """Run the encounter set; write ``encounters.parquet``/``.csv`` (one row per terrain, encounter
     and layout), ``summary.json``, ``summary_rows.csv`` and the figures into ``out_dir``; return the
@@ -191,6 +200,9 @@ def run(
     the 25 s warning alerting time) is late. ``navigation`` is the scenarios' ``navigation:`` model;
     ``simulation`` overrides their simulator options (default: PSF, speckle, Swerling 1) and
     ``rx_layout`` names the receive array (:mod:`skyradar.rx_layouts`; default the prototype's square).
+    ``family`` is ``synthetic`` (:func:`~skyradar.experiments.encounter_set.make_encounters`) or
+    ``real-flights`` (:func:`~skyradar.experiments.encounter_real.make_real_encounters`: recorded
+    flights, the ``flights`` extra).
     Finished encounters are kept in ``encounters.partial.parquet`` while the run goes on; a run that
     was interrupted resumes from them when started again with the same settings.
     """
@@ -203,14 +215,21 @@ def run(
     cfg = RADAR_ALERT_CONFIG
     if not uncertainty:
         cfg = replace(cfg, z_h_pos=0.0, z_h_vel=0.0, z_v_pos=0.0, z_v_vel=0.0)
-    enc = make_encounters(n_encounters, seed)
+    if family not in FAMILIES:
+        raise InputError(f"--family: must be one of {', '.join(FAMILIES)}, got {family!r}")
+    if family == "real-flights":
+        from skyradar.experiments.encounter_real import make_real_encounters
+
+        enc = make_real_encounters(n_encounters, seed)
+    else:
+        enc = make_encounters(n_encounters, seed)
     settings = {"n": n_encounters, "seed": seed, "frame_rate_hz": frame_rate_hz, "buffer": buffer,
                 "uncertainty": uncertainty, "terrains": list(terrains), "layouts": list(layouts),
                 "navigation": navigation, "suppression": SUPPRESSION, "late_lead_s": late_lead_s,
-                "simulation": simulation or {}, "rx_layout": rx_layout}  # fmt: skip
+                "simulation": simulation or {}, "rx_layout": rx_layout, "family": family}  # fmt: skip
     done, save = _partial_store(out_dir, {**settings, "version": _version()})
-    res = run_encounters(enc, seed, workers, progress, done, save, terrains=terrains, layouts=layouts,
-                         frame_rate_hz=frame_rate_hz, buffer=buffer, alert_config=cfg,
+    res = run_encounters(enc, seed, workers, progress, done, save, terrains=terrains, family=family,
+                         layouts=layouts, frame_rate_hz=frame_rate_hz, buffer=buffer, alert_config=cfg,
                          navigation=navigation, simulation=simulation, rx_layout=rx_layout)  # fmt: skip
     summary = write_report(res, out_dir, settings, late_lead_s, cfg.levels[-1].alerting_time_s)
     workers = check_workers(workers) or min(2, os.cpu_count() or 1)

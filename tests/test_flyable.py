@@ -299,3 +299,15 @@ def test_skyradar_flight_writes_the_path_and_its_figure(tmp_path):
     assert not (tmp_path / "p2.csv").exists() and not (tmp_path / "p2.txt").exists()
     again = skyradar("flight", "fixes.csv", "-o", "path.csv", cwd=tmp_path)  # never replaced unasked
     assert again.returncode == 2 and "path.csv" in again.stderr
+
+
+def test_an_output_under_a_file_is_refused_before_any_work(tmp_path):
+    (tmp_path / "afile").write_text("not a folder")
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(BASE))
+    for args in (
+        ("simulate", "s.yaml", "-o", "afile/run.zarr"),
+        ("flight", "s.yaml", "-o", "afile/sub/x.csv"),
+    ):
+        result = skyradar(*args, cwd=tmp_path)
+        assert_one_line_error(result, "afile", "is a file, not a folder")
+    assert (tmp_path / "afile").read_text() == "not a folder"

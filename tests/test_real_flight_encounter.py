@@ -90,3 +90,39 @@ def test_a_collision_course_glider_is_warned_early_and_the_warning_held(chain):
     last_seen = float(np.asarray(built.times_s)[visible][-1])
     assert np.diff(warning).max() < 0.25
     assert warning[-1] >= min(t_cpa, last_seen) - 0.25, (warning[-1], t_cpa, last_seen)
+
+
+def test_the_real_flight_family_is_seeded_and_its_geometry_is_flown():
+    from skyradar.daa.conflict import WellClearVolume
+    from skyradar.experiments.encounter_real import make_real_encounters, real_pair
+    from skyradar.scene.encounter_from_tracks import horizontal_cpa
+
+    a, b = make_real_encounters(6, seed=3), make_real_encounters(6, seed=3)
+    pd.testing.assert_frame_equal(a, b)
+    vol = WellClearVolume.do365_noncoop()
+    assert (a["horizontal_miss_m"] <= 3.0 * vol.dthr_m).all() and (
+        a["vertical_miss_m"].abs() <= 3 * vol.zthr_m
+    ).all()
+    for _, p in a.head(3).iterrows():
+        own, intruder = real_pair(p)
+        t, h_m, v_m = horizontal_cpa(own, intruder, window=(60.0, 130.0))
+        # The drawn miss is met at the meeting time, unless the flights turn there (then their real
+        # closest approach is nearby: what the scenario flies is what is scored).
+        assert abs(t - 120.0) < 15.0 and h_m <= p["horizontal_miss_m"] + 1.0
+        speed = np.linalg.norm(own.sample(np.arange(0.0, 130.0)).velocity_ned_mps, axis=1)
+        assert speed.min() >= 35.0 and speed.max() <= 90.0  # the stretches are chosen at GA speeds
+
+
+def test_a_warning_is_held_only_when_no_frame_drops_it():
+    from skyradar.experiments.encounter_chain import warning_held
+
+    ft = np.arange(0.0, 20.0, 0.1)
+    status = pd.DataFrame({"time_s": ft, "observable": ft < 18.0})  # leaves the beams at 18 s
+    continuous = ft[(ft >= 5.0) & (ft < 18.0)]
+    assert warning_held(continuous, status, t_cpa_s=19.0) == (True, pytest.approx(0.1))
+    dropped = continuous[(continuous < 9.0) | (continuous > 10.0)]  # a second without it
+    held, gap = warning_held(dropped, status, t_cpa_s=19.0)
+    assert not held and gap == pytest.approx(1.2, abs=0.01)  # 8.9 s to 10.1 s
+    ended_early = continuous[continuous < 12.0]  # gone 6 s before the intruder left the beams
+    assert not warning_held(ended_early, status, t_cpa_s=19.0)[0]
+    assert warning_held(np.array([]), status, t_cpa_s=19.0) == (True, 0.0)

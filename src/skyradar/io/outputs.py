@@ -166,6 +166,11 @@ def check_output(
     label = f"{option} {path}"
     if path.name.endswith((".partial", ".partial.done")):
         raise InputError(f"{label}: a '.partial' name is a run being written, not an output; name a new path")
+    for parent in path.absolute().parents:  # a file where a folder must be: refused before any work
+        if parent.exists():
+            if not parent.is_dir():
+                raise InputError(f"{label}: {parent} is a file, not a folder; name another output")
+            break
     out = _resolved(path)
     _check_not_input(out, inputs, label)
     _check_not_precious(out, label, kind)

@@ -288,11 +288,12 @@ def aircraft_from_adsb(
     """Aircraft from an ADS-B/track file (CSV, Parquet, JSON; see :mod:`skyradar.scene.adsb`).
 
     With ``start_time`` and absolute timestamps in the file, recording time 0 is ``start_time``;
-    otherwise it is the file's first timestamp.
+    otherwise it is the file's first timestamp. An ATC radar's traffic is of every type: each
+    aircraft's path is built within the ``any`` class's limits (:mod:`skyradar.scene.flyable`).
     """
     from skyradar.scene.adsb import read_trajectories
 
-    trajectories = read_trajectories(path, origin=receiver.geodetic)
+    trajectories = read_trajectories(path, origin=receiver.geodetic, aircraft_class="any")
     out = []
     for traj in trajectories.values():
         offset = 0.0

@@ -14,16 +14,22 @@ between fixes is bridged with the gentlest motion that joins them. Its rules:
 
 * a fix whose position repeats the previous one while the aircraft moves is stale (the receiver
   repeated the last position it had) and is dropped;
+* a fix out of reach of the flight around it at the class's top speed is dropped (a bad decode, or
+  a jump the aircraft cannot have flown);
 * a common lag of the positions behind the reported velocities (the time misalignment of the
   position messages) is estimated by least squares, ``r_i = -v_i * lag`` with ``r_i`` a fix's offset
-  from the smoothed path, and the fixes are re-timed when the lag is significant;
-* the measurement noise is measured, not assumed: the robust spread (1.4826 MAD) of the fixes about
-  the smoothed path, never below the ADS-B quantisation;
-* fixes more than 5 of those spreads (and 30 m) off the path cannot be reconciled with it and are
-  dropped, up to :data:`MAX_DROPPED_SHARE` of the file; a file with more is refused;
-* the process noise starts where the class's accelerations allow and is lowered until the path's
-  acceleration, everywhere between its samples, stays within the class's limits
-  (:class:`KinematicLimits`); a file that no path within the limits fits is refused.
+  from the smoothed path, refined over a few passes, and the fixes are re-timed when it is
+  significant; on a straight leg no lag shows (the lagged fixes lie on the same line);
+* the noise is measured, not assumed: the process noise and the position and velocity errors are
+  those that make the kept fixes most likely (the filter's innovation likelihood, a grid search;
+  the horizontal axes share theirs);
+* fixes more than 5 spreads (and 30 m) off the path cannot be reconciled with it and are dropped;
+* a file whose track column is far off its positions' course keeps its ground speed, carried along
+  the path's own direction, refined with each pass;
+* the process noise is lowered until the path's acceleration, everywhere between its samples, stays
+  within the class's limits (:class:`KinematicLimits`), and a fix that only a path faster than the
+  class can fly reaches (across a gap) is dropped;
+* a file that loses more than :data:`MAX_DROPPED_SHARE` of its fixes is refused.
 
 Every repair is returned as a note naming the fixes (rows of the file), which the readers print as
 one line per file. :func:`kinematic_violation` checks any trajectory against the limits; the scenario
@@ -108,8 +114,6 @@ AIRCRAFT_CLASSES: dict[str, KinematicLimits] = {
 MAX_DROPPED_SHARE = 0.25  # a file that loses more of its fixes than this is not one aircraft's flight
 _STALE_M = 0.5  # a position repeated within this while the aircraft moves is a repeat, not a fix, m
 _MOVING_MPS = 5.0
-_MIN_POSITION_SIGMA_M = (5.0, 5.0, 4.0)  # ADS-B position quantisation (~5 m) and 25 ft altitude steps
-_MIN_VELOCITY_SIGMA_MPS = (0.5, 0.5, 0.3)  # 1 kt and 64 ft/min reporting steps
 _OUTLIER_SPREADS = 5.0
 _OUTLIER_FLOOR_M = 30.0
 _SIGNIFICANT_LAG_S = 0.2

@@ -30,6 +30,7 @@ from skyradar.experiments.encounter_terrain import mirror_below_ground, own_alti
 from skyradar.scene.scenario import Scenario
 
 __all__ = [
+    "chain_rows",
     "run_encounter",
     "score_layout",
     "layout_heads",
@@ -194,18 +195,35 @@ def run_encounter(
     ``simulation`` overrides the scenario's simulator options and ``rx_layout`` names every head's
     receive array (:func:`~skyradar.experiments.encounter_set.encounter_scenario`).
     """
-    from skyradar.experiments.daa_chain import track_and_alert
-
     cfg = alert_config or RADAR_ALERT_CONFIG
     spec_args = (p, seed, frame_rate_hz, lookback_s, terrain, layouts, navigation, simulation, rx_layout)
     built, truth, shared = _scenario(*spec_args)
-    chain = run_chain(built, cfg, with_advice=False, process_options={"suppression": SUPPRESSION})
-    shared.update({f"{k}_s": float(v) for k, v in chain["timings_s"].items() if k in ("simulate", "process")})
     opts = {
         "fov_deg": fov_deg,
         "min_snr_db": min_snr_db,
         "observe_window_s": observe_window_s,
         "buffer": buffer,
+    }
+    return chain_rows(built, truth["t"], truth["rel"], shared, layouts, cfg, opts)
+
+
+def chain_rows(
+    built,
+    t: np.ndarray,
+    rel: np.ndarray,
+    shared: dict,
+    layouts: tuple[str, ...],
+    cfg: AlertConfig,
+    opts: dict,
+) -> list[dict[str, Any]]:
+    """Simulate and process ``built`` once, then track, alert and score each layout's heads: one row
+    per layout (:func:`score_layout` with ``opts``, the ``shared`` columns and the stage timings).
+    ``t`` and ``rel`` are the dense relative truth the encounter is scored on."""
+    from skyradar.experiments.daa_chain import track_and_alert
+
+    chain = run_chain(built, cfg, with_advice=False, process_options={"suppression": SUPPRESSION})
+    shared = shared | {
+        f"{k}_s": float(v) for k, v in chain["timings_s"].items() if k in ("simulate", "process")
     }
     det, rows = chain["detections"], []
     for layout in layouts:
@@ -214,13 +232,9 @@ def run_encounter(
         if len(heads) < len(built.heads):  # a subset of the simulated heads: track and alert again
             out = track_and_alert(det, built, heads, cfg, with_advice=False, truth=chain["truth"])
         truths = [chain["truth_by_head"][h] for h in heads]
-        row = score_layout(out, truths, built, truth["t"], truth["rel"], opts)
+        row = score_layout(out, truths, built, t, rel, opts)
         mine = det["radar"].isin(heads).to_numpy(bool) if "radar" in det else np.ones(len(det), bool)
-        row.update(
-            layout=layout,
-            detections=int(mine.sum()),
-            **shared,
-            **{f"{k}_s": float(v) for k, v in out["timings_s"].items() if k in ("track", "alert")},
-        )
+        timings = {f"{k}_s": float(v) for k, v in out["timings_s"].items() if k in ("track", "alert")}
+        row.update(layout=layout, detections=int(mine.sum()), **shared, **timings)
         rows.append(row)
     return rows

@@ -25,8 +25,7 @@ import pandas as pd
 
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig
 from skyradar.daa.conflict import WellClearVolume
-from skyradar.experiments.daa_chain import run_chain, track_and_alert
-from skyradar.experiments.encounter_chain import FRAME_RATE_HZ, SUPPRESSION, layout_heads, score_layout
+from skyradar.experiments.encounter_chain import FRAME_RATE_HZ, chain_rows
 from skyradar.experiments.encounter_set import T_CPA_S, event_times
 from skyradar.experiments.encounter_terrain import mirror_below_ground, own_altitude_m, site
 from skyradar.scene.adsb import fit_flight
@@ -230,7 +229,6 @@ def run_real_encounter(
                 intruder_at = _placed(intruder, where["origin"], -alt)
                 rel = rel * [1.0, 1.0, -1.0]
         built = Scenario.from_dict(_spec(p, where, folder, own_at, intruder_at, *args)).build()
-    chain = run_chain(built, cfg, with_advice=False, process_options={"suppression": SUPPRESSION})
     shared = {
         "frames": int(built.times_s.size),
         "t_start_s": start,
@@ -239,23 +237,10 @@ def run_real_encounter(
         "vertical_miss_flown_m": float(-rel[np.argmin(np.linalg.norm(rel, axis=1)), 2]),
         "own_altitude_m": float(alt),
     }
-    shared.update({f"{k}_s": float(v) for k, v in chain["timings_s"].items() if k in ("simulate", "process")})
     opts = {
         "fov_deg": fov_deg,
         "min_snr_db": min_snr_db,
         "observe_window_s": observe_window_s,
         "buffer": buffer,
     }
-    det, rows = chain["detections"], []
-    for layout in layouts:
-        heads = layout_heads(built, layout)
-        out = chain
-        if len(heads) < len(built.heads):
-            out = track_and_alert(det, built, heads, cfg, with_advice=False, truth=chain["truth"])
-        truths = [chain["truth_by_head"][h] for h in heads]
-        row = score_layout(out, truths, built, t, rel, opts)
-        mine = det["radar"].isin(heads).to_numpy(bool) if "radar" in det else np.ones(len(det), bool)
-        timings = {f"{k}_s": float(v) for k, v in out["timings_s"].items() if k in ("track", "alert")}
-        row.update(layout=layout, detections=int(mine.sum()), **shared, **timings)
-        rows.append(row)
-    return rows
+    return chain_rows(built, t, rel, shared, layouts, cfg, opts)

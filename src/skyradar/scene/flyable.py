@@ -255,58 +255,15 @@ def kinematic_violation(
 
 
 @njit(cache=True)
-def _rts_axis(t, z_pos, r_pos, z_vel, r_vel, q):  # pragma: no cover - compiled
-    """Smoothed (position, velocity) of one axis: forward Kalman filter, then the RTS pass back."""
+def _forward(t, z_pos, r_pos, z_vel, r_vel, q):  # pragma: no cover - compiled
+    """One axis' Kalman filter (position, velocity; white-noise acceleration of density ``q``) with
+    scalar updates: filtered and predicted states and covariances, and the measurements'
+    log-likelihood (the first position only starts the filter). NaN measurements are skipped."""
     n = t.size
     xf = np.zeros((n, 2))
     pf = np.zeros((n, 2, 2))
     xp = np.zeros((n, 2))
     pp = np.zeros((n, 2, 2))
-    x = np.zeros(2)
-    p = np.zeros((2, 2))
-    first = 0
-    while first < n and not np.isfinite(z_pos[first]):
-        first += 1
-    x[0] = z_pos[first] if first < n else 0.0
-    p[0, 0] = 1e8
-    p[1, 1] = 1e6
-    f = np.eye(2)
-    qk = np.empty((2, 2))
-    for k in range(n):
-        if k > 0:
-            dt = t[k] - t[k - 1]
-            f[0, 1] = dt
-            x = f @ x
-            qk[0, 0] = dt**3 / 3.0
-            qk[0, 1] = dt**2 / 2.0
-            qk[1, 0] = dt**2 / 2.0
-            qk[1, 1] = dt
-            p = f @ p @ f.T + q * qk
-        xp[k] = x
-        pp[k] = p
-        for j in range(2):
-            z = z_pos[k] if j == 0 else z_vel[k]
-            r = r_pos[k] if j == 0 else r_vel[k]
-            if np.isfinite(z):
-                s = p[j, j] + r
-                gain = p[:, j] / s
-                x = x + gain * (z - x[j])
-                p = p - np.outer(gain, p[j, :])
-                p = 0.5 * (p + p.T)
-        xf[k] = x
-        pf[k] = p
-    xs = xf.copy()
-    for k in range(n - 2, -1, -1):
-        f[0, 1] = t[k + 1] - t[k]
-        c = pf[k] @ f.T @ np.linalg.inv(pp[k + 1])
-        xs[k] = xf[k] + c @ (xs[k + 1] - xp[k + 1])
-    return xs
-
-
-@njit(cache=True)
-def _log_likelihood(t, z_pos, r_pos, z_vel, r_vel, q):  # pragma: no cover - compiled
-    """Log-likelihood of one axis' measurements under the model (forward filter, scalar updates)."""
-    n = t.size
     x = np.zeros(2)
     p = np.zeros((2, 2))
     first = 0
@@ -327,19 +284,36 @@ def _log_likelihood(t, z_pos, r_pos, z_vel, r_vel, q):  # pragma: no cover - com
             p[0, 1] += q * dt**2 / 2.0
             p[1, 0] += q * dt**2 / 2.0
             p[1, 1] += q * dt
+        xp[k] = x
+        pp[k] = p
         for j in range(2):
             z = z_pos[k] if j == 0 else z_vel[k]
-            r = r_pos if j == 0 else r_vel
+            r = r_pos[k] if j == 0 else r_vel[k]
             if np.isfinite(z):
                 s = p[j, j] + r
                 innovation = z - x[j]
-                if k > first:  # the first position only starts the filter
+                if k > first:
                     total -= 0.5 * (np.log(2.0 * np.pi * s) + innovation * innovation / s)
                 gain = p[:, j] / s
                 x = x + gain * innovation
                 p = p - np.outer(gain, p[j, :])
                 p = 0.5 * (p + p.T)
-    return total
+        xf[k] = x
+        pf[k] = p
+    return xf, pf, xp, pp, total
+
+
+@njit(cache=True)
+def _rts_axis(t, z_pos, r_pos, z_vel, r_vel, q):  # pragma: no cover - compiled
+    """Smoothed (position, velocity) of one axis: :func:`_forward`, then the RTS pass back."""
+    xf, pf, xp, pp, _total = _forward(t, z_pos, r_pos, z_vel, r_vel, q)
+    f = np.eye(2)
+    xs = xf.copy()
+    for k in range(t.size - 2, -1, -1):
+        f[0, 1] = t[k + 1] - t[k]
+        c = pf[k] @ f.T @ np.linalg.inv(pp[k + 1])
+        xs[k] = xf[k] + c @ (xs[k + 1] - xp[k + 1])
+    return xs
 
 
 def _noise_by_likelihood(
@@ -368,7 +342,8 @@ def _noise_by_likelihood(
         for q in q_grid:
             for sp in sp_grid:
                 for sv in sv_grid:
-                    ll = sum(_log_likelihood(times, zp, sp**2, zv, sv**2, q[axes[0]]) for zp, zv in z)
+                    r_p, r_v = np.full(times.size, sp**2), np.full(times.size, sv**2)
+                    ll = sum(_forward(times, zp, r_p, zv, r_v, q[axes[0]])[4] for zp, zv in z)
                     if ll > best:
                         best = ll
                         best_q[list(axes)] = q[axes[0]]

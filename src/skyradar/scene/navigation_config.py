@@ -108,8 +108,12 @@ def with_preset(value: Any) -> Any:
     return _preset(name) | {"model": name} | dict(value)
 
 
-_NonNeg = Field(ge=0.0, allow_inf_nan=False)
-_Tau = Field(gt=0.0, allow_inf_nan=False)
+def _up_to(high: float) -> Any:
+    return Field(ge=0.0, le=high, allow_inf_nan=False)
+
+
+def _tau() -> Any:
+    return Field(gt=0.0, le=1e6, allow_inf_nan=False)  # correlation times up to about 12 days, s
 
 
 class NavigationConfig(BaseModel):
@@ -118,21 +122,24 @@ class NavigationConfig(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
     model: ModelName = "ga-typical"
     seed: int | None = Field(None, ge=0)  # None: the scenario's simulation.seed
-    gnss_horizontal_bias_m: float = _NonNeg
-    gnss_horizontal_noise_m: float = _NonNeg
-    gnss_vertical_bias_m: float = _NonNeg
-    gnss_vertical_noise_m: float = _NonNeg
-    gnss_position_tau_s: float = _Tau
-    gnss_velocity_noise_mps: float = _NonNeg
-    gnss_vertical_velocity_noise_mps: float = _NonNeg
-    gnss_velocity_bias_mps: float = _NonNeg
-    gnss_velocity_tau_s: float = _Tau
-    roll_pitch_noise_deg: float = _NonNeg
-    roll_pitch_bias_deg: float = _NonNeg
-    roll_pitch_tau_s: float = _Tau
-    heading_noise_deg: float = _NonNeg
-    heading_bias_deg: float = _NonNeg
-    heading_tau_s: float = _Tau
+    # Plausible ranges: the errors of working avionics. Beyond them the model describes a failed
+    # sensor (a GNSS bias of kilometres, a heading off by tens of degrees), which is a different study
+    # (skyradar gpscheck's spoofing options), and a slip of units (mm for m) would silently blind the chain.
+    gnss_horizontal_bias_m: float = _up_to(100.0)
+    gnss_horizontal_noise_m: float = _up_to(50.0)
+    gnss_vertical_bias_m: float = _up_to(150.0)
+    gnss_vertical_noise_m: float = _up_to(50.0)
+    gnss_position_tau_s: float = _tau()
+    gnss_velocity_noise_mps: float = _up_to(5.0)
+    gnss_vertical_velocity_noise_mps: float = _up_to(5.0)
+    gnss_velocity_bias_mps: float = _up_to(5.0)
+    gnss_velocity_tau_s: float = _tau()
+    roll_pitch_noise_deg: float = _up_to(10.0)
+    roll_pitch_bias_deg: float = _up_to(10.0)
+    roll_pitch_tau_s: float = _tau()
+    heading_noise_deg: float = _up_to(20.0)
+    heading_bias_deg: float = _up_to(30.0)
+    heading_tau_s: float = _tau()
     gnss_latency_s: float = Field(ge=0.0, le=5.0, allow_inf_nan=False)
     ahrs_latency_s: float = Field(ge=0.0, le=5.0, allow_inf_nan=False)
 

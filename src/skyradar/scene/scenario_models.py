@@ -163,12 +163,22 @@ def _mount_shorthand(value: Any) -> Any:
     return {"preset": value} if isinstance(value, str) else value
 
 
+# Where a radar head sits on the aircraft (body frame forward, right, down, m): within 30 m of the
+# reference point, the size of the largest aircraft a GA radar flies on; a value beyond is a slip of
+# units (mm for m), which would put the head kilometres from the aircraft.
+LeverArm = tuple[
+    Annotated[float, Field(ge=-30.0, le=30.0, allow_inf_nan=False)],
+    Annotated[float, Field(ge=-30.0, le=30.0, allow_inf_nan=False)],
+    Annotated[float, Field(ge=-30.0, le=30.0, allow_inf_nan=False)],
+]
+
+
 class MountModel(_Model):
     """A preset name, optionally with fields changed, or an explicit placement."""
 
     preset: str | None = None
-    position_m: Vector3 | None = None
-    lever_arm_m: Vector3 | None = None  # the same as position_m (body frame forward, right, down, m)
+    position_m: LeverArm | None = None
+    lever_arm_m: LeverArm | None = None  # the same as position_m (body frame forward, right, down, m)
     yaw_deg: Finite | None = None
     pitch_deg: Finite | None = None
     roll_deg: Finite | None = None

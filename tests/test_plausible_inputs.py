@@ -1,0 +1,66 @@
+"""Physical inputs outside their plausible range are refused in one line, through the entry point.
+
+A radar head's lever arm is within 30 m of the aircraft's reference point and navigation errors are
+those of working avionics; a value beyond is a slip of units or a failed sensor, and run silently it
+blinds the chain (aircraft placed kilometres up, no detection, no warning).
+"""
+
+from __future__ import annotations
+
+import pytest
+import yaml
+
+from cli_helpers import assert_one_line_error, skyradar
+
+BASE = {
+    "name": "plausible",
+    "origin": {"lat_deg": 52.5, "lon_deg": 4.36, "alt_m": 0.0},
+    "duration_s": 1.0,
+    "frame_rate_hz": 5.0,
+    "ownship": {"type": "straight", "start_ned_m": [0, 0, -1000], "heading_deg": 0, "speed_mps": 50},
+}
+
+REFUSED = [
+    ({"mount": {"preset": "forward", "lever_arm_m": [1.0e9, 0.0, 0.0]}}, "mount.lever_arm_m.0", "<= 30"),
+    ({"mount": {"preset": "forward", "position_m": [0.0, -45.0, 0.0]}}, "mount.position_m.1", ">= -30"),
+    (
+        {"radars": [{"name": "nose", "mount": {"preset": "forward", "lever_arm_m": [2.0, 0.0, 1000.0]}}]},
+        "radars.0.mount.lever_arm_m.2",
+        "<= 30",
+    ),
+    (
+        {"navigation": {"model": "ga-typical", "heading_bias_deg": 1.0e6}},
+        "navigation.heading_bias_deg",
+        "<= 30",
+    ),
+    (
+        {"navigation": {"model": "ga-typical", "gnss_horizontal_bias_m": 1.0e7}},
+        "gnss_horizontal_bias_m",
+        "<= 100",
+    ),
+    (
+        {"navigation": {"model": "perfect", "gnss_velocity_noise_mps": 50.0}},
+        "gnss_velocity_noise_mps",
+        "<= 5",
+    ),
+]
+
+
+@pytest.mark.parametrize(("change", "field", "bound"), REFUSED)
+def test_implausible_physical_inputs_are_refused(tmp_path, change, field, bound):
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump({**BASE, **change}))
+    result = skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
+    assert_one_line_error(result, "s.yaml", field, bound)
+    assert not (tmp_path / "run.zarr").exists()
+
+
+def test_plausible_values_at_the_edge_are_accepted(tmp_path):
+    from skyradar.scene.scenario import load_scenario
+
+    change = {
+        "mount": {"preset": "forward", "lever_arm_m": [29.0, -12.0, 1.5]},
+        "navigation": {"model": "ga-typical", "heading_bias_deg": 30.0, "gnss_horizontal_bias_m": 100.0},
+    }
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump({**BASE, **change}))
+    built = load_scenario(tmp_path / "s.yaml").build()
+    assert tuple(built.heads[0].config.mount.position_m) == (29.0, -12.0, 1.5)

@@ -25,11 +25,12 @@ import pandas as pd
 
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig
 from skyradar.daa.conflict import WellClearVolume
+from skyradar.errors import InputError
 from skyradar.experiments.encounter_chain import FRAME_RATE_HZ, chain_rows
 from skyradar.experiments.encounter_set import T_CPA_S, event_times
 from skyradar.experiments.encounter_terrain import mirror_below_ground, own_altitude_m, site
 from skyradar.scene.adsb import fit_flight
-from skyradar.scene.encounter_from_tracks import encounter_from_tracks, trajectory_table
+from skyradar.scene.encounter_from_tracks import encounter_from_tracks, horizontal_cpa, trajectory_table
 from skyradar.scene.sample_flights import sample_flight
 from skyradar.scene.scenario import Scenario
 from skyradar.scene.trajectories import Trajectory
@@ -56,6 +57,8 @@ _OWN_SPEED_MPS = (35.0, 90.0)  # a GA own-ship's speeds over the stretch
 _INTRUDER_SPEED_MPS = (15.0, 90.0)
 _MAX_FIX_GAP_S = 20.0  # a stretch whose fixes leave a longer gap is a guess there, not a recording
 _CANDIDATE_STEP_S = 10.0
+_CPA_TOLERANCE_S = 10.0
+_MAX_DRAWS = 50
 
 
 @lru_cache(maxsize=16)
@@ -89,35 +92,44 @@ def make_real_encounters(n: int, seed: int = 0) -> pd.DataFrame:
     ``intruder_class``, ``intruder_time_s`` (each flight's time, s from its start, that is moved to
     the closest approach), ``horizontal_miss_m``, ``vertical_miss_m``, ``rotate_deg`` (the
     intruder's flight turned about the vertical), ``side``, ``rcs_m2``.
+
+    Real flights turn: moved to pass at a miss at ``T_CPA_S``, two of them may come closer at
+    another time. An encounter is what its closest approach is, so a draw whose closest approach
+    is more than :data:`_CPA_TOLERANCE_S` from ``T_CPA_S`` (where the frame window cannot hold the
+    approach to it) is drawn again.
     """
     rng = np.random.default_rng(seed)
     vol = WellClearVolume.do365_noncoop()
-    inside = rng.random(n) < 1 / 3
-    h = np.where(inside, rng.uniform(0, 0.9 * vol.dthr_m, n), rng.uniform(0, 3.0 * vol.dthr_m, n))
-    v = np.where(inside, rng.uniform(0, 0.9 * vol.zthr_m, n), rng.uniform(0, 3.0 * vol.zthr_m, n))
-    spread = ~inside & (rng.random(n) < 0.5)
-    v[spread] = rng.uniform(0, 0.9 * vol.zthr_m, spread.sum())
     rows = []
     for k in range(n):
         own = OWN_FLIGHTS[k % len(OWN_FLIGHTS)]
-        intruder, klass = INTRUDER_FLIGHTS[rng.integers(len(INTRUDER_FLIGHTS))]
-        own_times = _meeting_times(own, "ga", _OWN_SPEED_MPS)
-        intruder_times = _meeting_times(intruder, klass, _INTRUDER_SPEED_MPS)
-        rows.append(
-            {
+        inside = rng.random() < 1 / 3  # a third inside the volume, the rest near misses out to 3x it
+        h = rng.uniform(0, 0.9 * vol.dthr_m) if inside else rng.uniform(0, 3.0 * vol.dthr_m)
+        v = rng.uniform(0, 0.9 * vol.zthr_m) if inside else rng.uniform(0, 3.0 * vol.zthr_m)
+        if not inside and rng.random() < 0.5:
+            v = rng.uniform(0, 0.9 * vol.zthr_m)
+        for _draw in range(_MAX_DRAWS):
+            intruder, klass = INTRUDER_FLIGHTS[rng.integers(len(INTRUDER_FLIGHTS))]
+            row = {
                 "kind": "real",
                 "own_flight": own,
-                "own_time_s": float(rng.choice(own_times)),
+                "own_time_s": float(rng.choice(_meeting_times(own, "ga", _OWN_SPEED_MPS))),
                 "intruder_flight": intruder,
                 "intruder_class": klass,
-                "intruder_time_s": float(rng.choice(intruder_times)),
-                "horizontal_miss_m": float(max(h[k], 1.0)),
-                "vertical_miss_m": float(v[k] * rng.choice([-1.0, 1.0])),
+                "intruder_time_s": float(rng.choice(_meeting_times(intruder, klass, _INTRUDER_SPEED_MPS))),
+                "horizontal_miss_m": float(max(h, 1.0)),
+                "vertical_miss_m": float(v * rng.choice([-1.0, 1.0])),
                 "rotate_deg": float(rng.uniform(0.0, 360.0)),
                 "side": str(rng.choice(["left", "right"])),
                 "rcs_m2": float(np.exp(rng.uniform(np.log(1.0), np.log(5.0)))),
             }
-        )
+            own_path, intruder_path = real_pair(pd.Series(row))
+            t_cpa, _h, _v = horizontal_cpa(own_path, intruder_path, window=(0.0, T_CPA_S + _AFTER_S))
+            if abs(t_cpa - T_CPA_S) <= _CPA_TOLERANCE_S:
+                break
+        else:
+            raise InputError(f"real-flight encounter {k}: no draw of {_MAX_DRAWS} meets near {T_CPA_S:g} s")
+        rows.append(row)
     return pd.DataFrame(rows)
 
 

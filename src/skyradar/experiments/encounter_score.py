@@ -169,7 +169,9 @@ def summarise_layout(res: pd.DataFrame, late_lead_s: float) -> dict[str, Any]:
     minutes = float(res["flight_s"].sum()) / 60.0
     unwarned = res.loc[conflict & ~in_time, "cause"]
     frag = res.loc[res["intruder_tracks"] > 0, "intruder_tracks"]
-    warned = res["t_warning_s"].notna()
+    # A warning must hold to the closest approach where well clear is lost; for a near miss it may
+    # end once the intruder's path shows it passes clear (a manoeuvring intruder turns away).
+    warned = res["t_warning_s"].notna() & conflict
     held = res["warning_held"].astype(bool) if "warning_held" in res else pd.Series(True, index=res.index)
     s.update(
         warnings_not_held=int((warned & ~held).sum()),

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import Annotated
 
@@ -120,6 +121,7 @@ def experiment_encounters(
     from skyradar.experiments.encounter_terrain import parse_terrains
     from skyradar.experiments.encounters import DEFAULT_ENCOUNTERS, DEFAULT_TERRAIN_ENCOUNTERS, FAMILIES, run
     from skyradar.io.outputs import check_output, mark_folder
+    from skyradar.io.tables import write_json_atomic
     from skyradar.parallel import check_workers
     from skyradar.rx_layouts import check_rx_layout
 
@@ -145,4 +147,8 @@ def experiment_encounters(
             terrains=tuple(terrains), layouts=layouts, navigation=navigation, rx_layout=rx_layout,
             family=family,
         )  # fmt: skip
+    result["command"] = "skyradar " + " ".join(
+        sys.argv[1:]
+    )  # provenance: what was run, beside version and date
+    write_json_atomic(out / "summary.json", result)
     emit_result(result, as_json, "encounters")

@@ -234,7 +234,12 @@ def run(
     summary = write_report(res, out_dir, settings, late_lead_s, cfg.levels[-1].alerting_time_s)
     workers = check_workers(workers) or min(2, os.cpu_count() or 1)
     summary.update(
-        resumed_encounters=len(done), workers=workers, runtime_s=round(time.perf_counter() - t0, 1)
+        resumed_encounters=len(done),
+        workers=workers,
+        runtime_s=round(time.perf_counter() - t0, 1),
+        version=_version(),
+        date_utc=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+        load_average_1min=round(os.getloadavg()[0], 2),
     )
     write_json_atomic(out_dir / "summary.json", summary)
     for name in (_PARTIAL, _PARTIAL + ".json"):

@@ -222,7 +222,7 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
     settings = {"n": 2, "seed": 5, "frame_rate_hz": 4.7, "buffer": 1.5, "uncertainty": True,
                 "terrains": ["none"], "layouts": ["single"], "navigation": "ga-typical",
                 "suppression": "auto", "late_lead_s": 12.5, "simulation": LIGHT,
-                "rx_layout": "square"}  # fmt: skip
+                "rx_layout": "square", "family": "synthetic"}  # fmt: skip
     key = {**settings, "version": E._version()}
     _, save = E._partial_store(tmp_path, key)
     fake = {"t_lowc_s": np.nan, "t_cpa_s": 120.0, "conflict": False, "may_alert": False,
@@ -246,6 +246,7 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
     assert E._partial_store(tmp_path, {**key, "seed": 6})[0] == {}
     assert E._partial_store(tmp_path, {**key, "navigation": "perfect"})[0] == {}
     assert E._partial_store(tmp_path, {**key, "rx_layout": "kite"})[0] == {}
+    assert E._partial_store(tmp_path, {**key, "family": "real-flights"})[0] == {}
 
 
 def test_flat_terrain_variant_puts_ground_under_the_whole_window():

@@ -29,6 +29,7 @@ from skyradar.errors import InputError
 from skyradar.experiments.encounter_chain import FRAME_RATE_HZ, chain_rows
 from skyradar.experiments.encounter_set import T_CPA_S, event_times
 from skyradar.experiments.encounter_terrain import mirror_below_ground, own_altitude_m, site
+from skyradar.io.atomic import write_csv_atomic
 from skyradar.scene.adsb import fit_flight
 from skyradar.scene.encounter_from_tracks import encounter_from_tracks, horizontal_cpa, trajectory_table
 from skyradar.scene.sample_flights import sample_flight
@@ -157,8 +158,8 @@ def _placed(traj: Trajectory, origin: dict, down_m: float) -> Trajectory:
 
 
 def _spec(p, where, folder: Path, own, intruder, start, duration, frame_rate_hz, seed, radars, navigation):
-    trajectory_table(own).to_csv(folder / "own.csv", index=False)
-    trajectory_table(intruder).to_csv(folder / "intruder.csv", index=False)
+    write_csv_atomic(trajectory_table(own), folder / "own.csv", index=False)
+    write_csv_atomic(trajectory_table(intruder), folder / "intruder.csv", index=False)
     spec = {
         "name": f"real: {p['own_flight']} meets {p['intruder_flight']}",
         "origin": where["origin"],

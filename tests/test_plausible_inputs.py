@@ -7,6 +7,7 @@ blinds the chain (aircraft placed kilometres up, no detection, no warning).
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 import yaml
 
@@ -64,3 +65,44 @@ def test_plausible_values_at_the_edge_are_accepted(tmp_path):
     (tmp_path / "s.yaml").write_text(yaml.safe_dump({**BASE, **change}))
     built = load_scenario(tmp_path / "s.yaml").build()
     assert tuple(built.heads[0].config.mount.position_m) == (29.0, -12.0, 1.5)
+
+
+def _tif(path, z):
+    import rasterio
+
+    with rasterio.open(
+        path,
+        "w",
+        driver="GTiff",
+        height=z.shape[0],
+        width=z.shape[1],
+        count=1,
+        dtype=z.dtype,
+        crs="EPSG:4326",
+        transform=rasterio.Affine(0.001, 0.0, 4.33, 0.0, -0.001, 52.53),
+    ) as ds:  # fmt: skip  (no nodata declared, as in many downloads)
+        ds.write(z, 1)
+
+
+def test_an_undeclared_no_data_block_in_a_geotiff_is_not_read_as_terrain(tmp_path):
+    rows, cols = np.mgrid[0:60, 0:80]
+    z = (5.0 + 0.1 * rows + 0.05 * cols).astype(np.float32)
+    z[10:30, 10:40] = -3.4e38  # 12.5 % of the tile: a no-data block the file does not declare
+    _tif(tmp_path / "dem.tif", z)
+    scenario = {**BASE, "terrain": {"type": "file", "path": "dem.tif"}}
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(scenario))
+    result = skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
+    assert_one_line_error(result, "dem.tif", "-3.4e+38", "outside the land surface", "does not declare")
+    assert not (tmp_path / "run.zarr").exists()
+
+
+def test_a_few_undeclared_no_data_samples_are_filled_as_voids():
+    from skyradar.scene.dem_readers import terrain_from_arrays
+
+    rows, cols = np.mgrid[0:60, 0:80]
+    z = 5.0 + 0.1 * rows + 0.05 * cols
+    bad = z.copy()
+    bad[20, 30] = 32767.0  # an integer tile's undeclared no-data value
+    grid = {"dx_m": 30.0, "dy_m": 30.0, "lat0_deg": 52.5, "lon0_deg": 4.3}
+    t = terrain_from_arrays({"elevation": bad, **grid}, "t.npz")
+    assert float(t.elevation_m[20, 30]) == pytest.approx(z[20, 30], abs=1e-6)  # filled from a plane

@@ -22,7 +22,8 @@ THESIS_SD_M = [19.2, 39.9, 63.6, 251.2, 345.0]
 
 def _tile_values() -> np.ndarray:
     rows, cols = np.mgrid[0:N, 0:N]
-    return (rows * 7 - cols * 3 + 258).astype(np.int16)  # 258 = bytes 01 02: endianness shows
+    # 258 = bytes 01 02: endianness shows; 108-8658 m, inside the land surface's heights
+    return (rows * 7 - cols // 8 + 258).astype(np.int16)
 
 
 def _write_hgt(path, z) -> None:

@@ -3,7 +3,10 @@
 Every reader returns a :class:`~skyradar.scene.terrain.Terrain` with finite elevations. Voids
 (SRTM's -32768, a GeoTIFF's nodata value, NaN) and infinities are filled from the surrounding
 valid samples when they are at most ``max_void_fraction`` of the grid, and rejected with an
-:class:`~skyradar.errors.InputError` otherwise.
+:class:`~skyradar.errors.InputError` otherwise. A height outside the land surface,
+:data:`SURFACE_RANGE_M` (the Dead Sea shore to above Everest), is a void too: it is a no-data value
+the file does not declare (downloads use -3.4e38, -9999 and 32767), and read as a height it would
+put the radar thousands of kilometres above its ground and blind it.
 """
 
 from __future__ import annotations
@@ -23,15 +26,29 @@ from skyradar.extras import import_extra
 from skyradar.geo import geodetic_to_ned
 from skyradar.scene.terrain import Bounds, Terrain
 
-__all__ = ["read_dem", "read_hgt", "read_geotiff", "read_npz", "jacksboro", "fill_voids", "SRTM_VOID"]
+__all__ = [
+    "read_dem",
+    "read_hgt",
+    "read_geotiff",
+    "read_npz",
+    "jacksboro",
+    "fill_voids",
+    "SRTM_VOID",
+    "SURFACE_RANGE_M",
+]
 
 SRTM_VOID = -32768
+SURFACE_RANGE_M = (-500.0, 9000.0)  # every height of the Earth's land surface lies inside, m
 _HGT_NAME = re.compile(r"^([NS])(\d{2})([EW])(\d{3})", re.IGNORECASE)
 _log = logging.getLogger(__name__)
 
 
 def fill_voids(
-    elevation: np.ndarray, voids: np.ndarray, source: str, max_void_fraction: float = 0.01
+    elevation: np.ndarray,
+    voids: np.ndarray,
+    source: str,
+    max_void_fraction: float = 0.01,
+    undeclared: np.ndarray | None = None,
 ) -> np.ndarray:
     """Fill ``voids`` (bool mask) of ``elevation`` with the harmonic (Laplace) interpolant.
 
@@ -52,9 +69,16 @@ def fill_voids(
     if fraction == 0.0:
         return z
     if fraction > max_void_fraction or voids.all():
+        why = ""
+        if undeclared is not None and undeclared.any():
+            why = (
+                f"; {int(undeclared.sum())} of them hold {z[undeclared][0]:.6g}, outside the land surface "
+                f"[{SURFACE_RANGE_M[0]:g}, {SURFACE_RANGE_M[1]:g}] m: a no-data value the file does not "
+                "declare (or sea-floor depths: the radar sees the sea surface, clip them to 0)"
+            )
         raise InputError(
             f"{source}: {fraction * 100:.1f}% of samples are voids, above the fill limit "
-            f"{max_void_fraction * 100:g}% (field elevation)"
+            f"{max_void_fraction * 100:g}% (field elevation){why}"
         )
     ny, nx = z.shape
     rr, cc = np.nonzero(voids)
@@ -90,7 +114,10 @@ def _void_mask(z: np.ndarray, nodata: float | None = None) -> np.ndarray:
 
 
 def _fill(z: np.ndarray, source: str, max_void_fraction: float, nodata: float | None = None) -> np.ndarray:
-    return fill_voids(z, _void_mask(z, nodata), source, max_void_fraction)
+    declared = _void_mask(z, nodata)
+    with np.errstate(invalid="ignore"):
+        undeclared = ~declared & ((z < SURFACE_RANGE_M[0]) | (z > SURFACE_RANGE_M[1]))
+    return fill_voids(z, declared | undeclared, source, max_void_fraction, undeclared)
 
 
 def read_hgt(path: str | Path, max_void_fraction: float = 0.01, bounds: Bounds | None = None) -> Terrain:

@@ -81,3 +81,21 @@ def test_evaluate_without_truth_is_clear_error(tmp_path, monkeypatch, capsys, mi
                   "innovation_radial_velocity_mps": [0.0]}).to_parquet(trk)  # fmt: skip
     code, _, err = skyradar_in_process(monkeypatch, capsys, "evaluate", str(tmp_path / "run.zarr"), str(trk))
     assert code == 2 and missing in err and "run.zarr" in err
+
+
+def test_evaluate_refuses_tracks_outside_the_runs_frames(tmp_path):
+    """Tracks 10,000 s after the run's frames are not its tracks: one line, exit 2."""
+    from cli_helpers import assert_one_line_error, skyradar
+
+    cfg = RadarConfig.prototype_2022(range_limit_m=600.0, n_doppler=16)
+    t, R, V = _scene(cfg, n=30)
+    iq = np.zeros((t.size, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
+    targets = {"tgt_range_m": R, "tgt_radial_velocity_mps": V, "tgt_visible": np.ones_like(R, bool)}
+    frames_dataset(iq, t, cfg, targets=targets).to_zarr(tmp_path / "run.zarr", consolidated=False)
+    rows = pd.DataFrame(
+        {"time_s": t + 10_000.0, "track_id": 1, "range_m": R[:, 0], "radial_velocity_mps": V[:, 0],
+         "innovation_range_m": 0.0, "innovation_radial_velocity_mps": 0.0, "confirmed": True}
+    )  # fmt: skip
+    rows.to_parquet(tmp_path / "late.parquet")
+    result = skyradar("evaluate", "run.zarr", "late.parquet", cwd=tmp_path)
+    assert_one_line_error(result, "late.parquet", "time_s", "outside the frames of run.zarr")

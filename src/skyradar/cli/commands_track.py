@@ -232,12 +232,38 @@ def evaluate(
         sort_by="time_s",
         finite=["time_s", "track_id", "range_m", "radial_velocity_mps"],  # NaN was a scipy traceback
     )  # fmt: skip
+    _check_tracks_of_run(table, tracks, run)
     result = evaluate_run(run, table, threshold_px, gospa_c_px, truth, min_snr_db, coasting)
     # The table shows no lists: one readable row for the per-target counts (1 = one track per aircraft).
     pairs = zip(result["targets"], result["tracks_per_target"], strict=True)
     result["tracks_by_target"] = ", ".join(f"{name} {n}" for name, n in pairs)
     result["held_rows_by_reason"] = ", ".join(f"{k} {v}" for k, v in result["held_rows"].items()) or "none"
     emit_result(result, as_json, "track evaluation")
+
+
+def _check_tracks_of_run(table, tracks: Path, run: Path) -> None:
+    """Tracks are scored only against the run they were made from: the same own-ship (the
+    signature :mod:`skyradar.daa.provenance` carries, as ``alert`` checks it) and times inside the
+    run's frames (one frame of slack). Scored against another run they would count every aircraft
+    as missed, or match by chance."""
+    import numpy as np
+
+    from skyradar.daa.provenance import check_tracks_match_run
+    from skyradar.errors import InputError
+    from skyradar.io.frames import open_frames
+    from skyradar.io.frames_model import frame_times_s
+
+    ds = open_frames(run)
+    check_tracks_match_run(table.attrs, str(tracks), ds, str(run))
+    t = frame_times_s(ds)
+    times = table["time_s"].to_numpy(float)
+    if t.size and times.size:
+        slack = float(np.median(np.diff(t))) if t.size > 1 else 1.0
+        if times.min() < t[0] - slack or times.max() > t[-1] + slack:
+            raise InputError(
+                f"{tracks}: field 'time_s' ({times.min():.6g}..{times.max():.6g} s) is outside the frames "
+                f"of {run} ({t[0]:.6g}..{t[-1]:.6g} s): tracks of another run? score them against their own"
+            )
 
 
 @experiment_app.command("ch4")

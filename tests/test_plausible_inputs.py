@@ -106,3 +106,15 @@ def test_a_few_undeclared_no_data_samples_are_filled_as_voids():
     grid = {"dx_m": 30.0, "dy_m": 30.0, "lat0_deg": 52.5, "lon0_deg": 4.3}
     t = terrain_from_arrays({"elevation": bad, **grid}, "t.npz")
     assert float(t.elevation_m[20, 30]) == pytest.approx(z[20, 30], abs=1e-6)  # filled from a plane
+
+
+def test_a_decompression_bomb_is_refused_quickly(tmp_path):
+    """A 0.6 MB .json.gz that inflates to 600 MB: refused at the 256 MiB ceiling, in one line."""
+    import gzip
+
+    with gzip.open(tmp_path / "bomb.json.gz", "wb", compresslevel=9) as fh:
+        for _ in range(600):
+            fh.write(b" " * (1 << 20))
+    result = skyradar("flight", "bomb.json.gz", "-o", "b.csv", cwd=tmp_path)
+    assert_one_line_error(result, "bomb.json.gz", "inflates to more than 256 MiB")
+    assert not (tmp_path / "b.csv").exists()

@@ -69,6 +69,8 @@ _SI_VELOCITY = ("vn", "ve", "vd")
 _log = logging.getLogger(__name__)
 _TIME_NAMES = {"timestamp", "time", "time_s"}
 _OPENERS = {".gz": gzip.open, ".bz2": bz2.open, ".xz": lzma.open}
+# A recorded flight, even a day of 1-Hz fixes as JSON, is tens of MB: more is not one track file.
+MAX_INFLATED_BYTES = 256 << 20
 
 
 def read_track_table(path: str | Path) -> pd.DataFrame:
@@ -83,6 +85,7 @@ def read_track_table(path: str | Path) -> pd.DataFrame:
         else None
     )
     kind = kind or (suffixes[-1] if suffixes else "")
+    _check_inflated_size(path)
     try:
         if kind in (".csv", ".txt"):
             # Addresses and callsigns are text: keep leading zeros ("008123").
@@ -96,6 +99,26 @@ def read_track_table(path: str | Path) -> pd.DataFrame:
     except Exception as exc:  # noqa: BLE001 - any reader failure becomes one clear line
         raise InputError(f"{path}: cannot read as {kind[1:]} ({type(exc).__name__}: {exc})") from exc
     raise InputError(f"{path}: unknown file type '{kind or path.name}' (use .csv, .parquet or .json)")
+
+
+def _check_inflated_size(path: Path) -> None:
+    """Refuse a compressed file that inflates beyond :data:`MAX_INFLATED_BYTES` before parsing it: a
+    small archive can hold gigabytes (a decompression bomb), which would take minutes and all memory."""
+    opener = _OPENERS.get(path.suffix.lower())
+    if opener is None:
+        return
+    total = 0
+    try:
+        with opener(path, "rb") as fh:
+            while chunk := fh.read(1 << 20):
+                total += len(chunk)
+                if total > MAX_INFLATED_BYTES:
+                    raise InputError(
+                        f"{path}: inflates to more than {MAX_INFLATED_BYTES >> 20} MiB; a track file is "
+                        "far smaller (decompress and cut it first)"
+                    )
+    except (OSError, EOFError, lzma.LZMAError) as exc:
+        raise InputError(f"{path}: cannot decompress ({type(exc).__name__}: {exc})") from exc
 
 
 def _read_json(path: Path, lines: bool) -> pd.DataFrame:

@@ -118,3 +118,36 @@ def test_a_decompression_bomb_is_refused_quickly(tmp_path):
     result = skyradar("flight", "bomb.json.gz", "-o", "b.csv", cwd=tmp_path)
     assert_one_line_error(result, "bomb.json.gz", "inflates to more than 256 MiB")
     assert not (tmp_path / "b.csv").exists()
+
+
+@pytest.mark.parametrize(
+    "settings",
+    [
+        {"levels": [{"name": "only", "dthr_m": 670.56, "zthr_m": 137.16, "alerting_time_s": 25}]},
+        {
+            "levels": [
+                {"name": n, "dthr_m": 0.0, "zthr_m": 0.0, "alerting_time_s": 25}
+                for n in ("preventive", "corrective", "warning")
+            ]
+        },  # fmt: skip
+        {"min_track_age_s": 1.0e9},
+        {"max_velocity_sigma_mps": 0.0},
+    ],
+)
+def test_an_alert_config_that_never_warns_is_refused(tmp_path, settings):
+    """Each of these once switched warnings off without a word; checked on a head-on course at load."""
+    (tmp_path / "quiet.yaml").write_text(yaml.safe_dump(settings))
+    from skyradar.daa.alert_config import alert_config
+    from skyradar.errors import InputError
+
+    with pytest.raises(
+        InputError, match=r"quiet.yaml: these settings never warn on a head-on collision course"
+    ):
+        alert_config(tmp_path / "quiet.yaml")
+
+
+def test_an_alert_config_that_warns_is_accepted(tmp_path):
+    from skyradar.daa.alert_config import alert_config
+
+    (tmp_path / "strict.yaml").write_text(yaml.safe_dump({"m": 3, "n": 5, "min_track_age_s": 3.0}))
+    assert alert_config(tmp_path / "strict.yaml").m == 3

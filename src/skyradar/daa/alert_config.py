@@ -36,9 +36,10 @@ from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig, AlertLevel
 from skyradar.daa.conflict import WellClearVolume
 from skyradar.errors import InputError
 
-__all__ = ["ALERT_CONFIGS", "alert_config"]
+__all__ = ["ALERT_CONFIGS", "WARNING_LEVEL", "alert_config", "check_warns_head_on"]
 
 ALERT_CONFIGS = {"radar": RADAR_ALERT_CONFIG, "default": AlertConfig()}
+WARNING_LEVEL = 3  # preventive 1, corrective 2, warning 3: the level every DAA score counts
 _INTS = ("m", "n")
 _FLOATS = ("persistence_s", "hysteresis_s", "z_h_pos", "z_h_vel", "z_v_pos", "z_v_vel", "min_track_age_s")
 _OPTIONAL = ("period_s", "max_velocity_sigma_mps")
@@ -134,6 +135,50 @@ def alert_config(value: str | Path) -> AlertConfig:
     if base not in ALERT_CONFIGS:
         raise InputError(f"{path}: field 'base' must be radar or default, got {base!r}")
     try:
-        return dataclasses.replace(ALERT_CONFIGS[base], **_fields(str(path), data))
+        config = dataclasses.replace(ALERT_CONFIGS[base], **_fields(str(path), data))
     except ValueError as exc:  # AlertConfig's own checks (1 <= m <= n, period_s > 0)
         raise InputError(f"{path}: {exc}") from None
+    check_warns_head_on(config, str(path))
+    return config
+
+
+def check_warns_head_on(config: AlertConfig, label: str) -> None:
+    """Refuse settings that cannot warn on a plain collision course: a converged track of a head-on
+    intruder, both aircraft at 50 m/s, 3 km apart and passing 100 m apart (inside the collision
+    volume), must reach the warning level (the third, :data:`WARNING_LEVEL`) before they meet. One
+    level, zero volumes, a minimum track age or a persistence longer than the approach, or a
+    velocity gate no track passes would silently switch the warnings off.
+
+    Examples
+    --------
+    >>> check_warns_head_on(RADAR_ALERT_CONFIG, "radar")
+    >>> check_warns_head_on(dataclasses.replace(RADAR_ALERT_CONFIG, min_track_age_s=1e9), "slow.yaml")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: slow.yaml: these settings never warn ...
+    """
+    import numpy as np
+    import pandas as pd
+
+    from skyradar.daa.pipeline import alerts_from_tracks
+
+    t = np.arange(0.0, 30.0, 1.0 / 9.4)  # 3 km apart at 100 m/s closing: they meet at 30 s, 100 m apart
+    own = pd.DataFrame({"time_s": t, "own_north_m": 50.0 * t, "own_east_m": 0.0, "own_down_m": -1000.0,
+                        "own_vn_mps": 50.0, "own_ve_mps": 0.0, "own_vd_mps": 0.0})  # fmt: skip
+    tracks = pd.DataFrame({"time_s": t, "track_id": 1, "north_m": 3000.0 - 50.0 * t, "east_m": 100.0,
+                           "down_m": -1000.0, "vn_mps": -50.0, "ve_mps": 0.0, "vd_mps": 0.0,
+                           "confirmed": True})  # fmt: skip
+    # A converged radar track: 20 m of position and 2 m/s of velocity error per axis.
+    for name, variance in (("pp", 400.0), ("vv", 4.0), ("pv", 0.0)):
+        for i in range(3):
+            for j in range(3):
+                tracks[f"cov_{name}_{i}{j}"] = variance if i == j else 0.0
+    alerts = alerts_from_tracks(tracks, own, config, with_advice=False, source=label)
+    if len(alerts) == 0 or int(alerts["level"].max()) < WARNING_LEVEL:
+        reached = int(alerts["level"].max()) if len(alerts) else 0
+        raise InputError(
+            f"{label}: these settings never warn on a head-on collision course (a converged track, "
+            f"50 m/s each, 3 km apart, 100 m miss; highest level reached {reached} of {WARNING_LEVEL}): "
+            "check levels, their volumes and alerting times, min_track_age_s, persistence_s and "
+            "max_velocity_sigma_mps"
+        )

@@ -151,3 +151,11 @@ def test_an_alert_config_that_warns_is_accepted(tmp_path):
 
     (tmp_path / "strict.yaml").write_text(yaml.safe_dump({"m": 3, "n": 5, "min_track_age_s": 3.0}))
     assert alert_config(tmp_path / "strict.yaml").m == 3
+
+
+@pytest.mark.parametrize("address", ["garbage address", "tcp://::::bad"])
+def test_a_malformed_scheduler_address_is_one_line(tmp_path, address):
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(BASE))
+    result = skyradar("simulate", "s.yaml", "-o", "run.zarr", "--scheduler", address, cwd=tmp_path)
+    assert_one_line_error(result, "--scheduler", "not a Dask scheduler address")
+    assert not list(tmp_path.glob("run.zarr*"))

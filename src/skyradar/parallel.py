@@ -67,6 +67,10 @@ def connect(scheduler: str | None, workers: int | None, timeout_s: float = 10.0)
     if scheduler is not None:
         try:
             return Client(scheduler, timeout=timeout_s)
+        except ValueError as exc:  # distributed's address parser: no port, ipv6 without brackets...
+            raise InputError(
+                f"--scheduler {scheduler}: not a Dask scheduler address (tcp://HOST:PORT): {exc}"
+            ) from exc
         except (OSError, TimeoutError) as exc:
             raise InputError(
                 f"--scheduler {scheduler}: no Dask scheduler answered within {timeout_s:.0f} s ({exc})"

@@ -159,3 +159,14 @@ def test_a_malformed_scheduler_address_is_one_line(tmp_path, address):
     result = skyradar("simulate", "s.yaml", "-o", "run.zarr", "--scheduler", address, cwd=tmp_path)
     assert_one_line_error(result, "--scheduler", "not a Dask scheduler address")
     assert not list(tmp_path.glob("run.zarr*"))
+
+
+@pytest.mark.parametrize(
+    "command",
+    [("simulate-passive", "-o", "rec.sigmf-meta"), ("passive", "rec.sigmf-meta", "-o", "d.parquet")],
+)
+def test_a_tiny_iq_chunk_is_refused(tmp_path, command):
+    """One-sample chunks made a 1-s recording take hours: the option is bounded below."""
+    result = skyradar(*command, "--chunk-samples", "1", cwd=tmp_path)
+    assert result.returncode == 2 and "--chunk-samples" in result.stderr and ">= 4096" in result.stderr
+    assert "Traceback" not in result.stderr

@@ -122,6 +122,10 @@ BenchSecondsOption = Annotated[
 ]
 NON_NEGATIVE = number_in(0.0)  # counts and durations where 0 means "skip"
 COUNT = number_in(1)  # frames, workers, chunk sizes: at least one
+# IQ samples per chunk: each chunk has a fixed cost (a write, filter state), so below a few thousand
+# samples the overhead dominates (1-sample chunks made a 1-s recording take hours); 2**26 complex
+# samples are 512 MiB.
+CHUNK_SAMPLES = number_in(4096, 1 << 26)
 PROBABILITY = number_in(0.0, 1.0, low_open=True, high_open=True)
 
 

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from skyradar.cli.app import (
-    COUNT,
+    CHUNK_SAMPLES,
     NON_NEGATIVE,
     POSITIVE,
     JsonOption,
@@ -47,7 +47,7 @@ def passive(
     ] = 45.0,
     chunk_samples: Annotated[
         int,
-        typer.Option("--chunk-samples", callback=COUNT, help="Samples per chunk (bounds memory)."),
+        typer.Option("--chunk-samples", callback=CHUNK_SAMPLES, help="Samples per chunk (bounds memory)."),
     ] = 1 << 20,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,

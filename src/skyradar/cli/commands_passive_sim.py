@@ -8,7 +8,16 @@ from typing import Annotated
 
 import typer
 
-from skyradar.cli.app import COUNT, POSITIVE, JsonOption, app, check_choice, console, emit_result, number_in
+from skyradar.cli.app import (
+    CHUNK_SAMPLES,
+    POSITIVE,
+    JsonOption,
+    app,
+    check_choice,
+    console,
+    emit_result,
+    number_in,
+)
 from skyradar.errors import InputError
 from skyradar.io.outputs import OVERWRITE_HELP
 
@@ -100,7 +109,10 @@ def simulate_passive(
     ] = None,
     no_aircraft: Annotated[bool, typer.Option("--no-aircraft", help="Static scene only.")] = False,
     chunk_samples: Annotated[
-        int, typer.Option("--chunk-samples", callback=COUNT, help="Samples simulated and written per chunk.")
+        int,
+        typer.Option(
+            "--chunk-samples", callback=CHUNK_SAMPLES, help="Samples simulated and written per chunk."
+        ),
     ] = 1 << 20,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,

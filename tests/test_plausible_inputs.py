@@ -170,3 +170,34 @@ def test_a_tiny_iq_chunk_is_refused(tmp_path, command):
     result = skyradar(*command, "--chunk-samples", "1", cwd=tmp_path)
     assert result.returncode == 2 and "--chunk-samples" in result.stderr and ">= 4096" in result.stderr
     assert "Traceback" not in result.stderr
+
+
+def test_one_head_commands_on_a_run_of_several_heads_ask_which(tmp_path):
+    """state, spur-map and calibrate use one head: on a two-head run they name the heads and ask."""
+    heads = [{"name": "nose", "mount": "forward"}, {"name": "belly", "mount": "forward-down"}]
+    two = {**BASE, "radars": heads, "simulation": {"noise": True, "psf": False, "speckle": False}}
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(two))
+    made = skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
+    assert made.returncode == 0, made.stderr
+    for args in (
+        ("state", "run.zarr", "-o", "st.parquet"),
+        ("spur-map", "run.zarr", "-o", "spurs.npz"),
+        (
+            "calibrate",
+            "run.zarr",
+            "-o",
+            "cal.json",
+            "--range",
+            "100",
+            "--azimuth",
+            "0",
+            "--elevation",
+            "0",
+        ),
+    ):
+        result = skyradar(*args, cwd=tmp_path)
+        assert_one_line_error(result, "run.zarr", "2 radar heads (nose, belly)", "give --head NAME")
+    bad = skyradar("state", "run.zarr", "-o", "st.parquet", "--head", "tail", cwd=tmp_path)
+    assert_one_line_error(bad, "--head", "'tail' is not a head of run.zarr")
+    ok = skyradar("state", "run.zarr", "-o", "st.parquet", "--head", "belly", cwd=tmp_path)
+    assert ok.returncode == 0, ok.stderr

@@ -5,17 +5,20 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Callable
+from pathlib import Path
 from typing import Annotated, Any
 
 import typer
 from rich.console import Console
 from rich.table import Table
 
+from skyradar.errors import InputError
 from skyradar.io.tables import jsonable
 
 __all__ = [
     "app", "experiment_app", "bench_app", "console", "emit_result", "JsonOption", "number_in",
     "check_number", "check_choice", "POSITIVE", "NON_NEGATIVE", "COUNT", "PROBABILITY", "WORKERS",
+    "CHUNK_SAMPLES", "HeadOption", "open_one_head",
 ]  # fmt: skip
 
 app = typer.Typer(
@@ -127,6 +130,27 @@ COUNT = number_in(1)  # frames, workers, chunk sizes: at least one
 # samples are 512 MiB.
 CHUNK_SAMPLES = number_in(4096, 1 << 26)
 PROBABILITY = number_in(0.0, 1.0, low_open=True, high_open=True)
+
+
+HeadOption = Annotated[
+    str | None, typer.Option("--head", help="The radar head to use, by name, in a run of several heads.")
+]
+
+
+def open_one_head(run: Path, head: str | None, what: str):
+    """The frames of one head of ``run`` for a command that uses one (``what``): a run of several
+    heads must name it (taking the first silently would estimate, map or calibrate the wrong one)."""
+    from skyradar.io.frames import open_frames
+    from skyradar.io.frames_heads import store_heads
+
+    heads = store_heads(run) if Path(run).is_dir() else None
+    if heads and len(heads) > 1 and head is None:
+        raise InputError(
+            f"{run}: has {len(heads)} radar heads ({', '.join(heads)}); {what} uses one: give --head NAME"
+        )
+    if heads and head is not None and head not in heads:
+        raise InputError(f"--head: {head!r} is not a head of {run} ({', '.join(heads)})")
+    return open_frames(run, head=head)
 
 
 def WORKERS(ctx: typer.Context, param: typer.CallbackParam, value: int | None) -> int | None:  # noqa: N802

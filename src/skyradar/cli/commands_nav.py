@@ -12,12 +12,14 @@ from skyradar.cli.app import (
     NON_NEGATIVE,
     POSITIVE,
     BenchSecondsOption,
+    HeadOption,
     JsonOption,
     app,
     bench_app,
     console,
     emit_result,
     experiment_app,
+    open_one_head,
 )
 from skyradar.io.outputs import OVERWRITE_HELP
 
@@ -38,6 +40,7 @@ def state(
         bool,
         typer.Option("--gps-gate", help="Thesis comparison: gate on the run's own_height_agl_m (150 m)."),
     ] = False,
+    head: HeadOption = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -49,7 +52,7 @@ def state(
     Runs in one process: each frame's estimate builds on the previous one (de-aliasing prior,
     terrain memory, Kalman filter), so the frames are not split across Dask workers.
     """
-    from skyradar.io.frames import open_frames, radar_config_of
+    from skyradar.io.frames import radar_config_of
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_table
     from skyradar.nav.flight_state import estimate_run
@@ -60,7 +63,7 @@ def state(
 
     if method not in ("thesis", "robust", "terrain"):
         raise InputError(f"--method: must be thesis, robust or terrain, got {method!r}")
-    ds = open_frames(run)
+    ds = open_one_head(run, head, "skyradar state")
     config = radar_config_of(ds, str(run))
     table = estimate_run(ds, method=method, gps_gate=gps_gate, source=str(run))
     write_table(

@@ -15,6 +15,7 @@ from skyradar.cli.app import (
     PROBABILITY,
     WORKERS,
     BenchSecondsOption,
+    HeadOption,
     JsonOption,
     app,
     bench_app,
@@ -24,6 +25,7 @@ from skyradar.cli.app import (
     emit_result,
     experiment_app,
     number_in,
+    open_one_head,
 )
 from skyradar.io.outputs import OVERWRITE_HELP
 
@@ -188,6 +190,7 @@ def calibrate(
     phase_only: Annotated[
         bool, typer.Option("--phase-only", help="Calibrate phases only, not gains.")
     ] = False,
+    head: HeadOption = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -196,13 +199,13 @@ def calibrate(
 
     from skyradar.errors import InputError
     from skyradar.io.checks import check_finite_frames
-    from skyradar.io.frames import open_frames, radar_config_of
+    from skyradar.io.frames import radar_config_of
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_json_atomic
     from skyradar.process.calibration import calibrate_from_frames, reflector_position
 
     check_output(output, [run], overwrite, kind="file")
-    ds = open_frames(run)
+    ds = open_one_head(run, head, "skyradar calibrate")
     config = radar_config_of(ds, str(run))
     if range_m >= config.range_limit_m:
         raise InputError(
@@ -234,6 +237,7 @@ def spur_map(
     pixels: Annotated[
         str, typer.Option("--pixels", help="'peaks' (detector points, thesis) or 'hits' (every lit pixel).")
     ] = "hits",
+    head: HeadOption = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -241,14 +245,14 @@ def spur_map(
     import numpy as np
 
     from skyradar.io.checks import check_finite_frames
-    from skyradar.io.frames import open_frames, radar_config_of
+    from skyradar.io.frames import radar_config_of
     from skyradar.io.outputs import check_output
     from skyradar.process.detect import integrate_channels
     from skyradar.process.spurs import learn_spur_map
 
     check_choice("--pixels", pixels, ("peaks", "hits"))
     check_output(output, [run], overwrite, kind="file")
-    ds = open_frames(run)
+    ds = open_one_head(run, head, "skyradar spur-map")
     config = radar_config_of(ds, str(run))
 
     def frames():

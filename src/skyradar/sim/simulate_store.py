@@ -15,6 +15,7 @@ import numpy as np
 import xarray as xr
 
 from skyradar.io.frames import FrameStoreWriter, check_store_space, frames_dataset
+from skyradar.io.locks import exclusive_output
 from skyradar.io.outputs import check_output
 from skyradar.sim.fingerprint import fingerprint, referenced_files
 from skyradar.sim.image import ImageSimulator
@@ -106,11 +107,22 @@ def simulate_to_zarr(
         Pixel format; cint16 halves the raw size at a bounded rounding error
         (:mod:`skyradar.io.cint16`).
 
-    Before any work the output is checked (:func:`skyradar.io.outputs.check_output`) and the
-    disk must hold the estimated store.
+    Before any work the output is checked (:func:`skyradar.io.outputs.check_output`), locked
+    against a second writer (:func:`skyradar.io.locks.exclusive_output`), and the disk must hold the
+    estimated store.
     """
     inputs = (getattr(built, "source", None), *referenced_files(built))
     check_output(path, inputs, overwrite, kind="frames store")
+    with exclusive_output(path):  # a second writer of the same store is refused, not interleaved
+        return _simulate_locked(
+            built, path, chunk_frames, scheduler, workers, progress, overwrite, compressor, precision, inputs
+        )
+
+
+def _simulate_locked(
+    built, path, chunk_frames, scheduler, workers, progress, overwrite, compressor, precision, inputs
+) -> Path:
+    """:func:`simulate_to_zarr` once the output is checked and locked."""
     # A chunk longer than the run is the whole run (--chunk-frames 10**20 must not size a 10^20 chunk).
     chunk_frames = max(1, min(int(chunk_frames), built.times_s.size))
     n = len(built.heads)  # several heads: n times the frames (sized with the first head's hardware)

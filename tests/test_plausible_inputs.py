@@ -201,3 +201,17 @@ def test_one_head_commands_on_a_run_of_several_heads_ask_which(tmp_path):
     assert_one_line_error(bad, "--head", "'tail' is not a head of run.zarr")
     ok = skyradar("state", "run.zarr", "-o", "st.parquet", "--head", "belly", cwd=tmp_path)
     assert ok.returncode == 0, ok.stderr
+
+
+def test_hostile_paths_give_one_line(tmp_path):
+    """A symbolic link loop as input or output and a name longer than the file system allows."""
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(BASE))
+    (tmp_path / "loop").symlink_to(tmp_path / "loop")
+    cases = [
+        (("simulate", "loop", "-o", "run.zarr"), "loop", "symbolic link loop"),
+        (("flight", "loop", "-o", "x.csv"), "loop", "symbolic link loop"),
+        (("simulate", "s.yaml", "-o", "a" * 300 + ".zarr"), "aaaa", "File name too long"),
+    ]
+    for args, path, reason in cases:
+        result = skyradar(*args, cwd=tmp_path)
+        assert_one_line_error(result, path, reason)

@@ -66,6 +66,13 @@ def _interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt
 
 
+def _os_error_line(exc: OSError) -> str:
+    """``PATH: reason`` of a file-system error (both paths of a rename), on one line."""
+    reason = exc.strerror or str(exc)
+    paths = [str(p) for p in (exc.filename, exc.filename2) if p is not None]
+    return f"{' -> '.join(paths)}: {reason}" if paths else reason
+
+
 def main() -> None:
     """Entry point of the ``skyradar`` script."""
     signal.signal(signal.SIGTERM, _interrupt)
@@ -75,6 +82,16 @@ def main() -> None:
         # One line even when a wrapped library message spans several (pandas' CSV parser errors do).
         message = " ".join(part.strip() for part in str(exc).splitlines() if part.strip())
         print(f"error: {message}", file=sys.stderr)
+        sys.exit(2)
+    except OSError as exc:
+        # The file system said no (permission, a name too long, not a folder, a full disk): the user's
+        # paths, not a bug. One line with the path, as for bad input.
+        print(f"error: {_os_error_line(exc)}", file=sys.stderr)
+        sys.exit(2)
+    except RuntimeError as exc:
+        if not str(exc).startswith("Symlink loop"):  # pathlib's resolve() reports a loop this way
+            raise
+        print(f"error: {str(exc).removeprefix('Symlink loop from ')}: a symbolic link loop", file=sys.stderr)
         sys.exit(2)
     except _NO_ARGS_IS_HELP as exc:
         # A bare `skyradar` (or `skyradar bench`) asks for help: Typer's rich help is already printed

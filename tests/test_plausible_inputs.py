@@ -215,3 +215,25 @@ def test_hostile_paths_give_one_line(tmp_path):
     for args, path, reason in cases:
         result = skyradar(*args, cwd=tmp_path)
         assert_one_line_error(result, path, reason)
+
+
+def test_sigmf_metadata_with_a_nan_rate_or_deep_nesting_is_one_line(tmp_path):
+    import json
+    import shutil
+
+    made = skyradar("simulate-passive", "-o", "rec.sigmf-meta", "--duration-s", "0.05", cwd=tmp_path)
+    assert made.returncode == 0, made.stderr
+    meta = json.loads((tmp_path / "rec.sigmf-meta").read_text())
+    meta["global"]["core:sample_rate"] = float("nan")
+    (tmp_path / "nan.sigmf-meta").write_text(json.dumps(meta))
+    (tmp_path / "deep.sigmf-meta").write_text("[" * 100_000 + "]" * 100_000)
+    for name in ("nan", "deep"):
+        shutil.copy(tmp_path / "rec.sigmf-data", tmp_path / f"{name}.sigmf-data")
+    assert_one_line_error(
+        skyradar("passive", "nan.sigmf-meta", "-o", "a.parquet", cwd=tmp_path),
+        "nan.sigmf-meta", "core:sample_rate", "finite rate",
+    )  # fmt: skip
+    assert_one_line_error(
+        skyradar("passive", "deep.sigmf-meta", "-o", "b.parquet", cwd=tmp_path),
+        "deep.sigmf-meta", "nested too deeply",
+    )  # fmt: skip

@@ -31,6 +31,7 @@ from __future__ import annotations
 import datetime as dt
 import hashlib
 import json
+import math
 import warnings
 from pathlib import Path
 
@@ -67,6 +68,8 @@ def _read_sigmf(meta_path: Path, data_path: Path, require_illuminator: bool) -> 
         meta = json.loads(meta_path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise InputError(f"{meta_path}: not a SigMF metadata file ({type(exc).__name__}: {exc})") from None
+    except RecursionError:  # JSON nested deeper than the parser's stack: no metadata file is
+        raise InputError(f"{meta_path}: not a SigMF metadata file (JSON nested too deeply)") from None
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -98,7 +101,7 @@ def _read_sigmf(meta_path: Path, data_path: Path, require_illuminator: bool) -> 
         ends.append(count)
     illum, illum_pos = _illuminator(str(meta_path), glob.get("skyradar:illuminator"), require_illuminator)
     info = {
-        "sample_rate_hz": glob["core:sample_rate"] if "core:sample_rate" in glob else _missing(meta_path),
+        "sample_rate_hz": _sample_rate(meta_path, glob),
         "center_frequency_hz": _centre_frequency(meta_path, captures[0], illum),
         "start_time": captures[0].get("core:datetime"),
         "receiver_geodetic": (float(lat), float(lon), float(alt[0]) if alt else 0.0),
@@ -129,8 +132,19 @@ def _mapping(where: Path, field: str, value: object) -> dict:
     return value
 
 
-def _missing(where: Path) -> float:
-    raise InputError(f"{where}: field 'core:sample_rate' is missing")
+def _sample_rate(where: Path, glob: dict) -> float:
+    """``core:sample_rate``, a finite rate above 0 (NaN, infinite or negative rates are refused)."""
+    if "core:sample_rate" not in glob:
+        raise InputError(f"{where}: field 'core:sample_rate' is missing")
+    value = glob["core:sample_rate"]
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, int | float)
+        or not math.isfinite(value)
+        or value <= 0
+    ):
+        raise InputError(f"{where}: field 'core:sample_rate' must be a finite rate > 0 Hz, got {value!r}")
+    return float(value)
 
 
 def read_iq_recording(path: str | Path, require_illuminator: bool = True) -> IqRecording:

@@ -170,6 +170,7 @@ def check_output(
         if parent.exists():
             if not parent.is_dir():
                 raise InputError(f"{label}: {parent} is a file, not a folder; name another output")
+            _check_writable(parent, label)
             break
     out = _resolved(path)
     _check_not_input(out, inputs, label)
@@ -177,6 +178,18 @@ def check_output(
     if path.exists() or path.is_symlink():
         _check_replaceable(path, label, kind, overwrite)
     return path
+
+
+def _check_writable(folder: Path, label: str) -> None:
+    """The nearest existing folder of an output must take a new file: tried, not guessed from mode
+    bits (root, ACLs and read-only mounts make those lie)."""
+    import tempfile
+
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as exc:
+        raise InputError(f"{label}: cannot write in {folder} ({exc.strerror or exc})") from None
 
 
 def _check_replaceable(path: Path, label: str, kind: str, overwrite: bool) -> None:

@@ -9,7 +9,19 @@ import subprocess
 import sys
 from pathlib import Path
 
-__all__ = ["skyradar", "skyradar_in_process", "assert_one_line_error"]
+__all__ = ["skyradar", "skyradar_in_process", "assert_one_line_error", "small_scenario"]
+
+
+def small_scenario(name: str, duration_s: float = 1.0, frame_rate_hz: float = 5.0, **changes) -> dict:
+    """A scenario dict that builds in a moment: a straight own-ship at 1 km over the North Sea coast."""
+    return {
+        "name": name,
+        "origin": {"lat_deg": 52.5, "lon_deg": 4.36, "alt_m": 0.0},
+        "duration_s": duration_s,
+        "frame_rate_hz": frame_rate_hz,
+        "ownship": {"type": "straight", "start_ned_m": [0, 0, -1000], "heading_deg": 0, "speed_mps": 50},
+        **changes,
+    }
 
 
 def skyradar(*args: str, cwd: Path, timeout: float = 300) -> subprocess.CompletedProcess:

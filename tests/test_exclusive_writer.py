@@ -12,17 +12,15 @@ import sys
 
 import yaml
 
-from cli_helpers import skyradar
+from cli_helpers import skyradar, small_scenario
 
-SCENARIO = {
-    "name": "two writers",
-    "origin": {"lat_deg": 52.5, "lon_deg": 4.36, "alt_m": 0.0},
-    "duration_s": 3.0,
-    "frame_rate_hz": 9.4,
-    "ownship": {"type": "straight", "start_ned_m": [0, 0, -1000], "heading_deg": 0, "speed_mps": 50},
-    "intruders": [{"type": "encounter", "kind": "head-on", "t_cpa_s": 30.0, "horizontal_miss_m": 100.0}],
-    "terrain": {"type": "flat", "height_m": 0.0, "size_m": 6000.0, "spacing_m": 30.0},
-}
+SCENARIO = small_scenario(
+    "two writers",
+    duration_s=3.0,
+    frame_rate_hz=9.4,
+    intruders=[{"type": "encounter", "kind": "head-on", "t_cpa_s": 30.0, "horizontal_miss_m": 100.0}],
+    terrain={"type": "flat", "height_m": 0.0, "size_m": 6000.0, "spacing_m": 30.0},
+)
 ROUNDS = 3  # the lock is checked 20 rounds in a row by hand; three keep the suite short
 
 

@@ -19,7 +19,7 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from cli_helpers import assert_one_line_error, skyradar
+from cli_helpers import assert_one_line_error, skyradar, small_scenario
 from skyradar.errors import InputError
 from skyradar.geo import ned_to_geodetic
 from skyradar.scene.adsb import FPM_MPS, FT_M, KT_MPS, read_trajectory
@@ -212,13 +212,7 @@ def test_a_banked_turn_at_45_deg_is_flyable_by_ga_but_not_by_a_transport():
     assert "horizontal acceleration" in kinematic_violation(t, vel, AIRCRAFT_CLASSES["transport"])[1]
 
 
-BASE = {
-    "name": "kinematics",
-    "origin": {"lat_deg": 52.5, "lon_deg": 4.36, "alt_m": 0.0},
-    "duration_s": 2.0,
-    "frame_rate_hz": 5.0,
-    "ownship": {"type": "straight", "start_ned_m": [0, 0, -1000], "heading_deg": 0, "speed_mps": 50},
-}
+BASE = small_scenario("kinematics", duration_s=2.0)
 
 
 def test_simulate_refuses_a_flight_beyond_its_class_in_one_line(tmp_path):

@@ -16,20 +16,14 @@ import sys
 import pytest
 import yaml
 
-from cli_helpers import assert_one_line_error
+from cli_helpers import assert_one_line_error, small_scenario
 
 DROP = [
     "setpriv",
     "--inh-caps=-dac_override,-dac_read_search",
     "--bounding-set=-dac_override,-dac_read_search",
 ]
-BASE = {
-    "name": "unprivileged",
-    "origin": {"lat_deg": 52.5, "lon_deg": 4.36, "alt_m": 0.0},
-    "duration_s": 1.0,
-    "frame_rate_hz": 5.0,
-    "ownship": {"type": "straight", "start_ned_m": [0, 0, -1000], "heading_deg": 0, "speed_mps": 50},
-}
+BASE = small_scenario("unprivileged")
 
 
 def _skyradar(*args: str, cwd) -> subprocess.CompletedProcess:

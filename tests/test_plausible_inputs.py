@@ -11,15 +11,9 @@ import numpy as np
 import pytest
 import yaml
 
-from cli_helpers import assert_one_line_error, skyradar
+from cli_helpers import assert_one_line_error, skyradar, small_scenario
 
-BASE = {
-    "name": "plausible",
-    "origin": {"lat_deg": 52.5, "lon_deg": 4.36, "alt_m": 0.0},
-    "duration_s": 1.0,
-    "frame_rate_hz": 5.0,
-    "ownship": {"type": "straight", "start_ned_m": [0, 0, -1000], "heading_deg": 0, "speed_mps": 50},
-}
+BASE = small_scenario("plausible")
 
 REFUSED = [
     ({"mount": {"preset": "forward", "lever_arm_m": [1.0e9, 0.0, 0.0]}}, "mount.lever_arm_m.0", "<= 30"),

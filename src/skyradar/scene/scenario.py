@@ -164,11 +164,12 @@ class Scenario:
     def frame_times(self) -> np.ndarray:
         """Frame times start_s + k / frame_rate_hz inside [start_s, start_s + duration_s), s."""
         m = self.model
-        n = max(1, int(np.floor(m.duration_s * m.frame_rate_hz + 1e-9)))
+        frames = m.duration_s * m.frame_rate_hz  # a float: 9e307 s x 2 Hz is infinite, no integer
+        n = max(1, int(np.floor(frames + 1e-9))) if frames <= MAX_FRAMES else MAX_FRAMES + 1
         if n > MAX_FRAMES:  # the time axis alone would not fit in memory, let alone the store
             raise InputError(
                 f"{self._label}: fields 'duration_s' ({m.duration_s:g}) x 'frame_rate_hz' "
-                f"({m.frame_rate_hz:g}) give {n:.3g} frames; at most {MAX_FRAMES:.0e}"
+                f"({m.frame_rate_hz:g}) give {frames:.3g} frames; at most {MAX_FRAMES:.0e}"
             )
         return m.start_s + np.arange(n) / m.frame_rate_hz
 

@@ -46,6 +46,9 @@ def test_export_writes_navigation_truth_and_intruders(tmp_path, monkeypatch, cap
     np.testing.assert_array_equal(crossing["tgt_east_m"], ds["tgt_east_m"].sel(target="crossing").values)
     bad = skyradar("export", "tables", "-o", "again", cwd=tmp_path)  # a folder of tables is not a run
     assert_one_line_error(bad, "tables")
+    csv = skyradar("export", "run.zarr", "-o", "own.csv", cwd=tmp_path)  # a table name, but not Parquet
+    assert_one_line_error(csv, "--output own.csv", "own.parquet")
+    assert not (tmp_path / "own.csv").exists()
 
 
 def test_intruder_table_adds_each_heads_view():

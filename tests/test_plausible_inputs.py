@@ -231,3 +231,14 @@ def test_sigmf_metadata_with_a_nan_rate_or_deep_nesting_is_one_line(tmp_path):
         skyradar("passive", "deep.sigmf-meta", "-o", "b.parquet", cwd=tmp_path),
         "deep.sigmf-meta", "nested too deeply",
     )  # fmt: skip
+
+
+def test_a_negated_range_column_is_refused_by_track(tmp_path):
+    import pandas as pd
+
+    det = pd.DataFrame({"time_s": [0.0, 0.1, 0.2], "frame": [0, 1, 2], "range_m": [-900.0, -895.0, -890.0],
+                        "radial_velocity_mps": [-50.0, -50.0, -50.0]})  # fmt: skip
+    det.to_parquet(tmp_path / "det.parquet")
+    result = skyradar("track", "det.parquet", "-o", "trk.parquet", cwd=tmp_path)
+    assert_one_line_error(result, "det.parquet", "range_m", "negative at row 0")
+    assert not (tmp_path / "trk.parquet").exists()

@@ -38,8 +38,13 @@ def export(
     from skyradar.io.run_origin import scenario_origin
     from skyradar.io.tables import write_table
 
-    own_path, intr_path = export_paths(output)
     folder = output.suffix.lower() != ".parquet"
+    if folder and output.suffix and not output.is_dir():  # own.csv would silently become a folder
+        raise InputError(
+            f"--output {output}: a table's name ends in .parquet; without it the output is a folder "
+            f"(name one without a suffix, or {output.with_suffix('.parquet').name})"
+        )
+    own_path, intr_path = export_paths(output)
     if folder:
         check_output(output, [run], overwrite, kind="folder")
     for path in (own_path, intr_path):

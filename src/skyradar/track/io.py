@@ -26,7 +26,7 @@ REQUIRED_DETECTION_COLUMNS = ("time_s", "range_m", "radial_velocity_mps")
 
 
 def validate_detections(df: pd.DataFrame, source: str = "detections") -> pd.DataFrame:
-    """Check a detections table: required columns, finite values, time never going backwards.
+    """Check a detections table: required columns, finite values, ranges >= 0, time never going backwards.
 
     Examples
     --------
@@ -44,6 +44,10 @@ def validate_detections(df: pd.DataFrame, source: str = "detections") -> pd.Data
             raise InputError(
                 f"{source}: field '{col}' is not a finite number at row {bad[0]} ({df[col].iloc[bad[0]]!r})"
             )
+    rng = pd.to_numeric(df["range_m"]).to_numpy(float)
+    if (rng < 0).any():  # a range is a distance: a negated column would be tracked behind the radar
+        i = int(np.flatnonzero(rng < 0)[0])
+        raise InputError(f"{source}: field 'range_m' is negative at row {i} ({rng[i]:g} m); a range is >= 0")
     t = df["time_s"].to_numpy(float)
     back = np.flatnonzero(t[1:] < t[:-1])
     if back.size:

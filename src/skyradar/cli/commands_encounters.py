@@ -121,7 +121,6 @@ def experiment_encounters(
     from skyradar.experiments.encounter_terrain import parse_terrains
     from skyradar.experiments.encounters import DEFAULT_ENCOUNTERS, DEFAULT_TERRAIN_ENCOUNTERS, FAMILIES, run
     from skyradar.io.outputs import check_output, mark_folder
-    from skyradar.io.tables import write_json_atomic
     from skyradar.parallel import check_workers
     from skyradar.rx_layouts import check_rx_layout
 
@@ -145,10 +144,6 @@ def experiment_encounters(
             out, n_encounters=n, seed=seed, frame_rate_hz=frame_rate, buffer=buffer, workers=workers,
             uncertainty=not no_uncertainty, progress=lambda k: bar.update(task, completed=k),
             terrains=tuple(terrains), layouts=layouts, navigation=navigation, rx_layout=rx_layout,
-            family=family,
+            family=family, command="skyradar " + " ".join(sys.argv[1:]),
         )  # fmt: skip
-    result["command"] = "skyradar " + " ".join(
-        sys.argv[1:]
-    )  # provenance: what was run, beside version and date
-    write_json_atomic(out / "summary.json", result)
     emit_result(result, as_json, "encounters")

@@ -189,6 +189,7 @@ def run(
     simulation: dict[str, Any] | None = None,
     rx_layout: str = "square",
     family: str = "synthetic",
+    command: str | None = None,
 ) -> dict:
     """Run the encounter set; write ``encounters.parquet``/``.csv`` (one row per terrain, encounter
     and layout), ``summary.json``, ``summary_rows.csv`` and the figures into ``out_dir``; return the
@@ -202,7 +203,8 @@ def run(
     ``rx_layout`` names the receive array (:mod:`skyradar.rx_layouts`; default the prototype's square).
     ``family`` is ``synthetic`` (:func:`~skyradar.experiments.encounter_set.make_encounters`) or
     ``real-flights`` (:func:`~skyradar.experiments.encounter_real.make_real_encounters`: recorded
-    flights, the ``flights`` extra).
+    flights, the ``flights`` extra). The summary records its provenance: ``command`` (as the caller
+    ran it), the version with a digest of the source, the UTC date and the load average.
     Finished encounters are kept in ``encounters.partial.parquet`` while the run goes on; a run that
     was interrupted resumes from them when started again with the same settings.
     """
@@ -227,7 +229,8 @@ def run(
                 "uncertainty": uncertainty, "terrains": list(terrains), "layouts": list(layouts),
                 "navigation": navigation, "suppression": SUPPRESSION, "late_lead_s": late_lead_s,
                 "simulation": simulation or {}, "rx_layout": rx_layout, "family": family}  # fmt: skip
-    done, save = _partial_store(out_dir, {**settings, "version": _version()})
+    version = _version()
+    done, save = _partial_store(out_dir, {**settings, "version": version})
     res = run_encounters(enc, seed, workers, progress, done, save, terrains=terrains, family=family,
                          layouts=layouts, frame_rate_hz=frame_rate_hz, buffer=buffer, alert_config=cfg,
                          navigation=navigation, simulation=simulation, rx_layout=rx_layout)  # fmt: skip
@@ -237,7 +240,8 @@ def run(
         resumed_encounters=len(done),
         workers=workers,
         runtime_s=round(time.perf_counter() - t0, 1),
-        version=_version(),
+        version=version,
+        command=command,
         date_utc=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
         load_average_1min=round(os.getloadavg()[0], 2),
     )

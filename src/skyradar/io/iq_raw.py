@@ -15,7 +15,7 @@ import numpy as np
 
 from skyradar.errors import InputError
 from skyradar.io.atomic import atomic_path, write_text_atomic
-from skyradar.io.iq_recording import DATATYPES, IqRecording, _illuminator, _position
+from skyradar.io.iq_recording import DATATYPES, IqRecording, _illuminator, _position, positive_number
 from skyradar.io.safe_yaml import load_yaml
 
 __all__ = ["RAW_SUFFIXES", "read_raw_iq", "write_raw_iq"]
@@ -40,14 +40,7 @@ def read_raw_iq(data_path: str | Path, require_illuminator: bool = True) -> IqRe
     if not isinstance(info, dict):
         raise InputError(f"{sidecar}: sidecar must be a mapping, got {type(info).__name__}")
     for key in ("sample_rate_hz", "center_frequency_hz"):
-        value = info.get(key)
-        if (
-            isinstance(value, bool)
-            or not isinstance(value, int | float)
-            or not np.isfinite(value)
-            or value <= 0
-        ):
-            raise InputError(f"{sidecar}: field '{key}' must be a positive number, got {value!r}")
+        positive_number(str(sidecar), key, info.get(key))
     illum, illum_pos = _illuminator(str(sidecar), info.get("illuminator"), require_illuminator)
     receiver = info.get("receiver")
     fields = {

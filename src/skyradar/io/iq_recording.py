@@ -17,7 +17,7 @@ import numpy as np
 
 from skyradar.errors import InputError
 
-__all__ = ["DATATYPES", "IqRecording"]
+__all__ = ["DATATYPES", "IqRecording", "positive_number"]
 
 # SigMF datatype -> (numpy element dtype on disk, scale to float)
 DATATYPES: dict[str, tuple[str, float]] = {"cf32_le": ("<c8", 1.0), "ci16_le": ("<i2", 1.0 / 32768.0)}
@@ -131,6 +131,24 @@ class IqRecording:
             f"IqRecording({self.path.name}, {self.datatype}, {self.n_samples} samples at "
             f"{self.sample_rate_hz / 1e6:g} MS/s, {self.duration_s:.3f} s)"
         )
+
+
+def positive_number(where: str, field: str, value: Any, must_be: str = "a positive number") -> float:
+    """``value`` of metadata ``field`` as a float when it is a finite number above 0, else
+    :class:`InputError` naming ``where``, the field and the value (``must_be`` says what it must be).
+
+    Examples
+    --------
+    >>> positive_number("rec.json", "sample_rate_hz", 2e6)
+    2000000.0
+    >>> positive_number("rec.json", "sample_rate_hz", float("nan"))
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: rec.json: field 'sample_rate_hz' must be a positive number, got nan
+    """
+    if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value) or value <= 0:
+        raise InputError(f"{where}: field '{field}' must be {must_be}, got {value!r}")
+    return float(value)
 
 
 def _illuminator(where: str, obj: Any, required: bool) -> tuple[dict, tuple | None]:

@@ -31,7 +31,6 @@ from __future__ import annotations
 import datetime as dt
 import hashlib
 import json
-import math
 import warnings
 from pathlib import Path
 
@@ -40,7 +39,7 @@ import numpy as np
 from skyradar.errors import InputError
 from skyradar.io.atomic import atomic_path, write_text_atomic
 from skyradar.io.iq_raw import RAW_SUFFIXES, read_raw_iq, write_raw_iq
-from skyradar.io.iq_recording import DATATYPES, IqRecording, _illuminator, _position
+from skyradar.io.iq_recording import DATATYPES, IqRecording, _illuminator, _position, positive_number
 
 __all__ = ["DATATYPES", "IqRecording", "SigmfWriter", "read_iq_recording", "sigmf_paths", "write_raw_iq"]
 
@@ -136,15 +135,7 @@ def _sample_rate(where: Path, glob: dict) -> float:
     """``core:sample_rate``, a finite rate above 0 (NaN, infinite or negative rates are refused)."""
     if "core:sample_rate" not in glob:
         raise InputError(f"{where}: field 'core:sample_rate' is missing")
-    value = glob["core:sample_rate"]
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, int | float)
-        or not math.isfinite(value)
-        or value <= 0
-    ):
-        raise InputError(f"{where}: field 'core:sample_rate' must be a finite rate > 0 Hz, got {value!r}")
-    return float(value)
+    return positive_number(str(where), "core:sample_rate", glob["core:sample_rate"], "a finite rate > 0 Hz")
 
 
 def read_iq_recording(path: str | Path, require_illuminator: bool = True) -> IqRecording:

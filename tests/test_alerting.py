@@ -8,7 +8,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from skyradar.daa.alerting import AlertConfig, AlertFilter, filter_alert_levels, raw_alert_levels
+from skyradar.daa.alerting import (
+    RADAR_ALERT_CONFIG,
+    AlertConfig,
+    AlertFilter,
+    filter_alert_levels,
+    raw_alert_levels,
+    required_track_age,
+)
 from skyradar.daa.conflict import FT
 from skyradar.daa.pipeline import alerts_from_tracks
 from skyradar.errors import InputError
@@ -263,3 +270,50 @@ def test_velocity_gate_bounds_the_miss_error_not_the_velocity_error():
         for gate, c in ((True, cfg), (False, ungated))
     }
     assert levels == {("near", True): 3, ("near", False): 3, ("far", True): 0, ("far", False): 3}
+
+
+def _converged(tracks: pd.DataFrame, sigma_mps: float = 2.0) -> pd.DataFrame:
+    """A track with a converged velocity (``sigma_mps`` per horizontal axis, 20 m of position)."""
+    cov = {f"cov_vv_{i}{j}": (sigma_mps**2 if i == j else 0.0) for i in range(3) for j in range(3)}
+    cov |= {f"cov_pp_{i}{j}": (400.0 if i == j else 0.0) for i in range(3) for j in range(3)}
+    return tracks.assign(**cov)
+
+
+@pytest.mark.parametrize("closure_mps", [80.0, 100.0, 120.0])
+def test_a_track_confirmed_8_s_before_the_loss_warns_within_a_second(closure_mps):
+    # DO-365 judges an alert by the time it leaves the pilot: a track first confirmed 8 s before the
+    # loss of well clear cannot spend the fixed 2 s minimum age and then 2 s of M-of-N window on
+    # proving itself. At 9.4 frames/s its wait is a tenth of the time left, and the silenced rows are
+    # no evidence against the conflict in the 2-of-4-seconds filter.
+    dt = 1.0 / 9.4
+    own, tracks = _head_on(start_m=D_NC + 8.0 * closure_mps, closure_mps=closure_mps, duration_s=9.0, dt=dt)
+    out = alerts_from_tracks(_converged(tracks), own, RADAR_ALERT_CONFIG, with_advice=False)
+    first_warning = out["time_s"].to_numpy()[np.argmax(out["level"].to_numpy() == 3)]
+    assert out["level"].max() == 3
+    assert first_warning <= 1.0
+
+
+def test_a_track_far_from_its_loss_of_well_clear_waits_the_full_age():
+    # 20 s and more from the loss, a fresh track keeps the full minimum age: there is time to converge.
+    dt = 1.0 / 9.4
+    own, tracks = _head_on(start_m=D_NC + 24.0 * 100.0, closure_mps=100.0, duration_s=6.0, dt=dt)
+    out = alerts_from_tracks(_converged(tracks), own, RADAR_ALERT_CONFIG, with_advice=False)
+    t, level = out["time_s"].to_numpy(), out["level"].to_numpy()
+    assert (level[t < RADAR_ALERT_CONFIG.min_track_age_s] == 0).all()
+    assert level.max() == 3
+
+
+def test_required_track_age_scales_with_the_time_left_and_is_bounded():
+    s = np.array([[D_NC + 100.0 * t_left, 0.0, 0.0] for t_left in (0.0, 3.0, 8.0, 15.0, 30.0)])
+    v = np.tile([-100.0, 0.0, 0.0], (5, 1))
+    age = required_track_age(s, v, AlertConfig())
+    assert age.tolist() == pytest.approx([0.5, 0.5, 0.8, 1.5, 2.0])
+    # A track predicted to pass well clear waits the full age; so does every track when the floor is off.
+    diverging = required_track_age(
+        np.array([[3000.0, 5000.0, 0.0]]), np.array([[100.0, 0.0, 0.0]]), AlertConfig()
+    )
+    assert diverging.tolist() == [2.0]
+    cfg = AlertConfig(age_fraction_of_time_left=1.0, min_track_age_s=2.0, min_track_age_floor_s=2.0)
+    assert required_track_age(s, v, cfg).tolist() == [2.0] * 5
+    with pytest.raises(ValueError, match="age_fraction_of_time_left"):
+        AlertConfig(age_fraction_of_time_left=1.5)

@@ -124,7 +124,7 @@ def test_a_decompression_bomb_is_refused_quickly(tmp_path):
                 for n in ("preventive", "corrective", "warning")
             ]
         },  # fmt: skip
-        {"min_track_age_s": 1.0e9},
+        {"min_track_age_s": 1.0e9, "min_track_age_floor_s": 1.0e9},
         {"max_velocity_sigma_mps": 0.0},
     ],
 )

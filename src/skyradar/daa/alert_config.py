@@ -14,6 +14,8 @@ frames, no track-quality gate). A file holds :class:`AlertConfig` fields, starti
     hysteresis_s: 5.0
     z_h_pos: 1.5                 # also z_h_vel, z_v_pos, z_v_vel
     min_track_age_s: 2.0
+    age_fraction_of_time_left: 0.1   # a fresh track waits at most this share of the time left
+    min_track_age_floor_s: 0.5
     max_velocity_sigma_mps: 6.0  # null: no gate
     flarm_thresholds_s: [18, 13, 8]
     levels:                      # preventive, corrective, warning
@@ -41,7 +43,17 @@ __all__ = ["ALERT_CONFIGS", "WARNING_LEVEL", "alert_config", "check_warns_head_o
 ALERT_CONFIGS = {"radar": RADAR_ALERT_CONFIG, "default": AlertConfig()}
 WARNING_LEVEL = 3  # preventive 1, corrective 2, warning 3: the level every DAA score counts
 _INTS = ("m", "n")
-_FLOATS = ("persistence_s", "hysteresis_s", "z_h_pos", "z_h_vel", "z_v_pos", "z_v_vel", "min_track_age_s")
+_FLOATS = (
+    "persistence_s",
+    "hysteresis_s",
+    "z_h_pos",
+    "z_h_vel",
+    "z_v_pos",
+    "z_v_vel",
+    "min_track_age_s",
+    "age_fraction_of_time_left",
+    "min_track_age_floor_s",
+)
 _OPTIONAL = ("period_s", "max_velocity_sigma_mps")
 _VOLUME_KEYS = ("dthr_m", "zthr_m", "tthr_s", "tcoa_s")
 
@@ -152,7 +164,7 @@ def check_warns_head_on(config: AlertConfig, label: str) -> None:
     Examples
     --------
     >>> check_warns_head_on(RADAR_ALERT_CONFIG, "radar")
-    >>> check_warns_head_on(dataclasses.replace(RADAR_ALERT_CONFIG, min_track_age_s=1e9), "slow.yaml")
+    >>> check_warns_head_on(dataclasses.replace(RADAR_ALERT_CONFIG, min_track_age_s=1e9, min_track_age_floor_s=1e9), "slow.yaml")
     Traceback (most recent call last):
     ...
     skyradar.errors.InputError: slow.yaml: these settings never warn ...

@@ -33,6 +33,8 @@ __all__ = [
     "AlertFilter",
     "filter_alert_levels",
     "velocity_unconverged",
+    "required_track_age",
+    "alerting_rows",
 ]
 
 LEVEL_NAMES = ("none", "preventive", "corrective", "warning")
@@ -87,7 +89,18 @@ class AlertConfig:
         Times to impact of FLARM alarm levels 1, 2, 3, s.
     min_track_age_s : float
         A track raises no alert before it is this old, s: a fresh track's velocity has not
-        converged, and its covariance would widen the volumes to anything.
+        converged, and its covariance would widen the volumes to anything. The wait scales with
+        the urgency (:func:`required_track_age`): it is at most ``age_fraction_of_time_left``
+        of the predicted time to the loss of well clear and at least ``min_track_age_floor_s``.
+    age_fraction_of_time_left : float
+        The largest share of the time left before the loss of well clear a fresh track waits
+        before it may alert. DO-365 judges alerts by the time they leave the pilot; a track
+        first confirmed 8 s before the loss cannot spend 2 s of it proving itself, while the
+        velocity gate (``max_velocity_sigma_mps``) and the M-of-N filter still ask for a
+        converged, repeated prediction.
+    min_track_age_floor_s : float
+        The shortest wait of a fresh track however urgent, s: a few frames of range rate and
+        direction at the prototype's frame rate.
     max_velocity_sigma_mps : float, optional
         Track-quality gate: a track row whose horizontal velocity standard deviation
         ``sqrt(cov_vv_00 + cov_vv_11)`` exceeds this raises no alert, m/s (default off), while its
@@ -114,6 +127,8 @@ class AlertConfig:
     collision_volume: WellClearVolume = field(default_factory=WellClearVolume.nmac)
     flarm_thresholds_s: tuple[float, float, float] = (18.0, 13.0, 8.0)
     min_track_age_s: float = 2.0
+    age_fraction_of_time_left: float = 0.1
+    min_track_age_floor_s: float = 0.5
     max_velocity_sigma_mps: float | None = None
 
     def __post_init__(self) -> None:
@@ -121,6 +136,14 @@ class AlertConfig:
             raise ValueError(f"alert config: need 1 <= m <= n, got m={self.m}, n={self.n}")
         if self.period_s is not None and not self.period_s > 0:
             raise ValueError(f"alert config: period_s must be > 0, got {self.period_s}")
+        if not self.min_track_age_floor_s >= 0.0:
+            raise ValueError(
+                f"alert config: min_track_age_floor_s must be >= 0, got {self.min_track_age_floor_s}"
+            )
+        if not 0.0 <= self.age_fraction_of_time_left <= 1.0:
+            raise ValueError(
+                f"alert config: age_fraction_of_time_left must be in [0, 1], got {self.age_fraction_of_time_left}"
+            )
 
     @property
     def lookahead_s(self) -> float:
@@ -164,6 +187,62 @@ def velocity_unconverged(sigma_hv_mps: np.ndarray, tcpa_s: np.ndarray, config: A
         np.nan_to_num(np.asarray(sigma_hv_mps, float), nan=np.inf) * t
         > config.max_velocity_sigma_mps * warning_s
     )
+
+
+def required_track_age(s: np.ndarray, v: np.ndarray, config: AlertConfig) -> np.ndarray:
+    """Age a track needs before this row may alert, s, from the urgency of its prediction.
+
+    The time left is the predicted entry into the warning level's plain volume (not widened by
+    the track's covariance: a fresh track's wide covariance would make every track urgent). A
+    track predicted to lose well clear in ``t`` seconds waits ``age_fraction_of_time_left * t``,
+    bounded by ``min_track_age_floor_s`` (or ``min_track_age_s`` when that is shorter) and
+    ``min_track_age_s``; one predicted to stay clear
+    over the warning's alerting time waits ``min_track_age_s``.
+
+    Parameters
+    ----------
+    s, v : ndarray, shape (n, 3)
+        Relative position (m) and velocity (m/s), intruder minus own-ship, NED.
+    config : AlertConfig
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Required track age, s.
+
+    Examples
+    --------
+    >>> s = np.array([[2000.0, 0, 0], [900.0, 0, 0], [9000.0, 0, 0]])
+    >>> v = np.array([[-100.0, 0, 0], [-100.0, 0, 0], [-100.0, 0, 0]])
+    >>> required_track_age(s, v, AlertConfig()).round(2).tolist()
+    [1.33, 0.5, 2.0]
+    """
+    warning = config.levels[-1]
+    t_in, _ = loss_of_well_clear_interval(
+        np.atleast_2d(np.asarray(s, float)), np.atleast_2d(np.asarray(v, float)),
+        warning.volume, warning.alerting_time_s,
+    )  # fmt: skip
+    longest = config.min_track_age_s
+    wait = np.clip(
+        config.age_fraction_of_time_left * t_in, min(config.min_track_age_floor_s, longest), longest
+    )
+    return np.where(np.isfinite(t_in), wait, config.min_track_age_s)
+
+
+def alerting_rows(times_s: np.ndarray, required_age_s: np.ndarray) -> np.ndarray:
+    """Rows of one track (increasing ``times_s``) from the first one old enough to alert onward.
+
+    A track is old enough from its first row whose age (time since its first row) reaches that
+    row's :func:`required_track_age`, and stays so: age only grows.
+
+    Examples
+    --------
+    >>> alerting_rows(np.arange(5) * 0.5, np.array([2.0, 2.0, 0.9, 2.0, 2.0])).tolist()
+    [False, False, True, True, True]
+    """
+    t = np.asarray(times_s, float)
+    ready = t - t[0] >= np.asarray(required_age_s, float) - 1e-9 if t.size else np.zeros(0, bool)
+    return np.cumsum(ready) > 0
 
 
 def _volume_levels(s, v, tcpa, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2, miss=None):

@@ -24,7 +24,14 @@ import pandas as pd
 import xarray as xr
 
 from skyradar.daa.advice import advice_columns
-from skyradar.daa.alerting import AlertConfig, filter_alert_levels, raw_alert_levels, velocity_unconverged
+from skyradar.daa.alerting import (
+    AlertConfig,
+    alerting_rows,
+    filter_alert_levels,
+    raw_alert_levels,
+    required_track_age,
+    velocity_unconverged,
+)
 from skyradar.daa.conflict import traffic_indication
 from skyradar.daa.provenance import check_tracks_match_run
 from skyradar.daa.range_miss import range_miss_distance
@@ -42,19 +49,27 @@ __all__ = [
 ]
 
 
-def _issued_levels(df: pd.DataFrame, t: np.ndarray, raw: dict, cov_v, config: AlertConfig) -> np.ndarray:
-    """Issued level per row; silences (in ``raw``) unconverged and too young tracks first."""
+def _issued_levels(
+    df: pd.DataFrame, t: np.ndarray, raw: dict, s: np.ndarray, v: np.ndarray, cov_v, config: AlertConfig
+) -> np.ndarray:
+    """Issued level per row; silences (in ``raw``) unconverged and too young tracks first.
+
+    A track's rows before it is old enough (:func:`~skyradar.daa.alerting.alerting_rows`) say
+    nothing about the conflict: they are not fed to its M-of-N filter, which starts at the first
+    row that may alert instead of counting the silenced rows as "no conflict".
+    """
     if config.max_velocity_sigma_mps is not None and cov_v is not None:
         sigma_hv = np.sqrt(np.nan_to_num(cov_v[:, 0, 0] + cov_v[:, 1, 1], nan=np.inf))
         unconverged = velocity_unconverged(sigma_hv, raw["tcpa_s"], config)
         raw["level"][unconverged] = 0
         raw["flarm_level"][unconverged] = 0
     level = np.zeros(len(df), int)
+    required_age = required_track_age(s, v, config)
     for _, idx in df.groupby("track_id", sort=False).indices.items():
-        young = t[idx] - t[idx[0]] < config.min_track_age_s
-        raw["level"][idx[young]] = 0
-        raw["flarm_level"][idx[young]] = 0
-        level[idx] = filter_alert_levels(t[idx], raw["level"][idx], config)
+        ready = alerting_rows(t[idx], required_age[idx])
+        raw["level"][idx[~ready]] = 0
+        raw["flarm_level"][idx[~ready]] = 0
+        level[idx[ready]] = filter_alert_levels(t[idx[ready]], raw["level"][idx[ready]], config)
     return level
 
 
@@ -135,7 +150,7 @@ def alerts_from_tracks(
     s, v = df[["north_m", "east_m", "down_m"]].to_numpy(float) - own_pos, v_int - own_vel
     cov_p, cov_v = covariances(df)
     raw = raw_alert_levels(s, v, config, cov_p, cov_v, _unmeasured_miss(df, t, own_vel))
-    level = _issued_levels(df, t, raw, cov_v, config)
+    level = _issued_levels(df, t, raw, s, v, cov_v, config)
     out = _alerts_table(df, t, level, raw, s, v_int, own["own_yaw_rad"])
     if with_advice:
         corrective = config.levels[min(1, len(config.levels) - 1)]

@@ -164,7 +164,8 @@ def check_warns_head_on(config: AlertConfig, label: str) -> None:
     Examples
     --------
     >>> check_warns_head_on(RADAR_ALERT_CONFIG, "radar")
-    >>> check_warns_head_on(dataclasses.replace(RADAR_ALERT_CONFIG, min_track_age_s=1e9, min_track_age_floor_s=1e9), "slow.yaml")
+    >>> slow = dataclasses.replace(RADAR_ALERT_CONFIG, min_track_age_s=1e9, min_track_age_floor_s=1e9)
+    >>> check_warns_head_on(slow, "slow.yaml")
     Traceback (most recent call last):
     ...
     skyradar.errors.InputError: slow.yaml: these settings never warn ...

@@ -141,9 +141,8 @@ class AlertConfig:
                 f"alert config: min_track_age_floor_s must be >= 0, got {self.min_track_age_floor_s}"
             )
         if not 0.0 <= self.age_fraction_of_time_left <= 1.0:
-            raise ValueError(
-                f"alert config: age_fraction_of_time_left must be in [0, 1], got {self.age_fraction_of_time_left}"
-            )
+            fraction = self.age_fraction_of_time_left
+            raise ValueError(f"alert config: age_fraction_of_time_left must be in [0, 1], got {fraction}")
 
     @property
     def lookahead_s(self) -> float:

@@ -258,11 +258,15 @@ def test_track_without_a_measured_direction_needs_more_detections():
         d = det.assign(elevation_measured=measured)
         out = hold_ground_tracks(tracks, d, _own(t), WIDTH, C, flat_surface(AGL_M), test)
         assert (len(out) > 0) == kept, measured
-    # Ten detections of a point target without a measured direction: released at the tenth.
-    aircraft = np.column_stack([1500.0 - 40.0 * T, 0 * T, 0 * T])  # head-on, co-altitude
-    d = _detections(aircraft).assign(elevation_measured=False)
-    out = track_detections(d, ownship=_own(), ground_test=GroundTrackTest(surface_down=flat_surface(AGL_M)))
-    assert 9 / 9.4 <= _confirmed_from(out) <= 2.0
+    # A point target without a measured direction inside the ground's radial-velocity band (the
+    # own-ship overtakes it at 20 m/s): released at the tenth detection. A head-on one closing at
+    # 90 m/s, faster than any static point, at the fifth.
+    g = GroundTrackTest(surface_down=flat_surface(AGL_M))
+    for velocity_mps, earliest, latest in ((30.0, 9, 19), (-40.0, 5, 5)):
+        aircraft = np.column_stack([1500.0 + velocity_mps * T, 0 * T, 0 * T])  # co-altitude
+        d = _detections(aircraft).assign(elevation_measured=False)
+        out = track_detections(d, ownship=_own(), ground_test=g)
+        assert earliest / 9.4 <= _confirmed_from(out) <= latest / 9.4 + 1e-9, velocity_mps
 
 
 def test_prior_elevations_do_not_overrule_the_static_ground_fit():
@@ -357,11 +361,11 @@ def test_three_clutter_hits_a_range_line_fits_are_not_an_object():
         test = GroundTrackTest(release_detections=least)
         out = hold_ground_tracks(tracks, det, _own(t), WIDTH, C, flat_surface(AGL_M), test)
         assert (len(out) > 0) == kept, least
-    # A head-on aircraft's confirmation (its Doppler test needs its own history) is not delayed.
+    # A head-on aircraft closing faster than any static point is released at the fifth detection the
+    # ground test sees (the sixth: the first starts the track).
     aircraft = _detections(np.column_stack([1500.0 - 40.0 * T, 0 * T, 0 * T]))
-    tests = [GroundTrackTest(release_detections=m) for m in (3, GroundTrackTest().release_detections)]
-    first = [_confirmed_from(track_detections(aircraft, ownship=_own(), ground_test=g)) for g in tests]
-    assert first[1] == first[0] < 2.0
+    first = _confirmed_from(track_detections(aircraft, ownship=_own(), ground_test=GroundTrackTest()))
+    assert first <= 5 / 9.4 + 1e-9
 
 
 def test_a_ground_track_is_released_only_by_verdicts_on_new_directions(monkeypatch):
@@ -377,7 +381,8 @@ def test_a_ground_track_is_released_only_by_verdicts_on_new_directions(monkeypat
     def held_with(verdicts: list[str]) -> np.ndarray:
         calls = iter(verdicts)
         monkeypatch.setattr(gt, "_judge", lambda *a, **k: next(calls))
-        return gt._history_held(t, *([np.zeros(23)] * 4), None, WIDTH, C, test, [np.zeros(23)] * 4)
+        zeros, still = np.zeros(23), np.zeros((23, 3))
+        return gt._history_held(t, zeros, zeros, still, still, None, WIDTH, C, test, [zeros] * 4)
 
     assert held_with(["ground"] * 10 + [""] * 3 + ["ground"] * 10).all()
     held = held_with(["ground"] * 10 + [""] * 13)

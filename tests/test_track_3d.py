@@ -150,3 +150,44 @@ def test_a_height_restart_keeps_range_bearing_range_rate_and_vertical_speed(rel,
     assert np.allclose(seen(t3.x[0]), seen(before), atol=1e-6)
     assert np.isclose(own[2] - t3.x[0, 2], up_fraction * r) and t3.x[0, 5] == before[5]
     assert np.isclose(np.sqrt(t3.P[0, 2, 2]), 30.0)
+
+
+def _fly(t3: Tracker3D, track_id: int, times: np.ndarray, velocity: np.ndarray, start: np.ndarray) -> None:
+    rng = np.random.default_rng(track_id)
+    for t in times:
+        pos = start + velocity * t + rng.normal(0.0, 20.0, 3)
+        t3.step(float(t), np.array([track_id]), pos[None], np.array([400.0]))
+
+
+def test_a_reacquired_filter_keeps_the_lost_ones_velocity():
+    # 6 s of 10 Hz positions (20 m noise) give the velocity to a few m/s; after a 3 s gap, a new
+    # filter with 0.4 s of positions knows it to tens of m/s. Renamed to the lost id, it is fused
+    # with the lost filter predicted across the gap: the velocity error is that of the history.
+    velocity, start = np.array([-60.0, 20.0, 0.0]), np.array([3000.0, -500.0, -50.0])
+    t3 = Tracker3D()
+    _fly(t3, 1, np.arange(0.0, 6.0, 0.1), velocity, start)
+    _fly(t3, 2, np.arange(9.0, 9.4, 0.1), velocity, start)  # track 1 is lost, track 2 is new
+    fresh_sd = np.sqrt(t3.P[0, 3, 3])
+    t3.rename(np.array([2]), np.array([1]))
+    assert t3.ids.tolist() == [1]
+    fused_sd = np.sqrt(t3.P[0, 3, 3])
+    assert fused_sd < fresh_sd / 3
+    assert np.linalg.norm(t3.x[0, 3:5] - velocity[:2]) < 4.0 * fused_sd * np.sqrt(2) + 1.0
+
+
+def test_a_lost_filter_of_another_aircraft_is_not_fused():
+    # The lost filter predicts an aircraft 1 km from where the new track is: not one aircraft's.
+    t3 = Tracker3D()
+    _fly(t3, 1, np.arange(0.0, 6.0, 0.1), np.array([-60.0, 0.0, 0.0]), np.array([3000.0, 0.0, -50.0]))
+    _fly(t3, 2, np.arange(9.0, 9.4, 0.1), np.array([-60.0, 0.0, 0.0]), np.array([3000.0, 1000.0, -50.0]))
+    before = t3.x.copy(), t3.P.copy()
+    t3.rename(np.array([2]), np.array([1]))
+    np.testing.assert_array_equal(t3.x, before[0])
+    np.testing.assert_array_equal(t3.P, before[1])
+    # Nor is one forgotten after the memory.
+    t3 = Tracker3D(lost_memory_s=2.0)
+    _fly(t3, 1, np.arange(0.0, 6.0, 0.1), np.array([-60.0, 0.0, 0.0]), np.array([3000.0, 0.0, -50.0]))
+    _fly(t3, 2, np.arange(9.0, 9.4, 0.1), np.array([-60.0, 0.0, 0.0]), np.array([3000.0, 0.0, -50.0]))
+    before = t3.P.copy()
+    t3.rename(np.array([2]), np.array([1]))
+    np.testing.assert_array_equal(t3.P, before)

@@ -19,6 +19,13 @@ directions scatter far more (tens of degrees over terrain), and a filter that tr
 its velocity from those directions (55-65 m/s off for 5 s on a converging aircraft 300 m above flat
 ground). So each filter scales its position noise by what its own innovations show (covariance
 matching): an exponential average of ``NIS / 3`` against the stated noise, never below 1.
+
+A filter whose track is lost is kept for ``lost_memory_s``. When the range-Doppler tracker gives a
+new track a lost one's id (:mod:`skyradar.track.reacquisition`), the lost filter, predicted across
+the gap, is fused with the new one (:meth:`Tracker3D.rename`): the two rest on different detections,
+before and after the gap, so their information adds. The new filter alone has a few frames of
+directions and a velocity known to tens of m/s; with the lost one's history the reacquired track
+keeps the velocity it had, and the alerts that rest on it are not silenced again as unconverged.
 """
 
 from __future__ import annotations
@@ -155,6 +162,13 @@ class Tracker3D:
         ``[1, max_noise_scale]``, multiplies the position noise. 0: the stated noise, always.
     max_noise_scale : float
         Largest factor on the position noise (each NIS enters the average at most ``3 *`` this).
+    lost_memory_s : float
+        A filter whose track is no longer alive is kept this long for a reacquisition, s (the
+        range-Doppler tracker's ``reacquire_s``); 0 forgets it at once.
+    fusion_gate : float
+        Chi-square (6 degrees of freedom) gate on the difference of a lost filter, predicted
+        across the gap, and the reacquiring one; beyond it they are not one aircraft's, and the
+        new filter is kept alone.
 
     Examples
     --------
@@ -175,6 +189,8 @@ class Tracker3D:
         init_sigma_vertical_mps: float = 3.0,
         noise_memory: float = 0.1,
         max_noise_scale: float = 16.0,
+        lost_memory_s: float = 8.0,
+        fusion_gate: float = 22.5,
     ) -> None:
         self.sigma_accel_mps2 = float(sigma_accel_mps2)
         self.init_sigma_velocity_mps = float(init_sigma_velocity_mps)
@@ -190,6 +206,9 @@ class Tracker3D:
         self.rejects = np.zeros(0, np.int64)
         self.noise_scale = np.zeros(0)
         self.time_s: float | None = None
+        self.lost_memory_s = float(lost_memory_s)
+        self.fusion_gate = float(fusion_gate)
+        self._lost: dict[int, tuple[float, np.ndarray, np.ndarray, float]] = {}  # id: (t, x, P, noise)
 
     def step(
         self,
@@ -225,6 +244,7 @@ class Tracker3D:
         if cov.ndim == 1:
             cov = cov[:, None, None] * np.eye(3)
         keep = np.isin(self.ids, ids)
+        self._remember_lost(~keep)
         self._keep(keep)
         if self.time_s is not None and self.ids.size and time_s > self.time_s:
             dt = time_s - self.time_s
@@ -274,6 +294,48 @@ class Tracker3D:
         keep[pos[found]] = True
         order = np.flatnonzero(keep)[np.argsort(self.ids[keep], kind="stable")]
         self._keep(order)
+        for new_id in new_ids[found]:
+            self._fuse_lost(int(new_id))
+
+    def _remember_lost(self, gone: np.ndarray) -> None:
+        """Keep the filters ``gone`` (mask) for a reacquisition; forget those older than the memory."""
+        if self.time_s is not None and self.lost_memory_s > 0.0:
+            for row in np.flatnonzero(gone):
+                entry = (self.time_s, self.x[row].copy(), self.P[row].copy(), float(self.noise_scale[row]))
+                self._lost[int(self.ids[row])] = entry
+        if self.time_s is not None:
+            now = self.time_s
+            self._lost = {k: v for k, v in self._lost.items() if now - v[0] <= self.lost_memory_s}
+
+    def _fuse_lost(self, track_id: int) -> None:
+        """Fuse the lost filter of ``track_id``, predicted to now, into the live one of that id.
+
+        The lost filter's information (before the gap) and the live one's (after it) are
+        independent but for the process noise across the gap, which the prediction adds to the
+        lost one: ``P = (P_lost^-1 + P_live^-1)^-1``, ``x = P (P_lost^-1 x_lost + P_live^-1 x_live)``.
+        """
+        lost = self._lost.pop(track_id, None)
+        pos, found = _lookup(self.ids, np.array([track_id], np.int64))
+        if lost is None or not found[0] or self.time_s is None:
+            return
+        t_lost, x_lost, P_lost, _ = lost
+        row = int(pos[0])
+        dt = self.time_s - t_lost
+        if dt > 0.0:
+            x_lost, P_lost = predict(
+                x_lost[None], P_lost[None], cv3d_transition(dt), cv3d_process_noise(dt, self._accel_sigmas())
+            )
+            x_lost, P_lost = x_lost[0], P_lost[0]
+        x_live, P_live = self.x[row], self.P[row]
+        if not (np.all(np.isfinite(x_lost)) and np.all(np.isfinite(x_live))):
+            return
+        d = x_lost - x_live
+        if float(d @ np.linalg.solve(P_lost + P_live, d)) > self.fusion_gate:
+            return  # not one aircraft's: the new filter alone
+        info_lost, info_live = np.linalg.inv(P_lost), np.linalg.inv(P_live)
+        P = np.linalg.inv(info_lost + info_live)
+        self.x[row] = P @ (info_lost @ x_lost + info_live @ x_live)
+        self.P[row] = 0.5 * (P + P.T)
 
     def reset_height(
         self, ids: np.ndarray, own_state: np.ndarray, up_m: np.ndarray, sigma_m: np.ndarray

@@ -105,8 +105,10 @@ def experiment_encounters(
         str,
         typer.Option(
             "--family",
-            help="synthetic (parametric flights) or real-flights (recorded own-ship and intruder "
-            "flights of the 'flights' extra, moved to meet).",
+            help="synthetic (parametric flights), real-flights (recorded own-ship and intruder "
+            "flights of the 'flights' extra, moved to meet) or fast-closures (head-on and wide "
+            "crossings whose closing speed aliases into the ground's Doppler band; own-ship "
+            "300-700 m above hills and Jacksboro).",
         ),
     ] = "synthetic",
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,

@@ -26,7 +26,7 @@ from skyradar.experiments.encounter_set import (
     relative_truth,
     score_encounter,
 )
-from skyradar.experiments.encounter_terrain import mirror_below_ground, own_altitude_m
+from skyradar.experiments.encounter_terrain import OWN_AGL_RANGE_M, mirror_below_ground, own_altitude_m
 from skyradar.scene.scenario import Scenario
 
 __all__ = [
@@ -75,7 +75,9 @@ def _fly_above_ground(
     own = built.ownship.sample(times)
     ground_own = built.terrain.height_at(own.lat_deg, own.lon_deg)
     nominal = float(own.alt_m[0])
-    alt = own_altitude_m(ground_own) if terrain in ("hills", "jacksboro") else nominal
+    agl = float(p.get("own_agl_m", np.nan))  # a family's own height above the ground, else the default range
+    agl_range = (agl, agl) if np.isfinite(agl) else OWN_AGL_RANGE_M
+    alt = own_altitude_m(ground_own, agl_range) if terrain in ("hills", "jacksboro") else nominal
     tgt = built.intruders[0].trajectory.sample(times)
     ground_tgt = built.terrain.height_at(tgt.lat_deg, tgt.lon_deg)
     if mirror_below_ground(tgt.alt_m + (alt - nominal), ground_tgt, alt):

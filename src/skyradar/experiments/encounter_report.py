@@ -19,17 +19,60 @@ from skyradar.experiments.encounter_set import plot_encounters
 from skyradar.io.atomic import savefig_atomic, write_csv_atomic
 from skyradar.io.tables import write_table
 
-__all__ = ["summary_rows", "cost_ms_per_frame", "write_report", "plot_causes"]
+__all__ = ["summary_rows", "lead_against_clear_sky", "cost_ms_per_frame", "write_report", "plot_causes"]
 
 _STAGES = ("simulate", "process", "track", "alert")
 
 
 def summary_rows(res: pd.DataFrame, late_lead_s: float) -> list[dict[str, Any]]:
-    """One summary per terrain and layout, in the table's order."""
+    """One summary per terrain and layout, in the table's order.
+
+    When the run has clear sky (terrain ``none``) too, each terrain's row compares its warning
+    lead with clear sky's on the same encounters and layout (:func:`lead_against_clear_sky`).
+    """
     rows = []
     for (terrain, layout), g in res.groupby(["terrain", "layout"], sort=False):
-        rows.append({"terrain": terrain, "layout": layout, **summarise_layout(g, late_lead_s)})
+        row = {"terrain": terrain, "layout": layout, **summarise_layout(g, late_lead_s)}
+        if terrain != "none" and "none" in set(res["terrain"]):
+            clear = res[(res["terrain"] == "none") & (res["layout"] == layout)]
+            row["lead_against_clear_sky"] = lead_against_clear_sky(g, clear)
+        rows.append(row)
     return rows
+
+
+def lead_against_clear_sky(terrain: pd.DataFrame, clear: pd.DataFrame) -> dict[str, Any]:
+    """Warning lead over a terrain against clear sky's on the same encounters (one layout each).
+
+    Over the conflicts observable in both that both warned: the median lead of each, and the median
+    of the per-encounter difference (terrain minus clear sky, s; negative: the ground cost time).
+
+    Examples
+    --------
+    >>> clear = pd.DataFrame({"encounter": [0, 1, 2], "observable": True, "t_lowc_s": 100.0,
+    ...                       "t_warning_s": [80.0, 85.0, np.nan]})
+    >>> hills = clear.assign(t_warning_s=[84.0, 86.0, 90.0])
+    >>> lead_against_clear_sky(hills, clear)["median_difference_s"]
+    -2.5
+    """
+    both = terrain.merge(clear, on="encounter", suffixes=("", "_clear"))
+    lead = both["t_lowc_s"] - both["t_warning_s"]
+    lead_clear = both["t_lowc_s_clear"] - both["t_warning_s_clear"]
+    ok = both["observable"] & both["observable_clear"] & lead.notna() & lead_clear.notna()
+    ok &= both["t_lowc_s"].notna()
+    if not ok.any():
+        nan = float("nan")
+        return {
+            "encounters": 0,
+            "median_lead_s": nan,
+            "median_lead_clear_sky_s": nan,
+            "median_difference_s": nan,
+        }
+    return {
+        "encounters": int(ok.sum()),
+        "median_lead_s": float(np.median(lead[ok])),
+        "median_lead_clear_sky_s": float(np.median(lead_clear[ok])),
+        "median_difference_s": float(np.median((lead - lead_clear)[ok])),
+    }
 
 
 def cost_ms_per_frame(res: pd.DataFrame) -> dict[str, float]:

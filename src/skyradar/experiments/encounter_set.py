@@ -32,6 +32,8 @@ __all__ = [
     "OWN_ALTITUDE_M",
     "T_CPA_S",
     "make_encounters",
+    "make_fast_closures",
+    "FAST_CLOSURE_AGL_M",
     "encounter_scenario",
     "relative_truth",
     "event_times",
@@ -86,6 +88,58 @@ def make_encounters(n: int, seed: int = 0) -> pd.DataFrame:
             "climb_mps": np.where(climbing, sign * rng.uniform(2.0, 6.0, n), np.nan),
             "side": rng.choice(["left", "right"], n),
             "rcs_m2": np.exp(rng.uniform(np.log(1.0), np.log(5.0), n)),
+        }
+    )
+
+
+FAST_CLOSURE_AGL_M = (300.0, 700.0)
+FAST_CLOSURE_KINDS = ("head-on", "crossing", "climbing")
+
+
+def make_fast_closures(n: int, seed: int = 0) -> pd.DataFrame:
+    """The fast-closure family: encounters whose closing speed aliases into the ground's Doppler band.
+
+    Own-ship at ``OWN_SPEED_MPS`` (50 m/s) meets intruders at 30-70 m/s head-on, crossing at
+    110-160 deg, or crossing at 110-170 deg while climbing or descending 2-6 m/s through its
+    level: closing speeds of about 78-117 m/s, which alias (image width 78.3 m/s at the
+    prototype's 9.4 frames/s) into the band of radial velocities the ground ahead fills. Over
+    relief that is the geometry where clutter hides an intruder and a radar has the least time.
+    Misses are drawn as in :func:`make_encounters` (a third inside the well-clear volume). The
+    column ``own_agl_m`` (uniform in :data:`FAST_CLOSURE_AGL_M`) sets the own-ship's lowest height
+    above the ground under its track over hills and Jacksboro.
+
+    Examples
+    --------
+    >>> enc = make_fast_closures(6, seed=1)
+    >>> enc["kind"].tolist()
+    ['head-on', 'crossing', 'climbing', 'head-on', 'crossing', 'climbing']
+    >>> bool(enc["crossing_angle_deg"].abs().min() >= 110.0), bool(enc["own_agl_m"].between(300, 700).all())
+    (True, True)
+    """
+    rng = np.random.default_rng(seed)
+    kind = np.array(FAST_CLOSURE_KINDS)[np.arange(n) % len(FAST_CLOSURE_KINDS)]
+    inside = rng.random(n) < 1 / 3
+    vol = WellClearVolume.do365_noncoop()
+    h = np.where(inside, rng.uniform(0, 0.9 * vol.dthr_m, n), rng.uniform(0, 3.0 * vol.dthr_m, n))
+    v = np.where(inside, rng.uniform(0, 0.9 * vol.zthr_m, n), rng.uniform(0, 3.0 * vol.zthr_m, n))
+    spread = ~inside & (rng.random(n) < 0.5)
+    v[spread] = rng.uniform(0, 0.9 * vol.zthr_m, spread.sum())
+    sign = rng.choice([-1.0, 1.0], n)
+    angle = np.select(
+        [kind == "crossing", kind == "climbing"], [rng.uniform(110, 160, n), rng.uniform(110, 170, n)], np.nan
+    )
+    climbing = kind == "climbing"
+    return pd.DataFrame(
+        {
+            "kind": kind,
+            "horizontal_miss_m": np.where(climbing, np.maximum(h, 1.0), h),
+            "vertical_miss_m": np.where(climbing, 0.0, v * sign),
+            "intruder_speed_mps": rng.uniform(30, 70, n),
+            "crossing_angle_deg": angle * rng.choice([-1.0, 1.0], n),
+            "climb_mps": np.where(climbing, sign * rng.uniform(2.0, 6.0, n), np.nan),
+            "side": rng.choice(["left", "right"], n),
+            "rcs_m2": np.exp(rng.uniform(np.log(1.0), np.log(5.0), n)),
+            "own_agl_m": rng.uniform(*FAST_CLOSURE_AGL_M, n),
         }
     )
 

@@ -56,7 +56,7 @@ def test_chunks_of_two_frames_give_the_whole_runs_rows(run, whole):
 
 
 def test_blocks_with_the_runs_anchors_give_the_whole_runs_rows(run, whole):
-    # The encounter chain simulates and processes blocks of frames (experiments.daa_chain).
+    # The encounter chain simulates and processes blocks of frames (skyradar.chain).
     anchors, parts = clutter_anchors(run), []
     for s in range(0, run.sizes["time"], 3):
         block = process_frames(run.isel(time=slice(s, s + 3)), suppression="auto", anchors=anchors[s : s + 3])

@@ -10,7 +10,6 @@ import shutil
 import subprocess
 import sys
 import tomllib
-import warnings
 from pathlib import Path
 
 import pytest
@@ -97,11 +96,11 @@ def test_a_new_package_outside_the_layering_breaks_the_check(tiny_tree: Path):
     assert "skyradar.radarheads" in result.stdout + result.stderr
 
 
-def test_the_old_terrain_names_still_import_with_a_deprecation_warning():
-    import skyradar.scene.terrain as terrain
-    from skyradar.scene.synthetic_terrain import flat_terrain
 
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        assert terrain.flat_terrain is flat_terrain
-    assert any(issubclass(w.category, DeprecationWarning) for w in caught)
+def test_only_the_command_line_sits_above_experiments_and_benchmarks():
+    # Library code (the chain, the demo, every stage) never imports the experiments or the benchmarks:
+    # only the command line and ``python -m skyradar`` may.
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]
+    (contract,) = config["contracts"]
+    layers = [{n.strip() for n in layer.split("|")} for layer in contract["layers"]]
+    assert layers[:3] == [{"__main__"}, {"cli"}, {"experiments", "benchmarks"}]

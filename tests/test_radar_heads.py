@@ -7,9 +7,9 @@ import pandas as pd
 import pytest
 
 from cli_helpers import assert_one_line_error, skyradar
+from skyradar.chain import label_tracks, run_chain
 from skyradar.config import Mount
 from skyradar.errors import InputError
-from skyradar.experiments.daa_chain import label_tracks, run_chain
 from skyradar.geo import rotation_matrix
 from skyradar.io.frames import open_frames
 from skyradar.io.frames_heads import store_heads

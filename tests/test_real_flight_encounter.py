@@ -15,8 +15,8 @@ import pandas as pd
 import pytest
 import yaml
 
+from skyradar.chain import label_tracks, run_chain
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG
-from skyradar.experiments.daa_chain import label_tracks, run_chain
 from skyradar.experiments.encounter_set import event_times, relative_truth
 from skyradar.scene.adsb import read_trajectory
 from skyradar.scene.encounter_from_tracks import encounter_from_tracks, encounter_scenario, trajectory_table

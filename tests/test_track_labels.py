@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from skyradar.experiments.daa_chain import confirmed_rows, label_tracks
+from skyradar.chain import confirmed_rows, label_tracks
 from skyradar.experiments.encounter_score import track_counts
 
 

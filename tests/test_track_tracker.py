@@ -4,9 +4,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from skyradar.benchmarks.track import associate_naive
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
-from skyradar.track.association import associate, associate_naive
+from skyradar.track.association import associate
 from skyradar.track.io import Truth
 from skyradar.track.metrics import track_metrics
 from skyradar.track.models import radar_model

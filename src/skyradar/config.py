@@ -16,7 +16,6 @@ the aircraft body frame (forward, right, down).
 from __future__ import annotations
 
 import json
-import warnings
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any
@@ -206,15 +205,9 @@ class RadarConfig:
 
     @classmethod
     def prototype_2022(cls, **changes: Any) -> RadarConfig:
-        """The 2022 thesis prototype (seed-brief.md), with optional field overrides."""
+        """The 2022 thesis prototype (Maas 2022, the X-band FMCW radar flown on a light aircraft), with
+        optional field overrides."""
         return cls(**changes)
-
-    @classmethod
-    def seed_prototype(cls, **changes: Any) -> RadarConfig:
-        """Deprecated name of :meth:`prototype_2022`; removed in the next release."""
-        msg = "RadarConfig.seed_prototype() is deprecated; use RadarConfig.prototype_2022()"
-        warnings.warn(msg, DeprecationWarning, stacklevel=2)
-        return cls.prototype_2022(**changes)
 
     def replace(self, **changes: Any) -> RadarConfig:
         """A copy with some fields changed (dataclasses.replace)."""

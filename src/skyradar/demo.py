@@ -23,10 +23,10 @@ from typing import Any
 
 import pandas as pd
 
+from skyradar.chain import label_tracks
+from skyradar.chain import run_chain as _run_chain
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG
 from skyradar.errors import InputError
-from skyradar.experiments.daa_chain import label_tracks
-from skyradar.experiments.daa_chain import run_chain as _run_chain
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.scene.scenario import load_scenario
@@ -56,7 +56,7 @@ def demo_scenario_path() -> Path:
 
 
 def run_chain(built, keep_frames: tuple[int, ...] = ()) -> dict[str, Any]:
-    """:func:`skyradar.experiments.daa_chain.run_chain` with :data:`DEMO_ALERT_CONFIG`."""
+    """:func:`skyradar.chain.run_chain` with :data:`DEMO_ALERT_CONFIG`."""
     return _run_chain(built, DEMO_ALERT_CONFIG, keep_frames)
 
 

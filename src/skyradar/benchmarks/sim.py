@@ -42,7 +42,7 @@ from skyradar.config import RadarConfig
 from skyradar.geo import geodetic_to_ned
 from skyradar.sim._terrain_kernel import cell_count_grid
 from skyradar.sim.geometry import AntennaGeometry
-from skyradar.sim.image import ImageSimulator, PlatformState, _reflectivity_table, two_way_gain_table
+from skyradar.sim.image import ImageSimulator, PlatformState, reflectivity_table, two_way_gain_table
 from skyradar.units import nearest_bin
 
 __all__ = [
@@ -74,7 +74,7 @@ class FacetPhysics:
         self.config = config
         self.gain2, self.gain2_step = two_way_gain_table(config)
         self._gain2_f64 = self.gain2.astype(float)  # the kernel reads float32 into float64 math
-        self.refl_table = _reflectivity_table("cosine")
+        self.refl_table = reflectivity_table("cosine")
         self.coupling_s = config.range_doppler_coupling_s if coupling else 0.0
         self.power_const = config.pe_w * config.wavelength_m**2 / (4 * np.pi) ** 3
         self.r_max_m = config.range_resolution_m * (config.n_range + 2)

@@ -1,4 +1,4 @@
-"""Experiments that reproduce seed-brief.md ch2 to ch7, and the DAA evaluation.
+"""Experiments that reproduce the thesis' chapters 2 to 7 (Maas 2022), and the DAA evaluation.
 
 ``encounters`` scores the whole chain on an encounter set and ``demo`` (in :mod:`skyradar.demo`)
 flies one scenario end to end. ch6 is the GPS check against a map, ch7 the passive radar.

@@ -4,7 +4,7 @@ The frames cover the last ``lookback_s`` before the loss of well clear (or the C
 earlier than the intruder is inside the range limit: 40 s is the 25 s warning alerting time plus
 15 s to confirm a track and let its velocity converge (on the seed-1 set at 4.7 Hz, 45 s gave the
 same warnings and 35 s cut the median lead by 2 s). Every head of the scenario is simulated and
-processed once (:func:`skyradar.experiments.daa_chain.run_chain`: the chain a user gets, with
+processed once (:func:`skyradar.chain.run_chain`: the chain a user gets, with
 its default clutter suppression, ground flags and navigation errors); each layout then tracks and
 alerts its own heads' detections, so a single head and the three-head layout are compared on the
 same frames, noise and clutter.
@@ -17,8 +17,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from skyradar.chain import confirmed_rows, label_tracks, run_chain
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig
-from skyradar.experiments.daa_chain import confirmed_rows, label_tracks, run_chain
 from skyradar.experiments.encounter_score import frame_status, track_counts, unwarned_cause
 from skyradar.experiments.encounter_set import (
     encounter_scenario,
@@ -221,7 +221,7 @@ def chain_rows(
     """Simulate and process ``built`` once, then track, alert and score each layout's heads: one row
     per layout (:func:`score_layout` with ``opts``, the ``shared`` columns and the stage timings).
     ``t`` and ``rel`` are the dense relative truth the encounter is scored on."""
-    from skyradar.experiments.daa_chain import track_and_alert
+    from skyradar.chain import track_and_alert
 
     chain = run_chain(built, cfg, with_advice=False, process_options={"suppression": SUPPRESSION})
     shared = shared | {

@@ -326,19 +326,3 @@ def read_recording(path: str | Path) -> tuple[AdcFrames, RadarConfig]:
     scale = _positive(sidecar, meta, "scale") if "scale" in meta else 1.0
     times = _frame_times(sidecar, meta, sizes["frame"], config)
     return AdcFrames(raw, axes, pairs, scale, times), config
-
-
-def __getattr__(name: str) -> Any:
-    # write_recording moved to skyradar.io.recording_writer (issue 16); the old name stays one release.
-    if name == "write_recording":
-        import warnings
-
-        from skyradar.io.recording_writer import write_recording
-
-        warnings.warn(
-            "skyradar.io.recordings.write_recording is deprecated; use skyradar.io.recording_writer",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        return write_recording
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -19,13 +19,13 @@ in reality (the tangent plane itself would rise 2.8 m above the ground 6 km from
 Readers (:func:`read_dem`, :func:`jacksboro`) live in :mod:`skyradar.scene.dem_readers` and
 synthetic surfaces (:func:`flat_terrain`, :func:`fractal_terrain`, :func:`roughness_map`) in
 :mod:`skyradar.scene.synthetic_terrain`; both import :class:`Terrain` from here, never the other way
-round (their names are still importable from this module, deprecated, for one release).
+round.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Literal, NamedTuple
+from typing import Literal, NamedTuple
 
 import numpy as np
 
@@ -35,38 +35,10 @@ from skyradar.geo import geodetic_to_ned, ned_to_geodetic
 _WGS84_A_M = 6_378_137.0
 _WGS84_E2 = 6.69437999014e-3
 
-# Deprecated aliases (PEP 562), kept for one release: the reader and synthetic modules import Terrain
-# from here, so this module never imports them; nothing in skyradar uses these names from here.
-_DEPRECATED = {
-    "read_dem": "skyradar.scene.dem_readers",
-    "read_hgt": "skyradar.scene.dem_readers",
-    "read_geotiff": "skyradar.scene.dem_readers",
-    "read_npz": "skyradar.scene.dem_readers",
-    "jacksboro": "skyradar.scene.dem_readers",
-    "flat_terrain": "skyradar.scene.synthetic_terrain",
-    "fractal_terrain": "skyradar.scene.synthetic_terrain",
-    "roughness_map": "skyradar.scene.synthetic_terrain",
-    "local_height_sd": "skyradar.scene.synthetic_terrain",
-}
-
 __all__ = ["Terrain", "Bounds", "metres_per_degree"]
 
 # Index distance (grid cells) within which a position counts as on the edge: float rounding only.
 _EDGE_TOL = 1e-9
-
-
-def __getattr__(name: str) -> Any:
-    if name in _DEPRECATED:
-        import importlib
-        import warnings
-
-        warnings.warn(
-            f"skyradar.scene.terrain.{name} is deprecated: import it from {_DEPRECATED[name]}",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        return getattr(importlib.import_module(_DEPRECATED[name]), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 class Bounds(NamedTuple):

@@ -14,7 +14,7 @@ The thesis' method (seed-brief.md ch2) made exact where it simplified:
 - optionally (issue 12.1): the range and Doppler windows' point-spread (:mod:`skyradar.sim.psf`),
   speckle on terrain and Swerling 1 fluctuation of the targets.
 
-Pixel units: |pixel|^2 is received power in W for a scatterer centred in that pixel.
+Pixel units: ``|pixel|^2`` is received power in W for a scatterer centred in that pixel.
 """
 
 from __future__ import annotations
@@ -48,7 +48,6 @@ __all__ = [
 ]
 _NO_SPECKLE = np.uint64(0)
 
-_reflectivity_table = reflectivity_table  # the old private name (benchmarks.sim)
 
 
 class ImageSimulator:

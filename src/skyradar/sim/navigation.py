@@ -12,8 +12,7 @@ seeded from ``navigation.seed`` or else ``simulation.seed``. Every error group d
 own random stream whatever its size, so ``only-heading`` sees exactly ``ga-typical``'s heading
 error: the cost of each error can be compared on one realisation.
 
-This is also the home of the AHRS attitude model ch5 uses (:func:`ahrs_attitude`, formerly
-``skyradar.nav.ahrs``).
+This is also the home of the AHRS attitude model the flight-state chapter uses (:func:`ahrs_attitude`).
 """
 
 from __future__ import annotations

@@ -6,8 +6,6 @@ marginal of its gate), found with ``np.searchsorted``. The surviving pairs are s
 Mahalanobis distance of the possibly wrapped innovation, or its l2 norm in pixels, as in the
 thesis) and the Hungarian algorithm (:func:`scipy.optimize.linear_sum_assignment`) picks the
 assignment on the small dense matrix of tracks and detections that have any gated pair.
-:func:`associate_naive` is the plain per-pair loop, kept as the benchmark baseline and as a test
-oracle.
 """
 
 from __future__ import annotations
@@ -19,7 +17,7 @@ from scipy.optimize import linear_sum_assignment
 
 from skyradar.track.kalman import innovation
 
-__all__ = ["Association", "associate", "associate_naive", "pair_costs"]
+__all__ = ["Association", "associate", "pair_costs"]
 
 _FORBIDDEN = 1e12
 
@@ -166,48 +164,3 @@ def associate(
     t_idx, d_idx, y, cost = t_idx[ok], d_idx[ok], y[ok], cost[ok]
     pick = _solve(t_idx, d_idx, cost)
     return Association(t_idx[pick], d_idx[pick], y[pick], cost[pick])
-
-
-def associate_naive(
-    z_pred: np.ndarray,
-    S: np.ndarray,
-    z: np.ndarray,
-    gate: float,
-    doppler_width_mps: float | None = None,
-    range_wrap_m: np.ndarray | None = None,
-    metric: str = "mahalanobis",
-    pixel_size: tuple[float, float] = (1.0, 1.0),
-    max_alias: int = 2,
-) -> Association:
-    """Same contract as :func:`associate`, scoring every pair in a Python loop (baseline)."""
-    n, m = len(z_pred), len(z)
-    C = np.full((n, m), _FORBIDDEN)
-    Y = np.zeros((n, m, 2))
-    for i in range(n):
-        S_inv = np.linalg.inv(S[i])
-        for j in range(m):
-            y = z[j] - z_pred[i]
-            if doppler_width_mps is not None:
-                y[1] = (y[1] + doppler_width_mps / 2) % doppler_width_mps - doppler_width_mps / 2
-            if range_wrap_m is not None and np.isfinite(range_wrap_m[i]) and range_wrap_m[i] > 0:
-                w = range_wrap_m[i]
-                if (
-                    abs(y[0])
-                    > (np.sqrt(gate * S[i, 0, 0]) if metric != "l2" else gate * pixel_size[0]) + max_alias * w
-                ):
-                    continue
-                y[0] = (y[0] + w / 2) % w - w / 2
-            c = (
-                float(np.hypot(y[0] / pixel_size[0], y[1] / pixel_size[1]))
-                if metric == "l2"
-                else float(y @ S_inv @ y)
-            )
-            if c < gate:
-                C[i, j] = c
-                Y[i, j] = y
-    if n == 0 or m == 0:
-        return Association(np.zeros(0, int), np.zeros(0, int), np.zeros((0, 2)), np.zeros(0))
-    r, c = linear_sum_assignment(C)
-    keep = C[r, c] < _FORBIDDEN
-    r, c = r[keep], c[keep]
-    return Association(r, c, Y[r, c], C[r, c])

@@ -1,6 +1,17 @@
 """The whole DAA chain on one built scenario: simulate -> process -> track -> alert.
 
-Used by ``skyradar demo`` and ``skyradar experiment encounters``. Frames are simulated and
+The Python entry point of the chain (``skyradar demo`` and ``skyradar experiment encounters`` run
+it too)::
+
+    from skyradar.chain import run_chain
+    from skyradar.daa.alerting import RADAR_ALERT_CONFIG
+    from skyradar.scene.scenario import load_scenario
+
+    built = load_scenario("my_scenario.yaml").build()
+    out = run_chain(built, RADAR_ALERT_CONFIG)
+    out["alerts"].query("level == 3")  # the warnings: time, track, range, bearing, advice
+
+ Frames are simulated and
 processed in blocks of ``block_frames`` so that memory stays bounded (a minute of frames is
 ~750 MB); only the detections, tracks and alerts tables are kept, plus any frames asked for.
 

@@ -4,8 +4,11 @@ A raw level is the highest level ``k`` whose well-clear volume is predicted to b
 alerting time. The filter turns the per-frame raw levels of one track into a steady indication:
 level ``k`` is issued when at least ``M`` of the last ``N`` raw levels reach ``k``; a level, once
 issued, is held at least ``persistence_s``, and it is lowered only after the M-of-N level has stayed
-below it for ``hysteresis_s``. The defaults follow DAIDALUS' DO-365B configuration
-(``alerting_m = 2``, ``alerting_n = 4``, ``persistence_time = 4 s``, ``hysteresis_time = 5 s``).
+below it for ``hysteresis_s``. The threshold has hysteresis too: an issued level counts as still
+reached while its volume is predicted lost within ``hold_time_factor`` times its alerting time, so a
+prediction that sits near the edge of the alerting time does not make the alert chatter. The
+defaults follow DAIDALUS' DO-365B configuration (``alerting_m = 2``, ``alerting_n = 4``,
+``persistence_time = 4 s``, ``hysteresis_time = 5 s``).
 """
 
 from __future__ import annotations
@@ -101,6 +104,11 @@ class AlertConfig:
     min_track_age_floor_s : float
         The shortest wait of a fresh track however urgent, s: a few frames of range rate and
         direction at the prototype's frame rate.
+    hold_time_factor : float
+        An issued level is held while its (widened) volume is predicted lost within this multiple
+        of its alerting time (threshold hysteresis, >= 1): a raw level that hovers at the edge of
+        the alerting time, as a track's prediction does when the widened volume's edge crosses
+        the alerting time, raises the alert once and does not drop and raise it again.
     max_velocity_sigma_mps : float, optional
         Track-quality gate: a track row whose horizontal velocity standard deviation
         ``sqrt(cov_vv_00 + cov_vv_11)`` exceeds this raises no alert, m/s (default off), while its
@@ -129,6 +137,7 @@ class AlertConfig:
     min_track_age_s: float = 2.0
     age_fraction_of_time_left: float = 0.1
     min_track_age_floor_s: float = 0.5
+    hold_time_factor: float = 1.5
     max_velocity_sigma_mps: float | None = None
 
     def __post_init__(self) -> None:
@@ -136,6 +145,8 @@ class AlertConfig:
             raise ValueError(f"alert config: need 1 <= m <= n, got m={self.m}, n={self.n}")
         if self.period_s is not None and not self.period_s > 0:
             raise ValueError(f"alert config: period_s must be > 0, got {self.period_s}")
+        if not self.hold_time_factor >= 1.0:
+            raise ValueError(f"alert config: hold_time_factor must be >= 1, got {self.hold_time_factor}")
         if not self.min_track_age_floor_s >= 0.0:
             raise ValueError(
                 f"alert config: min_track_age_floor_s must be >= 0, got {self.min_track_age_floor_s}"
@@ -246,9 +257,11 @@ def alerting_rows(times_s: np.ndarray, required_age_s: np.ndarray) -> np.ndarray
 
 def _volume_levels(s, v, tcpa, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2, miss=None):
     """Highest level whose (widened) volume is lost within its alerting time, its entry time,
-    and the widened thresholds ``{level: (dthr_m, zthr_m)}`` of every level. ``miss`` (miss
-    distance and sigma, m) clears the levels whose plain cylinder it passes outside."""
+    the widened thresholds ``{level: (dthr_m, zthr_m)}`` of every level, and the highest level
+    lost within ``hold_time_factor`` times its alerting time. ``miss`` (miss distance and sigma,
+    m) clears the levels whose plain cylinder it passes outside."""
     level = np.zeros(len(s), int)
+    hold = np.zeros(len(s), int)
     t_in_out = np.full(len(s), np.nan)
     widened = {}
     z = (config.z_h_pos, config.z_h_vel, config.z_v_pos, config.z_v_vel)
@@ -256,13 +269,16 @@ def _volume_levels(s, v, tcpa, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2, m
         t_ref = np.clip(tcpa, 0.0, lv.alerting_time_s)
         dthr, zthr = widened_thresholds(lv.volume, cov_pos_m2, cov_vel_m2ps2, t_ref, *z)
         widened[k] = (dthr, zthr)
-        t_in, _ = loss_of_well_clear_interval(s, v, lv.volume, lv.alerting_time_s, dthr, zthr)
-        hit = np.isfinite(t_in)
+        held_s = config.hold_time_factor * lv.alerting_time_s
+        t_in, _ = loss_of_well_clear_interval(s, v, lv.volume, held_s, dthr, zthr)
+        possible = np.ones(len(s), bool)
         if miss is not None and lv.volume.tthr_s == 0.0 and lv.volume.tcoa_s == 0.0:
-            hit &= ~cannot_enter(*miss, lv.volume.dthr_m, lv.volume.zthr_m)
+            possible = ~cannot_enter(*miss, lv.volume.dthr_m, lv.volume.zthr_m)
+        hit = possible & (t_in <= lv.alerting_time_s)
         level = np.where(hit, k, level)
+        hold = np.where(possible & np.isfinite(t_in), k, hold)
         t_in_out = np.where(hit, t_in, t_in_out)
-    return level, t_in_out, widened
+    return level, t_in_out, widened, hold
 
 
 def raw_alert_levels(
@@ -290,9 +306,11 @@ def raw_alert_levels(
     Returns
     -------
     dict of ndarray
-        ``level`` (0..3), ``t_in_s`` (entry time into the highest-level volume lost, or the
-        corrective one; NaN if none), ``tcpa_s``, ``hmd_m``, ``vmd_m``, ``time_to_impact_s``,
-        ``flarm_level``, ``dthr_m``, ``zthr_m`` (widened corrective thresholds).
+        ``level`` (0..3), ``hold_level`` (the highest level an issued alert is held at,
+        :attr:`AlertConfig.hold_time_factor`), ``t_in_s`` (entry time into the highest-level
+        volume lost, or the corrective one; NaN if none), ``tcpa_s``, ``hmd_m``, ``vmd_m``,
+        ``time_to_impact_s``, ``flarm_level``, ``dthr_m``, ``zthr_m`` (widened corrective
+        thresholds).
 
     Examples
     --------
@@ -304,11 +322,12 @@ def raw_alert_levels(
     s = np.atleast_2d(np.asarray(s, float))
     v = np.atleast_2d(np.asarray(v, float))
     tcpa, hmd, vmd = cpa(s, v)
-    level, t_in_out, widened = _volume_levels(s, v, tcpa, config, cov_pos_m2, cov_vel_m2ps2, miss)
+    level, t_in_out, widened, hold = _volume_levels(s, v, tcpa, config, cov_pos_m2, cov_vel_m2ps2, miss)
     t_imp, _ = loss_of_well_clear_interval(s, v, config.collision_volume, config.flarm_thresholds_s[0])
     corrective = widened[min(2, len(config.levels))]
     return {
         "level": level,
+        "hold_level": np.maximum(hold, level),
         "t_in_s": t_in_out,
         "tcpa_s": tcpa,
         "hmd_m": hmd,
@@ -337,18 +356,25 @@ class AlertFilter:
     def __init__(self, config: AlertConfig | None = None) -> None:
         self.config = config or AlertConfig()
         self._raw: list[int] = []
+        self._hold: list[int] = []
         self._times: list[float] = []
         self.level = 0
         self._raised_at = -np.inf
         self._below_since: float | None = None
 
-    def update(self, time_s: float, raw_level: int) -> int:
-        """Feed the raw level of the frame at ``time_s`` (s); return the issued level."""
+    def update(self, time_s: float, raw_level: int, hold_level: int | None = None) -> int:
+        """Feed the raw level of the frame at ``time_s`` (s); return the issued level.
+
+        ``hold_level`` (default ``raw_level``) is the highest level the frame would hold an issued
+        alert at (:attr:`AlertConfig.hold_time_factor`): the issued level is not lowered while
+        the M-of-N of these reaches it.
+        """
         cfg = self.config
-        candidate = self._m_of_n_level(time_s, int(raw_level))
+        hold = int(raw_level) if hold_level is None else max(int(hold_level), int(raw_level))
+        candidate, held = self._m_of_n_level(time_s, int(raw_level), hold)
         if candidate > self.level:
             self.level, self._raised_at, self._below_since = candidate, time_s, None
-        elif candidate == self.level:
+        elif candidate == self.level or held >= self.level:
             self._below_since = None
         else:
             if self._below_since is None:
@@ -358,27 +384,37 @@ class AlertFilter:
                 self.level, self._below_since = candidate, None
         return self.level
 
-    def _m_of_n_level(self, time_s: float, raw_level: int) -> int:
-        """Highest level reached by M of the last N samples (frames, or periods of ``period_s``)."""
+    def _m_of_n_level(self, time_s: float, raw_level: int, hold_level: int) -> tuple[int, int]:
+        """Highest level reached by M of the last N samples (frames, or periods of ``period_s``),
+        of the raw levels and of the hold levels."""
         cfg = self.config
         self._raw.append(raw_level)
+        self._hold.append(hold_level)
         self._times.append(float(time_s))
         if cfg.period_s is None:
-            self._raw, self._times = self._raw[-cfg.n :], self._times[-cfg.n :]
-            need = float(cfg.m)
+            start = max(len(self._raw) - cfg.n, 0)
         else:
             # Frames strictly inside the window (a tolerance keeps exactly n periods of frames).
             start = next(i for i, t in enumerate(self._times) if t > time_s - cfg.n * cfg.period_s + 1e-9)
-            self._raw, self._times = self._raw[start:], self._times[start:]
-            need = max(float(cfg.m), cfg.m / cfg.n * len(self._raw))
-        counts = [sum(r >= k for r in self._raw) for k in range(1, len(cfg.levels) + 1)]
-        return max([k for k, c in enumerate(counts, start=1) if c >= need], default=0)
+        self._raw, self._hold, self._times = self._raw[start:], self._hold[start:], self._times[start:]
+        need = float(cfg.m) if cfg.period_s is None else max(float(cfg.m), cfg.m / cfg.n * len(self._raw))
+
+        def reached(levels: list[int]) -> int:
+            counts = [sum(r >= k for r in levels) for k in range(1, len(cfg.levels) + 1)]
+            return max([k for k, c in enumerate(counts, start=1) if c >= need], default=0)
+
+        return reached(self._raw), reached(self._hold)
 
 
 def filter_alert_levels(
-    times_s: np.ndarray, raw_levels: np.ndarray, config: AlertConfig | None = None
+    times_s: np.ndarray,
+    raw_levels: np.ndarray,
+    config: AlertConfig | None = None,
+    hold_levels: np.ndarray | None = None,
 ) -> np.ndarray:
     """Issued levels of one track from its raw levels at increasing ``times_s`` (see :class:`AlertFilter`).
+
+    ``hold_levels`` (default the raw levels) are the levels each frame holds an issued alert at.
 
     Examples
     --------
@@ -386,4 +422,8 @@ def filter_alert_levels(
     [0, 1, 1, 1]
     """
     filt = AlertFilter(config)
-    return np.array([filt.update(float(t), int(r)) for t, r in zip(times_s, raw_levels, strict=True)], int)
+    hold = raw_levels if hold_levels is None else hold_levels
+    return np.array(
+        [filt.update(float(t), int(r), int(h)) for t, r, h in zip(times_s, raw_levels, hold, strict=True)],
+        int,
+    )

@@ -62,6 +62,7 @@ def _issued_levels(
         sigma_hv = np.sqrt(np.nan_to_num(cov_v[:, 0, 0] + cov_v[:, 1, 1], nan=np.inf))
         unconverged = velocity_unconverged(sigma_hv, raw["tcpa_s"], config)
         raw["level"][unconverged] = 0
+        raw["hold_level"][unconverged] = 0
         raw["flarm_level"][unconverged] = 0
     level = np.zeros(len(df), int)
     required_age = required_track_age(s, v, config)
@@ -69,7 +70,8 @@ def _issued_levels(
         ready = alerting_rows(t[idx], required_age[idx])
         raw["level"][idx[~ready]] = 0
         raw["flarm_level"][idx[~ready]] = 0
-        level[idx[ready]] = filter_alert_levels(t[idx[ready]], raw["level"][idx[ready]], config)
+        rows = idx[ready]
+        level[rows] = filter_alert_levels(t[rows], raw["level"][rows], config, raw["hold_level"][rows])
     return level
 
 

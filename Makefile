@@ -7,7 +7,7 @@ STAMP_RUN := $(VENV)/.installed-run
 STAMP_DEV := $(VENV)/.installed-dev
 OUT ?= out
 
-.PHONY: demo test test-slow test-browser browser-deps lint format bench clean
+.PHONY: demo test test-slow test-browser browser-deps lint format bench docs clean
 
 $(BIN)/python:
 	@command -v $(PYTHON) >/dev/null 2>&1 || { echo "error: $(PYTHON) not found; set PYTHON=/path/to/python3.11" >&2; exit 1; }
@@ -66,6 +66,11 @@ lint: $(STAMP_DEV)
 format: $(STAMP_DEV)
 	$(BIN)/ruff format src tests
 	$(BIN)/ruff check --fix src tests
+
+# The documentation site, offline, warnings as errors: open $(OUT)/docs/index.html. The results page,
+# the CLI reference and the API reference are generated from docs/results/ and the package.
+docs: $(STAMP_DEV)
+	$(BIN)/python -m sphinx -b html -W --keep-going -q docs/source $(OUT)/docs
 
 # Every per-frame stage's benchmark and the whole-flight one (flight: no longer inside chain); each prints
 # its JSON as the last line.

@@ -82,7 +82,7 @@ class Mount:
 
     @classmethod
     def preset(cls, name: str) -> Mount:
-        """A named placement (the table above): forward = nose, left/right-wingtip, tail, side-*, ..."""
+        """A named placement (the table above): forward = nose, left/right-wingtip, tail, ``side-*``, ..."""
         if name not in _MOUNT_PRESETS:
             raise InputError(f"mount preset {name!r} unknown; choose from {sorted(_MOUNT_PRESETS)}")
         position_m, yaw_deg, pitch_deg = _MOUNT_PRESETS[name]

@@ -10,7 +10,7 @@ Doppler bins is the larger of
 
 - the row's largest I or Q magnitude / 32767: nothing is ever clipped;
 - sigma / 4, sigma = sqrt(P / 2) the noise standard deviation per component, P the frame's
-  noise power per pixel per rx estimated as median(|iq|^2) / ln 2 (exact for noise-only
+  noise power per pixel per rx estimated as ``median(|iq|^2)`` / ln 2 (exact for noise-only
   Rayleigh pixels; clutter pushes it up a little).
 
 Rounding leaves an error of at most half a step per component (plus float32 rounding of the

@@ -1,7 +1,7 @@
 """Frames as labelled xarray Datasets, and their Zarr store.
 
 A run is one Dataset with dims ``(time, range, doppler, rx)`` holding complex64 ``iq`` (pixel
-units: |iq|^2 is received power in W, thermal noise power per pixel is
+units: ``|iq|^2`` is received power in W, thermal noise power per pixel is
 ``RadarConfig.noise_power_w``), coordinates in SI units, the RadarConfig as a JSON attribute,
 and, when simulated, own-ship truth on ``time`` and intruder truth on ``(time, target)``.
 

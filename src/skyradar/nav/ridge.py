@@ -8,7 +8,7 @@ range bin. This module returns it, unaliased.
 
 Steps per frame:
 
-1. Power image (sum of |iq|^2 over receivers, :func:`summed_power_image`) and a noise floor: the
+1. Power image (sum of ``|iq|^2`` over receivers, :func:`summed_power_image`) and a noise floor: the
    larger of the thermal noise of the RadarConfig and a low quantile of the image scaled by the
    chi-square statistics of ``n_rx`` summed exponentials, so real data with a raised floor gate correctly.
 2. Gate: pixels ``threshold_db`` above the noise floor are "occupied"; per range bin, fades of

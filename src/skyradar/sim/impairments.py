@@ -4,7 +4,7 @@ Real flight data differ from the clean simulation by fixed bright spurs (self-in
 every frame, a bright line at zero Doppler over all ranges, returns at all velocities near the
 radar (up to about 100 m), per-antenna phase and gain errors and receiver noise; the ground return
 is also weaker. Each effect is a plain function on a range-Doppler cube (``(..., n_range,
-n_doppler, n_rx)``, pixel units: |pixel|^2 in W); spurs, channel errors and noise also exist for
+n_doppler, n_rx)``, pixel units: ``|pixel|^2`` in W); spurs, channel errors and noise also exist for
 ADC cubes ``(n_rx, n_chirp, n_sample)``. :class:`ImpairmentConfig` switches them on and sets their
 parameters (the ``impairments:`` section of a scenario file, defined in
 :mod:`skyradar.scene.impairment_config` and re-exported here); :func:`thesis_flight_look` is the

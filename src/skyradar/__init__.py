@@ -4,7 +4,7 @@ The pipeline, one subpackage per stage::
 
     scene -> sim -> process -> track -> daa
                     process -> nav (own-ship height and velocity over the terrain)
-    scene (map) -> sim (side-looking) -> nav.gpscheck (GPS check against the map, seed-brief.md ch6)
+    scene (map) -> sim (side-looking) -> nav.gpscheck (GPS check against the map, Maas 2022, ch. 6)
     io (SigMF IQ) -> passive (passive radar with an ATC radar as illuminator, ch7)
 """
 

@@ -1,6 +1,6 @@
 """Radar hardware description and every quantity derived from it.
 
-The default is the thesis prototype of seed-brief.md: a 9.425 GHz sawtooth FMCW radar sweeping
+The default is the thesis prototype (Maas 2022): a 9.425 GHz sawtooth FMCW radar sweeping
 10 MHz per chirp at 4921 chirps/s, sampled at 10 MHz, 250 chirps per frame, four receive
 antennas in a coplanar 2x2 square, processed to 5 km.
 

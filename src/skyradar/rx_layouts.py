@@ -13,8 +13,8 @@ azimuth there: mirror-symmetric about its vertical axis, its one horizontal base
 pair, which the antisymmetric combination of the two nulls takes, so its azimuth's bound through
 them is 6-22 deg where the square's is 0.7-2 deg at 27 dB
 (:func:`skyradar.process.clutter_doa.angle_sigmas_rad`; the blind axis turns from horizontal to
-vertical). Over hills a 200-set's first 32 encounters warned three conflicts 1.7-22 s later than the
-square (encounter 3: its track drifted up to 31 deg off in azimuth over 23 s, was dropped and started again).
+vertical). Over hills it can warn a conflict 1.7-22 s later than the square: a track's azimuth
+drifts up to 31 deg off over 23 s, and the track is dropped and started again.
 Its vertical aperture of one wavelength is unambiguous through the two half-wavelength pairs
 (:mod:`skyradar.process.doa` unwraps the long baseline from them).
 

@@ -22,8 +22,8 @@ coupling, and thermal noise.
   and ``np.bincount`` over the flat pixel index for the real and imaginary part per receiver.
 
 Ours is also timed with its full physics (exact geodesy, occlusion), at DEM spacing and at
-facets of at most dR/2, and at dR/2 with the windows' point-spread and speckle (issue 12.1:
-``frames_per_s_fine_psf``, its ratio to the same run's fine figure, and its multiple of the
+facets of at most dR/2, and at dR/2 with the windows' point-spread and speckle
+(``frames_per_s_fine_psf``, its ratio to the same run's fine figure, and its multiple of the
 9.4 Hz field rate); no baseline does that work, so those have no baseline ratio.
 """
 
@@ -56,7 +56,7 @@ __all__ = [
 
 TERRAIN_NOTE = "synthetic terrain (rolling hills, seed 0) in SRTM-3 .hgt format, not SRTM data"
 FIELD_RATE_HZ = 9.4  # the prototype's frame rate in flight
-THESIS_FRAMES_PER_S = 3.3  # seed-brief.md ch2: 727 frames in 219 s on the thesis' PC (not re-measured)
+THESIS_FRAMES_PER_S = 3.3  # Maas 2022, ch. 2: 727 frames in 219 s on the thesis' PC (not re-measured)
 
 
 class FacetPhysics:
@@ -290,11 +290,11 @@ def _sub_facets(sim: ImageSimulator, platform: PlatformState) -> int:
 
 
 def _psf_keys(config, terrain, origin, platform, ours, n: int, fps_fine: float) -> dict[str, Any]:
-    """Issue 12.1's keys: fine facets with the windows' point-spread and speckle, by both facet rules.
+    """The point-spread keys: fine facets with the windows' point-spread and speckle, by both facet rules.
 
     ``ours(sim, n)`` times a simulator: (frames/s, CPU-ms per frame).
     """
-    # Cells cut by their range and Doppler extent (the default with psf), and by ground size as before.
+    # Cells cut by their range and Doppler extent (the default with psf), and by ground size (uniform).
     fine_psf = ImageSimulator(config, terrain, origin, seed=1, psf=True, speckle=True)
     uniform_psf = ImageSimulator(
         config, terrain, origin, seed=1, psf=True, speckle=True, adaptive_facets=False

@@ -1,4 +1,4 @@
-"""``skyradar passive``, ``skyradar experiment ch7`` and ``skyradar bench passive`` (seed-brief ch7)."""
+"""``skyradar passive``, ``skyradar experiment ch7`` and ``skyradar bench passive`` (Maas 2022, ch. 7)."""
 
 from __future__ import annotations
 

@@ -84,7 +84,7 @@ def _run(scene, meta: Path, sample_rate_hz: float, chunk_samples: int, total: in
 
 @app.command("simulate-passive")
 def simulate_passive(
-    scenario: Annotated[str, typer.Argument(help="Built-in geometry: thesis (seed-brief ch7).")] = "thesis",
+    scenario: Annotated[str, typer.Argument(help="Built-in geometry: thesis (Maas 2022, ch. 7).")] = "thesis",
     output: Annotated[
         Path, typer.Option("-o", "--output", help="Recording to write: NAME.sigmf-meta (+ NAME.sigmf-data).")
     ] = Path("passive.sigmf-meta"),

@@ -6,9 +6,9 @@ the miss vector, perpendicular to ``u``), ``r^2 = m^2 + |u|^2 (t - t_c)^2`` and
 the relative speed squared, and every row then gives the 3-D miss distance
 ``m^2 = r^2 - (r rdot)^2 / |u|^2``. None of this needs a direction of arrival, so it holds where
 the elevation is not measured (the nulls of clutter suppression took it, and the track's height is
-the co-altitude prior): flat ground 300 m below, 200-set encounter 83, an aircraft overtaken 347 m
-below with a 794 m miss, warned because its track was held co-altitude: the fit over 10 s gave
-792-795 m from 8 s after the track was confirmed.
+the co-altitude prior): over flat ground 300 m below, an aircraft overtaken 347 m below with a
+794 m miss is warned while its track is held co-altitude, but the fit over 10 s gives 792-795 m
+from 8 s after the track is confirmed.
 
 A cylinder of horizontal radius ``D`` and half-height ``Z`` lies within ``sqrt(D^2 + Z^2)`` of its
 axis' centre, so an encounter whose miss distance is beyond that corner cannot lose that well-clear
@@ -19,11 +19,11 @@ square, :mod:`skyradar.rx_layouts`) whose elevation the nulls took: what is left
 the range, the range rate and the direction cosine along the antenna's y axis, and all three are
 unchanged when the whole relative path is rotated about that axis. A level aircraft passing 250 m
 below and one ahead near the own-ship's level descending at 5.1 m/s give the same rows, and the
-second loses well clear (flat ground 300 m below, 200-set encounter 123; the test
-``test_range_and_horizontal_direction_cannot_split_below_from_descending_through``). Entering the
-warning cylinder takes 4.5-5.9 m/s of vertical speed for the flat-300 must-not-alert encounters
-still warned (123, 188, 28): a bound on the intruder's vertical rate below that would be an
-assumption about traffic, not a measurement. The ``kite`` array measures those elevations.
+second loses well clear (the test
+``test_range_and_horizontal_direction_cannot_split_below_from_descending_through``). An intruder
+that passes well below over flat ground 300 m below, and must not alert, enters the warning
+cylinder only with 4.5-5.9 m/s of vertical speed: a bound on the intruder's vertical rate below
+that would be an assumption about traffic, not a measurement. The ``kite`` array measures those elevations.
 
 The fit is per track over a sliding window; it refuses (NaN) where it has too few rows, where the
 own-ship's velocity changed in the window (a turn bends the relative path), or where the rows do

@@ -1,6 +1,6 @@
 """ch3: detection and 3-D direction of arrival with a radar on the ground aimed at the sky.
 
-The thesis' field test in simulation (seed-brief.md ch3). The thesis prototype stands 2 m above
+The thesis' field test in simulation (Maas 2022, ch. 3). The thesis prototype stands 2 m above
 the ground near Delft, boresight at bearing -37.7 deg and pitched up ``pitch_deg`` (default
 3 deg), so the calibration building (5 deg right, 1 deg below boresight) lies where the thesis
 located it: north-west, about 2 deg above the horizon, 15 m above the radar (thesis: 372 m north,
@@ -78,7 +78,7 @@ __all__ = ["THESIS_TABLE", "run", "square_array_m", "unambiguous_half_angle_deg"
 HANN_FRAMES = 9
 SPUR_THRESHOLD = 0.05
 OUTLIER_DEG = 10.0  # a DoA error this large is an ambiguity (wrong wrap), not noise
-# seed-brief.md ch3: (raw mean, raw SD, Hann mean, Hann SD)
+# Maas 2022, ch. 3: (raw mean, raw SD, Hann mean, Hann SD)
 THESIS_TABLE = {
     "dist_m": (46.2, 30.3, 30.7, 16.1),
     "az_deg": (-0.4, 1.8, -0.37, 0.8),

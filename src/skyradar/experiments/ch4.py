@@ -1,4 +1,4 @@
-"""Experiment ch4: radar-aware versus traditional tracking around an airfield (seed-brief.md ch4).
+"""Experiment ch4: radar-aware versus traditional tracking around an airfield (Maas 2022, ch. 4).
 
 Three own-ship flights (Circuit, Zulu, Free) with ten VFR intruders each
 (:mod:`skyradar.experiments.ch4_flights`), a forward-looking prototype radar, and both trackers on
@@ -60,7 +60,7 @@ __all__ = [
     "THESIS",
 ]
 
-# seed-brief.md ch4 (pixels, counts): traditional / proposed / by hand.
+# Maas 2022, ch. 4 (pixels, counts): traditional / proposed / by hand.
 THESIS = {
     "circuit": {"innov_mean": (2.1, 2.0), "innov_p95": (7.1, 4.9), "tracks": (42, 14), "truth": 14},
     "zulu": {"innov_mean": (2.7, 2.5), "innov_p95": (10.5, 7.1), "tracks": (42, 9), "truth": 9},

@@ -60,7 +60,7 @@ TERRAINS: dict[str, float | None] = {
     "sd345": 345.0,
     "jacksboro": None,
 }
-# seed-brief.md ch5: height error mean / SD [m] of the thesis, one frame per second.
+# Maas 2022, ch. 5: height error mean / SD [m] of the thesis, one frame per second.
 THESIS_TABLE = {
     "flat": (8.5, 6.5),
     "sd19": (10.3, 13.1),

@@ -3,7 +3,7 @@
 The aircraft flies north through the terrain's centre at constant ground speed. Its altitude
 follows the terrain smoothed along the track (Gaussian, ``smooth_m``) plus a constant chosen so
 that the mean height above the terrain directly below is exactly ``height_m`` on every terrain
-(seed-brief.md ch5: same flight, same mean height above ground). Vertical speed is therefore
+(Maas 2022, ch. 5: same flight, same mean height above ground). Vertical speed is therefore
 non-zero over hilly terrain: the flight climbs and descends.
 """
 

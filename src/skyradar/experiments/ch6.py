@@ -51,7 +51,7 @@ from skyradar.units import wrap_angle
 
 __all__ = ["THESIS_TABLE", "SPOOF_CASES", "ACCEPTANCE", "run"]
 
-# seed-brief.md ch6, experiment B (20 random frames): heading error deg, position error m, false positives,
+# Maas 2022, ch. 6, experiment B (20 random frames): heading error deg, position error m, false positives,
 # frames correct (None: not published).
 THESIS_TABLE = {
     "threshold_entropy": (5.0, 45.0, 0.42, None),

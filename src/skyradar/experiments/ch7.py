@@ -1,4 +1,4 @@
-"""ch7 experiment: passive bistatic radar with a rotating ATC radar as illuminator (seed brief ch7).
+"""ch7 experiment: passive bistatic radar with a rotating ATC radar as illuminator (Maas 2022, ch. 7).
 
 1. The thesis' test pulse through the matched filter, with and without the Hann window.
 2. The thesis geometry (:func:`skyradar.passive.scene.thesis_scene`: receiver on a tower 12 km from an

@@ -13,7 +13,7 @@ crosses it. A rotation is ``floor(time / period)``; 40 s at 13.5 rpm is 9 rotati
 - The aircraft is *seen* in a rotation when a detection (either channel) lies within ``aircraft_m`` of
   its true position within ``time_tol_s`` of its beam pass; the position error is that distance.
 - A detection is *false* when it matches no truth reflector (building, clutter point, or the aircraft
-  within ``aircraft_m`` and ``time_tol_s``): the known reflectors of the issue's acceptance are every
+  within ``aircraft_m`` and ``time_tol_s``): the known reflectors the acceptance counts are every
   reflector the scene holds. The blind zone is already dropped by the processor.
 """
 

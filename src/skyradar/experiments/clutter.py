@@ -26,7 +26,7 @@ And in the intruder's own cells: the improvement factor over its CFAR window (th
 clutter raised the threshold) in the frames where it was missed without suppression.
 
 The IF "in the cells where the head-on intruder was lost" (``h{H}_if_db_lost_cells_median`` and
-``_min``, the issue's acceptance figure, >= 25 dB asked for): lost frames are those where the
+``_min``, the acceptance figure, >= 25 dB required): lost frames are those where the
 intruder is a hit in the clear-sky twin but not in the no-suppression run (detections within 2
 range and 3 Doppler bins of its truth cell, the brightest cell of the noise-free intruder-only
 run; the suppressed run plays no part in choosing them); lost cells are the CA-CFAR training

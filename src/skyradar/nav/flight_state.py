@@ -1,4 +1,4 @@
-"""Own-ship flight state over the terrain from the ground returns of each frame (seed-brief.md ch5).
+"""Own-ship flight state over the terrain from the ground returns of each frame (Maas 2022, ch. 5).
 
 Per frame: the ground ridge (:mod:`skyradar.nav.ridge`), a flat-plane inversion
 (:mod:`skyradar.nav.inversion`) and a quality figure; over the run: the Kalman filter of

@@ -3,7 +3,7 @@
 Over a flat, static ground plane every ground point moves at ``-V`` relative to the radar. At
 range ``r`` the ground forms a circle; its point straight ahead on the track has the largest
 closing speed, i.e. the most *negative* radial velocity (radial velocity is positive
-receding). For that point (seed-brief.md ch5)::
+receding). For that point (Maas 2022, ch. 5)::
 
     V_r r + V_Z H = -V_X sqrt(r^2 - H^2)
 

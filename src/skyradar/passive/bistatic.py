@@ -7,9 +7,10 @@ transmitter to receiver and ``S = R1 + R2``, ``|R1 u - b| = S - R1`` gives
 
     ``R1 = (S^2 - L^2) / (2 (S - u . b))``.
 
-This is the transmitter-angle form of the seed brief's ``R2 = ((R1+R2)^2 - L^2) / (2 (R1+R2 + L sin a))``
-(Willis, Bistatic Radar, eq. 5.2, ``a`` the receiver's look angle from the baseline normal), which the
-tests check against. Near the baseline the direct pulse swamps the echoes: that blind zone is masked.
+This is the transmitter-angle form of the thesis' ``R2 = ((R1+R2)^2 - L^2) / (2 (R1+R2 + L sin a))``
+(Maas 2022, ch. 7; Willis, Bistatic Radar, eq. 5.2; ``a`` the receiver's look angle from the baseline
+normal), which the tests check against. Near the baseline the direct pulse swamps the echoes: that
+blind zone is masked.
 """
 
 from __future__ import annotations
@@ -66,7 +67,7 @@ def ellipse_point(
 def receiver_range_willis(
     bistatic_range: np.ndarray | float, baseline_m: float, theta_r_rad: np.ndarray
 ) -> np.ndarray:
-    """Seed-brief/Willis receiver range ``R2 = (S^2 - L^2) / (2 (S + L sin theta_R))``.
+    """The thesis' and Willis' receiver range ``R2 = (S^2 - L^2) / (2 (S + L sin theta_R))``.
 
     ``theta_R`` is the receiver's look angle from the baseline's normal, positive away from the
     transmitter: ``sin theta_R = -unit(target - rx) . unit(tx - rx)``.

@@ -1,6 +1,6 @@
 """Matched filter for a pulsed illuminator: FFT convolution with the conjugate, time-reversed pulse.
 
-The thesis (seed brief ch7) writes the filter as ``y[n] = sum_m s[n-m] h[m]`` with ``h`` the complex
+The thesis (Maas 2022, ch. 7) writes the filter as ``y[n] = sum_m s[n-m] h[m]`` with ``h`` the complex
 conjugate of the (time-reversed) pulse, optionally tapered by a Hann window ``w[m] = sin^2(pi m / N)``
 that narrows the peak's skirts and lowers the range sidelobes. Its test pulse is a 0.1 ms linear FM,
 ``f(t) = 5.0 MHz - 7.0 GHz/s * t``, present from 0.1 to 0.2 ms; the filter output peaks mid-pulse at

@@ -11,7 +11,7 @@ points) and ground clutter. Aircraft follow any :class:`~skyradar.scene.trajecto
 excess path over the direct signal, i.e. ``c`` times the delay after the direct pulse) and the bistatic
 Doppler ``-(v . u_tx + v . u_rx) / lambda`` (``u`` the unit vectors from each site to the reflector).
 
-:func:`thesis_scene` is the geometry of seed-brief ch7: a receiver on a 40 m tower 12 km from the
+:func:`thesis_scene` is the geometry of Maas 2022, ch. 7: a receiver on a 40 m tower 12 km from the
 radar, five urban clusters at 14-20 km from the receiver, ground clutter, and a small aircraft (RCS
 1 m^2) flying 1.5-2.8 km from the receiver during a 40 s (9-sweep) recording.
 """
@@ -304,7 +304,7 @@ def aircraft_from_adsb(
 
 
 def thesis_scene(duration_s: float = 40.0, seed: int = 0, aircraft: bool = True) -> PassiveScene:
-    """The seed-brief ch7 geometry (synthetic sites near Utrecht, NL; no real town is modelled).
+    """The geometry of Maas 2022, ch. 7 (synthetic sites near Utrecht, NL; no real town is modelled).
 
     Receiver antenna on a 40 m tower; the PSR 12 km to the west-south-west (bearing 250 deg) on a 20 m
     mast; five building clusters 14.5-19.5 km from the receiver; 800 ground-clutter points; a small
@@ -356,5 +356,5 @@ def thesis_scene(duration_s: float = 40.0, seed: int = 0, aircraft: bool = True)
         azimuth_at_t0_rad=float(az_rx - np.radians(30.0)),
         first_pulse_s=2.0e-4,
         seed=seed,
-        description="seed-brief ch7 geometry: PSR 12 km from a tower receiver, 5 clusters, 1 aircraft",
+        description="Maas 2022 ch. 7 geometry: PSR 12 km from a tower receiver, 5 clusters, 1 aircraft",
     )

@@ -108,11 +108,11 @@ def plain_wave_is_mixed(
     the wave is the clutter's when a static point in its direction has the detection's radial
     velocity (within :data:`_STATIC_FIT_MPS`, modulo ``2 VLim``): a ground return, for the ground
     filter. Otherwise, when it points at the ground (at least half way down to a flat ground at
-    the subspace's height, at its range), it is a mixture pointing at neither. Flat ground 300 m
-    below, 200-set encounter 15, a head-on intruder aliased into the ground band: half its
-    detections had the plain direction 48-90 deg off its bearing, 10-25 m/s off the static Doppler
-    there, at the ground's depression; flagged ground, they were lost to the tracker and its warning
-    came late. Those are searched through the nulls instead. A mixture pulled less far keeps its
+    the subspace's height, at its range), it is a mixture pointing at neither. Over flat ground
+    300 m below, a head-on intruder aliased into the ground band has half its detections with the
+    plain direction 48-90 deg off its bearing, 10-25 m/s off the static Doppler there, at the
+    ground's depression; flagged ground, they would be lost to the tracker and its warning would
+    come late. Those are searched through the nulls instead. A mixture pulled less far keeps its
     plain direction (biased towards the ground, with an elevation the tracker can weigh: searched
     through the nulls it would lose it). Below :data:`_NEAR_GROUND` heights of range (the altitude
     return's end-fire mirrors) and without the subspace's geometry: never mixed.
@@ -166,10 +166,10 @@ def detect_suppressed(
     :func:`skyradar.process.doa.estimate_directions`. Cells whose nulls are adaptive
     (:mod:`skyradar.process.clutter_adaptive`) are always projected (over relief one unpredicted
     clutter direction 40 dB over the noise is a plane wave too: its direction, 20-40 deg below the
-    intruder's, was taken for the intruder's in a quarter of a Jacksboro intruder track's
+    intruder's, is taken for the intruder's in a quarter of a Jacksboro intruder track's
     detections) and searched through their training ring's whitening ``R^-1`` instead of the
-    projector (:func:`~skyradar.process.clutter_adaptive.ring_whitening`): over Jacksboro it halved
-    the median azimuth error at the intruder (4.2 to 1.9 deg, 25 frames).
+    projector (:func:`~skyradar.process.clutter_adaptive.ring_whitening`): over Jacksboro it halves
+    the median azimuth error at the intruder (4.2 to 1.9 deg over 25 frames).
     """
     sup = suppress_clutter(cube, clutter, config)
     det = detect(

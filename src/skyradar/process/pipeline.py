@@ -41,7 +41,7 @@ from skyradar.io.checks import check_finite_frames
 from skyradar.io.frames import radar_config_of
 from skyradar.io.frames_model import frame_times_s
 from skyradar.io.navigation import navigation_state
-from skyradar.io.run_origin import scenario_origin  # re-exported: it lived here before issue 16
+from skyradar.io.run_origin import scenario_origin  # re-exported: the origin of a processed run
 from skyradar.process.clutter_anchors import prediction_anchors
 from skyradar.process.clutter_frames import detect_suppressed, frame_clutter
 from skyradar.process.detect import detect, integrate_channels

@@ -1,7 +1,7 @@
 """Spur maps: pixels that light up in most frames whatever the scene does.
 
 Self-interference puts fixed bright spots into every frame. With a static radar looking at a
-static scene every bright spot is a spur (seed-brief.md ch3): run the detector over a series of
+static scene every bright spot is a spur (Maas 2022, ch. 3): run the detector over a series of
 frames, dilate every detected point by one pixel (Doppler wraps), count how often each pixel is
 hit, and call pixels hit in more than a fraction ``threshold`` of the frames spurs (the thesis
 compared 2, 5, 10 and 25 %). Detections whose peak falls inside the map are flagged.

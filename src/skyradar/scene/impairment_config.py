@@ -112,7 +112,7 @@ class ImpairmentConfig(BaseModel):
 
 
 def thesis_flight_look(seed: int = 0) -> ImpairmentConfig:
-    """Preset reproducing the look of the thesis' flight data (seed-brief.md ch2).
+    """Preset reproducing the look of the thesis' flight data (Maas 2022, ch. 2).
 
     Ground 10 dB weaker than simulated; six fixed spurs 25-30 dB above the prototype's noise in
     every frame; returns at all velocities within 100 m; a bright zero-Doppler line (45 dB above

@@ -5,7 +5,7 @@ Two rules:
 - **uniform** (the default without the point-spread, and the rule of the ch2-ch6 results): every
   cell is cut into ``ceil(spacing / facet_size_m)`` sub-facets per axis, so no sub-facet edge is
   longer than ``facet_size_m`` on the ground;
-- **adaptive** (the default with the point-spread, issue 12.1): each cell is cut as finely as its
+- **adaptive** (the default with the point-spread): each cell is cut as finely as its
   own range and Doppler extent need. Along each cell axis, ``n`` is the smallest count for which
   one sub-facet edge spans at most ``facet_size_m`` of range and at most ``facet_size_m / dR``
   Doppler bins (half a bin each with the default ``facet_size_m = dR/2``). A cell seen from

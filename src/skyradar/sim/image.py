@@ -1,6 +1,6 @@
 """Image-domain FMCW radar simulator: scene in, range x Doppler x rx cube out, one frame at a time.
 
-The thesis' method (seed-brief.md ch2) made exact where it simplified:
+The thesis' method (Maas 2022, ch. 2) made exact where it simplified:
 
 - geodetic to local coordinates exactly (pymap3d); attitude relative to the local vertical;
 - terrain cropped to RLim around the radar before any per-facet work, then subdivided into
@@ -11,7 +11,7 @@ The thesis' method (seed-brief.md ch2) made exact where it simplified:
 - two-way antenna gain, radar equation, exact two-way path phase per receive antenna;
 - Doppler with aliasing wrap and the sawtooth range-Doppler coupling;
 - one-pass scatter-add and calibrated thermal noise (k T B_n F per pixel, so SNR is physical);
-- optionally (issue 12.1): the range and Doppler windows' point-spread (:mod:`skyradar.sim.psf`),
+- optionally: the range and Doppler windows' point-spread (:mod:`skyradar.sim.psf`),
   speckle on terrain and Swerling 1 fluctuation of the targets.
 
 Pixel units: ``|pixel|^2`` is received power in W for a scatterer centred in that pixel.
@@ -47,7 +47,6 @@ __all__ = [
     "two_way_gain_table",
 ]
 _NO_SPECKLE = np.uint64(0)
-
 
 
 class ImageSimulator:

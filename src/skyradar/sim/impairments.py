@@ -1,4 +1,4 @@
-"""Hardware impairments that make simulated frames look like real ones (seed-brief.md ch2, ch3).
+"""Hardware impairments that make simulated frames look like real ones (Maas 2022, ch. 2 and 3).
 
 Real flight data differ from the clean simulation by fixed bright spurs (self-interference) in
 every frame, a bright line at zero Doppler over all ranges, returns at all velocities near the

@@ -1,4 +1,4 @@
-"""Side-looking radar frames of a land-cover map (seed-brief.md ch6): the GPS check's radar input.
+"""Side-looking radar frames of a land-cover map (Maas 2022, ch. 6): the GPS check's radar input.
 
 Every pixel of a land-cover raster (:func:`skyradar.scene.land_cover.rasterise_land_cover`: class code
 and building height on a north/east :class:`~skyradar.scene.ground_grid.GroundGrid`) is one flat

@@ -151,7 +151,8 @@ def scenario_truth(built, simulator: ImageSimulator | None = None) -> tuple[dict
     own, intruders = _states(built, np.arange(built.times_s.size))
     targets = _intruder_truth(built, own, intruders, simulator) if intruders else {}
     ownship = _ownship_truth(built, own)
-    # The navigation solution (nav_*) beside the truth: the chain reads only nav_* (issue 13.2).
+    # The navigation solution (nav_*) beside the truth: the chain reads only nav_*, as an aircraft
+    # knows only its navigation solution.
     return ownship | navigation_variables(built, ownship), targets, [i.name for i in built.intruders]
 
 

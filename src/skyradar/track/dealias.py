@@ -1,4 +1,4 @@
-"""De-aliasing of the radial velocity from the range history (seed-brief.md ch4, change 3).
+"""De-aliasing of the radial velocity from the range history (Maas 2022, ch. 4, change 3).
 
 The Doppler axis only measures the radial velocity modulo ``W = 2 VLim``; the range does not alias.
 Once a track has two or more range observations, the slope of range against time gives the

@@ -129,8 +129,8 @@ class Measure3D:
         """Restart the 3-D height of each track whose readings now agree on one and did not last frame.
 
         Its height so far is the co-altitude prior (or a first scattered reading): a gradual pull
-        from there takes seconds the alert does not have (flat ground 300 m below, 200-set
-        encounter 23: first seen 780 m away, already inside the horizontal volume)."""
+        from there takes seconds the alert does not have (over flat ground 300 m below, an aircraft
+        overtaken 339 m above is first seen 780 m away, already inside the horizontal volume)."""
         agreed = np.isfinite(track_up)
         new = agreed & ~np.isin(ids, list(self.agreed_ids))
         self.agreed_ids = {int(i) for i in np.asarray(ids)[agreed]}

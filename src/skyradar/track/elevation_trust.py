@@ -4,36 +4,35 @@ Clutter suppression (``process.clutter_frames``) measures a detection's elevatio
 unmeasured where the nulls take the elevation dimension of the 2x2 array (``elevation_measured``
 False; the direction then holds the co-altitude prior). A *measured* elevation in a cell the
 ground also fills is not always the target's: where the ground is 15 dB over the target, the
-plain DoA of the cell is the ground's (flat ground 300 m below, ``--n 3`` encounter 2: the
-co-altitude intruder's "measured" elevations were -16 to -20 deg, the ground's depression at
-those ranges), and after whitening a mixture lands between the target and the ground (Jacksboro:
--13 to -28 deg for the same intruder). Both errors pull *towards the ground*, so they are below
-the target's true elevation; none can put a reading above the own-ship's horizontal when the
-ground is below it. Hence the asymmetric rule (:func:`elevation_trusted`): inside the ground's
-range-Doppler band (:func:`in_ground_band`) an elevation counts only when it is measured and more
-than ``k`` standard deviations above the own-ship's horizontal; outside the band every measured
-elevation counts. The rest are *free*: the tracker places them at the co-altitude prior (elevation
-0 above the own-ship's horizontal, :func:`at_elevation`) with a vertical-angle sigma of
+plain DoA of the cell is the ground's (over flat ground 300 m below, a co-altitude intruder's
+"measured" elevations are -16 to -20 deg, the ground's depression at those ranges), and after
+whitening a mixture lands between the target and the ground (-13 to -28 deg for the same
+intruder over Jacksboro). Both errors pull *towards the ground*, so they are below the target's
+true elevation; none can put a reading above the own-ship's horizontal when the ground is below
+it. Hence the asymmetric rule (:func:`elevation_trusted`): inside the ground's range-Doppler band
+(:func:`in_ground_band`) an elevation counts only when it is measured and more than ``k``
+standard deviations above the own-ship's horizontal; outside the band every measured elevation
+counts. The rest are *free*: the tracker places them at the co-altitude prior (elevation 0 above
+the own-ship's horizontal, :func:`at_elevation`) with a vertical-angle sigma of
 :data:`FREE_ELEVATION_SIGMA_RAD`, while range and azimuth count in full. A track with no trusted
 elevation then stays co-altitude; one with trusted elevations follows them (a free reading weighs
-1/300 of a trusted one at 0.02 rad). Free readings placed at the track's
-*predicted* elevation instead held nothing: the radial-velocity update then moved the height
-unopposed (hills, 200-set encounter 88, 110 m below with no trusted reading: its track climbed to
-500 m up and a conflict was missed).
+1/300 of a trusted one at 0.02 rad). Free readings are not placed at the track's *predicted*
+elevation: there they hold nothing, and the radial-velocity update moves the height unopposed (a
+track 110 m below with no trusted reading can climb to 500 m up and miss a conflict).
 
-What this buys (hills, 200-encounter set, encounter 23, an aircraft overtaken 339 m above): its
-elevations were measured on 30-70 % of the detections, at 27-45 deg, within a few degrees of the
-truth; the co-altitude prior of the others held the track 74 m above the own-ship and it was
-warned. Below the horizontal one reading cannot be told from the ground's pull, but a track's
-readings can (:class:`BelowConsensus`): the ground's pull scatters from frame to frame or lies on
-the surface, an aircraft's readings agree, clear of it. Those that agree are trusted (hills,
-encounter 188, 281 m below: its false warning is gone). Once a track's readings agree on a height
-above, its free readings sit at that height instead of the co-altitude prior, its
-trusted readings above at that height too (with the readings' spread as sigma), and the 3-D
-filter restarts its height there (``doa_feed``): read one at a time, the scattered readings of
-an aircraft above let the first one accepted set the height. What it still costs: an intruder below
-whose readings are mostly unmeasured or scattered keeps the co-altitude prior and is warned as if
-co-altitude: a false warning where it passes well below (encounters 28 and 83), never a missed one.
+An aircraft overtaken 339 m above has its elevations measured on 30-70 % of its detections, at
+27-45 deg, within a few degrees of the truth; the co-altitude prior of the others holds its track
+74 m above the own-ship, and it is warned. Below the horizontal one reading cannot be told from
+the ground's pull, but a track's readings can (:class:`BelowConsensus`): the ground's pull
+scatters from frame to frame or lies on the surface, an aircraft's readings agree, clear of it.
+Those that agree are trusted, so an aircraft passing 281 m below is not warned as co-altitude.
+Once a track's readings agree on a height above, its free readings sit at that height instead of
+the co-altitude prior, its trusted readings above at that height too (with the readings' spread
+as sigma), and the 3-D filter restarts its height there (``doa_feed``): read one at a time, the
+scattered readings of an aircraft above let the first one accepted set the height. What it still
+costs: an intruder below whose readings are mostly unmeasured or scattered keeps the co-altitude
+prior and is warned as if co-altitude: a false warning where it passes well below, never a
+missed one.
 """
 
 from __future__ import annotations
@@ -48,7 +47,7 @@ __all__ = [
 FREE_ELEVATION_SIGMA_RAD = 0.35  # vertical-angle sigma of a free detection, at the co-altitude prior
 # Least elevation scatter assumed inside the ground's band when a reading is judged above the horizontal
 # (3 of it: 8.6 deg): readings through the nulls scatter by degrees past their bound, with a heavy upper
-# tail (hills, 200-set encounter 48, 39 m below: 1.7 % of its measured elevations above 8.6 deg).
+# tail (over hills, an aircraft 39 m below has 1.7 % of its measured elevations above 8.6 deg).
 BAND_ELEVATION_SIGMA_RAD = 0.05
 _GROUND_RANGE_FRACTION = 0.5  # ground may be in range from half the own-ship's height above it (relief)
 
@@ -67,9 +66,9 @@ def in_ground_band(
     below). NaN ``height_agl_m`` (clear sky, no terrain): False everywhere.
     ``radial_velocity_mps`` is the cell's: the alias within ``+-V_lim`` (``units.wrap``), not the
     de-aliased velocity. A head-on closure of -115 m/s sits in the cell of -36.7 m/s, which the
-    ground fills at 50 m/s (Jacksboro, 200-set encounter 15, 47 m below: judged on -115 m/s, its
-    readings pulled down by the ground there were trusted, its track was held 245-335 m below the
-    aircraft, and it was never warned). When the own-ship is faster than ``V_lim`` less the
+    ground fills at 50 m/s: judged on -115 m/s, the readings of an intruder 47 m below that the
+    ground pulls down would be trusted, its track held 245-335 m below the aircraft, and it would
+    never be warned. When the own-ship is faster than ``V_lim`` less the
     margin, every cell beyond half its height above the ground is in the band.
 
     Examples
@@ -117,14 +116,14 @@ def elevation_trusted(
 class AboveVotes:
     """Per track, whether most of its recent in-band elevations say it flies above the own-ship.
 
-    A co-altitude aircraft's readings through the nulls scatter with heavy tails (hills, 200-set
-    encounter 48, 39 m below: 1.7 % of 303 measured elevations more than 8.6 deg above the
-    horizontal, 0.7 % more than 12 deg). Trusted one by one, each such reading lifted the track and
-    the free readings then held it there: it climbed to 620 m above and a near collision was never
-    warned. An aircraft that is above has nearly all its readings above (hills 23, 163, Jacksboro
-    23: 93-99 %). So a track's in-band elevations count only while at least ``least`` of its last
+    A co-altitude aircraft's readings through the nulls scatter with heavy tails (over hills, an
+    aircraft 39 m below has 1.7 % of 303 measured elevations more than 8.6 deg above the
+    horizontal, 0.7 % more than 12 deg). Trusted one by one, each such reading lifts the track and
+    the free readings then hold it there: it can climb to 620 m above, and a near collision goes
+    unwarned. An aircraft that is above has nearly all its readings above (93-99 % over hills and
+    Jacksboro). So a track's in-band elevations count only while at least ``least`` of its last
     ``window`` measured in-band readings were above the threshold, and stay voted while ``keep``
-    are (readings pulled to the ground come in runs: a vote lost on each let the co-altitude prior
+    are (readings pulled to the ground come in runs: a vote lost on each lets the co-altitude prior
     of the free readings drag the track back down). 7 of 10: a co-altitude track
     with 5 % of its readings 10-30 deg up in bursts of three stays within 60 m of its height (5 of
     10 let one of three draws climb 420 m); 14 of 20 resists more but an aircraft 340 m above
@@ -132,9 +131,9 @@ class AboveVotes:
 
     While voted, the track's height is the median height ``r sin(el)`` of those readings above, and
     their spread (1.4826 median absolute deviation) its uncertainty: one reading at a time, the
-    scattered readings of an aircraft above (flat ground 300 m below, 200-set encounter 23: 14-43
-    deg for a true 27-32 deg, on 30 % of its detections) set the track's height from the first one
-    accepted and the gate kept out the rest; it stayed 170 m up, 339 m being the truth.
+    scattered readings of an aircraft above (over flat ground 300 m below, one overtaken 339 m
+    above reads 14-43 deg for a true 27-32 deg, on 30 % of its detections) set the track's height
+    from the first one accepted and the gate keeps out the rest; the track stays 170 m up.
 
     Examples
     --------
@@ -201,12 +200,12 @@ class BelowConsensus:
     """Per track, the height below the own-ship its recent in-band elevations agree on, if any.
 
     Readings the ground pulls scatter: the target-to-clutter ratio of a cell changes from frame to
-    frame (target fluctuation, speckle), and so does where a mixture points (hills, 200-set
-    encounters 48 and 88, 39 and 110 m below: the heights implied by ten successive readings spread
-    by 35-190 m, median absolute deviation, 4-20 times their bound). An aircraft below has its
-    readings where it is (encounter 188, 281 m below: spread 2-31 m, within its bound). Readings
-    the ground dominates agree too, on the surface (Jacksboro, ``--n 3`` encounter 2, co-altitude:
-    340-350 m below, 3-21 m above the terrain there). So a track's below readings count once at
+    frame (target fluctuation, speckle), and so does where a mixture points (over hills, for
+    aircraft 39 and 110 m below, the heights implied by ten successive readings spread by 35-190 m,
+    median absolute deviation, 4-20 times their bound). An aircraft below has its readings where it
+    is (281 m below: spread 2-31 m, within its bound). Readings the ground dominates agree too, on
+    the surface (a co-altitude intruder over Jacksboro reads 340-350 m below, 3-21 m above the
+    terrain there). So a track's below readings count once at
     least ``least`` of its last ``window`` measured in-band readings are below the threshold, the
     heights ``r sin(el)`` they imply spread by at most ``spread`` times their median bound
     ``r sigma``, and the median reading is clear of the surface by its margin (``clear_m`` > 0 per
@@ -354,13 +353,13 @@ def _placed(positions_m, own, range_m, sigma, trusted, agreed, track_up, spread,
     above) at their track's height ``track_up`` with a sigma of at least ``sqrt(window)`` times its
     ``spread`` (m): the height is the median of the last ``window`` readings, fed every frame, and
     their spread measures their scatter within that second, not the slow clutter pull they share;
-    fed at the spread, the filter took the median's drift for a vertical speed (hills, 200-set
-    encounter 163, level 232 m above: 253 to 210 m over 12 s, -2.5 to -3 m/s at a sigma of 0.8-1.1,
-    and a false warning after the closest approach), so ``window`` successive feeds weigh as one
+    fed at the spread, the filter takes the median's drift for a vertical speed (over hills, an
+    aircraft level 232 m above drifts from 253 to 210 m over 12 s: -2.5 to -3 m/s at a sigma of
+    0.8-1.1, and a false warning after the closest approach), so ``window`` successive feeds weigh as one
     (in the band a track's height rests on what its readings agree on, not on each scattered one);
-    free ones at the track's height now, else at ``last_up_m`` (a vote lost on a run of readings the
-    ground pulled let the co-altitude prior drag the track down: flat ground 300 m below, 200-set
-    encounter 138, 280 m above, down to 103 m in 20 s, and warned), else at elevation 0 (the
+    free ones at the track's current height, else at ``last_up_m`` (a vote lost on a run of
+    readings the ground pulls would let the co-altitude prior drag the track down: over flat ground
+    300 m below, an aircraft 280 m above would sink to 103 m in 20 s, and be warned), else at elevation 0 (the
     co-altitude prior), with :data:`FREE_ELEVATION_SIGMA_RAD`."""
     sigma = np.where(agreed, np.fmax(sigma, np.sqrt(window) * spread / range_m), sigma)
     moved = (~trusted | agreed) & np.isfinite(positions_m).all(axis=1)
@@ -375,8 +374,8 @@ def _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids, k: 
     """In-band readings below the horizontal that agree with their track's :class:`BelowConsensus`.
 
     A consensus below only trusts its readings; it neither places free ones nor restarts the
-    track's height: readings a mixture pulls can agree too (flat ground 1000 m below, 200-set
-    encounter 67: 103 m below, readings agreeing 700 m below; held there, its track was never
+    track's height: readings a mixture pulls can agree too (over flat ground 1000 m below, an
+    aircraft 103 m below has readings agreeing 700 m below; held there, its track would never be
     warned). Above the horizontal the ground pulls none."""
     wide = k * np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD)
     up, loose, is_below = range_m * np.sin(elevation), range_m * wide, elevation < -wide

@@ -118,7 +118,8 @@ def doa_on_the_ground(elevation_measured, height_sd, n: int = 10, max_sd: float 
     in sd) count: at least
     three, and their median height is below ``max_sd``. Azimuths may scatter (ground beside the
     track in one cell). Not proof of ground: an aircraft in a ground cell can read the ground's
-    direction too (terrain set flat-300 encounter 2); so it only asks for more detections.
+    direction too (a co-altitude intruder over flat ground 300 m below reads the ground's
+    depression); so it only asks for more detections.
 
     Examples
     --------

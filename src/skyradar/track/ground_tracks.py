@@ -34,13 +34,13 @@ miss distance from the own-ship's line of flight: it can be ground only when tha
 reaches the terrain. A circling aircraft's ``w`` turns and fits no static point. The price is
 time: an aircraft inside the ground's range-Doppler band is held until its history departs from
 a static point's (about 1.5 s for a 20 m/s relative-speed difference; a converging aircraft at
-46.5 m/s against the own-ship's 50 m/s, 550 m miss over ground 300 m below, was held 7 s and
+46.5 m/s against the own-ship's 50 m/s, 550 m miss over ground 300 m below, is held 7 s and
 warned after its loss of well clear). So a direction of arrival that says, reliably and
 consistently, that the track flies above the ground overrules the static fit
 (:func:`doa_in_the_air`); sidelobe ground read as air with a consistent wrong direction then
 stays a track. An elevation that clutter suppression left unobservable (``process.clutter_doa``
 places it co-altitude) is no evidence either way: it neither overrules the static fit (its prior
-elevation 0 with a steady azimuth looked like "one direction in the air" and released ground
+elevation 0 with a steady azimuth looks like "one direction in the air" and would release ground
 patches over hills) nor holds a track by itself.
 
 :func:`hold_ground_tracks` applies both tests causally (a row uses only the detections up to it)
@@ -127,17 +127,17 @@ class GroundTrackTest:
         can be judged; fewer: held.
     release_detections : int
         Detections before a track judged an object is released. Five, not three: three hits of
-        residual clutter on different scatterers fit a range line through some Doppler alias
-        (hills, 200-set encounters 33 and 188, each confirmed for 0.5 s). Judging still starts at
-        ``min_detections``, so a static fit seen at the third detection counts (the altitude
-        return of encounter 27 was judged an object first at its fifth).
+        residual clutter on different scatterers can fit a range line through some Doppler alias
+        and confirm a clutter track for half a second. Judging still starts at
+        ``min_detections``, so a static fit seen at the third detection counts (an altitude
+        return can be judged an object first at its fifth).
     release_span_detections : int
         Detections a run of "object" verdicts must span to release a track a static ground point
-        fitted. Successive judgements share 9 of 10 directions, so a run of three was one chance
-        window: a ground patch read a few degrees off its azimuth, over a valley (hills, 200-set
-        encounters 6 and 28: confirmed for 0.2 s each at 2.7-3.1 km). Five cost a fast head-on
-        intruder whose aliased Doppler fits a static point 1.4 s of warning (encounter 15); three
-        cost it 0.3 s.
+        fitted. A ground patch 2.7-3.1 km away read a few degrees off its azimuth over a valley
+        gives a few verdicts in a row that say "in the air"; successive judgements share 9 of 10
+        directions, so a release needs verdicts spanning three detections. Five would cost a fast
+        head-on intruder whose aliased Doppler fits a static point 1.4 s of warning; three cost it
+        0.3 s.
     max_history : int
         The most recent detections a fit uses.
     surface_down : callable, optional

@@ -2,7 +2,7 @@
 
 The innovation is computed outside the update (:func:`innovation`) so the tracker can wrap it: the
 Doppler axis of a range-Doppler image is circular, and the shortest way round the image is the right
-residual (seed-brief.md ch4; the wrap is :func:`skyradar.units.wrap`). ``predict``, ``update`` and
+residual (Maas 2022, ch. 4; the wrap is :func:`skyradar.units.wrap`). ``predict``, ``update`` and
 ``innovation_covariance`` are re-exported from :mod:`skyradar.kalman`, their one home.
 """
 

@@ -3,7 +3,7 @@
 Both models share one state layout, ``x = (R, V_R, dR/dt, dV_R/dt)``: range [m], radial velocity
 [m/s], range rate [m/s] and radial acceleration [m/s^2], and observe ``z = (R, V_R)`` through
 ``H = [[1, 0, 0, 0], [0, 1, 0, 0]]``. They differ in how the state moves and how the Doppler
-innovation is measured (seed-brief.md ch4):
+innovation is measured (Maas 2022, ch. 4):
 
 * :func:`traditional_model` is the camera-image tracker: two independent constant-velocity axes.
   Range follows its own rate ``dR/dt`` (column 2 of F), the Doppler axis follows ``dV_R/dt``

@@ -5,8 +5,8 @@ id of a lost one when their predicted range and Doppler agree. It decides frame 
 the track-level ground test (:mod:`skyradar.track.ground_tracks`) has seen either history. A lost
 track that was ground clutter predicts badly (its alias is often unresolved, its range spread is
 hundreds of metres after a few seconds), so its large gate can take an aircraft's new track; the
-aircraft's rows then carried the ground track's id (hills, 200-encounter set, encounter 96: an
-intruder reacquired a chain of ground clutter tracks and was warned under their id). Here each
+aircraft's rows then carry the ground track's id (over hills an intruder can reacquire a chain
+of ground clutter tracks and be warned under their id). Here each
 reacquisition is undone unless the track that was lost is, on its own rows, an object the ground
 test confirms: an aircraft's track does not inherit a ground track's id, and a ground track's
 reacquisition by more ground is not joined into one long clutter track either.

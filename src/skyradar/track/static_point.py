@@ -160,9 +160,9 @@ def _gauss_newton(residuals: Callable, ne: np.ndarray, n: int, trim: float, step
     ``residuals(ne)`` maps (m, 2) starts to (m, 2n) normalised residuals (the ``n`` detections'
     ranges, then their Doppler); the Jacobian is taken by 1 m differences (the surface may be a
     DEM). Levenberg-Marquardt: a start moves only when its trimmed chi-square drops, else its
-    damping grows. Plain Gauss-Newton steps overshot along the fit's long valley (the point
+    damping grows. Plain Gauss-Newton steps overshoot along the fit's long valley (the point
     slides along the iso-range, iso-Doppler line with little change) and over a DEM's kinks,
-    and missed minima well inside the test's limit (hills, 200-encounter set, encounter 8).
+    and miss minima well inside the test's limit.
     Returns each start's trimmed chi-square (m,) and the number of detections kept.
     """
     ne = np.asarray(ne, float).copy()

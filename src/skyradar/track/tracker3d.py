@@ -1,7 +1,7 @@
 """3-D tracks on direction-of-arrival positions, associated through the range-Doppler tracker.
 
-DoA positions are too noisy to associate on their own (tens of metres at a few km, seed-brief.md
-ch3), while range and radial velocity are measured to a pixel. So association is done once, in
+DoA positions are too noisy to associate on their own (tens of metres at a few km, Maas 2022,
+ch. 3), while range and radial velocity are measured to a pixel. So association is done once, in
 range-Doppler, and every range-Doppler track owns one 3-D constant-velocity Kalman filter in the
 scenario NED frame, state ``(north, east, down, vn, ve, vd)`` [m, m/s], updated with the position of
 the detection its range-Doppler track was assigned. The filter carries its covariance.
@@ -349,8 +349,8 @@ class Tracker3D:
         moves on its range sphere (same range and bearing): the range is measured to a metre,
         and a height changed at a fixed horizontal position would contradict it. The horizontal
         speed along the bearing is rescaled to keep the range rate, which is measured to a few
-        cm/s: kept as it was, the range-rate updates turned the difference into a vertical speed
-        (hills, 200-set encounter 123, 250 m below and level: 4 m/s of climb, and a false warning).
+        cm/s: left unchanged, the range-rate updates would turn the difference into a vertical speed
+        (a level aircraft 250 m below would gain 4 m/s of climb, and a false warning).
         The vertical speed and its sigma are kept.
 
         Examples

@@ -1,4 +1,4 @@
-"""GPS integrity from a side-looking ground-scanning radar (seed-brief.md ch6).
+"""GPS integrity from a side-looking ground-scanning radar (Maas 2022, ch. 6).
 
 ``projection`` puts a frame's ground returns on a body-aligned ground grid; ``preprocess`` scales and
 transforms radar and map images the thesis' ways; ``compare`` scores poses with SSIM (the thesis' 300-decoy

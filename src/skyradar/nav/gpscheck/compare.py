@@ -2,7 +2,7 @@
 
 The thesis compared the pre-processed radar image with the map image at the GPS pose and at 300 false
 poses (0-150 m away, +-15 deg heading) using SSIM, picked the best-scoring pose, and reported heading
-error, position error and the share of false poses scoring above the true one (seed-brief.md ch6).
+error, position error and the share of false poses scoring above the true one (Maas 2022, ch. 6).
 
 :func:`ssim_scores` is SSIM exactly as ``skimage.metrics.structural_similarity`` computes it (7 x 7
 uniform window, sample covariance, K1 = 0.01, K2 = 0.03), averaged over the pixels whose whole window

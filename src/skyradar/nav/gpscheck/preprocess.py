@@ -1,4 +1,4 @@
-"""The thesis' pre-processing of radar and map images before they are compared (seed-brief.md ch6).
+"""The thesis' pre-processing of radar and map images before they are compared (Maas 2022, ch. 6).
 
 Each method is a scaling step followed by a transform, as in the thesis:
 

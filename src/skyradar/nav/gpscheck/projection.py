@@ -1,4 +1,4 @@
-"""A side-looking radar frame projected onto the flat ground around the aircraft (seed-brief.md ch6).
+"""A side-looking radar frame projected onto the flat ground around the aircraft (Maas 2022, ch. 6).
 
 The thesis put each range-Doppler pixel of a wingtip radar on the ground plane: the range bin gives
 a sphere around the antenna, the Doppler bin a cone around the velocity vector (radial velocity

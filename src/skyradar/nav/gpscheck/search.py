@@ -1,6 +1,6 @@
 """Continuous search for the pose offset that best aligns a radar ground image with the map.
 
-The thesis' named next step (seed-brief.md ch6): instead of scoring a pool of 300 poses, estimate the
+The thesis' named next step (Maas 2022, ch. 6): instead of scoring a pool of 300 poses, estimate the
 offset ``(d_north, d_east, d_heading)`` from the GPS pose to the pose where radar and map agree best.
 
 For each candidate heading the map is sampled once on a body grid enlarged by the search margin, and

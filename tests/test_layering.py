@@ -96,7 +96,6 @@ def test_a_new_package_outside_the_layering_breaks_the_check(tiny_tree: Path):
     assert "skyradar.radarheads" in result.stdout + result.stderr
 
 
-
 def test_only_the_command_line_sits_above_experiments_and_benchmarks():
     # Library code (the chain, the demo, every stage) never imports the experiments or the benchmarks:
     # only the command line and ``python -m skyradar`` may.

@@ -19,7 +19,7 @@ counted under the first cause that holds in some frame of that window:
 ``below_13db``
     in a beam and in view, but weaker than ``min_snr_db``.
 
-Tracks that do not follow the intruder (:func:`skyradar.experiments.daa_chain.label_tracks`) are
+Tracks that do not follow the intruder (:func:`skyradar.chain.label_tracks`) are
 clutter; a clutter track is a *ground* track when its median height above the terrain is below
 half of own-ship's (only over terrain).
 """
@@ -132,7 +132,7 @@ def track_counts(
 ) -> dict[str, int]:
     """Intruder, clutter and ground tracks of one run and the clutter/ground tracks that warned.
 
-    ``labels`` from :func:`~skyradar.experiments.daa_chain.label_tracks`; ``warned_ids`` the tracks
+    ``labels`` from :func:`~skyradar.chain.label_tracks`; ``warned_ids`` the tracks
     with a warning; ``terrain`` (a :class:`~skyradar.scene.terrain.Terrain` or None) and own-ship's
     median height above it decide which clutter tracks are ground tracks: median height below half
     the own-ship's, or no measured altitude on any row (``altitude_measured``: its height is the

@@ -242,3 +242,14 @@ def test_a_negated_range_column_is_refused_by_track(tmp_path):
     result = skyradar("track", "det.parquet", "-o", "trk.parquet", cwd=tmp_path)
     assert_one_line_error(result, "det.parquet", "range_m", "negative at row 0")
     assert not (tmp_path / "trk.parquet").exists()
+
+
+@pytest.mark.parametrize("name", ["../x", ".", "zarr.json", ".zattrs", "a/b", "nose head"])
+def test_a_radar_head_name_that_is_not_a_plain_name_is_refused(tmp_path, name):
+    # A head's frames are a group named after it: a path or a Zarr metadata key would write outside it
+    # (and crashed half-way, leaving a .partial store).
+    heads = [{"name": name, "mount": "nose"}, {"name": "left", "mount": "left-wingtip"}]
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump({**BASE, "duration_s": 0.4, "radars": heads}))
+    done = skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
+    assert_one_line_error(done, "radars.0.name")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.yaml"]

@@ -197,13 +197,13 @@ def _check_ranges(path, rows, lat, lon, alt, alt_field: str, label: str) -> None
         if out.any():
             i = int(np.nonzero(out)[0][0])
             raise InputError(
-                f"{path}: field '{field_name}' out of range at row {rows[i]} ({values[i]}){label}"
+                f"{path}: field '{field_name}' out of range at row {rows[i]} ({values[i]:.6g}){label}"
             )
     low = np.flatnonzero((alt < ALT_LIMITS_M[0]) | (alt > ALT_LIMITS_M[1]))
     if low.size:
         i = int(low[0])
         raise InputError(
-            f"{path}: field '{alt_field}' out of range at row {rows[i]} ({alt[i]:.0f} m is outside "
+            f"{path}: field '{alt_field}' out of range at row {rows[i]} ({alt[i]:.6g} m is outside "
             f"[{ALT_LIMITS_M[0]:g}, {ALT_LIMITS_M[1]:g}] m){label}"
         )
 

@@ -198,9 +198,17 @@ def clean_rows(
     for name, values in zip(("latitude", "longitude"), lat_lon, strict=True):
         if values is None:
             raise InputError(f"{path}: missing required field '{name}'; columns are {list(df.columns)}")
-    no_fix = ~(np.isfinite(lat_lon[0]) & np.isfinite(lat_lon[1]) & np.isfinite(alt))
-    if no_fix.any():
-        notes.append(f"dropped {int(no_fix.sum())} row(s) without a position")
+    no_position = ~(np.isfinite(lat_lon[0]) & np.isfinite(lat_lon[1]))
+    no_altitude = ~np.isfinite(alt) & ~no_position
+    no_fix = no_position | no_altitude
+    if no_position.any():
+        notes.append(f"dropped {int(no_position.sum())} row(s) without a position")
+    if no_altitude.any():
+        first = int(np.flatnonzero(no_altitude)[0])
+        notes.append(
+            f"dropped {int(no_altitude.sum())} row(s) whose '{alt_field}' is not a number "
+            f"(first: row {first}, {df[alt_field].iloc[first]!r})"
+        )
         df, t, alt = df[~no_fix], t[~no_fix], alt[~no_fix]
     return df, col, t, alt, alt_field, notes
 

@@ -44,10 +44,11 @@ Flight parameters are those of :mod:`skyradar.scene.flights` (``straight``, ``ci
 
 from __future__ import annotations
 
+import re
 from datetime import datetime
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
 from skyradar.rx_layouts import RX_LAYOUTS
 from skyradar.scene.impairment_config import ImpairmentConfig
@@ -184,10 +185,18 @@ class MountModel(_Model):
     roll_deg: Finite | None = None
 
 
+def _head_name(name: str) -> str:
+    """A head's frames are a group of the store named after it: a plain name, never a path (``a/b``,
+    ``..``) or a Zarr metadata key (``zarr.json``, ``.zattrs``), which would write outside its group."""
+    if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9_-]{0,63}", name):
+        raise ValueError("a head name is 1-64 letters, digits, '_' or '-', starting with a letter or digit")
+    return name
+
+
 class RadarHeadModel(_Model):
     """One radar head of a multi-head aircraft: its name, mount and overrides of the top-level radar."""
 
-    name: str = Field(min_length=1)
+    name: Annotated[str, AfterValidator(_head_name)]
     mount: Annotated[MountModel, BeforeValidator(_mount_shorthand)]
     radar: RadarModel | None = None
 

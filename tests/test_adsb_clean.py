@@ -222,4 +222,4 @@ def test_readsb_trace_json(tmp_path, reference, caplog):
     )
     traj, line = _read(tmp_path / "trace_full_3c6444.json", caplog)
     _same(traj, reference)
-    assert traj.name == "DLH4AB" and "dropped 1 row(s) without a position" in line
+    assert traj.name == "DLH4AB" and "dropped 1 row(s) without an altitude" in line

@@ -204,11 +204,12 @@ def clean_rows(
     if no_position.any():
         notes.append(f"dropped {int(no_position.sum())} row(s) without a position")
     if no_altitude.any():
-        first = int(np.flatnonzero(no_altitude)[0])
+        first = df.index[int(np.flatnonzero(no_altitude)[0])]
         notes.append(
-            f"dropped {int(no_altitude.sum())} row(s) whose '{alt_field}' is not a number "
-            f"(first: row {first}, {df[alt_field].iloc[first]!r})"
+            f"dropped {int(no_altitude.sum())} row(s) without an altitude ('{alt_field}' empty or not "
+            f"a number; first: row {first})"
         )
+    if no_fix.any():
         df, t, alt = df[~no_fix], t[~no_fix], alt[~no_fix]
     return df, col, t, alt, alt_field, notes
 

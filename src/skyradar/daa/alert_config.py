@@ -17,6 +17,7 @@ frames, no track-quality gate). A file holds :class:`AlertConfig` fields, starti
     age_fraction_of_time_left: 0.1   # a fresh track waits at most this share of the time left
     min_track_age_floor_s: 0.5
     hold_time_factor: 1.5            # an issued level holds while lost within 1.5x its alerting time
+    lost_track_hold_s: 8.0           # a lost track's prediction holds its alert this long
     max_velocity_sigma_mps: 6.0  # null: no gate
     flarm_thresholds_s: [18, 13, 8]
     levels:                      # preventive, corrective, warning
@@ -55,6 +56,7 @@ _FLOATS = (
     "age_fraction_of_time_left",
     "min_track_age_floor_s",
     "hold_time_factor",
+    "lost_track_hold_s",
 )
 _OPTIONAL = ("period_s", "max_velocity_sigma_mps")
 _VOLUME_KEYS = ("dthr_m", "zthr_m", "tthr_s", "tcoa_s")

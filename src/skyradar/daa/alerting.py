@@ -109,6 +109,10 @@ class AlertConfig:
         of its alerting time (threshold hysteresis, >= 1): a raw level that hovers at the edge of
         the alerting time, as a track's prediction does when the widened volume's edge crosses
         the alerting time, raises the alert once and does not drop and raise it again.
+    lost_track_hold_s : float
+        A confirmed track that has no row on a frame is predicted there from its last row for this
+        long, s (the tracker's reacquisition memory), and the prediction may hold the level the
+        track reached, never raise it (:mod:`skyradar.daa.lost_tracks`); 0 turns it off.
     max_velocity_sigma_mps : float, optional
         Track-quality gate: a track row whose horizontal velocity standard deviation
         ``sqrt(cov_vv_00 + cov_vv_11)`` exceeds this raises no alert, m/s (default off), while its
@@ -138,6 +142,7 @@ class AlertConfig:
     age_fraction_of_time_left: float = 0.1
     min_track_age_floor_s: float = 0.5
     hold_time_factor: float = 1.5
+    lost_track_hold_s: float = 8.0
     max_velocity_sigma_mps: float | None = None
 
     def __post_init__(self) -> None:
@@ -147,6 +152,8 @@ class AlertConfig:
             raise ValueError(f"alert config: period_s must be > 0, got {self.period_s}")
         if not self.hold_time_factor >= 1.0:
             raise ValueError(f"alert config: hold_time_factor must be >= 1, got {self.hold_time_factor}")
+        if not self.lost_track_hold_s >= 0.0:
+            raise ValueError(f"alert config: lost_track_hold_s must be >= 0, got {self.lost_track_hold_s}")
         if not self.min_track_age_floor_s >= 0.0:
             raise ValueError(
                 f"alert config: min_track_age_floor_s must be >= 0, got {self.min_track_age_floor_s}"

@@ -9,7 +9,9 @@ clear), ``time_to_impact_s, tcpa_s, hmd_m, vmd_m, range_m, bearing_deg`` (relati
 positive right), ``sector`` (0..11 clockwise from dead ahead), ``layer`` (-2..2), ``rel_north_m,
 rel_east_m, rel_alt_m`` (positive above), ``climb_rate_mps`` (intruder, positive up),
 ``altitude_measured`` (False: the track's height is a co-altitude prior, no elevation of it was
-measured; the tracks table's flag, True for tables without it), and the advice
+measured; the tracks table's flag, True for tables without it), ``extrapolated`` (True: the track
+had no confirmed row on this frame, and the row is its prediction from its last one, which holds
+its alert but never raises it, :mod:`skyradar.daa.lost_tracks`), and the advice
 of that frame, repeated on every row of the frame (empty/NaN when no track alerts):
 ``heading_bands_deg, vs_bands_mps, terrain_vs_bands_mps`` (flattened conflict intervals
 ``[lo0, hi0, lo1, hi1, ...]``), ``preferred_heading_deg, preferred_vs_mps``.
@@ -33,6 +35,7 @@ from skyradar.daa.alerting import (
     velocity_unconverged,
 )
 from skyradar.daa.conflict import traffic_indication
+from skyradar.daa.lost_tracks import lost_track_rows
 from skyradar.daa.provenance import check_tracks_match_run
 from skyradar.daa.range_miss import range_miss_distance
 from skyradar.daa.run_tables import ownship_from_frames, truth_tracks
@@ -103,13 +106,16 @@ def _altitude_measured(df: pd.DataFrame) -> np.ndarray:
     return df["altitude_measured"].to_numpy(bool)  # checked by clean_tracks
 
 
-def _unmeasured_miss(df: pd.DataFrame, t: np.ndarray, own_vel: np.ndarray) -> tuple | None:
+def _unmeasured_miss(
+    df: pd.DataFrame, t: np.ndarray, own_vel: np.ndarray, predicted: np.ndarray
+) -> tuple | None:
     """The range-only miss distance and sigma (:mod:`skyradar.daa.range_miss`) on rows whose height
-    is the co-altitude prior (NaN elsewhere: a measured height is the 3-D track's to judge)."""
+    is the co-altitude prior (NaN elsewhere: a measured height is the 3-D track's to judge, and a
+    lost track's prediction has no range measured)."""
     if not {"range_m", "range_rate_mps", "altitude_measured"} <= set(df):
         return None
-    ids, measured = df["track_id"].to_numpy(), df["altitude_measured"].to_numpy(bool)
-    fit = np.isin(ids, ids[~measured])  # only tracks with such rows (the fit spans measured ones too)
+    ids, measured = df["track_id"].to_numpy(), df["altitude_measured"].to_numpy(bool) | predicted
+    fit = np.isin(ids, ids[~measured]) & ~predicted  # tracks with such rows (the fit spans measured ones)
     miss, sigma = np.full((2, len(df)), np.nan)
     r, rdot = df["range_m"].to_numpy(float)[fit], df["range_rate_mps"].to_numpy(float)[fit]
     miss[fit], sigma[fit] = range_miss_distance(ids[fit], t[fit], r, rdot, own_vel[fit])
@@ -144,6 +150,8 @@ def alerts_from_tracks(
     """
     config = config or AlertConfig()
     df = clean_tracks(tracks, source)
+    df = lost_track_rows(df, ownship["time_s"].to_numpy(float), config.lost_track_hold_s)
+    predicted = df["extrapolated"].to_numpy(bool)
     t = df["time_s"].to_numpy(float)
     own = interp_ownship(ownship, t, source)
     own_pos = np.stack([own["own_north_m"], own["own_east_m"], own["own_down_m"]], -1)
@@ -151,9 +159,12 @@ def alerts_from_tracks(
     v_int = df[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(float)
     s, v = df[["north_m", "east_m", "down_m"]].to_numpy(float) - own_pos, v_int - own_vel
     cov_p, cov_v = covariances(df)
-    raw = raw_alert_levels(s, v, config, cov_p, cov_v, _unmeasured_miss(df, t, own_vel))
+    raw = raw_alert_levels(s, v, config, cov_p, cov_v, _unmeasured_miss(df, t, own_vel, predicted))
+    raw["level"][predicted] = 0  # a prediction holds a track's level, never raises it
+    raw["flarm_level"][predicted] = 0
     level = _issued_levels(df, t, raw, s, v, cov_v, config)
     out = _alerts_table(df, t, level, raw, s, v_int, own["own_yaw_rad"])
+    out["extrapolated"] = predicted
     if with_advice:
         corrective = config.levels[min(1, len(config.levels) - 1)]
         height = own.get("own_height_agl_m")

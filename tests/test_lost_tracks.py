@@ -1,0 +1,64 @@
+"""A lost track's prediction holds its alert through the gap, never raises one, and stops in time."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from skyradar.daa.alerting import RADAR_ALERT_CONFIG
+from skyradar.daa.conflict import WellClearVolume
+from skyradar.daa.lost_tracks import lost_track_rows
+from skyradar.daa.pipeline import alerts_from_tracks
+
+FRAME_S = 1.0 / 9.4
+D_NC = WellClearVolume.do365_noncoop().dthr_m
+
+
+def _head_on(seconds_to_lowc: float, duration_s: float, sigma_v: float = 2.0):
+    """Own-ship north at 50 m/s; an intruder closing head-on at 100 m/s, a converged track of it."""
+    t = np.arange(0.0, duration_s, FRAME_S)
+    own = pd.DataFrame({"time_s": t, "own_north_m": 50.0 * t, "own_east_m": 0.0, "own_down_m": -1000.0,
+                        "own_vn_mps": 50.0, "own_ve_mps": 0.0, "own_vd_mps": 0.0,
+                        "own_yaw_rad": 0.0})  # fmt: skip
+    start = D_NC + 100.0 * seconds_to_lowc
+    tracks = pd.DataFrame({"time_s": t, "track_id": 4, "north_m": start - 50.0 * t, "east_m": 30.0,
+                           "down_m": -1000.0, "vn_mps": -50.0, "ve_mps": 0.0, "vd_mps": 0.0})  # fmt: skip
+    cov = {f"cov_{k}_{i}{j}": ((400.0 if k == "pp" else sigma_v**2) if i == j and k != "pv" else 0.0)
+           for k in ("pp", "vv", "pv") for i in range(3) for j in range(3)}  # fmt: skip
+    return own, tracks.assign(**cov)
+
+
+def test_a_warning_is_held_on_every_frame_of_a_fade():
+    own, tracks = _head_on(seconds_to_lowc=15.0, duration_s=12.0)
+    faded = tracks[(tracks["time_s"] < 5.0) | (tracks["time_s"] > 8.0)]
+    alerts = alerts_from_tracks(faded, own, RADAR_ALERT_CONFIG, with_advice=False)
+    assert len(alerts) == len(tracks)  # one row per frame, the fade's predicted
+    gap = alerts[(alerts["time_s"] > 5.0) & (alerts["time_s"] < 8.0)]
+    assert gap["extrapolated"].all() and (gap["level"] == 3).all()
+    # The prediction follows the intruder: 100 m/s closing, from its last row.
+    last = faded[faded["time_s"] < 5.0].iloc[-1]
+    dt = gap["time_s"].to_numpy() - last["time_s"]
+    np.testing.assert_allclose(gap["range_m"].to_numpy(), np.hypot(last["north_m"] - 50.0 * last["time_s"]
+                               - 100.0 * dt, 30.0), rtol=1e-6)  # fmt: skip
+
+
+def test_a_prediction_never_raises_an_alert():
+    # The track was seen only far out (no warning yet: too young); its prediction alone would put it
+    # inside the volume within the warning's time, but a prediction is no evidence of a conflict.
+    own, tracks = _head_on(seconds_to_lowc=12.0, duration_s=10.0)
+    seen = tracks[tracks["time_s"] < 0.4]
+    alerts = alerts_from_tracks(seen, own, RADAR_ALERT_CONFIG, with_advice=False)
+    assert alerts["extrapolated"].iloc[len(seen) :].all()
+    assert alerts["level"].max() == 0 and alerts["raw_level"].max() == 0
+
+
+def test_predictions_stop_after_the_hold_and_widen_with_time():
+    own, tracks = _head_on(seconds_to_lowc=30.0, duration_s=20.0)
+    seen = tracks[tracks["time_s"] < 2.0]
+    rows = lost_track_rows(seen, own["time_s"].to_numpy(), hold_s=8.0)
+    predicted = rows[rows["extrapolated"]]
+    assert predicted["time_s"].max() <= seen["time_s"].max() + 8.0 + 1e-9
+    assert predicted["time_s"].max() > seen["time_s"].max() + 8.0 - FRAME_S
+    sigma = np.sqrt(predicted["cov_pp_00"].to_numpy())
+    assert (np.diff(sigma) > 0).all() and sigma[0] > 20.0
+    assert len(lost_track_rows(seen, own["time_s"].to_numpy(), hold_s=0.0)) == len(seen)

@@ -49,6 +49,19 @@ KINDS = ("head-on", "crossing", "converging", "overtaking", "climbing")
 _DT_TRUTH_S = 0.05
 
 
+def _draw_misses(rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Horizontal and vertical misses (m) and the vertical side (+-1) of ``n`` encounters: a third
+    inside the well-clear volume (conflicts), the rest spread to three times it, half of those a near
+    miss clearly outside in one of the two only."""
+    inside = rng.random(n) < 1 / 3
+    vol = WellClearVolume.do365_noncoop()
+    h = np.where(inside, rng.uniform(0, 0.9 * vol.dthr_m, n), rng.uniform(0, 3.0 * vol.dthr_m, n))
+    v = np.where(inside, rng.uniform(0, 0.9 * vol.zthr_m, n), rng.uniform(0, 3.0 * vol.zthr_m, n))
+    spread = ~inside & (rng.random(n) < 0.5)
+    v[spread] = rng.uniform(0, 0.9 * vol.zthr_m, spread.sum())
+    return h, v, rng.choice([-1.0, 1.0], n)
+
+
 def make_encounters(n: int, seed: int = 0) -> pd.DataFrame:
     """Encounter parameters, ``n`` rows cycling through the kinds; seeded and reproducible.
 
@@ -63,14 +76,7 @@ def make_encounters(n: int, seed: int = 0) -> pd.DataFrame:
     """
     rng = np.random.default_rng(seed)
     kind = np.array(KINDS)[np.arange(n) % len(KINDS)]
-    # A third of the set inside the volume (conflicts), the rest spread to 3x it.
-    inside = rng.random(n) < 1 / 3
-    vol = WellClearVolume.do365_noncoop()
-    h = np.where(inside, rng.uniform(0, 0.9 * vol.dthr_m, n), rng.uniform(0, 3.0 * vol.dthr_m, n))
-    v = np.where(inside, rng.uniform(0, 0.9 * vol.zthr_m, n), rng.uniform(0, 3.0 * vol.zthr_m, n))
-    spread = ~inside & (rng.random(n) < 0.5)  # near misses: one of the two clearly outside
-    v[spread] = rng.uniform(0, 0.9 * vol.zthr_m, spread.sum())
-    sign = rng.choice([-1.0, 1.0], n)
+    h, v, sign = _draw_misses(rng, n)
     angle = np.select(
         [kind == "crossing", kind == "converging", kind == "climbing"],
         [rng.uniform(60, 120, n), rng.uniform(20, 60, n), rng.uniform(30, 150, n)],
@@ -118,13 +124,7 @@ def make_fast_closures(n: int, seed: int = 0) -> pd.DataFrame:
     """
     rng = np.random.default_rng(seed)
     kind = np.array(FAST_CLOSURE_KINDS)[np.arange(n) % len(FAST_CLOSURE_KINDS)]
-    inside = rng.random(n) < 1 / 3
-    vol = WellClearVolume.do365_noncoop()
-    h = np.where(inside, rng.uniform(0, 0.9 * vol.dthr_m, n), rng.uniform(0, 3.0 * vol.dthr_m, n))
-    v = np.where(inside, rng.uniform(0, 0.9 * vol.zthr_m, n), rng.uniform(0, 3.0 * vol.zthr_m, n))
-    spread = ~inside & (rng.random(n) < 0.5)
-    v[spread] = rng.uniform(0, 0.9 * vol.zthr_m, spread.sum())
-    sign = rng.choice([-1.0, 1.0], n)
+    h, v, sign = _draw_misses(rng, n)
     angle = np.select(
         [kind == "crossing", kind == "climbing"], [rng.uniform(110, 160, n), rng.uniform(110, 170, n)], np.nan
     )

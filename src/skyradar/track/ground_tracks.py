@@ -191,6 +191,16 @@ class GroundTrackTest:
     fast_min_detections: int = 5
 
 
+def _doppler_path(
+    t: np.ndarray, radial_velocity_mps: np.ndarray, width_mps: float, coupling_s: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The radial velocities unwrapped by continuity, and the apparent range change they make from the
+    first detection (their time integral plus the range-Doppler coupling's change), m."""
+    v = np.unwrap(np.asarray(radial_velocity_mps, float), period=width_mps)
+    moved = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))]) + coupling_s * (v - v[0])
+    return v, moved
+
+
 def range_doppler_consistent(
     time_s: np.ndarray,
     range_m: np.ndarray,
@@ -218,8 +228,7 @@ def range_doppler_consistent(
     test = test or GroundTrackTest()
     t = np.asarray(time_s, float)
     rng = np.asarray(range_m, float)
-    v = np.unwrap(np.asarray(radial_velocity_mps, float), period=width_mps)
-    moved = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))]) + coupling_s * (v - v[0])
+    _, moved = _doppler_path(t, radial_velocity_mps, width_mps, coupling_s)
     limit = chi2.isf(test.tail, max(rng.size - int(np.floor(test.trim * rng.size)) - 1, 1))
     for k in range(-max_alias, max_alias + 1):
         res = rng - moved - k * width_mps * (t - t[0])
@@ -286,8 +295,7 @@ def faster_than_ground(
     rng = np.asarray(range_m, float)
     if t.size < 3:
         return False
-    v = np.unwrap(np.asarray(radial_velocity_mps, float), period=width_mps)
-    moved = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))]) + coupling_s * (v - v[0])
+    v, moved = _doppler_path(t, radial_velocity_mps, width_mps, coupling_s)
     excess = rng - moved  # constant + k * width * (t - t0) + noise
     tc = t - t.mean()
     sxx = float(np.sum(tc**2))

@@ -62,3 +62,20 @@ def test_predictions_stop_after_the_hold_and_widen_with_time():
     sigma = np.sqrt(predicted["cov_pp_00"].to_numpy())
     assert (np.diff(sigma) > 0).all() and sigma[0] > 20.0
     assert len(lost_track_rows(seen, own["time_s"].to_numpy(), hold_s=0.0)) == len(seen)
+
+
+def test_predictions_count_neither_for_nor_against_raising_a_level():
+    # A track at "no conflict" is lost for 2 s and comes back predicting a warning: the 2-of-4-seconds
+    # filter raises it as soon as the measured rows say so, not later because the predictions of the
+    # gap were counted as "no conflict".
+    from skyradar.daa.alerting import filter_alert_levels
+
+    t = np.arange(0.0, 8.0, 0.25)
+    measured = np.where(t < 1.0, 0, 3)
+    gap = (t >= 1.0) & (t < 3.0)
+    as_evidence = filter_alert_levels(t, np.where(gap, 0, measured), RADAR_ALERT_CONFIG)
+    as_prediction = filter_alert_levels(t, np.where(gap, -1, measured), RADAR_ALERT_CONFIG)
+    first = {name: t[np.argmax(levels == 3)] for name, levels in (("e", as_evidence), ("p", as_prediction))}
+    # Half the measured rows of the last 4 s: the four before the gap say no, the fourth after it tips it.
+    assert first["p"] == 3.75
+    assert first["e"] > first["p"]

@@ -374,10 +374,12 @@ class AlertFilter:
 
         ``hold_level`` (default ``raw_level``) is the highest level the frame would hold an issued
         alert at (:attr:`AlertConfig.hold_time_factor`): the issued level is not lowered while
-        the M-of-N of these reaches it.
+        the M-of-N of these reaches it. A negative ``raw_level`` says the frame has no evidence
+        to raise a level (a lost track's prediction): it is left out of the raising M-of-N, whose
+        share is taken over the frames with evidence, and counts only towards holding.
         """
         cfg = self.config
-        hold = int(raw_level) if hold_level is None else max(int(hold_level), int(raw_level))
+        hold = max(int(raw_level), 0) if hold_level is None else max(int(hold_level), int(raw_level))
         candidate, held = self._m_of_n_level(time_s, int(raw_level), hold)
         if candidate > self.level:
             self.level, self._raised_at, self._below_since = candidate, time_s, None
@@ -404,10 +406,11 @@ class AlertFilter:
             # Frames strictly inside the window (a tolerance keeps exactly n periods of frames).
             start = next(i for i, t in enumerate(self._times) if t > time_s - cfg.n * cfg.period_s + 1e-9)
         self._raw, self._hold, self._times = self._raw[start:], self._hold[start:], self._times[start:]
-        need = float(cfg.m) if cfg.period_s is None else max(float(cfg.m), cfg.m / cfg.n * len(self._raw))
 
         def reached(levels: list[int]) -> int:
-            counts = [sum(r >= k for r in levels) for k in range(1, len(cfg.levels) + 1)]
+            known = [r for r in levels if r >= 0]
+            need = float(cfg.m) if cfg.period_s is None else max(float(cfg.m), cfg.m / cfg.n * len(known))
+            counts = [sum(r >= k for r in known) for k in range(1, len(cfg.levels) + 1)]
             return max([k for k, c in enumerate(counts, start=1) if c >= need], default=0)
 
         return reached(self._raw), reached(self._hold)

@@ -53,7 +53,14 @@ __all__ = [
 
 
 def _issued_levels(
-    df: pd.DataFrame, t: np.ndarray, raw: dict, s: np.ndarray, v: np.ndarray, cov_v, config: AlertConfig
+    df: pd.DataFrame,
+    t: np.ndarray,
+    raw: dict,
+    s: np.ndarray,
+    v: np.ndarray,
+    cov_v,
+    config: AlertConfig,
+    predicted: np.ndarray,
 ) -> np.ndarray:
     """Issued level per row; silences (in ``raw``) unconverged and too young tracks first.
 
@@ -74,7 +81,8 @@ def _issued_levels(
         raw["level"][idx[~ready]] = 0
         raw["flarm_level"][idx[~ready]] = 0
         rows = idx[ready]
-        level[rows] = filter_alert_levels(t[rows], raw["level"][rows], config, raw["hold_level"][rows])
+        evidence = np.where(predicted[rows], -1, raw["level"][rows])  # a prediction is no evidence
+        level[rows] = filter_alert_levels(t[rows], evidence, config, raw["hold_level"][rows])
     return level
 
 
@@ -162,7 +170,7 @@ def alerts_from_tracks(
     raw = raw_alert_levels(s, v, config, cov_p, cov_v, _unmeasured_miss(df, t, own_vel, predicted))
     raw["level"][predicted] = 0  # a prediction holds a track's level, never raises it
     raw["flarm_level"][predicted] = 0
-    level = _issued_levels(df, t, raw, s, v, cov_v, config)
+    level = _issued_levels(df, t, raw, s, v, cov_v, config, predicted)
     out = _alerts_table(df, t, level, raw, s, v_int, own["own_yaw_rad"])
     out["extrapolated"] = predicted
     if with_advice:

@@ -1,6 +1,7 @@
 """The documentation site builds offline with warnings as errors, and its generated pages hold what
 they are generated from: the results page the numbers of docs/results/*.json, the CLI reference the
-commands of the Typer app."""
+commands of the Typer app, the scenario reference every key of the scenario models (checked against
+their JSON schema and the shipped scenarios), the output-tables page every documented column."""
 
 from __future__ import annotations
 
@@ -77,3 +78,165 @@ def test_pages_of_every_stage_are_built(site):
     for page in ("getting-started", "user-guide/simulate", "how-it-works/alerting", "api/track", "changelog"):
         assert (site / f"{page}.html").is_file(), page
     assert "Unreleased" in _text(site / "changelog.html")  # CHANGELOG.md is included
+
+
+# ---- the scenario reference ------------------------------------------------------------------
+def _plain(fragment: str) -> str:
+    """An HTML fragment's text, tags dropped and whitespace collapsed."""
+    return re.sub(r"\s+", " ", html.unescape(re.sub(r"<[^>]+>", "", fragment))).strip()
+
+
+def _scenario_page(site: Path) -> dict[str, dict]:
+    """The built scenario reference by model (lower-case name): its YAML paths and its key rows,
+    each row ``{"type", "required", "default", "description"}`` as the page shows them."""
+    page = (site / "reference" / "scenario.html").read_text()
+    sections = {}
+    for chunk in page.split('<section id="scenario-')[1:]:
+        name = chunk[: chunk.index('"')]
+        where = re.search(r'<p class="skyradar-scenario-paths">(.*?)</p>', chunk, re.DOTALL)
+        table = re.search(r"<tbody>(.*?)</tbody>", chunk, re.DOTALL)
+        if where is None or table is None:  # the page's own title section
+            continue
+        paths = [_plain(code) for code in re.findall(r"<code[^>]*>(.*?)</code>", where[1], re.DOTALL)]
+        rows = {}
+        for row in re.findall(r"<tr[^>]*>(.*?)</tr>", table[1], re.DOTALL):
+            key, *cells = [_plain(cell) for cell in re.findall(r"<td[^>]*>(.*?)</td>", row, re.DOTALL)]
+            rows[key] = dict(zip(("type", "required", "default", "description"), cells, strict=True))
+        sections[name] = {"paths": ["" if p == "(top level)" else p for p in paths], "rows": rows}
+    return sections
+
+
+def _schema_keys() -> tuple[set[tuple[str, str]], set[tuple[str, str]], dict]:
+    """From the scenario model's JSON schema: every (model, key), every (YAML path, model) and each
+    model's properties, so that the page is checked against pydantic's view, not the directive's."""
+    from skyradar.scene.scenario_models import ScenarioModel
+
+    schema = ScenarioModel.model_json_schema()
+    defs = {name.lower(): d for name, d in schema["$defs"].items()} | {"scenariomodel": schema}
+    keys = {(model, key) for model, d in defs.items() for key in d.get("properties", {})}
+    paths: set[tuple[str, str]] = set()
+
+    def walk(node: dict, path: str) -> None:
+        if "$ref" in node:
+            model = node["$ref"].rsplit("/", 1)[1].lower()
+            if (path, model) not in paths:
+                paths.add((path, model))
+                for key, sub in defs[model]["properties"].items():
+                    walk(sub, f"{path}.{key}" if path else key)
+            return
+        for sub in node.get("anyOf", []) + node.get("oneOf", []):
+            walk(sub, path)
+        if isinstance(node.get("items"), dict):
+            walk(node["items"], path + "[]")
+
+    paths.add(("", "scenariomodel"))
+    for key, sub in schema["properties"].items():
+        walk(sub, key)
+    return keys, paths, defs
+
+
+def test_scenario_reference_lists_every_key_of_the_schema(site):
+    """Every key reachable from the top-level scenario model is on the page, in its model's section,
+    with a description; every YAML path a model appears at is named; every default the page shows
+    reads back (as YAML) as the schema's default. A new field without documentation fails here."""
+    import yaml
+
+    page = _scenario_page(site)
+    keys, paths, defs = _schema_keys()
+    on_page = {(model, key) for model, section in page.items() for key in section["rows"]}
+    assert on_page == keys, f"missing: {sorted(keys - on_page)}; not in the schema: {sorted(on_page - keys)}"
+    assert {(p, model) for model, s in page.items() for p in s["paths"]} == paths
+    for model, section in page.items():
+        for key, row in section["rows"].items():
+            assert row["description"], f"{model}.{key} has no description"
+            assert row["required"] in ("yes", "no"), (model, key, row)
+            prop = defs[model]["properties"][key]
+            assert (row["required"] == "yes") == (key in defs[model].get("required", [])) or (
+                model == "navigationconfig" and row["default"].startswith("from model")
+            ), (model, key, row)
+            if "default" in prop and row["default"] and not row["default"].startswith("from "):
+                assert yaml.safe_load(row["default"]) == prop["default"], (model, key, row["default"])
+
+
+def _section_at(page: dict, path: str, data: dict) -> dict:
+    """The page's section for the mapping ``data`` at ``path``; a tagged union's by ``data["type"]``."""
+    candidates = [s for s in page.values() if path in s["paths"]]
+    if len(candidates) > 1:
+        candidates = [s for s in candidates if s["rows"].get("type", {}).get("type") == data.get("type")]
+    assert len(candidates) == 1, f"{path}: {len(candidates)} sections for {data}"
+    return candidates[0]
+
+
+def _keys_on_page(page: dict, data: dict, path: str = "") -> list[str]:
+    """The keys of a scenario mapping (recursively) the page does not list at their path."""
+    rows = _section_at(page, path, data)["rows"]
+    missing = []
+    for key, value in data.items():
+        here = f"{path}.{key}" if path else key
+        if key not in rows:
+            missing.append(here)
+        elif isinstance(value, dict):
+            missing += _keys_on_page(page, value, here)
+        elif isinstance(value, list):
+            missing += [
+                m for item in value if isinstance(item, dict) for m in _keys_on_page(page, item, here + "[]")
+            ]
+    return missing
+
+
+def test_shipped_scenarios_use_only_keys_on_the_page(site):
+    import yaml
+
+    page = _scenario_page(site)
+    shipped = sorted((ROOT / "src" / "skyradar" / "data" / "scenarios").glob("*.yaml"))
+    assert any(p.name == "ch2_flat_forward.yaml" for p in shipped)
+    for path in shipped:
+        assert not _keys_on_page(page, yaml.safe_load(path.read_text())), path.name
+
+
+def test_a_scenario_written_from_the_page_loads(site, tmp_path):
+    """A scenario whose keys all come from the page, optional ones at the defaults the page shows,
+    validates to the same scenario as one that leaves them out, and builds."""
+    import yaml
+
+    from skyradar.scene.scenario import load_scenario
+
+    page = _scenario_page(site)
+
+    def defaults(section: dict) -> dict:
+        rows = section["rows"].items()
+        return {k: yaml.safe_load(r["default"]) for k, r in rows if r["default"] and r["required"] == "no"}
+
+    minimal = {
+        "origin": {"lat_deg": 52.0, "lon_deg": 4.36},
+        "duration_s": 1.0,
+        "ownship": {"type": "straight", "start_ned_m": [0.0, 0.0, -1000.0], "speed_mps": 50.0},
+    }
+    full = defaults(_section_at(page, "", {})) | minimal
+    full["ownship"] = defaults(_section_at(page, "ownship", minimal["ownship"])) | minimal["ownship"]
+    for section in ("origin", "simulation"):
+        full[section] = defaults(_section_at(page, section, {})) | full.get(section, {})
+    assert not _keys_on_page(page, full)
+    for name, data in (("minimal", minimal), ("full", full)):
+        (tmp_path / f"{name}.yaml").write_text(yaml.safe_dump(data, sort_keys=False))
+    written = load_scenario(tmp_path / "full.yaml")
+    assert written.model == load_scenario(tmp_path / "minimal.yaml").model
+    assert len(written.build().times_s) == 9  # 1 s at the page's default 9.4 frames per second
+
+
+# ---- the output tables -----------------------------------------------------------------------
+def test_output_tables_page_shows_every_documented_column(site):
+    """Each ``skyradar-columns`` table of the page holds, in order, the columns of the mapping it names."""
+    import importlib
+
+    source = (SOURCE / "reference" / "tables.rst").read_text()
+    named = re.findall(r"^\.\. skyradar-columns:: (\S+)$", source, flags=re.MULTILINE)
+    assert len(named) == 8  # detections, tracks, alerts, state, passive, gpscheck, two export tables
+    page = (site / "reference" / "tables.html").read_text()
+    tables = re.findall(r'<table class="[^"]*skyradar-table-columns[^"]*">(.*?)</table>', page, re.DOTALL)
+    assert len(tables) == len(named)
+    for dotted, table in zip(named, tables, strict=True):
+        module, _, name = dotted.rpartition(".")
+        columns = getattr(importlib.import_module(module), name)
+        rows = re.findall(r"<tr[^>]*>\s*<td[^>]*>(.*?)</td>", table, re.DOTALL)
+        assert [_plain(cell) for cell in rows] == list(columns), dotted

@@ -1,8 +1,9 @@
 """Sphinx configuration of the skyradar documentation (``make docs``).
 
 The build is offline: no intersphinx inventories are fetched and no page loads anything from the
-network at build time. The results page, the CLI reference and the API reference are generated
-from the project itself by the directives in ``_ext/skyradar_docs.py``.
+network at build time. The results page, the CLI reference, the scenario reference, the output
+tables and the API reference are generated from the project itself by the directives in
+``_ext/skyradar_docs.py``.
 """
 
 import sys

@@ -12,6 +12,14 @@
 ``skyradar-api``
     A subpackage's API: its docstring, a summary table of its public modules and an ``automodule``
     section per module. Private modules (``_name``) and deprecated aliases are left out.
+``skyradar-scenario``
+    The scenario file's reference, read from the pydantic models: one section per model reachable
+    from the top-level scenario model, with the YAML paths it appears at and a table of its keys
+    (type, whether required, default, description). A field without a description is a warning,
+    which ``make docs`` (``-W``) turns into an error.
+``skyradar-columns``
+    An output table's columns from the producing module's ``*_COLUMNS`` constant (column ->
+    ``"unit; meaning"``, optional columns ending in ``"; optional: when"``).
 
 Nothing is written into the source tree; every page is built from the files and the package as
 they are at build time.
@@ -19,14 +27,21 @@ they are at build time.
 
 from __future__ import annotations
 
+import datetime
 import importlib
 import importlib.util
+import inspect
 import json
 import math
 import pkgutil
 import re
+import types
+import typing
 from pathlib import Path
 
+import annotated_types as at
+import pydantic
+import pydantic.fields
 from docutils import nodes
 from docutils.parsers.rst import directives
 from docutils.statemachine import StringList
@@ -287,9 +302,266 @@ class ApiDirective(SphinxDirective):
         return node.children
 
 
+# ---- the scenario reference ------------------------------------------------------------------
+SCENARIO_MODEL = "skyradar.scene.scenario_models.ScenarioModel"
+# Plain names of the Python types a YAML value takes.
+TYPE_NAMES = {float: "float", int: "int", str: "str", bool: "bool", datetime.datetime: "datetime"}
+
+
+def _unwrap(annotation) -> tuple[object, list]:
+    """The type inside ``Annotated[...]`` layers and their metadata, outermost first."""
+    metadata: list = []
+    while typing.get_origin(annotation) is typing.Annotated:
+        annotation, *extra = typing.get_args(annotation)
+        metadata += extra
+    return annotation, metadata
+
+
+def _is_model(annotation) -> bool:
+    return isinstance(annotation, type) and issubclass(annotation, pydantic.BaseModel)
+
+
+def _union_args(annotation) -> tuple | None:
+    unions = (typing.Union, types.UnionType)
+    return typing.get_args(annotation) if typing.get_origin(annotation) in unions else None
+
+
+def _models_in(annotation, suffix: str = "") -> list[tuple[type, str]]:
+    """The models a field's value may be, each with the path suffix to it (``[]`` for a list's items)."""
+    annotation, _ = _unwrap(annotation)
+    if _is_model(annotation):
+        return [(annotation, suffix)]
+    if typing.get_origin(annotation) is list:
+        return _models_in(typing.get_args(annotation)[0], suffix + "[]")
+    return [found for arg in _union_args(annotation) or () for found in _models_in(arg, suffix)]
+
+
+def _join(path: str, key: str) -> str:
+    return f"{path}.{key}" if path else key
+
+
+def scenario_models(top: type) -> list[tuple[type, list[str]]]:
+    """Every model reachable from ``top`` (breadth first) with the YAML paths it appears at.
+
+    ``top`` itself is at the path ``""``; a list's items add ``[]`` (``intruders[]``), and every
+    member of a union is at the union's path.
+    """
+    paths: dict[type, list[str]] = {}
+    queue = [(top, "")]
+    while queue:
+        model, path = queue.pop(0)
+        if path in paths.setdefault(model, []):
+            continue
+        paths[model].append(path)
+        for key, field in model.model_fields.items():
+            queue += [(child, _join(path, key) + suffix) for child, suffix in _models_in(field.annotation)]
+    return list(paths.items())
+
+
+def _number(value) -> str:
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+_LIMITS = ((at.Gt, ">", "gt"), (at.Ge, ">=", "ge"), (at.Lt, "<", "lt"), (at.Le, "<=", "le"))
+
+
+def _constraints(metadata) -> list[str]:
+    """``> 0``, ``<= 180``, ``at least 1 item`` of pydantic's constraint metadata."""
+    out = []
+    for item in metadata:
+        if isinstance(item, pydantic.fields.FieldInfo):
+            out += _constraints(item.metadata)
+        for kind, sign, name in _LIMITS:
+            if isinstance(item, kind):
+                out.append(f"{sign} {_number(getattr(item, name))}")
+        if isinstance(item, at.MinLen):
+            out.append(f"at least {item.min_length} item" + ("s" if item.min_length != 1 else ""))
+        if isinstance(item, at.MaxLen):
+            out.append(f"at most {item.max_length} items")
+    return out
+
+
+def _variant_tag(model: type) -> str | None:
+    """The ``type`` value that picks ``model`` out of a tagged union, if it has one."""
+    field = model.model_fields.get("type")
+    values = typing.get_args(field.annotation) if field is not None else ()
+    return values[0] if len(values) == 1 else None
+
+
+def yaml_value(value) -> str:
+    """A default as it is written in a scenario file (``yaml.safe_load`` reads the same value back).
+
+    >>> yaml_value((0.0, 0.0, -1.0)), yaml_value(None), yaml_value(True), yaml_value("ga")
+    ('[0.0, 0.0, -1.0]', 'null', 'true', 'ga')
+    """
+    import yaml
+
+    if isinstance(value, pydantic.BaseModel):
+        preset = SCENARIO_PRESETS.get(type(value).__name__)
+        if preset is not None:  # a named model stands for its values
+            return yaml_value(getattr(value, preset[0]))
+        return "{}" if value == type(value)() else yaml_value(value.model_dump())
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(yaml_value(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k}: {yaml_value(v)}" for k, v in value.items()) + "}"
+    if isinstance(value, str) and yaml.safe_load(value) != value:
+        return json.dumps(value)
+    return yaml.safe_dump(value, default_flow_style=True).removesuffix("\n").removesuffix("\n...")
+
+
+# Models whose keys a named model fills in before validation (``navigation: ga-typical``): the model's
+# name key, and the function that gives the values of a name.
+SCENARIO_PRESETS = {"NavigationConfig": ("model", "skyradar.scene.navigation_config.with_preset")}
+
+
+def _import(dotted: str):
+    module, _, name = dotted.rpartition(".")
+    return getattr(importlib.import_module(module), name)
+
+
+class ScenarioDirective(SphinxDirective):
+    """``.. skyradar-scenario:: [dotted.path.to.TopModel]``: every model of a scenario file, one
+    section each (label ``scenario-<modelname>``), with a table of its keys."""
+
+    optional_arguments = 1
+
+    def run(self) -> list[nodes.Node]:
+        models = scenario_models(_import(self.arguments[0] if self.arguments else SCENARIO_MODEL))
+        for module in {model.__module__ for model, _ in models}:  # rebuilt when a model's module changes
+            self.env.note_dependency(importlib.import_module(module).__file__)
+        return [self._section(model, paths) for model, paths in models]
+
+    def _section(self, model: type, paths: list[str]) -> nodes.section:
+        section = _section(self, model.__name__, "scenario-" + model.__name__)
+        where = nodes.paragraph(classes=["skyradar-scenario-paths"])
+        where += nodes.Text("YAML: ")
+        for i, path in enumerate(paths):
+            where += nodes.Text(", " if i else "")
+            where += nodes.literal(path or "(top level)", path or "(top level)")
+        section += where
+        doc = re.split(r"\n\S[^\n]*\n-{3,}\n", "\n" + inspect.cleandoc(model.__doc__ or "") + "\n")[0]
+        lines = [*doc.strip().splitlines(), "", f"Model: :class:`{model.__module__}.{model.__name__}`."]
+        nested_parse_with_titles(
+            self.state, StringList(lines, source=f"<{model.__name__} docstring>"), section
+        )
+        preset = self._preset_values(model)
+        keys = sorted(model.model_fields, key=lambda k: k != "type")  # a variant's tag first
+        rows = [self._row(model, key, model.model_fields[key], preset) for key in keys]
+        section += _table(
+            ["key", "type", "required", "default", "description"], rows, classes=["skyradar-scenario-keys"]
+        )
+        return section
+
+    def _preset_values(self, model: type) -> tuple[str, dict] | None:
+        """The name key and the default named model's values of a model that ``SCENARIO_PRESETS`` names."""
+        spec = SCENARIO_PRESETS.get(model.__name__)
+        if spec is None:
+            return None
+        values = _import(spec[1])(None)
+        return spec[0], values
+
+    def _row(self, model: type, key: str, field, preset) -> list:
+        filled = preset is not None and field.is_required() and key in preset[1]
+        if field.is_required() and not filled:
+            required, default = "yes", nodes.paragraph()
+        else:
+            required = "no"
+            if filled:
+                name, value = preset[1][preset[0]], yaml_value(preset[1][key])
+                default = nodes.paragraph("", "", nodes.Text(f"from {preset[0]}; {name}: "))
+                default += nodes.literal(value, value)
+            else:
+                value = yaml_value(field.default_factory() if field.default_factory else field.default)
+                default = nodes.paragraph("", "", nodes.literal(value, value))
+        if not field.description:
+            self.state.document.reporter.warning(
+                f"scenario key {model.__name__}.{key} has no description: add Field(description=...)",
+                line=self.lineno,
+            )
+        text, messages = self.state.inline_text(field.description or "", self.lineno)
+        description = nodes.paragraph("", "", *text, *messages)
+        return [
+            nodes.paragraph("", "", nodes.literal(key, key)),
+            self._type(field),
+            required,
+            default,
+            description,
+        ]
+
+    def _type(self, field) -> nodes.paragraph:
+        out = nodes.paragraph()
+        out.extend(self._type_nodes(field.annotation))
+        extra = _constraints(field.metadata)
+        if extra:
+            out += nodes.Text(f" ({', '.join(extra)})")
+        return out
+
+    def _type_nodes(self, annotation) -> list[nodes.Node]:
+        annotation, metadata = _unwrap(annotation)
+        limits = _constraints(metadata)
+        members = _union_args(annotation)
+        origin = typing.get_origin(annotation)
+        if members is not None:
+            out: list[nodes.Node] = []
+            for i, member in enumerate(members):
+                out += ([nodes.Text(" | ")] if i else []) + self._type_nodes(member)
+        elif origin is typing.Literal:
+            out = []
+            for i, value in enumerate(typing.get_args(annotation)):
+                out += ([nodes.Text(" | ")] if i else []) + [nodes.literal(str(value), str(value))]
+        elif _is_model(annotation):
+            name = annotation.__name__
+            out = [nodes.reference(name, name, internal=True, refid=nodes.make_id("scenario-" + name))]
+            if (tag := _variant_tag(annotation)) is not None:
+                out += [nodes.Text(" ("), nodes.literal(f"type: {tag}", f"type: {tag}"), nodes.Text(")")]
+        elif origin is list:
+            out = [nodes.Text("list of "), *self._type_nodes(typing.get_args(annotation)[0])]
+        elif origin is tuple:
+            args = typing.get_args(annotation)
+            each = {tuple(_constraints(_unwrap(a)[1])) for a in args}
+            out = [nodes.Text("[" + ", ".join(TYPE_NAMES.get(_unwrap(a)[0], str(a)) for a in args) + "]")]
+            if len(each) == 1 and (common := next(iter(each))):
+                out.append(nodes.Text(f" (each {', '.join(common)})"))
+        elif annotation is type(None):
+            out = [nodes.literal("null", "null")]
+        else:
+            out = [nodes.Text(TYPE_NAMES.get(annotation, getattr(annotation, "__name__", str(annotation))))]
+        if limits and origin is not tuple:
+            out.append(nodes.Text(f" ({', '.join(limits)})"))
+        return out
+
+
+class ColumnsDirective(SphinxDirective):
+    """``.. skyradar-columns:: skyradar.process.pipeline.DETECTION_TABLE_COLUMNS``: a table's columns
+    (name, unit, when written, meaning) from the producing module's mapping."""
+
+    required_arguments = 1
+
+    def run(self) -> list[nodes.Node]:
+        from skyradar.io.table_columns import column_doc
+
+        columns = _import(self.arguments[0])
+        self.env.note_dependency(importlib.import_module(self.arguments[0].rpartition(".")[0]).__file__)
+        rows = []
+        for name, text in columns.items():
+            doc = column_doc(text)
+            rows.append(
+                [
+                    nodes.paragraph("", "", nodes.literal(name, name)),
+                    doc.unit,
+                    "always" if doc.optional is None else doc.optional,
+                    _paragraph(doc.meaning),
+                ]
+            )
+        return [_table(["column", "unit", "written", "meaning"], rows, classes=["skyradar-table-columns"])]
+
+
 def setup(app: Sphinx) -> dict:
     app.add_directive("skyradar-results", ResultsDirective)
     app.add_directive("skyradar-cli", CliDirective)
     app.add_directive("skyradar-api", ApiDirective)
     app.add_directive("skyradar-alert-config", AlertConfigDirective)
+    app.add_directive("skyradar-scenario", ScenarioDirective)
+    app.add_directive("skyradar-columns", ColumnsDirective)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}

@@ -3,18 +3,12 @@
 The input tables are described in :mod:`skyradar.daa.tables`; :mod:`skyradar.daa.run_tables`
 takes the own-ship state (and a simulated run's truth as tracks) from a frames run.
 
-Alerts table (output), one row per track per frame: ``time_s, track_id, level`` (issued: 0 none,
-1 preventive, 2 corrective, 3 warning), ``raw_level, flarm_level, t_in_s`` (predicted loss of well
-clear), ``time_to_impact_s, tcpa_s, hmd_m, vmd_m, range_m, bearing_deg`` (relative to the heading,
-positive right), ``sector`` (0..11 clockwise from dead ahead), ``layer`` (-2..2), ``rel_north_m,
-rel_east_m, rel_alt_m`` (positive above), ``climb_rate_mps`` (intruder, positive up),
-``altitude_measured`` (False: the track's height is a co-altitude prior, no elevation of it was
-measured; the tracks table's flag, True for tables without it), ``extrapolated`` (True: the track
-had no confirmed row on this frame, and the row is its prediction from its last one, which holds
-its alert but never raises it, :mod:`skyradar.daa.lost_tracks`), and the advice
-of that frame, repeated on every row of the frame (empty/NaN when no track alerts):
-``heading_bands_deg, vs_bands_mps, terrain_vs_bands_mps`` (flattened conflict intervals
-``[lo0, hi0, lo1, hi1, ...]``), ``preferred_heading_deg, preferred_vs_mps``.
+Alerts table (output), one row per track per frame, with the columns of :data:`ALERT_COLUMNS`
+(each one's unit and meaning): the issued level (0 none, 1 preventive, 2 corrective, 3 warning),
+the conflict geometry, the FLARM-like traffic indication, whether the track's height was measured
+and whether the row is a lost track's prediction (``extrapolated``: it holds the track's alert but
+never raises it, :mod:`skyradar.daa.lost_tracks`), and the advice of the frame, repeated on every
+row of the frame (empty/NaN when no track alerts; left out with ``with_advice=False``).
 """
 
 from __future__ import annotations
@@ -42,6 +36,7 @@ from skyradar.daa.run_tables import ownship_from_frames, truth_tracks
 from skyradar.daa.tables import OWNSHIP_COLUMNS, TRACK_COLUMNS, clean_tracks, covariances, interp_ownship
 
 __all__ = [
+    "ALERT_COLUMNS",
     "TRACK_COLUMNS",
     "OWNSHIP_COLUMNS",
     "ownship_from_frames",
@@ -84,6 +79,46 @@ def _issued_levels(
         evidence = np.where(predicted[rows], -1, raw["level"][rows])  # a prediction is no evidence
         level[rows] = filter_alert_levels(t[rows], evidence, config, raw["hold_level"][rows])
     return level
+
+
+_NO_ADVICE = "not with --no-advice"
+# The alerts table (``skyradar alert``), column -> "unit; meaning" (skyradar.io.table_columns).
+ALERT_COLUMNS: dict[str, str] = {
+    "time_s": "s; elapsed time of the frame since the run's start_time",
+    "track_id": "-; the tracks table's track_id",
+    "level": "-; issued alert level after the M-of-N filter and hold: 0 none, 1 preventive, 2 corrective, "
+    "3 warning",
+    "raw_level": "-; the level this frame's geometry alone gives (0 on extrapolated rows)",
+    "flarm_level": "-; FLARM-style alarm level 0..3 from time_to_impact_s",
+    "t_in_s": "s; predicted time to the loss of well clear (the highest level's volume, else the "
+    "corrective one); NaN: none",
+    "time_to_impact_s": "s; predicted time of entry into the collision volume; NaN: none",
+    "tcpa_s": "s; time to the horizontal closest point of approach; negative: diverging",
+    "hmd_m": "m; horizontal miss distance at the closest point of approach (from now if diverging)",
+    "vmd_m": "m; vertical separation at the closest point of approach",
+    "range_m": "m; distance from the own-ship to the intruder",
+    "bearing_deg": "deg; bearing of the intruder relative to the own-ship's heading, positive right",
+    "sector": "-; clock sector 0..11 of the bearing, 30 deg each, 0 dead ahead, counting clockwise",
+    "layer": "-; vertical layer from the elevation angle: -2 far below, 0 level, 2 far above",
+    "rel_north_m": "m; intruder north of the own-ship",
+    "rel_east_m": "m; intruder east of the own-ship",
+    "rel_alt_m": "m; intruder height above the own-ship",
+    "climb_rate_mps": "m/s; the intruder's climb rate, positive up",
+    "altitude_measured": "-; False: the track's height is a co-altitude prior, no elevation of it was "
+    "measured (the tracks table's flag; True for tables without it)",
+    "extrapolated": "-; True: the track had no confirmed row on this frame; the row is its prediction "
+    "from its last one",
+    "heading_bands_deg": "deg; headings in conflict with the traffic, flattened intervals [lo0, hi0, lo1, "
+    f"hi1, ...], per frame; optional: {_NO_ADVICE}",
+    "vs_bands_mps": "m/s; vertical speeds in conflict with the traffic, flattened intervals, per frame; "
+    f"optional: {_NO_ADVICE}",
+    "terrain_vs_bands_mps": "m/s; vertical speeds that come too close to the terrain, flattened "
+    f"intervals, per frame; optional: {_NO_ADVICE}",
+    "preferred_heading_deg": "deg; the preferred conflict-free heading, per frame (NaN: no alert); "
+    f"optional: {_NO_ADVICE}",
+    "preferred_vs_mps": "m/s; the preferred conflict-free vertical speed, positive up, per frame (NaN: "
+    f"no alert); optional: {_NO_ADVICE}",
+}
 
 
 def _alerts_table(df, t, level, raw, s, v_int, yaw_rad) -> pd.DataFrame:

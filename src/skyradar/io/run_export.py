@@ -7,6 +7,7 @@ row per frame and intruder; a store of several radar heads adds each head's own 
 (``tgt_visible``, ``tgt_snr_db``... whatever differs between heads) as ``<variable>@<head>``
 columns; the unsuffixed columns are the first head's.
 Both carry ``time_s`` (s since the run's start) and ``utc`` (the instant, from ``start_time``).
+:data:`OWNSHIP_EXPORT_COLUMNS` and :data:`INTRUDER_EXPORT_COLUMNS` give each column's unit and meaning.
 """
 
 from __future__ import annotations
@@ -17,9 +18,43 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from skyradar.io.frames_model import frame_times_s, start_time_of
+from skyradar.io.frames_model import OWNSHIP_VARS, TARGET_VARS, frame_times_s, start_time_of
 
-__all__ = ["ownship_table", "intruder_table", "export_paths"]
+__all__ = [
+    "OWNSHIP_EXPORT_COLUMNS",
+    "INTRUDER_EXPORT_COLUMNS",
+    "ownship_table",
+    "intruder_table",
+    "export_paths",
+]
+
+
+def _documented(variables: dict[str, tuple[str, str]], names) -> dict[str, str]:
+    """Store variables as table columns: "unit; meaning; optional: when" (skyradar.io.table_columns)."""
+    units = {"degree": "deg", "1": "-"}
+    stored = "optional: the run stores the variable (a simulated run stores every one)"
+    return {n: f"{units.get(variables[n][0], variables[n][0])}; {variables[n][1]}; {stored}" for n in names}
+
+
+_CLOCK_COLUMNS = {
+    "time_s": "s; elapsed time of the frame since the run's start_time",
+    "utc": "-; UTC instant of the frame (start_time + time_s)",
+}
+# The own-ship table of ``skyradar export``: the navigation solution, then the truth, each in name order.
+OWNSHIP_EXPORT_COLUMNS: dict[str, str] = _CLOCK_COLUMNS | _documented(
+    OWNSHIP_VARS, sorted(OWNSHIP_VARS, key=lambda n: (not n.startswith("nav_"), n))
+)
+# The intruder table of ``skyradar export``, one row per frame and intruder.
+INTRUDER_EXPORT_COLUMNS: dict[str, str] = (
+    _CLOCK_COLUMNS
+    | {"target": "-; the intruder's name", "target_index": "-; the intruder's index in the run, from 0"}
+    | _documented(TARGET_VARS, TARGET_VARS)
+    | {
+        "<variable>@<head>": "as <variable>; <variable> as the radar head <head> sees it; optional: a run of "
+        "several heads, for every tgt_ variable that differs between them (the unsuffixed column is the "
+        "first head's)"
+    }
+)
 
 
 def _clock(ds: xr.Dataset) -> dict[str, np.ndarray]:

@@ -43,6 +43,7 @@ from skyradar.sim.navigation import AhrsModel, ahrs_attitude
 
 __all__ = [
     "METHODS",
+    "STATE_TABLE_COLUMNS",
     "FrameEstimate",
     "estimate_frame",
     "mount_height_offset_m",
@@ -52,6 +53,28 @@ __all__ = [
 
 METHODS = ("thesis", "robust")
 STATE_COLUMNS = ("vx", "vz", "h")
+# The flight-state table (``skyradar state``), column -> "unit; meaning" (skyradar.io.table_columns).
+STATE_TABLE_COLUMNS: dict[str, str] = {
+    "time_s": "s; elapsed time of the frame since the run's start_time",
+    "frame": "-; frame number in the run, from 0",
+    "vx_raw_mps": "m/s; this frame's horizontal ground speed from the ground ridge (NaN: low quality)",
+    "vz_raw_mps": "m/s; this frame's vertical speed, positive down (NaN: low quality)",
+    "h_raw_m": "m; this frame's height of the own-ship reference point above the ground (NaN: low quality)",
+    "vx_raw_sd_mps": "m/s; one-sigma uncertainty of vx_raw_mps",
+    "vz_raw_sd_mps": "m/s; one-sigma uncertainty of vz_raw_mps",
+    "h_raw_sd_m": "m; one-sigma uncertainty of h_raw_m",
+    "quality": "-; 0..1, the ridge fit's inlier fraction times min(1, inliers / 50)",
+    "low_quality": "-; True: too few inliers or too low a quality (only sky in view); the filter skips it",
+    "n_ridge": "-; ground-ridge points of the frame",
+    "n_inliers": "-; ridge points the fit kept",
+    "vx_mps": "m/s; Kalman-filtered horizontal ground speed",
+    "vx_sd_mps": "m/s; one-sigma uncertainty of vx_mps",
+    "vz_mps": "m/s; Kalman-filtered vertical speed, positive down",
+    "vz_sd_mps": "m/s; one-sigma uncertainty of vz_mps",
+    "h_m": "m; Kalman-filtered height above the ground",
+    "h_sd_m": "m; one-sigma uncertainty of h_m",
+    "used_by_filter": "-; True: the filter took this frame's raw estimate (it passed the innovation gate)",
+}
 
 
 @dataclass(frozen=True)

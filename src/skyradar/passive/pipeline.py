@@ -8,8 +8,9 @@ few numbers per pulse (time and direct-path amplitude) for the scan phase. At th
 target in overlapping dwells merge into one detection (azimuth the SNR-weighted mean); the bistatic
 ellipse gives east/north; the blind zone is dropped.
 
-Output columns: ``time_s, sweep, channel, bistatic_range_m, doppler_hz, snr_db, azimuth_deg, east_m,
-north_m, r_tx_m, r_rx_m`` (east/north in metres from the receiver, in its horizontal plane).
+Output columns: :data:`COLUMNS` (``time_s, sweep, channel, bistatic_range_m, doppler_hz, snr_db,
+azimuth_deg, east_m, north_m, r_tx_m, r_rx_m``; east/north in metres from the receiver, in its
+horizontal plane), each one's unit and meaning in :data:`PASSIVE_TABLE_COLUMNS`.
 """
 
 from __future__ import annotations
@@ -30,10 +31,23 @@ from skyradar.passive.profiles import ProfileExtractor, read_chunks
 from skyradar.passive.pulses import estimate_pulse, scan_phase
 
 __all__ = ["PassiveSettings", "PassiveResult", "process_recording", "merge_candidates", "drop_sidelobes",
-           "COLUMNS"]  # fmt: skip
+           "COLUMNS", "PASSIVE_TABLE_COLUMNS"]  # fmt: skip
 
-COLUMNS = ["time_s", "sweep", "channel", "bistatic_range_m", "doppler_hz", "snr_db", "azimuth_deg",
-           "east_m", "north_m", "r_tx_m", "r_rx_m"]  # fmt: skip
+# The passive detections table (``skyradar passive``), column -> "unit; meaning" (skyradar.io.table_columns).
+PASSIVE_TABLE_COLUMNS: dict[str, str] = {
+    "time_s": "s; time of the detection's strongest look, from the recording's first sample",
+    "sweep": "-; the illuminator's rotation: one rotation centred on a main-beam crossing of the receiver",
+    "channel": "-; static (the zero-Doppler channel) or moving (the moving-target channel)",
+    "bistatic_range_m": "m; extra path of the echo over the direct path, R1 + R2 - L",
+    "doppler_hz": "Hz; bistatic Doppler shift (0 in the static channel)",
+    "snr_db": "dB; signal-to-noise ratio against the CFAR's local noise estimate",
+    "azimuth_deg": "deg; the illuminator's beam azimuth at the detection, clockwise from north",
+    "east_m": "m; position east of the receiver, in its horizontal plane",
+    "north_m": "m; position north of the receiver, in its horizontal plane",
+    "r_tx_m": "m; range from the transmitter to the echo, R1",
+    "r_rx_m": "m; range from the echo to the receiver, R2",
+}
+COLUMNS = list(PASSIVE_TABLE_COLUMNS)
 
 
 @dataclass(frozen=True)

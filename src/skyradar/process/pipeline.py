@@ -1,9 +1,10 @@
 """Frames in, detections table out: spur mask, detection, DoA, world position, ground filter.
 
 One row per detection per frame with the columns of :data:`DETECTION_COLUMNS` (SI units,
-radians). ``range_m`` is the apparent range of the peak (bin ``k`` at ``k * dR``): the sawtooth
-range-Doppler coupling (``v * fc / (B PRF)``, 0.19 m per m/s) is left in because the measured
-radial velocity may be aliased. World coordinates need the own-ship navigation state in the
+radians; :data:`DETECTION_TABLE_COLUMNS` gives each one's unit and meaning). ``range_m`` is the
+apparent range of the peak (bin ``k`` at ``k * dR``): the sawtooth range-Doppler coupling
+(``v * fc / (B PRF)``, 0.19 m per m/s) is left in because the measured radial velocity may be
+aliased. World coordinates need the own-ship navigation state in the
 Dataset (``nav_*`` variables, GNSS/AHRS with errors, via :func:`skyradar.io.navigation.navigation_state`;
 ``own_*`` truth only in stores written before navigation existed, with a logged note and
 ``table.attrs["navigation_source"] == "truth"``); the scenario's geodetic origin is read from the attributes
@@ -55,15 +56,39 @@ from skyradar.process.ground import flag_ground, height_above_ground_m, surface_
 from skyradar.process.spurs import SpurMap
 
 __all__ = [
-    "DETECTION_COLUMNS", "clutter_anchors", "process_chunk", "process_cube", "process_frames",
-    "scenario_origin",
+    "DETECTION_COLUMNS", "DETECTION_TABLE_COLUMNS", "clutter_anchors", "process_chunk", "process_cube",
+    "process_frames", "scenario_origin",
 ]  # fmt: skip
 
-DETECTION_COLUMNS = [
-    "time_s", "frame", "range_m", "radial_velocity_mps", "range_bin", "doppler_bin", "snr_db", "power_db",
-    "azimuth_rad", "elevation_rad", "elevation_measured", "x_body_m", "y_body_m", "z_body_m", "north_m",
-    "east_m", "down_m", "lat_deg", "lon_deg", "alt_m", "is_ground", "spur",
-]  # fmt: skip
+# The detections table (``skyradar process``), column -> "unit; meaning" (skyradar.io.table_columns).
+DETECTION_TABLE_COLUMNS: dict[str, str] = {
+    "time_s": "s; elapsed time of the frame since the run's start_time",
+    "frame": "-; frame number in the run, from 0",
+    "range_m": "m; apparent range of the peak: bin k at k dR, the range-Doppler coupling left in",
+    "radial_velocity_mps": "m/s; radial velocity of the peak, positive receding, aliased into [-VLim, VLim)",
+    "range_bin": "-; sub-pixel range bin of the peak",
+    "doppler_bin": "-; sub-pixel Doppler bin of the peak, wrapped into [0, n_doppler)",
+    "snr_db": "dB; signal-to-noise ratio of the peak per channel and pixel, (power - noise) / noise",
+    "power_db": "dBW; peak pixel power, the mean over the receive channels",
+    "azimuth_rad": "rad; direction of arrival in the antenna frame, positive right",
+    "elevation_rad": "rad; direction of arrival in the antenna frame, positive up (0 where not measured)",
+    "elevation_measured": "-; False: clutter suppression left no elevation; elevation_rad is the level prior",
+    "x_body_m": "m; position in the body frame, forward of the reference point",
+    "y_body_m": "m; position in the body frame, right",
+    "z_body_m": "m; position in the body frame, down",
+    "north_m": "m; position north in the scenario NED frame, from the navigation solution (NaN without it)",
+    "east_m": "m; position east in the scenario NED frame (NaN without own-ship navigation)",
+    "down_m": "m; position down in the scenario NED frame (NaN without own-ship navigation)",
+    "lat_deg": "deg; WGS84 latitude (NaN without own-ship navigation)",
+    "lon_deg": "deg; WGS84 longitude (NaN without own-ship navigation)",
+    "alt_m": "m; height above the WGS84 ellipsoid (NaN without own-ship navigation)",
+    "is_ground": "-; True: the ground filter explains the detection as a ground return",
+    "spur": "-; True: the peak lies in the spur map (--spur-mode flag; masked spurs are not detected)",
+    "radar": "-; name of the radar head that detected it (`radar` for a run of one head)",
+}
+# The columns of one head's frames (process_frames); `radar` is added when the heads' tables merge
+# (skyradar.process.detect_run.merge_head_tables).
+DETECTION_COLUMNS = [c for c in DETECTION_TABLE_COLUMNS if c != "radar"]
 _OWN = ("own_north_m", "own_east_m", "own_down_m", "own_vn_mps", "own_ve_mps", "own_vd_mps")
 _ATT = ("own_yaw_rad", "own_pitch_rad", "own_roll_rad", "own_height_agl_m")
 _GEO = ("own_lat_deg", "own_lon_deg", "own_alt_m")

@@ -23,43 +23,78 @@ __all__ = [
 # ---- configuration ------------------------------------------------------------------------------
 class _Section(BaseModel):
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-    enabled: bool = True
+    enabled: bool = Field(True, description="Apply this section; false switches it off.")
 
 
 class Spur(BaseModel):
+    """One fixed spur: a bright pixel in every frame (nearest pixel; the velocity wraps)."""
+
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-    range_m: float = Field(ge=0.0)
-    velocity_mps: float
-    power_dbm: float
+    range_m: float = Field(ge=0.0, description="Range of the spur's pixel, m.")
+    velocity_mps: float = Field(description="Radial velocity of the spur's pixel, m/s.")
+    power_dbm: float = Field(description="Pixel power, dBm.")
 
 
 class SpursConfig(_Section):
-    spurs: list[Spur] = Field(default_factory=list)
-    map_file: str | None = None  # .npy boolean (n_range, n_doppler) spur map
-    map_power_dbm: float = -130.0
-    leakage: bool = True
+    """Fixed spurs (self-interference), the same in every frame; each spur's phase per channel is fixed by
+    the impairments' ``seed``."""
+
+    spurs: list[Spur] = Field(default_factory=list, description="The spurs, one entry each.")
+    map_file: str | None = Field(
+        None,
+        description="A measured spur map: ``.npy`` boolean array (n_range, n_doppler); every true pixel "
+        "is a spur.",
+    )
+    map_power_dbm: float = Field(-130.0, description="Power of the spur map's pixels, dBm.")
+    leakage: bool = Field(
+        True,
+        description="Add the Hann windows' main-lobe neighbours (amplitude -1/2 per bin step in each axis), "
+        "as an on-bin tone shows after the default windows.",
+    )
 
 
 class ZeroDopplerConfig(_Section):
-    power_dbm_at_100m: float = -115.0
-    falloff_db_per_decade: float = Field(20.0, ge=0.0)
-    width_bins: int = Field(1, ge=1, le=9)
+    """A bright line on the zero-Doppler bin over all ranges."""
+
+    power_dbm_at_100m: float = Field(-115.0, description="Pixel power at 100 m, dBm.")
+    falloff_db_per_decade: float = Field(
+        20.0, ge=0.0, description="Fall of the pixel power per decade of range, dB."
+    )
+    width_bins: int = Field(
+        1, ge=1, le=9, description="Doppler bins the line covers, 6 dB down per bin away from zero Doppler."
+    )
 
 
 class NearRangeConfig(_Section):
-    power_dbm: float = -110.0
-    range_m: float = Field(100.0, gt=0.0)
+    """Returns at all velocities near the radar: a new random pattern every frame."""
+
+    power_dbm: float = Field(-110.0, description="Mean pixel power at zero range, dBm.")
+    range_m: float = Field(
+        100.0,
+        gt=0.0,
+        description="Range where the power has fallen by 30 dB (linearly in dB), m; none beyond.",
+    )
 
 
 class ChannelErrorsConfig(_Section):
-    gain_db: list[float] | None = None
-    phase_deg: list[float] | None = None
-    gain_sd_db: float = Field(0.0, ge=0.0)
-    phase_sd_deg: float = Field(0.0, ge=0.0)
+    """Per-antenna gain and phase errors; channel 0 is the reference."""
+
+    gain_db: list[float] | None = Field(
+        None, description="Gain error of each receive channel, dB; unset: drawn with ``gain_sd_db``."
+    )
+    phase_deg: list[float] | None = Field(
+        None, description="Phase error of each receive channel, degrees; unset: drawn with ``phase_sd_deg``."
+    )
+    gain_sd_db: float = Field(0.0, ge=0.0, description="Standard deviation of the drawn gain errors, dB.")
+    phase_sd_deg: float = Field(
+        0.0, ge=0.0, description="Standard deviation of the drawn phase errors, degrees."
+    )
 
 
 class NoiseConfig(_Section):
-    noise_figure_db: float | None = None  # default: the radar's
+    """Thermal receiver noise added with the impairments."""
+
+    noise_figure_db: float | None = Field(None, description="Receiver noise figure, dB; unset: the radar's.")
 
 
 class ImpairmentConfig(BaseModel):
@@ -76,14 +111,26 @@ class ImpairmentConfig(BaseModel):
     """
 
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-    preset: Literal["thesis_flight_look"] | None = None
-    spurs: SpursConfig | None = None
-    zero_doppler: ZeroDopplerConfig | None = None
-    near_range: NearRangeConfig | None = None
-    channel_errors: ChannelErrorsConfig | None = None
-    noise: NoiseConfig | None = None
-    ground_reflectivity_db: float = 0.0  # applied by the simulator, not by the cube functions
-    seed: int = Field(0, ge=0)
+    preset: Literal["thesis_flight_look"] | None = Field(
+        None,
+        description="Start from a preset's sections "
+        "(:func:`skyradar.scene.impairment_config.thesis_flight_look`); sections written beside it "
+        "replace the preset's one by one.",
+    )
+    spurs: SpursConfig | None = Field(None, description="Fixed spurs.")
+    zero_doppler: ZeroDopplerConfig | None = Field(None, description="The zero-Doppler line.")
+    near_range: NearRangeConfig | None = Field(None, description="Near-range leakage.")
+    channel_errors: ChannelErrorsConfig | None = Field(None, description="Per-antenna gain and phase errors.")
+    noise: NoiseConfig | None = Field(None, description="Receiver noise.")
+    ground_reflectivity_db: float = Field(
+        0.0, description="Extra gain of the terrain returns, dB (-10: the weaker ground seen in flight)."
+    )  # applied by the simulator, not by the cube functions
+    seed: int = Field(
+        0,
+        ge=0,
+        description="Seed: the fixed patterns (spurs, zero-Doppler line, channel errors) depend on it "
+        "alone, the frame-varying ones (near-range leakage, noise) on it and the frame.",
+    )
 
     @model_validator(mode="before")
     @classmethod

@@ -108,40 +108,60 @@ def with_preset(value: Any) -> Any:
     return _preset(name) | {"model": name} | dict(value)
 
 
-def _up_to(high: float) -> Any:
-    return Field(ge=0.0, le=high, allow_inf_nan=False)
+def _up_to(high: float, description: str) -> Any:
+    return Field(ge=0.0, le=high, allow_inf_nan=False, description=description)
 
 
-def _tau() -> Any:
-    return Field(gt=0.0, le=1e6, allow_inf_nan=False)  # correlation times up to about 12 days, s
+def _tau(description: str) -> Any:
+    # Correlation times up to about 12 days, s.
+    return Field(gt=0.0, le=1e6, allow_inf_nan=False, description=description)
 
 
 class NavigationConfig(BaseModel):
-    """One navigation error model (fields in the module docstring; SI units and degrees)."""
+    """One navigation error model: how wrong and how late the own-ship's GNSS and AHRS are.
+
+    Each error is a white noise per sample plus a first-order Gauss-Markov bias (its stationary
+    standard deviation ``*_bias_*`` and correlation time ``*_tau_s``). A plain string is a model
+    name (``navigation: only-heading``); keys given beside ``model`` override its values. The
+    values of ``ga-typical`` and their sources: :mod:`skyradar.scene.navigation_config`.
+    """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
-    model: ModelName = "ga-typical"
-    seed: int | None = Field(None, ge=0)  # None: the scenario's simulation.seed
+    model: ModelName = Field(
+        "ga-typical",
+        description="The named error model whose values the fields not given here take (``perfect``, "
+        "``ga-typical``, or ``only-GROUP``: one group of ``ga-typical``'s errors, the others zero).",
+    )
+    seed: int | None = Field(
+        None, ge=0, description="Seed of the error draws; unset: the scenario's ``simulation.seed``."
+    )
     # Plausible ranges: the errors of working avionics. Beyond them the model describes a failed
     # sensor (a GNSS bias of kilometres, a heading off by tens of degrees), which is a different study
     # (skyradar gpscheck's spoofing options), and a slip of units (mm for m) would silently blind the chain.
-    gnss_horizontal_bias_m: float = _up_to(100.0)
-    gnss_horizontal_noise_m: float = _up_to(50.0)
-    gnss_vertical_bias_m: float = _up_to(150.0)
-    gnss_vertical_noise_m: float = _up_to(50.0)
-    gnss_position_tau_s: float = _tau()
-    gnss_velocity_noise_mps: float = _up_to(5.0)
-    gnss_vertical_velocity_noise_mps: float = _up_to(5.0)
-    gnss_velocity_bias_mps: float = _up_to(5.0)
-    gnss_velocity_tau_s: float = _tau()
-    roll_pitch_noise_deg: float = _up_to(10.0)
-    roll_pitch_bias_deg: float = _up_to(10.0)
-    roll_pitch_tau_s: float = _tau()
-    heading_noise_deg: float = _up_to(20.0)
-    heading_bias_deg: float = _up_to(30.0)
-    heading_tau_s: float = _tau()
-    gnss_latency_s: float = Field(ge=0.0, le=5.0, allow_inf_nan=False)
-    ahrs_latency_s: float = Field(ge=0.0, le=5.0, allow_inf_nan=False)
+    gnss_horizontal_bias_m: float = _up_to(100.0, "GNSS horizontal position bias per axis, 1-sigma, m.")
+    gnss_horizontal_noise_m: float = _up_to(50.0, "GNSS horizontal position noise per axis, 1-sigma, m.")
+    gnss_vertical_bias_m: float = _up_to(150.0, "GNSS vertical position bias, 1-sigma, m.")
+    gnss_vertical_noise_m: float = _up_to(50.0, "GNSS vertical position noise, 1-sigma, m.")
+    gnss_position_tau_s: float = _tau("Correlation time of the GNSS position biases, s.")
+    gnss_velocity_noise_mps: float = _up_to(5.0, "GNSS horizontal velocity noise per axis, 1-sigma, m/s.")
+    gnss_vertical_velocity_noise_mps: float = _up_to(5.0, "GNSS vertical velocity noise, 1-sigma, m/s.")
+    gnss_velocity_bias_mps: float = _up_to(5.0, "GNSS velocity bias per axis, 1-sigma, m/s.")
+    gnss_velocity_tau_s: float = _tau("Correlation time of the GNSS velocity bias, s.")
+    roll_pitch_noise_deg: float = _up_to(10.0, "AHRS roll and pitch noise, 1-sigma, degrees.")
+    roll_pitch_bias_deg: float = _up_to(10.0, "AHRS roll and pitch bias, 1-sigma, degrees.")
+    roll_pitch_tau_s: float = _tau("Correlation time of the roll and pitch biases, s.")
+    heading_noise_deg: float = _up_to(20.0, "AHRS heading noise, 1-sigma, degrees.")
+    heading_bias_deg: float = _up_to(30.0, "AHRS heading bias, 1-sigma, degrees.")
+    heading_tau_s: float = _tau("Correlation time of the heading bias, s.")
+    gnss_latency_s: float = Field(
+        ge=0.0,
+        le=5.0,
+        allow_inf_nan=False,
+        description="Age of the GNSS data when a radar frame uses it (uncompensated latency), s.",
+    )
+    ahrs_latency_s: float = Field(
+        ge=0.0, le=5.0, allow_inf_nan=False, description="Age of the AHRS data when a radar frame uses it, s."
+    )
 
     @property
     def is_perfect(self) -> bool:

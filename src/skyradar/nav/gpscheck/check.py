@@ -22,6 +22,7 @@ from skyradar.io.frames_model import frame_times_s
 from skyradar.nav.gpscheck.compare import ssim_scores
 from skyradar.nav.gpscheck.monitor import (
     DEFAULT_SETTINGS,
+    VERDICTS,
     WING_UP,
     MonitorSettings,
     alerts,
@@ -36,7 +37,7 @@ from skyradar.scene.ground_grid import GroundGrid, PoseGrid, sample_at_pose
 __all__ = [
     "PIXEL_M", "DEFAULT_METHOD", "MAP_OPTIONS", "RADAR_OPTIONS", "radar_side", "pose_grid_for", "render_map",
     "prepare_map", "building_height_m", "correct_layover",
-    "check_coverage", "FrameCheck", "check_frame", "check_run",
+    "check_coverage", "FrameCheck", "check_frame", "check_run", "GPSCHECK_COLUMNS",
 ]  # fmt: skip
 
 PIXEL_M = 4.0  # about the ch6 radar's 3 m range resolution; 4 m keeps one frame's search under 0.5 s
@@ -182,6 +183,30 @@ def _state(ds, i: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     return np.array([get("own_north_m"), get("own_east_m"), attitude[0]]), attitude, velocity, height
 
 
+_NO_SEARCH = "NaN on a wing-up frame (no search)"
+# The GPS check table (``skyradar gpscheck``), column -> "unit; meaning" (skyradar.io.table_columns).
+GPSCHECK_COLUMNS: dict[str, str] = {
+    "frame": "-; frame number in the run, from 0",
+    "time_s": "s; elapsed time of the frame since the run's start_time",
+    "gps_north_m": "m; the GPS position checked, north in the scenario NED frame (with --gps-offset-north-m)",
+    "gps_east_m": "m; the GPS position checked, east in the scenario NED frame (with --gps-offset-east-m)",
+    "gps_heading_deg": "deg; the GPS heading checked, clockwise from north (with --gps-offset-heading-deg)",
+    "ground_fraction": "-; share of the beam's two-way energy on the ground within range (0..1)",
+    "gps_ssim": "-; structural similarity of the radar ground image and the map at the GPS pose (NaN: "
+    "wing up)",
+    "gps_ncc": f"-; normalised cross-correlation of radar and map at the GPS pose; {_NO_SEARCH}",
+    "peak_ncc": f"-; normalised cross-correlation at the best alignment; {_NO_SEARCH}",
+    "psr": f"-; peak-to-sidelobe ratio of the alignment search, its confidence; {_NO_SEARCH}",
+    "d_north_m": f"m; correction north that best aligns radar and map; {_NO_SEARCH}",
+    "d_east_m": f"m; correction east that best aligns radar and map; {_NO_SEARCH}",
+    "d_heading_deg": f"deg; heading correction that best aligns radar and map; {_NO_SEARCH}",
+    "correction_m": f"m; horizontal length of the correction; {_NO_SEARCH}",
+    "inconsistency": f"-; how far the correction is outside the tolerances (> 1: inconsistent); {_NO_SEARCH}",
+    "verdict": "-; the frame's verdict: " + ", ".join(VERDICTS),
+    "alert": "-; True: the last --alert-frames decided frames were all inconsistent",
+}
+
+
 def _row(frame: int, time_s: float, gps: np.ndarray, result: FrameCheck, settings) -> dict:
     off, nan = result.offset, float("nan")
     row = {
@@ -256,9 +281,8 @@ def check_run(
 
     ``gps_offset`` ``(north_m, east_m, heading_deg)`` is added to the run's own-ship pose: a biased or
     spoofed GPS (run :func:`check_coverage` first: the footprints must lie on the map). ``building_m`` is
-    the map's building height for the layover correction (:func:`building_height_m`). Columns: frame, time_s,
-    gps_north_m, gps_east_m, gps_heading_deg, ground_fraction, gps_ssim, gps_ncc, peak_ncc, psr,
-    d_north_m, d_east_m, d_heading_deg, correction_m, inconsistency, verdict, alert.
+    the map's building height for the layover correction (:func:`building_height_m`). Columns:
+    :data:`GPSCHECK_COLUMNS`.
     """
     pose_grid = pose_grid_for(config, pixel_m, source)
     _check_state(ds, source)

@@ -10,7 +10,7 @@ import pytest
 
 from skyradar.io.frames import open_frames
 from skyradar.process import clutter_frames
-from skyradar.process.pipeline import _own_state, clutter_anchors, process_frames
+from skyradar.process.pipeline import clutter_anchors, navigated_own_state, process_frames
 from skyradar.scene.scenario import Scenario
 from skyradar.sim.simulate_store import simulate_to_zarr
 
@@ -72,7 +72,9 @@ def test_a_run_processed_after_another_gives_the_same_rows(run, whole):
     for name in ("own_height_agl_m", "nav_height_agl_m"):
         if name in higher:
             higher[name] = higher[name] * 1.03
-    assert _own_state(higher)["own_height_agl_m"][0] != _own_state(run)["own_height_agl_m"][0]
+    assert (
+        navigated_own_state(higher)["own_height_agl_m"][0] != navigated_own_state(run)["own_height_agl_m"][0]
+    )
     clutter_frames._CACHE.clear()
     process_frames(higher, suppression="auto")
     pd.testing.assert_frame_equal(process_frames(run, suppression="auto"), whole)

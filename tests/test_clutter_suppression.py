@@ -14,7 +14,7 @@ from skyradar.process.cfar import cfar_2d_floor
 from skyradar.process.clutter_frames import frame_subspace
 from skyradar.process.clutter_suppress import null_count, projected_power, suppress_clutter
 from skyradar.process.ground import in_ground_band
-from skyradar.process.pipeline import _own_state, process_frames
+from skyradar.process.pipeline import navigated_own_state, process_frames
 from skyradar.process.power import power_image
 from skyradar.scene.synthetic_terrain import flat_terrain
 from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
@@ -62,7 +62,7 @@ def clutter_frame():
 @pytest.fixture(scope="module")
 def subspace(clutter_frame):
     # The pipeline's own cached prediction for this frame geometry (computed once per test run).
-    return frame_subspace(_own_state(clutter_frame), 0, CFG)
+    return frame_subspace(navigated_own_state(clutter_frame), 0, CFG)
 
 
 def test_head_on_intruder_in_sidelobe_clutter_is_found_only_with_suppression(clutter_frame):

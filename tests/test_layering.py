@@ -103,3 +103,20 @@ def test_only_the_command_line_sits_above_experiments_and_benchmarks():
     (contract,) = config["contracts"]
     layers = [{n.strip() for n in layer.split("|")} for layer in contract["layers"]]
     assert layers[:3] == [{"__main__"}, {"cli"}, {"experiments", "benchmarks"}]
+
+
+def test_no_module_imports_another_modules_private_names():
+    # A leading underscore says "this module's own": another module that needs it makes it public. Names
+    # of a private module (``sim._tables``, the compiled kernels) serve their package.
+    import ast
+
+    found = []
+    for path in sorted((ROOT / "src" / "skyradar").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not (isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("skyradar")):
+                continue
+            if node.module.split(".")[-1].startswith("_"):
+                continue
+            private = [a.name for a in node.names if a.name.startswith("_") and not a.name.startswith("__")]
+            found += [f"{path.relative_to(ROOT)}:{node.lineno}: {node.module}.{name}" for name in private]
+    assert not found, "\n".join(found)

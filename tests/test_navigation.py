@@ -205,7 +205,7 @@ def test_radar_height_replaces_the_gnss_height_where_the_estimator_was_trusted()
     import pandas as pd
 
     from skyradar.nav.radar_height import with_radar_height
-    from skyradar.process.pipeline import _own_state
+    from skyradar.process.pipeline import navigated_own_state
 
     ds = _scene(n_frames=4)
     t = np.arange(4) / 9.4  # _scene's frame times
@@ -216,6 +216,8 @@ def test_radar_height_replaces_the_gnss_height_where_the_estimator_was_trusted()
     gnss = ds["nav_height_agl_m"].values
     np.testing.assert_array_equal(out["nav_height_agl_m"].values, [590.0, 591.0, gnss[2], 603.0])
     np.testing.assert_array_equal(out["own_height_agl_m"].values, ds["own_height_agl_m"].values)
-    np.testing.assert_array_equal(_own_state(out)["own_height_agl_m"], [590.0, 591.0, gnss[2], 603.0])
+    np.testing.assert_array_equal(
+        navigated_own_state(out)["own_height_agl_m"], [590.0, 591.0, gnss[2], 603.0]
+    )
     with pytest.raises(InputError, match="h_m"):
         with_radar_height(ds, state.drop(columns="h_m"))

@@ -119,7 +119,7 @@ def process(
     ds = open_frames(run)
     config = _read_config(radar_config) if radar_config is not None else radar_config_of(ds, str(run))
     spurs = SpurMap.load(spur_map, config) if spur_map is not None else None
-    dem = _terrain_window(terrain, ds, config, run)
+    dem = terrain_window(terrain, ds, config, run)
     bar, task = _progress(ds.sizes["time"] * len(store_heads(run) or [run]), "frames")
     with bar:  # every radar head of the run, one table with a `radar` column (skyradar.io.frames_heads)
         table, configs = detect_run_heads(
@@ -140,7 +140,7 @@ def process(
     emit_result(result, as_json, "detections")
 
 
-def _terrain_window(terrain: str | None, ds, config, run: Path):
+def terrain_window(terrain: str | None, ds, config, run: Path):
     from skyradar.scene.terrain_names import recorded_terrain, terrain_for_run
 
     if terrain is None:  # the scenario terrain the run was simulated over, if it records one

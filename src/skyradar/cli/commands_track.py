@@ -105,7 +105,7 @@ def _ownship_and_origin(ownship: Path | None, table, origin: str | None):
 
 def _ground_test(terrain: str | None, run, ownship: Path | None, own, origin_lla, config):
     """The track-level ground test over ``--terrain`` (default: the terrain the run records)."""
-    from skyradar.cli.commands_process import _terrain_window
+    from skyradar.cli.commands_process import terrain_window
     from skyradar.errors import InputError
     from skyradar.track.ground_tracks import GroundTrackTest, median_ground_down_m, terrain_surface
 
@@ -113,7 +113,7 @@ def _ground_test(terrain: str | None, run, ownship: Path | None, own, origin_lla
         if terrain is not None and terrain.strip().lower() != "none":
             raise InputError(f"--terrain {terrain}: needs --ownship (the run or own-ship table) to place it")
         return True
-    dem = _terrain_window(terrain, run, config, ownship)
+    dem = terrain_window(terrain, run, config, ownship)
     if dem is None or not hasattr(dem, "height_at") or origin_lla is None:
         return True  # level ground at the own-ship's height above ground, where it has one
     return GroundTrackTest(surface_down=terrain_surface(dem, origin_lla, median_ground_down_m(own)))

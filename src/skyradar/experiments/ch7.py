@@ -76,7 +76,7 @@ def _run(out_dir: Path, tmp: Path, seconds: float, seed: int, progress) -> dict[
     )
     from skyradar.experiments.ch7_score import score
     from skyradar.io.sigmf_io import read_iq_recording
-    from skyradar.passive.pipeline import _geometry, process_recording
+    from skyradar.passive.pipeline import process_recording, receiver_geometry
 
     t0 = time.perf_counter()
     thesis_pulse_figure(out_dir / "ch7_testpulse.png")
@@ -92,7 +92,7 @@ def _run(out_dir: Path, tmp: Path, seconds: float, seed: int, progress) -> dict[
     truth = pd.read_parquet(rec.truth_table_path)
     s = score(det, truth, res.scan_period_s, seconds)
     n_rot = s["rotations"]
-    tx_en, _ = _geometry(rec)
+    tx_en, _ = receiver_geometry(rec)
     plan_view_figure(out_dir / "ch7_sweeps.png", det, truth, tx_en, res.scan_period_s, n_rot)
     aircraft_figure(out_dir / "ch7_aircraft.png", det, truth)
     result = _summary(s, pulse, res, t_sim, t_proc, time.perf_counter() - t0)

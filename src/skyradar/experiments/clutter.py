@@ -58,7 +58,7 @@ from skyradar.io.tables import write_json_atomic
 from skyradar.process.clutter_frames import frame_subspace
 from skyradar.process.clutter_suppress import projected_power, suppress_clutter
 from skyradar.process.doa import steering_vector
-from skyradar.process.pipeline import _own_state, process_frames
+from skyradar.process.pipeline import navigated_own_state, process_frames
 from skyradar.process.power import power_image
 from skyradar.units import wrap
 
@@ -193,7 +193,7 @@ def _case(height_m: float, n_frames: int, seed: int) -> tuple[pd.DataFrame, pd.D
     suppressed = process_frames(full, suppression="knowledge-aided")
     t2 = time.perf_counter()
     config = radar_config_of(full, "clutter scene")
-    sub = frame_subspace(_own_state(full, "clutter scene"), 0, config)
+    sub = frame_subspace(navigated_own_state(full, "clutter scene"), 0, config)
     cubes = np.asarray(full["iq"])
     tables = {"clear": clear, "none": plain, "suppressed": suppressed}
     frames = pd.DataFrame([_frame_measures(i, cubes[i], clutter[i], target[i], sub, config, tables)

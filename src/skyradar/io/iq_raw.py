@@ -15,7 +15,13 @@ import numpy as np
 
 from skyradar.errors import InputError
 from skyradar.io.atomic import atomic_path, write_text_atomic
-from skyradar.io.iq_recording import DATATYPES, IqRecording, _illuminator, _position, positive_number
+from skyradar.io.iq_recording import (
+    DATATYPES,
+    IqRecording,
+    metadata_illuminator,
+    metadata_position,
+    positive_number,
+)
 from skyradar.io.safe_yaml import load_yaml
 
 __all__ = ["RAW_SUFFIXES", "read_raw_iq", "write_raw_iq"]
@@ -41,11 +47,11 @@ def read_raw_iq(data_path: str | Path, require_illuminator: bool = True) -> IqRe
         raise InputError(f"{sidecar}: sidecar must be a mapping, got {type(info).__name__}")
     for key in ("sample_rate_hz", "center_frequency_hz"):
         positive_number(str(sidecar), key, info.get(key))
-    illum, illum_pos = _illuminator(str(sidecar), info.get("illuminator"), require_illuminator)
+    illum, illum_pos = metadata_illuminator(str(sidecar), info.get("illuminator"), require_illuminator)
     receiver = info.get("receiver")
     fields = {
         **info,
-        "receiver_geodetic": _position(str(sidecar), "receiver", receiver),
+        "receiver_geodetic": metadata_position(str(sidecar), "receiver", receiver),
         "illuminator": illum,
         "illuminator_geodetic": illum_pos,
         "receiver": receiver,

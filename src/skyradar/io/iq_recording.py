@@ -24,7 +24,7 @@ DATATYPES: dict[str, tuple[str, float]] = {"cf32_le": ("<c8", 1.0), "ci16_le": (
 _POSITION = ("latitude", "longitude", "altitude")
 
 
-def _position(where: str, field: str, obj: Any) -> tuple[float, float, float]:
+def metadata_position(where: str, field: str, obj: Any) -> tuple[float, float, float]:
     try:
         lat, lon, alt = (float(obj[k]) for k in _POSITION)
     except (KeyError, TypeError, ValueError):
@@ -151,7 +151,7 @@ def positive_number(where: str, field: str, value: Any, must_be: str = "a positi
     return float(value)
 
 
-def _illuminator(where: str, obj: Any, required: bool) -> tuple[dict, tuple | None]:
+def metadata_illuminator(where: str, obj: Any, required: bool) -> tuple[dict, tuple | None]:
     if not isinstance(obj, dict) or not all(k in obj for k in _POSITION):
         if required:
             raise InputError(
@@ -159,4 +159,4 @@ def _illuminator(where: str, obj: Any, required: bool) -> tuple[dict, tuple | No
                 f"the transmitter's site is needed to place echoes (got {obj!r})"
             )
         return (obj if isinstance(obj, dict) else {}), None
-    return obj, _position(where, "skyradar:illuminator", obj)
+    return obj, metadata_position(where, "skyradar:illuminator", obj)

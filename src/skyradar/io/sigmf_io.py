@@ -39,7 +39,13 @@ import numpy as np
 from skyradar.errors import InputError
 from skyradar.io.atomic import atomic_path, write_text_atomic
 from skyradar.io.iq_raw import RAW_SUFFIXES, read_raw_iq, write_raw_iq
-from skyradar.io.iq_recording import DATATYPES, IqRecording, _illuminator, _position, positive_number
+from skyradar.io.iq_recording import (
+    DATATYPES,
+    IqRecording,
+    metadata_illuminator,
+    metadata_position,
+    positive_number,
+)
 
 __all__ = ["DATATYPES", "IqRecording", "SigmfWriter", "read_iq_recording", "sigmf_paths", "write_raw_iq"]
 
@@ -98,7 +104,9 @@ def _read_sigmf(meta_path: Path, data_path: Path, require_illuminator: bool) -> 
                 f"{meta_path}: field 'skyradar:sample_count' must be a whole number, got {count!r}"
             )
         ends.append(count)
-    illum, illum_pos = _illuminator(str(meta_path), glob.get("skyradar:illuminator"), require_illuminator)
+    illum, illum_pos = metadata_illuminator(
+        str(meta_path), glob.get("skyradar:illuminator"), require_illuminator
+    )
     info = {
         "sample_rate_hz": _sample_rate(meta_path, glob),
         "center_frequency_hz": _centre_frequency(meta_path, captures[0], illum),
@@ -225,8 +233,8 @@ class SigmfWriter:
         for p in (self.meta_path, self.data_path):
             if p.exists() and not overwrite:
                 raise InputError(f"{p}: already exists (use --overwrite to replace it)")
-        lat, lon, alt = _position(str(self.meta_path), "receiver", receiver)
-        _illuminator(str(self.meta_path), illuminator, True)
+        lat, lon, alt = metadata_position(str(self.meta_path), "receiver", receiver)
+        metadata_illuminator(str(self.meta_path), illuminator, True)
         self.n_samples = 0
         self._global = {
             "core:datatype": "cf32_le",

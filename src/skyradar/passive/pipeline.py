@@ -80,7 +80,7 @@ class PassiveResult:
     pulse_source: str
 
 
-def _geometry(recording) -> tuple[np.ndarray, float]:
+def receiver_geometry(recording) -> tuple[np.ndarray, float]:
     rx = recording.receiver_geodetic
     ned = geodetic_to_ned(*recording.illuminator_geodetic, *rx)
     tx_en = np.array([ned[1], ned[0]])
@@ -133,7 +133,7 @@ def _process(recording, settings: PassiveSettings | None, progress) -> PassiveRe
     s = settings or PassiveSettings()
     ill = Illuminator.from_metadata(recording.illuminator)
     fs = recording.sample_rate_hz
-    tx_en, bearing = _geometry(recording)
+    tx_en, bearing = receiver_geometry(recording)
     template = _template(recording, ill, s)
     n_lags = int(np.ceil(s.max_bistatic_range_m / C_MPS * fs)) + 1
     extractor = ProfileExtractor(

@@ -156,7 +156,7 @@ def process_cube(
     }
 
 
-def _own_state(ds: xr.Dataset, source: str = "frames") -> dict[str, np.ndarray] | None:
+def navigated_own_state(ds: xr.Dataset, source: str = "frames") -> dict[str, np.ndarray] | None:
     """Own-ship state per frame as the aircraft knows it: the navigation solution, never the truth.
 
     :func:`skyradar.io.navigation.navigation_state` reads ``nav_*`` (``own_*`` only for stores
@@ -248,7 +248,7 @@ def clutter_anchors(ds: xr.Dataset, terrain: Any = None, source: str = "frames")
     For a run processed in blocks (``process_frames(block, anchors=...)``): each block is then
     suppressed as in the whole run (:mod:`skyradar.process.clutter_anchors`).
     """
-    own = _own_state(ds, source)
+    own = navigated_own_state(ds, source)
     return None if own is None else prediction_anchors(own, terrain)
 
 
@@ -338,7 +338,7 @@ def process_frames(
     """
     config = _checked_config(ds, config, spur_map, source)
     first, stop, _ = (frames or slice(None)).indices(ds.sizes["time"])
-    own, origin = _own_state(ds, source), scenario_origin(ds)
+    own, origin = navigated_own_state(ds, source), scenario_origin(ds)
     times = frame_times_s(ds)
     if anchors is None and own is not None and suppression in ("knowledge-aided", "auto"):
         anchors = prediction_anchors(own, terrain, stop)  # walked from frame 0: chunking changes nothing

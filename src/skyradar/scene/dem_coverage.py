@@ -112,7 +112,7 @@ def dem_for_run(path: str | Path, ds: Any, range_limit_m: float, source: str) ->
     """
     from skyradar.scene.dem_readers import read_dem
 
-    lat, lon, origin = _run_track(ds, source)
+    lat, lon, origin = run_track(ds, source)
     times = frame_times_s(ds)
     try:
         terrain = read_dem(path, bounds=footprint_bounds(lat, lon, range_limit_m + _MARGIN_M))
@@ -123,7 +123,7 @@ def dem_for_run(path: str | Path, ds: Any, range_limit_m: float, source: str) ->
     return terrain
 
 
-def _run_track(ds: Any, source: str) -> tuple[np.ndarray, np.ndarray, tuple[float, ...] | None]:
+def run_track(ds: Any, source: str) -> tuple[np.ndarray, np.ndarray, tuple[float, ...] | None]:
     """Own-ship latitude/longitude per frame as the aircraft knows them (navigation), and the origin."""
     from skyradar.geo import ned_to_geodetic
     from skyradar.io.navigation import navigation_state

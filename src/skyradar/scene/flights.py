@@ -13,7 +13,7 @@ from typing import Literal
 import numpy as np
 
 from skyradar.errors import InputError
-from skyradar.scene.trajectories import _MIN_TRACK_SPEED_MPS, GRAVITY_MPS2, Trajectory
+from skyradar.scene.trajectories import GRAVITY_MPS2, MIN_TRACK_SPEED_MPS, Trajectory
 
 __all__ = ["straight", "circle", "circuit", "encounter", "ENCOUNTER_KINDS"]
 
@@ -74,7 +74,7 @@ def straight(
     pos = start + np.outer(t - t[0], vel)
     vels = np.broadcast_to(vel, pos.shape)
     attitude = None
-    if speed < _MIN_TRACK_SPEED_MPS:  # hovering or vertical: heading is the requested one, not the track
+    if speed < MIN_TRACK_SPEED_MPS:  # hovering or vertical: heading is the requested one, not the track
         attitude = np.tile([psi, np.arctan2(float(climb_mps), speed), 0.0], (t.size, 1))
     return Trajectory.from_states(t, pos, vels, attitude, origin=origin, name=name)
 
@@ -273,7 +273,7 @@ def _ownship_at(ownship: Trajectory, t_s: float) -> tuple[np.ndarray, np.ndarray
     v_o = own.velocity_ned_mps[0]
     p_o = own.position_ned_m[0] + v_o * (t_s - t_near)
     ground = float(np.hypot(v_o[0], v_o[1]))
-    if ground < _MIN_TRACK_SPEED_MPS:
+    if ground < MIN_TRACK_SPEED_MPS:
         raise InputError(
             f"field 't_cpa_s': own-ship '{ownship.name}' has no track at {t_s} s (speed {ground:.2f} m/s)"
         )

@@ -109,7 +109,7 @@ def terrain_for_run(value: str, ds: Any, range_limit_m: float, source: str) -> T
     built-in terrain that does not lie under the own-ship, or a run without own-ship position.
     """
     from skyradar.io.frames_model import frame_times_s
-    from skyradar.scene.dem_coverage import _run_track, check_dem_covers, dem_for_run
+    from skyradar.scene.dem_coverage import check_dem_covers, dem_for_run, run_track
 
     name = str(value).strip().lower()
     if name not in BUILTIN_TERRAINS:
@@ -120,7 +120,7 @@ def terrain_for_run(value: str, ds: Any, range_limit_m: float, source: str) -> T
                 f"({', '.join(BUILTIN_TERRAINS)})"
             )
         return dem_for_run(path, ds, range_limit_m, source)
-    lat, lon, origin = _run_track(ds, source)
+    lat, lon, origin = run_track(ds, source)
     spec = _spec(ds)
     if name == "fractal" and (spec is None or spec.get("type") != "fractal"):
         raise InputError(

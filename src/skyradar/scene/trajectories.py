@@ -38,7 +38,7 @@ __all__ = [
 
 GRAVITY_MPS2 = 9.80665  # standard gravity, m/s^2
 _TIME_TOLERANCE_S = 1e-6  # frame times computed as start + k / rate may overshoot the span by rounding
-_MIN_TRACK_SPEED_MPS = 0.5  # below this the track angle is noise; heading is held
+MIN_TRACK_SPEED_MPS = 0.5  # below this the track angle is noise; heading is held
 
 
 @dataclass(frozen=True)
@@ -369,7 +369,7 @@ def derive_attitude(
         )
     ground = np.hypot(v[:, 0], v[:, 1])
     track = np.arctan2(v[:, 1], v[:, 0])
-    moving = ground >= _MIN_TRACK_SPEED_MPS
+    moving = ground >= MIN_TRACK_SPEED_MPS
     if np.any(moving) and not np.all(moving):
         # Hold the last valid track (first valid one before any motion).
         idx = np.where(moving, np.arange(t.size), -1)

@@ -68,11 +68,11 @@ from skyradar.track.ground_doa import (
     elevation_measured_flags,
 )
 from skyradar.track.static_point import (
-    _trimmed_sum,
     fits_static_ground,
     flat_surface,
     static_point_measurements,
     terrain_surface,
+    trimmed_sum,
 )
 
 _CLEAR_S = 3.0  # judged an object off the ground this long on end: not judged again
@@ -233,7 +233,7 @@ def range_doppler_consistent(
     for k in range(-max_alias, max_alias + 1):
         res = rng - moved - k * width_mps * (t - t[0])
         z2 = ((res - np.median(res)) / test.sigma_range_m) ** 2
-        if _trimmed_sum(z2, test.trim)[0] <= limit:
+        if trimmed_sum(z2, test.trim)[0] <= limit:
             return True
     return False
 
@@ -314,7 +314,7 @@ def faster_than_ground(
     res = excess - k * width_mps * (t - t[0])
     z2 = ((res - res.mean()) / test.sigma_range_jitter_m) ** 2
     keep = t.size - int(np.floor(test.trim * t.size))
-    return bool(_trimmed_sum(z2, test.trim)[0] <= chi2.isf(test.tail, max(keep - 2, 1)))
+    return bool(trimmed_sum(z2, test.trim)[0] <= chi2.isf(test.tail, max(keep - 2, 1)))
 
 
 def _own_state(ownship: pd.DataFrame, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -356,7 +356,7 @@ def doppler_smooth(
     res = v - np.polyval(np.polyfit(t - t[0], v, degree), t - t[0])
     z2 = (res / test.point_sigma_velocity_mps) ** 2
     keep = t.size - int(np.floor(test.trim * t.size))
-    return bool(_trimmed_sum(z2, test.trim)[0] <= chi2.isf(test.tail, max(keep - degree - 1, 1)))
+    return bool(trimmed_sum(z2, test.trim)[0] <= chi2.isf(test.tail, max(keep - degree - 1, 1)))
 
 
 def _judge(sl, t, rng, vel, own_p, own_v, surface_down, width, coupling, test, doa) -> str:

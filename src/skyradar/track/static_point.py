@@ -51,7 +51,7 @@ def static_point_measurements(
     return r + coupling_s * v, v
 
 
-def _trimmed_sum(z2: np.ndarray, trim: float) -> tuple[float, int]:
+def trimmed_sum(z2: np.ndarray, trim: float) -> tuple[float, int]:
     """Sum of the smallest ``1 - trim`` of the squared normalised residuals, and how many."""
     keep = z2.size - int(np.floor(trim * z2.size))
     return float(np.sum(np.partition(z2, keep - 1)[:keep])), keep

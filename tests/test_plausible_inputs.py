@@ -253,3 +253,19 @@ def test_a_radar_head_name_that_is_not_a_plain_name_is_refused(tmp_path, name):
     done = skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
     assert_one_line_error(done, "radars.0.name")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.yaml"]
+
+
+@pytest.mark.parametrize(
+    "radar",
+    [
+        {"rx_positions_m": [[0, 0, 0], [0, 1.0e6, 0], [0, 0, 1.0e6], [0, 1.0e6, 1.0e6]]},  # km for m
+        {"rx_positions_m": [[0, 0, 0], [0, 3.0, 0], [0, 0, 0.0156], [0, 3.0, 0.0156]]},
+        {"tx_position_m": [0.0, 500.0, 0.0]},
+    ],
+)
+def test_an_antenna_array_larger_than_one_aircraft_is_refused(tmp_path, radar):
+    # One radar's antennas sit on one aircraft, within 2 m of each other; farther is a unit mistake.
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump({**BASE, "duration_s": 0.4, "radar": radar}))
+    done = skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
+    assert_one_line_error(done, "radar.", "2 m")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.yaml"]

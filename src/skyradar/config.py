@@ -48,6 +48,9 @@ _MOUNT_PRESETS: dict[str, tuple[tuple[float, float, float], float, float]] = {
 }
 
 
+_MAX_APERTURE_M = 2.0  # the largest extent of one radar's antennas, m
+
+
 @dataclass(frozen=True)
 class Mount:
     """Where the antenna sits on the aircraft and how it is turned.
@@ -176,9 +179,22 @@ class RadarConfig:
             raise InputError(
                 "radar.rx_positions_m: all receive antennas are at one point; no baseline for DoA"
             )
+        # One radar's antennas sit on one aircraft: within 2 m of each other (a wingspan holds several
+        # heads, each its own radar); farther apart they are a mistyped unit, not an array.
+        span_m = float(np.ptp(rx, axis=0).max())
+        if span_m > _MAX_APERTURE_M:
+            raise InputError(
+                f"radar.rx_positions_m: the receive antennas span {span_m:.4g} m, more than one radar's "
+                f"{_MAX_APERTURE_M:g} m (positions are metres in the antenna frame)"
+            )
         tx = np.zeros(3) if self.tx_position_m is None else np.array(self.tx_position_m, dtype=float)
         if tx.shape != (3,) or not np.all(np.isfinite(tx)):
             raise InputError(f"radar.tx_position_m must be 3 finite metres, got {self.tx_position_m!r}")
+        if np.abs(tx).max() > _MAX_APERTURE_M:
+            raise InputError(
+                f"radar.tx_position_m: {np.abs(tx).max():.4g} m from the antenna frame's origin, more than "
+                f"one radar's {_MAX_APERTURE_M:g} m"
+            )
         cal = (
             np.ones(rx.shape[0], complex)
             if self.rx_calibration is None

@@ -78,12 +78,13 @@ def lost_track_rows(tracks: pd.DataFrame, frame_times_s: np.ndarray, hold_s: flo
     added = []
     for _, rows in tracks.groupby("track_id", sort=False):
         t = rows["time_s"].to_numpy(float)
-        inside = (frames > t[0]) & (frames <= t[-1] + hold_s)
-        near = np.abs(frames[:, None] - t[None, :]).min(axis=1) <= half_frame if t.size else inside
-        gap_frames = frames[inside & ~near]
+        window = frames[(frames > t[0]) & (frames <= t[-1] + hold_s)]
+        last = np.searchsorted(t, window, side="right") - 1  # the row at or before each frame
+        after = np.minimum(last + 1, t.size - 1)
+        nearest = np.minimum(window - t[last], np.abs(t[after] - window))
+        gap_frames, last = window[nearest > half_frame], last[nearest > half_frame]
         if gap_frames.size == 0:
             continue
-        last = np.searchsorted(t, gap_frames, side="right") - 1
         dt = gap_frames - t[last]
         keep = dt <= hold_s
         if not keep.any():

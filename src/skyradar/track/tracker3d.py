@@ -208,7 +208,7 @@ class Tracker3D:
         self.time_s: float | None = None
         self.lost_memory_s = float(lost_memory_s)
         self.fusion_gate = float(fusion_gate)
-        self._lost: dict[int, tuple[float, np.ndarray, np.ndarray, float]] = {}  # id: (t, x, P, noise)
+        self._lost: dict[int, tuple[float, np.ndarray, np.ndarray]] = {}  # id: (time, x, P) when lost
 
     def step(
         self,
@@ -301,8 +301,7 @@ class Tracker3D:
         """Keep the filters ``gone`` (mask) for a reacquisition; forget those older than the memory."""
         if self.time_s is not None and self.lost_memory_s > 0.0:
             for row in np.flatnonzero(gone):
-                entry = (self.time_s, self.x[row].copy(), self.P[row].copy(), float(self.noise_scale[row]))
-                self._lost[int(self.ids[row])] = entry
+                self._lost[int(self.ids[row])] = (self.time_s, self.x[row].copy(), self.P[row].copy())
         if self.time_s is not None:
             now = self.time_s
             self._lost = {k: v for k, v in self._lost.items() if now - v[0] <= self.lost_memory_s}
@@ -318,7 +317,7 @@ class Tracker3D:
         pos, found = _lookup(self.ids, np.array([track_id], np.int64))
         if lost is None or not found[0] or self.time_s is None:
             return
-        t_lost, x_lost, P_lost, _ = lost
+        t_lost, x_lost, P_lost = lost
         row = int(pos[0])
         dt = self.time_s - t_lost
         if dt > 0.0:

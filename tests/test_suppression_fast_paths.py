@@ -1,4 +1,4 @@
-"""The fast paths of clutter suppression (issue 12 point 2) against the straightforward versions."""
+"""The fast paths of clutter suppression against the straightforward versions."""
 
 from __future__ import annotations
 
@@ -10,7 +10,13 @@ import pytest
 from skyradar.config import RadarConfig
 from skyradar.process import clutter_anchors, clutter_frames
 from skyradar.process.cfar import cfar_2d_floor
-from skyradar.process.clutter_doa import projected_directions
+from skyradar.process.clutter_doa import (
+    _COARSE_DEG,
+    _coarse,
+    _grid_scores,
+    projected_directions,
+    projected_scores,
+)
 from skyradar.process.doa import direction_from_angles, steering_vector
 
 CFG = RadarConfig.prototype_2022()
@@ -55,6 +61,22 @@ def test_coarse_to_fine_direction_search_finds_the_exhaustive_lattice_best():
         got = abs(np.vdot(ps, z)) ** 2 / np.vdot(ps, ps).real
         assert got >= best * (1 - 1e-5)
         assert np.degrees(np.arccos(min(1.0, float(u @ u_ref)))) < 0.1
+
+
+def test_coarse_grid_scores_from_the_real_basis_equal_the_projected_matched_filter_per_point():
+    rng = np.random.default_rng(3)
+    a, e = np.meshgrid(np.radians(_COARSE_DEG), np.radians(_COARSE_DEG), indexing="ij")
+    steer = steering_vector(direction_from_angles(a.ravel(), e.ravel()), CFG)
+    for m in (0, 1, 2):
+        z = rng.standard_normal(4) + 1j * rng.standard_normal(4)
+        q = np.linalg.qr(rng.standard_normal((4, 4)) + 1j * rng.standard_normal((4, 4)))[0][:, :m]
+        for p in (
+            np.eye(4) - q @ q.conj().T,
+            np.linalg.inv(np.cov(rng.standard_normal((4, 40))) + 0.5 * np.eye(4)),
+        ):
+            p = np.ascontiguousarray(p, complex)
+            got = _grid_scores(_coarse(CFG), z, p, np.empty(len(steer)))
+            np.testing.assert_allclose(got, projected_scores(steer, z, p), rtol=1e-9, atol=1e-12)
 
 
 @pytest.mark.parametrize("clutter_rows", [10, 60])  # under and over 1 % of pixels that could be hits

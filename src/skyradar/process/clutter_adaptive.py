@@ -56,7 +56,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from skyradar.process.top_eigen import eigen_scratch, top_eigenpairs
+from skyradar.process.top_eigen import eigen_scratch, top_eigenpairs, top_two_eigenpairs
 
 __all__ = ["adaptive_nulls", "ring_whitening", "ADAPTIVE_WINDOW", "ADAPTIVE_GATE", "EIGEN_EDGE", "RING_CLIP"]
 
@@ -212,7 +212,9 @@ def _adapt(cube, inv_gain, cand, ring_mean, inv_floor, max_nulls, edge, window, 
     hr, hd, gr, gd = window
     # A few cells: their rings summed directly; many: sliding sums over the whole frame (cheaper
     # past about one ring sample per frame cell).
-    sat = _packed_sat(cube, inv_gain, hd) if cand.size * (2 * hr + 1) * (2 * hd + 1) > n_r * n_d else None
+    # (An empty table, not None, marks the direct sums: an optional array costs a check per access.)
+    direct = cand.size * (2 * hr + 1) * (2 * hd + 1) <= n_r * n_d
+    sat = np.zeros((0, 0, 0)) if direct else _packed_sat(cube, inv_gain, hd)
     a = np.empty((n_k, n_k), np.complex128)
     v = np.eye(n_k, max_nulls).astype(np.complex128)
     lam = np.empty(max_nulls)
@@ -220,14 +222,18 @@ def _adapt(cube, inv_gain, cand, ring_mean, inv_floor, max_nulls, edge, window, 
     scratch = eigen_scratch(n_k, max_nulls)
     for c in range(cand.size):
         r, d = cand[c] // n_d, cand[c] % n_d
-        if sat is None:
+        if direct:
             trace = _ring_direct(cube, inv_gain, r, d, window, a) * inv_floor
         else:
             trace = _ring_matrix(sat, r, d, window, n_r, a) * inv_floor
         for i in range(n_k):
             for j in range(n_k):
                 a[i, j] *= inv_floor  # in floors
-        top_eigenpairs(a, v, lam, edge, 1e-4, 50, scratch)  # a in floors: 1e-4 of the noise left a null
+        # a in floors: a null leaves 1e-4 of the noise of its direction
+        if max_nulls == 2:
+            top_two_eigenpairs(a, v, lam, edge, 1e-4, 50, scratch)
+        else:
+            top_eigenpairs(a, v, lam, edge, 1e-4, 50, scratch)
         m = 0
         for i in range(max_nulls):
             if lam[i] > edge:

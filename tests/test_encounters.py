@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from skyradar.code_version import code_version
 from skyradar.daa.conflict import FT
 from skyradar.errors import InputError
 from skyradar.experiments.encounter_set import (
@@ -223,7 +224,7 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
                 "terrains": ["none"], "layouts": ["single"], "navigation": "ga-typical",
                 "suppression": "auto", "late_lead_s": 12.5, "simulation": LIGHT,
                 "rx_layout": "square", "family": "synthetic", "split": "development"}  # fmt: skip
-    key = {**settings, "version": E._version()}
+    key = {**settings, "version": code_version()}
     _, save = E._partial_store(tmp_path, key)
     fake = {"t_lowc_s": np.nan, "t_cpa_s": 120.0, "conflict": False, "may_alert": False,
             "observable": False, "t_warning_s": np.nan, "min_horizontal_m": 3000.0, "min_vertical_m": 0.0,
@@ -285,17 +286,16 @@ def test_one_simulation_scores_the_nose_head_and_the_three_head_layout():
 
 def test_a_run_resumes_only_on_the_same_code(tmp_path, monkeypatch):
     import skyradar
-    from skyradar.experiments import encounters as E
 
     package = tmp_path / "pkg"
     package.mkdir()
     (package / "__init__.py").write_text("")
     (package / "chain.py").write_text("GATE = 16.0\n")
     monkeypatch.setattr(skyradar, "__file__", str(package / "__init__.py"))
-    before = E._version()
-    assert E._version() == before
+    before = code_version()
+    assert code_version() == before
     (package / "chain.py").write_text("GATE = 9.0\n")  # the chain changed between two sessions
-    assert E._version() != before
+    assert code_version() != before
 
 
 def test_run_encounter_builds_its_scenario_with_the_simulation_and_array_asked_for():

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -15,6 +17,7 @@ from skyradar.errors import InputError
 from skyradar.geo import direction_angles, ned_rotation_to, ned_to_geodetic, rotation_matrix
 from skyradar.io.frames import frames_dataset
 from skyradar.process.pipeline import DETECTION_COLUMNS, process_frames
+from skyradar.process.realtime import paced_latencies
 from skyradar.process.smoothing import hann_smooth, hann_window
 from skyradar.process.spurs import SpurMap
 from skyradar.scene.synthetic_terrain import flat_terrain
@@ -228,3 +231,24 @@ def test_hann_smoothing_reduces_white_noise_by_the_window_power():
     assert ratio == pytest.approx(np.sqrt(np.sum(w**2)), rel=0.02)
     with pytest.raises(InputError, match="window"):
         hann_smooth(noise, 0)
+
+
+def test_cli_process_realtime_times_every_frame_against_its_head_interval(tmp_path, monkeypatch, capsys):
+    ds, _ = scene(n_frames=3)
+    ds.to_zarr(tmp_path / "run.zarr", consolidated=False)
+    out = tmp_path / "det.parquet"
+    code, stdout, _ = run_cli(
+        monkeypatch, capsys, "process", tmp_path / "run.zarr", "-o", out, "--realtime", "--json"
+    )
+    assert code == 0
+    result = json.loads(stdout.strip().splitlines()[-1])
+    timed = pd.DataFrame(json.loads(pd.read_parquet(out).attrs["frame_timing"]))
+    assert timed["frame"].tolist() == [0, 1, 2] and (timed["processing_s"] > 0).all()
+    # latency: the queue of one processor fed at the recorded frame times
+    np.testing.assert_allclose(timed["latency_s"], paced_latencies(timed["time_s"], timed["processing_s"]))
+    assert result["realtime_frames"] == 3
+    assert result["realtime_deadline_misses"] == int((timed["latency_s"] > timed["deadline_s"]).sum())
+    # frames timed on Dask workers would not time one processor: refused before any work
+    both = ("process", tmp_path / "run.zarr", "-o", tmp_path / "d2.parquet", "--realtime", "--workers", 2)
+    code, _, stderr = run_cli(monkeypatch, capsys, *both)
+    assert code == 2 and "--realtime" in stderr and not (tmp_path / "d2.parquet").exists()

@@ -16,9 +16,9 @@ from skyradar.errors import InputError
 from skyradar.io.tables import jsonable
 
 __all__ = [
-    "app", "experiment_app", "bench_app", "console", "emit_result", "JsonOption", "number_in",
-    "check_number", "check_choice", "POSITIVE", "NON_NEGATIVE", "COUNT", "PROBABILITY", "WORKERS",
-    "CHUNK_SAMPLES", "HeadOption", "open_one_head",
+    "app", "experiment_app", "bench_app", "console", "emit_result", "emit_measurement", "JsonOption",
+    "number_in", "check_number", "check_choice", "POSITIVE", "NON_NEGATIVE", "COUNT", "PROBABILITY",
+    "WORKERS", "CHUNK_SAMPLES", "HeadOption", "open_one_head",
 ]  # fmt: skip
 
 app = typer.Typer(
@@ -55,6 +55,25 @@ def emit_result(result: dict[str, Any], as_json: bool, title: str) -> None:
     console.print(table)
     if as_json:
         print(json.dumps(jsonable(result)), flush=True)
+
+
+def emit_measurement(result: dict[str, Any], as_json: bool, title: str) -> None:
+    """:func:`emit_result` for a measurement (a benchmark): with the code that measured it
+    (:func:`skyradar.code_version.code_version`), the command, the UTC date and the 1-minute load
+    average, so that a saved result says what ran, when, and how busy the machine was."""
+    import os
+    import sys
+    import time
+
+    from skyradar.code_version import code_version
+
+    result = {
+        "version": code_version(),
+        "command": "skyradar " + " ".join(sys.argv[1:]),
+        "date_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+        "load_average_1min": round(os.getloadavg()[0], 2),  # unless the benchmark sampled its own
+    } | result
+    emit_result(result, as_json, title)
 
 
 def check_number(

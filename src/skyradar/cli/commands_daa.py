@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from skyradar.cli.app import COUNT, JsonOption, app, bench_app, emit_result
+from skyradar.cli.app import COUNT, JsonOption, app, bench_app, emit_measurement, emit_result
 from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["alert", "serve", "bench_alert"]  # experiment encounters: skyradar.cli.commands_encounters
@@ -133,4 +133,4 @@ def bench_alert(
     """Alerting frames per second (with advice), and the range-only miss distance against a numpy baseline."""
     from skyradar.benchmarks.alert import run as run_bench
 
-    emit_result(run_bench(n_tracks=tracks, n_frames=frames), as_json, "bench alert")
+    emit_measurement(run_bench(n_tracks=tracks, n_frames=frames), as_json, "bench alert")

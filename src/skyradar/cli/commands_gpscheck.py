@@ -15,6 +15,7 @@ from skyradar.cli.app import (
     app,
     bench_app,
     console,
+    emit_measurement,
     emit_result,
     experiment_app,
     number_in,
@@ -272,4 +273,4 @@ def bench_gpscheck(
     """One GPS-check frame (300 poses by SSIM; the continuous search) vs a straightforward baseline."""
     from skyradar.benchmarks.gpscheck import run as run_bench
 
-    emit_result(run_bench(min_time_s=seconds), as_json, "bench gpscheck")
+    emit_measurement(run_bench(min_time_s=seconds), as_json, "bench gpscheck")

@@ -17,6 +17,7 @@ from skyradar.cli.app import (
     app,
     bench_app,
     console,
+    emit_measurement,
     emit_result,
     experiment_app,
     open_one_head,
@@ -161,4 +162,4 @@ def bench_state(
     """Flight-state frames per second on 333 x 250 x 4 cubes: robust and terrain-aware vs the thesis' loop."""
     from skyradar.benchmarks.flight_state import run as run_bench
 
-    emit_result(run_bench(min_time_s=seconds), as_json, "bench state")
+    emit_measurement(run_bench(min_time_s=seconds), as_json, "bench state")

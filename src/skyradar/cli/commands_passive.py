@@ -15,6 +15,7 @@ from skyradar.cli.app import (
     app,
     bench_app,
     console,
+    emit_measurement,
     emit_result,
     experiment_app,
 )  # fmt: skip
@@ -161,4 +162,4 @@ def bench_passive(
     from skyradar.benchmarks.passive import run as run_bench
 
     console.print("bench passive: simulating two recordings, then processing them", soft_wrap=True)
-    emit_result(run_bench(seconds=seconds), as_json, "bench passive")
+    emit_measurement(run_bench(seconds=seconds), as_json, "bench passive")

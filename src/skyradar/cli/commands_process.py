@@ -22,6 +22,7 @@ from skyradar.cli.app import (
     check_choice,
     check_number,
     console,
+    emit_measurement,
     emit_result,
     experiment_app,
     number_in,
@@ -29,7 +30,7 @@ from skyradar.cli.app import (
 )
 from skyradar.io.outputs import OVERWRITE_HELP
 
-__all__ = ["process", "calibrate", "spur_map", "experiment_ch3", "bench_process"]
+__all__ = ["process", "calibrate", "spur_map", "experiment_ch3", "bench_process", "bench_realtime"]
 
 
 def _progress(total: int, label: str):
@@ -95,6 +96,16 @@ def process(
     workers: _WorkersOpt = None,
     chunk_frames: _ChunkFramesOpt = 64,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
+    realtime: Annotated[
+        bool,
+        typer.Option(
+            "--realtime",
+            help="Time every frame here, on one processor, as if the frames arrived at their recorded "
+            "times: the summary's realtime_* keys give deadline misses (a frame not done before its "
+            "head's next one arrives) and latency percentiles; the table's metadata 'frame_timing' "
+            "holds each frame's processing time, latency and whether it kept up.",
+        ),
+    ] = False,
     as_json: JsonOption = False,
 ) -> None:
     """Detect objects in every frame and locate them in 3-D: one row per detection per frame.
@@ -102,18 +113,24 @@ def process(
     Columns: time_s, frame, range_m, radial_velocity_mps, range/doppler_bin, snr_db, power_db,
     azimuth/elevation_rad (antenna frame), x/y/z_body_m, north/east/down_m, lat/lon/alt, is_ground, spur.
     """
+    import pandas as pd
+
     from skyradar.daa.provenance import ownship_signature
+    from skyradar.errors import InputError
     from skyradar.io.frames import open_frames, radar_config_of
     from skyradar.io.frames_heads import store_heads
     from skyradar.io.navigation import navigation_source
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_table
     from skyradar.process.detect_run import detect_run_heads, detection_summary
+    from skyradar.process.realtime import frame_latencies, realtime_summary
     from skyradar.process.spurs import SpurMap
 
     check_choice("--method", method, ("cfar", "os-cfar", "shi-tomasi"))
     check_choice("--spur-mode", spur_mode, ("mask", "flag"))
     check_choice("--suppression", suppression, ("auto", "knowledge-aided", "none"))
+    if realtime and (scheduler is not None or workers):
+        raise InputError("--realtime times frames on one processor: leave out --scheduler and --workers")
     dem_path = Path(terrain) if terrain is not None and Path(terrain).exists() else None
     check_output(output, [run, spur_map, dem_path, radar_config], overwrite, kind="table")
     ds = open_frames(run)
@@ -121,11 +138,12 @@ def process(
     spurs = SpurMap.load(spur_map, config) if spur_map is not None else None
     dem = terrain_window(terrain, ds, config, run)
     bar, task = _progress(ds.sizes["time"] * len(store_heads(run) or [run]), "frames")
+    frame_costs: dict[str, list] | None = {} if realtime else None
     with bar:  # every radar head of the run, one table with a `radar` column (skyradar.io.frames_heads)
         table, configs = detect_run_heads(
             run, None if radar_config is None else config, lambda n: bar.update(task, completed=n),
             spurs=spurs, terrain=dem, method=method, spur_mode=spur_mode, pfa=pfa, scheduler=scheduler,
-            workers=workers, chunk_frames=chunk_frames, suppression=suppression,
+            workers=workers, chunk_frames=chunk_frames, suppression=suppression, frame_costs=frame_costs,
         )  # fmt: skip
     # The own-ship signature lets `alert` check that the tracks and its --ownship run belong together.
     meta = {"radar_config": config.to_json(), "source": str(run)}
@@ -134,8 +152,18 @@ def process(
     meta.update({"ownship_signature": sig} if (sig := ownship_signature(ds, str(run))) else {})
     # Which own-ship state placed the detections: nav_* (GNSS/AHRS with errors), or an old store's truth.
     meta["navigation"] = navigation_source(ds) or "none"
+    if frame_costs is not None:
+        timed = frame_latencies(
+            pd.DataFrame(
+                [(name, *cost) for name, costs in frame_costs.items() for cost in costs],
+                columns=["radar", "frame", "time_s", "processing_s"],
+            )
+        )
+        meta["frame_timing"] = timed.to_json(orient="records")
     write_table(table, output, metadata=meta)
     result = detection_summary(table, ds.sizes["time"]) | {"navigation": meta["navigation"]}
+    if frame_costs is not None:
+        result.update({f"realtime_{key}": value for key, value in realtime_summary(timed).items()})
     result["output"] = str(output)
     emit_result(result, as_json, "detections")
 
@@ -336,4 +364,26 @@ def bench_process(
     """Detection + DoA frames per second (333 x 250 x 4), ours vs a baseline; suppressed_*: terrain cubes."""
     from skyradar.benchmarks.process import run as run_bench
 
-    emit_result(run_bench(min_time_s=seconds), as_json, "bench process")
+    emit_measurement(run_bench(min_time_s=seconds), as_json, "bench process")
+
+
+@bench_app.command("realtime")
+def bench_realtime(
+    seconds: Annotated[
+        float,
+        typer.Option(
+            "--seconds",
+            callback=number_in(5.0, 600.0),
+            help="Wall time of frames fed in real time, s (5-600).",
+        ),
+    ] = 60.0,
+    frame_rate: Annotated[
+        float,
+        typer.Option("--frame-rate", callback=number_in(0.5, 100.0), help="Frames per second of each head."),
+    ] = 9.4,
+    as_json: JsonOption = False,
+) -> None:
+    """Three heads over hills processed as their frames arrive, on one core: deadline misses, latency."""
+    from skyradar.benchmarks.realtime import run_realtime
+
+    emit_measurement(run_realtime(seconds=seconds, frame_rate_hz=frame_rate), as_json, "bench realtime")

@@ -14,6 +14,7 @@ from skyradar.cli.app import (
     app,
     bench_app,
     console,
+    emit_measurement,
     emit_result,
     experiment_app,
     number_in,
@@ -161,7 +162,7 @@ def bench_sim(
 
     if not (math.isfinite(seconds) and 0.0 <= seconds <= 600.0):
         raise InputError(f"--seconds: must be a finite number >= 0 and <= 600, got {seconds!r}")
-    emit_result(run(n_frames=frames, min_seconds=seconds), json_out, "bench sim")
+    emit_measurement(run(n_frames=frames, min_seconds=seconds), json_out, "bench sim")
 
 
 @app.command()
@@ -229,4 +230,4 @@ def bench_flight(
     """Whole-flight simulation throughput on Dask with 1 and 2 workers, and peak memory over a long flight."""
     from skyradar.benchmarks.flight import run
 
-    emit_result(run(frames=frames, long_frames=long_frames), json_out, "bench flight")
+    emit_measurement(run(frames=frames, long_frames=long_frames), json_out, "bench flight")

@@ -17,6 +17,7 @@ from skyradar.cli.app import (
     check_choice,
     check_number,
     console,
+    emit_measurement,
     emit_result,
     experiment_app,
     number_in,
@@ -314,4 +315,4 @@ def bench_track(
     """Tracker frames per second at ~200 detections per frame, against a per-pair-loop baseline."""
     from skyradar.benchmarks.track import run as run_bench
 
-    emit_result(run_bench(n_frames=frames, detections_per_frame=detections), as_json, "bench track")
+    emit_measurement(run_bench(n_frames=frames, detections_per_frame=detections), as_json, "bench track")

@@ -16,7 +16,6 @@ The encounters are independent, so they run in ``workers`` processes (one numba 
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import time
@@ -29,6 +28,7 @@ from typing import Any
 
 import pandas as pd
 
+from skyradar.code_version import code_version
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG
 from skyradar.errors import InputError
 from skyradar.experiments.encounter_chain import FRAME_RATE_HZ, LAYOUTS, SUPPRESSION, run_encounter
@@ -238,7 +238,7 @@ def run(
                 "navigation": navigation, "suppression": SUPPRESSION, "late_lead_s": late_lead_s,
                 "simulation": simulation or {}, "rx_layout": rx_layout, "family": family,
                 "split": "evaluation" if seed >= EVALUATION_SEEDS_FROM else "development"}  # fmt: skip
-    version = _version()
+    version = code_version()
     done, save = _partial_store(out_dir, {**settings, "version": version})
     res = run_encounters(enc, seed, workers, progress, done, save, terrains=terrains, family=family,
                          layouts=layouts, frame_rate_hz=frame_rate_hz, buffer=buffer, alert_config=cfg,
@@ -258,17 +258,3 @@ def run(
     for name in (_PARTIAL, _PARTIAL + ".json"):
         (out_dir / name).unlink(missing_ok=True)
     return summary
-
-
-def _version() -> str:
-    """The package version and a digest of its source: a run resumes only on the same code (a
-    set of hundreds of encounters can span days of development at one version number)."""
-    from importlib.metadata import version
-
-    import skyradar
-
-    digest = hashlib.sha256()
-    root = Path(skyradar.__file__).parent
-    for path in sorted(root.rglob("*.py")):
-        digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes())
-    return f"{version('skyradar')}+{digest.hexdigest()[:16]}"

@@ -40,18 +40,25 @@ def detect_run(
     progress: Callable[[int], None] | None = None,
     head: str | None = None,
     suppression: str = "none",
+    frame_costs: list[tuple[int, float, float]] | None = None,
 ) -> pd.DataFrame:
     """Detections table of the frames run at ``run`` (opened as ``ds``; radar ``head`` of it).
 
     Without ``scheduler`` and ``workers`` the frames are processed here; else in chunks of
     ``chunk_frames`` on an existing Dask scheduler or a local cluster of ``workers``. ``progress``
-    is called with the number of frames done so far. ``suppression``: see :func:`process_frames`.
+    is called with the number of frames done so far. ``suppression`` and ``frame_costs`` (each
+    frame's processing time, here only: frames timed on Dask workers would not time one processor):
+    see :func:`process_frames`.
     """
     if scheduler is None and not workers:
         return process_frames(
             ds, spurs, terrain, method, spur_mode, progress=progress, source=str(run), config=config, pfa=pfa,
-            suppression=suppression,
+            suppression=suppression, frame_costs=frame_costs,
         )  # fmt: skip
+    if frame_costs is not None:
+        from skyradar.errors import InputError
+
+        raise InputError("--realtime times frames on one processor: leave out --scheduler and --workers")
     done = 0
 
     def advance(n: int) -> None:
@@ -99,6 +106,7 @@ def detect_run_heads(
     run: str | Path,
     config: RadarConfig | None = None,
     progress: Callable[[int], None] | None = None,
+    frame_costs: dict[str, list[tuple[int, float, float]]] | None = None,
     **kwargs: Any,
 ) -> tuple[pd.DataFrame, dict[str, RadarConfig]]:
     """Detections of every radar head of the run at ``run``, merged (:func:`merge_head_tables`).
@@ -106,6 +114,7 @@ def detect_run_heads(
     ``kwargs`` are :func:`detect_run`'s (spurs, terrain, method, ...). ``config`` replaces the
     stored RadarConfig of a single-head run (a multi-head run refuses it: which head would it be?).
     Returns the table and each head's RadarConfig. ``progress`` gets frames done over all heads.
+    ``frame_costs`` (a dict, filled here) receives each head's :func:`process_frames` frame costs.
     """
     from skyradar.errors import InputError
     from skyradar.io.frames import radar_config_of
@@ -119,9 +128,10 @@ def detect_run_heads(
     for name in names or ["radar"]:
         ds = open_frames(run, None if names is None else name)
         cfg = config if config is not None else radar_config_of(ds, str(run))
+        costs = None if frame_costs is None else frame_costs.setdefault(name, [])
         tables[name] = detect_run(
             run, ds, cfg, progress=functools.partial(_shifted, progress, done) if progress else None,
-            head=None if names is None else name, **kwargs,
+            head=None if names is None else name, frame_costs=costs, **kwargs,
         )  # fmt: skip
         configs[name], done = cfg, done + ds.sizes["time"]
     return merge_head_tables(tables), configs

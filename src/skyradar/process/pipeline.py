@@ -28,6 +28,7 @@ Examples
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from typing import Any, Literal
 
@@ -312,6 +313,7 @@ def process_frames(
     suppression: str = "none",
     frames: slice | None = None,
     anchors: np.ndarray | None = None,
+    frame_costs: list[tuple[int, float, float]] | None = None,
     **detect_kwargs: Any,
 ) -> pd.DataFrame:
     """Detections table of a frames Dataset (see the module docstring for the columns).
@@ -335,6 +337,9 @@ def process_frames(
     frames, anchors : slice and ndarray (n_frames, 6), optional
         Only ``frames`` of ``ds`` (a Dask chunk: frame numbers, own-ship state and clutter
         predictions stay the whole run's); ``anchors`` of a block of a longer run (:func:`clutter_anchors`).
+    frame_costs : list, optional
+        Receives ``(frame, time_s, processing_s)`` per frame: the wall time from the frame's clutter
+        prediction to its located detections (reading the frames from the store is not included).
     """
     config = _checked_config(ds, config, spur_map, source)
     first, stop, _ = (frames or slice(None)).indices(ds.sizes["time"])
@@ -348,12 +353,15 @@ def process_frames(
         check_finite_frames(block, start, source)
         for offset, cube in enumerate(block):
             i = start + offset
+            began = time.perf_counter()
             try:
                 clutter = frame_clutter(suppression, own, i, config, terrain, anchors)
                 out = process_cube(cube, config, spur_map, method, spur_mode, clutter, **detect_kwargs)
             except InputError as exc:  # e.g. CFAR windows that do not fit: say which run
                 raise InputError(f"{source}: {exc}") from None
             rows.append(_located(out, times[i], i, own, origin, config, terrain))
+            if frame_costs is not None:
+                frame_costs.append((i, float(times[i]), time.perf_counter() - began))
         if progress is not None:
             progress(min(start + batch_frames, stop) - first)
     table = pd.DataFrame({c: np.concatenate([r[c] for r in rows]) for c in DETECTION_COLUMNS})

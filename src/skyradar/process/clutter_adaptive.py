@@ -230,8 +230,8 @@ def _adapt(cube, inv_gain, cand, ring_mean, inv_floor, max_nulls, edge, window, 
             for j in range(n_k):
                 a[i, j] *= inv_floor  # in floors
         # a in floors: a null leaves 1e-4 of the noise of its direction
-        if max_nulls == 2:  # warm from the previous candidate's pairs (not the first's identity)
-            top_two_eigenpairs(a, v, lam, edge, 1e-4, 50, scratch, c > 0)
+        if max_nulls == 2:
+            top_two_eigenpairs(a, v, lam, edge, 1e-4, 50, scratch)
         else:
             top_eigenpairs(a, v, lam, edge, 1e-4, 50, scratch)
         m = 0

@@ -178,7 +178,7 @@ def _ritz_two(a, v, w, vu, wu, lam):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def top_two_eigenpairs(
-    a, v, lam, relevant, tol=1e-4, max_iter=50, scratch=None, warm=False
+    a, v, lam, relevant, tol=1e-4, max_iter=50, scratch=None
 ):  # pragma: no cover - compiled
     """:func:`top_eigenpairs` for two pairs (``v`` of shape (n, 2)), its Ritz step in closed form.
 
@@ -188,10 +188,6 @@ def top_two_eigenpairs(
     2 x 2 Hermitian eigenproblem solved by its quadratic instead of Jacobi sweeps (no sweeps, no
     sorting: the larger root comes first). The pairs agree with :func:`top_eigenpairs` to the stopping
     tolerance (a test checks it on random covariances).
-
-    ``warm``: ``v`` and ``lam`` hold the pairs of a nearby matrix (the previous cell's): one shifted
-    power step ``(a - shift) v`` comes first, its shift from those eigenvalues, which saves the
-    Rayleigh-Ritz step and residual test that a start this close almost never passes.
 
     Examples
     --------
@@ -206,15 +202,6 @@ def top_two_eigenpairs(
     trace = 0.0
     for i in range(n):
         trace += a[i, i].real
-    if warm:
-        shift = min(max((trace - lam[0] - lam[1]) / (n - 2), 0.0), 0.5 * max(lam[1], 0.0)) if n > 2 else 0.0
-        for i in range(n):
-            w0, w1 = -shift * v[i, 0], -shift * v[i, 1]
-            for k in range(n):
-                w0 += a[i, k] * v[k, 0]
-                w1 += a[i, k] * v[k, 1]
-            wu[i, 0], wu[i, 1] = w0, w1
-        _orthonormal_into(v, wu)
     for step in range(1, max_iter + 1):
         _ritz_two(a, v, w, vu, wu, lam)
         if _converged(vu, wu, lam, relevant, tol):

@@ -45,7 +45,7 @@ def test_usage_error_is_short_with_exit_2(tmp_path, args, needle):
     assert needle in result.stderr
 
 
-# --- ordinary input that used to crash ---------------------------------------------------------------
+# --- ordinary input that must not crash ---------------------------------------------------------------
 
 
 def _detections(path: Path, n: int, ground: bool) -> Path:
@@ -85,6 +85,8 @@ def test_track_without_air_detections_writes_empty_table(tmp_path, n, ground, mo
         (("bench", "process", "--seconds", "-1"), ["--seconds", "-1"]),
         (("bench", "track", "--frames", "0"), ["--frames", "0"]),
         (("bench", "flight", "--frames", "0"), ["--frames", "0"]),
+        (("bench", "encounter", "--terrain", "marsh"), ["--terrain", "marsh"]),
+        (("bench", "realtime", "--frame-rate", "inf"), ["--frame-rate", "inf"]),
         (("experiment", "ch4", "--chain", "bogus"), ["--chain", "bogus"]),
         (("experiment", "ch5", "--duration", "-1"), ["--duration", "-1"]),
         (("experiment", "ch5", "--fast-duration", "inf"), ["--fast-duration", "inf"]),
@@ -251,7 +253,7 @@ _OWN = {"type": "straight", "start_ned_m": [0, 0, -500], "heading_deg": 0, "spee
     ("change", "needles"),
     [
         ({"radar": {"range_limit_m": 1}}, ["range_limit_m", "0 range bins"]),
-        ({"duration_s": 1e12}, ["duration_s", "frame_rate_hz", "frames"]),  # used to be a MemoryError
+        ({"duration_s": 1e12}, ["duration_s", "frame_rate_hz", "frames"]),  # refused, not a MemoryError
         ({"ownship": {**_OWN, "speed_mps": 1e9}}, ["ownship", "speed", "Mach 3"]),
         ({"ownship": {**_OWN, "start_ned_m": [0, 0, 1e7]}}, ["ownship", "altitude"]),
     ],

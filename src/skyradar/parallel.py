@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import logging
 import os
-from collections.abc import Callable, Sequence
+import signal
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from typing import Any
 
 from skyradar.errors import InputError
@@ -78,11 +80,36 @@ def connect(scheduler: str | None, workers: int | None, timeout_s: float = 10.0)
     check_workers(workers)
     # A worker logs every failed task with its traceback (ERROR); the client re-raises the error
     # itself (bad input: one line), so our own cluster's workers log only what is critical.
-    cluster = LocalCluster(
-        n_workers=int(workers or 2), threads_per_worker=1, processes=True, dashboard_address=None,
-        silence_logs=logging.CRITICAL,
-    )  # fmt: skip
-    return Client(cluster)
+    # Ctrl-C or SIGTERM while the cluster starts is held until it has started: a cluster interrupted
+    # half way leaves workers starting, and distributed's exit handler fails on them with a traceback.
+    with _interrupts_held() as held:
+        cluster = LocalCluster(
+            n_workers=int(workers or 2), threads_per_worker=1, processes=True, dashboard_address=None,
+            silence_logs=logging.CRITICAL,
+        )  # fmt: skip
+        client = Client(cluster)
+    if held:
+        close(client, owns_cluster=True)
+        raise KeyboardInterrupt
+    return client
+
+
+@contextmanager
+def _interrupts_held() -> Iterator[list[int]]:
+    """Record SIGINT and SIGTERM instead of acting on them for the block; yields the list of those
+    that came. Outside the main thread (where handlers cannot change) nothing is held."""
+    held: list[int] = []
+    previous = {}
+    try:
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            previous[signum] = signal.signal(signum, lambda number, frame: held.append(number))
+    except ValueError:  # not the main thread
+        pass
+    try:
+        yield held
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
 def close(client, owns_cluster: bool) -> None:

@@ -8,10 +8,19 @@ from typing import Annotated
 
 import typer
 
-from skyradar.cli.app import NON_NEGATIVE, JsonOption, check_choice, emit_result, experiment_app, number_in
+from skyradar.cli.app import (
+    NON_NEGATIVE,
+    JsonOption,
+    bench_app,
+    check_choice,
+    emit_measurement,
+    emit_result,
+    experiment_app,
+    number_in,
+)
 from skyradar.io.outputs import OVERWRITE_HELP
 
-__all__ = ["experiment_encounters"]
+__all__ = ["experiment_encounters", "bench_encounter"]
 
 _LAYOUT_CHOICES = {"both": ("single", "three-head"), "single": ("single",), "three-head": ("three-head",)}
 
@@ -90,7 +99,19 @@ def experiment_encounters(
     n: _N = None,
     seed: Annotated[int, typer.Option("--seed", callback=NON_NEGATIVE, help="Random seed.")] = 0,
     workers: Annotated[
-        int | None, typer.Option(min=1, help="Worker processes (default: up to 2, one per core).")
+        int | None,
+        typer.Option(
+            min=1,
+            help="Worker processes of a local Dask cluster, one encounter per task (default: up to 2, one "
+            "per core; 1 runs here, without Dask).",
+        ),
+    ] = None,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(
+            "--scheduler",
+            help="Address of an existing Dask scheduler (tcp://HOST:PORT) to run the encounters on.",
+        ),
     ] = None,
     frame_rate: _FRAME_RATE = 9.4,
     buffer: _BUFFER = 1.5,
@@ -146,6 +167,27 @@ def experiment_encounters(
             out, n_encounters=n, seed=seed, frame_rate_hz=frame_rate, buffer=buffer, workers=workers,
             uncertainty=not no_uncertainty, progress=lambda k: bar.update(task, completed=k),
             terrains=tuple(terrains), layouts=layouts, navigation=navigation, rx_layout=rx_layout,
-            family=family, command="skyradar " + " ".join(sys.argv[1:]),
+            family=family, command="skyradar " + " ".join(sys.argv[1:]), scheduler=scheduler,
         )  # fmt: skip
     emit_result(result, as_json, "encounters")
+
+
+@bench_app.command("encounter")
+def bench_encounter(
+    terrain: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--terrain",
+            help="Terrain to fly the encounter over (repeat; default flat-300, hills, jacksboro).",
+        ),
+    ] = None,
+    as_json: JsonOption = False,
+) -> None:
+    """CPU seconds of one encounter end to end per terrain, with each stage's time, against 9 CPU-s."""
+    from skyradar.benchmarks.encounter import BENCH_TERRAINS, run_encounter_bench
+    from skyradar.experiments.encounter_terrain import TERRAINS
+
+    terrains = tuple(terrain) if terrain else BENCH_TERRAINS
+    for name in terrains:
+        check_choice("--terrain", name, TERRAINS)
+    emit_measurement(run_encounter_bench(terrains), as_json, "bench encounter")

@@ -293,7 +293,7 @@ def experiment_ch4(
     from skyradar.errors import InputError
     from skyradar.experiments.ch4 import run as run_ch4
 
-    # Checked here, before the process pool: a worker's error would come back as a long traceback.
+    # Checked here, before the cluster starts: a worker's error would come back as a long traceback.
     if chain not in ("full", "geometry"):
         raise InputError(f"--chain: must be 'full' or 'geometry', got {chain!r}")
     from skyradar.io.outputs import check_output, mark_folder

@@ -32,7 +32,6 @@ per-scenario detection and track tables, and three figures.
 from __future__ import annotations
 
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -42,7 +41,7 @@ from skyradar.config import RadarConfig
 from skyradar.experiments.ch4_flights import EPBC, SCENARIOS, Traffic, build_traffic
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
-from skyradar.parallel import check_workers
+from skyradar.parallel import check_workers, close, connect
 from skyradar.track.detectable import detection_threshold_snr_db
 from skyradar.track.io import Truth
 from skyradar.track.metrics import track_metrics, truth_segments
@@ -269,14 +268,15 @@ def run(
     out_dir: Path, chain: str = "full", frame_rate_hz: float = 9.4, interval_s: float = 15.0,
     tail_s: float = 45.0, workers: int = 2, scenarios: tuple[str, ...] = SCENARIOS, seed: int = 0,
 ) -> dict:  # fmt: skip
-    """Run all scenarios (in ``workers`` processes), write tables and figures, return the summary.
+    """Run all scenarios (on a local Dask cluster of ``workers`` processes), write tables and figures,
+    return the summary.
 
     ``seed`` seeds the simulator's noise (full chain) or the synthetic detections (geometry chain).
     """
     from skyradar.errors import InputError
     from skyradar.experiments.ch4_figures import draw_figures
 
-    # Checked before the process pool: a worker's error comes back as a long traceback.
+    # Checked before the cluster starts: a worker's error comes back as a long traceback.
     if chain not in ("full", "geometry"):
         raise InputError(f"experiment ch4: chain must be 'full' or 'geometry', got {chain!r}")
     unknown = [name for name in scenarios if name not in SCENARIOS]
@@ -286,14 +286,17 @@ def run(
         raise InputError(
             f"experiment ch4: need frame_rate_hz > 0 and workers >= 1, got {frame_rate_hz}, {workers}"
         )
-    check_workers(workers)  # a fork pool of 10**20 processes exhausted memory
+    check_workers(workers)  # 10**20 local worker processes would exhaust memory
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
     jobs = [(name, chain, frame_rate_hz, interval_s, tail_s, 1.0, seed) for name in scenarios]
-    if workers > 1 and len(jobs) > 1:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
-            results = list(pool.map(_run_one, jobs))
+    if workers > 1 and len(jobs) > 1:  # one Dask task per scenario on a local cluster
+        client = connect(None, min(workers, len(jobs)))
+        try:
+            results = client.gather(client.map(_run_one, jobs, pure=False))
+        finally:
+            close(client, owns_cluster=True)
     else:
         results = [_run_one(j) for j in jobs]
     per_scenario = {}

@@ -20,9 +20,7 @@ import json
 import os
 import time
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import replace
-from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
@@ -36,7 +34,7 @@ from skyradar.experiments.encounter_report import write_report
 from skyradar.experiments.encounter_set import make_encounters, make_fast_closures
 from skyradar.experiments.encounter_terrain import TERRAINS
 from skyradar.io.tables import write_json_atomic, write_table
-from skyradar.parallel import check_workers
+from skyradar.parallel import check_workers, close, connect
 from skyradar.rx_layouts import check_rx_layout
 
 __all__ = [
@@ -58,14 +56,6 @@ DEFAULT_TERRAIN_ENCOUNTERS = 3
 FAMILIES = ("synthetic", "real-flights", "fast-closures")
 EVALUATION_SEEDS_FROM = 7000  # seeds from here on are held out: report on them, never tune on them
 _PARTIAL = "encounters.partial.parquet"
-_CHUNK = 1  # encounters per worker task (each writes the partial table once): over terrain one costs
-# minutes, so an interrupted run loses at most the encounters in flight
-
-
-def _init_worker() -> None:
-    import numba
-
-    numba.set_num_threads(1)
 
 
 def _run_rows(tasks: list[tuple[str, int, dict]], kw: dict) -> list[tuple[str, int, list[dict]]]:
@@ -79,6 +69,14 @@ def _run_rows(tasks: list[tuple[str, int, dict]], kw: dict) -> list[tuple[str, i
     ]
 
 
+def _dask_rows(tasks: list[tuple[str, int, dict]], kw: dict) -> list[tuple[str, int, list[dict]]]:
+    """:func:`_run_rows` in a Dask worker: one numba thread (the workers already fill the cores)."""
+    import numba
+
+    numba.set_num_threads(1)
+    return _run_rows(tasks, kw)
+
+
 def run_encounters(
     params: pd.DataFrame,
     seed: int = 0,
@@ -88,14 +86,22 @@ def run_encounters(
     on_chunk: Callable[[dict], None] | None = None,
     terrains: tuple[str, ...] = ("none",),
     family: str = "synthetic",
+    scheduler: str | None = None,
     **options: Any,
 ) -> pd.DataFrame:
-    """All encounters (rows of ``params``) over every terrain, ``workers`` processes.
+    """All encounters (rows of ``params``) over every terrain: here, or one Dask task per encounter.
+
+    With ``scheduler`` (a Dask scheduler's address) the encounters run on that cluster; else with
+    ``workers`` > 1 (default: up to 2, one per core) on a local Dask cluster of that many worker
+    processes; with ``workers=1`` in this process. The rows do not depend on where they ran (each
+    encounter's seed is ``seed`` plus its index).
 
     Returns one row per terrain, encounter and layout (columns ``terrain``, ``encounter``,
     ``layout``, the encounter's parameters and its result). ``progress`` is called with the number
     of encounters finished; ``done`` holds result rows already computed ({(terrain, i): rows},
-    skipped here) and ``on_chunk`` receives all rows so far after each chunk. Options go to
+    skipped here) and ``on_chunk`` receives all rows so far after each encounter. Interrupted
+    (Ctrl-C, SIGTERM), the encounters in flight are cancelled and a local cluster is shut down; what
+    finished has reached ``on_chunk``. Options go to
     :func:`~skyradar.experiments.encounter_chain.run_encounter` (``family="real-flights"``:
     :func:`~skyradar.experiments.encounter_real.run_real_encounter`).
     """
@@ -103,8 +109,6 @@ def run_encounters(
     results: dict[tuple[str, int], list[dict]] = dict(done or {})
     records = params.to_dict("records")
     todo = [(tr, i, p) for tr in terrains for i, p in enumerate(records) if (tr, i) not in results]
-    size = max(1, min(_CHUNK, len(todo) // (2 * workers)))  # small runs: every worker gets some
-    chunks = [todo[k : k + size] for k in range(0, len(todo), size)]
     kw = {"seed": seed, "options": options, "family": family}
 
     def finished(rows: list[tuple[str, int, list[dict]]]) -> None:
@@ -114,31 +118,24 @@ def run_encounters(
         if progress:
             progress(len(results))
 
-    if workers <= 1:
-        for c in chunks:
-            finished(_run_rows(c, kw))
-    elif chunks:
-        ctx = get_context("spawn")  # numba's thread pools do not survive fork
-        pool = ProcessPoolExecutor(workers, mp_context=ctx, initializer=_init_worker)
+    if scheduler is None and workers <= 1:
+        for task in todo:
+            finished(_run_rows([task], kw))
+    elif todo:
+        from distributed import as_completed
+
+        client = connect(scheduler, workers)  # an interrupt while it starts: it is closed, then raised
+        futures = []
         try:
-            futures = [pool.submit(_run_rows, c, kw) for c in chunks]
-            for fut in as_completed(futures):
-                finished(fut.result())
-        except BaseException:  # Ctrl-C: stop now; what finished is saved by on_chunk
-            _stop(pool)
+            futures = [client.submit(_dask_rows, [task], kw, pure=False) for task in todo]
+            for future in as_completed(futures):
+                finished(future.result())
+        except BaseException:  # Ctrl-C or SIGTERM: stop now; what finished is saved by on_chunk
+            client.cancel(futures)
             raise
-        pool.shutdown()
+        finally:
+            close(client, owns_cluster=scheduler is None)
     return _long_table(params, results, terrains)
-
-
-def _stop(pool: ProcessPoolExecutor) -> None:
-    """Cancel queued chunks and end the running workers (they ignore SIGINT and run for minutes)."""
-    procs = list((getattr(pool, "_processes", None) or {}).values())
-    pool.shutdown(wait=False, cancel_futures=True)
-    for proc in procs:
-        proc.terminate()
-    for proc in procs:
-        proc.join(timeout=5)
 
 
 def _long_table(params: pd.DataFrame, results: dict, terrains) -> pd.DataFrame:
@@ -192,6 +189,7 @@ def run(
     rx_layout: str = "square",
     family: str = "synthetic",
     command: str | None = None,
+    scheduler: str | None = None,
 ) -> dict:
     """Run the encounter set; write ``encounters.parquet``/``.csv`` (one row per terrain, encounter
     and layout), ``summary.json``, ``summary_rows.csv`` and the figures into ``out_dir``; return the
@@ -212,7 +210,8 @@ def run(
     UTC date and the load average, and its ``split``: seeds from :data:`EVALUATION_SEEDS_FROM` are
     the evaluation split, never looked at while tuning; smaller ones are for development.
     Finished encounters are kept in ``encounters.partial.parquet`` while the run goes on; a run that
-    was interrupted resumes from them when started again with the same settings.
+    was interrupted resumes from them when started again with the same settings. ``scheduler`` and
+    ``workers``: where the encounters run (:func:`run_encounters`).
     """
     terrains, layouts = tuple(terrains), tuple(x for x in LAYOUTS if x in layouts)
     _check(n_encounters, terrains, tuple(layouts) or ("",))
@@ -240,14 +239,17 @@ def run(
                 "split": "evaluation" if seed >= EVALUATION_SEEDS_FROM else "development"}  # fmt: skip
     version = code_version()
     done, save = _partial_store(out_dir, {**settings, "version": version})
-    res = run_encounters(enc, seed, workers, progress, done, save, terrains=terrains, family=family,
-                         layouts=layouts, frame_rate_hz=frame_rate_hz, buffer=buffer, alert_config=cfg,
-                         navigation=navigation, simulation=simulation, rx_layout=rx_layout)  # fmt: skip
+    res = run_encounters(
+        enc, seed, workers, progress, done, save, terrains=terrains, family=family, scheduler=scheduler,
+        layouts=layouts, frame_rate_hz=frame_rate_hz, buffer=buffer, alert_config=cfg, navigation=navigation,
+        simulation=simulation, rx_layout=rx_layout,
+    )  # fmt: skip
     summary = write_report(res, out_dir, settings, late_lead_s, cfg.levels[-1].alerting_time_s)
     workers = check_workers(workers) or min(2, os.cpu_count() or 1)
     summary.update(
         resumed_encounters=len(done),
-        workers=workers,
+        workers=workers if scheduler is None else None,
+        scheduler=scheduler,
         runtime_s=round(time.perf_counter() - t0, 1),
         version=version,
         command=command,

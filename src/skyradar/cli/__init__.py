@@ -1,7 +1,8 @@
 """Command-line interface: ``skyradar COMMAND --help``.
 
 Each command module registers its commands on the shared Typer apps in :mod:`skyradar.cli.app`;
-this module imports them and turns bad input into one line on stderr with exit code 2.
+this module imports them, runs the command with its outputs locked (one writer per output) and turns
+bad input into one line on stderr with exit code 2.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ import skyradar.cli.commands_traffic  # noqa: F401  (registers commands)
 from skyradar.cli import commands_sim  # noqa: F401  (registers commands)
 from skyradar.cli.app import app
 from skyradar.errors import InputError
+from skyradar.io.locks import command_outputs
 
 __all__ = ["app", "main"]
 
@@ -77,7 +79,10 @@ def main() -> None:
     """Entry point of the ``skyradar`` script."""
     signal.signal(signal.SIGTERM, _interrupt)
     try:
-        code = app(standalone_mode=False)
+        # Every output a command checks (skyradar.io.outputs.check_output, before any work) stays
+        # locked until the command returns, after its output is renamed into place.
+        with command_outputs():
+            code = app(standalone_mode=False)
     except InputError as exc:
         # One line even when a wrapped library message spans several (pandas' CSV parser errors do).
         message = " ".join(part.strip() for part in str(exc).splitlines() if part.strip())

@@ -8,7 +8,9 @@ Rules (one :class:`~skyradar.errors.InputError` line naming the option, the path
 - ``NAME.partial`` (a run being written) is never an output;
 - an existing path is replaced only when this tool wrote it (a frames store carries the attribute
   ``skyradar_format``, a Parquet table the metadata key ``skyradar_format``, an output folder the
-  marker file :data:`FOLDER_MARKER`) or with ``--overwrite``; other existing paths are refused.
+  marker file :data:`FOLDER_MARKER`) or with ``--overwrite``; other existing paths are refused;
+- one writer per output: inside a command (:func:`skyradar.io.locks.command_outputs`) a checked
+  output is locked until the command ends, so a second command writing it is refused at once.
 
 Replacement happens at the very end (:func:`replace_path`: old aside, new in, old deleted), so an
 interrupted run never loses the old output.
@@ -24,6 +26,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from skyradar.errors import InputError
+from skyradar.io.locks import hold_output
 
 __all__ = [
     "FOLDER_MARKER",
@@ -149,6 +152,11 @@ def check_output(
     option : str
         The option named in the error (``--output``, ``--out``).
 
+    Inside a command (:func:`skyradar.io.locks.command_outputs`) the output is locked from here until
+    the command ends; the checks that do not depend on what is at ``path`` come first, those of an
+    existing path after the lock (a second writer learns that another command writes it, not what
+    that command's half-written output looks like).
+
     Examples
     --------
     >>> import tempfile
@@ -175,6 +183,7 @@ def check_output(
     out = _resolved(path)
     _check_not_input(out, inputs, label)
     _check_not_precious(out, label, kind)
+    hold_output(path, option)
     if path.exists() or path.is_symlink():
         _check_replaceable(path, label, kind, overwrite)
     return path

@@ -86,6 +86,16 @@ def test_dem_with_too_many_voids(tmp_path):
     )
 
 
+def test_dem_without_finite_heights(tmp_path):
+    elevation = np.full((101, 101), np.nan)
+    np.savez(tmp_path / "dem.npz", elevation=elevation, dx=1 / 1200, dy=1 / 1200, xmin=4.3, ymax=52.05)
+    scenario = _write(tmp_path, {**BASE, "terrain": {"type": "file", "path": "dem.npz"}})
+    _assert_one_line_error(
+        _skyradar("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path),
+        "dem.npz", "field 'elevation'", "no finite heights",
+    )  # fmt: skip
+
+
 def test_wrong_hgt_size(tmp_path):
     (tmp_path / "N52E004.hgt").write_bytes(b"\x00" * 100)
     scenario = _write(tmp_path, {**BASE, "terrain": {"type": "file", "path": "N52E004.hgt"}})

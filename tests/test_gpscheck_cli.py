@@ -101,6 +101,18 @@ def test_map_not_covering_the_footprint_is_one_line(tmp_path):
     assert_one_line_error(result, "small.tif", "does not cover the radar footprint")
 
 
+def test_map_without_finite_values_is_one_line(tmp_path):
+    # An all-NaN map would leave every frame "no decision: too little structure"; the map is named.
+    from skyradar.sim.land_cover_scene import ch6_radar_config
+
+    grid = GroundGrid.from_extent(-1500.0, 1500.0, -1500.0, 1500.0, pixel_m=10.0)
+    _write_tif(tmp_path / "empty.tif", grid, np.full(grid.shape, np.nan, np.float32))
+    run = _empty_run(tmp_path / "side.zarr", ch6_radar_config())
+    result = skyradar("gpscheck", str(run), "--map", "empty.tif", "-o", "check.parquet", cwd=tmp_path)
+    assert_one_line_error(result, "empty.tif", "field 'band 1'", "no finite heights")
+    assert not (tmp_path / "check.parquet").exists()
+
+
 @pytest.fixture(scope="module")
 def town_run(tmp_path_factory):
     from skyradar.sim.geometry import PlatformState

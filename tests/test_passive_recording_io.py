@@ -102,6 +102,35 @@ def test_truncated_data_is_one_line(tmp_path):
         read_iq_recording(meta)
 
 
+def test_cf32_data_declared_ci16_is_one_line(tmp_path):
+    # Float32 samples read as int16 pairs are bit patterns, not a signal: named as such, not as
+    # "no direct-path pulse" after the whole recording is processed.
+    meta, x = _recording(tmp_path)
+    _edit_meta(meta, lambda d: d["global"].update({"core:datatype": "ci16_le"}))
+    result = skyradar("passive", meta.name, "-o", "det.parquet", cwd=tmp_path)
+    needles = ["rec.sigmf-data", "does not look like the declared datatype 'ci16_le'", "'core:datatype'"]
+    assert_one_line_error(result, *needles, "rec.sigmf-meta")
+    assert not (tmp_path / "det.parquet").exists()
+    side = {"sample_rate_hz": 5e6, "center_frequency_hz": 2.8e9, "receiver": RX, "illuminator": TX}
+    write_raw_iq(tmp_path / "raw.cf32", x, side).rename(tmp_path / "raw.ci16")  # sidecar raw.json kept
+    result = skyradar("passive", "raw.ci16", "-o", "det.parquet", cwd=tmp_path)
+    assert_one_line_error(result, "raw.ci16", "does not look like the declared datatype 'ci16_le'", "'.ci16'")
+
+
+@pytest.mark.parametrize("level", [3e-4, 0.01, 0.25, 0.6])
+def test_ci16_data_of_any_level_reads(tmp_path, level):
+    # Noise from a few codes to clipping, and the tone with the most float32-like codes (0.65 of full
+    # scale: 70 % of its samples): never taken for float32 data.
+    rng = np.random.default_rng(2)
+    n = 1 << 15
+    noise = level * (rng.standard_normal(n) + 1j * rng.standard_normal(n))
+    tone = 0.65 * np.exp(2j * np.pi * 0.0123 * np.arange(n))
+    side = {"sample_rate_hz": 5e6, "center_frequency_hz": 2.8e9, "receiver": RX, "illuminator": TX}
+    for name, x in (("noise", noise), ("tone", tone)):
+        rec = read_iq_recording(write_raw_iq(tmp_path / f"{name}.ci16", x, side, "ci16_le"))
+        assert rec.n_samples == n
+
+
 def test_raw_without_sidecar_or_illuminator(tmp_path):
     (tmp_path / "x.cf32").write_bytes(np.zeros(8, np.complex64).tobytes())
     with pytest.raises(InputError, match="no sidecar"):
@@ -131,7 +160,7 @@ def test_simulate_passive_cli_writes_a_readable_recording_and_refuses_bad_input(
 
 
 def test_passive_refuses_unreadable_recordings_in_one_line(tmp_path):
-    """Issue 15's bad inputs that belong to reading, through the real `skyradar passive` entry point."""
+    """Bad inputs that belong to reading, through the real `skyradar passive` entry point."""
     cases = {
         "cu8": lambda d: d["global"].update({"core:datatype": "cu8"}),
         "short": None,

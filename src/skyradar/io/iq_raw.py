@@ -55,6 +55,7 @@ def read_raw_iq(data_path: str | Path, require_illuminator: bool = True) -> IqRe
         "illuminator": illum,
         "illuminator_geodetic": illum_pos,
         "receiver": receiver,
+        "datatype_declared_by": f"the file suffix {data_path.suffix!r}",
     }
     return IqRecording(sidecar, data_path, RAW_SUFFIXES[data_path.suffix.lower()], 0, fields)
 

@@ -89,6 +89,9 @@ class IqRecording:
                 f"{int(expected)} its metadata ({self.path.name}) says"
             )
         self._dtype, self._offset, self._sample_bytes = dtype, offset_bytes, sample_bytes
+        if datatype == "ci16_le":
+            declared = info.get("datatype_declared_by") or f"field 'core:datatype' of {self.path.name}"
+            _check_not_float32(self.data_path, offset_bytes, self.n_samples, declared)
         stem = self.path.name.removesuffix(".sigmf-meta")
         stem = stem.rsplit(".", 1)[0] if stem == self.path.name else stem
         truth = self.path.with_name(stem + ".truth.parquet")
@@ -130,6 +133,42 @@ class IqRecording:
         return (
             f"IqRecording({self.path.name}, {self.datatype}, {self.n_samples} samples at "
             f"{self.sample_rate_hz / 1e6:g} MS/s, {self.duration_s:.3f} s)"
+        )
+
+
+# A float32 whose biased exponent lies here is 2^-64 .. 2^40 in magnitude (5e-20 .. 1e12): any sample
+# value a receiver writes as cf32. Read as ci16, such a word is one whose Q code (the top bits, where
+# the exponent is) lies in 8064 .. 21503 or -24704 .. -11265. Real int16 data has small codes too:
+# noise puts at most 40 % of its samples there (clipped at full scale), a tone at most 70 % (at 0.65
+# of full scale), cf32 data all but its zeros.
+_FLOAT32_EXPONENTS = (127 - 64, 127 + 40)
+_LIKE_FLOAT32 = 0.95  # share of non-zero samples in that band above which ci16 data is cf32
+_PROBE_SAMPLES = 1 << 16  # read at the start and in the middle of the data
+
+
+def _check_not_float32(data_path: Path, offset_bytes: int, n_samples: int, declared: str) -> None:
+    """Refuse ci16 data whose 4-byte samples are float32 values (cf32 data declared ci16).
+
+    Cf32 data read as ci16 is twice as many samples of bit patterns, not a signal; the processor
+    would only report that it finds no pulse. :class:`InputError` names the file and where the
+    datatype is declared (``declared``).
+    """
+    words = []
+    with open(data_path, "rb") as f:
+        for start in sorted({0, max(n_samples // 2 - _PROBE_SAMPLES // 2, 0)}):
+            f.seek(offset_bytes + 4 * start)
+            words.append(np.fromfile(f, dtype="<u4", count=min(_PROBE_SAMPLES, n_samples - start)))
+    word = np.concatenate(words)
+    word = word[(word & 0x7FFFFFFF) != 0]  # zero samples (I = Q = 0, or +-0.0) say nothing
+    if word.size < 256:
+        return
+    exponent = (word >> 23) & 0xFF
+    share = float(np.mean((exponent >= _FLOAT32_EXPONENTS[0]) & (exponent <= _FLOAT32_EXPONENTS[1])))
+    if share >= _LIKE_FLOAT32:
+        raise InputError(
+            f"{data_path}: the data does not look like the declared datatype 'ci16_le' ({declared}): "
+            f"{share:.0%} of its non-zero 4-byte samples are float32 values between 5e-20 and 1e12, as "
+            "in cf32_le data; declare 'cf32_le' if it is"
         )
 
 

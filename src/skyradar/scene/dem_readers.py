@@ -68,7 +68,14 @@ def fill_voids(
     fraction = float(voids.mean())
     if fraction == 0.0:
         return z
-    if fraction > max_void_fraction or voids.all():
+    if voids.all():  # nothing to fill from: say so, not a void fraction
+        first = z.flat[0]
+        shown = "" if np.isnan(first) else f", first {first:.6g}"
+        raise InputError(
+            f"{source}: field 'elevation' holds no finite heights (every sample read is NaN, no-data or "
+            f"outside the land surface{shown}); give a DEM with data"
+        )
+    if fraction > max_void_fraction:
         why = ""
         if undeclared is not None and undeclared.any():
             why = (

@@ -76,7 +76,8 @@ def read_map_raster(
     Raises
     ------
     InputError
-        One line naming the file: missing, unreadable, no georeference, or no such band.
+        One line naming the file: missing, unreadable, no georeference, no such band, or a band
+        without one finite value.
     """
     path = Path(path)
     rasterio = import_extra("rasterio", "geo", f"reading {path}")
@@ -110,4 +111,20 @@ def read_map_raster(
             dst_nodata=np.nan,
             resampling=warp.Resampling.bilinear,
         )
+        if not np.isfinite(image).any() and not _has_finite_value(src, band):
+            # Every pixel NaN or no-data: nothing to compare (each frame would be "too little structure").
+            raise InputError(
+                f"{path}: field 'band {band}' holds no finite heights or values (every pixel is NaN, "
+                "infinite or no-data); give a map with data"
+            )
     return MapRaster(image, grid, float(origin_lat_deg), float(origin_lon_deg), str(path))
+
+
+def _has_finite_value(src: rasterio.DatasetReader, band: int) -> bool:
+    """True when ``band`` holds a finite value that is not the no-data value; read block by block."""
+    for _, window in src.block_windows(band):
+        block = src.read(band, window=window, masked=True)
+        values = block.compressed() if np.ma.isMaskedArray(block) else np.ravel(block)
+        if np.isfinite(values).any():
+            return True
+    return False

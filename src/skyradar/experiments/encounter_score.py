@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from skyradar.experiments.encounter_set import summarise
+from skyradar.experiments.encounter_set import rate_interval, summarise
 from skyradar.units import wrap_angle
 
 __all__ = ["CAUSES", "frame_status", "conflict_cause", "unwarned_cause", "track_counts", "summarise_layout"]
@@ -177,6 +177,7 @@ def summarise_layout(res: pd.DataFrame, late_lead_s: float) -> dict[str, Any]:
         warnings_not_held=int((warned & ~held).sum()),
         warned_before_lowc=int(in_time.sum()),
         warned_before_lowc_fraction=float(in_time.sum() / max(int(conflict.sum()), 1)),
+        warned_before_lowc_fraction_ci95=rate_interval(int(in_time.sum()), int(conflict.sum())),
         unwarned_by_cause={c: int((unwarned == c).sum()) for c in CAUSES},
         flight_minutes=round(minutes, 2),
         clutter_tracks=int(res["clutter_tracks"].sum()),

@@ -28,6 +28,7 @@ from skyradar.daa.conflict import WellClearVolume
 from skyradar.io.atomic import savefig_atomic
 
 __all__ = [
+    "rate_interval",
     "OWN_SPEED_MPS",
     "OWN_ALTITUDE_M",
     "T_CPA_S",
@@ -282,8 +283,32 @@ def score_encounter(
     }
 
 
+def rate_interval(count: int, trials: int) -> list[float]:
+    """95 % Wilson score interval ``[low, high]`` of a rate ``count / trials`` (NaN without trials).
+
+    A rate from a few dozen encounters is a wide range, not a number: one false warning in 34
+    must-not-alert encounters is anywhere from 0.5 % to 15 %. The Wilson interval (scipy's
+    ``binomtest(...).proportion_ci(method="wilson")``) keeps its coverage near 95 % down to counts of
+    0 and ``trials``, where the normal approximation collapses to a point.
+
+    Examples
+    --------
+    >>> [round(x, 3) for x in rate_interval(1, 34)]
+    [0.005, 0.149]
+    >>> [round(x, 3) for x in rate_interval(0, 34)]
+    [0.0, 0.102]
+    """
+    if trials <= 0:
+        return [float("nan"), float("nan")]
+    from scipy.stats import binomtest
+
+    ci = binomtest(int(count), int(trials)).proportion_ci(confidence_level=0.95, method="wilson")
+    return [float(ci.low), float(ci.high)]
+
+
 def summarise(res: pd.DataFrame, late_lead_s: float) -> dict[str, Any]:
-    """Counts and rates of the encounter table (see ``skyradar experiment encounters --help``)."""
+    """Counts and rates of the encounter table (see ``skyradar experiment encounters --help``);
+    each rate with its 95 % interval (:func:`rate_interval`, key ``RATE_ci95``)."""
     lead = res["t_lowc_s"] - res["t_warning_s"]
     in_time = res["t_warning_s"] < res["t_lowc_s"]
     obs, conflict = res["observable"], res["conflict"]
@@ -303,6 +328,9 @@ def summarise(res: pd.DataFrame, late_lead_s: float) -> dict[str, Any]:
         "must_not_alert_encounters": int(must_not.sum()),
         "false_warnings": int((must_not & warned).sum()),
         "false_warning_rate": float((must_not & warned).sum() / max(int(must_not.sum()), 1)),
+        "false_warning_rate_ci95": rate_interval(int((must_not & warned).sum()), int(must_not.sum())),
+        "missed_warning_rate": float((obs & ~in_time).sum() / max(int(obs.sum()), 1)),
+        "missed_warning_rate_ci95": rate_interval(int((obs & ~in_time).sum()), int(obs.sum())),
         "median_warning_lead_s": float(np.median(lead[good])) if good.any() else float("nan"),
     }
 

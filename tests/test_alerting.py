@@ -253,12 +253,11 @@ def test_m_of_n_over_periods_counts_seconds_not_frames():
 
 
 def test_velocity_gate_bounds_the_miss_error_not_the_velocity_error():
-    # Hills encounter 15 of the 200-encounter set: a head-on intruder first detected over clutter
-    # 1.7 km away (114 m/s closing), its cross-range velocity known to 10-20 m/s for seconds after
-    # suppression's scattered directions. The plain 6 m/s gate kept it silent through its loss of
-    # well clear. At 8 s to CPA a 12 m/s error moves the predicted miss by ~100 m, less than 6 m/s
-    # does at the warning's 25 s: the gate is on that product. A far track with the same error stays
-    # silent.
+    # Over hills, a head-on intruder first detected over clutter 1.7 km away (114 m/s closing), its
+    # cross-range velocity known to 10-20 m/s for seconds after suppression's scattered directions. A
+    # plain 6 m/s gate keeps it silent through its loss of well clear. At 8 s to CPA a 12 m/s error
+    # moves the predicted miss by ~100 m, less than 6 m/s does at the warning's 25 s: the gate is on
+    # that product. A far track with the same error stays silent.
     cfg = AlertConfig(max_velocity_sigma_mps=6.0, min_track_age_s=0.0)
     ungated = AlertConfig(min_track_age_s=0.0)
     cov = {f"cov_vv_{i}{j}": (12.0**2 / 2 if i == j and i < 2 else 0.0) for i in range(3) for j in range(3)}

@@ -52,7 +52,7 @@ def test_two_files_give_exactly_the_interpolated_gains(tmp_path):
     np.testing.assert_allclose(l1.gain_db(az, 0.0), [-21.0, 2.0, 6.5, 11.0, 8.0, 5.0, -6.0], atol=1e-12)
     el = np.radians([-90.0, -45.0, 10.0, 20.0, 55.0, 90.0])
     np.testing.assert_allclose(l1.gain_db(0.0, el), [-19.0, -4.0, 7.5, 4.0, -10.5, -25.0], atol=1e-12)
-    # Off the planes: L1 adds the dB losses, L2 takes their norm (seed brief ch2).
+    # Off the planes: L1 adds the dB losses (the thesis' choice), L2 takes their norm.
     loss_az, loss_el = 11.0 - 5.0, 11.0 - 4.0  # az 30 deg, el 20 deg
     assert float(l1.gain_db(np.radians(30.0), np.radians(20.0))) == pytest.approx(11.0 - loss_az - loss_el)
     assert float(l2.gain_db(np.radians(30.0), np.radians(20.0))) == pytest.approx(

@@ -39,7 +39,7 @@ def test_crashed_table_write_leaves_target_and_no_temporary(tmp_path, monkeypatc
     with pytest.raises(OSError, match="disk full"):
         write_table(pd.DataFrame({"a": [9]}), target)
     monkeypatch.undo()
-    assert [p.name for p in tmp_path.iterdir()] == ["t.parquet"]  # the old code left t.parquet.tmp
+    assert [p.name for p in tmp_path.iterdir()] == ["t.parquet"]  # no t.parquet.tmp left behind
     assert read_table(target)["a"].tolist() == [1, 2]
 
 
@@ -92,7 +92,7 @@ def test_crashed_figure_leaves_no_temporary(tmp_path, monkeypatch):
     with pytest.raises(OSError, match="disk full"):
         save_frame_figure(frame, cfg, target)
     monkeypatch.undo()
-    assert [p.name for p in tmp_path.iterdir()] == ["f.png"]  # the old code left f.tmp.png
+    assert [p.name for p in tmp_path.iterdir()] == ["f.png"]  # no f.tmp.png left behind
     assert target.read_bytes() == b"old figure"
     save_frame_figure(frame, cfg, target)
     assert target.read_bytes()[:4] == b"\x89PNG"

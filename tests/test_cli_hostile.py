@@ -1,5 +1,5 @@
-"""Hostile inputs a reviewer tried against the integrated CLI: each once failed (traceback, two-line
-error, fork bomb, silently wrong answer) and now ends in one line naming file/option, field and value.
+"""Hostile inputs against the integrated CLI: each ends in one line naming file/option, field and value,
+never in a traceback, a two-line error, a fork bomb or a silently wrong answer.
 
 Every case runs through the real entry point (``python -m skyradar``). One tiny simulated run is
 shared by the module (a few seconds); tracks tables are made from its truth in-process.
@@ -99,7 +99,7 @@ def test_alert_refuses_corrupt_track_values(tiny_run, name, change, needles):
 
 
 def test_alert_counts_rows_without_velocity(tiny_run):
-    # NaN velocity means "no direction of arrival": skipped, but no longer silently.
+    # NaN velocity means "no direction of arrival": skipped, and the skip is reported.
     name = _tracks_variant(tiny_run, "nan_v.parquet", _set("vn_mps", np.nan, slice(None)))
     result = _skyradar(
         "alert", name, "--ownship", "run.zarr", "-o", "alerts_nan_v.parquet", "--json", cwd=tiny_run

@@ -1,4 +1,4 @@
-"""The cheap clutter prediction (issue 12): packed sums, compiled Jacobi, lazy cells, fewer predictions.
+"""The cheap clutter prediction: packed sums, compiled Jacobi, lazy cells, fewer predictions.
 
 Checked against the straightforward computation (every tap's outer product summed with numpy,
 ``numpy.linalg.eigh``), and for the reuse of a prediction under navigation noise and in a turn.
@@ -137,7 +137,7 @@ def _predictions(own: dict, monkeypatch) -> list:
 
 
 def test_navigation_noise_and_a_banked_turn_do_not_force_new_predictions(monkeypatch):
-    # GNSS velocity noise (0.2 m/s white per frame) used to cross the 0.35 m/s reuse tolerance on
+    # GNSS velocity noise (0.2 m/s white per frame) alone crosses the 0.35 m/s reuse tolerance on
     # many frames; the 5-frame mean keeps 100 frames on one or two predictions, in level flight and
     # in a steady 35 deg banked turn (the velocity in the heading-free frame is constant there).
     assert len(_predictions(_turning_own(100, 0.0, 0.2), monkeypatch)) <= 2

@@ -1,4 +1,4 @@
-"""Knowledge-aided clutter suppression (issue 12 point 2): prediction, calibration, detection, bad input."""
+"""Knowledge-aided clutter suppression: prediction, calibration, detection, bad input."""
 
 from __future__ import annotations
 
@@ -175,11 +175,11 @@ def test_experiment_clutter_writes_figures_table_and_json(tmp_path):
 
 
 def test_intruder_mixed_with_sidelobe_clutter_keeps_its_detections_and_elevation():
-    # Flat ground 300 m below (the geometry of the 200-set's encounter 15): a head-on intruder 46 m
-    # below, 14 deg left, closing at 116 m/s (aliased into the ground band), its cell shared with
-    # the ground 40-60 deg either side. The plain direction of the mixture is pulled a few degrees
-    # towards the ground, not onto it: it keeps it, with its measured elevation, and is not ground
-    # (one pulled onto the ground is searched through the nulls: plain_wave_is_mixed's example).
+    # Flat ground 300 m below: a head-on intruder 46 m below, 14 deg left, closing at 116 m/s (aliased
+    # into the ground band), its cell shared with the ground 40-60 deg either side. The plain direction
+    # of the mixture is pulled a few degrees towards the ground, not onto it: it keeps it, with its
+    # measured elevation, and is not ground (one pulled onto the ground is searched through the nulls:
+    # plain_wave_is_mixed's example).
     height, bearing = 300.0, np.radians(-14.0)
     own = PlatformState(np.array([0.0, 0.0, -height]), np.array([SPEED_MPS, 0.0, 0.0]), np.zeros(3))
     rel = 1500.0 * np.array([np.cos(bearing), np.sin(bearing), 0.0]) + np.array([0.0, 0.0, 46.0])

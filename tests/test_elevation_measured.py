@@ -1,5 +1,5 @@
 """An elevation clutter suppression left unobservable is carried as ``elevation_measured`` False, not
-guessed from the value 0 (issue 12): the ground filter and the track-level ground test do not count it as
+guessed from the value 0: the ground filter and the track-level ground test do not count it as
 a measured direction (tests/test_ground_tracks.py); clutter_doa.projected_directions' doctest shows the
 flag itself."""
 

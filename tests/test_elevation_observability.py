@@ -1,6 +1,6 @@
-"""The elevation of a detection after clutter suppression (issue 12): measured when its Cramer-Rao bound
-through the cell's projector or whitening allows, a co-altitude prior otherwise, and a track with no
-measured elevation flies at that prior and says so."""
+"""The elevation of a detection after clutter suppression: measured when its Cramer-Rao bound through
+the cell's projector or whitening allows, a co-altitude prior otherwise, and a track with no measured
+elevation flies at that prior and says so."""
 
 from __future__ import annotations
 
@@ -74,7 +74,7 @@ def test_two_nulls_at_one_elevation_leave_no_elevation_and_finite_clutter_some()
 def test_with_no_elevation_the_azimuth_keeps_the_measured_cone(az, el, el_null, az_null):
     # Two nulls at one elevation leave the score a function of the horizontal direction cosine only:
     # the prior's azimuth is the point of that cone at elevation 0 (closed form), wherever on the cone
-    # the 2-D search's best point fell (up to 28 deg high before: flat-1000 encounter 67's track).
+    # the 2-D search's best point falls (up to 28 deg high on a track over flat ground 1000 m below).
     u = direction_from_angles(np.array([az]), np.array([el]))
     z = np.sqrt(10**2.0 * N0) * steering_vector(u, CFG)
     s_c = steering_vector(direction_from_angles(np.array([az_null, -az_null]), np.full(2, el_null)), CFG)

@@ -1,11 +1,10 @@
 """Which elevations a track's height rests on in the ground's range-Doppler band (track.elevation_trust).
 
-Hills, 200-encounter set, encounter 23: an aircraft overtaken 339 m above the own-ship had its
-elevation measured on 30-70 % of its detections, within a few degrees of the truth; the co-altitude
-prior of the unmeasured rest held its track 74 m up and it was warned. Flat ground 300 m below,
-``--n 3`` encounter 2: a co-altitude intruder's "measured" elevations were the ground's depression
-(the plain DoA of a cell the ground fills); trusted, they carried the track 250-360 m down and its
-warning was missed.
+Over hills, an aircraft overtaken 339 m above the own-ship can have its elevation measured on
+30-70 % of its detections, within a few degrees of the truth; held at the co-altitude prior of the
+unmeasured rest its track stays 74 m up and it is warned. Over flat ground 300 m below, a co-altitude
+intruder's "measured" elevations can be the ground's depression (the plain DoA of a cell the ground
+fills); trusted, they carry the track 250-360 m down and its warning is missed.
 """
 
 from __future__ import annotations
@@ -83,11 +82,11 @@ def test_an_aircraft_above_with_some_measured_elevations_is_tracked_at_its_heigh
 
 
 def test_elevations_scattered_past_their_bound_still_bring_the_track_to_its_height():
-    # Jacksboro, 200-set encounter 23: elevations measured through the nulls scatter by degrees, far
-    # past their Cramer-Rao bound at 25 dB (under 1 deg). Trusted at the bound, the first ones set the
-    # track's height and gated the rest out (11 of 18 in its first 2 s); it reached its true height
-    # (339 m up) only after 12 s, and was warned meanwhile (its free readings then held the track's
-    # predicted height; at the co-altitude prior they weigh little against trusted ones).
+    # Jacksboro: elevations measured through the nulls scatter by degrees, far past their Cramer-Rao
+    # bound at 25 dB (under 1 deg). Trusted at the bound, the first ones would set the track's height
+    # and gate the rest out (11 of 18 in its first 2 s); it would reach its true height (339 m up) only
+    # after 12 s, and be warned meanwhile (its free readings then hold the track's predicted height; at
+    # the co-altitude prior they weigh little against trusted ones).
     for seed in range(4):
         reading = np.where(np.random.default_rng(seed).random(N) < 0.5, "true", "prior")
         det = _aircraft(340.0, 30.0, reading, ahead_m=1200.0, noise_rad=0.06)
@@ -97,10 +96,10 @@ def test_elevations_scattered_past_their_bound_still_bring_the_track_to_its_heig
 
 
 def test_an_aircraft_above_first_seen_close_is_at_its_height_a_second_after_its_readings_agree():
-    # Flat ground 300 m below, 200-set encounter 23: overtaken 339 m above, first seen 780 m away
-    # (already inside the warning's horizontal volume), 30 % of its elevations measured, at 14-43 deg
-    # for a true 27-32 deg. One reading at a time the first accepted set the height (170 m up) and
-    # the gate kept out the rest for 20 s: a false warning. Here 10 deg (1 sigma) of scatter.
+    # Flat ground 300 m below: overtaken 339 m above, first seen 780 m away (already inside the
+    # warning's horizontal volume), 30 % of its elevations measured, at 14-43 deg for a true 27-32 deg.
+    # One reading at a time, the first accepted would set the height (170 m up) and the gate keep out
+    # the rest for 20 s: a false warning. Here 10 deg (1 sigma) of scatter.
     for seed in range(4):
         reading = np.where(np.random.default_rng(seed).random(N) < 0.3, "true", "prior")
         det = _aircraft(340.0, 30.0, reading, ahead_m=700.0, noise_rad=0.15)
@@ -112,10 +111,10 @@ def test_an_aircraft_above_first_seen_close_is_at_its_height_a_second_after_its_
 
 
 def test_a_track_keeps_its_agreed_height_through_a_run_of_readings_the_ground_pulls():
-    # Flat ground 300 m below, 200-set encounter 138: 280 m above, its vote lost on a run of readings
-    # pulled to the ground; the co-altitude prior of its free readings then dragged the track down to
-    # 103 m in 20 s and it was warned. Here the readings are at the ground's depression after 6 s
-    # (at the co-altitude prior again the track ends 30-70 m up).
+    # Flat ground 300 m below: 280 m above, its vote lost on a run of readings pulled to the ground,
+    # the co-altitude prior of its free readings would drag the track down to 103 m in 20 s and it
+    # would be warned. Here the readings are at the ground's depression after 6 s (at the co-altitude
+    # prior again the track ends 30-70 m up).
     t = np.arange(N) / 9.4
     for seed in range(4):
         rng = np.random.default_rng(seed)
@@ -141,10 +140,10 @@ def _lift(det: pd.DataFrame, rows: np.ndarray, elevation_rad: np.ndarray) -> pd.
 
 
 def test_outliers_above_do_not_lift_a_co_altitude_intruder():
-    # Hills, 200-set encounter 48: an aircraft 39 m below, overtaken (a near collision). 1.7 % of its
-    # 303 elevations were more than 8.6 deg up; trusted one by one, each lifted its track and the
-    # free readings held it there: 620 m up, never warned. Here 5 % of the readings at 10-30 deg, in
-    # bursts of three (without the track's vote: 573, 233 and 340 m off).
+    # Hills: an aircraft 39 m below, overtaken (a near collision), with 1.7 % of its 303 elevations
+    # more than 8.6 deg up. Trusted one by one, each would lift its track and the free readings hold
+    # it there: 620 m up, never warned. Here 5 % of the readings at 10-30 deg, in bursts of three
+    # (without the track's vote: 573, 233 and 340 m off).
     for seed in range(3):
         rng = np.random.default_rng(seed)
         det = _aircraft(-39.0, 30.0, np.full(N, "true"), noise_rad=0.05)
@@ -156,10 +155,10 @@ def test_outliers_above_do_not_lift_a_co_altitude_intruder():
 
 
 def test_a_track_without_trusted_elevations_stays_co_altitude():
-    # Hills, 200-set encounter 88: overtaken 110 m below, every reading below the horizontal (none
-    # trusted). Placed at the track's predicted elevation they held nothing, the radial-velocity
-    # update lifted the track to 500 m up and the conflict was missed. At the co-altitude prior the
-    # track stays co-altitude: warned as if level with the own-ship.
+    # Hills: overtaken 110 m below, every reading below the horizontal (none trusted). Placed at the
+    # track's predicted elevation they hold nothing, the radial-velocity update lifts the track to
+    # 500 m up and the conflict is missed. At the co-altitude prior the track stays co-altitude:
+    # warned as if level with the own-ship.
     for up_m in (-110.0, -40.0):
         det = _aircraft(up_m, 35.0, np.full(N, "true"), noise_rad=0.05)
         confirmed = track_detections(det, ownship=_own(), ground_test=False).query("confirmed")
@@ -199,10 +198,10 @@ def test_measured_elevations_below_count_outside_the_ground_band():
 def test_a_closing_speed_whose_alias_the_ground_fills_is_in_the_band():
     # The prototype's V_lim is 39 m/s: at 50 m/s the ground's band folds over every Doppler cell, so a
     # head-on closure of 80 m/s shares its cell (alias -1.7 m/s) with the ground, whose pull gives
-    # readings below that look like these (Jacksboro 200-set encounter 15, 47 m below: trusted
-    # because -115 m/s is outside the unfolded band, they held its track 245-335 m below it and it
-    # was never warned). Readings below in the band are not trusted unless they agree clear of the
-    # ground (here 200 m above it, less than 3 bounds at these ranges): the track stays co-altitude.
+    # readings below that look like these (over Jacksboro, 47 m below: trusted because -115 m/s is
+    # outside the unfolded band, they would hold its track 245-335 m below it and it would never be
+    # warned). Readings below in the band are not trusted unless they agree clear of the ground (here
+    # 200 m above it, less than 3 bounds at these ranges): the track stays co-altitude.
     reading = np.full(N, "true")
     det = _aircraft(-300.0, -30.0, reading, ahead_m=3000.0)
     assert np.all(np.abs(det.radial_velocity_mps) > SPEED_MPS + 5.0)
@@ -211,9 +210,9 @@ def test_a_closing_speed_whose_alias_the_ground_fills_is_in_the_band():
 
 
 def test_an_aircraft_below_whose_elevations_agree_is_tracked_at_its_height():
-    # Hills, 200-set encounter 188: overtaken 281 m below, its in-band readings agreed within their
-    # bound, 200 m above the terrain; held at the co-altitude prior it was warned (a false warning).
-    # Here 300 m below, 200 m above a level ground, readings at the bound (25 dB: 0.013 rad).
+    # Hills: overtaken 281 m below, its in-band readings agreeing within their bound, 200 m above the
+    # terrain; held at the co-altitude prior it would be warned (a false warning). Here 300 m below,
+    # 200 m above a level ground, readings at the bound (25 dB: 0.013 rad).
     det = _aircraft(-300.0, 30.0, np.full(N, "true"), ahead_m=700.0, noise_rad=0.013)
     confirmed = track_detections(det, ownship=_own(), ground_test=False).query("confirmed")
     after_5_s = confirmed[confirmed.time_s > 5.0]
@@ -222,8 +221,8 @@ def test_an_aircraft_below_whose_elevations_agree_is_tracked_at_its_height():
 
 
 def test_readings_the_ground_pulls_keep_a_co_altitude_intruder_at_its_height():
-    # Hills 48 and 88: readings of a mixture scatter between the target and the ground (no
-    # consensus). Jacksboro --n 3 encounter 2: readings the ground dominates agree, on the surface.
+    # Readings of a mixture scatter between the target and the ground (no consensus, as over hills
+    # above); readings the ground dominates agree, on the surface (as over Jacksboro).
     for reading in ("mixed", "ground"):
         det = _aircraft(0.0, 30.0, np.full(N, reading), ahead_m=700.0)
         confirmed = track_detections(det, ownship=_own(), ground_test=False).query("confirmed")

@@ -1,6 +1,6 @@
 """ch6 acceptance on the full experiment through the real entry point (slow: a few minutes).
 
-Bounds from issue 14: the best thesis method at least 19 of 20 frames correct with at most 5 % decoy
+The acceptance bounds: the best thesis method at least 19 of 20 frames correct with at most 5 % decoy
 false positives; the continuous search's median errors at most 10 m and 1 deg on decided frames; a 50 m
 spoof detected in at least 95 % of decided frames at a false-alarm rate of at most 5 %; wing-up frames
 all "no decision"; JSON as the last stdout line, figures and table written.

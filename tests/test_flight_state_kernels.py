@@ -1,6 +1,6 @@
-"""The compiled flight-state loops give exactly what scipy.ndimage / numpy give (issue 16 point 7).
+"""The compiled flight-state loops give exactly what scipy.ndimage / numpy give.
 
-The references here are the implementations the kernels replaced (scipy's binary closing and run
+The references here are plain implementations of the same steps (scipy's binary closing and run
 labelling, numpy's argsort and broadcast scoring) and scipy's finite-difference Jacobian.
 """
 

@@ -1,7 +1,7 @@
 """Ridge extraction and per-frame flight state on range-Doppler images built here from a flat plane.
 
 The images are made independently of the simulator: random ground points on a flat plane,
-mapped to their nearest (range, Doppler) bin with the conventions of seed-brief.md (range bin k
+mapped to their nearest (range, Doppler) bin with the package's conventions (range bin k
 at k dR, Doppler bin j at (j - nV/2) dV, wrap outside +-VLim, sawtooth coupling), powers from
 the radar equation with cosine reflectivity and the default antenna pattern, random phases.
 """

@@ -73,8 +73,8 @@ def test_classify_ground_separates_terrain_from_aircraft_for_a_moving_radar():
     ground = classify_ground(rng, v_meas, u, CFG, own_v, height)
     assert ground.tolist() == [True, False, False]
     # The crossing aircraft has the ground's radial velocity there: Doppler alone would call it ground
-    # (issue 12: a circling glider lost 158 of 348 detections that way), so without a height above
-    # ground nothing is ground.
+    # (a circling glider can lose 158 of 348 detections that way), so without a height above ground
+    # nothing is ground.
     static = doppler_matches_static(v_meas, static_radial_velocity_mps(u, own_v), CFG, 1.0)
     assert static.tolist() == [True, False, True]
     assert not classify_ground(rng, v_meas, u, CFG, own_v, None).any()
@@ -131,8 +131,8 @@ def _ridge_frame(elevation_deg: float) -> dict:
 
 def test_ridge_beside_the_track_nearer_than_the_ground_below_is_ground():
     # Flat ground 550 m below, and a ridge east of 300 m whose top is 263 m higher: its returns come
-    # at 500 m, nearer than the ground below. With a fixed 30 m margin they were "unreachable" and
-    # kept as air (confirmed ground tracks over Jacksboro); the band now widens by the sampled rise.
+    # at 500 m, nearer than the ground below. With a fixed 30 m margin they would be "unreachable"
+    # and kept as air (confirmed ground tracks over Jacksboro), so the band widens by the sampled rise.
     from skyradar.process.ground import flag_ground
 
     ridge_top_down_m = 500.0 * np.sin(np.radians(35.0))

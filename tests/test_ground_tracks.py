@@ -151,11 +151,11 @@ def test_history_starts_again_after_a_reacquisition_gap():
 
 
 def test_converging_aircraft_fits_a_static_point_but_its_direction_keeps_it():
-    # Flat-300 encounter 2 of the terrain set (converging at 60 deg, 42 m/s, 550 m miss, co-altitude)
+    # Over flat ground 300 m below, an aircraft converging at 60 deg (42 m/s, 550 m miss, co-altitude)
     # has |w| = 46.5 m/s against the own-ship's 50 m/s, so its range and Doppler fit a static point
-    # for seconds (its miss distance reaches the ground 300 m below). Held until they did not, it
-    # was warned 0.5 s after its loss of well clear. A direction of arrival that puts it in the
-    # air, consistently, keeps it confirmed; without one it is held.
+    # for seconds (its miss distance reaches the ground 300 m below). Held until they do not, it would
+    # be warned 0.5 s after its loss of well clear. A direction of arrival that puts it in the air,
+    # consistently, keeps it confirmed; without one it is held.
     from skyradar.track.ground_tracks import GroundTrackTest
 
     agl = 300.0
@@ -183,7 +183,7 @@ def test_doppler_of_a_point_is_smooth_that_of_a_clutter_patch_is_not():
     # CRLB at the 13 dB threshold (0.027 m/s for 250 bins of 0.31 m/s) follows one smooth curve in
     # every 10-detection window: a circling glider (80 m radius, 25 m/s), a crossing aircraft, and
     # one receding at the alias edge (unwrapped). A ground patch of four static scatterers 1 deg
-    # apart in azimuth at one range (hills encounter 0: residual clutter at 40 deg azimuth, range
+    # apart in azimuth at one range (residual clutter over hills at 40 deg azimuth, range
     # and Doppler consistent, no single static point fits) gives detections from one or another:
     # its Doppler jumps by ~0.5 m/s and it is held; with the test off it is a confirmed track.
     from skyradar.track.ground_tracks import GroundTrackTest, doppler_smooth
@@ -215,9 +215,9 @@ def test_doppler_of_a_point_is_smooth_that_of_a_clutter_patch_is_not():
 
 
 def test_short_track_whose_measured_directions_are_on_the_ground_needs_more_detections():
-    # Jacksboro encounter 2 (saved detections, times from 0): residual clutter at the alias edge,
-    # three detections in 0.2 s whose ranges some alias fits, measured elevations -25 deg on the
-    # surface, was confirmed at its third and kept to its fourth (a placeholder 0 deg elevation).
+    # Residual clutter over Jacksboro at the alias edge (saved detections, times from 0): three
+    # detections in 0.2 s whose ranges some alias fits, measured elevations -25 deg on the surface,
+    # would otherwise be confirmed at its third and kept to its fourth (a placeholder 0 deg elevation).
     # With the directions on the surface it needs ten detections; with them in the air, three.
     from skyradar.track.ground_tracks import GroundTrackTest, hold_ground_tracks
 
@@ -270,12 +270,11 @@ def test_track_without_a_measured_direction_needs_more_detections():
 
 
 def test_prior_elevations_do_not_overrule_the_static_ground_fit():
-    # Hills encounter 0 of the 200-encounter set: a ground patch 2.3 km away, 6 of every 10
-    # detections with no measured elevation (the chain's prior: elevation 0, co-altitude) at a
-    # steady azimuth, the others measured on the surface. The prior directions agreed with each
-    # other, so they read as "one direction in the air" and released the track (a confirmed
-    # ground track 56 m below the terrain, a warning in encounter 8). Prior elevations say
-    # nothing of the height: the static fit holds it. Measured co-altitude directions (a
+    # Over hills, a ground patch 2.3 km away: 6 of every 10 detections with no measured elevation
+    # (the chain's prior: elevation 0, co-altitude) at a steady azimuth, the others measured on the
+    # surface. The prior directions agree with each other; read as "one direction in the air" they
+    # would release the track (a confirmed ground track 56 m below the terrain, and a warning). Prior
+    # elevations say nothing of the height: the static fit holds it. Measured co-altitude directions (a
     # sidelobe read consistently as air) still overrule the fit, as documented.
     from skyradar.track.ground_tracks import GroundTrackTest
 
@@ -297,12 +296,12 @@ def test_prior_elevations_do_not_overrule_the_static_ground_fit():
 
 
 def test_static_point_near_the_line_of_flight_fits_whatever_the_noise():
-    # Hills encounter 8 of the 200-encounter set: a ground patch 7 deg below the line of flight,
-    # Doppler within 0.5 m/s of the own-ship's speed. Its detections' rings around the velocity
-    # are ~200 m wide and one detection's Doppler error moves them by tens of metres, so a ring
-    # often misses the surface and gave the fit no start near the point; undamped Gauss-Newton
-    # steps then missed minima well inside the limit. A fit that failed released the track for a
-    # row: the ground track confirmed 21 rows. Every 10-detection window must fit.
+    # Over hills, a ground patch 7 deg below the line of flight, Doppler within 0.5 m/s of the
+    # own-ship's speed. Its detections' rings around the velocity are ~200 m wide and one detection's
+    # Doppler error moves them by tens of metres, so a ring often misses the surface and gives the fit
+    # no start near the point; undamped Gauss-Newton steps would then miss minima well inside the limit.
+    # A fit that fails releases the track for a row (a ground track confirmed for 21 rows). Every
+    # 10-detection window must fit.
     own = _own()
     own_p = own[["own_north_m", "own_east_m", "own_down_m"]].to_numpy()
     own_v = own[["own_vn_mps", "own_ve_mps", "own_vd_mps"]].to_numpy()
@@ -323,11 +322,11 @@ def test_static_point_near_the_line_of_flight_fits_whatever_the_noise():
 
 
 def test_a_doppler_step_starts_a_held_tracks_history_again():
-    # Hills encounter 10 of the 200-encounter set: a track began on one ground patch and went on
-    # with another 4.4 m/s away in Doppler (no measured elevation). Once the step left the Doppler
-    # test's window, the static fit over the whole history could not trim its first three
-    # detections, and a ground track was confirmed for 60 rows. The step now starts the history
-    # again; the second patch alone is a static point on the surface and the track stays held.
+    # Over hills, a track that begins on one ground patch and goes on with another 4.4 m/s away in
+    # Doppler (no measured elevation). Once the step leaves the Doppler test's window, a static fit over
+    # the whole history cannot trim its first three detections (a ground track confirmed for 60 rows).
+    # The step starts the history again; the second patch alone is a static point on the surface and
+    # the track stays held.
     from skyradar.track.ground_tracks import GroundTrackTest, hold_ground_tracks
 
     own = _own()

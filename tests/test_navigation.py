@@ -1,4 +1,4 @@
-"""Own-ship navigation with errors (issue 13.2): the model's statistics, the scenario key, and that
+"""Own-ship navigation with errors: the model's statistics, the scenario key, and that
 the simulator's own-ship truth never enters process, track or alert."""
 
 from __future__ import annotations

@@ -1,9 +1,10 @@
 """Comments, docstrings and documents state rules and their reasons, never the project's history.
 
-No session numbers, issue numbers, commit hashes, evaluation-encounter ids or citations of a private
-brief: a reader has none of them, and the thesis (Maas 2022) is the reference to cite. The README,
-every document under docs/ except docs/results/ (JSON records of runs) and every Python file of the
-package are searched.
+No session numbers, issue numbers ("issue 12", "#41"), commit hashes, evaluation-encounter ids or
+citations of a private brief: a reader has none of them, and the thesis (Maas 2022) is the reference
+to cite. The README, every document under docs/ except docs/results/ (JSON records of runs), every
+Python file of the package and every Python file of the tests but this one (module docstrings,
+comments, docstrings and test names alike) are searched.
 """
 
 from __future__ import annotations
@@ -13,8 +14,16 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 HISTORY = re.compile(
-    r"session [0-9]|issue [0-9]|encounter [0-9]+|\b[0-9a-f]{7}\b \(|seed-brief", flags=re.IGNORECASE
+    r"session[ _][0-9]|issue[ _][0-9]|encounter[ _][0-9]+|\b[0-9a-f]{7}\b \(|commit [0-9a-f]{7}"
+    r"|seed[- ]brief|(?<![\w&/])#[0-9]+\b",
+    flags=re.IGNORECASE,
 )
+# Lines of test files that other work has open, reworded there: (file, words of the line). Each entry
+# goes as soon as its line tells no history; an entry whose line no longer matches fails the test.
+PENDING = {
+    ("tests/test_clutter_adaptive.py", "Adaptive post-Doppler nulls where the clutter prediction fails"),
+    ("tests/test_passive_recording_io.py", "bad inputs that belong to reading, through the real"),
+}
 
 
 def _searched() -> list[Path]:
@@ -24,25 +33,47 @@ def _searched() -> list[Path]:
     files = [ROOT / "README.md"]
     files += sorted(p for p in documents if not skipped & set(p.parents))
     files += sorted((ROOT / "src" / "skyradar").rglob("*.py"))
+    tests = (p for p in (ROOT / "tests").rglob("*.py") if "__pycache__" not in p.parts)
+    files += sorted(p for p in tests if p != Path(__file__).resolve())  # this file names what it forbids
     return files
 
 
-def _hits(path: Path) -> list[str]:
+def _hits(path: Path) -> list[tuple[str, int, str]]:
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError:  # images and other binary files tell no history in words
         return []
-    where = path.relative_to(ROOT)
+    where = path.relative_to(ROOT).as_posix()
     lines = enumerate(text.splitlines(), 1)
-    return [f"{where}:{n}: {line.strip()}" for n, line in lines if HISTORY.search(line)]
+    return [(where, n, line.strip()) for n, line in lines if HISTORY.search(line)]
+
+
+def _pending(hit: tuple[str, int, str]) -> tuple[str, str] | None:
+    where, _, line = hit
+    return next(((f, words) for f, words in PENDING if f == where and words in line), None)
 
 
 def test_the_searched_files_exist():
     files = _searched()
     assert files[0].is_file()
-    assert any(p.suffix == ".py" for p in files)
+    assert any(p.suffix == ".py" and "src" in p.parts for p in files)
+    assert any(p.suffix == ".py" and "tests" in p.parts for p in files)
+
+
+def test_the_pattern_finds_each_kind_of_history():
+    told = [
+        "(issue 12 point 4)", "Issue 12.1: sub-facets", "def test_issue_12_gap():", "session 3",
+        "hills encounter 96", "fixed in commit 1a2b3c4", "a1b2c3d (the revert)", "seed-brief.md",
+        "the seed brief's form", "see #41",
+    ]  # fmt: skip
+    assert [line for line in told if not HISTORY.search(line)] == []
+    plain = ['scope="session"', "encounter_score", "&#39;", "page.html#2", "# 3 frames", "issued warning"]
+    assert [line for line in plain if HISTORY.search(line)] == []
 
 
 def test_no_comment_docstring_or_document_tells_history():
     hits = [hit for path in _searched() for hit in _hits(path)]
-    assert not hits, "history in comments, docstrings or documents:\n" + "\n".join(hits)
+    told = [f"{where}:{n}: {line}" for where, n, line in hits if _pending((where, n, line)) is None]
+    assert not told, "history in comments, docstrings, test names or documents:\n" + "\n".join(told)
+    stale = PENDING - {_pending(hit) for hit in hits}
+    assert not stale, f"these lines tell no history any more, remove them from PENDING: {sorted(stale)}"

@@ -1,6 +1,6 @@
-"""One home per formula (issue 16): the formulas that were pasted around src/ must not come back.
+"""One home per formula: each formula below is written once in src/, and everywhere else calls it.
 
-Each pattern below is a formula that now has exactly one home; a match anywhere else in src/ fails
+Each pattern below is a formula that has exactly one home; a match anywhere else in src/ fails
 with the file, line and the function to call instead. Token-level duplicate finders (pylint's
 ``duplicate-code``) need 6-8 identical lines and miss these one-to-three-line pastes, which is why
 they are listed here by shape.

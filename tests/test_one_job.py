@@ -1,4 +1,4 @@
-"""Issue 16: modules and commands that did two jobs now do one (daa tables vs alerting, bench chain)."""
+"""One job per module and command: daa tables apart from alerting, bench chain apart from bench flight."""
 
 from __future__ import annotations
 
@@ -51,6 +51,6 @@ def test_a_run_without_ownship_state_has_no_ownship_table():
         alerts_for_run(ds, run_name="b.zarr")
 
 
-def test_bench_chain_no_longer_runs_the_flight_benchmark(tmp_path):
+def test_bench_chain_does_not_run_the_flight_benchmark(tmp_path):
     result = skyradar("bench", "chain", "--flight-frames", "5", cwd=tmp_path)
     assert_one_line_error(result, "--flight-frames 5", "skyradar bench flight --frames 5")

@@ -10,7 +10,7 @@ from cli_helpers import skyradar
 
 
 @pytest.mark.slow
-def test_experiment_ch7_meets_the_issue_acceptance(tmp_path):
+def test_experiment_ch7_meets_its_acceptance_bounds(tmp_path):
     result = skyradar("experiment", "ch7", "--out", "ch7", "--json", cwd=tmp_path, timeout=900)
     assert result.returncode == 0, result.stderr
     out = json.loads(result.stdout.strip().splitlines()[-1])

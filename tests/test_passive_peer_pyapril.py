@@ -1,4 +1,4 @@
-"""Peer check (issue 15): our matched filter + clutter cancellation against pyapril's on one dwell.
+"""Peer check: our matched filter + clutter cancellation against pyapril's on one dwell.
 
 pyapril (a dev extra) does passive radar for continuous illuminators: ``ECAS`` cancels the reference's
 delayed copies from the surveillance channel, ``cc_detector_td`` computes the cross-ambiguity. For a

@@ -71,7 +71,7 @@ def test_ellipse_point_inverts_the_bistatic_range_and_matches_willis(east, north
     s = bistatic_range_m(target, tx, rx)
     point, got_r1, got_r2 = ellipse_point(s, az, tx, rx)
     np.testing.assert_allclose(point, target, atol=1e-6 * (r1 + r2))
-    # The seed brief's receiver-angle form: sin(theta_R) = -unit(target - rx) . unit(tx - rx).
+    # The thesis' receiver-angle form: sin(theta_R) = -unit(target - rx) . unit(tx - rx).
     sin_theta = np.clip(-np.dot(target / r2, tx / baseline), -1.0, 1.0)
     assert receiver_range_willis(s, baseline, np.arcsin(sin_theta)) == pytest.approx(r2, rel=1e-6)
     assert got_r1 == pytest.approx(r1, rel=1e-6) and got_r2 == pytest.approx(r2, rel=1e-6)

@@ -1,4 +1,4 @@
-"""Passive-radar illuminator, scene and IQ simulator (issue 15 point 1) against closed forms and peers.
+"""Passive-radar illuminator, scene and IQ simulator against closed forms and peers.
 
 Expected values come from formulas written out here (Friis, the bistatic radar equation, bistatic
 geometry from pymap3d positions) or from scipy, never from the simulator's own helpers.

@@ -1,4 +1,4 @@
-"""Several radar heads (issue 13.1): scenario radars:, the multi-head store, process, fused tracking."""
+"""Several radar heads: scenario radars:, the multi-head store, process, fused tracking."""
 
 from __future__ import annotations
 

@@ -121,12 +121,12 @@ def test_a_real_conflict_is_still_warned_whatever_the_altitude_flag():
 
 
 def test_range_and_horizontal_direction_cannot_split_below_from_descending_through():
-    # Flat ground 300 m below, 200-set encounter 123: overtaken 250 m below, 28 m aside, 29.5 m/s
-    # closing; its elevation is nulled with the ground (square array), so the track holds range,
-    # range rate and the horizontal direction cosine east / r. Rotating the relative path about the
-    # antenna's y axis (east, own-ship level and heading north) keeps all three; 10 deg of rotation
-    # is an intruder ahead near the own-ship's level descending at 5.1 m/s (1000 ft/min) that loses
-    # well clear 22 s before the closest approach.
+    # Flat ground 300 m below: overtaken 250 m below, 28 m aside, 29.5 m/s closing; its elevation is
+    # nulled with the ground (square array), so the track holds range, range rate and the horizontal
+    # direction cosine east / r. Rotating the relative path about the antenna's y axis (east, own-ship
+    # level and heading north) keeps all three; 10 deg of rotation is an intruder ahead near the
+    # own-ship's level descending at 5.1 m/s (1000 ft/min) that loses well clear 22 s before the
+    # closest approach.
     t = np.arange(-40.0, 20.0, 1 / 9.4)
     level = np.column_stack([-29.5 * t, np.full_like(t, -27.6), np.full_like(t, 250.2)])
     turn = np.radians(-10.0)

@@ -1,9 +1,9 @@
 """Track ids through reacquisition: an aircraft's track does not take a ground track's id.
 
-Over hills (200-encounter set, encounter 96) an intruder's new track reacquired the id of a lost
-chain of ground clutter tracks: the lost track's prediction, alias unresolved, had a range spread
-of 168 m and took the intruder inside its gate. The intruder was then warned under the ground
-track's id, with the ground track's rows as its history.
+Over hills, an intruder's new track can meet a lost chain of ground clutter tracks whose
+prediction, alias unresolved, has a range spread of 168 m and takes the intruder inside its gate.
+Reacquiring that id, the intruder would be warned under the ground track's id, with the ground
+track's rows as its history.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Inputs that used to give a silently wrong run: a DEM far from the flight, tracks alerted against
+"""Inputs that must not give a silently wrong run: a DEM far from the flight, tracks alerted against
 another run's own-ship; and the DEM window the scenario reads."""
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ def _scenario(tmp_path: Path, name: str = "s.yaml", **changes) -> Path:
 
 # ------------------------------------------------------------------ DEM far from the flight
 def test_simulate_refuses_a_dem_tile_far_from_the_origin(tmp_path):
-    _hgt(tmp_path, "N07E060.hgt")  # valid, but 5000 km from the origin: used to give no terrain, exit 0
+    _hgt(tmp_path, "N07E060.hgt")  # valid, but 5000 km from the origin: no terrain at all
     scenario = _scenario(tmp_path, terrain={"type": "file", "path": "N07E060.hgt"})
     result = _skyradar("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path)
     needles = ("s.yaml", "terrain", "N07E060.hgt", "lat 7..8, lon 60..61", "origin lat 52.5")
@@ -171,7 +171,7 @@ def test_alert_refuses_an_ownship_run_the_tracks_did_not_come_from(tmp_path, two
     ):
         result = _skyradar(*args, cwd=tmp_path)
         assert result.returncode == 0, result.stderr
-    # Another run with the same frame times: the old code alerted against it and exited 0.
+    # Another run with the same frame times passes a check of the times alone; its origin differs.
     result = _skyradar("alert", "trk.parquet", "--ownship", "run_b.zarr", "-o", "al.parquet", cwd=tmp_path)
     _assert_one_line_error(result, "trk.parquet", "run_a.zarr", "run_b.zarr", "0..0.8 s", "origins differ")
     assert not (tmp_path / "al.parquet").exists()
@@ -180,7 +180,7 @@ def test_alert_refuses_an_ownship_run_the_tracks_did_not_come_from(tmp_path, two
 
 
 def test_alert_traces_tables_without_a_signature_back_to_their_run(tmp_path, two_runs):
-    # Tables written before the signature existed: tracks -> detections -> run through 'source'.
+    # Tables without a signature: tracks -> detections -> run through 'source'.
     _with_runs(tmp_path, two_runs)
     det = pd.DataFrame({"time_s": [0.0]})
     det.attrs["source"] = "run_a.zarr"

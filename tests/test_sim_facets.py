@@ -1,4 +1,4 @@
-"""Issue 12.1: sub-facets sized by their own range and Doppler extent (``skyradar.sim.facets``).
+"""Sub-facets sized by their own range and Doppler extent (``skyradar.sim.facets``).
 
 Two checks against independent measures: the extent of every sub-facet measured on a dense grid
 of points of its bilinear patch (not from the corner formula the rule uses), and the clutter power

@@ -1,4 +1,4 @@
-"""Issue 12.1: the image simulator's window point-spread, speckle and Swerling against the raw ADC chain.
+"""The image simulator's window point-spread, speckle and Swerling against the raw ADC chain.
 
 The peer is the chirp-level simulation (:mod:`skyradar.sim.raw`: beat signal from the exact
 delays of every sample) through the windowed FFTs of ``process.rangedoppler``. Its pixels are

@@ -1,4 +1,4 @@
-"""3-D track quality for the DAA layer and sliding-window confirmation (issue 5 follow-up)."""
+"""3-D track quality for the DAA layer and sliding-window confirmation."""
 
 import numpy as np
 import pandas as pd

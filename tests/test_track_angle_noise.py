@@ -1,6 +1,6 @@
-"""The 3-D filter scales its DoA position noise by what its innovations show (issue 12: directions after
-clutter suppression scatter far beyond the SNR bound, and a filter trusting the bound took its velocity
-from them: a converging aircraft 300 m above flat ground was warned 0.6 s after its loss of well clear)."""
+"""The 3-D filter scales its DoA position noise by what its innovations show: directions after clutter
+suppression scatter far beyond the SNR bound, and a filter trusting the bound takes its velocity from
+them (a converging aircraft 300 m above flat ground is then warned 0.6 s after its loss of well clear)."""
 
 import numpy as np
 import pytest

@@ -1,10 +1,10 @@
-"""Completeness on the full chain (issue 12 point 4): the tracker steps on every frame and `evaluate`
-scores against what the radar could see.
+"""Completeness on the full chain: the tracker steps on every frame and `evaluate` scores against
+what the radar could see.
 
-Each test failed before its fix: `skyradar track` stepped only on frames holding a detection, so a
-track had no rows (and counted no misses) over a gap of frames without detections; `evaluate`
-counted every in-beam frame as truth, also far below the detection threshold. The completeness is
-checked against Stone Soup's SIAP completeness (an independent implementation) on the same rows.
+Stepping only on frames holding a detection would leave a track without rows (and count no misses)
+over a gap of frames without detections; counting every in-beam frame as truth would count frames far
+below the detection threshold too. The completeness is checked against Stone Soup's SIAP
+completeness (an independent implementation) on the same rows.
 """
 
 from __future__ import annotations
@@ -104,8 +104,8 @@ def test_completeness_equals_stone_soup_siap(seed):
 
 
 def test_tracker_steps_on_frames_without_any_detection():
-    """Frame stepping (the deleter's clock): a 1.5 s stretch of frames with no detection at all used
-    to leave the track without rows there (it was neither coasted nor counted as missing)."""
+    """Frame stepping (the deleter's clock): a 1.5 s stretch of frames with no detection at all still
+    gives the track a row at each of those frames, coasted."""
     t = np.arange(0.0, 12.0, 1 / RATE_HZ)
     r = (2500.0 - 40.0 * t)[:, None]
     det = synthetic_detections(t, r, np.full_like(r, -40.0), config=CFG, sigma_range_m=4.4, seed=1)
@@ -138,7 +138,7 @@ def _run_with_snr(tmp_path, snr_db: np.ndarray, t: np.ndarray, r: np.ndarray, v:
 
 def test_evaluate_truth_is_what_the_radar_could_see(tmp_path, monkeypatch, capsys):
     """Truth: an aircraft in the beam for 12 s, its expected SNR below the CA-CFAR threshold for the
-    first 6 (no detections there, as a CFAR would give). Scored on the beam, completeness was 0.5."""
+    first 6 (no detections there, as a CFAR would give). Scored on the beam, completeness is about 0.5."""
     t = np.arange(0.0, 12.0, 1 / RATE_HZ)
     r, v = (2500.0 - 30.0 * t)[:, None], np.full((t.size, 1), -30.0)
     snr = np.where(t < 6.0, 2.0, 15.0)[:, None]

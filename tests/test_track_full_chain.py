@@ -1,4 +1,4 @@
-"""One track per aircraft on the full chain (issue 12 point 4): simulate -> process -> track -> evaluate.
+"""One track per aircraft on the full chain: simulate -> process -> track -> evaluate.
 
 A circling glider given as ADS-B gives it (OpenSky units, fixes every 5-12 s) and a fast head-on
 intruder whose radial velocity aliases (-120 m/s closing against VLim = 39 m/s), with the own-ship

@@ -1,4 +1,8 @@
-"""Scoring labels a track by what it followed while confirmed (issue 12: hills encounter 96)."""
+"""Scoring labels a track by what it followed while confirmed.
+
+An intruder's track that took the id of a lost ground track keeps the ground track's unconfirmed hops
+under that id; read over every row they outvote the intruder, read over the confirmed rows they do not.
+"""
 
 from __future__ import annotations
 
@@ -47,7 +51,7 @@ def test_a_track_is_its_intruders_when_its_confirmed_rows_follow_it():
     times = np.arange(300) / 9.4
     track = _reacquired_track(times, n_ground=200)  # 2/3 of its rows are the ground track's
     assert label_tracks(track, _truth(times)) == {118: "intruder"}
-    # Read over every row (the rule before), the ground's hops outvote the intruder.
+    # Read over every row, the ground's hops outvote the intruder.
     everything = track.assign(confirmed=True)
     assert label_tracks(everything, _truth(times)) == {118: "clutter"}
 

@@ -1,9 +1,9 @@
-"""One track per aircraft (issue 12 point 4): gaps, aliasing, clutter in a grown gate, gliders, S-turns.
+"""One track per aircraft: gaps, aliasing, clutter in a grown gate, gliders, S-turns.
 
 Truth comes from the scene geometry (which aircraft is in the beam and when its detections are
-withheld), never from the detections or the tracks being scored. Each test failed before
-reacquisition (:mod:`skyradar.track.reacquisition`): the deleter closed a track 2 s into a gap and the
-aircraft came back as a new track.
+withheld), never from the detections or the tracks being scored. Each test needs reacquisition
+(:mod:`skyradar.track.reacquisition`): without it the deleter closes a track 2 s into a gap and the
+aircraft comes back as a new track.
 """
 
 from __future__ import annotations
@@ -55,14 +55,14 @@ def _straight(gap_s: tuple[float, float], v_mps: float, seed: int = 0, clutter: 
 
 @pytest.mark.parametrize("gap_s", [3.0, 5.0, 7.0])
 def test_detection_gap_keeps_the_track_id(gap_s):
-    """Deleter: a gap of several seconds (beam edge, SNR dip) used to start a second track."""
+    """Deleter: a gap of several seconds (beam edge, SNR dip) does not start a second track."""
     t, _, _, det = _straight((6.0, 6.0 + gap_s), -30.0)
     tracks = track_detections(det, "radar", CFG, frame_times_s=t)
     assert _ids_on(tracks, det, 0).size == 1
 
 
 def test_gap_longer_than_reacquisition_is_a_new_track():
-    """An aircraft that stays away longer than ``reacquire_s`` is a new track, as before."""
+    """An aircraft that stays away longer than ``reacquire_s`` is a new track, as without reacquisition."""
     t, _, _, det = _straight((6.0, 15.0), -30.0)
     tracks = track_detections(
         det, "radar", CFG, tracker_config=TrackerConfig(reacquire_s=8.0), frame_times_s=t
@@ -82,7 +82,7 @@ def test_fast_intruder_reacquired_with_its_alias():
 
 
 def test_clutter_taken_after_a_long_coast_does_not_break_the_track():
-    """Association: a clutter point inside the gap's grown gate used to drag the track away."""
+    """Association: a clutter point inside the gap's grown gate does not drag the track away."""
     t, r, vis, det = _straight((6.0, 9.0), -30.0, clutter=0.0)
     k = int(np.searchsorted(t, 7.8))
     lure = {

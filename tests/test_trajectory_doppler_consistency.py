@@ -1,9 +1,9 @@
-"""A trajectory's sampled velocity is the motion of its sampled position (issue 12 point 4).
+"""A trajectory's sampled velocity is the motion of its sampled position.
 
-Sampled every 5-12 s, as ADS-B gives it, a thermalling glider's interpolated velocities differed from
-the motion of its Hermite-interpolated positions by metres per second; the simulator then gave it a
-Doppler that disagreed with its range rate, and the radar-aware tracker, whose range follows the
-Doppler, lagged it by 10-15 m in range until it broke the track.
+Sampled every 5-12 s, as ADS-B gives it, a thermalling glider's velocities interpolated on their own
+can differ from the motion of its Hermite-interpolated positions by metres per second; the simulator
+would then give it a Doppler that disagrees with its range rate, and the radar-aware tracker, whose
+range follows the Doppler, would lag it by 10-15 m in range until it broke the track.
 """
 
 from __future__ import annotations

@@ -267,7 +267,7 @@ def test_cli_serve_runs_and_rejects_missing_run(run, tmp_path):
     assert "warning" not in err.decode()  # the default host is loopback
 
 
-# --- Safe by default (issue 11): served files, origin, command queue, hostile commands, CLI checks.
+# --- Safe by default: served files, origin, command queue, hostile commands, CLI checks.
 
 
 def _serve(*args, timeout=120):

@@ -22,7 +22,6 @@ HISTORY = re.compile(
 # goes as soon as its line tells no history; an entry whose line no longer matches fails the test.
 PENDING = {
     ("tests/test_clutter_adaptive.py", "Adaptive post-Doppler nulls where the clutter prediction fails"),
-    ("tests/test_passive_recording_io.py", "bad inputs that belong to reading, through the real"),
 }
 
 

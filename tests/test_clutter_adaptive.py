@@ -1,4 +1,4 @@
-"""Adaptive post-Doppler nulls where the clutter prediction fails (issue 12 point 2, over relief)."""
+"""Adaptive post-Doppler nulls where the clutter prediction fails (over relief)."""
 
 from __future__ import annotations
 

@@ -294,7 +294,7 @@ def test_a_run_resumes_only_on_the_same_code(tmp_path, monkeypatch):
     monkeypatch.setattr(skyradar, "__file__", str(package / "__init__.py"))
     before = code_version()
     assert code_version() == before
-    (package / "chain.py").write_text("GATE = 9.0\n")  # the chain changed between two sessions
+    (package / "chain.py").write_text("GATE = 9.0\n")  # the chain's code changes between two runs
     assert code_version() != before
 
 

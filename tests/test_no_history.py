@@ -18,11 +18,6 @@ HISTORY = re.compile(
     r"|seed[- ]brief|(?<![\w&/])#[0-9]+\b",
     flags=re.IGNORECASE,
 )
-# Lines of test files that other work has open, reworded there: (file, words of the line). Each entry
-# goes as soon as its line tells no history; an entry whose line no longer matches fails the test.
-PENDING = {
-    ("tests/test_clutter_adaptive.py", "Adaptive post-Doppler nulls where the clutter prediction fails"),
-}
 
 
 def _searched() -> list[Path]:
@@ -47,11 +42,6 @@ def _hits(path: Path) -> list[tuple[str, int, str]]:
     return [(where, n, line.strip()) for n, line in lines if HISTORY.search(line)]
 
 
-def _pending(hit: tuple[str, int, str]) -> tuple[str, str] | None:
-    where, _, line = hit
-    return next(((f, words) for f, words in PENDING if f == where and words in line), None)
-
-
 def test_the_searched_files_exist():
     files = _searched()
     assert files[0].is_file()
@@ -71,8 +61,5 @@ def test_the_pattern_finds_each_kind_of_history():
 
 
 def test_no_comment_docstring_or_document_tells_history():
-    hits = [hit for path in _searched() for hit in _hits(path)]
-    told = [f"{where}:{n}: {line}" for where, n, line in hits if _pending((where, n, line)) is None]
+    told = [f"{where}:{n}: {line}" for path in _searched() for where, n, line in _hits(path)]
     assert not told, "history in comments, docstrings, test names or documents:\n" + "\n".join(told)
-    stale = PENDING - {_pending(hit) for hit in hits}
-    assert not stale, f"these lines tell no history any more, remove them from PENDING: {sorted(stale)}"

@@ -321,11 +321,11 @@ def test_required_track_age_scales_with_the_time_left_and_is_bounded():
 def test_an_issued_warning_is_held_while_its_loss_is_predicted_within_the_hold_time():
     # Threshold hysteresis: a head-on intruder whose predicted entry hovers around the warning's 25 s
     # alerting time (22-28 s, a track's prediction wobbling with its velocity) is warned once and not
-    # dropped: the warning holds while the entry stays within 1.5 x 25 s.
-    s = np.array([[D_NC + 100.0 * t_left, 0.0, 0.0] for t_left in (20.0, 30.0, 40.0)])
+    # dropped: the warning holds while the entry stays within its early alerting time (90 s).
+    s = np.array([[D_NC + 100.0 * t_left, 0.0, 0.0] for t_left in (20.0, 80.0, 100.0)])
     out = raw_alert_levels(s, np.tile([-100.0, 0.0, 0.0], (3, 1)), AlertConfig())
-    assert out["level"].tolist() == [3, 2, 2]
-    assert out["hold_level"].tolist() == [3, 3, 2]
+    assert out["level"].tolist() == [3, 0, 0]  # beyond the corrective's 55 s too
+    assert out["hold_level"].tolist() == [3, 3, 2]  # within 90 s (warning) and 110 s (corrective)
     t = np.arange(0.0, 30.0, 0.5)
     t_left = 25.0 + 3.0 * np.sin(t)  # the predicted entry wobbles about the alerting time
     raw = np.where(t_left <= 25.0, 3, 2)

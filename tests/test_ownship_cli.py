@@ -97,7 +97,7 @@ def test_alert_config_names_and_file(tmp_path):
         ("m: 2.5\n", "field 'm': must be an integer >= 1"),
         ("persistance_s: 4\n", "field 'persistance_s' is not an alert setting"),
         ("levels: [{name: warning, dthr_m: 600}]\n", "field 'levels'.0: must have name"),
-        ("base: fast\n", "field 'base' must be radar or default"),
+        ("base: fast\n", "field 'base' must be radar, default or do365b"),
         ("[1, 2\n", "not valid YAML"),
     ]:
         (tmp_path / "b.yaml").write_text(text)

@@ -31,8 +31,9 @@ def alert(
         str,
         typer.Option(
             "--config",
-            help="Alert settings: radar (the README's results; default), default (DAIDALUS DO-365B: "
-            "2 of 4 frames, no track-quality gate) or FILE.yaml (fields of skyradar.daa.alert_config).",
+            help="Alert settings: radar (every result of the docs; default), do365b (DAIDALUS' DO-365B "
+            "non-cooperative alerter: early alerting times 110/110/90 s, 2 of 4, reset after a 5 s gap), "
+            "default (AlertConfig's own defaults) or FILE.yaml (fields of skyradar.daa.alert_config).",
         ),
     ] = "radar",
     no_advice: Annotated[

@@ -1,17 +1,34 @@
 """Alerting settings by name or from a YAML file (``skyradar alert --config radar|default|FILE.yaml``).
 
 ``radar`` is :data:`~skyradar.daa.alerting.RADAR_ALERT_CONFIG`, the settings every DAA result of
-this project uses (``experiment encounters``, ``demo``) and ``alert``'s default; ``default`` is
-:class:`~skyradar.daa.alerting.AlertConfig` as DAIDALUS' DO-365B configuration has it (2 of 4
-frames, no track-quality gate). A file holds :class:`AlertConfig` fields, starting from ``base``
-(``radar`` unless given)::
+this project uses (``experiment encounters``, ``demo``) and ``alert``'s default; ``do365b`` is
+:data:`~skyradar.daa.alerting.DO365B_ALERT_CONFIG`, DAIDALUS' DO-365B non-cooperative alerter
+(its ``DO_365B_no_SUM`` configuration: 2200 ft / 450 ft on every level, alerting times 55, 55,
+25 s and early alerting times 110, 110, 90 s, 2 of 4, persistence 4 s, reset after a 5 s data gap);
+``default`` is :class:`~skyradar.daa.alerting.AlertConfig` with its own defaults. What ``radar``
+changes from ``do365b``, and why:
 
-    base: radar                  # or default
+- its first level is preventive on a 700 ft vertical threshold (DO-365's cooperative Phase I
+  preventive alert), to warn vertical encounters earlier; DO-365B's non-cooperative first level has
+  the corrective volume;
+- an issued level holds while lost within 1.5 times its alerting time (37.5 s for the warning),
+  not within DAIDALUS' early alerting time (90 s): a radar track's prediction after a manoeuvre is
+  trusted less far ahead; and it is lowered only after its M-of-N stayed below for 5 s;
+- tracks wait before alerting (a share of the time left, at most 2 s), a track whose horizontal
+  velocity is known worse than 6 m/s (scaled by the time to CPA) raises nothing, and the vertical
+  speed's z-score is 1 (the tracker's level-flight prior): a fresh radar track's velocity is
+  noise, which DAIDALUS, fed by ADS-B-quality tracks, does not expect;
+- a lost track's prediction holds its level for 8 s (radar tracks drop out in clutter and nulls).
+
+A file holds :class:`AlertConfig` fields, starting from ``base`` (``radar`` unless given)::
+
+    base: radar                  # or default, do365b
     m: 3
     n: 5
     period_s: 1.0                # null: M of N frames
     persistence_s: 4.0
     hysteresis_s: 5.0
+    gap_reset_s: null            # DAIDALUS' hysteresis_time: reset after a data gap this long
     z_h_pos: 1.5                 # also z_h_vel, z_v_pos, z_v_vel
     min_track_age_s: 2.0
     age_fraction_of_time_left: 0.1   # a fresh track waits at most this share of the time left
@@ -23,7 +40,7 @@ frames, no track-quality gate). A file holds :class:`AlertConfig` fields, starti
     levels:                      # preventive, corrective, warning
       - {name: preventive, dthr_m: 670.56, zthr_m: 213.36, alerting_time_s: 55}
       - {name: corrective, dthr_m: 670.56, zthr_m: 137.16, alerting_time_s: 55}
-      - {name: warning, dthr_m: 670.56, zthr_m: 137.16, alerting_time_s: 25}
+      - {name: warning, dthr_m: 670.56, zthr_m: 137.16, alerting_time_s: 25, early_alerting_time_s: 90}
     collision_volume: {dthr_m: 152.4, zthr_m: 30.48}
 
 Every field is checked; a wrong one is refused in one line naming the file, the field and the value.
@@ -36,13 +53,13 @@ import math
 from pathlib import Path
 from typing import Any
 
-from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig, AlertLevel
+from skyradar.daa.alerting import DO365B_ALERT_CONFIG, RADAR_ALERT_CONFIG, AlertConfig, AlertLevel
 from skyradar.daa.conflict import WellClearVolume
 from skyradar.errors import InputError
 
 __all__ = ["ALERT_CONFIGS", "WARNING_LEVEL", "alert_config", "check_warns_head_on"]
 
-ALERT_CONFIGS = {"radar": RADAR_ALERT_CONFIG, "default": AlertConfig()}
+ALERT_CONFIGS = {"radar": RADAR_ALERT_CONFIG, "default": AlertConfig(), "do365b": DO365B_ALERT_CONFIG}
 WARNING_LEVEL = 3  # preventive 1, corrective 2, warning 3: the level every DAA score counts
 _INTS = ("m", "n")
 _FLOATS = (
@@ -58,7 +75,7 @@ _FLOATS = (
     "hold_time_factor",
     "lost_track_hold_s",
 )
-_OPTIONAL = ("period_s", "max_velocity_sigma_mps")
+_OPTIONAL = ("period_s", "max_velocity_sigma_mps", "gap_reset_s")
 _VOLUME_KEYS = ("dthr_m", "zthr_m", "tthr_s", "tcoa_s")
 
 
@@ -91,9 +108,14 @@ def _levels(label: str, value: Any) -> tuple[AlertLevel, ...]:
         where = f"{label}.{i}"
         if not isinstance(item, dict) or not {"name", "alerting_time_s"} <= set(item):
             raise InputError(f"{where}: must have name, dthr_m, zthr_m and alerting_time_s, got {item!r}")
-        volume = {k: v for k, v in item.items() if k not in ("name", "alerting_time_s")}
+        volume = {
+            k: v for k, v in item.items() if k not in ("name", "alerting_time_s", "early_alerting_time_s")
+        }
         time_s = _number(f"{where}.alerting_time_s", item["alerting_time_s"])
-        levels.append(AlertLevel(str(item["name"]), _volume(where, volume), time_s))
+        early = item.get("early_alerting_time_s")
+        if early is not None:
+            early = _number(f"{where}.early_alerting_time_s", early, low=time_s)
+        levels.append(AlertLevel(str(item["name"]), _volume(where, volume), time_s, early))
     return tuple(levels)
 
 
@@ -122,7 +144,7 @@ def _fields(label: str, data: dict) -> dict:
 
 
 def alert_config(value: str | Path) -> AlertConfig:
-    """The alerting settings ``value`` names: ``radar``, ``default``, or a YAML file of fields.
+    """The alerting settings ``value`` names: ``radar``, ``default``, ``do365b``, or a YAML file of fields.
 
     Examples
     --------
@@ -131,13 +153,13 @@ def alert_config(value: str | Path) -> AlertConfig:
     >>> alert_config("fast")
     Traceback (most recent call last):
     ...
-    skyradar.errors.InputError: --config fast: not radar, default or an existing .yaml file
+    skyradar.errors.InputError: --config fast: not radar, default, do365b or an existing .yaml file
     """
     if str(value) in ALERT_CONFIGS:
         return ALERT_CONFIGS[str(value)]
     path = Path(value)
     if path.suffix.lower() not in (".yaml", ".yml") or not path.is_file():
-        raise InputError(f"--config {value}: not radar, default or an existing .yaml file")
+        raise InputError(f"--config {value}: not radar, default, do365b or an existing .yaml file")
     from skyradar.io.safe_yaml import load_yaml
 
     try:
@@ -149,7 +171,7 @@ def alert_config(value: str | Path) -> AlertConfig:
         raise InputError(f"{path}: must be a mapping of alert settings, got {type(data).__name__}")
     base = data.pop("base", "radar")
     if base not in ALERT_CONFIGS:
-        raise InputError(f"{path}: field 'base' must be radar or default, got {base!r}")
+        raise InputError(f"{path}: field 'base' must be radar, default or do365b, got {base!r}")
     try:
         config = dataclasses.replace(ALERT_CONFIGS[base], **_fields(str(path), data))
     except ValueError as exc:  # AlertConfig's own checks (1 <= m <= n, period_s > 0)

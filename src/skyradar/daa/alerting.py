@@ -32,6 +32,8 @@ __all__ = [
     "AlertLevel",
     "AlertConfig",
     "RADAR_ALERT_CONFIG",
+    "DO365B_ALERT_CONFIG",
+    "do365b_noncoop_levels",
     "raw_alert_levels",
     "AlertFilter",
     "filter_alert_levels",
@@ -45,22 +47,53 @@ LEVEL_NAMES = ("none", "preventive", "corrective", "warning")
 
 @dataclass(frozen=True)
 class AlertLevel:
-    """One alert level: its volume and alerting time (s)."""
+    """One alert level: its volume, alerting time (s) and early alerting time (s).
+
+    ``early_alerting_time_s`` (DAIDALUS' ``early_alerting_time``, at least the alerting time): once
+    the level is issued, it stays reached while its volume is predicted lost within this time.
+    None: :attr:`AlertConfig.hold_time_factor` times the alerting time.
+    """
 
     name: str
     volume: WellClearVolume
     alerting_time_s: float
+    early_alerting_time_s: float | None = None
+
+    def hold_time_s(self, hold_time_factor: float) -> float:
+        """The time within which a predicted loss holds this level once issued, s."""
+        if self.early_alerting_time_s is not None:
+            return max(self.early_alerting_time_s, self.alerting_time_s)
+        return hold_time_factor * self.alerting_time_s
+
+
+def do365b_noncoop_levels() -> tuple[AlertLevel, ...]:
+    """DAIDALUS' DO-365B non-cooperative alerter (``DWC_Non_Coop`` of its ``DO_365B_no_SUM``
+    configuration): all three levels on the 2200 ft / 450 ft volume without tau, alerting times
+    55, 55 and 25 s, early alerting times 110, 110 and 90 s. Its first level shows no guidance.
+
+    Examples
+    --------
+    >>> [(lv.alerting_time_s, lv.early_alerting_time_s) for lv in do365b_noncoop_levels()]
+    [(55.0, 110.0), (55.0, 110.0), (25.0, 90.0)]
+    """
+    nc = WellClearVolume.do365_noncoop()
+    return (
+        AlertLevel("preventive", nc, 55.0, 110.0),
+        AlertLevel("corrective", nc, 55.0, 110.0),
+        AlertLevel("warning", nc, 25.0, 90.0),
+    )
 
 
 def _noncoop_levels() -> tuple[AlertLevel, ...]:
-    # DAIDALUS DO-365B "DWC_Non_Coop" alerter (2200 ft / 450 ft, no tau; 55, 55, 25 s). Its preventive
+    # DAIDALUS DO-365B "DWC_Non_Coop" alerter (2200 ft / 450 ft, no tau; alerting times 55, 55, 25 s,
+    # early alerting times 110, 110, 90 s: an issued level holds while lost within those). Its preventive
     # level differs from the corrective one only by guidance region; we give it the 700 ft vertical
     # threshold of the DO-365 Phase I preventive alert so that it warns earlier for vertical encounters.
     nc = WellClearVolume.do365_noncoop()
     return (
-        AlertLevel("preventive", WellClearVolume(nc.dthr_m, 700 * FT), 55.0),
-        AlertLevel("corrective", nc, 55.0),
-        AlertLevel("warning", nc, 25.0),
+        AlertLevel("preventive", WellClearVolume(nc.dthr_m, 700 * FT), 55.0, 110.0),
+        AlertLevel("corrective", nc, 55.0, 110.0),
+        AlertLevel("warning", nc, 25.0, 90.0),
     )
 
 
@@ -83,7 +116,13 @@ class AlertConfig:
     persistence_s : float
         Minimum time an issued level is held, s.
     hysteresis_s : float
-        Time the M-of-N level must stay below the issued one before it is lowered, s.
+        Time the M-of-N level must stay below the issued one before it is lowered, s (0: lowered
+        as soon as it falls, once ``persistence_s`` has passed, as DAIDALUS does).
+    gap_reset_s : float, optional
+        DAIDALUS' ``hysteresis_time``: an update more than this after the previous one (a data gap)
+        starts the filter afresh, its M-of-N memory reset with the new raw level counted M times, so
+        that level is issued at once (DAIDALUS' ``MofN.reset(value)``); so does the first update.
+        None (default): no reset, and a fresh filter needs M updates.
     z_h_pos, z_h_vel, z_v_pos, z_v_vel : float
         Sensor-uncertainty z-scores (see :func:`skyradar.daa.conflict.widened_thresholds`).
     collision_volume : WellClearVolume
@@ -132,6 +171,7 @@ class AlertConfig:
     period_s: float | None = None
     persistence_s: float = 4.0
     hysteresis_s: float = 5.0
+    gap_reset_s: float | None = None
     z_h_pos: float = 1.5
     z_h_vel: float = 1.0
     z_v_pos: float = 0.75
@@ -152,6 +192,8 @@ class AlertConfig:
             raise ValueError(f"alert config: period_s must be > 0, got {self.period_s}")
         if not self.hold_time_factor >= 1.0:
             raise ValueError(f"alert config: hold_time_factor must be >= 1, got {self.hold_time_factor}")
+        if self.gap_reset_s is not None and not self.gap_reset_s > 0:
+            raise ValueError(f"alert config: gap_reset_s must be > 0, got {self.gap_reset_s}")
         if not self.lost_track_hold_s >= 0.0:
             raise ValueError(f"alert config: lost_track_hold_s must be >= 0, got {self.lost_track_hold_s}")
         if not self.min_track_age_floor_s >= 0.0:
@@ -176,6 +218,19 @@ class AlertConfig:
 # misses outside 1.5 times the volume; with these, none, and no missed warning. The default seed 0
 # set is the held-out check. The gate scales with the time to CPA (velocity_unconverged).
 RADAR_ALERT_CONFIG = AlertConfig(period_s=1.0, max_velocity_sigma_mps=6.0, z_v_vel=1.0)
+
+
+# DAIDALUS' DO-365B non-cooperative alerting as its DO_365B_no_SUM configuration sets it: the
+# DWC_Non_Coop levels with their early alerting times, 2 of 4 updates, persistence 4 s, a level lowered
+# as soon as its M-of-N falls after that, the filter reset after a 5 s gap (hysteresis_time), the
+# sensor-uncertainty z-scores (h_vel_z_score at its 1.0 maximum), no track-age wait, no velocity gate,
+# no lost-track prediction. DAIDALUS takes 2 of 4 at its 1 Hz update: period_s = 1 keeps that meaning
+# at a radar's frame rate and is the same at 1 Hz.
+DO365B_ALERT_CONFIG = AlertConfig(
+    levels=do365b_noncoop_levels(), m=2, n=4, period_s=1.0, persistence_s=4.0, hysteresis_s=0.0,
+    gap_reset_s=5.0, z_h_pos=1.5, z_h_vel=1.0, z_v_pos=0.75, z_v_vel=1.5, min_track_age_s=0.0,
+    min_track_age_floor_s=0.0, lost_track_hold_s=0.0,
+)  # fmt: skip
 
 
 def velocity_unconverged(sigma_hv_mps: np.ndarray, tcpa_s: np.ndarray, config: AlertConfig) -> np.ndarray:
@@ -265,7 +320,7 @@ def alerting_rows(times_s: np.ndarray, required_age_s: np.ndarray) -> np.ndarray
 def _volume_levels(s, v, tcpa, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2, miss=None):
     """Highest level whose (widened) volume is lost within its alerting time, its entry time,
     the widened thresholds ``{level: (dthr_m, zthr_m)}`` of every level, and the highest level
-    lost within ``hold_time_factor`` times its alerting time. ``miss`` (miss distance and sigma,
+    lost within its hold time (:meth:`AlertLevel.hold_time_s`). ``miss`` (miss distance and sigma,
     m) clears the levels whose plain cylinder it passes outside."""
     level = np.zeros(len(s), int)
     hold = np.zeros(len(s), int)
@@ -276,7 +331,7 @@ def _volume_levels(s, v, tcpa, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2, m
         t_ref = np.clip(tcpa, 0.0, lv.alerting_time_s)
         dthr, zthr = widened_thresholds(lv.volume, cov_pos_m2, cov_vel_m2ps2, t_ref, *z)
         widened[k] = (dthr, zthr)
-        held_s = config.hold_time_factor * lv.alerting_time_s
+        held_s = lv.hold_time_s(config.hold_time_factor)
         t_in, _ = loss_of_well_clear_interval(s, v, lv.volume, held_s, dthr, zthr)
         possible = np.ones(len(s), bool)
         if miss is not None and lv.volume.tthr_s == 0.0 and lv.volume.tcoa_s == 0.0:
@@ -313,11 +368,11 @@ def raw_alert_levels(
     Returns
     -------
     dict of ndarray
-        ``level`` (0..3), ``hold_level`` (the highest level an issued alert is held at,
-        :attr:`AlertConfig.hold_time_factor`), ``t_in_s`` (entry time into the highest-level
-        volume lost, or the corrective one; NaN if none), ``tcpa_s``, ``hmd_m``, ``vmd_m``,
-        ``time_to_impact_s``, ``flarm_level``, ``dthr_m``, ``zthr_m`` (widened corrective
-        thresholds).
+        ``level`` (0..3), ``hold_level`` (the highest level an issued alert is held at: its
+        volume lost within its early alerting time, :meth:`AlertLevel.hold_time_s`), ``t_in_s``
+        (entry time into the highest-level volume lost, or the corrective one; NaN if none),
+        ``tcpa_s``, ``hmd_m``, ``vmd_m``, ``time_to_impact_s``, ``flarm_level``, ``dthr_m``,
+        ``zthr_m`` (widened corrective thresholds).
 
     Examples
     --------
@@ -368,6 +423,7 @@ class AlertFilter:
         self.level = 0
         self._raised_at = -np.inf
         self._below_since: float | None = None
+        self._seeded, self._seed = 0, (0, 0)  # a gap reset's copies of its first sample still counted
 
     def update(self, time_s: float, raw_level: int, hold_level: int | None = None) -> int:
         """Feed the raw level of the frame at ``time_s`` (s); return the issued level.
@@ -380,6 +436,13 @@ class AlertFilter:
         """
         cfg = self.config
         hold = max(int(raw_level), 0) if hold_level is None else max(int(hold_level), int(raw_level))
+        self._seeded = max(self._seeded - 1, 0)
+        if cfg.gap_reset_s is not None and (not self._times or time_s - self._times[-1] > cfg.gap_reset_s):
+            # DAIDALUS' reset (MofN.reset(value)): a fresh memory holding M copies of this sample,
+            # one of which each later update pushes out, and no alert.
+            self._raw, self._hold, self._times = [], [], []
+            self.level, self._raised_at, self._below_since = 0, -np.inf, None
+            self._seeded, self._seed = cfg.m - 1, (int(raw_level), hold)
         candidate, held = self._m_of_n_level(time_s, int(raw_level), hold)
         if candidate > self.level:
             self.level, self._raised_at, self._below_since = candidate, time_s, None
@@ -395,7 +458,8 @@ class AlertFilter:
 
     def _m_of_n_level(self, time_s: float, raw_level: int, hold_level: int) -> tuple[int, int]:
         """Highest level reached by M of the last N samples (frames, or periods of ``period_s``),
-        of the raw levels and of the hold levels."""
+        of the raw levels and of the hold levels; a reset's remaining copies of its first sample
+        (``gap_reset_s``) count with them."""
         cfg = self.config
         self._raw.append(raw_level)
         self._hold.append(hold_level)
@@ -413,7 +477,10 @@ class AlertFilter:
             counts = [sum(r >= k for r in known) for k in range(1, len(cfg.levels) + 1)]
             return max([k for k, c in enumerate(counts, start=1) if c >= need], default=0)
 
-        return reached(self._raw), reached(self._hold)
+        seeded_raw, seeded_hold = ([self._seed[0]], [self._seed[1]]) if self._seeded else ([], [])
+        return reached(seeded_raw * self._seeded + self._raw), reached(
+            seeded_hold * self._seeded + self._hold
+        )
 
 
 def filter_alert_levels(

@@ -81,20 +81,21 @@ def frame_latencies(frames: pd.DataFrame) -> pd.DataFrame:
 def realtime_summary(timed: pd.DataFrame) -> dict[str, Any]:
     """Frames, deadline misses and latency and processing percentiles (ms) of :func:`frame_latencies`.
 
-    ``utilisation`` is the processing time over the span of the frames' arrivals plus the last
-    one's processing; its complement is the margin.
+    ``load`` is the processing time over the span of the frames' arrivals plus the last one's
+    processing (the share of one processor the frames ask for; above 1 the queue only grows); its
+    complement is the margin.
 
     Examples
     --------
     >>> timed = frame_latencies(pd.DataFrame({"radar": "nose", "time_s": [0.0, 0.1, 0.2],
     ...                                       "processing_s": [0.05, 0.05, 0.05]}))
     >>> s = realtime_summary(timed)
-    >>> s["deadline_misses"], round(s["latency_p99_ms"], 1), round(s["utilisation"], 2)
+    >>> s["deadline_misses"], round(s["latency_p99_ms"], 1), round(s["load"], 2)
     (0, 50.0, 0.6)
     """
     latency, processing = timed["latency_s"].to_numpy(), timed["processing_s"].to_numpy()
     span = float(timed["time_s"].max() - timed["time_s"].min() + processing[-1]) if len(timed) else 0.0
-    utilisation = float(processing.sum() / span) if span > 0 else float("nan")
+    load = float(processing.sum() / span) if span > 0 else float("nan")
     q = (lambda x, p: 1e3 * float(np.quantile(x, p))) if len(timed) else (lambda x, p: float("nan"))
     return {
         "frames": int(len(timed)),
@@ -105,6 +106,6 @@ def realtime_summary(timed: pd.DataFrame) -> dict[str, Any]:
         "latency_max_ms": 1e3 * float(latency.max()) if len(timed) else float("nan"),
         "processing_median_ms": q(processing, 0.5),
         "processing_p99_ms": q(processing, 0.99),
-        "utilisation": utilisation,
-        "margin": 1.0 - utilisation,
+        "load": load,
+        "margin": 1.0 - load,
     }

@@ -112,7 +112,8 @@ def run_realtime(
 ) -> dict:
     """Process three heads' frames at ``frame_rate_hz`` each for ``seconds`` of wall time on one core.
 
-    Returns deadline misses, latency and processing-time percentiles (ms), the load on the core and the margin.
+    Returns deadline misses, latency and processing-time percentiles (ms), the load on the core and
+    the margin.
     """
     heads = []
     for head in THREE_HEAD_RADARS:

@@ -35,6 +35,7 @@ __all__ = [
     "score_layout",
     "layout_heads",
     "warning_held",
+    "warning_flickers",
     "FRAME_RATE_HZ",
     "LAYOUTS",
     "SUPPRESSION",
@@ -110,6 +111,20 @@ def warning_held(warn_times_s: np.ndarray, status: pd.DataFrame, t_cpa_s: float)
     return bool(gap <= 1.5 * frame_s + 1e-9), gap
 
 
+def warning_flickers(warn_times_s: np.ndarray, frame_s: float, t_cpa_s: float) -> int:
+    """How often a warning drops and comes back before the closest approach: the gaps longer than
+    1.5 frames between the frames it is shown on.
+
+    Examples
+    --------
+    >>> warning_flickers(np.array([10.0, 10.1, 10.2, 14.0, 14.1, 30.0]), 0.1, 20.0)
+    1
+    """
+    warn = np.unique(np.asarray(warn_times_s, float))
+    warn = warn[warn <= t_cpa_s]
+    return int(np.sum(np.diff(warn) > 1.5 * frame_s + 1e-9)) if warn.size > 1 else 0
+
+
 def score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[str, Any]:
     """One layout's result row from its tracks and alerts (``chain``) and its heads' truth."""
     tracks, alerts = chain["tracks"], chain["alerts"]
@@ -122,6 +137,9 @@ def score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[s
     row["warning_held"], row["warning_gap_max_s"] = warning_held(
         warn["time_s"].to_numpy(float)[mine], status, row["t_cpa_s"]
     )
+    ft = status["time_s"].to_numpy(float)
+    frame_s = float(np.median(np.diff(ft))) if ft.size > 1 else 0.0
+    row["warning_flickers"] = warning_flickers(warn["time_s"].to_numpy(float)[mine], frame_s, row["t_cpa_s"])
     row["cause"] = unwarned_cause(status, row["t_lowc_s"], row["t_warning_s"], window)
     other = warn["time_s"].to_numpy(float)[~mine]
     own_agl = (

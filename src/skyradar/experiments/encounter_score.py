@@ -175,6 +175,10 @@ def summarise_layout(res: pd.DataFrame, late_lead_s: float) -> dict[str, Any]:
     held = res["warning_held"].astype(bool) if "warning_held" in res else pd.Series(True, index=res.index)
     s.update(
         warnings_not_held=int((warned & ~held).sum()),
+        alert_flickers=int(res["warning_flickers"].sum()) if "warning_flickers" in res else 0,
+        encounters_with_alert_flicker=int((res["warning_flickers"] > 0).sum())
+        if "warning_flickers" in res
+        else 0,
         warned_before_lowc=int(in_time.sum()),
         warned_before_lowc_fraction=float(in_time.sum() / max(int(conflict.sum()), 1)),
         warned_before_lowc_fraction_ci95=rate_interval(int(in_time.sum()), int(conflict.sum())),

@@ -223,7 +223,8 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
     settings = {"n": 2, "seed": 5, "frame_rate_hz": 4.7, "buffer": 1.5, "uncertainty": True,
                 "terrains": ["none"], "layouts": ["single"], "navigation": "ga-typical",
                 "suppression": "auto", "late_lead_s": 12.5, "simulation": LIGHT,
-                "rx_layout": "square", "family": "synthetic", "split": "development"}  # fmt: skip
+                "rx_layout": "square", "family": "synthetic", "split": "development",
+                "alert_config": "radar"}  # fmt: skip
     key = {**settings, "version": code_version()}
     _, save = E._partial_store(tmp_path, key)
     fake = {"t_lowc_s": np.nan, "t_cpa_s": 120.0, "conflict": False, "may_alert": False,

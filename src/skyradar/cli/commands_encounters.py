@@ -132,6 +132,14 @@ def experiment_encounters(
             "300-700 m above hills and Jacksboro).",
         ),
     ] = "synthetic",
+    alert_settings: Annotated[
+        str,
+        typer.Option(
+            "--alert-config",
+            help="Alerting settings the chain warns with: radar (the default, every result of the docs) "
+            "or do365b (DAIDALUS' DO-365B non-cooperative alerter).",
+        ),
+    ] = "radar",
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -149,6 +157,7 @@ def experiment_encounters(
 
     check_workers(workers)
     check_choice("--family", family, FAMILIES)
+    check_choice("--alert-config", alert_settings, ("radar", "do365b"))
     if family == "real-flights":
         from skyradar.scene.sample_flights import sample_flights
 
@@ -168,6 +177,7 @@ def experiment_encounters(
             uncertainty=not no_uncertainty, progress=lambda k: bar.update(task, completed=k),
             terrains=tuple(terrains), layouts=layouts, navigation=navigation, rx_layout=rx_layout,
             family=family, command="skyradar " + " ".join(sys.argv[1:]), scheduler=scheduler,
+            alert_settings=alert_settings,
         )  # fmt: skip
     emit_result(result, as_json, "encounters")
 
@@ -184,7 +194,7 @@ def bench_encounter(
     as_json: JsonOption = False,
 ) -> None:
     """CPU seconds of one encounter end to end per terrain, with each stage's time, against 9 CPU-s."""
-    from skyradar.benchmarks.encounter import BENCH_TERRAINS, run_encounter_bench
+    from skyradar.experiments.encounter_cost import BENCH_TERRAINS, run_encounter_bench
     from skyradar.experiments.encounter_terrain import TERRAINS
 
     terrains = tuple(terrain) if terrain else BENCH_TERRAINS

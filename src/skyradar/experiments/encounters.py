@@ -27,7 +27,7 @@ from typing import Any
 import pandas as pd
 
 from skyradar.code_version import code_version
-from skyradar.daa.alerting import RADAR_ALERT_CONFIG
+from skyradar.daa.alert_config import ALERT_CONFIGS
 from skyradar.errors import InputError
 from skyradar.experiments.encounter_chain import FRAME_RATE_HZ, LAYOUTS, SUPPRESSION, run_encounter
 from skyradar.experiments.encounter_report import write_report
@@ -190,6 +190,7 @@ def run(
     family: str = "synthetic",
     command: str | None = None,
     scheduler: str | None = None,
+    alert_settings: str = "radar",
 ) -> dict:
     """Run the encounter set; write ``encounters.parquet``/``.csv`` (one row per terrain, encounter
     and layout), ``summary.json``, ``summary_rows.csv`` and the figures into ``out_dir``; return the
@@ -211,15 +212,18 @@ def run(
     the evaluation split, never looked at while tuning; smaller ones are for development.
     Finished encounters are kept in ``encounters.partial.parquet`` while the run goes on; a run that
     was interrupted resumes from them when started again with the same settings. ``scheduler`` and
-    ``workers``: where the encounters run (:func:`run_encounters`).
+    ``workers``: where the encounters run (:func:`run_encounters`). ``alert_settings`` names the
+    alerting settings (:data:`skyradar.daa.alert_config.ALERT_CONFIGS`: ``radar``, ``do365b``).
     """
     terrains, layouts = tuple(terrains), tuple(x for x in LAYOUTS if x in layouts)
     _check(n_encounters, terrains, tuple(layouts) or ("",))
     check_rx_layout(rx_layout, "--rx-layout:")
     t0 = time.perf_counter()
+    cfg = ALERT_CONFIGS.get(alert_settings)
+    if cfg is None:
+        raise InputError(f"--alert-config: must be one of {', '.join(ALERT_CONFIGS)}, got {alert_settings!r}")
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    cfg = RADAR_ALERT_CONFIG
     if not uncertainty:
         cfg = replace(cfg, z_h_pos=0.0, z_h_vel=0.0, z_v_pos=0.0, z_v_vel=0.0)
     if family not in FAMILIES:
@@ -235,6 +239,7 @@ def run(
     settings = {"n": n_encounters, "seed": seed, "frame_rate_hz": frame_rate_hz, "buffer": buffer,
                 "uncertainty": uncertainty, "terrains": list(terrains), "layouts": list(layouts),
                 "navigation": navigation, "suppression": SUPPRESSION, "late_lead_s": late_lead_s,
+                "alert_config": alert_settings,
                 "simulation": simulation or {}, "rx_layout": rx_layout, "family": family,
                 "split": "evaluation" if seed >= EVALUATION_SEEDS_FROM else "development"}  # fmt: skip
     version = code_version()

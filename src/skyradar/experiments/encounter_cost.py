@@ -1,4 +1,4 @@
-"""Benchmark: what one encounter costs end to end, per terrain and per stage.
+"""What one encounter costs end to end, per terrain and per stage (`skyradar bench encounter`).
 
 A DAA study lives on how many encounters it can fly. This runs the first encounter of the
 synthetic set (:func:`skyradar.experiments.encounter_set.make_encounters`, seed 0: head-on) through

@@ -48,7 +48,7 @@ def site(tmp_path_factory) -> Path:
 def test_results_page_holds_the_measured_numbers(site):
     sys.path.insert(0, str(SOURCE / "_ext"))
     try:
-        from skyradar_docs import format_value
+        from skyradar_docs import _with_intervals, format_value
     finally:
         sys.path.remove(str(SOURCE / "_ext"))
     text = _text(site / "results.html")
@@ -56,15 +56,21 @@ def test_results_page_holds_the_measured_numbers(site):
     assert files, "no measured summaries in docs/results"
     for path in files:
         summary = json.loads(path.read_text())
-        row = summary["rows"][0]
+        row = _with_intervals(summary["rows"][0])  # the interval from the counts where not recorded
         assert path.name in text
         assert summary["date_utc"] in text
         assert summary["command"] in text
         # The row's terrain, layout and headline numbers, in the page's table order.
         columns = ("terrain", "layout", "encounters", "conflicts", "observable_conflicts", "missed_warnings")
-        columns += ("false_warnings", "false_warning_rate", "median_warning_lead_s")
+        columns += ("false_warnings", "false_warning_rate", "false_warning_rate_ci95")
+        columns += ("median_warning_lead_s",)
         cells = [format_value(k, row[k]) for k in columns]
         assert " ".join(cells) in text, f"{path.name}: first row {cells} not on the results page"
+    benchmarks = sorted((RESULTS / "benchmarks").glob("*.json"))
+    assert benchmarks, "no saved benchmark results in docs/results/benchmarks"
+    for path in benchmarks:
+        result = json.loads(path.read_text())
+        assert path.name in text and result["date_utc"] in text and result["command"] in text
 
 
 def test_cli_reference_names_the_commands(site):

@@ -4,6 +4,9 @@
     One section per measured summary in ``docs/results/*.json``: its settings and provenance
     (command, version, date, load average) and a table of the headline numbers of each row. No
     number on the results page is written by hand.
+``skyradar-benchmarks``
+    One section per saved benchmark result in ``docs/results/benchmarks/*.json`` (the last line of
+    ``skyradar bench NAME --json``): its provenance, then every key it measured.
 ``skyradar-cli``
     The command-line reference, read from the Typer app's click command tree
     (``typer.main.get_command``): each command's help, usage, arguments and options.
@@ -52,15 +55,18 @@ from sphinx.util.nodes import nested_parse_with_titles
 # Settings of one summary, in the order shown; `split` and `load_average_1min` are shown when present.
 SUMMARY_FIELDS = ("family", "terrains", "layouts", "encounters", "seed", "split")
 PROVENANCE_FIELDS = ("command", "version", "date_utc", "load_average_1min")
-# Headline numbers of one row (a terrain and a layout); `warnings_not_held` only when present.
+# Headline numbers of one row (a terrain and a layout); `warnings_not_held` and `alert_flickers` only
+# when present.
 ROW_FIELDS = (
     "conflicts",
     "observable_conflicts",
     "missed_warnings",
     "false_warnings",
     "false_warning_rate",
+    "false_warning_rate_ci95",
     "median_warning_lead_s",
     "warnings_not_held",
+    "alert_flickers",
 )
 # Decimals of the fractional numbers; the rest are counts.
 DECIMALS = {"false_warning_rate": 3, "median_warning_lead_s": 1, "load_average_1min": 2}
@@ -76,6 +82,8 @@ def format_value(name: str, value: object) -> str:
     """
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return "n/a"
+    if name.endswith("_ci95") and isinstance(value, list | tuple) and len(value) == 2:
+        return "n/a" if any(math.isnan(v) for v in value) else f"{value[0]:.3f}-{value[1]:.3f}"
     if isinstance(value, list | tuple):
         return ", ".join(str(v) for v in value)
     if isinstance(value, float) and name in DECIMALS:
@@ -83,6 +91,22 @@ def format_value(name: str, value: object) -> str:
     if isinstance(value, float) and value.is_integer():
         return str(int(value))
     return str(value)
+
+
+# Rates and the counts they come from: a summary written before it recorded the rate's interval gets
+# it from those counts here (the same Wilson interval skyradar.experiments.encounter_set writes).
+RATE_COUNTS = {"false_warning_rate": ("false_warnings", "must_not_alert_encounters")}
+
+
+def _with_intervals(row: dict) -> dict:
+    """``row`` with each rate's ``_ci95`` interval, from its counts where the summary lacks it."""
+    from skyradar.experiments.encounter_set import rate_interval
+
+    row = dict(row)
+    for rate, (count, trials) in RATE_COUNTS.items():
+        if f"{rate}_ci95" not in row and count in row and trials in row:
+            row[f"{rate}_ci95"] = rate_interval(int(row[count]), int(row[trials]))
+    return row
 
 
 def _inline(text: str) -> list[nodes.Node]:
@@ -174,8 +198,9 @@ class ResultsDirective(SphinxDirective):
             body += nodes.literal(value, value) if key in ("command", "version") else nodes.Text(value)
             fields += nodes.field("", nodes.field_name(key, key), nodes.field_body("", body))
         section += fields
-        rows = summary.get("rows") or [summary]
-        shown = [f for f in ROW_FIELDS if f != "warnings_not_held" or any(f in r for r in rows)]
+        rows = [_with_intervals(r) for r in summary.get("rows") or [summary]]
+        optional = ("warnings_not_held", "alert_flickers")  # shown where the summary has them
+        shown = [f for f in ROW_FIELDS if f not in optional or any(f in r for r in rows)]
         section += _table(
             # A zero-width space after each underscore lets the long column names wrap.
             [f.replace("_", "_\u200b") for f in ("terrain", "layout", "encounters", *shown)],
@@ -183,6 +208,50 @@ class ResultsDirective(SphinxDirective):
             classes=["skyradar-results-rows"],
         )
         return section
+
+
+class BenchmarksDirective(SphinxDirective):
+    """``.. skyradar-benchmarks:: [folder]``: the saved ``skyradar bench ... --json`` results
+    (default ``docs/results/benchmarks``), each with its provenance and every measured key."""
+
+    optional_arguments = 1
+
+    def run(self) -> list[nodes.Node]:
+        folder = Path(self.env.srcdir, self.arguments[0] if self.arguments else "../results/benchmarks").resolve()
+        files = sorted(folder.glob("*.json"))
+        if not files:
+            return [self.state.document.reporter.warning(f"no benchmark JSON in {folder}", line=self.lineno)]
+        out: list[nodes.Node] = []
+        for path in files:
+            self.env.note_dependency(str(path))
+            result = json.loads(path.read_text())
+            section = _section(self, path.name, "bench-" + path.stem)
+            fields = nodes.field_list()
+            for key in PROVENANCE_FIELDS:
+                value = format_value(key, result.get(key))
+                body = nodes.paragraph()
+                body += nodes.literal(value, value) if key in ("command", "version") else nodes.Text(value)
+                fields += nodes.field("", nodes.field_name(key, key), nodes.field_body("", body))
+            section += fields
+            rows = [
+                [key.replace("_", "_\u200b"), _bench_value(value)]
+                for key, value in result.items()
+                if key not in PROVENANCE_FIELDS
+            ]
+            section += _table(["key", "value"], rows, classes=["skyradar-bench"])
+            out.append(section)
+        return out
+
+
+def _bench_value(value: object) -> str:
+    """A measured value as shown: floats to four significant digits, lists and the rest as JSON."""
+    if isinstance(value, bool) or value is None:
+        return str(value)
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    if isinstance(value, int | str):
+        return str(value)
+    return json.dumps(value)
 
 
 class AlertConfigDirective(SphinxDirective):
@@ -559,6 +628,7 @@ class ColumnsDirective(SphinxDirective):
 
 def setup(app: Sphinx) -> dict:
     app.add_directive("skyradar-results", ResultsDirective)
+    app.add_directive("skyradar-benchmarks", BenchmarksDirective)
     app.add_directive("skyradar-cli", CliDirective)
     app.add_directive("skyradar-api", ApiDirective)
     app.add_directive("skyradar-alert-config", AlertConfigDirective)

@@ -11,7 +11,8 @@
     The command-line reference, read from the Typer app's click command tree
     (``typer.main.get_command``): each command's help, usage, arguments and options.
 ``skyradar-alert-config``
-    The alerting settings, DAIDALUS' defaults beside the radar's, read from the package.
+    The alerting settings, DAIDALUS' DO-365B non-cooperative alerter beside the radar's, read from
+    the package.
 ``skyradar-api``
     A subpackage's API: its docstring, a summary table of its public modules and an ``automodule``
     section per module. Private modules (``_name``) and deprecated aliases are left out.
@@ -217,7 +218,8 @@ class BenchmarksDirective(SphinxDirective):
     optional_arguments = 1
 
     def run(self) -> list[nodes.Node]:
-        folder = Path(self.env.srcdir, self.arguments[0] if self.arguments else "../results/benchmarks").resolve()
+        where = self.arguments[0] if self.arguments else "../results/benchmarks"
+        folder = Path(self.env.srcdir, where).resolve()
         files = sorted(folder.glob("*.json"))
         if not files:
             return [self.state.document.reporter.warning(f"no benchmark JSON in {folder}", line=self.lineno)]
@@ -255,24 +257,30 @@ def _bench_value(value: object) -> str:
 
 
 class AlertConfigDirective(SphinxDirective):
-    """``.. skyradar-alert-config::``: every field of ``AlertConfig()`` (DAIDALUS' DO-365B settings)
-    beside ``RADAR_ALERT_CONFIG`` (``skyradar alert --config radar``), read from the package."""
+    """``.. skyradar-alert-config::``: every field of ``DO365B_ALERT_CONFIG`` (DAIDALUS' DO-365B
+    non-cooperative alerter, ``--config do365b``) beside ``RADAR_ALERT_CONFIG`` (``--config radar``),
+    read from the package."""
 
     def run(self) -> list[nodes.Node]:
         import dataclasses
 
-        from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig
+        from skyradar.daa.alerting import DO365B_ALERT_CONFIG, RADAR_ALERT_CONFIG, AlertConfig
 
-        default = AlertConfig()
+        def level(lv) -> str:
+            early = lv.early_alerting_time_s
+            hold = f" (held to {early:g} s)" if early is not None else ""
+            volume = f"{lv.volume.dthr_m:.0f} m x {lv.volume.zthr_m:.0f} m"
+            return f"{lv.name} {volume}, {lv.alerting_time_s:g} s{hold}"
+
         rows = []
         for f in dataclasses.fields(AlertConfig):
-            a, b = getattr(default, f.name), getattr(RADAR_ALERT_CONFIG, f.name)
+            a, b = getattr(DO365B_ALERT_CONFIG, f.name), getattr(RADAR_ALERT_CONFIG, f.name)
             if f.name == "levels":
-                a, b = (", ".join(f"{lv.name} {lv.alerting_time_s:g} s" for lv in x) for x in (a, b))
+                a, b = ("; ".join(level(lv) for lv in x) for x in (a, b))
             elif f.name == "collision_volume":
                 a, b = (f"{x.dthr_m:g} m x {x.zthr_m:g} m" for x in (a, b))
             rows.append([nodes.paragraph("", "", nodes.literal(f.name, f.name)), str(a), str(b)])
-        return [_table(["field", "default", "radar"], rows, classes=["skyradar-alert-config"])]
+        return [_table(["field", "do365b", "radar"], rows, classes=["skyradar-alert-config"])]
 
 
 def _help_paragraphs(text: str | None) -> list[str]:

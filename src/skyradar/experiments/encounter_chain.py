@@ -27,6 +27,7 @@ from skyradar.experiments.encounter_set import (
     score_encounter,
 )
 from skyradar.experiments.encounter_terrain import OWN_AGL_RANGE_M, mirror_below_ground, own_altitude_m
+from skyradar.experiments.sensor_figures import intruder_track_figures
 from skyradar.scene.scenario import Scenario
 
 __all__ = [
@@ -147,6 +148,7 @@ def score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[s
     )
     warned = {int(i) for i in warn["track_id"]}
     row.update(track_counts(confirmed_rows(tracks), warned, labels, built.terrain, own_agl))
+    row.update(intruder_track_figures(tracks, labels, truths[0]))
     row.update(
         t_other_warning_s=float(other.min()) if other.size else float("nan"),
         tracks=int(tracks["track_id"].nunique()),

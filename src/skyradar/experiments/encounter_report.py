@@ -16,6 +16,7 @@ import pandas as pd
 
 from skyradar.experiments.encounter_score import CAUSES, summarise_layout
 from skyradar.experiments.encounter_set import plot_encounters
+from skyradar.experiments.sensor_figures import plot_sensor_figures
 from skyradar.io.atomic import savefig_atomic, write_csv_atomic
 from skyradar.io.tables import write_table
 
@@ -132,7 +133,10 @@ def write_report(
     rows = summary_rows(res, late_lead_s)
     buffer = settings["buffer"]
     write_table(res, out_dir / "encounters.parquet")
-    write_csv_atomic(res, out_dir / "encounters.csv", index=False)
+    # The per-encounter track-error samples stay in the Parquet table (lists do not fit a CSV cell).
+    write_csv_atomic(
+        res.drop(columns=["track_errors"], errors="ignore"), out_dir / "encounters.csv", index=False
+    )
     flat = [{k: v for k, v in r.items() if not isinstance(v, dict)} for r in rows]
     write_csv_atomic(pd.DataFrame(flat), out_dir / "summary_rows.csv", index=False)
     first = res["terrain"].iloc[0]
@@ -141,6 +145,9 @@ def write_report(
         g = res[(res["terrain"] == r["terrain"]) & (res["layout"] == r["layout"])]
         name = "encounters.png" if r is primary else f"encounters_{r['terrain']}_{r['layout']}.png"
         plot_encounters(g, out_dir / name, buffer, warning_time_s)
+        plot_sensor_figures(
+            g, out_dir / f"sensor_{r['terrain']}_{r['layout']}.png", f"{r['terrain']}, {r['layout']}"
+        )
     plot_causes(rows, out_dir / "causes.png")
     once = res.drop_duplicates(["terrain", "encounter"])
     mine = res[(res["terrain"] == first) & (res["layout"] == primary["layout"])]

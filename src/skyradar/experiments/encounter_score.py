@@ -32,6 +32,7 @@ import numpy as np
 import pandas as pd
 
 from skyradar.experiments.encounter_set import rate_interval, summarise
+from skyradar.experiments.sensor_figures import sensor_summary
 from skyradar.units import wrap_angle
 
 __all__ = ["CAUSES", "frame_status", "conflict_cause", "unwarned_cause", "track_counts", "summarise_layout"]
@@ -192,6 +193,7 @@ def summarise_layout(res: pd.DataFrame, late_lead_s: float) -> dict[str, Any]:
         ground_tracks_per_min=float(res["ground_tracks"].sum() / minutes) if minutes else float("nan"),
         ground_track_warnings=int(res["ground_warning_tracks"].sum()),
         intruder_tracked_encounters=int(frag.size),
+        sensor=sensor_summary(res),
         track_fragments_per_intruder={
             "median": float(frag.median()) if frag.size else float("nan"),
             "mean": float(frag.mean()) if frag.size else float("nan"),

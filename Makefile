@@ -60,12 +60,12 @@ test-browser: $(STAMP_DEV) browser-deps
 	SKYRADAR_SCREENSHOT_DIR=$(OUT)/browser $(BIN)/python -m pytest -q -m browser tests/browser
 
 lint: $(STAMP_DEV)
-	$(BIN)/ruff check src tests
-	$(BIN)/ruff format --check src tests
+	$(BIN)/ruff check src tests examples
+	$(BIN)/ruff format --check src tests examples
 
 format: $(STAMP_DEV)
-	$(BIN)/ruff format src tests
-	$(BIN)/ruff check --fix src tests
+	$(BIN)/ruff format src tests examples
+	$(BIN)/ruff check --fix src tests examples
 
 # The documentation site, offline, warnings as errors: open $(OUT)/docs/index.html. The results page,
 # the CLI reference and the API reference are generated from docs/results/ and the package.

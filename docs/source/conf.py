@@ -23,13 +23,26 @@ extensions = [
     "sphinx.ext.autosummary",
     "numpydoc",
     "myst_parser",
+    "sphinx_gallery.gen_gallery",
     "skyradar_docs",
 ]
+# The examples gallery: examples/*.py at the repository's root, run at every build (a script is run
+# again only when it changed); its pages are generated into gallery/, which git ignores.
+sphinx_gallery_conf = {
+    "examples_dirs": "../../examples",
+    "gallery_dirs": "gallery",
+    "filename_pattern": r"plot_",
+    "download_all_examples": False,
+    "remove_config_comments": True,
+    "abort_on_example_error": True,
+    "show_memory": False,
+    "matplotlib_animations": False,
+}
 # No sphinx.ext.intersphinx: it would fetch other projects' inventories at build time.
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "_ext"]
+exclude_patterns = ["_build", "_ext", "gallery/*.ipynb", "gallery/*.py", "gallery/*.codeobj.json", "gallery/*.md5"]
 templates_path: list[str] = []
 
 # API reference: numpydoc docstrings, read leniently (no per-docstring validation).

@@ -4,9 +4,9 @@ One frame is: predict every track (one batched Kalman step), gate and assign det
 (:func:`skyradar.track.association.associate`, Hungarian), update the assigned tracks with the
 model's innovation, de-alias the radial velocity (radar model), start tentative tracks from
 unassigned detections, confirm them M-of-N (sliding window), and close tracks after misses.
-The parts are plain objects passed in, as in Stone Soup: the motion model (:mod:`skyradar.track.models`), the
-associator function, the initiator (:class:`~skyradar.track.initiation.MOfN`) and the deleter
-(:class:`~skyradar.track.deletion.MissDeleter`).
+The parts are objects passed in, as in Stone Soup, each filling a role typed in
+:mod:`skyradar.track.components`: the motion model (:mod:`skyradar.track.models`), the associator,
+the initiator, the deleter and the reacquirer.
 
 Tracks live as a struct of arrays (states ``(n, 4)``, covariances ``(n, 4, 4)``, counters), so the
 cost per frame is a fixed number of numpy calls, whatever the number of tracks.
@@ -14,11 +14,10 @@ cost per frame is a fixed number of numpy calls, whatever the number of tracks.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 
 from skyradar.track.association import Association, associate
+from skyradar.track.components import Associator, Deleter, Initiator, Reacquirer
 from skyradar.track.dealias import dealias_velocity, push_history, range_rate_fit
 from skyradar.track.deletion import MissDeleter
 from skyradar.track.initiation import MOfN, push_hit
@@ -45,14 +44,20 @@ class RangeDopplerTracker:
     config : TrackerConfig, optional
     pixel_size : (float, float)
         (dR [m], dV [m/s]) of the image, for the l2 metric.
-    associator : callable, optional
-        Same signature as :func:`~skyradar.track.association.associate` (the default).
-    initiator, deleter : optional
-        Objects with the :class:`MOfN` / :class:`MissDeleter` interface.
-    reacquirer : optional
-        Object with the :class:`~skyradar.track.reacquisition.LostTracks` interface: keeps closed
-        confirmed tracks and gives their id to a newly confirmed track on the same aircraft
-        (default from ``config.reacquire_s``; ``reacquire_s=0`` turns it off).
+    associator : Associator, optional
+        :class:`~skyradar.track.components.Associator`; default
+        :func:`~skyradar.track.association.associate`.
+    initiator : Initiator, optional
+        :class:`~skyradar.track.components.Initiator`; default :class:`MOfN` of the config's
+        ``confirm_m`` of ``confirm_n``.
+    deleter : Deleter, optional
+        :class:`~skyradar.track.components.Deleter`; default :class:`MissDeleter` of the config's
+        ``max_misses`` and ``max_coast_s``.
+    reacquirer : Reacquirer, optional
+        :class:`~skyradar.track.components.Reacquirer`: keeps closed confirmed tracks and gives
+        their id to a newly confirmed track on the same aircraft (default
+        :class:`~skyradar.track.reacquisition.LostTracks` from ``config.reacquire_s``;
+        ``reacquire_s=0`` turns it off).
     report_tentative : bool
         Also report tentative tracks (tracks born in this frame are reported from the next one).
 
@@ -71,11 +76,11 @@ class RangeDopplerTracker:
         model: MotionModel,
         config: TrackerConfig | None = None,
         pixel_size: tuple[float, float] = (14.99, 0.313),
-        associator: Callable[..., Association] = associate,
-        initiator: MOfN | None = None,
-        deleter: MissDeleter | None = None,
+        associator: Associator = associate,
+        initiator: Initiator | None = None,
+        deleter: Deleter | None = None,
         report_tentative: bool = False,
-        reacquirer: LostTracks | None = None,
+        reacquirer: Reacquirer | None = None,
     ) -> None:
         self.model = model
         self.report_tentative = bool(report_tentative)

@@ -1,0 +1,93 @@
+"""The roles a tracker is composed of, as typed interfaces (Stone Soup's components).
+
+:class:`~skyradar.track.tracker.RangeDopplerTracker` is put together from parts passed in: an
+associator that gates and assigns detections to tracks, an initiator that confirms tentative tracks,
+a deleter that closes tracks, and a reacquirer that gives a lost track's id back to the aircraft when
+it is found again. Each role is a :class:`typing.Protocol`: any object with the methods (and the
+attributes the tracker reads) fits, without inheriting from anything, and a type checker or
+``isinstance`` (the protocols are runtime-checkable) says whether it does. The motion model
+(prediction and update matrices) is the :class:`~skyradar.track.models.MotionModel` value the
+tracker is built with; the batched Kalman step itself is :mod:`skyradar.track.kalman`.
+
+The shipped parts: :func:`~skyradar.track.association.associate` (Hungarian assignment in a
+Mahalanobis or pixel gate, Doppler-alias aware), :class:`~skyradar.track.initiation.MOfN`,
+:class:`~skyradar.track.deletion.MissDeleter` and :class:`~skyradar.track.reacquisition.LostTracks`.
+
+Examples
+--------
+>>> from skyradar.track.deletion import MissDeleter
+>>> from skyradar.track.initiation import MOfN
+>>> isinstance(MissDeleter(), Deleter), isinstance(MOfN(3, 4), Initiator)
+(True, True)
+"""
+
+from __future__ import annotations
+
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+from skyradar.track.association import Association
+
+__all__ = ["Associator", "Initiator", "Deleter", "Reacquirer"]
+
+
+@runtime_checkable
+class Associator(Protocol):
+    """Gates and assigns one frame's detections to the predicted tracks."""
+
+    def __call__(
+        self,
+        z_pred: np.ndarray,
+        S: np.ndarray,
+        z: np.ndarray,
+        gate: float,
+        doppler_width_mps: float | None = None,
+        range_wrap_m: np.ndarray | None = None,
+        metric: str = "mahalanobis",
+        pixel_size: tuple[float, float] = (1.0, 1.0),
+        max_alias: int = 2,
+    ) -> Association:
+        """Pairs of (track row of ``z_pred``, detection row of ``z``) with their innovations.
+
+        ``z_pred`` (n, 2) and ``z`` (m, 2) are (range [m], radial velocity [m/s]); ``S`` (n, 2, 2)
+        the innovation covariances; ``gate`` the largest assignment cost kept.
+        """
+        ...
+
+
+@runtime_checkable
+class Initiator(Protocol):
+    """Confirms tentative tracks on a sliding window of hits (``m`` of the last ``n`` frames)."""
+
+    m: int
+    n: int
+
+    def window_status(self, window: np.ndarray, misses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Which tracks are confirmed and which failed, from each track's hit window (a bit per
+        frame, newest lowest) and its consecutive misses."""
+        ...
+
+
+@runtime_checkable
+class Deleter(Protocol):
+    """Closes tracks that went unobserved."""
+
+    max_coast_s: float
+
+    def delete(self, misses: np.ndarray, time_since_update_s: np.ndarray) -> np.ndarray:
+        """Boolean mask of tracks to close, from their consecutive misses and time without an update, s."""
+        ...
+
+
+@runtime_checkable
+class Reacquirer(Protocol):
+    """Keeps closed confirmed tracks and gives their id to a new track on the same aircraft."""
+
+    def add_anchored(self, tracks: dict[str, np.ndarray], mask: np.ndarray) -> None:
+        """Keep the tracks ``mask`` of the tracker's struct of arrays, at their anchor states."""
+        ...
+
+    def match(self, x: np.ndarray, P: np.ndarray, time_s: float) -> tuple[np.ndarray, np.ndarray]:
+        """Lost id (-1: none) and velocity alias shift for each newly confirmed state ``x``, ``P``."""
+        ...

@@ -28,7 +28,7 @@ def code_version() -> str:
     # The package that holds this module (always imported before it); looked up, not imported, so
     # that this module stays below every other in the layers.
     digest = hashlib.sha256()
-    root = Path(sys.modules["skyradar"].__file__).parent
+    root = Path(str(sys.modules["skyradar"].__file__)).parent
     for path in sorted(root.rglob("*.py")):
         digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes())
     return f"{version('skyradar')}+{digest.hexdigest()[:16]}"

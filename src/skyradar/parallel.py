@@ -163,12 +163,12 @@ def map_frame_chunks(
     """
     bounds = [(s, min(s + chunk_frames, n_frames)) for s in range(0, n_frames, chunk_frames)]
     if scheduler is None and not workers:
-        results = []
+        here = []
         for start, stop in bounds:
-            results.append(job(path, start, stop, *args))
+            here.append(job(path, start, stop, *args))
             if progress:
                 progress(stop - start)
-        return results
+        return here
     client = connect(scheduler, workers)
     from distributed import as_completed
 

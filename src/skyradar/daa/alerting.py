@@ -335,7 +335,8 @@ def _volume_levels(s, v, tcpa, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2, m
         t_in, _ = loss_of_well_clear_interval(s, v, lv.volume, held_s, dthr, zthr)
         possible = np.ones(len(s), bool)
         if miss is not None and lv.volume.tthr_s == 0.0 and lv.volume.tcoa_s == 0.0:
-            possible = ~cannot_enter(*miss, lv.volume.dthr_m, lv.volume.zthr_m)
+            miss_m, sigma_m = miss
+            possible = ~cannot_enter(miss_m, sigma_m, lv.volume.dthr_m, lv.volume.zthr_m)
         hit = possible & (t_in <= lv.alerting_time_s)
         level = np.where(hit, k, level)
         hold = np.where(possible & np.isfinite(t_in), k, hold)

@@ -132,6 +132,15 @@ def experiment_encounters(
             "300-700 m above hills and Jacksboro).",
         ),
     ] = "synthetic",
+    split: Annotated[
+        str | None,
+        typer.Option(
+            "--split",
+            help="Which split the seed must belong to: development (seeds below 7000: tune on these) or "
+            "evaluation (7000 and up: report on these, never tune). Refused when the seed is in the "
+            "other; the summary records the split either way.",
+        ),
+    ] = None,
     alert_settings: Annotated[
         str,
         typer.Option(
@@ -149,8 +158,15 @@ def experiment_encounters(
     missed, late and false warnings, clutter and ground tracks, track fragments, warning lead.
     """
     from skyradar.cli.commands_sim import frame_progress
+    from skyradar.errors import InputError
     from skyradar.experiments.encounter_terrain import parse_terrains
-    from skyradar.experiments.encounters import DEFAULT_ENCOUNTERS, DEFAULT_TERRAIN_ENCOUNTERS, FAMILIES, run
+    from skyradar.experiments.encounters import (
+        DEFAULT_ENCOUNTERS,
+        DEFAULT_TERRAIN_ENCOUNTERS,
+        EVALUATION_SEEDS_FROM,
+        FAMILIES,
+        run,
+    )
     from skyradar.io.outputs import check_output, mark_folder
     from skyradar.parallel import check_workers
     from skyradar.rx_layouts import check_rx_layout
@@ -158,6 +174,15 @@ def experiment_encounters(
     check_workers(workers)
     check_choice("--family", family, FAMILIES)
     check_choice("--alert-config", alert_settings, ("radar", "do365b"))
+    if split is not None:
+        check_choice("--split", split, ("development", "evaluation"))
+        if (seed >= EVALUATION_SEEDS_FROM) != (split == "evaluation"):
+            where = (
+                f"{EVALUATION_SEEDS_FROM} and up"
+                if split == "evaluation"
+                else f"below {EVALUATION_SEEDS_FROM}"
+            )
+            raise InputError(f"--seed {seed}: not in the {split} split (its seeds are {where})")
     if family == "real-flights":
         from skyradar.scene.sample_flights import sample_flights
 

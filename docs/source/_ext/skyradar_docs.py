@@ -54,7 +54,7 @@ from sphinx.util.docutils import SphinxDirective
 from sphinx.util.nodes import nested_parse_with_titles
 
 # Settings of one summary, in the order shown; `split` and `load_average_1min` are shown when present.
-SUMMARY_FIELDS = ("family", "terrains", "layouts", "encounters", "seed", "split")
+SUMMARY_FIELDS = ("family", "terrains", "layouts", "encounters", "seed", "split", "alert_config")
 PROVENANCE_FIELDS = ("command", "version", "date_utc", "load_average_1min")
 # Headline numbers of one row (a terrain and a layout); `warnings_not_held` and `alert_flickers` only
 # when present.
@@ -174,7 +174,8 @@ class ResultsDirective(SphinxDirective):
         for path in files:
             self.env.note_dependency(str(path))
             summaries.append((path.name, json.loads(path.read_text())))
-        fields = [f for f in SUMMARY_FIELDS if f != "split" or any("split" in s for _, s in summaries)]
+        optional = ("split", "alert_config")  # shown when some summary has them
+        fields = [f for f in SUMMARY_FIELDS if f not in optional or any(f in s for _, s in summaries)]
         rows = [
             [
                 nodes.paragraph("", "", _link(name, "results-" + Path(name).stem)),
@@ -192,7 +193,7 @@ class ResultsDirective(SphinxDirective):
         section = _section(self, name, "results-" + Path(name).stem)
         fields = nodes.field_list()
         for key in (*SUMMARY_FIELDS, *PROVENANCE_FIELDS):
-            if key not in summary and key in ("split", "load_average_1min"):
+            if key not in summary and key in ("split", "alert_config", "load_average_1min"):
                 continue
             value = format_value(key, summary.get(key))
             body = nodes.paragraph()

@@ -4,12 +4,10 @@ from __future__ import annotations
 
 import json
 
+import distributed
 import pandas as pd
-import pytest
 
 from cli_helpers import assert_one_line_error, skyradar
-
-distributed = pytest.importorskip("distributed")
 
 # Wall times differ run to run; everything else in a row is the encounter's result.
 _TIMINGS = ["simulate_s", "process_s", "track_s", "alert_s"]

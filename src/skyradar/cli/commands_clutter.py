@@ -15,9 +15,9 @@ __all__ = ["experiment_clutter"]
 
 @experiment_app.command("clutter")
 def experiment_clutter(
-    out: Annotated[Path, typer.Option("--out", help="Output directory for figures and tables.")] = Path(
-        "out/clutter"
-    ),
+    out: Annotated[
+        Path, typer.Option("-o", "--output", "--out", help="Output directory for figures and tables.")
+    ] = Path("out/clutter"),
     frames: Annotated[
         int,
         typer.Option(

@@ -34,7 +34,9 @@ def format_timeline(timeline) -> str:
 
 @app.command()
 def demo(
-    out: Annotated[Path, typer.Option("--out", help="Report folder to write.")] = Path("out/demo"),
+    out: Annotated[Path, typer.Option("-o", "--output", "--out", help="Report folder to write.")] = Path(
+        "out/demo"
+    ),
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:

@@ -95,7 +95,9 @@ _RX_LAYOUT = Annotated[
 
 @experiment_app.command("encounters")
 def experiment_encounters(
-    out: Annotated[Path, typer.Option("--out", help="Output directory.")] = Path("out/encounters"),
+    out: Annotated[Path, typer.Option("-o", "--output", "--out", help="Output directory.")] = Path(
+        "out/encounters"
+    ),
     n: _N = None,
     seed: Annotated[int, typer.Option("--seed", callback=NON_NEGATIVE, help="Random seed.")] = 0,
     workers: Annotated[

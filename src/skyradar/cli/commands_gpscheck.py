@@ -210,9 +210,9 @@ def _print_summary(result: dict, table, alert_frames: int) -> None:
 
 @experiment_app.command("ch6")
 def experiment_ch6(
-    out: Annotated[Path, typer.Option("--out", help="Output directory for table, JSON and figures.")] = Path(
-        "out/ch6"
-    ),
+    out: Annotated[
+        Path, typer.Option("-o", "--output", "--out", help="Output directory for table, JSON and figures.")
+    ] = Path("out/ch6"),
     seed: Annotated[
         int, typer.Option("--seed", callback=NON_NEGATIVE, help="Speckle, map and frames seed.")
     ] = 6,

@@ -80,7 +80,8 @@ def state(
 @experiment_app.command("ch5")
 def experiment_ch5(
     out: Annotated[
-        Path, typer.Option("--out", help="Output directory for table, JSON, states and figures.")
+        Path,
+        typer.Option("-o", "--output", "--out", help="Output directory for table, JSON, states and figures."),
     ] = Path("out/ch5"),
     duration_s: Annotated[
         float, typer.Option("--duration", callback=POSITIVE, help="Flight length at 1 frame/s, s.")

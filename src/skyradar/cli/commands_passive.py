@@ -118,9 +118,9 @@ class _progress:
 
 @experiment_app.command("ch7")
 def experiment_ch7(
-    out: Annotated[Path, typer.Option("--out", help="Output directory for figures and tables.")] = Path(
-        "out/ch7"
-    ),
+    out: Annotated[
+        Path, typer.Option("-o", "--output", "--out", help="Output directory for figures and tables.")
+    ] = Path("out/ch7"),
     seconds: Annotated[
         float, typer.Option("--seconds", callback=POSITIVE, help="Recording length (thesis: 40 s, 9 sweeps).")
     ] = 40.0,

@@ -298,9 +298,9 @@ def spur_map(
 
 @experiment_app.command("ch3")
 def experiment_ch3(
-    out: Annotated[Path, typer.Option("--out", help="Output directory for figures and tables.")] = Path(
-        "out/ch3"
-    ),
+    out: Annotated[
+        Path, typer.Option("-o", "--output", "--out", help="Output directory for figures and tables.")
+    ] = Path("out/ch3"),
     frames: Annotated[
         int, typer.Option("--frames", callback=COUNT, help="Flyover frames (thesis: 300).")
     ] = 300,

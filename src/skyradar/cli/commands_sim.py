@@ -21,7 +21,7 @@ from skyradar.cli.app import (
 )
 from skyradar.io.outputs import OVERWRITE_HELP
 
-OutDir = Annotated[Path, typer.Option("--out", help="Folder for figures and tables.")]
+OutDir = Annotated[Path, typer.Option("-o", "--output", "--out", help="Folder for figures and tables.")]
 
 
 def frame_progress(total: int, label: str) -> Progress:

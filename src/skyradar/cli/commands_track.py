@@ -269,9 +269,9 @@ def _check_tracks_of_run(table, tracks: Path, run: Path) -> None:
 
 @experiment_app.command("ch4")
 def experiment_ch4(
-    out: Annotated[Path, typer.Option("--out", help="Output directory for tables and figures.")] = Path(
-        "out/ch4"
-    ),
+    out: Annotated[
+        Path, typer.Option("-o", "--output", "--out", help="Output directory for tables and figures.")
+    ] = Path("out/ch4"),
     chain: Annotated[
         str,
         typer.Option(

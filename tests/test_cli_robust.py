@@ -95,6 +95,8 @@ def test_track_without_air_detections_writes_empty_table(tmp_path, n, ground, mo
         (("experiment", "encounters", "--split", "development", "--seed", "7001"),
          ["--seed 7001", "development"]),
         (("experiment", "encounters", "--alert-config", "fast"), ["--alert-config", "fast"]),
+        (("passive", "r.sigmf-meta", "-o", "p.parquet", "--max-range-m", "3e4", "--max-range-km", "30"),
+         ["--max-range-m", "--max-range-km"]),
         (("process", "run.zarr", "-o", "d.parquet", "--pfa", "5"), ["--pfa", "5"]),
         (("process", "run.zarr", "-o", "d.parquet", "--pfa", "-1"), ["--pfa", "-1"]),
         (("calibrate", "r.zarr", "-o", "c.json", "--range", "-5", "--azimuth", "0", "--elevation", "0"),

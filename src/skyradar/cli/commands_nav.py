@@ -84,7 +84,8 @@ def experiment_ch5(
         typer.Option("-o", "--output", "--out", help="Output directory for table, JSON, states and figures."),
     ] = Path("out/ch5"),
     duration_s: Annotated[
-        float, typer.Option("--duration", callback=POSITIVE, help="Flight length at 1 frame/s, s.")
+        float,
+        typer.Option("--duration-s", "--duration", callback=POSITIVE, help="Flight length at 1 frame/s, s."),
     ] = 40.0,
     fast_duration_s: Annotated[
         float,

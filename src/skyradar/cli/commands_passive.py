@@ -42,10 +42,16 @@ def passive(
             "'recording' (the strongest direct-path pulse of the first rotation).",
         ),
     ] = "metadata",
+    max_range_m: Annotated[
+        float | None,
+        typer.Option(
+            "--max-range-m", callback=POSITIVE, help="Largest bistatic range R1+R2-L, m (default 45000)."
+        ),
+    ] = None,
     max_range_km: Annotated[
-        float,
-        typer.Option("--max-range-km", callback=POSITIVE, help="Largest bistatic range R1+R2-L, km."),
-    ] = 45.0,
+        float | None,
+        typer.Option("--max-range-km", callback=POSITIVE, help="The same in km (give one of the two)."),
+    ] = None,
     chunk_samples: Annotated[
         int,
         typer.Option("--chunk-samples", callback=CHUNK_SAMPLES, help="Samples per chunk (bounds memory)."),
@@ -67,11 +73,12 @@ def passive(
     from skyradar.passive.pipeline import PassiveSettings, process_recording
 
     check_choice("--pulse", pulse, ("metadata", "recording"))
+    max_bistatic_range_m = _max_range_m(max_range_m, max_range_km)
     inputs = [recording, *_recording_files(recording, sigmf_paths)]
     check_output(output, inputs, overwrite, kind="table")
     rec = read_iq_recording(recording)
     settings = PassiveSettings(
-        max_bistatic_range_m=max_range_km * 1e3, pulse=pulse, chunk_samples=chunk_samples
+        max_bistatic_range_m=max_bistatic_range_m, pulse=pulse, chunk_samples=chunk_samples
     )
     with _progress(rec.n_samples) as update:
         result = process_recording(rec, settings, progress=update)
@@ -163,3 +170,14 @@ def bench_passive(
 
     console.print("bench passive: simulating two recordings, then processing them", soft_wrap=True)
     emit_measurement(run_bench(seconds=seconds), as_json, "bench passive")
+
+
+def _max_range_m(max_range_m: float | None, max_range_km: float | None) -> float:
+    """The largest bistatic range, m, from whichever of the two options was given (45 km by default)."""
+    from skyradar.errors import InputError
+
+    if max_range_m is not None and max_range_km is not None:
+        raise InputError("--max-range-m and --max-range-km: give one of the two (the same range in m or km)")
+    if max_range_km is not None:
+        return max_range_km * 1e3
+    return 45_000.0 if max_range_m is None else max_range_m

@@ -323,7 +323,7 @@ def _psf_keys(config, terrain, origin, platform, ours, n: int, fps_fine: float) 
         "fine_psf_uniform_cpu_ms_per_frame": cpu_uniform_psf,
         "sub_facets_per_frame_fine_psf_uniform": _sub_facets(uniform_psf, platform(0)),
         "fine_psf_vs_uniform": fps_fine_psf / fps_uniform_psf,
-        "fine_psf_uniform": "as fine_psf, every cell cut into facets <= dR/2 on the ground (the rule before)",
+        "fine_psf_uniform": "as fine_psf, every cell cut into facets <= dR/2 on the ground (the baseline)",
     }
 
 

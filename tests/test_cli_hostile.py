@@ -79,7 +79,7 @@ def _add_flag(column: str, first_value):
         # NaN time or id went through np.interp into alerts with NaN times, exit 0.
         ("nan_time.parquet", _set("time_s", np.nan), ["nan_time.parquet", "'time_s'", "row 0"]),
         ("nan_id.parquet", _set("track_id", np.nan), ["nan_id.parquet", "'track_id'", "row 0"]),
-        # A string velocity was a ValueError traceback.
+        # A string velocity is one line, not a ValueError traceback.
         ("str_v.parquet", _set("vn_mps", "fast", slice(None)), ["str_v.parquet", "'vn_mps'", "fast"]),
         # An infinite position was dropped like a missing one: no alert and no word.
         ("inf_n.parquet", _set("north_m", np.inf, slice(None)), ["inf_n.parquet", "'north_m'", "inf"]),
@@ -148,7 +148,7 @@ def test_huge_worker_count_is_refused_before_any_process_starts(tiny_run, comman
     [
         # --frames 10**20 was blamed on the ch2 scenario's duration_s.
         (["experiment", "ch2", "--frames", str(10**20)], ["--frames", str(10**20)]),
-        # --duration 1e308 and --n 10**20 were numpy "Maximum allowed size exceeded" tracebacks.
+        # --duration 1e308 and --n 10**20 would ask numpy for arrays beyond "Maximum allowed size".
         (["experiment", "ch5", "--duration", "1e308"], ["--duration", "1e+308"]),
         (["experiment", "encounters", "--n", str(10**20)], ["--n", str(10**20)]),
         (["experiment", "encounters", "--rx-layout", "ring"], ["--rx-layout", "'ring'"]),
@@ -161,7 +161,7 @@ def test_experiment_sizes_are_bounded_before_the_output_folder(tmp_path, args, n
 
 
 def test_evaluate_refuses_nan_radial_velocity(tiny_run):
-    # A NaN in a scored column was a scipy "matrix contains invalid numeric entries" traceback.
+    # A NaN in a scored column would reach scipy's assignment ("matrix contains invalid numeric entries").
     import pandas as pd
 
     tracks = pd.read_parquet(tiny_run / "tracks.parquet").assign(
@@ -175,8 +175,8 @@ def test_evaluate_refuses_nan_radial_velocity(tiny_run):
 @pytest.mark.parametrize(
     ("args", "needles"),
     [
-        # Each was a traceback ("Maximum allowed size exceeded", "lam value too large") or blamed a
-        # temporary scenario file's duration_s.
+        # Each would raise inside numpy ("Maximum allowed size exceeded", "lam value too large") or blame
+        # a temporary scenario file's duration_s: refused under the option's own name instead.
         (["bench", "chain", "--workers", str(10**20)], ["--workers", str(10**20)]),
         (["bench", "track", "--detections", str(10**20)], ["--detections", str(10**20)]),
         (["bench", "flight", "--frames", str(10**20)], ["--frames", str(10**20)]),

@@ -110,7 +110,7 @@ def test_an_intruder_that_turns_away_is_lowered_once_its_entry_is_beyond_the_ear
     # The head-on warned at 50 s; at 55 s the intruder stops closing (relative velocity 0.5 m/s):
     # the entry (2500 - 670.56) / 0.5 = 3659 s away is past every early alerting time, so the warning
     # goes after its 4 s persistence (raised at 50 s: kept to 54 s) and the M-of-N of the held level
-    # falls: 2 of 4 updates of 56-59 s no longer hold it: lowered at 57 s (56 and 57 without).
+    # falls: 2 of 4 updates of 56-59 s do not hold it: lowered at 57 s (56 and 57 without).
     t = np.arange(0.0, 70.0)
     north = np.where(t <= 55.0, 8000.0 - 100.0 * t, 2500.0 - 0.5 * (t - 55.0))
     s = np.column_stack([north, np.zeros_like(t), np.zeros_like(t)])

@@ -102,6 +102,18 @@ def _strongest(a, lam, relevant):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def _full_pairs(a, v, lam, full, fv, fl, full_order):  # pragma: no cover - compiled
+    # The fallback of the subspace iterations: the strongest v.shape[1] pairs of the full Jacobi sweeps.
+    n, m = v.shape
+    full[:, :] = a
+    hermitian_eigh(full, fv, fl, full_order, 1e-12, 30)
+    for c in range(m):
+        lam[c] = fl[full_order[c]]
+        for i in range(n):
+            v[i, c] = fv[i, full_order[c]]
+
+
+@njit(cache=True)
 def top_eigenpairs(a, v, lam, relevant, tol=1e-4, max_iter=50, scratch=None):  # pragma: no cover - compiled
     """The ``v.shape[1]`` strongest eigen-pairs of a Hermitian ``a`` by subspace iteration from ``v``.
 
@@ -127,12 +139,7 @@ def top_eigenpairs(a, v, lam, relevant, tol=1e-4, max_iter=50, scratch=None):  #
                 return step
             break
         _orthonormal_into(v, wu)
-    full[:, :] = a
-    hermitian_eigh(full, fv, fl, full_order, 1e-12, 30)
-    for c in range(m):
-        lam[c] = fl[full_order[c]]
-        for i in range(n):
-            v[i, c] = fv[i, full_order[c]]
+    _full_pairs(a, v, lam, full, fv, fl, full_order)
     return max_iter + 1
 
 
@@ -219,10 +226,5 @@ def top_two_eigenpairs(
             for c in range(2):
                 wu[i, c] -= shift * vu[i, c]
         _orthonormal_into(v, wu)
-    full[:, :] = a
-    hermitian_eigh(full, fv, fl, full_order, 1e-12, 30)
-    for c in range(2):
-        lam[c] = fl[full_order[c]]
-        for i in range(n):
-            v[i, c] = fv[i, full_order[c]]
+    _full_pairs(a, v, lam, full, fv, fl, full_order)
     return max_iter + 1

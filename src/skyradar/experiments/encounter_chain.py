@@ -106,10 +106,15 @@ def warning_held(warn_times_s: np.ndarray, status: pd.DataFrame, t_cpa_s: float)
     ft, ok = status["time_s"].to_numpy(float), status["observable"].to_numpy(bool)
     frames = ft[(ft >= warn[0]) & (ft <= t_cpa_s) & ok]
     end = float(frames.max()) if frames.size else warn[0]
-    frame_s = float(np.median(np.diff(ft))) if ft.size > 1 else 0.0
+    frame_s = frame_interval_s(ft)
     shown = np.concatenate([warn[warn <= end], [end]]) if end > warn[-1] else warn[warn <= end]
     gap = float(np.diff(shown).max()) if shown.size > 1 else 0.0
     return bool(gap <= 1.5 * frame_s + 1e-9), gap
+
+
+def frame_interval_s(frame_times_s: np.ndarray) -> float:
+    """The run's frame interval, s: the median step between frame times (0 for one frame)."""
+    return float(np.median(np.diff(frame_times_s))) if len(frame_times_s) > 1 else 0.0
 
 
 def warning_flickers(warn_times_s: np.ndarray, frame_s: float, t_cpa_s: float) -> int:
@@ -134,13 +139,11 @@ def score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[s
     mine = warn["track_id"].map(lambda i: labels.get(int(i)) == "intruder").to_numpy(bool)
     status = frame_status(truths, opts["fov_deg"], opts["min_snr_db"])
     window = opts["observe_window_s"]
-    row = score_encounter(t, rel, warn["time_s"].to_numpy(float)[mine], status, opts["buffer"], window)
-    row["warning_held"], row["warning_gap_max_s"] = warning_held(
-        warn["time_s"].to_numpy(float)[mine], status, row["t_cpa_s"]
-    )
-    ft = status["time_s"].to_numpy(float)
-    frame_s = float(np.median(np.diff(ft))) if ft.size > 1 else 0.0
-    row["warning_flickers"] = warning_flickers(warn["time_s"].to_numpy(float)[mine], frame_s, row["t_cpa_s"])
+    warning_times = warn["time_s"].to_numpy(float)[mine]  # the intruder's warning frames
+    row = score_encounter(t, rel, warning_times, status, opts["buffer"], window)
+    row["warning_held"], row["warning_gap_max_s"] = warning_held(warning_times, status, row["t_cpa_s"])
+    frame_s = frame_interval_s(status["time_s"].to_numpy(float))
+    row["warning_flickers"] = warning_flickers(warning_times, frame_s, row["t_cpa_s"])
     row["cause"] = unwarned_cause(status, row["t_lowc_s"], row["t_warning_s"], window)
     other = warn["time_s"].to_numpy(float)[~mine]
     own_agl = (

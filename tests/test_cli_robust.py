@@ -95,6 +95,7 @@ def test_track_without_air_detections_writes_empty_table(tmp_path, n, ground, mo
         (("experiment", "encounters", "--split", "development", "--seed", "7001"),
          ["--seed 7001", "development"]),
         (("experiment", "encounters", "--alert-config", "fast"), ["--alert-config", "fast"]),
+        (("experiment", "clutter", "--terrain", "hills,marsh"), ["--terrain", "marsh", "jacksboro"]),
         (("passive", "r.sigmf-meta", "-o", "p.parquet", "--max-range-m", "3e4", "--max-range-km", "30"),
          ["--max-range-m", "--max-range-km"]),
         (("process", "run.zarr", "-o", "d.parquet", "--pfa", "5"), ["--pfa", "5"]),

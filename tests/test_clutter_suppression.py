@@ -161,19 +161,6 @@ def test_bench_suppressed_agrees_with_its_numpy_baseline():
     assert result["suppressed_detections_per_frame"] < result["terrain_unsuppressed_detections_per_frame"] / 3
 
 
-@pytest.mark.slow
-def test_experiment_clutter_writes_figures_table_and_json(tmp_path):
-    import json
-
-    result = skyradar("experiment", "clutter", "--frames", "2", "--out", "c", "--json", cwd=tmp_path)
-    assert result.returncode == 0, result.stderr
-    summary = json.loads(result.stdout.strip().splitlines()[-1])
-    assert summary["h1000_frames"] == 2 and "h300_usable_doppler_fraction_suppressed" in summary
-    assert {"h1000_if_db_lost_cells_median", "h300_if_db_lost_cells_min"} <= set(summary)
-    for name in ("sinr_loss.png", "intruder.png", "frames.csv", "sinr_loss.csv", "summary.json"):
-        assert (tmp_path / "c" / name).exists()
-
-
 def test_intruder_mixed_with_sidelobe_clutter_keeps_its_detections_and_elevation():
     # Flat ground 300 m below: a head-on intruder 46 m below, 14 deg left, closing at 116 m/s (aliased
     # into the ground band), its cell shared with the ground 40-60 deg either side. The plain direction

@@ -100,6 +100,8 @@ def test_track_without_air_detections_writes_empty_table(tmp_path, n, ground, mo
          ["--max-range-m", "--max-range-km"]),
         (("process", "run.zarr", "-o", "d.parquet", "--pfa", "5"), ["--pfa", "5"]),
         (("process", "run.zarr", "-o", "d.parquet", "--pfa", "-1"), ["--pfa", "-1"]),
+        (("process", "run.zarr", "-o", "d.parquet", "--pfa-secondary", "1"), ["--pfa-secondary", "1"]),
+        (("process", "run.zarr", "-o", "d.parquet", "--pfa-secondary", "nan"), ["--pfa-secondary", "nan"]),
         (("calibrate", "r.zarr", "-o", "c.json", "--range", "-5", "--azimuth", "0", "--elevation", "0"),
          ["--range", "-5"]),
         (("spur-map", "r.zarr", "-o", "s.npz", "--threshold", "2"), ["--threshold", "2"]),

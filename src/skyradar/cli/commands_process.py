@@ -53,6 +53,16 @@ _PfaOpt = Annotated[
     float,
     typer.Option("--pfa", callback=PROBABILITY, help="CFAR false-alarm probability per pixel, in (0, 1)."),
 ]
+_PfaSecondaryOpt = Annotated[
+    float,
+    typer.Option(
+        "--pfa-secondary",
+        callback=number_in(0.0, 1.0, high_open=True),
+        help="False-alarm probability of the secondary threshold in clutter-nulled cells, in [0, 1): "
+        "detections that pass it but not --pfa are flagged 'secondary' and only update a confirmed "
+        "track inside its gate. 0, or not above --pfa: none.",
+    ),
+]
 _TerrainOpt = Annotated[
     str | None,
     typer.Option(
@@ -89,6 +99,7 @@ def process(
     spur_mode: _SpurModeOpt = "mask",
     method: _MethodOpt = "cfar",
     pfa: _PfaOpt = 2e-8,
+    pfa_secondary: _PfaSecondaryOpt = 1e-4,
     terrain: _TerrainOpt = None,
     radar_config: _RadarConfigOpt = None,
     suppression: _SuppressionOpt = "auto",
@@ -111,7 +122,8 @@ def process(
     """Detect objects in every frame and locate them in 3-D: one row per detection per frame.
 
     Columns: time_s, frame, range_m, radial_velocity_mps, range/doppler_bin, snr_db, power_db,
-    azimuth/elevation_rad (antenna frame), x/y/z_body_m, north/east/down_m, lat/lon/alt, is_ground, spur.
+    azimuth/elevation_rad (antenna frame), x/y/z_body_m, north/east/down_m, lat/lon/alt, is_ground, spur,
+    secondary.
     """
     import pandas as pd
 
@@ -144,6 +156,7 @@ def process(
             run, None if radar_config is None else config, lambda n: bar.update(task, completed=n),
             spurs=spurs, terrain=dem, method=method, spur_mode=spur_mode, pfa=pfa, scheduler=scheduler,
             workers=workers, chunk_frames=chunk_frames, suppression=suppression, frame_costs=frame_costs,
+            pfa_secondary=pfa_secondary or None,
         )  # fmt: skip
     # The own-ship signature lets `alert` check that the tracks and its --ownship run belong together.
     meta = {"radar_config": config.to_json(), "source": str(run)}

@@ -67,6 +67,9 @@ class Detections:
         Noise power per pixel used for the SNR, W.
     snr_db : ndarray
         Per-channel, per-pixel SNR of the peak, ``(power - noise) / noise`` in dB.
+    secondary : ndarray of bool
+        True where the blob passed only the secondary threshold of a nulled cell (see
+        :func:`detect`'s ``pfa_secondary``); all False by default.
     """
 
     range_index: np.ndarray
@@ -76,6 +79,11 @@ class Detections:
     power_w: np.ndarray
     noise_w: np.ndarray
     snr_db: np.ndarray
+    secondary: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.secondary is None:
+            object.__setattr__(self, "secondary", np.zeros(self.range_index.size, bool))
 
     def __len__(self) -> int:
         return int(self.range_index.size)
@@ -248,7 +256,34 @@ def _suppressed_cfar(power, floor_w, channels, exclude, train_exclude, guard, tr
     skip = skip if exclude is None or train_exclude is None else exclude | train_exclude
     # Noise estimates only where a hit is possible: the peaks read it, nothing else does.
     hits, noise_map = cfar_2d_floor(power, channels, floor_w, skip, guard, train, pfa, noise_map=False)
-    return (hits if exclude is None else hits & ~exclude), noise_map
+    return (hits if exclude is None else hits & ~exclude), noise_map, skip
+
+
+def _secondary_blobs(
+    power, hits, noise_map, channels, n_rx, floor_w, exclude, skip, guard, train, pfa_secondary
+):
+    """Peaks of the blobs that pass ``pfa_secondary`` in nulled cells and hold no primary hit.
+
+    A blob with a primary hit is the primary detection's; the rest are the secondary detections.
+    Their noise estimates are merged into ``noise_map`` (NaN elsewhere, as the sparse CFAR leaves it).
+    """
+    low, low_noise = cfar_2d_floor(
+        power, channels, floor_w, skip, guard, train, pfa_secondary, noise_map=False
+    )
+    low &= channels < n_rx
+    if exclude is not None:
+        low &= ~exclude
+    if not low.any():
+        return np.zeros(0, np.intp), np.zeros(0, np.intp)
+    merged = low | hits
+    r_all, d_all = blob_peaks(merged, power)
+    r_pri, d_pri = blob_peaks(merged, power, hits)
+    primary = np.zeros(power.shape, bool)
+    primary[r_pri, d_pri] = True
+    keep = ~primary[r_all, d_all]
+    r, d = r_all[keep], d_all[keep]
+    noise_map[r, d] = low_noise[r, d]
+    return r, d
 
 
 def detect(
@@ -264,6 +299,7 @@ def detect(
     channels: np.ndarray | None = None,
     train_exclude: np.ndarray | None = None,
     noise_floor_w: float | None = None,
+    pfa_secondary: float | None = None,
 ) -> Detections:
     """Detect objects in a channel-integrated power image: one detection per blob.
 
@@ -285,6 +321,12 @@ def detect(
     channels, train_exclude, noise_floor_w : optional
         A clutter-suppressed image's channels per pixel, pixels kept out of CFAR training only and
         noise floor (default ``config.noise_power_w``): :func:`skyradar.process.cfar.cfar_2d_floor`.
+    pfa_secondary : float, optional
+        With ``channels`` and above ``pfa``: also report, flagged ``secondary``, the blobs of
+        nulled cells (fewer than ``config.n_rx`` channels left) that pass CA-CFAR at this larger
+        false-alarm probability but not at ``pfa``. The nulls cost a target in a ground cell several dB of
+        SNR; a tracker that already follows it needs only the few cells its gate predicts, where
+        this threshold's false alarms are rare, and may update it from them (never start a track).
     """
     power = np.asarray(power, dtype=np.float32)
     if power.shape != (config.n_range, config.n_doppler):
@@ -294,8 +336,18 @@ def detect(
         )
     if channels is not None and method == "cfar":
         floor = config.noise_power_w if noise_floor_w is None else noise_floor_w
-        hits, noise_map = _suppressed_cfar(power, floor, channels, exclude, train_exclude, guard, train, pfa)
+        hits, noise_map, skip = _suppressed_cfar(
+            power, floor, channels, exclude, train_exclude, guard, train, pfa
+        )
         r, d = blob_peaks(hits, power)
+        secondary = np.zeros(r.size, bool)
+        if pfa_secondary is not None and not 0.0 < pfa_secondary < 1.0:
+            raise InputError(f"detect: field 'pfa_secondary' must be in (0, 1), got {pfa_secondary}")
+        if pfa_secondary is not None and pfa_secondary > pfa:
+            args = (power, hits, noise_map, channels, config.n_rx, floor, exclude, skip, guard, train)
+            r_low, d_low = _secondary_blobs(*args, pfa_secondary)
+            r, d = np.concatenate([r, r_low]), np.concatenate([d, d_low])
+            secondary = np.concatenate([secondary, np.ones(r_low.size, bool)])
         noise = noise_map[r, d] if use_cfar_noise else np.full(r.size, config.noise_power_w, np.float32)
     elif method in ("cfar", "os-cfar"):
         kind = "ca" if method == "cfar" else "os"
@@ -310,4 +362,6 @@ def detect(
     rb, db = refine_peaks(power, r, d)
     p = power[r, d]
     snr = 10.0 * np.log10(np.maximum(p / noise - 1.0, 1e-3))
+    if channels is not None and method == "cfar":
+        return Detections(r, d, rb, db, p, noise, snr, secondary)
     return Detections(r, d, rb, db, p, noise, snr)

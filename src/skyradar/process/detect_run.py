@@ -19,7 +19,7 @@ from skyradar.config import RadarConfig
 from skyradar.io.frames import open_frames
 from skyradar.io.frames_heads import store_heads
 from skyradar.parallel import map_frame_chunks
-from skyradar.process.pipeline import process_chunk, process_frames
+from skyradar.process.pipeline import PFA_SECONDARY, process_chunk, process_frames
 from skyradar.process.spurs import SpurMap
 
 __all__ = ["detect_run", "detect_run_heads", "merge_head_tables", "detection_summary"]
@@ -41,19 +41,20 @@ def detect_run(
     head: str | None = None,
     suppression: str = "none",
     frame_costs: list[tuple[int, float, float]] | None = None,
+    pfa_secondary: float | None = PFA_SECONDARY,
 ) -> pd.DataFrame:
     """Detections table of the frames run at ``run`` (opened as ``ds``; radar ``head`` of it).
 
     Without ``scheduler`` and ``workers`` the frames are processed here; else in chunks of
     ``chunk_frames`` on an existing Dask scheduler or a local cluster of ``workers``. ``progress``
-    is called with the number of frames done so far. ``suppression`` and ``frame_costs`` (each
-    frame's processing time, here only: frames timed on Dask workers would not time one processor):
-    see :func:`process_frames`.
+    is called with the number of frames done so far. ``suppression``, ``pfa_secondary`` and
+    ``frame_costs`` (each frame's processing time, here only: frames timed on Dask workers would
+    not time one processor): see :func:`process_frames`.
     """
     if scheduler is None and not workers:
         return process_frames(
             ds, spurs, terrain, method, spur_mode, progress=progress, source=str(run), config=config, pfa=pfa,
-            suppression=suppression, frame_costs=frame_costs,
+            suppression=suppression, frame_costs=frame_costs, pfa_secondary=pfa_secondary,
         )  # fmt: skip
     if frame_costs is not None:
         from skyradar.errors import InputError
@@ -68,7 +69,11 @@ def detect_run(
             progress(done)
 
     job = functools.partial(
-        process_chunk if head is None else _head_chunk, config=config, pfa=pfa, suppression=suppression
+        process_chunk if head is None else _head_chunk,
+        config=config,
+        pfa=pfa,
+        suppression=suppression,
+        pfa_secondary=pfa_secondary,
     )
     job = job if head is None else functools.partial(job, head=head)
     parts = map_frame_chunks(
@@ -142,17 +147,20 @@ def _shifted(progress: Callable[[int], None], offset: int, n: int) -> None:
 
 
 def detection_summary(table: pd.DataFrame, n_frames: int) -> dict[str, Any]:
-    """Frames, detections, detections per frame, ground and spur detections of a detections table.
+    """Frames, detections, detections per frame, ground, spur and secondary detections of a
+    detections table (``secondary``: rows of the lower threshold in nulled cells, 0 without the column).
 
     Examples
     --------
     >>> detection_summary(pd.DataFrame({"is_ground": [True, False], "spur": [False, False]}), 4)
-    {'frames': 4, 'detections': 2, 'detections_per_frame': 0.5, 'ground': 1, 'spur': 0}
+    {'frames': 4, 'detections': 2, 'detections_per_frame': 0.5, 'ground': 1, 'spur': 0, 'secondary': 0}
     """
+    secondary = int(table["secondary"].sum()) if "secondary" in table.columns else 0
     return {
         "frames": n_frames,
         "detections": len(table),
         "detections_per_frame": len(table) / n_frames,
         "ground": int(table["is_ground"].sum()),
         "spur": int(table["spur"].sum()),
+        "secondary": secondary,
     }

@@ -57,9 +57,15 @@ from skyradar.process.ground import flag_ground, height_above_ground_m, surface_
 from skyradar.process.spurs import SpurMap
 
 __all__ = [
-    "DETECTION_COLUMNS", "DETECTION_TABLE_COLUMNS", "clutter_anchors", "process_chunk", "process_cube",
-    "process_frames", "scenario_origin",
-]  # fmt: skip
+    "DETECTION_COLUMNS",
+    "DETECTION_TABLE_COLUMNS",
+    "PFA_SECONDARY",
+    "clutter_anchors",
+    "process_chunk",
+    "process_cube",
+    "process_frames",
+    "scenario_origin",
+]
 
 # The detections table (``skyradar process``), column -> "unit; meaning" (skyradar.io.table_columns).
 DETECTION_TABLE_COLUMNS: dict[str, str] = {
@@ -85,11 +91,17 @@ DETECTION_TABLE_COLUMNS: dict[str, str] = {
     "alt_m": "m; height above the WGS84 ellipsoid (NaN without own-ship navigation)",
     "is_ground": "-; True: the ground filter explains the detection as a ground return",
     "spur": "-; True: the peak lies in the spur map (--spur-mode flag; masked spurs are not detected)",
+    "secondary": "-; True: the peak passed only the secondary threshold of a nulled cell: it may update "
+    "a track, never start one",
     "radar": "-; name of the radar head that detected it (`radar` for a run of one head)",
 }
 # The columns of one head's frames (process_frames); `radar` is added when the heads' tables merge
 # (skyradar.process.detect_run.merge_head_tables).
 DETECTION_COLUMNS = [c for c in DETECTION_TABLE_COLUMNS if c != "radar"]
+# The secondary threshold of nulled cells. Two nulls in a ground cell cost a target about 5 dB;
+# against the primary 2e-8 this threshold is about 2.4 dB lower (Gamma(2) noise), and a confirmed
+# track's gate of a few cells sees one of its false alarms in thousands of frames.
+PFA_SECONDARY = 1e-4
 _OWN = ("own_north_m", "own_east_m", "own_down_m", "own_vn_mps", "own_ve_mps", "own_vd_mps")
 _ATT = ("own_yaw_rad", "own_pitch_rad", "own_roll_rad", "own_height_agl_m")
 _GEO = ("own_lat_deg", "own_lon_deg", "own_alt_m")
@@ -152,6 +164,7 @@ def process_cube(
         "y_body_m": body[:, 1],
         "z_body_m": body[:, 2],
         "spur": spur,
+        "secondary": det.secondary,
         "u_ant": u,
         "coherence": coherence,
     }
@@ -314,6 +327,7 @@ def process_frames(
     frames: slice | None = None,
     anchors: np.ndarray | None = None,
     frame_costs: list[tuple[int, float, float]] | None = None,
+    pfa_secondary: float | None = PFA_SECONDARY,
     **detect_kwargs: Any,
 ) -> pd.DataFrame:
     """Detections table of a frames Dataset (see the module docstring for the columns).
@@ -340,6 +354,10 @@ def process_frames(
     frame_costs : list, optional
         Receives ``(frame, time_s, processing_s)`` per frame: the wall time from the frame's clutter
         prediction to its located detections (reading the frames from the store is not included).
+    pfa_secondary : float or None
+        With suppression, the false-alarm probability of the secondary threshold in nulled cells
+        (:func:`skyradar.process.detect.detect`; rows flagged ``secondary``, which the tracker
+        uses only inside a confirmed track's gate); None, or not above ``pfa``: none.
     """
     config = _checked_config(ds, config, spur_map, source)
     first, stop, _ = (frames or slice(None)).indices(ds.sizes["time"])
@@ -356,7 +374,16 @@ def process_frames(
             began = time.perf_counter()
             try:
                 clutter = frame_clutter(suppression, own, i, config, terrain, anchors)
-                out = process_cube(cube, config, spur_map, method, spur_mode, clutter, **detect_kwargs)
+                out = process_cube(
+                    cube,
+                    config,
+                    spur_map,
+                    method,
+                    spur_mode,
+                    clutter,
+                    pfa_secondary=pfa_secondary,
+                    **detect_kwargs,
+                )
             except InputError as exc:  # e.g. CFAR windows that do not fit: say which run
                 raise InputError(f"{source}: {exc}") from None
             rows.append(_located(out, times[i], i, own, origin, config, terrain))

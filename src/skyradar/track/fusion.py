@@ -112,6 +112,8 @@ def fuse_heads(
     v = det["radial_velocity_mps"].to_numpy(float)
     pos = det[list(_NED)].to_numpy(float) if all(c in det.columns for c in _NED) else None
     snr = det["snr_db"].to_numpy(float) if "snr_db" in det.columns else np.zeros(len(det))
+    if "secondary" in det.columns:  # a primary detection outranks a secondary one of the same object
+        snr = snr - 1e3 * det["secondary"].fillna(False).to_numpy(bool)
     heads = det[HEAD_COLUMN].astype(str).to_numpy()
     gates = (range_gate_bins * config.range_resolution_m, doppler_gate_bins * config.doppler_resolution_mps)
     gates += (position_gate,)

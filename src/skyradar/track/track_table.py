@@ -229,10 +229,13 @@ def _held(tracks, detections, ownship, config: RadarConfig, ground_test) -> pd.D
 def _run_tracker(tracker: RangeDopplerTracker, m3, detections: pd.DataFrame, grid, lo, hi) -> list[dict]:
     """Step the tracker (and the 3-D tracks) frame by frame; one dict of column arrays per frame."""
     z_all = detections[["range_m", "radial_velocity_mps"]].to_numpy(float)
+    secondary = np.zeros(len(detections), bool)
+    if "secondary" in detections.columns:
+        secondary = detections["secondary"].fillna(False).to_numpy(bool)
     frames = frame_numbers(grid, detections)
     chunks: list[dict[str, np.ndarray]] = []
     for k, (time_s, a, b) in enumerate(zip(grid, lo, hi, strict=True)):
-        out = tracker.step(float(time_s), z_all[a:b])
+        out = tracker.step(float(time_s), z_all[a:b], secondary[a:b])
         row = _frame_rows(tracker, out, time_s, frames[k], a)
         row["reacquired"] = out.reacquired
         row["reacquired_t"] = np.full(len(out.reacquired), float(time_s))

@@ -127,14 +127,22 @@ class RangeDopplerTracker:
         """Live tracks, tentative and confirmed."""
         return int(self.tracks["ids"].size)
 
-    def step(self, time_s: float, z: np.ndarray) -> FrameTracks:
+    def step(self, time_s: float, z: np.ndarray, secondary: np.ndarray | None = None) -> FrameTracks:
         """Process one frame of detections ``z`` (m, 2) = (range [m], radial velocity [m/s]).
 
-        ``time_s`` must not decrease between calls.
+        ``secondary`` (bool, one per detection) marks detections that passed only a secondary,
+        lower threshold (:func:`skyradar.process.detect.detect`'s ``pfa_secondary``): they may
+        update a confirmed track that no primary detection updates, inside its gate, and never
+        start or confirm a track. A confirmed track's gate spans a few cells, where the lower
+        threshold's false alarms are rare; over the whole image they are not. ``time_s`` must not
+        decrease between calls.
         """
         if self.time_s is not None and time_s < self.time_s:
             raise ValueError(f"time goes backwards ({self.time_s} -> {time_s})")
         z = np.asarray(z, float).reshape(-1, 2)
+        secondary = np.zeros(len(z), bool) if secondary is None else np.asarray(secondary, bool).reshape(-1)
+        if secondary.size != len(z):
+            raise ValueError(f"secondary has {secondary.size} flags for {len(z)} detections")
         tr = self.tracks
         if self.time_s is not None and tr["ids"].size and time_s > self.time_s:
             dt = time_s - self.time_s
@@ -150,7 +158,7 @@ class RangeDopplerTracker:
                 tr["x"], tr["P"] = predict(tr["x"], tr["P"], F, Q)
         self.time_s = float(time_s)
         self._close_stale()
-        assoc = self._associate(z)
+        assoc = self._associate(z, secondary)
         assigned = np.full(tr["ids"].size, -1)
         assigned[assoc.track_index] = assoc.detection_index
         innov = np.full((tr["ids"].size, 2), np.nan)
@@ -161,7 +169,7 @@ class RangeDopplerTracker:
         assigned, innov = assigned[alive], innov[alive]
         used = np.zeros(len(z), bool)
         used[assoc.detection_index] = True
-        new_det = np.flatnonzero(~used)
+        new_det = np.flatnonzero(~used & ~secondary)
         self._start(z[new_det])
         alive_ids = tr["ids"]
         alive_det = np.concatenate([assigned, new_det])
@@ -196,7 +204,7 @@ class RangeDopplerTracker:
             )
         return self._cache[key]
 
-    def _associate(self, z: np.ndarray) -> Association:
+    def _associate(self, z: np.ndarray, secondary: np.ndarray) -> Association:
         tr, m = self.tracks, self.model
         # H = [[1, c, 0, 0], [0, 1, 0, 0]] written out: S = H P H^T + R without batched matmuls.
         c, P, x = m.coupling_s, tr["P"], tr["x"]
@@ -214,14 +222,20 @@ class RangeDopplerTracker:
         # Confirmed tracks choose first; tentative tracks share what is left. Otherwise the
         # solver's preference for more pairs lets a new track take a confirmed track's detection
         # while the confirmed track is handed a clutter point.
+        # Secondary detections come last, to the confirmed tracks no primary detection updated.
+        confirmed = tr["confirmed"]
         if self.config.confirmed_first:
-            stages = [np.flatnonzero(tr["confirmed"]), np.flatnonzero(~tr["confirmed"])]
+            stages = [(np.flatnonzero(confirmed), False), (np.flatnonzero(~confirmed), False)]
         else:
-            stages = [np.arange(tr["ids"].size)]
+            stages = [(np.arange(tr["ids"].size), False)]
+        if secondary.any():
+            stages.append((np.flatnonzero(confirmed), True))
         free = np.ones(len(z), bool)
+        taken = np.zeros(tr["ids"].size, bool)
         parts = []
-        for rows in stages:
-            dets = np.flatnonzero(free)
+        for rows, lower in stages:
+            rows = rows[~taken[rows]]
+            dets = np.flatnonzero(free & (secondary == lower))
             if rows.size == 0 or dets.size == 0:
                 continue
             a = self.associator(
@@ -237,6 +251,7 @@ class RangeDopplerTracker:
             )
             parts.append(Association(rows[a.track_index], dets[a.detection_index], a.innovation, a.cost))
             free[dets[a.detection_index]] = False
+            taken[rows[a.track_index]] = True
         if not parts:
             return Association(np.zeros(0, int), np.zeros(0, int), np.zeros((0, 2)), np.zeros(0))
         return Association(

@@ -57,6 +57,7 @@ def _classes(name: str, *extra: type) -> tuple[type, ...]:
 
 _NO_ARGS_IS_HELP = _classes("NoArgsIsHelpError")
 _CLICK_ERRORS = _classes("ClickException")
+_MISSING = _classes("MissingParameter")
 _EXITS = _classes("Exit", typer.Exit)
 _ABORTS = _classes("Abort", typer.Abort)
 
@@ -73,6 +74,29 @@ def _os_error_line(exc: OSError) -> str:
     reason = exc.strerror or str(exc)
     paths = [str(p) for p in (exc.filename, exc.filename2) if p is not None]
     return f"{' -> '.join(paths)}: {reason}" if paths else reason
+
+
+def _choice_error(exc: Exception) -> str | None:
+    """``--method: must be one of cfar, os-cfar, shi-tomasi, got 'x'``: a value outside the choices of an
+    option typed with an enum (:mod:`skyradar.cli.choices`), on one line; None for other usage errors."""
+    param = getattr(exc, "param", None)
+    if param is None or isinstance(exc, _MISSING):
+        return None
+    # typer >= 0.2x keeps the choices on the parameter's type descriptor; older typer on a click.Choice.
+    choices = getattr(getattr(param, "type_descriptor", None), "choices", None)
+    choices = choices or getattr(getattr(param, "type", None), "choices", None)
+    if not choices:
+        return None
+    names = ", ".join(str(getattr(choice, "value", choice)) for choice in choices)
+    if param.param_type_name == "argument":
+        name = str(param.name).upper()
+    else:
+        name = next((opt for opt in param.opts if opt.startswith("--")), param.opts[0])
+    errors = getattr(exc.__cause__, "errors", None)  # typer's pydantic check holds the value given
+    first = errors()[0] if callable(errors) and errors() else {}
+    if "input" in first:
+        return f"{name}: must be one of {names}, got {first['input']!r}"
+    return f"{name}: {str(getattr(exc, 'message', exc)).removeprefix('Value error, ')}"  # click.Choice's
 
 
 def main() -> None:
@@ -108,8 +132,12 @@ def main() -> None:
     except _EXITS as exc:
         sys.exit(exc.exit_code)
     except _CLICK_ERRORS as exc:
-        exc.show()
-        sys.exit(exc.exit_code)
+        line = _choice_error(exc)
+        if line is None:
+            exc.show()
+            sys.exit(exc.exit_code)
+        print(f"error: {line}", file=sys.stderr)  # as a value checked by hand
+        sys.exit(2)
     except (KeyboardInterrupt, *_ABORTS):
         code = 130
     # With standalone_mode=False click returns 130 on Ctrl-C instead of raising.

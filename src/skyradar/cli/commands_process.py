@@ -19,7 +19,6 @@ from skyradar.cli.app import (
     JsonOption,
     app,
     bench_app,
-    check_choice,
     check_number,
     console,
     emit_measurement,
@@ -28,6 +27,7 @@ from skyradar.cli.app import (
     number_in,
     open_one_head,
 )
+from skyradar.cli.choices import Ch3Path, Detector, SpurMode, SpurPixels, Suppression
 from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["process", "calibrate", "spur_map", "experiment_ch3", "bench_process", "bench_realtime"]
@@ -46,9 +46,15 @@ _SpurMapOpt = Annotated[
     Path | None, typer.Option("--spur-map", help="Spur map (.npz from `skyradar spur-map`).")
 ]
 _SpurModeOpt = Annotated[
-    str, typer.Option("--spur-mode", help="'mask' spur pixels before detection or 'flag' detections in them.")
+    SpurMode,
+    typer.Option("--spur-mode", help="'mask' spur pixels before detection or 'flag' detections in them."),
 ]
-_MethodOpt = Annotated[str, typer.Option("--method", help="Detector: cfar, os-cfar or shi-tomasi.")]
+_MethodOpt = Annotated[
+    Detector,
+    typer.Option(
+        "--method", help="Detector: cfar (CA-CFAR), os-cfar (ordered-statistic CFAR) or shi-tomasi (corners)."
+    ),
+]
 _PfaOpt = Annotated[
     float,
     typer.Option("--pfa", callback=PROBABILITY, help="CFAR false-alarm probability per pixel, in (0, 1)."),
@@ -75,7 +81,7 @@ _RadarConfigOpt = Annotated[
     Path | None, typer.Option("--radar-config", help="RadarConfig JSON (e.g. from `skyradar calibrate`).")
 ]
 _SuppressionOpt = Annotated[
-    str,
+    Suppression,
     typer.Option(
         "--suppression",
         help="Ground clutter suppression before detection: auto (where the run has own-ship velocity, "
@@ -96,13 +102,13 @@ def process(
     run: Annotated[Path, typer.Argument(help="Frames run (Zarr directory).")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Detections table to write (Parquet).")],
     spur_map: _SpurMapOpt = None,
-    spur_mode: _SpurModeOpt = "mask",
-    method: _MethodOpt = "cfar",
+    spur_mode: _SpurModeOpt = SpurMode.mask,
+    method: _MethodOpt = Detector.cfar,
     pfa: _PfaOpt = 2e-8,
     pfa_secondary: _PfaSecondaryOpt = 1e-4,
     terrain: _TerrainOpt = None,
     radar_config: _RadarConfigOpt = None,
-    suppression: _SuppressionOpt = "auto",
+    suppression: _SuppressionOpt = Suppression.auto,
     scheduler: _SchedulerOpt = None,
     workers: _WorkersOpt = None,
     chunk_frames: _ChunkFramesOpt = 64,
@@ -138,9 +144,6 @@ def process(
     from skyradar.process.realtime import frame_latencies, realtime_summary
     from skyradar.process.spurs import SpurMap
 
-    check_choice("--method", method, ("cfar", "os-cfar", "shi-tomasi"))
-    check_choice("--spur-mode", spur_mode, ("mask", "flag"))
-    check_choice("--suppression", suppression, ("auto", "knowledge-aided", "none"))
     if realtime and (scheduler is not None or workers):
         raise InputError("--realtime times frames on one processor: leave out --scheduler and --workers")
     dem_path = Path(terrain) if terrain is not None and Path(terrain).exists() else None
@@ -154,8 +157,9 @@ def process(
     with bar:  # every radar head of the run, one table with a `radar` column (skyradar.io.frames_heads)
         table, configs = detect_run_heads(
             run, None if radar_config is None else config, lambda n: bar.update(task, completed=n),
-            spurs=spurs, terrain=dem, method=method, spur_mode=spur_mode, pfa=pfa, scheduler=scheduler,
-            workers=workers, chunk_frames=chunk_frames, suppression=suppression, frame_costs=frame_costs,
+            spurs=spurs, terrain=dem, method=method.value, spur_mode=spur_mode.value, pfa=pfa,
+            scheduler=scheduler, workers=workers, chunk_frames=chunk_frames, suppression=suppression.value,
+            frame_costs=frame_costs,
             pfa_secondary=pfa_secondary or None,
         )  # fmt: skip
     # The own-ship signature lets `alert` check that the tracks and its --ownship run belong together.
@@ -276,8 +280,9 @@ def spur_map(
         ),
     ] = 0.05,
     pixels: Annotated[
-        str, typer.Option("--pixels", help="'peaks' (detector points, thesis) or 'hits' (every lit pixel).")
-    ] = "hits",
+        SpurPixels,
+        typer.Option("--pixels", help="'peaks' (detector points, thesis) or 'hits' (every lit pixel)."),
+    ] = SpurPixels.hits,
     head: HeadOption = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
@@ -291,7 +296,6 @@ def spur_map(
     from skyradar.process.detect import integrate_channels
     from skyradar.process.spurs import learn_spur_map
 
-    check_choice("--pixels", pixels, ("peaks", "hits"))
     check_output(output, [run], overwrite, kind="file")
     ds = open_one_head(run, head, "skyradar spur-map")
     config = radar_config_of(ds, str(run))
@@ -302,7 +306,7 @@ def spur_map(
             check_finite_frames(cube[None], i, run)  # a NaN frame would silently mark no spurs
             yield integrate_channels(cube, config.rx_calibration)
 
-    learned = learn_spur_map(frames(), config, threshold, pixels)
+    learned = learn_spur_map(frames(), config, threshold, pixels.value)
     learned.save(output)
     result = {"frames": learned.n_frames, "spur_pixels": int(learned.mask.sum()), "threshold": threshold,
               "output": str(output)}  # fmt: skip
@@ -318,8 +322,9 @@ def experiment_ch3(
         int, typer.Option("--frames", callback=COUNT, help="Flyover frames (thesis: 300).")
     ] = 300,
     path: Annotated[
-        str, typer.Option("--path", help="'circuit' (500-3000 m racetrack) or 'approach' (32 s at 9.4 fps).")
-    ] = "circuit",
+        Ch3Path,
+        typer.Option("--path", help="'circuit' (500-3000 m racetrack) or 'approach' (32 s at 9.4 fps)."),
+    ] = Ch3Path.circuit,
     seed: Annotated[int, typer.Option("--seed", callback=NON_NEGATIVE, help="Random seed.")] = 0,
     rx_spacing: Annotated[
         float,
@@ -350,7 +355,6 @@ def experiment_ch3(
     from skyradar.experiments.ch3 import run as run_ch3
     from skyradar.io.outputs import check_output, mark_folder
 
-    check_choice("--path", path, ("circuit", "approach"))
     check_output(out, (), overwrite, kind="folder", option="--out")
 
     try:
@@ -363,7 +367,7 @@ def experiment_ch3(
         check_number("--compare", spacing, 0.0, 1.0, low_open=True)
     mark_folder(out)
     result = run_ch3(
-        out, n_frames=frames, path=path, seed=seed, pitch_deg=pitch, rx_spacing_wavelengths=rx_spacing,
+        out, n_frames=frames, path=path.value, seed=seed, pitch_deg=pitch, rx_spacing_wavelengths=rx_spacing,
         compare_spacings=others,
     )  # fmt: skip
     emit_result(result, as_json, "ch3: detection and direction of arrival")

@@ -22,6 +22,7 @@ from skyradar.cli.app import (
     experiment_app,
     open_one_head,
 )
+from skyradar.cli.choices import StateMethod
 from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["state", "experiment_ch5", "bench_state"]
@@ -32,11 +33,11 @@ def state(
     run: Annotated[Path, typer.Argument(help="Frames run (Zarr directory), radar seeing the ground.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="State table to write (Parquet).")],
     method: Annotated[
-        str,
+        StateMethod,
         typer.Option(
             "--method", help="robust (default), thesis, or terrain (DoA + terrain memory, needs AHRS)."
         ),
-    ] = "robust",
+    ] = StateMethod.robust,
     gps_gate: Annotated[
         bool,
         typer.Option("--gps-gate", help="Thesis comparison: gate on the run's own_height_agl_m (150 m)."),
@@ -60,15 +61,11 @@ def state(
     from skyradar.nav.state_summary import state_summary
 
     check_output(output, [run], overwrite, kind="table")
-    from skyradar.errors import InputError
-
-    if method not in ("thesis", "robust", "terrain"):
-        raise InputError(f"--method: must be thesis, robust or terrain, got {method!r}")
     ds = open_one_head(run, head, "skyradar state")
     config = radar_config_of(ds, str(run))
-    table = estimate_run(ds, method=method, gps_gate=gps_gate, source=str(run))
+    table = estimate_run(ds, method=method.value, gps_gate=gps_gate, source=str(run))
     write_table(
-        table, output, metadata={"radar_config": config.to_json(), "source": str(run), "method": method}
+        table, output, metadata={"radar_config": config.to_json(), "source": str(run), "method": method.value}
     )
     truth = ds["own_height_agl_m"].to_numpy() if "own_height_agl_m" in ds else None
     summary = state_summary(table, truth)

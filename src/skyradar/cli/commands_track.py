@@ -14,7 +14,6 @@ from skyradar.cli.app import (
     JsonOption,
     app,
     bench_app,
-    check_choice,
     check_number,
     console,
     emit_measurement,
@@ -22,6 +21,7 @@ from skyradar.cli.app import (
     experiment_app,
     number_in,
 )
+from skyradar.cli.choices import Ch4Chain, TrackerModel, TruthMode
 from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["track", "evaluate", "experiment_ch4", "bench_track"]
@@ -45,7 +45,8 @@ def _origin(text: str | None) -> tuple[float, float, float] | None:
 _FINITE_DB = number_in(-100.0, 100.0)  # an SNR in dB: finite, and a typo like 1e9 is refused
 
 _ModelOpt = Annotated[
-    str, typer.Option("--model", help="'radar' (aliasing-aware, coupled) or 'traditional' (image tracker).")
+    TrackerModel,
+    typer.Option("--model", help="'radar' (aliasing-aware, coupled) or 'traditional' (image tracker)."),
 ]
 _OriginOpt = Annotated[
     str | None,
@@ -126,7 +127,7 @@ def track(
         Path, typer.Argument(help="Detections table (Parquet or CSV) from `skyradar process`.")
     ],
     output: Annotated[Path, typer.Option("-o", "--output", help="Tracks table to write (Parquet).")],
-    model: _ModelOpt = "radar",
+    model: _ModelOpt = TrackerModel.radar,
     origin: _OriginOpt = None,
     ownship: _OwnshipOpt = None,
     terrain: _TerrainOpt = None,
@@ -146,14 +147,11 @@ def track(
 
     import numpy as np
 
-    from skyradar.errors import InputError
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_table
     from skyradar.track.io import radar_config_from_attrs, read_detections
     from skyradar.track.track_table import track_air_detections
 
-    if model not in ("radar", "traditional"):
-        raise InputError(f"--model: must be 'radar' or 'traditional', got {model!r}")
     check_output(output, [detections, ownship], overwrite, kind="table")
     _origin(origin)  # a bad --origin is named before any reading
     table = read_detections(detections)
@@ -162,8 +160,8 @@ def track(
     ground_test = _ground_test(terrain, run, ownship, own, origin_lla, config)
     # The own-ship state of a run has every frame's time: the tracker steps on frames without detections.
     run_times = None if own is None else own["time_s"].to_numpy(float)
-    tracks, n_used = track_air_detections(table, model, config, origin_lla, own, run_times, ground_test)
-    meta = {"radar_config": config.to_json(), "source": str(detections), "model": model}
+    tracks, n_used = track_air_detections(table, model.value, config, origin_lla, own, run_times, ground_test)
+    meta = {"radar_config": config.to_json(), "source": str(detections), "model": model.value}
     if origin_lla is not None:
         meta["origin_lla"] = json.dumps([float(v) for v in origin_lla])
     if table.attrs.get("ownship_signature"):  # carried on for `alert` (see skyradar.daa.provenance)
@@ -178,7 +176,7 @@ def track(
         )
     n_frames = int(np.unique(table["time_s"].to_numpy(float)).size)
     result = {"frames": n_frames, "detections": n_used, "tracks": int(tracks["track_id"].nunique())}
-    result |= {"rows": len(tracks), "model": model, "output": str(output), "origin_from": origin_from}
+    result |= {"rows": len(tracks), "model": model.value, "output": str(output), "origin_from": origin_from}
     emit_result(result, as_json, "tracks")
 
 
@@ -193,13 +191,13 @@ def evaluate(
         float, typer.Option("--gospa-c", callback=POSITIVE, help="GOSPA cut-off distance, pixels.")
     ] = 10.0,
     truth: Annotated[
-        str,
+        TruthMode,
         typer.Option(
             "--truth",
             help="'detectable': frames in a beam with expected SNR >= --min-snr-db; 'beam': every "
             "in-beam frame.",
         ),
-    ] = "detectable",
+    ] = TruthMode.detectable,
     min_snr_db: Annotated[
         float | None,
         typer.Option(
@@ -223,9 +221,8 @@ def evaluate(
     The truth is what the radar could see (in a beam and at the detection SNR), from the scenario
     alone; several radar heads are combined."""
     from skyradar.io.tables import read_table
-    from skyradar.track.evaluate import TRUTH_MODES, evaluate_run
+    from skyradar.track.evaluate import evaluate_run
 
-    check_choice("--truth", truth, TRUTH_MODES)  # before any reading
     table = read_table(
         tracks,
         required=["time_s", "track_id", "range_m", "radial_velocity_mps", "innovation_range_m",
@@ -234,7 +231,7 @@ def evaluate(
         finite=["time_s", "track_id", "range_m", "radial_velocity_mps"],  # NaN was a scipy traceback
     )  # fmt: skip
     _check_tracks_of_run(table, tracks, run)
-    result = evaluate_run(run, table, threshold_px, gospa_c_px, truth, min_snr_db, coasting)
+    result = evaluate_run(run, table, threshold_px, gospa_c_px, truth.value, min_snr_db, coasting)
     # The table shows no lists: one readable row for the per-target counts (1 = one track per aircraft).
     pairs = zip(result["targets"], result["tracks_per_target"], strict=True)
     result["tracks_by_target"] = ", ".join(f"{name} {n}" for name, n in pairs)
@@ -273,11 +270,11 @@ def experiment_ch4(
         Path, typer.Option("-o", "--output", "--out", help="Output directory for tables and figures.")
     ] = Path("out/ch4"),
     chain: Annotated[
-        str,
+        Ch4Chain,
         typer.Option(
             "--chain", help="'full' (simulate frames, detect, track) or 'geometry' (detections from truth)."
         ),
-    ] = "full",
+    ] = Ch4Chain.full,
     seed: Annotated[
         int,
         typer.Option(
@@ -290,16 +287,11 @@ def experiment_ch4(
     as_json: JsonOption = False,
 ) -> None:
     """Thesis ch4: radar-aware vs traditional tracker around an airfield (Circuit, Zulu, Free)."""
-    from skyradar.errors import InputError
     from skyradar.experiments.ch4 import run as run_ch4
-
-    # Checked here, before the cluster starts: a worker's error would come back as a long traceback.
-    if chain not in ("full", "geometry"):
-        raise InputError(f"--chain: must be 'full' or 'geometry', got {chain!r}")
     from skyradar.io.outputs import check_output, mark_folder
 
     check_output(out, (), overwrite, kind="folder", option="--out")
-    result = run_ch4(mark_folder(out), chain=chain, seed=seed)
+    result = run_ch4(mark_folder(out), chain=chain.value, seed=seed)
     emit_result(result, as_json, "ch4 tracking")
 
 

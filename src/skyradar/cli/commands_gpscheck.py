@@ -20,6 +20,7 @@ from skyradar.cli.app import (
     experiment_app,
     number_in,
 )
+from skyradar.cli.choices import GpsCheckMethod
 from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["gpscheck", "experiment_ch6", "bench_gpscheck", "parse_frames"]
@@ -109,7 +110,8 @@ _Frames = Annotated[
 _Run = Annotated[Path, typer.Argument(help="Frames run (Zarr) of a side-looking (wingtip) radar.")]
 _Map = Annotated[Path, typer.Option("--map", help="Reference map: OpenStreetMap .osm.pbf or GeoTIFF.")]
 _Method = Annotated[
-    str, typer.Option("--method", help="Pre-processing: clahe_ridge (default), clahe_entropy, ...")
+    GpsCheckMethod,
+    typer.Option("--method", help="Pre-processing of the radar and map images before they are compared."),
 ]
 
 
@@ -118,7 +120,7 @@ def gpscheck(
     run: _Run,
     map_path: _Map,
     output: Annotated[Path, typer.Option("-o", "--output", help="Per-frame check table to write (Parquet).")],
-    method: _Method = "clahe_ridge",
+    method: _Method = GpsCheckMethod.clahe_ridge,
     frames: _Frames = None,
     offset_north_m: _OffsetNorth = 0.0,
     offset_east_m: _OffsetEast = 0.0,
@@ -137,15 +139,12 @@ def gpscheck(
     (wing up; too little structure). An alert when GPS is inconsistent for --alert-frames decided
     frames in a row. The --gps-offset-* options move the run's GPS pose, to try a spoofed GPS.
     """
-    from skyradar.cli.app import check_choice
     from skyradar.io.frames import open_frames, radar_config_of
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_table
     from skyradar.nav.gpscheck.check import PIXEL_M, check_coverage, check_run, prepare_map, radar_side
     from skyradar.nav.gpscheck.monitor import MonitorSettings
-    from skyradar.nav.gpscheck.preprocess import METHODS
 
-    check_choice("--method", method, METHODS)
     check_output(output, [run, map_path], overwrite, kind="table")
     ds = open_frames(run)
     config = radar_config_of(ds, str(run))
@@ -159,14 +158,15 @@ def gpscheck(
 
     image, grid, building_m = _load_map(map_path, ds, PIXEL_M, covers, run)
     building_m = building_m if building_height is None else building_height
-    maps = prepare_map(image, [method])
+    maps = prepare_map(image, [method.value])
     settings = MonitorSettings(alert_frames=alert_frames)
     table = check_run(
-        ds, config, maps[method], grid, frames=picked, method=method, settings=settings, source=str(run),
+        ds, config, maps[method.value], grid, frames=picked, method=method.value, settings=settings,
+        source=str(run),
         gps_offset=gps_offset, building_m=building_m,
     )  # fmt: skip
     write_table(table, output, metadata={"radar_config": config.to_json(), "source": str(run),
-                                         "map": str(map_path), "method": method})  # fmt: skip
+                                         "map": str(map_path), "method": method.value})  # fmt: skip
     result = _summary(table, output)
     _print_summary(result, table, alert_frames)
     emit_result(result, as_json, "gpscheck")

@@ -19,6 +19,7 @@ from skyradar.cli.app import (
     emit_result,
     experiment_app,
 )  # fmt: skip
+from skyradar.cli.choices import PassivePulse
 from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["passive", "experiment_ch7", "bench_passive"]
@@ -35,13 +36,13 @@ def passive(
     ],
     output: Annotated[Path, typer.Option("-o", "--output", help="Detections table to write (Parquet).")],
     pulse: Annotated[
-        str,
+        PassivePulse,
         typer.Option(
             "--pulse",
             help="Matched-filter template: 'metadata' (the illuminator's long pulse as described) or "
             "'recording' (the strongest direct-path pulse of the first rotation).",
         ),
-    ] = "metadata",
+    ] = PassivePulse.metadata,
     max_range_m: Annotated[
         float | None,
         typer.Option(
@@ -66,23 +67,21 @@ def passive(
     the beam. Writes one row per detection: time_s, sweep, channel (static/moving), bistatic_range_m,
     doppler_hz, snr_db, azimuth_deg, east_m, north_m (from the receiver), r_tx_m, r_rx_m.
     """
-    from skyradar.cli.app import check_choice
     from skyradar.io.outputs import check_output
     from skyradar.io.sigmf_io import read_iq_recording, sigmf_paths
     from skyradar.io.tables import write_table
     from skyradar.passive.pipeline import PassiveSettings, process_recording
 
-    check_choice("--pulse", pulse, ("metadata", "recording"))
     max_bistatic_range_m = _max_range_m(max_range_m, max_range_km)
     inputs = [recording, *_recording_files(recording, sigmf_paths)]
     check_output(output, inputs, overwrite, kind="table")
     rec = read_iq_recording(recording)
     settings = PassiveSettings(
-        max_bistatic_range_m=max_bistatic_range_m, pulse=pulse, chunk_samples=chunk_samples
+        max_bistatic_range_m=max_bistatic_range_m, pulse=pulse.value, chunk_samples=chunk_samples
     )
     with _progress(rec.n_samples) as update:
         result = process_recording(rec, settings, progress=update)
-    meta = {"source": str(recording), "pulse": pulse, "scan_period_s": result.scan_period_s}
+    meta = {"source": str(recording), "pulse": pulse.value, "scan_period_s": result.scan_period_s}
     write_table(result.detections, output, metadata=meta)
     emit_result(_summary(result, output), as_json, "passive detections")
 

@@ -17,6 +17,7 @@ from skyradar.cli.app import (
     emit_result,
     number_in,
 )
+from skyradar.cli.choices import Compressor, Precision
 from skyradar.errors import InputError
 from skyradar.io.outputs import OVERWRITE_HELP
 
@@ -44,15 +45,16 @@ def rd(
     ] = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     compress: Annotated[
-        str, typer.Option("--compress", help="Lossless codec for the pixels: none, zstd or blosc.")
-    ] = "none",
+        Compressor,
+        typer.Option("--compress", help="Lossless codec for the pixels (blosc: zstd, byte shuffle)."),
+    ] = Compressor.none,
     precision: Annotated[
-        str,
+        Precision,
         typer.Option(
             "--precision",
             help="Pixel format: complex64 (exact) or cint16 (int16 I/Q, a scale per frame, range, rx).",
         ),
-    ] = "complex64",
+    ] = Precision.complex64,
     as_json: JsonOption = False,
 ) -> None:
     """Turn a raw ADC recording into range-Doppler frames (the same store the simulator writes).
@@ -63,14 +65,9 @@ def rd(
     fully checked first: a bad recording leaves no output.
     """
     from skyradar.errors import InputError
-    from skyradar.io.frames import COMPRESSORS, PRECISIONS
     from skyradar.process.rd_store import recording_to_frames
     from skyradar.process.windows import get_window
 
-    choices = (("--compress", compress, COMPRESSORS), ("--precision", precision, PRECISIONS))
-    for option, value, allowed in choices:
-        if value not in allowed:
-            raise InputError(f"{option}: must be one of {', '.join(allowed)}, got {value!r}")
     for option, spec in (("--range-window", range_window), ("--doppler-window", doppler_window)):
         try:
             get_window(spec, 8)
@@ -82,7 +79,7 @@ def rd(
 
     result = recording_to_frames(
         recording, output, range_window, doppler_window, remove_dc, chunk_frames, scheduler, workers, report,
-        overwrite=overwrite, compressor=compress, precision=precision,
+        overwrite=overwrite, compressor=compress.value, precision=precision.value,
     )  # fmt: skip
     emit_result(result, as_json, "range-Doppler frames")
 

@@ -19,6 +19,7 @@ from skyradar.cli.app import (
     experiment_app,
     number_in,
 )
+from skyradar.cli.choices import Compressor, Precision
 from skyradar.io.outputs import OVERWRITE_HELP
 
 OutDir = Annotated[Path, typer.Option("-o", "--output", "--out", help="Folder for figures and tables.")]
@@ -37,7 +38,7 @@ def frame_progress(total: int, label: str) -> Progress:
 
 
 _CompressOpt = Annotated[
-    str,
+    Compressor,
     typer.Option(
         "--compress",
         help="Lossless codec for the pixels: none (8 bytes per complex pixel), zstd, or blosc "
@@ -45,7 +46,7 @@ _CompressOpt = Annotated[
     ),
 ]
 _PrecisionOpt = Annotated[
-    str,
+    Precision,
     typer.Option(
         "--precision",
         help="Pixel format: complex64 (exact, 8 bytes per pixel) or cint16 (int16 I/Q with a scale "
@@ -67,8 +68,8 @@ def simulate(
         int | None, typer.Option(callback=COUNT, help="Run on a local Dask cluster of this many workers.")
     ] = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
-    compress: _CompressOpt = "none",
-    precision: _PrecisionOpt = "complex64",
+    compress: _CompressOpt = Compressor.none,
+    precision: _PrecisionOpt = Precision.complex64,
 ) -> None:
     """Simulate a scenario into a frames store (range x Doppler x rx per frame, plus truth).
 
@@ -76,7 +77,6 @@ def simulate(
     interruption, the same command resumes without recomputing finished chunks.
     """
     from skyradar.errors import InputError
-    from skyradar.io.frames import COMPRESSORS, PRECISIONS
     from skyradar.io.outputs import check_output
     from skyradar.io.store_size import check_store_space
     from skyradar.scene.scenario import load_scenario
@@ -84,23 +84,19 @@ def simulate(
 
     if chunk_frames < 1:
         raise InputError(f"--chunk-frames must be >= 1, got {chunk_frames}")
-    if compress not in COMPRESSORS:
-        raise InputError(f"--compress: must be one of {', '.join(COMPRESSORS)}, got {compress!r}")
-    if precision not in PRECISIONS:
-        raise InputError(f"--precision: must be one of {', '.join(PRECISIONS)}, got {precision!r}")
     check_output(output, [scenario], overwrite, kind="frames store")  # before any work
     loaded = load_scenario(scenario)
     # Before the build: a huge run is refused in a second, not after minutes of truth geometry.
     n_heads = len(loaded.model.radars or [None])  # several radar heads: a group of frames each
     check_store_space(output, loaded.radar_config(), n_heads * loaded.frame_times().size,
-                      n_heads * chunk_frames, compress, precision)  # fmt: skip
+                      n_heads * chunk_frames, compress.value, precision.value)  # fmt: skip
     built = loaded.build()
     n = built.times_s.size
     with frame_progress(n, f"simulate {built.name}") as bar:
         task = bar.add_task("frames", total=n)
         path = simulate_to_zarr(
             built, output, chunk_frames, scheduler, workers, progress=lambda k: bar.advance(task, k),
-            overwrite=overwrite, compressor=compress, precision=precision,
+            overwrite=overwrite, compressor=compress.value, precision=precision.value,
         )  # fmt: skip
     heads = f" of {len(built.heads)} radar heads ({', '.join(h.name for h in built.heads)})"
     console.print(f"wrote {n} frames{heads if len(built.heads) > 1 else ''} to {path}")

@@ -13,17 +13,15 @@ from skyradar.cli.app import (
     POSITIVE,
     JsonOption,
     app,
-    check_choice,
     check_number,
     console,
     emit_result,
 )
+from skyradar.cli.choices import AircraftClass, Side
 from skyradar.errors import InputError
 from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["flight", "make_encounter"]
-
-_CLASSES = ("ga", "glider", "transport", "any")
 
 _Icao = Annotated[str | None, typer.Option(help="Aircraft address to take from a file holding several.")]
 _Track = Annotated[Path, typer.Argument(help="Track file (ADS-B/GPS: CSV, JSON, Parquet; .gz too).")]
@@ -46,7 +44,7 @@ _TIntruder = Annotated[
     ),
 ]
 _Rotate = Annotated[float, typer.Option("--rotate-deg", help="Turn the intruder's flight, deg clockwise.")]
-_Side = Annotated[str, typer.Option("--side", help="Side of the own ship's track: right or left.")]
+_Side = Annotated[Side, typer.Option("--side", help="Side of the own ship's track the intruder passes.")]
 _Before = Annotated[
     float, typer.Option("--before-s", callback=POSITIVE, help="Scenario start, s before CPA.")
 ]
@@ -64,8 +62,7 @@ def _flight(path: Path, icao24: str | None, aircraft_class: str):
 def _class_option(role: str) -> object:
     return typer.Option(
         f"--{role}-class" if role else "--aircraft-class",
-        help=f"Aircraft class whose kinematic limits the {role or 'built'} path keeps to: "
-        f"{', '.join(_CLASSES)}.",
+        help=f"Aircraft class whose kinematic limits the {role or 'built'} path keeps to.",
     )
 
 
@@ -80,7 +77,7 @@ def flight(
         Path | None,
         typer.Option("--figure", help="The built path drawn against the fixes (PNG, SVG or PDF)."),
     ] = None,
-    aircraft_class: Annotated[str, _class_option("")] = "ga",
+    aircraft_class: Annotated[AircraftClass, _class_option("")] = AircraftClass.ga,
     icao24: _Icao = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
@@ -96,7 +93,6 @@ def flight(
     from skyradar.scene.encounter_from_tracks import trajectory_table
     from skyradar.scene.flyable import hermite_accelerations
 
-    check_choice("--aircraft-class", aircraft_class, _CLASSES)
     if output.suffix.lower() not in (".csv", ".parquet"):
         raise InputError(f"--output: {output} must end in .csv or .parquet")
     check_output(output, [track], overwrite, kind="file")
@@ -104,7 +100,7 @@ def flight(
         if figure.suffix.lower() not in (".png", ".svg", ".pdf"):
             raise InputError(f"--figure: {figure} must end in .png, .svg or .pdf")
         check_output(figure, [track], overwrite, kind="file", option="--figure")
-    fit = fit_flight(track, aircraft_class, icao24)
+    fit = fit_flight(track, aircraft_class.value, icao24)
     table = trajectory_table(fit.trajectory)
     if output.suffix.lower() == ".csv":
         write_csv_atomic(table, output, index=False)
@@ -122,7 +118,7 @@ def flight(
         "output": str(output),
         "figure": None if figure is None else str(figure),
         "name": traj.name,
-        "aircraft_class": aircraft_class,
+        "aircraft_class": aircraft_class.value,
         "fixes": int(fit.fix_time_s.size),
         "fixes_used": int(fit.path.kept.sum()),
         "position_lag_s": fit.path.lag_s,
@@ -173,13 +169,13 @@ def make_encounter(
     t_cpa: _TCpa = None,
     intruder_time: _TIntruder = None,
     rotate_deg: _Rotate = 0.0,
-    side: _Side = "right",
+    side: _Side = Side.right,
     before_s: _Before = 60.0,
     after_s: _After = 20.0,
     ownship_icao24: _Icao = None,
     intruder_icao24: _Icao = None,
-    ownship_class: Annotated[str, _class_option("ownship")] = "ga",
-    intruder_class: Annotated[str, _class_option("intruder")] = "ga",
+    ownship_class: Annotated[AircraftClass, _class_option("ownship")] = AircraftClass.ga,
+    intruder_class: Annotated[AircraftClass, _class_option("intruder")] = AircraftClass.ga,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -190,17 +186,16 @@ def make_encounter(
     from skyradar.io.outputs import check_output
     from skyradar.scene.encounter_from_tracks import encounter_from_tracks
 
-    check_choice("--side", side, ("right", "left"))
-    check_choice("--ownship-class", ownship_class, _CLASSES)
-    check_choice("--intruder-class", intruder_class, _CLASSES)
     check_number("--vertical-miss-m", vertical_miss_m, -10_000.0, 10_000.0)
     check_number("--rotate-deg", rotate_deg, -360.0, 360.0)
     for path in (output, *_side_files(output)):
         check_output(path, [ownship, intruder], overwrite, kind="file")
-    a, b = _flight(ownship, ownship_icao24, ownship_class), _flight(intruder, intruder_icao24, intruder_class)
+    classes = (ownship_class.value, intruder_class.value)
+    a, b = _flight(ownship, ownship_icao24, classes[0]), _flight(intruder, intruder_icao24, classes[1])
     t_cpa = 0.5 * a.end_s if t_cpa is None else t_cpa
-    own, intr = encounter_from_tracks(a, b, t_cpa, miss_m, vertical_miss_m, intruder_time, rotate_deg, side)
-    classes = (ownship_class, intruder_class)
+    own, intr = encounter_from_tracks(
+        a, b, t_cpa, miss_m, vertical_miss_m, intruder_time, rotate_deg, side.value
+    )
     result = _write(output, own, intr, t_cpa, (before_s, after_s), f"{a.name} meets {b.name}", classes)
     t, h_m = result["t_cpa_s"], result["horizontal_miss_m"]
     if abs(t - t_cpa) > 0.1 or abs(h_m - miss_m) > 1.0:  # manoeuvring flights: say what they really do

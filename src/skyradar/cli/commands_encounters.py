@@ -12,35 +12,22 @@ from skyradar.cli.app import (
     NON_NEGATIVE,
     JsonOption,
     bench_app,
-    check_choice,
     emit_measurement,
     emit_result,
     experiment_app,
     number_in,
 )
+from skyradar.cli.choices import AlertSettings, EncounterTerrain, Family, Layout, Navigation, RxLayout, Split
 from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["experiment_encounters", "bench_encounter"]
 
-_LAYOUT_CHOICES = {"both": ("single", "three-head"), "single": ("single",), "three-head": ("three-head",)}
-
-
-def _layouts(value: str) -> tuple[str, ...]:
-    from skyradar.errors import InputError
-
-    if value not in _LAYOUT_CHOICES:
-        raise InputError(
-            f"experiment encounters: option '--layout' must be both, single or three-head, got {value!r}"
-        )
-    return _LAYOUT_CHOICES[value]
-
-
-def _navigation(value: str) -> str:
-    from skyradar.scene.navigation_config import navigation_config
-
-    navigation_config(value, label="experiment encounters: option '--navigation'")  # one line on a bad name
-    return value
-
+# The layouts each --layout scores.
+_LAYOUTS = {
+    Layout.both: ("single", "three-head"),
+    Layout.single: ("single",),
+    Layout.three_head: ("three-head",),
+}
 
 _N = Annotated[
     int | None,
@@ -69,22 +56,22 @@ _TERRAIN = Annotated[
     ),
 ]
 _LAYOUT = Annotated[
-    str,
+    Layout,
     typer.Option(
         help="Radar heads scored: single (forward +-35 deg), three-head (nose and wingtips, +-110 deg) "
         "or both (one simulation, tracked and alerted per layout)."
     ),
 ]
 _NAVIGATION = Annotated[
-    str,
+    Navigation,
     typer.Option(
-        help="Own-ship navigation errors the chain sees (scenario 'navigation:' model, e.g. ga-typical, "
-        "perfect, only-heading); scoring always uses the truth."
+        help="Own-ship navigation errors the chain sees (a scenario's 'navigation:' model; only-X: the "
+        "typical errors of X alone); scoring always uses the truth."
     ),
 ]
 
 _RX_LAYOUT = Annotated[
-    str,
+    RxLayout,
     typer.Option(
         "--rx-layout",
         help="Receive array of every head (scenario 'radar.rx_layout:'): square (the prototype's 2x2) "
@@ -121,11 +108,11 @@ def experiment_encounters(
         bool, typer.Option("--no-uncertainty", help="Do not widen the volumes by the track covariance.")
     ] = False,
     terrain: _TERRAIN = "none",
-    layout: _LAYOUT = "both",
-    navigation: _NAVIGATION = "ga-typical",
-    rx_layout: _RX_LAYOUT = "square",
+    layout: _LAYOUT = Layout.both,
+    navigation: _NAVIGATION = Navigation.ga_typical,
+    rx_layout: _RX_LAYOUT = RxLayout.square,
     family: Annotated[
-        str,
+        Family,
         typer.Option(
             "--family",
             help="synthetic (parametric flights), real-flights (recorded own-ship and intruder "
@@ -133,9 +120,9 @@ def experiment_encounters(
             "crossings whose closing speed aliases into the ground's Doppler band; own-ship "
             "300-700 m above hills and Jacksboro).",
         ),
-    ] = "synthetic",
+    ] = Family.synthetic,
     split: Annotated[
-        str | None,
+        Split | None,
         typer.Option(
             "--split",
             help="Which split the seed must belong to: development (seeds below 7000: tune on these) or "
@@ -144,13 +131,13 @@ def experiment_encounters(
         ),
     ] = None,
     alert_settings: Annotated[
-        str,
+        AlertSettings,
         typer.Option(
             "--alert-config",
             help="Alerting settings the chain warns with: radar (the default, every result of the docs) "
             "or do365b (DAIDALUS' DO-365B non-cooperative alerter).",
         ),
-    ] = "radar",
+    ] = AlertSettings.radar,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -166,34 +153,26 @@ def experiment_encounters(
         DEFAULT_ENCOUNTERS,
         DEFAULT_TERRAIN_ENCOUNTERS,
         EVALUATION_SEEDS_FROM,
-        FAMILIES,
         run,
     )
     from skyradar.io.outputs import check_output, mark_folder
     from skyradar.parallel import check_workers
-    from skyradar.rx_layouts import check_rx_layout
 
     check_workers(workers)
-    check_choice("--family", family, FAMILIES)
-    check_choice("--alert-config", alert_settings, ("radar", "do365b"))
-    if split is not None:
-        check_choice("--split", split, ("development", "evaluation"))
-        if (seed >= EVALUATION_SEEDS_FROM) != (split == "evaluation"):
-            where = (
-                f"{EVALUATION_SEEDS_FROM} and up"
-                if split == "evaluation"
-                else f"below {EVALUATION_SEEDS_FROM}"
-            )
-            raise InputError(f"--seed {seed}: not in the {split} split (its seeds are {where})")
-    if family == "real-flights":
+    if split is not None and (seed >= EVALUATION_SEEDS_FROM) != (split is Split.evaluation):
+        where = (
+            f"{EVALUATION_SEEDS_FROM} and up"
+            if split is Split.evaluation
+            else f"below {EVALUATION_SEEDS_FROM}"
+        )
+        raise InputError(f"--seed {seed}: not in the {split.value} split (its seeds are {where})")
+    if family is Family.real_flights:
         from skyradar.scene.sample_flights import sample_flights
 
         sample_flights("gliders")  # the 'flights' extra, before any output is made
-    terrains, layouts = parse_terrains(terrain), _layouts(layout)
+    terrains, layouts = parse_terrains(terrain), _LAYOUTS[layout]
     if n is None:  # over terrain an encounter costs minutes: the default keeps a run within 5 minutes
         n = DEFAULT_ENCOUNTERS if terrains == ["none"] else DEFAULT_TERRAIN_ENCOUNTERS
-    _navigation(navigation)
-    check_rx_layout(rx_layout, "experiment encounters: option '--rx-layout'")
     check_output(out, (), overwrite, kind="folder", option="--out")
     mark_folder(out)
     total = n * len(terrains)
@@ -202,9 +181,9 @@ def experiment_encounters(
         result = run(
             out, n_encounters=n, seed=seed, frame_rate_hz=frame_rate, buffer=buffer, workers=workers,
             uncertainty=not no_uncertainty, progress=lambda k: bar.update(task, completed=k),
-            terrains=tuple(terrains), layouts=layouts, navigation=navigation, rx_layout=rx_layout,
-            family=family, command="skyradar " + " ".join(sys.argv[1:]), scheduler=scheduler,
-            alert_settings=alert_settings,
+            terrains=tuple(terrains), layouts=layouts, navigation=navigation.value,
+            rx_layout=rx_layout.value, family=family.value, command="skyradar " + " ".join(sys.argv[1:]),
+            scheduler=scheduler, alert_settings=alert_settings.value,
         )  # fmt: skip
     emit_result(result, as_json, "encounters")
 
@@ -212,7 +191,7 @@ def experiment_encounters(
 @bench_app.command("encounter")
 def bench_encounter(
     terrain: Annotated[
-        list[str] | None,
+        list[EncounterTerrain] | None,
         typer.Option(
             "--terrain",
             help="Terrain to fly the encounter over (repeat; default flat-300, hills, jacksboro).",
@@ -222,9 +201,6 @@ def bench_encounter(
 ) -> None:
     """CPU seconds of one encounter end to end per terrain, with each stage's time, against 9 CPU-s."""
     from skyradar.experiments.encounter_cost import BENCH_TERRAINS, run_encounter_bench
-    from skyradar.experiments.encounter_terrain import TERRAINS
 
-    terrains = tuple(terrain) if terrain else BENCH_TERRAINS
-    for name in terrains:
-        check_choice("--terrain", name, TERRAINS)
+    terrains = tuple(t.value for t in terrain) if terrain else BENCH_TERRAINS
     emit_measurement(run_encounter_bench(terrains), as_json, "bench encounter")

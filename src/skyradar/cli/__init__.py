@@ -2,7 +2,19 @@
 
 Each command module registers its commands on the shared Typer apps in :mod:`skyradar.cli.app`;
 this module imports them, runs the command with its outputs locked (one writer per output) and turns
-bad input into one line on stderr with exit code 2.
+bad input into one line on stderr with exit code 2. Public: ``app`` (the Typer application, for
+``typer.testing.CliRunner``) and :func:`main` (the ``skyradar`` script).
+
+Modules: :mod:`.app` (the apps, option callbacks, result printing), :mod:`.choices` (the options'
+fixed choices as string enums) and one module per group of commands: :mod:`.commands_sim`
+(``simulate``, ``scenarios``, ``sweep``), :mod:`.commands_raw` (``rd``), :mod:`.commands_process`
+(``process``, ``calibrate``, ``spur-map``), :mod:`.commands_track` (``track``, ``evaluate``),
+:mod:`.commands_nav` (``state``), :mod:`.commands_gpscheck` (``gpscheck``), :mod:`.commands_daa`
+(``alert``, ``serve``), :mod:`.commands_export` (``export``), :mod:`.commands_traffic` (``flight``,
+``make-encounter``), :mod:`.commands_passive` (``passive``), :mod:`.commands_passive_sim`
+(``simulate-passive``), :mod:`.commands_demo` (``demo``), :mod:`.commands_encounters` and
+:mod:`.commands_clutter` (``experiment encounters``, ``experiment clutter``); each also holds its
+``experiment`` and ``bench`` commands.
 """
 
 from __future__ import annotations

@@ -3,6 +3,26 @@
 ``encounters`` scores the whole chain on an encounter set and ``demo`` (in :mod:`skyradar.demo`)
 flies one scenario end to end. ch6 is the GPS check against a map, ch7 the passive radar.
 
-Each module's ``run(out_dir, ...) -> dict`` writes its figures (PNG) and its table, and returns
-the measured values that ``skyradar experiment NAME --json`` prints.
+Each experiment module's ``run(out_dir, ...) -> dict`` writes its figures (PNG) and its table, and
+returns the measured values that ``skyradar experiment NAME --json`` prints. The experiments, the
+public modules of this package (``from skyradar.experiments import ch2``; none is imported with the
+package):
+
+- :mod:`.ch2` (simulator against closed form), with no helper module;
+- :mod:`.ch3` (detection and direction of arrival from the ground), with :mod:`.ch3_scene` and
+  :mod:`.ch3_figures`;
+- :mod:`.ch4` (radar-aware against traditional tracking), with :mod:`.ch4_flights` and
+  :mod:`.ch4_figures`;
+- :mod:`.ch5` (flight state over terrain), with :mod:`.ch5_flight` and :mod:`.ch5_report`;
+- :mod:`.ch6` (the GPS check), with :mod:`.ch6_flight` and :mod:`.ch6_report`;
+- :mod:`.ch7` (passive radar), with :mod:`.ch7_score` and :mod:`.ch7_figures`;
+- :mod:`.clutter` (knowledge-aided clutter suppression), with :mod:`.clutter_scene` and
+  :mod:`.clutter_report`;
+- :mod:`.encounters` (the DAA encounter set), with :mod:`.encounter_set`, :mod:`.encounter_terrain`,
+  :mod:`.encounter_real`, :mod:`.encounter_chain`, :mod:`.encounter_score`,
+  :mod:`.encounter_report`, :mod:`.sensor_figures` and :mod:`.encounter_cost` (``bench encounter``).
+
+:mod:`.ground_scenes` scores the ground filter on named scenes over flat ground, hills and Jacksboro.
 """
+
+__all__ = ["ch2", "ch3", "ch4", "ch5", "ch6", "ch7", "clutter", "encounters"]

@@ -1,1 +1,47 @@
-"""Reading and writing frames (xarray/Zarr) and tables (Parquet)."""
+"""Reading and writing frames (xarray/Zarr) and tables (Parquet), recordings, and the output guard.
+
+The names users call, importable from here (each is imported from its module on first use, so
+``import skyradar.io`` stays cheap):
+
+- :func:`~.frames.open_frames`, :func:`~.frames.frames_dataset` and :func:`~.frames.radar_config_of`:
+  frames stores;
+- :func:`~.tables.read_table` and :func:`~.tables.write_table`: Parquet (or CSV) tables;
+- :func:`~.recordings.read_recording` and :func:`~.recording_writer.write_recording`: raw ADC
+  recordings; :func:`~.sigmf_io.read_iq_recording`: a passive receiver's IQ;
+- :func:`~.outputs.check_output`: the check every writing command makes before any work.
+
+Modules: frames (:mod:`.frames`, :mod:`.frames_model`, :mod:`.frames_heads`, :mod:`.cint16`,
+:mod:`.checks`, :mod:`.store_size`, :mod:`.navigation`, :mod:`.run_origin`, :mod:`.run_export`,
+:mod:`.ownship_input`); tables (:mod:`.tables`, :mod:`.table_columns`); recordings
+(:mod:`.recordings`, :mod:`.recording_writer`, :mod:`.sigmf_io`, :mod:`.iq_raw`,
+:mod:`.iq_recording`); writing safely (:mod:`.outputs`, :mod:`.atomic`, :mod:`.locks`) and reading
+safely (:mod:`.safe_yaml`).
+"""
+
+from __future__ import annotations
+
+# Each public name by the module it lives in, imported on first use (PEP 562).
+_EXPORTS = {
+    "frames": ("open_frames", "frames_dataset", "radar_config_of"),
+    "tables": ("read_table", "write_table"),
+    "recordings": ("read_recording",),
+    "recording_writer": ("write_recording",),
+    "sigmf_io": ("read_iq_recording",),
+    "outputs": ("check_output",),
+}
+__all__ = [name for names in _EXPORTS.values() for name in names]
+
+
+def __getattr__(name: str):
+    module = next((module for module, names in _EXPORTS.items() if name in names), None)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    from importlib import import_module
+
+    value = getattr(import_module(f"{__name__}.{module}"), name)
+    globals()[name] = value  # imported once; a plain attribute from then on
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

@@ -1,1 +1,36 @@
-"""Matplotlib figures (headless Agg backend)."""
+"""Matplotlib figures (headless Agg backend).
+
+The names users call, importable from here (each is imported from its module on first use, so
+``import skyradar.viz`` does not load matplotlib):
+
+- :func:`~.rangedoppler.save_frame_figure`, :func:`~.rangedoppler.plot_strength` and
+  :func:`~.rangedoppler.plot_phase_difference`: range-Doppler frames (:mod:`.rangedoppler`);
+- :func:`~.flight.flight_fit_figure`: a recorded flight's flyable path against its fixes
+  (:mod:`.flight`, ``skyradar flight --figure``);
+- :func:`~.report.write_report`: the figures and page of the demo (:mod:`.report`).
+"""
+
+from __future__ import annotations
+
+# Each public name by the module it lives in, imported on first use (PEP 562).
+_EXPORTS = {
+    "rangedoppler": ("save_frame_figure", "plot_strength", "plot_phase_difference"),
+    "flight": ("flight_fit_figure",),
+    "report": ("write_report",),
+}
+__all__ = [name for names in _EXPORTS.values() for name in names]
+
+
+def __getattr__(name: str):
+    module = next((module for module, names in _EXPORTS.items() if name in names), None)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    from importlib import import_module
+
+    value = getattr(import_module(f"{__name__}.{module}"), name)
+    globals()[name] = value  # imported once; a plain attribute from then on
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

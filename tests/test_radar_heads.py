@@ -222,10 +222,9 @@ def test_full_chain_handover_left_head_to_nose_keeps_one_track_id():
     labels = label_tracks(out["tracks"], out["truth"])
     mine = [tid for tid, name in labels.items() if name == "crossing-left"]
     assert len(mine) == 1
-    det = out["detections"]
-    air = det[~(det["is_ground"].astype(bool) | det["spur"].astype(bool))].reset_index(drop=True)
+    det = out["detections"]  # the tracks' detection_row indexes this table
     one = out["tracks"][out["tracks"]["track_id"] == mine[0]]
-    used = air.iloc[one["detection_row"][one["detection_row"] >= 0].to_numpy()]
+    used = det.iloc[one["detection_row"][one["detection_row"] >= 0].to_numpy()]
     first = used.groupby("radar")["time_s"].min()
     assert first["left"] < 1.0 and first["nose"] > first["left"]  # the left head first, then the nose
     assert one["time_s"].max() > built.times_s[-1] - 1.0  # to the end, as the nose's (and left's) track

@@ -41,7 +41,7 @@ from skyradar.process.pipeline import clutter_anchors, process_frames
 from skyradar.scene.radar_heads import select_heads
 from skyradar.sim.scenario_frames import make_simulator, scenario_truth, simulate_frames
 from skyradar.track.ground_tracks import GroundTrackTest, median_ground_down_m, terrain_surface
-from skyradar.track.track_table import track_detections
+from skyradar.track.track_table import track_detections, tracker_detections
 from skyradar.units import wrap
 
 __all__ = ["run_chain", "track_and_alert", "label_tracks", "confirmed_rows"]
@@ -146,9 +146,11 @@ def track_and_alert(
     """Track (all heads fused) and alert a detections table of ``built``, with only ``heads`` of it.
 
     ``truth`` is a frames Dataset of the run (own-ship variables; default: computed again). The
-    air detections (not ground, not spur) of the chosen heads are tracked; ``detection_row`` of
-    the tracks indexes that subset. Returns ``tracks``, ``alerts``, ``ownship``, ``detections``
-    (the subset) and ``timings_s`` (track, alert).
+    chosen heads' detections are tracked as :func:`~skyradar.track.track_table.tracker_detections`
+    gives them (spurs out, ground-flagged rows only inside a confirmed track's gate, without their
+    direction); ``detection_row`` of the tracks indexes the returned ``detections`` (the chosen
+    heads' rows). Returns ``tracks``, ``alerts``, ``ownship``, ``detections`` and ``timings_s``
+    (track, alert).
     """
     chosen = select_heads(built.heads, heads, "track_and_alert")
     if len({(h.config.v_lim_mps, h.config.range_resolution_m) for h in chosen}) > 1:
@@ -160,19 +162,22 @@ def track_and_alert(
     mine = np.ones(len(detections), bool)
     if heads is not None and "radar" in detections.columns:
         mine = detections["radar"].isin([h.name for h in chosen]).to_numpy(bool)
-    keep = mine & ~(detections["is_ground"].to_numpy(bool) | detections["spur"].to_numpy(bool))
+    air, used = tracker_detections(detections[mine])
     t0 = time.perf_counter()
     tracks = track_detections(
-        detections[keep].reset_index(drop=True), "radar", chosen[0].config,
+        air, "radar", chosen[0].config,
         frame_times_s=built.times_s, origin=built.origin, ownship=own,
         ground_test=GroundTrackTest(surface_down=_surface(built, own)),
     )  # fmt: skip
+    rows = tracks["detection_row"].to_numpy()
+    tracks["detection_row"] = np.where(rows >= 0, used[np.maximum(rows, 0)], -1) if used.size else rows
     timings = {"track": time.perf_counter() - t0}
     t0 = time.perf_counter()
     alerts = alerts_from_tracks(tracks, own, alert_config, with_advice=with_advice, source=built.name)
     timings["alert"] = time.perf_counter() - t0
-    return {"tracks": tracks, "alerts": alerts, "ownship": own, "detections": detections[mine],
-            "timings_s": timings}  # fmt: skip
+    mine_table = detections[mine].reset_index(drop=True)
+    out = {"tracks": tracks, "alerts": alerts, "ownship": own, "detections": mine_table}
+    return out | {"timings_s": timings}
 
 
 def _surface(built, own: pd.DataFrame):

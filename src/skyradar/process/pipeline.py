@@ -114,6 +114,7 @@ def process_cube(
     method: Literal["cfar", "os-cfar", "shi-tomasi"] = "cfar",
     spur_mode: Literal["mask", "flag"] = "mask",
     clutter: Any = None,
+    pfa_secondary: float | None = PFA_SECONDARY,
     **detect_kwargs: Any,
 ) -> dict[str, np.ndarray]:
     """Detection and DoA for one (n_range, n_doppler, n_rx) frame, antenna and body frames.
@@ -121,7 +122,9 @@ def process_cube(
     With a spur map, ``spur_mode="mask"`` removes spur pixels before detection (they are neither
     detected nor used as CFAR training cells, so an object beside a spur line stays visible);
     ``"flag"`` detects as usual and marks detections whose peak is in the map (thesis). With
-    ``clutter`` (a :class:`skyradar.process.clutter.ClutterSubspace`) ground clutter is suppressed first.
+    ``clutter`` (a :class:`skyradar.process.clutter.ClutterSubspace`) ground clutter is suppressed
+    first, and the nulled cells also take the secondary threshold ``pfa_secondary``
+    (:func:`skyradar.process.detect.detect`; None: none).
 
     Returns a dict of equal-length arrays: the detection columns up to ``z_body_m`` plus
     ``spur``, ``u_ant`` (n, 3) unit vectors and ``coherence`` (:func:`.direction_coherence`).
@@ -134,7 +137,7 @@ def process_cube(
     exclude = spur_map.mask if masking else None
     if clutter is not None:  # a ClutterSubspace: knowledge-aided suppression before detection
         det, u, coherence, elevation_measured = detect_suppressed(
-            cube, config, clutter, exclude, method, **detect_kwargs
+            cube, config, clutter, exclude, method, pfa_secondary=pfa_secondary, **detect_kwargs
         )
     else:
         power = integrate_channels(cube, config.rx_calibration)

@@ -112,17 +112,18 @@ def fuse_heads(
     v = det["radial_velocity_mps"].to_numpy(float)
     pos = det[list(_NED)].to_numpy(float) if all(c in det.columns for c in _NED) else None
     snr = det["snr_db"].to_numpy(float) if "snr_db" in det.columns else np.zeros(len(det))
-    if "secondary" in det.columns:  # a primary detection outranks a secondary one of the same object
-        snr = snr - 1e3 * det["secondary"].fillna(False).to_numpy(bool)
     heads = det[HEAD_COLUMN].astype(str).to_numpy()
     gates = (range_gate_bins * config.range_resolution_m, doppler_gate_bins * config.doppler_resolution_mps)
     gates += (position_gate,)
     times = det["time_s"].to_numpy(float)
     dup = np.zeros(len(det), bool)
+    # Secondary rows (gate-only candidates, skyradar.track.tracker) are kept as they are: a track
+    # takes at most one detection per frame, primary ones first, and the rest start nothing.
+    primary = ~det["secondary"].fillna(False).to_numpy(bool) if "secondary" in det.columns else None
     _, start, count = np.unique(times, return_index=True, return_counts=True)
     for a, n in zip(start, count, strict=True):
-        if n > 1:
-            sl = slice(a, a + n)
+        sl = np.arange(a, a + n) if primary is None else a + np.flatnonzero(primary[a : a + n])
+        if sl.size > 1:
             p = None if pos is None else pos[sl]
             dup[sl] = _duplicates(r[sl], v[sl], p, heads[sl], snr[sl], 2.0 * config.v_lim_mps, gates)
     rows = np.flatnonzero(~dup)

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pandas as pd
 import pytest
 
 from cli_helpers import skyradar, skyradar_in_process
+from skyradar.code_version import code_version
 from skyradar.config import RadarConfig
 from skyradar.experiments.clutter import _hit
 
@@ -37,6 +39,15 @@ def test_relief_cases_write_one_summary_entry_and_figures_per_terrain(tmp_path, 
         assert (tmp_path / "c" / f"sinr_loss_{name}.png").exists()
         assert (tmp_path / "c" / f"intruder_{name}.png").exists()
     assert [row["terrain"] for row in summary["rows"]] == ["hills", "jacksboro"]
+    # Provenance, as every measured result records it; the same in the saved summary.
+    assert summary["command"].startswith("skyradar experiment clutter --frames 4 --terrain hills,jacksboro")
+    assert summary["version"] == code_version()
+    assert re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", summary["date_utc"])
+    assert summary["load_average_1min"] >= 0.0
+    saved = json.loads((tmp_path / "c" / "summary.json").read_text())
+    assert {k: saved[k] for k in ("version", "command", "date_utc")} == {
+        k: summary[k] for k in ("version", "command", "date_utc")
+    }
     frames = pd.read_csv(tmp_path / "c" / "frames.csv")
     assert set(frames.terrain) == {"hills", "jacksboro"} and "cell_if_db" in frames
     assert set(pd.read_csv(tmp_path / "c" / "sinr_loss.csv").terrain) == {"hills", "jacksboro"}

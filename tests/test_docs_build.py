@@ -73,6 +73,40 @@ def test_results_page_holds_the_measured_numbers(site):
         assert path.name in text and result["date_utc"] in text and result["command"] in text
 
 
+def test_results_page_holds_the_clutter_experiments_numbers(site):
+    """Each saved ``experiment clutter`` summary (``skyradar-clutter``): its provenance, a row per
+    figure of merit with one value per terrain, and the figures kept beside it."""
+    sys.path.insert(0, str(SOURCE / "_ext"))
+    try:
+        from skyradar_docs import CLUTTER_FIGURES, format_value
+    finally:
+        sys.path.remove(str(SOURCE / "_ext"))
+    page = (site / "results.html").read_text()
+    text = _text(site / "results.html").replace("\u2019", "'")  # smart quotes back to plain
+    files = sorted((RESULTS / "clutter").glob("*.json"))
+    assert files, "no clutter experiment summaries in docs/results/clutter"
+    for path in files:
+        summary = json.loads(path.read_text())
+        assert path.name in text
+        for key in ("version", "command", "date_utc"):
+            assert summary[key] in text, (path.name, key)
+        assert format_value("load_average_1min", summary["load_average_1min"]) in text
+        cases = summary["terrains"]
+        assert "key meaning " + " ".join(cases) in text, f"{path.name}: no table with a column per terrain"
+        for key, meaning, _ in CLUTTER_FIGURES:
+            cells = [format_value(key, case[key]) for case in cases.values()]
+            if key == "visible_frames":
+                cells = [f"{c} of {case['frames']}" for c, case in zip(cells, cases.values(), strict=True)]
+            row = " ".join([key, meaning, *cells])
+            assert row in text, f"{path.name}: row {row!r} not on the page"
+        kept = [Path(f).name for f in summary["figures"] if (path.parent / Path(f).name).is_file()]
+        assert kept, f"{path.name}: no figure kept beside it"
+        for name in kept:
+            stem = re.escape(Path(name).stem)
+            image = re.search(rf'<img[^>]+src="(_images/{stem}\d*\.png)"', page)
+            assert image and (site / image[1]).is_file(), name
+
+
 def test_cli_reference_names_the_commands(site):
     text = _text(site / "cli.html")
     for command in ("simulate", "process", "track", "alert", "experiment encounters"):

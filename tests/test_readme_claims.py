@@ -15,7 +15,10 @@ from skyradar.cli import app
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
-RECORDS = sorted((ROOT / "docs" / "results").glob("*.json"))
+# The encounter summaries and the clutter experiment's.
+RECORDS = sorted((ROOT / "docs" / "results").glob("*.json")) + sorted(
+    (ROOT / "docs" / "results" / "clutter").glob("*.json")
+)
 
 
 def _command(record: Path) -> list[str]:

@@ -7,6 +7,10 @@
 ``skyradar-benchmarks``
     One section per saved benchmark result in ``docs/results/benchmarks/*.json`` (the last line of
     ``skyradar bench NAME --json``): its provenance, then every key it measured.
+``skyradar-clutter``
+    One section per ``skyradar experiment clutter`` summary in ``docs/results/clutter/*.json``: its
+    settings and provenance, a table of the figures of merit per terrain, and the figures the run
+    wrote that are kept beside the JSON.
 ``skyradar-cli``
     The command-line reference, read from the Typer app's click command tree
     (``typer.main.get_command``): each command's help, usage, arguments and options.
@@ -37,6 +41,7 @@ import importlib.util
 import inspect
 import json
 import math
+import os
 import pkgutil
 import re
 import types
@@ -69,8 +74,40 @@ ROW_FIELDS = (
     "warnings_not_held",
     "alert_flickers",
 )
+# Figures of merit of one terrain case of the clutter experiment (its summary's ``terrains``), in the
+# order shown: key, meaning (with its unit), decimals (None: a count).
+CLUTTER_FIGURES = (
+    ("own_agl_m_median", "own-ship height above the ground, median, m", 0),
+    ("visible_frames", "frames the intruder is detected in without the ground, of all frames", None),
+    ("detection_fraction_none", "detection fraction without suppression", 2),
+    ("detection_fraction_suppressed", "detection fraction with suppression", 2),
+    ("detection_fraction_suppressed_with_secondary", "the same counting secondary detections", 2),
+    ("intruder_cell_if_db_median", "improvement factor in the intruder's cell, median, dB", 1),
+    (
+        "intruder_cell_clutter_frames",
+        "of those, frames whose intruder cell holds clutter over the noise",
+        None,
+    ),
+    ("intruder_cell_if_db_median_clutter", "improvement factor in its cell in those frames, median, dB", 1),
+    ("lost_frames_with_cells", "frames lost to clutter with CFAR-window cells of CNR >= 25 dB", None),
+    ("if_db_lost_cells_median", "improvement factor in those cells (the lost cells), median, dB", 1),
+    ("mdv_mps_none", "minimum detectable velocity without suppression, m/s", 2),
+    ("mdv_mps_suppressed", "minimum detectable velocity with suppression, m/s", 2),
+    ("usable_doppler_fraction_none", "usable Doppler fraction without suppression", 2),
+    ("usable_doppler_fraction_suppressed", "usable Doppler fraction with suppression", 2),
+)
+CLUTTER_SETTINGS = ("frames_per_case", "seed", "terrains")
+# What each figure of a terrain case shows, by its file name's prefix.
+CLUTTER_PLOTS = {
+    "sinr_loss": "SINR loss against radial velocity, with and without suppression",
+    "intruder": "the intruder's SNR, the clutter and the improvement factor at it against its range, "
+    "and its detections",
+}
+
 # Decimals of the fractional numbers; the rest are counts.
-DECIMALS = {"false_warning_rate": 3, "median_warning_lead_s": 1, "load_average_1min": 2}
+DECIMALS = {"false_warning_rate": 3, "median_warning_lead_s": 1, "load_average_1min": 2} | {
+    key: decimals for key, _, decimals in CLUTTER_FIGURES if decimals is not None
+}
 
 
 def format_value(name: str, value: object) -> str:
@@ -243,6 +280,69 @@ class BenchmarksDirective(SphinxDirective):
             ]
             section += _table(["key", "value"], rows, classes=["skyradar-bench"])
             out.append(section)
+        return out
+
+
+class ClutterDirective(SphinxDirective):
+    """``.. skyradar-clutter:: [folder]``: the saved ``skyradar experiment clutter`` summaries (default
+    ``docs/results/clutter``), each with its settings and provenance, a table of
+    :data:`CLUTTER_FIGURES` with one column per terrain, and the figures of its ``figures`` list
+    that are kept beside the JSON (a figure left out of the folder is left out of the page)."""
+
+    optional_arguments = 1
+
+    def run(self) -> list[nodes.Node]:
+        where = self.arguments[0] if self.arguments else "../results/clutter"
+        folder = Path(self.env.srcdir, where).resolve()
+        files = sorted(folder.glob("*.json"))
+        if not files:
+            warning = f"no clutter summary JSON in {folder}"
+            return [self.state.document.reporter.warning(warning, line=self.lineno)]
+        out: list[nodes.Node] = []
+        for path in files:
+            self.env.note_dependency(str(path))
+            out.append(self._summary_section(path, json.loads(path.read_text())))
+        return out
+
+    def _summary_section(self, path: Path, summary: dict) -> nodes.section:
+        section = _section(self, path.name, "clutter-" + path.stem)
+        fields = nodes.field_list()
+        for key in (*CLUTTER_SETTINGS, *PROVENANCE_FIELDS):
+            # ``terrains`` maps each terrain case to its figures: the settings name the cases.
+            value = format_value(key, list(summary[key]) if key == "terrains" else summary.get(key))
+            body = nodes.paragraph()
+            body += nodes.literal(value, value) if key in ("command", "version") else nodes.Text(value)
+            fields += nodes.field("", nodes.field_name(key, key), nodes.field_body("", body))
+        section += fields
+        cases = summary.get("terrains") or {}
+        rows = []
+        for key, meaning, _ in CLUTTER_FIGURES:
+            cells = [format_value(key, case.get(key)) for case in cases.values()]
+            if key == "visible_frames":  # of how many
+                cells = [
+                    f"{c} of {format_value('frames', case.get('frames'))}"
+                    for c, case in zip(cells, cases.values(), strict=True)
+                ]
+            rows.append([nodes.paragraph("", "", nodes.literal(key, key)), meaning, *cells])
+        section += _table(["key", "meaning", *cases], rows, classes=["skyradar-clutter"])
+        section.extend(self._figures(path.parent, summary))
+        return section
+
+    def _figures(self, folder: Path, summary: dict) -> list[nodes.figure]:
+        """A figure node per PNG of the summary's ``figures`` that is kept in ``folder``."""
+        here = Path(self.env.doc2path(self.env.docname)).parent
+        out = []
+        for name in (Path(f).name for f in summary.get("figures") or []):
+            png = folder / name
+            if not png.is_file():
+                continue
+            self.env.note_dependency(str(png))
+            kind, _, terrain = png.stem.rpartition("_")
+            text = f"{name}: {CLUTTER_PLOTS.get(kind, kind)}, {terrain}."
+            figure = nodes.figure(classes=["skyradar-clutter-figure"])
+            figure += nodes.image(uri=Path(os.path.relpath(png, here)).as_posix(), alt=name)
+            figure += nodes.caption(text, text)
+            out.append(figure)
         return out
 
 
@@ -638,6 +738,7 @@ class ColumnsDirective(SphinxDirective):
 def setup(app: Sphinx) -> dict:
     app.add_directive("skyradar-results", ResultsDirective)
     app.add_directive("skyradar-benchmarks", BenchmarksDirective)
+    app.add_directive("skyradar-clutter", ClutterDirective)
     app.add_directive("skyradar-cli", CliDirective)
     app.add_directive("skyradar-api", ApiDirective)
     app.add_directive("skyradar-alert-config", AlertConfigDirective)

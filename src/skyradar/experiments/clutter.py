@@ -75,6 +75,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from skyradar.code_version import code_version, provenance
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.experiments.clutter_report import plot_sinr_loss, plot_track, summary_rows
@@ -365,7 +366,11 @@ def _title(terrain: str, summary: dict) -> str:
 
 
 def run(
-    out: Path, n_frames: int = 24, terrains: tuple[str, ...] = DEFAULT_TERRAINS, seed: int = 0
+    out: Path,
+    n_frames: int = 24,
+    terrains: tuple[str, ...] = DEFAULT_TERRAINS,
+    seed: int = 0,
+    command: str | None = None,
 ) -> dict[str, Any]:
     """Run the terrain cases; write ``frames.csv``, ``sinr_loss.csv``, ``summary.json`` and PNG figures.
 
@@ -379,6 +384,8 @@ def run(
         Terrain cases, names of :data:`TERRAINS`.
     seed : int
         Noise seed; over relief it also picks the hills surface and the point over Jacksboro.
+    command : str, optional
+        The command the summary records (default: this process' command line).
 
     Returns
     -------
@@ -386,10 +393,12 @@ def run(
         ``terrains``: one entry of figures of merit per terrain case (see the module docstring;
         heights in m, velocities in m/s, times in s); ``rows``: the summary table, one row per
         terrain (column ``terrain``); ``figures``: the PNG paths (``sinr_loss_<terrain>.png``,
-        ``intruder_<terrain>.png``); ``runtime_s``.
+        ``intruder_<terrain>.png``); ``runtime_s``; and the provenance every measured result
+        records (:func:`skyradar.code_version.provenance`: ``version``, the code version when the
+        run started, ``command``, ``date_utc``, ``load_average_1min``).
     """
     out = Path(out)
-    start = time.perf_counter()
+    start, version = time.perf_counter(), code_version()
     terrains = tuple(parse_terrains(",".join(terrains)))
     result: dict[str, Any] = {"frames_per_case": n_frames, "seed": seed, "terrains": {}}
     all_frames, all_curves, figures = [], [], []
@@ -410,5 +419,6 @@ def run(
     result["figures"] = [str(p) for p in figures]
     result["rows"] = summary_rows(result["terrains"])
     result["runtime_s"] = time.perf_counter() - start
+    result |= provenance(command, version)
     write_json_atomic(out / "summary.json", result)
     return result

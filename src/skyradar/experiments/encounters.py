@@ -26,7 +26,7 @@ from typing import Any
 
 import pandas as pd
 
-from skyradar.code_version import code_version
+from skyradar.code_version import code_version, provenance
 from skyradar.daa.alert_config import ALERT_CONFIGS
 from skyradar.errors import InputError
 from skyradar.experiments.encounter_chain import FRAME_RATE_HZ, LAYOUTS, SUPPRESSION, run_encounter
@@ -207,8 +207,9 @@ def run(
     flights, the ``flights`` extra) or ``fast-closures``
     (:func:`~skyradar.experiments.encounter_set.make_fast_closures`: closing speeds that alias into
     the ground's Doppler band, own-ship 300-700 m above the ground). The summary records its
-    provenance: ``command`` (as the caller ran it), the version with a digest of the source, the
-    UTC date and the load average, and its ``split``: seeds from :data:`EVALUATION_SEEDS_FROM` are
+    provenance (:func:`skyradar.code_version.provenance`): ``command`` (as the caller ran it, by
+    default this process' command line), the version with a digest of the source, the UTC date and
+    the load average, and its ``split``: seeds from :data:`EVALUATION_SEEDS_FROM` are
     the evaluation split, never looked at while tuning; smaller ones are for development.
     Finished encounters are kept in ``encounters.partial.parquet`` while the run goes on; a run that
     was interrupted resumes from them when started again with the same settings. ``scheduler`` and
@@ -256,10 +257,7 @@ def run(
         workers=workers if scheduler is None else None,
         scheduler=scheduler,
         runtime_s=round(time.perf_counter() - t0, 1),
-        version=version,
-        command=command,
-        date_utc=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-        load_average_1min=round(os.getloadavg()[0], 2),
+        **provenance(command, version),
     )
     write_json_atomic(out_dir / "summary.json", summary)
     for name in (_PARTIAL, _PARTIAL + ".json"):

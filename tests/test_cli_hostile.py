@@ -83,6 +83,8 @@ def _add_flag(column: str, first_value):
         ("str_v.parquet", _set("vn_mps", "fast", slice(None)), ["str_v.parquet", "'vn_mps'", "fast"]),
         # An infinite position was dropped like a missing one: no alert and no word.
         ("inf_n.parquet", _set("north_m", np.inf, slice(None)), ["inf_n.parquet", "'north_m'", "inf"]),
+        # 1e308 is finite: it passed, overflowed in the conflict geometry and gave alerts at range inf.
+        ("big_n.parquet", _set("north_m", 1e308), ["big_n.parquet", "'north_m'", "1e+308", "row 0"]),
         # The altitude flag is read as a boolean; "maybe" must not become True.
         (
             "alt_flag.parquet",

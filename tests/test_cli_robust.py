@@ -151,6 +151,29 @@ def test_yaml_alias_bomb_is_refused_quickly(tmp_path, command):
     _assert_one_line_error(result, "bomb.yaml", "aliases expand")
 
 
+def test_deeply_nested_yaml_is_one_line(tmp_path):
+    # [[[[... deeper than the parser's stack was a RecursionError traceback of 3000 lines.
+    (tmp_path / "deep.yaml").write_text("[" * 100_000 + "]" * 100_000)
+    result = _skyradar("simulate", "deep.yaml", "-o", "run.zarr", cwd=tmp_path)
+    _assert_one_line_error(result, "deep.yaml", "nested too deeply")
+
+
+def test_deeply_nested_json_sidecars_are_refused(tmp_path):
+    # The other JSON a command reads: a radar config, a recording's sidecar, a raw IQ file's sidecar.
+    from skyradar.cli.commands_process import _read_config
+    from skyradar.errors import InputError
+    from skyradar.io.iq_raw import read_raw_iq
+    from skyradar.io.recordings import _load_sidecar
+
+    deep = "[" * 100_000 + "]" * 100_000
+    for name in ("radar.json", "rec.json", "iq.json"):
+        (tmp_path / name).write_text(deep)
+    (tmp_path / "iq.cf32").write_bytes(b"\0" * 64)
+    for read, name in ((_read_config, "radar.json"), (_load_sidecar, "rec.json"), (read_raw_iq, "iq.cf32")):
+        with pytest.raises(InputError, match="nested too deeply"):
+            read(tmp_path / name)
+
+
 def test_recursive_yaml_alias_is_refused(tmp_path):
     scenario = tmp_path / "loop.yaml"
     scenario.write_text("name: &a [1, *a]\n")
@@ -255,6 +278,22 @@ def test_rd_refuses_repeated_frame_times(tmp_path):
     _assert_one_line_error(result, "rec.json", "frame_times_s", "frame 2")
 
 
+def test_a_frame_time_of_1e308_is_refused(tmp_path):
+    # Finite, so a recording's store and a run's frames took it; the filters' powers of dt overflow.
+    import json
+
+    from skyradar.errors import InputError
+    from skyradar.io.checks import check_frame_times
+    from skyradar.io.recordings import read_recording
+
+    rec = _recording(tmp_path / "rec.npy")
+    (tmp_path / "rec.json").write_text(json.dumps({"frame_times_s": [0.0, 0.1, 1e308]}))
+    with pytest.raises(InputError, match=r"rec.json: field 'frame_times_s' is 1e\+308 s at frame 2"):
+        read_recording(rec)
+    with pytest.raises(InputError, match=r"run.zarr: field 'time' is 1e\+308 s at frame 2"):
+        check_frame_times(np.array([0.0, 0.1, 1e308]), "run.zarr")
+
+
 _OWN = {"type": "straight", "start_ned_m": [0, 0, -500], "heading_deg": 0, "speed_mps": 40}
 
 
@@ -265,6 +304,9 @@ _OWN = {"type": "straight", "start_ned_m": [0, 0, -500], "heading_deg": 0, "spee
         ({"duration_s": 1e12}, ["duration_s", "frame_rate_hz", "frames"]),  # refused, not a MemoryError
         ({"ownship": {**_OWN, "speed_mps": 1e9}}, ["ownship", "speed", "Mach 3"]),
         ({"ownship": {**_OWN, "start_ned_m": [0, 0, 1e7]}}, ["ownship", "altitude"]),
+        # 1e308: numpy's "Maximum allowed dimension exceeded" (a traceback) and an overflow of 10**(NF/10)
+        ({"terrain": {"type": "flat", "size_m": 1e308}}, ["'terrain.size_m'", "1e+12", "1e+308"]),
+        ({"radar": {"noise_figure_db": 1e11}}, ["noise_figure_db", "+-300"]),
     ],
 )
 def test_nonsense_scenario_is_refused(tmp_path, change, needles):

@@ -113,6 +113,20 @@ def test_map_without_finite_values_is_one_line(tmp_path):
     assert not (tmp_path / "check.parquet").exists()
 
 
+def test_map_without_data_under_the_flight_is_one_line(tmp_path):
+    # Data in a corner, none under the flight: every frame was "no decision: too little structure".
+    from skyradar.sim.land_cover_scene import ch6_radar_config
+
+    grid = GroundGrid.from_extent(-1500.0, 1500.0, -1500.0, 1500.0, pixel_m=10.0)
+    image = np.full(grid.shape, np.nan, np.float32)
+    image[:40, :40] = np.random.default_rng(0).random((40, 40))
+    _write_tif(tmp_path / "corner.tif", grid, image)
+    run = _empty_run(tmp_path / "side.zarr", ch6_radar_config(), n=3)
+    result = skyradar("gpscheck", str(run), "--map", "corner.tif", "-o", "check.parquet", cwd=tmp_path)
+    assert_one_line_error(result, "corner.tif", "does not cover the flight", "all 3 frames", "its data lie")
+    assert not (tmp_path / "check.parquet").exists()
+
+
 @pytest.fixture(scope="module")
 def town_run(tmp_path_factory):
     from skyradar.sim.geometry import PlatformState

@@ -124,7 +124,7 @@ def test_a_decompression_bomb_is_refused_quickly(tmp_path):
                 for n in ("preventive", "corrective", "warning")
             ]
         },  # fmt: skip
-        {"min_track_age_s": 1.0e9, "min_track_age_floor_s": 1.0e9},
+        {"min_track_age_s": 1.0e5, "min_track_age_floor_s": 1.0e5},  # 1e9 s: beyond every setting's 1e6
         {"max_velocity_sigma_mps": 0.0},
     ],
 )
@@ -140,6 +140,31 @@ def test_an_alert_config_that_never_warns_is_refused(tmp_path, settings):
         alert_config(tmp_path / "quiet.yaml")
 
 
+def test_an_alert_config_that_alerts_on_everything_is_refused_through_the_entry_point(tmp_path):
+    """A preventive volume of 100 km (1e308 m is out of range) alerts on every aircraft in sight. The
+    config is named before the tracks are read: they need not exist. (The settings that never warn
+    are refused by the same check, above; test_ownship_cli runs a bad config through the CLI.)"""
+    levels = [{"name": "preventive", "dthr_m": 1.0e5, "zthr_m": 1.0e5, "alerting_time_s": 55},
+              {"name": "corrective", "dthr_m": 670.56, "zthr_m": 137.16, "alerting_time_s": 55},
+              {"name": "warning", "dthr_m": 670.56, "zthr_m": 137.16, "alerting_time_s": 25}]  # fmt: skip
+    (tmp_path / "c.yaml").write_text(yaml.safe_dump({"levels": levels}))
+    args = ("alert", "t.parquet", "--ownship", "run.zarr", "-o", "a.parquet", "--config", "c.yaml")
+    assert_one_line_error(
+        skyradar(*args, cwd=tmp_path), "c.yaml", "alert on an aircraft 10 km abeam flying alongside"
+    )
+
+
+def test_an_alert_setting_beyond_1e6_is_refused(tmp_path):
+    # z 1e308 overflowed the widened volumes (numpy warnings, then an alert on everything).
+    from skyradar.daa.alert_config import alert_config
+    from skyradar.errors import InputError
+
+    (tmp_path / "z.yaml").write_text(yaml.safe_dump({"z_h_pos": 1.0e308}))
+    message = r"z.yaml: field 'z_h_pos': must be a finite number from 0 to 1e\+06"
+    with pytest.raises(InputError, match=message):
+        alert_config(tmp_path / "z.yaml")
+
+
 def test_an_alert_config_that_warns_is_accepted(tmp_path):
     from skyradar.daa.alert_config import alert_config
 
@@ -153,6 +178,14 @@ def test_a_malformed_scheduler_address_is_one_line(tmp_path, address):
     result = skyradar("simulate", "s.yaml", "-o", "run.zarr", "--scheduler", address, cwd=tmp_path)
     assert_one_line_error(result, "--scheduler", "not a Dask scheduler address")
     assert not list(tmp_path.glob("run.zarr*"))
+
+
+def test_a_scheduler_address_without_a_valid_port_is_refused_before_the_output_folder(tmp_path):
+    # tcp://HOST:99999 waited 10 s for an answer that cannot come, and left the experiment's folder.
+    result = skyradar("experiment", "encounters", "--scheduler", "tcp://127.0.0.1:99999", "--out", "x",
+                      cwd=tmp_path)  # fmt: skip
+    assert_one_line_error(result, "--scheduler tcp://127.0.0.1:99999", "port 99999 is not 1..65535")
+    assert not (tmp_path / "x").exists()
 
 
 @pytest.mark.parametrize(
@@ -205,10 +238,13 @@ def test_hostile_paths_give_one_line(tmp_path):
         (("simulate", "loop", "-o", "run.zarr"), "loop", "symbolic link loop"),
         (("flight", "loop", "-o", "x.csv"), "loop", "symbolic link loop"),
         (("simulate", "s.yaml", "-o", "a" * 300 + ".zarr"), "aaaa", "File name too long"),
+        # 250 bytes fit, the temporary name written first does not: refused before the run, not after it
+        (("simulate", "s.yaml", "-o", "b" * 245 + ".zarr"), "bbbb", "File name too long"),
     ]
     for args, path, reason in cases:
         result = skyradar(*args, cwd=tmp_path)
         assert_one_line_error(result, path, reason)
+    assert not any(p.name.startswith(("aaa", "bbb", ".aaa", ".bbb")) for p in tmp_path.iterdir())
 
 
 def test_sigmf_metadata_with_a_nan_rate_or_deep_nesting_is_one_line(tmp_path):
@@ -220,8 +256,12 @@ def test_sigmf_metadata_with_a_nan_rate_or_deep_nesting_is_one_line(tmp_path):
     meta = json.loads((tmp_path / "rec.sigmf-meta").read_text())
     meta["global"]["core:sample_rate"] = float("nan")
     (tmp_path / "nan.sigmf-meta").write_text(json.dumps(meta))
+    meta["global"]["core:sample_rate"] = 5e6
+    meta["global"]["skyradar:illuminator"]["pri_s"] = [1e308] * 4  # crashed the pulse profile
+    meta["global"].pop("core:sha512", None)
+    (tmp_path / "pri.sigmf-meta").write_text(json.dumps(meta))
     (tmp_path / "deep.sigmf-meta").write_text("[" * 100_000 + "]" * 100_000)
-    for name in ("nan", "deep"):
+    for name in ("nan", "deep", "pri"):
         shutil.copy(tmp_path / "rec.sigmf-data", tmp_path / f"{name}.sigmf-data")
     assert_one_line_error(
         skyradar("passive", "nan.sigmf-meta", "-o", "a.parquet", cwd=tmp_path),
@@ -230,6 +270,10 @@ def test_sigmf_metadata_with_a_nan_rate_or_deep_nesting_is_one_line(tmp_path):
     assert_one_line_error(
         skyradar("passive", "deep.sigmf-meta", "-o", "b.parquet", cwd=tmp_path),
         "deep.sigmf-meta", "nested too deeply",
+    )  # fmt: skip
+    assert_one_line_error(
+        skyradar("passive", "pri.sigmf-meta", "-o", "c.parquet", cwd=tmp_path),
+        "pri.sigmf-meta", "'pri_s'", "1e+308",
     )  # fmt: skip
 
 
@@ -242,6 +286,42 @@ def test_a_negated_range_column_is_refused_by_track(tmp_path):
     result = skyradar("track", "det.parquet", "-o", "trk.parquet", cwd=tmp_path)
     assert_one_line_error(result, "det.parquet", "range_m", "negative at row 0")
     assert not (tmp_path / "trk.parquet").exists()
+
+
+def test_a_range_of_1e308_is_refused_by_track(tmp_path):
+    # Finite, so it passed the checks, and the tracker dropped the detection without a word.
+    import pandas as pd
+
+    det = pd.DataFrame({"time_s": [0.0, 0.1, 0.2], "frame": [0, 1, 2], "range_m": [900.0, 1e308, 890.0],
+                        "radial_velocity_mps": [-50.0, -50.0, -50.0]})  # fmt: skip
+    det.to_parquet(tmp_path / "det.parquet")
+    result = skyradar("track", "det.parquet", "-o", "trk.parquet", cwd=tmp_path)
+    assert_one_line_error(result, "det.parquet", "'range_m'", "1e+308", "row 1")
+    assert not (tmp_path / "trk.parquet").exists()
+
+
+@pytest.mark.parametrize(
+    ("row", "needles"),
+    [
+        ("10,52.001,4.36,1000,1e308,0,0", ["'groundspeed'", "row 1", "1e+308 kt"]),  # was a traceback
+        ("10,52.001,4.36,FL350,100,0,0", ["'altitude'", "row 1", "'FL350'"]),  # was dropped as empty
+    ],
+)
+def test_a_flight_file_with_a_corrupt_number_is_one_line(tmp_path, row, needles):
+    rows = ["0,52,4.36,1000,100,0,0", row, "20,52.002,4.36,1000,100,0,0", "30,52.003,4.36,1000,100,0,0"]
+    head = "timestamp,latitude,longitude,altitude,groundspeed,track,vertical_rate"
+    (tmp_path / "f.csv").write_text("\n".join([head, *rows]) + "\n")
+    assert_one_line_error(skyradar("flight", "f.csv", "-o", "p.csv", cwd=tmp_path), "f.csv", *needles)
+    assert not (tmp_path / "p.csv").exists()
+
+
+def test_a_refused_intruder_file_is_the_one_line_after_a_good_own_ship_file(tmp_path):
+    # The own-ship file's repair note came first: two lines for one refusal.
+    head = "timestamp,latitude,longitude,altitude\n"
+    (tmp_path / "own.csv").write_text(head + "0,52,4.36,1000\n60,52.03,4.36,1000\n")
+    (tmp_path / "int.csv").write_text(head + "0,52.06,4.37,1000\n60,52.03,4.37,high\n")
+    result = skyradar("make-encounter", "own.csv", "int.csv", "-o", "e.yaml", cwd=tmp_path)
+    assert_one_line_error(result, "int.csv", "'altitude'", "'high'")
 
 
 @pytest.mark.parametrize("name", ["../x", ".", "zarr.json", ".zattrs", "a/b", "nose head"])

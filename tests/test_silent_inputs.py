@@ -78,6 +78,20 @@ def test_scenario_reads_only_the_dem_window_it_needs(tmp_path):
     np.testing.assert_allclose(built.terrain.height_at(lat, lon), full.height_at(lat, lon), atol=1e-3)
 
 
+def test_an_undeclared_no_data_block_under_the_flight_of_a_large_npz_is_refused(tmp_path):
+    # 0.03 % of the whole grid, under the fill limit, so it was filled as terrain without a word; it is
+    # a large part of the window the flight sees, and the limit now applies to that window (as for
+    # .hgt and .tif files).
+    step, z = 0.0005, np.full((600, 600), 10.0)
+    z[295:305, 295:305] = -9999.0  # 550 x 340 m under the origin
+    corner = {"xmin": 4.36 - 300 * step, "ymax": 52.5 + 300 * step}
+    np.savez(tmp_path / "big.npz", elevation=z, dx=step, dy=step, **corner)
+    scenario = _scenario(tmp_path, terrain={"type": "file", "path": "big.npz"})
+    result = _skyradar("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path)
+    _assert_one_line_error(result, "s.yaml", "big.npz", "-9999", "above the fill limit", "does not declare")
+    assert not any(tmp_path.glob("run.zarr*"))
+
+
 def test_process_refuses_a_dem_far_from_the_runs_own_ship(tmp_path):
     built = Scenario.from_dict(BASE, source=tmp_path / "s.yaml").build()
     simulate_to_zarr(built, tmp_path / "run.zarr", chunk_frames=5)
@@ -175,6 +189,12 @@ def test_alert_refuses_an_ownship_run_the_tracks_did_not_come_from(tmp_path, two
     result = _skyradar("alert", "trk.parquet", "--ownship", "run_b.zarr", "-o", "al.parquet", cwd=tmp_path)
     _assert_one_line_error(result, "trk.parquet", "run_a.zarr", "run_b.zarr", "0..0.8 s", "origins differ")
     assert not (tmp_path / "al.parquet").exists()
+    # evaluate's check names its run as the argument it is (evaluate has no --ownship).
+    from skyradar.cli.commands_track import _check_tracks_of_run
+
+    tracks = pd.read_parquet(tmp_path / "trk.parquet")
+    with pytest.raises(InputError, match="but the run .*run_b.zarr is another run .* origins differ"):
+        _check_tracks_of_run(tracks, tmp_path / "trk.parquet", tmp_path / "run_b.zarr")
     result = _skyradar("alert", "trk.parquet", "--ownship", "run_a.zarr", "-o", "al.parquet", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
 

@@ -165,6 +165,10 @@ class RadarConfig:
             value = getattr(self, name)
             if not (np.isfinite(value) and value > 0):
                 raise InputError(f"radar.{name} must be a positive number, got {value!r}")
+        for name in ("pe_dbm", "noise_figure_db"):  # powers in dB: 10 ** (1e11 / 10) overflowed mid-run
+            value = getattr(self, name)
+            if not (np.isfinite(value) and abs(value) <= 300.0):
+                raise InputError(f"radar.{name} must be a finite number of dB within +-300, got {value!r}")
         if int(self.n_doppler) != self.n_doppler or self.n_doppler < 2:
             raise InputError(f"radar.n_doppler must be an integer >= 2, got {self.n_doppler!r}")
         if self.prf_hz >= self.fs_hz:

@@ -16,7 +16,10 @@ from typing import Any
 from skyradar.errors import InputError
 from skyradar.extras import import_extra
 
-__all__ = ["connect", "close", "map_chunks", "map_frame_chunks", "check_workers", "max_local_workers"]
+__all__ = [
+    "connect", "close", "map_chunks", "map_frame_chunks", "check_workers", "check_scheduler",
+    "max_local_workers",
+]  # fmt: skip
 
 _WORKERS_PER_CORE = 4  # more local worker processes than this only thrash (each holds numba + numpy)
 
@@ -55,6 +58,34 @@ def check_workers(workers: int | None, option: str = "--workers") -> int | None:
             f"{option}: must be an integer from 1 to {limit} (4 per core on this machine), got {workers!r}"
         )
     return int(workers)
+
+
+def check_scheduler(scheduler: str | None, option: str = "--scheduler") -> str | None:
+    """``scheduler`` if None or a Dask address with a port from 1 to 65535, else
+    :class:`InputError`: checked before any work, not after the scenario is built or the output
+    folder made (``tcp://host:99999`` waited 10 s for an answer that cannot come).
+
+    Examples
+    --------
+    >>> check_scheduler("tcp://127.0.0.1:8786")
+    'tcp://127.0.0.1:8786'
+    >>> check_scheduler("tcp://127.0.0.1:99999")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: --scheduler tcp://127.0.0.1:99999: not a Dask scheduler address ...
+    """
+    if scheduler is None:
+        return None
+    addressing = import_extra("distributed.comm.addressing", "dask", f"{option} (a Dask cluster)")
+    try:
+        _host, port = addressing.get_address_host_port(scheduler)
+        if not 1 <= int(port) <= 65535:
+            raise ValueError(f"port {port} is not 1..65535")
+    except (ValueError, TypeError) as exc:
+        raise InputError(
+            f"{option} {scheduler}: not a Dask scheduler address (tcp://HOST:PORT): {exc}"
+        ) from None
+    return scheduler
 
 
 def connect(scheduler: str | None, workers: int | None, timeout_s: float = 10.0):

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import json
+import logging
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -18,7 +20,7 @@ from skyradar.io.tables import jsonable
 __all__ = [
     "app", "experiment_app", "bench_app", "console", "emit_result", "emit_measurement", "JsonOption",
     "number_in", "check_number", "check_choice", "POSITIVE", "NON_NEGATIVE", "COUNT", "PROBABILITY",
-    "WORKERS", "CHUNK_SAMPLES", "HeadOption", "open_one_head",
+    "WORKERS", "SCHEDULER", "CHUNK_SAMPLES", "HeadOption", "open_one_head", "notes_after_inputs",
 ]  # fmt: skip
 
 app = typer.Typer(
@@ -40,6 +42,30 @@ JsonOption = Annotated[bool, typer.Option("--json", help="Print the result as JS
 
 # Progress bars and tables go to stderr so that stdout's last line is the JSON result.
 console = Console(stderr=True)
+
+
+@contextmanager
+def notes_after_inputs() -> Iterator[None]:
+    """Hold the warnings skyradar logs in the block (the one-line repair note of each flight file) and
+    show them when the block ends well: when an input read in the block is refused, its error is the
+    one line on stderr, not the note of the file read before it."""
+    held: list[logging.LogRecord] = []
+
+    class _Hold(logging.Handler):
+        def emit(self, record: logging.LogRecord) -> None:
+            held.append(record)
+
+    logger, handler = logging.getLogger("skyradar"), _Hold(logging.WARNING)
+    propagate = logger.propagate
+    logger.addHandler(handler)
+    logger.propagate = False
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
+        logger.propagate = propagate
+    for record in held:  # reached only when the block raised nothing
+        logging.getLogger(record.name).handle(record)
 
 
 def emit_result(result: dict[str, Any], as_json: bool, title: str) -> None:
@@ -180,6 +206,17 @@ def WORKERS(ctx: typer.Context, param: typer.CallbackParam, value: int | None) -
         return value
     name = param.opts[0] if param is not None and param.opts else "--workers"
     return check_workers(value, name)
+
+
+def SCHEDULER(ctx: typer.Context, param: typer.CallbackParam, value: str | None) -> str | None:  # noqa: N802
+    """Callback for ``--scheduler``: a Dask address (:func:`~skyradar.parallel.check_scheduler`), before
+    any work."""
+    from skyradar.parallel import check_scheduler
+
+    if ctx is not None and getattr(ctx, "resilient_parsing", False):
+        return value
+    name = param.opts[0] if param is not None and param.opts else "--scheduler"
+    return check_scheduler(value, name)
 
 
 def check_choice(option: str, value: str, choices: tuple[str, ...]) -> str:

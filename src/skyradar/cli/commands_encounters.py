@@ -10,6 +10,7 @@ import typer
 
 from skyradar.cli.app import (
     NON_NEGATIVE,
+    SCHEDULER,
     JsonOption,
     bench_app,
     emit_measurement,
@@ -99,6 +100,7 @@ def experiment_encounters(
         str | None,
         typer.Option(
             "--scheduler",
+            callback=SCHEDULER,
             help="Address of an existing Dask scheduler (tcp://HOST:PORT) to run the encounters on.",
         ),
     ] = None,

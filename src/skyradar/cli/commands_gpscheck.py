@@ -57,8 +57,8 @@ def parse_frames(text: str | None, n_frames: int) -> list[int]:
 
 
 def _load_map(path: Path, ds, pixel_m: float, covers, run: Path):
-    """(map image, grid, building height) from .osm.pbf or GeoTIFF; ``covers(extent)`` checks the
-    footprints against the map before it is rendered."""
+    """(map image, grid, building height) from .osm.pbf or GeoTIFF; ``covers(extent, image)`` checks the
+    footprints against the map (a raster's: against its data) before it is rendered."""
     from skyradar.errors import InputError
     from skyradar.extras import require_extra
 
@@ -80,7 +80,7 @@ def _load_map(path: Path, ds, pixel_m: float, covers, run: Path):
         from skyradar.scene.map_raster import read_map_raster
 
         raster = read_map_raster(path, None, *origin)
-        covers(raster.grid)
+        covers(raster.grid, raster.image)  # the footprints on the map's data, not only its extent
         return raster.image, raster.grid, 0.0
     raise InputError(
         f"--map: {path} must be an OpenStreetMap .osm.pbf extract or a GeoTIFF (.tif), by its name"
@@ -152,9 +152,9 @@ def gpscheck(
     picked = parse_frames(frames, ds.sizes["time"])
     gps_offset = (offset_north_m, offset_east_m, offset_heading_deg)
 
-    def covers(extent) -> None:
+    def covers(extent, image=None) -> None:
         check_coverage(ds, config, extent, frames=picked, gps_offset=gps_offset, source=str(run),
-                       map_source=str(map_path))  # fmt: skip
+                       map_source=str(map_path), map_image=image)  # fmt: skip
 
     image, grid, building_m = _load_map(map_path, ds, PIXEL_M, covers, run)
     building_m = building_m if building_height is None else building_height

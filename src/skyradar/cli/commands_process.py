@@ -13,6 +13,7 @@ from skyradar.cli.app import (
     NON_NEGATIVE,
     POSITIVE,
     PROBABILITY,
+    SCHEDULER,
     WORKERS,
     BenchSecondsOption,
     HeadOption,
@@ -88,7 +89,9 @@ _SuppressionOpt = Annotated[
         "attitude and height above ground), knowledge-aided (required), none.",
     ),
 ]
-_SchedulerOpt = Annotated[str | None, typer.Option(help="Address of an existing Dask scheduler.")]
+_SchedulerOpt = Annotated[
+    str | None, typer.Option(callback=SCHEDULER, help="Address of an existing Dask scheduler.")
+]
 _WorkersOpt = Annotated[
     int | None, typer.Option(callback=WORKERS, help="Run on a local Dask cluster of this many workers.")
 ]
@@ -206,6 +209,8 @@ def _read_config(path: Path):
         raise InputError(f"{path}: cannot read radar config ({exc.strerror})") from None
     except (ValueError, KeyError, TypeError) as exc:
         raise InputError(f"{path}: not a radar config ({type(exc).__name__}: {exc})") from None
+    except RecursionError:  # JSON nested deeper than the parser's stack
+        raise InputError(f"{path}: not a radar config (JSON nested too deeply)") from None
 
 
 @app.command()

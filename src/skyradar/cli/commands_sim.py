@@ -10,6 +10,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from skyradar.cli.app import (
     COUNT,
+    SCHEDULER,
     JsonOption,
     app,
     bench_app,
@@ -17,6 +18,7 @@ from skyradar.cli.app import (
     emit_measurement,
     emit_result,
     experiment_app,
+    notes_after_inputs,
     number_in,
 )
 from skyradar.cli.choices import Compressor, Precision
@@ -63,7 +65,9 @@ def simulate(
     chunk_frames: Annotated[
         int, typer.Option(callback=COUNT, help="Frames per chunk: the unit of work and of resumption.")
     ] = 16,
-    scheduler: Annotated[str | None, typer.Option(help="Address of an existing Dask scheduler.")] = None,
+    scheduler: Annotated[
+        str | None, typer.Option(callback=SCHEDULER, help="Address of an existing Dask scheduler.")
+    ] = None,
     workers: Annotated[
         int | None, typer.Option(callback=COUNT, help="Run on a local Dask cluster of this many workers.")
     ] = None,
@@ -85,12 +89,13 @@ def simulate(
     if chunk_frames < 1:
         raise InputError(f"--chunk-frames must be >= 1, got {chunk_frames}")
     check_output(output, [scenario], overwrite, kind="frames store")  # before any work
-    loaded = load_scenario(scenario)
-    # Before the build: a huge run is refused in a second, not after minutes of truth geometry.
-    n_heads = len(loaded.model.radars or [None])  # several radar heads: a group of frames each
-    check_store_space(output, loaded.radar_config(), n_heads * loaded.frame_times().size,
-                      n_heads * chunk_frames, compress.value, precision.value)  # fmt: skip
-    built = loaded.build()
+    with notes_after_inputs():  # a refused file is the one line, not the note of the file before it
+        loaded = load_scenario(scenario)
+        # Before the build: a huge run is refused in a second, not after minutes of truth geometry.
+        n_heads = len(loaded.model.radars or [None])  # several radar heads: a group of frames each
+        check_store_space(output, loaded.radar_config(), n_heads * loaded.frame_times().size,
+                          n_heads * chunk_frames, compress.value, precision.value)  # fmt: skip
+        built = loaded.build()
     n = built.times_s.size
     with frame_progress(n, f"simulate {built.name}") as bar:
         task = bar.add_task("frames", total=n)
@@ -169,7 +174,9 @@ def sweep(
     ],
     values: Annotated[str, typer.Option(help="Comma-separated values, e.g. 0,19.2,39.9.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Table of all runs (.csv or .parquet).")],
-    scheduler: Annotated[str | None, typer.Option(help="Address of an existing Dask scheduler.")] = None,
+    scheduler: Annotated[
+        str | None, typer.Option(callback=SCHEDULER, help="Address of an existing Dask scheduler.")
+    ] = None,
     workers: Annotated[
         int | None, typer.Option(callback=COUNT, help="Run on a local Dask cluster of this many workers.")
     ] = None,

@@ -252,7 +252,7 @@ def _check_tracks_of_run(table, tracks: Path, run: Path) -> None:
     from skyradar.io.frames_model import frame_times_s
 
     ds = open_frames(run)
-    check_tracks_match_run(table.attrs, str(tracks), ds, str(run))
+    check_tracks_match_run(table.attrs, str(tracks), ds, str(run), option="the run")
     t = frame_times_s(ds)
     times = table["time_s"].to_numpy(float)
     if t.size and times.size:

@@ -16,6 +16,7 @@ from skyradar.cli.app import (
     check_number,
     console,
     emit_result,
+    notes_after_inputs,
 )
 from skyradar.cli.choices import AircraftClass, Side
 from skyradar.errors import InputError
@@ -191,7 +192,8 @@ def make_encounter(
     for path in (output, *_side_files(output)):
         check_output(path, [ownship, intruder], overwrite, kind="file")
     classes = (ownship_class.value, intruder_class.value)
-    a, b = _flight(ownship, ownship_icao24, classes[0]), _flight(intruder, intruder_icao24, classes[1])
+    with notes_after_inputs():  # a refused intruder file is the one line, not the own-ship file's note
+        a, b = _flight(ownship, ownship_icao24, classes[0]), _flight(intruder, intruder_icao24, classes[1])
     t_cpa = 0.5 * a.end_s if t_cpa is None else t_cpa
     own, intr = encounter_from_tracks(
         a, b, t_cpa, miss_m, vertical_miss_m, intruder_time, rotate_deg, side.value

@@ -79,12 +79,17 @@ _OPTIONAL = ("period_s", "max_velocity_sigma_mps", "gap_reset_s")
 _VOLUME_KEYS = ("dthr_m", "zthr_m", "tthr_s", "tcoa_s")
 
 
+# Every setting (s, m, frames, z-scores) is far below this; beyond, the conflict geometry overflows to
+# inf and NaN (a volume of 1e308 m alerted on everything, with numpy's warnings on the way).
+_LARGEST = 1e6
+
+
 def _number(label: str, value: Any, integer: bool = False, low: float = 0.0) -> float:
     ok = isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
-    ok = ok and (float(value).is_integer() if integer else True) and value >= low
+    ok = ok and (float(value).is_integer() if integer else True) and low <= value <= _LARGEST
     if not ok:
         kind = "an integer" if integer else "a finite number"
-        raise InputError(f"{label}: must be {kind} >= {low:g}, got {value!r}")
+        raise InputError(f"{label}: must be {kind} from {low:g} to {_LARGEST:g}, got {value!r}")
     return int(value) if integer else float(value)
 
 
@@ -172,8 +177,9 @@ def alert_config(value: str | Path) -> AlertConfig:
     base = data.pop("base", "radar")
     if base not in ALERT_CONFIGS:
         raise InputError(f"{path}: field 'base' must be radar, default or do365b, got {base!r}")
+    changes = _fields(str(path), data)  # its InputError (a ValueError) names the file once
     try:
-        config = dataclasses.replace(ALERT_CONFIGS[base], **_fields(str(path), data))
+        config = dataclasses.replace(ALERT_CONFIGS[base], **changes)
     except ValueError as exc:  # AlertConfig's own checks (1 <= m <= n, period_s > 0)
         raise InputError(f"{path}: {exc}") from None
     check_warns_head_on(config, str(path))
@@ -185,7 +191,9 @@ def check_warns_head_on(config: AlertConfig, label: str) -> None:
     intruder, both aircraft at 50 m/s, 3 km apart and passing 100 m apart (inside the collision
     volume), must reach the warning level (the third, :data:`WARNING_LEVEL`) before they meet. One
     level, zero volumes, a minimum track age or a persistence longer than the approach, or a
-    velocity gate no track passes would silently switch the warnings off.
+    velocity gate no track passes would silently switch the warnings off. Nor may they alert on an
+    aircraft 10 km abeam flying alongside: volumes, alerting times or z-scores of 1e308 alert on
+    everything.
 
     Examples
     --------
@@ -207,12 +215,23 @@ def check_warns_head_on(config: AlertConfig, label: str) -> None:
     tracks = pd.DataFrame({"time_s": t, "track_id": 1, "north_m": 3000.0 - 50.0 * t, "east_m": 100.0,
                            "down_m": -1000.0, "vn_mps": -50.0, "ve_mps": 0.0, "vd_mps": 0.0,
                            "confirmed": True})  # fmt: skip
+    # And an aircraft 10 km abeam flying alongside, which no alerting may flag.
+    alongside = tracks.assign(track_id=2, north_m=50.0 * t, east_m=10_000.0, vn_mps=50.0)
+    tracks = pd.concat([tracks, alongside], ignore_index=True).sort_values(["time_s", "track_id"])
     # A converged radar track: 20 m of position and 2 m/s of velocity error per axis.
     for name, variance in (("pp", 400.0), ("vv", 4.0), ("pv", 0.0)):
         for i in range(3):
             for j in range(3):
                 tracks[f"cov_{name}_{i}{j}"] = variance if i == j else 0.0
-    alerts = alerts_from_tracks(tracks, own, config, with_advice=False, source=label)
+    every = alerts_from_tracks(tracks, own, config, with_advice=False, source=label)
+    clear = every[every["track_id"] == 2]
+    if len(clear) and int(clear["level"].max()) > 0:
+        raise InputError(
+            f"{label}: these settings alert on an aircraft 10 km abeam flying alongside (level "
+            f"{int(clear['level'].max())} of {WARNING_LEVEL}): check levels, their volumes (dthr_m, zthr_m) "
+            "and alerting times, and the z-scores z_h_pos, z_h_vel, z_v_pos, z_v_vel"
+        )
+    alerts = every[every["track_id"] == 1]
     if len(alerts) == 0 or int(alerts["level"].max()) < WARNING_LEVEL:
         reached = int(alerts["level"].max()) if len(alerts) else 0
         raise InputError(

@@ -113,10 +113,13 @@ def _mismatch(made: dict[str, Any], origin: Any, t: np.ndarray, pos: np.ndarray)
     return None
 
 
-def check_tracks_match_run(tracks_attrs: dict[str, Any], tracks_path: str, ds: xr.Dataset, run: str) -> None:
+def check_tracks_match_run(
+    tracks_attrs: dict[str, Any], tracks_path: str, ds: xr.Dataset, run: str, option: str = "--ownship"
+) -> None:
     """Raise :class:`InputError` when the tracks were not made from the frames run ``run``.
 
-    ``tracks_attrs`` is the tracks table's metadata (``DataFrame.attrs``). Without a signature
+    ``tracks_attrs`` is the tracks table's metadata (``DataFrame.attrs``); ``option`` is how the
+    command was given ``run`` (``""`` for an argument), named in the message. Without a signature
     anywhere along its ``source`` chain, or without own-ship state in ``ds``, nothing can be
     compared and nothing is raised (the time-span check of the alerting still applies).
     """
@@ -133,7 +136,8 @@ def check_tracks_match_run(tracks_attrs: dict[str, Any], tracks_path: str, ds: x
     if why is not None:
         was = _describe(*made["time_span_s"], made.get("origin"))
         raise InputError(
-            f"{tracks_path}: tracks come from run {made['run']} ({was}) but --ownship {run} is another "
+            f"{tracks_path}: tracks come from run {made['run']} ({was}) but {option + ' ' if option else ''}"
+            f"{run} is another "
             f"run ({_describe(t[0], t[-1], origin)}): {why}; "
             "give the run the tracks were made from"
         )

@@ -14,7 +14,11 @@ import numpy as np
 
 from skyradar.errors import InputError
 
-__all__ = ["check_frame_times", "check_finite_frames"]
+__all__ = ["MAX_TIME_S", "check_frame_times", "check_finite_frames"]
+
+# Frame and table times stay within +-1e10 s (elapsed seconds, or unix seconds for 300 years): beyond,
+# they are no clock's reading, and the steps between frames overflow in the filters' powers of dt.
+MAX_TIME_S = 1.0e10
 
 
 def check_frame_times(
@@ -38,6 +42,12 @@ def check_frame_times(
     if bad.size:
         raise InputError(
             f"{source}: field '{field}' is not a finite number at {index_name} {bad[0]} (got {t[bad[0]]})"
+        )
+    far = np.flatnonzero(np.abs(t) > MAX_TIME_S)
+    if far.size:  # 1e308 is finite, and no clock's reading: the frame steps would overflow
+        raise InputError(
+            f"{source}: field '{field}' is {t[far[0]]:g} s at {index_name} {far[0]}, "
+            f"beyond +-{MAX_TIME_S:g} s"
         )
     back = np.flatnonzero(np.diff(t) <= 0.0)
     if back.size:

@@ -43,6 +43,8 @@ def read_raw_iq(data_path: str | Path, require_illuminator: bool = True) -> IqRe
         info = json.loads(text) if sidecar.suffix == ".json" else load_yaml(text, sidecar)
     except (OSError, ValueError) as exc:
         raise InputError(f"{sidecar}: cannot read sidecar ({exc})") from None
+    except RecursionError:  # JSON nested deeper than the parser's stack
+        raise InputError(f"{sidecar}: cannot read sidecar (nested too deeply)") from None
     if not isinstance(info, dict):
         raise InputError(f"{sidecar}: sidecar must be a mapping, got {type(info).__name__}")
     for key in ("sample_rate_hz", "center_frequency_hz"):

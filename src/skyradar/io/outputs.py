@@ -179,6 +179,8 @@ def check_output(
             if not parent.is_dir():
                 raise InputError(f"{label}: {parent} is a file, not a folder; name another output")
             _check_writable(parent, label)
+            if kind != "folder":  # a folder is made under its own name; files go inside it
+                _check_name_length(path, parent, label)
             break
     out = _resolved(path)
     _check_not_input(out, inputs, label)
@@ -187,6 +189,30 @@ def check_output(
     if path.exists() or path.is_symlink():
         _check_replaceable(path, label, kind, overwrite)
     return path
+
+
+# What skyradar adds to an output's name while writing it: ``.NAME.<12 hex>.tmp<suffix>`` for a file
+# (skyradar.io.atomic), ``NAME.partial.done`` for a store, ``.NAME.old-<pid>`` for the replaced one.
+_TEMPORARY_EXTRA_BYTES = 18
+
+
+def _check_name_length(path: Path, folder: Path, label: str) -> None:
+    """The output's name, and the temporary names skyradar writes it under first, must fit the file
+    system's name limit: else the command would fail at its very end, after all its work, naming a
+    file the user never gave."""
+    if path.name in ("", ".", ".."):
+        return
+    try:
+        limit = os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        limit = 255
+    size = len(os.fsencode(path.name))
+    extra = _TEMPORARY_EXTRA_BYTES + len(os.fsencode(path.suffix))
+    if size + extra > limit:
+        raise InputError(
+            f"{label}: File name too long: {size} bytes, and skyradar writes it under a temporary name "
+            f"{extra} bytes longer; {folder} takes names of at most {limit} bytes: keep it to {limit - extra}"
+        )
 
 
 def _check_writable(folder: Path, label: str) -> None:

@@ -50,6 +50,7 @@ import yaml
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
+from skyradar.io.checks import MAX_TIME_S
 from skyradar.io.safe_yaml import load_yaml
 
 __all__ = ["AXES", "DTYPES", "AdcFrames", "read_recording"]
@@ -130,6 +131,8 @@ def _load_sidecar(path: Path) -> dict[str, Any]:
         raise
     except (OSError, ValueError, yaml.YAMLError) as exc:
         raise InputError(f"{path}: cannot parse sidecar ({type(exc).__name__}: {exc})") from exc
+    except RecursionError:  # JSON nested deeper than the parser's stack
+        raise InputError(f"{path}: cannot parse sidecar (nested too deeply)") from None
     if not isinstance(meta, dict):
         raise InputError(f"{path}: sidecar must be a mapping of fields, got {type(meta).__name__}")
     return meta
@@ -196,6 +199,12 @@ def _frame_times(sidecar: Path, meta: dict[str, Any], n_frames: int, config: Rad
         times = np.asarray(meta["frame_times_s"], float)
         if times.shape != (n_frames,) or not np.all(np.isfinite(times)):
             raise InputError(f"{sidecar}: field 'frame_times_s' must hold {n_frames} finite times")
+        far = np.flatnonzero(np.abs(times) > MAX_TIME_S)  # 1e308 is finite, and no clock's reading
+        if far.size:
+            raise InputError(
+                f"{sidecar}: field 'frame_times_s' is {times[far[0]]:g} s at frame {far[0]}, beyond "
+                f"+-{MAX_TIME_S:g} s"
+            )
         back = np.flatnonzero(np.diff(times) <= 0)  # a repeated time is as wrong as a backward one
         if back.size:
             i = int(back[0]) + 1

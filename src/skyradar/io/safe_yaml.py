@@ -117,6 +117,8 @@ def load_yaml(text: str, source: str | Path, limit: int = MAX_EXPANDED_NODES) ->
         where = f" at line {mark.line + 1}" if mark is not None else ""
         problem = getattr(exc, "problem", None) or type(exc).__name__
         raise InputError(f"{source}: not valid YAML{where} ({problem})") from None
+    except RecursionError:  # [[[[... deeper than the parser's stack: no scenario or setting is
+        raise InputError(f"{source}: not valid YAML (nested too deeply)") from None
     finally:
         loader.dispose()
 

@@ -79,10 +79,18 @@ def _number(name: str, value: object) -> float:
     return float(value)
 
 
+# Upper bounds of a rotating PSR's fields: far beyond any such radar, and beyond them the sample counts
+# and phases computed from them overflow (a PRI of 1e308 s crashed the pulse profile with a traceback).
+_MAXIMA = {"carrier_frequency_hz": 1e12, "peak_power_w": 1e10, "beamwidth_az_deg": 360.0,
+           "rotation_rpm": 600.0, "pri_s": 1.0}  # fmt: skip
+
+
 def _positive(name: str, value: float) -> float:
     value = float(value)
-    if not math.isfinite(value) or value <= 0:
-        raise InputError(f"illuminator: field '{name}' must be a positive number, got {value!r}")
+    top = _MAXIMA.get(name, math.inf)
+    if not math.isfinite(value) or value <= 0 or value > top:
+        bound = f" up to {top:g}" if math.isfinite(top) else ""
+        raise InputError(f"illuminator: field '{name}' must be a positive number{bound}, got {value!r}")
     return value
 
 

@@ -131,7 +131,7 @@ def process_recording(
 
 def _process(recording, settings: PassiveSettings | None, progress) -> PassiveResult:
     s = settings or PassiveSettings()
-    ill = Illuminator.from_metadata(recording.illuminator)
+    ill = Illuminator.from_recording(recording)  # an error names the recording
     fs = recording.sample_rate_hz
     tx_en, bearing = receiver_geometry(recording)
     template = _template(recording, ill, s)

@@ -164,14 +164,31 @@ def _number(df: pd.DataFrame, name: str) -> np.ndarray:
     return pd.to_numeric(df[name], errors="coerce").to_numpy(dtype=float)
 
 
-def _local_velocity(df: pd.DataFrame) -> np.ndarray | None:
-    """Velocities (n, 3) in the local NED frame, NaN where a row has none; None without columns."""
+def _local_velocity(df: pd.DataFrame, path: Path | str = "track", label: str = "") -> np.ndarray | None:
+    """Velocities (n, 3) in the local NED frame, NaN where a row has none; None without columns.
+
+    A recorded speed beyond Mach 3 (or a track angle beyond +-360 deg) is refused naming the row: a
+    value like 1e308 is a corrupt field, not a fix to smooth through.
+    """
+
+    def checked(name: str, limit: float, unit: str) -> np.ndarray:
+        values = _number(df, name)
+        with np.errstate(invalid="ignore"):
+            bad = np.flatnonzero(np.isinf(values) | (np.abs(values) > limit))  # NaN: missing
+        if bad.size:
+            i = int(bad[0])
+            raise InputError(
+                f"{path}: field '{name}' out of range at row {df.index[i]} ({values[i]:.6g} {unit} is beyond "
+                f"+-{limit:.6g} {unit}){label}"
+            )
+        return values
+
     if all(c in df.columns for c in _SI_VELOCITY):
-        return np.stack([_number(df, c) for c in _SI_VELOCITY], axis=-1)
+        return np.stack([checked(c, MAX_SPEED_MPS, "m/s") for c in _SI_VELOCITY], axis=-1)
     if all(c in df.columns for c in _OPENSKY_VELOCITY):
-        gs, trk, vr = (_number(df, c) for c in _OPENSKY_VELOCITY)
-        gs = gs * KT_MPS
-        trk = np.radians(trk)
+        gs = checked("groundspeed", MAX_SPEED_MPS / KT_MPS, "kt") * KT_MPS
+        trk = np.radians(checked("track", 360.0, "deg"))
+        vr = checked("vertical_rate", MAX_SPEED_MPS / FPM_MPS, "ft/min")
         return np.stack([gs * np.cos(trk), gs * np.sin(trk), -vr * FPM_MPS], axis=-1)
     return None
 
@@ -294,7 +311,7 @@ def _one_trajectory(
     pos = geodetic_to_ned(lat, lon, alt, *origin)
     zero = float(t[0]) if time_zero_s is None else float(time_zero_s)
     t_rel = t - zero
-    local = _local_velocity(df)
+    local = _local_velocity(df, path, label)
     vel = local_ned = ground_speed = None
     if local is not None:
         vel = np.einsum("nji,nj->ni", origin_to_local_rotation(lat, lon, origin[0], origin[1]), local)

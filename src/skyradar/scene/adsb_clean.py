@@ -167,6 +167,24 @@ def _merge_same_times(path: Path, df: pd.DataFrame, t: np.ndarray, label: str) -
     return merged.reset_index().set_index("_row").rename_axis(None)
 
 
+def _refuse_text(path: Path, df: pd.DataFrame, name: str, label: str) -> None:
+    """Refuse a text that is not a number in a numeric field (``FL350``, ``1000ft``): an empty field is a
+    missing value (the row is dropped and the drop reported), a word is a format this reader does not
+    know, and dropping it would build the flight from the other rows without a word about why."""
+    if name not in df.columns or pd.api.types.is_numeric_dtype(df[name]):
+        return
+    raw = df[name].astype(object)
+    text = raw.map(lambda v: v.strip().lower() if isinstance(v, str) else None)
+    words = text.notna() & ~text.isin(["", "nan", "ground"])  # readsb's "ground": no altitude
+    bad = words & pd.to_numeric(raw.where(words), errors="coerce").isna()
+    if bad.any():
+        row = raw.index[int(np.flatnonzero(bad.to_numpy())[0])]
+        raise InputError(
+            f"{path}: field '{name}' is not a number at row {row} ({raw.loc[row]!r}){label}; "
+            "give a number (or leave the field empty)"
+        )
+
+
 def clean_rows(
     path: Path, df: pd.DataFrame, impala: bool = False, label: str = ""
 ) -> tuple[pd.DataFrame, str, np.ndarray, np.ndarray, str, list[str]]:
@@ -189,6 +207,8 @@ def clean_rows(
     t = df.pop("_t").to_numpy(dtype=float)
     if len(df) < n_before:
         notes.append(f"merged {n_before - len(df)} row(s) sharing a timestamp")
+    for name in ("latitude", "longitude", "alt_m", "geoaltitude", "baroaltitude" if impala else "altitude"):
+        _refuse_text(path, df, name, label)
     try:
         alt, alt_field, alt_note = altitude_m(df, impala)
     except InputError as exc:

@@ -279,8 +279,14 @@ def _scalar(data: Mapping, key: str, source: str) -> float:
     return value
 
 
-def terrain_from_arrays(data: Mapping, source: str, max_void_fraction: float = 0.01) -> Terrain:
-    """Build a Terrain from an ``.npz``-style mapping (see :func:`read_npz` for the keys)."""
+def terrain_from_arrays(
+    data: Mapping, source: str, max_void_fraction: float = 0.01, bounds: Bounds | None = None
+) -> Terrain:
+    """Build a Terrain from an ``.npz``-style mapping (see :func:`read_npz` for the keys).
+
+    With ``bounds`` only the samples covering them (plus one of margin) are kept, and the void limit
+    applies to those: a no-data block under the flight is not diluted by the rest of a large grid.
+    """
     keys = set(data.keys())
     if "elevation" not in keys:
         raise InputError(f"{source}: field 'elevation' is missing (have {sorted(keys)})")
@@ -288,7 +294,23 @@ def terrain_from_arrays(data: Mapping, source: str, max_void_fraction: float = 0
     if raw.ndim != 2:
         raise InputError(f"{source}: field 'elevation' must be 2-D (shape {raw.shape})")
     nodata = _scalar(data, "nodata", source) if "nodata" in keys else None
-    z = _fill(raw, source, max_void_fraction, nodata)
+    if bounds is None:
+        return _npz_grid(data, keys, _fill(raw, source, max_void_fraction, nodata), source)
+    # The grid's placement first (heights zero), to find the window; then the window's voids are filled.
+    whole = _npz_grid(data, keys, np.zeros(raw.shape, np.float32), source)
+    rows, cols = (np.asarray(v, float) for v in whole.index_of(
+        np.array([bounds.south_deg, bounds.south_deg, bounds.north_deg, bounds.north_deg]),
+        np.array([bounds.west_deg, bounds.east_deg, bounds.west_deg, bounds.east_deg]),
+    ))  # fmt: skip
+    rs = _index_span(rows.min(), rows.max(), raw.shape[0])
+    cs = _index_span(cols.min(), cols.max(), raw.shape[1])
+    _check_overlap(source, whole.bounds, bounds, rs, cs)
+    window = whole.crop(rs, cs)
+    return replace(window, elevation_m=_fill(raw[rs, cs], source, max_void_fraction, nodata))
+
+
+def _npz_grid(data: Mapping, keys: set, z: np.ndarray, source: str) -> Terrain:
+    """The Terrain of heights ``z`` placed as the ``.npz`` fields say."""
     if {"dx_m", "dy_m", "lat0_deg", "lon0_deg"} <= keys:
         rot = _scalar(data, "rotation_deg", source) if "rotation_deg" in keys else 0.0
         vals = [_scalar(data, k, source) for k in ("lat0_deg", "lon0_deg", "dy_m", "dx_m")]
@@ -312,14 +334,15 @@ def terrain_from_arrays(data: Mapping, source: str, max_void_fraction: float = 0
     )
 
 
-def read_npz(path: str | Path, max_void_fraction: float = 0.01) -> Terrain:
+def read_npz(path: str | Path, max_void_fraction: float = 0.01, bounds: Bounds | None = None) -> Terrain:
     """Read a DEM from ``.npz``.
 
     Keys: ``elevation`` (2-D, row 0 north) and either ``dx, dy, xmin, ymax`` in degrees
     (matplotlib's ``jacksboro_fault_dem.npz`` convention; with ``xmax``/``ymin`` also present
     and spanning n*d, the bounds are pixel edges; the larger of ``ymin``/``ymax`` is north) or
     ``dx_m, dy_m, lat0_deg, lon0_deg`` (+ optional ``rotation_deg``) for a projected grid
-    anchored at sample [0, 0]. Optional ``nodata``.
+    anchored at sample [0, 0]. Optional ``nodata``. With ``bounds`` only the window covering them is
+    kept (and void-filled), as :func:`read_hgt` and :func:`read_geotiff` read theirs.
     """
     path = Path(path)
     try:
@@ -327,7 +350,7 @@ def read_npz(path: str | Path, max_void_fraction: float = 0.01) -> Terrain:
             arrays = {k: data[k] for k in data.files}
     except (OSError, ValueError) as exc:
         raise InputError(f"{path.name}: cannot read .npz ({exc})") from exc
-    return terrain_from_arrays(arrays, path.name, max_void_fraction)
+    return terrain_from_arrays(arrays, path.name, max_void_fraction, bounds)
 
 
 def jacksboro(max_void_fraction: float = 0.01) -> Terrain:
@@ -356,9 +379,8 @@ def read_dem(
 ) -> Terrain:
     """Read a DEM by suffix: ``.hgt`` (SRTM), ``.tif``/``.tiff`` (GeoTIFF), ``.npz``.
 
-    ``bounds`` (south, west, north, east, degrees): read only that area of ``.hgt`` and GeoTIFF
-    files (``.npz`` files are read whole); see
-    :func:`skyradar.scene.dem_coverage.footprint_bounds`.
+    ``bounds`` (south, west, north, east, degrees): read only that area (an ``.npz`` file is
+    loaded whole, then cut to it); see :func:`skyradar.scene.dem_coverage.footprint_bounds`.
 
     Voids up to ``max_void_fraction`` of the samples are filled; more raise InputError.
     ``height_offset_m`` is added to every elevation: Terrain heights are above the WGS84
@@ -383,8 +405,7 @@ def read_dem(
         raise InputError(
             f"{path.name}: field 'max_void_fraction' must be within [0, 1] ({max_void_fraction})"
         )
-    windowed = reader is not read_npz  # .npz files are small and read whole
-    terrain = reader(path, max_void_fraction, bounds) if windowed else reader(path, max_void_fraction)
+    terrain = reader(path, max_void_fraction, bounds)
     if height_offset_m:
         terrain = replace(terrain, elevation_m=terrain.elevation_m + np.float32(height_offset_m))
     return terrain

@@ -78,8 +78,6 @@ __all__ = [
 # Tag values of the unions; pydantic puts them in error locations, the messages leave them out.
 TAGS = frozenset({"flat", "fractal", "file", "jacksboro", "straight", "circle", "circuit", "encounter"})
 
-Vector3 = tuple[float, float, float]
-
 
 def _not_bool(value: Any) -> Any:
     # pydantic's lax mode reads YAML's true/false as 1.0/0.0; a boolean is never a quantity.
@@ -88,8 +86,13 @@ def _not_bool(value: Any) -> Any:
     return value
 
 
-Positive = Annotated[float, BeforeValidator(_not_bool), Field(gt=0, allow_inf_nan=False)]
-Finite = Annotated[float, BeforeValidator(_not_bool), Field(allow_inf_nan=False)]
+# Every quantity of a scenario (metres, m/s, Hz, dB, m^2) is far inside +-1e12: beyond, its square or
+# product overflows to inf and NaN deep in the build (1e308 m/s was refused as "attitude_rad is not
+# finite", a 1e308 m terrain crashed numpy), so it is refused here naming its field.
+LARGEST = 1e12
+Positive = Annotated[float, BeforeValidator(_not_bool), Field(gt=0, le=LARGEST, allow_inf_nan=False)]
+Finite = Annotated[float, BeforeValidator(_not_bool), Field(ge=-LARGEST, le=LARGEST, allow_inf_nan=False)]
+Vector3 = tuple[Finite, Finite, Finite]
 # Scenario times stay within +-1e9 s (about 32 years): beyond that float64 frame times lose the
 # resolution the frame grid needs (start_s 1e308 was reported as "time_s not increasing").
 Time = Annotated[float, BeforeValidator(_not_bool), Field(ge=-1e9, le=1e9, allow_inf_nan=False)]
@@ -277,12 +280,27 @@ class RadarHeadModel(_Model):
     )
 
 
+MAX_GRID_SAMPLES = 10_000  # per side of a flat or fractal terrain: 10^8 heights, 400 MB as float32
+
+
 class _GridTerrain(_Model):
     height_m: Finite | None = Field(
-        None, description="Mean height above the WGS84 ellipsoid, m; unset: the origin's altitude."
+        None,
+        ge=-500.0,  # the land surface's range (skyradar.scene.dem_readers.SURFACE_RANGE_M), as for DEMs
+        le=9000.0,
+        description="Mean height above the WGS84 ellipsoid, m; unset: the origin's altitude.",
     )
     size_m: Positive = Field(12_000.0, description="Side of the square grid centred on the origin, m.")
     spacing_m: Positive = Field(30.0, description="Grid spacing, m.")
+
+    @model_validator(mode="after")
+    def _grid_fits(self) -> _GridTerrain:
+        per_side = self.size_m / self.spacing_m
+        if per_side > MAX_GRID_SAMPLES:  # a 1e12 m grid asked numpy for an array beyond its maximum
+            raise ValueError(
+                f"size_m / spacing_m is {per_side:.4g} samples per side, more than {MAX_GRID_SAMPLES}"
+            )
+        return self
 
 
 class FlatTerrainModel(_GridTerrain):
@@ -297,6 +315,7 @@ class FractalTerrainModel(_GridTerrain):
     type: Literal["fractal"] = Field(description="The terrain variant.")
     local_sd_m: float = Field(
         ge=0.0,
+        le=2000.0,  # hills of 2 km standard deviation are more than any land surface has
         allow_inf_nan=False,
         description="Roughness: the median over cells of the local height standard deviation, m.",
     )
@@ -342,7 +361,7 @@ class _Timed(_Model):
     start_time_s: Time | None = Field(
         None, description="Scenario time of the flight's start, s; unset: the scenario's ``start_s``."
     )
-    rate_hz: Positive = Field(20.0, description=_RATE)
+    rate_hz: Positive = Field(20.0, le=1000.0, description=_RATE)
 
 
 class FileFlight(_Model):
@@ -375,7 +394,9 @@ class StraightFlight(_Timed):
         "above the origin.",
     )
     heading_deg: Finite = Field(0.0, description="Track, degrees clockwise from north.")
-    speed_mps: float = Field(ge=0.0, allow_inf_nan=False, description="Horizontal (ground) speed, m/s.")
+    speed_mps: float = Field(
+        ge=0.0, le=LARGEST, allow_inf_nan=False, description="Horizontal (ground) speed, m/s."
+    )
     climb_mps: Finite = Field(0.0, description="Climb rate, m/s, positive up.")
 
 
@@ -452,7 +473,7 @@ class EncounterFlight(_Model):
         "time span."
     )
     horizontal_miss_m: float = Field(
-        0.0, ge=0.0, allow_inf_nan=False, description="Horizontal distance at the CPA, m."
+        0.0, ge=0.0, le=LARGEST, allow_inf_nan=False, description="Horizontal distance at the CPA, m."
     )
     vertical_miss_m: Finite = Field(
         0.0, description="Intruder height above the own-ship at the CPA, m; negative: below."
@@ -473,7 +494,7 @@ class EncounterFlight(_Model):
     side: Literal["right", "left"] = Field(
         "right", description="The own-ship's side the intruder passes at the CPA, where the geometry allows."
     )
-    rate_hz: Positive = Field(20.0, description=_RATE)
+    rate_hz: Positive = Field(20.0, le=1000.0, description=_RATE)
     aircraft_class: AircraftClass = Field("ga", description=_AIRCRAFT_CLASS)
 
 

@@ -9,7 +9,7 @@ import pandas as pd
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
-from skyradar.io.checks import check_frame_times
+from skyradar.io.checks import MAX_TIME_S, check_frame_times
 from skyradar.io.frames_model import frame_times_s
 from skyradar.io.tables import finite_column, read_table
 
@@ -23,6 +23,12 @@ __all__ = [
 ]
 
 REQUIRED_DETECTION_COLUMNS = ("time_s", "range_m", "radial_velocity_mps")
+# What a detection may hold: times within 1e10 s (unix seconds fit), ranges and positions within
+# 10 000 km, radial velocities within 10 km/s.
+_DETECTION_LIMITS = {
+    "time_s": (MAX_TIME_S, "s"), "range_m": (1.0e7, "m"), "radial_velocity_mps": (1.0e4, "m/s"),
+    "north_m": (1.0e7, "m"), "east_m": (1.0e7, "m"), "down_m": (1.0e7, "m"),
+}  # fmt: skip
 
 
 def validate_detections(df: pd.DataFrame, source: str = "detections") -> pd.DataFrame:
@@ -48,6 +54,17 @@ def validate_detections(df: pd.DataFrame, source: str = "detections") -> pd.Data
     if (rng < 0).any():  # a range is a distance: a negated column would be tracked behind the radar
         i = int(np.flatnonzero(rng < 0)[0])
         raise InputError(f"{source}: field 'range_m' is negative at row {i} ({rng[i]:g} m); a range is >= 0")
+    for col, (limit, unit) in _DETECTION_LIMITS.items():  # 1e308 is finite, but no radar measures it
+        if col in df.columns:
+            values = pd.to_numeric(df[col], errors="coerce").to_numpy(float)
+            with np.errstate(invalid="ignore"):
+                beyond = np.flatnonzero(np.abs(values) > limit)
+            if beyond.size:
+                i = int(beyond[0])
+                raise InputError(
+                    f"{source}: field '{col}' is {values[i]:.6g} {unit} at row {i}, beyond +-{limit:g} "
+                    f"{unit}: not a radar measurement"
+                )
     t = df["time_s"].to_numpy(float)
     back = np.flatnonzero(t[1:] < t[:-1])
     if back.size:

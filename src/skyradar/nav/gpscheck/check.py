@@ -240,11 +240,17 @@ def check_coverage(
     source: str = "run",
     map_source: str | None = None,
     min_ground_fraction: float = DEFAULT_SETTINGS.min_ground_fraction,
+    map_image: np.ndarray | None = None,
+    min_data_fraction: float = 0.9,
 ) -> None:
     """One-line error naming the map when a frame's ground footprint at the GPS pose is off the map.
 
     The footprint is geometric (where the beam meets the ground within range), so no frame is read.
-    ``map_extent`` is :class:`MapLayers` or a :class:`GroundGrid`.
+    ``map_extent`` is :class:`MapLayers` or a :class:`GroundGrid`. With ``map_image`` (a raster map on
+    that grid, NaN where the file has no data) the footprint must also lie on the map's data: at least
+    ``min_data_fraction`` of it in every frame. A map with data elsewhere but none under the flight
+    would otherwise give every frame "no decision: too little structure", which reads like a verdict
+    on the radar image, not on the map.
     """
     from skyradar.scene.map_render import check_map_covers  # geo extra: imported when used
 
@@ -252,7 +258,9 @@ def check_coverage(
     _check_state(ds, source)
     ones = np.ones((config.n_range, config.n_doppler))
     offset = np.array([gps_offset[0], gps_offset[1], np.radians(gps_offset[2])])
-    for i in range(ds.sizes["time"]) if frames is None else frames:
+    picked = list(range(ds.sizes["time"]) if frames is None else frames)
+    short: list[tuple[int, float]] = []  # (frame, share of its footprint on map data) below the minimum
+    for i in picked:
         gps, attitude, velocity, height = _state(ds, i)
         if ground_in_view_fraction(config, attitude, height) < min_ground_fraction:
             continue  # a wing-up frame is "no decision" wherever its sliver of ground falls
@@ -260,6 +268,46 @@ def check_coverage(
         if seen.any():
             north, east = pose_grid.world_points(*(gps + offset))
             check_map_covers(map_extent, north[seen], east[seen], source=map_source)
+            if map_image is not None:
+                share = _share_on_data(map_image, map_extent, north[seen], east[seen])
+                if share < min_data_fraction:
+                    short.append((int(i), share))
+    if short:
+        raise InputError(_no_map_data(map_image, map_extent, short, len(picked), map_source or "map",
+                                      min_data_fraction, frame_times_s(ds)))  # fmt: skip
+
+
+def _share_on_data(image: np.ndarray, grid: GroundGrid, north: np.ndarray, east: np.ndarray) -> float:
+    """Share of the world points that fall on a pixel of ``image`` holding data (finite)."""
+    row, col = (np.rint(v).astype(np.intp) for v in grid.world_to_pixel(north, east))
+    inside = (row >= 0) & (row < image.shape[0]) & (col >= 0) & (col < image.shape[1])
+    on_data = np.zeros(row.shape, bool)
+    on_data[inside] = np.isfinite(image[row[inside], col[inside]])
+    return float(on_data.mean()) if on_data.size else 0.0
+
+
+def _no_map_data(image, grid, short, n_frames: int, name: str, need: float, times_s) -> str:
+    """The one line for footprints off the map's data: in every frame (the map does not cover the
+    flight) or in some (named, to leave out with --frames)."""
+    rows, cols = np.nonzero(np.isfinite(image))
+    north, east = grid.pixel_to_world(rows, cols)
+    where = "it holds no data"
+    if rows.size:
+        where = f"its data lie at north {north.min():.0f}..{north.max():.0f} m, "
+        where += f"east {east.min():.0f}..{east.max():.0f} m"
+    frame, share = short[0]
+    rule = f"less than {100 * need:.0f}% of the radar footprint lies on map data"
+    example = f"frame {frame} at t = {float(times_s[frame]):.6g} s: {100 * share:.0f}%"
+    if len(short) == n_frames:
+        return (
+            f"{name}: the map does not cover the flight: in all {n_frames} frames checked {rule} "
+            f"({example}); {where}; give a map of the flown area"
+        )
+    listed = ", ".join(str(f) for f, _ in short[:10]) + (", ..." if len(short) > 10 else "")
+    return (
+        f"{name}: the map does not cover part of the flight: in {len(short)} of {n_frames} frames ({listed}) "
+        f"{rule} ({example}); {where}; give a map of the flown area, or leave those frames out with --frames"
+    )
 
 
 def check_run(

@@ -388,3 +388,25 @@ def test_track_refuses_empty_or_nan_ownship(tmp_path, rows, needles):
     result = _skyradar("track", str(source), "-o", "t.parquet", "--ownship", "own.csv", cwd=tmp_path)
     _assert_one_line_error(result, *needles)
     assert not (tmp_path / "t.parquet").exists()
+
+
+def test_alert_refuses_a_nan_ownship_table(tmp_path):
+    # alert interpolated its own-ship state through the NaN and alerted, exit 0.
+    header = "time_s,own_north_m,own_east_m,own_down_m,own_vn_mps,own_ve_mps,own_vd_mps"
+    rows = ["0,0,0,-800,50,0,0", "1,nan,0,-800,50,0,0", "2,100,0,-800,50,0,0"]
+    (tmp_path / "own.csv").write_text("\n".join([header, *rows]) + "\n")
+    cols = ["time_s", "track_id", "north_m", "east_m", "down_m", "vn_mps", "ve_mps", "vd_mps"]
+    track = pd.DataFrame([[1.0, 1, 2000.0, 0.0, -800.0, -50.0, 0.0, 0.0]], columns=cols)
+    track.to_parquet(tmp_path / "t.parquet")
+    result = _skyradar("alert", "t.parquet", "--ownship", "own.csv", "-o", "a.parquet", cwd=tmp_path)
+    _assert_one_line_error(result, "own.csv", "'own_north_m'", "row 1", "nan")
+    assert not (tmp_path / "a.parquet").exists()
+
+
+def test_a_1e308_ownship_state_is_refused_by_track():
+    from skyradar.errors import InputError
+    from skyradar.track.io import validate_ownship
+
+    own = pd.DataFrame({"time_s": [0.0, 1.0], "own_north_m": [0.0, 1e308], "own_vn_mps": [50.0, 50.0]})
+    with pytest.raises(InputError, match=r"own.csv: field 'own_north_m' is 1e\+308 m at row 1"):
+        validate_ownship(own, ("time_s", "own_north_m", "own_vn_mps"), "own.csv")

@@ -234,8 +234,8 @@ def alerts_for_run(
     if tracks is None:
         own = ownship_from_frames(run, run_name)
         return alerts_from_tracks(truth_tracks(run), own, config, with_advice, run_name)
+    own = ownship_from_frames(run, run_name)  # a corrupt own-ship state is named before it is compared
     check_tracks_match_run(tracks.attrs, tracks_name, run, run_name)
-    own = ownship_from_frames(run, run_name)
     return alerts_from_tracks(tracks, own, config, with_advice, tracks_name)
 
 

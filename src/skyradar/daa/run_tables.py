@@ -9,10 +9,11 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from skyradar.daa.tables import OPTIONAL_OWNSHIP_COLUMNS, OWNSHIP_COLUMNS, TRACK_COLUMNS
+from skyradar.daa.tables import OPTIONAL_OWNSHIP_COLUMNS, OWNSHIP_COLUMNS, STATE_LIMITS, TRACK_COLUMNS
 from skyradar.errors import InputError
 from skyradar.io.frames_model import frame_times_s
 from skyradar.io.navigation import navigation_state
+from skyradar.io.tables import finite_column
 
 __all__ = ["has_ownship", "ownship_from_frames", "truth_tracks"]
 
@@ -43,6 +44,18 @@ def ownship_from_frames(ds: xr.Dataset, source: str = "frames") -> pd.DataFrame:
     keep = ["time_s", *OWNSHIP_COLUMNS[1:], *(c for c in OPTIONAL_OWNSHIP_COLUMNS if c in state)]
     table = state[keep].copy()
     table.attrs["navigation_source"] = state.attrs["navigation_source"]
+    # The own-ship's state at every frame: NaN (interpolated through silently) and 1e308 (inf in the
+    # conflict geometry) are refused naming the row, as in a tracks table.
+    for name in OWNSHIP_COLUMNS[1:]:
+        values = finite_column(table.reset_index(drop=True), name, source)
+        limit, unit = STATE_LIMITS[name[-1]]
+        beyond = np.flatnonzero(np.abs(values) > limit)
+        if beyond.size:
+            i = int(beyond[0])
+            raise InputError(
+                f"{source}: field '{name}' is {values[i]:.6g} {unit} at row {i}, beyond +-{limit:g} "
+                f"{unit}: not the own-ship's state"
+            )
     return table
 
 

@@ -22,15 +22,15 @@ from skyradar.errors import InputError
 from skyradar.io.tables import finite_column
 from skyradar.track.track_table import OWNSHIP_COLUMNS as TRACKER_OWNSHIP_COLUMNS
 
-__all__ = ["TRACK_COLUMNS", "OWNSHIP_COLUMNS", "OPTIONAL_OWNSHIP_COLUMNS", "clean_tracks", "interp_ownship",
-           "covariances"]  # fmt: skip
+__all__ = ["TRACK_COLUMNS", "OWNSHIP_COLUMNS", "OPTIONAL_OWNSHIP_COLUMNS", "STATE_LIMITS", "clean_tracks",
+           "interp_ownship", "covariances"]  # fmt: skip
 
 TRACK_COLUMNS = ["time_s", "track_id", "north_m", "east_m", "down_m", "vn_mps", "ve_mps", "vd_mps"]
 OWNSHIP_COLUMNS = list(TRACKER_OWNSHIP_COLUMNS)  # the own-ship table the tracker reads, too
 OPTIONAL_OWNSHIP_COLUMNS = ["own_yaw_rad", "own_height_agl_m"]
 # Bounds of a track's state by the last letter of its column: positions within 10 000 km of the origin,
 # velocities within 10 km/s (ten times Mach 3, room for a fresh track's unconverged estimate).
-_LIMITS = {"m": (1.0e7, "m"), "s": (1.0e4, "m/s")}
+STATE_LIMITS = {"m": (1.0e7, "m"), "s": (1.0e4, "m/s")}
 _COV_P = [f"cov_pp_{i}{j}" for i in range(3) for j in range(3)]
 _COV_V = [f"cov_vv_{i}{j}" for i in range(3) for j in range(3)]
 
@@ -47,7 +47,7 @@ def clean_tracks(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
     df = tracks.reset_index(drop=True)
     cols = {c: finite_column(df, c, source, allow_nan=c not in ("time_s", "track_id")) for c in TRACK_COLUMNS}
     for name in TRACK_COLUMNS[2:]:  # 1e308 is finite, but no aircraft's position or velocity
-        limit, unit = _LIMITS[name[-1]]
+        limit, unit = STATE_LIMITS[name[-1]]
         with np.errstate(invalid="ignore"):
             beyond = np.flatnonzero(np.abs(cols[name]) > limit)
         if beyond.size:

@@ -29,6 +29,7 @@ _DETECTION_LIMITS = {
     "time_s": (MAX_TIME_S, "s"), "range_m": (1.0e7, "m"), "radial_velocity_mps": (1.0e4, "m/s"),
     "north_m": (1.0e7, "m"), "east_m": (1.0e7, "m"), "down_m": (1.0e7, "m"),
 }  # fmt: skip
+_OWNSHIP_LIMITS = {"m": (1.0e7, "m"), "mps": (1.0e4, "m/s")}  # by the unit ending the column's name
 
 
 def validate_detections(df: pd.DataFrame, source: str = "detections") -> pd.DataFrame:
@@ -88,7 +89,15 @@ def validate_ownship(df: pd.DataFrame, columns: tuple[str, ...], source: str = "
     if len(df) == 0:
         raise InputError(f"{source}: no rows; the own-ship state is needed at every frame")
     for col in columns:
-        finite_column(df, col, source)
+        values = finite_column(df, col, source)
+        limit, unit = _OWNSHIP_LIMITS.get(col.rsplit("_", 1)[-1], (np.inf, ""))
+        beyond = np.flatnonzero(np.abs(values) > limit)
+        if beyond.size:  # 1e308 is finite, and no aircraft's position or velocity
+            i = int(beyond[0])
+            raise InputError(
+                f"{source}: field '{col}' is {values[i]:.6g} {unit} at row {i}, beyond +-{limit:g} {unit}: "
+                "not the own-ship's state"
+            )
     check_frame_times(df[columns[0]].to_numpy(float), source, field=columns[0], index_name="row")
     return df
 

@@ -3,8 +3,7 @@
 Nulling ground clutter in a cell costs a target there several dB of SNR. A second, lower CFAR
 threshold in those cells finds it again; its false alarms are spread over the whole nulled region,
 so its detections only update a confirmed track inside the few cells its gate predicts and never
-start or confirm one. Ground-flagged detections come to the tracker the same way, without their
-direction: an aircraft in the ground's Doppler band shares its cell with the ground.
+start or confirm one.
 """
 
 from __future__ import annotations
@@ -17,9 +16,7 @@ from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.process.detect import detect
 from skyradar.track.fusion import fuse_heads
-from skyradar.track.ground_tracks import hold_ground_tracks
 from skyradar.track.models import radar_model
-from skyradar.track.track_table import track_air_detections, tracker_detections
 from skyradar.track.tracker import RangeDopplerTracker
 
 CFG = RadarConfig.prototype_2022()
@@ -152,68 +149,3 @@ def test_fusion_keeps_secondary_rows_apart_from_the_duplicate_search():
     fused, rows = fuse_heads(det)
     # The two primary rows are one object (the stronger kept); the secondary row is left to the gates.
     assert rows.tolist() == [0, 2] and fused["secondary"].tolist() == [True, False]
-
-
-def _closure_table(n: int, ground_from: int) -> pd.DataFrame:
-    """A closing aircraft's detections at 9.4 frames/s with directions on its true bearing; from
-    frame ``ground_from`` on, flagged ground with a direction pulled 40 deg down onto the surface."""
-    t = np.arange(n) / 9.4
-    flagged = np.arange(n) >= ground_from
-    down = np.where(flagged, 900.0, -50.0)  # pulled onto the surface 900 m below vs. at its height
-    return pd.DataFrame(
-        {
-            "time_s": t,
-            "frame": np.arange(n),
-            "range_m": 2000.0 - 30.0 * t,
-            "radial_velocity_mps": np.full(n, -30.0),
-            "snr_db": np.full(n, 15.0),
-            "azimuth_rad": np.where(flagged, 0.3, 0.0),
-            "elevation_rad": np.where(flagged, -0.7, 0.0),
-            "elevation_measured": True,
-            "north_m": 2000.0 - 30.0 * t,
-            "east_m": np.zeros(n),
-            "down_m": down,
-            "is_ground": flagged,
-            "spur": False,
-        }
-    )
-
-
-def test_ground_flagged_detections_in_a_confirmed_gate_keep_the_track_without_their_direction():
-    table = _closure_table(40, ground_from=10)
-    tracks, n_air = track_air_detections(table, ground_test=False)
-    assert n_air == 10 and tracks.track_id.nunique() == 1
-    rows = tracks.detection_row.to_numpy()
-    assert set(range(10, 40)) <= set(rows.tolist())  # every flagged detection updated the track
-    air, used = tracker_detections(table)
-    assert (
-        air.loc[10:, "secondary"].all()
-        and air.loc[10:, ["north_m", "down_m", "azimuth_rad"]].isna().all().all()
-    )
-    assert not air.loc[10:, "elevation_measured"].any() and used.tolist() == list(range(40))
-
-
-def test_ground_flagged_detections_alone_start_no_track():
-    tracks, n_air = track_air_detections(_closure_table(40, ground_from=0), ground_test=False)
-    assert n_air == 0 and len(tracks) == 0
-
-
-def test_a_ground_flagged_detection_counts_in_the_ground_test_by_its_range_and_doppler_alone():
-    # Own-ship north at 50 m/s, 900 m above level ground; the aircraft 50 m above it, 2 km ahead,
-    # its first ten detections flagged ground with directions pulled onto the surface.
-    table = _closure_table(40, ground_from=40)
-    t = table["time_s"].to_numpy()
-    table["north_m"] = 50.0 * t + table["range_m"]
-    pulled = np.arange(40) < 10
-    table.loc[pulled, ["is_ground", "down_m", "elevation_rad", "azimuth_rad"]] = [True, 900.0, -0.45, 0.3]
-    own = pd.DataFrame(
-        {"time_s": t, "own_north_m": 50.0 * t, "own_east_m": 0.0, "own_down_m": 0.0, "own_vn_mps": 50.0,
-         "own_ve_mps": 0.0, "own_vd_mps": 0.0, "own_height_agl_m": 900.0}
-    )  # fmt: skip
-    tracks = pd.DataFrame({"time_s": t, "track_id": 1, "detection_row": np.arange(40), "confirmed": True})
-    width, coupling = 2.0 * CFG.v_lim_mps, CFG.range_doppler_coupling_s
-    as_tracked = hold_ground_tracks(tracks, tracker_detections(table)[0], own, width, coupling)
-    as_flagged = hold_ground_tracks(tracks, table, own, width, coupling)
-    released = [int(np.argmax(h["held_by"].to_numpy() == "")) for h in (as_tracked, as_flagged)]
-    # Their ranges and Doppler count against a static point; their directions, on the surface, do not.
-    assert released[0] <= released[1] and (as_tracked["held_by"].iloc[released[0] :] == "").all()

@@ -23,7 +23,6 @@ __all__ = [
     "track_detections",
     "track_air_detections",
     "tracker_detections",
-    "DIRECTION_COLUMNS",
     "empty_tracks",
     "TRACK_COLUMNS",
     "TRACK_TABLE_COLUMNS",
@@ -281,27 +280,23 @@ def track_air_detections(
     run_times_s: np.ndarray | None = None,
     ground_test: GroundTrackTest | bool = True,
 ) -> tuple[pd.DataFrame, int]:
-    """Tracks of a ``skyradar process`` table: its air detections, and its ground-flagged ones only
-    inside a confirmed track's gate (:func:`tracker_detections`); spurs are left out.
+    """Tracks of a ``skyradar process`` table without its ground and spur detections
+    (:func:`tracker_detections`).
 
     The tracker steps on every frame (:func:`skyradar.track.frame_grid.frame_grid`: the run's
     times ``run_times_s`` when given, else the frames of the ``frame`` column, including frames
-    without any detection), so a frame without a detection is a miss and coasting tracks keep
+    without any detection), so a frame without an air detection is a miss and coasting tracks keep
     their rows. ``detection_row`` refers to the rows of ``detections``. ``ground_test``: as in
-    :func:`track_detections`. Returns the tracks and the number of air detections (neither
-    ground nor spur) offered to the tracker.
+    :func:`track_detections`. Returns the tracks and the number of detections tracked.
 
     Examples
     --------
-    A track confirmed on air detections keeps its two ground-flagged ones (its gate holds them);
-    the third ground-flagged detection, far from any track, starts nothing.
-
     >>> t = np.arange(10) * 0.1
-    >>> det = pd.DataFrame({"time_s": np.r_[t, 0.9], "range_m": np.r_[1000 - 50 * t, 3000.0],
-    ...                     "radial_velocity_mps": np.full(11, 28.3), "is_ground": np.r_[t > 0.75, True]})
-    >>> tracks, n_used = track_air_detections(det.sort_values("time_s", kind="stable"))
-    >>> n_used, sorted(tracks.detection_row.tolist())[-2:], tracks.track_id.nunique()
-    (8, [8, 9], 1)
+    >>> det = pd.DataFrame({"time_s": t, "range_m": 1000 - 50 * t, "radial_velocity_mps": np.full(10, 28.3),
+    ...                     "is_ground": t > 0.75})
+    >>> tracks, n_used = track_air_detections(det)
+    >>> n_used, int(tracks.detection_row.max())
+    (8, 7)
     """
     frame_times = frame_grid(detections, run_times_s)
     air, keep = tracker_detections(detections)
@@ -310,56 +305,32 @@ def track_air_detections(
     )
     rows = tracks["detection_row"].to_numpy()
     tracks["detection_row"] = np.where(rows >= 0, keep[np.maximum(rows, 0)], -1) if keep.size else rows
-    ground = air["is_ground"].fillna(False).to_numpy(bool) if "is_ground" in air.columns else None
-    return tracks, int(len(air) if ground is None else (~ground).sum())
-
-
-# Columns that hold a detection's direction of arrival, or a position computed from it.
-DIRECTION_COLUMNS = (
-    "azimuth_rad", "elevation_rad", "x_body_m", "y_body_m", "z_body_m",
-    "north_m", "east_m", "down_m", "lat_deg", "lon_deg", "alt_m",
-)  # fmt: skip
+    return tracks, int(keep.size)
 
 
 def tracker_detections(detections: pd.DataFrame) -> tuple[pd.DataFrame, np.ndarray]:
-    """The rows of a ``skyradar process`` table the tracker takes, and their rows in it.
+    """The rows of a ``skyradar process`` table the tracker takes, and their rows in it: neither
+    ground-flagged (``is_ground``) nor spur rows.
 
-    Spur rows are left out. A ground-flagged row (``is_ground``) comes in as a secondary
-    detection (``secondary`` True) without its direction (:data:`DIRECTION_COLUMNS` NaN,
-    ``elevation_measured`` False): it may update a confirmed track whose gate holds it, never
-    start or confirm one, and the ground test reads its range and Doppler, not its direction. A
-    ground flag says the ground explains the detection, not that nothing else is in its cell: an
-    aircraft whose Doppler aliases into the ground's band shares its cell with the ground at its
-    own range, whose returns pull the direction of the cell's peak onto the surface, and the
-    aircraft's detection is flagged. Its range and Doppler stay the peak's; its direction is the
-    ground's, so only the range and Doppler are used.
+    Ground-flagged rows stay out even inside a confirmed track's gate: over relief the ground's
+    band holds many of them, and a clutter track fed by them lives on until the ground test
+    releases it as an object.
 
     Examples
     --------
     >>> det = pd.DataFrame({"time_s": [0.0, 0.0, 0.0], "range_m": [900.0, 1000.0, 1100.0],
-    ...     "radial_velocity_mps": [-20.0, -20.0, -20.0], "azimuth_rad": [0.1, 0.2, 0.3],
+    ...     "radial_velocity_mps": [-20.0, -20.0, -20.0],
     ...     "is_ground": [False, True, False], "spur": [False, False, True]})
     >>> air, rows = tracker_detections(det)
-    >>> rows.tolist(), air["secondary"].tolist(), air["azimuth_rad"].isna().tolist()
-    ([0, 1], [False, True], [False, True])
+    >>> rows.tolist(), air["range_m"].tolist()
+    ([0], [900.0])
     """
-
-    def flag(name: str) -> np.ndarray:
-        if name not in detections.columns:
-            return np.zeros(len(detections), bool)
-        return detections[name].fillna(False).to_numpy(bool)
-
-    rows = np.flatnonzero(~flag("spur"))
-    air = detections.iloc[rows].reset_index(drop=True)
-    ground = flag("is_ground")[rows]
-    if not ground.any():
-        return air, rows
-    air["secondary"] = flag("secondary")[rows] | ground
-    for column in DIRECTION_COLUMNS:
-        if column in air.columns:
-            air.loc[ground, column] = np.nan
-    air["elevation_measured"] = np.where(ground, False, air.get("elevation_measured", True)).astype(bool)
-    return air, rows
+    keep = np.ones(len(detections), bool)
+    for flag in ("is_ground", "spur"):
+        if flag in detections.columns:
+            keep &= ~detections[flag].fillna(False).to_numpy(bool)
+    rows = np.flatnonzero(keep)
+    return detections.iloc[rows].reset_index(drop=True), rows
 
 
 def _assemble(

@@ -23,6 +23,8 @@ Modules: the tracker (:mod:`.tracker`, :mod:`.types`, :mod:`.components`, :mod:`
 
 from __future__ import annotations
 
+from skyradar.lazy_exports import lazy_exports
+
 # Each public name by the module it lives in, imported on first use (PEP 562).
 _EXPORTS = {
     "track_table": ("track_detections", "track_air_detections"),
@@ -34,19 +36,4 @@ _EXPORTS = {
     "evaluate": ("evaluate_run",),
     "metrics": ("track_metrics",),
 }
-__all__ = [name for names in _EXPORTS.values() for name in names]
-
-
-def __getattr__(name: str):
-    module = next((module for module, names in _EXPORTS.items() if name in names), None)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    from importlib import import_module
-
-    value = getattr(import_module(f"{__name__}.{module}"), name)
-    globals()[name] = value  # imported once; a plain attribute from then on
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *__all__})
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -77,7 +77,7 @@ import pandas as pd
 
 from skyradar.code_version import code_version, provenance
 from skyradar.config import RadarConfig
-from skyradar.errors import InputError
+from skyradar.experiments import encounter_terrain
 from skyradar.experiments.clutter_report import plot_sinr_loss, plot_track, summary_rows
 from skyradar.experiments.clutter_scene import OWN_SPEED_MPS, relief_altitude_m, scene_dict, scene_frames
 from skyradar.experiments.encounter_set import FAST_CLOSURE_AGL_M
@@ -104,7 +104,6 @@ START_M, END_M, CLOSING_MPS = 5000.0, 1300.0, 100.0
 RELIEF_CLOSING_MPS = 106.7
 TERRAINS = ("flat-1000", "flat-300", "hills", "jacksboro")
 DEFAULT_TERRAINS = TERRAINS  # all four: about 35 s on 2 cores
-_ALIASES = {"flat": "flat-1000"}
 _CFAR_HALF = (6, 10)  # guard + training cells each side (range, Doppler) of the default CA-CFAR
 _CFAR_GUARD = (2, 2)
 IF_CELL_CNR_DB = 25.0  # per-cell IF is bounded by the cell's CNR: judged where 25 dB is possible
@@ -121,16 +120,7 @@ def parse_terrains(value: str, option: str = "--terrain") -> list[str]:
     >>> parse_terrains("flat")
     ['flat-1000']
     """
-    if value.strip() == "all":
-        return list(TERRAINS)
-    names = [_ALIASES.get(v.strip(), v.strip()) for v in value.split(",")]
-    for name in names:
-        if name not in TERRAINS:
-            raise InputError(
-                f"{option}: must be all or a comma-separated list of {', '.join(TERRAINS)} (or flat), "
-                f"got {value!r}"
-            )
-    return list(dict.fromkeys(names))
+    return encounter_terrain.parse_terrains(value, TERRAINS, option)
 
 
 def _db(x: np.ndarray | float) -> np.ndarray:

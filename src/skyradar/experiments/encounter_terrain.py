@@ -47,8 +47,9 @@ _GRID_SIZE_M = 16_000.0  # the frame window's own-ship track (2 km) plus the 5 k
 _JACKSBORO_OFFSET_M = 3_000.0
 
 
-def parse_terrains(value: str) -> list[str]:
-    """Terrain names from ``--terrain`` (comma-separated; ``all`` = every one), in the given order.
+def parse_terrains(value: str, terrains: tuple[str, ...] = TERRAINS, option: str = "--terrain") -> list[str]:
+    """Terrain names from ``option`` (comma-separated names of ``terrains``; ``all`` = every one;
+    ``flat`` = ``flat-1000``, ``clear`` = ``none``), in the given order, each once.
 
     Examples
     --------
@@ -58,13 +59,13 @@ def parse_terrains(value: str) -> list[str]:
     ['none', 'flat-300', 'flat-1000', 'hills', 'jacksboro']
     """
     if value.strip() == "all":
-        return list(TERRAINS)
+        return list(terrains)
     names = [_ALIASES.get(v.strip(), v.strip()) for v in value.split(",")]
     for name in names:
-        if name not in TERRAINS:
+        if name not in terrains:
             raise InputError(
-                f"experiment encounters: option '--terrain' must be all or a comma-separated list of "
-                f"{', '.join(TERRAINS)} (or flat), got {value!r}"
+                f"{option}: must be all or a comma-separated list of {', '.join(terrains)} (or flat), "
+                f"got {value!r}"
             )
     return list(dict.fromkeys(names))
 

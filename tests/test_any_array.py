@@ -145,3 +145,11 @@ def test_ura_2x3_direction_error_is_within_a_few_bounds_on_a_clear_sky_target():
     # RMS error within a few bounds (the range-Doppler peak's straddle and the window add some).
     assert np.sqrt(np.mean(err_az**2)) < 4 * np.sqrt(np.mean(sd_az**2)) + np.radians(0.3)
     assert np.sqrt(np.mean(err_el**2)) < 4 * np.sqrt(np.mean(sd_el**2)) + np.radians(0.3)
+
+
+def test_bench_reports_frames_per_second_of_1_6_and_8_channels():
+    from skyradar.benchmarks.process import run_arrays
+
+    out = run_arrays(n_cubes=1, n_targets=2, min_time_s=0.05)
+    for n_rx in (1, 6, 8):
+        assert out[f"rx{n_rx}_frames_per_s"] > 0 and out[f"rx{n_rx}_cpu_frames_per_s"] > 0

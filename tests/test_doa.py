@@ -161,9 +161,11 @@ def test_bad_layouts_and_reflectors_are_input_errors():
     line = CFG.replace(rx_positions_m=np.array([[0, 0, 0], [0, LAM / 2, 0], [0, LAM, 0], [0, 1.5 * LAM, 0]]))
     with pytest.raises(InputError, match="one line"):
         estimate_directions(np.ones((1, 4)), line)
-    two = CFG.replace(rx_positions_m=np.array([[0, 0, 0], [0, LAM / 2, 0], [0, 0, 0], [0, LAM / 2, 0]]))
+    with pytest.raises(InputError, match="coincide"):  # a channel counted twice is refused up front
+        CFG.replace(rx_positions_m=np.array([[0, 0, 0], [0, LAM / 2, 0], [0, 0, 0], [0, LAM / 2, 0]]))
+    two = CFG.replace(rx_positions_m=np.array([[0, 0, 0], [0, LAM / 2, 0]]), rx_calibration=None)
     with pytest.raises(InputError, match="distinct"):
-        estimate_directions(np.ones((1, 4)), two)
+        estimate_directions(np.ones((1, 2)), two)
     with pytest.raises(InputError, match="channels"):
         estimate_directions(np.ones((1, 3)), CFG)
     behind = reflector_position(438.0, np.radians(120.0), 0.0)

@@ -26,8 +26,9 @@ def test_square_is_the_prototype_default():
 def test_every_layout_is_planar_with_half_wavelength_pairs_spanning_the_plane(name):
     # DoA unwraps longer baselines from the pairs at most lambda/2 apart: those must span y and z.
     rx = rx_layout_m(name, WAVELENGTH_M)
-    assert rx.shape == (4, 3) and np.all(rx[:, 0] == 0.0)
-    short = [rx[j] - rx[i] for i in range(4) for j in range(i + 1, 4)
+    n = rx.shape[0]
+    assert rx.shape[1] == 3 and n >= 4 and np.all(rx[:, 0] == 0.0)
+    short = [rx[j] - rx[i] for i in range(n) for j in range(i + 1, n)
              if np.linalg.norm(rx[j] - rx[i]) <= WAVELENGTH_M / 2 + 1e-12]  # fmt: skip
     assert np.linalg.matrix_rank(np.array(short)[:, 1:]) == 2
 

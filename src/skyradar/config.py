@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike
 
 from skyradar.antenna import AntennaPattern, GainCut
 from skyradar.errors import InputError
-from skyradar.rx_layouts import rx_layout_m
+from skyradar.rx_layouts import MAX_RX, rx_layout_m
 from skyradar.units import centred_bin, centred_bin_value, nearest_bin
 
 __all__ = ["SPEED_OF_LIGHT", "BOLTZMANN", "Mount", "RadarConfig"]
@@ -123,7 +123,8 @@ class RadarConfig:
         Processed range (RLim), m.
     rx_positions_m : ndarray, shape (n_rx, 3), or str
         Receive antenna phase centres in the antenna frame, m, or a layout name of
-        :func:`skyradar.rx_layouts.rx_layout_m` (``"square"``, ``"kite"``). Default: the 2x2
+        :func:`skyradar.rx_layouts.rx_layout_m` (``"square"``, ``"kite"``, ``"ura-2x3"``,
+        ``"ura-2x4"``); 1 to 32 distinct positions. Default: the 2x2
         square, half-wavelength spacing.
     tx_position_m : ndarray, shape (3,)
         Transmit antenna phase centre in the antenna frame, m.
@@ -175,14 +176,27 @@ class RadarConfig:
             raise InputError(f"radar.prf_hz ({self.prf_hz}) must be below fs_hz ({self.fs_hz})")
         rx = "square" if self.rx_positions_m is None else self.rx_positions_m
         rx = rx_layout_m(rx, self.wavelength_m) if isinstance(rx, str) else np.array(rx, dtype=float)
-        if rx.ndim != 2 or rx.shape[1] != 3 or rx.shape[0] < 1 or not np.all(np.isfinite(rx)):
+        if rx.size == 0:  # [] from a scenario, or (0, 3)
+            rx = rx.reshape(0, 3)
+        if rx.ndim != 2 or rx.shape[1] != 3:
             raise InputError(
-                f"radar.rx_positions_m must be an (n_rx, 3) array of finite metres, got shape {rx.shape}"
+                f"radar.rx_positions_m must be an (n_rx, 3) array of metres, got shape {rx.shape}"
             )
+        if not 1 <= rx.shape[0] <= MAX_RX:
+            raise InputError(
+                f"radar.rx_positions_m: {rx.shape[0]} receive antennas; a radar has 1 to {MAX_RX}"
+            )
+        if not np.all(np.isfinite(rx)):
+            bad = int(np.flatnonzero(~np.all(np.isfinite(rx), axis=1))[0])
+            raise InputError(f"radar.rx_positions_m: antenna {bad} is not finite metres: {rx[bad].tolist()}")
         if rx.shape[0] > 1 and np.ptp(rx, axis=0).max() < 1e-6:
             raise InputError(
                 "radar.rx_positions_m: all receive antennas are at one point; no baseline for DoA"
             )
+        gap = np.linalg.norm(rx[:, None, :] - rx[None, :, :], axis=2) + np.eye(rx.shape[0])
+        if np.any(gap < 1e-6):  # two phase centres in one place: one channel counted twice
+            i, j = sorted(int(v) for v in np.argwhere(gap < 1e-6)[0])
+            raise InputError(f"radar.rx_positions_m: antennas {i} and {j} coincide at {rx[i].tolist()} m")
         # One radar's antennas sit on one aircraft: within 2 m of each other (a wingspan holds several
         # heads, each its own radar); farther apart they are a mistyped unit, not an array.
         span_m = float(np.ptp(rx, axis=0).max())

@@ -18,6 +18,18 @@ drifts up to 31 deg off over 23 s, and the track is dropped and started again.
 Its vertical aperture of one wavelength is unambiguous through the two half-wavelength pairs
 (:mod:`skyradar.process.doa` unwraps the long baseline from them).
 
+``ura-2x3`` and ``ura-2x4`` are uniform rectangular arrays at the prototype's half-wavelength
+element spacing: two rows (one above the other) of three or four columns across, centred on the
+boresight axis. More channels buy angle accuracy (the Cramer-Rao bound falls with the aperture's
+second moments, :func:`skyradar.process.doa.doa_crlb`) and more clutter nulls.
+
+Unambiguous field of view: every layout here has half-wavelength pairs spanning the array plane
+(the kite's one-wavelength baseline is unwrapped from them), so each is free of grating lobes
+over the whole forward half-space, azimuth and elevation -90..90 deg; the antenna pattern, not the
+array, limits the usable field of view (:func:`skyradar.process.doa.array_geometry`).
+
+Any other array is given by its positions (``radar.rx_positions_m``, 1 to :data:`MAX_RX` rows).
+
 Examples
 --------
 >>> rx_layout_m("square", 0.04).round(3).tolist()[0]
@@ -32,25 +44,28 @@ import numpy as np
 
 from skyradar.errors import InputError
 
-__all__ = ["RX_LAYOUTS", "check_rx_layout", "rx_layout_m", "square_m"]
+__all__ = ["MAX_RX", "RX_LAYOUTS", "check_rx_layout", "rx_layout_m", "square_m", "ura_m"]
 
-RX_LAYOUTS = ("square", "kite")
+RX_LAYOUTS = ("square", "kite", "ura-2x3", "ura-2x4")
+MAX_RX = 32  # receive channels a radar may have (CFAR and noise-floor tables are built up to it)
 
 
 def rx_layout_m(name: str, wavelength_m: float) -> np.ndarray:
-    """Receive antenna positions (4, 3), m, of a named layout for the wavelength ``wavelength_m`` (m).
+    """Receive antenna positions (n_rx, 3), m, of a named layout for the wavelength ``wavelength_m`` (m).
 
     Parameters
     ----------
     name : str
-        ``"square"`` (2x2, half-wavelength sides) or ``"kite"`` (see the module docstring).
+        ``"square"`` (2x2, half-wavelength sides), ``"kite"``, ``"ura-2x3"`` or ``"ura-2x4"`` (see
+        the module docstring).
     wavelength_m : float
         Carrier wavelength, m.
 
     Returns
     -------
-    ndarray, shape (4, 3)
-        Rows (0, right, down) in the antenna frame, m, centred on the boresight axis for the square.
+    ndarray, shape (n_rx, 3)
+        Rows (0, right, down) in the antenna frame, m (4 rows; 6 and 8 for the URAs), centred on the
+        boresight axis for the square and the URAs.
 
     Examples
     --------
@@ -59,11 +74,14 @@ def rx_layout_m(name: str, wavelength_m: float) -> np.ndarray:
     >>> rx_layout_m("ring", 0.04)
     Traceback (most recent call last):
     ...
-    skyradar.errors.InputError: radar.rx_positions_m: layout must be square or kite, got 'ring'
+    skyradar.errors.InputError: radar.rx_positions_m: layout must be one of square, kite, ..., got 'ring'
     """
     check_rx_layout(name, "radar.rx_positions_m: layout")
     if name == "square":
         return square_m(float(wavelength_m) / 2.0)
+    if name.startswith("ura-"):
+        rows, cols = (int(v) for v in name[4:].split("x"))
+        return ura_m(rows, cols, float(wavelength_m) / 2.0)
     q = float(wavelength_m) / 4.0
     return np.array([[0.0, -q, -q], [0.0, q, -q], [0.0, 0.0, q], [0.0, 0.0, 3.0 * q]])
 
@@ -80,6 +98,23 @@ def square_m(side_m: float) -> np.ndarray:
     return np.array([[0.0, -h, -h], [0.0, h, -h], [0.0, -h, h], [0.0, h, h]])
 
 
+def ura_m(rows: int, cols: int, spacing_m: float) -> np.ndarray:
+    """Positions (rows * cols, 3), m, of a uniform rectangular array centred on the boresight axis.
+
+    Row-major: the top row (most negative down) first, each row from left to right.
+
+    Examples
+    --------
+    >>> ura_m(2, 3, 0.02)[:, 1:].round(3).tolist()  # (right, down), m
+    [[-0.02, -0.01], [0.0, -0.01], [0.02, -0.01], [-0.02, 0.01], [0.0, 0.01], [0.02, 0.01]]
+    """
+    s = float(spacing_m)
+    down, right = np.meshgrid(
+        (np.arange(rows) - (rows - 1) / 2.0) * s, (np.arange(cols) - (cols - 1) / 2.0) * s, indexing="ij"
+    )
+    return np.column_stack([np.zeros(rows * cols), right.ravel(), down.ravel()])
+
+
 def check_rx_layout(name: str, label: str) -> str:
     """``name`` if it is a layout of :data:`RX_LAYOUTS`, else InputError ``"{label} must be ..."``.
 
@@ -89,5 +124,5 @@ def check_rx_layout(name: str, label: str) -> str:
     'kite'
     """
     if name not in RX_LAYOUTS:
-        raise InputError(f"{label} must be {' or '.join(RX_LAYOUTS)}, got {name!r}")
+        raise InputError(f"{label} must be one of {', '.join(RX_LAYOUTS)}, got {name!r}")
     return name

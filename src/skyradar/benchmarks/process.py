@@ -1,5 +1,8 @@
 """Benchmark: detection + DoA frames per second on prototype-size cubes (333 x 250 x 4).
 
+The same for other receive arrays (``rx{n}_frames_per_s``, ``rx{n}_cpu_frames_per_s``): one
+channel (no direction), ``ura-2x3`` (6) and ``ura-2x4`` (8), on cubes of the same targets.
+
 Ours: :func:`skyradar.process.pipeline.process_cube` (compiled channel integration, box-filter
 CA-CFAR with Doppler wrap, blob peaks, vectorised phase least squares). Baseline, measured in the
 same run on the same cubes: the textbook numpy/scipy version (``np.abs(.)**2`` mean,
@@ -31,7 +34,7 @@ from skyradar.process.doa import direction_from_angles
 from skyradar.process.pipeline import process_cube
 from skyradar.process.spurs import SpurMap
 
-__all__ = ["synthetic_frame", "baseline_process", "run"]
+__all__ = ["synthetic_frame", "baseline_process", "run", "run_arrays"]
 
 
 def synthetic_frame(
@@ -114,14 +117,10 @@ def _frames_per_s(fn, cubes: list[np.ndarray], min_time_s: float) -> tuple[float
             return n / elapsed, n / max(time.process_time() - c0, 1e-9)
 
 
-def run(n_cubes: int = 8, n_targets: int = 5, min_time_s: float = 2.0, seed: int = 0) -> dict:
-    """Measure detection + DoA throughput of ours and the baseline on the same cubes.
+_OTHER_ARRAYS = {1: [[0.0, 0.0, 0.0]], 6: "ura-2x3", 8: "ura-2x4"}
 
-    Returns ``frames_per_s`` (wall clock), ``baseline_frames_per_s``, ``speedup``, the same per
-    process-CPU second (``cpu_frames_per_s``: what a free core would do), the machine's load
-    average, the cube shape and the detections per frame of each (they should agree).
-    """
-    config = RadarConfig.prototype_2022()
+
+def _synthetic_cubes(config: RadarConfig, n_cubes: int, n_targets: int, seed: int) -> list[np.ndarray]:
     rng = np.random.default_rng(seed)
     cubes = []
     for _ in range(n_cubes):
@@ -136,6 +135,31 @@ def run(n_cubes: int = 8, n_targets: int = 5, min_time_s: float = 2.0, seed: int
             for _ in range(n_targets)
         ]
         cubes.append(synthetic_frame(config, targets, rng)[0])
+    return cubes
+
+
+def run_arrays(n_cubes: int = 4, n_targets: int = 5, min_time_s: float = 1.0, seed: int = 0) -> dict:
+    """``process_cube`` frames per second (wall clock and per CPU second) of the 1-, 6- and 8-channel
+    arrays (``rx1_*``, ``rx6_*``, ``rx8_*``)."""
+    out = {}
+    for n_rx, rx in _OTHER_ARRAYS.items():
+        config = RadarConfig.prototype_2022(rx_positions_m=rx)
+        cubes = _synthetic_cubes(config, n_cubes, n_targets, seed)
+        wall, cpu = _frames_per_s(lambda c, cfg=config: process_cube(c, cfg), cubes, min_time_s)
+        out[f"rx{n_rx}_frames_per_s"], out[f"rx{n_rx}_cpu_frames_per_s"] = float(wall), float(cpu)
+    return out
+
+
+def run(n_cubes: int = 8, n_targets: int = 5, min_time_s: float = 2.0, seed: int = 0) -> dict:
+    """Measure detection + DoA throughput of ours and the baseline on the same cubes.
+
+    Returns ``frames_per_s`` (wall clock), ``baseline_frames_per_s``, ``speedup``, the same per
+    process-CPU second (``cpu_frames_per_s``: what a free core would do), the machine's load
+    average, the cube shape and the detections per frame of each (they should agree); and
+    :func:`run_arrays`' frames per second of other receive arrays.
+    """
+    config = RadarConfig.prototype_2022()
+    cubes = _synthetic_cubes(config, n_cubes, n_targets, seed)
     ours, ours_cpu = _frames_per_s(lambda c: process_cube(c, config), cubes, min_time_s)
     # With a spur map (zero-Doppler column and near-range rows masked): spur-aware CFAR.
     freq = np.zeros((config.n_range, config.n_doppler), np.float32)
@@ -155,6 +179,7 @@ def run(n_cubes: int = 8, n_targets: int = 5, min_time_s: float = 2.0, seed: int
     return (
         suppressed
         | run_adaptive(seed=seed)
+        | run_arrays(n_targets=n_targets, min_time_s=min_time_s / 2, seed=seed)
         | {
             "frames_per_s": float(ours),
             "baseline_frames_per_s": float(base),

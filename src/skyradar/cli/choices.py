@@ -170,6 +170,8 @@ class RxLayout(StrEnum):
 
     square = "square"
     kite = "kite"
+    ura_2x3 = "ura-2x3"
+    ura_2x4 = "ura-2x4"
 
 
 class Family(StrEnum):

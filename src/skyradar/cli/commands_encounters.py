@@ -76,7 +76,8 @@ _RX_LAYOUT = Annotated[
     typer.Option(
         "--rx-layout",
         help="Receive array of every head (scenario 'radar.rx_layout:'): square (the prototype's 2x2) "
-        "or kite (no centre of symmetry: keeps the elevation of targets in flat-ground clutter).",
+        "kite (no centre of symmetry: keeps the elevation of targets in flat-ground clutter), or the "
+        "uniform rectangular arrays ura-2x3 and ura-2x4 (half-wavelength spacing).",
     ),
 ]
 

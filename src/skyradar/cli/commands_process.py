@@ -383,7 +383,8 @@ def bench_process(
     seconds: BenchSecondsOption = 2.0,
     as_json: JsonOption = False,
 ) -> None:
-    """Detection + DoA frames per second (333 x 250 x 4), ours vs a baseline; suppressed_*: terrain cubes."""
+    """Detection + DoA frames per second (333 x 250 x 4), ours vs a baseline; suppressed_*: terrain cubes;
+    rx1_*, rx6_*, rx8_*: 1-, 6- and 8-channel arrays."""
     from skyradar.benchmarks.process import run as run_bench
 
     emit_measurement(run_bench(min_time_s=seconds), as_json, "bench process")

@@ -30,6 +30,7 @@ from numba import njit
 from scipy import ndimage  # stats, integrate, optimize: imported where used (scipy.stats alone ~0.5 s)
 
 from skyradar.errors import InputError
+from skyradar.rx_layouts import MAX_RX
 
 __all__ = ["cfar_factor", "cfar_2d", "cfar_2d_floor", "training_cells"]
 
@@ -334,7 +335,7 @@ def _floor_tables(pfa: float, n_max: int) -> np.ndarray:
 
     n = np.arange(1, n_max + 1)
     rows = [np.full(n_max + 1, np.inf)]
-    for big_l in range(1, 9):
+    for big_l in range(1, MAX_RX + 1):
         known = stats.gamma.isf(pfa, big_l, scale=1.0 / big_l)  # noise mean known exactly
         rows.append(np.r_[known, stats.f.isf(pfa, 2 * big_l, 2 * n * big_l)])
     return np.asarray(rows, np.float32)
@@ -382,7 +383,7 @@ def cfar_2d_floor(
         raise InputError(f"cfar: field 'pfa' must be in (0, 1), got {pfa}")
     table = _floor_tables(float(pfa), n_train)
     skip = np.zeros(power.shape, np.bool_) if train_exclude is None else np.asarray(train_exclude, np.bool_)
-    big_l = np.ascontiguousarray(np.clip(channels, 1, 8), np.int8)
+    big_l = np.ascontiguousarray(np.clip(channels, 1, MAX_RX), np.int8)
     floor = np.float32(noise_floor_w)
     hits = np.empty(power.shape, np.bool_)
     only = not noise_map

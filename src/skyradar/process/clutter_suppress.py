@@ -51,6 +51,7 @@ from skyradar.errors import InputError
 from skyradar.process.clutter import ClutterSubspace, cell_scratch, decompose_cell
 from skyradar.process.clutter_adaptive import adaptive_nulls
 from skyradar.process.power import power_image
+from skyradar.rx_layouts import MAX_RX
 
 __all__ = [
     "Suppressed",
@@ -100,10 +101,10 @@ class Suppressed:
         return np.where(self.adaptive[..., None, None], self.adaptive_vectors, subspace.vectors)
 
 
-# Median of Gamma(L, 1/L) (the channel mean of L unit-noise channels), L = 1..8.
+# Median of Gamma(L, 1/L) (the channel mean of L unit-noise channels), L = 1..MAX_RX.
 # Median of the mean of n unit-mean exponentials (Gamma(n, 1/n)); scipy.special, not scipy.stats, keeps
 # `import skyradar.process` light for every command that only reads a table.
-_GAMMA_MEDIAN = np.array([np.nan, *(gammaincinv(n, 0.5) / n for n in range(1, 9))])
+_GAMMA_MEDIAN = np.array([np.nan, *(gammaincinv(n, 0.5) / n for n in range(1, MAX_RX + 1))])
 
 
 def measured_floor(
@@ -124,7 +125,7 @@ def measured_floor(
     k = values.size // 2
     values.partition(k)  # np.median's result without its wrapper (a tenth of a frame's suppression)
     median = values[k] if values.size % 2 else (values[:k].max() + values[k]) / np.float32(2.0)
-    return float(median / _GAMMA_MEDIAN[min(max(n_rx, 1), 8)])
+    return float(median / _GAMMA_MEDIAN[min(max(n_rx, 1), MAX_RX)])
 
 
 def null_count(
@@ -174,7 +175,7 @@ def suppress_clutter(
     cube: np.ndarray,
     subspace: ClutterSubspace,
     config: RadarConfig,
-    max_nulls: int = 2,
+    max_nulls: int | None = None,
     gate: float = 3.0,
     adaptive: bool = True,
 ) -> Suppressed:
@@ -186,8 +187,9 @@ def suppress_clutter(
         One frame, uncalibrated channels (``config.rx_calibration`` is divided out here).
     subspace : ClutterSubspace
         The frame geometry's predicted clutter.
-    max_nulls : int
-        Most directions nulled in one cell (2 keeps two channels' worth of noise averaging).
+    max_nulls : int, optional
+        Most directions nulled in one cell; default 2 (keeps two channels' worth of noise averaging
+        on the 2x2), at most ``n_rx - 1`` (none on a one-channel radar).
     gate : float
         A direction is nulled when the measured clutter-to-noise ratio times its eigenvalue
         fraction exceeds this.
@@ -198,6 +200,8 @@ def suppress_clutter(
     cube = np.asarray(cube)
     if cube.shape != subspace.predicted.shape + (config.n_rx,):
         raise InputError(f"suppression: frame shape {cube.shape} does not fit the clutter prediction")
+    if max_nulls is None:
+        max_nulls = min(2, config.n_rx - 1)
     if not 0 <= max_nulls < config.n_rx:
         raise InputError(f"suppression: field 'max_nulls' must be in [0, {config.n_rx - 1}], got {max_nulls}")
     raw = power_image(cube, config.rx_calibration)

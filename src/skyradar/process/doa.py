@@ -291,11 +291,15 @@ def estimate_directions(
     Returns
     -------
     ndarray, shape (n, 3)
-        Unit vectors; multiply by the measured range for positions.
+        Unit vectors; multiply by the measured range for positions. A one-channel radar has no
+        direction: every row is NaN (its detections carry NaN angles and positions, and the
+        tracker follows them in range and range rate only).
     """
     z = np.atleast_2d(np.asarray(pixels))
     if z.ndim != 2 or z.shape[1] != config.n_rx:
         raise InputError(f"doa: field 'rx' has {z.shape[-1]} channels, radar_config has {config.n_rx}")
+    if config.n_rx == 1:
+        return np.full((z.shape[0], 3), np.nan)
     if not calibrated:
         z = z / config.rx_calibration
     geo = array_geometry(config, facing)

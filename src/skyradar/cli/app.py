@@ -19,7 +19,7 @@ from skyradar.io.tables import jsonable
 
 __all__ = [
     "app", "experiment_app", "bench_app", "console", "emit_result", "emit_measurement", "JsonOption",
-    "number_in", "check_number", "check_choice", "POSITIVE", "NON_NEGATIVE", "COUNT", "PROBABILITY",
+    "number_in", "check_number", "POSITIVE", "NON_NEGATIVE", "COUNT", "PROBABILITY",
     "WORKERS", "SCHEDULER", "CHUNK_SAMPLES", "HeadOption", "open_one_head", "notes_after_inputs",
 ]  # fmt: skip
 
@@ -217,20 +217,3 @@ def SCHEDULER(ctx: typer.Context, param: typer.CallbackParam, value: str | None)
         return value
     name = param.opts[0] if param is not None and param.opts else "--scheduler"
     return check_scheduler(value, name)
-
-
-def check_choice(option: str, value: str, choices: tuple[str, ...]) -> str:
-    """``value`` if it is one of ``choices``, else :class:`InputError` naming the option.
-
-    Checked before any file is opened, so the message names the option, not a library field.
-
-    Examples
-    --------
-    >>> check_choice("--model", "radar", ("radar", "traditional"))
-    'radar'
-    """
-    from skyradar.errors import InputError
-
-    if value not in choices:
-        raise InputError(f"{option}: must be one of {', '.join(choices)}, got {value!r}")
-    return value

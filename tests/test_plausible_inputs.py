@@ -237,6 +237,7 @@ def test_hostile_paths_give_one_line(tmp_path):
     cases = [
         (("simulate", "loop", "-o", "run.zarr"), "loop", "symbolic link loop"),
         (("flight", "loop", "-o", "x.csv"), "loop", "symbolic link loop"),
+        (("process", "loop", "-o", "d.parquet"), "loop", "symbolic link"),
         (("simulate", "s.yaml", "-o", "a" * 300 + ".zarr"), "aaaa", "File name too long"),
         # 250 bytes fit, the temporary name written first does not: refused before the run, not after it
         (("simulate", "s.yaml", "-o", "b" * 245 + ".zarr"), "bbbb", "File name too long"),
@@ -245,6 +246,20 @@ def test_hostile_paths_give_one_line(tmp_path):
         result = skyradar(*args, cwd=tmp_path)
         assert_one_line_error(result, path, reason)
     assert not any(p.name.startswith(("aaa", "bbb", ".aaa", ".bbb")) for p in tmp_path.iterdir())
+
+
+def test_a_run_or_own_ship_behind_a_link_that_leads_nowhere_is_named_so(tmp_path):
+    from skyradar.errors import InputError
+    from skyradar.io.frames import open_frames
+    from skyradar.io.ownship_input import open_ownship
+
+    (tmp_path / "loop").symlink_to(tmp_path / "loop")
+    (tmp_path / "gone").symlink_to(tmp_path / "missing.zarr")
+    for name in ("loop", "gone"):
+        with pytest.raises(InputError, match="symbolic link that leads nowhere"):
+            open_frames(tmp_path / name)
+        with pytest.raises(InputError, match="symbolic link that leads nowhere"):
+            open_ownship(tmp_path / name)
 
 
 def test_sigmf_metadata_with_a_nan_rate_or_deep_nesting_is_one_line(tmp_path):

@@ -171,6 +171,8 @@ def open_frames(path: str | Path, head: int | str | None = None) -> xr.Dataset:
             f"{path}: an unfinished run (still being written, or interrupted); rerun the command that "
             f"writes {path.name.removesuffix('.partial')} to resume it"
         )
+    if not path.exists() and path.is_symlink():
+        raise InputError(f"{path}: a symbolic link that leads nowhere (a loop, or its target is missing)")
     if not path.exists():
         partial = path.with_name(path.name + ".partial")
         hint = f" (an unfinished run is at {partial}; rerun to resume)" if partial.exists() else ""

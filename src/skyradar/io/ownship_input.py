@@ -86,6 +86,8 @@ def open_ownship(path: str | Path, option: str = "--ownship") -> xr.Dataset:
     from skyradar.io.tables import read_table
 
     path = Path(path)
+    if not path.exists() and path.is_symlink():
+        raise InputError(f"{option} {path}: a symbolic link that leads nowhere (a loop, or no target)")
     if not path.exists():
         raise InputError(f"{option} {path}: no such run or table")
     if path.is_dir():

@@ -13,7 +13,7 @@ from skyradar.daa.tables import OPTIONAL_OWNSHIP_COLUMNS, OWNSHIP_COLUMNS, STATE
 from skyradar.errors import InputError
 from skyradar.io.frames_model import frame_times_s
 from skyradar.io.navigation import navigation_state
-from skyradar.io.tables import finite_column
+from skyradar.io.tables import check_within, finite_column
 
 __all__ = ["has_ownship", "ownship_from_frames", "truth_tracks"]
 
@@ -49,13 +49,7 @@ def ownship_from_frames(ds: xr.Dataset, source: str = "frames") -> pd.DataFrame:
     for name in OWNSHIP_COLUMNS[1:]:
         values = finite_column(table.reset_index(drop=True), name, source)
         limit, unit = STATE_LIMITS[name[-1]]
-        beyond = np.flatnonzero(np.abs(values) > limit)
-        if beyond.size:
-            i = int(beyond[0])
-            raise InputError(
-                f"{source}: field '{name}' is {values[i]:.6g} {unit} at row {i}, beyond +-{limit:g} "
-                f"{unit}: not the own-ship's state"
-            )
+        check_within(values, limit, unit, source, name, "not the own-ship's state")
     return table
 
 

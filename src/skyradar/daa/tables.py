@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from skyradar.errors import InputError
-from skyradar.io.tables import finite_column
+from skyradar.io.tables import check_within, finite_column
 from skyradar.track.track_table import OWNSHIP_COLUMNS as TRACKER_OWNSHIP_COLUMNS
 
 __all__ = ["TRACK_COLUMNS", "OWNSHIP_COLUMNS", "OPTIONAL_OWNSHIP_COLUMNS", "STATE_LIMITS", "clean_tracks",
@@ -48,14 +48,7 @@ def clean_tracks(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
     cols = {c: finite_column(df, c, source, allow_nan=c not in ("time_s", "track_id")) for c in TRACK_COLUMNS}
     for name in TRACK_COLUMNS[2:]:  # 1e308 is finite, but no aircraft's position or velocity
         limit, unit = STATE_LIMITS[name[-1]]
-        with np.errstate(invalid="ignore"):
-            beyond = np.flatnonzero(np.abs(cols[name]) > limit)
-        if beyond.size:
-            i = int(beyond[0])
-            raise InputError(
-                f"{source}: field '{name}' is {cols[name][i]:.6g} {unit} at row {i}, beyond +-{limit:g} "
-                f"{unit}: not an aircraft's state in the run's NED frame"
-            )
+        check_within(cols[name], limit, unit, source, name, "not an aircraft's state in the run's NED frame")
     ids = cols["track_id"]
     if (ids != np.round(ids)).any():
         bad = int(np.flatnonzero(ids != np.round(ids))[0])

@@ -19,7 +19,7 @@ import pandas as pd
 from skyradar.errors import InputError
 from skyradar.io.atomic import write_text_atomic, write_with
 
-__all__ = ["finite_column", "write_table", "read_table", "write_json_atomic", "jsonable"]
+__all__ = ["finite_column", "check_within", "write_table", "read_table", "write_json_atomic", "jsonable"]
 
 
 def write_table(df: pd.DataFrame, path: str | Path, metadata: dict[str, Any] | None = None) -> Path:
@@ -90,6 +90,29 @@ def finite_column(df: pd.DataFrame, col: str, source: str | Path, allow_nan: boo
         raw = raw.item() if hasattr(raw, "item") else raw
         raise InputError(f"{source}: field '{col}' is not a finite number at row {bad[0]} ({raw!r})")
     return values
+
+
+def check_within(
+    values: np.ndarray, limit: float, unit: str, source: str | Path, col: str, what: str
+) -> None:
+    """Refuse the first of ``values`` (column ``col``) beyond +-``limit``, naming the row; NaN passes.
+
+    1e308 is a finite number, but no measurement or state ``what`` describes holds it.
+
+    Examples
+    --------
+    >>> check_within(np.array([1.0, 1e308]), 1e7, "m", "t.csv", "x", "not a position")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: t.csv: field 'x' is 1e+308 m at row 1, beyond +-1e+07 m: not a position
+    """
+    with np.errstate(invalid="ignore"):
+        beyond = np.flatnonzero(np.abs(values) > limit)
+    if beyond.size:
+        i = int(beyond[0])
+        raise InputError(
+            f"{source}: field '{col}' is {values[i]:.6g} {unit} at row {i}, beyond +-{limit:g} {unit}: {what}"
+        )
 
 
 def jsonable(value: Any) -> Any:

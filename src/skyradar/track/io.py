@@ -11,7 +11,7 @@ from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.io.checks import MAX_TIME_S, check_frame_times
 from skyradar.io.frames_model import frame_times_s
-from skyradar.io.tables import finite_column, read_table
+from skyradar.io.tables import check_within, finite_column, read_table
 
 __all__ = [
     "REQUIRED_DETECTION_COLUMNS",
@@ -58,14 +58,7 @@ def validate_detections(df: pd.DataFrame, source: str = "detections") -> pd.Data
     for col, (limit, unit) in _DETECTION_LIMITS.items():  # 1e308 is finite, but no radar measures it
         if col in df.columns:
             values = pd.to_numeric(df[col], errors="coerce").to_numpy(float)
-            with np.errstate(invalid="ignore"):
-                beyond = np.flatnonzero(np.abs(values) > limit)
-            if beyond.size:
-                i = int(beyond[0])
-                raise InputError(
-                    f"{source}: field '{col}' is {values[i]:.6g} {unit} at row {i}, beyond +-{limit:g} "
-                    f"{unit}: not a radar measurement"
-                )
+            check_within(values, limit, unit, source, col, "not a radar measurement")
     t = df["time_s"].to_numpy(float)
     back = np.flatnonzero(t[1:] < t[:-1])
     if back.size:
@@ -91,13 +84,7 @@ def validate_ownship(df: pd.DataFrame, columns: tuple[str, ...], source: str = "
     for col in columns:
         values = finite_column(df, col, source)
         limit, unit = _OWNSHIP_LIMITS.get(col.rsplit("_", 1)[-1], (np.inf, ""))
-        beyond = np.flatnonzero(np.abs(values) > limit)
-        if beyond.size:  # 1e308 is finite, and no aircraft's position or velocity
-            i = int(beyond[0])
-            raise InputError(
-                f"{source}: field '{col}' is {values[i]:.6g} {unit} at row {i}, beyond +-{limit:g} {unit}: "
-                "not the own-ship's state"
-            )
+        check_within(values, limit, unit, source, col, "not the own-ship's state")
     check_frame_times(df[columns[0]].to_numpy(float), source, field=columns[0], index_name="row")
     return df
 

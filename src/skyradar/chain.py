@@ -40,6 +40,7 @@ from skyradar.process.detect_run import merge_head_tables
 from skyradar.process.pipeline import clutter_anchors, process_frames
 from skyradar.scene.radar_heads import select_heads
 from skyradar.sim.scenario_frames import make_simulator, scenario_truth, simulate_frames
+from skyradar.track.fusion import restore_detection_rows
 from skyradar.track.ground_tracks import GroundTrackTest, median_ground_down_m, terrain_surface
 from skyradar.track.track_table import track_detections, tracker_detections
 from skyradar.units import wrap
@@ -169,8 +170,7 @@ def track_and_alert(
         frame_times_s=built.times_s, origin=built.origin, ownship=own,
         ground_test=GroundTrackTest(surface_down=_surface(built, own)),
     )  # fmt: skip
-    rows = tracks["detection_row"].to_numpy()
-    tracks["detection_row"] = np.where(rows >= 0, used[np.maximum(rows, 0)], -1) if used.size else rows
+    tracks = restore_detection_rows(tracks, used)  # detection_row indexes the chosen heads' rows
     timings = {"track": time.perf_counter() - t0}
     t0 = time.perf_counter()
     alerts = alerts_from_tracks(tracks, own, alert_config, with_advice=with_advice, source=built.name)

@@ -303,9 +303,7 @@ def track_air_detections(
     tracks = track_detections(
         air, model, config, frame_times_s=frame_times, origin=origin, ownship=ownship, ground_test=ground_test
     )
-    rows = tracks["detection_row"].to_numpy()
-    tracks["detection_row"] = np.where(rows >= 0, keep[np.maximum(rows, 0)], -1) if keep.size else rows
-    return tracks, int(keep.size)
+    return restore_detection_rows(tracks, keep), int(keep.size)
 
 
 def tracker_detections(detections: pd.DataFrame) -> tuple[pd.DataFrame, np.ndarray]:

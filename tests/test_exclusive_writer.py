@@ -33,11 +33,12 @@ SCENARIO = small_scenario(
     intruders=[{"type": "encounter", "kind": "head-on", "t_cpa_s": 30.0, "horizontal_miss_m": 100.0}],
     terrain={"type": "flat", "height_m": 0.0, "size_m": 6000.0, "spacing_m": 30.0},
 )
-ROUNDS = 3  # the lock is checked 20 rounds in a row by hand; three keep the suite short
+ROUNDS = 3
 REFUSAL = "another skyradar command is writing it now"
 PIPES = {"stdout": subprocess.PIPE, "stderr": subprocess.PIPE, "text": True}
 
 
+@pytest.mark.slow  # the race as users meet it; the tests below make the same overlap certain, in seconds
 def test_a_second_writer_of_the_same_store_is_refused(tmp_path):
     (tmp_path / "s.yaml").write_text(yaml.safe_dump(SCENARIO))
     raced: list[bool] = []

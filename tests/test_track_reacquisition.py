@@ -100,6 +100,35 @@ def test_clutter_taken_after_a_long_coast_does_not_break_the_track():
     assert not lured["confirmed"].any()
 
 
+def test_a_patchy_return_keeps_the_track_until_the_deleter_closes_it():
+    """Deletion: an aircraft seen in bursts (a closure in ground clutter: 3 of every 7 frames, never 4
+    of 5) after a gap keeps its track, unconfirmed, and is confirmed again with its id and its resolved
+    alias as soon as the returns are steady, even after longer than ``reacquire_s`` of bursts. A track
+    never confirmed is dropped when its window fails, so the same bursts alone confirm nothing."""
+    t = np.arange(0.0, 22.0, 1 / RATE_HZ)
+    v_mps = -115.0  # aliased once: observed near -115 + W
+    r = (4000.0 + v_mps * t)[:, None]
+    k = np.arange(t.size)
+    bursts = (t >= 5.0) & (t < 15.0)
+    in_burst = np.isin((k - np.searchsorted(t, 5.0)) % 7, (0, 2, 3))
+    vis = (~bursts | in_burst)[:, None]
+    det = synthetic_detections(t, r, np.full_like(r, v_mps), visible=vis, config=CFG, sigma_range_m=4.4,
+                               sigma_velocity_mps=0.093, seed=4)  # fmt: skip
+    tracks = track_detections(det, "radar", CFG, frame_times_s=t)
+    ids = _ids_on(tracks, det, 0)
+    assert ids.size == 1
+    mine = tracks[tracks["track_id"] == ids[0]]
+    steady = mine[mine["time_s"] >= 15.0]
+    first = steady.loc[steady["confirmed"], "time_s"].min()
+    assert first <= t[np.searchsorted(t, 15.0) + 4] + 1e-9  # four steady frames: M of N again
+    after = steady[steady["confirmed"]]
+    assert np.all(np.abs(after["radial_velocity_mps"].to_numpy() - v_mps) < 2.0)
+    # The bursts alone (no steady start) never confirm a track.
+    alone = det[(det["time_s"] >= 5.0) & (det["time_s"] < 15.0)].reset_index(drop=True)
+    lone = track_detections(alone, "radar", CFG, frame_times_s=t[bursts])
+    assert not lone["confirmed"].any()
+
+
 def test_another_aircraft_does_not_take_a_lost_id():
     """A new aircraft elsewhere in the image after a track was lost gets its own id."""
     t = np.arange(0.0, 12.0, 1 / RATE_HZ)

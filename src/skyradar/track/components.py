@@ -91,3 +91,10 @@ class Reacquirer(Protocol):
     def match(self, x: np.ndarray, P: np.ndarray, time_s: float) -> tuple[np.ndarray, np.ndarray]:
         """Lost id (-1: none) and velocity alias shift for each newly confirmed state ``x``, ``P``."""
         ...
+
+    def predict(
+        self, x: np.ndarray, P: np.ndarray, resolved: np.ndarray, dt_s: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """States ``x``, ``P`` (alias ``resolved``) carried ``dt_s`` seconds across a gap, as a lost
+        track is carried to be matched."""
+        ...

@@ -163,19 +163,37 @@ class LostTracks:
         self._take(drop)
         return ids, alias
 
-    def _predicted_observation(self, time_s: float) -> tuple[np.ndarray, np.ndarray]:
-        """Observed (range, radial velocity) of every lost track at ``time_s`` and its covariance."""
-        m, H = self._gentle, self.model.measurement_matrix
-        dt = time_s - self.time_s
-        resolved = self.resolved | (not self.model.dealias)
-        P = self.P.copy()
+    def predict(
+        self, x: np.ndarray, P: np.ndarray, resolved: np.ndarray, dt_s: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """States ``x`` (k, 4), ``P`` (k, 4, 4) carried ``dt_s`` (k,) seconds across a gap, as a lost
+        track is: gentle jerk, and (radar model) a radial acceleration that decays as a manoeuvre.
+
+        Examples
+        --------
+        >>> from skyradar.track.models import radar_model
+        >>> lost = LostTracks(radar_model(78.3))
+        >>> x, P = np.array([[2000.0, -60.0, -60.0, 1.0]]), np.diag([16.0, 0.04, 1.0, 0.25])[None]
+        >>> xp, Pp = lost.predict(x, P, np.array([True]), np.array([2.0]))
+        >>> round(float(xp[0, 0]), 1), bool(Pp[0, 0, 0] > 16.0)
+        (1881.5, True)
+        """
+        m = self._gentle
+        dt = np.asarray(dt_s, float)
+        resolved = np.asarray(resolved, bool) | (not self.model.dealias)
+        P = np.array(P, float)
         if self.model.coupled:
             F = manoeuvre_transition(dt, self.tau_s, resolved)
             P[:, 3, 3] += self.sigma_accel_mps2**2
         else:
             F = m.transition(dt)
         Q = np.where(resolved[:, None, None], m.process_noise(dt), m.process_noise_unresolved(dt))
-        xp, Pp = predict(self.x, P, F, Q)
+        return predict(x, P, F, Q)
+
+    def _predicted_observation(self, time_s: float) -> tuple[np.ndarray, np.ndarray]:
+        """Observed (range, radial velocity) of every lost track at ``time_s`` and its covariance."""
+        H = self.model.measurement_matrix
+        xp, Pp = self.predict(self.x, self.P, self.resolved, time_s - self.time_s)
         return xp @ H.T, H @ Pp @ H.T
 
     def _take(self, keep: np.ndarray) -> None:

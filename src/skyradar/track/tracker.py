@@ -341,9 +341,24 @@ class RangeDopplerTracker:
         confirmed_now, failed = self.initiator.window_status(tr["window"], tr["misses"])
         tr["confirmed"] = tr["confirmed"] | (tentative & confirmed_now)
         set_anchor(tr, np.flatnonzero(tentative & tr["confirmed"]), self.time_s)
-        dead = (tentative & failed & ~tr["confirmed"]) | (
-            tr["confirmed"] & self.deleter.delete(tr["misses"], self.time_s - tr["t_update"])
+        # A track that was confirmed and must be confirmed again after a gap lives until the
+        # deleter's coasting limits close it, as a confirmed track does: a patchy return (an aircraft
+        # in clutter, a fade) fails an M-of-N window without the aircraft being gone, and a new track
+        # on the same returns would need a full window of its own. When its window fails, the
+        # updates since the gap did not confirm the aircraft (they may be clutter its grown gate
+        # took), so it goes back to its anchor, its last solid state, carried to now as a lost
+        # track is. Only tracks never confirmed are dropped when their window fails.
+        known = tr["confirmed"] | tr["was_confirmed"]
+        dead = (tentative & failed & ~known) | (
+            known & self.deleter.delete(tr["misses"], self.time_s - tr["t_update"])
         )
+        back = np.flatnonzero(tentative & failed & known & ~tr["confirmed"] & ~dead)
+        if back.size:
+            tr["x"][back], tr["P"][back] = self.reacquirer.predict(
+                tr["anchor_x"][back], tr["anchor_P"][back], tr["anchor_resolved"][back],
+                self.time_s - tr["anchor_t"][back],
+            )  # fmt: skip
+            tr["resolved"][back] = tr["anchor_resolved"][back]
         # Closed tracks that were ever confirmed are kept as lost, at their last solid update.
         self.reacquirer.add_anchored(tr, dead & tr["was_confirmed"])
         self._reacquire(np.flatnonzero(tentative & tr["confirmed"] & ~tr["was_confirmed"] & ~dead))

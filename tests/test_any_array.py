@@ -123,10 +123,14 @@ def test_one_channel_chain_runs_to_alerts_in_range_and_range_rate():
     assert len(det) >= 8 and det["azimuth_rad"].isna().all() and det["north_m"].isna().all()
     assert (np.abs(det["range_m"] - 560) < 60).all()
     assert len(tracks) > 0 and tracks["range_m"].notna().all() and tracks["north_m"].isna().all()
-    # The alerting stage runs; a track without a position has no conflict geometry: its rows are
-    # counted as skipped, not alerted.
-    assert "level" in out["alerts"].columns and len(out["alerts"]) == 0
-    assert 0 < out["alerts"].attrs["rows_skipped_no_state"] <= len(tracks)
+    # A track without a position is alerted on its range-only geometry (tests/test_one_channel_alerts.py):
+    # every confirmed row is in the alerts, none skipped; in 1 s the range fit has not spanned the 4 s
+    # it needs, so no row has a miss distance yet and none alerts.
+    alerts = out["alerts"]
+    assert len(alerts) == tracks["confirmed"].sum() and (alerts["geometry"] == "range-only").all()
+    assert alerts.attrs["rows_skipped_no_state"] == 0
+    assert alerts["miss_m"].isna().all() and (alerts["level"] == 0).all()
+    assert np.allclose(alerts["range_m"], tracks.loc[tracks["confirmed"], "range_m"])
 
 
 def test_ura_2x3_direction_error_is_within_a_few_bounds_on_a_clear_sky_target():

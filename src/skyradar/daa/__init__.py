@@ -12,7 +12,8 @@ The names users call, importable from here (each is imported from its module on 
 
 Modules: :mod:`.conflict` (closest approach, well clear), :mod:`.alerting` (levels, persistence),
 :mod:`.alert_config` (settings by name or file), :mod:`.advice` (bands, the preferred manoeuvre),
-:mod:`.range_miss`, :mod:`.lost_tracks`; tables (:mod:`.pipeline`, :mod:`.tables`,
+:mod:`.range_miss`, :mod:`.range_only` (alerting a track without a position),
+:mod:`.lost_tracks`; tables (:mod:`.pipeline`, :mod:`.tables`,
 :mod:`.run_tables`, :mod:`.provenance`).
 """
 

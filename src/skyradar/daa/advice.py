@@ -330,7 +330,16 @@ def resolution_advice(
 
 
 def advice_columns(
-    alerts, s, v_int, own_vel, height_agl_m, dthr_m, zthr_m, volume: WellClearVolume, alerting_time_s: float
+    alerts,
+    s,
+    v_int,
+    own_vel,
+    height_agl_m,
+    dthr_m,
+    zthr_m,
+    volume: WellClearVolume,
+    alerting_time_s: float,
+    located: np.ndarray | None = None,
 ) -> None:
     """Add the per-frame advice columns to an alerts table (in place), on frames with an issued alert.
 
@@ -338,6 +347,11 @@ def advice_columns(
     relative to the own-ship, intruder velocity), ``own_vel``, ``dthr_m`` and ``zthr_m`` are per
     row, ``height_agl_m`` per row or None. Each frame's :func:`resolution_advice` is repeated on
     every row of the frame; frames with no alert get empty bands and NaN preferences.
+
+    ``located`` (per row, default all True) marks the rows with a position. A row without one (a
+    range-only track, :mod:`skyradar.daa.range_only`) has no bearing: it takes no part in the
+    advice, and a frame where such a row alerts gets none (empty bands, NaN preferences), since a
+    band or manoeuvre computed without it could lead into it.
     """
     n = len(alerts)
     names = ("heading_bands_deg", "vs_bands_mps", "terrain_vs_bands_mps")
@@ -345,16 +359,18 @@ def advice_columns(
     pref = {"preferred_heading_deg": np.full(n, np.nan), "preferred_vs_mps": np.full(n, np.nan)}
     times = alerts["time_s"].to_numpy()
     alerting = alerts["level"].to_numpy() > 0
+    placed = np.ones(n, bool) if located is None else np.asarray(located, bool)
     # Rows are sorted by time, so each frame is one contiguous block.
     starts = np.flatnonzero(np.r_[True, times[1:] != times[:-1]])
     stops = np.r_[starts[1:], n]
     for a, b in zip(starts, stops, strict=True):
-        if not alerting[a:b].any():
+        if not alerting[a:b].any() or (alerting[a:b] & ~placed[a:b]).any():
             continue
+        rows = np.arange(a, b)[placed[a:b]]
         adv = resolution_advice(
-            own_vel[a], s[a:b], v_int[a:b], volume, alerting_time_s,
+            own_vel[a], s[rows], v_int[rows], volume, alerting_time_s,
             height_agl_m=None if height_agl_m is None else float(height_agl_m[a]),
-            dthr_m=dthr_m[a:b], zthr_m=zthr_m[a:b],
+            dthr_m=dthr_m[rows], zthr_m=zthr_m[rows],
         )  # fmt: skip
         for name in names:
             flat = [float(x) for band in adv[name] for x in band]

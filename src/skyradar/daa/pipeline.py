@@ -7,8 +7,15 @@ Alerts table (output), one row per track per frame, with the columns of :data:`A
 (each one's unit and meaning): the issued level (0 none, 1 preventive, 2 corrective, 3 warning),
 the conflict geometry, the FLARM-like traffic indication, whether the track's height was measured
 and whether the row is a lost track's prediction (``extrapolated``: it holds the track's alert but
-never raises it, :mod:`skyradar.daa.lost_tracks`), and the advice of the frame, repeated on every
-row of the frame (empty/NaN when no track alerts; left out with ``with_advice=False``).
+never raises it, :mod:`skyradar.daa.lost_tracks`), the geometry it was alerted on, and the advice
+of the frame, repeated on every row of the frame (empty/NaN when no track alerts; left out with
+``with_advice=False``).
+
+A track row without a position but with a range and a range rate (a one-channel radar's,
+:func:`skyradar.daa.tables.range_only_rows`) is alerted on its range-only geometry
+(:mod:`skyradar.daa.range_only`, ``geometry`` ``range-only``): its columns of direction, height and
+horizontal geometry are NaN (``sector`` and ``layer`` -1), and no advice is given on a frame where
+such a row alerts.
 """
 
 from __future__ import annotations
@@ -31,9 +38,17 @@ from skyradar.daa.alerting import (
 from skyradar.daa.conflict import traffic_indication
 from skyradar.daa.lost_tracks import lost_track_rows
 from skyradar.daa.provenance import check_tracks_match_run
-from skyradar.daa.range_miss import range_miss_distance
+from skyradar.daa.range_miss import range_only_fit
+from skyradar.daa.range_only import range_only_levels
 from skyradar.daa.run_tables import ownship_from_frames, truth_tracks
-from skyradar.daa.tables import OWNSHIP_COLUMNS, TRACK_COLUMNS, clean_tracks, covariances, interp_ownship
+from skyradar.daa.tables import (
+    OWNSHIP_COLUMNS,
+    RANGE_COLUMNS,
+    TRACK_COLUMNS,
+    clean_tracks,
+    covariances,
+    interp_ownship,
+)
 
 __all__ = [
     "ALERT_COLUMNS",
@@ -56,28 +71,36 @@ def _issued_levels(
     cov_v,
     config: AlertConfig,
     predicted: np.ndarray,
+    located: np.ndarray,
 ) -> np.ndarray:
     """Issued level per row; silences (in ``raw``) unconverged and too young tracks first.
 
     A track's rows before it is old enough (:func:`~skyradar.daa.alerting.alerting_rows`) say
     nothing about the conflict: they are not fed to its M-of-N filter, which starts at the first
-    row that may alert instead of counting the silenced rows as "no conflict".
+    row that may alert instead of counting the silenced rows as "no conflict". Rows without a
+    position (``located`` False) have no velocity covariance to gate on (the range fit's spread
+    stands for it) and wait ``min_track_age_s``; those whose range fit refused (``raw["known"]``
+    False) are no evidence either way, neither raising nor holding a level.
     """
     if config.max_velocity_sigma_mps is not None and cov_v is not None:
         sigma_hv = np.sqrt(np.nan_to_num(cov_v[:, 0, 0] + cov_v[:, 1, 1], nan=np.inf))
-        unconverged = velocity_unconverged(sigma_hv, raw["tcpa_s"], config)
+        unconverged = velocity_unconverged(sigma_hv, raw["tcpa_s"], config) & located
         raw["level"][unconverged] = 0
         raw["hold_level"][unconverged] = 0
         raw["flarm_level"][unconverged] = 0
     level = np.zeros(len(df), int)
-    required_age = required_track_age(s, v, config)
+    required_age = np.full(len(df), config.min_track_age_s)
+    required_age[located] = required_track_age(s[located], v[located], config)
+    unknown = ~raw["known"]
     for _, idx in df.groupby("track_id", sort=False).indices.items():
         ready = alerting_rows(t[idx], required_age[idx])
         raw["level"][idx[~ready]] = 0
         raw["flarm_level"][idx[~ready]] = 0
         rows = idx[ready]
-        evidence = np.where(predicted[rows], -1, raw["level"][rows])  # a prediction is no evidence
-        level[rows] = filter_alert_levels(t[rows], evidence, config, raw["hold_level"][rows])
+        # A prediction, and a range-only row whose fit refused, are no evidence of a conflict.
+        evidence = np.where(predicted[rows] | unknown[rows], -1, raw["level"][rows])
+        hold = np.where(unknown[rows], -1, raw["hold_level"][rows])
+        level[rows] = filter_alert_levels(t[rows], evidence, config, hold)
     return level
 
 
@@ -93,52 +116,68 @@ ALERT_COLUMNS: dict[str, str] = {
     "t_in_s": "s; predicted time to the loss of well clear (the highest level's volume, else the "
     "corrective one); NaN: none",
     "time_to_impact_s": "s; predicted time of entry into the collision volume; NaN: none",
-    "tcpa_s": "s; time to the horizontal closest point of approach; negative: diverging",
-    "hmd_m": "m; horizontal miss distance at the closest point of approach (from now if diverging)",
-    "vmd_m": "m; vertical separation at the closest point of approach",
-    "range_m": "m; distance from the own-ship to the intruder",
-    "bearing_deg": "deg; bearing of the intruder relative to the own-ship's heading, positive right",
-    "sector": "-; clock sector 0..11 of the bearing, 30 deg each, 0 dead ahead, counting clockwise",
-    "layer": "-; vertical layer from the elevation angle: -2 far below, 0 level, 2 far above",
-    "rel_north_m": "m; intruder north of the own-ship",
-    "rel_east_m": "m; intruder east of the own-ship",
-    "rel_alt_m": "m; intruder height above the own-ship",
-    "climb_rate_mps": "m/s; the intruder's climb rate, positive up",
-    "altitude_measured": "-; False: the track's height is a co-altitude prior, no elevation of it was "
-    "measured (the tracks table's flag; True for tables without it)",
+    "tcpa_s": "s; time to the horizontal closest point of approach (range-only rows: the 3-D one of the "
+    "range fit); negative: diverging",
+    "hmd_m": "m; horizontal miss distance at the closest point of approach (from now if diverging; NaN on "
+    "range-only rows)",
+    "vmd_m": "m; vertical separation at the closest point of approach (NaN on range-only rows)",
+    "miss_m": "m; 3-D miss distance from the track's range and range rate alone (range-only rows, and rows "
+    "whose height is a co-altitude prior); NaN elsewhere or where the fit refuses",
+    "range_m": "m; distance from the own-ship to the intruder (range-only rows: the track's range; "
+    "extrapolated: the range fit's)",
+    "bearing_deg": "deg; bearing of the intruder relative to the own-ship's heading, positive right (NaN "
+    "on range-only rows)",
+    "sector": "-; clock sector 0..11 of the bearing, 30 deg each, 0 dead ahead, counting clockwise (-1 on "
+    "range-only rows)",
+    "layer": "-; vertical layer from the elevation angle: -2 far below, 0 level, 2 far above (-1 on "
+    "range-only rows: unknown)",
+    "rel_north_m": "m; intruder north of the own-ship (NaN on range-only rows)",
+    "rel_east_m": "m; intruder east of the own-ship (NaN on range-only rows)",
+    "rel_alt_m": "m; intruder height above the own-ship (NaN on range-only rows)",
+    "climb_rate_mps": "m/s; the intruder's climb rate, positive up (NaN on range-only rows)",
+    "altitude_measured": "-; False: the track's height is a co-altitude prior, or it has none (range-only "
+    "rows), no elevation of it was measured (the tracks table's flag; True for tables without it)",
     "extrapolated": "-; True: the track had no confirmed row on this frame; the row is its prediction "
     "from its last one",
+    "geometry": "-; what the row is alerted on: 3-d (the track's position and velocity, well-clear "
+    "cylinders) or range-only (no direction: the 3-D miss from range and range rate against the "
+    "cylinders' corners sqrt(D^2 + Z^2), skyradar.daa.range_only)",
     "heading_bands_deg": "deg; headings in conflict with the traffic, flattened intervals [lo0, hi0, lo1, "
-    f"hi1, ...], per frame; optional: {_NO_ADVICE}",
-    "vs_bands_mps": "m/s; vertical speeds in conflict with the traffic, flattened intervals, per frame; "
-    f"optional: {_NO_ADVICE}",
+    f"hi1, ...], per frame (empty: no alert, or a range-only row alerts: no bearing, no band); optional: "
+    f"{_NO_ADVICE}",
+    "vs_bands_mps": "m/s; vertical speeds in conflict with the traffic, flattened intervals, per frame "
+    f"(empty as heading_bands_deg); optional: {_NO_ADVICE}",
     "terrain_vs_bands_mps": "m/s; vertical speeds that come too close to the terrain, flattened "
     f"intervals, per frame; optional: {_NO_ADVICE}",
-    "preferred_heading_deg": "deg; the preferred conflict-free heading, per frame (NaN: no alert); "
-    f"optional: {_NO_ADVICE}",
+    "preferred_heading_deg": "deg; the preferred conflict-free heading, per frame (NaN: no alert, or a "
+    f"range-only row alerts: no direction to advise); optional: {_NO_ADVICE}",
     "preferred_vs_mps": "m/s; the preferred conflict-free vertical speed, positive up, per frame (NaN: "
-    f"no alert); optional: {_NO_ADVICE}",
+    f"no alert, or a range-only row alerts); optional: {_NO_ADVICE}",
 }
 
 
-def _alerts_table(df, t, level, raw, s, v_int, yaw_rad) -> pd.DataFrame:
-    ind = traffic_indication(s, yaw_rad)
-    geometry = ("t_in_s", "time_to_impact_s", "tcpa_s", "hmd_m", "vmd_m")
+def _alerts_table(df, t, level, raw, s, v_int, yaw_rad, located, range_m) -> pd.DataFrame:
+    ind = traffic_indication(np.where(located[:, None], s, 0.0), yaw_rad)  # no NaN cast to a sector
+
+    def placed(values: np.ndarray) -> np.ndarray:
+        return np.where(located, values, np.nan)
+
+    geometry = ("t_in_s", "time_to_impact_s", "tcpa_s", "hmd_m", "vmd_m", "miss_m")
     return pd.DataFrame(
         {"time_s": t, "track_id": df["track_id"].to_numpy(), "level": level}
         | {"raw_level": raw["level"], "flarm_level": raw["flarm_level"]}
         | {name: raw[name] for name in geometry}
         | {
-            "range_m": np.linalg.norm(s, axis=-1),
-            "bearing_deg": np.degrees(ind["bearing_rad"]),
-            "sector": ind["sector"],
-            "layer": ind["layer"],
+            "range_m": range_m,
+            "bearing_deg": placed(np.degrees(ind["bearing_rad"])),
+            "sector": np.where(located, ind["sector"], -1),
+            "layer": np.where(located, ind["layer"], -1),
             "rel_north_m": s[:, 0],
             "rel_east_m": s[:, 1],
-            "rel_alt_m": ind["rel_alt_m"],
-            "climb_rate_mps": -v_int[:, 2],
+            "rel_alt_m": placed(ind["rel_alt_m"]),
+            "climb_rate_mps": placed(-v_int[:, 2]),
             # False: the track's height is the co-altitude prior, rel_alt_m is not a measurement.
-            "altitude_measured": _altitude_measured(df),
+            "altitude_measured": _altitude_measured(df) & located,
         }
     )
 
@@ -149,20 +188,68 @@ def _altitude_measured(df: pd.DataFrame) -> np.ndarray:
     return df["altitude_measured"].to_numpy(bool)  # checked by clean_tracks
 
 
-def _unmeasured_miss(
-    df: pd.DataFrame, t: np.ndarray, own_vel: np.ndarray, predicted: np.ndarray
-) -> tuple | None:
-    """The range-only miss distance and sigma (:mod:`skyradar.daa.range_miss`) on rows whose height
-    is the co-altitude prior (NaN elsewhere: a measured height is the 3-D track's to judge, and a
-    lost track's prediction has no range measured)."""
-    if not {"range_m", "range_rate_mps", "altitude_measured"} <= set(df):
-        return None
-    ids, measured = df["track_id"].to_numpy(), df["altitude_measured"].to_numpy(bool) | predicted
-    fit = np.isin(ids, ids[~measured]) & ~predicted  # tracks with such rows (the fit spans measured ones)
-    miss, sigma = np.full((2, len(df)), np.nan)
-    r, rdot = df["range_m"].to_numpy(float)[fit], df["range_rate_mps"].to_numpy(float)[fit]
-    miss[fit], sigma[fit] = range_miss_distance(ids[fit], t[fit], r, rdot, own_vel[fit])
-    return np.where(measured, np.nan, miss), np.where(measured, np.nan, sigma)
+def _range_fit(
+    df: pd.DataFrame, t: np.ndarray, own_vel: np.ndarray, predicted: np.ndarray, located: np.ndarray
+) -> np.ndarray:
+    """The range-only path (:func:`~skyradar.daa.range_miss.range_only_fit`: miss, sigma, relative
+    speed squared, time of closest approach; shape (4, n)) of the rows whose height is the
+    co-altitude prior or that have no position; NaN elsewhere (a measured height is the 3-D
+    track's to judge). The fit runs over every measured row of such tracks. A lost track's
+    prediction has no range measured: a range-only one carries the path of its track's last
+    measured row, which straight motion keeps (the four are constants of it)."""
+    fit = np.full((4, len(df)), np.nan)
+    if not set(RANGE_COLUMNS) <= set(df):
+        return fit
+    ids = df["track_id"].to_numpy()
+    needed = (~_altitude_measured(df) | ~located) & ~predicted
+    rows = np.isin(ids, ids[needed]) & ~predicted
+    r, rdot = (df[c].to_numpy(float)[rows] for c in RANGE_COLUMNS)
+    fit[:, rows] = range_only_fit(ids[rows], t[rows], r, rdot, own_vel[rows])
+    fit[:, ~needed] = np.nan
+    carried = predicted & ~located
+    if carried.any():
+        # Rows are in time order: each prediction takes the last measured row of its track.
+        source = pd.Series(np.where(predicted, np.nan, np.arange(len(df)))).groupby(ids).ffill()
+        src = source.to_numpy()[carried]
+        values = np.full((4, src.size), np.nan)
+        ok = np.isfinite(src)
+        values[:, ok] = fit[:, src[ok].astype(int)]
+        fit[:, carried] = values
+    return fit
+
+
+def _merged_levels(
+    s: np.ndarray,
+    v: np.ndarray,
+    t: np.ndarray,
+    config: AlertConfig,
+    cov_p,
+    cov_v,
+    fit: np.ndarray,
+    located: np.ndarray,
+) -> dict[str, np.ndarray]:
+    """Raw levels and geometry of every row: the 3-D geometry on rows with a position
+    (:func:`~skyradar.daa.alerting.raw_alert_levels`, the range fit's miss clearing levels of rows
+    whose height is the co-altitude prior), the range-only one on the others
+    (:func:`~skyradar.daa.range_only.range_only_levels`)."""
+    n = len(t)
+    raw: dict[str, np.ndarray] = {
+        name: np.zeros(n, int) for name in ("level", "hold_level", "flarm_level")
+    } | {name: np.full(n, np.nan) for name in ("t_in_s", "time_to_impact_s", "tcpa_s", "hmd_m", "vmd_m",
+                                                 "dthr_m", "zthr_m")}  # fmt: skip
+    raw["miss_m"] = fit[0].copy()
+    raw["known"] = located.copy()
+    if located.any():
+        cp, cv = (None if c is None else c[located] for c in (cov_p, cov_v))
+        miss = (fit[0, located], fit[1, located])
+        for name, values in raw_alert_levels(s[located], v[located], config, cp, cv, miss).items():
+            raw[name][located] = values
+    if (~located).any():
+        far = ~located
+        ranged = range_only_levels(fit[0, far], fit[1, far], fit[2, far], fit[3, far] - t[far], config)
+        for name, values in ranged.items():
+            raw[name][far] = values
+    return raw
 
 
 def alerts_from_tracks(
@@ -201,19 +288,27 @@ def alerts_from_tracks(
     own_vel = np.stack([own["own_vn_mps"], own["own_ve_mps"], own["own_vd_mps"]], -1)
     v_int = df[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(float)
     s, v = df[["north_m", "east_m", "down_m"]].to_numpy(float) - own_pos, v_int - own_vel
+    located = np.isfinite(s).all(axis=1) & np.isfinite(v).all(axis=1)  # else a range-only row
     cov_p, cov_v = covariances(df)
-    raw = raw_alert_levels(s, v, config, cov_p, cov_v, _unmeasured_miss(df, t, own_vel, predicted))
+    fit = _range_fit(df, t, own_vel, predicted, located)
+    raw = _merged_levels(s, v, t, config, cov_p, cov_v, fit, located)
     raw["level"][predicted] = 0  # a prediction holds a track's level, never raises it
     raw["flarm_level"][predicted] = 0
-    level = _issued_levels(df, t, raw, s, v, cov_v, config, predicted)
-    out = _alerts_table(df, t, level, raw, s, v_int, own["own_yaw_rad"])
+    level = _issued_levels(df, t, raw, s, v, cov_v, config, predicted, located)
+    measured_r = df["range_m"].to_numpy(float) if "range_m" in df else np.full(len(df), np.nan)
+    fitted_r = np.sqrt(fit[0] ** 2 + fit[2] * (fit[3] - t) ** 2)
+    range_m = np.where(
+        located, np.linalg.norm(s, axis=-1), np.where(np.isnan(measured_r), fitted_r, measured_r)
+    )
+    out = _alerts_table(df, t, level, raw, s, v_int, own["own_yaw_rad"], located, range_m)
     out["extrapolated"] = predicted
+    out["geometry"] = np.where(located, "3-d", "range-only")
     if with_advice:
         corrective = config.levels[min(1, len(config.levels) - 1)]
         height = own.get("own_height_agl_m")
         dthr, zthr = raw["dthr_m"], raw["zthr_m"]
         volume, alerting_time_s = corrective.volume, corrective.alerting_time_s
-        advice_columns(out, s, v_int, own_vel, height, dthr, zthr, volume, alerting_time_s)
+        advice_columns(out, s, v_int, own_vel, height, dthr, zthr, volume, alerting_time_s, located)
     out.attrs["rows_skipped_no_state"] = df.attrs["rows_skipped_no_state"]
     return out
 
@@ -255,8 +350,9 @@ def alert_summary(alerts: pd.DataFrame) -> dict[str, Any]:
         "tracks_with_warning": int(warn["track_id"].nunique()),
         "first_warning_s": float(warn["time_s"].min()) if len(warn) else float("nan"),
         "max_level": int(alerts["level"].max()) if len(alerts) else 0,
-        # NaN position/velocity (no direction of arrival) cannot be alerted on: say how many.
+        # NaN position/velocity without a range and range rate cannot be alerted on: say how many.
         "rows_skipped_no_state": int(alerts.attrs.get("rows_skipped_no_state", 0)),
+        "rows_range_only": int((alerts["geometry"] == "range-only").sum()) if "geometry" in alerts else 0,
     }
     for level in (1, 2, 3):
         result[f"rows_level_{level}"] = int(np.sum(alerts["level"].to_numpy() == level))

@@ -25,6 +25,9 @@ that passes well below over flat ground 300 m below, and must not alert, enters 
 cylinder only with 4.5-5.9 m/s of vertical speed: a bound on the intruder's vertical rate below
 that would be an assumption about traffic, not a measurement. The ``kite`` array measures those elevations.
 
+A track with no direction at all (one channel) is alerted on this miss alone, against the
+cylinder's corner (:mod:`skyradar.daa.range_only`, from :func:`range_only_fit`).
+
 The fit is per track over a sliding window; it refuses (NaN) where it has too few rows, where the
 own-ship's velocity changed in the window (a turn bends the relative path), or where the rows do
 not agree on one miss distance (a manoeuvring intruder, a range-rate alias): the spread of the
@@ -36,7 +39,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["range_miss_distance", "miss_of_window", "cannot_enter"]
+__all__ = ["range_miss_distance", "range_only_fit", "miss_of_window", "cannot_enter"]
 
 
 def range_miss_distance(
@@ -69,7 +72,7 @@ def range_miss_distance(
     -------
     miss_m, sigma_m : ndarray, shape (n,)
         Miss distance, m, and its standard deviation (spread of the rows' values), m; NaN where
-        the fit refuses.
+        the fit refuses or the rows' squared misses centre on zero or below.
 
     Examples
     --------
@@ -81,28 +84,76 @@ def range_miss_distance(
     >>> round(float(miss[-1]), 3), bool(np.isnan(miss[0]))  # the first rows span too little
     (500.0, True)
     """
+    fit = range_only_fit(track_id, time_s, range_m, range_rate_mps, own_velocity_mps, window_s, min_span_s,
+                         min_rows, own_accel_tol_mps)  # fmt: skip
+    positive = fit[0] > 0.0  # a miss of zero (a collision course within the noise) is no clearance
+    return np.where(positive, fit[0], np.nan), np.where(positive, fit[1], np.nan)
+
+
+def range_only_fit(
+    track_id: np.ndarray,
+    time_s: np.ndarray,
+    range_m: np.ndarray,
+    range_rate_mps: np.ndarray,
+    own_velocity_mps: np.ndarray,
+    window_s: float = 10.0,
+    min_span_s: float = 4.0,
+    min_rows: int = 20,
+    own_accel_tol_mps: float = 1.0,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The straight relative path each row's window of range and range rate fits: its 3-D miss
+    distance and uncertainty (:func:`range_miss_distance`), relative speed squared and time of the
+    3-D closest approach.
+
+    The fitted line ``r rdot = |u|^2 (t - t_c)`` gives ``|u|^2`` (its slope) and ``t_c`` (its zero);
+    with the miss ``m`` the range follows at any time, ``r(t)^2 = m^2 + |u|^2 (t - t_c)^2``. All
+    four are constants of straight relative motion, so a row's values also describe the path after
+    it. Parameters as :func:`range_miss_distance`.
+
+    Returns
+    -------
+    miss_m, sigma_m : ndarray, shape (n,)
+        3-D miss distance and its standard deviation, m. Where the rows' squared misses
+        ``r^2 - (r rdot)^2 / |u|^2`` centre on zero or below (a collision course, within the
+        noise), the miss is 0 and its deviation the square root of their spread, m.
+    speed2_m2ps2 : ndarray, shape (n,)
+        Relative speed squared ``|u|^2``, m^2/s^2.
+    t_cpa_s : ndarray, shape (n,)
+        Time of the 3-D closest approach, s (on the clock of ``time_s``). All four are NaN where
+        the fit refuses.
+
+    Examples
+    --------
+    >>> t = np.arange(0.0, 12.0, 0.1)
+    >>> rel = np.column_stack([2000.0 - 60.0 * t, np.full_like(t, 300.0), np.full_like(t, 400.0)])
+    >>> r = np.linalg.norm(rel, axis=1)
+    >>> rdot = (rel @ np.array([-60.0, 0.0, 0.0])) / r
+    >>> m, sd, u2, tc = range_only_fit(np.zeros(t.size, int), t, r, rdot, np.tile([50.0, 0, 0], (t.size, 1)))
+    >>> round(float(m[-1]), 3), round(float(u2[-1]), 3), round(float(tc[-1]), 3)
+    (500.0, 3600.0, 33.333)
+    """
     ids = np.asarray(track_id)
     n = ids.size
-    miss, sigma = np.full(n, np.nan), np.full(n, np.nan)
+    out = np.full((4, n), np.nan)
     if n == 0:
-        return miss, sigma
+        return out[0], out[1], out[2], out[3]
     t = np.asarray(time_s, float)
     r, rdot = np.asarray(range_m, float), np.asarray(range_rate_mps, float)
     own_v = np.asarray(own_velocity_mps, float).reshape(n, 3)
     order = np.argsort(ids, kind="stable")
     bounds = np.flatnonzero(np.diff(ids[order])) + 1
     for rows in np.split(order, bounds):
-        m, s = _fit_track(t[rows], r[rows], r[rows] * rdot[rows], own_v[rows], window_s, min_span_s,
-                          min_rows, own_accel_tol_mps)  # fmt: skip
-        miss[rows], sigma[rows] = m, s
-    return miss, sigma
+        out[:, rows] = _fit_track(t[rows], r[rows], r[rows] * rdot[rows], own_v[rows], window_s, min_span_s,
+                                  min_rows, own_accel_tol_mps)  # fmt: skip
+    return out[0], out[1], out[2], out[3]
 
 
 @numba.njit(cache=True)
 def _fit_track(t, r, y, own_v, window_s, min_span_s, min_rows, own_tol):  # pragma: no cover - numba
-    # y = r * rdot, a straight line in time of slope |u|^2 (module docstring).
+    # y = r * rdot, a straight line in time of slope |u|^2 and zero at the closest approach
+    # (module docstring). Rows: miss, sigma, |u|^2, time of the closest approach.
     n = t.size
-    miss, sigma = np.full(n, np.nan), np.full(n, np.nan)
+    out = np.full((4, n), np.nan)
     i0 = 0
     for j in range(n):
         while t[i0] <= t[j] - window_s:
@@ -117,8 +168,13 @@ def _fit_track(t, r, y, own_v, window_s, min_span_s, min_rows, own_tol):  # prag
         u2 = (tc * (yw - yw.mean())).sum() / (tc * tc).sum()
         if not u2 > 0.0:
             continue
-        miss[j], sigma[j] = miss_of_window(r[i0 : j + 1], yw, u2)
-    return miss, sigma
+        m, s = miss_of_window(r[i0 : j + 1], yw, u2)
+        if m != m:  # NaN: the rows' squared misses centre on zero or below, a collision course
+            m2 = r[i0 : j + 1] ** 2 - yw**2 / u2
+            m, s = 0.0, np.sqrt(1.4826 * np.median(np.abs(m2 - np.median(m2))))
+        out[0, j], out[1, j], out[2, j] = m, s, u2
+        out[3, j] = tw.mean() - yw.mean() / u2
+    return out
 
 
 @numba.njit(cache=True)

@@ -4,9 +4,11 @@ Tracks table (input), one row per track per frame, SI units, NED in the scenario
 ``time_s, track_id, north_m, east_m, down_m, vn_mps, ve_mps, vd_mps`` and, when the tracker gives
 them, the position covariance ``cov_pp_00 .. cov_pp_22`` (m^2) and velocity covariance
 ``cov_vv_00 .. cov_vv_22`` (m^2/s^2), row-major 3x3 in NED; missing covariance counts as zero.
-Rows with NaN position or velocity (no direction of arrival) are skipped; with a ``confirmed``
-column only confirmed rows are used. ``AlertConfig.max_velocity_sigma_mps`` silences rows of tracks
-whose velocity has not converged.
+Rows with NaN position or velocity (no direction of arrival) are skipped, except the range-only
+rows: no position (NaN ``north_m`` or ``east_m``) but a range ``range_m`` (m) and range rate
+``range_rate_mps`` (m/s), which are alerted on the range-only geometry
+(:mod:`skyradar.daa.range_only`). With a ``confirmed`` column only confirmed rows are used.
+``AlertConfig.max_velocity_sigma_mps`` silences rows of tracks whose velocity has not converged.
 
 Own-ship table: ``time_s, own_north_m, own_east_m, own_down_m, own_vn_mps, own_ve_mps, own_vd_mps``
 and optionally ``own_yaw_rad`` (heading; else the ground track) and ``own_height_agl_m`` (terrain
@@ -22,8 +24,8 @@ from skyradar.errors import InputError
 from skyradar.io.tables import check_within, finite_column
 from skyradar.track.track_table import OWNSHIP_COLUMNS as TRACKER_OWNSHIP_COLUMNS
 
-__all__ = ["TRACK_COLUMNS", "OWNSHIP_COLUMNS", "OPTIONAL_OWNSHIP_COLUMNS", "STATE_LIMITS", "clean_tracks",
-           "interp_ownship", "covariances"]  # fmt: skip
+__all__ = ["TRACK_COLUMNS", "OWNSHIP_COLUMNS", "OPTIONAL_OWNSHIP_COLUMNS", "STATE_LIMITS", "RANGE_COLUMNS",
+           "clean_tracks", "range_only_rows", "interp_ownship", "covariances"]  # fmt: skip
 
 TRACK_COLUMNS = ["time_s", "track_id", "north_m", "east_m", "down_m", "vn_mps", "ve_mps", "vd_mps"]
 OWNSHIP_COLUMNS = list(TRACKER_OWNSHIP_COLUMNS)  # the own-ship table the tracker reads, too
@@ -31,15 +33,19 @@ OPTIONAL_OWNSHIP_COLUMNS = ["own_yaw_rad", "own_height_agl_m"]
 # Bounds of a track's state by the last letter of its column: positions within 10 000 km of the origin,
 # velocities within 10 km/s (ten times Mach 3, room for a fresh track's unconverged estimate).
 STATE_LIMITS = {"m": (1.0e7, "m"), "s": (1.0e4, "m/s")}
+RANGE_COLUMNS = ("range_m", "range_rate_mps")  # a range-only row's measurements (m, m/s)
 _COV_P = [f"cov_pp_{i}{j}" for i in range(3) for j in range(3)]
 _COV_V = [f"cov_vv_{i}{j}" for i in range(3) for j in range(3)]
 
 
 def clean_tracks(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
-    """Checked, confirmed rows with a 3-D state; ``attrs['rows_skipped_no_state']`` counts the others.
+    """Checked, confirmed rows with a 3-D state or range-only; ``attrs['rows_skipped_no_state']``
+    counts the others.
 
-    NaN position/velocity means "no direction of arrival" and skips the row; anything else that
-    is not a finite number (a string, an infinity, a NaN time or id) is refused naming the row.
+    NaN position/velocity means "no direction of arrival" and skips the row, unless the row has no
+    position at all (NaN ``north_m`` or ``east_m``) and a finite ``range_m`` and ``range_rate_mps``
+    (:func:`range_only_rows`); anything else that is not a finite number (a string, an infinity, a
+    NaN time or id) is refused naming the row.
     """
     missing = [c for c in TRACK_COLUMNS if c not in tracks]
     if missing:
@@ -54,16 +60,38 @@ def clean_tracks(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
         bad = int(np.flatnonzero(ids != np.round(ids))[0])
         raise InputError(f"{source}: field 'track_id' is not a whole number at row {bad} ({ids[bad]!r})")
     # Track ids stay integers in the alerts, as the tracker wrote them.
+    for name in RANGE_COLUMNS:
+        if name in df:
+            cols[name] = finite_column(df, name, source, allow_nan=True)
+            limit, unit = STATE_LIMITS[name[-1]]
+            check_within(cols[name], limit, unit, source, name, "not a range or range rate of an aircraft")
     df = df.assign(**cols | {"track_id": ids.astype(np.int64)})
     for name in ("confirmed", "altitude_measured"):
         if name in df:
             df = df.assign(**{name: _flag(df[name], name, source)})
     if "confirmed" in df:
         df = df[df["confirmed"].to_numpy()]
-    ok = np.isfinite(df[TRACK_COLUMNS[2:]].to_numpy(float)).all(axis=1)
+    ok = np.isfinite(df[TRACK_COLUMNS[2:]].to_numpy(float)).all(axis=1) | range_only_rows(df)
     clean = df[ok].sort_values(["time_s", "track_id"], kind="stable").reset_index(drop=True)
     clean.attrs["rows_skipped_no_state"] = int((~ok).sum())
     return clean
+
+
+def range_only_rows(tracks: pd.DataFrame) -> np.ndarray:
+    """Rows without a position (NaN ``north_m`` or ``east_m``) that have a finite range and range
+    rate: a one-channel radar's track, or a track whose directions are missing.
+
+    Examples
+    --------
+    >>> t = pd.DataFrame({"north_m": [np.nan, np.nan, 1.0], "east_m": [np.nan, np.nan, 2.0],
+    ...                   "range_m": [900.0, np.nan, 5.0], "range_rate_mps": [-50.0, -50.0, 0.0]})
+    >>> range_only_rows(t).tolist()
+    [True, False, False]
+    """
+    if not set(RANGE_COLUMNS) <= set(tracks):
+        return np.zeros(len(tracks), bool)
+    no_position = ~np.isfinite(tracks[["north_m", "east_m"]].to_numpy(float)).all(axis=1)
+    return no_position & np.isfinite(tracks[list(RANGE_COLUMNS)].to_numpy(float)).all(axis=1)
 
 
 def _flag(flag: pd.Series, name: str, source: str) -> np.ndarray:

@@ -67,11 +67,14 @@ function render(f) {
   renderAdvice(f);
 }
 
+// A range-only track (one channel) has no bearing and no height: sector -1, rel_alt_m null.
 function clock(sector) {
-  return sector === 0 ? 12 : sector;
+  if (sector === null || sector === undefined || sector < 0) return "no bearing";
+  return `${sector === 0 ? 12 : sector} o'clock`;
 }
 
 function relAltText(m) {
+  if (m === null || m === undefined) return "height ?";
   const h = Math.round(m / FT / 100);
   return (h >= 0 ? "+" : "-") + String(Math.abs(h)).padStart(2, "0");
 }
@@ -207,7 +210,7 @@ function renderTable(f) {
     const tr = document.createElement("tr");
     tr.dataset.track = t.track_id;
     tr.dataset.level = t.level;
-    const cells = [t.track_id, LEVEL_NAMES[t.level] || t.level, t.flarm_level, `${clock(t.sector)} o'clock`,
+    const cells = [t.track_id, LEVEL_NAMES[t.level] || t.level, t.flarm_level, clock(t.sector),
       Math.round(t.range_m), relAltText(t.rel_alt_m) + trendArrow(t.climb_rate_mps),
       t.tcpa_s === null ? "-" : t.tcpa_s.toFixed(0)];
     for (const c of cells) {
@@ -228,7 +231,7 @@ function renderAlert(f) {
     return;
   }
   el.dataset.track = top.track_id;
-  el.textContent = `${LEVEL_NAMES[top.level].toUpperCase()}  #${top.track_id}  ${clock(top.sector)} o'clock  `
+  el.textContent = `${LEVEL_NAMES[top.level].toUpperCase()}  #${top.track_id}  ${clock(top.sector)}  `
     + `${relAltText(top.rel_alt_m)}${trendArrow(top.climb_rate_mps)}  ${Math.round(top.range_m)} m`;
 }
 

@@ -100,6 +100,9 @@ def test_alert_timeline_lists_each_level_change():
     assert tl["level_name"].tolist() == ["preventive", "WARNING", "none"]
     assert "WARNING" in format_timeline(tl)
     assert format_timeline(tl.iloc[:0]) == "alert timeline: no alerts"
+    # A range-only row (a one-channel radar) has no bearing or height to print.
+    ranged = format_timeline(tl.assign(bearing_deg=np.nan, rel_alt_m=np.nan))
+    assert "no bearing" in ranged and "rel alt unknown" in ranged and "nan" not in ranged
 
 
 def test_demo_out_must_be_a_directory(tmp_path):

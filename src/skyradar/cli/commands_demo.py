@@ -24,10 +24,12 @@ def format_timeline(timeline) -> str:
         advice = "" if getattr(r, "altitude_measured", True) else " (not measured)"
         if r.level > 0 and math.isfinite(heading):
             advice += f"  advice: heading {heading:.0f} deg, vs {r.preferred_vs_mps:+.1f} m/s"
+        # A track without a direction (a one-channel radar) has a range but no bearing or height.
+        bearing = f"{r.bearing_deg:+5.0f} deg" if math.isfinite(r.bearing_deg) else "no bearing"
+        height = f"{r.rel_alt_m:+5.0f} m" if math.isfinite(r.rel_alt_m) else "unknown"
         lines.append(
             f"  t={r.time_s:6.1f} s  T{r.track_id:<4d} {r.intruder:<10s} {r.level} {r.level_name:<10s} "
-            f"range {r.range_m:6.0f} m  bearing {r.bearing_deg:+5.0f} deg  "
-            f"rel alt {r.rel_alt_m:+5.0f} m{advice}"
+            f"range {r.range_m:6.0f} m  bearing {bearing}  rel alt {height}{advice}"
         )
     return "\n".join(lines)
 

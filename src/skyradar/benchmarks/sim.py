@@ -281,7 +281,10 @@ def _baseline_fps(config, terrain, origin, geometry, n_frames, baseline_frames, 
 def _sub_facets(sim: ImageSimulator, platform: PlatformState) -> int:
     """Sub-facets the simulator cuts the terrain in view into for one frame (cells culled whole: 0)."""
     geom = sim.geometry(platform)
-    p_ant = np.ascontiguousarray(sim.terrain_view(geom).p_ned @ geom.rot_ned_to_ant.T)
+    view = sim.terrain_view(geom)
+    if view is None:  # no terrain in range
+        return 0
+    p_ant = np.ascontiguousarray(view.p_ned @ geom.rot_ned_to_ant.T)
     v_ground = geom.rot_ned_to_ant @ -geom.velocity_ned_mps
     rule, cfg = sim._facets, sim.config
     r_max = cfg.range_resolution_m * (cfg.n_range + 2)  # the kernel's

@@ -249,7 +249,9 @@ def _time_frames(fn, n_frames: int, min_seconds: float) -> float:
 def _time_frames_cpu(fn, n_frames: int, min_seconds: float) -> tuple[float, float]:
     """Frames/s (median wall time) and the median CPU-ms per frame, all threads (process time)."""
     fn(0)
-    times, cpu, start = [], [], time.perf_counter()
+    times: list[float] = []
+    cpu: list[float] = []
+    start = time.perf_counter()
     while len(times) < n_frames or time.perf_counter() - start < min_seconds:
         t0, c0 = time.perf_counter(), time.process_time()
         fn(len(times) + 1)

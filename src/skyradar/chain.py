@@ -81,7 +81,8 @@ def _detect(built, heads, keep_frames, block_frames, timings, options) -> tuple[
             truth = truths[name]
             ds = truth.isel(time=slice(start, start + rows.size)).assign(iq=(truth["iq"].dims, iq))
             t0 = time.perf_counter()
-            block = None if anchors[name] is None else anchors[name][start : start + rows.size]
+            run_anchors = anchors[name]
+            block = None if run_anchors is None else run_anchors[start : start + rows.size]
             det = process_frames(ds, terrain=built.terrain, source=built.name, anchors=block, **options)
             det["frame"] += start
             detections[name].append(det)

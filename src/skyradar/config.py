@@ -18,7 +18,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -49,6 +49,9 @@ _MOUNT_PRESETS: dict[str, tuple[tuple[float, float, float], float, float]] = {
 
 
 _MAX_APERTURE_M = 2.0  # the largest extent of one radar's antennas, m
+
+# The default of a dataclass field that __post_init__ always replaces (None: "derive it").
+_SET_BY_POST_INIT: Any = None
 
 
 @dataclass(frozen=True)
@@ -153,13 +156,36 @@ class RadarConfig:
     bandwidth_hz: float = 10e6
     n_doppler: int = 250
     range_limit_m: float = 5000.0
-    rx_positions_m: np.ndarray | str | None = None
-    tx_position_m: np.ndarray | None = None
+    # The three arrays are always arrays once built: __post_init__ turns a layout name or None into
+    # one. What the constructor accepts is spelled out in the __init__ below, for the type checker
+    # only (the dataclass writes the real one).
+    rx_positions_m: np.ndarray = _SET_BY_POST_INIT
+    tx_position_m: np.ndarray = _SET_BY_POST_INIT
     noise_figure_db: float = 6.0
     temperature_k: float = 290.0
     antenna: AntennaPattern = field(default_factory=AntennaPattern.default)
     mount: Mount = field(default_factory=Mount)
-    rx_calibration: np.ndarray | None = None
+    rx_calibration: np.ndarray = _SET_BY_POST_INIT
+
+    if TYPE_CHECKING:
+
+        def __init__(
+            self,
+            fc_hz: float = ...,
+            fs_hz: float = ...,
+            prf_hz: float = ...,
+            pe_dbm: float = ...,
+            bandwidth_hz: float = ...,
+            n_doppler: int = ...,
+            range_limit_m: float = ...,
+            rx_positions_m: ArrayLike | str | None = ...,
+            tx_position_m: ArrayLike | None = ...,
+            noise_figure_db: float = ...,
+            temperature_k: float = ...,
+            antenna: AntennaPattern = ...,
+            mount: Mount = ...,
+            rx_calibration: ArrayLike | None = ...,
+        ) -> None: ...
 
     def __post_init__(self) -> None:
         for name in ("fc_hz", "fs_hz", "prf_hz", "bandwidth_hz", "range_limit_m", "temperature_k"):

@@ -82,7 +82,7 @@ def _summary(chain: dict[str, Any], labels: dict[int, str], timeline: pd.DataFra
     alerts, det = chain["alerts"], chain["detections"]
     names = [str(x) for x in chain["truth"]["target"].values]
     max_level = alerts.groupby("track_id")["level"].max() if len(alerts) else pd.Series(dtype=int)
-    per = {}
+    per: dict[str, dict[str, Any]] = {}
     for name in names + ["clutter"]:
         ids = [t for t, lab in labels.items() if lab == name]
         lv = max_level.reindex(ids).fillna(0)

@@ -143,8 +143,8 @@ def ned_to_geodetic(
     ned = np.asarray(ned_m, dtype=float)
     if ned.shape == (3,) and not flat_earth:
         ecef = _geodetic_to_ecef(lat0_deg, lon0_deg, alt0_m) + _ecef_from_ned(lat0_deg, lon0_deg) @ ned
-        lat, lon, alt = ecef_to_geodetic_point(*ecef)
-        return np.asarray(lat), np.asarray(lon), np.asarray(alt)
+        point = ecef_to_geodetic_point(*ecef)
+        return np.asarray(point[0]), np.asarray(point[1]), np.asarray(point[2])
     if flat_earth:
         lat = lat0_deg + np.degrees(ned[..., 0] / EARTH_RADIUS_M)
         lon = lon0_deg + np.degrees(ned[..., 1] / (EARTH_RADIUS_M * np.cos(np.radians(lat0_deg))))

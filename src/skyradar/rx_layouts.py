@@ -40,13 +40,16 @@ Examples
 
 from __future__ import annotations
 
+from typing import Literal, get_args
+
 import numpy as np
 
 from skyradar.errors import InputError
 
-__all__ = ["MAX_RX", "RX_LAYOUTS", "check_rx_layout", "rx_layout_m", "square_m", "ura_m"]
+__all__ = ["MAX_RX", "RX_LAYOUTS", "RxLayout", "check_rx_layout", "rx_layout_m", "square_m", "ura_m"]
 
-RX_LAYOUTS = ("square", "kite", "ura-2x3", "ura-2x4")
+RxLayout = Literal["square", "kite", "ura-2x3", "ura-2x4"]  # the layouts' names
+RX_LAYOUTS: tuple[str, ...] = get_args(RxLayout)
 MAX_RX = 32  # receive channels a radar may have (CFAR and noise-floor tables are built up to it)
 
 

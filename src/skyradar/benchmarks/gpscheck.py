@@ -94,7 +94,8 @@ def baseline_search(radar, mask, map_image, grid, pose_grid, pose, margin_m=250.
 def _seconds(fn, min_time_s: float) -> float:
     """Median seconds per call over at least ``min_time_s`` (one warm-up call first)."""
     fn()
-    times, start = [], time.perf_counter()
+    times: list[float] = []
+    start = time.perf_counter()
     while time.perf_counter() - start < min_time_s or len(times) < 3:
         t = time.perf_counter()
         fn()
@@ -108,7 +109,8 @@ def run(min_time_s: float = 2.0, seed: int = 0) -> dict[str, Any]:
     map_image, grid = synthetic_city(rng)
     pose_grid = PoseGrid.side_looking(500.0, 4.0)
     truth = np.array([1200.0, 700.0, 0.3])
-    clean = sample_at_pose(map_image, grid, pose_grid, *truth, fill=0.0)
+    north_m, east_m, heading_rad = truth
+    clean = sample_at_pose(map_image, grid, pose_grid, north_m, east_m, heading_rad, fill=0.0)
     right = np.broadcast_to(pose_grid.right_m, pose_grid.shape)
     forward = np.broadcast_to(pose_grid.forward_m[:, None], pose_grid.shape)
     mask = (np.hypot(forward, right) < 460.0) & (np.abs(np.arctan2(forward, right)) < np.radians(30))

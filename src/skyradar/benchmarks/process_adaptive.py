@@ -126,6 +126,7 @@ def run_adaptive(n_cubes: int = 4, seed: int = 0) -> dict:
         )
         same.append(float(np.mean(s.nulls == b.nulls)))
         same_hits.append(_hit_cells(s, config) == _hit_cells(b, config))
+        assert s.adaptive is not None  # suppress_clutter's adaptive pass (its default) sets it
         cells.append(int(s.adaptive.sum()))
     return {
         "relief_adaptive_cells_per_frame": float(np.mean(cells)),

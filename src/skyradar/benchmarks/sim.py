@@ -249,7 +249,9 @@ def _time_frames(fn, n_frames: int, min_seconds: float) -> float:
 def _time_frames_cpu(fn, n_frames: int, min_seconds: float) -> tuple[float, float]:
     """Frames/s (median wall time) and the median CPU-ms per frame, all threads (process time)."""
     fn(0)
-    times, cpu, start = [], [], time.perf_counter()
+    times: list[float] = []
+    cpu: list[float] = []
+    start = time.perf_counter()
     while len(times) < n_frames or time.perf_counter() - start < min_seconds:
         t0, c0 = time.perf_counter(), time.process_time()
         fn(len(times) + 1)
@@ -281,7 +283,10 @@ def _baseline_fps(config, terrain, origin, geometry, n_frames, baseline_frames, 
 def _sub_facets(sim: ImageSimulator, platform: PlatformState) -> int:
     """Sub-facets the simulator cuts the terrain in view into for one frame (cells culled whole: 0)."""
     geom = sim.geometry(platform)
-    p_ant = np.ascontiguousarray(sim.terrain_view(geom).p_ned @ geom.rot_ned_to_ant.T)
+    view = sim.terrain_view(geom)
+    if view is None:  # no terrain in range
+        return 0
+    p_ant = np.ascontiguousarray(view.p_ned @ geom.rot_ned_to_ant.T)
     v_ground = geom.rot_ned_to_ant @ -geom.velocity_ned_mps
     rule, cfg = sim._facets, sim.config
     r_max = cfg.range_resolution_m * (cfg.n_range + 2)  # the kernel's

@@ -23,6 +23,7 @@ import importlib
 import signal
 import sys
 from types import ModuleType
+from typing import Any
 
 import typer
 
@@ -62,7 +63,8 @@ def _click_exception_modules() -> list[ModuleType]:
     return modules
 
 
-def _classes(name: str, *extra: type) -> tuple[type, ...]:
+def _classes(name: str, *extra: type[BaseException]) -> tuple[type[Any], ...]:
+    # type[Any]: the classes come from whichever click is installed, found by name at run time.
     found = [getattr(module, name) for module in _click_exception_modules() if hasattr(module, name)]
     return tuple(dict.fromkeys([*found, *extra]))
 
@@ -72,6 +74,7 @@ _CLICK_ERRORS = _classes("ClickException")
 _MISSING = _classes("MissingParameter")
 _EXITS = _classes("Exit", typer.Exit)
 _ABORTS = _classes("Abort", typer.Abort)
+_INTERRUPTS: tuple[type[BaseException], ...] = (KeyboardInterrupt, *_ABORTS)
 
 
 def _interrupt(signum: int, frame: object) -> None:
@@ -150,7 +153,7 @@ def main() -> None:
             sys.exit(exc.exit_code)
         print(f"error: {line}", file=sys.stderr)  # as a value checked by hand
         sys.exit(2)
-    except (KeyboardInterrupt, *_ABORTS):
+    except _INTERRUPTS:
         code = 130
     # With standalone_mode=False click returns 130 on Ctrl-C instead of raising.
     if code == 130:

@@ -70,8 +70,8 @@ def state(
     truth = ds["own_height_agl_m"].to_numpy() if "own_height_agl_m" in ds else None
     summary = state_summary(table, truth)
     # "output" after the medians and before the height error, as the command always printed it.
-    head = {k: v for k, v in summary.items() if not k.startswith("h_err")}
-    emit_result(head | {"output": str(output)} | summary, as_json, "own-ship state")
+    medians = {k: v for k, v in summary.items() if not k.startswith("h_err")}
+    emit_result(medians | {"output": str(output)} | summary, as_json, "own-ship state")
 
 
 @experiment_app.command("ch5")

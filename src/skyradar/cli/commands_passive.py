@@ -139,6 +139,8 @@ def experiment_ch7(
     as_json: JsonOption = False,
 ) -> None:
     """ch7: passive radar with an ATC radar as illuminator: test pulse, thesis geometry, 9 sweeps."""
+    from rich.progress import TaskID
+
     from skyradar.cli.commands_sim import frame_progress
     from skyradar.experiments.ch7 import run as run_ch7
     from skyradar.io.outputs import check_output, mark_folder
@@ -146,7 +148,7 @@ def experiment_ch7(
     check_output(out, (), overwrite, kind="folder", option="--out")
     mark_folder(out)
     with frame_progress(1, "ch7: samples") as bar:
-        tasks: dict[str, int] = {}
+        tasks: dict[str, TaskID] = {}
 
         def progress(stage: str, done: int, total: int) -> None:
             if stage not in tasks:

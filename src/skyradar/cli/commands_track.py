@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
@@ -115,6 +115,7 @@ def _ground_test(terrain: str | None, run, ownship: Path | None, own, origin_lla
         if terrain is not None and terrain.strip().lower() != "none":
             raise InputError(f"--terrain {terrain}: needs --ownship (the run or own-ship table) to place it")
         return True
+    assert ownship is not None  # the run is the one opened from --ownship
     dem = terrain_window(terrain, run, config, ownship)
     if dem is None or not hasattr(dem, "height_at") or origin_lla is None:
         return True  # level ground at the own-ship's height above ground, where it has one
@@ -175,7 +176,11 @@ def track(
             soft_wrap=True,
         )
     n_frames = int(np.unique(table["time_s"].to_numpy(float)).size)
-    result = {"frames": n_frames, "detections": n_used, "tracks": int(tracks["track_id"].nunique())}
+    result: dict[str, Any] = {
+        "frames": n_frames,
+        "detections": n_used,
+        "tracks": int(tracks["track_id"].nunique()),
+    }
     result |= {"rows": len(tracks), "model": model.value, "output": str(output), "origin_from": origin_from}
     emit_result(result, as_json, "tracks")
 

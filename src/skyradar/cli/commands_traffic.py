@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
@@ -155,7 +155,7 @@ def _write(
     write_text_atomic(output, yaml.safe_dump(scenario, sort_keys=False))
     window = (scenario["start_s"], scenario["start_s"] + scenario["duration_s"])
     t, h_m, v_m = horizontal_cpa(own, intr, window=window)  # what the scenario really flies
-    result = {"output": str(output), "ownship": str(own_csv), "intruder": str(intr_csv)}
+    result: dict[str, Any] = {"output": str(output), "ownship": str(own_csv), "intruder": str(intr_csv)}
     result |= {"t_cpa_s": t, "horizontal_miss_m": h_m, "vertical_miss_m": v_m}
     return result | {"start_s": scenario["start_s"], "duration_s": scenario["duration_s"]}
 

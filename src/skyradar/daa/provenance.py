@@ -99,8 +99,11 @@ def _describe(t0: float, t1: float, origin: Any) -> str:
 def _mismatch(made: dict[str, Any], origin: Any, t: np.ndarray, pos: np.ndarray) -> str | None:
     """Why the signature ``made`` is not the run (origin, times ``t``, own-ship ``pos``), or None."""
     a = made.get("origin")
-    both = a is not None and origin is not None
-    if both and max(abs(a[0] - origin[0]), abs(a[1] - origin[1])) > _ORIGIN_TOLERANCE_DEG:
+    if (
+        a is not None
+        and origin is not None
+        and max(abs(a[0] - origin[0]), abs(a[1] - origin[1])) > _ORIGIN_TOLERANCE_DEG
+    ):
         return "the NED origins differ"
     inside = [s for s in made["samples"] if t[0] - 1e-6 <= s[0] <= t[-1] + 1e-6]
     if not inside:
@@ -134,7 +137,8 @@ def check_tracks_match_run(
     origin = scenario_origin(ds)
     why = _mismatch(made, origin, t, pos)
     if why is not None:
-        was = _describe(*made["time_span_s"], made.get("origin"))
+        t0, t1 = made["time_span_s"]
+        was = _describe(t0, t1, made.get("origin"))
         raise InputError(
             f"{tracks_path}: tracks come from run {made['run']} ({was}) but {option + ' ' if option else ''}"
             f"{run} is another "

@@ -39,7 +39,7 @@ def ownship_from_frames(ds: xr.Dataset, source: str = "frames") -> pd.DataFrame:
     """
     state = navigation_state(ds, source)
     missing = [c for c in OWNSHIP_COLUMNS[1:] if state is None or c not in state]
-    if missing:
+    if state is None or missing:
         raise InputError(f"{source}: no own-ship state (missing variable(s) {missing})")
     keep = ["time_s", *OWNSHIP_COLUMNS[1:], *(c for c in OPTIONAL_OWNSHIP_COLUMNS if c in state)]
     table = state[keep].copy()

@@ -185,7 +185,7 @@ def _frame_measures(i, full, clutter, target, sub, config, tables) -> dict[str, 
     """Hits (clear sky; ground without, with suppression) and the improvement factor at the intruder."""
     noise = config.noise_power_w
     t_raw = power_image(target, config.rx_calibration)
-    k, j = np.unravel_index(np.argmax(t_raw), t_raw.shape)
+    k, j = (int(v) for v in np.unravel_index(np.argmax(t_raw), t_raw.shape))
     sup = suppress_clutter(full, sub, config)  # the nulls the processing chose on the real frame
     c_in = power_image(clutter, config.rx_calibration)
     vectors = sup.applied_vectors(sub)  # adaptive cells' own nulls where the prediction was not kept
@@ -245,7 +245,7 @@ def _geometry(terrain: str, n_frames: int, seed: int) -> tuple[dict[str, Any], f
     relief = not terrain.startswith("flat-")
     closing = RELIEF_CLOSING_MPS if relief else CLOSING_MPS
     duration = (START_M - END_M) / closing
-    common = dict(n_frames=n_frames, frame_rate_hz=n_frames / duration, closing_mps=closing,
+    common: dict[str, Any] = dict(n_frames=n_frames, frame_rate_hz=n_frames / duration, closing_mps=closing,
                   start_range_m=START_M, seed=seed, rcs_m2=RCS_M2)  # fmt: skip
     if not relief:
         return common, float(terrain[5:])
@@ -267,6 +267,7 @@ def _case(terrain: str, n_frames: int, seed: int) -> tuple[pd.DataFrame, pd.Data
     t2 = time.perf_counter()
     config = radar_config_of(full, "clutter scene")
     own = navigated_own_state(full, "clutter scene")
+    assert own is not None  # the scene records the own-ship's navigation
     anchors = prediction_anchors(own)  # as the processing walks them: each frame's own prediction
     subs = [frame_subspace(own, i, config, None, anchors) for i in range(n_frames)]
     cubes = np.asarray(full["iq"])

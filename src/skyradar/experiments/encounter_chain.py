@@ -140,7 +140,7 @@ def score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[s
     status = frame_status(truths, opts["fov_deg"], opts["min_snr_db"])
     window = opts["observe_window_s"]
     warning_times = warn["time_s"].to_numpy(float)[mine]  # the intruder's warning frames
-    row = score_encounter(t, rel, warning_times, status, opts["buffer"], window)
+    row: dict[str, Any] = score_encounter(t, rel, warning_times, status, opts["buffer"], window)
     row["warning_held"], row["warning_gap_max_s"] = warning_held(warning_times, status, row["t_cpa_s"])
     frame_s = frame_interval_s(status["time_s"].to_numpy(float))
     row["warning_flickers"] = warning_flickers(warning_times, frame_s, row["t_cpa_s"])

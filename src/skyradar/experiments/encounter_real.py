@@ -18,7 +18,7 @@ from __future__ import annotations
 import tempfile
 from functools import lru_cache
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
@@ -54,6 +54,8 @@ INTRUDER_FLIGHTS = (
     ("calibration/cardiff", "ga"),
 )
 _BEFORE_S, _AFTER_S = T_CPA_S, 10.0  # the stretch of each flight around its meeting time, s
+# A table's side of the intruder, as encounter_from_tracks takes it.
+_SIDES: dict[str, Literal["right", "left"]] = {"right": "right", "left": "left"}
 _OWN_SPEED_MPS = (35.0, 90.0)  # a GA own-ship's speeds over the stretch
 _INTRUDER_SPEED_MPS = (15.0, 90.0)
 _MAX_FIX_GAP_S = 20.0  # a stretch whose fixes leave a longer gap is a guess there, not a recording
@@ -143,9 +145,11 @@ def real_pair(p: pd.Series) -> tuple[Trajectory, Trajectory]:
     own = own.between(t_own - _BEFORE_S, t_own + _AFTER_S).shifted(T_CPA_S - t_own)
     intruder = intruder.between(t_int - _BEFORE_S - 5.0, t_int + _AFTER_S + 5.0)
     miss = (float(p["horizontal_miss_m"]), float(p["vertical_miss_m"]))
+    side = _SIDES.get(str(p["side"]))
+    if side is None:
+        raise InputError(f"real-flight encounter: side must be 'right' or 'left', got {p['side']!r}")
     return encounter_from_tracks(
-        own, intruder, T_CPA_S, *miss, intruder_time_s=t_int, rotate_deg=float(p["rotate_deg"]),
-        side=str(p["side"]),
+        own, intruder, T_CPA_S, *miss, intruder_time_s=t_int, rotate_deg=float(p["rotate_deg"]), side=side,
     )  # fmt: skip
 
 

@@ -88,8 +88,8 @@ def site(terrain: str | None, seed: int) -> dict[str, Any]:
     if name.startswith("flat-"):
         return {"origin": origin, "terrain": {"type": "flat", **grid}, "own_altitude_m": float(name[5:])}
     if name == "hills":
-        terrain = {"type": "fractal", "local_sd_m": _HILLS_SD_M, "seed": int(seed), **grid}
-        return {"origin": origin, "terrain": terrain, "own_altitude_m": 550.0}
+        hills = {"type": "fractal", "local_sd_m": _HILLS_SD_M, "seed": int(seed), **grid}
+        return {"origin": origin, "terrain": hills, "own_altitude_m": 550.0}
     if name == "jacksboro":
         from skyradar.geo import ned_to_geodetic
         from skyradar.scene.dem_readers import jacksboro

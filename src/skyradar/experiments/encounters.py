@@ -59,6 +59,7 @@ _PARTIAL = "encounters.partial.parquet"
 
 
 def _run_rows(tasks: list[tuple[str, int, dict]], kw: dict) -> list[tuple[str, int, list[dict]]]:
+    one: Callable[..., list[dict[str, Any]]]  # run_encounter or run_real_encounter: their options differ
     if kw["family"] == "real-flights":
         from skyradar.experiments.encounter_real import run_real_encounter as one
     else:

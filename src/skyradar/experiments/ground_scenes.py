@@ -152,7 +152,7 @@ def score_scene(table: pd.DataFrame, truth: pd.DataFrame, n_doppler: int) -> dic
             owner[int(np.argmin(dist))] = row.name
     flagged = table.is_ground.to_numpy()
     ground = owner == ""
-    out = {"detections": len(table), "ground": int(ground.sum())}
+    out: dict[str, float] = {"detections": len(table), "ground": int(ground.sum())}
     out["ground_flagged"] = float(flagged[ground].mean()) if ground.any() else float("nan")
     for name in AIRCRAFT:
         mine = owner == name

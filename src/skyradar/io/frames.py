@@ -233,7 +233,7 @@ class FrameStoreWriter:
     def __init__(
         self,
         path: str | Path,
-        template: xr.Dataset,
+        template: xr.Dataset | dict[str, xr.Dataset],
         chunk_frames: int,
         fingerprint: str,
         overwrite: bool = False,
@@ -321,7 +321,9 @@ class FrameStoreWriter:
         if precision is None:
             import zarr
 
-            precision = zarr.open_group(self.partial, mode="r").attrs.get("skyradar_precision", "complex64")
+            precision = str(
+                zarr.open_group(self.partial, mode="r").attrs.get("skyradar_precision", "complex64")
+            )
         self.precision = precision
         self.groups = heads.store_heads(self.partial) or [None]
         self.path = self.partial.with_name(self.partial.name.removesuffix(".partial"))

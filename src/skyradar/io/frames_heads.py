@@ -60,7 +60,7 @@ def store_heads(path: str | Path) -> list[str] | None:
         text = zarr.open_group(Path(path), mode="r").attrs.get(HEADS_ATTR)
     except Exception:  # noqa: BLE001 - not a readable Zarr group: not a multi-head store
         return None
-    return None if text is None else [str(h) for h in json.loads(text)]
+    return None if text is None else [str(h) for h in json.loads(str(text))]
 
 
 def mark_heads_complete(partial: Path, groups: list) -> None:

@@ -145,7 +145,7 @@ def parse_start_time(value: Any, source: str = "scenario", field: str = "start_t
 
 def format_start_time(when: np.datetime64) -> str:
     """``datetime64`` as ISO 8601 UTC with a ``Z`` (whole seconds shown without a fraction)."""
-    text = str(np.datetime64(when, "ns"))
+    text = str(np.datetime64(when, "ns"))  # type: ignore[call-overload]  # numpy's stub: no (datetime64, unit)
     head, _, frac = text.partition(".")
     frac = frac.rstrip("0")
     return f"{head}.{frac}Z" if frac else f"{head}Z"

@@ -108,7 +108,7 @@ def is_ours(path: str | Path, kind: str) -> bool:
     return False
 
 
-def _check_not_input(out: Path, inputs: Iterable[str | Path], label: str) -> None:
+def _check_not_input(out: Path, inputs: Iterable[str | Path | None], label: str) -> None:
     for item in inputs:
         if item is None:
             continue

@@ -32,7 +32,9 @@ import datetime as dt
 import hashlib
 import json
 import warnings
+from contextlib import AbstractContextManager
 from pathlib import Path
+from typing import Any, BinaryIO, Literal
 
 import numpy as np
 
@@ -247,11 +249,11 @@ class SigmfWriter:
             "skyradar:illuminator": json.loads(json.dumps(illuminator)),
             "skyradar:receiver": dict(receiver_info or {}),
         }
-        self._capture = {"core:sample_start": 0, "core:frequency": float(center_frequency_hz)}
+        self._capture: dict[str, Any] = {"core:sample_start": 0, "core:frequency": float(center_frequency_hz)}
         self._capture["core:datetime"] = _iso(start_time)
         self._hash = hashlib.sha512()
-        self._ctx = None
-        self._file = None
+        self._ctx: AbstractContextManager[Path] | None = None  # the data file's atomic_path, while open
+        self._file: BinaryIO | None = None
 
     def __enter__(self) -> SigmfWriter:
         self._ctx = atomic_path(self.data_path)
@@ -264,6 +266,7 @@ class SigmfWriter:
         block = np.ascontiguousarray(samples, dtype="<c8").ravel()
         buf = block.tobytes()
         self._hash.update(buf)
+        assert self._file is not None, "SigmfWriter.write outside its with block"
         self._file.write(buf)
         self.n_samples += block.size
 
@@ -280,7 +283,8 @@ class SigmfWriter:
             handle.validate()
         return handle._metadata
 
-    def __exit__(self, exc_type, exc, tb) -> bool:
+    def __exit__(self, exc_type, exc, tb) -> Literal[False]:
+        assert self._file is not None and self._ctx is not None  # set by __enter__
         self._file.close()
         if exc_type is not None:
             self._ctx.__exit__(exc_type, exc, tb)

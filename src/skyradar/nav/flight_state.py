@@ -198,7 +198,7 @@ def _attitudes(ds: xr.Dataset, times: np.ndarray, ahrs: AhrsModel | None, seed: 
 def _frame_rows(
     ds: xr.Dataset, config: RadarConfig, method: str, progress, source: str, attitudes: np.ndarray
 ) -> list[dict]:
-    from skyradar.nav.terrain_aware import TerrainAwareEstimator
+    from skyradar.nav.terrain_aware import TerrainAwareEstimator, TerrainEstimate
 
     times = frame_times_s(ds)
     aware = TerrainAwareEstimator(config) if method == "terrain" else None
@@ -207,6 +207,7 @@ def _frame_rows(
         attitude = attitudes[i]
         frame = np.asarray(ds.iq[i].values)
         check_finite_frames(frame[None], i, source)  # a NaN would come out as a wrong state, not an error
+        fit: TerrainEstimate | StateFit
         if aware is not None:
             est = aware.update(times[i], frame, attitude)
             fit, quality, low, n_ridge, n_in = est, est.quality, est.low_quality, est.n_points, est.n_points

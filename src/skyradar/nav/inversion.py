@@ -349,7 +349,8 @@ def _huber_fit(x0: np.ndarray, bounds, f_scale: float, args: tuple) -> tuple[np.
     """Huber-loss minimum and Jacobian of the ridge residuals within ``bounds``."""
     # The same Huber minimum as scipy's least_squares, without its per-iteration overhead (most of
     # a frame's time); scipy when the reweighted Gauss-Newton does not converge.
-    fast = huber_least_squares(_residuals, _jacobian, x0, *map(np.array, bounds), f_scale, args)
+    lower, upper = (np.array(b) for b in bounds)
+    fast = huber_least_squares(_residuals, _jacobian, x0, lower, upper, f_scale, args)
     if fast is None:
         sol = least_squares(
             _residuals, x0, jac=_jacobian, loss="huber", f_scale=f_scale, args=args, x_scale=[10, 1, 100],

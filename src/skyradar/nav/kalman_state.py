@@ -144,5 +144,6 @@ def filter_states(
         elif usable:
             x, p, accepted[i], rejections = _gated_update(x, p, z, r_diag, gate, s, rejections)
         if x is not None:
+            assert p is not None  # set with x
             out_x[i], out_sd[i] = x, np.sqrt(np.clip(np.diag(p), 0.0, None))
     return FilterOutput(out_x, out_sd, accepted)

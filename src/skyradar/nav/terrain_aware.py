@@ -170,7 +170,8 @@ class TerrainAwareEstimator:
 
         ``ridge`` may be passed when already extracted from this cube.
         """
-        failed = TerrainEstimate(*([float("nan")] * 6), 0.0, True, 0)
+        nan = float("nan")
+        failed = TerrainEstimate(nan, nan, nan, nan, nan, nan, 0.0, True, 0)
         if ridge is None:
             ridge = extract_ridge(cube, self.config, prior_state=self.prior)
         if len(ridge) < self.min_points:

@@ -34,7 +34,7 @@ def ca_threshold_factor(n_train: int, pfa: float) -> float:
 
 
 def _box(shape: int | tuple[int, ...], ndim: int) -> tuple[int, ...]:
-    sizes = (shape,) * ndim if np.isscalar(shape) else tuple(shape)
+    sizes = (shape,) * ndim if isinstance(shape, int | float | np.number) else tuple(shape)
     if len(sizes) != ndim:
         raise InputError(f"CFAR: window {shape} does not match a {ndim}-D map")
     return tuple(int(s) for s in sizes)

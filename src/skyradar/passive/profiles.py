@@ -88,7 +88,7 @@ class ProfileExtractor:
         # The other pulse of the PRI (an ATC radar's short pulse, at a known delay after the long one)
         # leaks through the filter: its direct path is blanked, i.e. its few raw samples' contribution
         # to the filter output is subtracted (the filter is linear). Echoes lose those microseconds only.
-        self.blank = None
+        self.blank: tuple[int, int] | None = None  # (first raw sample, width) of the companion pulse
         if companion is not None:
             delay, width = companion
             first = int(np.floor(delay * self.fs)) - 2
@@ -119,6 +119,7 @@ class ProfileExtractor:
 
     def _blanked(self, x: np.ndarray, peaks: np.ndarray) -> np.ndarray:
         """Filter output (segment lags) of just the companion pulse's raw samples, per pulse."""
+        assert self.blank is not None  # blanked only with a companion pulse
         first, width = self.blank
         at = peaks[:, None] + first + np.arange(width)[None, :]
         ok = (at >= 0) & (at < x.size)

@@ -22,8 +22,10 @@ import datetime as dt
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from skyradar.errors import InputError
 from skyradar.geo import EARTH_RADIUS_M, geodetic_to_ned, ned_to_geodetic
@@ -82,6 +84,13 @@ class Reflectors:
     rcs_m2: np.ndarray
     kind: np.ndarray
     group: np.ndarray
+
+    if TYPE_CHECKING:
+        # The constructor takes anything array-like (a single kind or group name for all the points);
+        # __post_init__ turns each into its array. The dataclass writes the real __init__.
+        def __init__(
+            self, position_ned_m: ArrayLike, rcs_m2: ArrayLike, kind: ArrayLike, group: ArrayLike
+        ) -> None: ...
 
     def __post_init__(self) -> None:
         pos = np.asarray(self.position_ned_m, dtype=float).reshape(-1, 3)

@@ -249,10 +249,11 @@ def _ring_depths(
     rng = config.range_axis_m[config.range_axis_m > 0]
     phi = np.linspace(-np.pi, np.pi, n_azimuth, endpoint=False)
     depth = np.full((rng.size, phi.size), float(height_agl_m))
-    for _ in range(3 if depth_fn is not None else 0):
-        # The ground under a ring sample sets its depression, which moves the sample: iterate.
-        horizontal = np.sqrt(np.maximum(rng[:, None] ** 2 - depth**2, 0.0))
-        depth = np.asarray(depth_fn(horizontal * np.cos(phi), horizontal * np.sin(phi)), float)
+    if depth_fn is not None:
+        for _ in range(3):
+            # The ground under a ring sample sets its depression, which moves the sample: iterate.
+            horizontal = np.sqrt(np.maximum(rng[:, None] ** 2 - depth**2, 0.0))
+            depth = np.asarray(depth_fn(horizontal * np.cos(phi), horizontal * np.sin(phi)), float)
     return rng, phi, depth
 
 

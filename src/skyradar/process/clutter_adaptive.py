@@ -302,7 +302,7 @@ def adaptive_nulls(
     n_r, n_d, n_k = cube.shape
     mask = np.zeros((n_r, n_d), np.bool_)
     vectors = np.empty((n_r, n_d, n_k, n_k), np.complex64)
-    window = tuple(int(w) for w in window)
+    window = (int(window[0]), int(window[1]), int(window[2]), int(window[3]))
     level, clip = ADAPTIVE_GATE * floor_w, RING_CLIP * floor_w
     cand, ring_mean = _candidates(power, clutter_to_noise, float(gate), level, clip, window)
     if cand.size:
@@ -338,5 +338,5 @@ def ring_whitening(
     rr, dd = (np.ascontiguousarray(x, np.int64) for x in (range_index, doppler_index))
     out = np.empty((rr.size, cube.shape[2], cube.shape[2]), np.complex128)
     z = np.ascontiguousarray(cube, np.complex64)
-    window = tuple(int(w) for w in window)
+    window = (int(window[0]), int(window[1]), int(window[2]), int(window[3]))
     return _whitening(z, np.asarray(inv_gain, np.complex64), rr, dd, window, 1.0 / floor_w, out)

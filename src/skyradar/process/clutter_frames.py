@@ -21,7 +21,7 @@ cell. With two nulls elevation is often unobservable (see that module, whose exa
 from __future__ import annotations
 
 from collections import OrderedDict
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -152,7 +152,7 @@ def detect_suppressed(
     config: RadarConfig,
     clutter: ClutterSubspace,
     exclude: np.ndarray | None = None,
-    method: str = "cfar",
+    method: Literal["cfar", "os-cfar", "shi-tomasi"] = "cfar",
     **detect_kwargs: Any,
 ) -> tuple[Detections, np.ndarray, np.ndarray, np.ndarray]:
     """Detections, antenna-frame directions, coherence and whether the elevation was measured

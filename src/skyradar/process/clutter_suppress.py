@@ -90,6 +90,7 @@ class Suppressed:
         the adaptive ones where the cell was adaptive, else the prediction's."""
         vectors = subspace.cell_vectors(range_index, doppler_index)
         if self.adaptive is not None:
+            assert self.adaptive_vectors is not None  # set together with adaptive
             own = self.adaptive[range_index, doppler_index]
             vectors[own] = self.adaptive_vectors[range_index[own], doppler_index[own]]
         return vectors
@@ -98,6 +99,7 @@ class Suppressed:
         """:meth:`cell_vectors` of every cell (n_range, n_doppler, n_rx, n_rx)."""
         if self.adaptive is None or not self.adaptive.any():
             return subspace.vectors
+        assert self.adaptive_vectors is not None  # set together with adaptive
         return np.where(self.adaptive[..., None, None], self.adaptive_vectors, subspace.vectors)
 
 
@@ -214,7 +216,7 @@ def suppress_clutter(
     cells = (subspace.covariance, subspace.predicted, subspace.done, subspace._vectors, subspace._fractions)
     rows = (*subspace.calibrated_rows(inv_gain), inv_gain)
     _fused(z, raw, *cells, *rows, *rule, power, nulls, unsuppressed, cnr)
-    trained = (None, None)
+    trained: tuple[np.ndarray, np.ndarray] | tuple[None, None] = (None, None)
     if adaptive:
         trained = adaptive_nulls(z, inv_gain, cnr, floor, power, nulls, unsuppressed, max_nulls, gate)
     channels = (config.n_rx - nulls).astype(np.int8)

@@ -83,9 +83,23 @@ def detect_run(
     return pd.concat(parts, ignore_index=True)
 
 
-def _head_chunk(path: str, start: int, stop: int, *args: Any, head: str, **kwargs: Any) -> pd.DataFrame:
+def _head_chunk(
+    path: str,
+    start: int,
+    stop: int,
+    spur_map: SpurMap | None,
+    terrain: Any,
+    method: Literal["cfar", "os-cfar", "shi-tomasi"],
+    spur_mode: Literal["mask", "flag"],
+    *,
+    head: str,
+    **kwargs: Any,
+) -> pd.DataFrame:
     # process_chunk for one head of a multi-head run (a Dask worker opens the run itself).
-    return process_frames(open_frames(path, head), *args, source=path, frames=slice(start, stop), **kwargs)
+    return process_frames(
+        open_frames(path, head), spur_map, terrain, method, spur_mode, source=path, frames=slice(start, stop),
+        **kwargs,
+    )  # fmt: skip
 
 
 def merge_head_tables(tables: dict[str, pd.DataFrame]) -> pd.DataFrame:

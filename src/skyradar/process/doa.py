@@ -184,8 +184,10 @@ def array_geometry(
 ) -> ArrayGeometry:
     """Least-squares operators of ``config``'s receive array (cached); InputError for unusable layouts."""
     rx = np.ascontiguousarray(config.rx_positions_m, dtype=float)
-    facing = tuple(float(f) for f in np.asarray(facing, float) / np.linalg.norm(facing))
-    return _geometry(rx.tobytes(), rx.shape[0], float(config.wavelength_m), facing, _fov_half_angle(config))
+    fx, fy, fz = (float(f) for f in np.asarray(facing, float) / np.linalg.norm(facing))
+    return _geometry(
+        rx.tobytes(), rx.shape[0], float(config.wavelength_m), (fx, fy, fz), _fov_half_angle(config)
+    )
 
 
 _FOV_CACHE: dict[int, tuple[object, float]] = {}
@@ -240,9 +242,11 @@ def steering_vector(u: np.ndarray, config: RadarConfig) -> np.ndarray:
 
 def _coarse(z: np.ndarray, geo: ArrayGeometry) -> np.ndarray:
     if geo.pairs is not None:
+        assert geo.pair_solve is not None  # set with pairs
         d = np.angle(z[:, geo.pairs[:, 1]] * np.conj(z[:, geo.pairs[:, 0]]))
         return d @ geo.pair_solve.T
     # Beamforming: the grid point whose predicted phases best match the measured ones.
+    assert geo.grid is not None and geo.grid_match is not None  # set where pairs is not
     score = np.abs(z @ geo.grid_match)  # (n, n_grid)
     return geo.grid[np.argmax(score, axis=1)]
 

@@ -56,6 +56,8 @@ __all__ = [
     "flag_ground",
 ]
 
+# NED points (..., 3) -> their (lat_deg, lon_deg, alt_m), as skyradar.geo.ned_to_geodetic.
+GeodeticFn = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]
 
 _ONE_DEG = float(np.radians(1.0))
 _CHI2_2DOF_3SD = 11.829  # chi-square quantile of 2 degrees of freedom at 0.9973 (3 sd in one)
@@ -271,7 +273,7 @@ def classify_ground(
 
 
 def surface_height_fn(
-    flat_down_m: float, terrain: Any, geodetic: Callable[[np.ndarray], tuple] | None
+    flat_down_m: float, terrain: Any, geodetic: GeodeticFn | None
 ) -> Callable[[np.ndarray], np.ndarray]:
     """Height above the surface of NED points (..., 3): the DEM, else a flat ground at ``flat_down_m``.
 
@@ -289,6 +291,7 @@ def surface_height_fn(
         flat = flat_down_m - points[..., 2]
         if terrain is None:
             return flat
+        assert geodetic is not None  # a terrain is placed through its geodetic mapping
         dem = height_above_ground_m(*geodetic(points), terrain)
         return np.where(np.isfinite(dem), dem, flat)
 

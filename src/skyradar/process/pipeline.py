@@ -53,7 +53,7 @@ from skyradar.process.doa import (
     direction_coherence,
     estimate_directions,
 )
-from skyradar.process.ground import flag_ground, height_above_ground_m, surface_height_fn
+from skyradar.process.ground import GeodeticFn, flag_ground, height_above_ground_m, surface_height_fn
 from skyradar.process.spurs import SpurMap
 
 __all__ = [
@@ -133,8 +133,7 @@ def process_cube(
         raise InputError(f"frame: field 'rx' has {cube.shape[-1]} channels, radar_config has {config.n_rx}")
     if spur_mode not in ("mask", "flag"):
         raise InputError(f"process: field 'spur_mode' must be 'mask' or 'flag', got {spur_mode!r}")
-    masking = spur_map is not None and spur_mode == "mask"
-    exclude = spur_map.mask if masking else None
+    exclude = spur_map.mask if spur_map is not None and spur_mode == "mask" else None
     if clutter is not None:  # a ClutterSubspace: knowledge-aided suppression before detection
         det, u, coherence, elevation_measured = detect_suppressed(
             cube, config, clutter, exclude, method, pfa_secondary=pfa_secondary, **detect_kwargs
@@ -211,11 +210,14 @@ def _to_world(
     ned = pos + body @ body_to_ned.T
     u_ned = out["u_ant"] @ (body_to_ned @ config.mount.rotation).T
     geodetic = _geodetic_fn(own, i, origin)
-    geo = geodetic(ned) if geodetic is not None else tuple(np.full(len(ned), np.nan) for _ in range(3))
+    if geodetic is not None:
+        geo = geodetic(ned)
+    else:
+        geo = (np.full(len(ned), np.nan), np.full(len(ned), np.nan), np.full(len(ned), np.nan))
     return ned, geo, u_ned
 
 
-def _geodetic_fn(own: dict[str, np.ndarray], i: int, origin: tuple | None) -> Callable | None:
+def _geodetic_fn(own: dict[str, np.ndarray], i: int, origin: tuple | None) -> GeodeticFn | None:
     """NED points -> (lat, lon, alt) for frame ``i``: from the scenario origin, else relative to the
     own-ship's geodetic fix (about 2 m off at 5 km); None with neither."""
     if origin is not None:
@@ -245,11 +247,12 @@ def _ground_flags(
     n = len(out["range_m"])
     if own is None or n == 0:
         return np.zeros(n, bool)
+    assert u_ned is not None  # found with own (_to_world)
     own_agl = float(own["own_height_agl_m"][i])
     pos = np.array([own["own_north_m"][i], own["own_east_m"][i], own["own_down_m"][i]])
     geodetic = _geodetic_fn(own, i, origin)
     located = geodetic is not None
-    if terrain is not None and located and not np.isfinite(own_agl):
+    if terrain is not None and geodetic is not None and not np.isfinite(own_agl):
         own_agl = float(height_above_ground_m(*geodetic(pos[None]), terrain)[0])
     if not np.isfinite(own_agl):
         return np.zeros(n, bool)  # no terrain, no own-ship height: Doppler alone cannot decide
@@ -269,15 +272,30 @@ def clutter_anchors(ds: xr.Dataset, terrain: Any = None, source: str = "frames")
     return None if own is None else prediction_anchors(own, terrain)
 
 
-def process_chunk(path: str, start: int, stop: int, *args: Any, **kwargs: Any) -> pd.DataFrame:
+def process_chunk(
+    path: str,
+    start: int,
+    stop: int,
+    spur_map: SpurMap | None = None,
+    terrain: Any = None,
+    method: Literal["cfar", "os-cfar", "shi-tomasi"] = "cfar",
+    spur_mode: Literal["mask", "flag"] = "mask",
+    progress: Callable[[int], None] | None = None,
+    batch_frames: int = 16,
+    **kwargs: Any,
+) -> pd.DataFrame:
     """:func:`process_frames` on frames ``start:stop`` of the run at ``path`` (frame numbers kept).
 
     The unit of work for Dask workers: they open the run themselves. The own-ship state and the
-    clutter predictions' anchors are the whole run's, so the rows equal the plain loop's.
+    clutter predictions' anchors are the whole run's, so the rows equal the plain loop's. The
+    other arguments are :func:`process_frames`'.
     """
     from skyradar.io.frames import open_frames
 
-    return process_frames(open_frames(path), *args, source=path, frames=slice(start, stop), **kwargs)
+    return process_frames(
+        open_frames(path), spur_map, terrain, method, spur_mode, progress, batch_frames,
+        source=path, frames=slice(start, stop), **kwargs,
+    )  # fmt: skip
 
 
 def _checked_config(ds: xr.Dataset, config: RadarConfig | None, spur_map, source: str) -> RadarConfig:

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Iterable, Iterator, Sequence
+from concurrent.futures import Future
 from functools import lru_cache
 from typing import Any
 
@@ -197,7 +198,8 @@ class RangeDopplerProcessor:
             if self.workers <= 1:
                 yield from (self._frame(adc, remove_dc, gains, 1) for adc in adc_frames)
                 return
-            pool, pending = frame_pool(self.workers), deque()
+            pool = frame_pool(self.workers)
+            pending: deque[Future[np.ndarray]] = deque()
             for adc in adc_frames:
                 pending.append(pool.submit(self._frame, adc, remove_dc, gains, 1))
                 if len(pending) >= self.workers:

@@ -88,7 +88,12 @@ def _template(frames, config, chunk_frames: int, attrs: dict[str, Any]):
     return frames_dataset(lazy, frames.times_s, config, attrs=attrs)
 
 
-def _write_pending(args: tuple, pending: list[int], client, progress: Callable[[int], None] | None) -> None:
+def _write_pending(
+    args: tuple[str, str, int, dict[str, Any]],
+    pending: list[int],
+    client,
+    progress: Callable[[int], None] | None,
+) -> None:
     """Process and write the chunks ``pending`` here, or on the Dask ``client``."""
     if client is None:
         for index in pending:

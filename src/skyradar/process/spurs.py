@@ -185,6 +185,7 @@ def learn_spur_map(
         n += 1
     if n == 0:
         raise InputError("spur map: no frames to learn from")
+    assert counts is not None  # set by the first of the n frames
     return SpurMap(counts / np.float32(n), threshold, n)
 
 

@@ -33,9 +33,10 @@ import gzip
 import json
 import logging
 import lzma
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
 import pandas as pd
@@ -68,7 +69,7 @@ _OPENSKY_VELOCITY = ("groundspeed", "track", "vertical_rate")
 _SI_VELOCITY = ("vn", "ve", "vd")
 _log = logging.getLogger(__name__)
 _TIME_NAMES = {"timestamp", "time", "time_s"}
-_OPENERS = {".gz": gzip.open, ".bz2": bz2.open, ".xz": lzma.open}
+_OPENERS: dict[str, Callable[..., IO[Any]]] = {".gz": gzip.open, ".bz2": bz2.open, ".xz": lzma.open}
 # A recorded flight, even a day of 1-Hz fixes as JSON, is tens of MB: more is not one track file.
 MAX_INFLATED_BYTES = 256 << 20
 
@@ -305,9 +306,11 @@ def _one_trajectory(
     lat, lon = _number(df, "latitude"), _number(df, "longitude")
     keep = _drop_glitches(path, df.index.to_numpy(), t, lat, lon, alt, alt_field, label, notes)
     df, t, lat, lon, alt = df[keep], t[keep], lat[keep], lon[keep], alt[keep]
-    origin = (
-        (float(lat[0]), float(lon[0]), float(alt[0])) if origin is None else tuple(float(v) for v in origin)
-    )
+    if origin is None:
+        origin = (float(lat[0]), float(lon[0]), float(alt[0]))
+    else:
+        lat0, lon0, alt0 = origin
+        origin = (float(lat0), float(lon0), float(alt0))
     pos = geodetic_to_ned(lat, lon, alt, *origin)
     zero = float(t[0]) if time_zero_s is None else float(time_zero_s)
     t_rel = t - zero

@@ -218,7 +218,9 @@ def clean_rows(
     for name, values in zip(("latitude", "longitude"), lat_lon, strict=True):
         if values is None:
             raise InputError(f"{path}: missing required field '{name}'; columns are {list(df.columns)}")
-    no_position = ~(np.isfinite(lat_lon[0]) & np.isfinite(lat_lon[1]))
+    lat, lon = lat_lon
+    assert lat is not None and lon is not None  # both present: checked above
+    no_position = ~(np.isfinite(lat) & np.isfinite(lon))
     no_altitude = ~np.isfinite(alt) & ~no_position
     no_fix = no_position | no_altitude
     if no_position.any():

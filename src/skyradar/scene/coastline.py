@@ -8,6 +8,8 @@ calls a face sea when more of the coastline has it on its right-hand side than o
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import shapely
 from shapely.geometry import LineString, Polygon
@@ -59,7 +61,7 @@ def sea_polygons(coastlines: list[LineString] | np.ndarray, box: Polygon) -> lis
     [(5.0, 0.0, 10.0, 10.0)]
     """
     lines = [shapely.intersection(line, box) for line in coastlines if line is not None and not line.is_empty]
-    parts = []
+    parts: list[Any] = []  # lines and the other geometries an intersection gives
     for line in lines:
         parts.extend(getattr(line, "geoms", [line]))
     parts = [p for p in parts if isinstance(p, LineString) and p.length > 0]

@@ -92,7 +92,8 @@ def fill_voids(
     index = np.full(z.shape, -1, np.intp)
     index[rr, cc] = np.arange(rr.size)
     diag, rhs = np.zeros(rr.size), np.zeros(rr.size)
-    rows, cols = [], []
+    row_parts: list[np.ndarray] = []
+    col_parts: list[np.ndarray] = []
     for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
         qr, qc = rr + dr, cc + dc
         ok = (qr >= 0) & (qr < ny) & (qc >= 0) & (qc < nx)
@@ -101,9 +102,9 @@ def fill_voids(
         q = index[qr, qc]
         known = q < 0
         np.add.at(rhs, p[known], z[qr[known], qc[known]])
-        rows.append(p[~known])
-        cols.append(q[~known])
-    rows, cols = np.concatenate(rows), np.concatenate(cols)
+        row_parts.append(p[~known])
+        col_parts.append(q[~known])
+    rows, cols = np.concatenate(row_parts), np.concatenate(col_parts)
     m = rr.size
     lap = sparse.csr_matrix((-np.ones(rows.size), (rows, cols)), shape=(m, m)) + sparse.diags(diag)
     z[rr, cc] = spsolve(lap.tocsc(), rhs)
@@ -313,8 +314,8 @@ def _npz_grid(data: Mapping, keys: set, z: np.ndarray, source: str) -> Terrain:
     """The Terrain of heights ``z`` placed as the ``.npz`` fields say."""
     if {"dx_m", "dy_m", "lat0_deg", "lon0_deg"} <= keys:
         rot = _scalar(data, "rotation_deg", source) if "rotation_deg" in keys else 0.0
-        vals = [_scalar(data, k, source) for k in ("lat0_deg", "lon0_deg", "dy_m", "dx_m")]
-        return Terrain.projected(z, *vals, rotation_deg=rot, source=source)
+        lat0, lon0, dy, dx = (_scalar(data, k, source) for k in ("lat0_deg", "lon0_deg", "dy_m", "dx_m"))
+        return Terrain.projected(z, lat0, lon0, dy, dx, rotation_deg=rot, source=source)
     if {"dx", "dy", "xmin", "ymax"} <= keys:
         dx, dy = abs(_scalar(data, "dx", source)), abs(_scalar(data, "dy", source))
         west, north = _scalar(data, "xmin", source), _scalar(data, "ymax", source)
@@ -364,6 +365,7 @@ def jacksboro(max_void_fraction: float = 0.01) -> Terrain:
     from matplotlib import cbook
 
     data = cbook.get_sample_data("jacksboro_fault_dem.npz")
+    assert isinstance(data, np.lib.npyio.NpzFile)  # an .npz sample loads as one
     arrays = {k: data[k] for k in data.files}
     return terrain_from_arrays(arrays, "jacksboro_fault_dem.npz", max_void_fraction)
 

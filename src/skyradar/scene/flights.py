@@ -141,14 +141,14 @@ def _turtle(
     """Horizontal position (n, 2) and heading (n,) at arc lengths ``s`` along the pieces."""
     starts = np.concatenate([[0.0], np.cumsum([p[0] for p in pieces])])
     xy0, h0 = [np.zeros(2)], [heading0]
-    for length, kappa in pieces:  # position and heading at the start of each piece
+    for length, curvature in pieces:  # position and heading at the start of each piece
         h, p = h0[-1], xy0[-1]
-        if kappa == 0.0:
+        if curvature == 0.0:
             xy0.append(p + length * np.array([np.cos(h), np.sin(h)]))
         else:
-            h_end = h + kappa * length
-            xy0.append(p + (np.array([np.sin(h_end) - np.sin(h), np.cos(h) - np.cos(h_end)]) / kappa))
-        h0.append(h + kappa * length)
+            h_end = h + curvature * length
+            xy0.append(p + (np.array([np.sin(h_end) - np.sin(h), np.cos(h) - np.cos(h_end)]) / curvature))
+        h0.append(h + curvature * length)
     k = np.clip(np.searchsorted(starts, s, side="right") - 1, 0, len(pieces) - 1)
     ds = s - starts[k]
     kappa = np.array([p[1] for p in pieces])[k]
@@ -269,7 +269,7 @@ def _ownship_at(ownship: Trajectory, t_s: float) -> tuple[np.ndarray, np.ndarray
     """Own-ship position, velocity and ground speed at ``t_s``; refused without a ground track."""
     # Beyond own-ship's span, its last (or first) state is extrapolated in a straight line.
     t_near = min(max(t_s, ownship.start_s), ownship.end_s)
-    own = ownship.sample([t_near])
+    own = ownship.sample(np.array([t_near]))
     v_o = own.velocity_ned_mps[0]
     p_o = own.position_ned_m[0] + v_o * (t_s - t_near)
     ground = float(np.hypot(v_o[0], v_o[1]))

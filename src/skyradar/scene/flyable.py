@@ -494,6 +494,7 @@ def flyable_path(
     if heading_from_path:
         vel = np.full((t.size, 3), np.nan)  # horizontal filled from the path's direction below
     has_vel = vel is not None and np.isfinite(vel[:, :2]).all(axis=1).sum() >= 3 or heading_from_path
+    fit_vel = vel if has_vel else None  # the velocities the smoother follows (None: positions only)
     limit = np.array([limits.horizontal_accel_mps2, limits.horizontal_accel_mps2, limits.vertical_accel_mps2])
     # Acceleration spectral density: a velocity change of the class's full acceleration held over a
     # typical interval between fixes is one standard deviation, so the first fit follows a hard turn
@@ -511,7 +512,7 @@ def flyable_path(
             raise InputError(f"{label}: fewer than 2 usable fixes after repairs")
         vel_rows = keep & vel_ok
         grid, (at_pos, at_vel) = _grid((pos_t, t[vel_rows]), step_s)
-        v = vel[vel_rows] if has_vel else None
+        v = None if fit_vel is None else fit_vel[vel_rows]
         return grid, _smooth(grid, at_pos, pos[keep], at_vel, v, sigma_p, sigma_v, q), at_pos
 
     lag_passes = _LAG_PASSES if has_vel and not heading_from_path else 0
@@ -522,7 +523,8 @@ def flyable_path(
         at = np.clip(np.searchsorted(grid, t - lag), 0, grid.size - 1)
         horizontal = states[at, :2, 1]
         norm = np.linalg.norm(horizontal, axis=1, keepdims=True)
-        vel[:, :2] = np.where(
+        assert fit_vel is not None and ground_speed_mps is not None  # heading_from_path
+        fit_vel[:, :2] = np.where(
             norm > _MOVING_MPS, ground_speed_mps[:, None] * horizontal / np.maximum(norm, 1e-9), np.nan
         )
 
@@ -531,12 +533,12 @@ def flyable_path(
     for _pass in range(lag_passes + 4):
         if heading_from_path:
             carry_ground_speed(grid, states)
-        if has_vel:
-            vel_ok = np.isfinite(vel[:, :2]).all(axis=1)
+        if fit_vel is not None:
+            vel_ok = np.isfinite(fit_vel[:, :2]).all(axis=1)
         if _pass >= lag_passes:  # the noise that makes the kept fixes most likely
             rows_v = keep & vel_ok
             q, sigma_p, sigma_v = _noise_by_likelihood(
-                t[keep] - lag, pos[keep], t[rows_v], vel[rows_v] if has_vel else None, q0
+                t[keep] - lag, pos[keep], t[rows_v], None if fit_vel is None else fit_vel[rows_v], q0
             )
         grid, states, at = fit(q)
         offset = pos[keep] - states[at, :, 0]

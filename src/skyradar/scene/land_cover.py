@@ -41,6 +41,8 @@ returns rise, nor at the lowest grazing angles (below about 1 deg) where Billing
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from skyradar.extras import import_extra
@@ -86,11 +88,11 @@ def sigma0(class_code: np.ndarray | int, grazing_rad: np.ndarray | float) -> np.
     return gamma * np.maximum(np.sin(grazing_rad), 0.0)
 
 
-def _valid(geometry: object) -> bool:
+def _valid(geometry: Any) -> bool:
     return geometry is not None and not geometry.is_empty
 
 
-def _shapes(geometries: np.ndarray, value: float) -> list[tuple[object, float]]:
+def _shapes(geometries: np.ndarray, value: int) -> list[tuple[object, int]]:
     return [(g, value) for g in geometries if _valid(g)]
 
 

@@ -50,12 +50,12 @@ MAP_STYLE = MapStyle()
 
 
 def _paint(image: np.ndarray, geometries: np.ndarray, value: float, grid: GroundGrid) -> None:
-    geometries = [g for g in geometries if g is not None and not g.is_empty]
-    if not geometries:
+    shapes = [g for g in geometries if g is not None and not g.is_empty]
+    if not shapes:
         return
     rasterize = import_extra("rasterio.features", "geo", "drawing a map").rasterize
     mask = rasterize(
-        [(g, 1) for g in geometries], out_shape=grid.shape, transform=grid.transform, fill=0, dtype="uint8"
+        [(g, 1) for g in shapes], out_shape=grid.shape, transform=grid.transform, fill=0, dtype="uint8"
     )
     image[mask.astype(bool)] = value
 

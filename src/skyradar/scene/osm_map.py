@@ -76,7 +76,8 @@ _HIGHWAY_CLASS = {
 _RAILWAYS = ("rail", "tram", "light_rail", "subway", "narrow_gauge", "preserved", "monorail", "funicular")
 # Area layers from landuse / natural / leisure / water tags (a feature goes to the first layer it matches).
 AREA_LAYERS = ("water", "forest", "grass", "open_land")
-_AREA_TAGS = {
+# layer: {tag key: the values that put a feature in the layer (None: any value)}
+_AREA_TAGS: dict[str, dict[str, tuple[str, ...] | None]] = {
     "water": {
         "natural": ("water", "bay"),
         "landuse": ("basin", "reservoir", "pond"),
@@ -263,7 +264,8 @@ def _geodetic_layers(raw: dict) -> dict[str, gpd.GeoDataFrame]:
     layers["roads"] = _empty({"road_class": "str", "width_m": "float64"})
     if _present(roads):
         cls = np.array([_HIGHWAY_CLASS.get(h) for h in _tag(roads, "highway")], dtype=object)
-        keep = np.not_equal(cls, None) & _not_tunnel(roads) & _kind(roads, ("LineString", "MultiLineString"))
+        # An object array compares with None elementwise; numpy's stub admits no None operand.
+        keep = np.not_equal(cls, None) & _not_tunnel(roads)  # type: ignore[call-overload]  # numpy stub & _kind(roads, ("LineString", "MultiLineString"))
         widths = np.array([ROAD_WIDTH_M[c] for c in cls[keep]], dtype=float)
         layers["roads"] = _pick(roads, keep, road_class=cls[keep].astype(str), width_m=widths)
     rail = raw["railways"]

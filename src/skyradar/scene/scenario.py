@@ -208,6 +208,7 @@ class Scenario:
         # Measured cuts: the CSV's own errors name that file, its line and column.
         if a.cuts_csv is not None:
             return AntennaPattern.from_cuts_csv(self._path(a.cuts_csv), a.combine)
+        assert a.azimuth_csv is not None and a.elevation_csv is not None  # both or neither (AntennaModel)
         return AntennaPattern.from_csv(self._path(a.azimuth_csv), self._path(a.elevation_csv), a.combine)
 
     def _mount(self, mm, section: str = "mount") -> Mount:
@@ -265,6 +266,7 @@ class Scenario:
                 params = spec.model_dump(
                     exclude={"type", "name", "rcs_m2", "time_offset_s", "aircraft_class"}
                 )
+                assert ownship is not None  # an intruder's: the own-ship is never an encounter flight
                 return encounter_flight(ownship, params, name)
             from skyradar.scene import flights
 
@@ -284,7 +286,7 @@ class Scenario:
             where = f" (file {spec.path})" if isinstance(spec, FileFlight) else ""
             raise InputError(f"{self._label}: field '{section}'{where}: {exc}") from None
 
-    def _origin(self) -> tuple[tuple[float, float, float] | None, Trajectory | None, Any]:
+    def _origin(self) -> tuple[tuple[float, float, float], Trajectory | None, Any]:
         """(origin, own-ship if read to find it, terrain if built to find it)."""
         m = self.model
         if m.origin is not None:
@@ -336,7 +338,8 @@ class Scenario:
             # The simulator crops within the range limit plus a few facets of each position.
             area = footprint_bounds(own.lat_deg, own.lon_deg, radar.range_limit_m + 1000.0)
             terrain = self._terrain(origin, area)
-        if terrain is not None and self.model.terrain.type in ("file", "jacksboro"):
+        model_terrain = self.model.terrain
+        if terrain is not None and model_terrain is not None and model_terrain.type in ("file", "jacksboro"):
             try:
                 check_dem_covers(terrain, own.lat_deg, own.lon_deg, own.time_s, origin)
             except InputError as exc:
@@ -386,7 +389,7 @@ class Scenario:
             intruders.append(Intruder(name, traj, float(spec.rcs_m2)))
         return BuiltScenario(
             name=m.name,
-            origin=tuple(float(v) for v in origin),
+            origin=(float(origin[0]), float(origin[1]), float(origin[2])),
             radar=radar,
             heads=heads,
             terrain=terrain,

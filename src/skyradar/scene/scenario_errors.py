@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 from skyradar.io.safe_yaml import short_repr
@@ -18,7 +19,7 @@ def _describe(value: Any) -> str:
     return short_repr(value)
 
 
-def validation_error_line(source: str, err: dict[str, Any]) -> str:
+def validation_error_line(source: str, err: Mapping[str, Any]) -> str:
     """One line from a pydantic error: file, dotted field, what is wrong, the value."""
     loc = [
         str(p) for p in err["loc"] if not (isinstance(p, str) and (p in TAGS or p.startswith("function-")))

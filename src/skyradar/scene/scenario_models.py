@@ -50,7 +50,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
-from skyradar.rx_layouts import RX_LAYOUTS
+from skyradar.rx_layouts import RxLayout
 from skyradar.scene.impairment_config import ImpairmentConfig
 from skyradar.scene.navigation_config import NavigationConfig, with_preset
 
@@ -183,7 +183,7 @@ class RadarModel(_Model):
         description="Receive antenna phase centres in the antenna frame (x boresight, y right, z down), "
         "one ``[x, y, z]`` per antenna, m; or ``rx_layout``.",
     )
-    rx_layout: Literal[RX_LAYOUTS] | None = Field(
+    rx_layout: RxLayout | None = Field(
         None,
         description="A named receive array (:mod:`skyradar.rx_layouts`): ``square`` is the prototype's "
         "2x2 at half-wavelength spacing; or ``rx_positions_m``.",

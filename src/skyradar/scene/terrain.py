@@ -175,7 +175,7 @@ class Terrain:
         r = np.radians(self.rotation_deg)
         return up * np.cos(r) - right * np.sin(r), up * np.sin(r) + right * np.cos(r)
 
-    def latlon_of(self, rows: np.ndarray, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def latlon_of(self, rows: np.ndarray | float, cols: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
         """Geodetic (lat_deg, lon_deg) of fractional (row, col) indices (broadcast)."""
         rows, cols = np.asarray(rows, float), np.asarray(cols, float)
         if self.is_geographic:

@@ -60,7 +60,8 @@ def _origin(ds: Any, source: str) -> tuple[float, float, float]:
             f"{source}: {_OPTION} needs the run's origin (attributes origin_lat_deg, origin_lon_deg, "
             "origin_alt_m) to place a built-in terrain; this run has none"
         )
-    return tuple(float(v) for v in origin)
+    lat, lon, alt = origin
+    return float(lat), float(lon), float(alt)
 
 
 def recorded_terrain(ds: Any, source: str = "frames") -> Terrain | None:

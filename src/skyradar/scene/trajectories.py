@@ -293,7 +293,7 @@ class Trajectory:
         return replace(self, position_ned_m=pos, velocity_ned_mps=vel, origin=(lat0, lon0, alt0))
 
 
-def _ecef_from_ned(lat_deg: np.ndarray, lon_deg: np.ndarray) -> np.ndarray:
+def _ecef_from_ned(lat_deg: np.ndarray | float, lon_deg: np.ndarray | float) -> np.ndarray:
     # Columns are the N, E, D unit vectors in ECEF; shape (..., 3, 3).
     lat, lon = np.radians(lat_deg), np.radians(lon_deg)
     sl, cl, so, co = np.sin(lat), np.cos(lat), np.sin(lon), np.cos(lon)

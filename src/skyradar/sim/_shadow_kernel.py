@@ -78,9 +78,9 @@ def shadow_mask(
     >>> np.nonzero(mask[0])[0].tolist()  # ...hides the ground up to 20 m out (the grazing ray)
     [11, 12, 13, 14, 15, 16, 17, 18, 19]
     """
-    rows, cols = np.indices(height.shape)
+    grid_rows, grid_cols = np.indices(height.shape)
     out = np.empty(height.size, bool)
-    rows, cols = rows.ravel().astype(np.int64), cols.ravel().astype(np.int64)
+    rows, cols = grid_rows.ravel().astype(np.int64), grid_cols.ravel().astype(np.int64)
     height = np.ascontiguousarray(height, np.float32)
     shadowed(height, rows, cols, np.asarray(antenna_rc, float), float(antenna_up_m), float(pixel_m), out)
     return out.reshape(height.shape)

@@ -20,6 +20,7 @@ reads a handful, and loop-invariant values come in as scalars, not as array read
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numba import int64, njit, uint64
@@ -38,7 +39,7 @@ _ID = 19  # the sub-facet's number in the frame (cell * sub-facets per cell + m)
 _TMP2, _TMP3 = 20, 21  # more temporaries (table look-ups)
 CELL_FIELDS = 22
 
-_OPTS = {"error_model": "numpy", "fastmath": True}
+_OPTS: dict[str, Any] = {"error_model": "numpy", "fastmath": True}
 _GAMMA = uint64(0x9E3779B97F4A7C15)
 _SQRT_HALF = np.float32(math.sqrt(0.5))
 _NEAR_M = 0.1  # receivers within this of the phase centre (per axis): _near_distance_row

@@ -82,12 +82,13 @@ def facet_rule(
     ((2, 2), (52, 36), 0.157)
     """
     finite = math.isfinite(facet_size_m)
-    uniform = tuple(max(1, math.ceil(s / facet_size_m)) if finite else 1 for s in spacing_m)
+    n_rows, n_cols = (max(1, math.ceil(s / facet_size_m)) if finite else 1 for s in spacing_m)
+    uniform = (n_rows, n_cols)
     if not adaptive or not finite:
         return FacetRule(uniform, uniform, (0.0, 0.0, 0.0, 0.0))
     target_v = facet_size_m / config.range_resolution_m * config.doppler_resolution_mps
-    n_min = tuple(min(n, 2) for n in uniform)
-    n_max = tuple(max(4 * n, 8) for n in uniform)
+    n_min = (min(n_rows, 2), min(n_cols, 2))
+    n_max = (max(4 * n_rows, 8), max(4 * n_cols, 8))
     return FacetRule(n_min, n_max, (float(facet_size_m), float(target_v), 0.0, 0.0))
 
 

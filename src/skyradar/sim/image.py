@@ -120,7 +120,8 @@ class ImageSimulator:
     ) -> None:
         self.config = config
         self.terrain = terrain
-        self.origin = tuple(float(v) for v in origin)
+        lat0, lon0, alt0 = origin
+        self.origin = (float(lat0), float(lon0), float(alt0))
         self.facet_size_m = config.range_resolution_m / 2.0 if facet_size_m is None else float(facet_size_m)
         if not self.facet_size_m > 0:
             raise InputError(f"simulation.facet_size_m must be > 0, got {facet_size_m!r}")
@@ -227,6 +228,7 @@ class ImageSimulator:
         # oversampled grid, or the per-thread blocks (summed, and cleared for the next frame).
         block = _array(self._scratch, "spread", (1, *frame.shape), np.complex64)
         work = _array(self._scratch, "spread_work", (self._grid_shape[0] * frame[0].size,), np.complex64)
+        assert self._psf is not None  # spread only with the point-spread
         apply_psf(grid, self._psf, block[0], work, clear=True)
         finalize_frame(block, sigma, key, frame)
 

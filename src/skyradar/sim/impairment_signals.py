@@ -6,6 +6,8 @@ switches them on.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from skyradar.config import BOLTZMANN, RadarConfig
@@ -41,16 +43,16 @@ def _spur_pixels(config, spurs, spur_map, map_power_dbm) -> tuple[np.ndarray, np
         if spur_map.shape != (config.n_range, config.n_doppler):
             expected = (config.n_range, config.n_doppler)
             raise InputError(f"impairments.spurs: spur map shape {spur_map.shape}, expected {expected}")
-        k, j = np.nonzero(spur_map)
-        rows += list(k)
-        cols += list(j)
-        power += [dbm_to_w(map_power_dbm)] * k.size
+        map_k, map_j = np.nonzero(spur_map)
+        rows += list(map_k)
+        cols += list(map_j)
+        power += [dbm_to_w(map_power_dbm)] * map_k.size
     return np.array(rows, int), np.array(cols, int), np.array(power, float)
 
 
 def spur_cube(
     config: RadarConfig,
-    spurs: list[tuple[float, float, float]] = (),
+    spurs: Sequence[tuple[float, float, float]] = (),
     spur_map: np.ndarray | None = None,
     map_power_dbm: float = -130.0,
     leakage: bool = True,

@@ -135,7 +135,8 @@ class LandCoverSimulator:
         if not np.all(np.isfinite(height)) or np.any(height < 0):
             raise InputError("land cover: height_m must be finite and >= 0 everywhere")
         self.config, self.grid, self.seed = config, grid, int(seed)
-        self.origin = tuple(float(v) for v in origin)
+        lat0, lon0, alt0 = origin
+        self.origin = (float(lat0), float(lon0), float(alt0))
         self.shadow, self.speckle = bool(shadow), bool(speckle)
         self.class_code = code.astype(np.int8)
         self.height_m = np.ascontiguousarray(height)

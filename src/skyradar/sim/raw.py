@@ -118,7 +118,8 @@ def _as_points(name: str, values: np.ndarray | None, n: int | None) -> np.ndarra
     arr = np.zeros((n or 0, 3)) if values is None else np.asarray(values, float)
     arr = arr.reshape(-1, 3) if arr.ndim == 1 and arr.size == 3 else arr
     if arr.ndim != 2 or arr.shape[1] != 3 or (n is not None and arr.shape[0] != n):
-        raise InputError(f"raw simulation: {name} must have shape (n, 3), got {np.shape(values)}")
+        got = arr.shape if values is None else np.shape(values)
+        raise InputError(f"raw simulation: {name} must have shape (n, 3), got {got}")
     if not np.all(np.isfinite(arr)):
         raise InputError(f"raw simulation: {name} has non-finite values")
     return arr

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import xarray as xr
@@ -20,6 +20,12 @@ from skyradar.scene.radar_heads import head_of
 from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
 from skyradar.sim.impairments import apply_impairments
 from skyradar.sim.navigation import navigation_variables
+
+if TYPE_CHECKING:
+    from skyradar.sim.land_cover_scene import LandCoverSimulator
+
+    # What make_simulator gives: the terrain simulator, or the land-cover one (a map's ground).
+    Simulator = ImageSimulator | LandCoverSimulator
 
 __all__ = ["make_simulator", "scenario_truth", "simulate_frames", "simulate", "frames_attrs"]
 
@@ -37,7 +43,7 @@ _SIM_KEYS = (
 )
 
 
-def make_simulator(built, head: int | str = 0) -> ImageSimulator:
+def make_simulator(built, head: int | str = 0) -> Simulator:
     """An :class:`ImageSimulator` of one radar head (index or name) of a BuiltScenario, with its
     ``sim_options`` and impairments; frames and truth of that head come from it."""
     radar = head_of(built.heads, head, "make_simulator").config
@@ -79,7 +85,7 @@ def _frame_inputs(own, intruders, i: int) -> tuple[PlatformState, list[PointTarg
     return platform, targets, which
 
 
-def simulate_frames(built, indices: np.ndarray, simulator: ImageSimulator | None = None) -> np.ndarray:
+def simulate_frames(built, indices: np.ndarray, simulator: Simulator | None = None) -> np.ndarray:
     """Frames ``indices`` of the simulator's head as an (n, range, doppler, rx) complex64 array."""
     simulator = simulator or make_simulator(built)
     indices = np.asarray(indices)
@@ -121,7 +127,7 @@ def _ownship_truth(built, own) -> dict[str, np.ndarray]:
     return truth | {"own_height_agl_m": agl}
 
 
-def _intruder_truth(built, own, intruders, simulator: ImageSimulator) -> dict[str, np.ndarray]:
+def _intruder_truth(built, own, intruders, simulator: Simulator) -> dict[str, np.ndarray]:
     n, n_t = own.time_s.size, len(intruders)
     keys = [f"tgt_{a}_m" for a in _XYZ] + [f"tgt_{a}_mps" for a in _VXYZ]
     keys += ["tgt_lat_deg", "tgt_lon_deg", "tgt_alt_m", "tgt_rcs_m2", *list(_TRUTH_FROM_GEOMETRY)[:-1]]
@@ -145,7 +151,7 @@ def _intruder_truth(built, own, intruders, simulator: ImageSimulator) -> dict[st
     return truth
 
 
-def scenario_truth(built, simulator: ImageSimulator | None = None) -> tuple[dict, dict, list[str]]:
+def scenario_truth(built, simulator: Simulator | None = None) -> tuple[dict, dict, list[str]]:
     """Own-ship truth on time and intruder truth on (time, target), named as in ``skyradar.io.frames``."""
     simulator = simulator or make_simulator(built)
     own, intruders = _states(built, np.arange(built.times_s.size))

@@ -34,14 +34,15 @@ def set_by_path(data: dict[str, Any], dotted: str, value: Any, source: str = "sc
     out = copy.deepcopy(data)
     keys = dotted.split(".")
     node: Any = out
-    for i, key in enumerate(keys):
+    for i, part in enumerate(keys):
         last = i == len(keys) - 1
+        key: str | int = part
         if isinstance(node, list):
-            if not key.isdigit() or int(key) >= len(node):
+            if not part.isdigit() or int(part) >= len(node):
                 raise InputError(
-                    f"{source}: --param {dotted}: '{key}' is not an index of a list of {len(node)}"
+                    f"{source}: --param {dotted}: '{part}' is not an index of a list of {len(node)}"
                 )
-            key = int(key)
+            key = int(part)
         elif not isinstance(node, dict):
             raise InputError(f"{source}: --param {dotted}: '{keys[i - 1]}' is not a section")
         elif not last and key not in node:
@@ -81,9 +82,9 @@ def run_table(built, frames: np.ndarray | None = None, chunk: int = 8) -> pd.Dat
         idx = np.arange(start, min(start + chunk, n))
         block = frames[idx] if frames is not None else simulate_frames(built, idx, simulator)
         for row, i in enumerate(idx):
-            for t in np.nonzero(visible[i])[0]:
-                power = np.mean(np.abs(block[row, int(k[i, t]), int(j[i, t])]) ** 2)
-                snr[i, t] = 10 * np.log10(power / cfg.noise_power_w)
+            for seen_t in np.nonzero(visible[i])[0]:
+                power = np.mean(np.abs(block[row, int(k[i, seen_t]), int(j[i, seen_t])]) ** 2)
+                snr[i, seen_t] = 10 * np.log10(power / cfg.noise_power_w)
     rows = []
     for t, name in enumerate(names):
         seen = visible[:, t]

@@ -44,10 +44,10 @@ class Measure3D:
         self.z = det[["range_m", "radial_velocity_mps"]].to_numpy(float)
         self.motion, self.width = motion, motion.doppler_width_mps
         if sigma_rad is None and "snr_db" in det.columns:
-            angles = [
+            azimuth, elevation = (
                 det[c].to_numpy(float) if c in det.columns else None for c in ("azimuth_rad", "elevation_rad")
-            ]
-            self.sigma = angle_sigma_rad(det["snr_db"].to_numpy(float), config, *angles)
+            )
+            self.sigma = angle_sigma_rad(det["snr_db"].to_numpy(float), config, azimuth, elevation)
         else:
             self.sigma = np.full(len(det), 0.04 if sigma_rad is None else float(sigma_rad))
         self.own, self.agl = None, np.full(len(grid), np.nan)

@@ -179,15 +179,16 @@ class _RecentReadings:
     """Each track's last ``window`` readings, kept from frame to frame; tracks not listed are forgotten."""
 
     def __init__(self, window: int) -> None:
-        self.window, self._by_track = int(window), {}
+        self.window = int(window)
+        self._by_track: dict[int, list] = {}
 
     def push(self, ids: np.ndarray, readings: list, counts: np.ndarray) -> list[list]:
         """Add ``readings[n]`` to track ``ids[n]`` where ``counts[n]``; each listed track's readings."""
-        ids = [int(i) for i in np.asarray(ids).tolist()]
-        listed = set(ids)
+        track_ids = [int(i) for i in np.asarray(ids).tolist()]
+        listed = set(track_ids)
         self._by_track = {i: v for i, v in self._by_track.items() if i in listed}
         out = []
-        for i, reading, c in zip(ids, readings, np.asarray(counts).tolist(), strict=True):
+        for i, reading, c in zip(track_ids, readings, np.asarray(counts).tolist(), strict=True):
             recent = self._by_track.setdefault(i, [])
             if c:
                 recent.append(reading)

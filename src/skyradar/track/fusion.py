@@ -113,8 +113,11 @@ def fuse_heads(
     pos = det[list(_NED)].to_numpy(float) if all(c in det.columns for c in _NED) else None
     snr = det["snr_db"].to_numpy(float) if "snr_db" in det.columns else np.zeros(len(det))
     heads = det[HEAD_COLUMN].astype(str).to_numpy()
-    gates = (range_gate_bins * config.range_resolution_m, doppler_gate_bins * config.doppler_resolution_mps)
-    gates += (position_gate,)
+    gates = (
+        range_gate_bins * config.range_resolution_m,
+        doppler_gate_bins * config.doppler_resolution_mps,
+        position_gate,
+    )
     times = det["time_s"].to_numpy(float)
     dup = np.zeros(len(det), bool)
     # Secondary rows (gate-only candidates, skyradar.track.tracker) are kept as they are: a track

@@ -369,7 +369,10 @@ def _judge(sl, t, rng, vel, own_p, own_v, surface_down, width, coupling, test, d
         measured = doa[3][sl]
         if not direction_measured(measured) or doa_on_the_ground(measured, doa[2][sl]):
             return "direction"
-    if surface_down is None or doa_in_the_air(*(a[sl] for a in doa), test.doa_sigma_rad, test.doa_field_rad):
+    azimuth, elevation, height_sd, measured = (a[sl] for a in doa)
+    if surface_down is None or doa_in_the_air(
+        azimuth, elevation, height_sd, measured, test.doa_sigma_rad, test.doa_field_rad
+    ):
         return ""
     fit = (test.sigma_range_m, test.sigma_velocity_mps, test.tail, test.trim)
     ground = fits_static_ground(rng[sl], vel[sl], own_p[sl], own_v[sl], surface_down, width, coupling, *fit)
@@ -456,8 +459,10 @@ def _track_held(det: np.ndarray, ownship, surface_down, width: float, coupling: 
     cuts = np.flatnonzero(np.diff(t) > test.rejudge_gap_s) + 1
     for a, b in zip(np.r_[0, cuts], np.r_[cuts, t.size], strict=True):
         s = slice(a, b)
-        own = (None, None) if own_p is None else (own_p[s], own_v[s])
-        why[s] = _history_held(t[s], rng[s], vel[s], *own, ground, width, coupling, test, [a[s] for a in doa])
+        own_ps, own_vs = (None, None) if own_p is None or own_v is None else (own_p[s], own_v[s])
+        why[s] = _history_held(
+            t[s], rng[s], vel[s], own_ps, own_vs, ground, width, coupling, test, [a[s] for a in doa]
+        )
     return why
 
 

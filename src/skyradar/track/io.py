@@ -148,7 +148,8 @@ def truth_from_frames(path: str | Path) -> tuple[Truth, RadarConfig]:
     from skyradar.io.frames import open_frames
     from skyradar.io.frames_heads import store_heads
 
-    heads = store_heads(path) or [None]
+    stored = store_heads(path)
+    heads: list[str | None] = [None] if stored is None else list(stored)
     sets = [_head_truth(open_frames(path, head=h) if h else open_frames(path), path) for h in heads]
     best = np.argmax(np.stack([np.where(s["tgt_visible"], np.nan_to_num(s["tgt_snr_db"], nan=-np.inf),
                                         -np.inf) for s in sets]), axis=0)  # fmt: skip

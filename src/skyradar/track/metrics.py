@@ -22,6 +22,8 @@ first updates are part of tracking it); ``*_confirmed`` repeats them over confir
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pandas as pd
 from scipy.optimize import linear_sum_assignment
@@ -342,7 +344,7 @@ def track_metrics(
     confirm: tuple[int, int] = (1, 1),
     counted: np.ndarray | None = None,
     coasting: bool = False,
-) -> dict[str, float]:
+) -> dict[str, Any]:
     """All track metrics of this module in one dict (see the module docstring).
 
     The defaults bridge truth gaps shorter than the tracker's coasting time (2 s) and do not count

@@ -122,12 +122,13 @@ class RunSource:
         # simulator's truth; it is small and written at creation: keep it in memory.
         state = navigation_state(ds, str(target))
         own = [] if state is None else [k for k in state if k.startswith("own_")]
-        self._own = {k: state[k].to_numpy(float) for k in own}
+        self._own = {} if state is None else {k: state[k].to_numpy(float) for k in own}
         self._compute_alerts()
 
     def _ready_frames(self) -> int:
         if not self.growing:
             return len(self.times)
+        assert self.ds is not None  # counted once the run is open
         chunk = int(self.ds["iq"].data.chunks[0][0])
         # Ask the writer's own bookkeeping which chunks are done (a leading run of them is shown).
         writer = FrameStoreWriter.attach(self.partial, chunk, len(self.times))
@@ -148,15 +149,17 @@ class RunSource:
             self.alerts = read_table(self.alerts_path, required=["time_s", "track_id", "level"])
             self.traffic_source = "alerts"
             return
+        assert self.ds is not None  # computed once the run is open
         if self.tracks_path is None and not has_ownship(self.ds):
             self.alerts, self.traffic_source = pd.DataFrame(), "none"  # e.g. a real recording: image only
             return
         tracks = None if self.tracks_path is None else read_table(self.tracks_path, sort_by="time_s")
         self.traffic_source = "truth" if tracks is None else "tracks"
         # Tracks without the run's own-ship state cannot be alerted: alerts_for_run says so.
-        names = {"run_name": str(self._opened), "tracks_name": str(self.tracks_path)}
         # The same settings as `skyradar alert` (its default --config radar) and every DAA result.
-        self.alerts = alerts_for_run(self.ds, tracks, RADAR_ALERT_CONFIG, **names)
+        self.alerts = alerts_for_run(
+            self.ds, tracks, RADAR_ALERT_CONFIG, run_name=str(self._opened), tracks_name=str(self.tracks_path)
+        )
 
     def info(self) -> dict[str, Any]:
         """Run summary for the page."""
@@ -172,11 +175,11 @@ class RunSource:
             "v_lim_mps": float(self.config.v_lim_mps),
         }
 
-    def _ownship(self, i: int) -> dict[str, float] | None:
+    def _ownship(self, i: int) -> dict[str, float | None] | None:
         if "own_north_m" not in self._own:
             return None
         row = {k: float(v[i]) for k, v in self._own.items()}
-        yaw = row.get("own_yaw_rad", np.arctan2(row["own_ve_mps"], row["own_vn_mps"]))
+        yaw = row["own_yaw_rad"] if "own_yaw_rad" in row else np.arctan2(row["own_ve_mps"], row["own_vn_mps"])
         return {
             "north_m": row["own_north_m"],
             "east_m": row["own_east_m"],
@@ -220,6 +223,7 @@ class RunSource:
                 "max_level": max([int(x["level"]) for x in traffic], default=0),
             }
             if with_image:
+                assert self.ds is not None  # frames are ready only once the run is open
                 png = range_doppler_png(np.asarray(self.ds["iq"][i].values), self.config.noise_power_w)
                 payload["rd_png"] = "data:image/png;base64," + base64.b64encode(png).decode()
         return payload

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -29,7 +30,7 @@ from skyradar.nav.gpscheck.monitor import (
     frame_verdict,
     inconsistency,
 )
-from skyradar.nav.gpscheck.preprocess import preprocess
+from skyradar.nav.gpscheck.preprocess import PreprocessOptions, preprocess
 from skyradar.nav.gpscheck.projection import frame_power, ground_image, ground_in_view_fraction
 from skyradar.nav.gpscheck.search import PoseOffset, search_offset
 from skyradar.scene.ground_grid import GroundGrid, PoseGrid, sample_at_pose
@@ -44,8 +45,8 @@ PIXEL_M = 4.0  # about the ch6 radar's 3 m range resolution; 4 m keeps one frame
 DEFAULT_METHOD = "clahe_ridge"
 # The map draws roads light and buildings dark; the radar sees them the other way round: invert the map.
 # Speckle is the radar's alone: a 3 x 3 median on the radar image.
-MAP_OPTIONS = {"invert": True}
-RADAR_OPTIONS = {"log_power": True, "despeckle_px": 3}
+MAP_OPTIONS: PreprocessOptions = {"invert": True}
+RADAR_OPTIONS: PreprocessOptions = {"log_power": True, "despeckle_px": 3}
 
 
 def radar_side(config: RadarConfig, source: str = "run") -> str:
@@ -166,7 +167,8 @@ def check_frame(
     if ground_fraction < settings.min_ground_fraction or mask.sum() < 64:
         return FrameCheck(float(ground_fraction), float("nan"), None, WING_UP)
     radar = preprocess(radar_image, method, mask, **RADAR_OPTIONS)
-    at_gps = sample_at_pose(map_processed, grid, pose_grid, *gps_pose, fill=0.0)
+    north_m, east_m, heading_rad = gps_pose
+    at_gps = sample_at_pose(map_processed, grid, pose_grid, north_m, east_m, heading_rad, fill=0.0)
     score = ssim_scores(radar, at_gps, mask)
     offset = search_offset(radar, mask, map_processed, grid, pose_grid, gps_pose, **search_options)
     return FrameCheck(
@@ -209,7 +211,7 @@ GPSCHECK_COLUMNS: dict[str, str] = {
 
 def _row(frame: int, time_s: float, gps: np.ndarray, result: FrameCheck, settings) -> dict:
     off, nan = result.offset, float("nan")
-    row = {
+    row: dict[str, Any] = {
         "frame": frame, "time_s": time_s, "gps_north_m": float(gps[0]), "gps_east_m": float(gps[1]),
         "gps_heading_deg": float(np.degrees(gps[2])), "ground_fraction": result.ground_fraction,
         "gps_ssim": result.gps_ssim,

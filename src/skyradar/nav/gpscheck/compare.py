@@ -110,7 +110,7 @@ def ssim_scores(
     *,
     win_size: int = 7,
     data_range: float = 1.0,
-) -> np.ndarray:
+) -> float | np.ndarray:
     """Mean SSIM of ``reference`` against each candidate, over the windows inside ``mask``.
 
     Parameters
@@ -226,7 +226,9 @@ def score_poses(
     where = pose_grid if map_pose_grid is None else map_pose_grid
     radar, radar_mask, where = crop_to_mask(radar, np.asarray(radar_mask, bool), where)
     candidates = sample_at_poses(map_world, grid, where, np.atleast_2d(poses), fill=0.0)
-    return ssim_scores(radar, candidates, radar_mask)
+    scores = ssim_scores(radar, candidates, radar_mask)
+    assert isinstance(scores, np.ndarray)  # candidates is a stack (n, rows, cols): an array of n
+    return scores
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,8 @@ and then sampled at any pose (:mod:`skyradar.nav.gpscheck.compare`).
 
 from __future__ import annotations
 
+from typing import TypedDict
+
 import numpy as np
 from scipy.ndimage import median_filter
 from skimage import exposure, filters
@@ -28,10 +30,21 @@ from skimage.util import img_as_ubyte
 
 from skyradar.errors import InputError
 
-__all__ = ["METHODS", "THESIS_METHOD_NUMBER", "scale_to_unit", "preprocess"]
+__all__ = ["METHODS", "THESIS_METHOD_NUMBER", "PreprocessOptions", "scale_to_unit", "preprocess"]
 
 METHODS = ("gamma", "threshold_entropy", "clahe_ridge", "clahe_entropy")
 THESIS_METHOD_NUMBER = {"threshold_entropy": 5, "clahe_ridge": 8, "clahe_entropy": 9}
+
+
+class PreprocessOptions(TypedDict, total=False):
+    """Keyword options of :func:`preprocess`, kept as a set (the map's, the radar's)."""
+
+    log_power: bool
+    invert: bool
+    despeckle_px: int
+    clahe_kernel_px: int
+    ridge_sigmas_px: tuple[float, ...]
+    entropy_radius_px: int
 
 
 def scale_to_unit(

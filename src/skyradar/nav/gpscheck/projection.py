@@ -51,7 +51,9 @@ def frame_power(iq: np.ndarray) -> np.ndarray:
     return power_image(iq)  # the one channel-mean power image (skyradar.process.power)
 
 
-def antenna_pose(config: RadarConfig, attitude_rad: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
+def antenna_pose(
+    config: RadarConfig, attitude_rad: Sequence[float] | np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Antenna phase centre relative to the aircraft (NED, m) and the NED-to-antenna rotation.
 
     Flat local frame: the attitude (yaw, pitch, roll) is relative to the local vertical.
@@ -110,8 +112,8 @@ def ground_image(
     power_rd: np.ndarray,
     config: RadarConfig,
     pose_grid: PoseGrid,
-    attitude_rad: Sequence[float],
-    velocity_ned_mps: Sequence[float],
+    attitude_rad: Sequence[float] | np.ndarray,
+    velocity_ned_mps: Sequence[float] | np.ndarray,
     height_m: float,
     beam_db: float = -10.0,
     compensate: bool = False,
@@ -195,7 +197,7 @@ def _ground_vectors(
 
 
 def ground_in_view_fraction(
-    config: RadarConfig, attitude_rad: Sequence[float], height_m: float, n: int = 61
+    config: RadarConfig, attitude_rad: Sequence[float] | np.ndarray, height_m: float, n: int = 61
 ) -> float:
     """Share of the beam's two-way energy that falls on the ground within the processed range.
 

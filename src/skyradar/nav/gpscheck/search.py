@@ -192,7 +192,7 @@ def search_offset(
     c_surf = s.surfaces(coarse)
     fine, surface, peaks, k = _fine(s, coarse[int(np.argmax([sf.max() for sf in c_surf]))], coarse_step_deg,
                                     fine_step_deg)  # fmt: skip
-    a, b = np.unravel_index(int(np.argmax(surface)), surface.shape)
+    a, b = (int(v) for v in np.unravel_index(int(np.argmax(surface)), surface.shape))
     da, db = _subpixel(surface, a, b)
     dk = _parabola(peaks[k - 1], peaks[k], peaks[k + 1]) if 0 < k < len(peaks) - 1 else 0.0
     d_heading = fine[k] + dk * np.radians(fine_step_deg)

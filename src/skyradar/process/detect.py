@@ -350,7 +350,7 @@ def detect(
             secondary = np.concatenate([secondary, np.ones(r_low.size, bool)])
         noise = noise_map[r, d] if use_cfar_noise else np.full(r.size, config.noise_power_w, np.float32)
     elif method in ("cfar", "os-cfar"):
-        kind = "ca" if method == "cfar" else "os"
+        kind: Literal["ca", "os"] = "ca" if method == "cfar" else "os"
         hits, noise_map = cfar_2d(power, guard, train, pfa, kind, config.n_rx, exclude=exclude)
         r, d = blob_peaks(hits, power)
         noise = noise_map[r, d] if use_cfar_noise else np.full(r.size, config.noise_power_w, np.float32)

@@ -84,6 +84,10 @@ class Deleter(Protocol):
 class Reacquirer(Protocol):
     """Keeps closed confirmed tracks and gives their id to a new track on the same aircraft."""
 
+    def __len__(self) -> int:
+        """Lost tracks kept."""
+        ...
+
     def add_anchored(self, tracks: dict[str, np.ndarray], mask: np.ndarray) -> None:
         """Keep the tracks ``mask`` of the tracker's struct of arrays, at their anchor states."""
         ...

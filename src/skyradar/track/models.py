@@ -73,7 +73,7 @@ class MotionModel:
     init_sigma_accel_mps2: float = 3.0
     coupling_s: float = 0.0
 
-    def transition(self, dt_s: np.ndarray) -> np.ndarray:
+    def transition(self, dt_s: float | np.ndarray) -> np.ndarray:
         """State transition matrices, shape ``dt_s.shape + (4, 4)``.
 
         Examples
@@ -88,7 +88,7 @@ class MotionModel:
         F[..., 1, 3] = dt
         return F
 
-    def process_noise(self, dt_s: np.ndarray) -> np.ndarray:
+    def process_noise(self, dt_s: float | np.ndarray) -> np.ndarray:
         """Process noise covariance matrices, shape ``dt_s.shape + (4, 4)``.
 
         The radar model treats ``(R, V_R, dV_R/dt)`` as one constant-acceleration chain driven by

@@ -93,10 +93,11 @@ class RangeDopplerTracker:
         self.reacquirer = reacquirer or LostTracks(model, c.reacquire_s, c.reacquire_jerk_mps3, c.gate,
                                                    c.resolve_fraction * model.doppler_width_mps)  # fmt: skip
         self._reacquired = np.zeros((0, 2), np.int64)
-        self.time_s: float | None = None
+        self.time_s: float | None = None  # the last frame's time; None before the first
+        self._now = 0.0  # the frame being processed, for the stages of step
         self._next_id = 0
         self._range_wrap: np.ndarray | None = None
-        self._cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+        self._cache: dict[float, tuple[np.ndarray, ...]] = {}
         k = self.config.history
         self.tracks = {
             "x": np.zeros((0, 4)),
@@ -156,7 +157,7 @@ class RangeDopplerTracker:
                     tr["x"][rows], tr["P"][rows] = predict(tr["x"][rows], tr["P"][rows], FF, QQ)
             else:
                 tr["x"], tr["P"] = predict(tr["x"], tr["P"], F, Q)
-        self.time_s = float(time_s)
+        self.time_s = self._now = float(time_s)
         self._close_stale()
         assoc = self._associate(z, secondary)
         assigned = np.full(tr["ids"].size, -1)
@@ -176,7 +177,7 @@ class RangeDopplerTracker:
         confirmed = tr["confirmed"][: assigned.size]
         out = np.ones(assigned.size, bool) if self.report_tentative else confirmed
         return FrameTracks(
-            self.time_s,
+            self._now,
             tr["ids"][: assigned.size][out],
             tr["x"][: assigned.size][out],
             tr["P"][: assigned.size][out],
@@ -216,7 +217,7 @@ class RangeDopplerTracker:
         range_wrap = None
         if self._thesis:
             range_wrap = np.where(
-                tr["n_updates"] == 1, m.doppler_width_mps * (self.time_s - tr["t_update"]), np.nan
+                tr["n_updates"] == 1, m.doppler_width_mps * (self._now - tr["t_update"]), np.nan
             )
         self._range_wrap = range_wrap
         # Confirmed tracks choose first; tentative tracks share what is left. Otherwise the
@@ -264,13 +265,13 @@ class RangeDopplerTracker:
         if rows.size == 0:
             return
         if self._range_wrap is not None:
-            self._shift_alias(rows, z[assoc.detection_index, 0], assoc.innovation[:, 0])
+            self._shift_alias(rows, z[assoc.detection_index, 0], assoc.innovation[:, 0], self._range_wrap)
         x, P = tr["x"][rows], tr["P"][rows]
         tr["x"][rows], tr["P"][rows] = update(x, P, assoc.innovation, self._H, self._R)
         if self._hybrid:
             self._resolve(rows)
         if self._thesis:
-            push_history(tr["hist_t"], rows, np.full(rows.size, self.time_s), tr["n_updates"][rows])
+            push_history(tr["hist_t"], rows, np.full(rows.size, self._now), tr["n_updates"][rows])
             push_history(tr["hist_r"], rows, z[assoc.detection_index, 0], tr["n_updates"][rows])
             rate = range_rate_fit(tr["hist_t"][rows], tr["hist_r"][rows], tr["n_updates"][rows] + 1)
             ok = np.isfinite(rate)
@@ -300,7 +301,9 @@ class RangeDopplerTracker:
         self.tracks["x"][rows, 1] += delta_mps
         self.tracks["x"][rows, 0] -= self.model.coupling_s * delta_mps
 
-    def _shift_alias(self, rows: np.ndarray, range_m: np.ndarray, wrapped_m: np.ndarray) -> None:
+    def _shift_alias(
+        self, rows: np.ndarray, range_m: np.ndarray, wrapped_m: np.ndarray, range_wrap: np.ndarray
+    ) -> None:
         """Move single-observation tracks to the alias their wrapped range innovation chose.
 
         The wrapped residual differs from the raw one by ``k * W * dt``; that ``k`` is the thesis'
@@ -308,7 +311,7 @@ class RangeDopplerTracker:
         shifted by ``k`` image widths (range by ``k W dt``) before the ordinary update.
         """
         tr, width = self.tracks, self.model.doppler_width_mps
-        span = self._range_wrap[rows]
+        span = range_wrap[rows]
         use = np.isfinite(span) & (span > 0)
         if not np.any(use):
             return
@@ -326,13 +329,13 @@ class RangeDopplerTracker:
         tr["window"] = np.where(again, 0, tr["window"])
         # The anchor moves only with updates right after another (a gate that had no time to grow).
         solid = hit & (tr["misses"] <= 1) & tr["confirmed"]
-        set_anchor(tr, np.flatnonzero(solid), self.time_s)
+        set_anchor(tr, np.flatnonzero(solid), self._now)
         tr["frames"] += 1
         tr["hits"] += hit
         tr["window"] = push_hit(tr["window"], hit, self.initiator.n)
         tr["n_updates"] += hit
         tr["misses"] = np.where(hit, 0, tr["misses"] + 1)
-        tr["t_update"] = np.where(hit, self.time_s, tr["t_update"])
+        tr["t_update"] = np.where(hit, self._now, tr["t_update"])
 
     def _manage(self) -> np.ndarray:
         """Confirm, delete and reacquire; returns the surviving tracks' pre-deletion rows, by id."""
@@ -340,7 +343,7 @@ class RangeDopplerTracker:
         tentative = ~tr["confirmed"]
         confirmed_now, failed = self.initiator.window_status(tr["window"], tr["misses"])
         tr["confirmed"] = tr["confirmed"] | (tentative & confirmed_now)
-        set_anchor(tr, np.flatnonzero(tentative & tr["confirmed"]), self.time_s)
+        set_anchor(tr, np.flatnonzero(tentative & tr["confirmed"]), self._now)
         # A track that was confirmed and must be confirmed again after a gap lives until the
         # deleter's coasting limits close it, as a confirmed track does: a patchy return (an aircraft
         # in clutter, a fade) fails an M-of-N window without the aircraft being gone, and a new track
@@ -350,13 +353,13 @@ class RangeDopplerTracker:
         # track is. Only tracks never confirmed are dropped when their window fails.
         known = tr["confirmed"] | tr["was_confirmed"]
         dead = (tentative & failed & ~known) | (
-            known & self.deleter.delete(tr["misses"], self.time_s - tr["t_update"])
+            known & self.deleter.delete(tr["misses"], self._now - tr["t_update"])
         )
         back = np.flatnonzero(tentative & failed & known & ~tr["confirmed"] & ~dead)
         if back.size:
             tr["x"][back], tr["P"][back] = self.reacquirer.predict(
                 tr["anchor_x"][back], tr["anchor_P"][back], tr["anchor_resolved"][back],
-                self.time_s - tr["anchor_t"][back],
+                self._now - tr["anchor_t"][back],
             )  # fmt: skip
             tr["resolved"][back] = tr["anchor_resolved"][back]
         # Closed tracks that were ever confirmed are kept as lost, at their last solid update.
@@ -376,7 +379,7 @@ class RangeDopplerTracker:
         frames between detections (``skyradar track`` steps on detection times) such a track meets
         the next frame with a gate over much of the image and takes whatever is there."""
         tr = self.tracks
-        stale = self.time_s - tr["t_update"] > self.deleter.max_coast_s
+        stale = self._now - tr["t_update"] > self.deleter.max_coast_s
         if not np.any(stale):
             return
         self.reacquirer.add_anchored(tr, stale & tr["was_confirmed"])
@@ -389,7 +392,7 @@ class RangeDopplerTracker:
         self._reacquired = np.zeros((0, 2), np.int64)
         if rows.size == 0 or len(self.reacquirer) == 0:
             return
-        lost_ids, alias = self.reacquirer.match(tr["x"][rows], tr["P"][rows], self.time_s)
+        lost_ids, alias = self.reacquirer.match(tr["x"][rows], tr["P"][rows], self._now)
         hit = lost_ids >= 0
         self._reacquired = np.column_stack([tr["ids"][rows[hit]], lost_ids[hit]])
         tr["ids"][rows[hit]] = lost_ids[hit]
@@ -412,13 +415,13 @@ class RangeDopplerTracker:
         k = self.config.history
         hist_t = np.full((n, k), np.nan)
         hist_r = np.full((n, k), np.nan)
-        hist_t[:, 0] = self.time_s
+        hist_t[:, 0] = self._now
         hist_r[:, 0] = z_new[:, 0]
         new = {
             "x": x,
             "P": np.broadcast_to(self._P0, (n, 4, 4)),
             "ids": np.arange(self._next_id, self._next_id + n),
-            "t_update": np.full(n, self.time_s),
+            "t_update": np.full(n, self._now),
             "hits": np.ones(n, np.int64),
             "frames": np.ones(n, np.int64),
             "window": np.ones(n, np.int64),
@@ -428,7 +431,7 @@ class RangeDopplerTracker:
             "hist_t": hist_t,
             "hist_r": hist_r,
             "resolved": np.zeros(n, bool),
-            **anchor_fields(x, np.broadcast_to(self._P0, (n, 4, 4)), self.time_s),
+            **anchor_fields(x, np.broadcast_to(self._P0, (n, 4, 4)), self._now),
         }
         self._next_id += n
         for name in _FIELDS:

@@ -145,9 +145,15 @@ def test_impala_state_vectors_use_geoaltitude_in_metres(tmp_path):
     df = _rows()
     alt_m = df["altitude"] * 0.3048
     impala = pd.DataFrame(
-        {"time": df["timestamp"], "icao24": df["icao24"], "lat": df["latitude"], "lon": df["longitude"],
-         "baroaltitude": alt_m - 30.0, "geoaltitude": alt_m.where(df.index != 2)}
-    )  # fmt: skip
+        {
+            "time": df["timestamp"],
+            "icao24": df["icao24"],
+            "lat": df["latitude"],
+            "lon": df["longitude"],
+            "baroaltitude": alt_m - 30.0,
+            "geoaltitude": alt_m.where(df.index != 2),
+        }
+    )
     impala.to_parquet(tmp_path / "f.parquet")
     traj = read_trajectory(tmp_path / "f.parquet")
     np.testing.assert_allclose(traj.sample(np.arange(len(df), dtype=float)).alt_m, alt_m, atol=0.2)

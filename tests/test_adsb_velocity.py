@@ -20,10 +20,17 @@ KT = 1852.0 / 3600.0
 def _write(tmp_path, track_deg: float) -> str:
     t = np.arange(0.0, 60.0, 5.0)
     north_m = 60.0 * t  # due north at 60 m/s
-    df = pd.DataFrame({"timestamp": 1_700_000_000 + t, "latitude": 48.0 + north_m / 111_200.0,
-                       "longitude": np.full(t.size, 16.0), "altitude": np.full(t.size, 3000.0),
-                       "groundspeed": np.full(t.size, 60.0 / KT), "track": np.full(t.size, track_deg),
-                       "vertical_rate": np.zeros(t.size)})  # fmt: skip
+    df = pd.DataFrame(
+        {
+            "timestamp": 1_700_000_000 + t,
+            "latitude": 48.0 + north_m / 111_200.0,
+            "longitude": np.full(t.size, 16.0),
+            "altitude": np.full(t.size, 3000.0),
+            "groundspeed": np.full(t.size, 60.0 / KT),
+            "track": np.full(t.size, track_deg),
+            "vertical_rate": np.zeros(t.size),
+        }
+    )
     path = tmp_path / f"track_{track_deg:g}.csv"
     df.to_csv(path, index=False)
     return str(path)

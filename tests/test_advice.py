@@ -155,9 +155,13 @@ def test_terrain_vertical_speed_bands():
     _, _, low = vertical_speed_bands(own, none, none, VOL, LOOK, height_agl_m=100.0, terrain_lookahead_s=20.0)
     assert low[vs < 2.5].all() and not low[vs >= 2.5].any()
     adv = resolution_advice(
-        np.array([50.0, 0, 3.0]), np.array([[4000.0, 0.0, 0.0]]), np.array([[-50.0, 0, 0]]), VOL, LOOK,
+        np.array([50.0, 0, 3.0]),
+        np.array([[4000.0, 0.0, 0.0]]),
+        np.array([[-50.0, 0, 0]]),
+        VOL,
+        LOOK,
         height_agl_m=120.0,
-    )  # fmt: skip
+    )
     assert adv["terrain_vs_bands_mps"]
     assert adv["preferred_vs_mps"] >= (150.0 - 120.0) / 30.0
 

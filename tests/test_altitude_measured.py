@@ -41,15 +41,32 @@ def _detections(elevation_measured: bool, n: int = 40) -> pd.DataFrame:
     north = 2000.0 - 60.0 * t
     down = np.where(elevation_measured, -200.0, 0.0)  # the prior puts it co-altitude
     slant = np.hypot(north, 200.0)
-    return pd.DataFrame({
-        "time_s": t, "range_m": slant, "radial_velocity_mps": -60.0 * north / slant, "north_m": north,
-        "east_m": 0.0, "down_m": down, "snr_db": 25.0, "elevation_measured": elevation_measured,
-    })  # fmt: skip
+    return pd.DataFrame(
+        {
+            "time_s": t,
+            "range_m": slant,
+            "radial_velocity_mps": -60.0 * north / slant,
+            "north_m": north,
+            "east_m": 0.0,
+            "down_m": down,
+            "snr_db": 25.0,
+            "elevation_measured": elevation_measured,
+        }
+    )
 
 
 def test_tracks_and_alerts_say_when_the_height_is_a_prior():
-    own = pd.DataFrame({"time_s": [0.0, 10.0], "own_north_m": 0.0, "own_east_m": 0.0, "own_down_m": 0.0,
-                        "own_vn_mps": 0.0, "own_ve_mps": 0.0, "own_vd_mps": 0.0})  # fmt: skip
+    own = pd.DataFrame(
+        {
+            "time_s": [0.0, 10.0],
+            "own_north_m": 0.0,
+            "own_east_m": 0.0,
+            "own_down_m": 0.0,
+            "own_vn_mps": 0.0,
+            "own_ve_mps": 0.0,
+            "own_vd_mps": 0.0,
+        }
+    )
     for measured in (True, False):
         tracks = track_detections(_detections(measured))
         confirmed = tracks[tracks["confirmed"]]
@@ -62,6 +79,15 @@ def test_tracks_and_alerts_say_when_the_height_is_a_prior():
 
 def test_alerts_of_tracks_without_the_flag_count_their_height_as_measured():
     tracks = track_detections(_detections(True)).drop(columns="altitude_measured")
-    own = pd.DataFrame({"time_s": [0.0, 10.0], "own_north_m": 0.0, "own_east_m": 0.0, "own_down_m": 0.0,
-                        "own_vn_mps": 0.0, "own_ve_mps": 0.0, "own_vd_mps": 0.0})  # fmt: skip
+    own = pd.DataFrame(
+        {
+            "time_s": [0.0, 10.0],
+            "own_north_m": 0.0,
+            "own_east_m": 0.0,
+            "own_down_m": 0.0,
+            "own_vn_mps": 0.0,
+            "own_ve_mps": 0.0,
+            "own_vd_mps": 0.0,
+        }
+    )
     assert alerts_from_tracks(tracks, own, with_advice=False)["altitude_measured"].all()

@@ -93,8 +93,12 @@ def test_crlb_of_the_2x3_array_is_the_closed_form():
     q = cfg.rx_positions_m - cfg.rx_positions_m.mean(axis=0)
     m = q.T @ q
     for az, el in [(0.4, -0.2), (-0.7, 0.5)]:
-        g = np.array([[-np.cos(el) * np.sin(az), np.cos(el) * np.cos(az), 0.0],
-                      [-np.sin(el) * np.cos(az), -np.sin(el) * np.sin(az), -np.cos(el)]]).T  # fmt: skip
+        g = np.array(
+            [
+                [-np.cos(el) * np.sin(az), np.cos(el) * np.cos(az), 0.0],
+                [-np.sin(el) * np.cos(az), -np.sin(el) * np.sin(az), -np.cos(el)],
+            ]
+        ).T
         cov = np.linalg.inv(2 * snr * kappa**2 * g.T @ m @ g)
         np.testing.assert_allclose(doa_crlb(snr_db, az, el, cfg), np.sqrt(np.diag(cov)), rtol=1e-10)
 
@@ -107,14 +111,24 @@ def test_one_channel_has_no_direction():
 
 def _head_on(rx, duration_s: float) -> dict:
     return {
-        "name": "array", "origin": {"lat_deg": 52.0, "lon_deg": 4.36, "alt_m": 0.0},
-        "radar": {"range_limit_m": 1500, "rx_positions_m": rx} if not isinstance(rx, str)
+        "name": "array",
+        "origin": {"lat_deg": 52.0, "lon_deg": 4.36, "alt_m": 0.0},
+        "radar": {"range_limit_m": 1500, "rx_positions_m": rx}
+        if not isinstance(rx, str)
         else {"range_limit_m": 1500, "rx_layout": rx},
         "ownship": {"type": "straight", "start_ned_m": [0, 0, -2000], "speed_mps": 50},
-        "intruders": [{"name": "A", "type": "straight", "start_ned_m": [600, -100, -2000],
-                       "heading_deg": 180, "speed_mps": 40}],
-        "frame_rate_hz": 9.4, "duration_s": duration_s,
-    }  # fmt: skip
+        "intruders": [
+            {
+                "name": "A",
+                "type": "straight",
+                "start_ned_m": [600, -100, -2000],
+                "heading_deg": 180,
+                "speed_mps": 40,
+            }
+        ],
+        "frame_rate_hz": 9.4,
+        "duration_s": duration_s,
+    }
 
 
 def test_one_channel_chain_runs_to_alerts_in_range_and_range_rate():

@@ -32,8 +32,13 @@ def test_ours_and_the_baseline_give_the_same_miss_distances(seed):
 
 def _cli(*args: str) -> subprocess.CompletedProcess:
     env = os.environ | {"COLUMNS": "200"}
-    return subprocess.run([sys.executable, "-m", "skyradar", "bench", "alert", *args],
-                          capture_output=True, text=True, env=env, timeout=300)  # fmt: skip
+    return subprocess.run(
+        [sys.executable, "-m", "skyradar", "bench", "alert", *args],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
+    )
 
 
 def test_bench_alert_prints_json_last():

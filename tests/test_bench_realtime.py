@@ -59,8 +59,10 @@ def test_bench_realtime_refuses_settings_out_of_range_in_one_line(args):
 def test_bench_realtime_prints_its_json_last():
     run = subprocess.run(
         [sys.executable, "-m", "skyradar", "bench", "realtime", "--seconds", "5", "--json"],
-        capture_output=True, text=True, check=True,
-    )  # fmt: skip
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     result = json.loads(run.stdout.strip().splitlines()[-1])
     assert result["realtime_frames"] == 3 * 47 and result["realtime_threads"] == 1
     assert result["realtime_latency_p99_ms"] >= result["realtime_latency_median_ms"] > 0

@@ -21,12 +21,20 @@ SCENARIO = {
     "mount": "forward",
     "terrain": {"type": "flat", "size_m": 3000, "spacing_m": 60},
     "ownship": {"type": "straight", "start_ned_m": [0, 0, -500], "heading_deg": 0, "speed_mps": 40},
-    "intruders": [{"name": "A", "type": "encounter", "kind": "head-on", "t_cpa_s": 30, "rcs_m2": 1.0,
-                   "intruder_speed_mps": 40}],
+    "intruders": [
+        {
+            "name": "A",
+            "type": "encounter",
+            "kind": "head-on",
+            "t_cpa_s": 30,
+            "rcs_m2": 1.0,
+            "intruder_speed_mps": 40,
+        }
+    ],
     "frame_rate_hz": 5.0,
     "duration_s": 2.4,
     "simulation": {"facet_size_m": 30.0},
-}  # fmt: skip
+}
 
 
 @pytest.fixture(scope="module")
@@ -86,15 +94,24 @@ def test_the_velocity_mean_is_the_last_five_frames_and_a_gap_spoils_only_those()
 
     rng = np.random.default_rng(1)
     n = 12
-    own = {"own_vn_mps": 50 + rng.normal(0, 0.2, n), "own_ve_mps": rng.normal(0, 0.2, n),
-           "own_vd_mps": rng.normal(0, 0.2, n), "own_yaw_rad": rng.uniform(-3, 3, n),
-           "own_pitch_rad": np.zeros(n), "own_roll_rad": np.zeros(n),
-           "own_height_agl_m": np.full(n, 400.0), "has_geo": np.array(False)}  # fmt: skip
+    own = {
+        "own_vn_mps": 50 + rng.normal(0, 0.2, n),
+        "own_ve_mps": rng.normal(0, 0.2, n),
+        "own_vd_mps": rng.normal(0, 0.2, n),
+        "own_yaw_rad": rng.uniform(-3, 3, n),
+        "own_pitch_rad": np.zeros(n),
+        "own_roll_rad": np.zeros(n),
+        "own_height_agl_m": np.full(n, 400.0),
+        "has_geo": np.array(False),
+    }
     got = frame_geometries(own)
     for i in range(n):  # peer: each frame's velocity rotated into its heading-free frame, then averaged
         rows = range(max(i - 4, 0), i + 1)
-        v = [rotation_matrix(own["own_yaw_rad"][j], 0.0, 0.0).T @ [own[k][j] for k in
-             ("own_vn_mps", "own_ve_mps", "own_vd_mps")] for j in rows]  # fmt: skip
+        v = [
+            rotation_matrix(own["own_yaw_rad"][j], 0.0, 0.0).T
+            @ [own[k][j] for k in ("own_vn_mps", "own_ve_mps", "own_vd_mps")]
+            for j in rows
+        ]
         np.testing.assert_allclose(got[i, :3], np.mean(v, axis=0), atol=1e-12)
     own["own_vn_mps"][3] = np.nan  # a navigation gap
     spoiled = ~np.isfinite(frame_geometries(own)).all(axis=1)

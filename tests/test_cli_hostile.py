@@ -215,10 +215,14 @@ def test_chunk_larger_than_the_run_is_the_whole_run(tmp_path):
 
 def test_directory_as_table_and_sweep_suffix(tmp_path):
     (tmp_path / "folder.parquet").mkdir()
-    _assert_one_line_error(_skyradar("track", "folder.parquet", "-o", "t.parquet", cwd=tmp_path),
-                           "folder.parquet", "is a directory")  # fmt: skip
+    _assert_one_line_error(
+        _skyradar("track", "folder.parquet", "-o", "t.parquet", cwd=tmp_path),
+        "folder.parquet",
+        "is a directory",
+    )
     (tmp_path / "s.yaml").write_text(yaml.safe_dump(BASE))
-    result = _skyradar("sweep", "s.yaml", "--param", "intruders.0.rcs_m2", "--values", "1,2", "-o", "x.txt",
-                       cwd=tmp_path)  # fmt: skip
+    result = _skyradar(
+        "sweep", "s.yaml", "--param", "intruders.0.rcs_m2", "--values", "1,2", "-o", "x.txt", cwd=tmp_path
+    )
     _assert_one_line_error(result, "x.txt", ".csv or .parquet")
     assert not (tmp_path / "x.txt").exists()

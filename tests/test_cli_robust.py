@@ -92,24 +92,30 @@ def test_track_without_air_detections_writes_empty_table(tmp_path, n, ground, mo
         (("experiment", "ch5", "--fast-duration", "inf"), ["--fast-duration", "inf"]),
         (("experiment", "encounters", "--frame-rate", "nan"), ["--frame-rate", "nan"]),
         (("experiment", "encounters", "--split", "evaluation", "--seed", "5"), ["--seed 5", "evaluation"]),
-        (("experiment", "encounters", "--split", "development", "--seed", "7001"),
-         ["--seed 7001", "development"]),
+        (
+            ("experiment", "encounters", "--split", "development", "--seed", "7001"),
+            ["--seed 7001", "development"],
+        ),
         (("experiment", "encounters", "--alert-config", "fast"), ["--alert-config", "fast"]),
         (("experiment", "clutter", "--terrain", "hills,marsh"), ["--terrain", "marsh", "jacksboro"]),
-        (("passive", "r.sigmf-meta", "-o", "p.parquet", "--max-range-m", "3e4", "--max-range-km", "30"),
-         ["--max-range-m", "--max-range-km"]),
+        (
+            ("passive", "r.sigmf-meta", "-o", "p.parquet", "--max-range-m", "3e4", "--max-range-km", "30"),
+            ["--max-range-m", "--max-range-km"],
+        ),
         (("process", "run.zarr", "-o", "d.parquet", "--pfa", "5"), ["--pfa", "5"]),
         (("process", "run.zarr", "-o", "d.parquet", "--pfa", "-1"), ["--pfa", "-1"]),
         (("process", "run.zarr", "-o", "d.parquet", "--pfa-secondary", "1"), ["--pfa-secondary", "1"]),
         (("process", "run.zarr", "-o", "d.parquet", "--pfa-secondary", "nan"), ["--pfa-secondary", "nan"]),
-        (("calibrate", "r.zarr", "-o", "c.json", "--range", "-5", "--azimuth", "0", "--elevation", "0"),
-         ["--range", "-5"]),
+        (
+            ("calibrate", "r.zarr", "-o", "c.json", "--range", "-5", "--azimuth", "0", "--elevation", "0"),
+            ["--range", "-5"],
+        ),
         (("spur-map", "r.zarr", "-o", "s.npz", "--threshold", "2"), ["--threshold", "2"]),
         (("simulate", "s.yaml", "-o", "r.zarr", "--workers", "0"), ["--workers", "0"]),
         (("track", "d.parquet", "-o", "t.parquet", "--origin", "95,4,0"), ["--origin", "lat_deg", "95"]),
         (("evaluate", "r.zarr", "t.parquet", "--gospa-c", "nan"), ["--gospa-c", "nan"]),
     ],
-)  # fmt: skip
+)
 def test_bad_option_values_give_one_line(tmp_path, args, needles):
     _detections(tmp_path / "d.parquet", 3, False)
     result = _skyradar(*args, cwd=tmp_path, timeout=60)
@@ -143,9 +149,13 @@ def test_yaml_alias_bomb_is_refused_quickly(tmp_path, command):
         args = ["sweep", str(bomb), "--param", "duration_s", "--values", "1", "-o", "t.csv"]
     try:
         result = subprocess.run(
-            [sys.executable, "-m", "skyradar", *args], cwd=tmp_path, capture_output=True, text=True,
-            timeout=60, preexec_fn=_limit_memory,
-        )  # fmt: skip
+            [sys.executable, "-m", "skyradar", *args],
+            cwd=tmp_path,
+            capture_output=True,
+            text=True,
+            timeout=60,
+            preexec_fn=_limit_memory,
+        )
     except subprocess.TimeoutExpired:
         pytest.fail("the YAML bomb was expanded (no answer within 60 s)")
     _assert_one_line_error(result, "bomb.yaml", "aliases expand")
@@ -361,11 +371,24 @@ def test_implausible_trajectory_file_is_refused(tmp_path, rows, needles):
         (("process", "run.zarr", "-o", "d.parquet", "--spur-mode", "bogus"), ["--spur-mode", "bogus"]),
         (("spur-map", "run.zarr", "-o", "s.npz", "--pixels", "bogus"), ["--pixels", "bogus"]),
         (("state", "run.zarr", "-o", "s.parquet", "--method", "bogus"), ["--method", "bogus"]),
-        (("calibrate", "run.zarr", "-o", "c.json", "--range", "5000", "--azimuth", "0", "--elevation", "0"),
-         ["--range", "5000", "run.zarr"]),
+        (
+            (
+                "calibrate",
+                "run.zarr",
+                "-o",
+                "c.json",
+                "--range",
+                "5000",
+                "--azimuth",
+                "0",
+                "--elevation",
+                "0",
+            ),
+            ["--range", "5000", "run.zarr"],
+        ),
         (("experiment", "ch3", "--path", "bogus"), ["--path", "bogus"]),
     ],
-)  # fmt: skip
+)
 def test_options_are_named_in_their_errors(tmp_path, args, needles):
     _store(tmp_path / "run.zarr")
     _assert_one_line_error(_skyradar(*args, cwd=tmp_path), *needles)

@@ -92,8 +92,10 @@ def test_dem_without_finite_heights(tmp_path):
     scenario = _write(tmp_path, {**BASE, "terrain": {"type": "file", "path": "dem.npz"}})
     _assert_one_line_error(
         _skyradar("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path),
-        "dem.npz", "field 'elevation'", "no finite heights",
-    )  # fmt: skip
+        "dem.npz",
+        "field 'elevation'",
+        "no finite heights",
+    )
 
 
 def test_wrong_hgt_size(tmp_path):

@@ -39,8 +39,22 @@ def _alive(pid: int) -> bool:
 
 
 def test_sigterm_ends_the_encounter_workers_and_says_how_to_resume(tmp_path):
-    command = [sys.executable, "-m", "skyradar", "experiment", "encounters", "--n", "8", "--workers", "2",
-               "--layout", "single", "--out", str(tmp_path / "out"), "--json"]  # fmt: skip
+    command = [
+        sys.executable,
+        "-m",
+        "skyradar",
+        "experiment",
+        "encounters",
+        "--n",
+        "8",
+        "--workers",
+        "2",
+        "--layout",
+        "single",
+        "--out",
+        str(tmp_path / "out"),
+        "--json",
+    ]
     proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline, workers = time.time() + 120, set()
     while time.time() < deadline and proc.poll() is None and len(workers) < 2:

@@ -42,8 +42,12 @@ def _reference(cube, cnr, floor, power0, window=ADAPTIVE_WINDOW, gate=3.0, max_n
     mask, unsup = np.zeros((n_r, n_d), bool), np.zeros((n_r, n_d), bool)
     for r in range(n_r):
         for d in range(n_d):
-            ring = [(rr, (d + o) % n_d) for rr in range(max(r - hr, 0), min(r + hr + 1, n_r))
-                    for o in range(-hd, hd + 1) if not (abs(rr - r) <= gr and abs(o) <= gd)]  # fmt: skip
+            ring = [
+                (rr, (d + o) % n_d)
+                for rr in range(max(r - hr, 0), min(r + hr + 1, n_r))
+                for o in range(-hd, hd + 1)
+                if not (abs(rr - r) <= gr and abs(o) <= gd)
+            ]
             rr, dd = np.array(ring).T
             if (
                 len(ring) < 16
@@ -128,16 +132,24 @@ def test_two_pair_solver_agrees_with_numpy_eigh_on_ring_covariances_warm_started
 @pytest.fixture(scope="module")
 def flat_prediction():
     one = np.ones(1)
-    own = {"own_vn_mps": 50 * one, "own_ve_mps": 0 * one, "own_vd_mps": 0 * one, "own_yaw_rad": 0 * one,
-           "own_pitch_rad": 0 * one, "own_roll_rad": 0 * one, "own_height_agl_m": 1000 * one,
-           "has_geo": np.array(False)}  # fmt: skip
+    own = {
+        "own_vn_mps": 50 * one,
+        "own_ve_mps": 0 * one,
+        "own_vd_mps": 0 * one,
+        "own_yaw_rad": 0 * one,
+        "own_pitch_rad": 0 * one,
+        "own_roll_rad": 0 * one,
+        "own_height_agl_m": 1000 * one,
+        "has_geo": np.array(False),
+    }
     return frame_subspace(own, 0, CFG)
 
 
 def _hits(cube, sub, adaptive, pixel):
     out = suppress_clutter(cube, sub, CFG, adaptive=adaptive)
-    det = detect(out.power, CFG, channels=out.channels, train_exclude=out.unsuppressed,
-                 noise_floor_w=out.noise_floor_w)  # fmt: skip
+    det = detect(
+        out.power, CFG, channels=out.channels, train_exclude=out.unsuppressed, noise_floor_w=out.noise_floor_w
+    )
     found = np.any((det.range_index == pixel[0]) & (det.doppler_index == pixel[1]))
     return out, bool(found), len(det)
 

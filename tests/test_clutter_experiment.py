@@ -16,17 +16,31 @@ from skyradar.experiments.clutter import _hit
 
 CFG = RadarConfig.prototype_2022()
 _NEW_KEYS = (
-    "intruder_cell_if_db_median", "intruder_cell_if_db_min", "detection_fraction_none",
-    "detection_fraction_suppressed", "detection_fraction_suppressed_with_secondary", "own_agl_m_median",
-    "mdv_mps_suppressed", "usable_doppler_fraction_suppressed",
-)  # fmt: skip
+    "intruder_cell_if_db_median",
+    "intruder_cell_if_db_min",
+    "detection_fraction_none",
+    "detection_fraction_suppressed",
+    "detection_fraction_suppressed_with_secondary",
+    "own_agl_m_median",
+    "mdv_mps_suppressed",
+    "usable_doppler_fraction_suppressed",
+)
 
 
 def test_relief_cases_write_one_summary_entry_and_figures_per_terrain(tmp_path, monkeypatch, capsys):
     code, out, err = skyradar_in_process(
-        monkeypatch, capsys, "experiment", "clutter", "--frames", "4", "--terrain", "hills,jacksboro",
-        "--out", tmp_path / "c", "--json",
-    )  # fmt: skip
+        monkeypatch,
+        capsys,
+        "experiment",
+        "clutter",
+        "--frames",
+        "4",
+        "--terrain",
+        "hills,jacksboro",
+        "--out",
+        tmp_path / "c",
+        "--json",
+    )
     assert code == 0, err
     summary = json.loads(out.strip().splitlines()[-1])
     assert list(summary["terrains"]) == ["hills", "jacksboro"]
@@ -65,9 +79,17 @@ def test_intruder_hit_counts_secondary_rows_only_when_asked():
 @pytest.mark.slow
 def test_flat_cases_write_figures_table_and_json(tmp_path):
     result = skyradar(
-        "experiment", "clutter", "--frames", "2", "--terrain", "flat-1000,flat-300", "--out", "c", "--json",
+        "experiment",
+        "clutter",
+        "--frames",
+        "2",
+        "--terrain",
+        "flat-1000,flat-300",
+        "--out",
+        "c",
+        "--json",
         cwd=tmp_path,
-    )  # fmt: skip
+    )
     assert result.returncode == 0, result.stderr
     summary = json.loads(result.stdout.strip().splitlines()[-1])
     flat = summary["terrains"]["flat-1000"]

@@ -120,9 +120,14 @@ def _turning_own(n: int, bank_deg: float, noise_mps: float) -> dict:
     t = np.arange(n) / 9.4
     rate = 9.81 * np.tan(np.radians(bank_deg)) / 60.0
     yaw = 0.2 + rate * t
-    own = {"own_vn_mps": 60 * np.cos(yaw), "own_ve_mps": 60 * np.sin(yaw),
-           "own_vd_mps": noise_mps * rng.standard_normal(n), "own_yaw_rad": yaw,
-           "own_pitch_rad": np.zeros(n), "own_roll_rad": np.full(n, np.radians(bank_deg))}  # fmt: skip
+    own = {
+        "own_vn_mps": 60 * np.cos(yaw),
+        "own_ve_mps": 60 * np.sin(yaw),
+        "own_vd_mps": noise_mps * rng.standard_normal(n),
+        "own_yaw_rad": yaw,
+        "own_pitch_rad": np.zeros(n),
+        "own_roll_rad": np.full(n, np.radians(bank_deg)),
+    }
     own["own_vn_mps"] = own["own_vn_mps"] + noise_mps * rng.standard_normal(n)
     return own | {"own_height_agl_m": np.full(n, 600.0), "has_geo": np.array(False)}
 

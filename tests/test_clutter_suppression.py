@@ -39,11 +39,17 @@ def _level_ownship(n: int, height_m: float) -> dict[str, np.ndarray]:
     """Own-ship variables of ``n`` frames flying north, level, at ``SPEED_MPS``, ``height_m`` up."""
     one = np.ones(n)
     return {
-        "own_north_m": 0 * one, "own_east_m": 0 * one, "own_down_m": -height_m * one,
-        "own_vn_mps": SPEED_MPS * one, "own_ve_mps": 0 * one, "own_vd_mps": 0 * one,
-        "own_yaw_rad": 0 * one, "own_pitch_rad": 0 * one, "own_roll_rad": 0 * one,
+        "own_north_m": 0 * one,
+        "own_east_m": 0 * one,
+        "own_down_m": -height_m * one,
+        "own_vn_mps": SPEED_MPS * one,
+        "own_ve_mps": 0 * one,
+        "own_vd_mps": 0 * one,
+        "own_yaw_rad": 0 * one,
+        "own_pitch_rad": 0 * one,
+        "own_roll_rad": 0 * one,
         "own_height_agl_m": height_m * one,
-    }  # fmt: skip
+    }
 
 
 def _intruder_hits(table) -> int:
@@ -91,12 +97,26 @@ def test_predicted_clutter_region_matches_the_closed_form_band(subspace):
     sub = subspace
     r, d = np.meshgrid(np.arange(CFG.n_range), np.arange(CFG.n_doppler), indexing="ij")
     rng = CFG.range_at_bin_m(r)
-    band = in_ground_band(rng, CFG.radial_velocity_at_bin_mps(d), np.array([SPEED_MPS, 0, 0]), HEIGHT_M, CFG,
-                          tolerance_mps=0.0, terrain_margin_m=0.0)  # fmt: skip
+    band = in_ground_band(
+        rng,
+        CFG.radial_velocity_at_bin_mps(d),
+        np.array([SPEED_MPS, 0, 0]),
+        HEIGHT_M,
+        CFG,
+        tolerance_mps=0.0,
+        terrain_margin_m=0.0,
+    )
     inside = band & (rng > HEIGHT_M + 5 * CFG.range_resolution_m)
     assert sub.predicted[inside].all()  # every cell the ground can reach is predicted
-    wide = in_ground_band(rng, CFG.radial_velocity_at_bin_mps(d), np.array([SPEED_MPS, 0, 0]), HEIGHT_M, CFG,
-                          tolerance_mps=3 * CFG.doppler_resolution_mps, terrain_margin_m=0.0)  # fmt: skip
+    wide = in_ground_band(
+        rng,
+        CFG.radial_velocity_at_bin_mps(d),
+        np.array([SPEED_MPS, 0, 0]),
+        HEIGHT_M,
+        CFG,
+        tolerance_mps=3 * CFG.doppler_resolution_mps,
+        terrain_margin_m=0.0,
+    )
     # (range PSF: near R = H a neighbouring range bin's ground is much faster; compare from 2 km on)
     assert not sub.predicted[~wide & (rng > 2 * HEIGHT_M)].any()
 
@@ -130,9 +150,16 @@ def test_knowledge_aided_without_own_ship_state_is_one_clear_error(tmp_path):
     assert not (tmp_path / "d.parquet").exists()
     # The same on a local Dask cluster: its workers do not print the failed task's traceback.
     result = skyradar(
-        "process", "run.zarr", "-o", "d.parquet", "--suppression", "knowledge-aided", "--workers", "2",
+        "process",
+        "run.zarr",
+        "-o",
+        "d.parquet",
+        "--suppression",
+        "knowledge-aided",
+        "--workers",
+        "2",
         cwd=tmp_path,
-    )  # fmt: skip
+    )
     assert_one_line_error(result, "run.zarr", "knowledge-aided", "own-ship state")
     assert not (tmp_path / "d.parquet").exists()
 

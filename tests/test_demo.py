@@ -22,10 +22,29 @@ from skyradar.scene.scenario import load_scenario
 def _collision(sigma_v_mps: float, dt: float = 0.5, duration_s: float = 40.0):
     """Own-ship north at 50 m/s; intruder head-on at 50 m/s, impact at t = 30 s; velocity sigma given."""
     t = np.arange(0.0, duration_s, dt)
-    own = pd.DataFrame({"time_s": t, "own_north_m": 50.0 * t, "own_east_m": 0.0, "own_down_m": -1000.0,
-                        "own_vn_mps": 50.0, "own_ve_mps": 0.0, "own_vd_mps": 0.0})  # fmt: skip
-    tracks = pd.DataFrame({"time_s": t, "track_id": 1, "north_m": 3000.0 - 50.0 * t, "east_m": 0.0,
-                           "down_m": -1000.0, "vn_mps": -50.0, "ve_mps": 0.0, "vd_mps": 0.0})  # fmt: skip
+    own = pd.DataFrame(
+        {
+            "time_s": t,
+            "own_north_m": 50.0 * t,
+            "own_east_m": 0.0,
+            "own_down_m": -1000.0,
+            "own_vn_mps": 50.0,
+            "own_ve_mps": 0.0,
+            "own_vd_mps": 0.0,
+        }
+    )
+    tracks = pd.DataFrame(
+        {
+            "time_s": t,
+            "track_id": 1,
+            "north_m": 3000.0 - 50.0 * t,
+            "east_m": 0.0,
+            "down_m": -1000.0,
+            "vn_mps": -50.0,
+            "ve_mps": 0.0,
+            "vd_mps": 0.0,
+        }
+    )
     for i in range(3):
         for j in range(3):
             tracks[f"cov_vv_{i}{j}"] = sigma_v_mps**2 if i == j else 0.0
@@ -60,11 +79,15 @@ def _truth(names=("a", "b")):
 def test_label_tracks_follows_nearest_truth_and_flags_clutter():
     truth = _truth()
     t = np.arange(5.0)
-    tracks = pd.concat([
-        pd.DataFrame({"time_s": t, "track_id": 7, "north_m": -100.0 * t + 20, "east_m": 10.0, "down_m": 0.0}),
-        pd.DataFrame({"time_s": t, "track_id": 8, "north_m": 100.0 * t, "east_m": 5.0, "down_m": -30.0}),
-        pd.DataFrame({"time_s": t, "track_id": 9, "north_m": 0.0, "east_m": 2000.0, "down_m": 0.0}),
-    ])  # fmt: skip
+    tracks = pd.concat(
+        [
+            pd.DataFrame(
+                {"time_s": t, "track_id": 7, "north_m": -100.0 * t + 20, "east_m": 10.0, "down_m": 0.0}
+            ),
+            pd.DataFrame({"time_s": t, "track_id": 8, "north_m": 100.0 * t, "east_m": 5.0, "down_m": -30.0}),
+            pd.DataFrame({"time_s": t, "track_id": 9, "north_m": 0.0, "east_m": 2000.0, "down_m": 0.0}),
+        ]
+    )
     assert label_tracks(tracks, truth) == {7: "b", 8: "a", 9: "clutter"}
 
 
@@ -74,8 +97,11 @@ def test_label_tracks_matches_a_prior_height_track_by_range_and_bearing():
     t = np.arange(5.0)
     north = 700.0 - 20.0 * t
     dims = ("time", "target")
-    data = {"tgt_north_m": (dims, north[:, None]), "tgt_east_m": (dims, np.zeros((5, 1))),
-            "tgt_down_m": (dims, np.full((5, 1), -339.0))}  # fmt: skip
+    data = {
+        "tgt_north_m": (dims, north[:, None]),
+        "tgt_east_m": (dims, np.zeros((5, 1))),
+        "tgt_down_m": (dims, np.full((5, 1), -339.0)),
+    }
     data |= {f"own_{axis}_m": ("time", np.zeros(5)) for axis in ("north", "east", "down")}
     truth = xr.Dataset(data, coords={"time": t, "target": ["a"]})
     slant = np.hypot(north, 339.0)
@@ -89,11 +115,17 @@ def test_label_tracks_matches_a_prior_height_track_by_range_and_bearing():
 
 
 def test_alert_timeline_lists_each_level_change():
-    alerts = pd.DataFrame({
-        "time_s": [0, 1, 2, 3, 4, 0, 1, 2], "track_id": [1, 1, 1, 1, 1, 2, 2, 2],
-        "level": [0, 1, 3, 3, 0, 0, 0, 0], "range_m": 1.0, "bearing_deg": 0.0, "rel_alt_m": 0.0,
-        "time_to_impact_s": np.nan,
-    })  # fmt: skip
+    alerts = pd.DataFrame(
+        {
+            "time_s": [0, 1, 2, 3, 4, 0, 1, 2],
+            "track_id": [1, 1, 1, 1, 1, 2, 2, 2],
+            "level": [0, 1, 3, 3, 0, 0, 0, 0],
+            "range_m": 1.0,
+            "bearing_deg": 0.0,
+            "rel_alt_m": 0.0,
+            "time_to_impact_s": np.nan,
+        }
+    )
     tl = alert_timeline(alerts, {1: "x"})
     assert tl[["time_s", "track_id", "level"]].values.tolist() == [[1, 1, 1], [2, 1, 3], [4, 1, 0]]
     assert tl["intruder"].tolist() == ["x"] * 3

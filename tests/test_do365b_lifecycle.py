@@ -42,8 +42,10 @@ def test_the_named_settings_are_daidalus_do365b_noncooperative():
     cfg = alert_config("do365b")
     assert cfg is DO365B_ALERT_CONFIG
     assert [(lv.alerting_time_s, lv.early_alerting_time_s) for lv in cfg.levels] == [
-        (55.0, 110.0), (55.0, 110.0), (25.0, 90.0),
-    ]  # fmt: skip
+        (55.0, 110.0),
+        (55.0, 110.0),
+        (25.0, 90.0),
+    ]
     assert {round(lv.volume.dthr_m, 2) for lv in cfg.levels} == {670.56}
     assert {round(lv.volume.zthr_m, 2) for lv in cfg.levels} == {137.16}
     assert (cfg.m, cfg.n, cfg.persistence_s, cfg.gap_reset_s) == (2, 4, 4.0, 5.0)

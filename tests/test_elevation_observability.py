@@ -32,8 +32,10 @@ def _off(steering: np.ndarray) -> np.ndarray:
 
 @settings(max_examples=40, deadline=None)
 @given(
-    st.floats(-1.0, 1.0), st.floats(-0.7, 0.7), st.floats(5.0, 40.0),
-)  # fmt: skip
+    st.floats(-1.0, 1.0),
+    st.floats(-0.7, 0.7),
+    st.floats(5.0, 40.0),
+)
 def test_without_nulls_the_bound_is_the_arrays_crlb(az, el, snr_db):
     # Peer: doa_crlb, the closed-form bound of the 2x2 array in white noise.
     u = direction_from_angles(np.array([az]), np.array([el]))
@@ -69,8 +71,11 @@ def test_two_nulls_at_one_elevation_leave_no_elevation_and_finite_clutter_some()
 
 @settings(max_examples=60, deadline=None)
 @given(
-    st.floats(-0.95, 0.95), st.floats(-0.25, 0.25), st.floats(-1.2, -0.3), st.floats(0.3, 1.2),
-)  # fmt: skip
+    st.floats(-0.95, 0.95),
+    st.floats(-0.25, 0.25),
+    st.floats(-1.2, -0.3),
+    st.floats(0.3, 1.2),
+)
 def test_with_no_elevation_the_azimuth_keeps_the_measured_cone(az, el, el_null, az_null):
     # Two nulls at one elevation leave the score a function of the horizontal direction cosine only:
     # the prior's azimuth is the point of that cone at elevation 0 (closed form), wherever on the cone
@@ -131,9 +136,12 @@ def _doppler_extended_crb(n_bins: int, cnr_db: float) -> float:
     ri, az_t, el_t, h = np.linalg.inv(r), np.radians(-29.0), np.radians(26.0), 1e-6
     s = st_vec(k0 / n, az_t, el_t)
     d = np.stack(
-        [(st_vec(k0 / n, az_t, el_t + h) - st_vec(k0 / n, az_t, el_t - h)) / (2 * h),
-         (st_vec(k0 / n, az_t + h, el_t) - st_vec(k0 / n, az_t - h, el_t)) / (2 * h)], 1,
-    )  # fmt: skip
+        [
+            (st_vec(k0 / n, az_t, el_t + h) - st_vec(k0 / n, az_t, el_t - h)) / (2 * h),
+            (st_vec(k0 / n, az_t + h, el_t) - st_vec(k0 / n, az_t - h, el_t)) / (2 * h),
+        ],
+        1,
+    )
     rs = ri @ s
     j = np.real(d.conj().T @ ri @ d - np.outer(d.conj().T @ rs, rs.conj() @ d) / (s.conj() @ rs).real)
     return float(np.sqrt(np.linalg.inv(2 * 10**2.7 * j)[0, 0]))
@@ -156,17 +164,35 @@ def _level_track(measured: np.ndarray, height_m: float) -> pd.DataFrame:
     north = 1500.0 - 60.0 * t
     slant = np.hypot(north, height_m)
     el = np.where(measured, np.arctan2(height_m, north), 0.0)
-    return pd.DataFrame({
-        "time_s": t, "range_m": slant, "radial_velocity_mps": -60.0 * north / slant, "snr_db": 25.0,
-        "azimuth_rad": 0.0, "elevation_rad": el, "north_m": slant * np.cos(el), "east_m": 0.0,
-        "down_m": -slant * np.sin(el), "elevation_measured": measured,
-    })  # fmt: skip
+    return pd.DataFrame(
+        {
+            "time_s": t,
+            "range_m": slant,
+            "radial_velocity_mps": -60.0 * north / slant,
+            "snr_db": 25.0,
+            "azimuth_rad": 0.0,
+            "elevation_rad": el,
+            "north_m": slant * np.cos(el),
+            "east_m": 0.0,
+            "down_m": -slant * np.sin(el),
+            "elevation_measured": measured,
+        }
+    )
 
 
 def _own(n: int) -> pd.DataFrame:
     t = np.arange(n) / 9.4
-    return pd.DataFrame({"time_s": t, "own_north_m": 0.0, "own_east_m": 0.0, "own_down_m": 0.0,
-                         "own_vn_mps": 0.0, "own_ve_mps": 0.0, "own_vd_mps": 0.0})  # fmt: skip
+    return pd.DataFrame(
+        {
+            "time_s": t,
+            "own_north_m": 0.0,
+            "own_east_m": 0.0,
+            "own_down_m": 0.0,
+            "own_vn_mps": 0.0,
+            "own_ve_mps": 0.0,
+            "own_vd_mps": 0.0,
+        }
+    )
 
 
 def test_a_track_with_no_measured_elevation_stays_at_the_co_altitude_prior():
@@ -197,9 +223,12 @@ def _in_plane(rx: np.ndarray, angle_rad: float) -> np.ndarray:
 
 @settings(max_examples=40, deadline=None)
 @given(
-    st.floats(0.0, np.pi / 2), st.floats(-0.6, 0.6), st.floats(0.1, 0.7), st.floats(-0.9, -0.2),
+    st.floats(0.0, np.pi / 2),
+    st.floats(-0.6, 0.6),
+    st.floats(0.1, 0.7),
+    st.floats(-0.9, -0.2),
     st.floats(0.3, 1.2),
-)  # fmt: skip
+)
 def test_no_rotation_of_the_square_array_keeps_an_elevation_through_two_ground_nulls(
     roll, az, el, el_ground, az_ground
 ):

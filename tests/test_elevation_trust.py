@@ -30,9 +30,18 @@ SPEED_MPS, AGL_M, N = 50.0, 500.0, 190  # 20 s at 9.4 Hz
 
 def _own(agl_m: float = AGL_M) -> pd.DataFrame:
     t = np.arange(N) / 9.4
-    return pd.DataFrame({"time_s": t, "own_north_m": SPEED_MPS * t, "own_east_m": 0.0, "own_down_m": 0.0,
-                         "own_vn_mps": SPEED_MPS, "own_ve_mps": 0.0, "own_vd_mps": 0.0,
-                         "own_height_agl_m": agl_m})  # fmt: skip
+    return pd.DataFrame(
+        {
+            "time_s": t,
+            "own_north_m": SPEED_MPS * t,
+            "own_east_m": 0.0,
+            "own_down_m": 0.0,
+            "own_vn_mps": SPEED_MPS,
+            "own_ve_mps": 0.0,
+            "own_vd_mps": 0.0,
+            "own_height_agl_m": agl_m,
+        }
+    )
 
 
 def _aircraft(
@@ -59,9 +68,20 @@ def _aircraft(
     apparent = r + CFG.range_doppler_coupling_s * v
     u = np.column_stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)])
     p = own + apparent[:, None] * u
-    return pd.DataFrame({"time_s": t, "range_m": apparent, "radial_velocity_mps": v, "snr_db": 25.0,
-                         "azimuth_rad": az, "elevation_rad": el, "north_m": p[:, 0], "east_m": p[:, 1],
-                         "down_m": p[:, 2], "elevation_measured": reading != "prior"})  # fmt: skip
+    return pd.DataFrame(
+        {
+            "time_s": t,
+            "range_m": apparent,
+            "radial_velocity_mps": v,
+            "snr_db": 25.0,
+            "azimuth_rad": az,
+            "elevation_rad": el,
+            "north_m": p[:, 0],
+            "east_m": p[:, 1],
+            "down_m": p[:, 2],
+            "elevation_measured": reading != "prior",
+        }
+    )
 
 
 def _last(tracks: pd.DataFrame) -> pd.Series:
@@ -242,8 +262,14 @@ def test_a_consensus_below_is_the_median_of_agreeing_readings_clear_of_the_groun
     up, bound, below, clear = (np.array(c) for c in zip(*rows, strict=True))
     consensus = BelowConsensus(window=10, least=7)
     for k in range(len(rows)):
-        h = consensus.update(np.array([5]), up[k : k + 1], bound[k : k + 1], below[k : k + 1],
-                             np.array([True]), clear[k : k + 1])[0]  # fmt: skip
+        h = consensus.update(
+            np.array([5]),
+            up[k : k + 1],
+            bound[k : k + 1],
+            below[k : k + 1],
+            np.array([True]),
+            clear[k : k + 1],
+        )[0]
     last = slice(len(rows) - 10, len(rows))
     if np.isfinite(h):
         assert h == np.median(up[last]) and below[last].sum() >= 7 and np.median(clear[last]) > 0.0
@@ -265,7 +291,7 @@ def test_a_consensus_below_is_the_median_of_agreeing_readings_clear_of_the_groun
         ),
         min_size=1,
         max_size=8,
-    ),  # fmt: skip
+    ),
 )
 def test_free_detections_keep_range_and_bearing_and_trusted_ones_do_not_move(rows):
     rng_m, bearing, el, measured, v = (np.array(c) for c in zip(*rows, strict=True))
@@ -300,8 +326,9 @@ def _vertical_speed_z_scores(seed: int, per_feed_window: int) -> np.ndarray:
         az = np.arctan2(rel[1], rel[0])
         pos = own + r * np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)])
         one = np.array([True])
-        p, sigma, *_ = place_elevations(pos[None], own, 50.0, np.array([0.01]), one, np.array([-15.0]),
-                                        500.0, votes, np.array([1]))  # fmt: skip
+        p, sigma, *_ = place_elevations(
+            pos[None], own, 50.0, np.array([0.01]), one, np.array([-15.0]), 500.0, votes, np.array([1])
+        )
         x, P = t3.step(t, np.array([1]), p, np.diag([25.0, (r * 0.01) ** 2, (r * sigma[0]) ** 2])[None])
         if t > 10.0:
             z.append(abs(x[0, 5]) / np.sqrt(P[0, 5, 5]))

@@ -16,8 +16,13 @@ from skyradar.experiments.encounter_terrain import mirror_below_ground, own_alti
 
 def _status(**flags) -> pd.DataFrame:
     n = 11
-    base = {"time_s": np.arange(n, dtype=float), "behind": np.zeros(n, bool), "in_beam": np.ones(n, bool),
-            "in_view": np.ones(n, bool), "observable": np.ones(n, bool)}  # fmt: skip
+    base = {
+        "time_s": np.arange(n, dtype=float),
+        "behind": np.zeros(n, bool),
+        "in_beam": np.ones(n, bool),
+        "in_view": np.ones(n, bool),
+        "observable": np.ones(n, bool),
+    }
     for name, frames in flags.items():
         base[name] = base[name].copy()
         base[name][frames] = not base[name][frames[0]]
@@ -27,10 +32,16 @@ def _status(**flags) -> pd.DataFrame:
 
 @pytest.mark.parametrize(
     ("flags", "cause"),
-    [({}, "missed"), ({"behind": [9]}, "behind"), ({"in_beam": [8]}, "outside_beams"),
-     ({"in_view": [4]}, "terrain_masked"), ({"observable": [10]}, "below_13db"),
-     ({"in_beam": [2], "behind": [9]}, "behind"), ({"in_view": [3], "in_beam": [5]}, "outside_beams")],
-)  # fmt: skip
+    [
+        ({}, "missed"),
+        ({"behind": [9]}, "behind"),
+        ({"in_beam": [8]}, "outside_beams"),
+        ({"in_view": [4]}, "terrain_masked"),
+        ({"observable": [10]}, "below_13db"),
+        ({"in_beam": [2], "behind": [9]}, "behind"),
+        ({"in_view": [3], "in_beam": [5]}, "outside_beams"),
+    ],
+)
 def test_conflict_cause_takes_the_first_cause_in_the_window_before_lowc(flags, cause):
     assert conflict_cause(_status(**flags), t_lowc_s=10.0, observe_window_s=8.0) == cause
 
@@ -54,8 +65,19 @@ def _results() -> pd.DataFrame:
         (False, False, False, np.nan, np.nan, "", 1, 3, 0, 0, 0),
         (False, False, False, np.nan, 60.0, "", 4, 0, 0, 0, 0),
     ]
-    cols = ["conflict", "may_alert", "observable", "t_lowc_s", "t_warning_s", "cause", "intruder_tracks",
-            "clutter_tracks", "clutter_warning_tracks", "ground_tracks", "ground_warning_tracks"]  # fmt: skip
+    cols = [
+        "conflict",
+        "may_alert",
+        "observable",
+        "t_lowc_s",
+        "t_warning_s",
+        "cause",
+        "intruder_tracks",
+        "clutter_tracks",
+        "clutter_warning_tracks",
+        "ground_tracks",
+        "ground_warning_tracks",
+    ]
     res = pd.DataFrame(rows, columns=cols)
     res["flight_s"] = 40.0  # 9 x 40 s = 6 minutes
     return res
@@ -66,8 +88,13 @@ def test_summary_over_all_conflicts_by_cause_with_clutter_and_fragments():
     assert (s["conflicts"], s["warned_before_lowc"]) == (6, 2)
     assert s["warned_before_lowc_fraction"] == pytest.approx(2 / 6)
     # Unwarned (or warned after LoWC) conflicts by cause; "missed" is the observable one.
-    assert s["unwarned_by_cause"] == {"missed": 1, "behind": 1, "outside_beams": 0, "terrain_masked": 1,
-                                      "below_13db": 1}  # fmt: skip
+    assert s["unwarned_by_cause"] == {
+        "missed": 1,
+        "behind": 1,
+        "outside_beams": 0,
+        "terrain_masked": 1,
+        "below_13db": 1,
+    }
     assert set(s["unwarned_by_cause"]) == set(CAUSES)
     assert s["missed_warnings"] == s["unwarned_by_cause"]["missed"] == 1
     assert s["must_not_alert_encounters"] == 2 and s["false_warnings"] == 1
@@ -90,23 +117,39 @@ def test_clutter_tracks_on_the_surface_or_without_a_measured_altitude_are_ground
         3: (590.0, False),  # co-altitude prior on every row: its height says nothing
         4: (600.0, True),  # the intruder
     }
-    tracks = pd.DataFrame([
-        {"track_id": tid, "alt_m": alt, "lat_deg": 51.99, "lon_deg": 4.01, "altitude_measured": known}
-        for tid, (alt, known) in rows.items() for _ in range(3)
-    ])  # fmt: skip
+    tracks = pd.DataFrame(
+        [
+            {"track_id": tid, "alt_m": alt, "lat_deg": 51.99, "lon_deg": 4.01, "altitude_measured": known}
+            for tid, (alt, known) in rows.items()
+            for _ in range(3)
+        ]
+    )
     labels = {1: "clutter", 2: "clutter", 3: "clutter", 4: "intruder"}
     counts = track_counts(tracks, {3}, labels, flat, own_agl_m=500.0)
-    assert counts == {"intruder_tracks": 1, "clutter_tracks": 3, "clutter_warning_tracks": 1,
-                      "ground_tracks": 2, "ground_warning_tracks": 1}  # fmt: skip
+    assert counts == {
+        "intruder_tracks": 1,
+        "clutter_tracks": 3,
+        "clutter_warning_tracks": 1,
+        "ground_tracks": 2,
+        "ground_warning_tracks": 1,
+    }
     without_flag = track_counts(tracks.drop(columns="altitude_measured"), {3}, labels, flat, own_agl_m=500.0)
     assert without_flag["ground_tracks"] == 1
 
 
 def test_cost_per_frame_counts_the_shared_simulation_once():
-    res = pd.DataFrame({"terrain": "none", "encounter": [0, 0, 1, 1], "layout": ["single", "three-head"] * 2,
-                        "frames": [100, 100, 300, 300], "simulate_s": [2.0, 2.0, 6.0, 6.0],
-                        "process_s": [1.0, 1.0, 3.0, 3.0], "track_s": [0.1, 0.4, 0.3, 1.2],
-                        "alert_s": 0.0})  # fmt: skip
+    res = pd.DataFrame(
+        {
+            "terrain": "none",
+            "encounter": [0, 0, 1, 1],
+            "layout": ["single", "three-head"] * 2,
+            "frames": [100, 100, 300, 300],
+            "simulate_s": [2.0, 2.0, 6.0, 6.0],
+            "process_s": [1.0, 1.0, 3.0, 3.0],
+            "track_s": [0.1, 0.4, 0.3, 1.2],
+            "alert_s": 0.0,
+        }
+    )
     c = cost_ms_per_frame(res)
     assert (c["simulate"], c["process"]) == (20.0, 10.0)
     assert (c["track_single"], c["track_three-head"]) == (1.0, 4.0)

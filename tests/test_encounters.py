@@ -60,8 +60,9 @@ def _closed_form_lowc(p: pd.Series, scale: float = 1.0) -> float:
         return float("nan")
     angle = {"head-on": 180.0, "overtaking": 0.0}.get(p["kind"], p["crossing_angle_deg"])
     track = np.radians(angle)
-    speed = np.hypot(p["intruder_speed_mps"] * np.cos(track) - OWN_SPEED_MPS,
-                     p["intruder_speed_mps"] * np.sin(track))  # fmt: skip
+    speed = np.hypot(
+        p["intruder_speed_mps"] * np.cos(track) - OWN_SPEED_MPS, p["intruder_speed_mps"] * np.sin(track)
+    )
     t_h = T_CPA_S - np.sqrt(d**2 - h**2) / speed
     climb = 0.0 if np.isnan(p["climb_mps"]) else abs(p["climb_mps"])  # climbing rows have v = 0
     t_v = T_CPA_S - z / climb if climb else -np.inf
@@ -79,8 +80,16 @@ def _geometrically_observable(p: pd.Series, t_lowc: float) -> bool:
 
 
 def _row(kind="head-on", h=0.0, v=0.0, speed=50.0, rcs=5.0, **kw) -> pd.Series:
-    base = {"kind": kind, "horizontal_miss_m": h, "vertical_miss_m": v, "intruder_speed_mps": speed,
-            "crossing_angle_deg": np.nan, "climb_mps": np.nan, "side": "right", "rcs_m2": rcs}  # fmt: skip
+    base = {
+        "kind": kind,
+        "horizontal_miss_m": h,
+        "vertical_miss_m": v,
+        "intruder_speed_mps": speed,
+        "crossing_angle_deg": np.nan,
+        "climb_mps": np.nan,
+        "side": "right",
+        "rcs_m2": rcs,
+    }
     return pd.Series({**base, **kw})
 
 
@@ -109,9 +118,14 @@ def test_scoring_matches_closed_form_head_on():
 
 @pytest.mark.parametrize(
     ("h", "v", "conflict", "may_alert"),
-    [(0.9 * D_NC, 0.9 * Z_NC, True, False), (1.2 * D_NC, 0.0, False, True), (0.0, 1.3 * Z_NC, False, True),
-     (1.6 * D_NC, 0.0, False, False), (0.0, 1.6 * Z_NC, False, False)],
-)  # fmt: skip
+    [
+        (0.9 * D_NC, 0.9 * Z_NC, True, False),
+        (1.2 * D_NC, 0.0, False, True),
+        (0.0, 1.3 * Z_NC, False, True),
+        (1.6 * D_NC, 0.0, False, False),
+        (0.0, 1.6 * Z_NC, False, False),
+    ],
+)
 def test_scoring_splits_conflict_may_alert_and_must_not(h, v, conflict, may_alert):
     built = Scenario.from_dict(encounter_scenario(_row(h=h, v=v), 60.0, 10.0, 4.7, 0)).build()
     t, rel = relative_truth(built)
@@ -134,13 +148,15 @@ def test_observable_needs_the_whole_window_in_view():
 
 
 def test_summary_counts():
-    res = pd.DataFrame({
-        "conflict": [True, True, True, False, False, False],
-        "may_alert": [False, False, False, True, False, False],
-        "observable": [True, True, False, False, False, False],
-        "t_lowc_s": [100.0, 100.0, 100.0, np.nan, np.nan, np.nan],
-        "t_warning_s": [80.0, 95.0, np.nan, 90.0, 70.0, np.nan],
-    })  # fmt: skip
+    res = pd.DataFrame(
+        {
+            "conflict": [True, True, True, False, False, False],
+            "may_alert": [False, False, False, True, False, False],
+            "observable": [True, True, False, False, False, False],
+            "t_lowc_s": [100.0, 100.0, 100.0, np.nan, np.nan, np.nan],
+            "t_warning_s": [80.0, 95.0, np.nan, 90.0, 70.0, np.nan],
+        }
+    )
     s = summarise(res, late_lead_s=12.5)
     assert (s["conflicts"], s["observable_conflicts"], s["missed_warnings"], s["late_warnings"]) == (
         3,
@@ -220,21 +236,57 @@ def test_experiment_counts_match_the_geometry_and_warns_every_observable_conflic
 def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
     from skyradar.experiments import encounters as E
 
-    settings = {"n": 2, "seed": 5, "frame_rate_hz": 4.7, "buffer": 1.5, "uncertainty": True,
-                "terrains": ["none"], "layouts": ["single"], "navigation": "ga-typical",
-                "suppression": "auto", "late_lead_s": 12.5, "simulation": LIGHT,
-                "rx_layout": "square", "family": "synthetic", "split": "development",
-                "alert_config": "radar"}  # fmt: skip
+    settings = {
+        "n": 2,
+        "seed": 5,
+        "frame_rate_hz": 4.7,
+        "buffer": 1.5,
+        "uncertainty": True,
+        "terrains": ["none"],
+        "layouts": ["single"],
+        "navigation": "ga-typical",
+        "suppression": "auto",
+        "late_lead_s": 12.5,
+        "simulation": LIGHT,
+        "rx_layout": "square",
+        "family": "synthetic",
+        "split": "development",
+        "alert_config": "radar",
+    }
     key = {**settings, "version": code_version()}
     _, save = E._partial_store(tmp_path, key)
-    fake = {"t_lowc_s": np.nan, "t_cpa_s": 120.0, "conflict": False, "may_alert": False,
-            "observable": False, "t_warning_s": np.nan, "min_horizontal_m": 3000.0, "min_vertical_m": 0.0,
-            "min_distance_m": 3000.0,
-            "cause": "", "intruder_tracks": 0, "clutter_tracks": 0, "clutter_warning_tracks": 0,
-            "ground_tracks": 0, "ground_warning_tracks": 0, "t_other_warning_s": np.nan, "tracks": 0,
-            "own_agl_m": np.nan, "layout": "single", "detections": 0, "frames": 7, "t_start_s": 75.0,
-            "flight_s": 1.5, "mirrored": False, "vertical_miss_flown_m": 0.0, "own_altitude_m": 1000.0,
-            "simulate_s": 0.0, "process_s": 0.0, "track_s": 0.0, "alert_s": 0.0}  # fmt: skip
+    fake = {
+        "t_lowc_s": np.nan,
+        "t_cpa_s": 120.0,
+        "conflict": False,
+        "may_alert": False,
+        "observable": False,
+        "t_warning_s": np.nan,
+        "min_horizontal_m": 3000.0,
+        "min_vertical_m": 0.0,
+        "min_distance_m": 3000.0,
+        "cause": "",
+        "intruder_tracks": 0,
+        "clutter_tracks": 0,
+        "clutter_warning_tracks": 0,
+        "ground_tracks": 0,
+        "ground_warning_tracks": 0,
+        "t_other_warning_s": np.nan,
+        "tracks": 0,
+        "own_agl_m": np.nan,
+        "layout": "single",
+        "detections": 0,
+        "frames": 7,
+        "t_start_s": 75.0,
+        "flight_s": 1.5,
+        "mirrored": False,
+        "vertical_miss_flown_m": 0.0,
+        "own_altitude_m": 1000.0,
+        "simulate_s": 0.0,
+        "process_s": 0.0,
+        "track_s": 0.0,
+        "alert_s": 0.0,
+    }
     save({("none", 0): [fake]})  # as left by a run interrupted after its first encounter
     s = E.run(
         tmp_path, n_encounters=2, seed=5, workers=1, frame_rate_hz=4.7, layouts=("single",), simulation=LIGHT
@@ -272,8 +324,9 @@ def test_one_simulation_scores_the_nose_head_and_the_three_head_layout():
     # A converging intruder from 50-52 deg off the nose: outside the nose's +-35 deg beam, inside the
     # right wingtip head's (yawed 75 deg).
     p = make_encounters(30, seed=0).iloc[2]
-    single, three = run_encounter(p, seed=2, frame_rate_hz=4.7, layouts=("single", "three-head"),
-                                  simulation=LIGHT)  # fmt: skip
+    single, three = run_encounter(
+        p, seed=2, frame_rate_hz=4.7, layouts=("single", "three-head"), simulation=LIGHT
+    )
     assert (single["layout"], three["layout"]) == ("single", "three-head")
     assert single["frames"] == three["frames"] and single["simulate_s"] == three["simulate_s"]  # shared
     assert single["conflict"] and three["conflict"] and single["t_lowc_s"] == three["t_lowc_s"]

@@ -93,8 +93,14 @@ def _feed(fd: int, text: str) -> None:
 def _detections_csv() -> str:
     """An aircraft closing at 60 m/s from 2 km, one detection per frame at 9.4 frames/s."""
     t = np.arange(20) / 9.4
-    table = pd.DataFrame({"time_s": t, "frame": np.arange(20), "range_m": 2000.0 - 60.0 * t,
-                          "radial_velocity_mps": np.full(20, -60.0)})  # fmt: skip
+    table = pd.DataFrame(
+        {
+            "time_s": t,
+            "frame": np.arange(20),
+            "range_m": 2000.0 - 60.0 * t,
+            "radial_velocity_mps": np.full(20, -60.0),
+        }
+    )
     return table.to_csv(index=False)
 
 
@@ -204,16 +210,22 @@ def _held_by_another_process(path: Path):
 # reading. (`evaluate`, `serve`, `scenarios` and `bench` write nothing.)
 WRITERS = {
     "simulate": (["simulate", "s.yaml", "-o", "run.zarr"], "--output run.zarr"),
-    "sweep": (["sweep", "s.yaml", "--param", "duration_s", "--values", "1,2", "-o", "sweep.csv"],
-              "--output sweep.csv"),
+    "sweep": (
+        ["sweep", "s.yaml", "--param", "duration_s", "--values", "1,2", "-o", "sweep.csv"],
+        "--output sweep.csv",
+    ),
     "rd": (["rd", "rec.npy", "-o", "rd.zarr"], "--output rd.zarr"),
     "process": (["process", "run.zarr", "-o", "det.parquet"], "--output det.parquet"),
-    "calibrate": (["calibrate", "run.zarr", "-o", "cal.json", "--range", "100", "--azimuth", "0",
-                   "--elevation", "0"], "--output cal.json"),
+    "calibrate": (
+        ["calibrate", "run.zarr", "-o", "cal.json", "--range", "100", "--azimuth", "0", "--elevation", "0"],
+        "--output cal.json",
+    ),
     "spur-map": (["spur-map", "run.zarr", "-o", "spurs.npz"], "--output spurs.npz"),
     "track": (["track", "det.parquet", "-o", "tracks.parquet"], "--output tracks.parquet"),
-    "alert": (["alert", "tracks.parquet", "--ownship", "run.zarr", "-o", "alerts.parquet"],
-              "--output alerts.parquet"),
+    "alert": (
+        ["alert", "tracks.parquet", "--ownship", "run.zarr", "-o", "alerts.parquet"],
+        "--output alerts.parquet",
+    ),
     "state": (["state", "run.zarr", "-o", "state.parquet"], "--output state.parquet"),
     "gpscheck": (["gpscheck", "run.zarr", "--map", "m.tif", "-o", "check.parquet"], "--output check.parquet"),
     "export": (["export", "run.zarr", "-o", "own"], "--output own"),
@@ -226,7 +238,7 @@ WRITERS = {
         f"experiment {name}": (["experiment", name, "--out", f"x-{name}"], f"--out x-{name}")
         for name in ("ch2", "ch3", "ch4", "ch5", "ch6", "ch7", "clutter", "encounters")
     },
-}  # fmt: skip
+}
 
 
 @pytest.mark.parametrize("command", list(WRITERS))

@@ -47,8 +47,12 @@ def _run_without(blocked: list[str], *args: str, tmp_path: Path) -> subprocess.C
     env = {**os.environ, "PYTHONPATH": str(site), "SKYRADAR_TEST_BLOCK": ",".join(blocked)}
     return subprocess.run(
         [sys.executable, "-m", "skyradar", *args],
-        cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
 
 
 def test_the_blocker_really_hides_a_module(tmp_path):

@@ -42,14 +42,33 @@ def ridge_scenario(tmp_path_factory):
         "name": "fast closure over a ridge",
         "origin": {"lat_deg": 52.0, "lon_deg": 5.0, "alt_m": 0.0},
         "terrain": {"type": "file", "path": dem},
-        "ownship": {"type": "straight", "start_ned_m": [-1500.0, 0.0, -AGL_M], "heading_deg": 0.0,
-                    "speed_mps": 50.0, "start_time_s": 0.0, "duration_s": 40.0},
-        "intruders": [{"name": "intruder", "type": "encounter", "kind": "head-on", "t_cpa_s": T_CPA_S,
-                       "horizontal_miss_m": 68.0, "vertical_miss_m": 0.0,
-                       "intruder_speed_mps": CLOSING_MPS - 50.0, "rcs_m2": 1.5, "rate_hz": 20.0}],
-        "frame_rate_hz": 9.4, "start_s": start_s, "duration_s": 1500.0 / CLOSING_MPS, "mount": "forward",
+        "ownship": {
+            "type": "straight",
+            "start_ned_m": [-1500.0, 0.0, -AGL_M],
+            "heading_deg": 0.0,
+            "speed_mps": 50.0,
+            "start_time_s": 0.0,
+            "duration_s": 40.0,
+        },
+        "intruders": [
+            {
+                "name": "intruder",
+                "type": "encounter",
+                "kind": "head-on",
+                "t_cpa_s": T_CPA_S,
+                "horizontal_miss_m": 68.0,
+                "vertical_miss_m": 0.0,
+                "intruder_speed_mps": CLOSING_MPS - 50.0,
+                "rcs_m2": 1.5,
+                "rate_hz": 20.0,
+            }
+        ],
+        "frame_rate_hz": 9.4,
+        "start_s": start_s,
+        "duration_s": 1500.0 / CLOSING_MPS,
+        "mount": "forward",
         "simulation": {"noise": True, "seed": 1, "psf": True, "speckle": True, "swerling": 1},
-    }  # fmt: skip
+    }
     return Scenario.from_dict(spec).build()
 
 

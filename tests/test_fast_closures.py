@@ -38,9 +38,18 @@ def _own(t: np.ndarray, bank_deg: float = 0.0, speed_mps: float = 50.0) -> pd.Da
         north, east = speed_mps * t, 0.0 * t
     else:
         north, east = speed_mps / rate * np.sin(heading), speed_mps / rate * (1.0 - np.cos(heading))
-    return pd.DataFrame({"time_s": t, "own_north_m": north, "own_east_m": east, "own_down_m": 0.0 * t,
-                         "own_vn_mps": speed_mps * np.cos(heading), "own_ve_mps": speed_mps * np.sin(heading),
-                         "own_vd_mps": 0.0 * t, "own_height_agl_m": AGL_M + 0.0 * t})  # fmt: skip
+    return pd.DataFrame(
+        {
+            "time_s": t,
+            "own_north_m": north,
+            "own_east_m": east,
+            "own_down_m": 0.0 * t,
+            "own_vn_mps": speed_mps * np.cos(heading),
+            "own_ve_mps": speed_mps * np.sin(heading),
+            "own_vd_mps": 0.0 * t,
+            "own_height_agl_m": AGL_M + 0.0 * t,
+        }
+    )
 
 
 def _state(own: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
@@ -62,11 +71,19 @@ def _closure_detections(closing_mps: float, miss_m: float, rng: np.random.Genera
     r = np.linalg.norm(d, axis=1)
     v = np.sum(d * ([-(closing_mps - 50.0), 0, 0] - np.array([50.0, 0, 0])), axis=1) / r
     measured_v = v + rng.normal(0.0, 0.05, n)
-    det = pd.DataFrame({"time_s": t, "range_m": r + C * v + rng.normal(0.0, 2.5, n),
-                        "radial_velocity_mps": (measured_v + WIDTH / 2) % WIDTH - WIDTH / 2,
-                        "azimuth_rad": rng.choice([-0.9, 0.9], n), "elevation_rad": 0.0 * t,
-                        "elevation_measured": False,
-                        "north_m": intruder[:, 0], "east_m": intruder[:, 1], "down_m": 0 * t})  # fmt: skip
+    det = pd.DataFrame(
+        {
+            "time_s": t,
+            "range_m": r + C * v + rng.normal(0.0, 2.5, n),
+            "radial_velocity_mps": (measured_v + WIDTH / 2) % WIDTH - WIDTH / 2,
+            "azimuth_rad": rng.choice([-0.9, 0.9], n),
+            "elevation_rad": 0.0 * t,
+            "elevation_measured": False,
+            "north_m": intruder[:, 0],
+            "east_m": intruder[:, 1],
+            "down_m": 0 * t,
+        }
+    )
     return det, own
 
 
@@ -79,8 +96,9 @@ def test_an_aliased_closure_clears_the_ground_hold_within_five_detections(closin
         det, own = _closure_detections(closing_mps, 70.0 + 30.0 * trial, rng, 12)
         aliased = det["radial_velocity_mps"].to_numpy()
         assert (np.abs(aliased) < 50.0).all()  # inside the ground band
-        tracks = pd.DataFrame({"time_s": det["time_s"], "track_id": 1, "detection_row": np.arange(12),
-                               "confirmed": True})  # fmt: skip
+        tracks = pd.DataFrame(
+            {"time_s": det["time_s"], "track_id": 1, "detection_row": np.arange(12), "confirmed": True}
+        )
         out = hold_ground_tracks(tracks, det, own, WIDTH, C, flat_surface(AGL_M))
         confirmed = out["confirmed"].to_numpy() if len(out) else np.zeros(0, bool)
         assert confirmed.any(), trial
@@ -158,12 +176,17 @@ def test_a_closure_lost_for_seconds_keeps_its_identity_and_its_warning():
     v = np.sum(d * ([-50.0, 0, 0] - own_v), axis=1) / r
     seen = ~((t > 5.5) & (t < 8.0))
     measured_v = v + rng.normal(0, 0.05, t.size)
-    det = pd.DataFrame({"time_s": t, "range_m": r + C * v + rng.normal(0.0, 2.5, t.size),
-                        "radial_velocity_mps": (measured_v + WIDTH / 2) % WIDTH - WIDTH / 2,
-                        "north_m": intruder[:, 0] + rng.normal(0, 15.0, t.size),
-                        "east_m": intruder[:, 1] + rng.normal(0, 15.0, t.size),
-                        "down_m": intruder[:, 2] + rng.normal(0, 5.0, t.size),
-                        "snr_db": 18.0 + 0 * t})[seen].reset_index(drop=True)  # fmt: skip
+    det = pd.DataFrame(
+        {
+            "time_s": t,
+            "range_m": r + C * v + rng.normal(0.0, 2.5, t.size),
+            "radial_velocity_mps": (measured_v + WIDTH / 2) % WIDTH - WIDTH / 2,
+            "north_m": intruder[:, 0] + rng.normal(0, 15.0, t.size),
+            "east_m": intruder[:, 1] + rng.normal(0, 15.0, t.size),
+            "down_m": intruder[:, 2] + rng.normal(0, 5.0, t.size),
+            "snr_db": 18.0 + 0 * t,
+        }
+    )[seen].reset_index(drop=True)
     tracks = track_detections(det, ownship=own, ground_test=GroundTrackTest(surface_down=flat_surface(AGL_M)))
     confirmed = tracks[tracks["confirmed"]]
     assert confirmed["track_id"].nunique() == 1

@@ -116,9 +116,17 @@ def test_paths_from_faulty_fixes_stay_within_the_limits(
     t, pos, vel = _flight(speed, legs)
     path = tmp_path / f"fixes_{seed}.csv"
     stale, n_fixes = _fixes_file(
-        path, t, pos, vel, interval_s=interval_s, jitter_s=jitter_s, noise_m=noise_m, lag_s=lag_s,
-        stale_share=stale_share, rng=rng,
-    )  # fmt: skip
+        path,
+        t,
+        pos,
+        vel,
+        interval_s=interval_s,
+        jitter_s=jitter_s,
+        noise_m=noise_m,
+        lag_s=lag_s,
+        stale_share=stale_share,
+        rng=rng,
+    )
     if len(stale) > MAX_DROPPED_SHARE * n_fixes:  # more faults than a file may have repaired
         with pytest.raises(InputError, match=rf"^{path}: \d+ of {n_fixes} fixes cannot be reconciled"):
             read_trajectory(path)
@@ -141,9 +149,17 @@ def test_stale_fixes_are_named_by_row(tmp_path, caplog):
     rng = np.random.default_rng(0)
     t, pos, vel = _flight(55.0, [(60.0, 0.0, 0.0), (30.0, 30.0, 2.0)])
     stale, _n = _fixes_file(
-        tmp_path / "own.csv", t, pos, vel, interval_s=1.0, jitter_s=0.0, noise_m=5.0, lag_s=0.0,
-        stale_share=0.05, rng=rng,
-    )  # fmt: skip
+        tmp_path / "own.csv",
+        t,
+        pos,
+        vel,
+        interval_s=1.0,
+        jitter_s=0.0,
+        noise_m=5.0,
+        lag_s=0.0,
+        stale_share=0.05,
+        rng=rng,
+    )
     _traj, line = _read(tmp_path / "own.csv", caplog)
     assert line.startswith(f"{tmp_path / 'own.csv'}: cleaned: ") and "\n" not in line
     assert f"dropped {len(stale)} stale fix(es)" in line
@@ -153,9 +169,17 @@ def test_stale_fixes_are_named_by_row(tmp_path, caplog):
 def test_a_late_position_stream_is_retimed_and_named(tmp_path, caplog):
     t, pos, vel = _flight(60.0, [(30.0, 0.0, 0.0), (60.0, 35.0, 0.0), (30.0, 0.0, 0.0)])
     _fixes_file(
-        tmp_path / "late.csv", t, pos, vel, interval_s=1.0, jitter_s=0.0, noise_m=3.0, lag_s=1.5,
-        stale_share=0.0, rng=np.random.default_rng(1),
-    )  # fmt: skip
+        tmp_path / "late.csv",
+        t,
+        pos,
+        vel,
+        interval_s=1.0,
+        jitter_s=0.0,
+        noise_m=3.0,
+        lag_s=1.5,
+        stale_share=0.0,
+        rng=np.random.default_rng(1),
+    )
     traj, line = _read(tmp_path / "late.csv", caplog)
     assert "positions re-timed by -1.4" in line or "positions re-timed by -1.5" in line
     inside = (t >= traj.start_s + 2) & (t <= traj.end_s - 2)
@@ -167,9 +191,17 @@ def test_a_spline_through_misaligned_fixes_would_not_be_flyable(tmp_path, caplog
     """The situation the smoother exists for: fixes 0.5 s off in time at 60 m/s, 1 s apart."""
     t, pos, vel = _flight(60.0, [(60.0, 0.0, 0.0), (60.0, 30.0, 0.0)])
     _fixes_file(
-        tmp_path / "jitter.csv", t, pos, vel, interval_s=1.0, jitter_s=0.5, noise_m=0.0, lag_s=0.0,
-        stale_share=0.0, rng=np.random.default_rng(2),
-    )  # fmt: skip
+        tmp_path / "jitter.csv",
+        t,
+        pos,
+        vel,
+        interval_s=1.0,
+        jitter_s=0.5,
+        noise_m=0.0,
+        lag_s=0.0,
+        stale_share=0.0,
+        rng=np.random.default_rng(2),
+    )
     df = pd.read_csv(tmp_path / "jitter.csv")
     # The fixes' times are jittered: stamped with a fake uniform clock, they say 30-90 m/s.
     stamped = np.round(df["timestamp"].to_numpy())
@@ -237,9 +269,17 @@ def test_scenario_file_flight_is_built_within_its_class(tmp_path):
     rng = np.random.default_rng(5)
     t, pos, vel = _flight(55.0, [(40.0, 0.0, 0.0), (40.0, -30.0, 1.0), (40.0, 0.0, 0.0)])
     _fixes_file(
-        tmp_path / "own.csv", t, pos, vel, interval_s=1.0, jitter_s=0.4, noise_m=15.0, lag_s=0.8,
-        stale_share=0.1, rng=rng,
-    )  # fmt: skip
+        tmp_path / "own.csv",
+        t,
+        pos,
+        vel,
+        interval_s=1.0,
+        jitter_s=0.4,
+        noise_m=15.0,
+        lag_s=0.8,
+        stale_share=0.1,
+        rng=rng,
+    )
     data = {
         "name": "file own-ship",
         "duration_s": 95.0,
@@ -260,9 +300,17 @@ def test_a_file_whose_track_is_off_flies_at_its_reported_ground_speed(tmp_path, 
     holds, and the path's own direction carries it (the fixes alone, jittered in time, swing it)."""
     t, pos, vel = _flight(62.0, [(60.0, 0.0, 0.0), (40.0, 20.0, 0.0), (60.0, 0.0, 0.0)])
     _fixes_file(
-        tmp_path / "off.csv", t, pos, vel, interval_s=5.0, jitter_s=1.5, noise_m=10.0, lag_s=0.0,
-        stale_share=0.0, rng=np.random.default_rng(6),
-    )  # fmt: skip
+        tmp_path / "off.csv",
+        t,
+        pos,
+        vel,
+        interval_s=5.0,
+        jitter_s=1.5,
+        noise_m=10.0,
+        lag_s=0.0,
+        stale_share=0.0,
+        rng=np.random.default_rng(6),
+    )
     df = pd.read_csv(tmp_path / "off.csv")
     df.assign(track=(df["track"] + 100.0) % 360.0).to_csv(tmp_path / "off.csv", index=False)
     traj, line = _read(tmp_path / "off.csv", caplog)
@@ -274,9 +322,17 @@ def test_a_file_whose_track_is_off_flies_at_its_reported_ground_speed(tmp_path, 
 def test_skyradar_flight_writes_the_path_and_its_figure(tmp_path):
     t, pos, vel = _flight(55.0, [(40.0, 0.0, 0.0), (40.0, 30.0, 1.0)])
     _fixes_file(
-        tmp_path / "fixes.csv", t, pos, vel, interval_s=1.0, jitter_s=0.3, noise_m=10.0, lag_s=0.5,
-        stale_share=0.05, rng=np.random.default_rng(7),
-    )  # fmt: skip
+        tmp_path / "fixes.csv",
+        t,
+        pos,
+        vel,
+        interval_s=1.0,
+        jitter_s=0.3,
+        noise_m=10.0,
+        lag_s=0.5,
+        stale_share=0.05,
+        rng=np.random.default_rng(7),
+    )
     result = skyradar("flight", "fixes.csv", "-o", "path.csv", "--figure", "path.png", "--json", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     import json

@@ -94,18 +94,21 @@ def _scene(bank_deg: float, turbulence_mps: float, seed: int, duration_s: float 
             "time_s": times[k],
             "frame": k,
             "range_m": rng_m[k] + rng.normal(0.0, 3.0, k.size),
-            "radial_velocity_mps": np.mod(radial[k] + rng.normal(0.0, 0.05, k.size) + config.v_lim_mps,
-                                          2 * config.v_lim_mps) - config.v_lim_mps,
+            "radial_velocity_mps": np.mod(
+                radial[k] + rng.normal(0.0, 0.05, k.size) + config.v_lim_mps, 2 * config.v_lim_mps
+            )
+            - config.v_lim_mps,
             "north_m": pos[:, 0],
             "east_m": pos[:, 1],
             "down_m": pos[:, 2],
             "elevation_measured": True,
             "snr_db": 25.0,
         }
-    )  # fmt: skip
+    )
     nav = navigation_solution(truth, times, "ga-typical", seed, ORIGIN)
-    ownship = pd.DataFrame({"time_s": times} | {f"own_{k[4:]}": v for k, v in nav.items() if k[4:] in
-                                               (n[4:] for n in truth)})  # fmt: skip
+    ownship = pd.DataFrame(
+        {"time_s": times} | {f"own_{k[4:]}": v for k, v in nav.items() if k[4:] in (n[4:] for n in truth)}
+    )
     return det, ownship, config, times
 
 

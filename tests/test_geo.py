@@ -13,9 +13,13 @@ from skyradar.geo import direction_angles, geodetic_to_ned, ned_rotation_to, ned
 
 @settings(max_examples=200, deadline=None)
 @given(
-    lat0=st.floats(-85, 85), lon0=st.floats(-180, 180), alt0=st.floats(-100, 3000),
-    n=st.floats(-60_000, 60_000), e=st.floats(-60_000, 60_000), d=st.floats(-12_000, 500),
-)  # fmt: skip
+    lat0=st.floats(-85, 85),
+    lon0=st.floats(-180, 180),
+    alt0=st.floats(-100, 3000),
+    n=st.floats(-60_000, 60_000),
+    e=st.floats(-60_000, 60_000),
+    d=st.floats(-12_000, 500),
+)
 def test_single_point_ned_to_geodetic_matches_pymap3d(lat0, lon0, alt0, n, e, d):
     lat, lon, alt = ned_to_geodetic(np.array([n, e, d]), lat0, lon0, alt0)
     ref = pymap3d.ned2geodetic(n, e, d, lat0, lon0, alt0)

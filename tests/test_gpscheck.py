@@ -20,7 +20,7 @@ from skyradar.nav.gpscheck.monitor import (
     MonitorSettings,
     alerts,
     frame_verdict,
-)  # fmt: skip
+)
 from skyradar.nav.gpscheck.preprocess import METHODS, preprocess
 from skyradar.nav.gpscheck.search import PoseOffset, _template, ncc_surface, search_offset
 from skyradar.scene.ground_grid import GroundGrid, PoseGrid, sample_at_pose

@@ -68,8 +68,15 @@ def _write_tif(path, grid: GroundGrid, image: np.ndarray):
 
     from skyradar.scene.map_raster import local_crs
 
-    profile = {"driver": "GTiff", "width": grid.shape[1], "height": grid.shape[0], "count": 1,
-               "dtype": "float32", "crs": local_crs(*ORIGIN), "transform": grid.transform}  # fmt: skip
+    profile = {
+        "driver": "GTiff",
+        "width": grid.shape[1],
+        "height": grid.shape[0],
+        "count": 1,
+        "dtype": "float32",
+        "crs": local_crs(*ORIGIN),
+        "transform": grid.transform,
+    }
     with rasterio.open(path, "w", **profile) as dst:
         dst.write(image, 1)
     return path
@@ -138,11 +145,17 @@ def town_run(tmp_path_factory):
     config = ch6_radar_config()
     sim = LandCoverSimulator(config, code, height, grid, origin=(*ORIGIN, 0.0), seed=1)
     state = _ownship(2, -50.0, 0.0)
-    iq = np.stack([
-        sim.frame(PlatformState(np.array([state["own_north_m"][i], 0.0, -200.0]), np.array([50.0, 0, 0]),
-                                np.zeros(3)), frame_index=i)
-        for i in range(2)
-    ])  # fmt: skip
+    iq = np.stack(
+        [
+            sim.frame(
+                PlatformState(
+                    np.array([state["own_north_m"][i], 0.0, -200.0]), np.array([50.0, 0, 0]), np.zeros(3)
+                ),
+                frame_index=i,
+            )
+            for i in range(2)
+        ]
+    )
     _write_tif(folder / "town.tif", grid, image)
     return _write_run(folder / "town.zarr", config, iq, -50.0, 0.0), folder / "town.tif"
 

@@ -162,10 +162,18 @@ def test_altitude_return_read_straight_up_is_ground():
     u = np.array([[np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)]] * 3)
     rng = np.array([286.0, 200.0, 286.0])  # altitude return; nearer than the ground; closing fast
     p = rng[:, None] * u
-    frame = {"range_m": rng, "snr_db": np.full(3, 13.0), "azimuth_rad": np.full(3, az),
-             "elevation_rad": np.full(3, el), "north_m": p[:, 0], "east_m": p[:, 1], "down_m": p[:, 2],
-             "radial_velocity_mps": np.array([-4.4, -4.4, -30.0]), "u_ant": u,
-             "coherence": np.full(3, 0.9)}  # fmt: skip
+    frame = {
+        "range_m": rng,
+        "snr_db": np.full(3, 13.0),
+        "azimuth_rad": np.full(3, az),
+        "elevation_rad": np.full(3, el),
+        "north_m": p[:, 0],
+        "east_m": p[:, 1],
+        "down_m": p[:, 2],
+        "radial_velocity_mps": np.array([-4.4, -4.4, -30.0]),
+        "u_ant": u,
+        "coherence": np.full(3, 0.9),
+    }
 
     def height_fn(points):
         return 300.0 - np.asarray(points, float)[..., 2]

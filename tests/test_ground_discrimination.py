@@ -111,8 +111,9 @@ def test_a_mixed_pixel_of_ground_left_and_right_is_ground_and_one_with_an_aircra
         "aircraft+ground": _elevation_of_mixture([left, right, aircraft], [0.5, 0.4j, 1.0]),
     }
     assert mixtures["ground"] == pytest.approx(el_ground, abs=np.radians(0.5))
-    flags = ground_in_elevation(np.full(2, 1500.0), np.array(list(mixtures.values())), height, np.zeros(3),
-                                np.eye(3), 60.0)  # fmt: skip
+    flags = ground_in_elevation(
+        np.full(2, 1500.0), np.array(list(mixtures.values())), height, np.zeros(3), np.eye(3), 60.0
+    )
     assert flags.tolist() == [True, False]
 
 

@@ -31,9 +31,18 @@ T = np.arange(0.0, 8.0, 1.0 / 9.4)
 def _own(t: np.ndarray = T) -> pd.DataFrame:
     """Own-ship flying north, level, 500 m above a level ground."""
     zero = 0.0 * t
-    return pd.DataFrame({"time_s": t, "own_north_m": SPEED_MPS * t, "own_east_m": zero, "own_down_m": zero,
-                         "own_vn_mps": SPEED_MPS + zero, "own_ve_mps": zero, "own_vd_mps": zero,
-                         "own_height_agl_m": AGL_M + zero})  # fmt: skip
+    return pd.DataFrame(
+        {
+            "time_s": t,
+            "own_north_m": SPEED_MPS * t,
+            "own_east_m": zero,
+            "own_down_m": zero,
+            "own_vn_mps": SPEED_MPS + zero,
+            "own_ve_mps": zero,
+            "own_vd_mps": zero,
+            "own_height_agl_m": AGL_M + zero,
+        }
+    )
 
 
 def _detections(target_ned: np.ndarray, seed: int = 0, t: np.ndarray = T, up_m: float = 0.0) -> pd.DataFrame:
@@ -47,10 +56,17 @@ def _detections(target_ned: np.ndarray, seed: int = 0, t: np.ndarray = T, up_m: 
     v_target = np.gradient(target_ned, t, axis=0)
     v = np.sum(d * (v_target - [SPEED_MPS, 0, 0]), axis=1) / r
     v_meas = v + rng.normal(0, 0.12, t.size)
-    return pd.DataFrame({"time_s": t, "range_m": r + C * v + rng.normal(0, 4.0, t.size),
-                         "radial_velocity_mps": (v_meas + WIDTH / 2) % WIDTH - WIDTH / 2,
-                         "north_m": target_ned[:, 0], "east_m": target_ned[:, 1],
-                         "down_m": target_ned[:, 2] - up_m, "snr_db": 20.0 + 0 * t})  # fmt: skip
+    return pd.DataFrame(
+        {
+            "time_s": t,
+            "range_m": r + C * v + rng.normal(0, 4.0, t.size),
+            "radial_velocity_mps": (v_meas + WIDTH / 2) % WIDTH - WIDTH / 2,
+            "north_m": target_ned[:, 0],
+            "east_m": target_ned[:, 1],
+            "down_m": target_ned[:, 2] - up_m,
+            "snr_db": 20.0 + 0 * t,
+        }
+    )
 
 
 def _confirmed_from(tracks: pd.DataFrame) -> float:
@@ -139,10 +155,16 @@ def test_history_starts_again_after_a_reacquisition_gap():
     t1 = T[:19]  # 1.8 s: long enough for its range rate to rule out a static point
     rho1 = rho2[0] - 115.0 * (t2[0] - t1)
     v1 = np.full(t1.size, 115.0 - WIDTH)
-    det = pd.DataFrame({"time_s": np.r_[t1, t2], "range_m": np.r_[rho1, rho2],
-                        "radial_velocity_mps": np.r_[v1, (v2 + WIDTH / 2) % WIDTH - WIDTH / 2]})  # fmt: skip
-    tracks = pd.DataFrame({"time_s": det["time_s"], "track_id": 7, "detection_row": np.arange(len(det)),
-                           "confirmed": True})  # fmt: skip
+    det = pd.DataFrame(
+        {
+            "time_s": np.r_[t1, t2],
+            "range_m": np.r_[rho1, rho2],
+            "radial_velocity_mps": np.r_[v1, (v2 + WIDTH / 2) % WIDTH - WIDTH / 2],
+        }
+    )
+    tracks = pd.DataFrame(
+        {"time_s": det["time_s"], "track_id": 7, "detection_row": np.arange(len(det)), "confirmed": True}
+    )
     after_gap = det["time_s"].to_numpy() > 3.0
     for gap_s, held_after in ((np.inf, False), (2.0, True)):
         out = hold_ground_tracks(tracks, det, own, WIDTH, C, None, GroundTrackTest(rejudge_gap_s=gap_s))
@@ -222,10 +244,15 @@ def test_short_track_whose_measured_directions_are_on_the_ground_needs_more_dete
     from skyradar.track.ground_tracks import GroundTrackTest, hold_ground_tracks
 
     t = np.array([0.0, 0.106, 0.213, 0.851])
-    det = pd.DataFrame({"time_s": t, "range_m": [809.44, 851.25, 884.39, 1056.77],
-                        "radial_velocity_mps": [36.99, 35.84, 34.75, 32.09],
-                        "azimuth_rad": np.radians([-28.6, -7.4, 5.2, -34.5]),
-                        "elevation_rad": np.radians([-25.4, -25.2, -25.1, 0.0])})  # fmt: skip
+    det = pd.DataFrame(
+        {
+            "time_s": t,
+            "range_m": [809.44, 851.25, 884.39, 1056.77],
+            "radial_velocity_mps": [36.99, 35.84, 34.75, 32.09],
+            "azimuth_rad": np.radians([-28.6, -7.4, 5.2, -34.5]),
+            "elevation_rad": np.radians([-25.4, -25.2, -25.1, 0.0]),
+        }
+    )
     own = _own(t)
     north, east = 800.0 * np.cos(det["azimuth_rad"]), 800.0 * np.sin(det["azimuth_rad"])
     tracks = pd.DataFrame({"time_s": t, "track_id": 3, "detection_row": np.arange(4), "confirmed": True})
@@ -248,10 +275,18 @@ def test_track_without_a_measured_direction_needs_more_detections():
     from skyradar.track.ground_tracks import GroundTrackTest, hold_ground_tracks
 
     t = np.array([15.745, 15.957, 16.064, 16.277]) - 15.745
-    det = pd.DataFrame({"time_s": t, "range_m": [664.42, 660.32, 646.97, 629.10],
-                        "radial_velocity_mps": [-16.03, -13.51, -11.83, -8.82],
-                        "azimuth_rad": [-1.073, 1.248, -1.108, 1.248], "elevation_rad": 0.0 * t,
-                        "north_m": 660.0 + 0 * t, "east_m": 0 * t, "down_m": 0 * t})  # fmt: skip
+    det = pd.DataFrame(
+        {
+            "time_s": t,
+            "range_m": [664.42, 660.32, 646.97, 629.10],
+            "radial_velocity_mps": [-16.03, -13.51, -11.83, -8.82],
+            "azimuth_rad": [-1.073, 1.248, -1.108, 1.248],
+            "elevation_rad": 0.0 * t,
+            "north_m": 660.0 + 0 * t,
+            "east_m": 0 * t,
+            "down_m": 0 * t,
+        }
+    )
     tracks = pd.DataFrame({"time_s": t, "track_id": 3, "detection_row": np.arange(4), "confirmed": True})
     test = GroundTrackTest(point_sigma_velocity_mps=None, release_detections=3)
     for measured, kept in ((False, False), (True, True)):
@@ -352,9 +387,16 @@ def test_three_clutter_hits_a_range_line_fits_are_not_an_object():
     from skyradar.track.ground_tracks import GroundTrackTest, hold_ground_tracks
 
     t = np.array([95.4, 95.5, 95.7, 96.6]) - 95.4
-    det = pd.DataFrame({"time_s": t, "range_m": [1446.5, 1461.5, 1528.0, 1724.1],
-                        "radial_velocity_mps": [35.2, 35.1, 34.3, 31.6],
-                        "north_m": 1500.0 + 0 * t, "east_m": 0 * t, "down_m": 0 * t})  # fmt: skip
+    det = pd.DataFrame(
+        {
+            "time_s": t,
+            "range_m": [1446.5, 1461.5, 1528.0, 1724.1],
+            "radial_velocity_mps": [35.2, 35.1, 34.3, 31.6],
+            "north_m": 1500.0 + 0 * t,
+            "east_m": 0 * t,
+            "down_m": 0 * t,
+        }
+    )
     tracks = pd.DataFrame({"time_s": t, "track_id": 3, "detection_row": np.arange(4), "confirmed": True})
     for least, kept in ((3, True), (GroundTrackTest().release_detections, False)):
         test = GroundTrackTest(release_detections=least)

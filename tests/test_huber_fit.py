@@ -28,9 +28,18 @@ def test_same_minimum_as_scipy_least_squares(seed):
     lower, upper = np.array([1e-3, -np.inf, 1.0]), np.array([np.inf, np.inf, 0.9999 * r.min()])
     x, jac = huber_least_squares(_residuals, _jacobian, x0, lower, upper, 2.0, args)
     ref = least_squares(
-        _residuals, x0, jac=_jacobian, loss="huber", f_scale=2.0, args=args, bounds=(lower, upper),
-        x_scale=[10, 1, 100], xtol=1e-15, ftol=1e-15, gtol=1e-15,
-    )  # fmt: skip
+        _residuals,
+        x0,
+        jac=_jacobian,
+        loss="huber",
+        f_scale=2.0,
+        args=args,
+        bounds=(lower, upper),
+        x_scale=[10, 1, 100],
+        xtol=1e-15,
+        ftol=1e-15,
+        gtol=1e-15,
+    )
     np.testing.assert_allclose(x, ref.x, rtol=1e-7, atol=1e-7)
     assert huber_cost(_residuals(x, *args), 2.0) <= ref.cost * (1 + 1e-12)
     np.testing.assert_allclose(jac, ref.jac, rtol=1e-5, atol=1e-6)
@@ -46,9 +55,17 @@ def test_an_active_bound_is_held():
         _residuals, _jacobian, np.array([40.0, 0.0, 0.5 * upper_h]), lower, upper, 2.0, args
     )
     ref = least_squares(
-        _residuals, np.array([40.0, 0.0, 0.5 * upper_h]), jac=_jacobian, loss="huber", f_scale=2.0,
-        args=args, bounds=(lower, upper), xtol=1e-15, ftol=1e-15, gtol=1e-15,
-    )  # fmt: skip
+        _residuals,
+        np.array([40.0, 0.0, 0.5 * upper_h]),
+        jac=_jacobian,
+        loss="huber",
+        f_scale=2.0,
+        args=args,
+        bounds=(lower, upper),
+        xtol=1e-15,
+        ftol=1e-15,
+        gtol=1e-15,
+    )
     assert x[2] == pytest.approx(upper_h, rel=1e-9)
     np.testing.assert_allclose(x, ref.x, rtol=1e-6)
 

@@ -15,17 +15,23 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-LINT_IMPORTS = [sys.executable, "-c", "import sys; from importlinter.cli import lint_imports_command; "
-                "sys.exit(lint_imports_command())"]  # fmt: skip
+LINT_IMPORTS = [
+    sys.executable,
+    "-c",
+    "import sys; from importlinter.cli import lint_imports_command; sys.exit(lint_imports_command())",
+]
 
 
 def _lint(config: Path, cwd: Path, pythonpath: Path) -> subprocess.CompletedProcess:
     # A subprocess: the tiny tree must shadow the installed skyradar on sys.path.
     return subprocess.run(
         [*LINT_IMPORTS, "--config", str(config), "--no-cache", "--no-logo"],
-        cwd=cwd, capture_output=True, text=True, timeout=120,
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=120,
         env={"PYTHONPATH": str(pythonpath), "PATH": "/usr/bin:/bin"},
-    )  # fmt: skip
+    )
 
 
 def _layer_names() -> list[str]:

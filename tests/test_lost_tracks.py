@@ -17,14 +17,37 @@ D_NC = WellClearVolume.do365_noncoop().dthr_m
 def _head_on(seconds_to_lowc: float, duration_s: float, sigma_v: float = 2.0):
     """Own-ship north at 50 m/s; an intruder closing head-on at 100 m/s, a converged track of it."""
     t = np.arange(0.0, duration_s, FRAME_S)
-    own = pd.DataFrame({"time_s": t, "own_north_m": 50.0 * t, "own_east_m": 0.0, "own_down_m": -1000.0,
-                        "own_vn_mps": 50.0, "own_ve_mps": 0.0, "own_vd_mps": 0.0,
-                        "own_yaw_rad": 0.0})  # fmt: skip
+    own = pd.DataFrame(
+        {
+            "time_s": t,
+            "own_north_m": 50.0 * t,
+            "own_east_m": 0.0,
+            "own_down_m": -1000.0,
+            "own_vn_mps": 50.0,
+            "own_ve_mps": 0.0,
+            "own_vd_mps": 0.0,
+            "own_yaw_rad": 0.0,
+        }
+    )
     start = D_NC + 100.0 * seconds_to_lowc
-    tracks = pd.DataFrame({"time_s": t, "track_id": 4, "north_m": start - 50.0 * t, "east_m": 30.0,
-                           "down_m": -1000.0, "vn_mps": -50.0, "ve_mps": 0.0, "vd_mps": 0.0})  # fmt: skip
-    cov = {f"cov_{k}_{i}{j}": ((400.0 if k == "pp" else sigma_v**2) if i == j and k != "pv" else 0.0)
-           for k in ("pp", "vv", "pv") for i in range(3) for j in range(3)}  # fmt: skip
+    tracks = pd.DataFrame(
+        {
+            "time_s": t,
+            "track_id": 4,
+            "north_m": start - 50.0 * t,
+            "east_m": 30.0,
+            "down_m": -1000.0,
+            "vn_mps": -50.0,
+            "ve_mps": 0.0,
+            "vd_mps": 0.0,
+        }
+    )
+    cov = {
+        f"cov_{k}_{i}{j}": ((400.0 if k == "pp" else sigma_v**2) if i == j and k != "pv" else 0.0)
+        for k in ("pp", "vv", "pv")
+        for i in range(3)
+        for j in range(3)
+    }
     return own, tracks.assign(**cov)
 
 
@@ -38,8 +61,11 @@ def test_a_warning_is_held_on_every_frame_of_a_fade():
     # The prediction follows the intruder: 100 m/s closing, from its last row.
     last = faded[faded["time_s"] < 5.0].iloc[-1]
     dt = gap["time_s"].to_numpy() - last["time_s"]
-    np.testing.assert_allclose(gap["range_m"].to_numpy(), np.hypot(last["north_m"] - 50.0 * last["time_s"]
-                               - 100.0 * dt, 30.0), rtol=1e-6)  # fmt: skip
+    np.testing.assert_allclose(
+        gap["range_m"].to_numpy(),
+        np.hypot(last["north_m"] - 50.0 * last["time_s"] - 100.0 * dt, 30.0),
+        rtol=1e-6,
+    )
 
 
 def test_a_prediction_never_raises_an_alert():

@@ -35,9 +35,13 @@ def _closed_form_cpa(own, intr, t0: float) -> tuple[float, float, float]:
 
 @pytest.mark.parametrize(
     ("own_heading", "intr_heading", "miss_m", "vertical_m", "rotate_deg", "side"),
-    [(30.0, 100.0, 200.0, 50.0, 0.0, "right"), (0.0, 180.0, 0.0, -100.0, 0.0, "left"),
-     (250.0, 250.0, 500.0, 0.0, 90.0, "left"), (90.0, 10.0, 1000.0, 150.0, -45.0, "right")],
-)  # fmt: skip
+    [
+        (30.0, 100.0, 200.0, 50.0, 0.0, "right"),
+        (0.0, 180.0, 0.0, -100.0, 0.0, "left"),
+        (250.0, 250.0, 500.0, 0.0, 90.0, "left"),
+        (90.0, 10.0, 1000.0, 150.0, -45.0, "right"),
+    ],
+)
 def test_closest_approach_is_the_requested_one(
     own_heading, intr_heading, miss_m, vertical_m, rotate_deg, side
 ):
@@ -96,8 +100,14 @@ def test_make_encounter_command(tmp_path, monkeypatch, capsys, caplog):
     for heading, origin in ((30.0, MUNICH), (100.0, LISBON)):
         traj = straight([0, 0, -1000], heading, 50.0, 200.0, origin=origin, rate_hz=1.0)
         s = traj.sample(traj.time_s)
-        df = pd.DataFrame({"timestamp": (1.7e9 + s.time_s) * 1000, "latitude": s.lat_deg,
-                           "longitude": s.lon_deg, "altitude": s.alt_m / 0.3048})  # fmt: skip
+        df = pd.DataFrame(
+            {
+                "timestamp": (1.7e9 + s.time_s) * 1000,
+                "latitude": s.lat_deg,
+                "longitude": s.lon_deg,
+                "altitude": s.alt_m / 0.3048,
+            }
+        )
         rows.append(df)
     rows[0].iloc[::-1].to_csv(tmp_path / "a.csv.gz", index=False)  # reversed, epoch ms: cleaned
     rows[1].to_json(tmp_path / "b.json", orient="records")

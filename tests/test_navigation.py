@@ -121,11 +121,21 @@ def _scene(n_frames: int = 24, seed: int = 0):
         v_r = (np.array([-60.0, 0.0, 0.0]) - [50.0, 0, 0]) @ (p - antenna) / np.linalg.norm(p - antenna)
         r, az, el = direction_angles(ant_to_ned.T @ (p - antenna))
         cubes.append(synthetic_frame(CFG, [(float(r), float(v_r), float(az), float(el), 35.0)], rng)[0])
-    nav = {"nav_north_m": own[:, 0], "nav_east_m": own[:, 1], "nav_down_m": own[:, 2],
-           "nav_vn_mps": np.full(n_frames, 50.0), "nav_ve_mps": np.zeros(n_frames),
-           "nav_vd_mps": np.zeros(n_frames), "nav_lat_deg": lat, "nav_lon_deg": lon, "nav_alt_m": alt,
-           "nav_yaw_rad": att[:, 0], "nav_pitch_rad": att[:, 1], "nav_roll_rad": att[:, 2],
-           "nav_height_agl_m": -own[:, 2]}  # fmt: skip
+    nav = {
+        "nav_north_m": own[:, 0],
+        "nav_east_m": own[:, 1],
+        "nav_down_m": own[:, 2],
+        "nav_vn_mps": np.full(n_frames, 50.0),
+        "nav_ve_mps": np.zeros(n_frames),
+        "nav_vd_mps": np.zeros(n_frames),
+        "nav_lat_deg": lat,
+        "nav_lon_deg": lon,
+        "nav_alt_m": alt,
+        "nav_yaw_rad": att[:, 0],
+        "nav_pitch_rad": att[:, 1],
+        "nav_roll_rad": att[:, 2],
+        "nav_height_agl_m": -own[:, 2],
+    }
     attrs = {"origin_lat_deg": ORIGIN[0], "origin_lon_deg": ORIGIN[1], "origin_alt_m": ORIGIN[2]}
     return frames_dataset(np.stack(cubes), times, CFG, ownship=nav | _truth(nav, 0.0), attrs=attrs)
 
@@ -139,8 +149,9 @@ def _chain(ds):
     terrain = flat_terrain(*ORIGIN[:2], height_m=0.0, size_m=8000.0, spacing_m=60.0)
     det = process_frames(ds, terrain=terrain)
     own = ownship_from_frames(ds)
-    tracks = track_detections(det[~det.is_ground], "radar", CFG, frame_times_s=np.asarray(own.time_s),
-                              origin=ORIGIN, ownship=own)  # fmt: skip
+    tracks = track_detections(
+        det[~det.is_ground], "radar", CFG, frame_times_s=np.asarray(own.time_s), origin=ORIGIN, ownship=own
+    )
     return det, tracks, alerts_from_tracks(tracks, own, with_advice=True)
 
 
@@ -193,12 +204,16 @@ def test_scenario_frames_carry_navigation_beside_truth_and_a_bad_model_is_one_li
         if model == "perfect":
             np.testing.assert_array_equal(nav["nav_yaw_rad"], own["own_yaw_rad"])
         else:  # seeded from simulation.seed unless the section names its own seed
-            ref = navigation_solution(own, built.times_s, built.navigation, seed or 2, built.origin,
-                                      built.terrain.height_at)  # fmt: skip
+            ref = navigation_solution(
+                own, built.times_s, built.navigation, seed or 2, built.origin, built.terrain.height_at
+            )
             np.testing.assert_array_equal(nav["nav_yaw_rad"], ref["nav_yaw_rad"])
     path.write_text(text + "navigation: {model: ga-typical, heading_bias_deg: -2}\n")
-    assert_one_line_error(skyradar("simulate", str(path), "--output", str(tmp_path / "r.zarr"), cwd=tmp_path),
-                          "navigation.heading_bias_deg", "-2")  # fmt: skip
+    assert_one_line_error(
+        skyradar("simulate", str(path), "--output", str(tmp_path / "r.zarr"), cwd=tmp_path),
+        "navigation.heading_bias_deg",
+        "-2",
+    )
 
 
 def test_radar_height_replaces_the_gnss_height_where_the_estimator_was_trusted():
@@ -210,8 +225,13 @@ def test_radar_height_replaces_the_gnss_height_where_the_estimator_was_trusted()
     ds = _scene(n_frames=4)
     t = np.arange(4) / 9.4  # _scene's frame times
     # Estimates a few ms off the frame times (nearest within half a frame), one not trusted, one unsorted.
-    state = pd.DataFrame({"time_s": t[[3, 0, 1, 2]] + 0.004, "h_m": [603.0, 590.0, 591.0, 592.0],
-                          "used_by_filter": [True, True, True, False]})  # fmt: skip
+    state = pd.DataFrame(
+        {
+            "time_s": t[[3, 0, 1, 2]] + 0.004,
+            "h_m": [603.0, 590.0, 591.0, 592.0],
+            "used_by_filter": [True, True, True, False],
+        }
+    )
     out = with_radar_height(ds, state)
     gnss = ds["nav_height_agl_m"].values
     np.testing.assert_array_equal(out["nav_height_agl_m"].values, [590.0, 591.0, gnss[2], 603.0])

@@ -51,10 +51,17 @@ def test_the_searched_files_exist():
 
 def test_the_pattern_finds_each_kind_of_history():
     told = [
-        "(issue 12 point 4)", "Issue 12.1: sub-facets", "def test_issue_12_gap():", "session 3",
-        "hills encounter 96", "fixed in commit 1a2b3c4", "a1b2c3d (the revert)", "seed-brief.md",
-        "the seed brief's form", "see #41",
-    ]  # fmt: skip
+        "(issue 12 point 4)",
+        "Issue 12.1: sub-facets",
+        "def test_issue_12_gap():",
+        "session 3",
+        "hills encounter 96",
+        "fixed in commit 1a2b3c4",
+        "a1b2c3d (the revert)",
+        "seed-brief.md",
+        "the seed brief's form",
+        "see #41",
+    ]
     assert [line for line in told if not HISTORY.search(line)] == []
     plain = ['scope="session"', "encounter_score", "&#39;", "page.html#2", "# 3 frames", "issued warning"]
     assert [line for line in plain if HISTORY.search(line)] == []

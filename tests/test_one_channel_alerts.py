@@ -29,18 +29,29 @@ NONCOOP = WellClearVolume.do365_noncoop()
 def _scenario() -> dict:
     def intruder(name: str, start: np.ndarray, **extra) -> dict:
         ned = [float(start[0]), float(start[1]), -2000.0 + float(start[2])]
-        return {"name": name, "type": "straight", "start_ned_m": ned, "heading_deg": 180,
-                "speed_mps": INTRUDER_SPEED, **extra}  # fmt: skip
+        return {
+            "name": name,
+            "type": "straight",
+            "start_ned_m": ned,
+            "heading_deg": 180,
+            "speed_mps": INTRUDER_SPEED,
+            **extra,
+        }
 
     return {
-        "name": "one channel", "origin": {"lat_deg": 52.0, "lon_deg": 4.36, "alt_m": 0.0},
+        "name": "one channel",
+        "origin": {"lat_deg": 52.0, "lon_deg": 4.36, "alt_m": 0.0},
         "radar": {"range_limit_m": 2500, "rx_positions_m": [[0.0, 0.0, 0.0]]},
         "ownship": {"type": "straight", "start_ned_m": [0, 0, -2000], "speed_mps": OWN_SPEED},
         # The abeam intruder is seen at 40-60 deg off boresight: a larger aircraft, so that it is tracked.
-        "intruders": [intruder("head-on", HEAD_ON), intruder("abeam", ABEAM, rcs_m2=50.0),
-                      intruder("below", BELOW)],
-        "frame_rate_hz": 9.4, "duration_s": 10.0,
-    }  # fmt: skip
+        "intruders": [
+            intruder("head-on", HEAD_ON),
+            intruder("abeam", ABEAM, rcs_m2=50.0),
+            intruder("below", BELOW),
+        ],
+        "frame_rate_hz": 9.4,
+        "duration_s": 10.0,
+    }
 
 
 @pytest.fixture(scope="module")
@@ -137,8 +148,9 @@ def test_range_only_fit_and_corner_entry_are_the_closed_form_ones(split_deg):
     t_cyl, _ = loss_of_well_clear_interval(rel[-1:], u[None, :], NONCOOP, 60.0)
     assert np.isnan(t_cyl[0]) if miss_vec[2] > NONCOOP.zthr_m else t_cyl[0] >= got[0] - 1e-9
     # Levels: a warning once the entry is within its 25 s alerting time, none beyond the corner.
-    levels = range_only_levels(np.array([miss, 2 * c]), np.zeros(2), np.full(2, 8100.0),
-                               np.array([t_cpa - T[-1]] * 2), AlertConfig())  # fmt: skip
+    levels = range_only_levels(
+        np.array([miss, 2 * c]), np.zeros(2), np.full(2, 8100.0), np.array([t_cpa - T[-1]] * 2), AlertConfig()
+    )
     assert levels["level"].tolist() == [WARNING, 0] and levels["known"].all()
     np.testing.assert_allclose(levels["t_in_s"][0], expected, rtol=1e-9)
 
@@ -159,16 +171,47 @@ def test_a_collision_course_fits_a_zero_miss_and_warns():
 
 def test_range_only_tracks_table_alerts_beside_a_3d_track_and_carries_its_path_through_a_gap():
     t = np.arange(0.0, 14.0, 0.2)
-    own = pd.DataFrame({"time_s": t, "own_north_m": 50.0 * t, "own_east_m": 0.0, "own_down_m": -1000.0,
-                        "own_vn_mps": 50.0, "own_ve_mps": 0.0, "own_vd_mps": 0.0})  # fmt: skip
+    own = pd.DataFrame(
+        {
+            "time_s": t,
+            "own_north_m": 50.0 * t,
+            "own_east_m": 0.0,
+            "own_down_m": -1000.0,
+            "own_vn_mps": 50.0,
+            "own_ve_mps": 0.0,
+            "own_vd_mps": 0.0,
+        }
+    )
     _, r, rdot = _straight(t, np.array([0.0, 100.0, 0.0]), np.array([-90.0, 0.0, 0.0]), 25.0)
-    ranged = pd.DataFrame({"time_s": t, "track_id": 1, "north_m": np.nan, "east_m": np.nan, "down_m": np.nan,
-                           "vn_mps": np.nan, "ve_mps": np.nan, "vd_mps": np.nan, "range_m": r,
-                           "range_rate_mps": rdot})  # fmt: skip
+    ranged = pd.DataFrame(
+        {
+            "time_s": t,
+            "track_id": 1,
+            "north_m": np.nan,
+            "east_m": np.nan,
+            "down_m": np.nan,
+            "vn_mps": np.nan,
+            "ve_mps": np.nan,
+            "vd_mps": np.nan,
+            "range_m": r,
+            "range_rate_mps": rdot,
+        }
+    )
     ranged = ranged[(t < 9.0) | (t > 11.0)]  # a 2 s gap: the lost track's prediction carries the path
-    located = pd.DataFrame({"time_s": t, "track_id": 2, "north_m": 50.0 * t + 3000.0 - 90.0 * t,
-                            "east_m": 2000.0, "down_m": -1000.0, "vn_mps": -40.0, "ve_mps": 0.0,
-                            "vd_mps": 0.0, "range_m": np.nan, "range_rate_mps": np.nan})  # fmt: skip
+    located = pd.DataFrame(
+        {
+            "time_s": t,
+            "track_id": 2,
+            "north_m": 50.0 * t + 3000.0 - 90.0 * t,
+            "east_m": 2000.0,
+            "down_m": -1000.0,
+            "vn_mps": -40.0,
+            "ve_mps": 0.0,
+            "vd_mps": 0.0,
+            "range_m": np.nan,
+            "range_rate_mps": np.nan,
+        }
+    )
     alerts = alerts_from_tracks(pd.concat([ranged, located]), own, AlertConfig())
     one, two = alerts[alerts["track_id"] == 1], alerts[alerts["track_id"] == 2]
     assert (one["geometry"] == "range-only").all() and (two["geometry"] == "3-d").all()

@@ -65,8 +65,15 @@ def _run(*args: str, cwd: Path) -> None:
 def chain(tmp_path_factory) -> Path:
     """A 6 s run with a head-on intruder through every command of the DAA chain, and its export."""
     folder = tmp_path_factory.mktemp("tables")
-    intruder = {"name": "A", "type": "encounter", "kind": "head-on", "t_cpa_s": 12.0,
-                "horizontal_miss_m": 50.0, "intruder_speed_mps": 40.0, "rcs_m2": 5.0}  # fmt: skip
+    intruder = {
+        "name": "A",
+        "type": "encounter",
+        "kind": "head-on",
+        "t_cpa_s": 12.0,
+        "horizontal_miss_m": 50.0,
+        "intruder_speed_mps": 40.0,
+        "rcs_m2": 5.0,
+    }
     scenario = small_scenario("output tables", duration_s=6.0, frame_rate_hz=5.0, intruders=[intruder])
     (folder / "s.yaml").write_text(yaml.safe_dump(scenario))
     _run("simulate", "s.yaml", "-o", "run.zarr", cwd=folder)
@@ -114,8 +121,13 @@ def test_export_tables_are_written_as_documented(chain):
 
 
 def test_state_table_is_written_as_documented(tmp_path):
-    scenario = small_scenario("state table", duration_s=1.0, frame_rate_hz=5.0, mount="forward-down",
-                              terrain={"type": "flat", "size_m": 6000.0, "spacing_m": 60.0})  # fmt: skip
+    scenario = small_scenario(
+        "state table",
+        duration_s=1.0,
+        frame_rate_hz=5.0,
+        mount="forward-down",
+        terrain={"type": "flat", "size_m": 6000.0, "spacing_m": 60.0},
+    )
     scenario["ownship"]["start_ned_m"] = [0, 0, -500]
     (tmp_path / "g.yaml").write_text(yaml.safe_dump(scenario))
     _run("simulate", "g.yaml", "-o", "g.zarr", cwd=tmp_path)

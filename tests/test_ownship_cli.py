@@ -39,11 +39,16 @@ def _detections(ds) -> pd.DataFrame:
     rows = []
     for k in range(ds.sizes["target"]):
         vis = ds["tgt_visible"].values[:, k]
-        rows.append(pd.DataFrame({
-            "time_s": t[vis], "range_m": ds["tgt_range_m"].values[vis, k],
-            "radial_velocity_mps": ds["tgt_radial_velocity_mps"].values[vis, k],
-            **{c: ds[f"tgt_{c}"].values[vis, k] for c in ("north_m", "east_m", "down_m")},
-        }))  # fmt: skip
+        rows.append(
+            pd.DataFrame(
+                {
+                    "time_s": t[vis],
+                    "range_m": ds["tgt_range_m"].values[vis, k],
+                    "radial_velocity_mps": ds["tgt_radial_velocity_mps"].values[vis, k],
+                    **{c: ds[f"tgt_{c}"].values[vis, k] for c in ("north_m", "east_m", "down_m")},
+                }
+            )
+        )
     return pd.concat(rows).sort_values("time_s", kind="stable").reset_index(drop=True)
 
 
@@ -61,12 +66,22 @@ def test_run_and_table_give_the_same_tracks_and_alerts_from_navigation(tmp_path,
     results = {}
     for name, own in (("run", tmp_path / "run.zarr"), ("table", table), ("true", tmp_path / "true_nav.zarr")):
         trk, alerts = tmp_path / f"trk_{name}.parquet", tmp_path / f"al_{name}.parquet"
-        code, out, err = skyradar_in_process(monkeypatch, capsys, "track", str(tmp_path / "det.parquet"),
-                              "--ownship", str(own), "-o", str(trk), "--json")  # fmt: skip
+        code, out, err = skyradar_in_process(
+            monkeypatch,
+            capsys,
+            "track",
+            str(tmp_path / "det.parquet"),
+            "--ownship",
+            str(own),
+            "-o",
+            str(trk),
+            "--json",
+        )
         assert code == 0, err
         results[name] = json.loads(out.strip().splitlines()[-1])
-        code, out, err = skyradar_in_process(monkeypatch, capsys, "alert", str(trk), "--ownship", str(own),
-                              "-o", str(alerts), "--json")  # fmt: skip
+        code, out, err = skyradar_in_process(
+            monkeypatch, capsys, "alert", str(trk), "--ownship", str(own), "-o", str(alerts), "--json"
+        )
         assert code == 0, err
         results[name] |= json.loads(out.strip().splitlines()[-1])
         results[name] |= {"alerts_df": pd.read_parquet(alerts), "tracks_df": pd.read_parquet(trk)}
@@ -108,8 +123,17 @@ def test_alert_config_names_and_file(tmp_path):
 
 def test_alert_bad_config_through_the_real_entry_point(tmp_path):
     (tmp_path / "alerts.yaml").write_text("z_h_pos: .nan\n")
-    result = skyradar("alert", "trk.parquet", "--ownship", "run.zarr", "-o", "al.parquet",
-                      "--config", "alerts.yaml", cwd=tmp_path)  # fmt: skip
+    result = skyradar(
+        "alert",
+        "trk.parquet",
+        "--ownship",
+        "run.zarr",
+        "-o",
+        "al.parquet",
+        "--config",
+        "alerts.yaml",
+        cwd=tmp_path,
+    )
     assert_one_line_error(result, "alerts.yaml: field 'z_h_pos'", "nan")
 
 

@@ -16,14 +16,23 @@ import pytest
 from skyradar.extras import EXTRAS
 
 PACKAGES = [
-    "scene", "sim", "process", "track", "daa", "nav", "passive", "io", "viz", "web", "experiments",
-    "benchmarks", "cli",
-]  # fmt: skip
+    "scene",
+    "sim",
+    "process",
+    "track",
+    "daa",
+    "nav",
+    "passive",
+    "io",
+    "viz",
+    "web",
+    "experiments",
+    "benchmarks",
+    "cli",
+]
 EXPORTS = [
-    (package, name)
-    for package in PACKAGES
-    for name in importlib.import_module(f"skyradar.{package}").__all__
-]  # fmt: skip
+    (package, name) for package in PACKAGES for name in importlib.import_module(f"skyradar.{package}").__all__
+]
 _EXTRA_MODULES = {module for modules in EXTRAS.values() for module in modules}
 
 

@@ -155,8 +155,11 @@ def test_simulate_passive_cli_writes_a_readable_recording_and_refuses_bad_input(
     again = skyradar("simulate-passive", "-o", "r.sigmf-meta", "--sample-rate-hz", "3e6", cwd=tmp_path)
     assert_one_line_error(again, "--overwrite")
     assert sorted(p.name for p in tmp_path.iterdir()) == [
-        "r.sigmf-data", "r.sigmf-meta", "r.truth.json", "r.truth.parquet",
-    ]  # fmt: skip
+        "r.sigmf-data",
+        "r.sigmf-meta",
+        "r.truth.json",
+        "r.truth.parquet",
+    ]
 
 
 def test_passive_refuses_unreadable_recordings_in_one_line(tmp_path):

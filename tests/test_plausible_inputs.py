@@ -74,7 +74,7 @@ def _tif(path, z):
         dtype=z.dtype,
         crs="EPSG:4326",
         transform=rasterio.Affine(0.001, 0.0, 4.33, 0.0, -0.001, 52.53),
-    ) as ds:  # fmt: skip  (no nodata declared, as in many downloads)
+    ) as ds:  # no nodata declared, as in many downloads
         ds.write(z, 1)
 
 
@@ -123,7 +123,7 @@ def test_a_decompression_bomb_is_refused_quickly(tmp_path):
                 {"name": n, "dthr_m": 0.0, "zthr_m": 0.0, "alerting_time_s": 25}
                 for n in ("preventive", "corrective", "warning")
             ]
-        },  # fmt: skip
+        },
         {"min_track_age_s": 1.0e5, "min_track_age_floor_s": 1.0e5},  # 1e9 s: beyond every setting's 1e6
         {"max_velocity_sigma_mps": 0.0},
     ],
@@ -144,9 +144,11 @@ def test_an_alert_config_that_alerts_on_everything_is_refused_through_the_entry_
     """A preventive volume of 100 km (1e308 m is out of range) alerts on every aircraft in sight. The
     config is named before the tracks are read: they need not exist. (The settings that never warn
     are refused by the same check, above; test_ownship_cli runs a bad config through the CLI.)"""
-    levels = [{"name": "preventive", "dthr_m": 1.0e5, "zthr_m": 1.0e5, "alerting_time_s": 55},
-              {"name": "corrective", "dthr_m": 670.56, "zthr_m": 137.16, "alerting_time_s": 55},
-              {"name": "warning", "dthr_m": 670.56, "zthr_m": 137.16, "alerting_time_s": 25}]  # fmt: skip
+    levels = [
+        {"name": "preventive", "dthr_m": 1.0e5, "zthr_m": 1.0e5, "alerting_time_s": 55},
+        {"name": "corrective", "dthr_m": 670.56, "zthr_m": 137.16, "alerting_time_s": 55},
+        {"name": "warning", "dthr_m": 670.56, "zthr_m": 137.16, "alerting_time_s": 25},
+    ]
     (tmp_path / "c.yaml").write_text(yaml.safe_dump({"levels": levels}))
     args = ("alert", "t.parquet", "--ownship", "run.zarr", "-o", "a.parquet", "--config", "c.yaml")
     assert_one_line_error(
@@ -182,8 +184,9 @@ def test_a_malformed_scheduler_address_is_one_line(tmp_path, address):
 
 def test_a_scheduler_address_without_a_valid_port_is_refused_before_the_output_folder(tmp_path):
     # tcp://HOST:99999 waited 10 s for an answer that cannot come, and left the experiment's folder.
-    result = skyradar("experiment", "encounters", "--scheduler", "tcp://127.0.0.1:99999", "--out", "x",
-                      cwd=tmp_path)  # fmt: skip
+    result = skyradar(
+        "experiment", "encounters", "--scheduler", "tcp://127.0.0.1:99999", "--out", "x", cwd=tmp_path
+    )
     assert_one_line_error(result, "--scheduler tcp://127.0.0.1:99999", "port 99999 is not 1..65535")
     assert not (tmp_path / "x").exists()
 
@@ -280,23 +283,34 @@ def test_sigmf_metadata_with_a_nan_rate_or_deep_nesting_is_one_line(tmp_path):
         shutil.copy(tmp_path / "rec.sigmf-data", tmp_path / f"{name}.sigmf-data")
     assert_one_line_error(
         skyradar("passive", "nan.sigmf-meta", "-o", "a.parquet", cwd=tmp_path),
-        "nan.sigmf-meta", "core:sample_rate", "finite rate",
-    )  # fmt: skip
+        "nan.sigmf-meta",
+        "core:sample_rate",
+        "finite rate",
+    )
     assert_one_line_error(
         skyradar("passive", "deep.sigmf-meta", "-o", "b.parquet", cwd=tmp_path),
-        "deep.sigmf-meta", "nested too deeply",
-    )  # fmt: skip
+        "deep.sigmf-meta",
+        "nested too deeply",
+    )
     assert_one_line_error(
         skyradar("passive", "pri.sigmf-meta", "-o", "c.parquet", cwd=tmp_path),
-        "pri.sigmf-meta", "'pri_s'", "1e+308",
-    )  # fmt: skip
+        "pri.sigmf-meta",
+        "'pri_s'",
+        "1e+308",
+    )
 
 
 def test_a_negated_range_column_is_refused_by_track(tmp_path):
     import pandas as pd
 
-    det = pd.DataFrame({"time_s": [0.0, 0.1, 0.2], "frame": [0, 1, 2], "range_m": [-900.0, -895.0, -890.0],
-                        "radial_velocity_mps": [-50.0, -50.0, -50.0]})  # fmt: skip
+    det = pd.DataFrame(
+        {
+            "time_s": [0.0, 0.1, 0.2],
+            "frame": [0, 1, 2],
+            "range_m": [-900.0, -895.0, -890.0],
+            "radial_velocity_mps": [-50.0, -50.0, -50.0],
+        }
+    )
     det.to_parquet(tmp_path / "det.parquet")
     result = skyradar("track", "det.parquet", "-o", "trk.parquet", cwd=tmp_path)
     assert_one_line_error(result, "det.parquet", "range_m", "negative at row 0")
@@ -307,8 +321,14 @@ def test_a_range_of_1e308_is_refused_by_track(tmp_path):
     # Finite, so it passed the checks, and the tracker dropped the detection without a word.
     import pandas as pd
 
-    det = pd.DataFrame({"time_s": [0.0, 0.1, 0.2], "frame": [0, 1, 2], "range_m": [900.0, 1e308, 890.0],
-                        "radial_velocity_mps": [-50.0, -50.0, -50.0]})  # fmt: skip
+    det = pd.DataFrame(
+        {
+            "time_s": [0.0, 0.1, 0.2],
+            "frame": [0, 1, 2],
+            "range_m": [900.0, 1e308, 890.0],
+            "radial_velocity_mps": [-50.0, -50.0, -50.0],
+        }
+    )
     det.to_parquet(tmp_path / "det.parquet")
     result = skyradar("track", "det.parquet", "-o", "trk.parquet", cwd=tmp_path)
     assert_one_line_error(result, "det.parquet", "'range_m'", "1e+308", "row 1")

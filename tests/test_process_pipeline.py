@@ -51,12 +51,19 @@ def scene(n_frames=3, seed=0):
         cubes.append(synthetic_frame(CFG, targets, rng)[0])
         truth.append((aircraft, ground))
     ownship = {
-        "own_north_m": own[:, 0], "own_east_m": own[:, 1], "own_down_m": own[:, 2],
+        "own_north_m": own[:, 0],
+        "own_east_m": own[:, 1],
+        "own_down_m": own[:, 2],
         "own_vn_mps": np.full(n_frames, own_v[0]),
-        "own_ve_mps": np.zeros(n_frames), "own_vd_mps": np.zeros(n_frames),
-        "own_lat_deg": lat, "own_lon_deg": lon, "own_alt_m": alt,
-        "own_yaw_rad": att[:, 0], "own_pitch_rad": att[:, 1], "own_roll_rad": att[:, 2],
-    }  # fmt: skip
+        "own_ve_mps": np.zeros(n_frames),
+        "own_vd_mps": np.zeros(n_frames),
+        "own_lat_deg": lat,
+        "own_lon_deg": lon,
+        "own_alt_m": alt,
+        "own_yaw_rad": att[:, 0],
+        "own_pitch_rad": att[:, 1],
+        "own_roll_rad": att[:, 2],
+    }
     attrs = {"origin_lat_deg": ORIGIN[0], "origin_lon_deg": ORIGIN[1], "origin_alt_m": ORIGIN[2]}
     return frames_dataset(np.stack(cubes), times, CFG, ownship=ownship, attrs=attrs), truth
 
@@ -138,8 +145,17 @@ def test_cli_process_writes_the_table_and_reports_bad_input(tmp_path, monkeypatc
     assert run_cli(monkeypatch, capsys, "process", tmp_path / "missing.zarr", "-o", out)[0] == 2
 
 
-CH3_KEYS = ("az_sd_deg", "el_sd_deg", "az_crlb_deg", "el_crlb_deg", "dist_mean_m", "calib_phase_err_deg",
-            "detected_frames", "frames", "false_alarms_per_frame")  # fmt: skip
+CH3_KEYS = (
+    "az_sd_deg",
+    "el_sd_deg",
+    "az_crlb_deg",
+    "el_crlb_deg",
+    "dist_mean_m",
+    "calib_phase_err_deg",
+    "detected_frames",
+    "frames",
+    "false_alarms_per_frame",
+)
 
 
 def test_ch3_experiment_smoke(tmp_path):
@@ -194,14 +210,25 @@ def test_simulated_flight_over_flat_ground_separates_terrain_from_the_intruder()
     # inside the band the intruder is clutter-limited, a different problem.
     intruder = np.array([[2000.0 + 62.0 * t, 100.0, -1000.0] for t in times])
     cubes = [
-        sim.frame(PlatformState(own[i], np.array([30.0, 0, 0]), np.zeros(3)),
-                  [PointTarget(intruder[i], np.array([62.0, 0, 0]), 10.0)], i)
+        sim.frame(
+            PlatformState(own[i], np.array([30.0, 0, 0]), np.zeros(3)),
+            [PointTarget(intruder[i], np.array([62.0, 0, 0]), 10.0)],
+            i,
+        )
         for i in range(2)
-    ]  # fmt: skip
+    ]
     lat, lon, alt = ned_to_geodetic(own, *ORIGIN)
-    ownship = {"own_north_m": own[:, 0], "own_east_m": own[:, 1], "own_down_m": own[:, 2],
-               "own_vn_mps": np.full(2, 30.0), "own_ve_mps": np.zeros(2), "own_vd_mps": np.zeros(2),
-               "own_lat_deg": lat, "own_lon_deg": lon, "own_alt_m": alt}  # fmt: skip
+    ownship = {
+        "own_north_m": own[:, 0],
+        "own_east_m": own[:, 1],
+        "own_down_m": own[:, 2],
+        "own_vn_mps": np.full(2, 30.0),
+        "own_ve_mps": np.zeros(2),
+        "own_vd_mps": np.zeros(2),
+        "own_lat_deg": lat,
+        "own_lon_deg": lon,
+        "own_alt_m": alt,
+    }
     attrs = {"origin_lat_deg": ORIGIN[0], "origin_lon_deg": ORIGIN[1], "origin_alt_m": ORIGIN[2]}
     ds = frames_dataset(np.stack(cubes), times, cfg, ownship=ownship, attrs=attrs)
     table = process_frames(ds, terrain=terrain)

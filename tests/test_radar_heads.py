@@ -40,7 +40,7 @@ def _spec(**changes) -> dict:
                 "heading_deg": 90,
                 "speed_mps": 40,
             },
-        ],  # fmt: skip
+        ],
         "frame_rate_hz": 9.4,
         "duration_s": 0.25,
     }
@@ -80,18 +80,24 @@ def test_three_head_layout_covers_plus_minus_110_deg():
 @pytest.mark.parametrize(
     ("change", "needles"),
     [
-        ({"radars": [{"name": "a", "mount": "nose"}, {"name": "a", "mount": "tail"}]},
-         ["radars.1.name", "twice"]),
+        (
+            {"radars": [{"name": "a", "mount": "nose"}, {"name": "a", "mount": "tail"}]},
+            ["radars.1.name", "twice"],
+        ),
         ({"radars": [{"name": "a", "mount": "belly"}]}, ["radars.0.mount.preset", "belly"]),
         ({"radars": [{"name": "a", "mount": {"lever_arm_m": [1, 2]}}]}, ["radars.0.mount.lever_arm_m"]),
         ({"radars": [{"name": "a", "mount": "nose"}], "mount": "forward"}, ["'mount'", "radars"]),
         ({"radars": []}, ["radars"]),
-        ({"radars": [{"name": "a", "mount": {"lever_arm_m": [1, 2, 3], "position_m": [1, 2, 3]}}]},
-         ["radars.0.mount", "not both"]),
-        ({"radars": [{"name": "a", "mount": "nose", "radar": {"n_doppler": 1}}]},
-         ["radars.0.radar.n_doppler"]),
+        (
+            {"radars": [{"name": "a", "mount": {"lever_arm_m": [1, 2, 3], "position_m": [1, 2, 3]}}]},
+            ["radars.0.mount", "not both"],
+        ),
+        (
+            {"radars": [{"name": "a", "mount": "nose", "radar": {"n_doppler": 1}}]},
+            ["radars.0.radar.n_doppler"],
+        ),
     ],
-)  # fmt: skip
+)
 def test_bad_radars_are_one_line_naming_the_field(change, needles):
     with pytest.raises(InputError) as err:
         Scenario.from_dict(_spec(**change), source="s.yaml").build()
@@ -166,8 +172,20 @@ def _head_detections(built, beam_deg: float = 45.0, seed: int = 0) -> tuple[pd.D
             body = np.asarray(cfg.mount.position_m) + r * (cfg.mount.rotation @ u_noisy)
             ned = own.position_ned_m[k] + b2n @ body
             rows.append((t[k], k, head.name, r, vr, 20.0, *body, *ned))
-    cols = ["time_s", "frame", "radar", "range_m", "radial_velocity_mps", "snr_db", "x_body_m", "y_body_m",
-            "z_body_m", "north_m", "east_m", "down_m"]  # fmt: skip
+    cols = [
+        "time_s",
+        "frame",
+        "radar",
+        "range_m",
+        "radial_velocity_mps",
+        "snr_db",
+        "x_body_m",
+        "y_body_m",
+        "z_body_m",
+        "north_m",
+        "east_m",
+        "down_m",
+    ]
     own_table = pd.DataFrame(
         np.column_stack([t, own.position_ned_m, own.velocity_ned_mps]), columns=list(OWNSHIP_COLUMNS)
     )
@@ -203,8 +221,9 @@ def test_crossing_intruder_keeps_one_track_id_from_left_head_to_nose(crossing):
 def test_without_fusion_the_overlap_gives_duplicate_tracks(crossing):
     # Control: the same detections as one head's (duplicates not merged) break the single track.
     built, det, own = crossing
-    tracks = track_detections(det.drop(columns="radar"), config=built.radar, frame_times_s=built.times_s,
-                              ownship=own)  # fmt: skip
+    tracks = track_detections(
+        det.drop(columns="radar"), config=built.radar, frame_times_s=built.times_s, ownship=own
+    )
     assert tracks[tracks["confirmed"]]["track_id"].nunique() > 1
 
 
@@ -240,8 +259,10 @@ def test_multi_head_store_resumes_and_keeps_each_head(tmp_path, precision):
     cfg = RadarConfig.prototype_2022(range_limit_m=300.0, n_doppler=8)
     shape = (3, cfg.n_range, cfg.n_doppler, cfg.n_rx)
     times = np.arange(3) * 0.1
-    templates = {h: frames_dataset(da.zeros(shape, dtype=np.complex64, chunks=(2, -1, -1, -1)), times, cfg)
-                 for h in ("nose", "tail")}  # fmt: skip
+    templates = {
+        h: frames_dataset(da.zeros(shape, dtype=np.complex64, chunks=(2, -1, -1, -1)), times, cfg)
+        for h in ("nose", "tail")
+    }
     rng = np.random.default_rng(1)
     cubes = {
         h: (rng.normal(size=shape) + 1j * rng.normal(size=shape)).astype(np.complex64) for h in templates

@@ -71,8 +71,13 @@ def test_tracks_are_fitted_apart():
         r, rdot = _range_rows(rel, np.tile(u, (T.size, 1)))
         rows.append(pd.DataFrame({"track_id": tid, "t": T, "r": r, "rdot": rdot}))
     df = pd.concat(rows).sort_values("t", kind="stable")
-    got, _ = range_miss_distance(df.track_id.to_numpy(), df.t.to_numpy(), df.r.to_numpy(),
-                                 df.rdot.to_numpy(), np.tile(OWN_V, (len(df), 1)))  # fmt: skip
+    got, _ = range_miss_distance(
+        df.track_id.to_numpy(),
+        df.t.to_numpy(),
+        df.r.to_numpy(),
+        df.rdot.to_numpy(),
+        np.tile(OWN_V, (len(df), 1)),
+    )
     last = pd.Series(got, index=df.track_id.to_numpy()).groupby(level=0).last()
     np.testing.assert_allclose(last.loc[[7, 3]], [300.0, 900.0], rtol=1e-6)
 
@@ -96,12 +101,33 @@ def _tracks(vertical_m: float, horizontal_m: float, measured: bool) -> tuple[pd.
     if not measured:  # co-altitude: same range and bearing, at the own-ship's height
         horiz = r / np.hypot(rel[:, 0], rel[:, 1])
         shown = own + np.column_stack([rel[:, 0] * horiz, rel[:, 1] * horiz, 0 * t])
-    tracks = pd.DataFrame({"time_s": t, "track_id": 1, "north_m": shown[:, 0], "east_m": shown[:, 1],
-                           "down_m": shown[:, 2], "vn_mps": -100.0, "ve_mps": 0.0, "vd_mps": 0.0,
-                           "range_m": r, "range_rate_mps": rdot, "altitude_measured": measured})  # fmt: skip
-    ownship = pd.DataFrame({"time_s": t, "own_north_m": own[:, 0], "own_east_m": own[:, 1],
-                            "own_down_m": own[:, 2], "own_vn_mps": 50.0, "own_ve_mps": 0.0, "own_vd_mps": 0.0,
-                            "own_yaw_rad": 0.0})  # fmt: skip
+    tracks = pd.DataFrame(
+        {
+            "time_s": t,
+            "track_id": 1,
+            "north_m": shown[:, 0],
+            "east_m": shown[:, 1],
+            "down_m": shown[:, 2],
+            "vn_mps": -100.0,
+            "ve_mps": 0.0,
+            "vd_mps": 0.0,
+            "range_m": r,
+            "range_rate_mps": rdot,
+            "altitude_measured": measured,
+        }
+    )
+    ownship = pd.DataFrame(
+        {
+            "time_s": t,
+            "own_north_m": own[:, 0],
+            "own_east_m": own[:, 1],
+            "own_down_m": own[:, 2],
+            "own_vn_mps": 50.0,
+            "own_ve_mps": 0.0,
+            "own_vd_mps": 0.0,
+            "own_yaw_rad": 0.0,
+        }
+    )
     return tracks, ownship
 
 
@@ -135,8 +161,11 @@ def test_range_and_horizontal_direction_cannot_split_below_from_descending_throu
     v_level, v_desc = np.gradient(level, t, axis=0), np.gradient(descending, t, axis=0)
     for a, b in zip(_range_rows(level, v_level), _range_rows(descending, v_desc), strict=True):
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-9)
-    np.testing.assert_allclose(level[:, 1] / np.linalg.norm(level, axis=1),
-                               descending[:, 1] / np.linalg.norm(descending, axis=1), rtol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(
+        level[:, 1] / np.linalg.norm(level, axis=1),
+        descending[:, 1] / np.linalg.norm(descending, axis=1),
+        rtol=1e-12,
+    )
     assert np.isclose(v_desc[0, 2], 29.5 * np.sin(-turn)) and v_desc[0, 2] < 5.2  # down, m/s
     volume = {"dthr_m": 670.56, "zthr_m": 137.16}  # the warning cylinder (DO-365 non-cooperative)
 

@@ -38,8 +38,13 @@ def test_aircraft_does_not_take_the_id_and_rows_of_a_lost_ground_track(cross_mps
     ground = T < 2.5  # the ground point, then a gap in which its track is closed and kept as lost
     air = T >= 4.6  # then an aircraft inside the lost track's gate
     aircraft = _aircraft_where_the_ground_point_is(T[air], 3.0, cross_mps)
-    det = pd.concat([_detections(np.tile(GROUND_POINT, (ground.sum(), 1)), t=T[ground], seed=1),
-                     _detections(aircraft, t=T[air], seed=2)], ignore_index=True)  # fmt: skip
+    det = pd.concat(
+        [
+            _detections(np.tile(GROUND_POINT, (ground.sum(), 1)), t=T[ground], seed=1),
+            _detections(aircraft, t=T[air], seed=2),
+        ],
+        ignore_index=True,
+    )
     tracks = track_detections(det, ownship=_own(T), frame_times_s=T)
     assert tracks.track_id.nunique() == 1 and tracks.confirmed.any()
     # No row of the aircraft's track is the ground point's, nor any time before the aircraft came.

@@ -36,13 +36,19 @@ def test_the_readme_scenario_runs_through_its_commands_and_its_python_example(tm
     for line in chain.strip().splitlines():
         command = line.split("#")[0].split()
         assert command[0] == "skyradar"
-        done = subprocess.run([sys.executable, "-m", "skyradar", *command[1:]], cwd=tmp_path,
-                              capture_output=True, text=True, timeout=300)  # fmt: skip
+        done = subprocess.run(
+            [sys.executable, "-m", "skyradar", *command[1:]],
+            cwd=tmp_path,
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
         assert done.returncode == 0, (line, done.stderr[-2000:])
     alerts = pd.read_parquet(tmp_path / "alerts.parquet")
     assert (alerts["level"] == 3).any()  # the head-on glider is warned
     (example,) = _blocks("python")
-    done = subprocess.run([sys.executable, "-c", example], cwd=tmp_path, capture_output=True, text=True,
-                          timeout=300)  # fmt: skip
+    done = subprocess.run(
+        [sys.executable, "-c", example], cwd=tmp_path, capture_output=True, text=True, timeout=300
+    )
     assert done.returncode == 0, done.stderr[-2000:]
     assert "time_s" in done.stdout and "preferred_heading_deg" in done.stdout

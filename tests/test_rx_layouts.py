@@ -28,8 +28,12 @@ def test_every_layout_is_planar_with_half_wavelength_pairs_spanning_the_plane(na
     rx = rx_layout_m(name, WAVELENGTH_M)
     n = rx.shape[0]
     assert rx.shape[1] == 3 and n >= 4 and np.all(rx[:, 0] == 0.0)
-    short = [rx[j] - rx[i] for i in range(n) for j in range(i + 1, n)
-             if np.linalg.norm(rx[j] - rx[i]) <= WAVELENGTH_M / 2 + 1e-12]  # fmt: skip
+    short = [
+        rx[j] - rx[i]
+        for i in range(n)
+        for j in range(i + 1, n)
+        if np.linalg.norm(rx[j] - rx[i]) <= WAVELENGTH_M / 2 + 1e-12
+    ]
     assert np.linalg.matrix_rank(np.array(short)[:, 1:]) == 2
 
 
@@ -51,11 +55,19 @@ def test_kite_directions_are_exact_without_noise_across_the_beam(az_deg, el_deg)
 
 def _spec(radar: dict) -> dict:
     return {
-        "name": "layout", "origin": {"lat_deg": 47.0, "lon_deg": 8.0, "alt_m": 0.0}, "radar": radar,
-        "ownship": {"type": "straight", "start_ned_m": [0, 0, -1000], "heading_deg": 0, "speed_mps": 50,
-                    "duration_s": 2},
-        "frame_rate_hz": 2, "duration_s": 1,
-    }  # fmt: skip
+        "name": "layout",
+        "origin": {"lat_deg": 47.0, "lon_deg": 8.0, "alt_m": 0.0},
+        "radar": radar,
+        "ownship": {
+            "type": "straight",
+            "start_ned_m": [0, 0, -1000],
+            "heading_deg": 0,
+            "speed_mps": 50,
+            "duration_s": 2,
+        },
+        "frame_rate_hz": 2,
+        "duration_s": 1,
+    }
 
 
 def test_scenario_rx_layout_names_the_array():
@@ -65,9 +77,11 @@ def test_scenario_rx_layout_names_the_array():
 
 def test_a_head_overrides_the_top_level_layout():
     spec = _spec({"rx_layout": "kite"}) | {
-        "radars": [{"name": "nose", "mount": "forward"},
-                   {"name": "tail", "mount": "forward", "radar": {"rx_layout": "square"}}],
-    }  # fmt: skip
+        "radars": [
+            {"name": "nose", "mount": "forward"},
+            {"name": "tail", "mount": "forward", "radar": {"rx_layout": "square"}},
+        ],
+    }
     heads = Scenario.from_dict(spec).build().heads
     assert [h.config.rx_positions_m[3, 2] > 0.02 for h in heads] == [True, False]
 

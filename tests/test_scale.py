@@ -104,8 +104,10 @@ def test_process_on_a_local_cluster_matches_the_plain_loop(tmp_path):
         out = tmp_path / f"{name}.parquet"
         result = subprocess.run(
             [sys.executable, "-m", "skyradar", "process", str(run), "-o", str(out), *extra],
-            capture_output=True, text=True, timeout=300,
-        )  # fmt: skip
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
         assert result.returncode == 0, result.stderr
         tables[name] = pd.read_parquet(out)
     assert len(tables["loop"]) > 0

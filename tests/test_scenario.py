@@ -273,8 +273,15 @@ def test_icao24_selects_one_aircraft_of_a_file(tmp_path):
     rows = []
     for icao, lat0 in (("aaa111", 52.01), ("bbb222", 52.02)):
         for k in range(12):
-            rows.append({"timestamp": 1_700_000_000 + k, "icao24": icao, "latitude": lat0 + k * 1e-4,
-                         "longitude": 4.36, "altitude": 2000.0})  # fmt: skip
+            rows.append(
+                {
+                    "timestamp": 1_700_000_000 + k,
+                    "icao24": icao,
+                    "latitude": lat0 + k * 1e-4,
+                    "longitude": 4.36,
+                    "altitude": 2000.0,
+                }
+            )
     pd.DataFrame(rows).to_csv(tmp_path / "traffic.csv", index=False)
     data = _with(intruders=[{"type": "file", "path": "traffic.csv", "icao24": "bbb222", "name": "B"}])
     built = load_scenario(_write(tmp_path, data, "ok.yaml")).build()

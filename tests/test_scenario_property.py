@@ -40,9 +40,17 @@ PLAUSIBLE = {
 plausible = st.fixed_dictionaries(PLAUSIBLE)
 # One field at a time taken far out (or to a bad name): the rest plausible.
 wild = st.tuples(plausible, st.sampled_from(sorted(PLAUSIBLE)), WILD).map(
-    lambda drawn: {**drawn[0], drawn[1]: ("jet" if drawn[1] == "aircraft_class" else
-                                          (drawn[2],) * 3 if drawn[1] == "lever_arm_m" else drawn[2])}
-)  # fmt: skip
+    lambda drawn: {
+        **drawn[0],
+        drawn[1]: (
+            "jet"
+            if drawn[1] == "aircraft_class"
+            else (drawn[2],) * 3
+            if drawn[1] == "lever_arm_m"
+            else drawn[2]
+        ),
+    }
+)
 
 
 def _scenario(v: dict) -> dict:
@@ -52,14 +60,28 @@ def _scenario(v: dict) -> dict:
         "duration_s": v["duration_s"],
         "frame_rate_hz": v["frame_rate_hz"],
         "mount": {"preset": "forward", "lever_arm_m": list(v["lever_arm_m"])},
-        "navigation": {"model": "ga-typical", "heading_bias_deg": v["heading_bias_deg"],
-                       "gnss_horizontal_bias_m": v["gnss_horizontal_bias_m"]},
-        "ownship": {"type": "straight", "start_ned_m": [0.0, 0.0, v["down_m"]], "heading_deg": 10.0,
-                    "speed_mps": v["speed_mps"], "aircraft_class": v["aircraft_class"]},
-        "intruders": [{"type": "encounter", "kind": "head-on", "t_cpa_s": 30.0,
-                       "horizontal_miss_m": v["horizontal_miss_m"],
-                       "intruder_speed_mps": v["intruder_speed_mps"]}],
-    }  # fmt: skip
+        "navigation": {
+            "model": "ga-typical",
+            "heading_bias_deg": v["heading_bias_deg"],
+            "gnss_horizontal_bias_m": v["gnss_horizontal_bias_m"],
+        },
+        "ownship": {
+            "type": "straight",
+            "start_ned_m": [0.0, 0.0, v["down_m"]],
+            "heading_deg": 10.0,
+            "speed_mps": v["speed_mps"],
+            "aircraft_class": v["aircraft_class"],
+        },
+        "intruders": [
+            {
+                "type": "encounter",
+                "kind": "head-on",
+                "t_cpa_s": 30.0,
+                "horizontal_miss_m": v["horizontal_miss_m"],
+                "intruder_speed_mps": v["intruder_speed_mps"],
+            }
+        ],
+    }
 
 
 def _built_or_refused(values) -> bool:

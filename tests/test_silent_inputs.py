@@ -108,9 +108,17 @@ def test_process_refuses_a_dem_far_from_the_runs_own_ship(tmp_path):
 # ------------------------------------------------------------------ GeoTIFF window
 def _write_tif(path: Path, z: np.ndarray, crs: str, tf: rasterio.Affine) -> None:
     with rasterio.open(
-        path, "w", driver="GTiff", height=z.shape[0], width=z.shape[1], count=1, dtype=z.dtype,
-        crs=crs, transform=tf, nodata=-9999.0,
-    ) as ds:  # fmt: skip
+        path,
+        "w",
+        driver="GTiff",
+        height=z.shape[0],
+        width=z.shape[1],
+        count=1,
+        dtype=z.dtype,
+        crs=crs,
+        transform=tf,
+        nodata=-9999.0,
+    ) as ds:
         ds.write(z, 1)
 
 

@@ -36,9 +36,20 @@ def _setup():
 def _reference(sim, view, head, common, key):
     blocks = np.zeros((2, *sim._grid_shape), np.complex64)
     terrain_returns(
-        *head, sim._facets.counts, sim._facets.adapt, *common, view.horizon, view.az_bin_rad, view.h_bin_m,
-        True, 2, blocks, _NO_SPARSE, 1, key,
-    )  # fmt: skip
+        *head,
+        sim._facets.counts,
+        sim._facets.adapt,
+        *common,
+        view.horizon,
+        view.az_bin_rad,
+        view.h_bin_m,
+        True,
+        2,
+        blocks,
+        _NO_SPARSE,
+        1,
+        key,
+    )
     return blocks.sum(axis=0)
 
 

@@ -66,8 +66,11 @@ def test_pytest_runs_the_docstring_examples_and_reports_every_skip():
     assert "src/skyradar" in opts["testpaths"]
     proc = subprocess.run(
         [sys.executable, "-m", "pytest", "--co", "-q", "-p", "no:cacheprovider", "src/skyradar/config.py"],
-        cwd=ROOT, capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert "src/skyradar/config.py::skyradar.config.RadarConfig" in proc.stdout, proc.stdout + proc.stderr
 
 
@@ -78,12 +81,18 @@ def test_make_test_installs_chromium_first_and_only_when_missing(tmp_path):
     for target in ("test", "test-browser"):
         out = subprocess.run(
             ["make", "-n", "-C", str(ROOT), target, f"CHROMIUM={missing}"],
-            capture_output=True, text=True, timeout=60, env=env,
-        ).stdout  # fmt: skip
+            capture_output=True,
+            text=True,
+            timeout=60,
+            env=env,
+        ).stdout
         assert "apt-get install -y" in out and "chromium" in out, out
         assert out.index("apt-get install") < out.index("-m pytest"), out
     present = subprocess.run(
         ["make", "-n", "-C", str(ROOT), "browser-deps", f"CHROMIUM={sys.executable}"],
-        capture_output=True, text=True, timeout=60, env=env,
-    ).stdout  # fmt: skip
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env,
+    ).stdout
     assert "apt-get" not in present, present

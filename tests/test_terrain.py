@@ -181,9 +181,17 @@ def test_jacksboro_loads():
 # ------------------------------------------------------------------ GeoTIFF
 def _write_tif(path, z, crs, tf, nodata=None):
     with rasterio.open(
-        path, "w", driver="GTiff", height=z.shape[0], width=z.shape[1], count=1, dtype=z.dtype,
-        crs=crs, transform=tf, nodata=nodata,
-    ) as ds:  # fmt: skip
+        path,
+        "w",
+        driver="GTiff",
+        height=z.shape[0],
+        width=z.shape[1],
+        count=1,
+        dtype=z.dtype,
+        crs=crs,
+        transform=tf,
+        nodata=nodata,
+    ) as ds:
         ds.write(z, 1)
 
 

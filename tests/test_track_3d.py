@@ -40,11 +40,17 @@ def _straight_encounter(seed: int, sigma_angle_rad: float = 0.03, gap=None):
     if gap is not None:
         keep[gap[0] : gap[1]] = False
     ned = own + rm[:, None] * un
-    det = pd.DataFrame({
-        "time_s": t, "frame": np.arange(t.size), "range_m": rm,
-        "radial_velocity_mps": wrap(V + rng.normal(0.0, 0.1, t.size), W),
-        "north_m": ned[:, 0], "east_m": ned[:, 1], "down_m": ned[:, 2],
-    })[keep]  # fmt: skip
+    det = pd.DataFrame(
+        {
+            "time_s": t,
+            "frame": np.arange(t.size),
+            "range_m": rm,
+            "radial_velocity_mps": wrap(V + rng.normal(0.0, 0.1, t.size), W),
+            "north_m": ned[:, 0],
+            "east_m": ned[:, 1],
+            "down_m": ned[:, 2],
+        }
+    )[keep]
     cols = {
         c: own[:, i] if i < 3 else np.full(t.size, own_v[i - 3]) for i, c in enumerate(OWNSHIP_COLUMNS[1:])
     }

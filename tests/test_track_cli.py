@@ -76,9 +76,16 @@ def test_evaluate_without_truth_is_clear_error(tmp_path, monkeypatch, capsys, mi
     iq = np.zeros((3, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
     frames_dataset(iq, np.arange(3.0), cfg).to_zarr(tmp_path / "run.zarr", consolidated=False)
     trk = tmp_path / "t.parquet"
-    pd.DataFrame({"time_s": [0.0], "track_id": [0], "range_m": [1.0], "radial_velocity_mps": [0.0],
-                  "innovation_range_m": [0.0],
-                  "innovation_radial_velocity_mps": [0.0]}).to_parquet(trk)  # fmt: skip
+    pd.DataFrame(
+        {
+            "time_s": [0.0],
+            "track_id": [0],
+            "range_m": [1.0],
+            "radial_velocity_mps": [0.0],
+            "innovation_range_m": [0.0],
+            "innovation_radial_velocity_mps": [0.0],
+        }
+    ).to_parquet(trk)
     code, _, err = skyradar_in_process(monkeypatch, capsys, "evaluate", str(tmp_path / "run.zarr"), str(trk))
     assert code == 2 and missing in err and "run.zarr" in err
 
@@ -93,9 +100,16 @@ def test_evaluate_refuses_tracks_outside_the_runs_frames(tmp_path):
     targets = {"tgt_range_m": R, "tgt_radial_velocity_mps": V, "tgt_visible": np.ones_like(R, bool)}
     frames_dataset(iq, t, cfg, targets=targets).to_zarr(tmp_path / "run.zarr", consolidated=False)
     rows = pd.DataFrame(
-        {"time_s": t + 10_000.0, "track_id": 1, "range_m": R[:, 0], "radial_velocity_mps": V[:, 0],
-         "innovation_range_m": 0.0, "innovation_radial_velocity_mps": 0.0, "confirmed": True}
-    )  # fmt: skip
+        {
+            "time_s": t + 10_000.0,
+            "track_id": 1,
+            "range_m": R[:, 0],
+            "radial_velocity_mps": V[:, 0],
+            "innovation_range_m": 0.0,
+            "innovation_radial_velocity_mps": 0.0,
+            "confirmed": True,
+        }
+    )
     rows.to_parquet(tmp_path / "late.parquet")
     result = skyradar("evaluate", "run.zarr", "late.parquet", cwd=tmp_path)
     assert_one_line_error(result, "late.parquet", "time_s", "outside the frames of run.zarr")

@@ -187,8 +187,12 @@ def test_truth_of_several_heads_is_their_union(tmp_path):
     first = (t < 0.3)[:, None]
     write_heads_root(tmp_path / "run.zarr", {}, ["left", "nose"])
     for name, vis, r, snr in (("left", first, 100.0, 9.0), ("nose", ~first, 101.0, 12.0)):
-        targets = {"tgt_range_m": np.full((t.size, 1), r), "tgt_radial_velocity_mps": np.zeros((t.size, 1)),
-                   "tgt_visible": vis, "tgt_snr_db": np.where(vis, snr, -30.0)}  # fmt: skip
+        targets = {
+            "tgt_range_m": np.full((t.size, 1), r),
+            "tgt_radial_velocity_mps": np.zeros((t.size, 1)),
+            "tgt_visible": vis,
+            "tgt_snr_db": np.where(vis, snr, -30.0),
+        }
         frames_dataset(iq, t, cfg, targets=targets).to_zarr(
             tmp_path / "run.zarr", group=name, consolidated=False
         )

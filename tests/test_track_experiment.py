@@ -25,9 +25,17 @@ def test_traffic_is_reproducible_and_in_ga_speed_range():
 def test_short_geometry_run_writes_tables_and_figures(tmp_path):
     res = run(tmp_path, chain="geometry", interval_s=4.0, tail_s=40.0, workers=1, scenarios=("free",))
     assert "synthesised" in res["detections_source"]
-    keys = ("truth_tracks", "tracks_radar", "tracks_traditional", "innov_mean_radar", "innov_p95_radar",
-            "innov_mean_traditional", "innov_p95_traditional", "gospa_radar",
-            "gospa_traditional")  # fmt: skip
+    keys = (
+        "truth_tracks",
+        "tracks_radar",
+        "tracks_traditional",
+        "innov_mean_radar",
+        "innov_p95_radar",
+        "innov_mean_traditional",
+        "innov_p95_traditional",
+        "gospa_radar",
+        "gospa_traditional",
+    )
     for key in keys:
         assert key in res["scenarios"]["free"]
     assert res["free_truth_tracks"] >= 1

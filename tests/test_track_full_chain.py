@@ -27,10 +27,17 @@ FT, KT = 0.3048, 1852.0 / 3600.0
 
 def _opensky_csv(path, t, pos, vel) -> None:
     lat, lon, alt = (np.asarray(v, float) for v in ned_to_geodetic(pos, *ORIGIN))
-    pd.DataFrame({"timestamp": 1_700_000_000 + t, "latitude": lat, "longitude": lon, "altitude": alt / FT,
-                  "groundspeed": np.hypot(vel[:, 0], vel[:, 1]) / KT,
-                  "track": np.degrees(np.arctan2(vel[:, 1], vel[:, 0])) % 360.0,
-                  "vertical_rate": -vel[:, 2] / FT * 60.0}).to_csv(path, index=False)  # fmt: skip
+    pd.DataFrame(
+        {
+            "timestamp": 1_700_000_000 + t,
+            "latitude": lat,
+            "longitude": lon,
+            "altitude": alt / FT,
+            "groundspeed": np.hypot(vel[:, 0], vel[:, 1]) / KT,
+            "track": np.degrees(np.arctan2(vel[:, 1], vel[:, 0])) % 360.0,
+            "vertical_rate": -vel[:, 2] / FT * 60.0,
+        }
+    ).to_csv(path, index=False)
 
 
 def _scene(tmp_path, duration_s: float = 40.0) -> None:

@@ -40,11 +40,20 @@ def _reacquired_track(times: np.ndarray, n_ground: int) -> pd.DataFrame:
     east[:n_ground] = rng.uniform(-2000.0, 2000.0, n_ground)
     down[:n_ground] = 0.0
     confirmed = np.arange(times.size) >= n_ground
-    return pd.DataFrame({
-        "time_s": times, "track_id": 118, "north_m": north, "east_m": east, "down_m": down,
-        "confirmed": confirmed, "altitude_measured": True, "lat_deg": np.nan, "lon_deg": np.nan,
-        "alt_m": -down,
-    })  # fmt: skip
+    return pd.DataFrame(
+        {
+            "time_s": times,
+            "track_id": 118,
+            "north_m": north,
+            "east_m": east,
+            "down_m": down,
+            "confirmed": confirmed,
+            "altitude_measured": True,
+            "lat_deg": np.nan,
+            "lon_deg": np.nan,
+            "alt_m": -down,
+        }
+    )
 
 
 def test_a_track_is_its_intruders_when_its_confirmed_rows_follow_it():

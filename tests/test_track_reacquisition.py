@@ -112,8 +112,16 @@ def test_a_patchy_return_keeps_the_track_until_the_deleter_closes_it():
     bursts = (t >= 5.0) & (t < 15.0)
     in_burst = np.isin((k - np.searchsorted(t, 5.0)) % 7, (0, 2, 3))
     vis = (~bursts | in_burst)[:, None]
-    det = synthetic_detections(t, r, np.full_like(r, v_mps), visible=vis, config=CFG, sigma_range_m=4.4,
-                               sigma_velocity_mps=0.093, seed=4)  # fmt: skip
+    det = synthetic_detections(
+        t,
+        r,
+        np.full_like(r, v_mps),
+        visible=vis,
+        config=CFG,
+        sigma_range_m=4.4,
+        sigma_velocity_mps=0.093,
+        seed=4,
+    )
     tracks = track_detections(det, "radar", CFG, frame_times_s=t)
     ids = _ids_on(tracks, det, 0)
     assert ids.size == 1

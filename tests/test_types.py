@@ -17,6 +17,9 @@ ROOT = Path(__file__).resolve().parents[1]
 def test_the_package_type_checks():
     run = subprocess.run(
         [sys.executable, "-m", "mypy", "--no-error-summary", "--cache-dir", str(ROOT / "out" / "mypy-cache")],
-        cwd=ROOT, capture_output=True, text=True, timeout=600,
-    )  # fmt: skip
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert run.returncode == 0, run.stdout + run.stderr

@@ -87,17 +87,24 @@ def _summary(chain: dict[str, Any], labels: dict[int, str], timeline: pd.DataFra
         ids = [t for t, lab in labels.items() if lab == name]
         lv = max_level.reindex(ids).fillna(0)
         warn = alerts[alerts["track_id"].isin(ids) & (alerts["level"] >= 3)]["time_s"]
-        per[name] = {"tracks": len(ids), "max_level": int(lv.max()) if len(lv) else 0,
-                     "first_warning_s": float(warn.min()) if len(warn) else None}  # fmt: skip
+        per[name] = {
+            "tracks": len(ids),
+            "max_level": int(lv.max()) if len(lv) else 0,
+            "first_warning_s": float(warn.min()) if len(warn) else None,
+        }
     others_warn = any(v["max_level"] >= 3 for k, v in per.items() if k != "collision")
     return {
-        "scenario": DEMO_SCENARIO, "frames": int(chain["truth"].sizes["time"]),
-        "detections": len(det), "detections_ground": int(det["is_ground"].sum()),
-        "detections_spur": int(det["spur"].sum()), "tracks": int(chain["tracks"]["track_id"].nunique()),
-        "intruders": per, "alert_changes": len(timeline),
+        "scenario": DEMO_SCENARIO,
+        "frames": int(chain["truth"].sizes["time"]),
+        "detections": len(det),
+        "detections_ground": int(det["is_ground"].sum()),
+        "detections_spur": int(det["spur"].sum()),
+        "tracks": int(chain["tracks"]["track_id"].nunique()),
+        "intruders": per,
+        "alert_changes": len(timeline),
         "acceptance": bool(per.get("collision", {}).get("max_level", 0) >= 3 and not others_warn),
         "timings_s": {k: round(v, 2) for k, v in chain["timings_s"].items()},
-    }  # fmt: skip
+    }
 
 
 def run_demo(out_dir: Path, scenario: str | Path | None = None) -> dict[str, Any]:

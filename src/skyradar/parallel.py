@@ -17,9 +17,14 @@ from skyradar.errors import InputError
 from skyradar.extras import import_extra
 
 __all__ = [
-    "connect", "close", "map_chunks", "map_frame_chunks", "check_workers", "check_scheduler",
+    "connect",
+    "close",
+    "map_chunks",
+    "map_frame_chunks",
+    "check_workers",
+    "check_scheduler",
     "max_local_workers",
-]  # fmt: skip
+]
 
 _WORKERS_PER_CORE = 4  # more local worker processes than this only thrash (each holds numba + numpy)
 
@@ -115,9 +120,12 @@ def connect(scheduler: str | None, workers: int | None, timeout_s: float = 10.0)
     # half way leaves workers starting, and distributed's exit handler fails on them with a traceback.
     with _interrupts_held() as held:
         cluster = LocalCluster(
-            n_workers=int(workers or 2), threads_per_worker=1, processes=True, dashboard_address=None,
+            n_workers=int(workers or 2),
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
             silence_logs=logging.CRITICAL,
-        )  # fmt: skip
+        )
         client = Client(cluster)
     if held:
         close(client, owns_cluster=True)

@@ -24,9 +24,15 @@ pytestmark = [
 
 CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = [
-    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-    "--disable-background-networking", "--disable-component-update", "--disable-sync",
-]  # fmt: skip
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
 # Sample run (skyradar.web.sample): the head-on intruder's issued warning starts at 35 s (see test_web.py).
 WARNING_AT_S = 35.0
 WARNING_COLOUR = (0xFF, 0x30, 0x30)

@@ -17,6 +17,16 @@ JSON). The benchmarks, the public modules of this package (none is imported with
 """
 
 __all__ = [
-    "sim", "flight", "range_doppler", "process", "process_clutter", "process_adaptive", "realtime",
-    "track", "alert", "flight_state", "gpscheck", "passive",
-]  # fmt: skip
+    "sim",
+    "flight",
+    "range_doppler",
+    "process",
+    "process_clutter",
+    "process_adaptive",
+    "realtime",
+    "track",
+    "alert",
+    "flight_state",
+    "gpscheck",
+    "passive",
+]

@@ -123,8 +123,13 @@ def _miss_inputs(tracks: pd.DataFrame, own: pd.DataFrame) -> tuple:
     t = tracks["time_s"].to_numpy(float)
     at = interp_ownship(own, t, "bench")
     own_v = np.column_stack([at["own_vn_mps"], at["own_ve_mps"], at["own_vd_mps"]])
-    return (tracks["track_id"].to_numpy(), t, tracks["range_m"].to_numpy(float),
-            tracks["range_rate_mps"].to_numpy(float), own_v)  # fmt: skip
+    return (
+        tracks["track_id"].to_numpy(),
+        t,
+        tracks["range_m"].to_numpy(float),
+        tracks["range_rate_mps"].to_numpy(float),
+        own_v,
+    )
 
 
 def _best_of(repeats: int, function, args: tuple) -> tuple[float, tuple]:

@@ -71,8 +71,12 @@ def baseline_search(radar, mask, map_image, grid, pose_grid, pose, margin_m=250.
     """skimage's masked phase correlation at the search's headings; best (shift m, heading deg)."""
     m = int(np.ceil(margin_m / pose_grid.pixel_m))
     h, w = pose_grid.shape
-    big = PoseGrid(pose_grid.forward0_m - m * pose_grid.pixel_m, pose_grid.right0_m - m * pose_grid.pixel_m,
-                   pose_grid.pixel_m, (h + 2 * m, w + 2 * m))  # fmt: skip
+    big = PoseGrid(
+        pose_grid.forward0_m - m * pose_grid.pixel_m,
+        pose_grid.right0_m - m * pose_grid.pixel_m,
+        pose_grid.pixel_m,
+        (h + 2 * m, w + 2 * m),
+    )
     padded, padded_mask = np.zeros(big.shape), np.zeros(big.shape, bool)
     padded[m : m + h, m : m + w], padded_mask[m : m + h, m : m + w] = radar, mask
     best = (-np.inf, 0.0, 0.0)

@@ -148,7 +148,10 @@ def _hit_cells(suppressed, config: RadarConfig) -> set[tuple[int, int]]:
     the baseline rewrites those in place)."""
     channels = (config.n_rx - suppressed.nulls).astype(np.int8)
     det = detect(
-        suppressed.power, config, channels=channels, train_exclude=suppressed.unsuppressed,
+        suppressed.power,
+        config,
+        channels=channels,
+        train_exclude=suppressed.unsuppressed,
         noise_floor_w=suppressed.noise_floor_w,
-    )  # fmt: skip
+    )
     return set(zip(det.range_index.tolist(), det.doppler_index.tolist(), strict=True))

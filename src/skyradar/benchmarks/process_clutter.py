@@ -128,13 +128,16 @@ def run_suppressed(n_cubes: int = 6, min_time_s: float = 2.0, seed: int = 0) -> 
         "terrain_unsuppressed_frames_per_s": float(plain),
         "subspace_s": float(subspace_s),
         # Primary detections: the numpy baseline has no secondary threshold.
-        "suppressed_detections_per_frame": float(np.mean([len(_primary(process_cube(c, config, clutter=sub)))
-                                                          for c in cubes])),
-        "suppressed_baseline_detections_per_frame": float(np.mean([len(baseline_suppressed(c, sub, config))
-                                                                   for c in cubes])),
-        "terrain_unsuppressed_detections_per_frame": float(np.mean([len(process_cube(c, config)["range_m"])
-                                                                    for c in cubes])),
-    }  # fmt: skip
+        "suppressed_detections_per_frame": float(
+            np.mean([len(_primary(process_cube(c, config, clutter=sub))) for c in cubes])
+        ),
+        "suppressed_baseline_detections_per_frame": float(
+            np.mean([len(baseline_suppressed(c, sub, config)) for c in cubes])
+        ),
+        "terrain_unsuppressed_detections_per_frame": float(
+            np.mean([len(process_cube(c, config)["range_m"]) for c in cubes])
+        ),
+    }
 
 
 def _primary(out: dict) -> np.ndarray:

@@ -18,10 +18,26 @@ from skyradar.errors import InputError
 from skyradar.io.tables import jsonable
 
 __all__ = [
-    "app", "experiment_app", "bench_app", "console", "emit_result", "emit_measurement", "JsonOption",
-    "number_in", "check_number", "POSITIVE", "NON_NEGATIVE", "COUNT", "PROBABILITY",
-    "WORKERS", "SCHEDULER", "CHUNK_SAMPLES", "HeadOption", "open_one_head", "notes_after_inputs",
-]  # fmt: skip
+    "app",
+    "experiment_app",
+    "bench_app",
+    "console",
+    "emit_result",
+    "emit_measurement",
+    "JsonOption",
+    "number_in",
+    "check_number",
+    "POSITIVE",
+    "NON_NEGATIVE",
+    "COUNT",
+    "PROBABILITY",
+    "WORKERS",
+    "SCHEDULER",
+    "CHUNK_SAMPLES",
+    "HeadOption",
+    "open_one_head",
+    "notes_after_inputs",
+]
 
 app = typer.Typer(
     name="skyradar",

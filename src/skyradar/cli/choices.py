@@ -16,11 +16,30 @@ from __future__ import annotations
 from enum import StrEnum
 
 __all__ = [
-    "Detector", "SpurMode", "Suppression", "SpurPixels", "Ch3Path", "TrackerModel", "TruthMode", "Ch4Chain",
-    "StateMethod", "AircraftClass", "Side", "Compressor", "Precision", "GpsCheckMethod", "PassivePulse",
-    "PassiveScenario", "Layout", "Navigation", "RxLayout", "Family", "Split", "AlertSettings",
+    "Detector",
+    "SpurMode",
+    "Suppression",
+    "SpurPixels",
+    "Ch3Path",
+    "TrackerModel",
+    "TruthMode",
+    "Ch4Chain",
+    "StateMethod",
+    "AircraftClass",
+    "Side",
+    "Compressor",
+    "Precision",
+    "GpsCheckMethod",
+    "PassivePulse",
+    "PassiveScenario",
+    "Layout",
+    "Navigation",
+    "RxLayout",
+    "Family",
+    "Split",
+    "AlertSettings",
     "EncounterTerrain",
-]  # fmt: skip
+]
 
 
 class Detector(StrEnum):

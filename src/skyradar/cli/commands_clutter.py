@@ -81,8 +81,12 @@ def _rows_view(rows: list[dict]):
             f"{r['detection_fraction_suppressed_with_secondary']:.2f}"
         )
         view.add_row(
-            r["terrain"], f"{r['own_agl_m']:.0f}", detected, f"{r['intruder_cell_if_db_median']:.1f}",
-            f"{r['if_db_lost_cells_median']:.1f}", f"{r['mdv_mps_suppressed']:.2f}",
+            r["terrain"],
+            f"{r['own_agl_m']:.0f}",
+            detected,
+            f"{r['intruder_cell_if_db_median']:.1f}",
+            f"{r['if_db_lost_cells_median']:.1f}",
+            f"{r['mdv_mps_suppressed']:.2f}",
             f"{r['udsf_none']:.2f}/{r['udsf_suppressed']:.2f}",
-        )  # fmt: skip
+        )
     return view

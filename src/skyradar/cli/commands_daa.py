@@ -60,9 +60,13 @@ def alert(
     table = read_table(tracks, required=TRACK_COLUMNS, sort_by="time_s")
     run_ds = open_ownship(ownship)
     alerts = alerts_for_run(
-        run_ds, table, settings, with_advice=not no_advice, run_name=str(ownship),
+        run_ds,
+        table,
+        settings,
+        with_advice=not no_advice,
+        run_name=str(ownship),
         tracks_name=str(tracks),
-    )  # fmt: skip
+    )
     write_table(alerts, output)
     summary = alert_summary(alerts)
     levels = {key: summary.pop(key) for key in ("rows_level_1", "rows_level_2", "rows_level_3")}

@@ -182,12 +182,23 @@ def experiment_encounters(
     with frame_progress(total, "encounters") as bar:
         task = bar.add_task("encounters", total=total)
         result = run(
-            out, n_encounters=n, seed=seed, frame_rate_hz=frame_rate, buffer=buffer, workers=workers,
-            uncertainty=not no_uncertainty, progress=lambda k: bar.update(task, completed=k),
-            terrains=tuple(terrains), layouts=layouts, navigation=navigation.value,
-            rx_layout=rx_layout.value, family=family.value, command="skyradar " + " ".join(sys.argv[1:]),
-            scheduler=scheduler, alert_settings=alert_settings.value,
-        )  # fmt: skip
+            out,
+            n_encounters=n,
+            seed=seed,
+            frame_rate_hz=frame_rate,
+            buffer=buffer,
+            workers=workers,
+            uncertainty=not no_uncertainty,
+            progress=lambda k: bar.update(task, completed=k),
+            terrains=tuple(terrains),
+            layouts=layouts,
+            navigation=navigation.value,
+            rx_layout=rx_layout.value,
+            family=family.value,
+            command="skyradar " + " ".join(sys.argv[1:]),
+            scheduler=scheduler,
+            alert_settings=alert_settings.value,
+        )
     emit_result(result, as_json, "encounters")
 
 

@@ -23,7 +23,7 @@ def export(
             "--output",
             help="Folder (gets ownship.parquet, intruders.parquet) or NAME.parquet (+NAME.intruders.parquet)",
         ),
-    ],  # fmt: skip
+    ],
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:

@@ -100,10 +100,11 @@ _OffsetHeading = Annotated[
 _Buildings = Annotated[
     float | None,
     typer.Option(
-        "--building-height-m", callback=number_in(0.0, 500.0),
+        "--building-height-m",
+        callback=number_in(0.0, 500.0),
         help="Typical building height for the layover correction (default: the OSM map's; 0 for a raster).",
     ),
-]  # fmt: skip
+]
 _Frames = Annotated[
     str | None, typer.Option("--frames", help="Frames to check: START:STOP or a comma list (default all).")
 ]
@@ -153,20 +154,43 @@ def gpscheck(
     gps_offset = (offset_north_m, offset_east_m, offset_heading_deg)
 
     def covers(extent, image=None) -> None:
-        check_coverage(ds, config, extent, frames=picked, gps_offset=gps_offset, source=str(run),
-                       map_source=str(map_path), map_image=image)  # fmt: skip
+        check_coverage(
+            ds,
+            config,
+            extent,
+            frames=picked,
+            gps_offset=gps_offset,
+            source=str(run),
+            map_source=str(map_path),
+            map_image=image,
+        )
 
     image, grid, building_m = _load_map(map_path, ds, PIXEL_M, covers, run)
     building_m = building_m if building_height is None else building_height
     maps = prepare_map(image, [method.value])
     settings = MonitorSettings(alert_frames=alert_frames)
     table = check_run(
-        ds, config, maps[method.value], grid, frames=picked, method=method.value, settings=settings,
+        ds,
+        config,
+        maps[method.value],
+        grid,
+        frames=picked,
+        method=method.value,
+        settings=settings,
         source=str(run),
-        gps_offset=gps_offset, building_m=building_m,
-    )  # fmt: skip
-    write_table(table, output, metadata={"radar_config": config.to_json(), "source": str(run),
-                                         "map": str(map_path), "method": method.value})  # fmt: skip
+        gps_offset=gps_offset,
+        building_m=building_m,
+    )
+    write_table(
+        table,
+        output,
+        metadata={
+            "radar_config": config.to_json(),
+            "source": str(run),
+            "map": str(map_path),
+            "method": method.value,
+        },
+    )
     result = _summary(table, output)
     _print_summary(result, table, alert_frames)
     emit_result(result, as_json, "gpscheck")

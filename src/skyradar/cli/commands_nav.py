@@ -146,10 +146,16 @@ def _ch5_view(rows: list[dict], label: str):
         ref = "" if not np.isfinite(row["thesis_h_err_mean_m"]) else f" [{row['thesis_h_err_mean_m']:g}]"
         ref_sd = "" if not np.isfinite(row["thesis_h_err_sd_m"]) else f" [{row['thesis_h_err_sd_m']:g}]"
         view.add_row(
-            row["rate"][5:], row["terrain"], row["method"], f"{row['h_err_mean_m']:.1f}{ref}",
-            f"{row['h_err_sd_m']:.1f}{ref_sd}", f"{row['vx_err_sd_mps']:.2f}", f"{row['vz_err_sd_mps']:.2f}",
-            f"{row['valid_fraction']:.2f}", f"{row['raw_valid_fraction']:.2f}",
-        )  # fmt: skip
+            row["rate"][5:],
+            row["terrain"],
+            row["method"],
+            f"{row['h_err_mean_m']:.1f}{ref}",
+            f"{row['h_err_sd_m']:.1f}{ref_sd}",
+            f"{row['vx_err_sd_mps']:.2f}",
+            f"{row['vz_err_sd_mps']:.2f}",
+            f"{row['valid_fraction']:.2f}",
+            f"{row['raw_valid_fraction']:.2f}",
+        )
     return view
 
 

@@ -18,7 +18,7 @@ from skyradar.cli.app import (
     emit_measurement,
     emit_result,
     experiment_app,
-)  # fmt: skip
+)
 from skyradar.cli.choices import PassivePulse
 from skyradar.io.outputs import OVERWRITE_HELP
 
@@ -89,11 +89,16 @@ def passive(
 def _summary(result, output: Path) -> dict:
     det = result.detections
     return {
-        "pulses": result.n_pulses, "dwells": result.n_dwells, "sweeps": int(det["sweep"].nunique()),
-        "detections": len(det), "moving": int((det["channel"] == "moving").sum()),
-        "static": int((det["channel"] == "static").sum()), "blind_zone_dropped": result.masked,
-        "scan_period_s": result.scan_period_s, "output": str(output),
-    }  # fmt: skip
+        "pulses": result.n_pulses,
+        "dwells": result.n_dwells,
+        "sweeps": int(det["sweep"].nunique()),
+        "detections": len(det),
+        "moving": int((det["channel"] == "moving").sum()),
+        "static": int((det["channel"] == "static").sum()),
+        "blind_zone_dropped": result.masked,
+        "scan_period_s": result.scan_period_s,
+        "output": str(output),
+    }
 
 
 def _recording_files(path: Path, sigmf_paths) -> list[Path]:

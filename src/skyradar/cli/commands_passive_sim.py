@@ -74,9 +74,13 @@ def _run(scene, meta: Path, sample_rate_hz: float, chunk_samples: int, total: in
     with Progress("simulating", BarColumn(), TimeRemainingColumn(), console=console) as bar:
         task = bar.add_task("samples", total=total)
         path = simulate_recording(
-            scene, meta, sample_rate_hz, chunk_samples, overwrite=True,
+            scene,
+            meta,
+            sample_rate_hz,
+            chunk_samples,
+            overwrite=True,
             progress=lambda done, _total: bar.update(task, completed=done),
-        )  # fmt: skip
+        )
     return path
 
 

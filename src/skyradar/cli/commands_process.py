@@ -37,8 +37,14 @@ __all__ = ["process", "calibrate", "spur_map", "experiment_ch3", "bench_process"
 def _progress(total: int, label: str):
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeRemainingColumn
 
-    bar = Progress("[progress.description]{task.description}", BarColumn(), MofNCompleteColumn(),
-                   TimeRemainingColumn(), console=console, transient=True)  # fmt: skip
+    bar = Progress(
+        "[progress.description]{task.description}",
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeRemainingColumn(),
+        console=console,
+        transient=True,
+    )
     return bar, bar.add_task(label, total=total)
 
 
@@ -159,12 +165,21 @@ def process(
     frame_costs: dict[str, list] | None = {} if realtime else None
     with bar:  # every radar head of the run, one table with a `radar` column (skyradar.io.frames_heads)
         table, configs = detect_run_heads(
-            run, None if radar_config is None else config, lambda n: bar.update(task, completed=n),
-            spurs=spurs, terrain=dem, method=method.value, spur_mode=spur_mode.value, pfa=pfa,
-            scheduler=scheduler, workers=workers, chunk_frames=chunk_frames, suppression=suppression.value,
+            run,
+            None if radar_config is None else config,
+            lambda n: bar.update(task, completed=n),
+            spurs=spurs,
+            terrain=dem,
+            method=method.value,
+            spur_mode=spur_mode.value,
+            pfa=pfa,
+            scheduler=scheduler,
+            workers=workers,
+            chunk_frames=chunk_frames,
+            suppression=suppression.value,
             frame_costs=frame_costs,
             pfa_secondary=pfa_secondary or None,
-        )  # fmt: skip
+        )
     # The own-ship signature lets `alert` check that the tracks and its --ownship run belong together.
     meta = {"radar_config": config.to_json(), "source": str(run)}
     if len(configs) > 1:  # each head's RadarConfig (mount, lever arm); radar_config is the first's
@@ -267,8 +282,12 @@ def calibrate(
     calibrated = calibrate_from_frames(cube, p, config, gain=not phase_only)
     write_json_atomic(output, calibrated.to_dict())
     phases = np.degrees(np.angle(calibrated.rx_calibration))
-    result = {"frames": int(cube.shape[0]), "output": str(output), "phase_deg": phases.round(3).tolist(),
-              "gain_db": (20 * np.log10(np.abs(calibrated.rx_calibration))).round(3).tolist()}  # fmt: skip
+    result = {
+        "frames": int(cube.shape[0]),
+        "output": str(output),
+        "phase_deg": phases.round(3).tolist(),
+        "gain_db": (20 * np.log10(np.abs(calibrated.rx_calibration))).round(3).tolist(),
+    }
     emit_result(result, as_json, "calibration")
 
 
@@ -313,8 +332,12 @@ def spur_map(
 
     learned = learn_spur_map(frames(), config, threshold, pixels.value)
     learned.save(output)
-    result = {"frames": learned.n_frames, "spur_pixels": int(learned.mask.sum()), "threshold": threshold,
-              "output": str(output)}  # fmt: skip
+    result = {
+        "frames": learned.n_frames,
+        "spur_pixels": int(learned.mask.sum()),
+        "threshold": threshold,
+        "output": str(output),
+    }
     emit_result(result, as_json, "spur map")
 
 
@@ -372,9 +395,14 @@ def experiment_ch3(
         check_number("--compare", spacing, 0.0, 1.0, low_open=True)
     mark_folder(out)
     result = run_ch3(
-        out, n_frames=frames, path=path.value, seed=seed, pitch_deg=pitch, rx_spacing_wavelengths=rx_spacing,
+        out,
+        n_frames=frames,
+        path=path.value,
+        seed=seed,
+        pitch_deg=pitch,
+        rx_spacing_wavelengths=rx_spacing,
         compare_spacings=others,
-    )  # fmt: skip
+    )
     emit_result(result, as_json, "ch3: detection and direction of arrival")
 
 

@@ -78,9 +78,19 @@ def rd(
         console.print(f"{frames} more frames written")
 
     result = recording_to_frames(
-        recording, output, range_window, doppler_window, remove_dc, chunk_frames, scheduler, workers, report,
-        overwrite=overwrite, compressor=compress.value, precision=precision.value,
-    )  # fmt: skip
+        recording,
+        output,
+        range_window,
+        doppler_window,
+        remove_dc,
+        chunk_frames,
+        scheduler,
+        workers,
+        report,
+        overwrite=overwrite,
+        compressor=compress.value,
+        precision=precision.value,
+    )
     emit_result(result, as_json, "range-Doppler frames")
 
 

@@ -93,16 +93,29 @@ def simulate(
         loaded = load_scenario(scenario)
         # Before the build: a huge run is refused in a second, not after minutes of truth geometry.
         n_heads = len(loaded.model.radars or [None])  # several radar heads: a group of frames each
-        check_store_space(output, loaded.radar_config(), n_heads * loaded.frame_times().size,
-                          n_heads * chunk_frames, compress.value, precision.value)  # fmt: skip
+        check_store_space(
+            output,
+            loaded.radar_config(),
+            n_heads * loaded.frame_times().size,
+            n_heads * chunk_frames,
+            compress.value,
+            precision.value,
+        )
         built = loaded.build()
     n = built.times_s.size
     with frame_progress(n, f"simulate {built.name}") as bar:
         task = bar.add_task("frames", total=n)
         path = simulate_to_zarr(
-            built, output, chunk_frames, scheduler, workers, progress=lambda k: bar.advance(task, k),
-            overwrite=overwrite, compressor=compress.value, precision=precision.value,
-        )  # fmt: skip
+            built,
+            output,
+            chunk_frames,
+            scheduler,
+            workers,
+            progress=lambda k: bar.advance(task, k),
+            overwrite=overwrite,
+            compressor=compress.value,
+            precision=precision.value,
+        )
     heads = f" of {len(built.heads)} radar heads ({', '.join(h.name for h in built.heads)})"
     console.print(f"wrote {n} frames{heads if len(built.heads) > 1 else ''} to {path}")
 
@@ -191,8 +204,10 @@ def sweep(
     from skyradar.sim.sweep import sweep as run_sweep
 
     if output.suffix.lower() not in (".csv", ".parquet"):
-        raise InputError(f"-o/--output: {output}: must end in .csv or .parquet (the table's format), "
-                         f"got {output.suffix or 'no suffix'!r}")  # fmt: skip
+        raise InputError(
+            f"-o/--output: {output}: must end in .csv or .parquet (the table's format), "
+            f"got {output.suffix or 'no suffix'!r}"
+        )
     kind = "file" if output.suffix.lower() == ".csv" else "table"
     check_output(output, [scenario], overwrite, kind=kind)
     value_list = parse_values(values)

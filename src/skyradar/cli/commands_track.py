@@ -230,11 +230,17 @@ def evaluate(
 
     table = read_table(
         tracks,
-        required=["time_s", "track_id", "range_m", "radial_velocity_mps", "innovation_range_m",
-                  "innovation_radial_velocity_mps"],
+        required=[
+            "time_s",
+            "track_id",
+            "range_m",
+            "radial_velocity_mps",
+            "innovation_range_m",
+            "innovation_radial_velocity_mps",
+        ],
         sort_by="time_s",
-        finite=["time_s", "track_id", "range_m", "radial_velocity_mps"],  # NaN was a scipy traceback
-    )  # fmt: skip
+        finite=["time_s", "track_id", "range_m", "radial_velocity_mps"],  # NaN would otherwise crash scipy
+    )
     _check_tracks_of_run(table, tracks, run)
     result = evaluate_run(run, table, threshold_px, gospa_c_px, truth.value, min_snr_db, coasting)
     # The table shows no lists: one readable row for the per-target counts (1 = one track per aircraft).

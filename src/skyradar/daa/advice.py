@@ -368,10 +368,15 @@ def advice_columns(
             continue
         rows = np.arange(a, b)[placed[a:b]]
         adv = resolution_advice(
-            own_vel[a], s[rows], v_int[rows], volume, alerting_time_s,
+            own_vel[a],
+            s[rows],
+            v_int[rows],
+            volume,
+            alerting_time_s,
             height_agl_m=None if height_agl_m is None else float(height_agl_m[a]),
-            dthr_m=dthr_m[rows], zthr_m=zthr_m[rows],
-        )  # fmt: skip
+            dthr_m=dthr_m[rows],
+            zthr_m=zthr_m[rows],
+        )
         for name in names:
             flat = [float(x) for band in adv[name] for x in band]
             lists[name][a:b] = [flat] * (b - a)

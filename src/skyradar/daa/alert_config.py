@@ -210,11 +210,30 @@ def check_warns_head_on(config: AlertConfig, label: str) -> None:
     from skyradar.daa.pipeline import alerts_from_tracks
 
     t = np.arange(0.0, 30.0, 1.0 / 9.4)  # 3 km apart at 100 m/s closing: they meet at 30 s, 100 m apart
-    own = pd.DataFrame({"time_s": t, "own_north_m": 50.0 * t, "own_east_m": 0.0, "own_down_m": -1000.0,
-                        "own_vn_mps": 50.0, "own_ve_mps": 0.0, "own_vd_mps": 0.0})  # fmt: skip
-    tracks = pd.DataFrame({"time_s": t, "track_id": 1, "north_m": 3000.0 - 50.0 * t, "east_m": 100.0,
-                           "down_m": -1000.0, "vn_mps": -50.0, "ve_mps": 0.0, "vd_mps": 0.0,
-                           "confirmed": True})  # fmt: skip
+    own = pd.DataFrame(
+        {
+            "time_s": t,
+            "own_north_m": 50.0 * t,
+            "own_east_m": 0.0,
+            "own_down_m": -1000.0,
+            "own_vn_mps": 50.0,
+            "own_ve_mps": 0.0,
+            "own_vd_mps": 0.0,
+        }
+    )
+    tracks = pd.DataFrame(
+        {
+            "time_s": t,
+            "track_id": 1,
+            "north_m": 3000.0 - 50.0 * t,
+            "east_m": 100.0,
+            "down_m": -1000.0,
+            "vn_mps": -50.0,
+            "ve_mps": 0.0,
+            "vd_mps": 0.0,
+            "confirmed": True,
+        }
+    )
     # And an aircraft 10 km abeam flying alongside, which no alerting may flag.
     alongside = tracks.assign(track_id=2, north_m=50.0 * t, east_m=10_000.0, vn_mps=50.0)
     tracks = pd.concat([tracks, alongside], ignore_index=True).sort_values(["time_s", "track_id"])

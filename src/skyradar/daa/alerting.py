@@ -227,10 +227,21 @@ RADAR_ALERT_CONFIG = AlertConfig(period_s=1.0, max_velocity_sigma_mps=6.0, z_v_v
 # no lost-track prediction. DAIDALUS takes 2 of 4 at its 1 Hz update: period_s = 1 keeps that meaning
 # at a radar's frame rate and is the same at 1 Hz.
 DO365B_ALERT_CONFIG = AlertConfig(
-    levels=do365b_noncoop_levels(), m=2, n=4, period_s=1.0, persistence_s=4.0, hysteresis_s=0.0,
-    gap_reset_s=5.0, z_h_pos=1.5, z_h_vel=1.0, z_v_pos=0.75, z_v_vel=1.5, min_track_age_s=0.0,
-    min_track_age_floor_s=0.0, lost_track_hold_s=0.0,
-)  # fmt: skip
+    levels=do365b_noncoop_levels(),
+    m=2,
+    n=4,
+    period_s=1.0,
+    persistence_s=4.0,
+    hysteresis_s=0.0,
+    gap_reset_s=5.0,
+    z_h_pos=1.5,
+    z_h_vel=1.0,
+    z_v_pos=0.75,
+    z_v_vel=1.5,
+    min_track_age_s=0.0,
+    min_track_age_floor_s=0.0,
+    lost_track_hold_s=0.0,
+)
 
 
 def velocity_unconverged(sigma_hv_mps: np.ndarray, tcpa_s: np.ndarray, config: AlertConfig) -> np.ndarray:
@@ -291,9 +302,11 @@ def required_track_age(s: np.ndarray, v: np.ndarray, config: AlertConfig) -> np.
     """
     warning = config.levels[-1]
     t_in, _ = loss_of_well_clear_interval(
-        np.atleast_2d(np.asarray(s, float)), np.atleast_2d(np.asarray(v, float)),
-        warning.volume, warning.alerting_time_s,
-    )  # fmt: skip
+        np.atleast_2d(np.asarray(s, float)),
+        np.atleast_2d(np.asarray(v, float)),
+        warning.volume,
+        warning.alerting_time_s,
+    )
     longest = config.min_track_age_s
     wait = np.clip(
         config.age_fraction_of_time_left * t_in, min(config.min_track_age_floor_s, longest), longest

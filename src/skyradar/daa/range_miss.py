@@ -84,8 +84,17 @@ def range_miss_distance(
     >>> round(float(miss[-1]), 3), bool(np.isnan(miss[0]))  # the first rows span too little
     (500.0, True)
     """
-    fit = range_only_fit(track_id, time_s, range_m, range_rate_mps, own_velocity_mps, window_s, min_span_s,
-                         min_rows, own_accel_tol_mps)  # fmt: skip
+    fit = range_only_fit(
+        track_id,
+        time_s,
+        range_m,
+        range_rate_mps,
+        own_velocity_mps,
+        window_s,
+        min_span_s,
+        min_rows,
+        own_accel_tol_mps,
+    )
     positive = fit[0] > 0.0  # a miss of zero (a collision course within the noise) is no clearance
     return np.where(positive, fit[0], np.nan), np.where(positive, fit[1], np.nan)
 
@@ -143,8 +152,16 @@ def range_only_fit(
     order = np.argsort(ids, kind="stable")
     bounds = np.flatnonzero(np.diff(ids[order])) + 1
     for rows in np.split(order, bounds):
-        out[:, rows] = _fit_track(t[rows], r[rows], r[rows] * rdot[rows], own_v[rows], window_s, min_span_s,
-                                  min_rows, own_accel_tol_mps)  # fmt: skip
+        out[:, rows] = _fit_track(
+            t[rows],
+            r[rows],
+            r[rows] * rdot[rows],
+            own_v[rows],
+            window_s,
+            min_span_s,
+            min_rows,
+            own_accel_tol_mps,
+        )
     return out[0], out[1], out[2], out[3]
 
 

@@ -24,8 +24,17 @@ from skyradar.errors import InputError
 from skyradar.io.tables import check_within, finite_column
 from skyradar.track.track_table import OWNSHIP_COLUMNS as TRACKER_OWNSHIP_COLUMNS
 
-__all__ = ["TRACK_COLUMNS", "OWNSHIP_COLUMNS", "OPTIONAL_OWNSHIP_COLUMNS", "STATE_LIMITS", "RANGE_COLUMNS",
-           "clean_tracks", "range_only_rows", "interp_ownship", "covariances"]  # fmt: skip
+__all__ = [
+    "TRACK_COLUMNS",
+    "OWNSHIP_COLUMNS",
+    "OPTIONAL_OWNSHIP_COLUMNS",
+    "STATE_LIMITS",
+    "RANGE_COLUMNS",
+    "clean_tracks",
+    "range_only_rows",
+    "interp_ownship",
+    "covariances",
+]
 
 TRACK_COLUMNS = ["time_s", "track_id", "north_m", "east_m", "down_m", "vn_mps", "ve_mps", "vd_mps"]
 OWNSHIP_COLUMNS = list(TRACKER_OWNSHIP_COLUMNS)  # the own-ship table the tracker reads, too

@@ -141,13 +141,19 @@ def run(out_dir: str | Path = "out/ch2", n_frames: int = 3) -> dict[str, Any]:
             ("near-range asymptote R [m]", r["asymptote_range_m"], 1000.0),
             ("velocity asymptote V [m/s]", r["asymptote_velocity_mps"], -30.0),
             ("intruder range [m]", r["intruder_range_m"], r["intruder_expected_range_m"]),
-            ("intruder radial velocity (aliased) [m/s]", r["intruder_velocity_mps"],
-             r["intruder_expected_velocity_mps"]),
-            ("60 m/s: wrapped ground starts at [m/s]", r["wrap60_min_velocity_mps"],
-             r["wrap60_expected_min_velocity_mps"]),
+            (
+                "intruder radial velocity (aliased) [m/s]",
+                r["intruder_velocity_mps"],
+                r["intruder_expected_velocity_mps"],
+            ),
+            (
+                "60 m/s: wrapped ground starts at [m/s]",
+                r["wrap60_min_velocity_mps"],
+                r["wrap60_expected_min_velocity_mps"],
+            ),
         ],
         columns=["quantity", "measured", "closed_form"],
-    )  # fmt: skip
+    )
     write_csv_atomic(table, out / "ch2_table.csv", index=False)
     write_json_atomic(out / "ch2.json", result)
     return result

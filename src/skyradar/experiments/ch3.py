@@ -113,9 +113,13 @@ def _static_phase(scene: dict, n_static: int) -> tuple[RadarConfig, Any, np.ndar
     out = process_cube(raw[0], cal)  # locate the building with the calibrated array, no spur map
     k = int(np.argmin(np.abs(out["range_m"] - BUILDING[0]) + 100 * np.abs(out["radial_velocity_mps"])))
     ned = scene["geom"].origin_ned_m + scene["geom"].rot_ned_to_ant.T @ (out["range_m"][k] * out["u_ant"][k])
-    building = {"building_north_m": ned[0], "building_east_m": ned[1], "building_up_m": -ned[2],
-                "building_az_err_deg": np.degrees(out["azimuth_rad"][k]) - BUILDING[1],
-                "building_el_err_deg": np.degrees(out["elevation_rad"][k]) - BUILDING[2]}  # fmt: skip
+    building = {
+        "building_north_m": ned[0],
+        "building_east_m": ned[1],
+        "building_up_m": -ned[2],
+        "building_az_err_deg": np.degrees(out["azimuth_rad"][k]) - BUILDING[1],
+        "building_el_err_deg": np.degrees(out["elevation_rad"][k]) - BUILDING[2],
+    }
     return cal, spur_map, raw[0], building
 
 
@@ -152,10 +156,18 @@ def _flyover(
                 continue
             if shown is None and k >= 0 and truth["snr_db"][0] > 20:
                 shown = (cube, out, truth)
-            row = {"time_s": times[i], "frame": i, "true_snr_db": truth["snr_db"][0], "detected": k >= 0,
-                   "true_range_m": truth["range_m"][0], "true_az_rad": truth["azimuth_rad"][0],
-                   "true_el_rad": truth["elevation_rad"][0], "true_north_m": ned[i, 0],
-                   "true_east_m": ned[i, 1], "true_down_m": ned[i, 2]}  # fmt: skip
+            row = {
+                "time_s": times[i],
+                "frame": i,
+                "true_snr_db": truth["snr_db"][0],
+                "detected": k >= 0,
+                "true_range_m": truth["range_m"][0],
+                "true_az_rad": truth["azimuth_rad"][0],
+                "true_el_rad": truth["elevation_rad"][0],
+                "true_north_m": ned[i, 0],
+                "true_east_m": ned[i, 1],
+                "true_down_m": ned[i, 2],
+            }
             est = (
                 np.full(3, np.nan)
                 if k < 0
@@ -191,8 +203,10 @@ def _doa_summary(track: pd.DataFrame, err: pd.DataFrame, cal: RadarConfig, spaci
     az_err, el_err = err.az_raw_deg[det], err.el_raw_deg[det]
     sd_az, sd_el = doa_crlb(track.snr_db[det], track.true_az_rad[det], track.true_el_rad[det], cal)
     return {
-        "rx_spacing_wavelengths": spacing, "unambiguous_half_angle_deg": unambiguous_half_angle_deg(spacing),
-        "az_sd_deg": float(az_err.std()), "el_sd_deg": float(el_err.std()),
+        "rx_spacing_wavelengths": spacing,
+        "unambiguous_half_angle_deg": unambiguous_half_angle_deg(spacing),
+        "az_sd_deg": float(az_err.std()),
+        "el_sd_deg": float(el_err.std()),
         "az_crlb_deg": float(np.degrees(np.sqrt(np.mean(sd_az**2)))),
         "el_crlb_deg": float(np.degrees(np.sqrt(np.mean(sd_el**2)))),
         # error / bound per detection: the bound varies with SNR and direction along the circuit
@@ -200,11 +214,12 @@ def _doa_summary(track: pd.DataFrame, err: pd.DataFrame, cal: RadarConfig, spaci
         "el_sd_over_crlb": float(np.std(np.radians(el_err) / sd_el)),
         "detected_frames": int(det.sum()),
         "doa_outliers": int(np.sum((np.abs(az_err) > OUTLIER_DEG) | (np.abs(el_err) > OUTLIER_DEG))),
-    }  # fmt: skip
+    }
 
 
-def _compare_array(spacing: float, pitch_deg: float, seed: int, spur_map, n_frames: int, n_static: int,
-                   path: str) -> dict[str, Any]:  # fmt: skip
+def _compare_array(
+    spacing: float, pitch_deg: float, seed: int, spur_map, n_frames: int, n_static: int, path: str
+) -> dict[str, Any]:
     """The same scene and noise seen by another array: calibrate on the building, fly, summarise.
 
     The spur map of the main array is reused: it is learned from non-coherent channel power,
@@ -224,9 +239,19 @@ def _error_table(err: pd.DataFrame, det: np.ndarray) -> pd.DataFrame:
     for key, (m_raw, s_raw, m_hann, s_hann) in THESIS_TABLE.items():
         name, unit = key.rsplit("_", 1)
         raw, hann = err[f"{name}_raw_{unit}"][det], err[f"{name}_hann_{unit}"][det]
-        table.append({"quantity": key, "raw_mean": raw.mean(), "raw_sd": raw.std(), "hann_mean": hann.mean(),
-                      "hann_sd": hann.std(), "thesis_raw_mean": m_raw, "thesis_raw_sd": s_raw,
-                      "thesis_hann_mean": m_hann, "thesis_hann_sd": s_hann})  # fmt: skip
+        table.append(
+            {
+                "quantity": key,
+                "raw_mean": raw.mean(),
+                "raw_sd": raw.std(),
+                "hann_mean": hann.mean(),
+                "hann_sd": hann.std(),
+                "thesis_raw_mean": m_raw,
+                "thesis_raw_sd": s_raw,
+                "thesis_hann_mean": m_hann,
+                "thesis_hann_sd": s_hann,
+            }
+        )
     return pd.DataFrame(table).set_index("quantity")
 
 
@@ -234,20 +259,27 @@ def _summary(track: pd.DataFrame, err: pd.DataFrame, table: pd.DataFrame, stats:
     det = track.detected.to_numpy()
     snr_ok = track.true_snr_db.to_numpy() >= 13.0
     result = {
-        "az_mean_deg": table.loc["az_deg", "raw_mean"], "el_mean_deg": table.loc["el_deg", "raw_mean"],
-        "az_hann_sd_deg": table.loc["az_deg", "hann_sd"], "el_hann_sd_deg": table.loc["el_deg", "hann_sd"],
+        "az_mean_deg": table.loc["az_deg", "raw_mean"],
+        "el_mean_deg": table.loc["el_deg", "raw_mean"],
+        "az_hann_sd_deg": table.loc["az_deg", "hann_sd"],
+        "el_hann_sd_deg": table.loc["el_deg", "hann_sd"],
         "az_sd_snr13_deg": float(err.az_raw_deg[det & snr_ok].std()),
         "el_sd_snr13_deg": float(err.el_raw_deg[det & snr_ok].std()),
-        "dist_mean_m": table.loc["dist_m", "raw_mean"], "dist_sd_m": table.loc["dist_m", "raw_sd"],
+        "dist_mean_m": table.loc["dist_m", "raw_mean"],
+        "dist_sd_m": table.loc["dist_m", "raw_sd"],
         "dist_hann_mean_m": table.loc["dist_m", "hann_mean"],
-        "dist_hann_sd_m": table.loc["dist_m", "hann_sd"], "frames": n_frames,
-        "detected_frames_snr13": int(det[snr_ok].sum()), "frames_snr13": int(snr_ok.sum()),
+        "dist_hann_sd_m": table.loc["dist_m", "hann_sd"],
+        "frames": n_frames,
+        "detected_frames_snr13": int(det[snr_ok].sum()),
+        "frames_snr13": int(snr_ok.sum()),
         "false_alarms_per_frame": stats["false_alarms"][("hits", SPUR_THRESHOLD)] / n_frames,
         "frame_interval_s": float(track.time_s.diff().median()) if n_frames > 1 else 0.0,
-        "min_range_m": float(track.true_range_m.min()), "max_range_m": float(track.true_range_m.max()),
-        "max_off_boresight_deg": float(np.degrees(np.max(np.arccos(
-            np.cos(track.true_az_rad) * np.cos(track.true_el_rad))))),
-    }  # fmt: skip
+        "min_range_m": float(track.true_range_m.min()),
+        "max_range_m": float(track.true_range_m.max()),
+        "max_off_boresight_deg": float(
+            np.degrees(np.max(np.arccos(np.cos(track.true_az_rad) * np.cos(track.true_el_rad))))
+        ),
+    }
     for (kind, thr), n_fa in stats["false_alarms"].items():
         tag = f"{int(thr * 100)}pct" + ("" if kind == "hits" else "_corner_map")
         result[f"false_alarms_per_frame_{tag}"] = n_fa / n_frames
@@ -255,8 +287,9 @@ def _summary(track: pd.DataFrame, err: pd.DataFrame, table: pd.DataFrame, stats:
     return result
 
 
-def _write_outputs(out_dir: Path, table: pd.DataFrame, track: pd.DataFrame, err: pd.DataFrame,
-                   sweep: list[dict]) -> None:  # fmt: skip
+def _write_outputs(
+    out_dir: Path, table: pd.DataFrame, track: pd.DataFrame, err: pd.DataFrame, sweep: list[dict]
+) -> None:
     write_table(table.reset_index(), out_dir / "ch3_table.parquet")
     write_csv_atomic(table, out_dir / "ch3_table.csv")
     write_table(
@@ -331,9 +364,15 @@ def run(
     main = _doa_summary(track, err, cal, spacing)
     main["calib_phase_err_deg"] = calibration_phase_error_deg(cal.rx_calibration, scene["true_gain"])
     compared = {s: _compare_array(s, pitch_deg, seed, spur_map, n_frames, n_static, path) for s in others}
-    result = {**main, **_summary(track, err, table, stats, n_frames), "pitch_deg": float(pitch_deg),
-              "spur_threshold": SPUR_THRESHOLD, "spur_pixels": int(spur_map["hits"].mask.sum()), "path": path,
-              **building}  # fmt: skip
+    result = {
+        **main,
+        **_summary(track, err, table, stats, n_frames),
+        "pitch_deg": float(pitch_deg),
+        "spur_threshold": SPUR_THRESHOLD,
+        "spur_pixels": int(spur_map["hits"].mask.sum()),
+        "path": path,
+        **building,
+    }
     result |= _spacing_sweep({spacing: main} | compared)
     _write_outputs(out_dir, table, track, err, result["spacing_sweep"])
     plot_all(out_dir, static_frame, cal, spur_map["hits"], shown, track, err, scene["geom"])

@@ -112,8 +112,13 @@ def plot_spacing(out_dir: Path, sweep: list[dict], thesis: dict) -> Path:
         ax.plot(spacing, [row[f"{name}_crlb_deg"] for row in sweep], "-", c=colour, label=f"{label} CRLB")
         ax.axhline(thesis[f"{name}_deg"][1], ls="--", c=colour, lw=1, label=f"thesis {label} SD")
     for row in sweep:
-        ax.annotate(f"+-{row['unambiguous_half_angle_deg']:.0f} deg", (row["rx_spacing_wavelengths"], 0.3),
-                    ha="center", fontsize=8, color="grey")  # fmt: skip
+        ax.annotate(
+            f"+-{row['unambiguous_half_angle_deg']:.0f} deg",
+            (row["rx_spacing_wavelengths"], 0.3),
+            ha="center",
+            fontsize=8,
+            color="grey",
+        )
     ax.set_xticks(spacing)
     top = max(thesis["az_deg"][1], thesis["el_deg"][1], *(row["az_sd_deg"] for row in sweep))
     ax.set_ylim(0.0, 1.3 * top)  # room for the legend above the thesis lines

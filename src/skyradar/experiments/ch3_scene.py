@@ -82,11 +82,19 @@ def build_scene(pitch_deg: float, seed: int, spacing: float) -> dict[str, Any]:
         update={
             "channel_errors": ChannelErrorsConfig(gain_db=gains.tolist(), phase_deg=phases.tolist()),
             "noise": NoiseConfig(),
-        }  # fmt: skip
+        }
     )
     true_gain = channel_errors(config.n_rx, gains.tolist(), phases.tolist())
-    return {"config": config, "platform": platform, "sim": sim, "geom": geom, "static": static, "imp": imp,
-            "true_gain": true_gain, "building_ant": building_ant}  # fmt: skip
+    return {
+        "config": config,
+        "platform": platform,
+        "sim": sim,
+        "geom": geom,
+        "static": static,
+        "imp": imp,
+        "true_gain": true_gain,
+        "building_ant": building_ant,
+    }
 
 
 def _racetrack(n: int = 6000) -> np.ndarray:

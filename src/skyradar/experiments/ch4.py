@@ -104,15 +104,20 @@ def count_truth_tracks(
     tc = tracker or TrackerConfig()
     vis = np.asarray(visible, bool)
     zeros = np.zeros(vis.shape)
-    labels = truth_segments(Truth(np.asarray(time_s, float), zeros, zeros, vis), tc.max_coast_s, 0.0,
-                            (tc.confirm_m, tc.confirm_n))  # fmt: skip
+    labels = truth_segments(
+        Truth(np.asarray(time_s, float), zeros, zeros, vis), tc.max_coast_s, 0.0, (tc.confirm_m, tc.confirm_n)
+    )
     return int(np.unique(labels[labels >= 0]).size), labels
 
 
 def scenario_truth(
-    name: str, config: RadarConfig, frame_rate_hz: float, interval_s: float, tail_s: float,
+    name: str,
+    config: RadarConfig,
+    frame_rate_hz: float,
+    interval_s: float,
+    tail_s: float,
     traffic: Traffic | None = None,
-) -> dict:  # fmt: skip
+) -> dict:
     """Frame times, own-ship samples and per-intruder truth (n_time, n_intruder) for one scenario.
 
     ``traffic`` replaces the generated traffic of scenario ``name`` (tests fly simple cases).
@@ -160,12 +165,22 @@ def _detect_full(truth: dict, config: RadarConfig, seed: int) -> pd.DataFrame:
         det = process_cube(sim.frame(platform, targets, k), config)
         body = np.column_stack([det["x_body_m"], det["y_body_m"], det["z_body_m"]])
         ned = own.position_ned_m[k] + body @ rotation_matrix(*own.attitude_rad[k]).T
-        rows.append(pd.DataFrame({
-            "time_s": t[k], "frame": k, "range_m": det["range_m"],
-            "radial_velocity_mps": det["radial_velocity_mps"], "snr_db": det["snr_db"],
-            "azimuth_rad": det["azimuth_rad"], "elevation_rad": det["elevation_rad"],
-            "north_m": ned[:, 0], "east_m": ned[:, 1], "down_m": ned[:, 2],
-        }))  # fmt: skip
+        rows.append(
+            pd.DataFrame(
+                {
+                    "time_s": t[k],
+                    "frame": k,
+                    "range_m": det["range_m"],
+                    "radial_velocity_mps": det["radial_velocity_mps"],
+                    "snr_db": det["snr_db"],
+                    "azimuth_rad": det["azimuth_rad"],
+                    "elevation_rad": det["elevation_rad"],
+                    "north_m": ned[:, 0],
+                    "east_m": ned[:, 1],
+                    "down_m": ned[:, 2],
+                }
+            )
+        )
     return pd.concat(rows, ignore_index=True)
 
 
@@ -175,21 +190,35 @@ def _detect_geometry(truth: dict, config: RadarConfig, seed: int, clutter_per_fr
     coupling, DoA with 0.04 rad error, and uniform clutter beyond 100 m (SNR column: 12 dB)."""
     snr = np.nan_to_num(truth["snr_db"], nan=-99.0)
     det = synthetic_detections(
-        truth["time_s"], truth["range_m"], truth["radial_velocity_mps"],
-        visible=truth["front"] & (truth["range_m"] < config.range_limit_m), config=config,
-        sigma_range_m=4.4, sigma_velocity_mps=0.093, pd_detect=1.0 / (1.0 + np.exp(-(snr - 6.7) / 0.8)),
-        clutter_per_frame=clutter_per_frame, positions_ned_m=truth["pos"], sigma_angle_rad=0.04, seed=seed,
+        truth["time_s"],
+        truth["range_m"],
+        truth["radial_velocity_mps"],
+        visible=truth["front"] & (truth["range_m"] < config.range_limit_m),
+        config=config,
+        sigma_range_m=4.4,
+        sigma_velocity_mps=0.093,
+        pd_detect=1.0 / (1.0 + np.exp(-(snr - 6.7) / 0.8)),
+        clutter_per_frame=clutter_per_frame,
+        positions_ned_m=truth["pos"],
+        sigma_angle_rad=0.04,
+        seed=seed,
         clutter_min_range_m=100.0,
-    )  # fmt: skip
+    )
     target = det["target"].to_numpy()
     det["snr_db"] = np.where(target >= 0, snr[det["frame"].to_numpy(), np.maximum(target, 0)], 12.0)
     return det
 
 
 def run_scenario(
-    name: str, chain: str = "full", frame_rate_hz: float = 9.4, interval_s: float = 15.0,
-    tail_s: float = 45.0, clutter_per_frame: float = 1.0, seed: int = 0, traffic: Traffic | None = None,
-) -> dict:  # fmt: skip
+    name: str,
+    chain: str = "full",
+    frame_rate_hz: float = 9.4,
+    interval_s: float = 15.0,
+    tail_s: float = 45.0,
+    clutter_per_frame: float = 1.0,
+    seed: int = 0,
+    traffic: Traffic | None = None,
+) -> dict:
     """Truth, detections, both trackers and their metrics for one scenario (``traffic``: see
     :func:`scenario_truth`)."""
     config = RadarConfig.prototype_2022()
@@ -210,10 +239,17 @@ def run_scenario(
         f"+{m:g}": count_truth_tracks(truth["time_s"], scenario_visibility(truth, threshold_db + m), tc)[0]
         for m in (3.0, 6.0)
     }
-    out = {"scenario": name, "chain": chain, "frames": int(truth["time_s"].size), "detections": len(det),
-           "detect_s": t_detect, "tracks": {}, "truth_snr_threshold_db": threshold_db,
-           "truth_tracks": count_truth_tracks(truth["time_s"], visible, tc)[0],
-           "truth_tracks_by_margin_db": by_margin}  # fmt: skip
+    out = {
+        "scenario": name,
+        "chain": chain,
+        "frames": int(truth["time_s"].size),
+        "detections": len(det),
+        "detect_s": t_detect,
+        "tracks": {},
+        "truth_snr_threshold_db": threshold_db,
+        "truth_tracks": count_truth_tracks(truth["time_s"], visible, tc)[0],
+        "truth_tracks_by_margin_db": by_margin,
+    }
     _track_and_score(out, truth, det, visible, config, chain)
     out["detections_table"] = det
     out["truth"] = truth
@@ -232,21 +268,48 @@ def _track_and_score(
     # false); true tracks are the counted spans of ``visible``.
     tr = Truth(truth["time_s"], truth["range_m"], truth["radial_velocity_mps"], truth["front"])
     own = truth["own"]
-    ownship = pd.DataFrame({"time_s": truth["time_s"], **{
-        c: own.position_ned_m[:, i] if i < 3 else own.velocity_ned_mps[:, i - 3]
-        for i, c in enumerate(OWNSHIP_COLUMNS[1:])}})  # fmt: skip
+    ownship = pd.DataFrame(
+        {
+            "time_s": truth["time_s"],
+            **{
+                c: own.position_ned_m[:, i] if i < 3 else own.velocity_ned_mps[:, i - 3]
+                for i, c in enumerate(OWNSHIP_COLUMNS[1:])
+            },
+        }
+    )
     # The geometry chain's DoA noise is a fixed 0.04 rad (see _detect_geometry), not the bound.
     sigma_rad = 0.04 if chain == "geometry" else None
     for model in ("radar", "traditional"):
         t1 = time.perf_counter()
-        tracks = track_detections(det, model, config, frame_times_s=truth["time_s"], origin=EPBC,
-                                  position_sigma_rad=sigma_rad, ownship=ownship)  # fmt: skip
-        m = track_metrics(tracks, tr, pixel, width, gap_s=tc.max_coast_s, min_duration_s=0.0,
-                          confirm=(tc.confirm_m, tc.confirm_n), counted=visible)  # fmt: skip
+        tracks = track_detections(
+            det,
+            model,
+            config,
+            frame_times_s=truth["time_s"],
+            origin=EPBC,
+            position_sigma_rad=sigma_rad,
+            ownship=ownship,
+        )
+        m = track_metrics(
+            tracks,
+            tr,
+            pixel,
+            width,
+            gap_s=tc.max_coast_s,
+            min_duration_s=0.0,
+            confirm=(tc.confirm_m, tc.confirm_n),
+            counted=visible,
+        )
         out[f"track_s_{model}"] = time.perf_counter() - t1
         out[f"tracks_{model}"] = m["tracks"]
-        keys = ("false_tracks", "fragmentation", "id_switches", "completeness", "missed_truth_tracks",
-                "gospa_mean")  # fmt: skip
+        keys = (
+            "false_tracks",
+            "fragmentation",
+            "id_switches",
+            "completeness",
+            "missed_truth_tracks",
+            "gospa_mean",
+        )
         for key in keys:
             out[f"{key}_{model}"] = m[key]
         # Confirmed tracks per true track (1 is ideal; more: fragments or false tracks).
@@ -265,9 +328,15 @@ def _run_one(args: tuple) -> dict:
 
 
 def run(
-    out_dir: Path, chain: str = "full", frame_rate_hz: float = 9.4, interval_s: float = 15.0,
-    tail_s: float = 45.0, workers: int = 2, scenarios: tuple[str, ...] = SCENARIOS, seed: int = 0,
-) -> dict:  # fmt: skip
+    out_dir: Path,
+    chain: str = "full",
+    frame_rate_hz: float = 9.4,
+    interval_s: float = 15.0,
+    tail_s: float = 45.0,
+    workers: int = 2,
+    scenarios: tuple[str, ...] = SCENARIOS,
+    seed: int = 0,
+) -> dict:
     """Run all scenarios (on a local Dask cluster of ``workers`` processes), write tables and figures,
     return the summary.
 
@@ -333,8 +402,16 @@ def _summary(per: dict, chain: str, elapsed_s: float, figures: list[str]) -> dic
         ),
     }
     ok_innov = ok_tracks = True
-    per_model = ("tracks", "false_tracks", "fragmentation", "missed_truth_tracks", "completeness",
-                 "innov_mean", "innov_p95", "gospa")  # fmt: skip
+    per_model = (
+        "tracks",
+        "false_tracks",
+        "fragmentation",
+        "missed_truth_tracks",
+        "completeness",
+        "innov_mean",
+        "innov_p95",
+        "gospa",
+    )
     for name, r in per.items():
         keys = ["truth_tracks", "id_switches_radar"]
         for key in keys + [f"{k}_{m}" for k in per_model for m in ("radar", "traditional")]:

@@ -33,8 +33,13 @@ def _range_doppler(results: list[dict], out_dir: Path, config: RadarConfig) -> s
             ax.scatter(det.radial_velocity_mps, det.range_m, s=1, c="0.8", rasterized=True)
             trk = res["tracks"][model]
             if len(trk):
-                ax.scatter(wrap(trk.radial_velocity_mps.to_numpy(), width), trk.range_m, s=2,
-                           c=_track_colours(trk.track_id.to_numpy()), rasterized=True)  # fmt: skip
+                ax.scatter(
+                    wrap(trk.radial_velocity_mps.to_numpy(), width),
+                    trk.range_m,
+                    s=2,
+                    c=_track_colours(trk.track_id.to_numpy()),
+                    rasterized=True,
+                )
             ax.set_xlim(-config.v_lim_mps, config.v_lim_mps)
             ax.set_ylim(0, config.range_limit_m)
             n = res[f"tracks_{model}"]
@@ -98,8 +103,13 @@ def _innovation_hist(results: list[dict], out_dir: Path, config: RadarConfig) ->
             y = trk[["innovation_range_m", "innovation_radial_velocity_mps"]].to_numpy()
             y = y[np.all(np.isfinite(y), axis=1)]
             px = np.hypot(y[:, 0] / pix[0], y[:, 1] / pix[1])
-            ax.hist(np.minimum(px, bins[-1]), bins, histtype="step", color=colour,
-                    label=f"{model}: mean {px.mean():.2f}, p95 {np.percentile(px, 95):.2f} px")  # fmt: skip
+            ax.hist(
+                np.minimum(px, bins[-1]),
+                bins,
+                histtype="step",
+                color=colour,
+                label=f"{model}: mean {px.mean():.2f}, p95 {np.percentile(px, 95):.2f} px",
+            )
         ax.set_yscale("log")
         ax.set_xlabel("innovation l2 [pixels]")
         ax.set_title(res["scenario"])

@@ -94,9 +94,16 @@ def _polar(bearing_deg: float, dist_m: float, down_m: float) -> np.ndarray:
 def _ownship(name: str, duration_s: float) -> Trajectory:
     if name == "circuit":
         return circuit(
-            [0.0, 0.0, 0.0], RUNWAY_HEADING_DEG, 300.0, 45.0, duration_s, touch_and_go=False,
-            start_leg="downwind", origin=EPBC, name="own-circuit",
-        )  # fmt: skip
+            [0.0, 0.0, 0.0],
+            RUNWAY_HEADING_DEG,
+            300.0,
+            45.0,
+            duration_s,
+            touch_and_go=False,
+            start_leg="downwind",
+            origin=EPBC,
+            name="own-circuit",
+        )
     if name == "zulu":
         # Inbound from Zulu (6 km south-west, 500 m) over the field, 180-deg turn, back out to Zulu.
         start = _polar(220.0, 6000.0, -500.0)
@@ -142,10 +149,13 @@ def _intruder(name: str, i: int, start_s: float, own: Trajectory, rng: np.random
     start = s.position_ned_m[0] + _polar(ahead, dist, 0.0)
     start[2] = -float(rng.uniform(500.0, 1500.0))
     hdg = ahead + 180.0 + float(rng.uniform(-70, 70))
-    segs = [(float(rng.uniform(15, 30)), float(rng.uniform(-0.5, 0.8)), 0.0, float(rng.uniform(-3, 3))),
-            (float(rng.uniform(8, 15)), 0.0, float(rng.choice([-5.0, 5.0])), 0.0),
-            (float(rng.uniform(20, 40)), 0.0, 0.0, float(rng.uniform(-4, 4))),
-            (10.0, 0.0, float(rng.choice([-6.0, 6.0])), 2.0), (30.0, 0.0, 0.0, 0.0)]  # fmt: skip
+    segs = [
+        (float(rng.uniform(15, 30)), float(rng.uniform(-0.5, 0.8)), 0.0, float(rng.uniform(-3, 3))),
+        (float(rng.uniform(8, 15)), 0.0, float(rng.choice([-5.0, 5.0])), 0.0),
+        (float(rng.uniform(20, 40)), 0.0, 0.0, float(rng.uniform(-4, 4))),
+        (10.0, 0.0, float(rng.choice([-6.0, 6.0])), 2.0),
+        (30.0, 0.0, 0.0, 0.0),
+    ]
     return fly(start, hdg, speed, segs, start_s, f"free-{i}")
 
 

@@ -41,7 +41,7 @@ from skyradar.nav.gpscheck.check import (
     pose_grid_for,
     prepare_map,
     render_map,
-)  # fmt: skip
+)
 from skyradar.nav.gpscheck.compare import decoy_test
 from skyradar.nav.gpscheck.monitor import DEFAULT_SETTINGS, WING_UP, inconsistency
 from skyradar.nav.gpscheck.preprocess import METHODS, preprocess
@@ -60,13 +60,22 @@ THESIS_TABLE = {
     "gamma": (None, None, 0.53, None),
 }
 # name -> (offset m, heading offset deg)
-SPOOF_CASES = {"0 m": (0.0, 0.0), "25 m": (25.0, 0.0), "50 m": (50.0, 0.0), "100 m": (100.0, 0.0),
-               "200 m": (200.0, 0.0), "5 deg": (0.0, 5.0)}  # fmt: skip
+SPOOF_CASES = {
+    "0 m": (0.0, 0.0),
+    "25 m": (25.0, 0.0),
+    "50 m": (50.0, 0.0),
+    "100 m": (100.0, 0.0),
+    "200 m": (200.0, 0.0),
+    "5 deg": (0.0, 5.0),
+}
 ACCEPTANCE = {
-    "best_method_correct_min": 19, "best_method_false_positive_max": 0.05,
+    "best_method_correct_min": 19,
+    "best_method_false_positive_max": 0.05,
     "search_median_position_m_max": 10.0,
-    "search_median_heading_deg_max": 1.0, "spoof_50m_detection_min": 0.95, "false_alarm_max": 0.05,
-}  # fmt: skip
+    "search_median_heading_deg_max": 1.0,
+    "spoof_50m_detection_min": 0.95,
+    "false_alarm_max": 0.05,
+}
 HEIGHT_M, SPEED_MPS, N_FRAMES = 200.0, 50.0, 20
 
 
@@ -109,9 +118,13 @@ def _frames(simulator, flight, rng: np.random.Generator):
     wing_up = np.flatnonzero(fraction < DEFAULT_SETTINGS.min_ground_fraction)
     index = np.concatenate([picked, wing_up])
     ds = simulate_land_cover_run(
-        simulator, flight.times_s[index], flight.position_ned_m[index], flight.velocity_ned_mps[index],
-        flight.attitude_rad[index], attrs={"experiment": "ch6"},
-    )  # fmt: skip
+        simulator,
+        flight.times_s[index],
+        flight.position_ned_m[index],
+        flight.velocity_ned_mps[index],
+        flight.attitude_rad[index],
+        attrs={"experiment": "ch6"},
+    )
     return ds, index, picked.size, fraction[index]
 
 
@@ -130,22 +143,38 @@ def _score_frame(
     for method in METHODS:
         radar = preprocess(image, method, mask, **RADAR_OPTIONS)
         d = decoy_test(radar, mask, maps[method], map_grid, pose_grid, truth, rng)
-        rows.append({"frame": k, "kind": "decoys", "method": method, "heading_error_deg": d.heading_error_deg,
-                     "position_error_m": d.position_error_m,
-                     "false_positive_fraction": d.false_positive_fraction,
-                     "correct": d.correct()})  # fmt: skip
+        rows.append(
+            {
+                "frame": k,
+                "kind": "decoys",
+                "method": method,
+                "heading_error_deg": d.heading_error_deg,
+                "position_error_m": d.position_error_m,
+                "false_positive_fraction": d.false_positive_fraction,
+                "correct": d.correct(),
+            }
+        )
     radar = preprocess(image, DEFAULT_METHOD, mask, **RADAR_OPTIONS)
     for case, (offset_m, heading_deg) in SPOOF_CASES.items():
         gps = _spoofed(truth, offset_m, heading_deg, rng)
         off = search_offset(radar, mask, maps[DEFAULT_METHOD], map_grid, pose_grid, gps)
         # The correction should bring the GPS pose back to the truth: its error is scored against truth.
         err = gps + np.array([off.d_north_m, off.d_east_m, np.radians(off.d_heading_deg)]) - truth
-        rows.append({"frame": k, "kind": "search", "method": DEFAULT_METHOD, "case": case,
-                     "position_error_m": float(np.hypot(err[0], err[1])),
-                     "heading_error_deg": float(abs(np.degrees(wrap_angle(err[2])))),
-                     "psr": off.psr, "statistic": inconsistency(off, DEFAULT_SETTINGS),
-                     "decided": bool(fraction >= DEFAULT_SETTINGS.min_ground_fraction
-                                     and off.psr >= DEFAULT_SETTINGS.min_psr)})  # fmt: skip
+        rows.append(
+            {
+                "frame": k,
+                "kind": "search",
+                "method": DEFAULT_METHOD,
+                "case": case,
+                "position_error_m": float(np.hypot(err[0], err[1])),
+                "heading_error_deg": float(abs(np.degrees(wrap_angle(err[2])))),
+                "psr": off.psr,
+                "statistic": inconsistency(off, DEFAULT_SETTINGS),
+                "decided": bool(
+                    fraction >= DEFAULT_SETTINGS.min_ground_fraction and off.psr >= DEFAULT_SETTINGS.min_psr
+                ),
+            }
+        )
     return rows
 
 
@@ -202,9 +231,15 @@ def run(out: Path, seed: int = 6, progress=None) -> dict[str, Any]:
             rows += _score_frame(k, image, fractions[k], truth, maps, map_grid, pose_grid, building_m, rng)
         else:
             fc = check_frame(
-                image, fractions[k], truth, maps[DEFAULT_METHOD], map_grid, pose_grid,
-                height_agl_m=HEIGHT_M, building_m=building_m,
-            )  # fmt: skip
+                image,
+                fractions[k],
+                truth,
+                maps[DEFAULT_METHOD],
+                map_grid,
+                pose_grid,
+                height_agl_m=HEIGHT_M,
+                building_m=building_m,
+            )
             rows.append(
                 {"frame": k, "kind": "wing_up", "verdict": fc.verdict, "no_decision": fc.verdict == WING_UP}
             )

@@ -33,24 +33,39 @@ def summary_table(frames: pd.DataFrame, thesis: dict, n_frames: int) -> tuple[pd
     for method in METHODS:
         d = decoys[decoys["method"] == method]
         t_head, t_pos, t_fp, t_correct = thesis[method]
-        rows.append({
-            "method": method, "thesis_method": THESIS_METHOD_NUMBER.get(method, ""), "frames": len(d),
-            "correct": int(d["correct"].sum()), "heading_error_deg": _median(d["heading_error_deg"]),
-            "position_error_m": _median(d["position_error_m"]),
-            "false_positive_fraction": float(d["false_positive_fraction"].mean()),
-            "thesis_correct": t_correct, "thesis_heading_error_deg": t_head, "thesis_position_error_m": t_pos,
-            "thesis_false_positive_fraction": t_fp,
-        })  # fmt: skip
+        rows.append(
+            {
+                "method": method,
+                "thesis_method": THESIS_METHOD_NUMBER.get(method, ""),
+                "frames": len(d),
+                "correct": int(d["correct"].sum()),
+                "heading_error_deg": _median(d["heading_error_deg"]),
+                "position_error_m": _median(d["position_error_m"]),
+                "false_positive_fraction": float(d["false_positive_fraction"].mean()),
+                "thesis_correct": t_correct,
+                "thesis_heading_error_deg": t_head,
+                "thesis_position_error_m": t_pos,
+                "thesis_false_positive_fraction": t_fp,
+            }
+        )
     search = frames[(frames["kind"] == "search") & (frames["case"] == "0 m")]
     decided = search[search["decided"]]
     correct = (decided["position_error_m"] <= 15.0) & (decided["heading_error_deg"] <= 2.0)
-    rows.append({
-        "method": f"search ({DEFAULT_METHOD}, NCC)", "thesis_method": "", "frames": len(decided),
-        "correct": int(correct.sum()), "heading_error_deg": _median(decided["heading_error_deg"]),
-        "position_error_m": _median(decided["position_error_m"]), "false_positive_fraction": float("nan"),
-        "thesis_correct": None, "thesis_heading_error_deg": None, "thesis_position_error_m": None,
-        "thesis_false_positive_fraction": None,
-    })  # fmt: skip
+    rows.append(
+        {
+            "method": f"search ({DEFAULT_METHOD}, NCC)",
+            "thesis_method": "",
+            "frames": len(decided),
+            "correct": int(correct.sum()),
+            "heading_error_deg": _median(decided["heading_error_deg"]),
+            "position_error_m": _median(decided["position_error_m"]),
+            "false_positive_fraction": float("nan"),
+            "thesis_correct": None,
+            "thesis_heading_error_deg": None,
+            "thesis_position_error_m": None,
+            "thesis_false_positive_fraction": None,
+        }
+    )
     table = pd.DataFrame(rows)
     ranked = table.iloc[: len(METHODS)].sort_values(
         ["correct", "false_positive_fraction"], ascending=[False, True]
@@ -58,15 +73,18 @@ def summary_table(frames: pd.DataFrame, thesis: dict, n_frames: int) -> tuple[pd
     best = ranked.iloc[0]
     wing = frames[frames["kind"] == "wing_up"]
     result = {
-        "frames": n_frames, "best_method": best["method"], "best_correct": int(best["correct"]),
+        "frames": n_frames,
+        "best_method": best["method"],
+        "best_correct": int(best["correct"]),
         "best_false_positive": float(best["false_positive_fraction"]),
-        "search_decided": int(len(decided)), "search_correct": int(correct.sum()),
+        "search_decided": int(len(decided)),
+        "search_correct": int(correct.sum()),
         "search_median_position_m": _median(decided["position_error_m"]),
         "search_median_heading_deg": _median(decided["heading_error_deg"]),
         "search_p90_position_m": float(decided["position_error_m"].quantile(0.9)) if len(decided) else None,
         "wing_up_frames": int(len(wing)),
         "wing_up_all_no_decision": bool(wing["no_decision"].all()) if len(wing) else True,
-    }  # fmt: skip
+    }
     return table, result
 
 
@@ -98,8 +116,11 @@ def plot_poses(path: Path, truth, image, maps, map_grid, at, pose_grid, rng) -> 
     )
     off = np.hypot(*(poses[k, :2] - truth[:2]))
     head = np.degrees(poses[k, 2] - truth[2])
-    _show(axes[3], sample_at_pose(maps[DEFAULT_METHOD], map_grid, at, *poses[k]),
-          f"best false pose ({off:.0f} m, {head:+.1f} deg)\nSSIM {scores[k + 1]:.3f}")  # fmt: skip
+    _show(
+        axes[3],
+        sample_at_pose(maps[DEFAULT_METHOD], map_grid, at, *poses[k]),
+        f"best false pose ({off:.0f} m, {head:+.1f} deg)\nSSIM {scores[k + 1]:.3f}",
+    )
     fig.suptitle("rows: forward (up), columns: right of the aircraft")
     savefig_atomic(fig, path, dpi=90)
     plt.close(fig)
@@ -132,8 +153,12 @@ def plot_roc(path: Path, roc: pd.DataFrame) -> Path:
     for case in [c for c in roc.columns if c not in ("threshold", "false_alarm")]:
         # Both rates fall as the threshold rises: walking the thresholds down traces the curve.
         order = np.argsort(roc["threshold"].to_numpy())[::-1]
-        ax.plot(roc["false_alarm"].to_numpy()[order], roc[case].to_numpy()[order], drawstyle="steps-post",
-                label=case)  # fmt: skip
+        ax.plot(
+            roc["false_alarm"].to_numpy()[order],
+            roc[case].to_numpy()[order],
+            drawstyle="steps-post",
+            label=case,
+        )
     ax.axvline(0.05, color="grey", ls=":")
     ax.set_xlabel("false-alarm rate (unspoofed frames)")
     ax.set_ylabel("detection rate (decided frames)")
@@ -165,9 +190,12 @@ def plot_all(
 ) -> list[str]:
     """Every ch6 figure into ``out``; their paths."""
     truth, image = images[0]
-    return [str(p) for p in (
-        plot_poses(out / "poses.png", truth, image, maps, map_grid, at, pose_grid, rng),
-        plot_surface(out / "surface.png", truth, image, maps, map_grid, at, pose_grid),
-        plot_roc(out / "roc.png", roc),
-        plot_flight(out / "flight.png", maps["gamma"], map_grid, flight, index, n_picked),
-    )]  # fmt: skip
+    return [
+        str(p)
+        for p in (
+            plot_poses(out / "poses.png", truth, image, maps, map_grid, at, pose_grid, rng),
+            plot_surface(out / "surface.png", truth, image, maps, map_grid, at, pose_grid),
+            plot_roc(out / "roc.png", roc),
+            plot_flight(out / "flight.png", maps["gamma"], map_grid, flight, index, n_picked),
+        )
+    ]

@@ -142,15 +142,27 @@ def _table(r: dict) -> pd.DataFrame:
     cl = f"{r['clusters_seen_every_rotation']}/{r['clusters']} towns in all {r['rotations']} rotations"
     rows = [
         ("urban clusters", THESIS["clusters_seen"], cl),
-        ("small aircraft seen", THESIS["aircraft_seen"],
-         f"{r['aircraft_seen']}/{r['aircraft_passes']} passes"),
+        (
+            "small aircraft seen",
+            THESIS["aircraft_seen"],
+            f"{r['aircraft_seen']}/{r['aircraft_passes']} passes",
+        ),
         ("aircraft median position error", THESIS["aircraft_error_m"], f"{r['aircraft_median_error_m']} m"),
-        ("false detections per sweep", THESIS["false_per_sweep"],
-         f"max {r['false_max_per_rotation']}, mean {r['false_mean_per_rotation']}"),
+        (
+            "false detections per sweep",
+            THESIS["false_per_sweep"],
+            f"max {r['false_max_per_rotation']}, mean {r['false_mean_per_rotation']}",
+        ),
         ("test pulse peak", "0.15 ms", f"{r['hann_peak_ms']} ms (Hann), {r['plain_peak_ms']} ms (plain)"),
-        ("0.01 echo 0.02 ms later", "visible only with Hann",
-         f"Hann: {r['hann_echo_visible']}, plain: {r['plain_echo_visible']}"),
-        ("processing", THESIS["method"],
-         "matched filter (Hann), direct-path removal, MTI, dwell Doppler, CFAR"),
-    ]  # fmt: skip
+        (
+            "0.01 echo 0.02 ms later",
+            "visible only with Hann",
+            f"Hann: {r['hann_echo_visible']}, plain: {r['plain_echo_visible']}",
+        ),
+        (
+            "processing",
+            THESIS["method"],
+            "matched filter (Hann), direct-path removal, MTI, dwell Doppler, CFAR",
+        ),
+    ]
     return pd.DataFrame(rows, columns=["quantity", "thesis", "ours"])

@@ -93,9 +93,14 @@ from skyradar.process.power import power_image
 from skyradar.units import wrap
 
 __all__ = [
-    "run", "doppler_metrics", "parse_terrains", "LOSS_THRESHOLD_DB", "TERRAINS", "DEFAULT_TERRAINS",
+    "run",
+    "doppler_metrics",
+    "parse_terrains",
+    "LOSS_THRESHOLD_DB",
+    "TERRAINS",
+    "DEFAULT_TERRAINS",
     "RELIEF_CLOSING_MPS",
-]  # fmt: skip
+]
 
 LOSS_THRESHOLD_DB = -5.0
 START_M, END_M, CLOSING_MPS = 5000.0, 1300.0, 100.0
@@ -196,7 +201,9 @@ def _frame_measures(i, full, clutter, target, sub, config, tables) -> dict[str, 
     cell_if = _db(gain * (c_in[wr, wd] + noise) / (c_out[wr, wd] + noise))
     bright = c_in[wr, wd] >= noise * 10 ** (IF_CELL_CNR_DB / 10)
     return {
-        "frame": i, "range_bin": int(k), "doppler_bin": int(j),
+        "frame": i,
+        "range_bin": int(k),
+        "doppler_bin": int(j),
         "snr_db": float(_db(t_raw[k, j] / noise)),
         "cell_cnr_db": float(_db(c_in[k, j] / noise)),
         "cell_if_db": float(_db(gain * (c_in[k, j] + noise) / (c_out[k, j] + noise))),
@@ -212,7 +219,7 @@ def _frame_measures(i, full, clutter, target, sub, config, tables) -> dict[str, 
         "hit_plain": _hit(tables["none"], i, k, j, config),
         "hit_suppressed": _hit(tables["suppressed"], i, k, j, config),
         "hit_suppressed_secondary": _hit(tables["suppressed"], i, k, j, config, secondary=True),
-    }  # fmt: skip
+    }
 
 
 def _curves(clutter_cubes, full_cubes, subs, config) -> pd.DataFrame:
@@ -230,13 +237,15 @@ def _curves(clutter_cubes, full_cubes, subs, config) -> pd.DataFrame:
         c_out += projected_power(clutter / config.rx_calibration, vectors, nulls)[rows].mean(axis=0)
         gain += projected_power(boresight, vectors, nulls)[rows].mean(axis=0)
     c_in, c_out, gain = (x / len(full_cubes) for x in (c_in, c_out, gain))
-    return pd.DataFrame({
-        "radial_velocity_mps": config.doppler_axis_mps,
-        "clutter_to_noise_db": _db(c_in / noise),
-        "sinr_loss_none_db": _db(noise / (c_in + noise)),
-        "sinr_loss_suppressed_db": _db(gain * noise / (c_out + noise)),
-        "improvement_factor_db": _db(gain * (c_in + noise) / (c_out + noise)),
-    })  # fmt: skip
+    return pd.DataFrame(
+        {
+            "radial_velocity_mps": config.doppler_axis_mps,
+            "clutter_to_noise_db": _db(c_in / noise),
+            "sinr_loss_none_db": _db(noise / (c_in + noise)),
+            "sinr_loss_suppressed_db": _db(gain * noise / (c_out + noise)),
+            "improvement_factor_db": _db(gain * (c_in + noise) / (c_out + noise)),
+        }
+    )
 
 
 def _geometry(terrain: str, n_frames: int, seed: int) -> tuple[dict[str, Any], float]:
@@ -245,8 +254,14 @@ def _geometry(terrain: str, n_frames: int, seed: int) -> tuple[dict[str, Any], f
     relief = not terrain.startswith("flat-")
     closing = RELIEF_CLOSING_MPS if relief else CLOSING_MPS
     duration = (START_M - END_M) / closing
-    common: dict[str, Any] = dict(n_frames=n_frames, frame_rate_hz=n_frames / duration, closing_mps=closing,
-                  start_range_m=START_M, seed=seed, rcs_m2=RCS_M2)  # fmt: skip
+    common: dict[str, Any] = dict(
+        n_frames=n_frames,
+        frame_rate_hz=n_frames / duration,
+        closing_mps=closing,
+        start_range_m=START_M,
+        seed=seed,
+        rcs_m2=RCS_M2,
+    )
     if not relief:
         return common, float(terrain[5:])
     common |= {"terrain": terrain, "terrain_seed": seed}
@@ -272,18 +287,24 @@ def _case(terrain: str, n_frames: int, seed: int) -> tuple[pd.DataFrame, pd.Data
     subs = [frame_subspace(own, i, config, None, anchors) for i in range(n_frames)]
     cubes = np.asarray(full["iq"])
     tables = {"clear": clear, "none": plain, "suppressed": suppressed}
-    frames = pd.DataFrame([_frame_measures(i, cubes[i], clutter[i], target[i], subs[i], config, tables)
-                           for i in range(n_frames)])  # fmt: skip
+    frames = pd.DataFrame(
+        [
+            _frame_measures(i, cubes[i], clutter[i], target[i], subs[i], config, tables)
+            for i in range(n_frames)
+        ]
+    )
     frames.insert(0, "terrain", terrain)
     frames.insert(1, "own_agl_m", np.asarray(full["own_height_agl_m"], float))
     frames["range_m"] = np.asarray(full["tgt_range_m"])[:, 0]
     curves = _curves(clutter, cubes, subs, config)
     curves.insert(0, "terrain", terrain)
-    timing = {"process_s_per_frame_none": (t1 - t0) / n_frames,
-              "process_s_per_frame_suppressed": (t2 - t1) / n_frames,
-              "detections_per_frame_none": len(plain) / n_frames,
-              "detections_per_frame_suppressed": len(suppressed) / n_frames,
-              "closing_mps": float(common["closing_mps"])}  # fmt: skip
+    timing = {
+        "process_s_per_frame_none": (t1 - t0) / n_frames,
+        "process_s_per_frame_suppressed": (t2 - t1) / n_frames,
+        "detections_per_frame_none": len(plain) / n_frames,
+        "detections_per_frame_suppressed": len(suppressed) / n_frames,
+        "closing_mps": float(common["closing_mps"]),
+    }
     return frames, curves, timing
 
 
@@ -339,13 +360,14 @@ def _case_summary(frames: pd.DataFrame, curves: pd.DataFrame, timing: dict) -> d
         "lost_bright_cell_if_db_min": _stat(lost.window_bright_if_db, "min"),
         "lost_bright_attenuation_db_median": _stat(lost.window_bright_attenuation_db, "median"),
         "lost_hits_suppressed": int(lost.hit_suppressed.sum()),
-        "mdv_mps_none": none["mdv_mps"], "mdv_mps_suppressed": supp["mdv_mps"],
+        "mdv_mps_none": none["mdv_mps"],
+        "mdv_mps_suppressed": supp["mdv_mps"],
         "usable_doppler_fraction_none": none["usable_doppler_fraction"],
         "usable_doppler_fraction_suppressed": supp["usable_doppler_fraction"],
         "if_db_median_over_doppler": float(np.median(curves["improvement_factor_db"])),
         "main_beam_clutter_mps": v_mbc,
         **timing,
-    }  # fmt: skip
+    }
 
 
 def _title(terrain: str, summary: dict) -> str:

@@ -67,29 +67,31 @@ def summary_rows(cases: dict[str, dict[str, Any]]) -> list[dict[str, Any]]:
     rows = []
     for terrain, case in cases.items():
         with_secondary = case["detection_fraction_suppressed_with_secondary"]
-        rows.append({
-            "terrain": terrain,
-            "own_agl_m": case["own_agl_m_median"],
-            "hits_none": case["intruder_hits_none"],
-            "hits_suppressed": case["intruder_hits_suppressed"],
-            "frames": case["frames"],
-            "visible_frames": case["visible_frames"],
-            "detection_fraction_none": case["detection_fraction_none"],
-            "detection_fraction_suppressed": case["detection_fraction_suppressed"],
-            "detection_fraction_suppressed_with_secondary": with_secondary,
-            "intruder_cell_if_db_median": case["intruder_cell_if_db_median"],
-            "intruder_cell_if_db_min": case["intruder_cell_if_db_min"],
-            "intruder_cell_clutter_frames": case["intruder_cell_clutter_frames"],
-            "intruder_cell_if_db_median_clutter": case["intruder_cell_if_db_median_clutter"],
-            "if_db_lost_cells_median": case["if_db_lost_cells_median"],
-            "if_db_lost_cells_min": case["if_db_lost_cells_min"],
-            "lost_frames_with_cells": case["lost_frames_with_cells"],
-            "target_gain_db_lost_cells": case["lost_cells_target_gain_db_median"],
-            "if_db_where_lost_median": case["lost_window_if_db_median"],
-            "if_db_where_lost_min": case["lost_window_if_db_min"],
-            "mdv_mps_none": case["mdv_mps_none"],
-            "mdv_mps_suppressed": case["mdv_mps_suppressed"],
-            "udsf_none": case["usable_doppler_fraction_none"],
-            "udsf_suppressed": case["usable_doppler_fraction_suppressed"],
-        })  # fmt: skip
+        rows.append(
+            {
+                "terrain": terrain,
+                "own_agl_m": case["own_agl_m_median"],
+                "hits_none": case["intruder_hits_none"],
+                "hits_suppressed": case["intruder_hits_suppressed"],
+                "frames": case["frames"],
+                "visible_frames": case["visible_frames"],
+                "detection_fraction_none": case["detection_fraction_none"],
+                "detection_fraction_suppressed": case["detection_fraction_suppressed"],
+                "detection_fraction_suppressed_with_secondary": with_secondary,
+                "intruder_cell_if_db_median": case["intruder_cell_if_db_median"],
+                "intruder_cell_if_db_min": case["intruder_cell_if_db_min"],
+                "intruder_cell_clutter_frames": case["intruder_cell_clutter_frames"],
+                "intruder_cell_if_db_median_clutter": case["intruder_cell_if_db_median_clutter"],
+                "if_db_lost_cells_median": case["if_db_lost_cells_median"],
+                "if_db_lost_cells_min": case["if_db_lost_cells_min"],
+                "lost_frames_with_cells": case["lost_frames_with_cells"],
+                "target_gain_db_lost_cells": case["lost_cells_target_gain_db_median"],
+                "if_db_where_lost_median": case["lost_window_if_db_median"],
+                "if_db_where_lost_min": case["lost_window_if_db_min"],
+                "mdv_mps_none": case["mdv_mps_none"],
+                "mdv_mps_suppressed": case["mdv_mps_suppressed"],
+                "udsf_none": case["usable_doppler_fraction_none"],
+                "udsf_suppressed": case["usable_doppler_fraction_suppressed"],
+            }
+        )
     return rows

@@ -71,17 +71,28 @@ def scene_dict(
         "origin": {"lat_deg": 52.0, "lon_deg": 5.0, "alt_m": 0.0} if where is None else where["origin"],
         "radar": {"antenna": {"beamwidth_deg": 70}},
         "mount": "forward",
-        "ownship": {"type": "straight", "start_ned_m": [0.0, 0.0, -float(height_m)], "heading_deg": 0.0,
-                    "speed_mps": OWN_SPEED_MPS},
-        "intruders": [{"name": "head-on", "type": "encounter", "kind": "head-on",
-                       "t_cpa_s": start_range_m / closing_mps,
-                       "intruder_speed_mps": closing_mps - OWN_SPEED_MPS, "rcs_m2": float(rcs_m2)}],
+        "ownship": {
+            "type": "straight",
+            "start_ned_m": [0.0, 0.0, -float(height_m)],
+            "heading_deg": 0.0,
+            "speed_mps": OWN_SPEED_MPS,
+        },
+        "intruders": [
+            {
+                "name": "head-on",
+                "type": "encounter",
+                "kind": "head-on",
+                "t_cpa_s": start_range_m / closing_mps,
+                "intruder_speed_mps": closing_mps - OWN_SPEED_MPS,
+                "rcs_m2": float(rcs_m2),
+            }
+        ],
         "frame_rate_hz": frame_rate_hz,
         "duration_s": n_frames / frame_rate_hz,
         "start_s": 0.0,
         "simulation": {"noise": bool(noise), "seed": int(seed), "facet_size_m": 7.5},
         "navigation": "perfect",
-    }  # fmt: skip
+    }
     if ground:
         flat = {"type": "flat", "size_m": float(size_m), "spacing_m": 30.0}
         data["terrain"] = flat if where is None else where["terrain"]
@@ -115,6 +126,10 @@ def scene_frames(data: dict[str, Any]) -> xr.Dataset:
     simulator = make_simulator(built)
     own, tgt, names = scenario_truth(built, simulator)
     iq = simulate_frames(built, np.arange(built.times_s.size), simulator)
-    attrs = {"scenario": built.name, "origin_lat_deg": built.origin[0], "origin_lon_deg": built.origin[1],
-             "origin_alt_m": built.origin[2]}  # fmt: skip
+    attrs = {
+        "scenario": built.name,
+        "origin_lat_deg": built.origin[0],
+        "origin_lon_deg": built.origin[1],
+        "origin_alt_m": built.origin[2],
+    }
     return frames_dataset(iq, built.times_s, built.radar, own, tgt, names, attrs)

@@ -149,16 +149,25 @@ def real_pair(p: pd.Series) -> tuple[Trajectory, Trajectory]:
     if side is None:
         raise InputError(f"real-flight encounter: side must be 'right' or 'left', got {p['side']!r}")
     return encounter_from_tracks(
-        own, intruder, T_CPA_S, *miss, intruder_time_s=t_int, rotate_deg=float(p["rotate_deg"]), side=side,
-    )  # fmt: skip
+        own,
+        intruder,
+        T_CPA_S,
+        *miss,
+        intruder_time_s=t_int,
+        rotate_deg=float(p["rotate_deg"]),
+        side=side,
+    )
 
 
 def _placed(traj: Trajectory, origin: dict, down_m: float) -> Trajectory:
     """The same motion at the set's site: NED positions kept, ``down_m`` added, the site's origin."""
     return Trajectory.from_states(
-        traj.time_s, traj.position_ned_m + [0.0, 0.0, down_m], traj.velocity_ned_mps,
-        origin=(origin["lat_deg"], origin["lon_deg"], origin["alt_m"]), name=traj.name,
-    )  # fmt: skip
+        traj.time_s,
+        traj.position_ned_m + [0.0, 0.0, down_m],
+        traj.velocity_ned_mps,
+        origin=(origin["lat_deg"], origin["lon_deg"], origin["alt_m"]),
+        name=traj.name,
+    )
 
 
 def _spec(p, where, folder: Path, own, intruder, start, duration, frame_rate_hz, seed, radars, navigation):
@@ -168,14 +177,21 @@ def _spec(p, where, folder: Path, own, intruder, start, duration, frame_rate_hz,
         "name": f"real: {p['own_flight']} meets {p['intruder_flight']}",
         "origin": where["origin"],
         "ownship": {"type": "file", "path": str(folder / "own.csv"), "time_zero_s": 0.0},
-        "intruders": [{"name": "intruder", "type": "file", "path": str(folder / "intruder.csv"),
-                       "time_zero_s": 0.0, "aircraft_class": str(p["intruder_class"]),
-                       "rcs_m2": float(p["rcs_m2"])}],
+        "intruders": [
+            {
+                "name": "intruder",
+                "type": "file",
+                "path": str(folder / "intruder.csv"),
+                "time_zero_s": 0.0,
+                "aircraft_class": str(p["intruder_class"]),
+                "rcs_m2": float(p["rcs_m2"]),
+            }
+        ],
         "frame_rate_hz": frame_rate_hz,
         "start_s": float(start),
         "duration_s": float(duration),
         "simulation": {"noise": True, "seed": int(seed), "psf": True, "speckle": True, "swerling": 1},
-    }  # fmt: skip
+    }
     if radars is None:
         spec["mount"] = "forward"
     else:
@@ -223,8 +239,14 @@ def run_real_encounter(
         args = (start, duration, frame_rate_hz, seed, radars, navigation)
         if where["terrain"] is not None and terrain in ("hills", "jacksboro"):
             # The own-ship's altitude from the ground under its track, as the synthetic set does.
-            first = _spec(p, where, folder, _placed(own, where["origin"], -alt),
-                          _placed(intruder, where["origin"], -alt), *args)  # fmt: skip
+            first = _spec(
+                p,
+                where,
+                folder,
+                _placed(own, where["origin"], -alt),
+                _placed(intruder, where["origin"], -alt),
+                *args,
+            )
             ground = Scenario.from_dict(first).build().terrain
             times = np.linspace(start, start + duration, 64)
             s_own = _placed(own, where["origin"], -alt).sample(times)
@@ -240,9 +262,12 @@ def run_real_encounter(
                 mirrored = True
                 flipped = intruder.position_ned_m * [1.0, 1.0, -1.0]
                 intruder = Trajectory.from_states(
-                    intruder.time_s, flipped, intruder.velocity_ned_mps * [1.0, 1.0, -1.0],
-                    origin=intruder.origin, name=intruder.name,
-                )  # fmt: skip
+                    intruder.time_s,
+                    flipped,
+                    intruder.velocity_ned_mps * [1.0, 1.0, -1.0],
+                    origin=intruder.origin,
+                    name=intruder.name,
+                )
                 intruder_at = _placed(intruder, where["origin"], -alt)
                 rel = rel * [1.0, 1.0, -1.0]
         built = Scenario.from_dict(_spec(p, where, folder, own_at, intruder_at, *args)).build()

@@ -147,11 +147,18 @@ def make_fast_closures(n: int, seed: int = 0) -> pd.DataFrame:
 
 def _intruder_spec(p: pd.Series) -> dict[str, Any]:
     kind = "crossing" if p["kind"] == "climbing" else str(p["kind"])
-    spec = {"name": "intruder", "type": "encounter", "kind": kind, "t_cpa_s": T_CPA_S,
-            "horizontal_miss_m": float(p["horizontal_miss_m"]),
-            "vertical_miss_m": float(p["vertical_miss_m"]),
-            "intruder_speed_mps": float(p["intruder_speed_mps"]), "side": str(p["side"]),
-            "rcs_m2": float(p["rcs_m2"]), "rate_hz": 20.0}  # fmt: skip
+    spec = {
+        "name": "intruder",
+        "type": "encounter",
+        "kind": kind,
+        "t_cpa_s": T_CPA_S,
+        "horizontal_miss_m": float(p["horizontal_miss_m"]),
+        "vertical_miss_m": float(p["vertical_miss_m"]),
+        "intruder_speed_mps": float(p["intruder_speed_mps"]),
+        "side": str(p["side"]),
+        "rcs_m2": float(p["rcs_m2"]),
+        "rate_hz": 20.0,
+    }
     if np.isfinite(p["crossing_angle_deg"]):
         spec["crossing_angle_deg"] = float(p["crossing_angle_deg"])
     if np.isfinite(p["climb_mps"]):
@@ -197,17 +204,28 @@ def encounter_scenario(
     scenario = {
         "name": f"encounter {p['kind']}",
         "origin": where["origin"],
-        "ownship": {"type": "straight", "start_ned_m": [-OWN_SPEED_MPS * T_CPA_S, 0.0, -alt],
-                    "heading_deg": 0.0, "speed_mps": OWN_SPEED_MPS, "start_time_s": 0.0,
-                    "duration_s": T_CPA_S + 10.0},
+        "ownship": {
+            "type": "straight",
+            "start_ned_m": [-OWN_SPEED_MPS * T_CPA_S, 0.0, -alt],
+            "heading_deg": 0.0,
+            "speed_mps": OWN_SPEED_MPS,
+            "start_time_s": 0.0,
+            "duration_s": T_CPA_S + 10.0,
+        },
         "intruders": [_intruder_spec(p)],
         "frame_rate_hz": frame_rate_hz,
         "start_s": float(start_s),
         "duration_s": float(duration_s),
         # The simulator's realistic options (sim.image): window point-spread, terrain speckle, Swerling 1.
-        "simulation": {"noise": True, "seed": int(seed), "psf": True, "speckle": True, "swerling": 1,
-                       **(simulation or {})},
-    }  # fmt: skip
+        "simulation": {
+            "noise": True,
+            "seed": int(seed),
+            "psf": True,
+            "speckle": True,
+            "swerling": 1,
+            **(simulation or {}),
+        },
+    }
     if radars is None:
         scenario["mount"] = "forward"
     else:
@@ -249,9 +267,13 @@ def event_times(t: np.ndarray, rel: np.ndarray) -> tuple[float, float]:
 
 
 def score_encounter(
-    t: np.ndarray, rel: np.ndarray, warn_times_s: np.ndarray, observed: pd.DataFrame, buffer: float,
+    t: np.ndarray,
+    rel: np.ndarray,
+    warn_times_s: np.ndarray,
+    observed: pd.DataFrame,
+    buffer: float,
     observe_window_s: float,
-) -> dict[str, float | bool]:  # fmt: skip
+) -> dict[str, float | bool]:
     """One encounter's result row from its dense relative truth and the chain's output.
 
     ``observed``: per frame ``time_s`` and ``observable`` (in the field of view with enough SNR).
@@ -345,23 +367,34 @@ def plot_encounters(res: pd.DataFrame, path: Path, buffer: float, warning_time_s
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.5))
     warned = res["t_warning_s"].notna()
     hidden = res["conflict"] & ~res["observable"]
-    groups = ((warned & ~hidden, "tab:red", "warning issued"), (~warned & ~hidden, "tab:green", "no warning"),
-              (hidden, "0.6", "conflict not observable (FOV / SNR)"))  # fmt: skip
+    groups = (
+        (warned & ~hidden, "tab:red", "warning issued"),
+        (~warned & ~hidden, "tab:green", "no warning"),
+        (hidden, "0.6", "conflict not observable (FOV / SNR)"),
+    )
     for mask, colour, label in groups:
-        ax[0].scatter(res.loc[mask, "min_horizontal_m"], res.loc[mask, "min_vertical_m"], s=8, c=colour,
-                      label=label)  # fmt: skip
+        ax[0].scatter(
+            res.loc[mask, "min_horizontal_m"], res.loc[mask, "min_vertical_m"], s=8, c=colour, label=label
+        )
     vol = WellClearVolume.do365_noncoop()
     ax[0].add_patch(plt.Rectangle((0, 0), vol.dthr_m, vol.zthr_m, fill=False, ls="--", color="k"))
-    ax[0].add_patch(plt.Rectangle((0, 0), buffer * vol.dthr_m, buffer * vol.zthr_m, fill=False, ls=":",
-                                  color="k"))  # fmt: skip
-    ax[0].set(xlabel="minimum horizontal separation [m]", ylabel="minimum vertical separation [m]",
-              title=f"encounters (dashed: well clear; dotted: x{buffer:g} may-alert buffer)")  # fmt: skip
+    ax[0].add_patch(
+        plt.Rectangle((0, 0), buffer * vol.dthr_m, buffer * vol.zthr_m, fill=False, ls=":", color="k")
+    )
+    ax[0].set(
+        xlabel="minimum horizontal separation [m]",
+        ylabel="minimum vertical separation [m]",
+        title=f"encounters (dashed: well clear; dotted: x{buffer:g} may-alert buffer)",
+    )
     ax[0].legend(loc="upper right", fontsize=8)
     lead = (res["t_lowc_s"] - res["t_warning_s"])[res["observable"]]
     ax[1].hist(lead.dropna(), bins=30, color="tab:blue")
     ax[1].axvline(warning_time_s, color="k", ls="--", label=f"warning alerting time {warning_time_s:g} s")
-    ax[1].set(xlabel="warning lead before loss of well clear [s]", ylabel="observable conflicts",
-              title="warning lead")  # fmt: skip
+    ax[1].set(
+        xlabel="warning lead before loss of well clear [s]",
+        ylabel="observable conflicts",
+        title="warning lead",
+    )
     ax[1].legend()
     fig.tight_layout()
     savefig_atomic(fig, path, dpi=110)

@@ -238,19 +238,43 @@ def run(
         enc = make_fast_closures(n_encounters, seed)
     else:
         enc = make_encounters(n_encounters, seed)
-    settings = {"n": n_encounters, "seed": seed, "frame_rate_hz": frame_rate_hz, "buffer": buffer,
-                "uncertainty": uncertainty, "terrains": list(terrains), "layouts": list(layouts),
-                "navigation": navigation, "suppression": SUPPRESSION, "late_lead_s": late_lead_s,
-                "alert_config": alert_settings,
-                "simulation": simulation or {}, "rx_layout": rx_layout, "family": family,
-                "split": "evaluation" if seed >= EVALUATION_SEEDS_FROM else "development"}  # fmt: skip
+    settings = {
+        "n": n_encounters,
+        "seed": seed,
+        "frame_rate_hz": frame_rate_hz,
+        "buffer": buffer,
+        "uncertainty": uncertainty,
+        "terrains": list(terrains),
+        "layouts": list(layouts),
+        "navigation": navigation,
+        "suppression": SUPPRESSION,
+        "late_lead_s": late_lead_s,
+        "alert_config": alert_settings,
+        "simulation": simulation or {},
+        "rx_layout": rx_layout,
+        "family": family,
+        "split": "evaluation" if seed >= EVALUATION_SEEDS_FROM else "development",
+    }
     version = code_version()
     done, save = _partial_store(out_dir, {**settings, "version": version})
     res = run_encounters(
-        enc, seed, workers, progress, done, save, terrains=terrains, family=family, scheduler=scheduler,
-        layouts=layouts, frame_rate_hz=frame_rate_hz, buffer=buffer, alert_config=cfg, navigation=navigation,
-        simulation=simulation, rx_layout=rx_layout,
-    )  # fmt: skip
+        enc,
+        seed,
+        workers,
+        progress,
+        done,
+        save,
+        terrains=terrains,
+        family=family,
+        scheduler=scheduler,
+        layouts=layouts,
+        frame_rate_hz=frame_rate_hz,
+        buffer=buffer,
+        alert_config=cfg,
+        navigation=navigation,
+        simulation=simulation,
+        rx_layout=rx_layout,
+    )
     summary = write_report(res, out_dir, settings, late_lead_s, cfg.levels[-1].alerting_time_s)
     workers = check_workers(workers) or min(2, os.cpu_count() or 1)
     summary.update(

@@ -71,9 +71,11 @@ def intruder_track_figures(tracks: pd.DataFrame, labels: dict[int, str], truth: 
     name = str(truth["target"].values[0])
     nan = float("nan")
     out: dict[str, Any] = {
-        "declaration_range_m": nan, "declaration_closing_mps": nan, "time_to_confirm_s": nan,
+        "declaration_range_m": nan,
+        "declaration_closing_mps": nan,
+        "time_to_confirm_s": nan,
         "track_errors": [],
-    }  # fmt: skip
+    }
     mine = [int(tid) for tid, label in labels.items() if label == name]
     rows = tracks[tracks["track_id"].isin(mine)] if len(tracks) else tracks
     if not len(rows) or "confirmed" not in rows or not rows["confirmed"].astype(bool).any():
@@ -99,10 +101,14 @@ def intruder_track_figures(tracks: pd.DataFrame, labels: dict[int, str], truth: 
     pos = confirmed[["north_m", "east_m", "down_m"]].to_numpy(float)
     vel = confirmed[["vn_mps", "ve_mps"]].to_numpy(float)
     err = pos - tgt[idx]
-    errors = np.column_stack([
-        rng[idx], np.hypot(err[:, 0], err[:, 1]), np.abs(err[:, 2]),
-        np.hypot(*(vel - tgt_v[idx, :2]).T),
-    ])  # fmt: skip
+    errors = np.column_stack(
+        [
+            rng[idx],
+            np.hypot(err[:, 0], err[:, 1]),
+            np.abs(err[:, 2]),
+            np.hypot(*(vel - tgt_v[idx, :2]).T),
+        ]
+    )
     keep = np.unique(np.linspace(0, len(errors) - 1, min(len(errors), _MAX_ERROR_ROWS)).round().astype(int))
     out["track_errors"] = errors[keep].round(2).tolist()
     return out
@@ -175,15 +181,22 @@ def plot_sensor_figures(res: pd.DataFrame, path: Path, title: str) -> None:
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.5))
     if "declaration_range_m" in res:
         ax[0].scatter(res["declaration_closing_mps"], res["declaration_range_m"] / 1000.0, s=10)
-    ax[0].set(xlabel="closing speed at declaration [m/s]", ylabel="declaration range [km]",
-              title=f"{title}: intruder track first confirmed")  # fmt: skip
+    ax[0].set(
+        xlabel="closing speed at declaration [m/s]",
+        ylabel="declaration range [km]",
+        title=f"{title}: intruder track first confirmed",
+    )
     errors = _error_samples(res)
     if len(errors):
         ax[1].scatter(errors[:, 0] / 1000.0, errors[:, 1], s=3, alpha=0.3, label="horizontal")
         ax[1].scatter(errors[:, 0] / 1000.0, errors[:, 2], s=3, alpha=0.3, label="vertical")
         ax[1].legend()
-    ax[1].set(xlabel="range [km]", ylabel="position error [m]", yscale="log",
-              title="confirmed intruder track rows against truth")  # fmt: skip
+    ax[1].set(
+        xlabel="range [km]",
+        ylabel="position error [m]",
+        yscale="log",
+        title="confirmed intruder track rows against truth",
+    )
     fig.tight_layout()
     savefig_atomic(fig, path, dpi=110)
     plt.close(fig)

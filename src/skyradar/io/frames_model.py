@@ -114,10 +114,25 @@ STANDARD_NAMES: dict[str, str] = {
 
 # RadarConfig fields and derived quantities written as flat ``radar_<name>`` attributes.
 _RADAR_SCALARS = (
-    "fc_hz", "fs_hz", "prf_hz", "pe_dbm", "bandwidth_hz", "n_doppler", "range_limit_m", "noise_figure_db",
-    "temperature_k", "wavelength_m", "n_range", "n_rx", "range_resolution_m", "doppler_resolution_mps",
-    "v_lim_mps", "frame_duration_s", "range_doppler_coupling_s", "noise_power_w",
-)  # fmt: skip
+    "fc_hz",
+    "fs_hz",
+    "prf_hz",
+    "pe_dbm",
+    "bandwidth_hz",
+    "n_doppler",
+    "range_limit_m",
+    "noise_figure_db",
+    "temperature_k",
+    "wavelength_m",
+    "n_range",
+    "n_rx",
+    "range_resolution_m",
+    "doppler_resolution_mps",
+    "v_lim_mps",
+    "frame_duration_s",
+    "range_doppler_coupling_s",
+    "noise_power_w",
+)
 
 
 def parse_start_time(value: Any, source: str = "scenario", field: str = "start_time") -> np.datetime64:

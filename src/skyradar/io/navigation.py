@@ -32,10 +32,20 @@ __all__ = ["STATE_COLUMNS", "NAVIGATION_SOURCES", "navigation_state", "navigatio
 
 _LOG = logging.getLogger(__name__)
 STATE_COLUMNS = (
-    "own_north_m", "own_east_m", "own_down_m", "own_vn_mps", "own_ve_mps", "own_vd_mps",
-    "own_yaw_rad", "own_pitch_rad", "own_roll_rad", "own_lat_deg", "own_lon_deg", "own_alt_m",
+    "own_north_m",
+    "own_east_m",
+    "own_down_m",
+    "own_vn_mps",
+    "own_ve_mps",
+    "own_vd_mps",
+    "own_yaw_rad",
+    "own_pitch_rad",
+    "own_roll_rad",
+    "own_lat_deg",
+    "own_lon_deg",
+    "own_alt_m",
     "own_height_agl_m",
-)  # fmt: skip
+)
 NAVIGATION_SOURCES = ("navigation", "truth")
 
 

@@ -271,8 +271,12 @@ def _open_npy(path: Path, meta: dict[str, Any]) -> tuple[np.ndarray, bool, Path]
 def _assume_prototype(meta: dict[str, Any]) -> None:
     """Sweep fields a ``.npy`` recording's sidecar leaves out: the thesis prototype's."""
     proto = RadarConfig.prototype_2022()
-    for key, value in (("sample_rate_hz", proto.fs_hz), ("fc_hz", proto.fc_hz),
-                       ("bandwidth_hz", proto.bandwidth_hz), ("prf_hz", proto.prf_hz)):  # fmt: skip
+    for key, value in (
+        ("sample_rate_hz", proto.fs_hz),
+        ("fc_hz", proto.fc_hz),
+        ("bandwidth_hz", proto.bandwidth_hz),
+        ("prf_hz", proto.prf_hz),
+    ):
         meta.setdefault(key, value)
 
 

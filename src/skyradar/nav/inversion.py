@@ -353,9 +353,15 @@ def _huber_fit(x0: np.ndarray, bounds, f_scale: float, args: tuple) -> tuple[np.
     fast = huber_least_squares(_residuals, _jacobian, x0, lower, upper, f_scale, args)
     if fast is None:
         sol = least_squares(
-            _residuals, x0, jac=_jacobian, loss="huber", f_scale=f_scale, args=args, x_scale=[10, 1, 100],
+            _residuals,
+            x0,
+            jac=_jacobian,
+            loss="huber",
+            f_scale=f_scale,
+            args=args,
+            x_scale=[10, 1, 100],
             bounds=bounds,
-        )  # fmt: skip
+        )
         fast = sol.x, sol.jac
     return fast
 

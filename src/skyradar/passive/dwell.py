@@ -84,9 +84,12 @@ def detect_dwells(
     out: list[dict] = []
     static_power = np.abs(profiles[:, :, lo:].mean(axis=1)) ** 2  # (dwells, lags)
     hits, snr = ca_cfar(
-        static_power, (0, s.guard_lags), (0, s.train_lags), s.pfa_static,
+        static_power,
+        (0, s.guard_lags),
+        (0, s.train_lags),
+        s.pfa_static,
         cells_per_independent=s.lags_per_independent,
-    )  # fmt: skip
+    )
     last = static_power.shape[1] - 1
     for w, k in local_peaks(hits, snr, batch=True):
         if k in (0, last):
@@ -102,9 +105,12 @@ def detect_dwells(
     doppler = (np.arange(n_dop) - n_dop // 2) * (prf_hz / n_dop)
     power = np.abs(_spectra(cancelled, t_kept, doppler)) ** 2  # (dwells, Doppler, lags)
     hits, snr = ca_cfar(
-        power, (0, 0, s.guard_lags), (0, 0, s.train_lags), s.pfa_moving,
+        power,
+        (0, 0, s.guard_lags),
+        (0, 0, s.train_lags),
+        s.pfa_moving,
         cells_per_independent=s.lags_per_independent,
-    )  # fmt: skip
+    )
     hits &= (np.abs(doppler) >= s.zero_doppler_guard_hz)[None, :, None]
     static_sum = static_power * profiles.shape[1] ** 2  # the zero-Doppler sum, on the moving power's scale
     for w, d, k in local_peaks(hits, snr, batch=True):
@@ -137,5 +143,11 @@ def _spectra(profiles: np.ndarray, times_s: np.ndarray, doppler_hz: np.ndarray) 
 
 
 def _candidate(channel: str, lag: float, doppler_hz: float, snr: float, t: float, power: float) -> dict:
-    return {"channel": channel, "lag": lag, "doppler_hz": doppler_hz, "snr_db": 10 * np.log10(snr),
-            "time_s": t, "power_db": 10 * np.log10(power + 1e-300)}  # fmt: skip
+    return {
+        "channel": channel,
+        "lag": lag,
+        "doppler_hz": doppler_hz,
+        "snr_db": 10 * np.log10(snr),
+        "time_s": t,
+        "power_db": 10 * np.log10(power + 1e-300),
+    }

@@ -81,8 +81,13 @@ def _number(name: str, value: object) -> float:
 
 # Upper bounds of a rotating PSR's fields: far beyond any such radar, and beyond them the sample counts
 # and phases computed from them overflow (a PRI of 1e308 s crashed the pulse profile with a traceback).
-_MAXIMA = {"carrier_frequency_hz": 1e12, "peak_power_w": 1e10, "beamwidth_az_deg": 360.0,
-           "rotation_rpm": 600.0, "pri_s": 1.0}  # fmt: skip
+_MAXIMA = {
+    "carrier_frequency_hz": 1e12,
+    "peak_power_w": 1e10,
+    "beamwidth_az_deg": 360.0,
+    "rotation_rpm": 600.0,
+    "pri_s": 1.0,
+}
 
 
 def _positive(name: str, value: float) -> float:

@@ -30,8 +30,15 @@ from skyradar.passive.mti import dwell_pulses
 from skyradar.passive.profiles import ProfileExtractor, read_chunks
 from skyradar.passive.pulses import estimate_pulse, scan_phase
 
-__all__ = ["PassiveSettings", "PassiveResult", "process_recording", "merge_candidates", "drop_sidelobes",
-           "COLUMNS", "PASSIVE_TABLE_COLUMNS"]  # fmt: skip
+__all__ = [
+    "PassiveSettings",
+    "PassiveResult",
+    "process_recording",
+    "merge_candidates",
+    "drop_sidelobes",
+    "COLUMNS",
+    "PASSIVE_TABLE_COLUMNS",
+]
 
 # The passive detections table (``skyradar passive``), column -> "unit; meaning" (skyradar.io.table_columns).
 PASSIVE_TABLE_COLUMNS: dict[str, str] = {
@@ -146,10 +153,11 @@ def _process(recording, settings: PassiveSettings | None, progress) -> PassiveRe
     min_range = s.min_bistatic_range_m if s.min_bistatic_range_m is not None else 3.0 * C_MPS / bandwidth
     # The guard covers the Hann-weighted compressed pulse (about 2 fs/B lags each side).
     dwell = replace(
-        s.dwell, min_lag=max(s.dwell.min_lag, int(np.ceil(min_range / C_MPS * fs))),
+        s.dwell,
+        min_lag=max(s.dwell.min_lag, int(np.ceil(min_range / C_MPS * fs))),
         guard_lags=max(s.dwell.guard_lags, int(np.ceil(2 * fs / bandwidth))),
         lags_per_independent=max(s.dwell.lags_per_independent, 1.5 * fs / bandwidth),  # Hann widens 1.5x
-    )  # fmt: skip
+    )
     if dwell.zero_doppler_guard_hz == 0.0:
         dwell = replace(dwell, zero_doppler_guard_hz=1.5 / (n_dwell * pri))
 
@@ -162,14 +170,22 @@ def _process(recording, settings: PassiveSettings | None, progress) -> PassiveRe
             f"{recording.path}: no direct-path pulse found (no matched-filter peak 30 dB above the median)"
         )
     scan = scan_phase(
-        times_all, np.concatenate(amps), ill.rotation_period_s, bearing, 1, source=str(recording.path),
-    )  # fmt: skip
+        times_all,
+        np.concatenate(amps),
+        ill.rotation_period_s,
+        bearing,
+        1,
+        source=str(recording.path),
+    )
     dwell_s = n_dwell * pri
     merged = _looks(candidates, s, scan, fs, C_MPS / bandwidth, dwell_s)
     blind = in_blind_zone(
-        merged["bistatic_range_m"].to_numpy(), merged["azimuth_rad"].to_numpy(), bearing, min_range,
+        merged["bistatic_range_m"].to_numpy(),
+        merged["azimuth_rad"].to_numpy(),
+        bearing,
+        min_range,
         np.radians(s.blind_half_width_deg),
-    )  # fmt: skip
+    )
     merged = merged[~blind].reset_index(drop=True)
     det = _positions(merged, tx_en, scan)
     n_pulses, n_masked = int(times_all.size), int(blind.sum())
@@ -192,10 +208,12 @@ def _looks(candidates: list[dict], s: PassiveSettings, scan, fs: float, resoluti
     merged["sweep"] = scan.sweep(merged["time_s"].to_numpy()) if len(merged) else []
     tols = (1.5 * resolution_m, 2.0 / dwell_s)
     is_static = merged["channel"] == "static" if len(merged) else pd.Series(dtype=bool)
-    merged = pd.concat([
-        drop_sidelobes(merged[is_static], *tols, s.static_sidelobe_margin_db, dwell_s, scan.period_s),
-        drop_sidelobes(merged[~is_static], *tols, s.sidelobe_margin_db, dwell_s, scan.period_s),
-    ])  # fmt: skip
+    merged = pd.concat(
+        [
+            drop_sidelobes(merged[is_static], *tols, s.static_sidelobe_margin_db, dwell_s, scan.period_s),
+            drop_sidelobes(merged[~is_static], *tols, s.sidelobe_margin_db, dwell_s, scan.period_s),
+        ]
+    )
     return merged
 
 
@@ -251,8 +269,11 @@ def _positions(merged: pd.DataFrame, tx_en: np.ndarray, scan) -> pd.DataFrame:
     det = merged.assign(
         sweep=scan.sweep(merged["time_s"].to_numpy()).astype(np.int64),
         azimuth_deg=np.degrees(merged["azimuth_rad"]),
-        east_m=point[:, 0], north_m=point[:, 1], r_tx_m=r1, r_rx_m=r2,
-    )  # fmt: skip
+        east_m=point[:, 0],
+        north_m=point[:, 1],
+        r_tx_m=r1,
+        r_rx_m=r2,
+    )
     return det[COLUMNS].sort_values(["time_s", "bistatic_range_m"]).reset_index(drop=True)
 
 

@@ -137,11 +137,18 @@ class _Synthesiser:
             block = np.zeros(n, complex)
             m = self.tau.size
             _add_pulses(
-                block, 0, self.fs, self.scene.illuminator.carrier_frequency_hz, np.full(m, frac / self.fs),
-                self.tau, np.zeros(m), self.amp1 * self.floor, np.full(m, pulse.width_s),
+                block,
+                0,
+                self.fs,
+                self.scene.illuminator.carrier_frequency_hz,
+                np.full(m, frac / self.fs),
+                self.tau,
+                np.zeros(m),
+                self.amp1 * self.floor,
+                np.full(m, pulse.width_s),
                 np.full(m, pulse.offset_hz - 0.5 * pulse.bandwidth_hz),
                 np.full(m, pulse.bandwidth_hz / pulse.width_s),
-            )  # fmt: skip
+            )
             self._cache[key] = block
         return block
 

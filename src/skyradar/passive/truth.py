@@ -95,9 +95,15 @@ def truth_table(scene: PassiveScene) -> pd.DataFrame:
     vel = np.stack(df["velocity"].to_numpy()) if len(df) else np.zeros((0, 3))
     g = bistatic_geometry(pos, vel, scene.illuminator_ned_m, ill.wavelength_m)
     power = echo_power_w(
-        ill.peak_power_w, ill.antenna_gain_dbi, 1.0, rx.antenna_gain_dbi, ill.wavelength_m, df["rcs_m2"],
-        g["r_tx_m"], g["r_rx_m"],
-    )  # fmt: skip
+        ill.peak_power_w,
+        ill.antenna_gain_dbi,
+        1.0,
+        rx.antenna_gain_dbi,
+        ill.wavelength_m,
+        df["rcs_m2"],
+        g["r_tx_m"],
+        g["r_rx_m"],
+    )
     out = pd.DataFrame(
         {
             "time_s": df["time_s"].to_numpy(float),

@@ -96,7 +96,8 @@ def window_dft16_kernel(q: int):
                 for m in range(4):
                     for t in range(qp):
                         o = _dft4(
-                            s[m * qp + t], s[im + m * qp + t], s[(4 + m) * qp + t], s[im + (4 + m) * qp + t],
+                            s[m * qp + t], s[im + m * qp + t],
+                            s[(4 + m) * qp + t], s[im + (4 + m) * qp + t],
                             s[(8 + m) * qp + t], s[im + (8 + m) * qp + t],
                             s[(12 + m) * qp + t], s[im + (12 + m) * qp + t],
                         )  # fmt: skip

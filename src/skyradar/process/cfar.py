@@ -396,6 +396,7 @@ def cfar_2d_floor(
     sat_p, sat_c, sat_v = (
         cv2.integral(_pad(x, hr, hd), sdepth=cv2.CV_64F) for x in (power, power * valid, valid)
     )
-    _floor_decide(power, sat_p, sat_c, sat_v, half, skip, big_l, table, floor, n_train, min_train,
-                  hits, noise, only)  # fmt: skip
+    _floor_decide(
+        power, sat_p, sat_c, sat_v, half, skip, big_l, table, floor, n_train, min_train, hits, noise, only
+    )
     return hits, noise

@@ -203,8 +203,21 @@ def _ring_matrix(sat, r, d, window, n_r, a):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _adapt(cube, inv_gain, cand, ring_mean, inv_floor, max_nulls, edge, window, power, nulls, unsuppressed,
-           mask, vectors):  # pragma: no cover - compiled  # fmt: skip
+def _adapt(
+    cube,
+    inv_gain,
+    cand,
+    ring_mean,
+    inv_floor,
+    max_nulls,
+    edge,
+    window,
+    power,
+    nulls,
+    unsuppressed,
+    mask,
+    vectors,
+):  # pragma: no cover - compiled
     # Per candidate: ring covariance, its max_nulls strongest eigen-pairs (warm from the previous
     # candidate), nulls on those above `edge` floors when they leave less over the ring than the
     # prediction did, then |P z|^2 / L of the cell itself.
@@ -324,9 +337,13 @@ def _whitening(cube, inv_gain, rr, dd, window, inv_floor, out):  # pragma: no co
 
 
 def ring_whitening(
-    cube: np.ndarray, inv_gain: np.ndarray, range_index: np.ndarray, doppler_index: np.ndarray,
-    floor_w: float, window: tuple[int, int, int, int] = ADAPTIVE_WINDOW,
-) -> np.ndarray:  # fmt: skip
+    cube: np.ndarray,
+    inv_gain: np.ndarray,
+    range_index: np.ndarray,
+    doppler_index: np.ndarray,
+    floor_w: float,
+    window: tuple[int, int, int, int] = ADAPTIVE_WINDOW,
+) -> np.ndarray:
     """``floor_w R^-1`` (n, n_rx, n_rx) of the given cells, ``R`` their ring's sample covariance.
 
     The whitening an adaptive cell's direction is estimated through

@@ -48,9 +48,13 @@ from skyradar.process.clutter import steering_into
 from skyradar.process.doa import direction_from_angles, steering_vector
 
 __all__ = [
-    "directions_after_projection", "projected_directions", "projected_scores", "elevation_sigma_rad",
-    "angle_sigmas_rad", "MAX_ELEVATION_SIGMA_RAD",
-]  # fmt: skip
+    "directions_after_projection",
+    "projected_directions",
+    "projected_scores",
+    "elevation_sigma_rad",
+    "angle_sigmas_rad",
+    "MAX_ELEVATION_SIGMA_RAD",
+]
 
 MAX_ELEVATION_SIGMA_RAD = float(np.radians(10.0))  # Cramer-Rao bound above which elevation is a prior
 _COARSE_DEG = np.arange(-70.0, 70.5, 2.0)

@@ -173,9 +173,15 @@ def detect_suppressed(
     """
     sup = suppress_clutter(cube, clutter, config)
     det = detect(
-        sup.power, config, method=method, exclude=exclude, channels=sup.channels,
-        train_exclude=sup.unsuppressed, noise_floor_w=sup.noise_floor_w, **detect_kwargs,
-    )  # fmt: skip
+        sup.power,
+        config,
+        method=method,
+        exclude=exclude,
+        channels=sup.channels,
+        train_exclude=sup.unsuppressed,
+        noise_floor_w=sup.noise_floor_w,
+        **detect_kwargs,
+    )
     pixels = cube[det.range_index, det.doppler_index]
     u = estimate_directions(pixels, config)
     coherence = direction_coherence(pixels, u, config)

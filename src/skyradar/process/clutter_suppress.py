@@ -256,10 +256,28 @@ def _ring_max(raw, top):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _fused(
-    cube, raw, acc, predicted, done, vectors, fractions, rows, rows_done, inv_gain,  # inputs; lazily filled
-    inv_floor, max_nulls, gate, residual,  # the rule
-    power, nulls, unsuppressed, cnr,  # outputs
-):  # pragma: no cover - compiled  # fmt: skip
+    # inputs; lazily filled
+    cube,
+    raw,
+    acc,
+    predicted,
+    done,
+    vectors,
+    fractions,
+    rows,
+    rows_done,
+    inv_gain,
+    # the rule
+    inv_floor,
+    max_nulls,
+    gate,
+    residual,
+    # outputs
+    power,
+    nulls,
+    unsuppressed,
+    cnr,
+):  # pragma: no cover - compiled
     # The clutter level (ring and peak rule) and null_count in one pass over the cells, then
     # projected_power where nulls were placed (same rules as those functions; tests compare them).
     # Two branch-light loops run faster than one that mixes them. A gated cell's eigen-pairs are

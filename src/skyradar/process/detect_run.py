@@ -53,9 +53,19 @@ def detect_run(
     """
     if scheduler is None and not workers:
         return process_frames(
-            ds, spurs, terrain, method, spur_mode, progress=progress, source=str(run), config=config, pfa=pfa,
-            suppression=suppression, frame_costs=frame_costs, pfa_secondary=pfa_secondary,
-        )  # fmt: skip
+            ds,
+            spurs,
+            terrain,
+            method,
+            spur_mode,
+            progress=progress,
+            source=str(run),
+            config=config,
+            pfa=pfa,
+            suppression=suppression,
+            frame_costs=frame_costs,
+            pfa_secondary=pfa_secondary,
+        )
     if frame_costs is not None:
         from skyradar.errors import InputError
 
@@ -77,9 +87,18 @@ def detect_run(
     )
     job = job if head is None else functools.partial(job, head=head)
     parts = map_frame_chunks(
-        job, str(run), ds.sizes["time"], max(1, chunk_frames), spurs, terrain, method, spur_mode,
-        scheduler=scheduler, workers=workers, progress=advance,
-    )  # fmt: skip
+        job,
+        str(run),
+        ds.sizes["time"],
+        max(1, chunk_frames),
+        spurs,
+        terrain,
+        method,
+        spur_mode,
+        scheduler=scheduler,
+        workers=workers,
+        progress=advance,
+    )
     return pd.concat(parts, ignore_index=True)
 
 
@@ -97,9 +116,15 @@ def _head_chunk(
 ) -> pd.DataFrame:
     # process_chunk for one head of a multi-head run (a Dask worker opens the run itself).
     return process_frames(
-        open_frames(path, head), spur_map, terrain, method, spur_mode, source=path, frames=slice(start, stop),
+        open_frames(path, head),
+        spur_map,
+        terrain,
+        method,
+        spur_mode,
+        source=path,
+        frames=slice(start, stop),
         **kwargs,
-    )  # fmt: skip
+    )
 
 
 def merge_head_tables(tables: dict[str, pd.DataFrame]) -> pd.DataFrame:
@@ -149,9 +174,14 @@ def detect_run_heads(
         cfg = config if config is not None else radar_config_of(ds, str(run))
         costs = None if frame_costs is None else frame_costs.setdefault(name, [])
         tables[name] = detect_run(
-            run, ds, cfg, progress=functools.partial(_shifted, progress, done) if progress else None,
-            head=None if names is None else name, frame_costs=costs, **kwargs,
-        )  # fmt: skip
+            run,
+            ds,
+            cfg,
+            progress=functools.partial(_shifted, progress, done) if progress else None,
+            head=None if names is None else name,
+            frame_costs=costs,
+            **kwargs,
+        )
         configs[name], done = cfg, done + ds.sizes["time"]
     return merge_head_tables(tables), configs
 

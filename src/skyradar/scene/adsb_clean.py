@@ -298,11 +298,19 @@ def readsb_trace(data: dict) -> pd.DataFrame:
 
         return [p[k] if len(p) > k and number(p[k]) else np.nan for p in points]
 
-    rows = pd.DataFrame({
-        "timestamp": float(data["timestamp"]) + np.asarray(column(0), float), "latitude": column(1),
-        "longitude": column(2), "altitude": column(3), "groundspeed": column(4), "track": column(5),
-        "vertical_rate": column(7), "geoaltitude": column(10),
-    }, dtype=float)  # fmt: skip
+    rows = pd.DataFrame(
+        {
+            "timestamp": float(data["timestamp"]) + np.asarray(column(0), float),
+            "latitude": column(1),
+            "longitude": column(2),
+            "altitude": column(3),
+            "groundspeed": column(4),
+            "track": column(5),
+            "vertical_rate": column(7),
+            "geoaltitude": column(10),
+        },
+        dtype=float,
+    )
     rows["icao24"] = str(data.get("icao", "trace"))
     flights = [p[8].get("flight") for p in points if isinstance(p[8], dict) and p[8].get("flight")]
     if flights:

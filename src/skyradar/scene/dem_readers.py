@@ -250,9 +250,14 @@ def _geotiff_window(ds, bounds: Bounds, name: str):
     from rasterio.windows import Window
 
     left, bottom, right, top = transform_bounds(
-        "EPSG:4326", ds.crs, bounds.west_deg, bounds.south_deg, bounds.east_deg, bounds.north_deg,
+        "EPSG:4326",
+        ds.crs,
+        bounds.west_deg,
+        bounds.south_deg,
+        bounds.east_deg,
+        bounds.north_deg,
         densify_pts=21,
-    )  # fmt: skip
+    )
     inverse = ~ds.transform
     cols, rows = zip(*(inverse @ (x, y) for x in (left, right) for y in (bottom, top)), strict=True)
     rs = _index_span(min(rows) - 0.5, max(rows) - 0.5, ds.height)  # pixel centres at +0.5
@@ -299,10 +304,13 @@ def terrain_from_arrays(
         return _npz_grid(data, keys, _fill(raw, source, max_void_fraction, nodata), source)
     # The grid's placement first (heights zero), to find the window; then the window's voids are filled.
     whole = _npz_grid(data, keys, np.zeros(raw.shape, np.float32), source)
-    rows, cols = (np.asarray(v, float) for v in whole.index_of(
-        np.array([bounds.south_deg, bounds.south_deg, bounds.north_deg, bounds.north_deg]),
-        np.array([bounds.west_deg, bounds.east_deg, bounds.west_deg, bounds.east_deg]),
-    ))  # fmt: skip
+    rows, cols = (
+        np.asarray(v, float)
+        for v in whole.index_of(
+            np.array([bounds.south_deg, bounds.south_deg, bounds.north_deg, bounds.north_deg]),
+            np.array([bounds.west_deg, bounds.east_deg, bounds.west_deg, bounds.east_deg]),
+        )
+    )
     rs = _index_span(rows.min(), rows.max(), raw.shape[0])
     cs = _index_span(cols.min(), cols.max(), raw.shape[1])
     _check_overlap(source, whole.bounds, bounds, rs, cs)

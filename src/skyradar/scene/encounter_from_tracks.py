@@ -104,9 +104,13 @@ def encounter_from_tracks(
     local = intruder.reframed((float(b_meet.lat_deg[0]), float(b_meet.lon_deg[0]), float(b_meet.alt_m[0])))
     rot = _yaw_rotation(rotate_deg)
     turned = Trajectory.from_states(
-        local.time_s + (t_cpa_s - t_b), local.position_ned_m @ rot.T, local.velocity_ned_mps @ rot.T,
-        origin=own.origin, name=intruder.name, epoch_s=intruder.epoch_s - (t_cpa_s - t_b),
-    )  # fmt: skip
+        local.time_s + (t_cpa_s - t_b),
+        local.position_ned_m @ rot.T,
+        local.velocity_ned_mps @ rot.T,
+        origin=own.origin,
+        name=intruder.name,
+        epoch_s=intruder.epoch_s - (t_cpa_s - t_b),
+    )
     a_state, b_state = own.sample(t_cpa_s), turned.sample(t_cpa_s)
     u = _miss_direction(
         a_state.velocity_ned_mps[0], b_state.velocity_ned_mps[0] - a_state.velocity_ned_mps[0], side
@@ -226,9 +230,16 @@ def trajectory_table(traj: Trajectory) -> pd.DataFrame:
     rot = origin_to_local_rotation(s.lat_deg, s.lon_deg, traj.origin[0], traj.origin[1])
     local = np.einsum("nij,nj->ni", rot, s.velocity_ned_mps)
     return pd.DataFrame(
-        {"time_s": s.time_s, "latitude": s.lat_deg, "longitude": s.lon_deg, "alt_m": s.alt_m,
-         "vn": local[:, 0], "ve": local[:, 1], "vd": local[:, 2]}
-    )  # fmt: skip
+        {
+            "time_s": s.time_s,
+            "latitude": s.lat_deg,
+            "longitude": s.lon_deg,
+            "alt_m": s.alt_m,
+            "vn": local[:, 0],
+            "ve": local[:, 1],
+            "vd": local[:, 2],
+        }
+    )
 
 
 def encounter_scenario(

@@ -280,9 +280,17 @@ def sample_at_poses(
     many = poses.shape[0] >= 8 and threading.current_thread() is threading.main_thread()
     kernel = _sample_parallel if many else _sample_serial
     kernel(
-        image, grid.north0_m, grid.east0_m, grid.pixel_m, poses, pose_grid.forward0_m, pose_grid.right0_m,
-        pose_grid.pixel_m, np.float32(fill), out,
-    )  # fmt: skip
+        image,
+        grid.north0_m,
+        grid.east0_m,
+        grid.pixel_m,
+        poses,
+        pose_grid.forward0_m,
+        pose_grid.right0_m,
+        pose_grid.pixel_m,
+        np.float32(fill),
+        out,
+    )
     return out[0] if single else out
 
 

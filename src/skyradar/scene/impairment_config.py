@@ -166,8 +166,14 @@ def thesis_flight_look(seed: int = 0) -> ImpairmentConfig:
     noise at 100 m, 30 dB at 1 km, 20 dB at 5 km); 0.5 dB / 10 deg channel errors. Thermal noise is left
     to the simulator.
     """
-    spurs = [(300.0, 12.5, -125.0), (750.0, -20.0, -128.0), (1200.0, 5.0, -126.0),
-             (1950.0, -31.0, -130.0), (2700.0, 25.0, -127.0), (3600.0, -8.0, -129.0)]  # fmt: skip
+    spurs = [
+        (300.0, 12.5, -125.0),
+        (750.0, -20.0, -128.0),
+        (1200.0, 5.0, -126.0),
+        (1950.0, -31.0, -130.0),
+        (2700.0, 25.0, -127.0),
+        (3600.0, -8.0, -129.0),
+    ]
     return ImpairmentConfig(
         spurs=SpursConfig(spurs=[Spur(range_m=r, velocity_mps=v, power_dbm=p) for r, v, p in spurs]),
         zero_doppler=ZeroDopplerConfig(power_dbm_at_100m=-110.0, falloff_db_per_decade=15.0),

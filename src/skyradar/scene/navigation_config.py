@@ -71,20 +71,34 @@ _GA_TYPICAL: dict[str, float] = {
 }
 # The error groups of the single-error ablations (correlation times are not errors: always kept).
 NAVIGATION_GROUPS: dict[str, tuple[str, ...]] = {
-    "gnss-position": ("gnss_horizontal_bias_m", "gnss_horizontal_noise_m", "gnss_vertical_bias_m",
-                      "gnss_vertical_noise_m"),
-    "gnss-velocity": ("gnss_velocity_noise_mps", "gnss_vertical_velocity_noise_mps",
-                      "gnss_velocity_bias_mps"),
+    "gnss-position": (
+        "gnss_horizontal_bias_m",
+        "gnss_horizontal_noise_m",
+        "gnss_vertical_bias_m",
+        "gnss_vertical_noise_m",
+    ),
+    "gnss-velocity": (
+        "gnss_velocity_noise_mps",
+        "gnss_vertical_velocity_noise_mps",
+        "gnss_velocity_bias_mps",
+    ),
     "attitude": ("roll_pitch_noise_deg", "roll_pitch_bias_deg"),
     "heading": ("heading_noise_deg", "heading_bias_deg"),
     "latency": ("gnss_latency_s", "ahrs_latency_s"),
-}  # fmt: skip
+}
 NAVIGATION_MODELS = ("perfect", "ga-typical", *(f"only-{g}" for g in NAVIGATION_GROUPS))
 _TAUS = ("gnss_position_tau_s", "gnss_velocity_tau_s", "roll_pitch_tau_s", "heading_tau_s")
 
 
-ModelName = Literal["perfect", "ga-typical", "only-gnss-position", "only-gnss-velocity", "only-attitude",
-                    "only-heading", "only-latency"]  # fmt: skip
+ModelName = Literal[
+    "perfect",
+    "ga-typical",
+    "only-gnss-position",
+    "only-gnss-velocity",
+    "only-attitude",
+    "only-heading",
+    "only-latency",
+]
 
 
 def _preset(model: str) -> dict[str, float]:

@@ -247,9 +247,14 @@ class Scenario:
                 return flat_terrain(origin[0], origin[1], height, t.size_m, t.spacing_m)
             assert isinstance(t, FractalTerrainModel)
             return fractal_terrain(
-                origin[0], origin[1], t.local_sd_m, size_m=t.size_m, spacing_m=t.spacing_m, seed=t.seed,
+                origin[0],
+                origin[1],
+                t.local_sd_m,
+                size_m=t.size_m,
+                spacing_m=t.spacing_m,
+                seed=t.seed,
                 mean_height_m=height,
-            )  # fmt: skip
+            )
         except InputError as exc:
             if str(exc).startswith("field 'origin'"):
                 raise InputError(f"{self._label}: {exc}") from None

@@ -85,9 +85,14 @@ def _built_in(name: str, spec: dict | None, ds: Any, source: str) -> Terrain:
     height = alt if height is None else float(height)
     if name == "fractal":
         return fractal_terrain(
-            lat, lon, float(spec["local_sd_m"]), size_m=size, spacing_m=spacing,
-            seed=int(spec.get("seed", 0)), mean_height_m=height,
-        )  # fmt: skip
+            lat,
+            lon,
+            float(spec["local_sd_m"]),
+            size_m=size,
+            spacing_m=spacing,
+            seed=int(spec.get("seed", 0)),
+            mean_height_m=height,
+        )
     return flat_terrain(lat, lon, height, size, spacing)
 
 

@@ -27,9 +27,14 @@ from numba import float32, int32, int64, njit, prange, types, uint64
 from numba.extending import intrinsic
 
 __all__ = [
-    "frame_key", "finalize_frame", "gaussian_noise", "mix64", "complex_normal", "polar_normal",
+    "frame_key",
+    "finalize_frame",
+    "gaussian_noise",
+    "mix64",
+    "complex_normal",
+    "polar_normal",
     "cis_count_f32",
-]  # fmt: skip
+]
 
 _GAMMA = np.uint64(0x9E3779B97F4A7C15)
 _F0, _F1, _F2, _HALF = np.float32(0.0), np.float32(1.0), np.float32(2.0), np.float32(0.5)

@@ -159,25 +159,92 @@ def _keep_band(s, k, lo, hi):
 
 
 @njit(inline="always")
-def _flush(scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel, coupling, n_range,
-           n_dopp, inv_wl, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m,
-           use_horizon, out, sparse, speckle_key, lo, hi):  # fmt: skip
+def _flush(
+    scratch,
+    k,
+    tx,
+    rx,
+    r_rx_sub,
+    cos_sin,
+    v_ground_ant,
+    r_max,
+    d_range,
+    d_vel,
+    coupling,
+    n_range,
+    n_dopp,
+    inv_wl,
+    power_const,
+    gain2,
+    gain2_step,
+    refl_table,
+    horizon,
+    az_bin_rad,
+    h_bin_m,
+    use_horizon,
+    out,
+    sparse,
+    speckle_key,
+    lo,
+    hi,
+):
     # terrain_returns' flush, keeping only the band's items.
     item_returns(
-        scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel, coupling, n_range,
-        n_dopp, inv_wl, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m,
-        use_horizon, speckle_key,
-    )  # fmt: skip
+        scratch,
+        k,
+        tx,
+        rx,
+        r_rx_sub,
+        cos_sin,
+        v_ground_ant,
+        r_max,
+        d_range,
+        d_vel,
+        coupling,
+        n_range,
+        n_dopp,
+        inv_wl,
+        power_const,
+        gain2,
+        gain2_step,
+        refl_table,
+        horizon,
+        az_bin_rad,
+        h_bin_m,
+        use_horizon,
+        speckle_key,
+    )
     _keep_band(scratch, k, lo, hi)
     scatter_items(out, sparse, 0, scratch, cos_sin, k)
 
 
 @njit(parallel=True, cache=True, fastmath=True, error_model="numpy")
 def _band_pass(
-    p_ned, p_ant, up_ant, tx, rx, v_ground_ant, counts, adapt, margin_m, edges, wavelength, d_range,
-    d_vel, coupling, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m, use_horizon,
-    out, speckle_key,
-):  # fmt: skip
+    p_ned,
+    p_ant,
+    up_ant,
+    tx,
+    rx,
+    v_ground_ant,
+    counts,
+    adapt,
+    margin_m,
+    edges,
+    wavelength,
+    d_range,
+    d_vel,
+    coupling,
+    power_const,
+    gain2,
+    gain2_step,
+    refl_table,
+    horizon,
+    az_bin_rad,
+    h_bin_m,
+    use_horizon,
+    out,
+    speckle_key,
+):
     ny, nx = p_ned.shape[0], p_ned.shape[1]
     n_range, n_dopp = out.shape[1], out.shape[2]
     r_max = d_range * (n_range + 2)
@@ -204,10 +271,35 @@ def _band_pass(
                 nu, nw = cell_counts(p_ant, i, j, v_ground_ant, n_min_r, n_min_c, n_max_r, n_max_c, adapt)
                 n_sub = nu * nw
                 if k + n_sub > cap:
-                    _flush(scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel,
-                           coupling, n_range, n_dopp, inv_wl, power_const, gain2, gain2_step, refl_table,
-                           horizon, az_bin_rad, h_bin_m, use_horizon, out, sparse, speckle_key, lo,
-                           hi)  # fmt: skip
+                    _flush(
+                        scratch,
+                        k,
+                        tx,
+                        rx,
+                        r_rx_sub,
+                        cos_sin,
+                        v_ground_ant,
+                        r_max,
+                        d_range,
+                        d_vel,
+                        coupling,
+                        n_range,
+                        n_dopp,
+                        inv_wl,
+                        power_const,
+                        gain2,
+                        gain2_step,
+                        refl_table,
+                        horizon,
+                        az_bin_rad,
+                        h_bin_m,
+                        use_horizon,
+                        out,
+                        sparse,
+                        speckle_key,
+                        lo,
+                        hi,
+                    )
                     k = 0
                 _sub_centres(us, ws, nu, nw)
                 _corner_terms(p_ant, i, j, ta)
@@ -220,9 +312,35 @@ def _band_pass(
                 number_items(scratch, k, float((i * (nx - 1) + j) * n_cell_max), n_sub)
                 k += n_sub
         if k > 0:
-            _flush(scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel, coupling,
-                   n_range, n_dopp, inv_wl, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad,
-                   h_bin_m, use_horizon, out, sparse, speckle_key, lo, hi)  # fmt: skip
+            _flush(
+                scratch,
+                k,
+                tx,
+                rx,
+                r_rx_sub,
+                cos_sin,
+                v_ground_ant,
+                r_max,
+                d_range,
+                d_vel,
+                coupling,
+                n_range,
+                n_dopp,
+                inv_wl,
+                power_const,
+                gain2,
+                gain2_step,
+                refl_table,
+                horizon,
+                az_bin_rad,
+                h_bin_m,
+                use_horizon,
+                out,
+                sparse,
+                speckle_key,
+                lo,
+                hi,
+            )
 
 
 def banded_returns(
@@ -264,9 +382,29 @@ def banded_returns(
     if edges[0] != 0 or edges[-1] != n_range or np.any(np.diff(edges) < 0):
         raise ValueError(f"banded_returns: edges must rise from 0 to {n_range}, got {edges}")
     _band_pass(
-        p_ned, p_ant, up_ant, tx, rx, v_ground_ant, np.asarray(rule.counts, np.int64),
-        np.asarray(rule.adapt, float), margin_m, edges, wavelength, d_range, d_vel, coupling,
-        power_const, gain2, gain2_step, refl_table, view.horizon, view.az_bin_rad, view.h_bin_m, use_horizon,
-        out, speckle_key,
-    )  # fmt: skip
+        p_ned,
+        p_ant,
+        up_ant,
+        tx,
+        rx,
+        v_ground_ant,
+        np.asarray(rule.counts, np.int64),
+        np.asarray(rule.adapt, float),
+        margin_m,
+        edges,
+        wavelength,
+        d_range,
+        d_vel,
+        coupling,
+        power_const,
+        gain2,
+        gain2_step,
+        refl_table,
+        view.horizon,
+        view.az_bin_rad,
+        view.h_bin_m,
+        use_horizon,
+        out,
+        speckle_key,
+    )
     return edges

@@ -29,8 +29,13 @@ from skyradar.sim._elementary import fast_atan2
 from skyradar.sim._noise_kernel import cis_count_f32, mix64, polar_normal
 
 __all__ = [
-    "CELL_FIELDS", "cell_geometry", "cell_geometry_scalar", "item_returns", "number_items", "scatter_items",
-]  # fmt: skip
+    "CELL_FIELDS",
+    "cell_geometry",
+    "cell_geometry_scalar",
+    "item_returns",
+    "number_items",
+    "scatter_items",
+]
 
 # Rows of the per-thread scratch array (one column per sub-facet of the batch).
 _X, _Y, _Z, _R0, _AREA, _COS_INC, _RTX, _RSUM, _RNG, _VR, _VALID, _KR, _KD, _AMP, _N, _E, _D = range(17)
@@ -287,9 +292,31 @@ def _point(t, u, w, c):
 
 
 @njit(error_model="numpy")
-def item_returns(s, n, tx, rx, r_rx, cos_sin, v_ground, r_max, d_range, d_vel, coupling, n_range, n_dopp,
-                 inv_wavelength, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad,
-                 h_bin_m, use_horizon, speckle_key):  # fmt: skip
+def item_returns(
+    s,
+    n,
+    tx,
+    rx,
+    r_rx,
+    cos_sin,
+    v_ground,
+    r_max,
+    d_range,
+    d_vel,
+    coupling,
+    n_range,
+    n_dopp,
+    inv_wavelength,
+    power_const,
+    gain2,
+    gain2_step,
+    refl_table,
+    horizon,
+    az_bin_rad,
+    h_bin_m,
+    use_horizon,
+    speckle_key,
+):
     """Validity, pixel (range, Doppler) as floats and per-receiver complex value of items.
 
     Reads the geometry rows of the first ``n`` items of ``s``; writes their _VALID, _KR, _KD,
@@ -330,8 +357,20 @@ def item_returns(s, n, tx, rx, r_rx, cos_sin, v_ground, r_max, d_range, d_vel, c
     # Look-up cells and weights into rows free by now (horizon, Doppler and range sums done).
     iy_, ty_, iz_, tz_, ir_, tr_ = s[_N][:n], s[_E][:n], s[_D][:n], rsum, v_r_, s[_TMP2][:n]
     n_refl = refl_table.shape[0]
-    _table_rows(iy_, ty_, iz_, tz_, ir_, tr_, tmp0, tmp1, cos_inc, float(gain2.shape[0] - 1), float(n_refl),
-                1.0 / (n_refl - 1))  # fmt: skip
+    _table_rows(
+        iy_,
+        ty_,
+        iz_,
+        tz_,
+        ir_,
+        tr_,
+        tmp0,
+        tmp1,
+        cos_inc,
+        float(gain2.shape[0] - 1),
+        float(n_refl),
+        1.0 / (n_refl - 1),
+    )
     gain_, refl_ = s[_TMP3][:n], tmp1
     _lookup_rows(gain_, refl_, iy_, ty_, iz_, tz_, ir_, tr_, gain2, refl_table)
     amp, turn = s[_AMP][:n], tmp0

@@ -250,10 +250,32 @@ def _sub_centres(us, ws, nu, nw):
 
 @njit(parallel=True, cache=True, fastmath=True, error_model="numpy")
 def terrain_returns(
-    p_ned, p_ant, up_ant, tx, rx, v_ground_ant, counts, adapt, wavelength, d_range, d_vel, coupling,
-    power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m, use_horizon, n_blocks, out,
-    sparse, mode, speckle_key,
-):  # fmt: skip
+    p_ned,
+    p_ant,
+    up_ant,
+    tx,
+    rx,
+    v_ground_ant,
+    counts,
+    adapt,
+    wavelength,
+    d_range,
+    d_vel,
+    coupling,
+    power_const,
+    gain2,
+    gain2_step,
+    refl_table,
+    horizon,
+    az_bin_rad,
+    h_bin_m,
+    use_horizon,
+    n_blocks,
+    out,
+    sparse,
+    mode,
+    speckle_key,
+):
     """Accumulate terrain returns into ``out`` of shape (n_blocks, n_range, n_doppler, n_rx).
 
     Parameters are in SI units. ``p_ned`` and ``p_ant`` are the cropped grid relative to the
@@ -297,16 +319,62 @@ def terrain_returns(
                     _corner_terms(p_ned, i, j, tn)
                 if mode != 1:
                     _reference_cell(
-                        ta, tn, up_ant, tx, rx, r_rx, v_ground_ant, nu, nw, wavelength, d_range, d_vel,
-                        coupling, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m,
-                        use_horizon, r_max, out, sparse, blk,
-                    )  # fmt: skip
+                        ta,
+                        tn,
+                        up_ant,
+                        tx,
+                        rx,
+                        r_rx,
+                        v_ground_ant,
+                        nu,
+                        nw,
+                        wavelength,
+                        d_range,
+                        d_vel,
+                        coupling,
+                        power_const,
+                        gain2,
+                        gain2_step,
+                        refl_table,
+                        horizon,
+                        az_bin_rad,
+                        h_bin_m,
+                        use_horizon,
+                        r_max,
+                        out,
+                        sparse,
+                        blk,
+                    )
                     continue
                 if k + n_sub > cap:  # the batch is full: into the cube first
-                    _flush(scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel,
-                           coupling, n_range, n_dopp, inv_wl, power_const, gain2, gain2_step, refl_table,
-                           horizon, az_bin_rad, h_bin_m, use_horizon, out, sparse, blk,
-                           speckle_key)  # fmt: skip
+                    _flush(
+                        scratch,
+                        k,
+                        tx,
+                        rx,
+                        r_rx_sub,
+                        cos_sin,
+                        v_ground_ant,
+                        r_max,
+                        d_range,
+                        d_vel,
+                        coupling,
+                        n_range,
+                        n_dopp,
+                        inv_wl,
+                        power_const,
+                        gain2,
+                        gain2_step,
+                        refl_table,
+                        horizon,
+                        az_bin_rad,
+                        h_bin_m,
+                        use_horizon,
+                        out,
+                        sparse,
+                        blk,
+                        speckle_key,
+                    )
                     k = 0
                 # The cell's own geometry loops pay off from 16 sub-facets; below, their set-up per
                 # row costs more (30 m hill grids, ~13 a cell: 18.7 -> 10.9 ms a frame with 16, not 8).
@@ -317,27 +385,121 @@ def terrain_returns(
                 number_items(scratch, k, float((i * (nx - 1) + j) * n_cell_max), n_sub)
                 k += n_sub
         if k > 0:  # the block's last batch
-            _flush(scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel, coupling,
-                   n_range, n_dopp, inv_wl, power_const, gain2, gain2_step, refl_table, horizon,
-                   az_bin_rad, h_bin_m, use_horizon, out, sparse, blk, speckle_key)  # fmt: skip
+            _flush(
+                scratch,
+                k,
+                tx,
+                rx,
+                r_rx_sub,
+                cos_sin,
+                v_ground_ant,
+                r_max,
+                d_range,
+                d_vel,
+                coupling,
+                n_range,
+                n_dopp,
+                inv_wl,
+                power_const,
+                gain2,
+                gain2_step,
+                refl_table,
+                horizon,
+                az_bin_rad,
+                h_bin_m,
+                use_horizon,
+                out,
+                sparse,
+                blk,
+                speckle_key,
+            )
 
 
 @njit(inline="always")
-def _flush(scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel, coupling, n_range,
-           n_dopp, inv_wl, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m,
-           use_horizon, out, sparse, blk, speckle_key):  # fmt: skip
+def _flush(
+    scratch,
+    k,
+    tx,
+    rx,
+    r_rx_sub,
+    cos_sin,
+    v_ground_ant,
+    r_max,
+    d_range,
+    d_vel,
+    coupling,
+    n_range,
+    n_dopp,
+    inv_wl,
+    power_const,
+    gain2,
+    gain2_step,
+    refl_table,
+    horizon,
+    az_bin_rad,
+    h_bin_m,
+    use_horizon,
+    out,
+    sparse,
+    blk,
+    speckle_key,
+):
     item_returns(
-        scratch, k, tx, rx, r_rx_sub, cos_sin, v_ground_ant, r_max, d_range, d_vel, coupling, n_range,
-        n_dopp, inv_wl, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m,
-        use_horizon, speckle_key,
-    )  # fmt: skip
+        scratch,
+        k,
+        tx,
+        rx,
+        r_rx_sub,
+        cos_sin,
+        v_ground_ant,
+        r_max,
+        d_range,
+        d_vel,
+        coupling,
+        n_range,
+        n_dopp,
+        inv_wl,
+        power_const,
+        gain2,
+        gain2_step,
+        refl_table,
+        horizon,
+        az_bin_rad,
+        h_bin_m,
+        use_horizon,
+        speckle_key,
+    )
     scatter_items(out, sparse, blk, scratch, cos_sin, k)
 
 
 @njit(inline="always")
-def _reference_cell(ta, tn, up_ant, tx, rx, r_rx, v_ground_ant, nsub_r, nsub_c, wavelength, d_range, d_vel,
-                    coupling, power_const, gain2, gain2_step, refl_table, horizon, az_bin_rad, h_bin_m,
-                    use_horizon, r_max, out, sparse, blk):  # fmt: skip
+def _reference_cell(
+    ta,
+    tn,
+    up_ant,
+    tx,
+    rx,
+    r_rx,
+    v_ground_ant,
+    nsub_r,
+    nsub_c,
+    wavelength,
+    d_range,
+    d_vel,
+    coupling,
+    power_const,
+    gain2,
+    gain2_step,
+    refl_table,
+    horizon,
+    az_bin_rad,
+    h_bin_m,
+    use_horizon,
+    r_max,
+    out,
+    sparse,
+    blk,
+):
     """The scalar reference: one cell's sub-facets one at a time, with early exits."""
     n_range, n_dopp = out.shape[1], out.shape[2]
     refl_step = 1.0 / (refl_table.shape[0] - 1)

@@ -73,9 +73,17 @@ def terrain_horizon(
 ) -> np.ndarray:
     """The whole (n_az, n_h) horizon map of the crop ``p_ned`` (NED, relative to the antenna)."""
     return horizon_map(
-        p_ned, rot_ned_to_ant, *grid.nsub, grid.r_lim_m, grid.az_bin_rad, grid.h_bin_m, grid.n_az, grid.n_h,
-        n_blocks, grid.sample_m,
-    )  # fmt: skip
+        p_ned,
+        rot_ned_to_ant,
+        *grid.nsub,
+        grid.r_lim_m,
+        grid.az_bin_rad,
+        grid.h_bin_m,
+        grid.n_az,
+        grid.n_h,
+        n_blocks,
+        grid.sample_m,
+    )
 
 
 def target_bins(
@@ -94,7 +102,16 @@ def target_clear(
     """True for points ``rel_ned`` not hidden by the crop ``p_ned``: the frame's test, without its map."""
     a, k, slope = target_bins(rel_ned, grid.az_bin_rad, grid.h_bin_m, grid.n_az, grid.n_h)
     entries = horizon_at(
-        p_ned, rot_ned_to_ant, *grid.nsub, grid.r_lim_m, grid.az_bin_rad, grid.h_bin_m, grid.n_az, grid.n_h,
-        grid.sample_m, a.astype(np.int64), k.astype(np.int64),
-    )  # fmt: skip
+        p_ned,
+        rot_ned_to_ant,
+        *grid.nsub,
+        grid.r_lim_m,
+        grid.az_bin_rad,
+        grid.h_bin_m,
+        grid.n_az,
+        grid.n_h,
+        grid.sample_m,
+        a.astype(np.int64),
+        k.astype(np.int64),
+    )
     return slope >= entries

@@ -343,19 +343,54 @@ class ImageSimulator:
         v_ground = rot @ (-geom.velocity_ned_mps)
         if self._kernel_mode == 1 and sparse[0].shape[1] == 0:  # dense: threads own range bands
             banded_returns(
-                view.p_ned, p_ant, -rot[:, 2], cfg.tx_position_m, cfg.rx_positions_m, v_ground, self._facets,
-                cfg.wavelength_m, cfg.range_resolution_m / n, cfg.doppler_resolution_mps / n, self.coupling_s,
-                power_const, self._gain2, self._gain2_step, self._refl_table, view, self.occlusion, blocks,
+                view.p_ned,
+                p_ant,
+                -rot[:, 2],
+                cfg.tx_position_m,
+                cfg.rx_positions_m,
+                v_ground,
+                self._facets,
+                cfg.wavelength_m,
+                cfg.range_resolution_m / n,
+                cfg.doppler_resolution_mps / n,
+                self.coupling_s,
+                power_const,
+                self._gain2,
+                self._gain2_step,
+                self._refl_table,
+                view,
+                self.occlusion,
+                blocks,
                 speckle,
-            )  # fmt: skip
+            )
             return
         terrain_returns(
-            view.p_ned, p_ant, -rot[:, 2], cfg.tx_position_m, cfg.rx_positions_m, v_ground,
-            self._facets.counts, self._facets.adapt, cfg.wavelength_m, cfg.range_resolution_m / n,
-            cfg.doppler_resolution_mps / n, self.coupling_s, power_const, self._gain2, self._gain2_step,
-            self._refl_table, view.horizon, view.az_bin_rad, view.h_bin_m, self.occlusion,
-            blocks.shape[0] or sparse[0].shape[0], blocks, sparse, self._kernel_mode, speckle,
-        )  # fmt: skip
+            view.p_ned,
+            p_ant,
+            -rot[:, 2],
+            cfg.tx_position_m,
+            cfg.rx_positions_m,
+            v_ground,
+            self._facets.counts,
+            self._facets.adapt,
+            cfg.wavelength_m,
+            cfg.range_resolution_m / n,
+            cfg.doppler_resolution_mps / n,
+            self.coupling_s,
+            power_const,
+            self._gain2,
+            self._gain2_step,
+            self._refl_table,
+            view.horizon,
+            view.az_bin_rad,
+            view.h_bin_m,
+            self.occlusion,
+            blocks.shape[0] or sparse[0].shape[0],
+            blocks,
+            sparse,
+            self._kernel_mode,
+            speckle,
+        )
 
     def _crop(self, geom: AntennaGeometry) -> tuple[slice, slice] | None:
         # Crop around the platform; the mount offset (metres) is added to the reach.
@@ -369,8 +404,9 @@ class ImageSimulator:
     def target_truth(self, platform: PlatformState, targets: Sequence[PointTarget]) -> dict[str, np.ndarray]:
         """Range, radial velocity, antenna-frame angles, expected SNR and visibility per target."""
         geom = self.geometry(platform)
-        return target_geometry(self.config, geom, targets, self.coupling_s, self._clear(geom, targets),
-                               self.noise_per_pixel_w)  # fmt: skip
+        return target_geometry(
+            self.config, geom, targets, self.coupling_s, self._clear(geom, targets), self.noise_per_pixel_w
+        )
 
     def _clear(self, geom: AntennaGeometry, targets: Sequence[PointTarget]) -> np.ndarray:
         # The frame's line-of-sight test (line_of_sight on the terrain view) from the horizon's

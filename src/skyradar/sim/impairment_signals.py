@@ -14,9 +14,15 @@ from skyradar.config import BOLTZMANN, RadarConfig
 from skyradar.errors import InputError
 
 __all__ = [
-    "dbm_to_w", "spur_cube", "spur_adc", "zero_doppler_line", "near_range_leakage", "channel_errors",
-    "apply_channel_errors", "receiver_noise",
-]  # fmt: skip
+    "dbm_to_w",
+    "spur_cube",
+    "spur_adc",
+    "zero_doppler_line",
+    "near_range_leakage",
+    "channel_errors",
+    "apply_channel_errors",
+    "receiver_noise",
+]
 
 
 def dbm_to_w(power_dbm: float | np.ndarray) -> float | np.ndarray:

@@ -249,8 +249,15 @@ class LandCoverSimulator:
     ) -> np.ndarray:
         antenna_rc = np.array(self.grid.world_to_pixel(antenna[0], antenna[1]), float)
         out = np.empty(rows.size, bool)
-        shadowed(self.height_m, rows.astype(np.int64), cols.astype(np.int64), antenna_rc, antenna_up,
-                 self.grid.pixel_m, out)  # fmt: skip
+        shadowed(
+            self.height_m,
+            rows.astype(np.int64),
+            cols.astype(np.int64),
+            antenna_rc,
+            antenna_up,
+            self.grid.pixel_m,
+            out,
+        )
         return out
 
 

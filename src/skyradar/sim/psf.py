@@ -42,9 +42,17 @@ from numba import njit, prange
 from skyradar.errors import InputError
 
 __all__ = [
-    "PSF_WINDOW", "PSFKernels", "window_response", "binned_kernel", "psf_kernels", "enbw", "apply_psf",
-    "target_psf_taps", "frame_options", "speckle_key",
-]  # fmt: skip
+    "PSF_WINDOW",
+    "PSFKernels",
+    "window_response",
+    "binned_kernel",
+    "psf_kernels",
+    "enbw",
+    "apply_psf",
+    "target_psf_taps",
+    "frame_options",
+    "speckle_key",
+]
 
 PSF_WINDOW = "hann"  # the default range and Doppler windows of process/range_doppler
 _TAIL = 1e-6  # kernel truncated where the power left out is below -60 dB of the whole
@@ -169,8 +177,17 @@ def _taps_into(dst, gains, rows, n):
     """``dst = sum(gains[t] * rows[t] for t < n)``; ``n`` a multiple of 4 (padding has gain 0)."""
     _set4(dst, gains[0], rows[0], gains[1], rows[1], gains[2], rows[2], gains[3], rows[3])
     for t in range(4, n, 4):
-        _add4(dst, gains[t], rows[t], gains[t + 1], rows[t + 1], gains[t + 2], rows[t + 2], gains[t + 3],
-              rows[t + 3])  # fmt: skip
+        _add4(
+            dst,
+            gains[t],
+            rows[t],
+            gains[t + 1],
+            rows[t + 1],
+            gains[t + 2],
+            rows[t + 2],
+            gains[t + 3],
+            rows[t + 3],
+        )
 
 
 @njit(inline="always")
@@ -277,9 +294,14 @@ def apply_psf(
     tmp = scratch.reshape(-1)[: n_fine_r * n_d * n_rx].view(np.float32)
     tmp = tmp.reshape(n_fine_r, n_d * step)
     _psf_kernel(
-        blocks.view(np.float32).reshape(blocks.shape[0], n_fine_r, -1), tmp,
-        out.view(np.float32).reshape(n_r, n_d * step), kernels.h_range, kernels.h_doppler, step, bool(clear),
-    )  # fmt: skip
+        blocks.view(np.float32).reshape(blocks.shape[0], n_fine_r, -1),
+        tmp,
+        out.view(np.float32).reshape(n_r, n_d * step),
+        kernels.h_range,
+        kernels.h_doppler,
+        step,
+        bool(clear),
+    )
 
 
 def target_psf_taps(

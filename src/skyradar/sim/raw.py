@@ -134,10 +134,19 @@ def _beat_signal(config: RadarConfig, pos, vel, power, t_ref: float, chunk: int)
     for start in range(0, keep.size, max(1, int(chunk))):
         sel = keep[start : start + chunk]
         _beat_kernel(
-            acc, np.ascontiguousarray(pos[sel]), np.ascontiguousarray(vel[sel]), amp[sel],
-            config.tx_position_m, config.rx_positions_m, config.fc_hz, config.chirp_slope_hz_per_s,
-            config.fs_hz, config.prf_hz, t_ref, SPEED_OF_LIGHT,
-        )  # fmt: skip
+            acc,
+            np.ascontiguousarray(pos[sel]),
+            np.ascontiguousarray(vel[sel]),
+            amp[sel],
+            config.tx_position_m,
+            config.rx_positions_m,
+            config.fc_hz,
+            config.chirp_slope_hz_per_s,
+            config.fs_hz,
+            config.prf_hz,
+            t_ref,
+            SPEED_OF_LIGHT,
+        )
     return acc
 
 

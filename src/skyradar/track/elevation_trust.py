@@ -40,9 +40,15 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = [
-    "FREE_ELEVATION_SIGMA_RAD", "BAND_ELEVATION_SIGMA_RAD", "in_ground_band", "elevation_trusted",
-    "at_elevation", "place_elevations", "AboveVotes", "BelowConsensus",
-]  # fmt: skip
+    "FREE_ELEVATION_SIGMA_RAD",
+    "BAND_ELEVATION_SIGMA_RAD",
+    "in_ground_band",
+    "elevation_trusted",
+    "at_elevation",
+    "place_elevations",
+    "AboveVotes",
+    "BelowConsensus",
+]
 
 FREE_ELEVATION_SIGMA_RAD = 0.35  # vertical-angle sigma of a free detection, at the co-altitude prior
 # Least elevation scatter assumed inside the ground's band when a reading is judged above the horizontal
@@ -243,8 +249,12 @@ class BelowConsensus:
         whether ``below`` the threshold, clearance ``clear_m`` of the surface) of each track ``ids``
         where ``counts``; returns each track's consensus height and its spread, m (NaN: none).
         Tracks not listed are forgotten."""
-        columns = (np.asarray(up_m, float), np.asarray(bound_m, float), np.asarray(below, float),
-                   np.asarray(clear_m, float))  # fmt: skip
+        columns = (
+            np.asarray(up_m, float),
+            np.asarray(bound_m, float),
+            np.asarray(below, float),
+            np.asarray(clear_m, float),
+        )
         recent = self._recent.push(ids, np.column_stack(columns).tolist(), counts)
         out = np.array([self._consensus(np.array(r, float).reshape(-1, 4)) for r in recent], float)
         out = out.reshape(-1, 2)

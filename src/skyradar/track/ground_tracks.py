@@ -320,8 +320,10 @@ def faster_than_ground(
 def _own_state(ownship: pd.DataFrame, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Own-ship NED position and velocity (k, 3) interpolated at ``times``."""
     t = ownship["time_s"].to_numpy(float)
-    cols = [[np.interp(times, t, ownship[f"own_{a}"].to_numpy(float)) for a in names]
-            for names in (("north_m", "east_m", "down_m"), ("vn_mps", "ve_mps", "vd_mps"))]  # fmt: skip
+    cols = [
+        [np.interp(times, t, ownship[f"own_{a}"].to_numpy(float)) for a in names]
+        for names in (("north_m", "east_m", "down_m"), ("vn_mps", "ve_mps", "vd_mps"))
+    ]
     return np.column_stack(cols[0]), np.column_stack(cols[1])
 
 

@@ -26,9 +26,13 @@ REQUIRED_DETECTION_COLUMNS = ("time_s", "range_m", "radial_velocity_mps")
 # What a detection may hold: times within 1e10 s (unix seconds fit), ranges and positions within
 # 10 000 km, radial velocities within 10 km/s.
 _DETECTION_LIMITS = {
-    "time_s": (MAX_TIME_S, "s"), "range_m": (1.0e7, "m"), "radial_velocity_mps": (1.0e4, "m/s"),
-    "north_m": (1.0e7, "m"), "east_m": (1.0e7, "m"), "down_m": (1.0e7, "m"),
-}  # fmt: skip
+    "time_s": (MAX_TIME_S, "s"),
+    "range_m": (1.0e7, "m"),
+    "radial_velocity_mps": (1.0e4, "m/s"),
+    "north_m": (1.0e7, "m"),
+    "east_m": (1.0e7, "m"),
+    "down_m": (1.0e7, "m"),
+}
 _OWNSHIP_LIMITS = {"m": (1.0e7, "m"), "mps": (1.0e4, "m/s")}  # by the unit ending the column's name
 
 
@@ -151,13 +155,23 @@ def truth_from_frames(path: str | Path) -> tuple[Truth, RadarConfig]:
     stored = store_heads(path)
     heads: list[str | None] = [None] if stored is None else list(stored)
     sets = [_head_truth(open_frames(path, head=h) if h else open_frames(path), path) for h in heads]
-    best = np.argmax(np.stack([np.where(s["tgt_visible"], np.nan_to_num(s["tgt_snr_db"], nan=-np.inf),
-                                        -np.inf) for s in sets]), axis=0)  # fmt: skip
+    best = np.argmax(
+        np.stack(
+            [np.where(s["tgt_visible"], np.nan_to_num(s["tgt_snr_db"], nan=-np.inf), -np.inf) for s in sets]
+        ),
+        axis=0,
+    )
     pick = {k: np.choose(best, [s[k] for s in sets]) for k in sets[0] if k.startswith("tgt_")}
     pick["tgt_visible"] = np.any([s["tgt_visible"] for s in sets], axis=0)
     first = sets[0]
-    truth = Truth(first["time_s"], pick["tgt_range_m"], pick["tgt_radial_velocity_mps"],
-                  pick["tgt_visible"], first["names"], pick["tgt_snr_db"])  # fmt: skip
+    truth = Truth(
+        first["time_s"],
+        pick["tgt_range_m"],
+        pick["tgt_radial_velocity_mps"],
+        pick["tgt_visible"],
+        first["names"],
+        pick["tgt_snr_db"],
+    )
     return truth, first["config"]
 
 

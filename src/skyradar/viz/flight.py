@@ -51,8 +51,14 @@ def flight_fit_figure(fit: FlightFit, path: str | Path, window_s: tuple[float, f
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
     ax = axes[0]
     ax.plot(s.position_ned_m[:, 1], s.position_ned_m[:, 0], "-", color="tab:blue", lw=1.2, label="built path")
-    ax.plot(fit.fix_position_ned_m[kept, 1], fit.fix_position_ned_m[kept, 0], ".", color="0.35", ms=4,
-            label=f"fixes used ({int(kept.sum())})")  # fmt: skip
+    ax.plot(
+        fit.fix_position_ned_m[kept, 1],
+        fit.fix_position_ned_m[kept, 0],
+        ".",
+        color="0.35",
+        ms=4,
+        label=f"fixes used ({int(kept.sum())})",
+    )
     if repaired.any():
         off = fit.fix_position_ned_m[repaired]
         label = f"fixes repaired away ({int(repaired.sum())})"
@@ -79,8 +85,9 @@ def flight_fit_figure(fit: FlightFit, path: str | Path, window_s: tuple[float, f
     )
     ax.plot(mid[shown], np.abs(a0[shown, 2]), "-", color="tab:green", lw=0.8, label="vertical")
     lim = fit.limits
-    ax.axhline(lim.horizontal_accel_mps2, color="tab:blue", ls="--", lw=0.8,
-               label=f"{lim.name} horizontal limit")  # fmt: skip
+    ax.axhline(
+        lim.horizontal_accel_mps2, color="tab:blue", ls="--", lw=0.8, label=f"{lim.name} horizontal limit"
+    )
     ax.axhline(
         lim.vertical_accel_mps2, color="tab:green", ls="--", lw=0.8, label=f"{lim.name} vertical limit"
     )

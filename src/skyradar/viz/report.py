@@ -40,10 +40,24 @@ def plot_range_doppler(frame, config, detections: pd.DataFrame, title: str, path
     fig, ax = plt.subplots(figsize=(7, 5))
     plot_strength(frame, config, ax=ax)
     ground = detections["is_ground"].to_numpy(bool) | detections["spur"].to_numpy(bool)
-    ax.plot(detections.loc[ground, "radial_velocity_mps"], detections.loc[ground, "range_m"], ".",
-            ms=1.5, color="white", alpha=0.5, label=f"ground/spur ({int(ground.sum())})")  # fmt: skip
-    ax.plot(detections.loc[~ground, "radial_velocity_mps"], detections.loc[~ground, "range_m"], "o",
-            mfc="none", mec="red", ms=7, label=f"kept for tracking ({int((~ground).sum())})")  # fmt: skip
+    ax.plot(
+        detections.loc[ground, "radial_velocity_mps"],
+        detections.loc[ground, "range_m"],
+        ".",
+        ms=1.5,
+        color="white",
+        alpha=0.5,
+        label=f"ground/spur ({int(ground.sum())})",
+    )
+    ax.plot(
+        detections.loc[~ground, "radial_velocity_mps"],
+        detections.loc[~ground, "range_m"],
+        "o",
+        mfc="none",
+        mec="red",
+        ms=7,
+        label=f"kept for tracking ({int((~ground).sum())})",
+    )
     ax.set_title(title)
     ax.legend(loc="upper right", fontsize=8)
     return _save(fig, path)
@@ -70,9 +84,14 @@ def plot_plan_view(
         ax.annotate(f"T{tid}", (g["east_m"].iloc[-1], g["north_m"].iloc[-1]), fontsize=7, color=c)
     warn = alerts[alerts["level"] >= 3]
     t = frame_times_s(truth)
-    ax.plot(warn["rel_east_m"] + np.interp(warn["time_s"], t, truth["own_east_m"]),
-            warn["rel_north_m"] + np.interp(warn["time_s"], t, truth["own_north_m"]),
-            "x", color=LEVEL_COLOURS[3], ms=6, label="track position at warning")  # fmt: skip
+    ax.plot(
+        warn["rel_east_m"] + np.interp(warn["time_s"], t, truth["own_east_m"]),
+        warn["rel_north_m"] + np.interp(warn["time_s"], t, truth["own_north_m"]),
+        "x",
+        color=LEVEL_COLOURS[3],
+        ms=6,
+        label="track position at warning",
+    )
     ax.set_xlabel("east [m]")
     ax.set_ylabel("north [m]")
     ax.set_aspect("equal", adjustable="datalim")

@@ -165,9 +165,16 @@ class LoopbackHostOnly:
                     await send({"type": "websocket.close", "code": 1008})
                     return
                 body = b"forbidden: this display answers only to localhost / 127.0.0.1 / [::1]\n"
-                await send({"type": "http.response.start", "status": 403,
-                            "headers": [(b"content-type", b"text/plain"),
-                                        (b"content-length", str(len(body)).encode())]})  # fmt: skip
+                await send(
+                    {
+                        "type": "http.response.start",
+                        "status": 403,
+                        "headers": [
+                            (b"content-type", b"text/plain"),
+                            (b"content-length", str(len(body)).encode()),
+                        ],
+                    }
+                )
                 await send({"type": "http.response.body", "body": body})
                 return
         await self.app(scope, receive, send)

@@ -24,11 +24,17 @@ def _truth(t: np.ndarray, range_limit_m: float) -> tuple[dict, dict]:
     own_n = 50.0 * t
     zeros = np.zeros_like(t)
     own = {
-        "own_north_m": own_n, "own_east_m": zeros, "own_down_m": zeros - 1000.0,
-        "own_vn_mps": zeros + 50.0, "own_ve_mps": zeros, "own_vd_mps": zeros,
-        "own_yaw_rad": zeros, "own_pitch_rad": zeros, "own_roll_rad": zeros,
+        "own_north_m": own_n,
+        "own_east_m": zeros,
+        "own_down_m": zeros - 1000.0,
+        "own_vn_mps": zeros + 50.0,
+        "own_ve_mps": zeros,
+        "own_vd_mps": zeros,
+        "own_yaw_rad": zeros,
+        "own_pitch_rad": zeros,
+        "own_roll_rad": zeros,
         "own_height_agl_m": zeros + 1000.0,
-    }  # fmt: skip
+    }
     pos = np.stack(
         [
             np.stack([6500.0 - 50.0 * t, zeros, zeros - 1000.0], -1),

@@ -195,8 +195,20 @@ class RunSource:
             return [], None
         dt = np.min(np.diff(self.times)) / 2 if len(self.times) > 1 else 0.5
         rows = self.alerts[np.abs(self.alerts["time_s"].to_numpy() - t) <= dt]
-        keys = ["track_id", "level", "flarm_level", "sector", "layer", "range_m", "bearing_deg", "tcpa_s",
-                "rel_north_m", "rel_east_m", "rel_alt_m", "climb_rate_mps"]  # fmt: skip
+        keys = [
+            "track_id",
+            "level",
+            "flarm_level",
+            "sector",
+            "layer",
+            "range_m",
+            "bearing_deg",
+            "tcpa_s",
+            "rel_north_m",
+            "rel_east_m",
+            "rel_alt_m",
+            "climb_rate_mps",
+        ]
         traffic = [{k: jsonable(r[k]) for k in keys if k in r} for r in rows.to_dict("records")]
         advice = None
         if len(rows) and "heading_bands_deg" in rows and rows["level"].max() > 0:

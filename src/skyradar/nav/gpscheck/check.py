@@ -36,10 +36,22 @@ from skyradar.nav.gpscheck.search import PoseOffset, search_offset
 from skyradar.scene.ground_grid import GroundGrid, PoseGrid, sample_at_pose
 
 __all__ = [
-    "PIXEL_M", "DEFAULT_METHOD", "MAP_OPTIONS", "RADAR_OPTIONS", "radar_side", "pose_grid_for", "render_map",
-    "prepare_map", "building_height_m", "correct_layover",
-    "check_coverage", "FrameCheck", "check_frame", "check_run", "GPSCHECK_COLUMNS",
-]  # fmt: skip
+    "PIXEL_M",
+    "DEFAULT_METHOD",
+    "MAP_OPTIONS",
+    "RADAR_OPTIONS",
+    "radar_side",
+    "pose_grid_for",
+    "render_map",
+    "prepare_map",
+    "building_height_m",
+    "correct_layover",
+    "check_coverage",
+    "FrameCheck",
+    "check_frame",
+    "check_run",
+    "GPSCHECK_COLUMNS",
+]
 
 PIXEL_M = 4.0  # about the ch6 radar's 3 m range resolution; 4 m keeps one frame's search under 0.5 s
 DEFAULT_METHOD = "clahe_ridge"
@@ -121,9 +133,11 @@ def render_map(layers, grid: GroundGrid) -> np.ndarray:
     from skyradar.scene.map_render import render_reference_map  # geo extra: imported when used
 
     half = GroundGrid(
-        grid.north0_m - grid.pixel_m / 4, grid.east0_m - grid.pixel_m / 4, grid.pixel_m / 2,
+        grid.north0_m - grid.pixel_m / 4,
+        grid.east0_m - grid.pixel_m / 4,
+        grid.pixel_m / 2,
         (2 * grid.shape[0], 2 * grid.shape[1]),
-    )  # fmt: skip
+    )
     return downscale_local_mean(render_reference_map(layers, half), (2, 2)).astype(np.float32)
 
 
@@ -212,10 +226,14 @@ GPSCHECK_COLUMNS: dict[str, str] = {
 def _row(frame: int, time_s: float, gps: np.ndarray, result: FrameCheck, settings) -> dict:
     off, nan = result.offset, float("nan")
     row: dict[str, Any] = {
-        "frame": frame, "time_s": time_s, "gps_north_m": float(gps[0]), "gps_east_m": float(gps[1]),
-        "gps_heading_deg": float(np.degrees(gps[2])), "ground_fraction": result.ground_fraction,
+        "frame": frame,
+        "time_s": time_s,
+        "gps_north_m": float(gps[0]),
+        "gps_east_m": float(gps[1]),
+        "gps_heading_deg": float(np.degrees(gps[2])),
+        "ground_fraction": result.ground_fraction,
         "gps_ssim": result.gps_ssim,
-    }  # fmt: skip
+    }
     for name in ("gps_ncc", "peak_ncc", "psr", "d_north_m", "d_east_m", "d_heading_deg"):
         row[name] = getattr(off, name) if off else nan
     row["correction_m"] = off.distance_m if off else nan
@@ -275,8 +293,17 @@ def check_coverage(
                 if share < min_data_fraction:
                     short.append((int(i), share))
     if short:
-        raise InputError(_no_map_data(map_image, map_extent, short, len(picked), map_source or "map",
-                                      min_data_fraction, frame_times_s(ds)))  # fmt: skip
+        raise InputError(
+            _no_map_data(
+                map_image,
+                map_extent,
+                short,
+                len(picked),
+                map_source or "map",
+                min_data_fraction,
+                frame_times_s(ds),
+            )
+        )
 
 
 def _share_on_data(image: np.ndarray, grid: GroundGrid, north: np.ndarray, east: np.ndarray) -> float:

@@ -200,10 +200,16 @@ def crop_to_mask(radar: np.ndarray, mask: np.ndarray, *grids: PoseGrid | None):
         return (radar, mask, *grids)
     r0, r1, c0, c1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
     cut = [
-        None if g is None else PoseGrid(g.forward0_m + r0 * g.pixel_m, g.right0_m + c0 * g.pixel_m, g.pixel_m,
-                                        (max(r1 - r0, 2), max(c1 - c0, 2)))
+        None
+        if g is None
+        else PoseGrid(
+            g.forward0_m + r0 * g.pixel_m,
+            g.right0_m + c0 * g.pixel_m,
+            g.pixel_m,
+            (max(r1 - r0, 2), max(c1 - c0, 2)),
+        )
         for g in grids
-    ]  # fmt: skip
+    ]
     r1, c1 = r0 + max(r1 - r0, 2), c0 + max(c1 - c0, 2)
     return (radar[r0:r1, c0:c1], mask[r0:r1, c0:c1], *cut)
 

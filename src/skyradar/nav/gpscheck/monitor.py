@@ -23,9 +23,17 @@ from skyradar.errors import InputError
 from skyradar.nav.gpscheck.search import PoseOffset
 
 __all__ = [
-    "CONSISTENT", "INCONSISTENT", "DEFAULT_SETTINGS", "WING_UP", "LOW_STRUCTURE", "VERDICTS",
-    "MonitorSettings", "inconsistency", "frame_verdict", "alerts",
-]  # fmt: skip
+    "CONSISTENT",
+    "INCONSISTENT",
+    "DEFAULT_SETTINGS",
+    "WING_UP",
+    "LOW_STRUCTURE",
+    "VERDICTS",
+    "MonitorSettings",
+    "inconsistency",
+    "frame_verdict",
+    "alerts",
+]
 
 CONSISTENT = "consistent"
 INCONSISTENT = "inconsistent"

@@ -118,9 +118,11 @@ class _Searcher:
         radar, mask, where = crop_to_mask(radar, mask, where)
         h, w = where.shape
         self.big = PoseGrid(
-            where.forward0_m - self.m * self.pix, where.right0_m - self.m * self.pix, self.pix,
+            where.forward0_m - self.m * self.pix,
+            where.right0_m - self.m * self.pix,
+            self.pix,
             (h + 2 * self.m, w + 2 * self.m),
-        )  # fmt: skip
+        )
         self.fft_shape = (fft.next_fast_len(h + 2 * self.m), fft.next_fast_len(w + 2 * self.m, real=True))
         t, self.n = _template(radar, mask)
         self.tf = fft.rfft2(t, s=self.fft_shape, workers=-1)
@@ -186,12 +188,14 @@ def search_offset(
     """
     if (np.asarray(radar_mask, bool) & np.isfinite(radar)).sum() < 16:
         raise InputError("search_offset: the radar footprint has fewer than 16 valid pixels")
-    s = _Searcher(radar, radar_mask & np.isfinite(radar), map_world, grid, pose_grid, gps_pose, margin_m,
-                  map_pose_grid)  # fmt: skip
+    s = _Searcher(
+        radar, radar_mask & np.isfinite(radar), map_world, grid, pose_grid, gps_pose, margin_m, map_pose_grid
+    )
     coarse = np.radians(np.arange(-max_heading_deg, max_heading_deg + 1e-9, coarse_step_deg))
     c_surf = s.surfaces(coarse)
-    fine, surface, peaks, k = _fine(s, coarse[int(np.argmax([sf.max() for sf in c_surf]))], coarse_step_deg,
-                                    fine_step_deg)  # fmt: skip
+    fine, surface, peaks, k = _fine(
+        s, coarse[int(np.argmax([sf.max() for sf in c_surf]))], coarse_step_deg, fine_step_deg
+    )
     a, b = (int(v) for v in np.unravel_index(int(np.argmax(surface)), surface.shape))
     da, db = _subpixel(surface, a, b)
     dk = _parabola(peaks[k - 1], peaks[k], peaks[k + 1]) if 0 < k < len(peaks) - 1 else 0.0

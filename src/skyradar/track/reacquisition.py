@@ -106,8 +106,13 @@ class LostTracks:
 
     def add_anchored(self, tracks: dict[str, np.ndarray], mask: np.ndarray) -> None:
         """Keep the tracker's tracks ``mask`` (struct of arrays) at their anchors (:func:`set_anchor`)."""
-        self.add(tracks["ids"][mask], tracks["anchor_x"][mask], tracks["anchor_P"][mask],
-                 tracks["anchor_resolved"][mask], tracks["anchor_t"][mask])  # fmt: skip
+        self.add(
+            tracks["ids"][mask],
+            tracks["anchor_x"][mask],
+            tracks["anchor_P"][mask],
+            tracks["anchor_resolved"][mask],
+            tracks["anchor_t"][mask],
+        )
 
     def expire(self, time_s: float) -> None:
         """Forget lost tracks closed more than ``max_age_s`` before ``time_s``."""

@@ -29,9 +29,25 @@ from skyradar.track.types import FrameTracks, TrackerConfig
 __all__ = ["TrackerConfig", "FrameTracks", "RangeDopplerTracker"]
 
 _FIELDS = (
-    "x", "P", "ids", "t_update", "hits", "frames", "window", "misses", "confirmed", "n_updates",
-    "hist_t", "hist_r", "resolved", "anchor_x", "anchor_P", "anchor_t", "anchor_resolved", "was_confirmed",
-)  # fmt: skip
+    "x",
+    "P",
+    "ids",
+    "t_update",
+    "hits",
+    "frames",
+    "window",
+    "misses",
+    "confirmed",
+    "n_updates",
+    "hist_t",
+    "hist_r",
+    "resolved",
+    "anchor_x",
+    "anchor_P",
+    "anchor_t",
+    "anchor_resolved",
+    "was_confirmed",
+)
 
 
 class RangeDopplerTracker:
@@ -90,8 +106,9 @@ class RangeDopplerTracker:
         self.initiator = initiator or MOfN(self.config.confirm_m, self.config.confirm_n)
         self.deleter = deleter or MissDeleter(self.config.max_misses, self.config.max_coast_s)
         c = self.config
-        self.reacquirer = reacquirer or LostTracks(model, c.reacquire_s, c.reacquire_jerk_mps3, c.gate,
-                                                   c.resolve_fraction * model.doppler_width_mps)  # fmt: skip
+        self.reacquirer = reacquirer or LostTracks(
+            model, c.reacquire_s, c.reacquire_jerk_mps3, c.gate, c.resolve_fraction * model.doppler_width_mps
+        )
         self._reacquired = np.zeros((0, 2), np.int64)
         self.time_s: float | None = None  # the last frame's time; None before the first
         self._now = 0.0  # the frame being processed, for the stages of step
@@ -358,9 +375,11 @@ class RangeDopplerTracker:
         back = np.flatnonzero(tentative & failed & known & ~tr["confirmed"] & ~dead)
         if back.size:
             tr["x"][back], tr["P"][back] = self.reacquirer.predict(
-                tr["anchor_x"][back], tr["anchor_P"][back], tr["anchor_resolved"][back],
+                tr["anchor_x"][back],
+                tr["anchor_P"][back],
+                tr["anchor_resolved"][back],
                 self._now - tr["anchor_t"][back],
-            )  # fmt: skip
+            )
             tr["resolved"][back] = tr["anchor_resolved"][back]
         # Closed tracks that were ever confirmed are kept as lost, at their last solid update.
         self.reacquirer.add_anchored(tr, dead & tr["was_confirmed"])

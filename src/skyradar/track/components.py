@@ -28,6 +28,7 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 
 from skyradar.track.association import Association
+from skyradar.track.types import TrackArrays
 
 __all__ = ["Associator", "Initiator", "Deleter", "Reacquirer"]
 
@@ -88,8 +89,8 @@ class Reacquirer(Protocol):
         """Lost tracks kept."""
         ...
 
-    def add_anchored(self, tracks: dict[str, np.ndarray], mask: np.ndarray) -> None:
-        """Keep the tracks ``mask`` of the tracker's struct of arrays, at their anchor states."""
+    def add_anchored(self, tracks: TrackArrays, mask: np.ndarray) -> None:
+        """Keep the tracker's tracks ``mask``, at their anchor states."""
         ...
 
     def match(self, x: np.ndarray, P: np.ndarray, time_s: float) -> tuple[np.ndarray, np.ndarray]:

@@ -70,7 +70,7 @@ class Measure3D:
         idx = det[has] + a
         pos = np.full((det.size, 3), np.nan)
         pos[has] = self.ned[idx]
-        state, resolved = tracker.tracks["x"], tracker.tracks["resolved"]
+        state, resolved = tracker.tracks.x, tracker.tracks.resolved
         v_meas = np.full(det.size, np.nan)
         v_meas[has] = self.z[idx, 1]
         # The detection's radial velocity moved to the track's (de-aliased) alias.

@@ -26,9 +26,10 @@ from scipy.optimize import linear_sum_assignment
 from skyradar.track.association import pair_costs
 from skyradar.track.kalman import predict
 from skyradar.track.models import MotionModel
+from skyradar.track.types import TrackArrays
 from skyradar.units import wrap
 
-__all__ = ["LostTracks", "anchor_fields", "set_anchor", "manoeuvre_transition"]
+__all__ = ["LostTracks", "manoeuvre_transition"]
 
 
 class LostTracks:
@@ -104,14 +105,15 @@ class LostTracks:
         self.resolved = np.concatenate([self.resolved, np.asarray(resolved, bool)])
         self.time_s = np.concatenate([self.time_s, np.broadcast_to(np.asarray(time_s, float), (len(ids),))])
 
-    def add_anchored(self, tracks: dict[str, np.ndarray], mask: np.ndarray) -> None:
-        """Keep the tracker's tracks ``mask`` (struct of arrays) at their anchors (:func:`set_anchor`)."""
+    def add_anchored(self, tracks: TrackArrays, mask: np.ndarray) -> None:
+        """Keep the tracker's tracks ``mask`` at their anchors
+        (:meth:`~skyradar.track.types.TrackArrays.set_anchor`)."""
         self.add(
-            tracks["ids"][mask],
-            tracks["anchor_x"][mask],
-            tracks["anchor_P"][mask],
-            tracks["anchor_resolved"][mask],
-            tracks["anchor_t"][mask],
+            tracks.ids[mask],
+            tracks.anchor_x[mask],
+            tracks.anchor_P[mask],
+            tracks.anchor_resolved[mask],
+            tracks.anchor_t[mask],
         )
 
     def expire(self, time_s: float) -> None:
@@ -232,33 +234,3 @@ def manoeuvre_transition(
     F[..., 1, 3] = F[..., 2, 3] = g1
     F[..., 3, 3] = np.exp(-x)
     return F
-
-
-def anchor_fields(x: np.ndarray, P: np.ndarray, time_s: float) -> dict[str, np.ndarray]:
-    """Anchor columns of new tracks for the tracker's struct of arrays (the state they start from).
-
-    A track's anchor is its state just after its last solid update: an update while confirmed and
-    not after a long coast, when the gate was small. A track lost after taking a clutter point in a
-    grown gate is then remembered where it last was reliably, not where the clutter took it.
-
-    Examples
-    --------
-    >>> sorted(anchor_fields(np.zeros((2, 4)), np.zeros((2, 4, 4)), 1.0))
-    ['anchor_P', 'anchor_resolved', 'anchor_t', 'anchor_x', 'was_confirmed']
-    """
-    n = len(x)
-    return {
-        "anchor_x": np.array(x, float),
-        "anchor_P": np.array(P, float),
-        "anchor_t": np.full(n, float(time_s)),
-        "anchor_resolved": np.zeros(n, bool),
-        "was_confirmed": np.zeros(n, bool),
-    }
-
-
-def set_anchor(tracks: dict[str, np.ndarray], rows: np.ndarray, time_s: float) -> None:
-    """Anchor tracks ``rows`` of the tracker's struct of arrays at their current state, in place."""
-    tracks["anchor_x"][rows] = tracks["x"][rows]
-    tracks["anchor_P"][rows] = tracks["P"][rows]
-    tracks["anchor_t"][rows] = time_s
-    tracks["anchor_resolved"][rows] = tracks["resolved"][rows]

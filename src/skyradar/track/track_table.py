@@ -253,7 +253,7 @@ def _frame_rows(tracker: RangeDopplerTracker, out, time_s: float, frame: int, fi
     """One frame's track rows (``out`` from :meth:`RangeDopplerTracker.step`) as column arrays."""
     n = out.track_id.size
     rows = np.searchsorted(out.alive_ids, out.track_id)
-    misses = tracker.tracks["misses"][rows]
+    misses = tracker.tracks.misses[rows]
     return {
         "time_s": np.full(n, time_s),
         "frame": np.full(n, frame, np.int64),
@@ -267,7 +267,7 @@ def _frame_rows(tracker: RangeDopplerTracker, out, time_s: float, frame: int, fi
         "confirmed": out.confirmed & (misses < tracker.initiator.n),
         "misses": misses,
         # A prediction only: the track was confirmed before and no detection was assigned to it now.
-        "coasted": (out.detection_index < 0) & tracker.tracks["was_confirmed"][rows],
+        "coasted": (out.detection_index < 0) & tracker.tracks.was_confirmed[rows],
     }
 
 

@@ -8,8 +8,9 @@ The parts are objects passed in, as in Stone Soup, each filling a role typed in
 :mod:`skyradar.track.components`: the motion model (:mod:`skyradar.track.models`), the associator,
 the initiator, the deleter and the reacquirer.
 
-Tracks live as a struct of arrays (states ``(n, 4)``, covariances ``(n, 4, 4)``, counters), so the
-cost per frame is a fixed number of numpy calls, whatever the number of tracks.
+Tracks live as one struct of arrays (:class:`~skyradar.track.types.TrackArrays`: states ``(n, 4)``,
+covariances ``(n, 4, 4)``, counters), so the cost per frame is a fixed number of numpy calls, whatever
+the number of tracks.
 """
 
 from __future__ import annotations
@@ -23,31 +24,10 @@ from skyradar.track.deletion import MissDeleter
 from skyradar.track.initiation import MOfN, push_hit
 from skyradar.track.kalman import predict, update
 from skyradar.track.models import MotionModel
-from skyradar.track.reacquisition import LostTracks, anchor_fields, set_anchor
-from skyradar.track.types import FrameTracks, TrackerConfig
+from skyradar.track.reacquisition import LostTracks
+from skyradar.track.types import FrameTracks, TrackArrays, TrackerConfig
 
 __all__ = ["TrackerConfig", "FrameTracks", "RangeDopplerTracker"]
-
-_FIELDS = (
-    "x",
-    "P",
-    "ids",
-    "t_update",
-    "hits",
-    "frames",
-    "window",
-    "misses",
-    "confirmed",
-    "n_updates",
-    "hist_t",
-    "hist_r",
-    "resolved",
-    "anchor_x",
-    "anchor_P",
-    "anchor_t",
-    "anchor_resolved",
-    "was_confirmed",
-)
 
 
 class RangeDopplerTracker:
@@ -115,23 +95,7 @@ class RangeDopplerTracker:
         self._next_id = 0
         self._range_wrap: np.ndarray | None = None
         self._cache: dict[float, tuple[np.ndarray, ...]] = {}
-        k = self.config.history
-        self.tracks = {
-            "x": np.zeros((0, 4)),
-            "P": np.zeros((0, 4, 4)),
-            "ids": np.zeros(0, np.int64),
-            "t_update": np.zeros(0),
-            "hits": np.zeros(0, np.int64),
-            "frames": np.zeros(0, np.int64),
-            "window": np.zeros(0, np.int64),
-            "misses": np.zeros(0, np.int64),
-            "confirmed": np.zeros(0, bool),
-            "n_updates": np.zeros(0, np.int64),
-            "hist_t": np.zeros((0, k)),
-            "hist_r": np.zeros((0, k)),
-            "resolved": np.zeros(0, bool),
-            **anchor_fields(np.zeros((0, 4)), np.zeros((0, 4, 4)), 0.0),
-        }
+        self.tracks = TrackArrays.empty(self.config.history)
         if self.config.dealias not in ("confident", "thesis"):
             raise ValueError(f"dealias must be 'confident' or 'thesis', got {self.config.dealias!r}")
         self._R = model.measurement_noise
@@ -143,7 +107,7 @@ class RangeDopplerTracker:
     @property
     def n_tracks(self) -> int:
         """Live tracks, tentative and confirmed."""
-        return int(self.tracks["ids"].size)
+        return self.tracks.size
 
     def step(self, time_s: float, z: np.ndarray, secondary: np.ndarray | None = None) -> FrameTracks:
         """Process one frame of detections ``z`` (m, 2) = (range [m], radial velocity [m/s]).
@@ -162,43 +126,43 @@ class RangeDopplerTracker:
         if secondary.size != len(z):
             raise ValueError(f"secondary has {secondary.size} flags for {len(z)} detections")
         tr = self.tracks
-        if self.time_s is not None and tr["ids"].size and time_s > self.time_s:
+        if self.time_s is not None and tr.ids.size and time_s > self.time_s:
             dt = time_s - self.time_s
             F, Q, F_u, Q_u = self._matrices(dt)
-            if self._hybrid and not tr["resolved"].all():
+            if self._hybrid and not tr.resolved.all():
                 # Two groups with one F each: cheaper than stacking a per-track F.
                 for rows, FF, QQ in (
-                    (np.flatnonzero(tr["resolved"]), F, Q),
-                    (np.flatnonzero(~tr["resolved"]), F_u, Q_u),
+                    (np.flatnonzero(tr.resolved), F, Q),
+                    (np.flatnonzero(~tr.resolved), F_u, Q_u),
                 ):
-                    tr["x"][rows], tr["P"][rows] = predict(tr["x"][rows], tr["P"][rows], FF, QQ)
+                    tr.x[rows], tr.P[rows] = predict(tr.x[rows], tr.P[rows], FF, QQ)
             else:
-                tr["x"], tr["P"] = predict(tr["x"], tr["P"], F, Q)
+                tr.x, tr.P = predict(tr.x, tr.P, F, Q)
         self.time_s = self._now = float(time_s)
         self._close_stale()
         assoc = self._associate(z, secondary)
-        assigned = np.full(tr["ids"].size, -1)
+        assigned = np.full(tr.ids.size, -1)
         assigned[assoc.track_index] = assoc.detection_index
-        innov = np.full((tr["ids"].size, 2), np.nan)
+        innov = np.full((tr.ids.size, 2), np.nan)
         innov[assoc.track_index] = assoc.innovation
         self._update(assoc, z)
-        self._bookkeep(assigned >= 0, tr["misses"] >= self.initiator.n)
+        self._bookkeep(assigned >= 0, tr.misses >= self.initiator.n)
         alive = self._manage()
         assigned, innov = assigned[alive], innov[alive]
         used = np.zeros(len(z), bool)
         used[assoc.detection_index] = True
         new_det = np.flatnonzero(~used & ~secondary)
         self._start(z[new_det])
-        alive_ids = tr["ids"]
+        alive_ids = tr.ids
         alive_det = np.concatenate([assigned, new_det])
-        confirmed = tr["confirmed"][: assigned.size]
+        confirmed = tr.confirmed[: assigned.size]
         out = np.ones(assigned.size, bool) if self.report_tentative else confirmed
         return FrameTracks(
             self._now,
-            tr["ids"][: assigned.size][out],
-            tr["x"][: assigned.size][out],
-            tr["P"][: assigned.size][out],
-            tr["n_updates"][: assigned.size][out],
+            tr.ids[: assigned.size][out],
+            tr.x[: assigned.size][out],
+            tr.P[: assigned.size][out],
+            tr.n_updates[: assigned.size][out],
             assigned[out],
             innov[out],
             alive_ids,
@@ -225,7 +189,7 @@ class RangeDopplerTracker:
     def _associate(self, z: np.ndarray, secondary: np.ndarray) -> Association:
         tr, m = self.tracks, self.model
         # H = [[1, c, 0, 0], [0, 1, 0, 0]] written out: S = H P H^T + R without batched matmuls.
-        c, P, x = m.coupling_s, tr["P"], tr["x"]
+        c, P, x = m.coupling_s, tr.P, tr.x
         z_pred = np.column_stack([x[:, 0] + c * x[:, 1], x[:, 1]])
         S = np.empty((x.shape[0], 2, 2))
         S[:, 0, 0] = P[:, 0, 0] + 2 * c * P[:, 0, 1] + c * c * P[:, 1, 1] + self._R[0, 0]
@@ -233,23 +197,21 @@ class RangeDopplerTracker:
         S[:, 1, 1] = P[:, 1, 1] + self._R[1, 1]
         range_wrap = None
         if self._thesis:
-            range_wrap = np.where(
-                tr["n_updates"] == 1, m.doppler_width_mps * (self._now - tr["t_update"]), np.nan
-            )
+            range_wrap = np.where(tr.n_updates == 1, m.doppler_width_mps * (self._now - tr.t_update), np.nan)
         self._range_wrap = range_wrap
         # Confirmed tracks choose first; tentative tracks share what is left. Otherwise the
         # solver's preference for more pairs lets a new track take a confirmed track's detection
         # while the confirmed track is handed a clutter point.
         # Secondary detections come last, to the confirmed tracks no primary detection updated.
-        confirmed = tr["confirmed"]
+        confirmed = tr.confirmed
         if self.config.confirmed_first:
             stages = [(np.flatnonzero(confirmed), False), (np.flatnonzero(~confirmed), False)]
         else:
-            stages = [(np.arange(tr["ids"].size), False)]
+            stages = [(np.arange(tr.ids.size), False)]
         if secondary.any():
             stages.append((np.flatnonzero(confirmed), True))
         free = np.ones(len(z), bool)
-        taken = np.zeros(tr["ids"].size, bool)
+        taken = np.zeros(tr.ids.size, bool)
         parts = []
         for rows, lower in stages:
             rows = rows[~taken[rows]]
@@ -283,40 +245,40 @@ class RangeDopplerTracker:
             return
         if self._range_wrap is not None:
             self._shift_alias(rows, z[assoc.detection_index, 0], assoc.innovation[:, 0], self._range_wrap)
-        x, P = tr["x"][rows], tr["P"][rows]
-        tr["x"][rows], tr["P"][rows] = update(x, P, assoc.innovation, self._H, self._R)
+        x, P = tr.x[rows], tr.P[rows]
+        tr.x[rows], tr.P[rows] = update(x, P, assoc.innovation, self._H, self._R)
         if self._hybrid:
             self._resolve(rows)
         if self._thesis:
-            push_history(tr["hist_t"], rows, np.full(rows.size, self._now), tr["n_updates"][rows])
-            push_history(tr["hist_r"], rows, z[assoc.detection_index, 0], tr["n_updates"][rows])
-            rate = range_rate_fit(tr["hist_t"][rows], tr["hist_r"][rows], tr["n_updates"][rows] + 1)
+            push_history(tr.hist_t, rows, np.full(rows.size, self._now), tr.n_updates[rows])
+            push_history(tr.hist_r, rows, z[assoc.detection_index, 0], tr.n_updates[rows])
+            rate = range_rate_fit(tr.hist_t[rows], tr.hist_r[rows], tr.n_updates[rows] + 1)
             ok = np.isfinite(rate)
             r_ok = rows[ok]
-            tr["x"][r_ok, 2] = rate[ok]
+            tr.x[r_ok, 2] = rate[ok]
             self._shift_velocity(
-                r_ok, dealias_velocity(tr["x"][r_ok, 1], rate[ok], m.doppler_width_mps) - tr["x"][r_ok, 1]
+                r_ok, dealias_velocity(tr.x[r_ok, 1], rate[ok], m.doppler_width_mps) - tr.x[r_ok, 1]
             )
 
     def _resolve(self, rows: np.ndarray) -> None:
         """Resolve the alias of tracks whose range rate is now known well enough (confident mode)."""
         tr, width = self.tracks, self.model.doppler_width_mps
-        sd = np.sqrt(tr["P"][rows, 2, 2])
-        now = ~tr["resolved"][rows] & (sd < self.config.resolve_fraction * width)
+        sd = np.sqrt(tr.P[rows, 2, 2])
+        now = ~tr.resolved[rows] & (sd < self.config.resolve_fraction * width)
         r = rows[now]
-        self._shift_velocity(r, dealias_velocity(tr["x"][r, 1], tr["x"][r, 2], width) - tr["x"][r, 1])
-        tr["resolved"][r] = True
-        done = rows[tr["resolved"][rows]]
+        self._shift_velocity(r, dealias_velocity(tr.x[r, 1], tr.x[r, 2], width) - tr.x[r, 1])
+        tr.resolved[r] = True
+        done = rows[tr.resolved[rows]]
         # Once resolved, range follows V_R; the range-rate state simply reports it.
-        tr["x"][done, 2] = tr["x"][done, 1]
+        tr.x[done, 2] = tr.x[done, 1]
 
     def _shift_velocity(self, rows: np.ndarray, delta_mps: np.ndarray) -> None:
         """Move V_R by whole image widths, keeping the predicted observed range unchanged.
 
         The observed range is ``R + c V_R`` (range-Doppler coupling), so R moves by ``-c dV``.
         """
-        self.tracks["x"][rows, 1] += delta_mps
-        self.tracks["x"][rows, 0] -= self.model.coupling_s * delta_mps
+        self.tracks.x[rows, 1] += delta_mps
+        self.tracks.x[rows, 0] -= self.model.coupling_s * delta_mps
 
     def _shift_alias(
         self, rows: np.ndarray, range_m: np.ndarray, wrapped_m: np.ndarray, range_wrap: np.ndarray
@@ -333,34 +295,34 @@ class RangeDopplerTracker:
         if not np.any(use):
             return
         r = rows[use]
-        k = np.round((range_m[use] - tr["x"][r, 0] - wrapped_m[use]) / span[use])
-        tr["x"][r, 0] += k * span[use]
+        k = np.round((range_m[use] - tr.x[r, 0] - wrapped_m[use]) / span[use])
+        tr.x[r, 0] += k * span[use]
         self._shift_velocity(r, k * width)
 
     def _bookkeep(self, hit: np.ndarray, long_gap: np.ndarray) -> None:
         tr = self.tracks
         # A confirmed track updated after coasting initiator.n frames or more may have taken clutter in
         # its grown gate: it must be confirmed again (M-of-N) and keeps its anchor meanwhile.
-        again = hit & long_gap & tr["confirmed"]
-        tr["confirmed"] &= ~again
-        tr["window"] = np.where(again, 0, tr["window"])
+        again = hit & long_gap & tr.confirmed
+        tr.confirmed &= ~again
+        tr.window = np.where(again, 0, tr.window)
         # The anchor moves only with updates right after another (a gate that had no time to grow).
-        solid = hit & (tr["misses"] <= 1) & tr["confirmed"]
-        set_anchor(tr, np.flatnonzero(solid), self._now)
-        tr["frames"] += 1
-        tr["hits"] += hit
-        tr["window"] = push_hit(tr["window"], hit, self.initiator.n)
-        tr["n_updates"] += hit
-        tr["misses"] = np.where(hit, 0, tr["misses"] + 1)
-        tr["t_update"] = np.where(hit, self._now, tr["t_update"])
+        solid = hit & (tr.misses <= 1) & tr.confirmed
+        tr.set_anchor(np.flatnonzero(solid), self._now)
+        tr.frames += 1
+        tr.hits += hit
+        tr.window = push_hit(tr.window, hit, self.initiator.n)
+        tr.n_updates += hit
+        tr.misses = np.where(hit, 0, tr.misses + 1)
+        tr.t_update = np.where(hit, self._now, tr.t_update)
 
     def _manage(self) -> np.ndarray:
         """Confirm, delete and reacquire; returns the surviving tracks' pre-deletion rows, by id."""
         tr = self.tracks
-        tentative = ~tr["confirmed"]
-        confirmed_now, failed = self.initiator.window_status(tr["window"], tr["misses"])
-        tr["confirmed"] = tr["confirmed"] | (tentative & confirmed_now)
-        set_anchor(tr, np.flatnonzero(tentative & tr["confirmed"]), self._now)
+        tentative = ~tr.confirmed
+        confirmed_now, failed = self.initiator.window_status(tr.window, tr.misses)
+        tr.confirmed = tr.confirmed | (tentative & confirmed_now)
+        tr.set_anchor(np.flatnonzero(tentative & tr.confirmed), self._now)
         # A track that was confirmed and must be confirmed again after a gap lives until the
         # deleter's coasting limits close it, as a confirmed track does: a patchy return (an aircraft
         # in clutter, a fade) fails an M-of-N window without the aircraft being gone, and a new track
@@ -368,29 +330,28 @@ class RangeDopplerTracker:
         # updates since the gap did not confirm the aircraft (they may be clutter its grown gate
         # took), so it goes back to its anchor, its last solid state, carried to now as a lost
         # track is. Only tracks never confirmed are dropped when their window fails.
-        known = tr["confirmed"] | tr["was_confirmed"]
+        known = tr.confirmed | tr.was_confirmed
         dead = (tentative & failed & ~known) | (
-            known & self.deleter.delete(tr["misses"], self._now - tr["t_update"])
+            known & self.deleter.delete(tr.misses, self._now - tr.t_update)
         )
-        back = np.flatnonzero(tentative & failed & known & ~tr["confirmed"] & ~dead)
+        back = np.flatnonzero(tentative & failed & known & ~tr.confirmed & ~dead)
         if back.size:
-            tr["x"][back], tr["P"][back] = self.reacquirer.predict(
-                tr["anchor_x"][back],
-                tr["anchor_P"][back],
-                tr["anchor_resolved"][back],
-                self._now - tr["anchor_t"][back],
+            tr.x[back], tr.P[back] = self.reacquirer.predict(
+                tr.anchor_x[back],
+                tr.anchor_P[back],
+                tr.anchor_resolved[back],
+                self._now - tr.anchor_t[back],
             )
-            tr["resolved"][back] = tr["anchor_resolved"][back]
+            tr.resolved[back] = tr.anchor_resolved[back]
         # Closed tracks that were ever confirmed are kept as lost, at their last solid update.
-        self.reacquirer.add_anchored(tr, dead & tr["was_confirmed"])
-        self._reacquire(np.flatnonzero(tentative & tr["confirmed"] & ~tr["was_confirmed"] & ~dead))
-        tr["was_confirmed"] |= tr["confirmed"]
+        self.reacquirer.add_anchored(tr, dead & tr.was_confirmed)
+        self._reacquire(np.flatnonzero(tentative & tr.confirmed & ~tr.was_confirmed & ~dead))
+        tr.was_confirmed |= tr.confirmed
         alive = np.flatnonzero(~dead)
         # A reacquired track has an older id: keep the rows sorted by id, as callers look ids up.
-        alive = alive[np.argsort(tr["ids"][alive], kind="stable")]
-        if alive.size != tr["ids"].size or np.any(np.diff(alive) < 0):
-            for name in _FIELDS:
-                tr[name] = tr[name][alive]
+        alive = alive[np.argsort(tr.ids[alive], kind="stable")]
+        if alive.size != tr.ids.size or np.any(np.diff(alive) < 0):
+            tr.keep(alive)
         return alive
 
     def _close_stale(self) -> None:
@@ -398,12 +359,11 @@ class RangeDopplerTracker:
         frames between detections (``skyradar track`` steps on detection times) such a track meets
         the next frame with a gate over much of the image and takes whatever is there."""
         tr = self.tracks
-        stale = self._now - tr["t_update"] > self.deleter.max_coast_s
+        stale = self._now - tr.t_update > self.deleter.max_coast_s
         if not np.any(stale):
             return
-        self.reacquirer.add_anchored(tr, stale & tr["was_confirmed"])
-        for name in _FIELDS:
-            tr[name] = tr[name][~stale]
+        self.reacquirer.add_anchored(tr, stale & tr.was_confirmed)
+        tr.keep(~stale)
 
     def _reacquire(self, rows: np.ndarray) -> None:
         """Give newly confirmed tracks ``rows`` the id (and the resolved alias) of a lost track."""
@@ -411,15 +371,15 @@ class RangeDopplerTracker:
         self._reacquired = np.zeros((0, 2), np.int64)
         if rows.size == 0 or len(self.reacquirer) == 0:
             return
-        lost_ids, alias = self.reacquirer.match(tr["x"][rows], tr["P"][rows], self._now)
+        lost_ids, alias = self.reacquirer.match(tr.x[rows], tr.P[rows], self._now)
         hit = lost_ids >= 0
-        self._reacquired = np.column_stack([tr["ids"][rows[hit]], lost_ids[hit]])
-        tr["ids"][rows[hit]] = lost_ids[hit]
+        self._reacquired = np.column_stack([tr.ids[rows[hit]], lost_ids[hit]])
+        tr.ids[rows[hit]] = lost_ids[hit]
         sure = hit & np.isfinite(alias)
         r = rows[sure]
         self._shift_velocity(r, alias[sure] * self.model.doppler_width_mps)
-        tr["resolved"][r] = True
-        tr["x"][r, 2] = tr["x"][r, 1]
+        tr.resolved[r] = True
+        tr.x[r, 2] = tr.x[r, 1]
 
     def _start(self, z_new: np.ndarray) -> None:
         n = len(z_new)
@@ -431,27 +391,9 @@ class RangeDopplerTracker:
         x[:, 0] -= m.coupling_s * z_new[:, 1]
         # The radar model's range rate starts at the (possibly aliased) radial velocity.
         x[:, 2] = z_new[:, 1] if m.coupled else 0.0
-        k = self.config.history
-        hist_t = np.full((n, k), np.nan)
-        hist_r = np.full((n, k), np.nan)
-        hist_t[:, 0] = self._now
-        hist_r[:, 0] = z_new[:, 0]
-        new = {
-            "x": x,
-            "P": np.broadcast_to(self._P0, (n, 4, 4)),
-            "ids": np.arange(self._next_id, self._next_id + n),
-            "t_update": np.full(n, self._now),
-            "hits": np.ones(n, np.int64),
-            "frames": np.ones(n, np.int64),
-            "window": np.ones(n, np.int64),
-            "misses": np.zeros(n, np.int64),
-            "confirmed": np.full(n, self.initiator.m <= 1),
-            "n_updates": np.ones(n, np.int64),
-            "hist_t": hist_t,
-            "hist_r": hist_r,
-            "resolved": np.zeros(n, bool),
-            **anchor_fields(x, np.broadcast_to(self._P0, (n, 4, 4)), self._now),
-        }
+        ids = np.arange(self._next_id, self._next_id + n)
         self._next_id += n
-        for name in _FIELDS:
-            tr[name] = np.concatenate([tr[name], new[name]])
+        born = TrackArrays.born(
+            x, self._P0, ids, self._now, z_new[:, 0], self.config.history, self.initiator.m <= 1
+        )
+        tr.extend(born)

@@ -1,12 +1,12 @@
-"""Settings and per-frame output of the range-Doppler tracker."""
+"""Settings, live tracks and per-frame output of the range-Doppler tracker."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-__all__ = ["TrackerConfig", "FrameTracks"]
+__all__ = ["TrackerConfig", "TrackArrays", "FrameTracks"]
 
 
 @dataclass(frozen=True)
@@ -62,6 +62,143 @@ class TrackerConfig:
     resolve_fraction: float = 1.0 / 6.0
     reacquire_s: float = 8.0
     reacquire_jerk_mps3: float = 1.5
+
+
+@dataclass
+class TrackArrays:
+    """The tracker's live tracks, tentative and confirmed, as a struct of arrays (one row a track).
+
+    A frame's work is a fixed number of numpy calls over these arrays, whatever the number of
+    tracks. Rows are kept sorted by ``ids``. :meth:`keep` and :meth:`extend` change the rows in
+    place, so every holder of the object sees the same tracks.
+
+    Attributes
+    ----------
+    x : ndarray, shape (n, 4)
+        State (range [m], radial velocity [m/s], range rate [m/s], radial acceleration [m/s^2]).
+    P : ndarray, shape (n, 4, 4)
+        State covariance.
+    ids : ndarray of int
+        Track ids.
+    t_update : ndarray
+        Time of the last update, s.
+    hits, frames, n_updates : ndarray of int
+        Updates and frames since birth, and updates (hits) counted for the range history.
+    window : ndarray of int
+        Hit bits of the last N frames, newest lowest (:func:`~skyradar.track.initiation.push_hit`).
+    misses : ndarray of int
+        Consecutive frames without an update.
+    confirmed : ndarray of bool
+        Confirmed now (M of N).
+    hist_t, hist_r : ndarray, shape (n, history)
+        Times (s) and ranges (m) of the last updates, for the range-rate fit that de-aliases.
+    resolved : ndarray of bool
+        The radial velocity's alias is resolved (range follows ``V_R``).
+    anchor_x, anchor_P, anchor_t, anchor_resolved : ndarray
+        The anchor: state, covariance, time (s) and alias flag just after the last solid update (an
+        update while confirmed and not after a long coast, when the gate was small). A track lost
+        after taking a clutter point in a grown gate is remembered there, not where the clutter
+        took it.
+    was_confirmed : ndarray of bool
+        Confirmed at some frame.
+
+    Examples
+    --------
+    >>> tracks = TrackArrays.empty(history=16)
+    >>> tracks.extend(TrackArrays.born(np.array([[1000.0, -20.0, -20.0, 0.0]]), np.eye(4), np.array([7]),
+    ...                                1.0, np.array([1000.0]), history=16, confirmed=False))
+    >>> tracks.size, tracks.ids.tolist(), tracks.anchor_t.tolist()
+    (1, [7], [1.0])
+    >>> tracks.keep(np.zeros(0, int)); tracks.size
+    0
+    """
+
+    x: np.ndarray
+    P: np.ndarray
+    ids: np.ndarray
+    t_update: np.ndarray
+    hits: np.ndarray
+    frames: np.ndarray
+    window: np.ndarray
+    misses: np.ndarray
+    confirmed: np.ndarray
+    n_updates: np.ndarray
+    hist_t: np.ndarray
+    hist_r: np.ndarray
+    resolved: np.ndarray
+    anchor_x: np.ndarray
+    anchor_P: np.ndarray
+    anchor_t: np.ndarray
+    anchor_resolved: np.ndarray
+    was_confirmed: np.ndarray
+
+    @classmethod
+    def empty(cls, history: int) -> TrackArrays:
+        """No tracks, with range histories of ``history`` entries."""
+        return cls.born(np.zeros((0, 4)), np.eye(4), np.zeros(0, np.int64), 0.0, np.zeros(0), history, False)
+
+    @classmethod
+    def born(
+        cls,
+        x: np.ndarray,
+        P0: np.ndarray,
+        ids: np.ndarray,
+        time_s: float,
+        range_m: np.ndarray,
+        history: int,
+        confirmed: bool,
+    ) -> TrackArrays:
+        """Tracks started at ``time_s`` from one detection each: states ``x`` (n, 4), covariance
+        ``P0`` (4, 4) for all, observed ranges ``range_m`` (m) as their first history entry;
+        ``confirmed`` when one hit confirms (M = 1). Each is its own anchor."""
+        n = len(x)
+        hist_t = np.full((n, history), np.nan)
+        hist_r = np.full((n, history), np.nan)
+        hist_t[:, 0] = time_s
+        hist_r[:, 0] = range_m
+        P = np.broadcast_to(np.asarray(P0, float), (n, 4, 4))
+        return cls(
+            x=np.array(x, float),
+            P=P.copy(),
+            ids=np.asarray(ids, np.int64),
+            t_update=np.full(n, float(time_s)),
+            hits=np.ones(n, np.int64),
+            frames=np.ones(n, np.int64),
+            window=np.ones(n, np.int64),
+            misses=np.zeros(n, np.int64),
+            confirmed=np.full(n, bool(confirmed)),
+            n_updates=np.ones(n, np.int64),
+            hist_t=hist_t,
+            hist_r=hist_r,
+            resolved=np.zeros(n, bool),
+            anchor_x=np.array(x, float),
+            anchor_P=P.copy(),
+            anchor_t=np.full(n, float(time_s)),
+            anchor_resolved=np.zeros(n, bool),
+            was_confirmed=np.zeros(n, bool),
+        )
+
+    @property
+    def size(self) -> int:
+        """Number of tracks."""
+        return int(self.ids.size)
+
+    def keep(self, rows: np.ndarray) -> None:
+        """Keep only ``rows`` (indices or a boolean mask), in their order, in place."""
+        for f in fields(self):
+            setattr(self, f.name, getattr(self, f.name)[rows])
+
+    def extend(self, other: TrackArrays) -> None:
+        """Append ``other``'s tracks after these, in place."""
+        for f in fields(self):
+            setattr(self, f.name, np.concatenate([getattr(self, f.name), getattr(other, f.name)]))
+
+    def set_anchor(self, rows: np.ndarray, time_s: float) -> None:
+        """Anchor tracks ``rows`` at their current state, at ``time_s``."""
+        self.anchor_x[rows] = self.x[rows]
+        self.anchor_P[rows] = self.P[rows]
+        self.anchor_t[rows] = time_s
+        self.anchor_resolved[rows] = self.resolved[rows]
 
 
 @dataclass(frozen=True)

@@ -271,6 +271,71 @@ def test_velocity_gate_bounds_the_miss_error_not_the_velocity_error():
     assert levels == {("near", True): 3, ("near", False): 3, ("far", True): 0, ("far", False): 3}
 
 
+def _crossing_ahead(true_offset_m: float, with_range: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Own-ship north at 50 m/s; an intruder 2.8 km ahead coming south at 65 m/s (115 m/s closing),
+    passing ``true_offset_m`` east. Its 3-D rows put it 300 m east (a track's estimate from scattered
+    directions, horizontal velocity sigma 10 m/s); its range and range rate are the true ones with a
+    pixel's noise (4 m, 0.1 m/s)."""
+    rng = np.random.default_rng(3)
+    t = np.arange(0.0, 10.0, 1.0 / 9.4)
+    own = pd.DataFrame(
+        {
+            "time_s": t,
+            "own_north_m": 50.0 * t,
+            "own_east_m": 0.0,
+            "own_down_m": -1000.0,
+            "own_vn_mps": 50.0,
+            "own_ve_mps": 0.0,
+            "own_vd_mps": 0.0,
+            "own_yaw_rad": 0.0,
+        }
+    )
+    north = 2800.0 - 65.0 * t
+    tracks = pd.DataFrame(
+        {
+            "time_s": t,
+            "track_id": 1,
+            "north_m": north,
+            "east_m": 300.0,
+            "down_m": -1000.0,
+            "vn_mps": -65.0,
+            "ve_mps": 0.0,
+            "vd_mps": 0.0,
+        }
+    )
+    tracks = tracks.assign(
+        **{f"cov_vv_{i}{j}": (50.0 if i == j and i < 2 else 0.0) for i in range(3) for j in range(3)}
+    )
+    if with_range:
+        rel_north = north - 50.0 * t
+        r = np.hypot(rel_north, true_offset_m)
+        rdot = rel_north * -115.0 / r
+        tracks = tracks.assign(
+            range_m=r + rng.normal(0, 4.0, t.size), range_rate_mps=rdot + rng.normal(0, 0.1, t.size)
+        )
+    return own, tracks
+
+
+def test_a_range_path_inside_the_volume_lifts_the_velocity_gate():
+    # A fast closure at 2-3 km over clutter: its directions scatter, so its horizontal velocity sigma
+    # stays near 10 m/s and the gate silences it while the CPA is more than 15 s away. Its range and
+    # Doppler are measured to a pixel: their path gives the 3-D miss to ~10 m, and the horizontal miss
+    # is at most that. Inside the volume's radius by 3 sigmas, the conflict holds whatever the
+    # velocity error; a path passing 1 km away (the directions alone made the conflict) stays silent.
+    cfg = AlertConfig(max_velocity_sigma_mps=6.0, min_track_age_s=0.0)
+    early = {}
+    for name, offset, with_range in (
+        ("inside", 320.0, True),
+        ("outside", 1000.0, True),
+        ("no range", 320.0, False),
+    ):
+        own, tracks = _crossing_ahead(offset, with_range)
+        out = alerts_from_tracks(tracks, own, cfg, with_advice=False)
+        gated = out["tcpa_s"].to_numpy() > 16.0  # the plain gate silences these rows (10 m/s x 16 s > 150 m)
+        early[name] = int(out["raw_level"].to_numpy()[gated].max())
+    assert early == {"inside": 3, "outside": 0, "no range": 0}
+
+
 def _converged(tracks: pd.DataFrame, sigma_mps: float = 2.0) -> pd.DataFrame:
     """A track with a converged velocity (``sigma_mps`` per horizontal axis, 20 m of position)."""
     cov = {f"cov_vv_{i}{j}": (sigma_mps**2 if i == j else 0.0) for i in range(3) for j in range(3)}

@@ -39,7 +39,7 @@ from skyradar.daa.conflict import traffic_indication
 from skyradar.daa.lost_tracks import lost_track_rows
 from skyradar.daa.provenance import check_tracks_match_run
 from skyradar.daa.range_miss import range_only_fit
-from skyradar.daa.range_only import range_only_levels
+from skyradar.daa.range_only import K_SIGMA, range_only_levels
 from skyradar.daa.run_tables import ownship_from_frames, truth_tracks
 from skyradar.daa.tables import (
     OWNSHIP_COLUMNS,
@@ -72,8 +72,19 @@ def _issued_levels(
     config: AlertConfig,
     predicted: np.ndarray,
     located: np.ndarray,
+    range_miss: np.ndarray,
 ) -> np.ndarray:
     """Issued level per row; silences (in ``raw``) unconverged and too young tracks first.
+
+    The velocity gate (:func:`~skyradar.daa.alerting.velocity_unconverged`) keeps a horizontal
+    velocity taken from noisy directions of arrival from making a conflict. It does not silence a
+    row whose range path (``range_miss``: the 3-D miss distance and its sigma fitted to the track's
+    range and range rate, :func:`~skyradar.daa.range_miss.range_only_fit`) passes inside the
+    warning volume's radius by :data:`~skyradar.daa.range_only.K_SIGMA` sigmas: the horizontal miss
+    is at most the 3-D miss, and range and Doppler are measured to a pixel whatever the directions
+    do, so that row's horizontal conflict holds whatever its velocity error. (A fast closure at
+    2 km over clutter can keep a horizontal velocity sigma near 10 m/s from scattered directions
+    while its range path gives the miss to about 10 m.)
 
     A track's rows before it is old enough (:func:`~skyradar.daa.alerting.alerting_rows`) say
     nothing about the conflict: they are not fed to its M-of-N filter, which starts at the first
@@ -84,7 +95,9 @@ def _issued_levels(
     """
     if config.max_velocity_sigma_mps is not None and cov_v is not None:
         sigma_hv = np.sqrt(np.nan_to_num(cov_v[:, 0, 0] + cov_v[:, 1, 1], nan=np.inf))
-        unconverged = velocity_unconverged(sigma_hv, raw["tcpa_s"], config) & located
+        radius_m = config.levels[-1].volume.dthr_m
+        inside = range_miss[0] + K_SIGMA * range_miss[1] < radius_m  # False where NaN
+        unconverged = velocity_unconverged(sigma_hv, raw["tcpa_s"], config) & located & ~inside
         raw["level"][unconverged] = 0
         raw["hold_level"][unconverged] = 0
         raw["flarm_level"][unconverged] = 0
@@ -188,33 +201,26 @@ def _altitude_measured(df: pd.DataFrame) -> np.ndarray:
     return df["altitude_measured"].to_numpy(bool)  # checked by clean_tracks
 
 
-def _range_fit(
-    df: pd.DataFrame, t: np.ndarray, own_vel: np.ndarray, predicted: np.ndarray, located: np.ndarray
-) -> np.ndarray:
+def _range_fit(df: pd.DataFrame, t: np.ndarray, own_vel: np.ndarray, predicted: np.ndarray) -> np.ndarray:
     """The range-only path (:func:`~skyradar.daa.range_miss.range_only_fit`: miss, sigma, relative
-    speed squared, time of closest approach; shape (4, n)) of the rows whose height is the
-    co-altitude prior or that have no position; NaN elsewhere (a measured height is the 3-D
-    track's to judge). The fit runs over every measured row of such tracks. A lost track's
-    prediction has no range measured: a range-only one carries the path of its track's last
-    measured row, which straight motion keeps (the four are constants of it)."""
+    speed squared, time of closest approach; shape (4, n)) of every measured row, over its track's
+    measured rows. A lost track's prediction has no range measured: it carries the path of its
+    track's last measured row, which straight motion keeps (the four are constants of it)."""
     fit = np.full((4, len(df)), np.nan)
     if not set(RANGE_COLUMNS) <= set(df):
         return fit
     ids = df["track_id"].to_numpy()
-    needed = (~_altitude_measured(df) | ~located) & ~predicted
-    rows = np.isin(ids, ids[needed]) & ~predicted
+    rows = ~predicted
     r, rdot = (df[c].to_numpy(float)[rows] for c in RANGE_COLUMNS)
     fit[:, rows] = range_only_fit(ids[rows], t[rows], r, rdot, own_vel[rows])
-    fit[:, ~needed] = np.nan
-    carried = predicted & ~located
-    if carried.any():
+    if predicted.any():
         # Rows are in time order: each prediction takes the last measured row of its track.
         source = pd.Series(np.where(predicted, np.nan, np.arange(len(df)))).groupby(ids).ffill()
-        src = source.to_numpy()[carried]
+        src = source.to_numpy()[predicted]
         values = np.full((4, src.size), np.nan)
         ok = np.isfinite(src)
         values[:, ok] = fit[:, src[ok].astype(int)]
-        fit[:, carried] = values
+        fit[:, predicted] = values
     return fit
 
 
@@ -290,11 +296,15 @@ def alerts_from_tracks(
     s, v = df[["north_m", "east_m", "down_m"]].to_numpy(float) - own_pos, v_int - own_vel
     located = np.isfinite(s).all(axis=1) & np.isfinite(v).all(axis=1)  # else a range-only row
     cov_p, cov_v = covariances(df)
-    fit = _range_fit(df, t, own_vel, predicted, located)
+    path = _range_fit(df, t, own_vel, predicted)
+    # The range path judges the levels of rows whose height is the co-altitude prior or that have
+    # no position (a measured height is the 3-D track's to judge), and a 3-D prediction carries none.
+    judged = (~_altitude_measured(df) | ~located) & ~(predicted & located)
+    fit = np.where(judged, path, np.nan)
     raw = _merged_levels(s, v, t, config, cov_p, cov_v, fit, located)
     raw["level"][predicted] = 0  # a prediction holds a track's level, never raises it
     raw["flarm_level"][predicted] = 0
-    level = _issued_levels(df, t, raw, s, v, cov_v, config, predicted, located)
+    level = _issued_levels(df, t, raw, s, v, cov_v, config, predicted, located, path[:2])
     measured_r = df["range_m"].to_numpy(float) if "range_m" in df else np.full(len(df), np.nan)
     fitted_r = np.sqrt(fit[0] ** 2 + fit[2] * (fit[3] - t) ** 2)
     range_m = np.where(

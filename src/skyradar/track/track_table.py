@@ -198,13 +198,22 @@ def _surface(ground_test) -> Callable | None:
 
 
 def _table(
-    chunks, origin, m3, detections, ownship, config: RadarConfig, ground_test, at_time_s: float | None = None
+    chunks,
+    origin,
+    m3,
+    detections,
+    ownship,
+    config: RadarConfig,
+    ground_test,
+    at_time_s: float | None = None,
+    walks: dict | None = None,
 ) -> pd.DataFrame:
     """The tracks table: ids through reacquisition, ``altitude_measured`` (on the elevations the
     3-D tracker trusted, :mod:`.elevation_trust`), then the ground hold.
 
     With ``at_time_s`` only the tracks with a row at that time are judged after the ids (each
-    track's rows are judged on its own, so theirs are those of the whole table)."""
+    track's rows are judged on its own, so theirs are those of the whole table); ``walks`` keeps
+    the ground hold's judgements between calls (:func:`~skyradar.track.ground_tracks.hold_ground_tracks`)."""
     t = _reacquired_ids(
         _assemble(chunks, origin, m3.active), chunks, detections, ownship, config, ground_test
     )
@@ -215,7 +224,7 @@ def _table(
         detections.assign(elevation_measured=m3.trusted) if m3.active and m3.own is not None else detections
     )
     t = t.assign(altitude_measured=altitude_measured(t.track_id, t.detection_row, read))
-    return _held(t, detections, ownship, config, ground_test)
+    return _held(t, detections, ownship, config, ground_test, walks)
 
 
 def _make_tracker(model, config: RadarConfig, tracker_config) -> tuple[MotionModel, RangeDopplerTracker]:
@@ -224,7 +233,7 @@ def _make_tracker(model, config: RadarConfig, tracker_config) -> tuple[MotionMod
     return motion, RangeDopplerTracker(motion, tracker_config, pixel, report_tentative=True)
 
 
-def _held(tracks, detections, ownship, config: RadarConfig, ground_test) -> pd.DataFrame:
+def _held(tracks, detections, ownship, config: RadarConfig, ground_test, walks=None) -> pd.DataFrame:
     """:func:`~skyradar.track.ground_tracks.hold_ground_tracks` with ``ground_test``'s settings, and
     ``held_by`` saying why each row is not confirmed (the tracker's reasons first)."""
     coasting = tracks["coasted"].to_numpy(bool) if "coasted" in tracks else np.zeros(len(tracks), bool)
@@ -234,7 +243,7 @@ def _held(tracks, detections, ownship, config: RadarConfig, ground_test) -> pd.D
         return tracks
     test = ground_test if isinstance(ground_test, GroundTrackTest) else GroundTrackTest()
     width, coupling = 2.0 * config.v_lim_mps, config.range_doppler_coupling_s
-    return hold_ground_tracks(tracks, detections, ownship, width, coupling, test.surface_down, test)
+    return hold_ground_tracks(tracks, detections, ownship, width, coupling, test.surface_down, test, walks)
 
 
 def _run_tracker(tracker: RangeDopplerTracker, m3, detections: pd.DataFrame, grid, lo, hi) -> list[dict]:
@@ -417,7 +426,8 @@ class TrackTableStream:
     The range-Doppler tracker and the 3-D feed keep their state between frames and step once per
     frame (:func:`_step_frame`, the batch loop's body). The table's finishing (ids through
     reacquisition, ``altitude_measured``, the ground hold) runs the batch's code on the rows so far
-    and keeps the tracks alive on the frame, so it costs each frame the history of those tracks.
+    and keeps the tracks alive on the frame; the ground hold keeps each track's judgements
+    (:class:`~skyradar.track.ground_tracks.TrackHoldWalk`) and judges only its new detections.
 
     What a stream cannot know makes its rows differ from the batch table's in three ways, all in
     rows that are not confirmed or in long tracks:
@@ -468,6 +478,7 @@ class TrackTableStream:
         self._input_rows: list[np.ndarray] = []  # per frame: the input row of each fused detection
         self._n_input = self._n_fused = 0
         self._own: list[pd.DataFrame] = []
+        self._walks: dict = {}  # the ground hold's judgements of each track, kept between frames
 
     def set_surface(self, surface_down: Callable | None) -> None:
         """The terrain (NE -> down, m) of the ground test and the 3-D feed from this frame on."""
@@ -507,6 +518,6 @@ class TrackTableStream:
         self._n_input, self._n_fused = self._n_input + len(det), self._n_fused + len(fused)
         table = pd.concat(self._fused, ignore_index=True)
         args = (self.origin, self._m3, table, own, self.config, self.ground_test)
-        t = _table(self._chunks, *args, at_time_s=float(time_s))
+        t = _table(self._chunks, *args, at_time_s=float(time_s), walks=self._walks)
         t = t[t["time_s"].to_numpy(float) == float(time_s)].reset_index(drop=True)
         return restore_detection_rows(t, np.concatenate(self._input_rows))

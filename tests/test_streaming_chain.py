@@ -1,4 +1,5 @@
-"""The streaming chain, fed frame by frame, gives the batch chain's detections, tracks and alerts.
+"""The streaming chain, fed frame by frame, gives the batch chain's detections, tracks and alerts: on a
+clear-sky head-on, over flat terrain with clutter suppression and navigation errors, and with two heads.
 
 Equal: every detection, every confirmed track row, every alert row (values to float tolerance).
 Not equal by design (:mod:`skyradar.stream`): the stream's tracks table holds no tentative rows of
@@ -45,7 +46,20 @@ OVER_TERRAIN = {
     "duration_s": 3.0,
     "simulation": {"facet_size_m": 30.0},
 }  # fmt: skip
-CASES = {"head-on": (HEAD_ON, {}), "terrain": (OVER_TERRAIN, {"suppression": "auto"})}
+# Two heads whose beams overlap on a converging intruder: the heads' detections fused frame by frame.
+TWO_HEADS = {
+    **HEAD_ON,
+    "name": "stream two heads",
+    "radars": [{"name": "nose", "mount": "nose"}, {"name": "left", "mount": "left-wingtip"}],
+    "intruders": [{"name": "A", "type": "straight", "start_ned_m": [1000, -700, -2000], "heading_deg": 150,
+                   "speed_mps": 40}],
+    "duration_s": 3.0,
+}  # fmt: skip
+CASES = {
+    "head-on": (HEAD_ON, {}),
+    "terrain": (OVER_TERRAIN, {"suppression": "auto"}),
+    "two heads": (TWO_HEADS, {}),
+}
 
 
 @pytest.fixture(scope="module", params=list(CASES))
@@ -80,6 +94,8 @@ def test_the_stream_gives_the_batch_detections(both):
     assert len(batch["detections"]) > 0
     if case == "terrain":  # the case means something only with ground returns in it
         assert batch["detections"]["is_ground"].sum() > 100
+    if case == "two heads":  # and with both heads seeing the intruder
+        assert batch["detections"]["radar"].nunique() == 2
     _assert_same(stream["detections"], batch["detections"])
     _assert_same(stream["ownship"], batch["ownship"])
 
@@ -103,11 +119,13 @@ def test_every_track_row_of_the_stream_is_the_batch_row_of_its_frame_and_track(b
 
 
 def test_the_stream_gives_the_batch_alerts(both):
-    _, batch, stream, results = both
-    assert (batch["alerts"]["level"] == 3).any()  # a warning is issued in both cases
+    case, batch, stream, results = both
+    if case != "two heads":
+        assert (batch["alerts"]["level"] == 3).any()  # the head-on intruder is warned
     _assert_same(stream["alerts"], batch["alerts"])
     advised = [r for r in results if r.advice is not None]
-    assert advised and all(np.isfinite(r.advice.preferred_heading_deg) for r in advised)
+    assert all(np.isfinite(r.advice.preferred_heading_deg) for r in advised)
+    assert bool(advised) == bool((batch["alerts"]["level"] > 0).any())
 
 
 def test_frames_come_in_time_order_and_stepping_past_the_end_raises_stop_iteration(both):

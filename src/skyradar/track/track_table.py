@@ -429,23 +429,24 @@ class TrackTableStream:
     and keeps the tracks alive on the frame; the ground hold keeps each track's judgements
     (:class:`~skyradar.track.ground_tracks.TrackHoldWalk`) and judges only its new detections.
 
-    What a stream cannot know makes its rows differ from the batch table's in three ways, all in
-    rows that are not confirmed or in long tracks:
+    What a stream cannot know makes its rows differ from the batch table's in three ways:
 
-    - A tentative track's rows are emitted only once it is (or was) confirmed: the batch keeps the
-      tentative rows of a track confirmed later, a stream cannot take them back.
+    - A track's rows are emitted only from its confirmation on: the batch keeps the tentative rows
+      of a track confirmed later, which a stream cannot take back. Every row emitted is the batch's.
     - The ground hold judges a track's newest detection on every frame; the batch, which knows which
-      of a long track's detections is its last, judges every fifth after the thirtieth and the last.
-      A verdict that changes between two judgements then shows a few frames earlier in the stream.
-    - With several heads the frames are fused as a multi-head run from the first
-      (``several_heads``); the batch fuses only when its table holds more than one head.
+      detection of a long track is its last, judges every fifth after the thirtieth, and the last.
+      A verdict that changes between two judgements then shows some frames earlier in the stream.
+    - With several heads, every frame is fused as a multi-head one (``several_heads``); the batch
+      fuses only when its table holds more than one head, and refers a single head's ranges to the
+      aircraft's reference point only then.
 
     Parameters
     ----------
     model, config, tracker_config, origin, position_sigma_rad, ground_test
         As in :func:`track_detections`.
     several_heads : bool
-        Whether the detections come from more than one radar head (:func:`~skyradar.track.fusion.fuse_heads`).
+        Whether the detections come from more than one radar head
+        (:func:`~skyradar.track.fusion.fuse_heads`).
 
     Examples
     --------

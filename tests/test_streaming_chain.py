@@ -123,6 +123,7 @@ def test_the_stream_gives_the_batch_alerts(both):
     if case != "two heads":
         assert (batch["alerts"]["level"] == 3).any()  # the head-on intruder is warned
     _assert_same(stream["alerts"], batch["alerts"])
+    assert stream["alerts"].attrs["rows_skipped_no_state"] == batch["alerts"].attrs["rows_skipped_no_state"]
     advised = [r for r in results if r.advice is not None]
     assert all(np.isfinite(r.advice.preferred_heading_deg) for r in advised)
     assert bool(advised) == bool((batch["alerts"]["level"] > 0).any())

@@ -194,6 +194,7 @@ class StreamingChain:
         self._own_truth: dict[str, list[float]] = {}
         self._navigated: list[dict[str, np.ndarray]] = []  # the last frames' navigated own-ship states
         self._n_detections = 0
+        self._skipped = 0  # confirmed track rows without a state to alert on, so far
         self._used: list[np.ndarray] = []  # per frame: rows of the detections table the tracker took
         self._out: dict[str, list] = {"detections": [], "tracks": [], "alerts": [], "ownship": []}
         self._truth: dict[str, list[xr.Dataset]] = {h.name: [] for h in self.heads}
@@ -239,7 +240,7 @@ class StreamingChain:
         self.timings_s["track"] += time.perf_counter() - t0
         t0 = time.perf_counter()
         alerts = self._alerter.step(time_s, rows, own_row)
-        alerts.attrs = {}
+        self._skipped += int(alerts.attrs.get("rows_skipped_no_state", 0))
         self.timings_s["alert"] += time.perf_counter() - t0
         self._out["tracks"].append(rows)
         self._out["alerts"].append(alerts)
@@ -263,13 +264,15 @@ class StreamingChain:
         ``detections`` (every head's, ``radar`` column), ``tracks`` (every row emitted: the
         confirmed rows and those of tracks confirmed before, their ``detection_row`` indexing
         ``detections``), ``alerts``, ``ownship``, ``truth`` (the first head's frames Dataset without
-        ``iq``), ``truth_by_head`` and ``timings_s`` per stage.
+        ``iq``), ``truth_by_head`` and ``timings_s`` per stage. The alerts' ``attrs`` count the
+        confirmed track rows skipped for want of a state, as the batch's do.
         """
         out: dict[str, Any] = {}
         for name, parts in self._out.items():
             out[name] = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()
         if not self._out["tracks"]:
             out["tracks"] = empty_tracks()
+        out["alerts"].attrs = {"rows_skipped_no_state": self._skipped}
         truths = {n: xr.concat(d, dim="time") if d else xr.Dataset() for n, d in self._truth.items()}
         return out | {"truth": truths[self.heads[0].name], "truth_by_head": truths,
                       "timings_s": dict(self.timings_s)}  # fmt: skip

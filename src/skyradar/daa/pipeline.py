@@ -394,7 +394,11 @@ class AlertStream:
         self._last_confirmed_s: dict[int, float] = {}
 
     def step(self, time_s: float, tracks: pd.DataFrame, ownship: pd.DataFrame) -> pd.DataFrame:
-        """Alert one frame: its tracks rows ``tracks`` (all at ``time_s``, s) and own-ship row ``ownship``."""
+        """Alert one frame: its tracks rows ``tracks`` (all at ``time_s``, s) and own-ship row ``ownship``.
+
+        Returns the frame's alerts rows; ``attrs["rows_skipped_no_state"]`` counts the frame's
+        confirmed rows that have no state to alert on.
+        """
         self._own.append(ownship)
         confirmed = (
             tracks["confirmed"].to_numpy(bool) if "confirmed" in tracks else np.ones(len(tracks), bool)
@@ -412,5 +416,7 @@ class AlertStream:
         alerts = alerts_from_tracks(history, own, self.config, self.with_advice, self.source)
         now = alerts["time_s"].to_numpy(float) == float(time_s)
         out = alerts[now].reset_index(drop=True)
-        out.attrs = dict(alerts.attrs)
+        # The frame's own count: its confirmed rows without a state (the history's are counted on theirs).
+        skipped = clean_tracks(tracks, self.source).attrs["rows_skipped_no_state"]
+        out.attrs = {"rows_skipped_no_state": skipped}
         return out

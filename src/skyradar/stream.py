@@ -44,7 +44,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from skyradar.chain import _surface
+from skyradar.chain import scenario_surface
 from skyradar.daa.alerting import AlertConfig
 from skyradar.daa.pipeline import AlertStream
 from skyradar.daa.run_tables import ownship_from_frames
@@ -234,7 +234,8 @@ class StreamingChain:
         self._used.append(self._n_detections + used)
         self._n_detections += len(det)
         t0 = time.perf_counter()
-        self._tracker.set_surface(_surface(self.built, pd.concat(self._out["ownship"], ignore_index=True)))
+        own_so_far = pd.concat(self._out["ownship"], ignore_index=True)
+        self._tracker.set_surface(scenario_surface(self.built, own_so_far))  # causal: the ground so far
         rows = self._tracker.step(time_s, i, air, own_row)
         rows = restore_detection_rows(rows, np.concatenate(self._used)) if len(rows) else rows
         self.timings_s["track"] += time.perf_counter() - t0

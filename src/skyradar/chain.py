@@ -45,7 +45,7 @@ from skyradar.track.ground_tracks import GroundTrackTest, median_ground_down_m, 
 from skyradar.track.track_table import track_detections, tracker_detections
 from skyradar.units import wrap
 
-__all__ = ["run_chain", "track_and_alert", "label_tracks", "confirmed_rows"]
+__all__ = ["run_chain", "track_and_alert", "label_tracks", "confirmed_rows", "scenario_surface"]
 
 _MATCH_M = 300.0  # a track is an intruder's if its median distance to that truth is below this
 
@@ -169,7 +169,7 @@ def track_and_alert(
     tracks = track_detections(
         air, "radar", chosen[0].config,
         frame_times_s=built.times_s, origin=built.origin, ownship=own,
-        ground_test=GroundTrackTest(surface_down=_surface(built, own)),
+        ground_test=GroundTrackTest(surface_down=scenario_surface(built, own)),
     )  # fmt: skip
     tracks = restore_detection_rows(tracks, used)  # detection_row indexes the chosen heads' rows
     timings = {"track": time.perf_counter() - t0}
@@ -181,8 +181,11 @@ def track_and_alert(
     return out | {"timings_s": timings}
 
 
-def _surface(built, own: pd.DataFrame):
-    """The scenario's ground for the track-level ground test (None: the own-ship's height above ground)."""
+def scenario_surface(built, own: pd.DataFrame):
+    """The scenario's ground for the track-level ground test (None: the own-ship's height above ground).
+
+    ``own`` is the own-ship table (its median ground under the own-ship is the level ground beyond
+    the DEM)."""
     if built.terrain is None or not hasattr(built.terrain, "height_at"):
         return None
     return terrain_surface(built.terrain, built.origin, median_ground_down_m(own))

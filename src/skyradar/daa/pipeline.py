@@ -57,6 +57,7 @@ __all__ = [
     "ownship_from_frames",
     "truth_tracks",
     "alerts_from_tracks",
+    "AlertStream",
     "alerts_for_run",
     "alert_summary",
 ]
@@ -367,3 +368,65 @@ def alert_summary(alerts: pd.DataFrame) -> dict[str, Any]:
     for level in (1, 2, 3):
         result[f"rows_level_{level}"] = int(np.sum(alerts["level"].to_numpy() == level))
     return result
+
+
+class AlertStream:
+    """:func:`alerts_from_tracks` one frame at a time: each call gives the alerts table's rows of a frame.
+
+    Every stage of the alerting is causal (a track's M-of-N filter, its age, its range fit over a
+    trailing window, a lost track's prediction from its last confirmed row, the frame's advice), so
+    a frame's rows computed from the tracks and own-ship rows up to it are the whole run's. Each
+    call runs :func:`alerts_from_tracks` over the history of the tracks that can have a row on the
+    frame (a confirmed row within ``lost_track_hold_s``) and keeps that frame's rows.
+
+    Parameters
+    ----------
+    config, with_advice, source
+        As in :func:`alerts_from_tracks`.
+
+    Examples
+    --------
+    >>> tracks = pd.DataFrame({"time_s": [0.0, 1.0], "track_id": 1, "north_m": [3000.0, 2900.0],
+    ...     "east_m": 0.0, "down_m": 0.0, "vn_mps": -100.0, "ve_mps": 0.0, "vd_mps": 0.0})
+    >>> own = pd.DataFrame({"time_s": [0.0, 1.0], "own_north_m": 0.0, "own_east_m": 0.0, "own_down_m": 0.0,
+    ...     "own_vn_mps": 0.0, "own_ve_mps": 0.0, "own_vd_mps": 0.0, "own_yaw_rad": 0.0})
+    >>> stream = AlertStream(with_advice=False)
+    >>> rows = [stream.step(t, tracks[tracks.time_s == t], own[own.time_s == t]) for t in (0.0, 1.0)]
+    >>> pd.concat(rows, ignore_index=True).equals(alerts_from_tracks(tracks, own, with_advice=False))
+    True
+    """
+
+    def __init__(self, config: AlertConfig | None = None, with_advice: bool = True, source: str = "tracks"):
+        self.config = config or AlertConfig()
+        self.with_advice, self.source = with_advice, source
+        self._tracks: list[pd.DataFrame] = []
+        self._own: list[pd.DataFrame] = []
+        self._last_confirmed_s: dict[int, float] = {}
+
+    def step(self, time_s: float, tracks: pd.DataFrame, ownship: pd.DataFrame) -> pd.DataFrame:
+        """Alert one frame: its tracks rows ``tracks`` (all at ``time_s``, s) and own-ship row ``ownship``.
+
+        Returns the frame's alerts rows; ``attrs["rows_skipped_no_state"]`` counts the frame's
+        confirmed rows that have no state to alert on.
+        """
+        self._own.append(ownship)
+        confirmed = (
+            tracks["confirmed"].to_numpy(bool) if "confirmed" in tracks else np.ones(len(tracks), bool)
+        )
+        self._tracks.append(tracks[confirmed])
+        self._last_confirmed_s.update(
+            dict.fromkeys(tracks["track_id"].to_numpy()[confirmed].tolist(), time_s)
+        )
+        own = pd.concat(self._own, ignore_index=True)
+        own.attrs = dict(ownship.attrs)
+        since = float(time_s) - self.config.lost_track_hold_s - 1e-9
+        alive = [i for i, t in self._last_confirmed_s.items() if t >= since]
+        history = pd.concat(self._tracks, ignore_index=True)
+        history = history[history["track_id"].isin(alive)]
+        alerts = alerts_from_tracks(history, own, self.config, self.with_advice, self.source)
+        now = alerts["time_s"].to_numpy(float) == float(time_s)
+        out = alerts[now].reset_index(drop=True)
+        # The frame's own count: its confirmed rows without a state (the history's are counted on theirs).
+        skipped = clean_tracks(tracks, self.source).attrs["rows_skipped_no_state"]
+        out.attrs = {"rows_skipped_no_state": skipped}
+        return out

@@ -38,6 +38,7 @@ import numpy as np
 from skyradar.process.ground import height_above_ground_m
 
 __all__ = [
+    "AnchorWalk",
     "frame_geometries",
     "prediction_anchors",
     "anchor_key",
@@ -142,11 +143,35 @@ def prediction_anchors(
     [999.7, 999.7, 1199.9, 999.7]
     """
     states = frame_geometries(own, terrain, stop)
-    anchors = np.full_like(states, np.nan)
-    recent: OrderedDict[tuple, np.ndarray] = OrderedDict()
-    for i, state in enumerate(states):
+    walk = AnchorWalk()
+    return np.array([walk.next(state) for state in states], float).reshape(states.shape)
+
+
+class AnchorWalk:
+    """The walk of :func:`prediction_anchors` one frame at a time: the anchor of each next frame.
+
+    It keeps the 8 anchors last used, so frame ``i``'s anchor is the one the whole run's walk gives
+    it when the frames are fed in order from frame 0 (a stream, :mod:`skyradar.stream`).
+
+    Examples
+    --------
+    >>> walk = AnchorWalk()
+    >>> first = walk.next(np.array([50.0, 0.0, 0.0, 0.0, 0.0, 1000.0]))
+    >>> bool(np.array_equal(walk.next(np.array([50.0, 0.0, 0.3, 0.0, 0.0, 1030.0])), first))
+    True
+    >>> bool(np.isnan(walk.next(np.full(6, np.nan))).all())
+    True
+    """
+
+    def __init__(self) -> None:
+        self._recent: OrderedDict[tuple, np.ndarray] = OrderedDict()
+
+    def next(self, state: np.ndarray) -> np.ndarray:
+        """Anchor of the frame whose geometry is ``state`` (a :func:`frame_geometries` row); NaN
+        where the geometry is unknown (no height above the ground)."""
         if not np.all(np.isfinite(state)):
-            continue
+            return np.full(np.shape(state), np.nan)
+        recent = self._recent
         at = _quantised(state)
         key = anchor_key(at)
         hit = recent.get(key)
@@ -160,5 +185,4 @@ def prediction_anchors(
             while len(recent) > RECENT_ANCHORS:
                 recent.popitem(last=False)
         recent.move_to_end(key)
-        anchors[i] = hit
-    return anchors
+        return hit

@@ -31,6 +31,7 @@ __all__ = [
     "AhrsModel",
     "ahrs_attitude",
     "gauss_markov",
+    "navigation_at_frame",
     "navigation_solution",
     "navigation_variables",
 ]
@@ -273,3 +274,34 @@ def navigation_variables(built, ownship_truth: Mapping[str, np.ndarray]) -> dict
     terrain = getattr(built, "terrain", None)
     height = terrain.height_at if terrain is not None and hasattr(terrain, "height_at") else None
     return navigation_solution(ownship_truth, built.times_s, cfg, seed, built.origin, height)
+
+
+def navigation_at_frame(built, ownship_truth: Mapping[str, np.ndarray]) -> dict[str, float]:
+    """The ``nav_*`` values of the newest frame of a run in progress: ``ownship_truth`` holds the
+    own-ship truth of frames ``0..i`` (arrays of length ``i + 1``); returns frame ``i``'s solution.
+
+    The solution is causal: the errors are drawn on the scenario's frame times (a function of the
+    seed and the times alone) and the latency looks back, so frame ``i`` of
+    :func:`navigation_variables` over the whole run depends on the truth up to frame ``i`` only.
+    The truth after frame ``i`` is not known yet; it stands at frame ``i``'s (any value gives the
+    same result). Costs one whole-run solution per call.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> built = SimpleNamespace(navigation="ga-typical", sim_options={"seed": 3}, terrain=None,
+    ...                         times_s=np.arange(5) * 0.1, origin=(52.0, 4.0, 0.0))
+    >>> names = [f"{a}_m" for a in _XYZ] + [f"{a}_mps" for a in _VXYZ] + [f"{a}_rad" for a in _ATT]
+    >>> truth = {f"own_{k}": np.linspace(0.0, 1.0, 5) for k in names}
+    >>> whole = navigation_variables(built, truth)
+    >>> first3 = navigation_at_frame(built, {k: v[:3] for k, v in truth.items()})
+    >>> bool(first3["nav_north_m"] == whole["nav_north_m"][2])
+    True
+    """
+    n = built.times_s.size
+    known = {k: np.asarray(v, float) for k, v in ownship_truth.items()}
+    i = next(iter(known.values())).size - 1
+    if not 0 <= i < n:
+        raise InputError(f"navigation: {i + 1} frames of truth for a run of {n}")
+    padded = {k: np.concatenate([v, np.full(n - v.size, v[-1])]) for k, v in known.items()}
+    return {k: float(v[i]) for k, v in navigation_variables(built, padded).items()}

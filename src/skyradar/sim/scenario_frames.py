@@ -17,6 +17,7 @@ import xarray as xr
 
 from skyradar.io.frames import frames_dataset
 from skyradar.scene.radar_heads import head_of
+from skyradar.scene.trajectories import TrajectorySample
 from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
 from skyradar.sim.impairments import apply_impairments
 from skyradar.sim.navigation import navigation_variables
@@ -27,7 +28,14 @@ if TYPE_CHECKING:
     # What make_simulator gives: the terrain simulator, or the land-cover one (a map's ground).
     Simulator = ImageSimulator | LandCoverSimulator
 
-__all__ = ["make_simulator", "scenario_truth", "simulate_frames", "simulate", "frames_attrs"]
+__all__ = [
+    "make_simulator",
+    "frames_truth",
+    "scenario_truth",
+    "simulate_frames",
+    "simulate",
+    "frames_attrs",
+]
 
 _SIM_KEYS = (
     "facet_size_m",
@@ -63,9 +71,11 @@ def make_simulator(built, head: int | str = 0) -> Simulator:
     return ImageSimulator(radar, built.terrain, built.origin, **options)
 
 
-def _states(built, indices: np.ndarray):
+def _states(built, indices: np.ndarray, ownship: TrajectorySample | None = None):
+    """Own-ship and intruder states of frames ``indices``; ``ownship`` replaces the scenario's own-ship
+    sample at those frames (a closed loop's states, known only at run time)."""
     times = built.times_s[indices]
-    own = built.ownship.sample(times)
+    own = built.ownship.sample(times) if ownship is None else ownship
     intruders = []
     for intruder in built.intruders:
         present = intruder.trajectory.covers(times)
@@ -85,11 +95,20 @@ def _frame_inputs(own, intruders, i: int) -> tuple[PlatformState, list[PointTarg
     return platform, targets, which
 
 
-def simulate_frames(built, indices: np.ndarray, simulator: Simulator | None = None) -> np.ndarray:
-    """Frames ``indices`` of the simulator's head as an (n, range, doppler, rx) complex64 array."""
+def simulate_frames(
+    built,
+    indices: np.ndarray,
+    simulator: Simulator | None = None,
+    ownship: TrajectorySample | None = None,
+) -> np.ndarray:
+    """Frames ``indices`` of the simulator's head as an (n, range, doppler, rx) complex64 array.
+
+    ``ownship`` (one state per frame of ``indices``) replaces the scenario's own-ship trajectory
+    sampled at those frames.
+    """
     simulator = simulator or make_simulator(built)
     indices = np.asarray(indices)
-    own, intruders = _states(built, indices)
+    own, intruders = _states(built, indices, ownship)
     cfg = simulator.config
     out = np.empty((indices.size, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
     impairments = getattr(built, "impairments", None)
@@ -151,15 +170,28 @@ def _intruder_truth(built, own, intruders, simulator: Simulator) -> dict[str, np
     return truth
 
 
+def frames_truth(
+    built,
+    indices: np.ndarray,
+    simulator: Simulator | None = None,
+    ownship: TrajectorySample | None = None,
+) -> tuple[dict, dict, list[str]]:
+    """Own-ship truth (``own_*``, no navigation solution) and intruder truth of frames ``indices``.
+
+    ``ownship`` replaces the scenario's own-ship sample at those frames, as in :func:`simulate_frames`.
+    """
+    simulator = simulator or make_simulator(built)
+    own, intruders = _states(built, np.asarray(indices), ownship)
+    targets = _intruder_truth(built, own, intruders, simulator) if intruders else {}
+    return _ownship_truth(built, own), targets, [i.name for i in built.intruders]
+
+
 def scenario_truth(built, simulator: Simulator | None = None) -> tuple[dict, dict, list[str]]:
     """Own-ship truth on time and intruder truth on (time, target), named as in ``skyradar.io.frames``."""
-    simulator = simulator or make_simulator(built)
-    own, intruders = _states(built, np.arange(built.times_s.size))
-    targets = _intruder_truth(built, own, intruders, simulator) if intruders else {}
-    ownship = _ownship_truth(built, own)
+    ownship, targets, names = frames_truth(built, np.arange(built.times_s.size), simulator)
     # The navigation solution (nav_*) beside the truth: the chain reads only nav_*, as an aircraft
     # knows only its navigation solution.
-    return ownship | navigation_variables(built, ownship), targets, [i.name for i in built.intruders]
+    return ownship | navigation_variables(built, ownship), targets, names
 
 
 def simulate(built, progress: Callable[[int], None] | None = None, head: int | str = 0) -> xr.Dataset:

@@ -40,29 +40,47 @@ class Measure3D:
         if not self.active:
             return
         self.t3 = Tracker3D()
-        self.ned = det[list(_NED)].to_numpy(float)
-        self.z = det[["range_m", "radial_velocity_mps"]].to_numpy(float)
+        self.config, self.sigma_rad = config, sigma_rad
         self.motion, self.width = motion, motion.doppler_width_mps
-        if sigma_rad is None and "snr_db" in det.columns:
-            azimuth, elevation = (
-                det[c].to_numpy(float) if c in det.columns else None for c in ("azimuth_rad", "elevation_rad")
-            )
-            self.sigma = angle_sigma_rad(det["snr_db"].to_numpy(float), config, azimuth, elevation)
-        else:
-            self.sigma = np.full(len(det), 0.04 if sigma_rad is None else float(sigma_rad))
+        self.ned, self.z, self.sigma = np.empty((0, 3)), np.empty((0, 2)), np.empty(0)
+        self.measured, self.trusted = np.empty(0, bool), np.empty(0, bool)
         self.own, self.agl = None, np.full(len(grid), np.nan)
         self.votes, self.below, self.surface_down = AboveVotes(), BelowConsensus(), surface_down
         self.agreed_up: dict[int, float] = {}  # the height each track's in-band readings last agreed on
         self.agreed_ids: set[int] = set()  # tracks whose in-band readings agreed on a height last frame
-        self.measured, self.trusted = elevation_measured_flags(det), np.zeros(len(det), bool)
+        self.add_detections(det)
         if ownship is not None:
-            validate_ownship(ownship, OWNSHIP_COLUMNS)
-            t = ownship["time_s"].to_numpy(float)
-            self.own = np.column_stack(
-                [np.interp(grid, t, ownship[c].to_numpy(float)) for c in OWNSHIP_COLUMNS[1:]]
+            self.own, self.agl = np.empty((0, len(OWNSHIP_COLUMNS) - 1)), np.empty(0)
+            self.add_frames(grid, ownship)
+
+    def add_detections(self, det) -> None:
+        """Append detections after the rows held (a stream adds each frame's; rows index them all)."""
+        ned = det[list(_NED)].to_numpy(float)
+        z = det[["range_m", "radial_velocity_mps"]].to_numpy(float)
+        if self.sigma_rad is None and "snr_db" in det.columns:
+            azimuth, elevation = (
+                det[c].to_numpy(float) if c in det.columns else None for c in ("azimuth_rad", "elevation_rad")
             )
-            if "own_height_agl_m" in ownship:  # the ground's range-Doppler band (elevation_trust)
-                self.agl = np.interp(grid, t, ownship["own_height_agl_m"].to_numpy(float))
+            sigma = angle_sigma_rad(det["snr_db"].to_numpy(float), self.config, azimuth, elevation)
+        else:
+            sigma = np.full(len(det), 0.04 if self.sigma_rad is None else float(self.sigma_rad))
+        self.ned, self.z = np.concatenate([self.ned, ned]), np.concatenate([self.z, z])
+        self.sigma = np.concatenate([self.sigma, sigma])
+        self.measured = np.concatenate([self.measured, elevation_measured_flags(det)])
+        self.trusted = np.concatenate([self.trusted, np.zeros(len(det), bool)])
+
+    def add_frames(self, grid, ownship) -> None:
+        """Append the own-ship state (:data:`OWNSHIP_COLUMNS`, optionally ``own_height_agl_m``) of the
+        frames at times ``grid``, interpolated from the table ``ownship``; frame ``k`` of
+        :meth:`step` indexes them all."""
+        validate_ownship(ownship, OWNSHIP_COLUMNS)
+        t = ownship["time_s"].to_numpy(float)
+        own = np.column_stack([np.interp(grid, t, ownship[c].to_numpy(float)) for c in OWNSHIP_COLUMNS[1:]])
+        agl = np.full(len(grid), np.nan)
+        if "own_height_agl_m" in ownship:  # the ground's range-Doppler band (elevation_trust)
+            agl = np.interp(grid, t, ownship["own_height_agl_m"].to_numpy(float))
+        self.own = own if self.own is None else np.concatenate([self.own, own])
+        self.agl = np.concatenate([self.agl, agl])
 
     def step(self, tracker, out, k: int, a: int, b: int) -> tuple[np.ndarray, np.ndarray]:
         det = out.alive_detection

@@ -74,6 +74,7 @@ def fuse_heads(
     range_gate_bins: float = 2.0,
     doppler_gate_bins: float = 2.0,
     position_gate: float = 0.3,
+    several_heads: bool | None = None,
 ) -> tuple[pd.DataFrame, np.ndarray | None]:
     """One world-frame detection stream from several heads' detections (see the module docstring).
 
@@ -87,6 +88,10 @@ def fuse_heads(
         the heads share that hardware for one tracker).
     range_gate_bins, doppler_gate_bins, position_gate : float
         Same-frame duplicate gates (range and Doppler resolutions; fraction of the range).
+    several_heads : bool, optional
+        Whether the detections come from more than one head; None: the ``radar`` column says so.
+        A stream fusing one frame at a time passes its chain's head count: a frame seen by one head
+        only is still referred to the reference point.
 
     Returns
     -------
@@ -104,7 +109,9 @@ def fuse_heads(
     >>> rows.tolist(), fused["radar"].tolist()
     ([1, 2], ['left', 'left'])
     """
-    if HEAD_COLUMN not in detections.columns or detections[HEAD_COLUMN].nunique() <= 1:
+    if several_heads is None:
+        several_heads = HEAD_COLUMN in detections.columns and detections[HEAD_COLUMN].nunique() > 1
+    if not several_heads or HEAD_COLUMN not in detections.columns:
         return detections, None
     config = config or RadarConfig.prototype_2022()
     det = detections.reset_index(drop=True)

@@ -50,6 +50,7 @@ are not ``confirmed``; a track never confirmed is dropped, like a tentative trac
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -97,6 +98,7 @@ __all__ = [
     "fits_static_ground",
     "range_doppler_consistent",
     "hold_ground_tracks",
+    "TrackHoldWalk",
     "faster_than_ground",
     "flat_surface",
     "terrain_surface",
@@ -400,47 +402,114 @@ def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test
     """
     n = rng.size
     why = np.full(n, "young", dtype=object)
-    last, clear_since, start, ground_seen, object_since = "young", np.inf, 0, False, n
-    least = test.min_detections
-    own_speed = np.linalg.norm(own_v, axis=1) if own_v is not None else None
+    walk = _HistoryWalk(test)
+    speed = np.linalg.norm(own_v, axis=1) if own_v is not None else None
+    history = _History(t, rng, vel, own_p, own_v, speed, doa)
     for k in range(test.min_detections - 1, n):
-        if t[k] - clear_since >= _CLEAR_S:
-            why[k:] = ""
-            break
+        why[k] = walk.judge(k, k == n - 1, history, surface_down, width, coupling)
+    return why
+
+
+@dataclass
+class _History:
+    """One detection history's columns, in time order: time (s), range (m), radial velocity (m/s),
+    the own-ship's position (m) and velocity (m/s, and speed) at each, and :func:`doa_height_sd`'s
+    four columns (``doa``). The own-ship's are None without an own-ship state."""
+
+    t: np.ndarray
+    rng: np.ndarray
+    vel: np.ndarray
+    own_p: np.ndarray | None
+    own_v: np.ndarray | None
+    own_speed: np.ndarray | None
+    doa: list
+
+    def upto(self, a: int, b: int) -> _History:
+        """Detections ``a:b``."""
+
+        def part(x: np.ndarray | None) -> np.ndarray | None:
+            return None if x is None else x[a:b]
+
+        return _History(self.t[a:b], self.rng[a:b], self.vel[a:b], part(self.own_p), part(self.own_v),
+                        part(self.own_speed), [x[a:b] for x in self.doa])  # fmt: skip
+
+    def extended(self, more: _History) -> _History:
+        """These detections, then ``more``."""
+
+        def cat(x: np.ndarray | None, y: np.ndarray | None) -> np.ndarray | None:
+            return None if x is None or y is None else np.concatenate([x, y])
+
+        doa = [np.concatenate([x, y]) for x, y in zip(self.doa, more.doa, strict=True)]
+        t, rng, vel = (np.concatenate([x, y]) for x, y in ((self.t, more.t), (self.rng, more.rng),
+                                                            (self.vel, more.vel)))  # fmt: skip
+        own_p, own_v = cat(self.own_p, more.own_p), cat(self.own_v, more.own_v)
+        return _History(t, rng, vel, own_p, own_v, cat(self.own_speed, more.own_speed), doa)
+
+
+@dataclass
+class _HistoryWalk:
+    """The walk of :func:`_history_held` over one history, one detection at a time.
+
+    Its state after detection ``k`` depends on the detections up to ``k`` alone, and on whether
+    ``k`` was the history's last (which is judged out of turn), so a stream keeps the walk over the
+    detections before its newest and judges the newest on a copy.
+    """
+
+    test: GroundTrackTest
+    last: str = "young"
+    clear_since: float = np.inf
+    start: int = 0
+    ground_seen: bool = False
+    object_since: float = np.inf  # the detection from which the judgements found an object
+    least: int = 0
+    cleared: bool = False  # an object off the ground for _CLEAR_S on end: not judged again
+
+    def __post_init__(self) -> None:
+        self.least = self.least or self.test.min_detections
+
+    def judge(self, k: int, is_last: bool, h: _History, surface_down, width, coupling) -> str:
+        """Why detection ``k`` (from ``test.min_detections - 1``, in order) holds the track."""
+        test, t = self.test, h.t
+        if self.cleared or t[k] - self.clear_since >= _CLEAR_S:
+            self.cleared = True
+            return ""
+        start = self.start
         recent = slice(max(start, k + 1 - 10), k + 1)
         if (
-            own_speed is not None
+            h.own_speed is not None
             and k + 1 - start >= max(test.min_detections, test.fast_min_detections)
             and faster_than_ground(
-                t[recent], rng[recent], vel[recent], own_speed[recent], width, coupling, test
+                t[recent], h.rng[recent], h.vel[recent], h.own_speed[recent], width, coupling, test
             )
-            and (test.point_sigma_velocity_mps is None or doppler_smooth(t[recent], vel[recent], width, test))
+            and (
+                test.point_sigma_velocity_mps is None or doppler_smooth(t[recent], h.vel[recent], width, test)
+            )
         ):  # one point, and no static point moves so fast: an object, however its Doppler aliases
-            ground_seen, least = False, test.min_detections
-            object_since = min(object_since, k)
-            last = "young" if k + 1 - start < test.release_detections else ""
-            clear_since = np.inf if last else min(clear_since, t[k])
-            why[k] = last
-            continue
-        if k + 1 - start >= least and (k < 30 or k % 5 == 0 or k == n - 1):
+            self.ground_seen, self.least = False, test.min_detections
+            self.object_since = min(self.object_since, k)
+            self.last = "young" if k + 1 - start < test.release_detections else ""
+            self.clear_since = np.inf if self.last else min(self.clear_since, t[k])
+            return self.last
+        if k + 1 - start >= self.least and (k < 30 or k % 5 == 0 or is_last):
             sl = slice(max(start, k + 1 - test.max_history), k + 1)
-            reason = _judge(sl, t, rng, vel, own_p, own_v, surface_down, width, coupling, test, doa)
+            args = (h.own_p, h.own_v, surface_down, width, coupling, test, h.doa)
+            reason = _judge(sl, t, h.rng, h.vel, *args)
             if reason == "rough":  # a fresh history, as long as the Doppler test's window
-                start, least = max(start, _largest_step(vel, width, sl)), test.ground_min_detections
+                self.start = max(start, _largest_step(h.vel, width, sl))
+                self.least = test.ground_min_detections
             if reason == "ground":  # ground once: as long a history as the Doppler test's to clear it
-                ground_seen, least = True, test.ground_min_detections
-            object_since = min(object_since, k) if reason == "" else n
-            released = k - object_since >= test.release_span_detections
-            early = k + 1 - start < max(least, test.release_detections)
+                self.ground_seen, self.least = True, test.ground_min_detections
+            self.object_since = min(self.object_since, k) if reason == "" else np.inf
+            released = k - self.object_since >= test.release_span_detections
+            early = k + 1 - self.start < max(self.least, test.release_detections)
             if reason:
-                last = reason
-            elif ground_seen and not released:
-                last = "ground-release"
+                self.last = reason
+            elif self.ground_seen and not released:
+                self.last = "ground-release"
             else:
-                last = "young" if early else ""
-            clear_since = np.inf if last else min(clear_since, t[k])
-        why[k] = last
-    return why
+                self.last = "young" if early else ""
+            self.clear_since = np.inf if self.last else min(self.clear_since, t[k])
+        return self.last
 
 
 def _largest_step(vel: np.ndarray, width: float, sl: slice) -> int:
@@ -453,19 +522,67 @@ def _largest_step(vel: np.ndarray, width: float, sl: slice) -> int:
 def _track_held(det: np.ndarray, ownship, surface_down, width: float, coupling: float, test) -> np.ndarray:
     """Why each detection of one track (``det``: time, range, radial velocity) holds it (``""``: not
     held), its history started again after every gap longer than ``test.rejudge_gap_s``."""
-    t, rng, vel = det[:, :3].T
-    own_p, own_v = _own_state(ownship, t) if ownship is not None else (None, None)
-    ground = surface_down if ownship is not None else None
-    doa = doa_height_sd(det, ground, test.doa_sigma_rad)
-    why = np.full(t.size, "young", dtype=object)
-    cuts = np.flatnonzero(np.diff(t) > test.rejudge_gap_s) + 1
-    for a, b in zip(np.r_[0, cuts], np.r_[cuts, t.size], strict=True):
-        s = slice(a, b)
-        own_ps, own_vs = (None, None) if own_p is None or own_v is None else (own_p[s], own_v[s])
-        why[s] = _history_held(
-            t[s], rng[s], vel[s], own_ps, own_vs, ground, width, coupling, test, [a[s] for a in doa]
-        )
-    return why
+    return TrackHoldWalk(test).why(det, ownship, surface_down, width, coupling)
+
+
+class TrackHoldWalk:
+    """:func:`_track_held` kept between calls on one track's growing detection history (a stream's).
+
+    Each call passes every detection of the track so far, those of earlier calls first and
+    unchanged. Each detection but the newest is judged once, as the whole history's walk judges
+    it (the last of a history before a gap as its last); the newest is judged on a copy of the walk,
+    as the last of the history so far. The columns of a detection (own-ship state, DoA height) are
+    computed when it arrives, with the ``ownship`` and ``surface_down`` of that call.
+    """
+
+    def __init__(self, test: GroundTrackTest) -> None:
+        self.test = test
+        self.history = _History(np.empty(0), np.empty(0), np.empty(0), None, None, None, [])
+        self.done: list[str] = []  # why of each detection judged for good
+        self.segment = 0  # first detection of the current history (after the last gap)
+        self.walk = _HistoryWalk(test)
+
+    def why(self, det: np.ndarray, ownship, surface_down, width: float, coupling: float) -> np.ndarray:
+        """Why each detection of ``det`` (rows: time, range, radial velocity, then
+        :data:`DOA_COLUMNS`; every detection of the track so far) holds the track."""
+        self._extend(det, ownship, surface_down)
+        n = self.history.t.size
+        ground = surface_down if ownship is not None else None
+        for j in range(len(self.done), n - 1):  # every detection but the newest: for good
+            self._start_history_at(j)
+            gap_after = self.history.t[j + 1] - self.history.t[j] > self.test.rejudge_gap_s
+            self.done.append(self._judge(j, gap_after, self.walk, ground, width, coupling))
+        if n == 0:
+            return np.array([], dtype=object)
+        self._start_history_at(n - 1)
+        newest = self._judge(n - 1, True, copy.copy(self.walk), ground, width, coupling)
+        return np.array([*self.done, newest], dtype=object)
+
+    def _start_history_at(self, j: int) -> None:
+        """A new history (and walk) from detection ``j`` when a gap precedes it."""
+        t = self.history.t
+        if j > self.segment and t[j] - t[j - 1] > self.test.rejudge_gap_s:
+            self.segment, self.walk = j, _HistoryWalk(self.test)
+
+    def _judge(self, j: int, is_last: bool, walk: _HistoryWalk, ground, width: float, coupling: float) -> str:
+        k = j - self.segment
+        if k < self.test.min_detections - 1:
+            return "young"
+        history = self.history.upto(self.segment, j + 1)
+        return walk.judge(k, is_last, history, ground, width, coupling)
+
+    def _extend(self, det: np.ndarray, ownship, surface_down) -> None:
+        """Add the columns of the detections of ``det`` not seen before."""
+        held = self.history.t.size
+        new = det[held:]
+        if held and new.size == 0:
+            return
+        t, rng, vel = new[:, :3].T
+        own_p, own_v = _own_state(ownship, t) if ownship is not None else (None, None)
+        speed = np.linalg.norm(own_v, axis=1) if own_v is not None else None
+        ground = surface_down if ownship is not None else None
+        more = _History(t, rng, vel, own_p, own_v, speed, doa_height_sd(new, ground, self.test.doa_sigma_rad))
+        self.history = more if held == 0 else self.history.extended(more)
 
 
 def median_ground_down_m(ownship: pd.DataFrame) -> float:
@@ -493,6 +610,7 @@ def hold_ground_tracks(
     coupling_s: float,
     surface_down: Callable[[np.ndarray], np.ndarray] | None = None,
     test: GroundTrackTest | None = None,
+    walks: dict[int, tuple[np.ndarray, TrackHoldWalk]] | None = None,
 ) -> pd.DataFrame:
     """A tracks table with the rows the ground explains (or that are no object) not ``confirmed``.
 
@@ -503,6 +621,11 @@ def hold_ground_tracks(
     A row takes the decision of the track's newest detection at or before it, and says in
     ``held_by`` why it is not confirmed (:data:`HOLD_REASONS`); tracks left without a confirmed row
     are dropped.
+
+    ``walks`` ({track id: (its detection rows, :class:`TrackHoldWalk`)}, updated in place) keeps
+    each track's judgements between calls on a growing table (a stream's): a track whose detection
+    rows extend those of the last call is judged on its new detections only. Only the tracks of
+    this call are kept.
     """
     test = test or GroundTrackTest()
     if len(tracks) == 0:
@@ -517,14 +640,25 @@ def hold_ground_tracks(
     )
     rows = tracks["detection_row"].to_numpy()
     why = np.full(len(tracks), "young", dtype=object)
-    for _, idx in tracks.groupby("track_id", sort=False).indices.items():
+    kept: dict[int, tuple[np.ndarray, TrackHoldWalk]] = {}
+    for track_id, idx in tracks.groupby("track_id", sort=False).indices.items():
         has = idx[rows[idx] >= 0]
         if has.size == 0:
             continue
-        h = _track_held(det[rows[has]], ownship, surface_down, width_mps, coupling_s, test)
+        if walks is None:
+            h = _track_held(det[rows[has]], ownship, surface_down, width_mps, coupling_s, test)
+        else:
+            entry = walks.get(int(track_id))
+            seen = rows[has][: 0 if entry is None else entry[0].size]
+            walk = TrackHoldWalk(test) if entry is None or not np.array_equal(seen, entry[0]) else entry[1]
+            h = walk.why(det[rows[has]], ownship, surface_down, width_mps, coupling_s)
+            kept[int(track_id)] = (rows[has], walk)
         # Each row (coasting ones too) takes the decision of the newest detection at or before it.
         pos = np.searchsorted(has, idx, side="right") - 1
         why[idx] = np.where(pos >= 0, h[np.maximum(pos, 0)], "young")
+    if walks is not None:
+        walks.clear()
+        walks.update(kept)
     was = tracks["confirmed"].to_numpy(bool)
     held_by = tracks["held_by"].to_numpy(object) if "held_by" in tracks else np.where(was, "", "tentative")
     out = tracks.assign(confirmed=was & (why == ""), held_by=np.where(was, why, held_by).astype(str))

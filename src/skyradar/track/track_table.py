@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -21,6 +22,7 @@ from skyradar.track.tracker import RangeDopplerTracker, TrackerConfig
 __all__ = [
     "make_model",
     "track_detections",
+    "TrackTableStream",
     "track_air_detections",
     "tracker_detections",
     "empty_tracks",
@@ -195,17 +197,34 @@ def _surface(ground_test) -> Callable | None:
     return ground_test.surface_down if isinstance(ground_test, GroundTrackTest) else None
 
 
-def _table(chunks, origin, m3, detections, ownship, config: RadarConfig, ground_test) -> pd.DataFrame:
+def _table(
+    chunks,
+    origin,
+    m3,
+    detections,
+    ownship,
+    config: RadarConfig,
+    ground_test,
+    at_time_s: float | None = None,
+    walks: dict | None = None,
+) -> pd.DataFrame:
     """The tracks table: ids through reacquisition, ``altitude_measured`` (on the elevations the
-    3-D tracker trusted, :mod:`.elevation_trust`), then the ground hold."""
+    3-D tracker trusted, :mod:`.elevation_trust`), then the ground hold.
+
+    With ``at_time_s`` only the tracks with a row at that time are judged after the ids (each
+    track's rows are judged on its own, so theirs are those of the whole table); ``walks`` keeps
+    the ground hold's judgements between calls (:func:`~skyradar.track.ground_tracks.hold_ground_tracks`)."""
     t = _reacquired_ids(
         _assemble(chunks, origin, m3.active), chunks, detections, ownship, config, ground_test
     )
+    if at_time_s is not None:
+        ids = t["track_id"].to_numpy()
+        t = t[np.isin(ids, ids[t["time_s"].to_numpy(float) == at_time_s])].reset_index(drop=True)
     read = (
         detections.assign(elevation_measured=m3.trusted) if m3.active and m3.own is not None else detections
     )
     t = t.assign(altitude_measured=altitude_measured(t.track_id, t.detection_row, read))
-    return _held(t, detections, ownship, config, ground_test)
+    return _held(t, detections, ownship, config, ground_test, walks)
 
 
 def _make_tracker(model, config: RadarConfig, tracker_config) -> tuple[MotionModel, RangeDopplerTracker]:
@@ -214,7 +233,7 @@ def _make_tracker(model, config: RadarConfig, tracker_config) -> tuple[MotionMod
     return motion, RangeDopplerTracker(motion, tracker_config, pixel, report_tentative=True)
 
 
-def _held(tracks, detections, ownship, config: RadarConfig, ground_test) -> pd.DataFrame:
+def _held(tracks, detections, ownship, config: RadarConfig, ground_test, walks=None) -> pd.DataFrame:
     """:func:`~skyradar.track.ground_tracks.hold_ground_tracks` with ``ground_test``'s settings, and
     ``held_by`` saying why each row is not confirmed (the tracker's reasons first)."""
     coasting = tracks["coasted"].to_numpy(bool) if "coasted" in tracks else np.zeros(len(tracks), bool)
@@ -224,29 +243,41 @@ def _held(tracks, detections, ownship, config: RadarConfig, ground_test) -> pd.D
         return tracks
     test = ground_test if isinstance(ground_test, GroundTrackTest) else GroundTrackTest()
     width, coupling = 2.0 * config.v_lim_mps, config.range_doppler_coupling_s
-    return hold_ground_tracks(tracks, detections, ownship, width, coupling, test.surface_down, test)
+    return hold_ground_tracks(tracks, detections, ownship, width, coupling, test.surface_down, test, walks)
 
 
 def _run_tracker(tracker: RangeDopplerTracker, m3, detections: pd.DataFrame, grid, lo, hi) -> list[dict]:
     """Step the tracker (and the 3-D tracks) frame by frame; one dict of column arrays per frame."""
-    z_all = detections[["range_m", "radial_velocity_mps"]].to_numpy(float)
+    z_all, secondary = _measurements(detections)
+    frames = frame_numbers(grid, detections)
+    return [
+        _step_frame(tracker, m3, k, time_s, frames[k], z_all[a:b], secondary[a:b], a)
+        for k, (time_s, a, b) in enumerate(zip(grid, lo, hi, strict=True))
+    ]
+
+
+def _measurements(detections: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+    """Range and radial velocity (n, 2) of each detection, and whether it is a secondary one."""
+    z = detections[["range_m", "radial_velocity_mps"]].to_numpy(float)
     secondary = np.zeros(len(detections), bool)
     if "secondary" in detections.columns:
         secondary = detections["secondary"].fillna(False).to_numpy(bool)
-    frames = frame_numbers(grid, detections)
-    chunks: list[dict[str, np.ndarray]] = []
-    for k, (time_s, a, b) in enumerate(zip(grid, lo, hi, strict=True)):
-        out = tracker.step(float(time_s), z_all[a:b], secondary[a:b])
-        row = _frame_rows(tracker, out, time_s, frames[k], a)
-        row["reacquired"] = out.reacquired
-        row["reacquired_t"] = np.full(len(out.reacquired), float(time_s))
-        if m3.active:
-            m3.t3.rename(out.reacquired[:, 0], out.reacquired[:, 1])
-            x, P = m3.step(tracker, out, k, a, b)
-            rows = np.searchsorted(out.alive_ids, out.track_id)
-            row["x3"], row["P3"] = x[rows], P[rows]
-        chunks.append(row)
-    return chunks
+    return z, secondary
+
+
+def _step_frame(tracker: RangeDopplerTracker, m3, k: int, time_s, frame, z, secondary, a: int) -> dict:
+    """One frame of :func:`_run_tracker`: frame ``k`` of the grid, its detections ``z`` the rows from
+    ``a`` of the table; the frame's dict of column arrays."""
+    out = tracker.step(float(time_s), z, secondary)
+    row = _frame_rows(tracker, out, time_s, frame, a)
+    row["reacquired"] = out.reacquired
+    row["reacquired_t"] = np.full(len(out.reacquired), float(time_s))
+    if m3.active:
+        m3.t3.rename(out.reacquired[:, 0], out.reacquired[:, 1])
+        x, P = m3.step(tracker, out, k, a, a + len(z))
+        rows = np.searchsorted(out.alive_ids, out.track_id)
+        row["x3"], row["P3"] = x[rows], P[rows]
+    return row
 
 
 def _frame_rows(tracker: RangeDopplerTracker, out, time_s: float, frame: int, first_row: int) -> dict:
@@ -387,3 +418,107 @@ def _reacquired_ids(
     df = relabel_reacquired(df, pairs, times, is_object)
     real = np.unique(df["track_id"].to_numpy()[df["confirmed"].to_numpy()])
     return df[np.isin(df["track_id"].to_numpy(), real)].reset_index(drop=True)
+
+
+class TrackTableStream:
+    """:func:`track_detections` one frame at a time: each call gives the tracks table's rows of that frame.
+
+    The range-Doppler tracker and the 3-D feed keep their state between frames and step once per
+    frame (:func:`_step_frame`, the batch loop's body). The table's finishing (ids through
+    reacquisition, ``altitude_measured``, the ground hold) runs the batch's code on the rows so far
+    and keeps the tracks alive on the frame; the ground hold keeps each track's judgements
+    (:class:`~skyradar.track.ground_tracks.TrackHoldWalk`) and judges only its new detections.
+
+    What a stream cannot know makes its rows differ from the batch table's in three ways:
+
+    - A track's rows are emitted only from its confirmation on: the batch keeps the tentative rows
+      of a track confirmed later, which a stream cannot take back. Every row emitted is the batch's.
+    - The ground hold judges a track's newest detection on every frame; the batch, which knows which
+      detection of a long track is its last, judges every fifth after the thirtieth, and the last.
+      A verdict that changes between two judgements then shows some frames earlier in the stream.
+    - With several heads, every frame is fused as a multi-head one (``several_heads``); the batch
+      fuses only when its table holds more than one head, and refers a single head's ranges to the
+      aircraft's reference point only then.
+
+    Parameters
+    ----------
+    model, config, tracker_config, origin, position_sigma_rad, ground_test
+        As in :func:`track_detections`.
+    several_heads : bool
+        Whether the detections come from more than one radar head
+        (:func:`~skyradar.track.fusion.fuse_heads`).
+
+    Examples
+    --------
+    >>> frames = [pd.DataFrame({"time_s": [0.1 * k], "range_m": [1000 - 5.0 * k],
+    ...                         "radial_velocity_mps": [28.3]}) for k in range(10)]
+    >>> stream = TrackTableStream()
+    >>> rows = pd.concat([stream.step(0.1 * k, k, f) for k, f in enumerate(frames)], ignore_index=True)
+    >>> batch = track_detections(pd.concat(frames, ignore_index=True))
+    >>> len(batch), len(rows), rows.equals(batch[batch.confirmed].reset_index(drop=True))
+    (9, 5, True)
+    """
+
+    def __init__(
+        self,
+        model: str | MotionModel = "radar",
+        config: RadarConfig | None = None,
+        tracker_config: TrackerConfig | None = None,
+        origin: tuple[float, float, float] | None = None,
+        position_sigma_rad: float | None = None,
+        ground_test: GroundTrackTest | bool = True,
+        several_heads: bool = False,
+    ) -> None:
+        self.config = config or RadarConfig.prototype_2022()
+        self.motion, self.tracker = _make_tracker(model, self.config, tracker_config)
+        self.origin, self.position_sigma_rad = origin, position_sigma_rad
+        self.ground_test, self.several_heads = ground_test, several_heads
+        self._m3: Measure3D | None = None
+        self._chunks: list[dict] = []
+        self._fused: list[pd.DataFrame] = []
+        self._input_rows: list[np.ndarray] = []  # per frame: the input row of each fused detection
+        self._n_input = self._n_fused = 0
+        self._own: list[pd.DataFrame] = []
+        self._walks: dict = {}  # the ground hold's judgements of each track, kept between frames
+
+    def set_surface(self, surface_down: Callable | None) -> None:
+        """The terrain (NE -> down, m) of the ground test and the 3-D feed from this frame on."""
+        test = self.ground_test if isinstance(self.ground_test, GroundTrackTest) else GroundTrackTest()
+        if self.ground_test is not False:
+            self.ground_test = replace(test, surface_down=surface_down)
+        if self._m3 is not None and self._m3.active:
+            self._m3.surface_down = surface_down
+
+    def step(
+        self, time_s: float, frame: int, detections: pd.DataFrame, ownship: pd.DataFrame | None = None
+    ) -> pd.DataFrame:
+        """Track one frame: its ``detections`` (rows of that frame only, any ``time_s`` equal to
+        ``time_s``, s) and the own-ship row ``ownship`` (:data:`OWNSHIP_COLUMNS` at ``time_s``).
+
+        Returns the frame's rows with :data:`TRACK_COLUMNS`; ``detection_row`` counts the
+        detections of every frame given so far, in order (the batch table's row numbers).
+        """
+        det = validate_detections(detections)
+        fused, rows = fuse_heads(det, self.config, several_heads=self.several_heads)
+        rows = np.arange(len(fused)) if rows is None else rows
+        if self._m3 is None:
+            surface = _surface(self.ground_test)
+            self._m3 = Measure3D(fused, self.config, self.motion, self.position_sigma_rad, None, [], surface)
+        elif self._m3.active:
+            self._m3.add_detections(fused)
+        if ownship is not None:
+            self._own.append(ownship)
+        own = pd.concat(self._own, ignore_index=True) if self._own else None
+        if self._m3.active and ownship is not None:
+            self._m3.add_frames(np.array([time_s], float), ownship)
+        z, secondary = _measurements(fused)
+        k, a = len(self._chunks), self._n_fused
+        self._chunks.append(_step_frame(self.tracker, self._m3, k, time_s, frame, z, secondary, a))
+        self._fused.append(fused)
+        self._input_rows.append(self._n_input + rows)
+        self._n_input, self._n_fused = self._n_input + len(det), self._n_fused + len(fused)
+        table = pd.concat(self._fused, ignore_index=True)
+        args = (self.origin, self._m3, table, own, self.config, self.ground_test)
+        t = _table(self._chunks, *args, at_time_s=float(time_s), walks=self._walks)
+        t = t[t["time_s"].to_numpy(float) == float(time_s)].reset_index(drop=True)
+        return restore_detection_rows(t, np.concatenate(self._input_rows))

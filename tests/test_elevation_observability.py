@@ -10,10 +10,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-# The properties run on hypothesis' fixed sequence of examples, the same on every run and machine: a
-# boresight target (azimuth and elevation 0) and a ground null mirrored exactly below the target are
-# degenerate geometries these properties do not hold at, and a random run would meet them by chance.
-
 from skyradar.config import RadarConfig
 from skyradar.process.clutter_doa import (
     MAX_ELEVATION_SIGMA_RAD,
@@ -24,6 +20,9 @@ from skyradar.process.clutter_doa import (
 from skyradar.process.doa import direction_from_angles, doa_crlb, steering_vector
 from skyradar.track.track_table import track_detections
 
+# The properties run on hypothesis' fixed sequence of examples, the same on every run and machine: a
+# boresight target (azimuth and elevation 0) and a ground null mirrored exactly below the target are
+# degenerate geometries these properties do not hold at, and a random run would meet them by chance.
 CFG = RadarConfig.prototype_2022()
 N0 = CFG.noise_power_w
 

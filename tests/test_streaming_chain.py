@@ -25,11 +25,18 @@ HEAD_ON = {
     "origin": {"lat_deg": 52.0, "lon_deg": 4.36, "alt_m": 0.0},
     "radar": {"range_limit_m": 1500},
     "ownship": {"type": "straight", "start_ned_m": [0, 0, -2000], "speed_mps": 50},
-    "intruders": [{"name": "A", "type": "straight", "start_ned_m": [1200, -60, -2000], "heading_deg": 180,
-                   "speed_mps": 40}],
+    "intruders": [
+        {
+            "name": "A",
+            "type": "straight",
+            "start_ned_m": [1200, -60, -2000],
+            "heading_deg": 180,
+            "speed_mps": 40,
+        }
+    ],
     "frame_rate_hz": 9.4,
     "duration_s": 4.0,
-}  # fmt: skip
+}
 # Flat ground 500 m below, clutter suppressed, GNSS/AHRS errors: ground detections, clutter tracks
 # held by the ground test, the clutter predictions' anchors moving with the navigation noise.
 OVER_TERRAIN = {
@@ -40,21 +47,36 @@ OVER_TERRAIN = {
     "terrain": {"type": "flat", "size_m": 3000, "spacing_m": 60},
     "navigation": {"model": "ga-typical"},
     "ownship": {"type": "straight", "start_ned_m": [0, 0, -500], "heading_deg": 0, "speed_mps": 40},
-    "intruders": [{"name": "A", "type": "encounter", "kind": "head-on", "t_cpa_s": 10, "rcs_m2": 2.0,
-                   "intruder_speed_mps": 40}],
+    "intruders": [
+        {
+            "name": "A",
+            "type": "encounter",
+            "kind": "head-on",
+            "t_cpa_s": 10,
+            "rcs_m2": 2.0,
+            "intruder_speed_mps": 40,
+        }
+    ],
     "frame_rate_hz": 5.0,
     "duration_s": 3.0,
     "simulation": {"facet_size_m": 30.0},
-}  # fmt: skip
+}
 # Two heads whose beams overlap on a converging intruder: the heads' detections fused frame by frame.
 TWO_HEADS = {
     **HEAD_ON,
     "name": "stream two heads",
     "radars": [{"name": "nose", "mount": "nose"}, {"name": "left", "mount": "left-wingtip"}],
-    "intruders": [{"name": "A", "type": "straight", "start_ned_m": [1000, -700, -2000], "heading_deg": 150,
-                   "speed_mps": 40}],
+    "intruders": [
+        {
+            "name": "A",
+            "type": "straight",
+            "start_ned_m": [1000, -700, -2000],
+            "heading_deg": 150,
+            "speed_mps": 40,
+        }
+    ],
     "duration_s": 3.0,
-}  # fmt: skip
+}
 CASES = {
     "head-on": (HEAD_ON, {}),
     "terrain": (OVER_TERRAIN, {"suppression": "auto"}),
@@ -81,8 +103,9 @@ def _assert_same(stream: pd.DataFrame, batch: pd.DataFrame) -> None:
     for column in batch.columns:
         a, b = stream[column], batch[column]
         if pd.api.types.is_numeric_dtype(b) and not pd.api.types.is_bool_dtype(b):
-            np.testing.assert_allclose(a.to_numpy(float), b.to_numpy(float), rtol=1e-9, atol=1e-9,
-                                       err_msg=column)  # fmt: skip
+            np.testing.assert_allclose(
+                a.to_numpy(float), b.to_numpy(float), rtol=1e-9, atol=1e-9, err_msg=column
+            )
         elif len(b) and isinstance(b.iloc[0], list | np.ndarray):
             assert all(np.allclose(x, y, equal_nan=True) for x, y in zip(a, b, strict=True)), column
         else:
@@ -155,8 +178,15 @@ class _Displaced(StreamingChain):
     def ownship_state(self, frame: int) -> TrajectorySample:
         own = super().ownship_state(frame)
         east = own.position_ned_m + np.array([0.0, 100.0, 0.0])
-        return TrajectorySample(own.time_s, east, own.velocity_ned_mps, own.attitude_rad,
-                                own.lat_deg, own.lon_deg + 100.0 / 68_600.0, own.alt_m)  # fmt: skip
+        return TrajectorySample(
+            own.time_s,
+            east,
+            own.velocity_ned_mps,
+            own.attitude_rad,
+            own.lat_deg,
+            own.lon_deg + 100.0 / 68_600.0,
+            own.alt_m,
+        )
 
 
 def test_the_ownship_state_seam_moves_everything_the_frame_sees():

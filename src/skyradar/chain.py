@@ -55,8 +55,13 @@ def _truth_dataset(built, simulator) -> xr.Dataset:
     own, tgt, names = scenario_truth(built, simulator)
     cfg = simulator.config
     shape = (built.times_s.size, cfg.n_range, cfg.n_doppler, cfg.n_rx)
-    attrs = {"scenario": built.name, "origin_lat_deg": built.origin[0], "origin_lon_deg": built.origin[1],
-             "origin_alt_m": built.origin[2], "start_time": getattr(built, "start_time", None)}  # fmt: skip
+    attrs = {
+        "scenario": built.name,
+        "origin_lat_deg": built.origin[0],
+        "origin_lon_deg": built.origin[1],
+        "origin_alt_m": built.origin[2],
+        "start_time": getattr(built, "start_time", None),
+    }
     iq = np.broadcast_to(np.zeros((), np.complex64), shape)
     return frames_dataset(iq, built.times_s, cfg, own, tgt, names, attrs)
 
@@ -132,9 +137,16 @@ def run_chain(
     det, truths, rd = _detect(built, chosen, keep_frames, block_frames, timings, process_options or {})
     truth = truths[chosen[0].name]
     out = track_and_alert(det, built, None, alert_config, with_advice, truth)
-    return {"truth": truth, "truth_by_head": truths, "detections": det, "tracks": out["tracks"],
-            "alerts": out["alerts"], "ownship": out["ownship"], "rd_frames": rd,
-            "timings_s": timings | out["timings_s"]}  # fmt: skip
+    return {
+        "truth": truth,
+        "truth_by_head": truths,
+        "detections": det,
+        "tracks": out["tracks"],
+        "alerts": out["alerts"],
+        "ownship": out["ownship"],
+        "rd_frames": rd,
+        "timings_s": timings | out["timings_s"],
+    }
 
 
 def track_and_alert(
@@ -157,8 +169,10 @@ def track_and_alert(
     chosen = select_heads(built.heads, heads, "track_and_alert")
     if len({(h.config.v_lim_mps, h.config.range_resolution_m) for h in chosen}) > 1:
         names = [h.name for h in chosen]
-        raise InputError(f"track_and_alert: heads {names} differ in Doppler width or range resolution; "
-                         "one tracker needs the same for all")  # fmt: skip
+        raise InputError(
+            f"track_and_alert: heads {names} differ in Doppler width or range resolution; "
+            "one tracker needs the same for all"
+        )
     truth = truth if truth is not None else _truth_dataset(built, make_simulator(built)).drop_vars("iq")
     own = ownship_from_frames(truth, built.name)
     mine = np.ones(len(detections), bool)
@@ -167,10 +181,14 @@ def track_and_alert(
     air, used = tracker_detections(detections[mine])
     t0 = time.perf_counter()
     tracks = track_detections(
-        air, "radar", chosen[0].config,
-        frame_times_s=built.times_s, origin=built.origin, ownship=own,
+        air,
+        "radar",
+        chosen[0].config,
+        frame_times_s=built.times_s,
+        origin=built.origin,
+        ownship=own,
         ground_test=GroundTrackTest(surface_down=scenario_surface(built, own)),
-    )  # fmt: skip
+    )
     tracks = restore_detection_rows(tracks, used)  # detection_row indexes the chosen heads' rows
     timings = {"track": time.perf_counter() - t0}
     t0 = time.perf_counter()

@@ -64,8 +64,13 @@ from skyradar.track.track_table import TrackTableStream, empty_tracks, tracker_d
 __all__ = ["Advice", "FrameResult", "StreamingChain"]
 
 _SMOOTH_FRAMES = 5  # frame_geometries' velocity mean: this frame and the 4 before it
-_ADVICE = ("heading_bands_deg", "vs_bands_mps", "terrain_vs_bands_mps", "preferred_heading_deg",
-           "preferred_vs_mps")  # fmt: skip
+_ADVICE = (
+    "heading_bands_deg",
+    "vs_bands_mps",
+    "terrain_vs_bands_mps",
+    "preferred_heading_deg",
+    "preferred_vs_mps",
+)
 
 
 @dataclass(frozen=True)
@@ -176,19 +181,28 @@ class StreamingChain:
         self.built = built
         self.heads = select_heads(built.heads, heads, "StreamingChain")
         if len({(h.config.v_lim_mps, h.config.range_resolution_m) for h in self.heads}) > 1:
-            raise InputError(f"StreamingChain: heads {[h.name for h in self.heads]} differ in Doppler "
-                             "width or range resolution; one tracker needs the same for all")  # fmt: skip
+            raise InputError(
+                f"StreamingChain: heads {[h.name for h in self.heads]} differ in Doppler "
+                "width or range resolution; one tracker needs the same for all"
+            )
         self.with_advice = with_advice
         self.process_options = dict(process_options or {})
         self._simulators = {h.name: make_simulator(built, h.name) for h in self.heads}
         self._walks = {h.name: AnchorWalk() for h in self.heads}
-        self._attrs = {"scenario": built.name, "origin_lat_deg": built.origin[0],
-                       "origin_lon_deg": built.origin[1], "origin_alt_m": built.origin[2],
-                       "start_time": getattr(built, "start_time", None)}  # fmt: skip
+        self._attrs = {
+            "scenario": built.name,
+            "origin_lat_deg": built.origin[0],
+            "origin_lon_deg": built.origin[1],
+            "origin_alt_m": built.origin[2],
+            "start_time": getattr(built, "start_time", None),
+        }
         self._tracker = TrackTableStream(
-            "radar", self.heads[0].config, origin=built.origin, ground_test=GroundTrackTest(),
+            "radar",
+            self.heads[0].config,
+            origin=built.origin,
+            ground_test=GroundTrackTest(),
             several_heads=len(self.heads) > 1,
-        )  # fmt: skip
+        )
         self._alerter = AlertStream(alert_config, with_advice=with_advice, source=built.name)
         self._next = 0
         self._own_truth: dict[str, list[float]] = {}
@@ -275,8 +289,11 @@ class StreamingChain:
             out["tracks"] = empty_tracks()
         out["alerts"].attrs = {"rows_skipped_no_state": self._skipped}
         truths = {n: xr.concat(d, dim="time") if d else xr.Dataset() for n, d in self._truth.items()}
-        return out | {"truth": truths[self.heads[0].name], "truth_by_head": truths,
-                      "timings_s": dict(self.timings_s)}  # fmt: skip
+        return out | {
+            "truth": truths[self.heads[0].name],
+            "truth_by_head": truths,
+            "timings_s": dict(self.timings_s),
+        }
 
     def _detect(self, i: int, own_sample: TrajectorySample) -> tuple[pd.DataFrame, pd.DataFrame]:
         """Frame ``i`` of every head: merged detections and the own-ship table's row."""
@@ -295,8 +312,9 @@ class StreamingChain:
             self.timings_s["simulate"] += time.perf_counter() - t0
             t0 = time.perf_counter()
             anchors = self._anchor(name, ds)
-            det = process_frames(ds, terrain=built.terrain, source=built.name, anchors=anchors,
-                                 **self.process_options)  # fmt: skip
+            det = process_frames(
+                ds, terrain=built.terrain, source=built.name, anchors=anchors, **self.process_options
+            )
             det["frame"] += i
             tables[name] = det
             self.timings_s["process"] += time.perf_counter() - t0
@@ -333,5 +351,8 @@ class StreamingChain:
         row = alerts.iloc[0]
         values = {name: row[name] for name in _ADVICE}
         bands = {k: [float(x) for x in values[k]] for k in _ADVICE[:3]}
-        return Advice(**bands, preferred_heading_deg=float(values["preferred_heading_deg"]),
-                      preferred_vs_mps=float(values["preferred_vs_mps"]))  # fmt: skip
+        return Advice(
+            **bands,
+            preferred_heading_deg=float(values["preferred_heading_deg"]),
+            preferred_vs_mps=float(values["preferred_vs_mps"]),
+        )

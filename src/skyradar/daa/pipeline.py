@@ -242,8 +242,10 @@ def _merged_levels(
     n = len(t)
     raw: dict[str, np.ndarray] = {
         name: np.zeros(n, int) for name in ("level", "hold_level", "flarm_level")
-    } | {name: np.full(n, np.nan) for name in ("t_in_s", "time_to_impact_s", "tcpa_s", "hmd_m", "vmd_m",
-                                                 "dthr_m", "zthr_m")}  # fmt: skip
+    } | {
+        name: np.full(n, np.nan)
+        for name in ("t_in_s", "time_to_impact_s", "tcpa_s", "hmd_m", "vmd_m", "dthr_m", "zthr_m")
+    }
     raw["miss_m"] = fit[0].copy()
     raw["known"] = located.copy()
     if located.any():

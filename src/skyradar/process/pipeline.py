@@ -293,9 +293,17 @@ def process_chunk(
     from skyradar.io.frames import open_frames
 
     return process_frames(
-        open_frames(path), spur_map, terrain, method, spur_mode, progress, batch_frames,
-        source=path, frames=slice(start, stop), **kwargs,
-    )  # fmt: skip
+        open_frames(path),
+        spur_map,
+        terrain,
+        method,
+        spur_mode,
+        progress,
+        batch_frames,
+        source=path,
+        frames=slice(start, stop),
+        **kwargs,
+    )
 
 
 def _checked_config(ds: xr.Dataset, config: RadarConfig | None, spur_map, source: str) -> RadarConfig:

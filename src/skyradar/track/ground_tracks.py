@@ -430,8 +430,15 @@ class _History:
         def part(x: np.ndarray | None) -> np.ndarray | None:
             return None if x is None else x[a:b]
 
-        return _History(self.t[a:b], self.rng[a:b], self.vel[a:b], part(self.own_p), part(self.own_v),
-                        part(self.own_speed), [x[a:b] for x in self.doa])  # fmt: skip
+        return _History(
+            self.t[a:b],
+            self.rng[a:b],
+            self.vel[a:b],
+            part(self.own_p),
+            part(self.own_v),
+            part(self.own_speed),
+            [x[a:b] for x in self.doa],
+        )
 
     def extended(self, more: _History) -> _History:
         """These detections, then ``more``."""
@@ -440,8 +447,9 @@ class _History:
             return None if x is None or y is None else np.concatenate([x, y])
 
         doa = [np.concatenate([x, y]) for x, y in zip(self.doa, more.doa, strict=True)]
-        t, rng, vel = (np.concatenate([x, y]) for x, y in ((self.t, more.t), (self.rng, more.rng),
-                                                            (self.vel, more.vel)))  # fmt: skip
+        t, rng, vel = (
+            np.concatenate([x, y]) for x, y in ((self.t, more.t), (self.rng, more.rng), (self.vel, more.vel))
+        )
         own_p, own_v = cat(self.own_p, more.own_p), cat(self.own_v, more.own_v)
         return _History(t, rng, vel, own_p, own_v, cat(self.own_speed, more.own_speed), doa)
 

@@ -374,12 +374,19 @@ def _assemble(
     state, var, innov = cat("state"), cat("var"), cat("innov")
     n = state.shape[0]
     cols: dict[str, np.ndarray] = {
-        "time_s": cat("time_s"), "frame": cat("frame"), "track_id": cat("track_id"),
-        "range_m": state[:, 0], "radial_velocity_mps": state[:, 1], "range_rate_mps": state[:, 2],
-        "radial_accel_mps2": state[:, 3], "var_range_m2": var[:, 0], "var_radial_velocity_m2ps2": var[:, 1],
-        "innovation_range_m": innov[:, 0], "innovation_radial_velocity_mps": innov[:, 1],
+        "time_s": cat("time_s"),
+        "frame": cat("frame"),
+        "track_id": cat("track_id"),
+        "range_m": state[:, 0],
+        "radial_velocity_mps": state[:, 1],
+        "range_rate_mps": state[:, 2],
+        "radial_accel_mps2": state[:, 3],
+        "var_range_m2": var[:, 0],
+        "var_radial_velocity_m2ps2": var[:, 1],
+        "innovation_range_m": innov[:, 0],
+        "innovation_radial_velocity_mps": innov[:, 1],
         "detection_row": cat("det"),
-    }  # fmt: skip
+    }
     x3 = cat("x3") if has3d else np.full((n, 6), np.nan)
     P3 = cat("P3") if has3d else np.full((n, 6, 6), np.nan)
     for i, name in enumerate(("north_m", "east_m", "down_m", "vn_mps", "ve_mps", "vd_mps")):

@@ -56,6 +56,7 @@ def test_baselines_add_thermal_noise_of_the_configured_power():
     assert np.mean(np.abs(cube) ** 2) == pytest.approx(config.noise_power_w, rel=0.01)
 
 
+@pytest.mark.slow
 def test_bench_sim_json_names_synthetic_terrain_and_both_ratios(tmp_path):
     result = subprocess.run(
         [sys.executable, "-m", "skyradar", "bench", "sim", "--json", "--frames", "1", "--seconds", "0"],

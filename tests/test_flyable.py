@@ -319,6 +319,7 @@ def test_a_file_whose_track_is_off_flies_at_its_reported_ground_speed(tmp_path, 
     assert np.abs(speed - 62.0).max() < 4.0  # the fixes between each other: 40-90 m/s
 
 
+@pytest.mark.slow
 def test_skyradar_flight_writes_the_path_and_its_figure(tmp_path):
     t, pos, vel = _flight(55.0, [(40.0, 0.0, 0.0), (40.0, 30.0, 1.0)])
     _fixes_file(

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pytest
 import yaml
 
 from cli_helpers import assert_one_line_error as _assert_one_line_error
@@ -146,6 +147,7 @@ def test_experiment_refuses_a_foreign_folder(tmp_path):
     assert sorted(p.name for p in (tmp_path / "mine").iterdir()) == ["thesis.tex"]
 
 
+@pytest.mark.slow
 def test_simulate_replaces_its_own_run_and_a_foreign_one_only_with_overwrite(tmp_path):
     _scenario(tmp_path)
     assert _skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path).returncode == 0
@@ -252,6 +254,7 @@ def test_simulate_refuses_a_run_that_cannot_fit(tmp_path):
 # ---- compressed store -----------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_compressed_store_reads_back_identical(tmp_path):
     _scenario(tmp_path)
     for codec in ("none", "blosc"):

@@ -202,6 +202,7 @@ def test_a_tiny_iq_chunk_is_refused(tmp_path, command):
     assert "Traceback" not in result.stderr
 
 
+@pytest.mark.slow
 def test_one_head_commands_on_a_run_of_several_heads_ask_which(tmp_path):
     """state, spur-map and calibrate use one head: on a two-head run they name the heads and ask."""
     heads = [{"name": "nose", "mount": "forward"}, {"name": "belly", "mount": "forward-down"}]

@@ -92,6 +92,7 @@ def test_a_collision_course_glider_is_warned_early_and_the_warning_held(chain):
     assert warning[-1] >= min(t_cpa, last_seen) - 0.25, (warning[-1], t_cpa, last_seen)
 
 
+@pytest.mark.slow
 def test_the_real_flight_family_is_seeded_and_its_geometry_is_flown():
     from skyradar.daa.conflict import WellClearVolume
     from skyradar.experiments.encounter_real import make_real_encounters, real_pair

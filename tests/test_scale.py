@@ -38,6 +38,7 @@ SCENARIO = {
 }
 
 
+@pytest.mark.slow
 def test_local_cluster_writes_the_same_bytes_as_the_plain_loop(tmp_path):
     built = Scenario.from_dict(SCENARIO, source=tmp_path / "s.yaml").build()
     loop = simulate_to_zarr(built, tmp_path / "loop.zarr", chunk_frames=2)
@@ -48,6 +49,7 @@ def test_local_cluster_writes_the_same_bytes_as_the_plain_loop(tmp_path):
     np.testing.assert_array_equal(a.tgt_range_m.values, b.tgt_range_m.values)
 
 
+@pytest.mark.slow
 def test_dead_scheduler_gives_one_line_and_no_output(tmp_path):
     (tmp_path / "s.yaml").write_text(yaml.safe_dump(SCENARIO))
     result = subprocess.run(

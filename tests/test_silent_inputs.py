@@ -185,6 +185,7 @@ def _with_runs(tmp_path: Path, runs: Path) -> None:
         (tmp_path / name).symlink_to(runs / name, target_is_directory=True)
 
 
+@pytest.mark.slow
 def test_alert_refuses_an_ownship_run_the_tracks_did_not_come_from(tmp_path, two_runs):
     _with_runs(tmp_path, two_runs)
     for args in (

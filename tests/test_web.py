@@ -232,6 +232,7 @@ def test_real_server_survives_abrupt_disconnects(run):
         assert httpx.get(url + "/api/info", timeout=10).json()["n_ready"] == 60
 
 
+@pytest.mark.slow
 def test_cli_serve_runs_and_rejects_missing_run(run, tmp_path):
     import socket
     import subprocess

@@ -45,7 +45,15 @@ from skyradar.track.ground_tracks import GroundTrackTest, median_ground_down_m, 
 from skyradar.track.track_table import track_detections, tracker_detections
 from skyradar.units import wrap
 
-__all__ = ["run_chain", "track_and_alert", "label_tracks", "confirmed_rows", "scenario_surface"]
+__all__ = [
+    "run_chain",
+    "track_and_alert",
+    "label_tracks",
+    "confirmed_rows",
+    "run_attrs",
+    "tracked_heads",
+    "scenario_surface",
+]
 
 _MATCH_M = 300.0  # a track is an intruder's if its median distance to that truth is below this
 
@@ -55,15 +63,32 @@ def _truth_dataset(built, simulator) -> xr.Dataset:
     own, tgt, names = scenario_truth(built, simulator)
     cfg = simulator.config
     shape = (built.times_s.size, cfg.n_range, cfg.n_doppler, cfg.n_rx)
-    attrs = {
+    iq = np.broadcast_to(np.zeros((), np.complex64), shape)
+    return frames_dataset(iq, built.times_s, cfg, own, tgt, names, run_attrs(built))
+
+
+def run_attrs(built) -> dict[str, Any]:
+    """The attributes the chain's frames Datasets carry: scenario name, origin, start time."""
+    return {
         "scenario": built.name,
         "origin_lat_deg": built.origin[0],
         "origin_lon_deg": built.origin[1],
         "origin_alt_m": built.origin[2],
         "start_time": getattr(built, "start_time", None),
     }
-    iq = np.broadcast_to(np.zeros((), np.complex64), shape)
-    return frames_dataset(iq, built.times_s, cfg, own, tgt, names, attrs)
+
+
+def tracked_heads(built, heads: list[str] | None, caller: str) -> list:
+    """The heads ``heads`` of ``built`` (all by default) that one tracker follows; InputError naming
+    ``caller`` when they differ in Doppler width or range resolution (one tracker's pixel grid)."""
+    chosen = select_heads(built.heads, heads, caller)
+    if len({(h.config.v_lim_mps, h.config.range_resolution_m) for h in chosen}) > 1:
+        names = [h.name for h in chosen]
+        raise InputError(
+            f"{caller}: heads {names} differ in Doppler width or range resolution; "
+            "one tracker needs the same for all"
+        )
+    return chosen
 
 
 def _detect(built, heads, keep_frames, block_frames, timings, options) -> tuple[pd.DataFrame, dict, dict]:
@@ -166,13 +191,7 @@ def track_and_alert(
     heads' rows). Returns ``tracks``, ``alerts``, ``ownship``, ``detections`` and ``timings_s``
     (track, alert).
     """
-    chosen = select_heads(built.heads, heads, "track_and_alert")
-    if len({(h.config.v_lim_mps, h.config.range_resolution_m) for h in chosen}) > 1:
-        names = [h.name for h in chosen]
-        raise InputError(
-            f"track_and_alert: heads {names} differ in Doppler width or range resolution; "
-            "one tracker needs the same for all"
-        )
+    chosen = tracked_heads(built, heads, "track_and_alert")
     truth = truth if truth is not None else _truth_dataset(built, make_simulator(built)).drop_vars("iq")
     own = ownship_from_frames(truth, built.name)
     mine = np.ones(len(detections), bool)

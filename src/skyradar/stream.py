@@ -44,16 +44,14 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from skyradar.chain import scenario_surface
+from skyradar.chain import run_attrs, scenario_surface, tracked_heads
 from skyradar.daa.alerting import AlertConfig
 from skyradar.daa.pipeline import AlertStream
 from skyradar.daa.run_tables import ownship_from_frames
-from skyradar.errors import InputError
 from skyradar.io.frames import frames_dataset
 from skyradar.process.clutter_anchors import AnchorWalk, frame_geometries
 from skyradar.process.detect_run import merge_head_tables
 from skyradar.process.pipeline import navigated_own_state, process_frames
-from skyradar.scene.radar_heads import select_heads
 from skyradar.scene.trajectories import TrajectorySample
 from skyradar.sim.navigation import navigation_at_frame
 from skyradar.sim.scenario_frames import frames_truth, make_simulator, simulate_frames
@@ -179,23 +177,12 @@ class StreamingChain:
         heads: list[str] | None = None,
     ) -> None:
         self.built = built
-        self.heads = select_heads(built.heads, heads, "StreamingChain")
-        if len({(h.config.v_lim_mps, h.config.range_resolution_m) for h in self.heads}) > 1:
-            raise InputError(
-                f"StreamingChain: heads {[h.name for h in self.heads]} differ in Doppler "
-                "width or range resolution; one tracker needs the same for all"
-            )
+        self.heads = tracked_heads(built, heads, "StreamingChain")
         self.with_advice = with_advice
         self.process_options = dict(process_options or {})
         self._simulators = {h.name: make_simulator(built, h.name) for h in self.heads}
         self._walks = {h.name: AnchorWalk() for h in self.heads}
-        self._attrs = {
-            "scenario": built.name,
-            "origin_lat_deg": built.origin[0],
-            "origin_lon_deg": built.origin[1],
-            "origin_alt_m": built.origin[2],
-            "start_time": getattr(built, "start_time", None),
-        }
+        self._attrs = run_attrs(built)
         self._tracker = TrackTableStream(
             "radar",
             self.heads[0].config,

@@ -59,7 +59,7 @@ from skyradar.track.fusion import restore_detection_rows
 from skyradar.track.ground_tracks import GroundTrackTest
 from skyradar.track.track_table import TrackTableStream, empty_tracks, tracker_detections
 
-__all__ = ["Advice", "FrameResult", "StreamingChain"]
+__all__ = ["Advice", "FrameResult", "StreamingChain", "frame_advice"]
 
 _SMOOTH_FRAMES = 5  # frame_geometries' velocity mean: this frame and the 4 before it
 _ADVICE = (
@@ -195,6 +195,7 @@ class StreamingChain:
         self._own_truth: dict[str, list[float]] = {}
         self._navigated: list[dict[str, np.ndarray]] = []  # the last frames' navigated own-ship states
         self._n_detections = 0
+        self._own_so_far: pd.DataFrame | None = None  # the own-ship table's rows so far
         self._skipped = 0  # confirmed track rows without a state to alert on, so far
         self._used: list[np.ndarray] = []  # per frame: rows of the detections table the tracker took
         self._out: dict[str, list] = {"detections": [], "tracks": [], "alerts": [], "ownship": []}
@@ -235,7 +236,8 @@ class StreamingChain:
         self._used.append(self._n_detections + used)
         self._n_detections += len(det)
         t0 = time.perf_counter()
-        own_so_far = pd.concat(self._out["ownship"], ignore_index=True)
+        parts = [own_row] if self._own_so_far is None else [self._own_so_far, own_row]
+        own_so_far = self._own_so_far = pd.concat(parts, ignore_index=True)
         self._tracker.set_surface(scenario_surface(self.built, own_so_far))  # causal: the ground so far
         rows = self._tracker.step(time_s, i, air, own_row)
         rows = restore_detection_rows(rows, np.concatenate(self._used)) if len(rows) else rows
@@ -248,7 +250,8 @@ class StreamingChain:
         self._out["alerts"].append(alerts)
         self._next += 1
         confirmed = rows[rows["confirmed"].to_numpy(bool)].reset_index(drop=True)
-        return FrameResult(i, time_s, det, confirmed, alerts, self._advice(alerts))
+        advice = frame_advice(alerts) if self.with_advice else None
+        return FrameResult(i, time_s, det, confirmed, alerts, advice)
 
     def __iter__(self) -> Iterator[FrameResult]:
         return self
@@ -331,15 +334,22 @@ class StreamingChain:
         geometry = frame_geometries(recent, self.built.terrain)[-1]
         return self._walks[name].next(geometry)[None, :]
 
-    def _advice(self, alerts: pd.DataFrame) -> Advice | None:
-        """The frame's advice (repeated on each of its alert rows) when an alert is issued on it."""
-        if not self.with_advice or len(alerts) == 0 or not (alerts["level"].to_numpy() > 0).any():
-            return None
-        row = alerts.iloc[0]
-        values = {name: row[name] for name in _ADVICE}
-        bands = {k: [float(x) for x in values[k]] for k in _ADVICE[:3]}
-        return Advice(
-            **bands,
-            preferred_heading_deg=float(values["preferred_heading_deg"]),
-            preferred_vs_mps=float(values["preferred_vs_mps"]),
-        )
+
+def frame_advice(alerts: pd.DataFrame) -> Advice | None:
+    """The advice of one frame's alerts rows (repeated on each row) when an alert is issued on it, else None.
+
+    Examples
+    --------
+    >>> frame_advice(pd.DataFrame({"level": [0]})) is None
+    True
+    """
+    if len(alerts) == 0 or not (alerts["level"].to_numpy() > 0).any() or _ADVICE[0] not in alerts:
+        return None
+    row = alerts.iloc[0]
+    values = {name: row[name] for name in _ADVICE}
+    bands = {k: [float(x) for x in values[k]] for k in _ADVICE[:3]}
+    return Advice(
+        **bands,
+        preferred_heading_deg=float(values["preferred_heading_deg"]),
+        preferred_vs_mps=float(values["preferred_vs_mps"]),
+    )

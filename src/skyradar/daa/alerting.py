@@ -267,7 +267,7 @@ def velocity_unconverged(sigma_hv_mps: np.ndarray, tcpa_s: np.ndarray, config: A
     warning_s = config.levels[-1].alerting_time_s
     t = np.clip(np.nan_to_num(np.asarray(tcpa_s, float), nan=warning_s), 8.0, warning_s)
     return (
-        np.nan_to_num(np.asarray(sigma_hv_mps, float), nan=np.inf) * t
+        np.nan_to_num(np.asarray(sigma_hv_mps, float), nan=np.inf, posinf=np.inf) * t
         > config.max_velocity_sigma_mps * warning_s
     )
 

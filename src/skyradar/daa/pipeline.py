@@ -20,6 +20,7 @@ such a row alerts.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -29,6 +30,7 @@ import xarray as xr
 from skyradar.daa.advice import advice_columns
 from skyradar.daa.alerting import (
     AlertConfig,
+    AlertFilter,
     alerting_rows,
     filter_alert_levels,
     raw_alert_levels,
@@ -38,7 +40,7 @@ from skyradar.daa.alerting import (
 from skyradar.daa.conflict import traffic_indication
 from skyradar.daa.lost_tracks import lost_track_rows
 from skyradar.daa.provenance import check_tracks_match_run
-from skyradar.daa.range_miss import range_only_fit
+from skyradar.daa.range_miss import RANGE_FIT_WINDOW_S, range_only_fit
 from skyradar.daa.range_only import K_SIGMA, range_only_levels
 from skyradar.daa.run_tables import ownship_from_frames, truth_tracks
 from skyradar.daa.tables import (
@@ -63,19 +65,10 @@ __all__ = [
 ]
 
 
-def _issued_levels(
-    df: pd.DataFrame,
-    t: np.ndarray,
-    raw: dict,
-    s: np.ndarray,
-    v: np.ndarray,
-    cov_v,
-    config: AlertConfig,
-    predicted: np.ndarray,
-    located: np.ndarray,
-    range_miss: np.ndarray,
-) -> np.ndarray:
-    """Issued level per row; silences (in ``raw``) unconverged and too young tracks first.
+def _gate_unconverged(
+    raw: dict, cov_v, config: AlertConfig, located: np.ndarray, range_miss: np.ndarray
+) -> None:
+    """Silences (in ``raw``) the rows whose horizontal velocity is not known well enough to alert on.
 
     The velocity gate (:func:`~skyradar.daa.alerting.velocity_unconverged`) keeps a horizontal
     velocity taken from noisy directions of arrival from making a conflict. It does not silence a
@@ -86,13 +79,6 @@ def _issued_levels(
     do, so that row's horizontal conflict holds whatever its velocity error. (A fast closure at
     2 km over clutter can keep a horizontal velocity sigma near 10 m/s from scattered directions
     while its range path gives the miss to about 10 m.)
-
-    A track's rows before it is old enough (:func:`~skyradar.daa.alerting.alerting_rows`) say
-    nothing about the conflict: they are not fed to its M-of-N filter, which starts at the first
-    row that may alert instead of counting the silenced rows as "no conflict". Rows without a
-    position (``located`` False) have no velocity covariance to gate on (the range fit's spread
-    stands for it) and wait ``min_track_age_s``; those whose range fit refused (``raw["known"]``
-    False) are no evidence either way, neither raising nor holding a level.
     """
     if config.max_velocity_sigma_mps is not None and cov_v is not None:
         sigma_hv = np.sqrt(np.nan_to_num(cov_v[:, 0, 0] + cov_v[:, 1, 1], nan=np.inf))
@@ -102,18 +88,43 @@ def _issued_levels(
         raw["level"][unconverged] = 0
         raw["hold_level"][unconverged] = 0
         raw["flarm_level"][unconverged] = 0
-    level = np.zeros(len(df), int)
-    required_age = np.full(len(df), config.min_track_age_s)
+
+
+def _required_age(s: np.ndarray, v: np.ndarray, config: AlertConfig, located: np.ndarray) -> np.ndarray:
+    """The age each row's track needs before the row may alert, s (rows without a position:
+    ``min_track_age_s``)."""
+    required_age = np.full(len(s), config.min_track_age_s)
     required_age[located] = required_track_age(s[located], v[located], config)
-    unknown = ~raw["known"]
+    return required_age
+
+
+def _filter_inputs(raw: dict, rows: np.ndarray, predicted: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The M-of-N filter's evidence and hold levels of ``rows``: a prediction, and a range-only row
+    whose fit refused, are no evidence of a conflict (-1)."""
+    unknown = ~raw["known"][rows]
+    evidence = np.where(predicted[rows] | unknown, -1, raw["level"][rows])
+    return evidence, np.where(unknown, -1, raw["hold_level"][rows])
+
+
+def _issued_levels(
+    df: pd.DataFrame, t: np.ndarray, raw: dict, required_age: np.ndarray, config: AlertConfig, predicted
+) -> np.ndarray:
+    """Issued level per row of a whole run; silences (in ``raw``) too young tracks first.
+
+    A track's rows before it is old enough (:func:`~skyradar.daa.alerting.alerting_rows`) say
+    nothing about the conflict: they are not fed to its M-of-N filter, which starts at the first
+    row that may alert instead of counting the silenced rows as "no conflict". Rows without a
+    position (``located`` False) have no velocity covariance to gate on (the range fit's spread
+    stands for it) and wait ``min_track_age_s``; those whose range fit refused (``raw["known"]``
+    False) are no evidence either way, neither raising nor holding a level.
+    """
+    level = np.zeros(len(df), int)
     for _, idx in df.groupby("track_id", sort=False).indices.items():
         ready = alerting_rows(t[idx], required_age[idx])
         raw["level"][idx[~ready]] = 0
         raw["flarm_level"][idx[~ready]] = 0
         rows = idx[ready]
-        # A prediction, and a range-only row whose fit refused, are no evidence of a conflict.
-        evidence = np.where(predicted[rows] | unknown[rows], -1, raw["level"][rows])
-        hold = np.where(unknown[rows], -1, raw["hold_level"][rows])
+        evidence, hold = _filter_inputs(raw, rows, predicted)
         level[rows] = filter_alert_levels(t[rows], evidence, config, hold)
     return level
 
@@ -288,7 +299,58 @@ def alerts_from_tracks(
         Alerts table (see module docstring).
     """
     config = config or AlertConfig()
-    df = clean_tracks(tracks, source)
+    rows = _alert_rows(tracks, ownship, config, source)
+    rows.level[:] = _issued_levels(rows.df, rows.t, rows.raw, rows.required_age, config, rows.predicted)
+    return _alerts_out(rows, config, with_advice)
+
+
+@dataclass
+class _AlertRows:
+    """Every row's state and raw levels, before the M-of-N filter issues its level."""
+
+    df: pd.DataFrame  # the clean tracks rows and the lost tracks' predictions, in time order
+    t: np.ndarray
+    own: dict[str, np.ndarray]  # the own-ship interpolated to the rows' times
+    own_vel: np.ndarray
+    s: np.ndarray  # relative position (intruder minus own-ship), m
+    v: np.ndarray  # relative velocity, m/s
+    v_int: np.ndarray  # the intruder's velocity, m/s
+    located: np.ndarray
+    predicted: np.ndarray
+    fit: np.ndarray  # the range path of the rows it judges, (4, n)
+    raw: dict
+    required_age: np.ndarray
+    level: np.ndarray  # the issued level, set by the filter
+
+    def select(self, keep: np.ndarray) -> _AlertRows:
+        """The rows where ``keep`` is True."""
+        df = self.df[keep].reset_index(drop=True)
+        df.attrs = dict(self.df.attrs)
+        return _AlertRows(
+            df,
+            self.t[keep],
+            {name: values[keep] for name, values in self.own.items()},
+            self.own_vel[keep],
+            self.s[keep],
+            self.v[keep],
+            self.v_int[keep],
+            self.located[keep],
+            self.predicted[keep],
+            self.fit[:, keep],
+            {name: values[keep] for name, values in self.raw.items()},
+            self.required_age[keep],
+            self.level[keep],
+        )
+
+
+def _alert_rows(
+    tracks: pd.DataFrame, ownship: pd.DataFrame, config: AlertConfig, source: str, cleaned: bool = False
+) -> _AlertRows:
+    """The state, geometry and raw levels of every row (:func:`alerts_from_tracks` up to its filter).
+    ``cleaned``: ``tracks`` are :func:`~skyradar.daa.tables.clean_tracks`' rows already."""
+    df = tracks.reset_index(drop=True) if cleaned else clean_tracks(tracks, source)
+    if cleaned:
+        df.attrs["rows_skipped_no_state"] = 0
     df = lost_track_rows(df, ownship["time_s"].to_numpy(float), config.lost_track_hold_s)
     predicted = df["extrapolated"].to_numpy(bool)
     t = df["time_s"].to_numpy(float)
@@ -307,14 +369,23 @@ def alerts_from_tracks(
     raw = _merged_levels(s, v, t, config, cov_p, cov_v, fit, located)
     raw["level"][predicted] = 0  # a prediction holds a track's level, never raises it
     raw["flarm_level"][predicted] = 0
-    level = _issued_levels(df, t, raw, s, v, cov_v, config, predicted, located, path[:2])
+    _gate_unconverged(raw, cov_v, config, located, path[:2])
+    required_age = _required_age(s, v, config, located)
+    level = np.zeros(len(df), int)
+    return _AlertRows(df, t, own, own_vel, s, v, v_int, located, predicted, fit, raw, required_age, level)
+
+
+def _alerts_out(rows: _AlertRows, config: AlertConfig, with_advice: bool) -> pd.DataFrame:
+    """The alerts table of rows whose level is issued: geometry, indication and the frames' advice."""
+    df, t, raw, s, located, fit, own = rows.df, rows.t, rows.raw, rows.s, rows.located, rows.fit, rows.own
+    v_int, own_vel, level = rows.v_int, rows.own_vel, rows.level
     measured_r = df["range_m"].to_numpy(float) if "range_m" in df else np.full(len(df), np.nan)
     fitted_r = np.sqrt(fit[0] ** 2 + fit[2] * (fit[3] - t) ** 2)
     range_m = np.where(
         located, np.linalg.norm(s, axis=-1), np.where(np.isnan(measured_r), fitted_r, measured_r)
     )
     out = _alerts_table(df, t, level, raw, s, v_int, own["own_yaw_rad"], located, range_m)
-    out["extrapolated"] = predicted
+    out["extrapolated"] = rows.predicted
     out["geometry"] = np.where(located, "3-d", "range-only")
     if with_advice:
         corrective = config.levels[min(1, len(config.levels) - 1)]
@@ -377,9 +448,16 @@ class AlertStream:
 
     Every stage of the alerting is causal (a track's M-of-N filter, its age, its range fit over a
     trailing window, a lost track's prediction from its last confirmed row, the frame's advice), so
-    a frame's rows computed from the tracks and own-ship rows up to it are the whole run's. Each
-    call runs :func:`alerts_from_tracks` over the history of the tracks that can have a row on the
-    frame (a confirmed row within ``lost_track_hold_s``) and keeps that frame's rows.
+    a frame's rows computed from the tracks and own-ship rows up to it are the whole run's. The
+    stream keeps what the stages need, and no more, so a frame costs the same at any point of a
+    run: each track's M-of-N filter (:class:`~skyradar.daa.alerting.AlertFilter`), fed one row per
+    frame, its first time and whether it is old enough to alert; and the tracks and own-ship rows
+    of a trailing window, of the tracks that can have a row on the frame (a confirmed row within
+    ``lost_track_hold_s``). The window is ``lost_track_hold_s`` plus the range fit's
+    :data:`~skyradar.daa.range_miss.RANGE_FIT_WINDOW_S` plus a second: a lost track's prediction
+    carries the range path of its last measured row, up to ``lost_track_hold_s`` old, fitted over
+    the window before that row. A prediction spaces its rows by the median frame interval of the
+    window (the batch: of the whole run).
 
     Parameters
     ----------
@@ -401,9 +479,13 @@ class AlertStream:
     def __init__(self, config: AlertConfig | None = None, with_advice: bool = True, source: str = "tracks"):
         self.config = config or AlertConfig()
         self.with_advice, self.source = with_advice, source
-        self._tracks: list[pd.DataFrame] = []
-        self._own: list[pd.DataFrame] = []
+        self._window_s = RANGE_FIT_WINDOW_S + self.config.lost_track_hold_s + 1.0
+        self._tracks: pd.DataFrame | None = None  # the confirmed rows of the window
+        self._own: pd.DataFrame | None = None  # the own-ship rows of the window
         self._last_confirmed_s: dict[int, float] = {}
+        self._filters: dict[int, AlertFilter] = {}
+        self._first_s: dict[int, float] = {}
+        self._ready: set[int] = set()
 
     def step(self, time_s: float, tracks: pd.DataFrame, ownship: pd.DataFrame) -> pd.DataFrame:
         """Alert one frame: its tracks rows ``tracks`` (all at ``time_s``, s) and own-ship row ``ownship``.
@@ -411,24 +493,51 @@ class AlertStream:
         Returns the frame's alerts rows; ``attrs["rows_skipped_no_state"]`` counts the frame's
         confirmed rows that have no state to alert on.
         """
-        self._own.append(ownship)
+        time_s = float(time_s)
         confirmed = (
             tracks["confirmed"].to_numpy(bool) if "confirmed" in tracks else np.ones(len(tracks), bool)
         )
-        self._tracks.append(tracks[confirmed])
+        clean = clean_tracks(tracks, self.source)  # each row is checked once, as it comes
+        self._own = _window_append(self._own, ownship, time_s - self._window_s)
+        self._tracks = _window_append(self._tracks, clean, time_s - self._window_s)
         self._last_confirmed_s.update(
             dict.fromkeys(tracks["track_id"].to_numpy()[confirmed].tolist(), time_s)
         )
-        own = pd.concat(self._own, ignore_index=True)
+        own = self._own.copy()
         own.attrs = dict(ownship.attrs)
-        since = float(time_s) - self.config.lost_track_hold_s - 1e-9
-        alive = [i for i, t in self._last_confirmed_s.items() if t >= since]
-        history = pd.concat(self._tracks, ignore_index=True)
-        history = history[history["track_id"].isin(alive)]
-        alerts = alerts_from_tracks(history, own, self.config, self.with_advice, self.source)
-        now = alerts["time_s"].to_numpy(float) == float(time_s)
-        out = alerts[now].reset_index(drop=True)
+        alive_since = time_s - self.config.lost_track_hold_s - 1e-9
+        alive = [i for i, t in self._last_confirmed_s.items() if t >= alive_since]
+        history = self._tracks[self._tracks["track_id"].isin(alive)]
+        rows = _alert_rows(history, own, self.config, self.source, cleaned=True)
+        rows = rows.select(rows.t == time_s)
+        self._issue(rows)
+        out = _alerts_out(rows, self.config, self.with_advice)
         # The frame's own count: its confirmed rows without a state (the history's are counted on theirs).
-        skipped = clean_tracks(tracks, self.source).attrs["rows_skipped_no_state"]
-        out.attrs = {"rows_skipped_no_state": skipped}
+        out.attrs = {"rows_skipped_no_state": clean.attrs["rows_skipped_no_state"]}
         return out
+
+    def _issue(self, rows: _AlertRows) -> None:
+        """The frame's issued levels (``rows.level``), each track's filter fed its row once it is old
+        enough (:func:`_issued_levels`, one row at a time)."""
+        ids = rows.df["track_id"].to_numpy()
+        for i, track in enumerate(ids.tolist()):
+            t = float(rows.t[i])
+            first = self._first_s.setdefault(track, t)
+            if track not in self._ready and t - first < rows.required_age[i] - 1e-9:
+                rows.raw["level"][i] = 0
+                rows.raw["flarm_level"][i] = 0
+                continue
+            self._ready.add(track)
+            evidence, hold = _filter_inputs(rows.raw, np.array([i]), rows.predicted)
+            track_filter = self._filters.setdefault(track, AlertFilter(self.config))
+            rows.level[i] = track_filter.update(t, int(evidence[0]), int(hold[0]))
+
+
+def _window_append(window: pd.DataFrame | None, rows: pd.DataFrame, since_s: float) -> pd.DataFrame:
+    """``window``'s rows from ``since_s`` on (s), and ``rows`` after them."""
+    if window is None:
+        return rows.reset_index(drop=True)
+    if len(rows) == 0:  # an empty frame adds no rows (and may lack the window's columns)
+        return window[window["time_s"].to_numpy(float) >= since_s].reset_index(drop=True)
+    kept = window[window["time_s"].to_numpy(float) >= since_s]
+    return pd.concat([kept, rows], ignore_index=True) if len(kept) else rows.reset_index(drop=True)

@@ -39,7 +39,9 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["range_miss_distance", "range_only_fit", "miss_of_window", "cannot_enter"]
+__all__ = ["RANGE_FIT_WINDOW_S", "range_miss_distance", "range_only_fit", "miss_of_window", "cannot_enter"]
+
+RANGE_FIT_WINDOW_S = 10.0  # the trailing window of a row's range fit, s
 
 
 def range_miss_distance(
@@ -48,7 +50,7 @@ def range_miss_distance(
     range_m: np.ndarray,
     range_rate_mps: np.ndarray,
     own_velocity_mps: np.ndarray,
-    window_s: float = 10.0,
+    window_s: float = RANGE_FIT_WINDOW_S,
     min_span_s: float = 4.0,
     min_rows: int = 20,
     own_accel_tol_mps: float = 1.0,
@@ -105,7 +107,7 @@ def range_only_fit(
     range_m: np.ndarray,
     range_rate_mps: np.ndarray,
     own_velocity_mps: np.ndarray,
-    window_s: float = 10.0,
+    window_s: float = RANGE_FIT_WINDOW_S,
     min_span_s: float = 4.0,
     min_rows: int = 20,
     own_accel_tol_mps: float = 1.0,

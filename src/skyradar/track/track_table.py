@@ -482,10 +482,10 @@ class TrackTableStream:
         self.ground_test, self.several_heads = ground_test, several_heads
         self._m3: Measure3D | None = None
         self._chunks: list[dict] = []
-        self._fused: list[pd.DataFrame] = []
+        self._fused: pd.DataFrame | None = None  # every frame's fused detections so far
         self._input_rows: list[np.ndarray] = []  # per frame: the input row of each fused detection
         self._n_input = self._n_fused = 0
-        self._own: list[pd.DataFrame] = []
+        self._own: pd.DataFrame | None = None  # the own-ship rows so far
         self._walks: dict = {}  # the ground hold's judgements of each track, kept between frames
 
     def set_surface(self, surface_down: Callable | None) -> None:
@@ -514,18 +514,25 @@ class TrackTableStream:
         elif self._m3.active:
             self._m3.add_detections(fused)
         if ownship is not None:
-            self._own.append(ownship)
-        own = pd.concat(self._own, ignore_index=True) if self._own else None
+            self._own = _appended(self._own, ownship)
+        own = self._own
         if self._m3.active and ownship is not None:
             self._m3.add_frames(np.array([time_s], float), ownship)
         z, secondary = _measurements(fused)
         k, a = len(self._chunks), self._n_fused
         self._chunks.append(_step_frame(self.tracker, self._m3, k, time_s, frame, z, secondary, a))
-        self._fused.append(fused)
+        self._fused = _appended(self._fused, fused)
         self._input_rows.append(self._n_input + rows)
         self._n_input, self._n_fused = self._n_input + len(det), self._n_fused + len(fused)
-        table = pd.concat(self._fused, ignore_index=True)
-        args = (self.origin, self._m3, table, own, self.config, self.ground_test)
+        args = (self.origin, self._m3, self._fused, own, self.config, self.ground_test)
         t = _table(self._chunks, *args, at_time_s=float(time_s), walks=self._walks)
         t = t[t["time_s"].to_numpy(float) == float(time_s)].reset_index(drop=True)
         return restore_detection_rows(t, np.concatenate(self._input_rows))
+
+
+def _appended(table: pd.DataFrame | None, rows: pd.DataFrame) -> pd.DataFrame:
+    """``table`` with ``rows`` after it (one concatenation of two: a frame costs the same at any
+    point of a run, where concatenating every frame's table anew grows with the run)."""
+    if table is None:
+        return rows.reset_index(drop=True)
+    return pd.concat([table, rows], ignore_index=True)

@@ -31,6 +31,7 @@ from skyradar.experiments.sensor_figures import intruder_track_figures
 from skyradar.scene.scenario import Scenario
 
 __all__ = [
+    "build_encounter",
     "chain_rows",
     "run_encounter",
     "score_layout",
@@ -51,10 +52,16 @@ SUPPRESSION = (
 
 
 def _window(
-    p: pd.Series, frame_rate_hz: float, lookback_s: float, seed: int, terrain: str | None
+    p: pd.Series,
+    frame_rate_hz: float,
+    lookback_s: float,
+    seed: int,
+    terrain: str | None,
+    end_s: float | None = None,
 ) -> tuple[float, float, np.ndarray, np.ndarray, Any]:
-    """Frame window (start, duration) in s, ``lookback_s`` before the LoWC or CPA and in range,
-    the dense relative truth (times, NED m) it was chosen on, and the scenario it was built from."""
+    """Frame window (start, duration) in s, ``lookback_s`` before the LoWC or CPA and in range, to
+    2 s after that event or to ``end_s``; the dense relative truth (times, NED m) it was chosen on,
+    and the scenario it was built from."""
     built = Scenario.from_dict(encounter_scenario(p, 0.0, 1.0, frame_rate_hz, seed, terrain)).build()
     t, rel = relative_truth(built)
     t_lowc, t_cpa = event_times(t, rel)
@@ -62,7 +69,7 @@ def _window(
     in_range = np.linalg.norm(rel, axis=1) <= built.radar.range_limit_m + _RANGE_MARGIN_M
     first = float(t[np.argmax(in_range & (t <= t_event))]) if in_range.any() else t_event - lookback_s
     start = max(t_event - lookback_s, first, float(t[0]))
-    end = min(t_event + 2.0, float(t[-1]))
+    end = min(t_event + 2.0 if end_s is None else float(end_s), float(t[-1]))
     return start, max(end - start, 2.0 / frame_rate_hz), t, rel, built
 
 
@@ -160,13 +167,31 @@ def score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[s
     return row
 
 
-def _scenario(
-    p, seed, frame_rate_hz, lookback_s, terrain, layouts, navigation, simulation, rx_layout
-) -> tuple:
-    """The built scenario of one encounter, its dense relative truth and the row's shared columns."""
+def build_encounter(
+    p: pd.Series,
+    seed: int,
+    frame_rate_hz: float,
+    lookback_s: float,
+    terrain: str | None,
+    layouts: tuple[str, ...],
+    navigation: str | dict | None,
+    simulation: dict[str, Any] | None,
+    rx_layout: str,
+    end_s: float | None = None,
+) -> tuple[Any, dict[str, np.ndarray], dict[str, Any]]:
+    """The built scenario of one encounter row, its dense relative truth and the row's shared columns.
+
+    The frames start ``lookback_s`` before the loss of well clear (or the CPA) and no earlier than
+    the intruder is in range; they end 2 s after that event, or at ``end_s`` (s, at most the
+    own-ship's last time). Over hills and Jacksboro the own-ship flies at its height above the
+    ground, the encounter mirrored in altitude when the intruder would pass too close to the ground.
+    ``layouts`` holding ``three-head`` mounts :data:`~skyradar.scene.examples.THREE_HEAD_RADARS`.
+    Returns the :class:`~skyradar.scene.scenario.BuiltScenario`, ``{"t": times (s), "rel":
+    intruder-minus-own-ship NED positions (m)}`` and the columns every result row of it shares.
+    """
     from skyradar.scene.examples import THREE_HEAD_RADARS
 
-    start, duration, t, rel, ground = _window(p, frame_rate_hz, lookback_s, seed, terrain)
+    start, duration, t, rel, ground = _window(p, frame_rate_hz, lookback_s, seed, terrain, end_s)
     vertical = p["vertical_miss_m"]
     alt, p, rel = _fly_above_ground(p, ground, start, duration, rel, terrain)
     radars = THREE_HEAD_RADARS if "three-head" in layouts else None
@@ -222,7 +247,7 @@ def run_encounter(
     """
     cfg = alert_config or RADAR_ALERT_CONFIG
     spec_args = (p, seed, frame_rate_hz, lookback_s, terrain, layouts, navigation, simulation, rx_layout)
-    built, truth, shared = _scenario(*spec_args)
+    built, truth, shared = build_encounter(*spec_args)
     opts = {
         "fov_deg": fov_deg,
         "min_snr_db": min_snr_db,

@@ -140,6 +140,10 @@ def _percent(x: float) -> str:
     return "n/a" if not np.isfinite(x) else f"{100.0 * x:.0f} %"
 
 
+def _number(x: float, decimals: int) -> str:
+    return "n/a" if not np.isfinite(x) else f"{x:.{decimals}f}"
+
+
 def _row_sentence(r: dict[str, Any]) -> str:
     """One terrain and layout's outcome in words."""
     lo, hi = r["warned_before_lowc_fraction_ci95"]
@@ -165,7 +169,8 @@ def summary_markdown(rows: list[dict[str, Any]], settings: dict[str, Any]) -> st
     rows : list of dict
         :func:`summary_rows` of the run.
     settings : dict
-        The run's settings (``n``, ``seed``, ``family``, ``split``, ``frame_rate_hz``).
+        The run's settings (``seed``, ``family``, ``split``, ``frame_rate_hz``), or its
+        ``summary.json``, which holds them.
 
     Returns
     -------
@@ -174,26 +179,36 @@ def summary_markdown(rows: list[dict[str, Any]], settings: dict[str, Any]) -> st
 
     Examples
     --------
-    >>> row = {"terrain": "none", "layout": "single", "conflicts": 10, "warned_before_lowc": 9,
-    ...        "warned_before_lowc_fraction": 0.9, "warned_before_lowc_fraction_ci95": [0.6, 0.98],
+    >>> row = {"terrain": "none", "layout": "single", "encounters": 30, "conflicts": 10,
+    ...        "warned_before_lowc": 9, "warned_before_lowc_fraction": 0.9,
+    ...        "warned_before_lowc_fraction_ci95": [0.6, 0.98],
     ...        "median_warning_lead_s": 21.5, "unwarned_by_cause": {"missed": 0, "behind": 1},
     ...        "false_warnings": 0, "must_not_alert_encounters": 12, "clutter_warnings": 0,
     ...        "clutter_tracks_per_min": 0.0}
-    >>> settings = {"n": 30, "seed": 7, "family": "synthetic", "split": "development", "frame_rate_hz": 4.7}
+    >>> settings = {"seed": 7, "family": "synthetic", "split": "development", "frame_rate_hz": 4.7}
     >>> print(summary_markdown([row], settings).split("\\n\\n")[2])
     Over none terrain with the single layout, 9 of 10 conflicts were warned before the loss of well
     clear (90 %, 95 % interval 60 % to 98 %), the median warning 21.5 s before it; unwarned: 1
     behind. A warning came in 0 of the 12 encounters that must not alert, and 0 clutter tracks
     reached a warning.
     """
-    lines = [
-        f"# Encounters: {settings['family']}, seed {settings['seed']} ({settings['split']} set)",
-        "",
-        f"{settings['n']} encounters per terrain and layout, at {settings['frame_rate_hz']:g} frames per "
-        "second, each flown through the whole chain (simulate, process, track, alert).",
-        "",
-    ]
-    lines += [line for r in rows for line in (textwrap.fill(_row_sentence(r), 100), "")]
+    intro = (
+        f"{rows[0]['encounters']} encounters per terrain and layout, at {settings['frame_rate_hz']:g} "
+        "frames per second, each flown through the whole chain (simulate, process, track, alert)."
+    )
+    figures = (
+        "Figures: `encounters.png` (each encounter's miss distances coloured by outcome, and the "
+        "warning lead), `causes.png` (every conflict: warned before its loss of well clear, or why "
+        "not), `sensor_<terrain>_<layout>.png` (what the radar saw of each intruder)."
+    )
+    data = (
+        "Data: `summary.json` (every number, with the command, version and machine load), "
+        "`summary_rows.csv` (one row per terrain and layout), `encounters.parquet` and "
+        "`encounters.csv` (one row per encounter)."
+    )
+    title = f"# Encounters: {settings['family']}, seed {settings['seed']} ({settings['split']} set)"
+    paragraphs = [title, intro, *(_row_sentence(r) for r in rows)]
+    lines = [line for text in paragraphs for line in (textwrap.fill(text, 100), "")]
     lines += [
         "| terrain | layout | conflicts | warned before LoWC | 95 % interval | median lead [s] | false "
         "warnings | clutter tracks per minute |",
@@ -204,20 +219,10 @@ def summary_markdown(rows: list[dict[str, Any]], settings: dict[str, Any]) -> st
         lines.append(
             f"| {r['terrain']} | {r['layout']} | {r['conflicts']} | {r['warned_before_lowc']} "
             f"({_percent(r['warned_before_lowc_fraction'])}) | {_percent(lo)} to {_percent(hi)} | "
-            f"{r['median_warning_lead_s']:.1f} | {r['false_warnings']} of {r['must_not_alert_encounters']} | "
-            f"{r['clutter_tracks_per_min']:.2f} |"
+            f"{_number(r['median_warning_lead_s'], 1)} | {r['false_warnings']} of "
+            f"{r['must_not_alert_encounters']} | {_number(r['clutter_tracks_per_min'], 2)} |"
         )
-    lines += [
-        "",
-        "Figures: `encounters.png` (each encounter's miss distances coloured by outcome, and the "
-        "warning lead), `causes.png` (every conflict: warned before its loss of well clear, or why "
-        "not), `sensor_<terrain>_<layout>.png` (what the radar saw of each intruder).",
-        "",
-        "Data: `summary.json` (every number, with the command, version and machine load), "
-        "`summary_rows.csv` (one row per terrain and layout), `encounters.parquet` and "
-        "`encounters.csv` (one row per encounter).",
-        "",
-    ]
+    lines += ["", textwrap.fill(figures, 100), "", textwrap.fill(data, 100), ""]
     return "\n".join(lines)
 
 

@@ -120,7 +120,8 @@ def test_bad_recordings_are_one_line_naming_file_field_and_value(tmp_path):
         ({"skyradar:sample_count": 7}, r"holds 24384 samples per channel, but field 'skyradar:sample_count'"),
         ({"skyradar:frame_times_s": [1.0, 0.5]}, r"field 'skyradar:frame_times_s' goes backwards"),
         ({"skyradar:scale": 0}, r"field 'skyradar:scale' .* got 0"),
-        ({"skyradar:samples_per_chirp": NS + 1}, r"not whole frames"),
+        ({"skyradar:samples_per_chirp": NS + 1}, rf"'skyradar:samples_per_chirp' is {NS + 1}, more than"),
+        ({"skyradar:samples_per_chirp": NS - 1}, r"not whole frames"),
     ],
 )
 def test_bad_fields(tmp_path, changes, match):

@@ -176,7 +176,13 @@ def _description(meta_path: Path, data_path: Path, meta: dict[str, Any]) -> dict
         )
     samples = int(fs // prf)
     if "skyradar:samples_per_chirp" in glob:
-        samples = int(_number(meta_path, glob, "skyradar:samples_per_chirp", "samples per chirp", True))
+        recorded = int(_number(meta_path, glob, "skyradar:samples_per_chirp", "samples per chirp", True))
+        if recorded > samples:
+            raise InputError(
+                f"{meta_path}: field 'skyradar:samples_per_chirp' is {recorded}, more than a chirp "
+                f"interval holds ('core:sample_rate' / 'skyradar:prf_hz' = {samples})"
+            )
+        samples = recorded
     header = capture.get("core:header_bytes", 0)
     if isinstance(header, bool) or not isinstance(header, int) or header < 0:
         raise InputError(f"{meta_path}: field 'core:header_bytes' must be a whole number >= 0, got {header}")

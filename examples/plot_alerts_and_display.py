@@ -92,7 +92,7 @@ geometry = ["time_s", "track_id", "level", "raw_level", "t_in_s", "tcpa_s", "hmd
 geometry += ["range_m", "bearing_deg", "sector", "rel_alt_m"]
 firsts = alerts.sort_values("time_s").drop_duplicates(["track_id", "level"])
 firsts = firsts.sort_values(["track_id", "time_s"])[geometry]
-firsts.insert(2, "intruder", firsts["track_id"].map(names))
+firsts.insert(2, "intruder", firsts["track_id"].map(lambda t: names.get(t, "clutter")))
 print(firsts.round(1).to_string(index=False))
 
 # %%
@@ -140,7 +140,12 @@ print(f"preferred vertical speed {advice['preferred_vs_mps']:.1f} m/s")
 # well clear last.
 fig, (ax_level, ax_heading, ax_vs) = plt.subplots(3, 1, figsize=(7, 8), sharex=True)
 for track_id, rows in alerts.groupby("track_id"):
-    ax_level.step(rows["time_s"], rows["level"], where="post", label=f"track {track_id} ({names[track_id]})")
+    ax_level.step(
+        rows["time_s"],
+        rows["level"],
+        where="post",
+        label=f"track {track_id} ({names.get(track_id, 'clutter')})",
+    )
 ax_level.set(ylabel="issued level", yticks=[0, 1, 2, 3], ylim=(-0.2, 3.2))
 ax_level.set_yticklabels(["none", "preventive", "corrective", "warning"])
 ax_level.legend(loc="upper left", fontsize=8)
@@ -178,7 +183,18 @@ plt.show()
 # ends, so a script (or this page's build) can read what the page reads: ``/api/info`` for the
 # run and ``/api/frame/N`` for a frame (``?image=false`` leaves out its image). The display needs
 # the ``web`` extra (``pip install skyradar[web]``).
-print(f"skyradar serve {run_path} --alerts {folder / 'alerts.parquet'}")
+print(f"in {folder}: skyradar serve run.zarr --alerts alerts.parquet")
+
+
+def rounded(value):
+    """``value`` with every float rounded to 0.1, for reading."""
+    if isinstance(value, dict):
+        return {key: rounded(item) for key, item in value.items()}
+    if isinstance(value, list):
+        return [rounded(item) for item in value]
+    return round(value, 1) if isinstance(value, float) else value
+
+
 if importlib.util.find_spec("fastapi") and importlib.util.find_spec("uvicorn"):
     from skyradar.web.server import create_app, serve_in_thread
 
@@ -190,8 +206,7 @@ if importlib.util.find_spec("fastapi") and importlib.util.find_spec("uvicorn"):
         with urllib.request.urlopen(f"{url}/api/frame/{index}?image=false", timeout=10) as response:
             shown = json.load(response)
     print(f"{info['run']}: {info['n_total']} frames, traffic from the {info['traffic_source']} table")
-    print(
-        json.dumps({k: shown[k] for k in ("time_s", "max_level", "ownship", "traffic", "advice")}, indent=1)
-    )
+    payload = {k: shown[k] for k in ("time_s", "max_level", "ownship", "traffic", "advice")}
+    print(json.dumps(rounded(payload), indent=1))
 else:
     print("the live display needs the web extra: pip install skyradar[web]")

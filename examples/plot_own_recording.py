@@ -8,8 +8,9 @@ skyradar, put a small sidecar (JSON or YAML, the ``skyradar-adc/1`` format of
 order of the ``axes``) and what the radar is (sample rate, carrier, sweep, chirp rate).
 ``skyradar rd`` turns the recording into the same range-Doppler frames store the simulator
 writes, so every later stage (``skyradar process``, ``track``, ``serve``) reads it as it reads a
-simulated run. (A passive receiver's baseband recording is a SigMF file instead; see the passive
-radar guide.)
+simulated run. A recording already in SigMF (``NAME.sigmf-meta`` and ``NAME.sigmf-data``) needs
+no sidecar: see the SigMF example; a passive receiver's SigMF recording goes to ``skyradar
+passive`` instead (the passive radar guide).
 
 Here "your radar" is simulated at chirp level (:func:`skyradar.sim.raw.simulate_adc`): three
 frames with two aircraft in front of it, quantised to 16-bit I/Q as an ADC would, and written in

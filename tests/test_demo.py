@@ -17,6 +17,7 @@ from skyradar.daa.pipeline import alerts_from_tracks
 from skyradar.demo import alert_timeline, demo_scenario_path, label_tracks, run_demo
 from skyradar.errors import InputError
 from skyradar.scene.scenario import load_scenario
+from skyradar.viz.report import intruder_outcomes, summary_sentences
 
 
 def _collision(sigma_v_mps: float, dt: float = 0.5, duration_s: float = 40.0):
@@ -180,6 +181,45 @@ def test_demo_writes_report(demo_run):
         assert (out / name).stat().st_size > 5000
         assert f'src="{name}"' in page
     assert "PASS" in page and "Advice" in page
+    # The page opens with the run in words, then the figures; the numbers stay in summary.json.
+    summary = page.index("<h2>Summary</h2>")
+    assert summary < page.index("range_doppler.png") and "collision: warning at " in page
+    assert page.count("skyradar demo") == 2 and '<a href="summary.json">' in page  # title, h1
     assert not list(out.glob("*.partial*"))
     timeline = pd.read_csv(out / "alert_timeline.csv")
     assert (timeline.loc[timeline["intruder"] == "collision", "level"] == 3).any()
+
+
+def test_summary_sentences_come_from_the_summary_and_timeline():
+    summary = {
+        "frames": 200,
+        "detections": 900,
+        "detections_ground": 700,
+        "detections_spur": 3,
+        "tracks": 4,
+        "acceptance": False,
+        "intruders": {
+            "collision": {"tracks": 2, "max_level": 3},
+            "jet": {"tracks": 1, "max_level": 2},
+            "glider": {"tracks": 0, "max_level": 0},
+            "clutter": {"tracks": 1, "max_level": 3},
+        },
+    }
+    timeline = pd.DataFrame(
+        {
+            "time_s": [12.0, 15.5, 16.0, 30.0, 31.0],
+            "intruder": ["collision", "collision", "jet", "clutter", "jet"],
+            "level": [1, 3, 2, 3, 0],
+        }
+    )
+    outcomes = intruder_outcomes(summary, timeline)
+    assert outcomes["highest_level_s"].tolist()[:2] == [15.5, 16.0]
+    lines = summary_sentences(summary, outcomes, 42.6)
+    assert lines == [
+        "200 frames over 43 s: 900 detections (700 on the ground, 3 on radar spurs), 4 tracks.",
+        "collision: warning at 15.5 s (first alert, preventive, at 12.0 s), from 2 tracks.",
+        "jet: corrective at 16.0 s, from 1 track.",
+        "glider: never tracked.",
+        "1 track follows no intruder (clutter); highest level warning.",
+        "Acceptance (a warning for the collision intruder, none for anything else): FAIL.",
+    ]

@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 from cli_helpers import assert_one_line_error, skyradar
-from skyradar.experiments.encounter_report import cost_ms_per_frame
+from skyradar.experiments.encounter_report import cost_ms_per_frame, summary_markdown
 from skyradar.experiments.encounter_score import CAUSES, conflict_cause, summarise_layout, track_counts
 from skyradar.experiments.encounter_set import make_encounters
 from skyradar.experiments.encounter_terrain import mirror_below_ground, own_altitude_m, parse_terrains
@@ -186,3 +186,21 @@ def test_bad_terrain_gives_one_line(tmp_path):
     r = skyradar("experiment", "encounters", "--terrain", "hills,moon", "--out", "o", cwd=tmp_path)
     assert_one_line_error(r, "--terrain", "moon")
     assert not (tmp_path / "o").exists()
+
+
+def test_summary_markdown_says_what_was_measured_from_the_rows():
+    row = {"terrain": "hills", "layout": "single", **summarise_layout(_results(), late_lead_s=12.5)}
+    text = summary_markdown(
+        [row], {"n": 9, "seed": 3, "family": "synthetic", "split": "development"} | {"frame_rate_hz": 4.7}
+    )
+    title, intro, sentence = text.split("\n\n")[:3]
+    assert title == "# Encounters: synthetic, seed 3 (development set)"
+    assert "9 encounters per terrain and layout, at 4.7 frames per second" in intro
+    sentence = " ".join(sentence.split())
+    assert "Over hills terrain with the single layout, 2 of 6 conflicts were warned" in sentence
+    assert "(33 %, 95 % interval 10 % to 70 %)" in sentence  # Wilson interval of 2 in 6
+    assert "unwarned: 1 missed (observable), 1 behind, 1 terrain masked, 1 below 13 dB SNR." in sentence
+    assert (
+        "A warning came in 1 of the 2 encounters that must not alert, and 1 clutter track reached" in sentence
+    )
+    assert "| hills | single | 6 | 2 (33 %) | 10 % to 70 % |" in text and "summary.json" in text

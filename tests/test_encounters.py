@@ -231,6 +231,9 @@ def test_experiment_counts_match_the_geometry_and_warns_every_observable_conflic
     assert table.loc[~conflict, "t_warning_s"].isna().all()
     assert json.loads((tmp_path / "summary.json").read_text())["encounters"] == 4
     assert (tmp_path / "encounters.png").stat().st_size > 10_000
+    words = " ".join((tmp_path / "summary.md").read_text().split())  # the run in words, from its numbers
+    assert f"{s['warned_before_lowc']} of {s['conflicts']} conflicts were warned" in words
+    assert f"the median warning {s['median_warning_lead_s']:.1f} s before it" in words
 
 
 def test_interrupted_run_resumes_from_its_partial_table(tmp_path):

@@ -489,3 +489,23 @@ def test_loopback_host_only_refuses_other_names(run):
         ):
             pass
         assert exc.value.code == 1008
+
+
+def test_frame_without_height_above_ground_is_strict_json(tmp_path):
+    """A clear-sky run has no height above the ground (NaN): the page gets null, never a bare NaN."""
+    ds = sample_run_dataset(n_frames=3)
+    ds["own_height_agl_m"] = ds["own_height_agl_m"] * np.nan
+    writer = FrameStoreWriter(tmp_path / "run.zarr", ds, 3, fingerprint="clear-sky")
+    writer.write_chunk(0, ds["iq"].values)
+    run = writer.close()
+    with TestClient(create_app(run, autoplay=False)) as client:
+        response = client.get("/api/frame/1?image=false")
+        assert response.status_code == 200
+        assert response.json()["ownship"]["height_agl_m"] is None
+        with client.websocket_connect("/ws") as ws:
+            ws.receive_text()  # info
+            json.loads(ws.receive_text(), parse_constant=_refuse)  # the first frame, as JSON.parse reads it
+
+
+def _refuse(name: str):
+    raise AssertionError(f"bare {name} in a WebSocket message")

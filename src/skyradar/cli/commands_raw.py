@@ -30,7 +30,10 @@ WINDOW_HELP = "hann, hamming, blackmanharris, chebyshev[:SIDELOBE_DB] or none."
 def rd(
     recording: Annotated[
         Path,
-        typer.Argument(help="Raw ADC recording: NAME.bin/.dat with NAME.json/.yaml sidecar, or NAME.npy."),
+        typer.Argument(
+            help="Raw ADC recording: NAME.bin/.dat with NAME.json/.yaml sidecar, NAME.npy, or SigMF "
+            "(NAME.sigmf-meta with NAME.sigmf-data)."
+        ),
     ],
     output: Annotated[Path, typer.Option("-o", "--output", help="Frames store to write (Zarr directory).")],
     range_window: Annotated[str, typer.Option("--range-window", help=WINDOW_HELP)] = "hann",

@@ -1,6 +1,8 @@
 """Tables, figures and the summary of ``skyradar experiment encounters``.
 
-Writes ``encounters.parquet`` and ``encounters.csv`` (one row per terrain, encounter and layout),
+Writes ``summary.md`` first: the run in a few sentences and one table row per terrain and layout,
+generated from the measured rows, with the figures and data files it comes from; then
+``encounters.parquet`` and ``encounters.csv`` (one row per terrain, encounter and layout),
 ``summary_rows.csv`` (one row per terrain and layout), ``encounters.png`` (the first terrain's
 last layout), ``encounters_<terrain>_<layout>.png`` for every other row and ``causes.png`` (every
 conflict of each row: warned before its loss of well clear, or the cause it was not).
@@ -8,6 +10,7 @@ conflict of each row: warned before its loss of well clear, or the cause it was 
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 from typing import Any
 
@@ -17,12 +20,24 @@ import pandas as pd
 from skyradar.experiments.encounter_score import CAUSES, summarise_layout
 from skyradar.experiments.encounter_set import plot_encounters
 from skyradar.experiments.sensor_figures import plot_sensor_figures
-from skyradar.io.atomic import savefig_atomic, write_csv_atomic
+from skyradar.io.atomic import savefig_atomic, write_csv_atomic, write_text_atomic
 from skyradar.io.tables import write_table
 
-__all__ = ["summary_rows", "lead_against_clear_sky", "cost_ms_per_frame", "write_report", "plot_causes"]
+__all__ = [
+    "summary_rows",
+    "lead_against_clear_sky",
+    "cost_ms_per_frame",
+    "summary_markdown",
+    "write_report",
+    "plot_causes",
+]
 
 _STAGES = ("simulate", "process", "track", "alert")
+_CAUSE_NAMES = {"missed": "missed (observable)", "below_13db": "below 13 dB SNR"}
+
+
+def _cause_name(cause: str) -> str:
+    return _CAUSE_NAMES.get(cause, cause.replace("_", " "))
 
 
 def summary_rows(res: pd.DataFrame, late_lead_s: float) -> list[dict[str, Any]]:
@@ -108,11 +123,7 @@ def plot_causes(rows: list[dict[str, Any]], path: Path) -> None:
     bottom = np.zeros(len(rows))
     parts = [("warned before LoWC", "tab:blue", [r["warned_before_lowc"] for r in rows])]
     colours = dict(zip(CAUSES, ("tab:red", "0.3", "0.55", "tab:brown", "0.8"), strict=True))
-    names = {"missed": "missed (observable)", "below_13db": "below 13 dB SNR"}
-    parts += [
-        (names.get(c, c.replace("_", " ")), colours[c], [r["unwarned_by_cause"][c] for r in rows])
-        for c in CAUSES
-    ]
+    parts += [(_cause_name(c), colours[c], [r["unwarned_by_cause"][c] for r in rows]) for c in CAUSES]
     for label, colour, values in parts:
         ax.bar(x, values, bottom=bottom, color=colour, label=label)
         bottom += np.asarray(values, float)
@@ -125,12 +136,103 @@ def plot_causes(rows: list[dict[str, Any]], path: Path) -> None:
     plt.close(fig)
 
 
+def _percent(x: float) -> str:
+    return "n/a" if not np.isfinite(x) else f"{100.0 * x:.0f} %"
+
+
+def _number(x: float, decimals: int) -> str:
+    return "n/a" if not np.isfinite(x) else f"{x:.{decimals}f}"
+
+
+def _row_sentence(r: dict[str, Any]) -> str:
+    """One terrain and layout's outcome in words."""
+    lo, hi = r["warned_before_lowc_fraction_ci95"]
+    lead = r["median_warning_lead_s"]
+    causes = [f"{n} {_cause_name(c)}" for c, n in r["unwarned_by_cause"].items() if n]
+    clutter = int(r["clutter_warnings"])
+    return (
+        f"Over {r['terrain']} terrain with the {r['layout']} layout, {r['warned_before_lowc']} of "
+        f"{r['conflicts']} conflicts were warned before the loss of well clear "
+        f"({_percent(r['warned_before_lowc_fraction'])}, 95 % interval {_percent(lo)} to {_percent(hi)})"
+        + (f", the median warning {lead:.1f} s before it" if np.isfinite(lead) else "")
+        + f"; unwarned: {', '.join(causes) or 'none'}. A warning came in {r['false_warnings']} of the "
+        f"{r['must_not_alert_encounters']} encounters that must not alert, and {clutter} clutter "
+        f"track{'' if clutter == 1 else 's'} reached a warning."
+    )
+
+
+def summary_markdown(rows: list[dict[str, Any]], settings: dict[str, Any]) -> str:
+    """``summary.md``: the run in sentences and a table, every number from ``rows``.
+
+    Parameters
+    ----------
+    rows : list of dict
+        :func:`summary_rows` of the run.
+    settings : dict
+        The run's settings (``seed``, ``family``, ``split``, ``frame_rate_hz``), or its
+        ``summary.json``, which holds them.
+
+    Returns
+    -------
+    str
+        Markdown: a title, one paragraph per terrain and layout, a table, the figures and data files.
+
+    Examples
+    --------
+    >>> row = {"terrain": "none", "layout": "single", "encounters": 30, "conflicts": 10,
+    ...        "warned_before_lowc": 9, "warned_before_lowc_fraction": 0.9,
+    ...        "warned_before_lowc_fraction_ci95": [0.6, 0.98],
+    ...        "median_warning_lead_s": 21.5, "unwarned_by_cause": {"missed": 0, "behind": 1},
+    ...        "false_warnings": 0, "must_not_alert_encounters": 12, "clutter_warnings": 0,
+    ...        "clutter_tracks_per_min": 0.0}
+    >>> settings = {"seed": 7, "family": "synthetic", "split": "development", "frame_rate_hz": 4.7}
+    >>> print(summary_markdown([row], settings).split("\\n\\n")[2])
+    Over none terrain with the single layout, 9 of 10 conflicts were warned before the loss of well
+    clear (90 %, 95 % interval 60 % to 98 %), the median warning 21.5 s before it; unwarned: 1
+    behind. A warning came in 0 of the 12 encounters that must not alert, and 0 clutter tracks
+    reached a warning.
+    """
+    intro = (
+        f"{rows[0]['encounters']} encounters per terrain and layout, at {settings['frame_rate_hz']:g} "
+        "frames per second, each flown through the whole chain (simulate, process, track, alert)."
+    )
+    figures = (
+        "Figures: `encounters.png` (each encounter's miss distances coloured by outcome, and the "
+        "warning lead), `causes.png` (every conflict: warned before its loss of well clear, or why "
+        "not), `sensor_<terrain>_<layout>.png` (what the radar saw of each intruder)."
+    )
+    data = (
+        "Data: `summary.json` (every number, with the command, version and machine load), "
+        "`summary_rows.csv` (one row per terrain and layout), `encounters.parquet` and "
+        "`encounters.csv` (one row per encounter)."
+    )
+    title = f"# Encounters: {settings['family']}, seed {settings['seed']} ({settings['split']} set)"
+    paragraphs = [title, intro, *(_row_sentence(r) for r in rows)]
+    lines = [line for text in paragraphs for line in (textwrap.fill(text, 100), "")]
+    lines += [
+        "| terrain | layout | conflicts | warned before LoWC | 95 % interval | median lead [s] | false "
+        "warnings | clutter tracks per minute |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        lo, hi = r["warned_before_lowc_fraction_ci95"]
+        lines.append(
+            f"| {r['terrain']} | {r['layout']} | {r['conflicts']} | {r['warned_before_lowc']} "
+            f"({_percent(r['warned_before_lowc_fraction'])}) | {_percent(lo)} to {_percent(hi)} | "
+            f"{_number(r['median_warning_lead_s'], 1)} | {r['false_warnings']} of "
+            f"{r['must_not_alert_encounters']} | {_number(r['clutter_tracks_per_min'], 2)} |"
+        )
+    lines += ["", textwrap.fill(figures, 100), "", textwrap.fill(data, 100), ""]
+    return "\n".join(lines)
+
+
 def write_report(
     res: pd.DataFrame, out_dir: Path, settings: dict, late_lead_s: float, warning_time_s: float
 ) -> dict[str, Any]:
     """Write the tables and figures of a finished run into ``out_dir``; return the summary (without
     runtime): the first terrain's last layout at the top level, every row under ``rows``."""
     rows = summary_rows(res, late_lead_s)
+    write_text_atomic(out_dir / "summary.md", summary_markdown(rows, settings))
     buffer = settings["buffer"]
     write_table(res, out_dir / "encounters.parquet")
     # The per-encounter track-error samples stay in the Parquet table (lists do not fit a CSV cell).

@@ -6,16 +6,17 @@ The names users call, importable from here (each is imported from its module on 
 - :func:`~.frames.open_frames`, :func:`~.frames.frames_dataset` and :func:`~.frames.radar_config_of`:
   frames stores;
 - :func:`~.tables.read_table` and :func:`~.tables.write_table`: Parquet (or CSV) tables;
-- :func:`~.recordings.read_recording` and :func:`~.recording_writer.write_recording`: raw ADC
-  recordings; :func:`~.sigmf_io.read_iq_recording`: a passive receiver's IQ;
+- :func:`~.recordings.read_recording`, :func:`~.recording_writer.write_recording` and
+  :func:`~.recording_writer.write_sigmf_recording`: raw ADC recordings (a sidecar beside the
+  samples, or SigMF); :func:`~.sigmf_io.read_iq_recording`: a passive receiver's IQ;
 - :func:`~.outputs.check_output`: the check every writing command makes before any work.
 
 Modules: frames (:mod:`.frames`, :mod:`.frames_model`, :mod:`.frames_heads`, :mod:`.cint16`,
 :mod:`.checks`, :mod:`.store_size`, :mod:`.navigation`, :mod:`.run_origin`, :mod:`.run_export`,
 :mod:`.ownship_input`); tables (:mod:`.tables`, :mod:`.table_columns`); recordings
-(:mod:`.recordings`, :mod:`.recording_writer`, :mod:`.sigmf_io`, :mod:`.iq_raw`,
-:mod:`.iq_recording`); writing safely (:mod:`.outputs`, :mod:`.atomic`, :mod:`.locks`) and reading
-safely (:mod:`.safe_yaml`).
+(:mod:`.recordings`, :mod:`.recording_sigmf`, :mod:`.recording_writer`, :mod:`.sigmf_io`,
+:mod:`.iq_raw`, :mod:`.iq_recording`); writing safely (:mod:`.outputs`, :mod:`.atomic`,
+:mod:`.locks`) and reading safely (:mod:`.safe_yaml`).
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ _EXPORTS = {
     "frames": ("open_frames", "frames_dataset", "radar_config_of"),
     "tables": ("read_table", "write_table"),
     "recordings": ("read_recording",),
-    "recording_writer": ("write_recording",),
+    "recording_writer": ("write_recording", "write_sigmf_recording"),
     "sigmf_io": ("read_iq_recording",),
     "outputs": ("check_output",),
 }

@@ -1,4 +1,5 @@
-"""Write raw ADC frames as a ``skyradar-adc/1`` recording (see :mod:`skyradar.io.recordings`).
+"""Write raw ADC frames as a ``skyradar-adc/1`` recording (see :mod:`skyradar.io.recordings`) or as
+SigMF (see :mod:`skyradar.io.recording_sigmf`).
 
 The frames are converted and written a few at a time, so memory stays bounded whatever the
 recording's length; both files go through unique temporary names, renamed when complete.
@@ -6,6 +7,7 @@ recording's length; both files go through unique temporary names, renamed when c
 
 from __future__ import annotations
 
+import hashlib
 import json
 from pathlib import Path
 
@@ -15,9 +17,10 @@ import yaml
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.io.atomic import atomic_path
+from skyradar.io.recording_sigmf import SIGMF_DTYPES, sigmf_adc_metadata, sigmf_pair
 from skyradar.io.recordings import AXES, DTYPES
 
-__all__ = ["write_recording"]
+__all__ = ["write_recording", "write_sigmf_recording"]
 
 _CHUNK_BYTES = 64 * 2**20  # input bytes converted at a time by write_recording
 
@@ -141,3 +144,93 @@ def _sidecar_meta(path: Path, shape, config: RadarConfig, dtype: str, scale: flo
     if times_s is not None:
         meta["frame_times_s"] = [float(t) for t in times_s]
     return json.loads(json.dumps(meta, default=float))  # plain Python types for YAML too
+
+
+def write_sigmf_recording(
+    path: str | Path,
+    frames: np.ndarray,
+    config: RadarConfig,
+    datatype: str = "ci16_le",
+    scale: float | None = None,
+    times_s: np.ndarray | None = None,
+    start_time: str | None = None,
+) -> Path:
+    """Write frames (frame, rx, chirp, sample) as a SigMF recording, atomically; return the meta path.
+
+    The samples go to ``NAME.sigmf-data`` channel-interleaved, chirp after chirp (the layout of
+    :mod:`skyradar.io.recording_sigmf`), a few frames at a time, so memory stays bounded whatever
+    the recording's length; then ``NAME.sigmf-meta`` describes them, with the data's SHA-512. Both
+    go through temporary names, the data file renamed first, so a metadata file under its final
+    name always describes a complete data file.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``NAME``, ``NAME.sigmf-meta`` or ``NAME.sigmf-data``.
+    frames : ndarray, shape (n_frames, n_rx, n_chirps, n_samples)
+        sqrt(W) at the ADC; complex for the ``c`` datatypes, real for the ``r`` ones.
+    config : RadarConfig
+        The radar; its ``n_doppler`` must be the frames' chirp count.
+    datatype : {'ci16_le', 'cf32_le', 'ri16_le', 'rf32_le'}
+        Integer types are quantised as ``round(x / scale)``.
+    scale : float, optional
+        sqrt(W) per sample unit; default so that the largest magnitude uses 30000 counts (int16)
+        or 1.0 (float types).
+    times_s : ndarray, optional
+        Frame start times, s (default back-to-back frames).
+    start_time : str, optional
+        ISO 8601 UTC time of the first sample (``core:datetime``).
+
+    Returns
+    -------
+    Path
+        ``NAME.sigmf-meta``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from skyradar.io.recordings import read_recording
+    >>> cfg = RadarConfig.prototype_2022(n_doppler=4)
+    >>> adc = np.ones((3, 4, 4, cfg.samples_per_chirp), np.complex64)
+    >>> meta = write_sigmf_recording(Path(tempfile.mkdtemp()) / "radar", adc, cfg, scale=1 / 1000)
+    >>> meta.name, read_recording(meta)[0].shape
+    ('radar.sigmf-meta', (3, 4, 4, 2032))
+    """
+    meta_path, data_path = sigmf_pair(path)
+    frames = np.asarray(frames)
+    if datatype not in SIGMF_DTYPES or not datatype.endswith("_le"):
+        writable = [d for d in SIGMF_DTYPES if d.endswith("_le")]
+        raise InputError(f"write_sigmf_recording: datatype {datatype!r}; choose from {writable}")
+    code, per = _check_write(data_path, frames, SIGMF_DTYPES[datatype][0])
+    if frames.shape[2] != config.n_doppler:
+        raise InputError(
+            f"write_sigmf_recording: frames have {frames.shape[2]} chirps, config.n_doppler is "
+            f"{config.n_doppler}"
+        )
+    step = _frames_per_chunk(frames)
+    if scale is None:
+        peak = _peak(frames, step)
+        scale = peak / 30000.0 if code == "i2" and peak > 0 else 1.0
+    digest = hashlib.sha512()
+    with atomic_path(meta_path) as tmp_meta, atomic_path(data_path) as tmp_data:
+        with open(tmp_data, "wb") as f:
+            for i in range(0, len(frames), step):
+                # SigMF's order: (frame, chirp, sample, rx), the channels of each sample side by side
+                block = np.ascontiguousarray(np.moveaxis(frames[i : i + step], 1, -1))
+                buf = _encode(block, scale, code, per).tobytes()
+                digest.update(buf)
+                f.write(buf)
+        n_frames, n_rx, _, n_samples = frames.shape
+        meta = sigmf_adc_metadata(
+            config,
+            n_rx,
+            n_samples,
+            datatype,
+            n_frames * config.n_doppler * n_samples,
+            scale,
+            times_s,
+            start_time,
+            digest.hexdigest(),
+        )
+        tmp_meta.write_text(json.dumps(meta, indent=1) + "\n", encoding="utf-8")
+    return meta_path

@@ -33,6 +33,9 @@ other than 4 needs ``radar.rx_positions_m``. A 3-D recording without a ``frame``
 supplies the radar fields and ``axes`` (default ``frame, rx, chirp, sample``); without one the
 thesis prototype's parameters are assumed.
 
+A SigMF recording (``NAME.sigmf-meta`` + ``NAME.sigmf-data``) carries the same fields in SigMF's
+``core`` keys and skyradar's ``skyradar:`` keys: :mod:`skyradar.io.recording_sigmf`.
+
 Every inconsistency raises :class:`InputError` naming the file, the field and the value, before any
 output is written. :func:`skyradar.io.recording_writer.write_recording` writes this format.
 """
@@ -53,7 +56,7 @@ from skyradar.errors import InputError
 from skyradar.io.checks import MAX_TIME_S
 from skyradar.io.safe_yaml import load_yaml
 
-__all__ = ["AXES", "DTYPES", "AdcFrames", "read_recording"]
+__all__ = ["AXES", "DTYPES", "AdcFrames", "is_sigmf", "open_described", "read_recording"]
 
 AXES = ("frame", "rx", "chirp", "sample")
 # Sidecar dtype name -> (numpy element dtype, values per sample)
@@ -281,12 +284,14 @@ def _assume_prototype(meta: dict[str, Any]) -> None:
 
 
 def read_recording(path: str | Path) -> tuple[AdcFrames, RadarConfig]:
-    """Open a raw ADC recording (binary + sidecar, or ``.npy``) without reading it into memory.
+    """Open a raw ADC recording (binary + sidecar, ``.npy`` or SigMF) without reading it into memory.
 
     Parameters
     ----------
     path : path
-        The data file (``NAME.bin``, ``NAME.npy``) or its sidecar (``NAME.json``/``NAME.yaml``).
+        The data file (``NAME.bin``, ``NAME.npy``) or its sidecar (``NAME.json``/``NAME.yaml``), or
+        a SigMF recording (``NAME.sigmf-meta``, ``NAME.sigmf-data`` or ``NAME``; the fields it needs
+        are in :mod:`skyradar.io.recording_sigmf`).
 
     Returns
     -------
@@ -308,27 +313,70 @@ def read_recording(path: str | Path) -> tuple[AdcFrames, RadarConfig]:
     ((2, 4, 8, 2032), 8, (1+1j))
     """
     path = Path(path)
+    if is_sigmf(path):
+        from skyradar.io.recording_sigmf import read_sigmf_recording
+
+        return read_sigmf_recording(path)
     if not path.exists():
         raise InputError(f"{path}: no such recording")
-    if path.suffix in (".json", ".yaml", ".yml"):
-        sidecar: Path | None = path
-    else:
-        sidecar = _sidecar_of(path)
+    sidecar = path if path.suffix in (".json", ".yaml", ".yml") else _sidecar_of(path)
     if path.suffix == ".npy":
         meta = _load_sidecar(sidecar) if sidecar else {}
-        raw, pairs, data = _open_npy(path, meta)
-        sidecar = sidecar or path
+        raw, pairs, _ = _open_npy(path, meta)
         meta.setdefault("axes", list(AXES if raw.ndim == 4 else AXES[1:]))
         _assume_prototype(meta)
-    else:
-        if sidecar is None:
-            raise InputError(
-                f"{path}: no sidecar {path.with_suffix('.json').name} or {path.with_suffix('.yaml').name}"
-            )
-        meta = _load_sidecar(sidecar)
-        if "data_file" not in meta and path != sidecar:
-            meta["data_file"] = path.name
-        raw, pairs, data = _open_binary(sidecar, meta)
+        return _frames_of(sidecar or path, meta, raw, pairs)
+    if sidecar is None:
+        raise InputError(
+            f"{path}: no sidecar {path.with_suffix('.json').name} or {path.with_suffix('.yaml').name}"
+        )
+    meta = _load_sidecar(sidecar)
+    if "data_file" not in meta and path != sidecar:
+        meta["data_file"] = path.name
+    return open_described(sidecar, meta)
+
+
+def is_sigmf(path: str | Path) -> bool:
+    """True if ``path`` names a SigMF recording: ``NAME.sigmf-meta``, ``NAME.sigmf-data``, or a bare
+    ``NAME`` with a ``NAME.sigmf-meta`` beside it.
+
+    Examples
+    --------
+    >>> is_sigmf("rec.sigmf-meta"), is_sigmf("rec.sigmf-data"), is_sigmf("rec.json")
+    (True, True, False)
+    """
+    path = Path(path)
+    if path.suffix in (".sigmf-meta", ".sigmf-data"):
+        return True
+    return not path.exists() and path.with_name(path.name + ".sigmf-meta").exists()
+
+
+def open_described(sidecar: Path, meta: dict[str, Any]) -> tuple[AdcFrames, RadarConfig]:
+    """Open the binary data file a ``skyradar-adc/1`` description names, checked field by field.
+
+    The part of :func:`read_recording` after the sidecar is parsed, for readers of other metadata
+    formats (:mod:`skyradar.io.recording_sigmf`) that translate their fields into these.
+
+    Parameters
+    ----------
+    sidecar : Path
+        The metadata file, named in every error and the base of a relative ``data_file``.
+    meta : dict
+        The fields of the ``skyradar-adc/1`` format (module docstring).
+
+    Returns
+    -------
+    frames : AdcFrames
+    config : RadarConfig
+    """
+    raw, pairs, _ = _open_binary(sidecar, meta)
+    return _frames_of(sidecar, meta, raw, pairs)
+
+
+def _frames_of(
+    sidecar: Path, meta: dict[str, Any], raw: np.ndarray, pairs: bool
+) -> tuple[AdcFrames, RadarConfig]:
+    """The frames view and radar of an opened data array, once axes, radar and times are checked."""
     ndim = raw.ndim - (1 if pairs else 0)
     axes = _check_axes(sidecar, meta["axes"], ndim)
     if "frame" not in axes:

@@ -27,10 +27,14 @@ __all__ = ["recording_to_frames", "recording_files"]
 def recording_files(recording: str | Path, frames: Any = None) -> list[Path]:
     """The files a recording is made of: the named one, its sidecar and its data file.
 
-    Every existing NAME.{json,yaml,yml,bin,dat,npy} beside it, and the memory-mapped data file.
+    Every existing NAME.{json,yaml,yml,bin,dat,npy,sigmf-meta,sigmf-data} beside it, and the
+    memory-mapped data file.
     """
     path = Path(recording)
-    files = [path] + [path.with_suffix(s) for s in (".json", ".yaml", ".yml", ".bin", ".dat", ".npy")]
+    suffixes = (".json", ".yaml", ".yml", ".bin", ".dat", ".npy", ".sigmf-meta", ".sigmf-data")
+    files = [path] + [path.with_suffix(s) for s in suffixes]
+    if not path.suffix:  # a SigMF recording named by its bare stem
+        files += [path.with_name(path.name + s) for s in (".sigmf-meta", ".sigmf-data")]
     mapped = getattr(getattr(frames, "raw", None), "filename", None)
     if mapped:
         files.append(Path(mapped))

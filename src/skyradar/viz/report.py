@@ -6,7 +6,6 @@ No build step: ``index.html`` links PNG files written next to it (matplotlib, Ag
 from __future__ import annotations
 
 import html
-import json
 from pathlib import Path
 from typing import Any
 
@@ -22,9 +21,18 @@ from skyradar.io.frames import radar_config_of  # noqa: E402
 from skyradar.io.frames_model import frame_times_s  # noqa: E402
 from skyradar.viz.rangedoppler import plot_strength  # noqa: E402
 
-__all__ = ["LEVEL_COLOURS", "plot_range_doppler", "plot_plan_view", "plot_alert_timeline", "write_report"]
+__all__ = [
+    "LEVEL_COLOURS",
+    "plot_range_doppler",
+    "plot_plan_view",
+    "plot_alert_timeline",
+    "intruder_outcomes",
+    "summary_sentences",
+    "write_report",
+]
 
 LEVEL_COLOURS = {0: "#9e9e9e", 1: "#1e88e5", 2: "#fb8c00", 3: "#e53935"}
+_LEVEL_WORDS = {0: "no alert", 1: "preventive", 2: "corrective", 3: "warning"}
 _INTRUDER_COLOURS = ("#d81b60", "#1e88e5", "#43a047", "#8e24aa", "#00897b")
 
 
@@ -135,6 +143,143 @@ def _advice_rows(alerts: pd.DataFrame) -> pd.DataFrame:
     return out.round(1)
 
 
+def intruder_outcomes(summary: dict[str, Any], timeline: pd.DataFrame) -> pd.DataFrame:
+    """One row per intruder of a demo run (and ``clutter``): its tracks, highest issued level, and
+    when its first alert and its highest level came (s; NaN: never).
+
+    Parameters
+    ----------
+    summary : dict
+        :func:`skyradar.demo.run_demo`'s summary (``intruders``: tracks, max_level per name).
+    timeline : DataFrame
+        :func:`skyradar.demo.alert_timeline` (``time_s``, ``intruder``, ``level``).
+
+    Returns
+    -------
+    DataFrame
+        Columns ``intruder``, ``tracks``, ``highest_level``, ``highest_level_s``, ``first_alert``,
+        ``first_alert_s`` (levels in words).
+
+    Examples
+    --------
+    >>> summary = {"intruders": {"a": {"tracks": 1, "max_level": 3}, "b": {"tracks": 2, "max_level": 0}}}
+    >>> timeline = pd.DataFrame({"time_s": [20.0, 24.5], "intruder": ["a", "a"], "level": [1, 3]})
+    >>> intruder_outcomes(summary, timeline)
+      intruder  tracks highest_level  highest_level_s first_alert  first_alert_s
+    0        a       1       warning             24.5  preventive           20.0
+    1        b       2      no alert              NaN    no alert            NaN
+    """
+    rows = []
+    for name, outcome in summary["intruders"].items():
+        mine = timeline[(timeline["intruder"] == name) & (timeline["level"] > 0)].sort_values("time_s")
+        top = int(outcome["max_level"])
+        reached = mine.loc[mine["level"] == top, "time_s"]
+        first = int(mine["level"].iloc[0]) if len(mine) else 0
+        rows.append(
+            {
+                "intruder": name,
+                "tracks": int(outcome["tracks"]),
+                "highest_level": _LEVEL_WORDS.get(top, str(top)),
+                "highest_level_s": float(reached.min()) if top > 0 and len(reached) else float("nan"),
+                "first_alert": _LEVEL_WORDS.get(first, str(first)),
+                "first_alert_s": float(mine["time_s"].iloc[0]) if len(mine) else float("nan"),
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def summary_sentences(summary: dict[str, Any], outcomes: pd.DataFrame, duration_s: float) -> list[str]:
+    """The demo report's opening, in words: what the chain measured and when each alert came.
+
+    Every number comes from the run's ``summary`` and ``outcomes`` (:func:`intruder_outcomes`).
+
+    Parameters
+    ----------
+    summary : dict
+        :func:`skyradar.demo.run_demo`'s summary.
+    outcomes : DataFrame
+        :func:`intruder_outcomes` of the run.
+    duration_s : float
+        Time from the first frame to the last, s.
+
+    Returns
+    -------
+    list of str
+        The run, one sentence per intruder, the clutter, the acceptance check.
+
+    Examples
+    --------
+    >>> summary = {"frames": 10, "detections": 50, "detections_ground": 30, "detections_spur": 0,
+    ...            "tracks": 3, "acceptance": True, "intruders": {"a": {"tracks": 1, "max_level": 3},
+    ...                                                           "clutter": {"tracks": 1, "max_level": 0}}}
+    >>> timeline = pd.DataFrame({"time_s": [20.0, 24.5], "intruder": ["a", "a"], "level": [1, 3]})
+    >>> for line in summary_sentences(summary, intruder_outcomes(summary, timeline), 40.0):
+    ...     print(line)
+    10 frames over 40 s: 50 detections (30 on the ground, 0 on radar spurs), 3 tracks.
+    a: warning at 24.5 s (first alert, preventive, at 20.0 s), from 1 track.
+    1 track follows no intruder (clutter); none alerted.
+    Acceptance (a warning for the collision intruder, none for anything else): PASS.
+    """
+
+    def tracks(n: int) -> str:
+        return f"{n} track" + ("" if n == 1 else "s")
+
+    lines = [
+        f"{summary['frames']} frames over {duration_s:.0f} s: {summary['detections']} detections "
+        f"({summary['detections_ground']} on the ground, {summary['detections_spur']} on radar spurs), "
+        f"{tracks(summary['tracks'])}."
+    ]
+    for row in outcomes.itertuples(index=False):
+        n = int(row.tracks)
+        if row.intruder == "clutter":
+            alerted = (
+                "none alerted" if row.highest_level == "no alert" else f"highest level {row.highest_level}"
+            )
+            follows = "follows" if n == 1 else "follow"
+            lines.append(f"{tracks(n)} {follows} no intruder (clutter); {alerted}.")
+        elif n == 0:
+            lines.append(f"{row.intruder}: never tracked.")
+        elif np.isnan(row.highest_level_s):
+            lines.append(f"{row.intruder}: tracked ({tracks(n)}), no alert.")
+        else:
+            earlier = ""
+            if row.first_alert_s < row.highest_level_s:
+                earlier = f" (first alert, {row.first_alert}, at {row.first_alert_s:.1f} s)"
+            when = f"{row.highest_level} at {row.highest_level_s:.1f} s"
+            lines.append(f"{row.intruder}: {when}{earlier}, from {tracks(n)}.")
+    verdict = "PASS" if summary["acceptance"] else "FAIL"
+    lines.append(f"Acceptance (a warning for the collision intruder, none for anything else): {verdict}.")
+    return lines
+
+
+def _summary_html(summary: dict[str, Any], timeline: pd.DataFrame, duration_s: float) -> str:
+    """The report's opening section: the run in sentences, the intruders' outcomes, what to look at."""
+    outcomes = intruder_outcomes(summary, timeline)
+    run, *per_intruder, verdict = summary_sentences(summary, outcomes, duration_s)
+    items = "".join(f"<li>{html.escape(line)}</li>" for line in per_intruder)
+    table = outcomes.rename(
+        columns={
+            "highest_level": "highest level",
+            "highest_level_s": "at [s]",
+            "first_alert": "first alert",
+            "first_alert_s": "first alert at [s]",
+        }
+    ).to_html(index=False, na_rep="", float_format="{:.1f}".format)
+    files = ("summary.json", "detections.parquet", "tracks.parquet", "alerts.parquet", "alert_timeline.csv")
+    links = ", ".join(f'<a href="{f}">{f}</a>' for f in files)
+    return f"""<h2>Summary</h2>
+<p>{html.escape(run)}</p>
+<ul>{items}</ul>
+<p><b>{html.escape(verdict)}</b></p>
+{table}
+<p>The chain: simulate, process (detections, directions, ground flags), track (3-D, from the detections
+that are neither ground nor spur), alert (confirmed tracks). What to look at: the plan view shows
+each confirmed track against the truth and where warnings were issued; the alert timeline each
+track's level over time, with every change listed below it; the advice table the bands and the
+preferred manoeuvre at the start of each corrective or warning episode.</p>
+<p>Data: {links} (the numbers above, the stage timings and every table).</p>"""
+
+
 def write_report(
     out_dir: Path, chain: dict[str, Any], labels, timeline: pd.DataFrame, summary, rd_frame: int
 ) -> Path:
@@ -152,16 +297,15 @@ def write_report(
     advice = _advice_rows(alerts)
     no_advice = "<p>no advice (no corrective or warning alert)</p>"
     advice_html = advice.to_html(index=False, na_rep="") if len(advice) else no_advice
+    name = str(truth.attrs.get("scenario", "")) or "skyradar demo"
+    title = html.escape(name if name.lower().startswith("skyradar") else f"skyradar demo: {name}")
     page = f"""<!doctype html>
-<html lang="en"><head><meta charset="utf-8"><title>skyradar demo</title>
+<html lang="en"><head><meta charset="utf-8"><title>{title}</title>
 <style>body{{font-family:sans-serif;max-width:1000px;margin:auto}}
 table{{border-collapse:collapse;font-size:13px}} td,th{{border:1px solid #ccc;padding:2px 6px}}
 img{{max-width:100%}}</style></head><body>
-<h1>skyradar demo: {html.escape(str(truth.attrs.get("scenario", "")))}</h1>
-<p>Simulate &rarr; process &rarr; track (3-D, non-ground non-spur detections) &rarr; alert (confirmed
-tracks). Acceptance (warning for the collision intruder, none for anything else):
-<b>{"PASS" if summary["acceptance"] else "FAIL"}</b></p>
-<h2>Summary</h2><pre>{html.escape(json.dumps(summary, indent=1))}</pre>
+<h1>{title}</h1>
+{_summary_html(summary, timeline, float(times[-1] - times[0]))}
 <h2>Range-Doppler with detections</h2><img src="range_doppler.png" alt="range-Doppler">
 <h2>Plan view: tracks and truth</h2><img src="plan_view.png" alt="plan view">
 <h2>Alert timeline</h2><img src="alert_timeline.png" alt="alert timeline">

@@ -180,15 +180,19 @@ class RunSource:
             return None
         row = {k: float(v[i]) for k, v in self._own.items()}
         yaw = row["own_yaw_rad"] if "own_yaw_rad" in row else np.arctan2(row["own_ve_mps"], row["own_vn_mps"])
-        return {
-            "north_m": row["own_north_m"],
-            "east_m": row["own_east_m"],
-            "alt_m": -row["own_down_m"],
-            "heading_deg": float(np.degrees(yaw) % 360.0),
-            "gs_mps": float(np.hypot(row["own_vn_mps"], row["own_ve_mps"])),
-            "vs_mps": -row["own_vd_mps"],
-            "height_agl_m": row.get("own_height_agl_m"),
-        }
+        # NaN (no terrain under a clear-sky run: no height above ground) goes out as null: JSON has no
+        # NaN, and a page's JSON.parse refuses the bare NaN a lenient encoder would write.
+        return jsonable(
+            {
+                "north_m": row["own_north_m"],
+                "east_m": row["own_east_m"],
+                "alt_m": -row["own_down_m"],
+                "heading_deg": float(np.degrees(yaw) % 360.0),
+                "gs_mps": float(np.hypot(row["own_vn_mps"], row["own_ve_mps"])),
+                "vs_mps": -row["own_vd_mps"],
+                "height_agl_m": row.get("own_height_agl_m"),
+            }
+        )
 
     def _traffic(self, t: float) -> tuple[list[dict[str, Any]], dict[str, Any] | None]:
         if self.alerts.empty:

@@ -257,7 +257,7 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
         "alert_config": "radar",
     }
     key = {**settings, "version": code_version()}
-    _, save = E._partial_store(tmp_path, key)
+    _, save = E.partial_store(tmp_path, key)
     fake = {
         "t_lowc_s": np.nan,
         "t_cpa_s": 120.0,
@@ -300,10 +300,10 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
     assert not list(tmp_path.glob("*.partial*"))
     # Different settings never reuse another run's rows.
     save({("none", 0): [fake]})
-    assert E._partial_store(tmp_path, {**key, "seed": 6})[0] == {}
-    assert E._partial_store(tmp_path, {**key, "navigation": "perfect"})[0] == {}
-    assert E._partial_store(tmp_path, {**key, "rx_layout": "kite"})[0] == {}
-    assert E._partial_store(tmp_path, {**key, "family": "real-flights"})[0] == {}
+    assert E.partial_store(tmp_path, {**key, "seed": 6})[0] == {}
+    assert E.partial_store(tmp_path, {**key, "navigation": "perfect"})[0] == {}
+    assert E.partial_store(tmp_path, {**key, "rx_layout": "kite"})[0] == {}
+    assert E.partial_store(tmp_path, {**key, "family": "real-flights"})[0] == {}
 
 
 def test_flat_terrain_variant_puts_ground_under_the_whole_window():

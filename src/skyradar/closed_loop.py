@@ -126,11 +126,19 @@ class ClosedLoopChain(StreamingChain):
 
 
 def _show_pilot(pilot: Pilot, time_s: float, alerts: pd.DataFrame) -> None:
+    """The frame's highest level, its advice and when the traffic alerting at the pilot's level
+    passes its closest approach (the latest of the frame's tracks), shown to the pilot."""
     level = int(alerts["level"].max()) if len(alerts) else 0
     advice = frame_advice(alerts)
     heading = advice.preferred_heading_deg if advice is not None else np.nan
     vs = advice.preferred_vs_mps if advice is not None else np.nan
-    pilot.observe(time_s, level, heading, vs)
+    passes = np.nan
+    if len(alerts) and "tcpa_s" in alerts:
+        alerting = alerts["level"].to_numpy() >= pilot.config.respond_level
+        tcpa = alerts["tcpa_s"].to_numpy(float)[alerting]
+        if np.isfinite(tcpa).any():
+            passes = float(time_s) + float(np.nanmax(tcpa))
+    pilot.observe(time_s, level, heading, vs, passes)
 
 
 def _plan_flown(plan: Trajectory, times_s: np.ndarray) -> pd.DataFrame:

@@ -8,15 +8,19 @@ calls for action. What the pilot does, and why:
   (preventive) only informs.
 - **When.** The pilot acts a reaction delay after the first frame of the alert: ``corrective_delay_s``
   for a corrective alert, ``warning_delay_s`` for a warning (a warning while a corrective reaction is
-  pending brings the action forward). Alerts that vanish before the action time cancel it.
+  pending brings the action forward). An alert gone for ``clear_s`` by the action time cancels it.
 - **What.** The pilot flies the newest preferred manoeuvre of the advice
   (:func:`skyradar.daa.advice.advice_columns`): with ``manoeuvre="horizontal"`` the preferred heading
-  (the preferred vertical speed when no heading is conflict-free), with ``"vertical"`` the preferred
+  (the preferred vertical speed when no heading is conflict-free) and ``heading_margin_deg`` past it,
+  away from the conflict band (the preferred heading lies at the band's edge: flown exactly, the
+  next frame's band takes it back), with ``"vertical"`` the preferred
   vertical speed (the heading when no vertical speed is), a vertical-speed change being at least
   ``min_vs_change_mps`` (500 ft/min). The aircraft turns toward the heading the shorter way at
   ``turn_rate_dps`` (3 deg/s, a standard-rate turn), changes its vertical speed at
   ``vertical_accel_mps2`` (0.25 g) and keeps its ground speed: DAIDALUS' kinematic assumptions.
-- **Back to the plan.** Once no alert at ``respond_level`` has been seen for ``clear_s``, the pilot
+- **Back to the plan.** Once no alert at ``respond_level`` has been seen for ``clear_s`` and the
+  traffic that alerted has passed its predicted closest approach (the display shows it behind; an
+  alert that clears while the traffic is still ahead only says the manoeuvre works), the pilot
   returns to the planned path: a lookahead path follower (the heading aims at the point of the path
   ``lookahead_s`` of flight ahead of the nearest one) and a vertical speed of at most
   ``min_vs_change_mps`` toward the planned altitude. The manoeuvre ends when the aircraft is back
@@ -68,8 +72,11 @@ class PilotConfig:
     min_vs_change_mps : float
         Smallest vertical-speed change of a vertical manoeuvre, and the largest vertical speed of the
         return to the planned altitude, m/s.
+    heading_margin_deg : float
+        How far past the preferred heading the pilot turns, away from the conflict band, deg.
     clear_s : float
-        Time without an alert at ``respond_level`` after which the pilot returns to the plan, s.
+        Time without an alert at ``respond_level`` after which the pilot returns to the plan (once
+        the traffic has passed its closest approach), s.
     lookahead_s : float
         Lookahead of the path follower that brings the aircraft back to its plan, s of flight.
     rejoin_tolerance_m : float
@@ -94,6 +101,7 @@ class PilotConfig:
     turn_rate_dps: float = 3.0
     vertical_accel_mps2: float = 0.25 * GRAVITY_MPS2
     min_vs_change_mps: float = 500.0 * FPM_MPS
+    heading_margin_deg: float = 5.0
     clear_s: float = 5.0
     lookahead_s: float = 10.0
     rejoin_tolerance_m: float = 15.0
@@ -110,7 +118,12 @@ class PilotConfig:
             if f.name in ("manoeuvre", "respond_level"):
                 continue
             value = getattr(self, f.name)
-            positive = f.name not in ("corrective_delay_s", "warning_delay_s", "clear_s")
+            positive = f.name not in (
+                "corrective_delay_s",
+                "warning_delay_s",
+                "clear_s",
+                "heading_margin_deg",
+            )
             if not np.isfinite(value) or value < 0 or (positive and value == 0) or value > 1e4:
                 bound = "> 0" if positive else ">= 0"
                 raise InputError(f"pilot: field '{f.name}' must be finite, {bound} and <= 1e4, got {value!r}")
@@ -165,9 +178,12 @@ class Pilot:
         self._deviated = False
         self._act_at_s = np.inf  # when the pending reaction is due, s
         self._last_alert_s = -np.inf
+        self._passes_s = -np.inf  # when the traffic that alerted passes its closest approach, s
         self._heading_deg = np.nan  # the newest advice
         self._vs_mps = np.nan
         self._target_vs_mps = np.nan
+        self._vs_at_action = 0.0
+        self._heading_at_action = 0.0
         self.manoeuvre_s = 0.0
         self.first_action_s = np.nan
         state = plan.sample(self.time_s)
@@ -186,16 +202,20 @@ class Pilot:
         level: int,
         preferred_heading_deg: float = np.nan,
         preferred_vs_mps: float = np.nan,
+        closest_approach_s: float = np.nan,
     ) -> None:
         """The pilot reads the display at ``time_s`` (s): the frame's highest alert level and its advice.
 
         ``preferred_heading_deg`` (deg from north) and ``preferred_vs_mps`` (m/s, positive up) are
-        the advice's preferred manoeuvre, NaN when it has none.
+        the advice's preferred manoeuvre, NaN when it has none; ``closest_approach_s`` is when the
+        alerting traffic is predicted to pass its closest approach (s, NaN: not known).
         """
         cfg = self.config
         if level < cfg.respond_level:
             return
         self._last_alert_s = float(time_s)
+        if np.isfinite(closest_approach_s):
+            self._passes_s = max(self._passes_s, float(closest_approach_s))
         if np.isfinite(preferred_heading_deg) or np.isfinite(preferred_vs_mps):
             self._heading_deg, self._vs_mps = float(preferred_heading_deg), float(preferred_vs_mps)
         if self.mode == "avoid":
@@ -254,16 +274,16 @@ class Pilot:
         self._log.append((self.time_s, *self._pos, *velocity, MODES.index(self.mode)))
 
     def _aim_vertical(self) -> None:
-        """The vertical speed a vertical manoeuvre flies: the advice's, changed by at least the minimum."""
+        """The vertical speed a vertical manoeuvre flies: the advice's, at least the minimum change away
+        from the vertical speed the manoeuvre started at."""
         if not np.isfinite(self._vs_mps):
             self._target_vs_mps = np.nan
             return
-        change = self._vs_mps - self._vs
+        change = self._vs_mps - self._vs_at_action
         if abs(change) < self.config.min_vs_change_mps:
-            change = np.copysign(
-                self.config.min_vs_change_mps, change if change != 0 else self._vs_mps or 1.0
-            )
-        self._target_vs_mps = self._vs + change
+            direction = change if change != 0 else (self._vs_mps or 1.0)
+            change = np.copysign(self.config.min_vs_change_mps, direction)
+        self._target_vs_mps = self._vs_at_action + change
 
     def _start_action(self) -> None:
         self._act_at_s = np.inf
@@ -276,6 +296,8 @@ class Pilot:
             self._deviated = True
         if np.isnan(self.first_action_s):
             self.first_action_s = self.time_s
+        self._vs_at_action = self._vs
+        self._heading_at_action = self._heading
         self.mode = "avoid"
         self._aim_vertical()
 
@@ -286,10 +308,16 @@ class Pilot:
             horizontal = np.isfinite(self._heading_deg) and (
                 cfg.manoeuvre == "horizontal" or not np.isfinite(self._target_vs_mps)
             )
-            heading = np.radians(self._heading_deg) if horizontal else self._heading
+            heading = self._avoid_heading() if horizontal else self._heading
             vs = self._vs if horizontal or not np.isfinite(self._target_vs_mps) else self._target_vs_mps
             return float(heading), float(vs)
         return self._path_targets()
+
+    def _avoid_heading(self) -> float:
+        """The preferred heading, ``heading_margin_deg`` further from the heading at the action, rad."""
+        preferred = np.radians(self._heading_deg)
+        side = np.sign(_wrap(preferred - self._heading_at_action))
+        return float(preferred + side * np.radians(self.config.heading_margin_deg))
 
     def _nearest_path_point(self) -> int:
         d = np.hypot(*(self._path.position_ned_m[:, :2] - self._pos[:2]).T)
@@ -323,7 +351,8 @@ class Pilot:
         cfg = self.config
         if self.time_s >= self._act_at_s - 1e-9:
             self._start_action()
-        if self.mode == "avoid" and self.time_s - self._last_alert_s >= cfg.clear_s:
+        clear = self.time_s - self._last_alert_s >= cfg.clear_s and self.time_s >= self._passes_s
+        if self.mode == "avoid" and clear:
             self.mode = "return"
         if not self._deviated:
             self.time_s += dt

@@ -33,6 +33,8 @@ __all__ = [
     "PassivePulse",
     "PassiveScenario",
     "Layout",
+    "ClosedLoopFamily",
+    "Manoeuvre",
     "Navigation",
     "RxLayout",
     "Family",
@@ -200,6 +202,21 @@ class Family(StrEnum):
     synthetic = "synthetic"
     real_flights = "real-flights"
     fast_closures = "fast-closures"
+
+
+class ClosedLoopFamily(StrEnum):
+    """``experiment closed-loop --family``: the encounter set flown closed-loop
+    (``skyradar.experiments.closed_loop.CLOSED_LOOP_FAMILIES``)."""
+
+    synthetic = "synthetic"
+    fast_closures = "fast-closures"
+
+
+class Manoeuvre(StrEnum):
+    """``experiment closed-loop --manoeuvre``: the advice the pilot flies (``skyradar.pilot.PilotConfig``)."""
+
+    horizontal = "horizontal"
+    vertical = "vertical"
 
 
 class Split(StrEnum):

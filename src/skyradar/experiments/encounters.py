@@ -46,6 +46,7 @@ __all__ = [
     "DEFAULT_TERRAIN_ENCOUNTERS",
     "FAMILIES",
     "EVALUATION_SEEDS_FROM",
+    "partial_store",
 ]
 
 MAX_ENCOUNTERS = 100_000  # 200 times the thesis-sized set; more is a typo, not a plan
@@ -60,7 +61,9 @@ _PARTIAL = "encounters.partial.parquet"
 
 def _run_rows(tasks: list[tuple[str, int, dict]], kw: dict) -> list[tuple[str, int, list[dict]]]:
     one: Callable[..., list[dict[str, Any]]]  # run_encounter or run_real_encounter: their options differ
-    if kw["family"] == "real-flights":
+    if kw.get("loop") == "closed":
+        from skyradar.experiments.closed_loop import run_closed_loop_encounter as one
+    elif kw["family"] == "real-flights":
         from skyradar.experiments.encounter_real import run_real_encounter as one
     else:
         one = run_encounter
@@ -88,6 +91,7 @@ def run_encounters(
     terrains: tuple[str, ...] = ("none",),
     family: str = "synthetic",
     scheduler: str | None = None,
+    loop: str = "open",
     **options: Any,
 ) -> pd.DataFrame:
     """All encounters (rows of ``params``) over every terrain: here, or one Dask task per encounter.
@@ -104,13 +108,14 @@ def run_encounters(
     (Ctrl-C, SIGTERM), the encounters in flight are cancelled and a local cluster is shut down; what
     finished has reached ``on_chunk``. Options go to
     :func:`~skyradar.experiments.encounter_chain.run_encounter` (``family="real-flights"``:
-    :func:`~skyradar.experiments.encounter_real.run_real_encounter`).
+    :func:`~skyradar.experiments.encounter_real.run_real_encounter`; ``loop="closed"``:
+    :func:`~skyradar.experiments.closed_loop.run_closed_loop_encounter`).
     """
     workers = check_workers(workers) or min(2, os.cpu_count() or 1)  # 10**20 spawned until memory ran out
     results: dict[tuple[str, int], list[dict]] = dict(done or {})
     records = params.to_dict("records")
     todo = [(tr, i, p) for tr in terrains for i, p in enumerate(records) if (tr, i) not in results]
-    kw = {"seed": seed, "options": options, "family": family}
+    kw = {"seed": seed, "options": options, "family": family, "loop": loop}
 
     def finished(rows: list[tuple[str, int, list[dict]]]) -> None:
         results.update({(tr, i): r for tr, i, r in rows})
@@ -147,9 +152,10 @@ def _long_table(params: pd.DataFrame, results: dict, terrains) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def _partial_store(out_dir: Path, key: dict) -> tuple[dict, Callable[[dict], None]]:
-    """Rows of an interrupted run with the same settings, and a writer that keeps them up to date."""
-    path, key_path = out_dir / _PARTIAL, out_dir / (_PARTIAL + ".json")
+def partial_store(out_dir: Path, key: dict, name: str = _PARTIAL) -> tuple[dict, Callable[[dict], None]]:
+    """Rows of an interrupted run with the same settings ``key`` (``{(terrain, encounter): rows}``,
+    from ``out_dir / name``), and a writer that keeps that file up to date with the rows so far."""
+    path, key_path = out_dir / name, out_dir / (name + ".json")
     done: dict[tuple[str, int], list[dict]] = {}
     if path.exists() and key_path.exists() and json.loads(key_path.read_text()) == key:
         table = pd.read_parquet(path)
@@ -256,7 +262,7 @@ def run(
         "split": "evaluation" if seed >= EVALUATION_SEEDS_FROM else "development",
     }
     version = code_version()
-    done, save = _partial_store(out_dir, {**settings, "version": version})
+    done, save = partial_store(out_dir, {**settings, "version": version})
     res = run_encounters(
         enc,
         seed,

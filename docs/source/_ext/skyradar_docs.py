@@ -346,6 +346,101 @@ class ClutterDirective(SphinxDirective):
         return out
 
 
+# The closed-loop summary's columns of one case (terrain and equipped case): counts, risk ratios with
+# their intervals, separation and the pilot's time off the plan.
+CLOSED_LOOP_FIELDS = (
+    ("lowc_unequipped", "losses of well clear unequipped"),
+    ("lowc_equipped", "losses of well clear equipped"),
+    ("lowc_risk_ratio", "risk ratio, loss of well clear"),
+    ("lowc_risk_ratio_interval", "its 95 % paired bootstrap interval"),
+    ("lowc_induced", "losses equipped where unequipped stayed well clear"),
+    ("lowc_resolved", "losses unequipped that equipped avoided"),
+    ("nmac_unequipped", "NMACs unequipped (500 ft / 100 ft)"),
+    ("nmac_equipped", "NMACs equipped"),
+    ("nmac_risk_ratio", "risk ratio, NMAC"),
+    ("nmac_risk_ratio_interval", "its 95 % paired bootstrap interval"),
+    (
+        "median_min_horizontal_unequipped_conflicts_m",
+        "median smallest horizontal separation of the conflicts, unequipped, m",
+    ),
+    ("median_min_horizontal_equipped_conflicts_m", "the same equipped, m"),
+    ("manoeuvred_encounters", "encounters the pilot manoeuvred in"),
+    ("manoeuvre_s_mean", "mean time off the plan per encounter, s"),
+    ("runtime_s_mean", "mean wall time of one encounter flown this way, s"),
+)
+
+
+def _closed_loop_value(name: str, value: object) -> str:
+    if isinstance(value, list | tuple) and len(value) == 2:
+        if any(v is None or (isinstance(v, float) and math.isnan(v)) for v in value):
+            return "n/a"
+        return f"{value[0]:.2f}-{value[1]:.2f}"
+    if isinstance(value, float) and not math.isnan(value) and not value.is_integer():
+        return f"{value:.2f}"
+    return format_value(name, value)
+
+
+class ClosedLoopDirective(SphinxDirective):
+    """``.. skyradar-closed-loop:: [folder]``: the saved ``skyradar experiment closed-loop`` summaries
+    (default ``docs/results/closed-loop``): settings and provenance, one column per terrain and
+    equipped case, and the run's figure when it is kept beside the JSON as ``<name>.png``."""
+
+    optional_arguments = 1
+
+    def run(self) -> list[nodes.Node]:
+        where = self.arguments[0] if self.arguments else "../results/closed-loop"
+        folder = Path(self.env.srcdir, where).resolve()
+        files = sorted(folder.glob("*.json"))
+        if not files:
+            warning = f"no closed-loop summary JSON in {folder}"
+            return [self.state.document.reporter.warning(warning, line=self.lineno)]
+        out: list[nodes.Node] = []
+        for path in files:
+            self.env.note_dependency(str(path))
+            out.append(self._summary_section(path, json.loads(path.read_text())))
+        return out
+
+    def _summary_section(self, path: Path, summary: dict) -> nodes.section:
+        section = _section(self, path.name, "closed-loop-" + path.stem)
+        fields = nodes.field_list()
+        settings = summary.get("settings") or {}
+        shown = {k: settings.get(k) for k in ("family", "terrains", "layouts", "n", "seed", "split")}
+        pilot = settings.get("pilot") or {}
+        shown["pilot"] = ", ".join(f"{k}={v}" for k, v in pilot.items())
+        shown |= {k: summary.get(k) for k in ("runtime_s", *PROVENANCE_FIELDS)}
+        for key, value in shown.items():
+            text = format_value(key, value)
+            body = nodes.paragraph()
+            body += nodes.literal(text, text) if key in ("command", "version") else nodes.Text(text)
+            fields += nodes.field("", nodes.field_name(key, key), nodes.field_body("", body))
+        section += fields
+        rows = summary.get("rows") or []
+        cases = [
+            f"{r['terrain']}: "
+            + ("perfect surveillance" if r["condition"] == "perfect" else f"radar, {r['layout']}")
+            for r in rows
+        ]
+        table = [
+            [
+                nodes.paragraph("", "", nodes.literal(key, key)),
+                meaning,
+                *[_closed_loop_value(key, r.get(key)) for r in rows],
+            ]
+            for key, meaning in (("encounters", "encounters flown"), *CLOSED_LOOP_FIELDS)
+        ]
+        section += _table(["key", "meaning", *cases], table, classes=["skyradar-closed-loop"])
+        png = path.with_suffix(".png")
+        if png.is_file():
+            self.env.note_dependency(str(png))
+            here = Path(self.env.doc2path(self.env.docname)).parent
+            figure = nodes.figure(classes=["skyradar-closed-loop-figure"])
+            figure += nodes.image(uri=Path(os.path.relpath(png, here)).as_posix(), alt=png.name)
+            text = f"{png.name}: smallest horizontal separation with and without DAA, and the rates."
+            figure += nodes.caption(text, text)
+            section += figure
+        return section
+
+
 def _bench_value(value: object) -> str:
     """A measured value as shown: floats to four significant digits, lists and the rest as JSON."""
     if isinstance(value, bool) or value is None:
@@ -739,6 +834,7 @@ def setup(app: Sphinx) -> dict:
     app.add_directive("skyradar-results", ResultsDirective)
     app.add_directive("skyradar-benchmarks", BenchmarksDirective)
     app.add_directive("skyradar-clutter", ClutterDirective)
+    app.add_directive("skyradar-closed-loop", ClosedLoopDirective)
     app.add_directive("skyradar-cli", CliDirective)
     app.add_directive("skyradar-api", ApiDirective)
     app.add_directive("skyradar-alert-config", AlertConfigDirective)

@@ -319,13 +319,13 @@ def plot(runs: dict[str, Any], detections: pd.DataFrame, path: Path) -> Path:
     labels = []
     for y, row in enumerate(detections.itertuples(index=False)):
         pair = (row.ownship, row.intruder)
-        for key, colour, dy in (("truth_pairs", "0.55", 0.15), ("used_pairs", "tab:red", -0.15)):
+        for key, colour, dy in (("truth_pairs", "0.55", -0.25), ("used_pairs", "tab:red", 0.0)):
             times = [r.time_s for r in records if pair in getattr(r, key)]
             for a, b in _intervals(times, step):
                 ax_time.plot([a, b + step], [y + dy, y + dy], color=colour, lw=6, solid_capstyle="butt")
         tracked = [r.time_s for r in records if pair[1] in r.tracked.get(pair[0], ())]
         for a, b in _intervals(tracked, step):
-            ax_time.plot([a, b + step], [y - 0.35, y - 0.35], color="tab:blue", lw=2)
+            ax_time.plot([a, b + step], [y + 0.25, y + 0.25], color="tab:blue", lw=2)
         labels.append(f"{row.ownship} / {row.intruder}: {row.outcome}")
     ax_time.set_yticks(range(len(labels)), labels, fontsize=8)
     ax_time.set_ylim(-0.8, max(len(labels), 1) - 0.2)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import re
+import sys
 import tempfile
 import time
 import warnings
@@ -168,6 +169,7 @@ def run_scenario(
         raise InputError(f"{path}: the scenario has no commands after t = 0 s; give the time to run to")
     t0 = time.perf_counter()
     sink: Any = open(log_path, "a") if log_path is not None else _Discard()  # noqa: SIM115
+    terminal = (sys.stdout, sys.stderr)  # progress reports go there, BlueSky's messages to the sink
     try:
         bs = _start(workdir, sink)
         with contextlib.redirect_stdout(sink), contextlib.redirect_stderr(sink), warnings.catch_warnings():
@@ -189,7 +191,8 @@ def run_scenario(
                     rows += _states(bs, simt)
                     next_sample += sample_s
                     if progress is not None:
-                        progress(simt)
+                        with contextlib.redirect_stdout(terminal[0]), contextlib.redirect_stderr(terminal[1]):
+                            progress(simt)
                 if simt >= end - 1e-9 or bs.sim.state != bs.OP and simt > 0:
                     break
         radars = {

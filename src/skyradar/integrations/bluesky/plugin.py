@@ -177,18 +177,27 @@ class SkyradarPlugin:
             self.requested[acid] = mounts
             if self.surveillance == "radar":
                 self._switch_on(acid, mounts, index)
+            elif self.terrain.kind in ("jacksboro", "file"):  # the same refusal as with the radar
+                self._terrain_under(acid, index)
             return True, f"SKYRADAR {acid}: radar on ({', '.join(mounts)})"
         except InputError as exc:
             return self._fail(exc)
+
+    def _terrain_under(self, acid: str, index: int) -> Any:
+        """The terrain around aircraft ``acid`` (index ``index``); InputError when it has no data there."""
+        import bluesky as bs
+
+        lat, lon = float(bs.traf.lat[index]), float(bs.traf.lon[index])
+        try:
+            return self.terrain.build(lat, lon, what=f"aircraft {acid}")
+        except InputError as exc:
+            raise InputError(f"SKYRADAR {acid}: no terrain data under the radar: {exc}") from None
 
     def _switch_on(self, acid: str, mounts: tuple[str, ...], index: int) -> None:
         import bluesky as bs
 
         lat, lon = float(bs.traf.lat[index]), float(bs.traf.lon[index])
-        try:
-            terrain = self.terrain.build(lat, lon, what=f"aircraft {acid}")
-        except InputError as exc:
-            raise InputError(f"SKYRADAR {acid}: no terrain data under the radar: {exc}") from None
+        terrain = self._terrain_under(acid, index)
         self.radars[acid] = AirborneRadar(
             acid,
             mounts,
@@ -252,9 +261,10 @@ class SkyradarPlugin:
         """Step every radar whose next frame is due (BlueSky's ``preupdate`` hook, every step)."""
         import bluesky as bs
 
-        if not self.radars or bs.traf.ntraf == 0:
+        time_s = float(bs.sim.simt)
+        if bs.traf.ntraf == 0 or all(r.next_frame_s > time_s + 1e-9 for r in self.radars.values()):
             return
-        traffic = TrafficState.from_traffic(bs.traf, float(bs.sim.simt))
+        traffic = TrafficState.from_traffic(bs.traf, time_s)
         for acid in list(self.radars):
             radar = self.radars[acid]
             if acid not in traffic.ids:  # deleted: its radar goes with it
@@ -391,7 +401,7 @@ class SkyradarPlugin:
 
 @dataclass
 class _Pair:
-    """Two aircraft in BlueSky's attribute names (the own-ship and one false track)."""
+    """Two aircraft in the attribute names BlueSky's detection reads (the own-ship and one false track)."""
 
     id: list[str]
     lat: np.ndarray
@@ -471,6 +481,10 @@ def install() -> dict[str, Any]:
         bs.traf.cd = DetectionGate(bs.traf.cd, plugin)
     if not isinstance(bs.traf.cr, ResolutionGate):
         bs.traf.cr = ResolutionGate(bs.traf.cr, plugin)
+    from bluesky.stack.cmdparser import get_commands
+
+    if PLUGIN_NAME in get_commands():  # installed before: BlueSky loads a plugin again on each PLUGIN LOAD
+        return {"preupdate": plugin.preupdate, "reset": plugin.reset}
     bs.stack.append_commands(
         {
             "SKYRADAR": [

@@ -122,6 +122,8 @@ class SkyradarPlugin:
         Directory that relative ``SKYRADARTERRAIN FILE`` paths are taken from (the scenario's).
     radars : dict of str to AirborneRadar
         The radars, by carrying aircraft.
+    requested : dict of str to tuple of str
+        Every ``SKYRADAR acid ON``'s heads, by aircraft (with ``TRUTH`` surveillance too).
     errors : list of str
         Every error line so far.
     log : list of DetectionRecord

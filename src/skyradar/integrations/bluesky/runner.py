@@ -14,6 +14,8 @@ run as one :class:`~skyradar.errors.InputError` line naming the scenario file.
 from __future__ import annotations
 
 import contextlib
+import fcntl
+import os
 import re
 import sys
 import tempfile
@@ -112,10 +114,14 @@ def _start(workdir: Path | None, log: Any) -> Any:
     locations = bluesky.plugins.__spec__.submodule_search_locations
     if str(PLUGIN_DIR) not in locations:
         locations.append(str(PLUGIN_DIR))
-    workdir = workdir or Path(tempfile.gettempdir()) / "skyradar-bluesky"
+    workdir = workdir or Path(tempfile.gettempdir()) / f"skyradar-bluesky-{os.getuid()}"
     workdir.mkdir(parents=True, exist_ok=True)
     with contextlib.redirect_stdout(log), contextlib.redirect_stderr(log):
-        bs.init(mode="sim", detached=True, workdir=str(workdir))
+        # BlueSky writes its settings and navigation-data cache into the folder on the first start:
+        # one process at a time, so that another one never reads a half-written cache.
+        with open(workdir / "skyradar.lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            bs.init(mode="sim", detached=True, workdir=str(workdir))
         from bluesky.core.plugin import Plugin
 
         if PLUGIN_NAME not in Plugin.loaded_plugins:
@@ -148,8 +154,9 @@ def run_scenario(
     sample_s : float
         Interval of the states table, s.
     workdir : Path, optional
-        BlueSky's working directory (its settings, caches and output; default a folder in the
-        system's temporary directory). Only the first run of a process uses it.
+        BlueSky's working directory (its settings, caches and output; default
+        ``skyradar-bluesky-UID`` in the system's temporary directory). Only the first run of a
+        process uses it.
     log_path : Path, optional
         File that receives BlueSky's messages (default: discarded).
     progress : callable, optional

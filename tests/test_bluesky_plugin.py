@@ -126,3 +126,48 @@ def test_bad_input_is_one_line_through_the_command(tmp_path, case):
     )
     assert_one_line_error(result, f"{path}: ", *needles)
     assert result.stdout == ""
+
+
+_USER_RUN = """
+import contextlib, io, sys
+import bluesky as bs
+
+with contextlib.redirect_stdout(io.StringIO()):
+    bs.init(mode="sim", detached=True, workdir=sys.argv[1])
+    bs.stack.stack("PCALL " + sys.argv[2] + " ABS")
+    for _ in range(200):  # 10 s at BlueSky's 0.05 s step
+        bs.sim.step()
+from skyradar.integrations.bluesky.plugin import plugin
+
+print(plugin.radars["OWN"].n_frames, len(plugin.log))
+"""
+
+
+def test_bluesky_loads_the_plugin_file_from_its_own_plugin_folder(tmp_path):
+    """What a BlueSky user does: the plugin's file in the working folder's plugins, PLUGIN LOAD SKYRADAR."""
+    import os
+    import shutil
+    import subprocess
+    import sys
+    import tempfile
+
+    from skyradar.integrations.bluesky import PLUGIN_DIR
+
+    (tmp_path / "plugins").mkdir()
+    shutil.copy(PLUGIN_DIR / "skyradar_radar.py", tmp_path / "plugins")
+    # BlueSky's navigation-data cache from the runner's folder, when it has one: 4 s less to start.
+    cache = Path(tempfile.gettempdir()) / f"skyradar-bluesky-{os.getuid()}" / "cache"
+    if cache.is_dir():
+        shutil.copytree(cache, tmp_path / "cache")
+    scenario = _scenario(tmp_path, "user", "00:00:00.00>PLUGIN LOAD SKYRADAR\n" + AHEAD)
+    script = tmp_path / "user_run.py"
+    script.write_text(_USER_RUN)
+    result = subprocess.run(
+        [sys.executable, str(script), str(tmp_path), str(scenario)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert result.returncode == 0, result.stderr
+    frames, steps = (int(v) for v in result.stdout.split())
+    assert frames == 20 and steps >= 9  # frames at 0, 0.5, ..., 9.5 s; a detection step a second

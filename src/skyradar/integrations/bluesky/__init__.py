@@ -8,8 +8,9 @@ resolution methods) is unchanged. The names users call (each imported from its m
 - :class:`~.radar.AirborneRadar`, :class:`~.radar.TerrainSpec`, :class:`~.radar.TrafficState`,
   :class:`~.radar.TrackEstimate`, :func:`~.radar.check_mountable` and ``MOUNTABLE_TYPES``: one
   aircraft's radar over traffic given one state at a time (no BlueSky needed);
-- :data:`~.plugin.plugin` and :func:`~.plugin.install`: the BlueSky plugin (its stack commands
-  ``SKYRADAR``, ``SKYRADARTERRAIN``, ``SKYRADARCFG``);
+- :class:`~.plugin.SkyradarPlugin` (its one instance: ``skyradar.integrations.bluesky.plugin.plugin``)
+  and :func:`~.plugin.install`: the BlueSky plugin (its stack commands ``SKYRADAR``,
+  ``SKYRADARTERRAIN``, ``SKYRADARCFG``);
 - :func:`~.runner.run_scenario`, :class:`~.runner.BlueSkyRun` and ``PLUGIN_DIR`` (the folder to put
   on BlueSky's plugin path): a scenario file run headless.
 
@@ -31,7 +32,7 @@ _EXPORTS = {
         "check_mountable",
         "MOUNTABLE_TYPES",
     ),
-    "plugin": ("plugin", "install"),
+    "plugin": ("SkyradarPlugin", "install"),
     "runner": ("run_scenario", "BlueSkyRun", "PLUGIN_DIR"),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

@@ -5,7 +5,9 @@ plugin itself is :mod:`skyradar.integrations.bluesky.plugin`. BlueSky reads the 
 type from the literal dictionary below before it imports the file.
 """
 
-from skyradar.integrations.bluesky import plugin as _skyradar
+from importlib import import_module
+
+_skyradar = import_module("skyradar.integrations.bluesky.plugin")
 
 
 def init_plugin():

@@ -37,6 +37,7 @@ PLUGIN_DIR = Path(__file__).parent / "bluesky_plugins"
 """The folder holding the file BlueSky loads the plugin from (``skyradar_radar.py``)."""
 
 _STOP_COMMANDS = ("HOLD", "QUIT", "STOP", "EXIT")
+_MAX_IDLE_STEPS = 100  # a scenario that never starts the simulation ends the run after this many steps
 _started: dict[str, Any] = {}  # the BlueSky simulation of this process, once started
 
 
@@ -173,7 +174,9 @@ def run_scenario(
     require_bluesky()
     end = scenario_end_s(path) if end_s is None else float(end_s)
     if not end > 0:
-        raise InputError(f"{path}: the scenario has no commands after t = 0 s; give the time to run to")
+        raise InputError(
+            f"{path}: the scenario has no commands after t = 0 s; give the time to run to (--end, or a HOLD)"
+        )
     t0 = time.perf_counter()
     sink: Any = open(log_path, "a") if log_path is not None else _Discard()  # noqa: SIM115
     terminal = (sys.stdout, sys.stderr)  # progress reports go there, BlueSky's messages to the sink
@@ -189,8 +192,10 @@ def run_scenario(
             bs.stack.stack(f"PCALL {path.resolve()} ABS")
             rows: list[dict[str, Any]] = []
             next_sample = 0.0
-            while True:
+            idle = 0  # steps the simulation did not run (nothing to fly and nothing scheduled)
+            while idle < _MAX_IDLE_STEPS:
                 bs.sim.step()
+                idle = idle + 1 if bs.sim.state != bs.OP else 0
                 if plugin.errors:
                     raise InputError(f"{path}: {plugin.errors[0]}")
                 simt = float(bs.sim.simt)

@@ -1,8 +1,9 @@
 """Optional extras: heavy dependencies only some commands need, and one clear error when one is missing.
 
 ``pip install skyradar`` installs what every command needs; ``skyradar[geo]`` (GeoTIFF DEMs, OSM maps),
-``skyradar[web]`` (``skyradar serve``), ``skyradar[dask]`` (``--workers`` / ``--scheduler``) and
-``skyradar[flights]`` (the recorded flights the ``traffic`` package ships) add the rest, ``skyradar[all]``
+``skyradar[web]`` (``skyradar serve``), ``skyradar[dask]`` (``--workers`` / ``--scheduler``),
+``skyradar[flights]`` (the recorded flights the ``traffic`` package ships) and ``skyradar[bluesky]``
+(the BlueSky traffic simulator, :mod:`skyradar.integrations.bluesky`) add the rest, ``skyradar[all]``
 everything. Every import of an extra's module goes through :func:`import_extra`
 (or :func:`require_extra` before a command starts), so a missing one is a single line naming the extra,
 exit code 2, never a traceback.
@@ -23,6 +24,7 @@ EXTRAS: dict[str, tuple[str, ...]] = {
     "web": ("fastapi", "uvicorn", "websockets"),
     "dask": ("distributed",),
     "flights": ("traffic",),
+    "bluesky": ("bluesky",),
 }
 
 

@@ -14,7 +14,8 @@ fixed choices as string enums) and one module per group of commands: :mod:`.comm
 ``make-encounter``), :mod:`.commands_passive` (``passive``), :mod:`.commands_passive_sim`
 (``simulate-passive``), :mod:`.commands_demo` (``demo``), :mod:`.commands_encounters` and
 :mod:`.commands_clutter` (``experiment encounters``, ``experiment clutter``),
-:mod:`.commands_closed_loop` (``experiment closed-loop``); each also holds its
+:mod:`.commands_closed_loop` (``experiment closed-loop``), :mod:`.commands_bluesky` (``experiment
+bluesky``); each also holds its
 ``experiment`` and ``bench`` commands.
 """
 
@@ -28,6 +29,7 @@ from typing import Any
 
 import typer
 
+import skyradar.cli.commands_bluesky  # noqa: F401  (registers commands)
 import skyradar.cli.commands_closed_loop  # noqa: F401  (registers commands)
 import skyradar.cli.commands_clutter  # noqa: F401  (registers commands)
 import skyradar.cli.commands_daa  # noqa: F401  (registers commands)

@@ -21,9 +21,11 @@ package):
 - :mod:`.encounters` (the DAA encounter set), with :mod:`.encounter_set`, :mod:`.encounter_terrain`,
   :mod:`.encounter_real`, :mod:`.encounter_chain`, :mod:`.encounter_score`,
   :mod:`.encounter_report`, :mod:`.sensor_figures` and :mod:`.encounter_cost` (``bench encounter``);
-- :mod:`.closed_loop` (the encounter set flown closed-loop: the pilot follows the advice).
+- :mod:`.closed_loop` (the encounter set flown closed-loop: the pilot follows the advice);
+- :mod:`.bluesky_compare` (BlueSky's perfect-state conflict detection against the radar's, through
+  the plugin of :mod:`skyradar.integrations.bluesky`).
 
 :mod:`.ground_scenes` scores the ground filter on named scenes over flat ground, hills and Jacksboro.
 """
 
-__all__ = ["ch2", "ch3", "ch4", "ch5", "ch6", "ch7", "clutter", "encounters", "closed_loop"]
+__all__ = ["ch2", "ch3", "ch4", "ch5", "ch6", "ch7", "clutter", "encounters", "closed_loop", "bluesky_compare"]

@@ -28,4 +28,15 @@ package):
 :mod:`.ground_scenes` scores the ground filter on named scenes over flat ground, hills and Jacksboro.
 """
 
-__all__ = ["ch2", "ch3", "ch4", "ch5", "ch6", "ch7", "clutter", "encounters", "closed_loop", "bluesky_compare"]
+__all__ = [
+    "ch2",
+    "ch3",
+    "ch4",
+    "ch5",
+    "ch6",
+    "ch7",
+    "clutter",
+    "encounters",
+    "closed_loop",
+    "bluesky_compare",
+]

@@ -47,6 +47,7 @@ def test_bench_alert_prints_json_last():
     result = json.loads(out.stdout.strip().splitlines()[-1])
     assert result["same_miss_distances"] and result["frames"] == 60 and result["tracks"] == 3
     assert result["frames_per_s"] > 0 and result["miss_speedup"] > 0
+    assert result["same_stream_alerts"] and result["stream_frames"] == 60 and result["stream_speedup"] > 0
 
 
 @pytest.mark.parametrize("args", [("--frames", "0"), ("--tracks", "200000", "--frames", "100000")])

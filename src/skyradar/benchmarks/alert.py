@@ -9,7 +9,12 @@ the resolution advice, timed whole (``frames_per_s``), and its range-only miss d
 (numba, one pass of a sliding window per track). Baseline, in the same run on the same rows: that
 miss distance as a straightforward numpy implementation computes it, a least-squares line through
 each row's window (:func:`range_miss_baseline`); both give the same numbers (a test checks it).
-Each of the two is timed as the shortest of three runs.
+Each of the two is timed as the shortest of three runs. The alerting frame by frame
+(:class:`skyradar.daa.pipeline.AlertStream`, which keeps each track's filter and a trailing window)
+is timed over the first ``stream_frames`` frames against the plain way of alerting a stream, in
+the same run on the same frames: :func:`~skyradar.daa.pipeline.alerts_from_tracks` over every row
+so far at each frame, keeping the frame's rows (:func:`stream_baseline`); both give the same table
+(``same_stream_alerts``).
 ``frames_per_s`` is wall-clock; the load average is reported beside it because the benchmark
 machine is often shared.
 """
@@ -23,12 +28,12 @@ import numpy as np
 import pandas as pd
 
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG
-from skyradar.daa.pipeline import alerts_from_tracks
+from skyradar.daa.pipeline import AlertStream, alerts_from_tracks
 from skyradar.daa.range_miss import miss_of_window, range_miss_distance
 from skyradar.daa.tables import interp_ownship
 from skyradar.errors import InputError
 
-__all__ = ["bench_tables", "range_miss_baseline", "run"]
+__all__ = ["bench_tables", "range_miss_baseline", "stream_baseline", "run"]
 
 FRAME_RATE_HZ = 9.4
 OWN_SPEED_MPS = 50.0
@@ -119,6 +124,37 @@ def range_miss_baseline(
     return miss, sigma
 
 
+def _frames(tracks: pd.DataFrame, own: pd.DataFrame, n_frames: int):
+    """The first ``n_frames`` frames: (time, the frame's tracks rows, its own-ship row)."""
+    times = own["time_s"].to_numpy(float)[:n_frames]
+    by_time = dict(tuple(tracks.groupby("time_s", sort=False)))
+    return [(t, by_time[t], own.iloc[[k]]) for k, t in enumerate(times)]
+
+
+def stream_baseline(tracks: pd.DataFrame, own: pd.DataFrame, n_frames: int) -> pd.DataFrame:
+    """Alerts of the first ``n_frames`` frames the plain way: at each frame, every row so far through
+    :func:`~skyradar.daa.pipeline.alerts_from_tracks`, keeping that frame's rows.
+
+    Examples
+    --------
+    >>> tracks, own = bench_tables(2, 12)
+    >>> len(stream_baseline(tracks, own, 12))
+    24
+    """
+    out = []
+    for k, (t, _, _) in enumerate(_frames(tracks, own, n_frames)):
+        so_far = tracks[tracks["time_s"].to_numpy(float) <= t]
+        alerts = alerts_from_tracks(so_far, own.iloc[: k + 1], RADAR_ALERT_CONFIG, True, "bench")
+        out.append(alerts[alerts["time_s"].to_numpy(float) == t])
+    return pd.concat(out, ignore_index=True)
+
+
+def _stream(tracks: pd.DataFrame, own: pd.DataFrame, n_frames: int) -> pd.DataFrame:
+    stream = AlertStream(RADAR_ALERT_CONFIG, with_advice=True, source="bench")
+    frames = [stream.step(t, rows, own_row) for t, rows, own_row in _frames(tracks, own, n_frames)]
+    return pd.concat(frames, ignore_index=True)
+
+
 def _miss_inputs(tracks: pd.DataFrame, own: pd.DataFrame) -> tuple:
     t = tracks["time_s"].to_numpy(float)
     at = interp_ownship(own, t, "bench")
@@ -142,19 +178,27 @@ def _best_of(repeats: int, function, args: tuple) -> tuple[float, tuple]:
     return best, result
 
 
-def run(n_tracks: int = 20, n_frames: int = 600, baseline_frames: int = 200, seed: int = 0) -> dict:
+def run(
+    n_tracks: int = 20,
+    n_frames: int = 600,
+    baseline_frames: int = 200,
+    stream_frames: int = 200,
+    seed: int = 0,
+) -> dict:
     """Measure the alerting stage and its range-only miss distance against the baseline.
 
     Examples
     --------
-    >>> r = run(n_tracks=2, n_frames=40, baseline_frames=30)
-    >>> r["same_miss_distances"], sorted(k for k in r if k.endswith("frames_per_s"))[:2]
-    (True, ['baseline_miss_frames_per_s', 'frames_per_s'])
+    >>> r = run(n_tracks=2, n_frames=40, baseline_frames=30, stream_frames=20)
+    >>> r["same_miss_distances"], r["same_stream_alerts"]
+    (True, True)
+    >>> sorted(k for k in r if k.endswith("frames_per_s"))[:2]
+    ['baseline_miss_frames_per_s', 'baseline_stream_frames_per_s']
     """
-    if n_tracks < 1 or n_frames < 1 or baseline_frames < 1:
+    if n_tracks < 1 or n_frames < 1 or baseline_frames < 1 or stream_frames < 1:
         raise InputError(
-            f"bench alert: need tracks >= 1, frames >= 1 and baseline_frames >= 1, "
-            f"got {n_tracks}, {n_frames}, {baseline_frames}"
+            f"bench alert: need tracks >= 1, frames >= 1, baseline_frames >= 1 and stream_frames >= 1, "
+            f"got {n_tracks}, {n_frames}, {baseline_frames}, {stream_frames}"
         )
     if n_tracks * n_frames > 2_000_000:  # the scene is built in memory up front
         raise InputError(f"bench alert: tracks x frames must be at most 2000000, got {n_tracks * n_frames}")
@@ -168,6 +212,13 @@ def run(n_tracks: int = 20, n_frames: int = 600, baseline_frames: int = 200, see
     elapsed_ours, ours = _best_of(3, range_miss_distance, inputs)
     elapsed_base, base = _best_of(3, range_miss_baseline, inputs)
     fps = n_frames / elapsed
+    ns = min(stream_frames, n_frames)
+    elapsed_stream, streamed = _best_of(1, _stream, (tracks, own, ns))
+    elapsed_plain, plain = _best_of(1, stream_baseline, (tracks, own, ns))
+    same_stream = len(streamed) == len(plain) and bool(
+        np.array_equal(streamed["level"].to_numpy(), plain["level"].to_numpy())
+        and np.allclose(streamed["tcpa_s"], plain["tcpa_s"], equal_nan=True)
+    )
     return {
         "frames_per_s": fps,
         "load_average_1min": os.getloadavg()[0],
@@ -175,6 +226,11 @@ def run(n_tracks: int = 20, n_frames: int = 600, baseline_frames: int = 200, see
         "baseline_miss_frames_per_s": nb / elapsed_base,
         "miss_speedup": elapsed_base / elapsed_ours,
         "same_miss_distances": bool(np.allclose(ours, base, equal_nan=True, rtol=1e-9, atol=1e-6)),
+        "stream_frames_per_s": ns / elapsed_stream,
+        "baseline_stream_frames_per_s": ns / elapsed_plain,
+        "stream_speedup": elapsed_plain / elapsed_stream,
+        "same_stream_alerts": same_stream,
+        "stream_frames": ns,
         "frames": n_frames,
         "tracks": n_tracks,
         "baseline_frames": nb,

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import Annotated
 
@@ -58,5 +59,6 @@ def experiment_bluesky(
             shown[name] = time_s
             console.print(f"[dim]{name} run: t = {time_s:.0f} s[/dim]")
 
-    result = run(out, scenario=scenario, end_s=end, progress=progress)
+    command = "skyradar " + " ".join(sys.argv[1:])
+    result = run(out, scenario=scenario, end_s=end, progress=progress, command=command)
     emit_result(result, as_json, "BlueSky: perfect state against the radar")

@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from skyradar.code_version import code_version, provenance
 from skyradar.io.atomic import savefig_atomic, write_csv_atomic
 from skyradar.io.tables import write_json_atomic
 
@@ -213,6 +214,7 @@ def run(
     scenario: Path | None = None,
     end_s: float | None = None,
     progress: Callable[[str, float], None] | None = None,
+    command: str | None = None,
 ) -> dict[str, Any]:
     """Compare BlueSky's perfect-state conflict detection with the radars' on ``scenario``.
 
@@ -226,6 +228,9 @@ def run(
         Simulation time to stop at, s (default: the scenario's ``HOLD``).
     progress : callable, optional
         Called with the run's name and its simulation time, s.
+    command : str, optional
+        The command line the summary records (default this process'), with the version, UTC date
+        and load average (:func:`skyradar.code_version.provenance`).
 
     Returns
     -------
@@ -235,6 +240,7 @@ def run(
     """
     from skyradar.integrations.bluesky.runner import run_scenario
 
+    packaged = scenario is None
     scenario = Path(scenario) if scenario is not None else demo_scenario()
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -262,7 +268,7 @@ def run(
     delays = detections["delay_s"].dropna()
     los = {name: separation[(separation.run == name) & separation.los] for name in runs}
     summary: dict[str, Any] = {
-        "scenario": str(scenario),
+        "scenario": f"{scenario.name} (packaged)" if packaged else str(scenario),
         "end_s": radar_run.end_s,
         "protected_zone_m": [rpz, hpz],
         "equipped": sorted(radar_run.radars),
@@ -282,6 +288,7 @@ def run(
         "wall_s_radar": round(radar_run.wall_s, 2),
         "wall_s": round(time.perf_counter() - t0, 2),
         "outputs": ["conflicts.csv", "separation.csv", "summary.json", "bluesky.png", "bluesky.log"],
+        **provenance(command, code_version()),
     }
     write_json_atomic(out_dir / "summary.json", summary)
     return summary

@@ -166,3 +166,54 @@ def test_the_experiment_runs_from_the_command_line_and_prints_its_json_last(tmp_
     for name in ("closed_loop.parquet", "closed_loop.csv", "summary.json", "summary.md", "closed_loop.png"):
         assert (out / name).exists()
     assert not (out / "closed-loop.partial.parquet").exists()
+
+
+def test_the_experiment_writes_its_tables_summary_and_figure_and_resumes(tmp_path, monkeypatch):
+    """The set's plumbing (runner, partial table, summary, report) with each encounter's flights
+    replaced by fixed rows: encounter i loses well clear unequipped when i is even, and the radar
+    resolves every loss but the first encounter's."""
+    import skyradar.experiments.closed_loop as experiment
+
+    calls = []
+
+    def flights(p, seed=0, terrain=None, layouts=("single",), **_):
+        i = seed - 100
+        calls.append(i)
+        lost = float(i % 2 == 0)
+        base = {"min_horizontal_m": 300.0 if lost else 900.0, "first_action_s": np.nan, "manoeuvre_s": 0.0}
+        rows = [
+            {"condition": "unequipped", "layout": "", "lowc": lost, "nmac": 0.0, **base, "runtime_s": 0.0}
+        ]
+        rows.append({**rows[0], "condition": "perfect", "lowc": 0.0, "min_horizontal_m": 800.0})
+        radar_lost = float(lost and i == 0)
+        rows += [
+            {**rows[0], "condition": "radar", "layout": layout, "lowc": radar_lost, "first_action_s": 10.0}
+            for layout in layouts
+        ]
+        return rows
+
+    monkeypatch.setattr(experiment, "run_closed_loop_encounter", flights)
+    summary = experiment.run(tmp_path / "a", n_encounters=4, seed=100, workers=1)
+    assert sorted(calls) == [0, 1, 2, 3]
+    perfect, radar = summary["rows"]
+    assert (perfect["lowc_unequipped"], perfect["lowc_equipped"], radar["lowc_equipped"]) == (2, 0, 1)
+    assert radar["lowc_risk_ratio"] == 0.5 and radar["lowc_resolved"] == 1 and radar["lowc_induced"] == 0
+    for name in ("closed_loop.parquet", "closed_loop.csv", "summary.json", "summary.md", "closed_loop.png"):
+        assert (tmp_path / "a" / name).exists()
+    assert "| none | radar, single | 2/4 | 1/4 | 0.50" in (tmp_path / "a" / "summary.md").read_text()
+    # An interrupted run resumes from its partial table when started again with the same settings.
+    calls.clear()
+    done, save = experiment_partial(tmp_path / "b", summary["settings"])
+    save({("none", 0): flights(None, seed=100), ("none", 1): flights(None, seed=101)})
+    calls.clear()
+    resumed = experiment.run(tmp_path / "b", n_encounters=4, seed=100, workers=1)
+    assert sorted(calls) == [2, 3] and resumed["resumed_encounters"] == 2
+    assert resumed["rows"][1]["lowc_equipped"] == 1
+
+
+def experiment_partial(out_dir, settings):
+    from skyradar.code_version import code_version
+    from skyradar.experiments.encounters import partial_store
+
+    out_dir.mkdir(parents=True)
+    return partial_store(out_dir, {**settings, "version": code_version()}, "closed-loop.partial.parquet")

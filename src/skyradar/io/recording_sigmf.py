@@ -51,8 +51,9 @@ import numpy as np
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.io.recordings import AdcFrames, open_described
+from skyradar.io.sigmf_io import sigmf_paths
 
-__all__ = ["EXTENSION", "SIGMF_DTYPES", "read_sigmf_recording", "sigmf_adc_metadata", "sigmf_pair"]
+__all__ = ["EXTENSION", "SIGMF_DTYPES", "read_sigmf_recording", "sigmf_adc_metadata"]
 
 EXTENSION = {"name": "skyradar", "version": "1.0.0", "optional": False}
 # SigMF datatype -> skyradar-adc/1 dtype (the element type, real or (I, Q) pairs) and byte order
@@ -74,20 +75,6 @@ _RENAMED = {
     "radar": "skyradar:radar",
     "radar.rx_positions_m": "skyradar:radar.rx_positions_m",
 }
-
-
-def sigmf_pair(path: str | Path) -> tuple[Path, Path]:
-    """(meta, data) paths of a SigMF recording named by either file or by the bare stem.
-
-    Examples
-    --------
-    >>> [p.name for p in sigmf_pair("out/radar.sigmf-data")]
-    ['radar.sigmf-meta', 'radar.sigmf-data']
-    """
-    path = Path(path)
-    if path.suffix in (".sigmf-meta", ".sigmf-data"):
-        path = path.with_suffix("")
-    return path.with_name(path.name + ".sigmf-meta"), path.with_name(path.name + ".sigmf-data")
 
 
 def _load(meta_path: Path, data_path: Path, named: Path) -> dict[str, Any]:
@@ -256,7 +243,7 @@ def read_sigmf_recording(path: str | Path) -> tuple[AdcFrames, RadarConfig]:
     ((2, 4, 8, 2032), 8, (1-2j))
     """
     path = Path(path)
-    meta_path, data_path = sigmf_pair(path)
+    meta_path, data_path = sigmf_paths(path)
     meta = _load(meta_path, data_path, path)
     description = _description(meta_path, data_path, meta)
     _validate_schema(meta_path, meta)

@@ -17,8 +17,9 @@ import yaml
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.io.atomic import atomic_path
-from skyradar.io.recording_sigmf import SIGMF_DTYPES, sigmf_adc_metadata, sigmf_pair
+from skyradar.io.recording_sigmf import SIGMF_DTYPES, sigmf_adc_metadata
 from skyradar.io.recordings import AXES, DTYPES
+from skyradar.io.sigmf_io import sigmf_paths
 
 __all__ = ["write_recording", "write_sigmf_recording"]
 
@@ -196,7 +197,7 @@ def write_sigmf_recording(
     >>> meta.name, read_recording(meta)[0].shape
     ('radar.sigmf-meta', (3, 4, 4, 2032))
     """
-    meta_path, data_path = sigmf_pair(path)
+    meta_path, data_path = sigmf_paths(path)
     frames = np.asarray(frames)
     if datatype not in SIGMF_DTYPES or not datatype.endswith("_le"):
         writable = [d for d in SIGMF_DTYPES if d.endswith("_le")]

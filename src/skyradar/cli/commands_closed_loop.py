@@ -8,8 +8,14 @@ from typing import Annotated
 
 import typer
 
-from skyradar.cli.app import NON_NEGATIVE, SCHEDULER, JsonOption, emit_result, experiment_app, number_in
-from skyradar.cli.choices import ClosedLoopFamily, Layout, Manoeuvre, Split
+from skyradar.cli.app import NON_NEGATIVE, JsonOption, emit_result, experiment_app, number_in
+from skyradar.cli.choices import ClosedLoopFamily, Layout, Manoeuvre
+from skyradar.cli.commands_encounters import (
+    EncounterSchedulerOption,
+    EncounterWorkersOption,
+    SplitOption,
+    check_split,
+)
 from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["experiment_closed_loop"]
@@ -74,30 +80,9 @@ def experiment_closed_loop(
             help="Pilot's reaction delay after a warning, s.",
         ),
     ] = 3.0,
-    workers: Annotated[
-        int | None,
-        typer.Option(
-            min=1,
-            help="Worker processes of a local Dask cluster, one encounter per task (default: up to 2; 1 "
-            "runs here, without Dask).",
-        ),
-    ] = None,
-    scheduler: Annotated[
-        str | None,
-        typer.Option(
-            "--scheduler",
-            callback=SCHEDULER,
-            help="Address of an existing Dask scheduler (tcp://HOST:PORT) to run the encounters on.",
-        ),
-    ] = None,
-    split: Annotated[
-        Split | None,
-        typer.Option(
-            "--split",
-            help="Which split the seed must belong to: development (below 7000) or evaluation (7000 "
-            "and up); refused when the seed is in the other.",
-        ),
-    ] = None,
+    workers: EncounterWorkersOption = None,
+    scheduler: EncounterSchedulerOption = None,
+    split: SplitOption = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -106,22 +91,14 @@ def experiment_closed_loop(
     NMAC, risk ratios against unequipped, induced losses, separation, time spent manoeuvring.
     """
     from skyradar.cli.commands_sim import frame_progress
-    from skyradar.errors import InputError
     from skyradar.experiments.closed_loop import run
     from skyradar.experiments.encounter_terrain import parse_terrains
-    from skyradar.experiments.encounters import EVALUATION_SEEDS_FROM
     from skyradar.io.outputs import check_output, mark_folder
     from skyradar.parallel import check_workers
     from skyradar.pilot import PilotConfig
 
     check_workers(workers)
-    if split is not None and (seed >= EVALUATION_SEEDS_FROM) != (split is Split.evaluation):
-        where = (
-            f"{EVALUATION_SEEDS_FROM} and up"
-            if split is Split.evaluation
-            else f"below {EVALUATION_SEEDS_FROM}"
-        )
-        raise InputError(f"--seed {seed}: not in the {split.value} split (its seeds are {where})")
+    check_split(seed, split)
     terrains = parse_terrains(terrain)
     pilot = PilotConfig(
         manoeuvre=manoeuvre.value, corrective_delay_s=corrective_delay, warning_delay_s=warning_delay

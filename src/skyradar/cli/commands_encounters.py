@@ -21,7 +21,14 @@ from skyradar.cli.app import (
 from skyradar.cli.choices import AlertSettings, EncounterTerrain, Family, Layout, Navigation, RxLayout, Split
 from skyradar.io.outputs import OVERWRITE_HELP
 
-__all__ = ["experiment_encounters", "bench_encounter"]
+__all__ = [
+    "experiment_encounters",
+    "bench_encounter",
+    "EncounterWorkersOption",
+    "EncounterSchedulerOption",
+    "SplitOption",
+    "check_split",
+]
 
 # The layouts each --layout scores.
 _LAYOUTS = {
@@ -71,6 +78,47 @@ _NAVIGATION = Annotated[
     ),
 ]
 
+EncounterWorkersOption = Annotated[
+    int | None,
+    typer.Option(
+        min=1,
+        help="Worker processes of a local Dask cluster, one encounter per task (default: up to 2, one "
+        "per core; 1 runs here, without Dask).",
+    ),
+]
+EncounterSchedulerOption = Annotated[
+    str | None,
+    typer.Option(
+        "--scheduler",
+        callback=SCHEDULER,
+        help="Address of an existing Dask scheduler (tcp://HOST:PORT) to run the encounters on.",
+    ),
+]
+SplitOption = Annotated[
+    Split | None,
+    typer.Option(
+        "--split",
+        help="Which split the seed must belong to: development (seeds below 7000: tune on these) or "
+        "evaluation (7000 and up: report on these, never tune). Refused when the seed is in the "
+        "other; the summary records the split either way.",
+    ),
+]
+
+
+def check_split(seed: int, split: Split | None) -> None:
+    """InputError unless ``seed`` belongs to ``split`` (None: either)."""
+    from skyradar.errors import InputError
+    from skyradar.experiments.encounters import EVALUATION_SEEDS_FROM
+
+    if split is not None and (seed >= EVALUATION_SEEDS_FROM) != (split is Split.evaluation):
+        where = (
+            f"{EVALUATION_SEEDS_FROM} and up"
+            if split is Split.evaluation
+            else f"below {EVALUATION_SEEDS_FROM}"
+        )
+        raise InputError(f"--seed {seed}: not in the {split.value} split (its seeds are {where})")
+
+
 _RX_LAYOUT = Annotated[
     RxLayout,
     typer.Option(
@@ -89,22 +137,8 @@ def experiment_encounters(
     ),
     n: _N = None,
     seed: Annotated[int, typer.Option("--seed", callback=NON_NEGATIVE, help="Random seed.")] = 0,
-    workers: Annotated[
-        int | None,
-        typer.Option(
-            min=1,
-            help="Worker processes of a local Dask cluster, one encounter per task (default: up to 2, one "
-            "per core; 1 runs here, without Dask).",
-        ),
-    ] = None,
-    scheduler: Annotated[
-        str | None,
-        typer.Option(
-            "--scheduler",
-            callback=SCHEDULER,
-            help="Address of an existing Dask scheduler (tcp://HOST:PORT) to run the encounters on.",
-        ),
-    ] = None,
+    workers: EncounterWorkersOption = None,
+    scheduler: EncounterSchedulerOption = None,
     frame_rate: _FRAME_RATE = 9.4,
     buffer: _BUFFER = 1.5,
     no_uncertainty: Annotated[
@@ -124,15 +158,7 @@ def experiment_encounters(
             "300-700 m above hills and Jacksboro).",
         ),
     ] = Family.synthetic,
-    split: Annotated[
-        Split | None,
-        typer.Option(
-            "--split",
-            help="Which split the seed must belong to: development (seeds below 7000: tune on these) or "
-            "evaluation (7000 and up: report on these, never tune). Refused when the seed is in the "
-            "other; the summary records the split either way.",
-        ),
-    ] = None,
+    split: SplitOption = None,
     alert_settings: Annotated[
         AlertSettings,
         typer.Option(
@@ -150,25 +176,13 @@ def experiment_encounters(
     missed, late and false warnings, clutter and ground tracks, track fragments, warning lead.
     """
     from skyradar.cli.commands_sim import frame_progress
-    from skyradar.errors import InputError
     from skyradar.experiments.encounter_terrain import parse_terrains
-    from skyradar.experiments.encounters import (
-        DEFAULT_ENCOUNTERS,
-        DEFAULT_TERRAIN_ENCOUNTERS,
-        EVALUATION_SEEDS_FROM,
-        run,
-    )
+    from skyradar.experiments.encounters import DEFAULT_ENCOUNTERS, DEFAULT_TERRAIN_ENCOUNTERS, run
     from skyradar.io.outputs import check_output, mark_folder
     from skyradar.parallel import check_workers
 
     check_workers(workers)
-    if split is not None and (seed >= EVALUATION_SEEDS_FROM) != (split is Split.evaluation):
-        where = (
-            f"{EVALUATION_SEEDS_FROM} and up"
-            if split is Split.evaluation
-            else f"below {EVALUATION_SEEDS_FROM}"
-        )
-        raise InputError(f"--seed {seed}: not in the {split.value} split (its seeds are {where})")
+    check_split(seed, split)
     if family is Family.real_flights:
         from skyradar.scene.sample_flights import sample_flights
 

@@ -39,7 +39,7 @@ import pandas as pd
 
 from skyradar.config import RadarConfig
 from skyradar.experiments.ch4_flights import EPBC, SCENARIOS, Traffic, build_traffic
-from skyradar.experiments.summary_md import beside, number, page, write_summary
+from skyradar.experiments.summary_md import beside, counted, number, page, write_summary
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.parallel import check_workers, close, connect
@@ -509,8 +509,8 @@ def summary_markdown(summary: dict, out_dir: Path | None = None) -> str:
         for name, r in per.items()
     )
     paragraphs = [
-        f"{len(per)} own-ship flights around an airfield with VFR intruders, both trackers on "
-        f"the same detections ({summary['detections_source']}; seed {summary['seed']}); true tracks come "
+        f"{counted(len(per), 'own-ship flight')} around an airfield with VFR intruders, both trackers "
+        f"on the same detections, seed {summary['seed']}: {summary['detections_source']}. True tracks come "
         "from the scenario, never from the detections.",
         f"The radar-aware tracker makes at most as many tracks as the traditional one {fewer}, and its "
         f"95th-percentile innovation is smaller {tighter}. {sentences} The thesis' numbers are in "

@@ -12,7 +12,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from skyradar.experiments.summary_md import number, page  # noqa: E402
+from skyradar.experiments.summary_md import counted, number, page  # noqa: E402
 from skyradar.io.atomic import savefig_atomic  # noqa: E402
 
 __all__ = ["plot_case", "summary_table", "acceptance_failures", "summary_markdown"]
@@ -207,10 +207,12 @@ def summary_markdown(results: dict[str, Any], out_dir: Path | None = None) -> st
     ]
     best = []
     for terrain, per in one_hz.items():
-        scored = {m: e for m, e in per.items() if e.get("h_err_sd_m") is not None}
-        scored = {m: e for m, e in scored.items() if np.isfinite(float(e["h_err_sd_m"]))}
+        rms = {
+            m: np.hypot(_number(e.get("h_err_mean_m")), _number(e.get("h_err_sd_m"))) for m, e in per.items()
+        }
+        scored = {m: e for m, e in per.items() if np.isfinite(rms[m])}
         if scored:
-            method, err = min(scored.items(), key=lambda kv: float(kv[1]["h_err_sd_m"]))
+            method, err = min(scored.items(), key=lambda kv: rms[kv[0]])
             ref = thesis.get(terrain)
             best.append(
                 f"{terrain}: {_METHOD_NAMES.get(method, method)} {_height_error(err)} m"
@@ -219,13 +221,14 @@ def summary_markdown(results: dict[str, Any], out_dir: Path | None = None) -> st
         else:
             best.append(f"{terrain}: no method estimates")
     failures = results.get("acceptance_failures") or []
+    fast = results.get("rate_9p4hz") or {}
     paragraphs = [
-        f"A terrain-following flight, {number(results['duration_s'], 0)} s at one "
-        f"frame per second over {len(one_hz)} terrains (and {len(results.get('rate_9p4hz') or {})} at the "
-        "9.4 Hz field rate), its height above ground and velocity estimated from the ground returns by "
-        "three methods, each filtered; errors are the filtered estimate minus the truth after the "
-        "filter's warm-up.",
-        "Height error (mean +- SD) of the method with the smallest SD per terrain: "
+        f"A terrain-following flight, {number(results['duration_s'], 0)} s at one frame per second "
+        f"over {counted(len(one_hz), 'terrain')}"
+        + (f" (and {len(fast)} of them at the 9.4 Hz field rate)" if fast else "")
+        + ", its height above ground and velocity estimated from the ground returns by three methods, "
+        "each filtered; errors are the filtered estimate minus the truth after the filter's warm-up.",
+        "Height error (mean +- SD) of the method with the smallest RMS error per terrain: "
         + "; ".join(best)
         + ". "
         + (

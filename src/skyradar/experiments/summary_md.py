@@ -18,7 +18,7 @@ from typing import Any
 
 from skyradar.io.atomic import write_text_atomic
 
-__all__ = ["SUMMARY_NAME", "number", "beside", "markdown_table", "page", "write_summary"]
+__all__ = ["SUMMARY_NAME", "number", "counted", "beside", "markdown_table", "page", "write_summary"]
 
 SUMMARY_NAME = "summary.md"
 WIDTH = 100  # prose lines are wrapped here; table rows stay one line each (markdown needs that)
@@ -52,6 +52,29 @@ def number(value: Any, decimals: int = 1) -> str:
         return str(value)
     value = float(value)
     return f"{value:.{decimals}f}" if math.isfinite(value) else "n/a"
+
+
+def counted(n: int, noun: str, nouns: str | None = None) -> str:
+    """``n`` and the noun in the number ``n`` asks for.
+
+    Parameters
+    ----------
+    n : int
+        The count.
+    noun, nouns : str
+        Singular and plural (default: the singular with an ``s``).
+
+    Returns
+    -------
+    str
+        For example ``1 terrain`` or ``3 terrains``.
+
+    Examples
+    --------
+    >>> counted(1, "terrain"), counted(3, "terrain"), counted(2, "own-ship flight")
+    ('1 terrain', '3 terrains', '2 own-ship flights')
+    """
+    return f"{n} {noun if n == 1 else (nouns or noun + 's')}"
 
 
 def beside(value: Any, reference: Any, decimals: int = 1) -> str:

@@ -79,7 +79,7 @@ def test_small_run_compares_arrays_on_the_same_flyover(tmp_path):
     assert r["calib_phase_err_deg"] <= 1.0 and half["calib_phase_err_deg"] <= 1.0
     assert r["doa_outliers"] == 0 and half["doa_outliers"] == 0
     assert json.loads((tmp_path / "ch3.json").read_text())["half_wavelength"] == half
-    for name in ("ch3_spacing.png", "ch3_spacing.parquet", "ch3_track_3d.png", "ch3_table.csv"):
+    for name in ("ch3_spacing.png", "ch3_spacing.parquet", "ch3_track_3d.png", "ch3_table.csv", "summary.md"):
         assert (tmp_path / name).exists()
 
 

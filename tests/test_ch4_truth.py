@@ -123,5 +123,6 @@ def test_full_ch4_chain_small(tmp_path):
     saved = json.loads((tmp_path / "ch4_results.json").read_text())
     assert saved["free_truth_tracks"] == r["truth_tracks"]
     assert "free" in (tmp_path / "ch4_results.csv").read_text()
+    assert "| free |" in (tmp_path / "summary.md").read_text()
     for name in res["figures"]:
         assert (tmp_path / name).stat().st_size > 10_000

@@ -65,6 +65,7 @@ def test_relief_cases_write_one_summary_entry_and_figures_per_terrain(tmp_path, 
     frames = pd.read_csv(tmp_path / "c" / "frames.csv")
     assert set(frames.terrain) == {"hills", "jacksboro"} and "cell_if_db" in frames
     assert set(pd.read_csv(tmp_path / "c" / "sinr_loss.csv").terrain) == {"hills", "jacksboro"}
+    assert "`intruder_jacksboro.png`" in (tmp_path / "c" / "summary.md").read_text()
 
 
 def test_intruder_hit_counts_secondary_rows_only_when_asked():
@@ -101,6 +102,7 @@ def test_flat_cases_write_figures_table_and_json(tmp_path):
         "frames.csv",
         "sinr_loss.csv",
         "summary.json",
+        "summary.md",
     ):
         assert (tmp_path / "c" / name).exists()
 

@@ -42,6 +42,6 @@ def test_fast_platform_wraps_to_the_right_edge(ch2):
 
 def test_outputs_written(ch2):
     out, r = ch2
-    for name in ("ch2_flat_30mps.png", "ch2_flat_60mps.png", "ch2_table.csv", "ch2.json"):
+    for name in ("ch2_flat_30mps.png", "ch2_flat_60mps.png", "ch2_table.csv", "ch2.json", "summary.md"):
         assert (out / name).stat().st_size > 0
     assert json.loads((out / "ch2.json").read_text())["intruder_range_m"] == r["intruder_range_m"]

@@ -45,5 +45,6 @@ def test_spoofing_and_wing_up(ch6):
 
 def test_outputs_written(ch6):
     _, out = ch6
-    for name in ("table.csv", "roc.csv", "frames.parquet", "ch6.json", "poses.png", "surface.png", "roc.png"):
+    names = ("table.csv", "roc.csv", "frames.parquet", "ch6.json", "summary.md", "poses.png", "surface.png")
+    for name in (*names, "roc.png"):
         assert (out / name).is_file(), name

@@ -38,6 +38,7 @@ def test_short_run_writes_table_json_and_figures(short):
     assert abs(robust["h_err_mean_m"]) <= 4.0 and robust["h_err_sd_m"] <= 3.0
     assert robust["vx_err_sd_mps"] <= 1.0 and robust["vz_err_sd_mps"] <= 1.0
     assert (out / "ch5_flat_rate_1hz.png").stat().st_size > 10_000
+    assert "`ch5_flat_rate_1hz.png`" in (out / "summary.md").read_text()
     table = pd.read_csv(out / "ch5_table.csv")
     assert sorted(set(table["attitude"])) == ["ahrs", "true"] and len(table) == 6
 

@@ -14,7 +14,8 @@ def test_experiment_ch7_meets_its_acceptance_bounds(tmp_path):
     result = skyradar("experiment", "ch7", "--out", "ch7", "--json", cwd=tmp_path, timeout=900)
     assert result.returncode == 0, result.stderr
     out = json.loads(result.stdout.strip().splitlines()[-1])
-    for name in ("ch7_testpulse.png", "ch7_sweeps.png", "ch7_aircraft.png", "ch7_table.csv", "ch7.json"):
+    names = ("ch7_testpulse.png", "ch7_sweeps.png", "ch7_aircraft.png", "ch7_table.csv", "ch7.json")
+    for name in (*names, "summary.md"):
         assert (tmp_path / "ch7" / name).is_file(), name
     assert out["rotations"] == 9
     failed = [k for k, ok in out["acceptance"].items() if not ok and k != "under_5_min"]

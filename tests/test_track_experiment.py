@@ -44,6 +44,7 @@ def test_short_geometry_run_writes_tables_and_figures(tmp_path):
     for name in res["figures"]:
         assert (tmp_path / name).stat().st_size > 10_000
     assert (tmp_path / "tracks_free_radar.parquet").exists()
+    assert "`tracks_<scenario>_<model>.parquet`" in (tmp_path / "summary.md").read_text()
 
 
 def test_bench_track_reports_ours_baseline_and_ratio():

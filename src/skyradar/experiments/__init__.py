@@ -3,10 +3,11 @@
 ``encounters`` scores the whole chain on an encounter set and ``demo`` (in :mod:`skyradar.demo`)
 flies one scenario end to end. ch6 is the GPS check against a map, ch7 the passive radar.
 
-Each experiment module's ``run(out_dir, ...) -> dict`` writes its figures (PNG) and its table, and
-returns the measured values that ``skyradar experiment NAME --json`` prints. The experiments, the
-public modules of this package (``from skyradar.experiments import ch2``; none is imported with the
-package):
+Each experiment module's ``run(out_dir, ...) -> dict`` writes its figures (PNG), its table and
+``summary.md`` (the run in sentences and a table of its headline values, laid out by
+:mod:`.summary_md`), and returns the measured values that ``skyradar experiment NAME --json``
+prints. The experiments, the public modules of this package (``from skyradar.experiments import
+ch2``; none is imported with the package):
 
 - :mod:`.ch2` (simulator against closed form), with no helper module;
 - :mod:`.ch3` (detection and direction of arrival from the ground), with :mod:`.ch3_scene` and

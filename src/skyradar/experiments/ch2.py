@@ -22,15 +22,17 @@ import yaml
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
+from skyradar.experiments.summary_md import number, page, write_summary
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic
 from skyradar.scene.scenario import Scenario, example_scenario
 from skyradar.sim.scenario_frames import make_simulator, scenario_truth, simulate_frames
 from skyradar.viz.rangedoppler import save_frame_figure, strength_db
 
-__all__ = ["run", "fit_asymptotes"]
+__all__ = ["run", "fit_asymptotes", "summary_markdown"]
 
 GROUND_DB = 12.0
+SLOW_MPS, FAST_MPS = 30.0, 60.0  # own-ship speeds: the ground inside the image, and wrapped past -VLim
 
 
 def _built(speed_mps: float, n_frames: int):
@@ -129,7 +131,7 @@ def run(out_dir: str | Path = "out/ch2", n_frames: int = 3) -> dict[str, Any]:
         raise InputError(f"--frames: must be an integer >= 1 and <= {MAX_FRAMES_PER_CASE}, got {n_frames!r}")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    slow, fast = _case(30.0, n_frames), _case(60.0, n_frames)
+    slow, fast = _case(SLOW_MPS, n_frames), _case(FAST_MPS, n_frames)
     cfg = slow["built"].radar
     result = _slow_case_measures(slow) | _wrap_measures(fast, cfg)
     result |= {"range_bin_m": cfg.range_resolution_m, "doppler_bin_mps": cfg.doppler_resolution_mps}
@@ -156,7 +158,90 @@ def run(out_dir: str | Path = "out/ch2", n_frames: int = 3) -> dict[str, Any]:
     )
     write_csv_atomic(table, out / "ch2_table.csv", index=False)
     write_json_atomic(out / "ch2.json", result)
+    write_summary(out, summary_markdown(result, out))
     return result
+
+
+_FILES = {
+    "ch2_flat_30mps.png": "the range-Doppler image at 30 m/s with both asymptotes and the intruder marked",
+    "ch2_flat_60mps.png": "the range-Doppler image at 60 m/s, the ground wrapped to the right edge",
+    "ch2_table.csv": "measured against closed form, one row per quantity",
+    "ch2.json": "every measured value",
+}
+
+
+def summary_markdown(result: dict[str, Any], out_dir: Path | None = None) -> str:
+    """``summary.md`` of a ch2 run: the asymptotes, the aliased intruder and the wrap against closed form.
+
+    Parameters
+    ----------
+    result : dict
+        The summary :func:`run` returns (also in ``ch2.json``).
+    out_dir : Path, optional
+        The run's folder: only the files present there are listed (None: all of them).
+
+    Returns
+    -------
+    str
+        Markdown: title, sentences, a table of measured against closed form, the files.
+
+    Examples
+    --------
+    >>> r = {"asymptote_range_m": 1001.2, "asymptote_range_expected_m": 1000.0,
+    ...      "first_ground_range_m": 996.1, "asymptote_velocity_mps": -30.1,
+    ...      "asymptote_velocity_expected_mps": -30.0, "intruder_range_m": 1995.0,
+    ...      "intruder_velocity_mps": 18.3, "intruder_snr_db": 31.0, "intruder_expected_range_m": 1995.0,
+    ...      "intruder_expected_velocity_mps": 18.3, "intruder_true_radial_velocity_mps": -60.0,
+    ...      "wrap60_right_edge": True, "wrap60_min_velocity_mps": 15.2,
+    ...      "wrap60_expected_min_velocity_mps": 15.0, "range_bin_m": 3.75, "doppler_bin_mps": 0.61,
+    ...      "frames_per_s": 41.0, "thesis_frames_per_s": 3.3}
+    >>> text = summary_markdown(r)
+    >>> print(text.splitlines()[0])
+    # ch2: the simulator against closed form
+    >>> "| near-range asymptote R [m] | 1001.2 | 1000.0 |" in text, "`ch2_flat_60mps.png`" in text
+    (True, True)
+    """
+    r = result
+    paragraphs = [
+        f"Own aircraft {number(r['asymptote_range_expected_m'], 0)} m over flat ground with a forward "
+        f"antenna, flying at {number(SLOW_MPS, 0)} m/s and at {number(FAST_MPS, 0)} m/s; the first simulated "
+        "frame of each, measured on the noisy image against closed form. "
+        f"At {number(SLOW_MPS, 0)} m/s the ground's near-range asymptote fits at "
+        f"{number(r['asymptote_range_m'])} m "
+        f"(closed form {number(r['asymptote_range_expected_m'])} m, one range bin "
+        f"{number(r['range_bin_m'], 2)} m) and its velocity asymptote at "
+        f"{number(r['asymptote_velocity_mps'])} m/s (closed form "
+        f"{number(r['asymptote_velocity_expected_mps'])} m/s). The head-on intruder, at a true radial "
+        f"velocity of {number(r['intruder_true_radial_velocity_mps'])} m/s, shows aliased at "
+        f"{number(r['intruder_velocity_mps'])} m/s and {number(r['intruder_range_m'])} m, "
+        f"{number(r['intruder_snr_db'])} dB over the noise (closed-form pixel: "
+        f"{number(r['intruder_expected_velocity_mps'])} m/s, {number(r['intruder_expected_range_m'])} m).",
+        f"At {number(FAST_MPS, 0)} m/s the ground "
+        f"{'wraps' if r['wrap60_right_edge'] else 'does not wrap'} to the right edge of the image, "
+        "the wrapped part starting at "
+        f"{number(r['wrap60_min_velocity_mps'])} m/s (closed form "
+        f"{number(r['wrap60_expected_min_velocity_mps'])} m/s). The simulator ran "
+        f"{number(r['frames_per_s'])} frames per second (the thesis' simulator: "
+        f"{number(r['thesis_frames_per_s'])}). Look at the two images for the asymptotes and the wrap.",
+    ]
+    rows = [
+        ["near-range asymptote R [m]", r["asymptote_range_m"], r["asymptote_range_expected_m"]],
+        ["velocity asymptote V [m/s]", r["asymptote_velocity_mps"], r["asymptote_velocity_expected_mps"]],
+        ["intruder range [m]", r["intruder_range_m"], r["intruder_expected_range_m"]],
+        [
+            "intruder radial velocity, aliased [m/s]",
+            r["intruder_velocity_mps"],
+            r["intruder_expected_velocity_mps"],
+        ],
+        [
+            "60 m/s: wrapped ground starts at [m/s]",
+            r["wrap60_min_velocity_mps"],
+            r["wrap60_expected_min_velocity_mps"],
+        ],
+        ["simulated frames per second", r["frames_per_s"], f"{number(r['thesis_frames_per_s'])} (thesis)"],
+    ]
+    header = ["quantity", "measured", "closed form or thesis"]
+    return page("ch2: the simulator against closed form", paragraphs, header, rows, _FILES, out_dir)
 
 
 def _figures(out: Path, slow: dict, fast: dict, result: dict[str, Any]) -> None:

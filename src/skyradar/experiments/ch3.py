@@ -62,6 +62,7 @@ from skyradar.experiments.ch3_scene import (
     square_array_m,
     unambiguous_half_angle_deg,
 )
+from skyradar.experiments.summary_md import number, page, write_summary
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.process.calibration import calibrate_from_frames, calibration_phase_error_deg
@@ -73,7 +74,7 @@ from skyradar.process.spurs import THESIS_THRESHOLDS, learn_spur_map
 from skyradar.sim.image import PointTarget
 from skyradar.sim.impairments import apply_impairments
 
-__all__ = ["THESIS_TABLE", "run", "square_array_m", "unambiguous_half_angle_deg"]
+__all__ = ["THESIS_TABLE", "run", "square_array_m", "summary_markdown", "unambiguous_half_angle_deg"]
 
 HANN_FRAMES = 9
 SPUR_THRESHOLD = 0.05
@@ -381,4 +382,95 @@ def run(
     result["runtime_s"] = time.perf_counter() - t0
     result = {k: (float(v) if isinstance(v, np.floating) else v) for k, v in result.items()}
     write_json_atomic(out_dir / "ch3.json", result)
+    write_summary(out_dir, summary_markdown(result, out_dir))
     return result
+
+
+_FILES = {
+    "ch3_range_doppler.png": "the static scene's range-Doppler image, the spur map and one flyover frame",
+    "ch3_track_3d.png": "the aircraft's located detections against its true path",
+    "ch3_errors.png": "position, azimuth and elevation errors along the flyover, raw and Hann-filtered",
+    "ch3_spacing.png": "DoA error and Cramer-Rao bound per receive spacing",
+    "ch3_table.csv": "error mean and SD, raw and Hann-filtered, beside the thesis' (also `.parquet`)",
+    "ch3_table.parquet": "the same table",
+    "ch3_track.parquet": "every flyover frame: truth, detection, location and errors",
+    "ch3_spacing.parquet": "the DoA summary of each receive spacing",
+    "ch3.json": "every measured value",
+}
+
+
+def summary_markdown(result: dict[str, Any], out_dir: Path | None = None) -> str:
+    """``summary.md`` of a ch3 run: detection and direction-of-arrival errors beside the thesis'.
+
+    The thesis' numbers are :data:`THESIS_TABLE` (raw mean, raw SD, Hann mean, Hann SD).
+
+    Parameters
+    ----------
+    result : dict
+        The summary :func:`run` returns (also in ``ch3.json``).
+    out_dir : Path, optional
+        The run's folder: only the files present there are listed (None: all of them).
+
+    Returns
+    -------
+    str
+        Markdown: title, sentences, a table of ours against the thesis, the files.
+
+    Examples
+    --------
+    >>> r = {"frames": 300, "path": "circuit", "rx_spacing_wavelengths": 0.6, "detected_frames": 270,
+    ...      "detected_frames_snr13": 268, "frames_snr13": 270, "false_alarms_per_frame": 0.0,
+    ...      "az_mean_deg": 0.02, "az_sd_deg": 0.61, "az_hann_sd_deg": 0.3, "az_crlb_deg": 0.55,
+    ...      "el_mean_deg": -0.03, "el_sd_deg": 0.72, "el_hann_sd_deg": 0.35, "el_crlb_deg": 0.66,
+    ...      "dist_mean_m": 20.1, "dist_sd_m": 14.2, "dist_hann_mean_m": 12.0, "dist_hann_sd_m": 7.5,
+    ...      "doa_outliers": 0, "calib_phase_err_deg": 0.4, "building_up_m": 15.2,
+    ...      "spacing_sweep": [{"rx_spacing_wavelengths": 0.6, "az_sd_deg": 0.61, "el_sd_deg": 0.72}]}
+    >>> text = summary_markdown(r)
+    >>> print(text.splitlines()[0])
+    # ch3: detection and direction of arrival from the ground
+    >>> "| azimuth error SD, raw [deg] | 0.61 | 1.80 |" in text, "`ch3_errors.png`" in text
+    (True, True)
+    >>> "`ch3_spacing.png`" in text  # drawn only when more than one spacing is flown
+    False
+    """
+    r = result
+    t = THESIS_TABLE  # (raw mean, raw SD, Hann mean, Hann SD)
+    headline = (
+        ("3-D position error mean, raw [m]", "dist_mean_m", t["dist_m"][0], 1),
+        ("3-D position error SD, raw [m]", "dist_sd_m", t["dist_m"][1], 1),
+        ("3-D position error mean, Hann-filtered [m]", "dist_hann_mean_m", t["dist_m"][2], 1),
+        ("3-D position error SD, Hann-filtered [m]", "dist_hann_sd_m", t["dist_m"][3], 1),
+        ("azimuth error mean, raw [deg]", "az_mean_deg", t["az_deg"][0], 2),
+        ("azimuth error SD, raw [deg]", "az_sd_deg", t["az_deg"][1], 2),
+        ("azimuth error SD, Hann-filtered [deg]", "az_hann_sd_deg", t["az_deg"][3], 2),
+        ("elevation error mean, raw [deg]", "el_mean_deg", t["el_deg"][0], 2),
+        ("elevation error SD, raw [deg]", "el_sd_deg", t["el_deg"][1], 2),
+        ("elevation error SD, Hann-filtered [deg]", "el_hann_sd_deg", t["el_deg"][3], 2),
+    )
+    rows = [[label, number(r[key], d), number(thesis, d)] for label, key, thesis, d in headline]
+    sweep = r.get("spacing_sweep", [])
+    spacing = ", ".join(
+        f"{number(s['rx_spacing_wavelengths'], 2)} wavelengths {number(s['az_sd_deg'], 2)} deg in azimuth "
+        f"and {number(s['el_sd_deg'], 2)} deg in elevation"
+        for s in sweep
+    )
+    paragraphs = [
+        f"A radar on the ground aimed at the sky, calibrated on a building, detects and locates a small "
+        f"aircraft on a {r['path']} over {r['frames']} frames with a 2x2 receive square of "
+        f"{number(r['rx_spacing_wavelengths'], 2)} wavelengths. It is detected in "
+        f"{r['detected_frames_snr13']} of the {r['frames_snr13']} frames where its SNR is at least 13 dB, "
+        f"with {number(r['false_alarms_per_frame'], 3)} false alarms per frame.",
+        f"Raw direction errors have an SD of {number(r['az_sd_deg'], 2)} deg in azimuth and "
+        f"{number(r['el_sd_deg'], 2)} deg in elevation (thesis {number(THESIS_TABLE['az_deg'][1], 2)} and "
+        f"{number(THESIS_TABLE['el_deg'][1], 2)} deg), against a Cramer-Rao bound of "
+        f"{number(r['az_crlb_deg'], 2)} and {number(r['el_crlb_deg'], 2)} deg; "
+        f"{r['doa_outliers']} detections were ambiguity outliers. The 3-D position error is "
+        f"{number(r['dist_mean_m'])} +- {number(r['dist_sd_m'])} m raw (thesis "
+        f"{number(THESIS_TABLE['dist_m'][0])} +- {number(THESIS_TABLE['dist_m'][1])} m). The channels "
+        f"are calibrated to {number(r['calib_phase_err_deg'], 2)} deg of phase; the building is located "
+        f"{number(r['building_up_m'])} m above the radar."
+        + (f" Per receive spacing the raw SD is: {spacing}." if len(sweep) > 1 else ""),
+    ]
+    files = {k: v for k, v in _FILES.items() if k != "ch3_spacing.png" or len(sweep) > 1}
+    title = "ch3: detection and direction of arrival from the ground"
+    return page(title, paragraphs, ["quantity", "measured", "thesis"], rows, files, out_dir)

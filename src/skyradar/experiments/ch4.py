@@ -39,6 +39,7 @@ import pandas as pd
 
 from skyradar.config import RadarConfig
 from skyradar.experiments.ch4_flights import EPBC, SCENARIOS, Traffic, build_traffic
+from skyradar.experiments.summary_md import beside, counted, number, page, write_summary
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.parallel import check_workers, close, connect
@@ -57,6 +58,7 @@ __all__ = [
     "scenario_visibility",
     "count_truth_tracks",
     "THESIS",
+    "summary_markdown",
 ]
 
 # Maas 2022, ch. 4 (pixels, counts): traditional / proposed / by hand.
@@ -382,6 +384,7 @@ def run(
     summary["seed"] = int(seed)
     write_csv_atomic(pd.DataFrame(per_scenario).T, out_dir / "ch4_results.csv")
     write_json_atomic(out_dir / "ch4_results.json", summary)
+    write_summary(out_dir, summary_markdown(summary, out_dir))
     return summary
 
 
@@ -424,3 +427,94 @@ def _summary(per: dict, chain: str, elapsed_s: float, figures: list[str]) -> dic
     flat["thesis"] = THESIS
     flat["figures"] = figures
     return flat
+
+
+_FIGURES = {
+    "ch4_tracks_range_doppler.png": "both trackers' tracks over the detections in range and Doppler",
+    "ch4_tracks_body.png": "radar-aware tracks over the visible truth, own-ship's horizontal body frame",
+    "ch4_innovation_hist.png": "innovation distance of both trackers, in pixels",
+}
+_DATA = {
+    "ch4_results.csv": "one row per scenario: every count and metric of both trackers",
+    "ch4_results.json": "every measured value, with the thesis' numbers",
+    "detections_<scenario>.parquet": "the detections both trackers got",
+    "tracks_<scenario>_<model>.parquet": "the tracks of each tracker (`radar`, `traditional`)",
+}
+
+
+def summary_markdown(summary: dict, out_dir: Path | None = None) -> str:
+    """``summary.md`` of a ch4 run: radar-aware against traditional tracking, beside the thesis' counts.
+
+    Parameters
+    ----------
+    summary : dict
+        The summary :func:`run` returns (also in ``ch4_results.json``): ``scenarios`` per scenario,
+        ``thesis`` (:data:`THESIS`), ``figures``.
+    out_dir : Path, optional
+        The run's folder: only the files present there are listed (None: all of them).
+
+    Returns
+    -------
+    str
+        Markdown: title, sentences, one table row per scenario, the files.
+
+    Examples
+    --------
+    >>> per = {"truth_tracks": 12, "tracks_radar": 13, "tracks_traditional": 30, "false_tracks_radar": 0,
+    ...        "false_tracks_traditional": 9, "missed_truth_tracks_radar": 1, "completeness_radar": 0.93,
+    ...        "innov_p95_radar": 3.1, "innov_p95_traditional": 6.4}
+    >>> s = {"scenarios": {"free": per}, "thesis": THESIS, "figures": ["ch4_tracks_body.png"],
+    ...      "detections_source": "full chain", "radar_p95_below_traditional_all": True,
+    ...      "radar_tracks_at_most_traditional_all": True, "seed": 0}
+    >>> text = summary_markdown(s)
+    >>> print(text.splitlines()[0])
+    # ch4: radar-aware against traditional tracking
+    >>> "| free | 12 (12) | 13 (13) | 30 (54) | 0 / 9 | 3.1 (10.7) | 6.4 (14.4) |" in text
+    True
+    >>> "`ch4_tracks_body.png`" in text, "`ch4_innovation_hist.png`" in text
+    (True, False)
+    """
+    per, thesis = summary["scenarios"], summary["thesis"]
+    rows = []
+    for name, r in per.items():
+        t = thesis.get(name, {"innov_p95": (None, None), "tracks": (None, None), "truth": None})
+        rows.append(
+            [
+                name,
+                beside(r["truth_tracks"], t["truth"]),
+                beside(r["tracks_radar"], t["tracks"][1]),
+                beside(r["tracks_traditional"], t["tracks"][0]),
+                f"{r['false_tracks_radar']} / {r['false_tracks_traditional']}",
+                beside(r["innov_p95_radar"], t["innov_p95"][1]),
+                beside(r["innov_p95_traditional"], t["innov_p95"][0]),
+            ]
+        )
+    header = [
+        "scenario",
+        "true tracks (thesis, by hand)",
+        "radar-aware tracks (thesis)",
+        "traditional tracks (thesis)",
+        "false tracks radar-aware / traditional",
+        "innovation p95 radar-aware [px] (thesis)",
+        "innovation p95 traditional [px] (thesis)",
+    ]
+    fewer = (
+        "in every scenario" if summary["radar_tracks_at_most_traditional_all"] else "not in every scenario"
+    )
+    tighter = "in every scenario" if summary["radar_p95_below_traditional_all"] else "not in every scenario"
+    sentences = " ".join(
+        f"{name}: {r['tracks_radar']} radar-aware and {r['tracks_traditional']} traditional tracks for "
+        f"{r['truth_tracks']} true tracks, {r['missed_truth_tracks_radar']} of them missed by the "
+        f"radar-aware tracker (completeness {number(r['completeness_radar'], 2)})."
+        for name, r in per.items()
+    )
+    paragraphs = [
+        f"{counted(len(per), 'own-ship flight')} around an airfield with VFR intruders, both trackers "
+        f"on the same detections, seed {summary['seed']}: {summary['detections_source']}. True tracks come "
+        "from the scenario, never from the detections.",
+        f"The radar-aware tracker makes at most as many tracks as the traditional one {fewer}, and its "
+        f"95th-percentile innovation is smaller {tighter}. {sentences} The thesis' numbers are in "
+        "brackets in the table.",
+    ]
+    files = {name: _FIGURES.get(name, "figure") for name in summary["figures"]} | _DATA
+    return page("ch4: radar-aware against traditional tracking", paragraphs, header, rows, files, out_dir)

@@ -323,7 +323,8 @@ def run(
     ``seed`` (``ahrs.rate_1hz``, ``ahrs.rate_9p4hz``). The table has one row per attitude source,
     rate, terrain and method.
     """
-    from skyradar.experiments.ch5_report import plot_case, summary_table
+    from skyradar.experiments.ch5_report import plot_case, summary_markdown, summary_table
+    from skyradar.experiments.summary_md import write_summary
 
     check_run_options(duration_s, fast_duration_s, terrains, fast_terrains, facet_size_m, warmup_s)
     out_dir = Path(out_dir)
@@ -364,4 +365,5 @@ def run(
         }
     )
     write_json_atomic(out_dir / "ch5.json", results)  # NaN (no valid frame) -> null
+    write_summary(out_dir, summary_markdown(results, out_dir))
     return results

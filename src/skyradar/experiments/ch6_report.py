@@ -1,4 +1,4 @@
-"""ch6's table (the thesis' beside ours) and figures (poses, similarity surface, ROC, flight)."""
+"""ch6's table (the thesis' beside ours), figures (poses, similarity surface, ROC, flight) and summary."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from skyradar.experiments.summary_md import beside, number, page  # noqa: E402
 from skyradar.io.atomic import savefig_atomic  # noqa: E402
 from skyradar.nav.gpscheck.check import DEFAULT_METHOD, RADAR_OPTIONS  # noqa: E402
 from skyradar.nav.gpscheck.compare import decoy_poses, score_poses  # noqa: E402
@@ -19,7 +20,7 @@ from skyradar.nav.gpscheck.preprocess import METHODS, THESIS_METHOD_NUMBER, prep
 from skyradar.nav.gpscheck.search import similarity_surface  # noqa: E402
 from skyradar.scene.ground_grid import sample_at_pose  # noqa: E402
 
-__all__ = ["summary_table", "plot_all"]
+__all__ = ["summary_table", "plot_all", "summary_markdown"]
 
 
 def _median(values: pd.Series) -> float:
@@ -199,3 +200,94 @@ def plot_all(
             plot_flight(out / "flight.png", maps["gamma"], map_grid, flight, index, n_picked),
         )
     ]
+
+
+_FIGURES = {
+    "poses.png": "one frame's radar ground image against the map at the true pose and at decoys",
+    "surface.png": "the similarity over pose offsets around the true pose",
+    "roc.png": "detection of each GPS spoof against the false-alarm rate",
+    "flight.png": "the flight over the map, the scored frames marked",
+}
+_DATA = {
+    "table.csv": "one row per method, the thesis' numbers beside ours, and the continuous search",
+    "roc.csv": "the ROC: false-alarm and detection rates per threshold",
+    "frames.parquet": "every scored frame, method and spoof case",
+    "ch6.json": "every measured value",
+}
+
+
+def summary_markdown(result: dict[str, Any], out_dir: Path | None = None) -> str:
+    """``summary.md`` of a ch6 run: the GPS check's methods beside the thesis', the search and spoofing.
+
+    Parameters
+    ----------
+    result : dict
+        The summary ``skyradar.experiments.ch6.run`` returns (also in ``ch6.json``), with its
+        ``table`` (:func:`summary_table`, as records) and ``figures``.
+    out_dir : Path, optional
+        The run's folder: only the files present there are listed (None: all of them).
+
+    Returns
+    -------
+    str
+        Markdown: title, sentences, one table row per method, the files.
+
+    Examples
+    --------
+    >>> row = {"method": "clahe_ridge", "frames": 20, "correct": 20, "heading_error_deg": 0.4,
+    ...        "position_error_m": 2.1, "false_positive_fraction": 0.01, "thesis_correct": 17,
+    ...        "thesis_heading_error_deg": 1.0, "thesis_position_error_m": 1.0,
+    ...        "thesis_false_positive_fraction": 0.14}
+    >>> r = {"frames": 20, "best_method": "clahe_ridge", "best_correct": 20, "best_false_positive": 0.01,
+    ...      "search_decided": 20, "search_correct": 19, "search_median_position_m": 3.2,
+    ...      "search_median_heading_deg": 0.3, "spoof_50m_detection": 1.0, "roc_false_alarm": 0.0,
+    ...      "monitor_false_alarm": 0.05, "wing_up_frames": 4, "wing_up_all_no_decision": True,
+    ...      "acceptance_failures": [], "table": [row], "figures": ["out/ch6/roc.png"]}
+    >>> text = summary_markdown(r)
+    >>> print(text.splitlines()[0])
+    # ch6: GPS check against an out-of-date map
+    >>> "| clahe_ridge | 20 of 20 (17) | 0.4 (1.0) | 2.1 (1.0) | 0.01 (0.14) |" in text
+    True
+    >>> "`roc.png`" in text, "`poses.png`" in text
+    (True, False)
+    """
+    r = result
+    rows = [
+        [
+            t["method"],
+            beside(f"{t['correct']} of {t['frames']}", t.get("thesis_correct")),
+            beside(t["heading_error_deg"], t.get("thesis_heading_error_deg"), 1),
+            beside(t["position_error_m"], t.get("thesis_position_error_m"), 1),
+            beside(t["false_positive_fraction"], t.get("thesis_false_positive_fraction"), 2),
+        ]
+        for t in r["table"]
+    ]
+    header = [
+        "method",
+        "frames correct (thesis)",
+        "median heading error [deg] (thesis)",
+        "median position error [m] (thesis)",
+        "false-positive fraction (thesis)",
+    ]
+    failures = r.get("acceptance_failures") or []
+    wing = "all" if r["wing_up_all_no_decision"] else "not all"
+    paragraphs = [
+        f"A side-looking radar over central Helsinki checks its GPS pose against an out-of-date "
+        f"map, on {r['frames']} random frames with ground in view as in the thesis' experiment B.",
+        f"The best method, {r['best_method']}, picks the true pose among decoys in {r['best_correct']} of "
+        f"{r['frames']} frames, with a false-positive fraction of {number(r['best_false_positive'], 2)}. "
+        f"The continuous search from the GPS pose decides {r['search_decided']} frames and is correct in "
+        f"{r['search_correct']}, with a median error of {number(r['search_median_position_m'])} m and "
+        f"{number(r['search_median_heading_deg'], 2)} deg. A GPS moved by 50 m is detected in "
+        f"{number(100 * r['spoof_50m_detection'], 0)} % of the frames at a false-alarm rate of "
+        f"{number(100 * r['roc_false_alarm'], 0)} % (the monitor's own threshold: "
+        f"{number(100 * r['monitor_false_alarm'], 0)} % false alarms); {wing} of the "
+        f"{r['wing_up_frames']} wing-up frames end in no decision. "
+        + (
+            "Every acceptance bound holds."
+            if not failures
+            else f"{len(failures)} acceptance bounds are missed: " + "; ".join(failures) + "."
+        ),
+    ]
+    files = {Path(p).name: _FIGURES.get(Path(p).name, "figure") for p in r.get("figures", [])} | _DATA
+    return page("ch6: GPS check against an out-of-date map", paragraphs, header, rows, files, out_dir)

@@ -10,7 +10,7 @@
 
 Writes ``ch7_testpulse.png``, ``ch7_sweeps.png``, ``ch7_aircraft.png``, ``ch7_table.csv`` (thesis
 beside ours), ``ch7_detections.parquet`` and ``ch7.json`` into ``out_dir`` (and, with
-``keep_recording``, the SigMF recording and its truth tables).
+``keep_recording``, the SigMF recording and its truth tables), then ``summary.md``.
 """
 
 from __future__ import annotations
@@ -22,10 +22,11 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from skyradar.experiments.summary_md import number, page, write_summary
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
 
-__all__ = ["run", "THESIS"]
+__all__ = ["run", "THESIS", "summary_markdown"]
 
 THESIS = {
     "clusters_seen": "9/9 sweeps (Vianen, Utrecht, Amersfoort, Hoevelaken at R2 14-20 km); 7/9 at 20.7 km",
@@ -64,6 +65,7 @@ def run(
         if keep_recording:
             for path in Path(tmp).iterdir():
                 shutil.move(str(path), out_dir / path.name)
+    write_summary(out_dir, summary_markdown(result, out_dir))
     return result
 
 
@@ -166,3 +168,72 @@ def _table(r: dict) -> pd.DataFrame:
         ),
     ]
     return pd.DataFrame(rows, columns=["quantity", "thesis", "ours"])
+
+
+_FILES = {
+    "ch7_testpulse.png": "the thesis' test pulse and its echo through the matched filter, plain and Hann",
+    "ch7_sweeps.png": "the detections of each rotation in plan view, static and moving, over the truth",
+    "ch7_aircraft.png": "the small aircraft's detections against its true path",
+    "ch7_table.csv": "the thesis' findings beside ours, one row per quantity",
+    "ch7_detections.parquet": "every detection of the processed recording",
+    "ch7.json": "every measured value, with the score against the truth",
+    "ch7_recording.<...>": "the simulated SigMF recording and its truth tables (kept on request)",
+}
+
+
+def summary_markdown(result: dict[str, Any], out_dir: Path | None = None) -> str:
+    """``summary.md`` of a ch7 run: towns, the small aircraft and false detections beside the thesis.
+
+    The table is the run's ``ch7_table.csv`` (the thesis' findings, :data:`THESIS`, beside ours).
+
+    Parameters
+    ----------
+    result : dict
+        The summary :func:`run` returns (also in ``ch7.json``).
+    out_dir : Path, optional
+        The run's folder: only the files present there are listed (None: all of them).
+
+    Returns
+    -------
+    str
+        Markdown: title, sentences, the table, the files.
+
+    Examples
+    --------
+    >>> r = {"rotations": 9, "clusters": 5, "clusters_seen_every_rotation": 5, "aircraft_seen": 9,
+    ...      "aircraft_passes": 9, "aircraft_median_error_m": 61.5, "false_total": 3,
+    ...      "false_max_per_rotation": 1, "false_mean_per_rotation": 0.33, "detections": 812,
+    ...      "scan_period_s": 4.4, "hann_peak_ms": 0.15, "plain_peak_ms": 0.15, "hann_echo_visible": True,
+    ...      "plain_echo_visible": False, "total_s": 140.2,
+    ...      "acceptance": {"clusters_9_of_9": True, "aircraft_8_of_9": True}}
+    >>> text = summary_markdown(r)
+    >>> print(text.splitlines()[0])
+    # ch7: passive radar with an air-traffic-control radar as illuminator
+    >>> "| small aircraft seen | 'possibly' 3/9 sweeps (R2 1.1-2.6 km) | 9/9 passes |" in text
+    True
+    >>> "`ch7_sweeps.png`" in text
+    True
+    """
+    r = result
+    missed = [name.replace("_", " ") for name, ok in r.get("acceptance", {}).items() if not ok]
+    paragraphs = [
+        f"A receiver on a tower listens to a rotating S-band air-traffic-control radar for {r['rotations']} "
+        "rotations; the simulated recording is processed as a real one would be and scored against the "
+        f"simulator's truth ({r['detections']} detections, {number(r['total_s'])} s in all).",
+        f"{r['clusters_seen_every_rotation']} of {r['clusters']} towns are seen in every rotation, and the "
+        f"small aircraft in {r['aircraft_seen']} of its {r['aircraft_passes']} passes with a median "
+        f"position error of {number(r['aircraft_median_error_m'])} m (thesis: "
+        f"{THESIS['aircraft_seen']}). False detections: {r['false_total']} in all, at most "
+        f"{r['false_max_per_rotation']} per rotation. With the Hann window the test pulse's weak echo is "
+        f"{'visible' if r['hann_echo_visible'] else 'not visible'}, without it "
+        f"{'visible' if r['plain_echo_visible'] else 'not visible'}. "
+        + (
+            "Every acceptance bound holds."
+            if not missed
+            else f"Acceptance bounds missed: {', '.join(missed)}."
+        ),
+    ]
+    table = _table(r)
+    rows = table.to_numpy().tolist()
+    title = "ch7: passive radar with an air-traffic-control radar as illuminator"
+    return page(title, paragraphs, list(table.columns), rows, _FILES, out_dir)

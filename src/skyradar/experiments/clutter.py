@@ -78,9 +78,10 @@ import pandas as pd
 from skyradar.code_version import code_version, provenance
 from skyradar.config import RadarConfig
 from skyradar.experiments import encounter_terrain
-from skyradar.experiments.clutter_report import plot_sinr_loss, plot_track, summary_rows
+from skyradar.experiments.clutter_report import plot_sinr_loss, plot_track, summary_markdown, summary_rows
 from skyradar.experiments.clutter_scene import OWN_SPEED_MPS, relief_altitude_m, scene_dict, scene_frames
 from skyradar.experiments.encounter_set import FAST_CLOSURE_AGL_M
+from skyradar.experiments.summary_md import write_summary
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.frames import radar_config_of
 from skyradar.io.tables import write_json_atomic
@@ -385,7 +386,8 @@ def run(
     seed: int = 0,
     command: str | None = None,
 ) -> dict[str, Any]:
-    """Run the terrain cases; write ``frames.csv``, ``sinr_loss.csv``, ``summary.json`` and PNG figures.
+    """Run the terrain cases; write ``frames.csv``, ``sinr_loss.csv``, ``summary.json``, ``summary.md``
+    and PNG figures.
 
     Parameters
     ----------
@@ -434,4 +436,5 @@ def run(
     result["runtime_s"] = time.perf_counter() - start
     result |= provenance(command, version)
     write_json_atomic(out / "summary.json", result)
+    write_summary(out, summary_markdown(result, out))
     return result

@@ -47,6 +47,7 @@ from skyradar.experiments.encounter_chain import (
 )
 from skyradar.experiments.encounter_set import T_CPA_S, make_encounters, make_fast_closures, rate_interval
 from skyradar.experiments.encounter_terrain import TERRAINS
+from skyradar.experiments.summary_md import markdown_table, number
 from skyradar.io.atomic import savefig_atomic, write_csv_atomic, write_text_atomic
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.pilot import PilotConfig
@@ -269,18 +270,37 @@ def _summary_md(rows: list[dict], settings: dict) -> str:
         f"{settings['pilot']['warning_delay_s']:g} s, flying the preferred {settings['pilot']['manoeuvre']} "
         "manoeuvre.",
         "",
-        "| terrain | case | LoWC unequipped | LoWC equipped | risk ratio LoWC (95 %) | NMAC unequipped "
-        "| NMAC equipped | induced LoWC | mean time manoeuvring, s |",
-        "|---|---|---|---|---|---|---|---|---|",
     ]
+    header = [
+        "terrain",
+        "case",
+        "LoWC unequipped",
+        "LoWC equipped",
+        "risk ratio LoWC (95 %)",
+        "NMAC unequipped",
+        "NMAC equipped",
+        "induced LoWC",
+        "mean time manoeuvring, s",
+    ]
+    table = []
     for r in rows:
         lo, hi = r["lowc_risk_ratio_interval"]
-        lines.append(
-            f"| {r['terrain']} | {_case_name(r)} | {r['lowc_unequipped']}/{r['encounters']} | "
-            f"{r['lowc_equipped']}/{r['encounters']} | {r['lowc_risk_ratio']:.2f} ({lo:.2f}-{hi:.2f}) | "
-            f"{r['nmac_unequipped']} | {r['nmac_equipped']} | {r['lowc_induced']} | "
-            f"{r['manoeuvre_s_mean']:.1f} |"
+        ratio = f"{number(r['lowc_risk_ratio'], 2)} ({number(lo, 2)}-{number(hi, 2)})"
+        n = r["encounters"]
+        table.append(
+            [
+                r["terrain"],
+                _case_name(r),
+                f"{r['lowc_unequipped']}/{n}",
+                f"{r['lowc_equipped']}/{n}",
+                ratio,
+                str(r["nmac_unequipped"]),
+                str(r["nmac_equipped"]),
+                str(r["lowc_induced"]),
+                r["manoeuvre_s_mean"],
+            ]
         )
+    lines.append(markdown_table(header, table))
     lines += [
         "",
         "The risk ratio is the rate equipped over the rate unequipped on the same encounters (NaN: no "

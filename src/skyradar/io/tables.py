@@ -81,9 +81,14 @@ def finite_column(df: pd.DataFrame, col: str, source: str | Path, allow_nan: boo
     ...
     skyradar.errors.InputError: t.csv: field 'x' is not a finite number at row 1 ('a')
     """
-    values = pd.to_numeric(df[col], errors="coerce").to_numpy(float)
-    # A NaN that was NaN in the file may be allowed; one made by coercing a string never is.
-    was_nan = pd.isna(df[col]).to_numpy()
+    column = df[col]
+    if pd.api.types.is_float_dtype(column.dtype) or pd.api.types.is_integer_dtype(column.dtype):
+        values = column.to_numpy(float)  # numbers already: nothing to coerce
+        was_nan = np.isnan(values)
+    else:
+        values = pd.to_numeric(column, errors="coerce").to_numpy(float)
+        # A NaN that was NaN in the file may be allowed; one made by coercing a string never is.
+        was_nan = pd.isna(column).to_numpy()
     bad = np.flatnonzero(np.isinf(values) | (np.isnan(values) & (~was_nan | (not allow_nan))))
     if bad.size:
         raw = df[col].iloc[bad[0]]

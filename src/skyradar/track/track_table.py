@@ -207,16 +207,18 @@ def _table(
     ground_test,
     at_time_s: float | None = None,
     walks: dict | None = None,
+    assembled: pd.DataFrame | None = None,
 ) -> pd.DataFrame:
     """The tracks table: ids through reacquisition, ``altitude_measured`` (on the elevations the
     3-D tracker trusted, :mod:`.elevation_trust`), then the ground hold.
 
     With ``at_time_s`` only the tracks with a row at that time are judged after the ids (each
     track's rows are judged on its own, so theirs are those of the whole table); ``walks`` keeps
-    the ground hold's judgements between calls (:func:`~skyradar.track.ground_tracks.hold_ground_tracks`)."""
-    t = _reacquired_ids(
-        _assemble(chunks, origin, m3.active), chunks, detections, ownship, config, ground_test
-    )
+    the ground hold's judgements between calls (:func:`~skyradar.track.ground_tracks.hold_ground_tracks`);
+    ``assembled`` is :func:`_assemble` of ``chunks`` when the caller keeps it."""
+    if assembled is None:
+        assembled = _assemble(chunks, origin, m3.active)
+    t = _reacquired_ids(assembled, chunks, detections, ownship, config, ground_test)
     if at_time_s is not None:
         ids = t["track_id"].to_numpy()
         t = t[np.isin(ids, ids[t["time_s"].to_numpy(float) == at_time_s])].reset_index(drop=True)
@@ -487,6 +489,7 @@ class TrackTableStream:
         self._n_input = self._n_fused = 0
         self._own: pd.DataFrame | None = None  # the own-ship rows so far
         self._walks: dict = {}  # the ground hold's judgements of each track, kept between frames
+        self._assembled: pd.DataFrame | None = None  # the tracker's rows of every frame so far
 
     def set_surface(self, surface_down: Callable | None) -> None:
         """The terrain (NE -> down, m) of the ground test and the 3-D feed from this frame on."""
@@ -525,7 +528,11 @@ class TrackTableStream:
         self._input_rows.append(self._n_input + rows)
         self._n_input, self._n_fused = self._n_input + len(det), self._n_fused + len(fused)
         args = (self.origin, self._m3, self._fused, own, self.config, self.ground_test)
-        t = _table(self._chunks, *args, at_time_s=float(time_s), walks=self._walks)
+        # Each frame's rows are assembled once (rows depend on their own frame only) and appended.
+        new = _assemble(self._chunks[-1:], self.origin, self._m3.active)
+        self._assembled = _appended(self._assembled, new) if len(new) else self._assembled
+        assembled = self._assembled if self._assembled is not None else new
+        t = _table(self._chunks, *args, at_time_s=float(time_s), walks=self._walks, assembled=assembled)
         t = t[t["time_s"].to_numpy(float) == float(time_s)].reset_index(drop=True)
         return restore_detection_rows(t, np.concatenate(self._input_rows))
 

@@ -12,10 +12,7 @@ import numpy as np
 import pytest
 
 from cli_helpers import assert_one_line_error, skyradar
-
-pytest.importorskip("bluesky")
-
-from skyradar.integrations.bluesky.runner import run_scenario  # noqa: E402
+from skyradar.integrations.bluesky.runner import run_scenario
 
 _SETUP = """00:00:00.00>ASAS ON
 00:00:00.00>RESO MVP

@@ -356,9 +356,9 @@ def test_a_run_resumes_only_on_the_same_code(tmp_path, monkeypatch):
 
 
 def test_run_encounter_builds_its_scenario_with_the_simulation_and_array_asked_for():
-    # simulation= was dropped on the way to the scenario: every "light" test ran the costly realism.
-    from skyradar.experiments.encounter_chain import _scenario
+    # The simulator options reach the scenario: a "light" test must not run the costly realism.
+    from skyradar.experiments.encounter_chain import build_encounter
 
-    built, _, _ = _scenario(_row(), 0, 4.7, 40.0, None, ("single",), None, LIGHT, "kite")
+    built, _, _ = build_encounter(_row(), 0, 4.7, 40.0, None, ("single",), None, LIGHT, "kite")
     assert {k: built.sim_options[k] for k in LIGHT} == LIGHT
     assert built.heads[0].config.rx_positions_m[3, 2] > 0.02  # the kite's tail, m below the centre

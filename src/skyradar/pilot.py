@@ -42,6 +42,7 @@ import pandas as pd
 from skyradar.errors import InputError
 from skyradar.geo import ned_to_geodetic
 from skyradar.scene.trajectories import GRAVITY_MPS2, Trajectory, TrajectorySample
+from skyradar.units import wrap_angle
 
 __all__ = ["PilotConfig", "Pilot", "MODES", "FPM_MPS"]
 
@@ -130,7 +131,7 @@ class PilotConfig:
 
 
 def _wrap(angle_rad: float) -> float:
-    return float((angle_rad + np.pi) % (2.0 * np.pi) - np.pi)
+    return float(wrap_angle(angle_rad))
 
 
 class Pilot:

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import os
 import time
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -168,7 +169,7 @@ def _miss_inputs(tracks: pd.DataFrame, own: pd.DataFrame) -> tuple:
     )
 
 
-def _best_of(repeats: int, function, args: tuple) -> tuple[float, tuple]:
+def _best_of(repeats: int, function, args: tuple) -> tuple[float, Any]:
     """Shortest wall time of ``repeats`` calls (a shared machine only ever adds time), and the result."""
     best = np.inf
     for _ in range(repeats):

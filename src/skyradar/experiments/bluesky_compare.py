@@ -34,7 +34,7 @@ import numpy as np
 import pandas as pd
 
 from skyradar.code_version import code_version, provenance
-from skyradar.io.atomic import savefig_atomic, write_csv_atomic
+from skyradar.io.atomic import savefig_atomic, write_csv_atomic, write_text_atomic
 from skyradar.io.tables import write_json_atomic
 
 __all__ = ["demo_scenario", "detection_table", "separation_table", "run", "plot"]
@@ -245,7 +245,7 @@ def run(
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     log_path = out_dir / "bluesky.log"
-    log_path.write_text("")
+    write_text_atomic(log_path, "")  # BlueSky's messages are appended to it as the runs go
     t0 = time.perf_counter()
     runs = {}
     for name in ("truth", "radar"):

@@ -57,6 +57,7 @@ from skyradar.sim.navigation import navigation_variables
 from skyradar.sim.scenario_frames import frames_truth, make_simulator, simulate_frames
 from skyradar.track.ground_tracks import GroundTrackTest
 from skyradar.track.track_table import TrackTableStream, tracker_detections
+from skyradar.units import wrap_angle
 
 __all__ = [
     "ASSOCIATION_GATE_M",
@@ -538,12 +539,12 @@ class AirborneRadar:
         ground_speed = math.hypot(local[0], local[1])
         turn_rate = 0.0
         if self._last_heading is not None and time_s > self._last_heading[0]:
-            change = (heading - self._last_heading[1] + math.pi) % (2 * math.pi) - math.pi
+            change = float(wrap_angle(heading - self._last_heading[1]))
             turn_rate = change / (time_s - self._last_heading[0])
         self._last_heading = (time_s, heading)
         roll = math.atan(ground_speed * turn_rate / GRAVITY_MPS2)
         pitch = math.atan2(float(state.vs_mps[i]), max(ground_speed, 1e-3))
-        att = np.array([[(heading + math.pi) % (2 * math.pi) - math.pi, pitch, roll]])
+        att = np.array([[float(wrap_angle(heading)), pitch, roll]])
         return TrajectorySample(
             np.array([time_s]),
             pos.reshape(1, 3),

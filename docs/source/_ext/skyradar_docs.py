@@ -197,6 +197,17 @@ def _section(directive: SphinxDirective, title: str, label: str) -> nodes.sectio
     return section
 
 
+def _field_list(values: dict[str, object]) -> nodes.field_list:
+    """A field list of ``values`` shown with :func:`format_value`, the command and version as code."""
+    fields = nodes.field_list()
+    for key, value in values.items():
+        text = format_value(key, value)
+        body = nodes.paragraph()
+        body += nodes.literal(text, text) if key in ("command", "version") else nodes.Text(text)
+        fields += nodes.field("", nodes.field_name(key, key), nodes.field_body("", body))
+    return fields
+
+
 class ResultsDirective(SphinxDirective):
     """``.. skyradar-results:: [folder]``: the measured summaries (default ``docs/results``)."""
 
@@ -228,15 +239,9 @@ class ResultsDirective(SphinxDirective):
 
     def _summary_section(self, name: str, summary: dict) -> nodes.section:
         section = _section(self, name, "results-" + Path(name).stem)
-        fields = nodes.field_list()
-        for key in (*SUMMARY_FIELDS, *PROVENANCE_FIELDS):
-            if key not in summary and key in ("split", "alert_config", "load_average_1min"):
-                continue
-            value = format_value(key, summary.get(key))
-            body = nodes.paragraph()
-            body += nodes.literal(value, value) if key in ("command", "version") else nodes.Text(value)
-            fields += nodes.field("", nodes.field_name(key, key), nodes.field_body("", body))
-        section += fields
+        optional = ("split", "alert_config", "load_average_1min")
+        keys = [k for k in (*SUMMARY_FIELDS, *PROVENANCE_FIELDS) if k in summary or k not in optional]
+        section += _field_list({k: summary.get(k) for k in keys})
         rows = [_with_intervals(r) for r in summary.get("rows") or [summary]]
         optional = ("warnings_not_held", "alert_flickers")  # shown where the summary has them
         shown = [f for f in ROW_FIELDS if f not in optional or any(f in r for r in rows)]
@@ -266,13 +271,7 @@ class BenchmarksDirective(SphinxDirective):
             self.env.note_dependency(str(path))
             result = json.loads(path.read_text())
             section = _section(self, path.name, "bench-" + path.stem)
-            fields = nodes.field_list()
-            for key in PROVENANCE_FIELDS:
-                value = format_value(key, result.get(key))
-                body = nodes.paragraph()
-                body += nodes.literal(value, value) if key in ("command", "version") else nodes.Text(value)
-                fields += nodes.field("", nodes.field_name(key, key), nodes.field_body("", body))
-            section += fields
+            section += _field_list({k: result.get(k) for k in PROVENANCE_FIELDS})
             rows = [
                 [key.replace("_", "_\u200b"), _bench_value(value)]
                 for key, value in result.items()
@@ -306,14 +305,9 @@ class ClutterDirective(SphinxDirective):
 
     def _summary_section(self, path: Path, summary: dict) -> nodes.section:
         section = _section(self, path.name, "clutter-" + path.stem)
-        fields = nodes.field_list()
-        for key in (*CLUTTER_SETTINGS, *PROVENANCE_FIELDS):
-            # ``terrains`` maps each terrain case to its figures: the settings name the cases.
-            value = format_value(key, list(summary[key]) if key == "terrains" else summary.get(key))
-            body = nodes.paragraph()
-            body += nodes.literal(value, value) if key in ("command", "version") else nodes.Text(value)
-            fields += nodes.field("", nodes.field_name(key, key), nodes.field_body("", body))
-        section += fields
+        # ``terrains`` maps each terrain case to its figures: the settings name the cases.
+        values = {k: list(summary[k]) if k == "terrains" else summary.get(k) for k in CLUTTER_SETTINGS}
+        section += _field_list(values | {k: summary.get(k) for k in PROVENANCE_FIELDS})
         cases = summary.get("terrains") or {}
         rows = []
         for key, meaning, _ in CLUTTER_FIGURES:
@@ -402,18 +396,12 @@ class ClosedLoopDirective(SphinxDirective):
 
     def _summary_section(self, path: Path, summary: dict) -> nodes.section:
         section = _section(self, path.name, "closed-loop-" + path.stem)
-        fields = nodes.field_list()
         settings = summary.get("settings") or {}
         shown = {k: settings.get(k) for k in ("family", "terrains", "layouts", "n", "seed", "split")}
         pilot = settings.get("pilot") or {}
         shown["pilot"] = ", ".join(f"{k}={v}" for k, v in pilot.items())
         shown |= {k: summary.get(k) for k in ("runtime_s", *PROVENANCE_FIELDS)}
-        for key, value in shown.items():
-            text = format_value(key, value)
-            body = nodes.paragraph()
-            body += nodes.literal(text, text) if key in ("command", "version") else nodes.Text(text)
-            fields += nodes.field("", nodes.field_name(key, key), nodes.field_body("", body))
-        section += fields
+        section += _field_list(shown)
         rows = summary.get("rows") or []
         cases = [
             f"{r['terrain']}: "

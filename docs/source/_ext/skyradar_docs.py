@@ -282,26 +282,37 @@ class BenchmarksDirective(SphinxDirective):
         return out
 
 
-class ClutterDirective(SphinxDirective):
-    """``.. skyradar-clutter:: [folder]``: the saved ``skyradar experiment clutter`` summaries (default
-    ``docs/results/clutter``), each with its settings and provenance, a table of
-    :data:`CLUTTER_FIGURES` with one column per terrain, and the figures of its ``figures`` list
-    that are kept beside the JSON (a figure left out of the folder is left out of the page)."""
+class _SummariesDirective(SphinxDirective):
+    """A section per summary JSON of a results folder (``default_folder`` unless given), each made by
+    ``_summary_section``; a warning when the folder holds none."""
 
     optional_arguments = 1
+    default_folder, what = "", ""
 
     def run(self) -> list[nodes.Node]:
-        where = self.arguments[0] if self.arguments else "../results/clutter"
+        where = self.arguments[0] if self.arguments else self.default_folder
         folder = Path(self.env.srcdir, where).resolve()
         files = sorted(folder.glob("*.json"))
         if not files:
-            warning = f"no clutter summary JSON in {folder}"
+            warning = f"no {self.what} summary JSON in {folder}"
             return [self.state.document.reporter.warning(warning, line=self.lineno)]
         out: list[nodes.Node] = []
         for path in files:
             self.env.note_dependency(str(path))
             out.append(self._summary_section(path, json.loads(path.read_text())))
         return out
+
+    def _summary_section(self, path: Path, summary: dict) -> nodes.section:
+        raise NotImplementedError
+
+
+class ClutterDirective(_SummariesDirective):
+    """``.. skyradar-clutter:: [folder]``: the saved ``skyradar experiment clutter`` summaries (default
+    ``docs/results/clutter``), each with its settings and provenance, a table of
+    :data:`CLUTTER_FIGURES` with one column per terrain, and the figures of its ``figures`` list
+    that are kept beside the JSON (a figure left out of the folder is left out of the page)."""
+
+    default_folder, what = "../results/clutter", "clutter"
 
     def _summary_section(self, path: Path, summary: dict) -> nodes.section:
         section = _section(self, path.name, "clutter-" + path.stem)
@@ -374,25 +385,12 @@ def _closed_loop_value(name: str, value: object) -> str:
     return format_value(name, value)
 
 
-class ClosedLoopDirective(SphinxDirective):
+class ClosedLoopDirective(_SummariesDirective):
     """``.. skyradar-closed-loop:: [folder]``: the saved ``skyradar experiment closed-loop`` summaries
     (default ``docs/results/closed-loop``): settings and provenance, one column per terrain and
     equipped case, and the run's figure when it is kept beside the JSON as ``<name>.png``."""
 
-    optional_arguments = 1
-
-    def run(self) -> list[nodes.Node]:
-        where = self.arguments[0] if self.arguments else "../results/closed-loop"
-        folder = Path(self.env.srcdir, where).resolve()
-        files = sorted(folder.glob("*.json"))
-        if not files:
-            warning = f"no closed-loop summary JSON in {folder}"
-            return [self.state.document.reporter.warning(warning, line=self.lineno)]
-        out: list[nodes.Node] = []
-        for path in files:
-            self.env.note_dependency(str(path))
-            out.append(self._summary_section(path, json.loads(path.read_text())))
-        return out
+    default_folder, what = "../results/closed-loop", "closed-loop"
 
     def _summary_section(self, path: Path, summary: dict) -> nodes.section:
         section = _section(self, path.name, "closed-loop-" + path.stem)

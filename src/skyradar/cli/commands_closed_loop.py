@@ -11,6 +11,7 @@ import typer
 from skyradar.cli.app import NON_NEGATIVE, JsonOption, emit_result, experiment_app, number_in
 from skyradar.cli.choices import ClosedLoopFamily, Layout, Manoeuvre
 from skyradar.cli.commands_encounters import (
+    LAYOUTS_SCORED,
     EncounterSchedulerOption,
     EncounterWorkersOption,
     SplitOption,
@@ -19,12 +20,6 @@ from skyradar.cli.commands_encounters import (
 from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = ["experiment_closed_loop"]
-
-_LAYOUTS = {
-    Layout.both: ("single", "three-head"),
-    Layout.single: ("single",),
-    Layout.three_head: ("three-head",),
-}
 
 
 @experiment_app.command("closed-loop")
@@ -113,7 +108,7 @@ def experiment_closed_loop(
             n_encounters=n,
             seed=seed,
             terrains=tuple(terrains),
-            layouts=_LAYOUTS[layout],
+            layouts=LAYOUTS_SCORED[layout],
             family=family.value,
             pilot=pilot,
             workers=workers,

@@ -25,13 +25,14 @@ __all__ = [
     "experiment_encounters",
     "bench_encounter",
     "EncounterWorkersOption",
+    "LAYOUTS_SCORED",
     "EncounterSchedulerOption",
     "SplitOption",
     "check_split",
 ]
 
 # The layouts each --layout scores.
-_LAYOUTS = {
+LAYOUTS_SCORED = {
     Layout.both: ("single", "three-head"),
     Layout.single: ("single",),
     Layout.three_head: ("three-head",),
@@ -187,7 +188,7 @@ def experiment_encounters(
         from skyradar.scene.sample_flights import sample_flights
 
         sample_flights("gliders")  # the 'flights' extra, before any output is made
-    terrains, layouts = parse_terrains(terrain), _LAYOUTS[layout]
+    terrains, layouts = parse_terrains(terrain), LAYOUTS_SCORED[layout]
     if n is None:  # over terrain an encounter costs minutes: the default keeps a run within 5 minutes
         n = DEFAULT_ENCOUNTERS if terrains == ["none"] else DEFAULT_TERRAIN_ENCOUNTERS
     check_output(out, (), overwrite, kind="folder", option="--out")

@@ -47,7 +47,7 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
 )
 experiment_app = typer.Typer(
-    help="Reproduce thesis chapters ch2-ch7; the DAA encounter sets, open and closed loop; skyradar inside BlueSky.",
+    help="Reproduce thesis chapters ch2-ch7; DAA encounter sets, open and closed loop; skyradar in BlueSky.",
     no_args_is_help=True,
 )
 bench_app = typer.Typer(help="Speed benchmarks; each prints JSON with --json.", no_args_is_help=True)

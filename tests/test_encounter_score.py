@@ -197,7 +197,7 @@ def test_summary_markdown_says_what_was_measured_from_the_rows():
     assert title == "# Encounters: synthetic, seed 3 (development set)"
     assert "9 encounters per terrain and layout, at 4.7 frames per second" in intro
     sentence = " ".join(sentence.split())
-    assert "Over hills terrain with the single layout, 2 of 6 conflicts were warned" in sentence
+    assert "Over hills with the single layout, 2 of 6 conflicts were warned" in sentence
     assert "(33 %, 95 % interval 10 % to 70 %)" in sentence  # Wilson interval of 2 in 6
     assert "unwarned: 1 missed (observable), 1 behind, 1 terrain masked, 1 below 13 dB SNR." in sentence
     assert (

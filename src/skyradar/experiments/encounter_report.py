@@ -150,8 +150,9 @@ def _row_sentence(r: dict[str, Any]) -> str:
     lead = r["median_warning_lead_s"]
     causes = [f"{n} {_cause_name(c)}" for c, n in r["unwarned_by_cause"].items() if n]
     clutter = int(r["clutter_warnings"])
+    where = "In clear sky" if r["terrain"] == "none" else f"Over {r['terrain']}"
     return (
-        f"Over {r['terrain']} terrain with the {r['layout']} layout, {r['warned_before_lowc']} of "
+        f"{where} with the {r['layout']} layout, {r['warned_before_lowc']} of "
         f"{r['conflicts']} conflicts were warned before the loss of well clear "
         f"({_percent(r['warned_before_lowc_fraction'])}, 95 % interval {_percent(lo)} to {_percent(hi)})"
         + (f", the median warning {lead:.1f} s before it" if np.isfinite(lead) else "")
@@ -187,7 +188,7 @@ def summary_markdown(rows: list[dict[str, Any]], settings: dict[str, Any]) -> st
     ...        "clutter_tracks_per_min": 0.0}
     >>> settings = {"seed": 7, "family": "synthetic", "split": "development", "frame_rate_hz": 4.7}
     >>> print(summary_markdown([row], settings).split("\\n\\n")[2])
-    Over none terrain with the single layout, 9 of 10 conflicts were warned before the loss of well
+    In clear sky with the single layout, 9 of 10 conflicts were warned before the loss of well
     clear (90 %, 95 % interval 60 % to 98 %), the median warning 21.5 s before it; unwarned: 1
     behind. A warning came in 0 of the 12 encounters that must not alert, and 0 clutter tracks
     reached a warning.

@@ -145,7 +145,7 @@ def experiment_ch2(
 
     check_output(out, (), overwrite, kind="folder", option="--out")
     result = run(mark_folder(out), n_frames=frames)
-    console.print(f"figures and table in {out}")
+    console.print(f"summary in {out / 'summary.md'}; figures and table in {out}")
     emit_result(result, json_out, "ch2: simulator against closed form")
 
 

@@ -227,11 +227,9 @@ def fly_radar(
 ) -> ClosedLoopRun:
     """The encounter with the radar chain in the loop (:class:`ClosedLoopChain`), to the last frame."""
     chain = ClosedLoopChain(built, pilot_config, alert_config, process_options, heads)
-    chain.run()
+    alerts = pd.concat([result.alerts for result in chain.run()], ignore_index=True)
     pilot = chain.pilot
-    return ClosedLoopRun(
-        "radar", pilot.flown(), chain.tables()["alerts"], pilot.first_action_s, pilot.manoeuvre_s
-    )
+    return ClosedLoopRun("radar", pilot.flown(), alerts, pilot.first_action_s, pilot.manoeuvre_s)
 
 
 def separation(

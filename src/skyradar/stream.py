@@ -49,6 +49,7 @@ from skyradar.daa.alerting import AlertConfig
 from skyradar.daa.pipeline import AlertStream
 from skyradar.daa.run_tables import ownship_from_frames
 from skyradar.io.frames import frames_dataset
+from skyradar.io.tables import appended
 from skyradar.process.clutter_anchors import AnchorWalk, frame_geometries
 from skyradar.process.detect_run import merge_head_tables
 from skyradar.process.pipeline import navigated_own_state, process_frames
@@ -236,8 +237,7 @@ class StreamingChain:
         self._used.append(self._n_detections + used)
         self._n_detections += len(det)
         t0 = time.perf_counter()
-        parts = [own_row] if self._own_so_far is None else [self._own_so_far, own_row]
-        own_so_far = self._own_so_far = pd.concat(parts, ignore_index=True)
+        own_so_far = self._own_so_far = appended(self._own_so_far, own_row)
         self._tracker.set_surface(scenario_surface(self.built, own_so_far))  # causal: the ground so far
         rows = self._tracker.step(time_s, i, air, own_row)
         rows = restore_detection_rows(rows, np.concatenate(self._used)) if len(rows) else rows

@@ -51,6 +51,7 @@ from skyradar.daa.tables import (
     covariances,
     interp_ownship,
 )
+from skyradar.io.tables import appended
 
 __all__ = [
     "ALERT_COLUMNS",
@@ -498,12 +499,12 @@ class AlertStream:
             tracks["confirmed"].to_numpy(bool) if "confirmed" in tracks else np.ones(len(tracks), bool)
         )
         clean = clean_tracks(tracks, self.source)  # each row is checked once, as it comes
-        self._own = _window_append(self._own, ownship, time_s - self._window_s)
-        self._tracks = _window_append(self._tracks, clean, time_s - self._window_s)
+        self._own = appended(_since(self._own, time_s - self._window_s), ownship)
+        self._tracks = appended(_since(self._tracks, time_s - self._window_s), clean)
         self._last_confirmed_s.update(
             dict.fromkeys(tracks["track_id"].to_numpy()[confirmed].tolist(), time_s)
         )
-        own = self._own.copy()
+        own = self._own  # a new frame each step: its attrs are this frame's own-ship's
         own.attrs = dict(ownship.attrs)
         alive_since = time_s - self.config.lost_track_hold_s - 1e-9
         alive = [i for i, t in self._last_confirmed_s.items() if t >= alive_since]
@@ -533,11 +534,6 @@ class AlertStream:
             rows.level[i] = track_filter.update(t, int(evidence[0]), int(hold[0]))
 
 
-def _window_append(window: pd.DataFrame | None, rows: pd.DataFrame, since_s: float) -> pd.DataFrame:
-    """``window``'s rows from ``since_s`` on (s), and ``rows`` after them."""
-    if window is None:
-        return rows.reset_index(drop=True)
-    if len(rows) == 0:  # an empty frame adds no rows (and may lack the window's columns)
-        return window[window["time_s"].to_numpy(float) >= since_s].reset_index(drop=True)
-    kept = window[window["time_s"].to_numpy(float) >= since_s]
-    return pd.concat([kept, rows], ignore_index=True) if len(kept) else rows.reset_index(drop=True)
+def _since(window: pd.DataFrame | None, since_s: float) -> pd.DataFrame | None:
+    """``window``'s rows from ``since_s`` on (s)."""
+    return None if window is None else window[window["time_s"].to_numpy(float) >= since_s]

@@ -46,7 +46,6 @@ from skyradar.experiments.encounter_chain import (
     layout_heads,
 )
 from skyradar.experiments.encounter_set import T_CPA_S, make_encounters, make_fast_closures, rate_interval
-from skyradar.experiments.encounter_terrain import TERRAINS
 from skyradar.experiments.summary_md import markdown_table, number
 from skyradar.io.atomic import savefig_atomic, write_csv_atomic, write_text_atomic
 from skyradar.io.tables import write_json_atomic, write_table
@@ -311,17 +310,6 @@ def _summary_md(rows: list[dict], settings: dict) -> str:
     return "\n".join(lines)
 
 
-def _check(n: int, terrains: tuple[str, ...], layouts: tuple[str, ...], family: str) -> None:
-    if not 1 <= n <= 100_000:
-        raise InputError(f"--n: must be an integer >= 1 and <= 100000, got {n!r}")
-    if not terrains or any(t not in TERRAINS for t in terrains):
-        raise InputError(f"--terrain: must be among {', '.join(TERRAINS)}, got {','.join(terrains)!r}")
-    if not layouts or any(x not in LAYOUTS for x in layouts):
-        raise InputError(f"--layout: must be among {', '.join(LAYOUTS)}, got {','.join(layouts)!r}")
-    if family not in CLOSED_LOOP_FAMILIES:
-        raise InputError(f"--family: must be one of {', '.join(CLOSED_LOOP_FAMILIES)}, got {family!r}")
-
-
 def run(
     out_dir: Path,
     n_encounters: int = DEFAULT_CLOSED_LOOP_ENCOUNTERS,
@@ -345,11 +333,18 @@ def run(
     the same settings. Seeds from :data:`~skyradar.experiments.encounters.EVALUATION_SEEDS_FROM` are
     the evaluation split.
     """
-    from skyradar.experiments.encounters import EVALUATION_SEEDS_FROM, partial_store, run_encounters
+    from skyradar.experiments.encounters import (
+        EVALUATION_SEEDS_FROM,
+        check_encounter_set,
+        partial_store,
+        run_encounters,
+    )
 
     terrains = tuple(terrains)
     layouts = tuple(x for x in LAYOUTS if x in layouts) or tuple(layouts)
-    _check(n_encounters, terrains, layouts, family)
+    check_encounter_set(n_encounters, terrains, layouts)
+    if family not in CLOSED_LOOP_FAMILIES:
+        raise InputError(f"--family: must be one of {', '.join(CLOSED_LOOP_FAMILIES)}, got {family!r}")
     pilot = pilot or PilotConfig()
     t0 = time.perf_counter()
     out_dir = Path(out_dir)

@@ -47,6 +47,7 @@ __all__ = [
     "FAMILIES",
     "EVALUATION_SEEDS_FROM",
     "partial_store",
+    "check_encounter_set",
 ]
 
 MAX_ENCOUNTERS = 100_000  # 200 times the thesis-sized set; more is a typo, not a plan
@@ -170,7 +171,8 @@ def partial_store(out_dir: Path, key: dict, name: str = _PARTIAL) -> tuple[dict,
     return done, save
 
 
-def _check(n_encounters: int, terrains: tuple[str, ...], layouts: tuple[str, ...]) -> None:
+def check_encounter_set(n_encounters: int, terrains: tuple[str, ...], layouts: tuple[str, ...]) -> None:
+    """InputError naming the option unless the set's size, terrains and layouts are ones it can fly."""
     if not 1 <= n_encounters <= MAX_ENCOUNTERS:  # 10**20 was a numpy "Maximum allowed size" traceback
         raise InputError(f"--n: must be an integer >= 1 and <= {MAX_ENCOUNTERS}, got {n_encounters!r}")
     if not terrains or any(t not in TERRAINS for t in terrains):
@@ -224,7 +226,7 @@ def run(
     alerting settings (:data:`skyradar.daa.alert_config.ALERT_CONFIGS`: ``radar``, ``do365b``).
     """
     terrains, layouts = tuple(terrains), tuple(x for x in LAYOUTS if x in layouts)
-    _check(n_encounters, terrains, tuple(layouts) or ("",))
+    check_encounter_set(n_encounters, terrains, tuple(layouts) or ("",))
     check_rx_layout(rx_layout, "--rx-layout:")
     t0 = time.perf_counter()
     cfg = ALERT_CONFIGS.get(alert_settings)

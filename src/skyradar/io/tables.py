@@ -19,7 +19,35 @@ import pandas as pd
 from skyradar.errors import InputError
 from skyradar.io.atomic import write_text_atomic, write_with
 
-__all__ = ["finite_column", "check_within", "write_table", "read_table", "write_json_atomic", "jsonable"]
+__all__ = [
+    "finite_column",
+    "check_within",
+    "write_table",
+    "read_table",
+    "write_json_atomic",
+    "jsonable",
+    "appended",
+]
+
+
+def appended(table: pd.DataFrame | None, rows: pd.DataFrame) -> pd.DataFrame:
+    """``table`` with ``rows`` after it, numbered from 0; a missing or empty side gives the other.
+
+    A stream that keeps its rows so far appends each frame's with one concatenation of two, so a
+    frame costs the same at any point of a run (concatenating every frame's table anew grows with
+    the run), and an empty frame, which may lack the table's columns, adds nothing.
+
+    Examples
+    --------
+    >>> t = appended(None, pd.DataFrame({"x": [1.0]}))
+    >>> appended(appended(t, pd.DataFrame()), pd.DataFrame({"x": [2.0]}))["x"].tolist()
+    [1.0, 2.0]
+    """
+    if table is None or len(table) == 0:
+        return rows.reset_index(drop=True)
+    if len(rows) == 0:
+        return table.reset_index(drop=True)
+    return pd.concat([table, rows], ignore_index=True)
 
 
 def write_table(df: pd.DataFrame, path: str | Path, metadata: dict[str, Any] | None = None) -> Path:

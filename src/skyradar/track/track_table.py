@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 
 from skyradar.config import RadarConfig
+from skyradar.io.tables import appended
 from skyradar.track.doa_feed import OWNSHIP_COLUMNS, Measure3D
 from skyradar.track.frame_grid import frame_grid, frame_numbers
 from skyradar.track.fusion import fuse_heads, restore_detection_rows
@@ -517,29 +518,20 @@ class TrackTableStream:
         elif self._m3.active:
             self._m3.add_detections(fused)
         if ownship is not None:
-            self._own = _appended(self._own, ownship)
+            self._own = appended(self._own, ownship)
         own = self._own
         if self._m3.active and ownship is not None:
             self._m3.add_frames(np.array([time_s], float), ownship)
         z, secondary = _measurements(fused)
         k, a = len(self._chunks), self._n_fused
         self._chunks.append(_step_frame(self.tracker, self._m3, k, time_s, frame, z, secondary, a))
-        self._fused = _appended(self._fused, fused)
+        self._fused = appended(self._fused, fused)
         self._input_rows.append(self._n_input + rows)
         self._n_input, self._n_fused = self._n_input + len(det), self._n_fused + len(fused)
         args = (self.origin, self._m3, self._fused, own, self.config, self.ground_test)
         # Each frame's rows are assembled once (rows depend on their own frame only) and appended.
         new = _assemble(self._chunks[-1:], self.origin, self._m3.active)
-        self._assembled = _appended(self._assembled, new) if len(new) else self._assembled
-        assembled = self._assembled if self._assembled is not None else new
+        self._assembled = assembled = appended(self._assembled, new)
         t = _table(self._chunks, *args, at_time_s=float(time_s), walks=self._walks, assembled=assembled)
         t = t[t["time_s"].to_numpy(float) == float(time_s)].reset_index(drop=True)
         return restore_detection_rows(t, np.concatenate(self._input_rows))
-
-
-def _appended(table: pd.DataFrame | None, rows: pd.DataFrame) -> pd.DataFrame:
-    """``table`` with ``rows`` after it (one concatenation of two: a frame costs the same at any
-    point of a run, where concatenating every frame's table anew grows with the run)."""
-    if table is None:
-        return rows.reset_index(drop=True)
-    return pd.concat([table, rows], ignore_index=True)

@@ -34,6 +34,7 @@ import numpy as np
 import pandas as pd
 
 from skyradar.code_version import code_version, provenance
+from skyradar.geo import geodetic_to_ned
 from skyradar.io.atomic import savefig_atomic, write_csv_atomic, write_text_atomic
 from skyradar.io.tables import write_json_atomic
 
@@ -165,15 +166,10 @@ def separation_table(states: pd.DataFrame, rpz_m: float, hpz_m: float, run_name:
         )
         if joined.empty:
             continue
-        lat0 = np.radians(joined["lat_deg"].to_numpy())
-        dn = np.radians(joined["lat_deg_b"].to_numpy() - joined["lat_deg"].to_numpy()) * 6371000.0
-        de = (
-            np.radians(joined["lon_deg_b"].to_numpy() - joined["lon_deg"].to_numpy())
-            * 6371000.0
-            * np.cos(lat0)
-        )
-        horizontal = np.hypot(dn, de)
-        vertical = np.abs(joined["alt_m_b"].to_numpy() - joined["alt_m"].to_numpy())
+        lat_a, lon_a, alt_a = (joined[c].to_numpy(float) for c in columns)
+        lat_b, lon_b, alt_b = (joined[f"{c}_b"].to_numpy(float) for c in columns)
+        rel = geodetic_to_ned(lat_b, lon_b, alt_b, lat_a, lon_a, alt_a, flat_earth=True)  # b seen from a
+        horizontal, vertical = np.hypot(rel[:, 0], rel[:, 1]), np.abs(rel[:, 2])
         k = int(np.argmin(horizontal))
         los = (horizontal < rpz_m) & (vertical < hpz_m)
         rows.append(
@@ -311,8 +307,7 @@ def plot(runs: dict[str, Any], detections: pd.DataFrame, path: Path) -> Path:
         colour = colours[k % len(colours)]
         for states, style, label in ((truth_states, "--", None), (radar_states, "-", acid)):
             s = states[states.acid == acid]
-            north = np.radians(s.lat_deg - lat0) * 6371.0
-            east = np.radians(s.lon_deg - lon0) * 6371.0 * np.cos(np.radians(lat0))
+            north, east = _north_east_km(s, lat0, lon0)
             width = 2.2 if acid in equipped else 1.2
             ax_map.plot(east, north, style, color=colour, lw=width, label=label)
         ax_map.plot(*_start(g, lat0, lon0), "o", color=colour, ms=4)
@@ -345,8 +340,14 @@ def plot(runs: dict[str, Any], detections: pd.DataFrame, path: Path) -> Path:
     return path
 
 
+def _north_east_km(states: pd.DataFrame, lat0: float, lon0: float) -> tuple[np.ndarray, np.ndarray]:
+    """North and east of the states' positions from (lat0, lon0), km (flat earth: a few km apart)."""
+    ned = geodetic_to_ned(
+        states["lat_deg"].to_numpy(), states["lon_deg"].to_numpy(), 0.0, lat0, lon0, flat_earth=True
+    )
+    return ned[..., 0] / 1000.0, ned[..., 1] / 1000.0
+
+
 def _start(group: pd.DataFrame, lat0: float, lon0: float) -> tuple[float, float]:
-    first = group.sort_values("time_s").iloc[0]
-    north = np.radians(first.lat_deg - lat0) * 6371.0
-    east = np.radians(first.lon_deg - lon0) * 6371.0 * np.cos(np.radians(lat0))
-    return float(east), float(north)
+    north, east = _north_east_km(group.sort_values("time_s").iloc[:1], lat0, lon0)
+    return float(east[0]), float(north[0])

@@ -549,10 +549,16 @@ class TrackHoldWalk:
         self.done: list[str] = []  # why of each detection judged for good
         self.segment = 0  # first detection of the current history (after the last gap)
         self.walk = _HistoryWalk(test)
+        self.newest: np.ndarray | None = None  # the last call's answer, while no detection comes
 
     def why(self, det: np.ndarray, ownship, surface_down, width: float, coupling: float) -> np.ndarray:
         """Why each detection of ``det`` (rows: time, range, radial velocity, then
-        :data:`DOA_COLUMNS`; every detection of the track so far) holds the track."""
+        :data:`DOA_COLUMNS`; every detection of the track so far) holds the track.
+
+        A call with no new detection gives the last call's answer: every judgement depends on the
+        detections and on the walk over those before the newest, and neither has changed."""
+        if self.newest is not None and len(det) == self.history.t.size:
+            return self.newest
         self._extend(det, ownship, surface_down)
         n = self.history.t.size
         ground = surface_down if ownship is not None else None
@@ -564,7 +570,8 @@ class TrackHoldWalk:
             return np.array([], dtype=object)
         self._start_history_at(n - 1)
         newest = self._judge(n - 1, True, copy.copy(self.walk), ground, width, coupling)
-        return np.array([*self.done, newest], dtype=object)
+        self.newest = np.array([*self.done, newest], dtype=object)
+        return self.newest
 
     def _start_history_at(self, j: int) -> None:
         """A new history (and walk) from detection ``j`` when a gap precedes it."""
@@ -641,12 +648,15 @@ def hold_ground_tracks(
     if surface_down is None and ownship is not None and np.isfinite(median_ground_down_m(ownship)):
         surface_down = flat_surface(median_ground_down_m(ownship))
     names = ["time_s", "range_m", "radial_velocity_mps", *DOA_COLUMNS[:-1]]
-    nan = np.full(len(detections), np.nan)
-    det = np.column_stack(
-        [detections[c].to_numpy(float) if c in detections else nan for c in names]
-        + [elevation_measured_flags(detections).astype(float)]
-    )
     rows = tracks["detection_row"].to_numpy()
+    # Only the detections the tracks hold are read (a stream's table holds every frame's).
+    used = np.unique(rows[rows >= 0])
+    held_detections = detections.iloc[used]
+    nan = np.full(used.size, np.nan)
+    det = np.column_stack(
+        [held_detections[c].to_numpy(float) if c in held_detections else nan for c in names]
+        + [elevation_measured_flags(held_detections).astype(float)]
+    )
     why = np.full(len(tracks), "young", dtype=object)
     kept: dict[int, tuple[np.ndarray, TrackHoldWalk]] = {}
     for track_id, idx in tracks.groupby("track_id", sort=False).indices.items():
@@ -654,12 +664,14 @@ def hold_ground_tracks(
         if has.size == 0:
             continue
         if walks is None:
-            h = _track_held(det[rows[has]], ownship, surface_down, width_mps, coupling_s, test)
+            h = _track_held(
+                det[np.searchsorted(used, rows[has])], ownship, surface_down, width_mps, coupling_s, test
+            )
         else:
             entry = walks.get(int(track_id))
             seen = rows[has][: 0 if entry is None else entry[0].size]
             walk = TrackHoldWalk(test) if entry is None or not np.array_equal(seen, entry[0]) else entry[1]
-            h = walk.why(det[rows[has]], ownship, surface_down, width_mps, coupling_s)
+            h = walk.why(det[np.searchsorted(used, rows[has])], ownship, surface_down, width_mps, coupling_s)
             kept[int(track_id)] = (rows[has], walk)
         # Each row (coasting ones too) takes the decision of the newest detection at or before it.
         pos = np.searchsorted(has, idx, side="right") - 1

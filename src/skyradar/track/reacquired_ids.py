@@ -27,6 +27,7 @@ def relabel_reacquired(
     pairs: np.ndarray,
     times_s: np.ndarray,
     is_object: Callable[[pd.DataFrame], bool] | None = None,
+    verdicts: dict[tuple[int, int, float], bool] | None = None,
 ) -> pd.DataFrame:
     """A tracks table with each kept reacquisition's track under the lost track's id.
 
@@ -44,6 +45,10 @@ def relabel_reacquired(
         Takes the rows of the lost track alone (from its start, or its own reacquisition, up to
         this one) and says whether it was a real object; a reacquisition of a track that was not
         is undone (the new track keeps its own id). Default: every reacquisition is kept.
+    verdicts : dict, optional
+        ``is_object``'s verdict on each reacquisition, by ``(new id, lost id, time)``, read where
+        present and filled in place: a caller that relabels a growing table (a stream's) judges
+        each reacquisition once, on the lost track's rows before it, which no later row changes.
 
     Returns
     -------
@@ -72,10 +77,19 @@ def relabel_reacquired(
         lost_rows = (segment == before) & (t < time)  # its tentative rows too, under its own id
         segment[(reported == lost) & (t >= time)] = new
         holder[lost] = new
-        if is_object is None or is_object(tracks[lost_rows]):
+        key = (new, lost, time)
+        if verdicts is not None and key in verdicts:
+            kept_id = verdicts[key]
+        else:
+            kept_id = is_object is None or is_object(tracks[lost_rows])
+            if verdicts is not None:
+                verdicts[key] = kept_id
+        if kept_id:
             final[new] = final.get(before, before)
-    ids = np.array([final.get(s, s) for s in segment.tolist()], np.int64)
-    out = tracks.assign(track_id=ids)
-    by_detection = out.assign(_nodet=out["detection_row"].to_numpy() < 0).sort_values("_nodet", kind="stable")
-    kept = by_detection.drop_duplicates(["time_s", "track_id"]).index
-    return out.loc[np.sort(kept)].reset_index(drop=True)
+    tracked, where = np.unique(segment, return_inverse=True)
+    ids = np.array([final.get(s, s) for s in tracked.tolist()], np.int64)[where.reshape(-1)]
+    # Of two rows of one id at one time, the one with a detection stays (else the first).
+    by_detection = np.argsort(tracks["detection_row"].to_numpy() < 0, kind="stable")
+    keys = pd.DataFrame({"time_s": t[by_detection], "track_id": ids[by_detection]})
+    kept = np.sort(by_detection[~keys.duplicated().to_numpy()])
+    return tracks.iloc[kept].assign(track_id=ids[kept]).reset_index(drop=True)

@@ -209,6 +209,7 @@ def _table(
     at_time_s: float | None = None,
     walks: dict | None = None,
     assembled: pd.DataFrame | None = None,
+    verdicts: dict | None = None,
 ) -> pd.DataFrame:
     """The tracks table: ids through reacquisition, ``altitude_measured`` (on the elevations the
     3-D tracker trusted, :mod:`.elevation_trust`), then the ground hold.
@@ -216,10 +217,12 @@ def _table(
     With ``at_time_s`` only the tracks with a row at that time are judged after the ids (each
     track's rows are judged on its own, so theirs are those of the whole table); ``walks`` keeps
     the ground hold's judgements between calls (:func:`~skyradar.track.ground_tracks.hold_ground_tracks`);
-    ``assembled`` is :func:`_assemble` of ``chunks`` when the caller keeps it."""
+    ``assembled`` is :func:`_assemble` of ``chunks`` when the caller keeps it; ``verdicts`` keeps
+    the ground test's verdict on each reacquisition between calls
+    (:func:`~skyradar.track.reacquired_ids.relabel_reacquired`)."""
     if assembled is None:
         assembled = _assemble(chunks, origin, m3.active)
-    t = _reacquired_ids(assembled, chunks, detections, ownship, config, ground_test)
+    t = _reacquired_ids(assembled, chunks, detections, ownship, config, ground_test, verdicts)
     if at_time_s is not None:
         ids = t["track_id"].to_numpy()
         t = t[np.isin(ids, ids[t["time_s"].to_numpy(float) == at_time_s])].reset_index(drop=True)
@@ -413,10 +416,11 @@ def _assemble(
 
 
 def _reacquired_ids(
-    df: pd.DataFrame, chunks, detections, ownship, config: RadarConfig, ground_test
+    df: pd.DataFrame, chunks, detections, ownship, config: RadarConfig, ground_test, verdicts=None
 ) -> pd.DataFrame:
     """Reacquisitions of lost tracks the ground test finds objects (:mod:`.reacquired_ids`), then
-    only tracks confirmed at some point: the tentative rows of the rest were clutter."""
+    only tracks confirmed at some point: the tentative rows of the rest were clutter. ``verdicts``
+    keeps the ground test's verdict on each reacquisition between calls on a growing table."""
     if len(df) == 0:
         return df
     pairs = np.concatenate([c["reacquired"] for c in chunks]).reshape(-1, 2)
@@ -425,7 +429,7 @@ def _reacquired_ids(
     def is_object(rows: pd.DataFrame) -> bool:
         return len(_held(rows, detections, ownship, config, ground_test)) > 0
 
-    df = relabel_reacquired(df, pairs, times, is_object)
+    df = relabel_reacquired(df, pairs, times, is_object, verdicts)
     real = np.unique(df["track_id"].to_numpy()[df["confirmed"].to_numpy()])
     return df[np.isin(df["track_id"].to_numpy(), real)].reset_index(drop=True)
 
@@ -491,6 +495,7 @@ class TrackTableStream:
         self._own: pd.DataFrame | None = None  # the own-ship rows so far
         self._walks: dict = {}  # the ground hold's judgements of each track, kept between frames
         self._assembled: pd.DataFrame | None = None  # the tracker's rows of every frame so far
+        self._verdicts: dict = {}  # the ground test's verdict on each reacquisition, judged once
 
     def set_surface(self, surface_down: Callable | None) -> None:
         """The terrain (NE -> down, m) of the ground test and the 3-D feed from this frame on."""
@@ -532,6 +537,13 @@ class TrackTableStream:
         # Each frame's rows are assembled once (rows depend on their own frame only) and appended.
         new = _assemble(self._chunks[-1:], self.origin, self._m3.active)
         self._assembled = assembled = appended(self._assembled, new)
-        t = _table(self._chunks, *args, at_time_s=float(time_s), walks=self._walks, assembled=assembled)
+        t = _table(
+            self._chunks,
+            *args,
+            at_time_s=float(time_s),
+            walks=self._walks,
+            assembled=assembled,
+            verdicts=self._verdicts,
+        )
         t = t[t["time_s"].to_numpy(float) == float(time_s)].reset_index(drop=True)
         return restore_detection_rows(t, np.concatenate(self._input_rows))

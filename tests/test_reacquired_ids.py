@@ -76,3 +76,23 @@ def test_a_chain_of_reacquisitions_joins_only_behind_objects():
 
     out = relabel_reacquired(df, pairs, times, is_object)
     assert out.track_id.tolist() == [1, 1, 2, 2, 2, 2, 2, 2, 4, 4]
+
+
+def test_known_verdicts_are_read_not_judged_again():
+    # A stream relabels its growing table every frame: each reacquisition is judged once, on the
+    # lost track's rows before it, which later rows do not change.
+    df = pd.DataFrame(
+        {"time_s": np.arange(6.0), "track_id": [1, 1, 2, 1, 1, 1], "detection_row": np.arange(6)}
+    )
+    pairs, times = np.array([[2, 1]]), np.array([3.0])
+    calls: list[list[int]] = []
+
+    def is_object(rows: pd.DataFrame) -> bool:
+        calls.append(rows.detection_row.tolist())
+        return True
+
+    verdicts: dict = {}
+    first = relabel_reacquired(df.iloc[:4], pairs, times, is_object, verdicts)
+    again = relabel_reacquired(df, pairs, times, is_object, verdicts)
+    assert calls == [[0, 1]] and verdicts == {(2, 1, 3.0): True}
+    assert again.iloc[:4].equals(first) and again.track_id.tolist() == [1] * 6

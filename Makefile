@@ -7,7 +7,7 @@ STAMP_RUN := $(VENV)/.installed-run
 STAMP_DEV := $(VENV)/.installed-dev
 OUT ?= out
 
-.PHONY: demo test test-slow test-browser browser-deps lint format bench docs clean
+.PHONY: demo test test-slow test-browser browser-deps lint format bench docs compare-experiments clean
 
 $(BIN)/python:
 	@command -v $(PYTHON) >/dev/null 2>&1 || { echo "error: $(PYTHON) not found; set PYTHON=/path/to/python3.11" >&2; exit 1; }
@@ -60,12 +60,12 @@ test-browser: $(STAMP_DEV) browser-deps
 	SKYRADAR_SCREENSHOT_DIR=$(OUT)/browser $(BIN)/python -m pytest -q -m browser tests/browser
 
 lint: $(STAMP_DEV)
-	$(BIN)/ruff check src tests examples
-	$(BIN)/ruff format --check src tests examples
+	$(BIN)/ruff check src tests examples scripts
+	$(BIN)/ruff format --check src tests examples scripts
 
 format: $(STAMP_DEV)
-	$(BIN)/ruff format src tests examples
-	$(BIN)/ruff check --fix src tests examples
+	$(BIN)/ruff format src tests examples scripts
+	$(BIN)/ruff check --fix src tests examples scripts
 
 # The documentation site, offline, warnings as errors: open $(OUT)/docs/index.html. The results page,
 # the CLI reference and the API reference are generated from docs/results/ and the package.
@@ -76,6 +76,12 @@ docs: $(STAMP_DEV)
 # its JSON as the last line.
 bench: $(STAMP_RUN)
 	@for name in sim chain flight process track state; do $(BIN)/skyradar bench $$name --json || exit 1; done
+
+# Every experiment at its defaults on BASE and on HEAD (default the checkout's HEAD), each version in its
+# own worktree under $(OUT)/compare; prints the values that differ, timings left out. BASE is required.
+compare-experiments: $(STAMP_RUN)
+	@test -n "$(BASE)" || { echo "make compare-experiments: give BASE=<commit>" >&2; exit 2; }
+	$(BIN)/python scripts/compare_experiments.py $(BASE) $(or $(HEAD),HEAD) --work $(OUT)/compare
 
 clean:
 	rm -rf $(VENV) $(OUT) build *.egg-info src/*.egg-info

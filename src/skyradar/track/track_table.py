@@ -90,6 +90,10 @@ def empty_tracks() -> pd.DataFrame:
     (0, True, 'int64')
     """
 
+    return _EMPTY_TRACKS.copy()
+
+
+def _empty_tracks_template() -> pd.DataFrame:
     # Integer row indices stay integer so that callers can index with them even when empty.
     def dtype(column: str) -> type:
         flags = ("confirmed", "coasted", "altitude_measured")
@@ -98,6 +102,9 @@ def empty_tracks() -> pd.DataFrame:
         return np.int64 if column in _INTEGER_COLUMNS else bool if column in flags else float
 
     return pd.DataFrame({c: pd.Series(dtype=dtype(c)) for c in TRACK_COLUMNS}, columns=TRACK_COLUMNS)
+
+
+_EMPTY_TRACKS = _empty_tracks_template()  # built once: a stream asks for an empty table on many frames
 
 
 def make_model(name: str, config: RadarConfig, **noise: float) -> MotionModel:

@@ -56,7 +56,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from skyradar.process.top_eigen import eigen_scratch, top_eigenpairs, top_two_eigenpairs
+from skyradar.process.top_eigen import eigen_scratch, top_eigenpairs, top_two_steps
 
 __all__ = ["adaptive_nulls", "ring_whitening", "ADAPTIVE_WINDOW", "ADAPTIVE_GATE", "EIGEN_EDGE", "RING_CLIP"]
 
@@ -233,6 +233,7 @@ def _adapt(
     lam = np.empty(max_nulls)
     z = np.empty(n_k, np.complex128)
     scratch = eigen_scratch(n_k, max_nulls)
+    w, vu, wu = scratch[0], scratch[1], scratch[2]
     for c in range(cand.size):
         r, d = cand[c] // n_d, cand[c] % n_d
         if direct:
@@ -244,7 +245,7 @@ def _adapt(
                 a[i, j] *= inv_floor  # in floors
         # a in floors: a null leaves 1e-4 of the noise of its direction
         if max_nulls == 2:
-            top_two_eigenpairs(a, v, lam, edge, 1e-4, 50, scratch)
+            top_two_steps(a, v, lam, edge, 1e-4, 50, w, vu, wu)
         else:
             top_eigenpairs(a, v, lam, edge, 1e-4, 50, scratch)
         m = 0

@@ -114,15 +114,15 @@ def test_rolling_summed_area_table_gives_the_whole_table_ring_covariances_exactl
             _sat_row(cube, inv_gain, hd, built, rolling[built % rows], rolling[(built + 1) % rows], row, z)
             built += 1
         for d in range(24):
-            assert _ring_matrix(rolling, r, d, ADAPTIVE_WINDOW, 30, a, rows) == _ring_matrix(
-                whole, r, d, ADAPTIVE_WINDOW, 30, b, 31
+            assert _ring_matrix(rolling, r, d, ADAPTIVE_WINDOW, 30, a, rows, 0.5) == _ring_matrix(
+                whole, r, d, ADAPTIVE_WINDOW, 30, b, 31, 0.5
             )
             np.testing.assert_array_equal(a, b)
     # and the whole table's covariance is the ring's sample covariance
     ring = [(rr, dd % 24) for rr in range(0, 6) for dd in range(-5, 6) if not (rr <= 2 and abs(dd) <= 2)]
     x = cube[tuple(np.array(ring).T)].astype(complex) * inv_gain.astype(complex)
-    _ring_matrix(whole, 0, 0, ADAPTIVE_WINDOW, 30, b, 31)
-    np.testing.assert_allclose(b, x.T @ x.conj() / len(ring), rtol=1e-9, atol=1e-9)
+    _ring_matrix(whole, 0, 0, ADAPTIVE_WINDOW, 30, b, 31, 0.5)
+    np.testing.assert_allclose(b, 0.5 * x.T @ x.conj() / len(ring), rtol=1e-9, atol=1e-9)
 
 
 @pytest.mark.parametrize("solver", [top_eigenpairs, top_two_eigenpairs])

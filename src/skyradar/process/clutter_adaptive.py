@@ -77,7 +77,11 @@ def _sat_row(cube, inv_gain, hd, r, prev, out, row, z):  # pragma: no cover - co
     for q in range(n_q):
         row[0, q] = 0.0
     for c in range(w):
-        d = (c - hd) % n_d
+        d = c - hd  # wrapped into 0..n_d-1 by steps of n_d (one at most when hd < n_d): no integer division
+        while d < 0:
+            d += n_d
+        while d >= n_d:
+            d -= n_d
         for k in range(n_k):
             z[k] = complex(cube[r, d, k]) * complex(inv_gain[k])
         p = n_k
@@ -193,28 +197,29 @@ def _slot_box(sat, lo, hi, d, hd, pad, q):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _ring_matrix(sat, r, d, window, n_r, a, rows):  # pragma: no cover - compiled
-    # The ring's sample covariance of cell (r, d) into a (n_k, n_k) from the packed sums; its trace.
-    # Table row t is held in slot t % rows (rows = n_r + 1: the whole table; fewer: a rolling one
-    # that holds at least the 2 hr + 2 rows around r).
+def _ring_matrix(sat, r, d, window, n_r, a, rows, scale):  # pragma: no cover - compiled
+    # The ring's sample covariance of cell (r, d) times `scale` into a (n_k, n_k) from the packed
+    # sums; its trace. Table row t is held in slot t % rows (rows = n_r + 1: the whole table; fewer:
+    # a rolling one that holds at least the 2 hr + 2 rows around r). The sums are scaled by one real
+    # factor, scale / count (numba divides a complex number by a real one as complex division).
     hr, hd, gr, gd = window
     n_k = a.shape[0]
     lo, hi = max(r - hr, 0), min(r + hr + 1, n_r)
     g_lo, g_hi = max(r - gr, 0), min(r + gr + 1, n_r)
-    count = (hi - lo) * (2 * hd + 1) - (g_hi - g_lo) * (2 * gd + 1)
+    factor = scale / ((hi - lo) * (2 * hd + 1) - (g_hi - g_lo) * (2 * gd + 1))
     lo, hi, g_lo, g_hi = lo % rows, hi % rows, g_lo % rows, g_hi % rows
     trace = 0.0
     for i in range(n_k):
         box = _slot_box(sat, lo, hi, d, hd, hd, i) - _slot_box(sat, g_lo, g_hi, d, gd, hd, i)
-        a[i, i] = box / count
-        trace += a[i, i].real
+        a[i, i] = box * factor
+        trace += box * factor
     p = n_k
     for i in range(n_k):
         for j in range(i + 1, n_k):
             re = _slot_box(sat, lo, hi, d, hd, hd, p) - _slot_box(sat, g_lo, g_hi, d, gd, hd, p)
             im = _slot_box(sat, lo, hi, d, hd, hd, p + 1) - _slot_box(sat, g_lo, g_hi, d, gd, hd, p + 1)
-            a[i, j] = complex(re, im) / count
-            a[j, i] = np.conj(a[i, j])
+            a[i, j] = complex(re * factor, im * factor)
+            a[j, i] = complex(re * factor, -im * factor)
             p += 2
     return trace
 
@@ -262,14 +267,14 @@ def _adapt(
         r, d = cand[c] // n_d, cand[c] % n_d
         if direct:
             trace = _ring_direct(cube, inv_gain, r, d, window, a) * inv_floor
+            for i in range(n_k):
+                for j in range(n_k):
+                    a[i, j] *= inv_floor  # in floors
         else:
             while built < min(r + hr + 1, n_r):
                 _sat_row(cube, inv_gain, hd, built, sat[built % rows], sat[(built + 1) % rows], row, z_row)
                 built += 1
-            trace = _ring_matrix(sat, r, d, window, n_r, a, rows) * inv_floor
-        for i in range(n_k):
-            for j in range(n_k):
-                a[i, j] *= inv_floor  # in floors
+            trace = _ring_matrix(sat, r, d, window, n_r, a, rows, inv_floor)  # in floors
         # a in floors: a null leaves 1e-4 of the noise of its direction
         if max_nulls == 2:
             top_two_steps(a, v, lam, edge, 1e-4, 50, w, vu, wu)

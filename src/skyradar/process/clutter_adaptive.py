@@ -99,7 +99,8 @@ def _sat_row(cube, inv_gain, hd, r, prev, out, row, z):  # pragma: no cover - co
 
 @njit(cache=True)
 def _packed_sat(cube, inv_gain, hd):  # pragma: no cover - compiled
-    # The whole summed-area table (n_r + 1, n_d + 2 hd + 1, n_k^2) of _sat_row's packed covariances.
+    # The whole summed-area table (n_r + 1, n_d + 2 hd + 1, n_k^2) of _sat_row's packed covariances:
+    # the reference the rolling table of _adapt is tested against.
     n_r, n_d, n_k = cube.shape
     sat = np.zeros((n_r + 1, n_d + 2 * hd + 1, n_k * n_k))
     row, z = np.zeros((n_d + 2 * hd + 1, n_k * n_k)), np.empty(n_k, np.complex128)
@@ -250,6 +251,7 @@ def _adapt(
     # come in range order, so only the 2 hr + 2 table rows around the current one are held (in the
     # second-level cache, where the whole table, 11 MB for a prototype frame, is not), each row
     # built once and from the same sums as the whole table.
+    # (An empty table, not None, marks the direct sums: an optional array costs a check per access.)
     direct = cand.size * (2 * hr + 1) * (2 * hd + 1) <= n_r * n_d
     rows = 2 * hr + 2
     n_q = n_k * n_k

@@ -228,9 +228,30 @@ def _first_step_two(a, v, w, wu, trace):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def top_two_steps(a, v, lam, relevant, tol, max_iter, w, vu, wu):  # pragma: no cover - compiled
-    """:func:`top_two_eigenpairs` with its work arrays ``w``, ``vu``, ``wu`` (each (n, 2), complex)
-    passed one by one: the per-cell form of the adaptive step's loop (unpacking a tuple of arrays
-    costs reference counting at every call)."""
+    """:func:`top_two_eigenpairs` with its work arrays passed one by one.
+
+    The per-cell form of the adaptive step's loop: unpacking a tuple of arrays costs reference
+    counting at every call.
+
+    Parameters
+    ----------
+    a : ndarray (n, n), complex128
+        Hermitian matrix (a covariance in noise floors for the adaptive step).
+    v : ndarray (n, 2), complex128
+        Start (orthonormal columns); receives the eigenvectors, strongest first.
+    lam : ndarray (2,)
+        Receives the eigenvalues, decreasing, in the units of ``a``.
+    relevant, tol, max_iter
+        As :func:`top_eigenpairs`.
+    w, vu, wu : ndarray (n, 2), complex128
+        Work arrays.
+
+    Returns
+    -------
+    int
+        The steps taken, the untested first one included; ``max_iter + 1`` when the full Jacobi
+        sweeps gave the pairs.
+    """
     n = v.shape[0]
     trace, frobenius = 0.0, 0.0
     for i in range(n):

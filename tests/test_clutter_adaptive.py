@@ -7,7 +7,13 @@ import pytest
 from scipy import stats
 
 from skyradar.config import RadarConfig
-from skyradar.process.clutter_adaptive import ADAPTIVE_WINDOW, adaptive_nulls
+from skyradar.process.clutter_adaptive import (
+    ADAPTIVE_WINDOW,
+    _packed_sat,
+    _ring_matrix,
+    _sat_row,
+    adaptive_nulls,
+)
 from skyradar.process.clutter_frames import detect_suppressed, frame_subspace
 from skyradar.process.clutter_suppress import suppress_clutter
 from skyradar.process.detect import detect
@@ -88,6 +94,35 @@ def test_adaptive_nulls_match_numpy_eigh_of_the_ring_covariance():
     # cell whose two strongest eigenvalues nearly tie converges slower): far below the noise
     diff = np.abs(power - ref_power)
     assert np.quantile(diff, 0.99) < 1e-3 and diff.max() < 0.1
+
+
+def test_rolling_summed_area_table_gives_the_whole_table_ring_covariances_exactly():
+    # The adaptive step holds 2 hr + 2 rows of the table, built as the candidates' range grows; each
+    # ring covariance from it equals the whole table's bit for bit, at the range edges too.
+    rng = np.random.default_rng(9)
+    cube = (_gauss(rng, 30, 24, 4) * 10 ** rng.uniform(0, 2, (30, 24, 1))).astype(np.complex64)
+    inv_gain = np.exp(1j * rng.uniform(0, 6.3, 4)).astype(np.complex64)
+    hr, hd = ADAPTIVE_WINDOW[:2]
+    whole = _packed_sat(cube, inv_gain, hd)
+    rows = 2 * hr + 2
+    rolling = np.zeros((rows, *whole.shape[1:]))
+    row, z = np.zeros(whole.shape[1:]), np.empty(4, complex)
+    a, b = np.empty((4, 4), complex), np.empty((4, 4), complex)
+    built = 0
+    for r in range(30):
+        while built < min(r + hr + 1, 30):
+            _sat_row(cube, inv_gain, hd, built, rolling[built % rows], rolling[(built + 1) % rows], row, z)
+            built += 1
+        for d in range(24):
+            assert _ring_matrix(rolling, r, d, ADAPTIVE_WINDOW, 30, a, rows, 0.5) == _ring_matrix(
+                whole, r, d, ADAPTIVE_WINDOW, 30, b, 31, 0.5
+            )
+            np.testing.assert_array_equal(a, b)
+    # and the whole table's covariance is the ring's sample covariance
+    ring = [(rr, dd % 24) for rr in range(0, 6) for dd in range(-5, 6) if not (rr <= 2 and abs(dd) <= 2)]
+    x = cube[tuple(np.array(ring).T)].astype(complex) * inv_gain.astype(complex)
+    _ring_matrix(whole, 0, 0, ADAPTIVE_WINDOW, 30, b, 31, 0.5)
+    np.testing.assert_allclose(b, 0.5 * x.T @ x.conj() / len(ring), rtol=1e-9, atol=1e-9)
 
 
 @pytest.mark.parametrize("solver", [top_eigenpairs, top_two_eigenpairs])

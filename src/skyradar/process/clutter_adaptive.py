@@ -56,7 +56,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from skyradar.process.top_eigen import eigen_scratch, top_eigenpairs, top_two_eigenpairs
+from skyradar.process.top_eigen import eigen_scratch, top_eigenpairs, top_two_steps
 
 __all__ = ["adaptive_nulls", "ring_whitening", "ADAPTIVE_WINDOW", "ADAPTIVE_GATE", "EIGEN_EDGE", "RING_CLIP"]
 
@@ -67,34 +67,45 @@ RING_CLIP = 8.0  # ring pixels count at most this many floors in the test: a tar
 
 
 @njit(cache=True)
-def _packed_sat(cube, inv_gain, hd):  # pragma: no cover - compiled
-    # Summed-area table (n_r + 1, n_d + 2 hd + 1, n_k^2) of each cell's packed covariance z z^H
-    # (z = cube * inv_gain): n_k real diagonal entries, then the upper triangle's (re, im) pairs
-    # row by row (the layout of skyradar.process.clutter), Doppler padded by wrapping.
-    n_r, n_d, n_k = cube.shape
+def _sat_row(cube, inv_gain, hd, r, prev, out, row, z):  # pragma: no cover - compiled
+    # Row r + 1 of the summed-area table of each cell's packed covariance z z^H (z = cube * inv_gain):
+    # n_k real diagonal entries, then the upper triangle's (re, im) pairs row by row (the layout of
+    # skyradar.process.clutter), Doppler padded by wrapping: out = prev (row r) + row r's running sums.
+    n_d, n_k = cube.shape[1], cube.shape[2]
     n_q = n_k * n_k
     w = n_d + 2 * hd
-    sat = np.zeros((n_r + 1, w + 1, n_q))
-    z = np.empty(n_k, np.complex128)
-    row = np.zeros((w + 1, n_q))
-    for r in range(n_r):
+    for q in range(n_q):
+        row[0, q] = 0.0
+    for c in range(w):
+        d = c - hd  # wrapped into 0..n_d-1 by steps of n_d (one at most when hd < n_d): no integer division
+        while d < 0:
+            d += n_d
+        while d >= n_d:
+            d -= n_d
+        for k in range(n_k):
+            z[k] = complex(cube[r, d, k]) * complex(inv_gain[k])
+        p = n_k
+        for i in range(n_k):
+            row[c + 1, i] = row[c, i] + z[i].real * z[i].real + z[i].imag * z[i].imag
+            for j in range(i + 1, n_k):
+                x = z[i] * np.conj(z[j])
+                row[c + 1, p] = row[c, p] + x.real
+                row[c + 1, p + 1] = row[c, p + 1] + x.imag
+                p += 2
+    for c in range(w + 1):
         for q in range(n_q):
-            row[0, q] = 0.0
-        for c in range(w):
-            d = (c - hd) % n_d
-            for k in range(n_k):
-                z[k] = complex(cube[r, d, k]) * complex(inv_gain[k])
-            p = n_k
-            for i in range(n_k):
-                row[c + 1, i] = row[c, i] + z[i].real * z[i].real + z[i].imag * z[i].imag
-                for j in range(i + 1, n_k):
-                    x = z[i] * np.conj(z[j])
-                    row[c + 1, p] = row[c, p] + x.real
-                    row[c + 1, p + 1] = row[c, p + 1] + x.imag
-                    p += 2
-        for c in range(w + 1):
-            for q in range(n_q):
-                sat[r + 1, c, q] = sat[r, c, q] + row[c, q]
+            out[c, q] = prev[c, q] + row[c, q]
+
+
+@njit(cache=True)
+def _packed_sat(cube, inv_gain, hd):  # pragma: no cover - compiled
+    # The whole summed-area table (n_r + 1, n_d + 2 hd + 1, n_k^2) of _sat_row's packed covariances:
+    # the reference the rolling table of _adapt is tested against.
+    n_r, n_d, n_k = cube.shape
+    sat = np.zeros((n_r + 1, n_d + 2 * hd + 1, n_k * n_k))
+    row, z = np.zeros((n_d + 2 * hd + 1, n_k * n_k)), np.empty(n_k, np.complex128)
+    for r in range(n_r):
+        _sat_row(cube, inv_gain, hd, r, sat[r], sat[r + 1], row, z)
     return sat
 
 
@@ -180,24 +191,36 @@ def _ring_direct(cube, inv_gain, r, d, window, a):  # pragma: no cover - compile
 
 
 @njit(cache=True)
-def _ring_matrix(sat, r, d, window, n_r, a):  # pragma: no cover - compiled
-    # The ring's sample covariance of cell (r, d) into a (n_k, n_k) from the packed sums; its trace.
+def _slot_box(sat, lo, hi, d, hd, pad, q):  # pragma: no cover - compiled
+    # _box with the table's rows given as slots (lo, hi) of a rolling table.
+    a, b = d + pad - hd, d + pad + hd + 1
+    return sat[hi, b, q] - sat[lo, b, q] - sat[hi, a, q] + sat[lo, a, q]
+
+
+@njit(cache=True)
+def _ring_matrix(sat, r, d, window, n_r, a, rows, scale):  # pragma: no cover - compiled
+    # The ring's sample covariance of cell (r, d) times `scale` into a (n_k, n_k) from the packed
+    # sums; its trace. Table row t is held in slot t % rows (rows = n_r + 1: the whole table; fewer:
+    # a rolling one that holds at least the 2 hr + 2 rows around r). The sums are scaled by one real
+    # factor, scale / count (numba divides a complex number by a real one as complex division).
     hr, hd, gr, gd = window
     n_k = a.shape[0]
-    rows = min(r + hr + 1, n_r) - max(r - hr, 0)
-    guard = min(r + gr + 1, n_r) - max(r - gr, 0)
-    count = rows * (2 * hd + 1) - guard * (2 * gd + 1)
+    lo, hi = max(r - hr, 0), min(r + hr + 1, n_r)
+    g_lo, g_hi = max(r - gr, 0), min(r + gr + 1, n_r)
+    factor = scale / ((hi - lo) * (2 * hd + 1) - (g_hi - g_lo) * (2 * gd + 1))
+    lo, hi, g_lo, g_hi = lo % rows, hi % rows, g_lo % rows, g_hi % rows
     trace = 0.0
     for i in range(n_k):
-        a[i, i] = (_box(sat, r, d, hr, hd, hd, n_r, i) - _box(sat, r, d, gr, gd, hd, n_r, i)) / count
-        trace += a[i, i].real
+        box = _slot_box(sat, lo, hi, d, hd, hd, i) - _slot_box(sat, g_lo, g_hi, d, gd, hd, i)
+        a[i, i] = box * factor
+        trace += box * factor
     p = n_k
     for i in range(n_k):
         for j in range(i + 1, n_k):
-            re = _box(sat, r, d, hr, hd, hd, n_r, p) - _box(sat, r, d, gr, gd, hd, n_r, p)
-            im = _box(sat, r, d, hr, hd, hd, n_r, p + 1) - _box(sat, r, d, gr, gd, hd, n_r, p + 1)
-            a[i, j] = complex(re, im) / count
-            a[j, i] = np.conj(a[i, j])
+            re = _slot_box(sat, lo, hi, d, hd, hd, p) - _slot_box(sat, g_lo, g_hi, d, gd, hd, p)
+            im = _slot_box(sat, lo, hi, d, hd, hd, p + 1) - _slot_box(sat, g_lo, g_hi, d, gd, hd, p + 1)
+            a[i, j] = complex(re * factor, im * factor)
+            a[j, i] = complex(re * factor, -im * factor)
             p += 2
     return trace
 
@@ -224,27 +247,39 @@ def _adapt(
     n_r, n_d, n_k = cube.shape
     hr, hd, gr, gd = window
     # A few cells: their rings summed directly; many: sliding sums over the whole frame (cheaper
-    # past about one ring sample per frame cell).
+    # past about one ring sample per frame cell), from a rolling summed-area table: the candidates
+    # come in range order, so only the 2 hr + 2 table rows around the current one are held (in the
+    # second-level cache, where the whole table, 11 MB for a prototype frame, is not), each row
+    # built once and from the same sums as the whole table.
     # (An empty table, not None, marks the direct sums: an optional array costs a check per access.)
     direct = cand.size * (2 * hr + 1) * (2 * hd + 1) <= n_r * n_d
-    sat = np.zeros((0, 0, 0)) if direct else _packed_sat(cube, inv_gain, hd)
+    rows = 2 * hr + 2
+    n_q = n_k * n_k
+    sat = np.zeros((0, 0, 0) if direct else (rows, n_d + 2 * hd + 1, n_q))
+    row = np.zeros((n_d + 2 * hd + 1, n_q))
+    z_row = np.empty(n_k, np.complex128)
+    built = 0  # table rows 0..built are in their slots (row 0, zeros, in slot 0)
     a = np.empty((n_k, n_k), np.complex128)
     v = np.eye(n_k, max_nulls).astype(np.complex128)
     lam = np.empty(max_nulls)
     z = np.empty(n_k, np.complex128)
     scratch = eigen_scratch(n_k, max_nulls)
+    w, vu, wu = scratch[0], scratch[1], scratch[2]
     for c in range(cand.size):
         r, d = cand[c] // n_d, cand[c] % n_d
         if direct:
             trace = _ring_direct(cube, inv_gain, r, d, window, a) * inv_floor
+            for i in range(n_k):
+                for j in range(n_k):
+                    a[i, j] *= inv_floor  # in floors
         else:
-            trace = _ring_matrix(sat, r, d, window, n_r, a) * inv_floor
-        for i in range(n_k):
-            for j in range(n_k):
-                a[i, j] *= inv_floor  # in floors
+            while built < min(r + hr + 1, n_r):
+                _sat_row(cube, inv_gain, hd, built, sat[built % rows], sat[(built + 1) % rows], row, z_row)
+                built += 1
+            trace = _ring_matrix(sat, r, d, window, n_r, a, rows, inv_floor)  # in floors
         # a in floors: a null leaves 1e-4 of the noise of its direction
         if max_nulls == 2:
-            top_two_eigenpairs(a, v, lam, edge, 1e-4, 50, scratch)
+            top_two_steps(a, v, lam, edge, 1e-4, 50, w, vu, wu)
         else:
             top_eigenpairs(a, v, lam, edge, 1e-4, 50, scratch)
         m = 0

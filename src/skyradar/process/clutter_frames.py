@@ -89,12 +89,16 @@ def frame_subspace(
 
 def _config_key(config: RadarConfig) -> str:
     """The JSON text of ``config`` (its full content), remembered for the object last asked about."""
-    if _CONFIG_KEY[0] is not config:
-        _CONFIG_KEY[:] = [config, config.to_json()]
-    return _CONFIG_KEY[1]
+    global _LAST_CONFIG
+    last = _LAST_CONFIG  # one tuple, replaced whole: threads never see a config with another's text
+    if last[0] is config:
+        return last[1]
+    text = config.to_json()
+    _LAST_CONFIG = (config, text)
+    return text
 
 
-_CONFIG_KEY: list = [None, ""]  # the config object last keyed and its JSON
+_LAST_CONFIG: tuple[RadarConfig | None, str] = (None, "")  # the config object last keyed, its JSON
 
 
 _PLANE_WAVE = 0.9  # unsuppressed coherence above which the plain DoA is kept in a projected cell

@@ -152,3 +152,22 @@ def test_navigation_noise_and_a_banked_turn_do_not_force_new_predictions(monkeyp
     own["own_vd_mps"] = np.where(np.arange(100) >= 50, -1.0, 0.0)
     calls = _predictions(own, monkeypatch)
     assert 2 <= len(calls) <= 3 and calls[-1][1][2] == -1.0
+
+
+def test_a_config_read_again_for_each_block_reuses_the_prediction(monkeypatch):
+    # A run processed in blocks reads its stored config once per block: equal content, a new object.
+    # The prediction depends on the content only, so the blocks share it: one prediction, not one
+    # per block.
+    calls = []
+    monkeypatch.setattr(clutter_frames, "clutter_subspace", lambda *a, **k: calls.append(a) or object())
+    monkeypatch.setattr(clutter_frames, "_CACHE", OrderedDict())
+    own = _turning_own(32, 0.0, 0.0)
+    for block in range(4):
+        config = RadarConfig.from_json(CFG.to_json())
+        for i in range(8 * block, 8 * block + 8):
+            clutter_frames.frame_subspace(own, i, config)
+    assert len(calls) == 1
+    # A config that differs (another calibration) gets its own prediction.
+    other = RadarConfig.from_dict(CFG.to_dict() | {"rx_calibration": [[1.0, 0.1]] * CFG.n_rx})
+    clutter_frames.frame_subspace(own, 0, other)
+    assert len(calls) == 2 and calls[-1][0] is other

@@ -72,9 +72,11 @@ def frame_subspace(
     anchor = anchors[i]
     if not np.all(np.isfinite(anchor)):
         return None
-    key = (*anchor_key(anchor), id(config))
+    # Keyed on the config's content (RadarConfig hashes and compares its JSON): a run processed in
+    # blocks reads an equal but new config per block, and a prediction depends on the content only.
+    key = (*anchor_key(anchor), _config_key(config))
     hit = _CACHE.get(key)
-    if hit is not None and hit[0] is config:  # the entry holds its config: its id is not reused
+    if hit is not None:
         _CACHE.move_to_end(key)
         return hit[1]
     ant_to_ned = rotation_matrix(0.0, float(anchor[3]), float(anchor[4])) @ config.mount.rotation
@@ -83,6 +85,20 @@ def frame_subspace(
     while len(_CACHE) > _CACHE_SIZE:
         _CACHE.popitem(last=False)
     return sub
+
+
+def _config_key(config: RadarConfig) -> str:
+    """The JSON text of ``config`` (its full content), remembered for the object last asked about."""
+    global _LAST_CONFIG
+    last = _LAST_CONFIG  # one tuple, replaced whole: threads never see a config with another's text
+    if last[0] is config:
+        return last[1]
+    text = config.to_json()
+    _LAST_CONFIG = (config, text)
+    return text
+
+
+_LAST_CONFIG: tuple[RadarConfig | None, str] = (None, "")  # the config object last keyed, its JSON
 
 
 _PLANE_WAVE = 0.9  # unsuppressed coherence above which the plain DoA is kept in a projected cell

@@ -39,8 +39,8 @@ from typing import Any
 import numpy as np
 
 from skyradar.config import RadarConfig
-from skyradar.process.ground_elevation import ground_in_elevation
-from skyradar.process.terrain_rise import terrain_rise_m
+from skyradar.process.ground_elevation import elevation_points, ground_in_elevation
+from skyradar.process.terrain_rise import rise_points, terrain_rise_m
 
 __all__ = [
     "static_radial_velocity_mps",
@@ -332,24 +332,30 @@ def flag_ground(
     points = np.stack([out["north_m"], out["east_m"], out["down_m"]], axis=1)
     antenna = points[0] - rng[0] * u_ned[0]
     v_r, u_ant = out["radial_velocity_mps"], np.asarray(out["u_ant"], float)
-    args = (antenna, ant_to_ned, height_fn, own_velocity_ned_mps, config)
-    ground = _ground_along(u_ant, rng, v_r, sd_az, sd_el, *args)
     unreliable = ~in_field_of_view(out["azimuth_rad"], out["elevation_rad"], config, 12.0)
     unreliable |= out["coherence"] < 0.5
+    # Every surface height this frame asks for, in one call of height_fn: over a DEM each call
+    # converts its points to geodetic and looks them up, a fixed cost larger than the points'.
+    el = np.asarray(out["elevation_rad"], float)[unreliable]
+    heights = _Prefetched(height_fn, _surface_queries(u_ant, rng, unreliable, el, antenna, ant_to_ned))
+    args = (antenna, ant_to_ned, heights, own_velocity_ned_mps, config)
+    ground = _ground_along(u_ant, rng, v_r, sd_az, sd_el, *args)
     # Over relief, ground beside the track can be nearer than the ground below: widen the band by
     # the terrain's rise around the radar (zero over flat ground, where the fixed margin stays).
     margin_m = np.full(rng.shape, TERRAIN_MARGIN_M)
     if unreliable.any():
-        margin_m[unreliable] += terrain_rise_m(height_fn, antenna, rng[unreliable])
+        margin_m[unreliable] += terrain_rise_m(heights, antenna, rng[unreliable])
     band = in_ground_band(rng, v_r, own_velocity_ned_mps, own_height_agl_m, config, terrain_margin_m=margin_m)
     mirrored = _mirrored_ground(u_ant, rng, v_r, sd_az, sd_el, band, own_height_agl_m, args)
     ground |= mirrored
     sel = unreliable & band
     hit = sel & mirrored
     if sel.any():
-        margin = 3.0 * np.hypot(rng[sel] * sd_el[sel], SURFACE_SD_M)
-        el = out["elevation_rad"][sel]
-        hit[sel] |= ground_in_elevation(rng[sel], el, height_fn, antenna, ant_to_ned, margin)
+        # Tested for every unreliable detection (the heights fetched above), kept where selected:
+        # each detection's test depends on its own row only.
+        margin = 3.0 * np.hypot(rng[unreliable] * sd_el[unreliable], SURFACE_SD_M)
+        tested = ground_in_elevation(rng[unreliable], el, heights, antenna, ant_to_ned, margin)
+        hit[sel] |= tested[sel[unreliable]]
     # An elevation the nulls left unobservable is a prior (elevation 0), not a measurement: such a
     # detection is ground here only by the mirror rule; its track's history decides the rest.
     measured = np.asarray(out.get("elevation_measured", np.ones(rng.size, bool)), bool)
@@ -367,9 +373,7 @@ def _mirrored_ground(u_ant, rng, v_r, sd_az, sd_el, band, own_agl_m, args) -> np
     :func:`classify_ground` vanishes, though every direction of that cone is as likely.
     """
     antenna, ant_to_ned, _, _, config = args
-    mirror = u_ant.copy()
-    mirror[:, 1:] *= np.where(np.abs(u_ant[:, 1:]) > _ENDFIRE_COSINE, -1.0, 1.0)
-    amb = np.any(mirror != u_ant, axis=1)
+    mirror, amb = _mirrors(u_ant)
     mirrored = np.zeros(rng.shape, bool)
     if not amb.any():
         return mirrored
@@ -380,6 +384,60 @@ def _mirrored_ground(u_ant, rng, v_r, sd_az, sd_el, band, own_agl_m, args) -> np
     with np.errstate(invalid="ignore"):
         altitude = amb & band & (down >= cone_cos) & (rng * cone_cos <= own_agl_m + leak)
     return mirrored | altitude
+
+
+def _mirrors(u_ant: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Directions with the end-fire direction cosines mirrored (beyond sin 45 deg), and which changed."""
+    mirror = u_ant.copy()
+    mirror[:, 1:] *= np.where(np.abs(u_ant[:, 1:]) > _ENDFIRE_COSINE, -1.0, 1.0)
+    return mirror, np.any(mirror != u_ant, axis=1)
+
+
+def _along_points(
+    u_ant: np.ndarray, rng: np.ndarray, antenna: np.ndarray, ant_to_ned: np.ndarray
+) -> np.ndarray:
+    """NED points (n, 3) at ``rng`` along antenna-frame directions ``u_ant`` from the antenna."""
+    return antenna + rng[:, None] * (u_ant @ np.asarray(ant_to_ned, float).T)
+
+
+def _surface_queries(u_ant, rng, unreliable, el, antenna, ant_to_ned) -> list[np.ndarray]:
+    """The point sets :func:`flag_ground` asks the surface height of, built as its steps build them."""
+    mirror, amb = _mirrors(u_ant)
+    queries = [_along_points(u_ant, rng, antenna, ant_to_ned)]
+    if amb.any():
+        queries.append(_along_points(mirror[amb], rng[amb], antenna, ant_to_ned))
+    if unreliable.any():
+        queries.append(antenna[None])
+        queries.append(rise_points(antenna, rng[unreliable])[1])
+        queries.append(elevation_points(rng[unreliable], el, antenna, ant_to_ned))
+    return queries
+
+
+class _Prefetched:
+    """A surface height function evaluated once on several point sets together.
+
+    Asked for one of those sets (the same shape and values, bit for bit) it returns that set's
+    heights; any other points go to the function itself. The heights are the same as separate
+    calls give: the height of a point depends on that point alone (elementwise geodetic
+    conversion and DEM interpolation, :func:`surface_height_fn`).
+    """
+
+    def __init__(self, height_fn: Callable[[np.ndarray], np.ndarray], queries: list[np.ndarray]):
+        self._fn = height_fn
+        flat = [np.asarray(q, float).reshape(-1, 3) for q in queries]
+        values = np.asarray(height_fn(np.concatenate(flat)), float)
+        ends = np.cumsum([len(f) for f in flat])[:-1]
+        self._sets = [
+            (np.asarray(q, float), v.reshape(np.shape(q)[:-1]))
+            for q, v in zip(queries, np.split(values, ends), strict=True)
+        ]
+
+    def __call__(self, points: np.ndarray) -> np.ndarray:
+        points = np.asarray(points, float)
+        for query, values in self._sets:
+            if query.shape == points.shape and query.tobytes() == points.tobytes():
+                return values.copy()
+        return self._fn(points)
 
 
 def _ground_along(u_ant, rng, v_r, sd_az, sd_el, antenna, ant_to_ned, height_fn, vel, config) -> np.ndarray:

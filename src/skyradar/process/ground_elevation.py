@@ -13,7 +13,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["ground_in_elevation"]
+__all__ = ["ground_in_elevation", "elevation_points"]
 
 
 def ground_in_elevation(
@@ -34,13 +34,29 @@ def ground_in_elevation(
     ground; an aircraft mixed with ground pulls it towards the aircraft. ``height_fn`` maps NED
     points (m, shape (..., 3)) to heights above the surface (NaN: unknown, not ground).
     """
-    az = np.linspace(-max_azimuth_rad, max_azimuth_rad, n_azimuth)
     el = np.asarray(elevation_rad, float)[:, None]
-    u_ant = np.stack(np.broadcast_arrays(np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)), -1)
-    points = np.asarray(antenna_ned_m, float) + np.asarray(range_m, float)[:, None, None] * (
-        u_ant @ np.asarray(ant_to_ned, float).T
+    h = height_fn(
+        elevation_points(range_m, elevation_rad, antenna_ned_m, ant_to_ned, max_azimuth_rad, n_azimuth)
     )
-    h = height_fn(points)
     margin = np.broadcast_to(np.asarray(margin_m, float), el.shape[:1])[:, None]
     with np.errstate(invalid="ignore"):
         return np.any(np.abs(h) <= margin, axis=1)
+
+
+def elevation_points(
+    range_m: np.ndarray,
+    elevation_rad: np.ndarray,
+    antenna_ned_m: np.ndarray,
+    ant_to_ned: np.ndarray,
+    max_azimuth_rad: float = np.radians(70.0),
+    n_azimuth: int = 29,
+) -> np.ndarray:
+    """NED points (n, n_azimuth, 3), m, that :func:`ground_in_elevation` tests: each detection's
+    range and antenna elevation at ``n_azimuth`` azimuths within ``+-max_azimuth_rad``. Each row
+    depends on its own detection only."""
+    az = np.linspace(-max_azimuth_rad, max_azimuth_rad, n_azimuth)
+    el = np.asarray(elevation_rad, float)[:, None]
+    u_ant = np.stack(np.broadcast_arrays(np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)), -1)
+    return np.asarray(antenna_ned_m, float) + np.asarray(range_m, float)[:, None, None] * (
+        u_ant @ np.asarray(ant_to_ned, float).T
+    )

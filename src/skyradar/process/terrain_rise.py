@@ -14,7 +14,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["terrain_rise_m"]
+__all__ = ["terrain_rise_m", "rise_points"]
 
 
 def terrain_rise_m(
@@ -59,13 +59,22 @@ def terrain_rise_m(
     if rng.size == 0:
         return np.zeros(0)
     antenna = np.asarray(antenna_ned_m, float)
-    radii = np.linspace(0.0, float(np.max(rng)), n_radii + 1)[1:]
-    az = np.linspace(0.0, 2.0 * np.pi, n_azimuth, endpoint=False)
-    offsets = np.stack([np.outer(radii, np.cos(az)), np.outer(radii, np.sin(az))], axis=-1)
-    points = np.concatenate([offsets, np.zeros((*offsets.shape[:2], 1))], axis=-1) + antenna
+    radii, points = rise_points(antenna, rng, n_radii, n_azimuth)
     below = float(np.asarray(height_fn(antenna[None]), float)[0])
     rise = below - np.asarray(height_fn(points), float)  # (ring, azimuth)
     ring_max = np.maximum.accumulate(np.nan_to_num(rise, nan=0.0).max(axis=1))
     # The ring at or beyond each range: a sampled bound, never smaller than the rise nearer in.
     k = np.clip(np.searchsorted(radii, rng, side="left"), 0, radii.size - 1)
     return np.maximum(ring_max[k], 0.0)
+
+
+def rise_points(
+    antenna_ned_m: np.ndarray, range_m: np.ndarray, n_radii: int = 16, n_azimuth: int = 24
+) -> tuple[np.ndarray, np.ndarray]:
+    """The rings :func:`terrain_rise_m` samples: their radii (n_radii,), m, and their NED points
+    (n_radii, n_azimuth, 3), m, at the radar's depth, out to the largest of ``range_m`` (not empty)."""
+    antenna = np.asarray(antenna_ned_m, float)
+    radii = np.linspace(0.0, float(np.max(range_m)), n_radii + 1)[1:]
+    az = np.linspace(0.0, 2.0 * np.pi, n_azimuth, endpoint=False)
+    offsets = np.stack([np.outer(radii, np.cos(az)), np.outer(radii, np.sin(az))], axis=-1)
+    return radii, np.concatenate([offsets, np.zeros((*offsets.shape[:2], 1))], axis=-1) + antenna

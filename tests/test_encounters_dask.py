@@ -16,7 +16,11 @@ _TIMINGS = ["simulate_s", "process_s", "track_s", "alert_s"]
 def test_encounters_on_a_dask_scheduler_match_the_local_run(tmp_path):
     common = ("experiment", "encounters", "--n", "2", "--layout", "single", "--frame-rate", "4.7", "--json")
     with distributed.LocalCluster(
-        n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
+        n_workers=1,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=":0",
+        scheduler_kwargs={"dashboard": False},
     ) as cluster:  # the test's own scheduler, as a user's cluster would be
         on_dask = skyradar(*common, "--out", "dask", "--scheduler", cluster.scheduler_address, cwd=tmp_path)
     here = skyradar(*common, "--out", "here", "--workers", "1", cwd=tmp_path)

@@ -133,3 +133,34 @@ def test_rd_on_a_local_cluster_matches_the_plain_loop(tmp_path):
     assert loop["frames"] == dask["frames"] == 5
     a, b = open_frames(tmp_path / "loop.zarr"), open_frames(tmp_path / "dask.zarr")
     assert a.iq.values.tobytes() == b.iq.values.tobytes()
+
+
+_PORT_TAKEN = """
+import socket, sys, warnings
+from skyradar.parallel import close, connect
+
+if __name__ == "__main__":
+    taken = socket.socket()
+    taken.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        taken.bind(("0.0.0.0", 8787))
+        taken.listen()
+    except OSError:
+        pass  # already taken by another cluster: the situation under test either way
+    warnings.simplefilter("default")
+    client = connect(None, 1)
+    print(client.submit(sum, [1, 2]).result())
+    close(client, owns_cluster=True)
+    taken.close()
+"""
+
+
+def test_a_local_cluster_starts_quietly_when_the_default_dashboard_port_is_taken(tmp_path):
+    # Another Dask cluster on the machine holds port 8787: ours takes a free port for its
+    # scheduler's HTTP server and says nothing (a one-line error must stay one line).
+    script = tmp_path / "port_taken.py"
+    script.write_text(_PORT_TAKEN)
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "3"
+    assert "8787" not in done.stderr and "Traceback" not in done.stderr, done.stderr

@@ -123,7 +123,10 @@ def connect(scheduler: str | None, workers: int | None, timeout_s: float = 10.0)
             n_workers=int(workers or 2),
             threads_per_worker=1,
             processes=True,
-            dashboard_address=None,
+            # No dashboard, and the scheduler's HTTP server on a free port: on the default 8787,
+            # taken by any other cluster on the machine, distributed warns on stderr.
+            dashboard_address=":0",
+            scheduler_kwargs={"dashboard": False},
             silence_logs=logging.CRITICAL,
         )
         client = Client(cluster)

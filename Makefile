@@ -25,8 +25,8 @@ $(STAMP_DEV): pyproject.toml | $(BIN)/python
 # The end-to-end DAA demo (simulate -> detect -> track -> alert -> report), then the ch2
 # simulator figures.
 demo: $(STAMP_RUN)
-	$(BIN)/skyradar demo --out $(OUT)/demo
-	$(BIN)/skyradar experiment ch2 --out $(OUT)/ch2
+	$(BIN)/skyradar demo -o $(OUT)/demo
+	$(BIN)/skyradar experiment ch2 -o $(OUT)/ch2
 
 # Debian's chromium for the headless display test (Playwright drives it; Playwright's own browser
 # download is never used). Installed here, once and visibly, never from inside a test: apt-get runs

@@ -46,7 +46,7 @@ def test_one_core_pins_the_process_and_its_threads_and_restores_them():
         assert os.sched_getaffinity(0) == before_cores
 
 
-@pytest.mark.parametrize("args", [("--seconds", "1"), ("--frame-rate", "0"), ("--seconds", "nan")])
+@pytest.mark.parametrize("args", [("--duration-s", "1"), ("--frame-rate-hz", "0"), ("--duration-s", "nan")])
 def test_bench_realtime_refuses_settings_out_of_range_in_one_line(args):
     run = subprocess.run(
         [sys.executable, "-m", "skyradar", "bench", "realtime", *args], capture_output=True, text=True
@@ -58,7 +58,7 @@ def test_bench_realtime_refuses_settings_out_of_range_in_one_line(args):
 @pytest.mark.slow
 def test_bench_realtime_prints_its_json_last():
     run = subprocess.run(
-        [sys.executable, "-m", "skyradar", "bench", "realtime", "--seconds", "5", "--json"],
+        [sys.executable, "-m", "skyradar", "bench", "realtime", "--duration-s", "5", "--json"],
         capture_output=True,
         text=True,
         check=True,

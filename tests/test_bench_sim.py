@@ -59,7 +59,7 @@ def test_baselines_add_thermal_noise_of_the_configured_power():
 @pytest.mark.slow
 def test_bench_sim_json_names_synthetic_terrain_and_both_ratios(tmp_path):
     result = subprocess.run(
-        [sys.executable, "-m", "skyradar", "bench", "sim", "--json", "--frames", "1", "--seconds", "0"],
+        [sys.executable, "-m", "skyradar", "bench", "sim", "--json", "--frames", "1", "--min-time-s", "0"],
         cwd=tmp_path,
         capture_output=True,
         text=True,

@@ -116,7 +116,7 @@ def test_bad_input_is_one_line_through_the_command(tmp_path, case):
         "bluesky",
         "--scenario",
         str(path),
-        "--out",
+        "--output",
         str(tmp_path / "out"),
         "--json",
         cwd=tmp_path,

@@ -157,7 +157,7 @@ def test_huge_worker_count_is_refused_before_any_process_starts(tiny_run, comman
     ],
 )
 def test_experiment_sizes_are_bounded_before_the_output_folder(tmp_path, args, needles):
-    result = _skyradar(*args, "--out", "out", cwd=tmp_path)
+    result = _skyradar(*args, "--output", "out", cwd=tmp_path)
     _assert_one_line_error(result, *needles)
     assert not (tmp_path / "out").exists()  # refused before the folder is made
 

@@ -51,7 +51,7 @@ def test_sigterm_ends_the_encounter_workers_and_says_how_to_resume(tmp_path):
         "2",
         "--layout",
         "single",
-        "--out",
+        "--output",
         str(tmp_path / "out"),
         "--json",
     ]

@@ -140,7 +140,7 @@ def test_alert_timeline_lists_each_level_change():
 
 def test_demo_out_must_be_a_directory(tmp_path):
     (tmp_path / "f").write_text("x")
-    with pytest.raises(InputError, match="--out must be a directory"):
+    with pytest.raises(InputError, match="--output must be a directory"):
         run_demo(tmp_path / "f")
 
 
@@ -153,7 +153,7 @@ def test_demo_scenario_is_package_data_and_valid():
 @pytest.fixture(scope="module")
 def demo_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("demo")
-    result = CliRunner().invoke(app, ["demo", "--out", str(out), "--json"])
+    result = CliRunner().invoke(app, ["demo", "--output", str(out), "--json"])
     assert result.exit_code == 0, result.output
     return out, result.stdout
 

@@ -114,6 +114,29 @@ def test_cli_reference_names_the_commands(site):
     assert "--output" in text and "--ownship" in text
 
 
+def test_gallery_runs_every_example(site):
+    """Every script in examples/ is run by the build: its page holds what it printed and a figure it
+    drew, and the gallery holds an example of each task a newcomer starts with."""
+    scripts = sorted((ROOT / "examples").glob("plot_*.py"))
+    for script in scripts:
+        page = site / "gallery" / f"{script.stem}.html"
+        assert page.is_file(), script.name
+        text = page.read_text()
+        assert "sphx-glr-script-out" in text, f"{script.name}: no printed output on its page"
+        image = re.search(rf'<img[^>]+src="\.\./(_images/sphx_glr_{script.stem}_\d+\.png)"', text)
+        assert image and (site / image[1]).is_file(), f"{script.name}: no figure on its page"
+    tasks = {
+        "the demo": "plot_demo",
+        "a scenario over your own DEM with real ADS-B traffic": "plot_own_terrain_real_traffic",
+        "reading alerts and advice, opening the live display": "plot_alerts_and_display",
+        "your own raw ADC recording": "plot_own_recording",
+        "your own SigMF recording": "plot_own_recording_sigmf",
+        "reproducing a thesis table": "plot_thesis_ch3",
+    }
+    missing = {task for task, stem in tasks.items() if not (ROOT / "examples" / f"{stem}.py").is_file()}
+    assert not missing, f"no gallery example for: {sorted(missing)}"
+
+
 def test_pages_of_every_stage_are_built(site):
     for page in ("getting-started", "user-guide/simulate", "how-it-works/alerting", "api/track", "changelog"):
         assert (site / f"{page}.html").is_file(), page

@@ -183,7 +183,7 @@ def test_jacksboro_dem_covers_every_encounter_window_and_range_limit():
 
 
 def test_bad_terrain_gives_one_line(tmp_path):
-    r = skyradar("experiment", "encounters", "--terrain", "hills,moon", "--out", "o", cwd=tmp_path)
+    r = skyradar("experiment", "encounters", "--terrain", "hills,moon", "--output", "o", cwd=tmp_path)
     assert_one_line_error(r, "--terrain", "moon")
     assert not (tmp_path / "o").exists()
 

@@ -14,7 +14,17 @@ _TIMINGS = ["simulate_s", "process_s", "track_s", "alert_s"]
 
 
 def test_encounters_on_a_dask_scheduler_match_the_local_run(tmp_path):
-    common = ("experiment", "encounters", "--n", "2", "--layout", "single", "--frame-rate", "4.7", "--json")
+    common = (
+        "experiment",
+        "encounters",
+        "--n",
+        "2",
+        "--layout",
+        "single",
+        "--frame-rate-hz",
+        "4.7",
+        "--json",
+    )
     with distributed.LocalCluster(
         n_workers=1,
         threads_per_worker=1,
@@ -22,8 +32,10 @@ def test_encounters_on_a_dask_scheduler_match_the_local_run(tmp_path):
         dashboard_address=":0",
         scheduler_kwargs={"dashboard": False},
     ) as cluster:  # the test's own scheduler, as a user's cluster would be
-        on_dask = skyradar(*common, "--out", "dask", "--scheduler", cluster.scheduler_address, cwd=tmp_path)
-    here = skyradar(*common, "--out", "here", "--workers", "1", cwd=tmp_path)
+        on_dask = skyradar(
+            *common, "--output", "dask", "--scheduler", cluster.scheduler_address, cwd=tmp_path
+        )
+    here = skyradar(*common, "--output", "here", "--workers", "1", cwd=tmp_path)
     assert on_dask.returncode == 0, on_dask.stderr
     assert here.returncode == 0, here.stderr
     tables = [
@@ -38,6 +50,14 @@ def test_encounters_on_a_dask_scheduler_match_the_local_run(tmp_path):
 
 def test_a_scheduler_that_does_not_answer_is_one_line(tmp_path):
     result = skyradar(
-        "experiment", "encounters", "--n", "1", "--scheduler", "tcp://127.0.0.1:9", "--out", "o", cwd=tmp_path
+        "experiment",
+        "encounters",
+        "--n",
+        "1",
+        "--scheduler",
+        "tcp://127.0.0.1:9",
+        "--output",
+        "o",
+        cwd=tmp_path,
     )
     assert_one_line_error(result, "--scheduler", "tcp://127.0.0.1:9")

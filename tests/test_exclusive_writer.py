@@ -157,7 +157,7 @@ def test_a_second_process_is_refused_while_the_first_writes(small_run, tmp_path)
     [
         (["export", "RUN", "-o", "own"], "--output own"),
         (["export", "RUN", "-o", "own.parquet"], "--output own.parquet"),
-        (["demo", "--out", "report"], "--out report"),
+        (["demo", "--output", "report"], "--output report"),
     ],
     ids=["export-folder", "export-table", "demo"],
 )
@@ -217,7 +217,18 @@ WRITERS = {
     "rd": (["rd", "rec.npy", "-o", "rd.zarr"], "--output rd.zarr"),
     "process": (["process", "run.zarr", "-o", "det.parquet"], "--output det.parquet"),
     "calibrate": (
-        ["calibrate", "run.zarr", "-o", "cal.json", "--range", "100", "--azimuth", "0", "--elevation", "0"],
+        [
+            "calibrate",
+            "run.zarr",
+            "-o",
+            "cal.json",
+            "--range-m",
+            "100",
+            "--azimuth-deg",
+            "0",
+            "--elevation-deg",
+            "0",
+        ],
         "--output cal.json",
     ),
     "spur-map": (["spur-map", "run.zarr", "-o", "spurs.npz"], "--output spurs.npz"),
@@ -233,9 +244,9 @@ WRITERS = {
     "simulate-passive": (["simulate-passive", "-o", "sim.sigmf-meta"], "--output sim.sigmf-meta"),
     "flight": (["flight", "fixes.csv", "-o", "path.csv"], "--output path.csv"),
     "make-encounter": (["make-encounter", "a.csv", "b.csv", "-o", "enc.yaml"], "--output enc.yaml"),
-    "demo": (["demo", "--out", "report"], "--out report"),
+    "demo": (["demo", "--output", "report"], "--output report"),
     **{
-        f"experiment {name}": (["experiment", name, "--out", f"x-{name}"], f"--out x-{name}")
+        f"experiment {name}": (["experiment", name, "--output", f"x-{name}"], f"--output x-{name}")
         for name in ("ch2", "ch3", "ch4", "ch5", "ch6", "ch7", "clutter", "encounters")
     },
 }

@@ -20,7 +20,7 @@ pytestmark = pytest.mark.slow
 @pytest.fixture(scope="module")
 def ch6(tmp_path_factory):
     folder = tmp_path_factory.mktemp("ch6")
-    result = skyradar("experiment", "ch6", "--out", str(folder / "out"), "--json", cwd=folder, timeout=900)
+    result = skyradar("experiment", "ch6", "--output", str(folder / "out"), "--json", cwd=folder, timeout=900)
     assert result.returncode == 0, result.stderr
     return json.loads(result.stdout.strip().splitlines()[-1]), folder / "out"
 

@@ -115,7 +115,7 @@ def test_acceptance_judges_every_case():
 def test_cli_refuses_a_flight_shorter_than_the_warmup(tmp_path, args, needles):
     # Run anyway, every error would be NaN (no frame after the 5 s warm-up) with exit code 0.
     result = subprocess.run(
-        [sys.executable, "-m", "skyradar", "experiment", "ch5", "--out", str(tmp_path / "o"), *args],
+        [sys.executable, "-m", "skyradar", "experiment", "ch5", "--output", str(tmp_path / "o"), *args],
         capture_output=True,
         text=True,
         timeout=300,

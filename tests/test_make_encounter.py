@@ -112,7 +112,7 @@ def test_make_encounter_command(tmp_path, monkeypatch, capsys, caplog):
     rows[0].iloc[::-1].to_csv(tmp_path / "a.csv.gz", index=False)  # reversed, epoch ms: cleaned
     rows[1].to_json(tmp_path / "b.json", orient="records")
     monkeypatch.chdir(tmp_path)
-    args = ("make-encounter", "a.csv.gz", "b.json", "-o", "enc.yaml", "--miss-m", "300", "--t-cpa", "100")
+    args = ("make-encounter", "a.csv.gz", "b.json", "-o", "enc.yaml", "--miss-m", "300", "--t-cpa-s", "100")
     code, stdout, stderr = skyradar_in_process(
         monkeypatch, capsys, *args, "--vertical-miss-m", "-60", "--json"
     )

@@ -142,7 +142,7 @@ def test_table_output_over_a_foreign_file_needs_overwrite(tmp_path):
 def test_experiment_refuses_a_foreign_folder(tmp_path):
     (tmp_path / "mine").mkdir()
     (tmp_path / "mine" / "thesis.tex").write_text("keep")
-    result = _skyradar("experiment", "ch2", "--out", "mine", "--frames", "1", cwd=tmp_path)
+    result = _skyradar("experiment", "ch2", "--output", "mine", "--frames", "1", cwd=tmp_path)
     _assert_one_line_error(result, "mine", "--overwrite")
     assert sorted(p.name for p in (tmp_path / "mine").iterdir()) == ["thesis.tex"]
 

@@ -29,6 +29,8 @@ PACKAGES = [
     "experiments",
     "benchmarks",
     "cli",
+    "integrations",
+    "integrations.bluesky",
 ]
 EXPORTS = [
     (package, name) for package in PACKAGES for name in importlib.import_module(f"skyradar.{package}").__all__

@@ -11,7 +11,7 @@ from cli_helpers import skyradar
 
 @pytest.mark.slow
 def test_experiment_ch7_meets_its_acceptance_bounds(tmp_path):
-    result = skyradar("experiment", "ch7", "--out", "ch7", "--json", cwd=tmp_path, timeout=900)
+    result = skyradar("experiment", "ch7", "--output", "ch7", "--json", cwd=tmp_path, timeout=900)
     assert result.returncode == 0, result.stderr
     out = json.loads(result.stdout.strip().splitlines()[-1])
     names = ("ch7_testpulse.png", "ch7_sweeps.png", "ch7_aircraft.png", "ch7_table.csv", "ch7.json")
@@ -24,7 +24,7 @@ def test_experiment_ch7_meets_its_acceptance_bounds(tmp_path):
 
 @pytest.mark.slow
 def test_bench_passive_reports_real_time_factor_and_bounded_memory(tmp_path):
-    result = skyradar("bench", "passive", "--seconds", "2", "--json", cwd=tmp_path, timeout=900)
+    result = skyradar("bench", "passive", "--duration-s", "2", "--json", cwd=tmp_path, timeout=900)
     assert result.returncode == 0, result.stderr
     out = json.loads(result.stdout.strip().splitlines()[-1])
     assert out["sample_rate_hz"] >= 5e6

@@ -185,7 +185,7 @@ def test_a_malformed_scheduler_address_is_one_line(tmp_path, address):
 def test_a_scheduler_address_without_a_valid_port_is_refused_before_the_output_folder(tmp_path):
     # tcp://HOST:99999 waited 10 s for an answer that cannot come, and left the experiment's folder.
     result = skyradar(
-        "experiment", "encounters", "--scheduler", "tcp://127.0.0.1:99999", "--out", "x", cwd=tmp_path
+        "experiment", "encounters", "--scheduler", "tcp://127.0.0.1:99999", "--output", "x", cwd=tmp_path
     )
     assert_one_line_error(result, "--scheduler tcp://127.0.0.1:99999", "port 99999 is not 1..65535")
     assert not (tmp_path / "x").exists()
@@ -218,11 +218,11 @@ def test_one_head_commands_on_a_run_of_several_heads_ask_which(tmp_path):
             "run.zarr",
             "-o",
             "cal.json",
-            "--range",
+            "--range-m",
             "100",
-            "--azimuth",
+            "--azimuth-deg",
             "0",
-            "--elevation",
+            "--elevation-deg",
             "0",
         ),
     ):

@@ -179,7 +179,7 @@ def test_cli_calibrate_then_process_with_the_calibrated_config(tmp_path, monkeyp
     aircraft = (1500.0, 20.0, np.radians(-12.0), np.radians(8.0), 35.0)
     cubes = np.stack([synthetic_frame(cfg, [building, aircraft], rng, rx_gain=offsets)[0] for _ in range(4)])
     frames_dataset(cubes, np.arange(4) * 0.1, cfg).to_zarr(tmp_path / "run.zarr", consolidated=False)
-    args = ["--range", 438, "--azimuth", 5, "--elevation", -1]
+    args = ["--range-m", 438, "--azimuth-deg", 5, "--elevation-deg", -1]
     calibrate = ("calibrate", tmp_path / "run.zarr", "-o", tmp_path / "radar.json", *args)
     assert run_cli(monkeypatch, capsys, *calibrate)[0] == 0
     cal = RadarConfig.from_json((tmp_path / "radar.json").read_text())
@@ -192,7 +192,7 @@ def test_cli_calibrate_then_process_with_the_calibrated_config(tmp_path, monkeyp
     assert len(plane) == 4
     assert np.degrees(np.abs(plane.azimuth_rad + np.radians(12.0))).max() < 1.0
     assert np.degrees(np.abs(plane.elevation_rad - np.radians(8.0))).max() < 1.0
-    wide = ["--range", 438, "--azimuth", 80, "--elevation", 0]
+    wide = ["--range-m", 438, "--azimuth-deg", 80, "--elevation-deg", 0]
     x_json = tmp_path / "x.json"
     code, _, stderr = run_cli(monkeypatch, capsys, "calibrate", tmp_path / "run.zarr", "-o", x_json, *wide)
     assert code == 2 and "field of view" in stderr

@@ -6,9 +6,10 @@ from __future__ import annotations
 import numpy as np
 
 from skyradar.track.association import associate
-from skyradar.track.components import Associator, Deleter, Initiator, Reacquirer
+from skyradar.track.components import Associator, Deleter, Initiator, Predictor, Reacquirer, Updater
 from skyradar.track.deletion import MissDeleter
 from skyradar.track.initiation import MOfN
+from skyradar.track.kalman import predict, update
 from skyradar.track.models import radar_model
 from skyradar.track.reacquisition import LostTracks
 from skyradar.track.tracker import RangeDopplerTracker
@@ -30,6 +31,7 @@ def _ids(tracker: RangeDopplerTracker, frames) -> list[list[int]]:
 
 def test_the_shipped_parts_fill_the_roles_and_an_object_without_the_methods_does_not():
     assert isinstance(associate, Associator)
+    assert isinstance(predict, Predictor) and isinstance(update, Updater)
     assert isinstance(MOfN(4, 5), Initiator)
     assert isinstance(MissDeleter(), Deleter)
     assert isinstance(LostTracks(MODEL, 8.0, 1.5, 16.0, 13.0), Reacquirer)
@@ -64,3 +66,36 @@ def test_an_associator_of_ones_own_is_called_with_the_frame_and_its_answer_used(
         RangeDopplerTracker(MODEL), frames
     )
     assert calls and set(calls) == {1}
+
+
+def _states(tracker: RangeDopplerTracker, frames) -> list[np.ndarray]:
+    return [tracker.step(t, z).state.copy() for t, z in frames]
+
+
+def test_a_predictor_and_an_updater_of_ones_own_are_called_and_their_answers_used():
+    """Wrappers that hand the shipped Kalman step's answers back give the default tracker's states
+    exactly; the same wrappers changing the answers change the states."""
+    frames = _frames(gap=(15,))
+    calls = {"predict": 0, "update": 0}
+
+    def counting_predict(x, P, F, Q):
+        calls["predict"] += 1
+        return predict(x, P, F, Q)
+
+    def counting_update(x, P, y, H, R, S=None):
+        calls["update"] += 1
+        return update(x, P, y, H, R, S)
+
+    default = _states(RangeDopplerTracker(MODEL), frames)
+    wrapped = _states(RangeDopplerTracker(MODEL, predictor=counting_predict, updater=counting_update), frames)
+    assert calls["predict"] >= 28 and calls["update"] >= 28  # every frame after the first has a track
+    assert len(wrapped) == len(default)
+    for a, b in zip(wrapped, default, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+    def frozen_update(x, P, y, H, R, S=None):
+        """Ignores every measurement: the tracks coast on their first state."""
+        return x, P
+
+    coasted = _states(RangeDopplerTracker(MODEL, updater=frozen_update), frames)
+    assert any(a.shape == b.shape and not np.array_equal(a, b) for a, b in zip(coasted, default, strict=True))

@@ -125,7 +125,7 @@ def run_demo(out_dir: Path, scenario: str | Path | None = None) -> dict[str, Any
     t_start = time.perf_counter()
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
-        raise InputError(f"{out_dir}: --out must be a directory, this is a file")
+        raise InputError(f"{out_dir}: --output must be a directory, this is a file")
     out_dir.mkdir(parents=True, exist_ok=True)
     built = load_scenario(scenario or demo_scenario_path()).build()
     rd_frame = built.times_s.size // 2  # mid-run: the collision intruder is tracked then

@@ -134,12 +134,12 @@ def check_number(
 
     Examples
     --------
-    >>> check_number("--seconds", 2.0, 0.0, low_open=True)
+    >>> check_number("--min-time-s", 2.0, 0.0, low_open=True)
     2.0
-    >>> check_number("--seconds", float("nan"), 0.0, low_open=True)
+    >>> check_number("--min-time-s", float("nan"), 0.0, low_open=True)
     Traceback (most recent call last):
     ...
-    skyradar.errors.InputError: --seconds: must be a finite number > 0, got nan
+    skyradar.errors.InputError: --min-time-s: must be a finite number > 0, got nan
     """
     from skyradar.errors import InputError
 
@@ -182,7 +182,7 @@ def number_in(
 
 POSITIVE = number_in(0.0, low_open=True)  # durations, distances, rates: finite and > 0
 BenchSecondsOption = Annotated[
-    float, typer.Option("--seconds", callback=POSITIVE, help="Minimum timing per implementation, s.")
+    float, typer.Option("--min-time-s", callback=POSITIVE, help="Minimum timing per implementation, s.")
 ]
 NON_NEGATIVE = number_in(0.0)  # counts and durations where 0 means "skip"
 COUNT = number_in(1)  # frames, workers, chunk sizes: at least one

@@ -24,13 +24,11 @@ def experiment_bluesky(
             "the packaged skyradar_demo.scn (two equipped light aircraft over hills, 3 minutes).",
         ),
     ] = None,
-    out: Annotated[Path, typer.Option("-o", "--output", "--out", help="Output directory.")] = Path(
-        "out/bluesky"
-    ),
+    out: Annotated[Path, typer.Option("-o", "--output", help="Output directory.")] = Path("out/bluesky"),
     end: Annotated[
         float | None,
         typer.Option(
-            "--end", callback=POSITIVE, help="Simulation time to stop at, s (default: the scenario's HOLD)."
+            "--end-s", callback=POSITIVE, help="Simulation time to stop at, s (default: the scenario's HOLD)."
         ),
     ] = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
@@ -50,7 +48,7 @@ def experiment_bluesky(
         from skyradar.errors import InputError
 
         raise InputError(f"{scenario}: no such BlueSky scenario file")
-    check_output(out, (scenario,), overwrite, kind="folder", option="--out")
+    check_output(out, (scenario,), overwrite, kind="folder", option="--output")
     mark_folder(out)
     shown = {"truth": -10.0, "radar": -10.0}
 

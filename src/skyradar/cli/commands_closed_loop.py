@@ -24,9 +24,7 @@ __all__ = ["experiment_closed_loop"]
 
 @experiment_app.command("closed-loop")
 def experiment_closed_loop(
-    out: Annotated[Path, typer.Option("-o", "--output", "--out", help="Output directory.")] = Path(
-        "out/closed-loop"
-    ),
+    out: Annotated[Path, typer.Option("-o", "--output", help="Output directory.")] = Path("out/closed-loop"),
     n: Annotated[
         int,
         typer.Option(
@@ -98,7 +96,7 @@ def experiment_closed_loop(
     pilot = PilotConfig(
         manoeuvre=manoeuvre.value, corrective_delay_s=corrective_delay, warning_delay_s=warning_delay
     )
-    check_output(out, (), overwrite, kind="folder", option="--out")
+    check_output(out, (), overwrite, kind="folder", option="--output")
     mark_folder(out)
     total = n * len(terrains)
     with frame_progress(total, "encounters") as bar:

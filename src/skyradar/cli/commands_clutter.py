@@ -25,7 +25,7 @@ _DEFAULT_TERRAINS = "flat-1000,flat-300,hills,jacksboro"  # clutter.DEFAULT_TERR
 @experiment_app.command("clutter")
 def experiment_clutter(
     out: Annotated[
-        Path, typer.Option("-o", "--output", "--out", help="Output directory for figures and tables.")
+        Path, typer.Option("-o", "--output", help="Output directory for figures and tables.")
     ] = Path("out/clutter"),
     frames: Annotated[
         int,
@@ -56,7 +56,7 @@ def experiment_clutter(
     terrains = parse_terrains(terrain)  # before any output: a bad name is one line
     from skyradar.io.outputs import check_output, mark_folder
 
-    check_output(out, (), overwrite, kind="folder", option="--out")
+    check_output(out, (), overwrite, kind="folder", option="--output")
     mark_folder(out)
     result = run(out, n_frames=frames, terrains=tuple(terrains), seed=seed)
     console.print(_rows_view(result["rows"]))

@@ -36,9 +36,7 @@ def format_timeline(timeline) -> str:
 
 @app.command()
 def demo(
-    out: Annotated[Path, typer.Option("-o", "--output", "--out", help="Report folder to write.")] = Path(
-        "out/demo"
-    ),
+    out: Annotated[Path, typer.Option("-o", "--output", help="Report folder to write.")] = Path("out/demo"),
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -53,7 +51,7 @@ def demo(
     from skyradar.demo import run_demo
     from skyradar.io.outputs import check_output, mark_folder
 
-    check_output(out, (), overwrite, kind="folder", option="--out")
+    check_output(out, (), overwrite, kind="folder", option="--output")
     summary = run_demo(mark_folder(out))
     timeline = pd.read_csv(out / "alert_timeline.csv")
     print(format_timeline(timeline), flush=True)

@@ -48,7 +48,10 @@ _N = Annotated[
     ),
 ]
 _FRAME_RATE = Annotated[
-    float, typer.Option(callback=number_in(0.5, 100.0), help="Radar frame rate, frames/s (the prototype's).")
+    float,
+    typer.Option(
+        "--frame-rate-hz", callback=number_in(0.5, 100.0), help="Radar frame rate, Hz (the prototype's)."
+    ),
 ]
 _BUFFER = Annotated[
     float,
@@ -133,9 +136,7 @@ _RX_LAYOUT = Annotated[
 
 @experiment_app.command("encounters")
 def experiment_encounters(
-    out: Annotated[Path, typer.Option("-o", "--output", "--out", help="Output directory.")] = Path(
-        "out/encounters"
-    ),
+    out: Annotated[Path, typer.Option("-o", "--output", help="Output directory.")] = Path("out/encounters"),
     n: _N = None,
     seed: Annotated[int, typer.Option("--seed", callback=NON_NEGATIVE, help="Random seed.")] = 0,
     workers: EncounterWorkersOption = None,
@@ -191,7 +192,7 @@ def experiment_encounters(
     terrains, layouts = parse_terrains(terrain), LAYOUTS_SCORED[layout]
     if n is None:  # over terrain an encounter costs minutes: the default keeps a run within 5 minutes
         n = DEFAULT_ENCOUNTERS if terrains == ["none"] else DEFAULT_TERRAIN_ENCOUNTERS
-    check_output(out, (), overwrite, kind="folder", option="--out")
+    check_output(out, (), overwrite, kind="folder", option="--output")
     mark_folder(out)
     total = n * len(terrains)
     with frame_progress(total, "encounters") as bar:

@@ -235,7 +235,7 @@ def _print_summary(result: dict, table, alert_frames: int) -> None:
 @experiment_app.command("ch6")
 def experiment_ch6(
     out: Annotated[
-        Path, typer.Option("-o", "--output", "--out", help="Output directory for table, JSON and figures.")
+        Path, typer.Option("-o", "--output", help="Output directory for table, JSON and figures.")
     ] = Path("out/ch6"),
     seed: Annotated[
         int, typer.Option("--seed", callback=NON_NEGATIVE, help="Speckle, map and frames seed.")
@@ -253,7 +253,7 @@ def experiment_ch6(
     from skyradar.experiments.ch6 import N_FRAMES, run
     from skyradar.io.outputs import check_output, mark_folder
 
-    check_output(out, (), overwrite, kind="folder", option="--out")
+    check_output(out, (), overwrite, kind="folder", option="--output")
     mark_folder(out)
     with Progress(console=console) as progress:
         task = progress.add_task("ch6 frames", total=N_FRAMES + 6)

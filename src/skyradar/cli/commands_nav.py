@@ -78,7 +78,7 @@ def state(
 def experiment_ch5(
     out: Annotated[
         Path,
-        typer.Option("-o", "--output", "--out", help="Output directory for table, JSON, states and figures."),
+        typer.Option("-o", "--output", help="Output directory for table, JSON, states and figures."),
     ] = Path("out/ch5"),
     duration_s: Annotated[
         float,
@@ -113,7 +113,7 @@ def experiment_ch5(
     check_run_options(duration_s, fast_duration_s)  # before any output: a bad option is one line
     from skyradar.io.outputs import check_output, mark_folder
 
-    check_output(out, (), overwrite, kind="folder", option="--out")
+    check_output(out, (), overwrite, kind="folder", option="--output")
     mark_folder(out)
     console.print(f"ch5: simulating and estimating into {out} ...")
     result = run(

@@ -44,15 +44,9 @@ def passive(
         ),
     ] = PassivePulse.metadata,
     max_range_m: Annotated[
-        float | None,
-        typer.Option(
-            "--max-range-m", callback=POSITIVE, help="Largest bistatic range R1+R2-L, m (default 45000)."
-        ),
-    ] = None,
-    max_range_km: Annotated[
-        float | None,
-        typer.Option("--max-range-km", callback=POSITIVE, help="The same in km (give one of the two)."),
-    ] = None,
+        float,
+        typer.Option("--max-range-m", callback=POSITIVE, help="Largest bistatic range R1+R2-L, m."),
+    ] = 45_000.0,
     chunk_samples: Annotated[
         int,
         typer.Option("--chunk-samples", callback=CHUNK_SAMPLES, help="Samples per chunk (bounds memory)."),
@@ -72,12 +66,11 @@ def passive(
     from skyradar.io.tables import write_table
     from skyradar.passive.pipeline import PassiveSettings, process_recording
 
-    max_bistatic_range_m = _max_range_m(max_range_m, max_range_km)
     inputs = [recording, *_recording_files(recording, sigmf_paths)]
     check_output(output, inputs, overwrite, kind="table")
     rec = read_iq_recording(recording)
     settings = PassiveSettings(
-        max_bistatic_range_m=max_bistatic_range_m, pulse=pulse.value, chunk_samples=chunk_samples
+        max_bistatic_range_m=max_range_m, pulse=pulse.value, chunk_samples=chunk_samples
     )
     with _progress(rec.n_samples) as update:
         result = process_recording(rec, settings, progress=update)
@@ -130,15 +123,16 @@ class _progress:
 @experiment_app.command("ch7")
 def experiment_ch7(
     out: Annotated[
-        Path, typer.Option("-o", "--output", "--out", help="Output directory for figures and tables.")
+        Path, typer.Option("-o", "--output", help="Output directory for figures and tables.")
     ] = Path("out/ch7"),
     seconds: Annotated[
-        float, typer.Option("--seconds", callback=POSITIVE, help="Recording length (thesis: 40 s, 9 sweeps).")
+        float,
+        typer.Option("--duration-s", callback=POSITIVE, help="Recording length, s (thesis: 40 s, 9 sweeps)."),
     ] = 40.0,
     seed: Annotated[int, typer.Option("--seed", callback=NON_NEGATIVE, help="Random seed of the scene.")] = 0,
     keep_recording: Annotated[
         bool,
-        typer.Option("--keep-recording", help="Keep the simulated recording (1.6 GB for 40 s) in --out."),
+        typer.Option("--keep-recording", help="Keep the simulated recording (1.6 GB for 40 s) in --output."),
     ] = False,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
@@ -150,7 +144,7 @@ def experiment_ch7(
     from skyradar.experiments.ch7 import run as run_ch7
     from skyradar.io.outputs import check_output, mark_folder
 
-    check_output(out, (), overwrite, kind="folder", option="--out")
+    check_output(out, (), overwrite, kind="folder", option="--output")
     mark_folder(out)
     with frame_progress(1, "ch7: samples") as bar:
         tasks: dict[str, TaskID] = {}
@@ -167,7 +161,8 @@ def experiment_ch7(
 @bench_app.command("passive")
 def bench_passive(
     seconds: Annotated[
-        float, typer.Option("--seconds", callback=POSITIVE, help="Length of the shorter test recording, s.")
+        float,
+        typer.Option("--duration-s", callback=POSITIVE, help="Length of the shorter test recording, s."),
     ] = 3.0,
     as_json: JsonOption = False,
 ) -> None:
@@ -176,14 +171,3 @@ def bench_passive(
 
     console.print("bench passive: simulating two recordings, then processing them", soft_wrap=True)
     emit_measurement(run_bench(seconds=seconds), as_json, "bench passive")
-
-
-def _max_range_m(max_range_m: float | None, max_range_km: float | None) -> float:
-    """The largest bistatic range, m, from whichever of the two options was given (45 km by default)."""
-    from skyradar.errors import InputError
-
-    if max_range_m is not None and max_range_km is not None:
-        raise InputError("--max-range-m and --max-range-km: give one of the two (the same range in m or km)")
-    if max_range_km is not None:
-        return max_range_km * 1e3
-    return 45_000.0 if max_range_m is None else max_range_m

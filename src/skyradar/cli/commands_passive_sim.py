@@ -94,9 +94,7 @@ def simulate_passive(
     ] = Path("passive.sigmf-meta"),
     duration_s: Annotated[
         float,
-        typer.Option(
-            "--duration-s", "--duration", callback=number_in(0.0, 3600.0, low_open=True), help="Length, s."
-        ),
+        typer.Option("--duration-s", callback=number_in(0.0, 3600.0, low_open=True), help="Length, s."),
     ] = 40.0,
     sample_rate_hz: Annotated[
         float, typer.Option("--sample-rate-hz", callback=POSITIVE, help="Complex sample rate, Hz.")

@@ -232,11 +232,11 @@ def _read_config(path: Path):
 def calibrate(
     run: Annotated[Path, typer.Argument(help="Frames run (Zarr) with a reflector at a known position.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Calibrated RadarConfig to write (JSON).")],
-    range_m: Annotated[float, typer.Option("--range", callback=POSITIVE, help="Reflector range, m.")],
+    range_m: Annotated[float, typer.Option("--range-m", callback=POSITIVE, help="Reflector range, m.")],
     azimuth_deg: Annotated[
         float,
         typer.Option(
-            "--azimuth",
+            "--azimuth-deg",
             callback=number_in(-180.0, 180.0),
             help="Reflector azimuth, deg (antenna frame, right +).",
         ),
@@ -244,7 +244,7 @@ def calibrate(
     elevation_deg: Annotated[
         float,
         typer.Option(
-            "--elevation",
+            "--elevation-deg",
             callback=number_in(-90.0, 90.0),
             help="Reflector elevation, deg (antenna frame, up +).",
         ),
@@ -274,7 +274,7 @@ def calibrate(
     config = radar_config_of(ds, str(run))
     if range_m >= config.range_limit_m:
         raise InputError(
-            f"--range: {range_m:g} m is beyond {run}'s processed range ({config.range_limit_m:g} m)"
+            f"--range-m: {range_m:g} m is beyond {run}'s processed range ({config.range_limit_m:g} m)"
         )
     p = reflector_position(range_m, np.radians(azimuth_deg), np.radians(elevation_deg))
     cube = np.asarray(ds["iq"].isel(time=slice(0, max(frames, 1))).values)
@@ -344,7 +344,7 @@ def spur_map(
 @experiment_app.command("ch3")
 def experiment_ch3(
     out: Annotated[
-        Path, typer.Option("-o", "--output", "--out", help="Output directory for figures and tables.")
+        Path, typer.Option("-o", "--output", help="Output directory for figures and tables.")
     ] = Path("out/ch3"),
     frames: Annotated[
         int, typer.Option("--frames", callback=COUNT, help="Flyover frames (thesis: 300).")
@@ -372,7 +372,7 @@ def experiment_ch3(
     pitch: Annotated[
         float,
         typer.Option(
-            "--pitch", callback=number_in(-90.0, 90.0), help="Boresight elevation above the horizon, deg."
+            "--pitch-deg", callback=number_in(-90.0, 90.0), help="Boresight elevation above the horizon, deg."
         ),
     ] = 3.0,
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
@@ -383,7 +383,7 @@ def experiment_ch3(
     from skyradar.experiments.ch3 import run as run_ch3
     from skyradar.io.outputs import check_output, mark_folder
 
-    check_output(out, (), overwrite, kind="folder", option="--out")
+    check_output(out, (), overwrite, kind="folder", option="--output")
 
     try:
         others = tuple(float(s) for s in compare.split(",") if s.strip())
@@ -423,14 +423,16 @@ def bench_realtime(
     seconds: Annotated[
         float,
         typer.Option(
-            "--seconds",
+            "--duration-s",
             callback=number_in(5.0, 600.0),
             help="Wall time of frames fed in real time, s (5-600).",
         ),
     ] = 60.0,
     frame_rate: Annotated[
         float,
-        typer.Option("--frame-rate", callback=number_in(0.5, 100.0), help="Frames per second of each head."),
+        typer.Option(
+            "--frame-rate-hz", callback=number_in(0.5, 100.0), help="Frames per second of each head, Hz."
+        ),
     ] = 9.4,
     as_json: JsonOption = False,
 ) -> None:

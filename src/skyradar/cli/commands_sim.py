@@ -24,7 +24,7 @@ from skyradar.cli.app import (
 from skyradar.cli.choices import Compressor, Precision
 from skyradar.io.outputs import OVERWRITE_HELP
 
-OutDir = Annotated[Path, typer.Option("-o", "--output", "--out", help="Folder for figures and tables.")]
+OutDir = Annotated[Path, typer.Option("-o", "--output", help="Folder for figures and tables.")]
 
 
 def frame_progress(total: int, label: str) -> Progress:
@@ -143,7 +143,7 @@ def experiment_ch2(
     from skyradar.experiments.ch2 import run
     from skyradar.io.outputs import check_output, mark_folder
 
-    check_output(out, (), overwrite, kind="folder", option="--out")
+    check_output(out, (), overwrite, kind="folder", option="--output")
     result = run(mark_folder(out), n_frames=frames)
     console.print(f"summary in {out / 'summary.md'}; figures and table in {out}")
     emit_result(result, json_out, "ch2: simulator against closed form")
@@ -159,7 +159,8 @@ def bench_sim(
         ),
     ] = 20,
     seconds: Annotated[
-        float, typer.Option(help="Time each implementation for at least this long, s (0 to 600).")
+        float,
+        typer.Option("--min-time-s", help="Time each implementation for at least this long, s (0 to 600)."),
     ] = 2.0,
 ) -> None:
     """Simulator frames/s against two numpy baselines, same run, same physics.
@@ -175,7 +176,7 @@ def bench_sim(
     from skyradar.errors import InputError
 
     if not (math.isfinite(seconds) and 0.0 <= seconds <= 600.0):
-        raise InputError(f"--seconds: must be a finite number >= 0 and <= 600, got {seconds!r}")
+        raise InputError(f"--min-time-s: must be a finite number >= 0 and <= 600, got {seconds!r}")
     emit_measurement(run(n_frames=frames, min_seconds=seconds), json_out, "bench sim")
 
 

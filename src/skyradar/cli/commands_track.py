@@ -278,7 +278,7 @@ def _check_tracks_of_run(table, tracks: Path, run: Path) -> None:
 @experiment_app.command("ch4")
 def experiment_ch4(
     out: Annotated[
-        Path, typer.Option("-o", "--output", "--out", help="Output directory for tables and figures.")
+        Path, typer.Option("-o", "--output", help="Output directory for tables and figures.")
     ] = Path("out/ch4"),
     chain: Annotated[
         Ch4Chain,
@@ -301,7 +301,7 @@ def experiment_ch4(
     from skyradar.experiments.ch4 import run as run_ch4
     from skyradar.io.outputs import check_output, mark_folder
 
-    check_output(out, (), overwrite, kind="folder", option="--out")
+    check_output(out, (), overwrite, kind="folder", option="--output")
     result = run_ch4(mark_folder(out), chain=chain.value, seed=seed)
     emit_result(result, as_json, "ch4 tracking")
 

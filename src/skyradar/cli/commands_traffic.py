@@ -36,12 +36,12 @@ _Vertical = Annotated[
 ]
 _TCpa = Annotated[
     float | None,
-    typer.Option("--t-cpa", help="CPA time, s after the own ship's first fix (default: middle)."),
+    typer.Option("--t-cpa-s", help="CPA time, s after the own ship's first fix (default: middle)."),
 ]
 _TIntruder = Annotated[
     float | None,
     typer.Option(
-        "--intruder-time", help="Intruder time moved to the CPA, s after its first fix (default: middle)."
+        "--intruder-time-s", help="Intruder time moved to the CPA, s after its first fix (default: middle)."
     ),
 ]
 _Rotate = Annotated[float, typer.Option("--rotate-deg", help="Turn the intruder's flight, deg clockwise.")]
@@ -203,7 +203,7 @@ def make_encounter(
     if abs(t - t_cpa) > 0.1 or abs(h_m - miss_m) > 1.0:  # manoeuvring flights: say what they really do
         console.print(
             f"note: the flights manoeuvre near the meeting: closest approach {h_m:.0f} m at {t:.2f} s "
-            f"(asked {miss_m:g} m at {t_cpa:g} s); try another --t-cpa or --intruder-time",
+            f"(asked {miss_m:g} m at {t_cpa:g} s); try another --t-cpa-s or --intruder-time-s",
             soft_wrap=True,
         )
     emit_result(result, as_json, "encounter")

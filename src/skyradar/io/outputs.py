@@ -150,7 +150,7 @@ def check_output(
         What the command writes; a "folder" is written into (files of the same name replaced,
         others kept) and gets the :data:`FOLDER_MARKER` file.
     option : str
-        The option named in the error (``--output``, ``--out``).
+        The option named in the error (``--output``).
 
     Inside a command (:func:`skyradar.io.locks.command_outputs`) the output is locked from here until
     the command ends; the checks that do not depend on what is at ``path`` come first, those of an
@@ -253,7 +253,7 @@ def mark_folder(path: str | Path) -> Path:
     path.mkdir(parents=True, exist_ok=True)
     marker = path / FOLDER_MARKER
     if not marker.exists():
-        marker.write_text("written by skyradar; `--out` may write into this folder again\n")
+        marker.write_text("written by skyradar; `--output` may write into this folder again\n")
     return path
 
 

@@ -6,7 +6,11 @@ The names users call, importable from here (each is imported from its module on 
 - :func:`~.track_table.track_detections`, :func:`~.track_table.track_air_detections`: a detections
   table in, a tracks table out (``skyradar track``);
 - :class:`~.tracker.RangeDopplerTracker` with its :class:`~.tracker.TrackerConfig` and the motion
-  models :func:`~.models.radar_model` and :func:`~.models.traditional_model`;
+  models :func:`~.models.radar_model` and :func:`~.models.traditional_model`; the roles it is
+  composed of, for parts of one's own (:mod:`.components`): :class:`~.components.Predictor`,
+  :class:`~.components.Associator`, :class:`~.components.Updater`, :class:`~.components.Initiator`,
+  :class:`~.components.Deleter` and :class:`~.components.Reacquirer`; the live tracks it holds,
+  :class:`~.types.TrackArrays`, and what a frame returns, :class:`~.types.FrameTracks`;
   :class:`~.tracker3d.Tracker3D`, the 3-D filter on direction-of-arrival positions;
 - :func:`~.io.read_detections` and :func:`~.simulated_detections.synthetic_detections`, detections
   from a file or from truth;
@@ -30,6 +34,8 @@ _EXPORTS = {
     "track_table": ("track_detections", "track_air_detections"),
     "tracker": ("RangeDopplerTracker", "TrackerConfig"),
     "models": ("radar_model", "traditional_model"),
+    "components": ("Predictor", "Associator", "Updater", "Initiator", "Deleter", "Reacquirer"),
+    "types": ("TrackArrays", "FrameTracks"),
     "tracker3d": ("Tracker3D",),
     "io": ("read_detections",),
     "simulated_detections": ("synthetic_detections",),

@@ -1,23 +1,30 @@
 """The roles a tracker is composed of, as typed interfaces (Stone Soup's components).
 
-:class:`~skyradar.track.tracker.RangeDopplerTracker` is put together from parts passed in: an
-associator that gates and assigns detections to tracks, an initiator that confirms tentative tracks,
-a deleter that closes tracks, and a reacquirer that gives a lost track's id back to the aircraft when
-it is found again. Each role is a :class:`typing.Protocol`: any object with the methods (and the
-attributes the tracker reads) fits, without inheriting from anything, and a type checker or
-``isinstance`` (the protocols are runtime-checkable) says whether it does. The motion model
-(prediction and update matrices) is the :class:`~skyradar.track.models.MotionModel` value the
-tracker is built with; the batched Kalman step itself is :mod:`skyradar.track.kalman`.
+:class:`~skyradar.track.tracker.RangeDopplerTracker` is put together from parts passed in: a
+predictor that carries every track's state to the frame's time, an associator that gates and
+assigns detections to tracks, an updater that corrects the assigned tracks with their innovations,
+an initiator that confirms tentative tracks, a deleter that closes tracks, and a reacquirer that
+gives a lost track's id back to the aircraft when it is found again. Each role is a
+:class:`typing.Protocol`: any object with the methods (and the attributes the tracker reads) fits,
+without inheriting from anything, and a type checker or ``isinstance`` (the protocols are
+runtime-checkable) says whether it does. The motion model (the transition, process-noise and
+measurement matrices the predictor and updater are given) is the
+:class:`~skyradar.track.models.MotionModel` value the tracker is built with.
 
-The shipped parts: :func:`~skyradar.track.association.associate` (Hungarian assignment in a
-Mahalanobis or pixel gate, Doppler-alias aware), :class:`~skyradar.track.initiation.MOfN`,
+The shipped parts: :func:`~skyradar.track.kalman.predict` and :func:`~skyradar.track.kalman.update`
+(the batched Kalman step, Joseph-form covariance),
+:func:`~skyradar.track.association.associate` (Hungarian assignment in a Mahalanobis or pixel gate,
+Doppler-alias aware), :class:`~skyradar.track.initiation.MOfN`,
 :class:`~skyradar.track.deletion.MissDeleter` and :class:`~skyradar.track.reacquisition.LostTracks`.
 
 Examples
 --------
 >>> from skyradar.track.deletion import MissDeleter
 >>> from skyradar.track.initiation import MOfN
+>>> from skyradar.track.kalman import predict, update
 >>> isinstance(MissDeleter(), Deleter), isinstance(MOfN(3, 4), Initiator)
+(True, True)
+>>> isinstance(predict, Predictor), isinstance(update, Updater)
 (True, True)
 """
 
@@ -30,7 +37,20 @@ import numpy as np
 from skyradar.track.association import Association
 from skyradar.track.types import TrackArrays
 
-__all__ = ["Associator", "Initiator", "Deleter", "Reacquirer"]
+__all__ = ["Predictor", "Associator", "Updater", "Initiator", "Deleter", "Reacquirer"]
+
+
+@runtime_checkable
+class Predictor(Protocol):
+    """Carries a stack of track states forward by one time step."""
+
+    def __call__(
+        self, x: np.ndarray, P: np.ndarray, F: np.ndarray, Q: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """States ``x`` (n, d) and covariances ``P`` (n, d, d) one step later, from the step's
+        transition ``F`` and process noise ``Q`` (each (d, d), or (n, d, d) per track), in the
+        states' units (m, m/s, ...)."""
+        ...
 
 
 @runtime_checkable
@@ -54,6 +74,26 @@ class Associator(Protocol):
         ``z_pred`` (n, 2) and ``z`` (m, 2) are (range [m], radial velocity [m/s]); ``S`` (n, 2, 2)
         the innovation covariances; ``gate`` the largest assignment cost kept.
         """
+        ...
+
+
+@runtime_checkable
+class Updater(Protocol):
+    """Corrects the assigned tracks' states with their measurements' innovations."""
+
+    def __call__(
+        self,
+        x: np.ndarray,
+        P: np.ndarray,
+        y: np.ndarray,
+        H: np.ndarray,
+        R: np.ndarray,
+        S: np.ndarray | None = None,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """States ``x`` (n, d) and covariances ``P`` (n, d, d) after the update with innovations
+        ``y`` (n, k) (wrapped by the tracker where the measurement space is circular), the
+        measurement matrix ``H`` (k, d), the measurement noise ``R`` (k, k) and, when the caller
+        has it, the innovation covariance ``S`` (n, k, k)."""
         ...
 
 

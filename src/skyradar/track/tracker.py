@@ -5,8 +5,8 @@ One frame is: predict every track (one batched Kalman step), gate and assign det
 model's innovation, de-alias the radial velocity (radar model), start tentative tracks from
 unassigned detections, confirm them M-of-N (sliding window), and close tracks after misses.
 The parts are objects passed in, as in Stone Soup, each filling a role typed in
-:mod:`skyradar.track.components`: the motion model (:mod:`skyradar.track.models`), the associator,
-the initiator, the deleter and the reacquirer.
+:mod:`skyradar.track.components`: the motion model (:mod:`skyradar.track.models`), the predictor,
+the associator, the updater, the initiator, the deleter and the reacquirer.
 
 Tracks live as one struct of arrays (:class:`~skyradar.track.types.TrackArrays`: states ``(n, 4)``,
 covariances ``(n, 4, 4)``, counters), so the cost per frame is a fixed number of numpy calls, whatever
@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from skyradar.track.association import Association, associate
-from skyradar.track.components import Associator, Deleter, Initiator, Reacquirer
+from skyradar.track.components import Associator, Deleter, Initiator, Predictor, Reacquirer, Updater
 from skyradar.track.dealias import dealias_velocity, push_history, range_rate_fit
 from skyradar.track.deletion import MissDeleter
 from skyradar.track.initiation import MOfN, push_hit
@@ -56,6 +56,12 @@ class RangeDopplerTracker:
         ``reacquire_s=0`` turns it off).
     report_tentative : bool
         Also report tentative tracks (tracks born in this frame are reported from the next one).
+    predictor : Predictor, optional
+        :class:`~skyradar.track.components.Predictor`: carries the tracks to each frame's time
+        with the model's transition and process noise; default :func:`~skyradar.track.kalman.predict`.
+    updater : Updater, optional
+        :class:`~skyradar.track.components.Updater`: corrects the assigned tracks with their
+        innovations; default :func:`~skyradar.track.kalman.update`.
 
     Examples
     --------
@@ -77,12 +83,16 @@ class RangeDopplerTracker:
         deleter: Deleter | None = None,
         report_tentative: bool = False,
         reacquirer: Reacquirer | None = None,
+        predictor: Predictor = predict,
+        updater: Updater = update,
     ) -> None:
         self.model = model
         self.report_tentative = bool(report_tentative)
         self.config = config or TrackerConfig()
         self.pixel_size = pixel_size
+        self.predictor = predictor
         self.associator = associator
+        self.updater = updater
         self.initiator = initiator or MOfN(self.config.confirm_m, self.config.confirm_n)
         self.deleter = deleter or MissDeleter(self.config.max_misses, self.config.max_coast_s)
         c = self.config
@@ -135,9 +145,9 @@ class RangeDopplerTracker:
                     (np.flatnonzero(tr.resolved), F, Q),
                     (np.flatnonzero(~tr.resolved), F_u, Q_u),
                 ):
-                    tr.x[rows], tr.P[rows] = predict(tr.x[rows], tr.P[rows], FF, QQ)
+                    tr.x[rows], tr.P[rows] = self.predictor(tr.x[rows], tr.P[rows], FF, QQ)
             else:
-                tr.x, tr.P = predict(tr.x, tr.P, F, Q)
+                tr.x, tr.P = self.predictor(tr.x, tr.P, F, Q)
         self.time_s = self._now = float(time_s)
         self._close_stale()
         assoc = self._associate(z, secondary)
@@ -246,7 +256,7 @@ class RangeDopplerTracker:
         if self._range_wrap is not None:
             self._shift_alias(rows, z[assoc.detection_index, 0], assoc.innovation[:, 0], self._range_wrap)
         x, P = tr.x[rows], tr.P[rows]
-        tr.x[rows], tr.P[rows] = update(x, P, assoc.innovation, self._H, self._R)
+        tr.x[rows], tr.P[rows] = self.updater(x, P, assoc.innovation, self._H, self._R)
         if self._hybrid:
             self._resolve(rows)
         if self._thesis:

@@ -175,7 +175,8 @@ def run_scenario(
     end = scenario_end_s(path) if end_s is None else float(end_s)
     if not end > 0:
         raise InputError(
-            f"{path}: the scenario has no commands after t = 0 s; give the time to run to (--end, or a HOLD)"
+            f"{path}: the scenario has no commands after t = 0 s; "
+            "give the time to run to (--end-s, or a HOLD)"
         )
     t0 = time.perf_counter()
     sink: Any = open(log_path, "a") if log_path is not None else _Discard()  # noqa: SIM115

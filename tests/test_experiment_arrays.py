@@ -17,6 +17,7 @@ from cli_helpers import assert_one_line_error, skyradar
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.experiments import arrays
+from skyradar.io.tables import jsonable
 
 
 def _ura_bound_deg(rows: int, cols: int, snr_db: float) -> tuple[float, float]:
@@ -165,9 +166,7 @@ def test_a_small_run_writes_its_files_with_one_row_per_array_on_the_same_encount
     assert table["encounter_set"].nunique() == 1  # both arrays flew the same encounter
     assert (table["encounters"] == 1).all()
     saved = json.loads((out / "summary.json").read_text())
-    assert saved["arrays"] == ["square", "ura-2x3"] and saved["rows"] == json.loads(
-        json.dumps(result["rows"])
-    )
+    assert saved["arrays"] == ["square", "ura-2x3"] and saved["rows"] == jsonable(result["rows"])
     per = {a["array"]: a for a in saved["per_array"]}
     assert per["ura-2x3"]["n_rx"] == 6 and per["square"]["n_rx"] == 4
     assert all(a["frames_per_s"] > 0 and len(a["doa"]) == 3 for a in per.values())

@@ -68,7 +68,7 @@ from skyradar.experiments.encounter_chain import FRAME_RATE_HZ
 from skyradar.experiments.encounter_set import make_encounters, rate_interval
 from skyradar.experiments.encounter_terrain import TERRAINS
 from skyradar.experiments.encounters import EVALUATION_SEEDS_FROM, MAX_ENCOUNTERS
-from skyradar.experiments.summary_md import markdown_table, number, page, write_summary
+from skyradar.experiments.summary_md import counted, markdown_table, number, page, write_summary
 from skyradar.io.atomic import savefig_atomic, write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.rx_layouts import RX_LAYOUTS, check_rx_layout
@@ -559,8 +559,8 @@ def run(
         "cpu_count": os.cpu_count(),
         **provenance(command, version),
     }
-    write_summary(out_dir, summary_markdown(result, out_dir))
     write_json_atomic(out_dir / "summary.json", result)
+    write_summary(out_dir, summary_markdown(result, out_dir))
     return result
 
 
@@ -568,8 +568,8 @@ def run(
 
 
 def _interval(ci: Sequence[float]) -> str:
-    lo, hi = ci
-    return "n/a" if not np.isfinite(lo) else f"{100 * lo:.0f}-{100 * hi:.0f} %"
+    lo, hi = ci  # None where the JSON holds a NaN (no trials)
+    return "n/a" if lo is None or not np.isfinite(lo) else f"{100 * lo:.0f}-{100 * hi:.0f} %"
 
 
 def summary_markdown(result: dict[str, Any], out_dir: Path | None = None) -> str:
@@ -577,7 +577,8 @@ def summary_markdown(result: dict[str, Any], out_dir: Path | None = None) -> str
     one per array of the sensor's own figures; every number from ``result``."""
     rows, per_array = result["rows"], result["per_array"]
     intro = (
-        f"{result['n']} encounters (seed {result['seed']}, {result['split']} split) per array and terrain, "
+        f"{counted(result['n'], 'encounter')} (seed {result['seed']}, {result['split']} split) per array "
+        "and terrain, "
         f"the same encounters for every array, each simulated with its own receive channels and flown "
         f"through the whole chain with the single forward head at {result['frame_rate_hz']:g} frames per "
         "second. Intervals are 95 % Wilson intervals; with a handful of encounters they are wide."
@@ -624,7 +625,7 @@ def summary_markdown(result: dict[str, Any], out_dir: Path | None = None) -> str
         "arrays_doa.png": "DoA error against the Cramer-Rao bound per array",
         "arrays_doppler.png": "SINR loss against Doppler per array, MDV marked",
         "arrays_frames_per_s.png": "processing frames per second per array",
-        "encounters_<array>": "each array's encounter run (its own summary, tables and figures)",
+        "encounters_<array>/summary.md": "each array's encounter run (its own summary, tables, figures)",
         "summary.json": "every number, with the command, version and machine load",
     }
     text = page(
@@ -636,6 +637,7 @@ def summary_markdown(result: dict[str, Any], out_dir: Path | None = None) -> str
             "array",
             "channels",
             "MDV [m/s]",
+            "MDV into ground band [m/s]",
             "usable Doppler",
             f"az error / bound at {snr_hi:g} dB",
             f"el error / bound at {snr_hi:g} dB",
@@ -646,6 +648,7 @@ def summary_markdown(result: dict[str, Any], out_dir: Path | None = None) -> str
                 a["array"],
                 a["n_rx"],
                 number(a["mdv_mps"], 2),
+                number(a["mdv_into_ground_band_mps"], 1),
                 number(a["usable_doppler_fraction"], 2),
                 number(a["doa"][-1]["azimuth_over_bound"], 2),
                 number(a["doa"][-1]["elevation_over_bound"], 2),
@@ -726,7 +729,10 @@ def plot_doppler(curves: list[pd.DataFrame], per_array: list[dict], path: Path) 
         label = f"{a['array']} (MDV into the ground band {into} m/s, usable {usable})"
         ax.plot(curve["radial_velocity_mps"], curve["sinr_loss_suppressed_db"], color=f"C{k}", label=label)
     ax.axhline(_LOSS_THRESHOLD_DB, color="k", ls="--", lw=0.8)
-    ax.axvline(per_array[0]["main_beam_clutter_mps"], color="0.5", ls=":", lw=0.8)
+    from skyradar.units import wrap
+
+    v_lim = float(np.max(np.abs(curves[0]["radial_velocity_mps"])))
+    ax.axvline(float(wrap(per_array[0]["main_beam_clutter_mps"], 2.0 * v_lim)), color="0.5", ls=":", lw=0.8)
     ax.set(xlabel="radial velocity [m/s]", ylabel="SINR loss [dB]", ylim=(-40, 2))
     ax.set_title("boresight target after clutter suppression (dotted: main-beam clutter)", fontsize=9)
     ax.legend(fontsize=8)

@@ -91,8 +91,8 @@ __all__ = [
 
 DEFAULT_ARRAYS = ("square", "ura-2x3")  # the prototype's 2x2 against the smallest larger array
 DEFAULT_TERRAINS = ("none", "flat-300")
-# Per array and terrain. The defaults (2 arrays, clear sky and flat-300) cost 326 CPU-s (user + system,
-# measured on 2 cores at load 13): about 165 s of wall clock on 2 free cores, within 5 minutes.
+# Per array and terrain. The defaults (2 arrays, clear sky and flat-300) took 3 min 16 s of wall clock and
+# 254 CPU-s (user + system), measured on 2 cores at load 3-4: within 5 minutes.
 DEFAULT_ENCOUNTERS = 2
 DOA_SNRS_DB = (10.0, 20.0, 30.0)  # per channel and pixel: near the detection threshold, mid, strong
 DOA_DIRECTION_DEG = (10.0, 5.0)  # azimuth right, elevation up, deg: off both axes of every array

@@ -50,7 +50,7 @@ def test_every_result_names_the_command_that_measured_it(record):
 def test_readme_and_package_list_the_experiments_that_exist():
     result = CliRunner().invoke(app, ["experiment", "--help"], env={"COLUMNS": "200"})
     listed = set(re.findall(r"^│ (\w[\w-]*) ", result.output, flags=re.MULTILINE))
-    others = {"encounters", "closed-loop", "clutter", "bluesky"}
+    others = {"encounters", "closed-loop", "clutter", "bluesky", "arrays"}
     assert listed == {"ch2", "ch3", "ch4", "ch5", "ch6", "ch7", *others}, result.output
     text = README.read_text()
     assert "`skyradar experiment ch2 ... ch7`" in text

@@ -15,7 +15,7 @@ fixed choices as string enums) and one module per group of commands: :mod:`.comm
 (``simulate-passive``), :mod:`.commands_demo` (``demo``), :mod:`.commands_encounters` and
 :mod:`.commands_clutter` (``experiment encounters``, ``experiment clutter``),
 :mod:`.commands_closed_loop` (``experiment closed-loop``), :mod:`.commands_bluesky` (``experiment
-bluesky``); each also holds its
+bluesky``), :mod:`.commands_arrays` (``experiment arrays``); each also holds its
 ``experiment`` and ``bench`` commands.
 """
 
@@ -29,6 +29,7 @@ from typing import Any
 
 import typer
 
+import skyradar.cli.commands_arrays  # noqa: F401  (registers commands)
 import skyradar.cli.commands_bluesky  # noqa: F401  (registers commands)
 import skyradar.cli.commands_closed_loop  # noqa: F401  (registers commands)
 import skyradar.cli.commands_clutter  # noqa: F401  (registers commands)

@@ -23,6 +23,8 @@ ch2``; none is imported with the package):
   :mod:`.encounter_real`, :mod:`.encounter_chain`, :mod:`.encounter_score`,
   :mod:`.encounter_report`, :mod:`.sensor_figures` and :mod:`.encounter_cost` (``bench encounter``);
 - :mod:`.closed_loop` (the encounter set flown closed-loop: the pilot follows the advice);
+- :mod:`.arrays` (receive arrays x terrains on the same encounters, through :mod:`.encounters`, with
+  each array's minimum detectable velocity, DoA error against its bound and frames per second);
 - :mod:`.bluesky_compare` (BlueSky's perfect-state conflict detection against the radar's, through
   the plugin of :mod:`skyradar.integrations.bluesky`).
 
@@ -39,5 +41,6 @@ __all__ = [
     "clutter",
     "encounters",
     "closed_loop",
+    "arrays",
     "bluesky_compare",
 ]

@@ -22,9 +22,7 @@ __all__ = ["experiment_arrays"]
 
 @experiment_app.command("arrays")
 def experiment_arrays(
-    out: Annotated[Path, typer.Option("-o", "--output", "--out", help="Output directory.")] = Path(
-        "out/arrays"
-    ),
+    out: Annotated[Path, typer.Option("-o", "--output", help="Output directory.")] = Path("out/arrays"),
     arrays: Annotated[
         str,
         typer.Option(
@@ -72,7 +70,7 @@ def experiment_arrays(
     terrains = parse_terrains(terrain)
     check_workers(workers)
     check_split(seed, split)
-    check_output(out, (), overwrite, kind="folder", option="--out")
+    check_output(out, (), overwrite, kind="folder", option="--output")
     mark_folder(out)
     total = n * len(terrains) * len(names)
     with frame_progress(total, "encounters") as bar:

@@ -148,10 +148,8 @@ def top_eigenpairs(a, v, lam, relevant, tol=1e-4, max_iter=50, scratch=None):  #
 
 
 @njit(cache=True)
-def _ritz_two(a, v, w, vu, wu, lam):  # pragma: no cover - compiled
-    # The Rayleigh-Ritz step of a two-column subspace in closed form: w = a v, h = v^H w (2 x 2,
-    # Hermitian), its eigen-pairs from the quadratic (mu = mean +- sqrt(d^2 + |h01|^2)), the
-    # Ritz vectors vu = v u and wu = w u = a vu, strongest first.
+def _two_column_product(a, v, w):  # pragma: no cover - compiled
+    # w = a v of a two-column subspace, and h = v^H w (2 x 2, Hermitian) as h00, h11 (real), h01.
     n = v.shape[0]
     h00, h11, h01 = 0.0, 0.0, 0j
     for i in range(n):
@@ -165,6 +163,16 @@ def _ritz_two(a, v, w, vu, wu, lam):  # pragma: no cover - compiled
         h00 += (c0 * w[i, 0]).real
         h11 += (c1 * w[i, 1]).real
         h01 += c0 * w[i, 1]
+    return h00, h11, h01
+
+
+@njit(cache=True)
+def _ritz_two(a, v, w, vu, wu, lam):  # pragma: no cover - compiled
+    # The Rayleigh-Ritz step of a two-column subspace in closed form: w = a v, h = v^H w (2 x 2,
+    # Hermitian), its eigen-pairs from the quadratic (mu = mean +- sqrt(d^2 + |h01|^2)), the
+    # Ritz vectors vu = v u and wu = w u = a vu, strongest first.
+    n = v.shape[0]
+    h00, h11, h01 = _two_column_product(a, v, w)
     mean, half = 0.5 * (h00 + h11), 0.5 * (h00 - h11)
     mag2 = h01.real * h01.real + h01.imag * h01.imag
     r = np.sqrt(half * half + mag2)
@@ -205,18 +213,7 @@ def _first_step_two(a, v, w, wu, trace):  # pragma: no cover - compiled
     # The first subspace step from the start: v <- orthonormal (a - shift) v, the shift from the
     # start's Ritz values (the 2 x 2 problem's roots only: no Ritz vectors, no residual test).
     n = v.shape[0]
-    h00, h11, h01 = 0.0, 0.0, 0j
-    for i in range(n):
-        w0, w1 = 0j, 0j
-        for k in range(n):
-            w0 += a[i, k] * v[k, 0]
-            w1 += a[i, k] * v[k, 1]
-        w[i, 0], w[i, 1] = w0, w1
-    for i in range(n):
-        c0, c1 = np.conj(v[i, 0]), np.conj(v[i, 1])
-        h00 += (c0 * w[i, 0]).real
-        h11 += (c1 * w[i, 1]).real
-        h01 += c0 * w[i, 1]
+    h00, h11, h01 = _two_column_product(a, v, w)
     mean, half = 0.5 * (h00 + h11), 0.5 * (h00 - h11)
     r = np.sqrt(half * half + h01.real * h01.real + h01.imag * h01.imag)
     shift = _shift(trace, mean + r, mean - r, n)

@@ -78,10 +78,11 @@ bench: $(STAMP_RUN)
 	@for name in sim chain flight process track state; do $(BIN)/skyradar bench $$name --json || exit 1; done
 
 # Every experiment at its defaults on BASE and on HEAD (default the checkout's HEAD), each version in its
-# own worktree under $(OUT)/compare; prints the values that differ, timings left out. BASE is required.
+# own worktree under $(OUT)/compare; prints the values that differ, timings left out (RTOL: relative
+# tolerance of measured floats, default exact). BASE is required.
 compare-experiments: $(STAMP_RUN)
 	@test -n "$(BASE)" || { echo "make compare-experiments: give BASE=<commit>" >&2; exit 2; }
-	$(BIN)/python scripts/compare_experiments.py $(BASE) $(or $(HEAD),HEAD) --work $(OUT)/compare
+	$(BIN)/python scripts/compare_experiments.py $(BASE) $(or $(HEAD),HEAD) --work $(OUT)/compare $(if $(RTOL),--rtol $(RTOL))
 
 clean:
 	rm -rf $(VENV) $(OUT) build *.egg-info src/*.egg-info

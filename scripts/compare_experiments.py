@@ -4,7 +4,9 @@ A refactor or a speed-up must leave what the experiments measure unchanged. This
 out each version into its own git worktree under ``--work`` (created here, never a user's
 folder), runs ``skyradar experiment NAME --json`` on it with that worktree's sources first on the
 path, and compares the last JSON line of the two runs value by value. Keys that time the run or
-name where and when it ran (``--ignore``, a regular expression on the key's path) are left out.
+name where and when it ran (``--ignore``, a regular expression on the key's path) are left out;
+``--rtol`` lets measured floats differ by a stated relative amount (a compiled kernel whose
+rounding changed), never counts, flags or strings.
 
 Usage (from the repository root, with the project's ``.venv``)::
 
@@ -29,11 +31,13 @@ from pathlib import Path
 
 EXPERIMENTS = ("ch2", "ch3", "ch4", "ch5", "ch6", "ch7", "clutter", "encounters", "closed-loop", "bluesky")
 
-# Keys that time a run or say where, when and by what it ran: never part of what it measured.
+# Keys that time a run or say where, when and by what it ran: never part of what it measured
+# (stage timings such as ``detect_s``, ``track_s_radar`` or ``process_s_per_frame_none`` included).
 DEFAULT_IGNORE = (
     r"(^|\.)(version|date_utc|command|load_average\w*|workers|scheduler|output|out_dir|files|figures"
-    r"|resumed_encounters)($|\.)"
+    r"|resumed_encounters|seconds)($|\.)"
     r"|(^|\.)\w*(runtime|wall|cpu|timing|elapsed|speedup|cost_ms|ms_per_frame|per_s)\w*($|\.)"
+    r"|(^|\.)(detect|track|process|simulate|alert|total)_s(_\w+)?($|\.)"
 )
 
 
@@ -52,18 +56,38 @@ def _flatten(value, prefix: str = "") -> dict[str, object]:
     return {prefix: value}
 
 
-def _same(a: object, b: object) -> bool:
-    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
-        return True
-    return a == b
+def _relative_difference(a: object, b: object) -> float:
+    """|a - b| / max(|a|, |b|) of two numbers, one a float (0 when equal, both NaN included); inf
+    for any other difference."""
+    if a == b:
+        return 0.0
+    # Only measurements (floats) have a tolerance: counts, flags and strings are equal or not.
+    if not (isinstance(a, float) or isinstance(b, float)):
+        return math.inf
+    if not all(isinstance(x, int | float) and not isinstance(x, bool) for x in (a, b)):
+        return math.inf
+    if math.isnan(a) and math.isnan(b):
+        return 0.0
+    if not (math.isfinite(a) and math.isfinite(b)):
+        return math.inf
+    return abs(a - b) / max(abs(a), abs(b))
 
 
-def compare(before: dict, after: dict, ignore: str) -> list[str]:
-    """Paths whose values differ between two JSON results (ignored paths left out)."""
+def compare(before: dict, after: dict, ignore: str, rtol: float = 0.0) -> list[str]:
+    """Paths whose values differ between two JSON results by more than ``rtol`` (relative; 0: any
+    difference), ignored paths left out. Counts, flags and strings must be equal whatever ``rtol``."""
     pattern = re.compile(ignore)
     a, b = _flatten(before), _flatten(after)
     keys = sorted((set(a) | set(b)) - {k for k in set(a) | set(b) if pattern.search(k)})
-    return [k for k in keys if k not in a or k not in b or not _same(a[k], b[k])]
+    return [k for k in keys if k not in a or k not in b or _relative_difference(a[k], b[k]) > rtol]
+
+
+def largest_relative_difference(before: dict, after: dict, ignore: str) -> float:
+    """The largest relative difference of the values both results hold (ignored paths left out)."""
+    pattern = re.compile(ignore)
+    a, b = _flatten(before), _flatten(after)
+    common = [k for k in set(a) & set(b) if not pattern.search(k)]
+    return max((_relative_difference(a[k], b[k]) for k in common), default=0.0)
 
 
 def _commit(rev: str) -> str:
@@ -114,6 +138,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--only", default=",".join(EXPERIMENTS), help="comma-separated experiments")
     parser.add_argument("--work", default="out/compare", help="folder for the worktrees and runs")
     parser.add_argument("--ignore", default=DEFAULT_IGNORE, help="regex of key paths not compared")
+    parser.add_argument(
+        "--rtol",
+        type=float,
+        default=0.0,
+        help="relative difference below which two numbers count as equal (default 0: exact)",
+    )
     args = parser.parse_args(argv)
     names = [n for n in args.only.split(",") if n]
     unknown = sorted(set(names) - set(EXPERIMENTS))
@@ -123,7 +153,12 @@ def main(argv: list[str] | None = None) -> int:
     work = Path(args.work).resolve()
     work.mkdir(parents=True, exist_ok=True)
     trees = [_worktree(work, _commit(rev)) for rev in (args.base, args.head)]
-    report: dict[str, object] = {"base": _commit(args.base), "head": _commit(args.head), "experiments": {}}
+    report: dict[str, object] = {
+        "base": _commit(args.base),
+        "head": _commit(args.head),
+        "rtol": args.rtol,
+        "experiments": {},
+    }
     equal = True
     for name in names:
         before, after = (_run(tree, name) for tree in trees)
@@ -133,8 +168,13 @@ def main(argv: list[str] | None = None) -> int:
                 "failed": [t.name for t, r in zip(trees, (before, after), strict=True) if r is None],
             }
         else:
-            differing = compare(before, after, args.ignore)
-            entry = {"equal": not differing, "differing": differing[:50], "n_differing": len(differing)}
+            differing = compare(before, after, args.ignore, args.rtol)
+            entry = {
+                "equal": not differing,
+                "differing": differing[:50],
+                "n_differing": len(differing),
+                "largest_relative_difference": largest_relative_difference(before, after, args.ignore),
+            }
         equal &= bool(entry["equal"])
         report["experiments"][name] = entry  # type: ignore[index]
         detail = entry.get("differing", entry.get("failed"))

@@ -67,3 +67,21 @@ def test_an_unknown_revision_is_one_line_with_exit_code_2(tmp_path):
         done.stderr.strip()
         == "compare_experiments: revision 'no-such-rev' is not a commit of this repository"
     )
+
+
+def test_a_tolerance_lets_floats_round_differently_but_never_counts():
+    before = _result()
+    after = _result(median_warning_lead_s=17.5 * (1 + 3e-6))
+    ignore = compare_experiments.DEFAULT_IGNORE
+    assert compare_experiments.compare(before, after, ignore) == ["median_warning_lead_s"]
+    assert compare_experiments.compare(before, after, ignore, rtol=1e-5) == []
+    assert 2e-6 < compare_experiments.largest_relative_difference(before, after, ignore) < 4e-6
+    assert compare_experiments.compare(before, _result(missed_warnings=1), ignore, rtol=10.0) == [
+        "missed_warnings"
+    ]
+
+
+def test_stage_timings_are_left_out():
+    before = {"scenarios": {"zulu": {"detect_s": 1.0, "track_s_radar": 2.0, "rmse_m": 3.0}}, "seconds": 4.0}
+    after = {"scenarios": {"zulu": {"detect_s": 9.0, "track_s_radar": 8.0, "rmse_m": 3.0}}, "seconds": 7.0}
+    assert compare_experiments.compare(before, after, compare_experiments.DEFAULT_IGNORE) == []

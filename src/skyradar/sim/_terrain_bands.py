@@ -24,7 +24,8 @@ rounding.
 
 Why the bound holds: a point of a cell's bilinear patch is a convex combination of its four
 corners, so its distance from the antenna is at most the largest corner distance and at least
-the nearest corner's minus the cell's extent (the ``_cell_beyond`` bound); the bin adds the
+the smallest corner component along the direction of the corners' centroid
+(``_terrain_kernel._cell_nearest``, also the whole-cell range cull); the bin adds the
 range-Doppler coupling (at most ``coupling * |v_ground|``) and the antennas' offsets from the
 phase centre (at most their largest distance from it), and one bin for rounding.
 """
@@ -46,7 +47,13 @@ from skyradar.sim._terrain_batch import (
     number_items,
     scatter_items,
 )
-from skyradar.sim._terrain_kernel import _cell_behind, _cell_beyond, _corner_terms, _sub_centres
+from skyradar.sim._terrain_kernel import (
+    _cell_behind,
+    _cell_beyond,
+    _cell_nearest,
+    _corner_terms,
+    _sub_centres,
+)
 from skyradar.sim.facets import cell_counts
 
 __all__ = ["banded_returns", "band_edges", "frame_edges"]
@@ -55,15 +62,13 @@ __all__ = ["banded_returns", "band_edges", "frame_edges"]
 @njit(inline="always")
 def _cell_bins(p_ant, i, j, d_range, margin_m):
     # Lowest and highest range bin any point of cell (i, j) can land in (module docstring).
-    near, far, extent = 1e300, 0.0, 0.0
+    far = 0.0
     for ci in range(2):
         for cj in range(2):
             x, y, z = p_ant[i + ci, j + cj, 0], p_ant[i + ci, j + cj, 1], p_ant[i + ci, j + cj, 2]
-            r = math.sqrt(x * x + y * y + z * z)
-            near, far = min(near, r), max(far, r)
-    for c in range(3):
-        extent += abs(p_ant[i + 1, j + 1, c] - p_ant[i, j, c]) + abs(p_ant[i + 1, j, c] - p_ant[i, j + 1, c])
-    lo = math.floor((max(near - extent, 0.0) - margin_m) / d_range + 0.5) - 1
+            far = max(far, math.sqrt(x * x + y * y + z * z))
+    near = _cell_nearest(p_ant, i, j)
+    lo = math.floor((near - margin_m) / d_range + 0.5) - 1
     hi = math.floor((far + margin_m) / d_range + 0.5) + 1
     return lo, hi
 

@@ -49,7 +49,6 @@ from skyradar.sim._terrain_batch import (
 )
 from skyradar.sim._terrain_kernel import (
     _cell_behind,
-    _cell_beyond,
     _cell_nearest,
     _corner_terms,
     _sub_centres,
@@ -60,16 +59,16 @@ __all__ = ["banded_returns", "band_edges", "frame_edges"]
 
 
 @njit(inline="always")
-def _cell_bins(p_ant, i, j, d_range, margin_m):
-    # Lowest and highest range bin any point of cell (i, j) can land in (module docstring).
-    far = 0.0
+def _cell_bins(p_ant, i, j, d_range, margin_m, near):
+    # Lowest and highest range bin any point of cell (i, j) can land in (module docstring);
+    # ``near`` is its _cell_nearest bound.
+    far2 = 0.0
     for ci in range(2):
         for cj in range(2):
             x, y, z = p_ant[i + ci, j + cj, 0], p_ant[i + ci, j + cj, 1], p_ant[i + ci, j + cj, 2]
-            far = max(far, math.sqrt(x * x + y * y + z * z))
-    near = _cell_nearest(p_ant, i, j)
+            far2 = max(far2, x * x + y * y + z * z)
     lo = math.floor((near - margin_m) / d_range + 0.5) - 1
-    hi = math.floor((far + margin_m) / d_range + 0.5) + 1
+    hi = math.floor((math.sqrt(far2) + margin_m) / d_range + 0.5) + 1
     return lo, hi
 
 
@@ -113,9 +112,12 @@ def _sampled_work(p_ant, v_ground_ant, counts, adapt, margin_m, d_range, n_range
     work = np.zeros(n_range + 1)
     for i in range(0, ny - 1, stride):
         for j in range(0, nx - 1, stride):
-            if _cell_behind(p_ant, i, j) or _cell_beyond(p_ant, i, j, r_max):
+            if _cell_behind(p_ant, i, j):
                 continue
-            c_lo, c_hi = _cell_bins(p_ant, i, j, d_range, margin_m)
+            near = _cell_nearest(p_ant, i, j)  # one bound for the cull and the bins
+            if near > r_max:
+                continue
+            c_lo, c_hi = _cell_bins(p_ant, i, j, d_range, margin_m, near)
             nu, nw = cell_counts(p_ant, i, j, v_ground_ant, n_min_r, n_min_c, n_max_r, n_max_c, adapt)
             work[min(max((c_lo + c_hi) // 2, 0), n_range)] += nu * nw * stride * stride
     return work
@@ -268,9 +270,12 @@ def _band_pass(
         k = 0
         for i in range(ny - 1):
             for j in range(nx - 1):
-                if _cell_behind(p_ant, i, j) or _cell_beyond(p_ant, i, j, r_max):
+                if _cell_behind(p_ant, i, j):
                     continue
-                c_lo, c_hi = _cell_bins(p_ant, i, j, d_range, margin_m)
+                near = _cell_nearest(p_ant, i, j)  # _cell_beyond's bound, also the lowest bin's
+                if near > r_max:
+                    continue
+                c_lo, c_hi = _cell_bins(p_ant, i, j, d_range, margin_m, near)
                 if c_hi < lo or c_lo >= hi:
                     continue
                 nu, nw = cell_counts(p_ant, i, j, v_ground_ant, n_min_r, n_min_c, n_max_r, n_max_c, adapt)

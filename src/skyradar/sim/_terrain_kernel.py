@@ -143,8 +143,8 @@ def _cell_nearest(p_ant, i, j):
         for ci in range(2):
             for cj in range(2):
                 x, y, z = p_ant[i + ci, j + cj, 0], p_ant[i + ci, j + cj, 1], p_ant[i + ci, j + cj, 2]
-                along = min(along, (cx * x + cy * y + cz * z) / norm)
-        bound = max(bound, along)
+                along = min(along, cx * x + cy * y + cz * z)
+        bound = max(bound, along / norm)
     return max(bound - _CULL_SLACK_M, 0.0)
 
 

@@ -24,7 +24,8 @@ rounding.
 
 Why the bound holds: a point of a cell's bilinear patch is a convex combination of its four
 corners, so its distance from the antenna is at most the largest corner distance and at least
-the nearest corner's minus the cell's extent (the ``_cell_beyond`` bound); the bin adds the
+the smallest corner component along the direction of the corners' centroid
+(``_terrain_kernel._cell_nearest``, also the whole-cell range cull); the bin adds the
 range-Doppler coupling (at most ``coupling * |v_ground|``) and the antennas' offsets from the
 phase centre (at most their largest distance from it), and one bin for rounding.
 """
@@ -46,25 +47,28 @@ from skyradar.sim._terrain_batch import (
     number_items,
     scatter_items,
 )
-from skyradar.sim._terrain_kernel import _cell_behind, _cell_beyond, _corner_terms, _sub_centres
+from skyradar.sim._terrain_kernel import (
+    _cell_behind,
+    _cell_nearest,
+    _corner_terms,
+    _sub_centres,
+)
 from skyradar.sim.facets import cell_counts
 
 __all__ = ["banded_returns", "band_edges", "frame_edges"]
 
 
 @njit(inline="always")
-def _cell_bins(p_ant, i, j, d_range, margin_m):
-    # Lowest and highest range bin any point of cell (i, j) can land in (module docstring).
-    near, far, extent = 1e300, 0.0, 0.0
+def _cell_bins(p_ant, i, j, d_range, margin_m, near):
+    # Lowest and highest range bin any point of cell (i, j) can land in (module docstring);
+    # ``near`` is its _cell_nearest bound.
+    far2 = 0.0
     for ci in range(2):
         for cj in range(2):
             x, y, z = p_ant[i + ci, j + cj, 0], p_ant[i + ci, j + cj, 1], p_ant[i + ci, j + cj, 2]
-            r = math.sqrt(x * x + y * y + z * z)
-            near, far = min(near, r), max(far, r)
-    for c in range(3):
-        extent += abs(p_ant[i + 1, j + 1, c] - p_ant[i, j, c]) + abs(p_ant[i + 1, j, c] - p_ant[i, j + 1, c])
-    lo = math.floor((max(near - extent, 0.0) - margin_m) / d_range + 0.5) - 1
-    hi = math.floor((far + margin_m) / d_range + 0.5) + 1
+            far2 = max(far2, x * x + y * y + z * z)
+    lo = math.floor((near - margin_m) / d_range + 0.5) - 1
+    hi = math.floor((math.sqrt(far2) + margin_m) / d_range + 0.5) + 1
     return lo, hi
 
 
@@ -108,9 +112,12 @@ def _sampled_work(p_ant, v_ground_ant, counts, adapt, margin_m, d_range, n_range
     work = np.zeros(n_range + 1)
     for i in range(0, ny - 1, stride):
         for j in range(0, nx - 1, stride):
-            if _cell_behind(p_ant, i, j) or _cell_beyond(p_ant, i, j, r_max):
+            if _cell_behind(p_ant, i, j):
                 continue
-            c_lo, c_hi = _cell_bins(p_ant, i, j, d_range, margin_m)
+            near = _cell_nearest(p_ant, i, j)  # one bound for the cull and the bins
+            if near > r_max:
+                continue
+            c_lo, c_hi = _cell_bins(p_ant, i, j, d_range, margin_m, near)
             nu, nw = cell_counts(p_ant, i, j, v_ground_ant, n_min_r, n_min_c, n_max_r, n_max_c, adapt)
             work[min(max((c_lo + c_hi) // 2, 0), n_range)] += nu * nw * stride * stride
     return work
@@ -263,9 +270,12 @@ def _band_pass(
         k = 0
         for i in range(ny - 1):
             for j in range(nx - 1):
-                if _cell_behind(p_ant, i, j) or _cell_beyond(p_ant, i, j, r_max):
+                if _cell_behind(p_ant, i, j):
                     continue
-                c_lo, c_hi = _cell_bins(p_ant, i, j, d_range, margin_m)
+                near = _cell_nearest(p_ant, i, j)  # _cell_beyond's bound, also the lowest bin's
+                if near > r_max:
+                    continue
+                c_lo, c_hi = _cell_bins(p_ant, i, j, d_range, margin_m, near)
                 if c_hi < lo or c_lo >= hi:
                     continue
                 nu, nw = cell_counts(p_ant, i, j, v_ground_ant, n_min_r, n_min_c, n_max_r, n_max_c, adapt)

@@ -27,6 +27,8 @@ from skyradar.sim._terrain_batch import (
 )
 from skyradar.sim.facets import cell_counts
 
+_CULL_SLACK_M = 1e-6  # m: the cull bound's margin over the rounding of the patch formula (1e-9 m at 10 km)
+
 __all__ = [
     "add_sparse",
     "cell_count_grid",
@@ -116,17 +118,41 @@ def _cell_behind(p_ant, i, j):
 
 
 @njit(inline="always")
-def _cell_beyond(p_ant, i, j, r_max):
-    # No point of the cell can be within r_max when its nearest corner is further than r_max
-    # plus the cell's largest extent (compared squared: no square roots).
-    nearest2, extent = 1e300, 0.0
+def _cell_nearest(p_ant, i, j):
+    """A lower bound (m) of the distance from the antenna to any point of cell (i, j).
+
+    A point of the bilinear patch is a convex combination of the four corners, so its
+    component along any unit vector ``n`` is at least the smallest corner component, and its
+    distance at least that component: with ``n`` towards the corners' centroid this is within
+    about half the cell's diagonal of the true nearest distance. The nearest corner's distance
+    minus the cell's extent (a sum of absolute coordinate differences) bounds it too; the
+    larger of the two holds. ``_CULL_SLACK_M`` covers the rounding of the patch formula.
+    """
+    cx, cy, cz, nearest2, extent = 0.0, 0.0, 0.0, 1e300, 0.0
     for ci in range(2):
         for cj in range(2):
             x, y, z = p_ant[i + ci, j + cj, 0], p_ant[i + ci, j + cj, 1], p_ant[i + ci, j + cj, 2]
             nearest2 = min(nearest2, x * x + y * y + z * z)
+            cx, cy, cz = cx + x, cy + y, cz + z
     for c in range(3):
         extent += abs(p_ant[i + 1, j + 1, c] - p_ant[i, j, c]) + abs(p_ant[i + 1, j, c] - p_ant[i, j + 1, c])
-    return nearest2 > (r_max + extent) * (r_max + extent)
+    bound = math.sqrt(nearest2) - extent
+    norm = math.sqrt(cx * cx + cy * cy + cz * cz)
+    if norm > 0.0:
+        along = 1e300
+        for ci in range(2):
+            for cj in range(2):
+                x, y, z = p_ant[i + ci, j + cj, 0], p_ant[i + ci, j + cj, 1], p_ant[i + ci, j + cj, 2]
+                along = min(along, cx * x + cy * y + cz * z)
+        bound = max(bound, along / norm)
+    return max(bound - _CULL_SLACK_M, 0.0)
+
+
+@njit(inline="always")
+def _cell_beyond(p_ant, i, j, r_max):
+    # No point of the cell can be within r_max when a lower bound of its distance exceeds it
+    # (its sub-facets would all fail the per-sub-facet test r0 <= r_max).
+    return _cell_nearest(p_ant, i, j) > r_max
 
 
 @njit(inline="always")

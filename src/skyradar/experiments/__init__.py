@@ -24,7 +24,8 @@ ch2``; none is imported with the package):
   :mod:`.encounter_report`, :mod:`.sensor_figures` and :mod:`.encounter_cost` (``bench encounter``);
 - :mod:`.closed_loop` (the encounter set flown closed-loop: the pilot follows the advice);
 - :mod:`.arrays` (receive arrays x terrains on the same encounters, through :mod:`.encounters`, with
-  each array's minimum detectable velocity, DoA error against its bound and frames per second);
+  each array's minimum detectable velocity, DoA error against its bound and frames per second),
+  with :mod:`.arrays_report`;
 - :mod:`.bluesky_compare` (BlueSky's perfect-state conflict detection against the radar's, through
   the plugin of :mod:`skyradar.integrations.bluesky`).
 

@@ -29,7 +29,19 @@ import subprocess
 import sys
 from pathlib import Path
 
-EXPERIMENTS = ("ch2", "ch3", "ch4", "ch5", "ch6", "ch7", "clutter", "encounters", "closed-loop", "bluesky")
+EXPERIMENTS = (
+    "ch2",
+    "ch3",
+    "ch4",
+    "ch5",
+    "ch6",
+    "ch7",
+    "clutter",
+    "encounters",
+    "closed-loop",
+    "bluesky",
+    "arrays",
+)
 
 # Keys that time a run or say where, when and by what it ran: never part of what it measured
 # (stage timings such as ``detect_s``, ``track_s_radar`` or ``process_s_per_frame_none`` included).

@@ -85,3 +85,16 @@ def test_stage_timings_are_left_out():
     before = {"scenarios": {"zulu": {"detect_s": 1.0, "track_s_radar": 2.0, "rmse_m": 3.0}}, "seconds": 4.0}
     after = {"scenarios": {"zulu": {"detect_s": 9.0, "track_s_radar": 8.0, "rmse_m": 3.0}}, "seconds": 7.0}
     assert compare_experiments.compare(before, after, compare_experiments.DEFAULT_IGNORE) == []
+
+
+def test_every_experiment_command_is_compared():
+    import click
+    import typer.main
+
+    from skyradar.cli import app
+
+    root = typer.main.get_command(app)
+    ctx = click.Context(root)
+    experiment = root.get_command(ctx, "experiment")
+    names = experiment.list_commands(click.Context(experiment, parent=ctx))
+    assert sorted(names) == sorted(compare_experiments.EXPERIMENTS)

@@ -77,6 +77,7 @@ from skyradar.track.static_point import (
 )
 
 _CLEAR_S = 3.0  # judged an object off the ground this long on end: not judged again
+_SPIKE_MIN_DETECTIONS = 6  # a Doppler history this long may leave out one detection and still test a curve
 
 # Why a track row is not confirmed (the tracks table's ``held_by``; "" when it is confirmed).
 HOLD_REASONS: dict[str, str] = {
@@ -355,8 +356,20 @@ def doppler_smooth(
     t, v = np.asarray(time_s, float)[-n:], np.asarray(radial_velocity_mps, float)[-n:]
     if t.size < 3:
         return True
-    degree = 2 if t.size >= 5 else 1  # a line over the first 0.2-0.3 s
     v = np.unwrap(v, period=width_mps)
+    if _smooth_curve(t, v, test):
+        return True
+    # One detection off the curve is a clutter hit the track's gate took (it spans a few cells where
+    # the ground is dense); a patch's scatterers taking turns put several off it.
+    if t.size < _SPIKE_MIN_DETECTIONS:
+        return False
+    return any(_smooth_curve(np.delete(t, j), np.delete(v, j), test) for j in range(t.size))
+
+
+def _smooth_curve(t: np.ndarray, v: np.ndarray, test: GroundTrackTest) -> bool:
+    """The trimmed chi-square test of :func:`doppler_smooth` on unwrapped radial velocities ``v``."""
+    assert test.point_sigma_velocity_mps is not None
+    degree = 2 if t.size >= 5 else 1  # a line over the first 0.2-0.3 s
     res = v - np.polyval(np.polyfit(t - t[0], v, degree), t - t[0])
     z2 = (res / test.point_sigma_velocity_mps) ** 2
     keep = t.size - int(np.floor(test.trim * t.size))

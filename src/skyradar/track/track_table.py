@@ -26,6 +26,7 @@ __all__ = [
     "TrackTableStream",
     "track_air_detections",
     "tracker_detections",
+    "own_speeds_mps",
     "empty_tracks",
     "TRACK_COLUMNS",
     "TRACK_TABLE_COLUMNS",
@@ -195,7 +196,7 @@ def track_detections(
     motion, tracker = _make_tracker(model, config, tracker_config)
     grid, lo, hi = _frame_slices(detections["time_s"].to_numpy(float), frame_times_s)
     m3 = Measure3D(detections, config, motion, position_sigma_rad, ownship, grid, _surface(ground_test))
-    chunks = _run_tracker(tracker, m3, detections, grid, lo, hi)
+    chunks = _run_tracker(tracker, m3, detections, grid, lo, hi, own_speeds_mps(ownship, grid))
     t = _table(chunks, origin, m3, detections, ownship, config, ground_test)
     return restore_detection_rows(t, head_rows)
 
@@ -259,14 +260,42 @@ def _held(tracks, detections, ownship, config: RadarConfig, ground_test, walks=N
     return hold_ground_tracks(tracks, detections, ownship, width, coupling, test.surface_down, test, walks)
 
 
-def _run_tracker(tracker: RangeDopplerTracker, m3, detections: pd.DataFrame, grid, lo, hi) -> list[dict]:
+def _run_tracker(
+    tracker: RangeDopplerTracker, m3, detections: pd.DataFrame, grid, lo, hi, speeds_mps: np.ndarray
+) -> list[dict]:
     """Step the tracker (and the 3-D tracks) frame by frame; one dict of column arrays per frame."""
     z_all, secondary = _measurements(detections)
     frames = frame_numbers(grid, detections)
     return [
-        _step_frame(tracker, m3, k, time_s, frames[k], z_all[a:b], secondary[a:b], a)
+        _step_frame(tracker, m3, k, time_s, frames[k], z_all[a:b], secondary[a:b], a, speeds_mps[k])
         for k, (time_s, a, b) in enumerate(zip(grid, lo, hi, strict=True))
     ]
+
+
+def own_speeds_mps(ownship: pd.DataFrame | None, times_s: np.ndarray) -> np.ndarray:
+    """The own-ship's speed (m/s, NED velocity's norm) at each of ``times_s`` (s), interpolated in
+    the ``ownship`` rows (:data:`OWNSHIP_COLUMNS`); NaN without them (or outside their times).
+
+    A static point's range changes at most at this speed: the tracker's range-walk initiation
+    (:mod:`skyradar.track.range_walk`) starts only tracks that close faster.
+
+    Examples
+    --------
+    >>> own = pd.DataFrame({"time_s": [0.0, 1.0], "own_vn_mps": [30.0, 40.0], "own_ve_mps": [40.0, 30.0],
+    ...                     "own_vd_mps": [0.0, 0.0]})
+    >>> own_speeds_mps(own, np.array([0.5, 2.0])).tolist()
+    [50.0, nan]
+    >>> own_speeds_mps(None, np.array([0.5])).tolist()
+    [nan]
+    """
+    times = np.asarray(times_s, float)
+    columns = ("own_vn_mps", "own_ve_mps", "own_vd_mps")
+    if ownship is None or len(ownship) == 0 or not all(c in ownship for c in columns):
+        return np.full(times.shape, np.nan)
+    t = ownship["time_s"].to_numpy(float)
+    speed = np.linalg.norm(ownship[list(columns)].to_numpy(float), axis=1)
+    order = np.argsort(t, kind="stable")
+    return np.interp(times, t[order], speed[order], left=np.nan, right=np.nan)
 
 
 def _measurements(detections: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
@@ -278,10 +307,13 @@ def _measurements(detections: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
     return z, secondary
 
 
-def _step_frame(tracker: RangeDopplerTracker, m3, k: int, time_s, frame, z, secondary, a: int) -> dict:
+def _step_frame(
+    tracker: RangeDopplerTracker, m3, k: int, time_s, frame, z, secondary, a: int, speed_mps: float
+) -> dict:
     """One frame of :func:`_run_tracker`: frame ``k`` of the grid, its detections ``z`` the rows from
-    ``a`` of the table; the frame's dict of column arrays."""
-    out = tracker.step(float(time_s), z, secondary)
+    ``a`` of the table, the own-ship's speed ``speed_mps`` (m/s, NaN unknown); the frame's dict of
+    column arrays."""
+    out = tracker.step(float(time_s), z, secondary, static_speed_mps=float(speed_mps))
     row = _frame_rows(tracker, out, time_s, frame, a)
     row["reacquired"] = out.reacquired
     row["reacquired_t"] = np.full(len(out.reacquired), float(time_s))
@@ -536,7 +568,10 @@ class TrackTableStream:
             self._m3.add_frames(np.array([time_s], float), ownship)
         z, secondary = _measurements(fused)
         k, a = len(self._chunks), self._n_fused
-        self._chunks.append(_step_frame(self.tracker, self._m3, k, time_s, frame, z, secondary, a))
+        speed = float("nan")
+        if ownship is not None and len(ownship):
+            speed = float(own_speeds_mps(ownship, ownship["time_s"].to_numpy(float))[-1])
+        self._chunks.append(_step_frame(self.tracker, self._m3, k, time_s, frame, z, secondary, a, speed))
         self._fused = appended(self._fused, fused)
         self._input_rows.append(self._n_input + rows)
         self._n_input, self._n_fused = self._n_input + len(det), self._n_fused + len(fused)

@@ -24,6 +24,7 @@ from skyradar.track.deletion import MissDeleter
 from skyradar.track.initiation import MOfN, push_hit
 from skyradar.track.kalman import predict, update
 from skyradar.track.models import MotionModel
+from skyradar.track.range_walk import RangeWalks
 from skyradar.track.reacquisition import LostTracks
 from skyradar.track.types import FrameTracks, TrackArrays, TrackerConfig
 
@@ -62,6 +63,11 @@ class RangeDopplerTracker:
     updater : Updater, optional
         :class:`~skyradar.track.components.Updater`: corrects the assigned tracks with their
         innovations; default :func:`~skyradar.track.kalman.update`.
+    range_walks : RangeWalks or False, optional
+        Confirms a track whose detections walk in range faster than any static point can
+        (:mod:`skyradar.track.range_walk`), on the frames where :meth:`step` is given the
+        own-ship's speed; default :class:`~skyradar.track.range_walk.RangeWalks` for models that
+        wrap the Doppler, False: off.
 
     Examples
     --------
@@ -85,6 +91,7 @@ class RangeDopplerTracker:
         reacquirer: Reacquirer | None = None,
         predictor: Predictor = predict,
         updater: Updater = update,
+        range_walks: RangeWalks | bool | None = None,
     ) -> None:
         self.model = model
         self.report_tentative = bool(report_tentative)
@@ -100,6 +107,10 @@ class RangeDopplerTracker:
             model, c.reacquire_s, c.reacquire_jerk_mps3, c.gate, c.resolve_fraction * model.doppler_width_mps
         )
         self._reacquired = np.zeros((0, 2), np.int64)
+        if range_walks is None:
+            range_walks = RangeWalks(model.doppler_width_mps) if model.wrap_doppler else False
+        self.range_walks: RangeWalks | None = range_walks if isinstance(range_walks, RangeWalks) else None
+        self._walked: set[int] = set()  # ids of the tracks a range walk confirmed
         self.time_s: float | None = None  # the last frame's time; None before the first
         self._now = 0.0  # the frame being processed, for the stages of step
         self._next_id = 0
@@ -119,15 +130,24 @@ class RangeDopplerTracker:
         """Live tracks, tentative and confirmed."""
         return self.tracks.size
 
-    def step(self, time_s: float, z: np.ndarray, secondary: np.ndarray | None = None) -> FrameTracks:
+    def step(
+        self,
+        time_s: float,
+        z: np.ndarray,
+        secondary: np.ndarray | None = None,
+        static_speed_mps: float = float("nan"),
+    ) -> FrameTracks:
         """Process one frame of detections ``z`` (m, 2) = (range [m], radial velocity [m/s]).
 
         ``secondary`` (bool, one per detection) marks detections that passed only a secondary,
         lower threshold (:func:`skyradar.process.detect.detect`'s ``pfa_secondary``): they may
         update a confirmed track that no primary detection updates, inside its gate, and never
-        start or confirm a track. A confirmed track's gate spans a few cells, where the lower
-        threshold's false alarms are rare; over the whole image they are not. ``time_s`` must not
-        decrease between calls.
+        start or confirm a track by M-of-N. A confirmed track's gate spans a few cells, where the
+        lower threshold's false alarms are rare; over the whole image they are not. They do count
+        in a range walk (:mod:`skyradar.track.range_walk`), whose line is a gate of one range bin
+        and a fraction of a m/s. ``static_speed_mps`` is the fastest a static point's range
+        changes this frame (the own-ship's speed, m/s); NaN (unknown) starts no walk.
+        ``time_s`` must not decrease between calls.
         """
         if self.time_s is not None and time_s < self.time_s:
             raise ValueError(f"time goes backwards ({self.time_s} -> {time_s})")
@@ -151,6 +171,8 @@ class RangeDopplerTracker:
         self.time_s = self._now = float(time_s)
         self._close_stale()
         assoc = self._associate(z, secondary)
+        walk_free = np.ones(len(z), bool)  # not taken by a confirmed track: may start or support a walk
+        walk_free[assoc.detection_index[tr.confirmed[assoc.track_index]]] = False
         assigned = np.full(tr.ids.size, -1)
         assigned[assoc.track_index] = assoc.detection_index
         innov = np.full((tr.ids.size, 2), np.nan)
@@ -163,8 +185,11 @@ class RangeDopplerTracker:
         used[assoc.detection_index] = True
         new_det = np.flatnonzero(~used & ~secondary)
         self._start(z[new_det])
-        alive_ids = tr.ids
         alive_det = np.concatenate([assigned, new_det])
+        if self.range_walks is not None:
+            walk_rows, walk_v = self.range_walks.step(self._now, z, walk_free, static_speed_mps)
+            alive_det = self._confirm_walks(walk_rows, walk_v, z, alive_det)
+        alive_ids = tr.ids
         confirmed = tr.confirmed[: assigned.size]
         out = np.ones(assigned.size, bool) if self.report_tentative else confirmed
         return FrameTracks(
@@ -180,6 +205,34 @@ class RangeDopplerTracker:
             confirmed[out],
             self._reacquired,
         )
+
+    def _confirm_walks(
+        self, rows: np.ndarray, velocity_mps: np.ndarray, z: np.ndarray, alive_det: np.ndarray
+    ) -> np.ndarray:
+        """Confirm the tracks of the detections ``rows`` that complete a range walk, at its true
+        radial velocity (the alias resolved); a detection no track took (a secondary one) starts
+        one. Returns ``alive_det`` with the started tracks' detections appended."""
+        if rows.size == 0:
+            return alive_det
+        tr, width = self.tracks, self.model.doppler_width_mps
+        missing = rows[~np.isin(rows, alive_det)]
+        if missing.size:
+            self._start(z[missing])
+            alive_det = np.concatenate([alive_det, missing])
+        track_rows = np.array([int(np.flatnonzero(alive_det == j)[0]) for j in rows])
+        fresh = track_rows[~tr.confirmed[track_rows]]
+        shift = np.round((velocity_mps - tr.x[track_rows, 1]) / width) * width
+        self._shift_velocity(track_rows, shift)
+        tr.resolved[track_rows] = True
+        tr.x[track_rows, 2] = tr.x[track_rows, 1]
+        tr.confirmed[track_rows] = True
+        tr.set_anchor(track_rows, self._now)
+        reacquired = self._reacquired
+        self._reacquire(fresh[~tr.was_confirmed[fresh]])
+        self._reacquired = np.concatenate([reacquired, self._reacquired])
+        tr.was_confirmed[track_rows] = True
+        self._walked.update(int(i) for i in tr.ids[track_rows])
+        return alive_det
 
     def _matrices(self, dt: float) -> tuple[np.ndarray, ...]:
         """F, Q (and their unresolved-alias versions) for a time step, cached by step."""
@@ -313,7 +366,9 @@ class RangeDopplerTracker:
         tr = self.tracks
         # A confirmed track updated after coasting initiator.n frames or more may have taken clutter in
         # its grown gate: it must be confirmed again (M-of-N) and keeps its anchor meanwhile.
-        again = hit & long_gap & tr.confirmed
+        # A track a range walk confirmed keeps its confirmation through its gaps (its detections come
+        # in bursts: that is why its walk, not M-of-N, confirmed it); the deleter still closes it.
+        again = hit & long_gap & tr.confirmed & ~np.isin(tr.ids, list(self._walked))
         tr.confirmed &= ~again
         tr.window = np.where(again, 0, tr.window)
         # The anchor moves only with updates right after another (a gate that had no time to grow).

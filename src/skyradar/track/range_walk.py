@@ -1,0 +1,229 @@
+"""Track initiation from a range walk: a fast closure confirmed by its range history, not its hit rate.
+
+A closure faster than the Doppler image is wide aliases into it; at the prototype's 78.3 m/s image
+a head-on closure at 113 m/s sits in the cell of -34.7 m/s. Over relief that cell is often the one
+the ground ahead fills, and the target is then detected in only a fraction of the frames, its
+detections at the threshold of a secondary test or beside a clutter ridge. An M-of-N rule (4 of 5
+frames) confirms nothing at a 30 % detection rate, and the aircraft is tracked only when it is
+near, seconds from the loss of well clear.
+
+Its range history says what its hit rate cannot. Between two detections of one object the range
+moves at its true radial velocity, which is the cell's Doppler plus a whole number of image
+widths: ``r(t) = r_0 + (v + k W) (t - t_0)``. For a given detection and ambiguity ``k`` the line is
+fixed; no slope is fitted. Detections of the same Doppler that lie on that line within a range
+bin, in enough frames spread over a few seconds, are one object moving at ``v + k W``. A static
+point cannot do it when ``|v + k W|`` exceeds the own-ship's speed: a static point's range changes
+at most at that speed, so the ground can only support such a line by chance coincidences, never
+by its geometry. Three tests keep that chance low where the ground's detections are dense (a
+clutter patch at one Doppler that the line crosses): the line must be supported in at least
+``least_frames`` frames spanning ``min_span_s`` (a patch a fast line crosses in a second does not
+span it); better than any line a static point could follow through the same detection
+(``static_ratio`` times the support of the best ground-compatible ambiguity, ``|v + k W|`` at most
+the own-ship's speed plus the margin); and by more detections than chance puts on it. The
+detections of that Doppler in the window that are not on the line, spread over their ranges, fall
+in the line's range gate at a Poisson rate ``lambda = n * 2 gate / extent``; the line's support
+must be one that rate reaches with a probability of at most ``false_walk_probability`` (about one
+false walk an hour over the whole image at 9.4 frames/s, ten candidates a frame and two
+ambiguities each).
+
+Only closing walks start tracks (``v + k W`` below minus the own-ship's speed less the margin):
+the alerting stage needs the aircraft that come nearer, and an opening line at the same speed would
+be an object moving away from a nose radar faster than the own-ship flies.
+
+Examples
+--------
+A closure at -113 m/s, aliased to -34.7 m/s, detected in every third frame at 9.4 frames/s; the
+own-ship flies at 50 m/s:
+
+>>> walks = RangeWalks(doppler_width_mps=78.3)
+>>> t = np.arange(40) / 9.4
+>>> started = []
+>>> for k, time_s in enumerate(t):
+...     z = np.array([[3000.0 - 113.0 * time_s, -113.0 + 78.3]]) if k % 3 == 0 else np.zeros((0, 2))
+...     rows, velocity = walks.step(time_s, z, np.ones(len(z), bool), static_speed_mps=50.0)
+...     started += [(round(float(time_s), 2), round(float(v), 1)) for v in velocity]
+>>> started[0]
+(2.23, -113.0)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import poisson
+
+__all__ = ["RangeWalkRule", "RangeWalks"]
+
+_MIN_EXTENT_M = 300.0  # least range extent the chance rate spreads a Doppler's detections over
+
+
+@dataclass(frozen=True)
+class RangeWalkRule:
+    """The settings of :class:`RangeWalks`.
+
+    Attributes
+    ----------
+    window_s : float
+        How far back a line looks for its support, s.
+    least_frames : int
+        Frames (the new detection's included) that must hold a detection on the line.
+    min_span_s : float
+        Least time between the line's oldest supporting detection and the new one, s.
+    range_gate_m : float
+        Largest range residual of a supporting detection from the line, m (a range bin: the line's
+        slope comes from the Doppler, known to a fraction of a m/s, so over a few seconds the line
+        is known to about the range measurement's own error).
+    doppler_gate_mps : float
+        Largest Doppler difference of a supporting detection from the new one, m/s (the closing
+        speed of a straight flight changes slowly far from the closest approach).
+    margin_mps : float
+        Speed over the own-ship's that a walk must exceed to be no static point's, m/s (the
+        navigated speed's error and the ground's own motion: trees, water, vehicles at walking pace).
+    max_closing_mps : float
+        Fastest closing speed considered, m/s (two light aircraft head-on: well under 200 m/s).
+    static_ratio : float
+        The walk's support must be this many times the best ground-compatible line's.
+    false_walk_probability : float
+        Largest chance that the detections of the walk's Doppler in the window put its support on
+        one line by coincidence (Poisson, see the module docstring).
+    """
+
+    window_s: float = 4.0
+    least_frames: int = 6
+    min_span_s: float = 2.0
+    range_gate_m: float = 15.0
+    doppler_gate_mps: float = 0.8
+    margin_mps: float = 10.0
+    max_closing_mps: float = 200.0
+    static_ratio: float = 2.0
+    false_walk_probability: float = 1e-6
+
+    def __post_init__(self) -> None:
+        if self.least_frames < 3:
+            raise ValueError(f"least_frames must be at least 3, got {self.least_frames}")
+        if not (0.0 < self.min_span_s <= self.window_s):
+            raise ValueError(f"need 0 < min_span_s <= window_s, got {self.min_span_s}, {self.window_s}")
+
+
+class RangeWalks:
+    """Finds detections that complete a fast closing range walk (see the module docstring).
+
+    Keeps the recent detections not taken by a confirmed track (times, frames, range, Doppler);
+    :meth:`step` searches each new candidate's lines against them, then adds the frame's candidates.
+
+    Parameters
+    ----------
+    doppler_width_mps : float
+        Width ``W`` of the Doppler image (``2 V_lim``), m/s.
+    rule : RangeWalkRule, optional
+        Thresholds (default :class:`RangeWalkRule`).
+    """
+
+    def __init__(self, doppler_width_mps: float, rule: RangeWalkRule | None = None) -> None:
+        self.width = float(doppler_width_mps)
+        self.rule = rule or RangeWalkRule()
+        self._frame = 0
+        self._t = np.zeros(0)
+        self._f = np.zeros(0, np.int64)
+        self._r = np.zeros(0)
+        self._v = np.zeros(0)
+
+    def step(
+        self, time_s: float, z: np.ndarray, candidate: np.ndarray, static_speed_mps: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """One frame: which of its detections complete a closing walk, and at which true radial velocity.
+
+        Parameters
+        ----------
+        time_s : float
+            The frame's time, s (not decreasing between calls).
+        z : ndarray, shape (n, 2)
+            The frame's detections: range (m) and the cell's radial velocity (m/s, aliased).
+        candidate : ndarray of bool, shape (n,)
+            Detections free to start or support a walk (not taken by a confirmed track).
+        static_speed_mps : float
+            The fastest a static point's range can change this frame (the own-ship's speed), m/s.
+            NaN: unknown, and no walk starts (the detections are still kept as support).
+
+        Returns
+        -------
+        rows : ndarray of int
+            Rows of ``z`` that complete a walk, at most one per walk.
+        velocity_mps : ndarray
+            Their true radial velocity (``v + k W``), m/s.
+        """
+        rule = self.rule
+        z = np.asarray(z, float).reshape(-1, 2)
+        keep = self._t >= time_s - rule.window_s
+        self._t, self._f, self._r, self._v = self._t[keep], self._f[keep], self._r[keep], self._v[keep]
+        rows: list[int] = []
+        velocity: list[float] = []
+        cand = np.flatnonzero(np.asarray(candidate, bool))
+        if np.isfinite(static_speed_mps) and self._t.size:
+            limit = float(static_speed_mps) + rule.margin_mps
+            taken = np.zeros(self._t.size, bool)
+            for i in cand:
+                found = self._walk(float(time_s), z[i], limit, taken)
+                if found is None:
+                    continue
+                v_true, support = found
+                taken[support] = True
+                rows.append(int(i))
+                velocity.append(v_true)
+            if taken.any():  # a walk's support belongs to its track now
+                left = ~taken
+                self._t, self._f, self._r, self._v = (
+                    self._t[left],
+                    self._f[left],
+                    self._r[left],
+                    self._v[left],
+                )
+        new = np.setdiff1d(cand, np.array(rows, int))
+        self._t = np.concatenate([self._t, np.full(new.size, float(time_s))])
+        self._f = np.concatenate([self._f, np.full(new.size, self._frame, np.int64)])
+        self._r = np.concatenate([self._r, z[new, 0]])
+        self._v = np.concatenate([self._v, z[new, 1]])
+        self._frame += 1
+        return np.array(rows, int), np.array(velocity, float)
+
+    def _walk(
+        self, time_s: float, zi: np.ndarray, limit_mps: float, taken: np.ndarray
+    ) -> tuple[float, np.ndarray] | None:
+        """The closing walk through detection ``zi`` with the most support, if it passes the rule."""
+        rule, width = self.rule, self.width
+        dv = (self._v - zi[1] + width / 2.0) % width - width / 2.0
+        near = np.flatnonzero((np.abs(dv) <= rule.doppler_gate_mps) & ~taken)
+        if near.size < rule.least_frames - 1:
+            return None
+        dt = self._t[near] - time_s  # <= 0
+        mean_v = zi[1] + 0.5 * dv[near]  # the two detections' mean Doppler, in zi's alias
+
+        def support(k: int) -> np.ndarray:
+            residual = self._r[near] - (zi[0] + (mean_v + k * width) * dt)
+            return near[np.abs(residual) <= rule.range_gate_m]
+
+        def frames(rows: np.ndarray) -> int:
+            return int(np.unique(self._f[rows]).size) + 1  # the new detection's frame too
+
+        k_max = int(np.ceil((rule.max_closing_mps + abs(zi[1])) / width)) + 1
+        ks = np.arange(-k_max, k_max + 1)
+        speeds = zi[1] + ks * width
+        static = max((frames(support(int(k))) for k in ks[np.abs(speeds) <= limit_mps]), default=1)
+        # Chance support: the Doppler's other detections in the window, spread over the ranges they cover.
+        extent_m = max(float(np.ptp(self._r[near])), _MIN_EXTENT_M) + 2.0 * rule.range_gate_m
+        per_detection = 2.0 * rule.range_gate_m / extent_m
+        best: tuple[float, np.ndarray] | None = None
+        best_n = 0
+        for k in ks[(speeds < -limit_mps) & (speeds >= -rule.max_closing_mps)]:
+            rows = support(int(k))
+            n = frames(rows)
+            if n < rule.least_frames or n < rule.static_ratio * static or n <= best_n:
+                continue
+            if time_s - self._t[rows].min() < rule.min_span_s:
+                continue
+            chance = (near.size - rows.size) * per_detection
+            if poisson.sf(n - 2, chance) > rule.false_walk_probability:  # P(at least n - 1 supports)
+                continue
+            best, best_n = (float(zi[1] + k * width), rows), n
+        return best

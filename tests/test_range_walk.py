@@ -1,0 +1,127 @@
+"""Range-walk initiation: a fast closure seen in a fraction of its frames is confirmed by its range
+history, and static clutter at the same Doppler never is (physics: a static point's range changes at
+most at the own-ship's speed)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from skyradar.track.ground_tracks import doppler_smooth
+from skyradar.track.models import radar_model
+from skyradar.track.range_walk import RangeWalkRule, RangeWalks
+from skyradar.track.tracker import RangeDopplerTracker
+
+WIDTH_MPS = 78.3  # the prototype's Doppler image at 9.4 frames/s
+FRAME_S = 1.0 / 9.4
+OWN_SPEED_MPS = 50.0
+
+
+def _wrap(v: np.ndarray | float) -> np.ndarray:
+    return (np.asarray(v, float) + WIDTH_MPS / 2) % WIDTH_MPS - WIDTH_MPS / 2
+
+
+def _clutter(rng: np.random.Generator, n_frames: int, per_frame: int, doppler_mps: float) -> list[np.ndarray]:
+    """Static ground scatterers at the target's Doppler (within a bin), their ranges moving at the
+    static point's radial velocity (the cell's Doppler: it is inside the own-ship's speed); each
+    frame shows a random ``per_frame`` of them, as a speckled patch does."""
+    start = rng.uniform(800.0, 4000.0, 60)
+    out = []
+    for k in range(n_frames):
+        pick = rng.choice(start.size, per_frame, replace=False)
+        r = start[pick] + doppler_mps * k * FRAME_S + rng.normal(0.0, 4.0, per_frame)
+        v = doppler_mps + rng.normal(0.0, 0.15, per_frame)
+        out.append(np.column_stack([r, v]))
+    return out
+
+
+def _run(frames: list[np.ndarray], own_speed_mps: float) -> tuple[RangeDopplerTracker, list]:
+    tracker = RangeDopplerTracker(radar_model(WIDTH_MPS))
+    outs = [tracker.step(k * FRAME_S, z, static_speed_mps=own_speed_mps) for k, z in enumerate(frames)]
+    return tracker, outs
+
+
+@pytest.mark.parametrize("closing_mps", [-100.0, -113.0, -117.0])
+def test_a_fast_closure_detected_in_a_third_of_its_frames_is_confirmed_by_its_range_walk(closing_mps):
+    rng = np.random.default_rng(7)
+    n = 60
+    hit = rng.random(n) < 0.33
+    frames = _clutter(rng, n, 2, float(_wrap(closing_mps)))
+    for k in np.flatnonzero(hit):
+        target = [
+            3200.0 + closing_mps * k * FRAME_S + rng.normal(0, 4.0),
+            _wrap(closing_mps) + rng.normal(0, 0.1),
+        ]
+        frames[k] = np.vstack([frames[k], target])
+    tracker, outs = _run(frames, OWN_SPEED_MPS)
+    on_target = []
+    for k, out in enumerate(outs):
+        expected = 3200.0 + closing_mps * k * FRAME_S
+        near = out.confirmed & (np.abs(out.state[:, 0] - expected) < 60.0)
+        if near.any():
+            on_target.append((k, float(out.state[near, 1][0])))
+    assert on_target, "the closure is never confirmed"
+    first, velocity = on_target[0]
+    sixth = np.flatnonzero(hit)[5]
+    # Confirmed once its walk holds six frames over two seconds, within a second of that.
+    assert first * FRAME_S <= max(sixth * FRAME_S, 2.0) + 1.0
+    assert velocity == pytest.approx(closing_mps, abs=1.0)  # the alias resolved by the walk
+    # Without the walk (no own-ship speed), 4 of 5 frames never hold at this rate.
+    _, plain = _run(frames, float("nan"))
+    plain_first = [k for k, out in enumerate(plain) if (out.confirmed & (out.state[:, 0] > 0)).any()]
+    assert not plain_first or plain_first[0] > first
+
+
+def test_static_clutter_at_the_closures_doppler_starts_no_walk():
+    rng = np.random.default_rng(3)
+    frames = _clutter(rng, 600, 12, float(_wrap(-113.0)))  # a minute of a dense patch, 12 per frame
+    walks = RangeWalks(WIDTH_MPS)
+    started = 0
+    for k, z in enumerate(frames):
+        rows, _ = walks.step(k * FRAME_S, z, np.ones(len(z), bool), OWN_SPEED_MPS)
+        started += rows.size
+    assert started == 0
+
+
+def test_a_walk_no_faster_than_a_static_point_starts_nothing():
+    """A closure at 55 m/s against an own-ship at 50 m/s: a static point could be that fast (margin)."""
+    walks = RangeWalks(WIDTH_MPS)
+    for k in range(60):
+        z = np.array([[3000.0 - 55.0 * k * FRAME_S, -55.0 + WIDTH_MPS]])
+        rows, _ = walks.step(k * FRAME_S, z, np.ones(1, bool), OWN_SPEED_MPS)
+        assert rows.size == 0
+
+
+def test_without_the_own_ships_speed_no_walk_starts():
+    walks = RangeWalks(WIDTH_MPS)
+    for k in range(60):
+        z = np.array([[3000.0 - 113.0 * k * FRAME_S, _wrap(-113.0)]])
+        rows, _ = walks.step(k * FRAME_S, z, np.ones(1, bool), float("nan"))
+        assert rows.size == 0
+
+
+def test_a_walk_must_span_its_minimum_time():
+    """Six detections in six consecutive frames (0.53 s) are what M-of-N is for, not a walk."""
+    walks = RangeWalks(WIDTH_MPS, RangeWalkRule(min_span_s=2.0))
+    for k in range(6):
+        z = np.array([[3000.0 - 113.0 * k * FRAME_S, _wrap(-113.0)]])
+        rows, _ = walks.step(k * FRAME_S, z, np.ones(1, bool), OWN_SPEED_MPS)
+        assert rows.size == 0
+
+
+def test_bad_rules_are_refused():
+    with pytest.raises(ValueError, match="least_frames"):
+        RangeWalkRule(least_frames=2)
+    with pytest.raises(ValueError, match="min_span_s"):
+        RangeWalkRule(min_span_s=5.0, window_s=4.0)
+
+
+def test_one_clutter_hit_in_a_tracks_doppler_history_is_not_a_patch():
+    t = np.arange(10) * 0.106
+    v = -34.5 + 0.02 * t + np.random.default_rng(1).normal(0, 0.03, 10)
+    spiked = v.copy()
+    spiked[4] += 1.3  # the gate took a clutter detection once
+    assert doppler_smooth(t, spiked, WIDTH_MPS)
+    twice = spiked.copy()
+    twice[7] -= 1.0  # two: scatterers taking turns
+    assert not doppler_smooth(t, twice, WIDTH_MPS)

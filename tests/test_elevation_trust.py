@@ -340,3 +340,27 @@ def test_a_voted_height_fed_every_frame_does_not_make_a_drift_a_vertical_speed()
     before = np.concatenate([_vertical_speed_z_scores(seed, 1) for seed in range(4)])
     assert (ours > 3.0).mean() < 0.02  # the level aircraft's vertical speed stays within its sigma
     assert (before > 3.0).mean() > 0.1  # fed at one reading's weight, the drift became a speed
+
+
+def test_an_aircraft_above_is_voted_above_by_its_median_before_any_single_reading_would_count():
+    """300 m above at 3 km (5.7 deg), readings scattered by 3.5 deg through the nulls: few pass the
+    single-reading threshold (8.6 deg), the median of twenty passes its own error."""
+    from skyradar.track.elevation_trust import AboveVotes, median_above
+
+    rng = np.random.default_rng(11)
+    votes = AboveVotes()
+    ids = np.array([5])
+    heights = []
+    for _ in range(20):
+        el = np.radians(5.7 + 3.5 * rng.standard_normal(1))
+        up = 3000.0 * np.sin(el)
+        above = el > 3 * 0.05
+        heights.append(votes.update(ids, above, np.ones(1, bool), up, el)[0][0])
+    assert np.isnan(heights[:19]).all()  # twenty readings first
+    assert abs(heights[-1] - 300.0) < 120.0
+    # A level aircraft: at most one window of twenty in a thousand reads it above; with the readings
+    # sharing a 1-deg bias (three times the ga-typical AHRS's pitch bias), at most one in a hundred.
+    level = np.radians(3.5 * np.random.default_rng(2).standard_normal((5000, 20)))
+    assert np.mean([median_above(window) for window in level]) <= 1e-3
+    biased = np.radians(1.0) + level
+    assert np.mean([median_above(window) for window in biased]) <= 0.01

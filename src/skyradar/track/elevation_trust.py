@@ -47,6 +47,9 @@ __all__ = [
     "at_elevation",
     "place_elevations",
     "AboveVotes",
+    "median_above",
+    "MEDIAN_ABOVE_FLOOR_RAD",
+    "MEDIAN_ABOVE_K",
     "BelowConsensus",
 ]
 
@@ -55,6 +58,10 @@ FREE_ELEVATION_SIGMA_RAD = 0.35  # vertical-angle sigma of a free detection, at 
 # (3 of it: 8.6 deg): readings through the nulls scatter by degrees past their bound, with a heavy upper
 # tail (over hills, an aircraft 39 m below has 1.7 % of its measured elevations above 8.6 deg).
 BAND_ELEVATION_SIGMA_RAD = 0.05
+# Elevation bias a track's readings share, rad (3 deg): three times the 1-deg dynamic pitch and roll
+# error of a GA MEMS AHRS (the ``ga-typical`` navigation's datasheet class) with the mount's alignment.
+MEDIAN_ABOVE_FLOOR_RAD = 0.052
+MEDIAN_ABOVE_K = 3.7  # standard errors of the median (one-sided 1e-4)
 _GROUND_RANGE_FRACTION = 0.5  # ground may be in range from half the own-ship's height above it (relief)
 
 
@@ -151,28 +158,74 @@ class AboveVotes:
     [310.0, nan]
     """
 
-    def __init__(self, window: int = 10, least: int = 7, keep: int = 4) -> None:
+    def __init__(self, window: int = 10, least: int = 7, keep: int = 4, median_window: int = 20) -> None:
         self.window, self.least, self.keep = int(window), int(least), int(keep)
-        self._recent = _RecentReadings(window)
+        self.median_window = int(median_window)
+        self._recent = _RecentReadings(max(self.window, self.median_window))
         self._voted: set[int] = set()
 
     def update(
-        self, ids: np.ndarray, above: np.ndarray, counts: np.ndarray, up_m: np.ndarray
+        self,
+        ids: np.ndarray,
+        above: np.ndarray,
+        counts: np.ndarray,
+        up_m: np.ndarray,
+        elevation_rad: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
         """Add this frame's vote ``above`` and height ``up_m`` (m above the own-ship) of each track
         ``ids`` where ``counts``; returns each track's height and its spread while voted above, m
-        (NaN: not voted). Tracks not listed are forgotten."""
-        readings = np.column_stack([np.asarray(above, float), np.asarray(up_m, float)]).tolist()
+        (NaN: not voted). Tracks not listed are forgotten. With the readings' ``elevation_rad``
+        (above the own-ship's horizontal), ``median_window`` readings whose median elevation is
+        above the horizontal (:func:`median_above`) vote the track above too, at the median of
+        those readings' heights."""
+        el = np.full(len(np.atleast_1d(up_m)), np.nan) if elevation_rad is None else elevation_rad
+        columns = (np.asarray(above, float), np.asarray(up_m, float), np.asarray(el, float))
+        readings = np.column_stack(columns).tolist()
         out = np.full((len(readings), 2), np.nan)
         voted = set()
         recents = self._recent.push(ids, readings, counts)
         for n, (i, recent) in enumerate(zip(np.asarray(ids).tolist(), recents, strict=True)):
-            votes, up = np.array(recent, float).reshape(-1, 2).T
-            if votes.sum() >= (self.keep if i in self._voted else self.least):
-                out[n] = _median_and_spread(up[votes > 0])
+            votes, up, elevation = np.array(recent, float).reshape(-1, 3).T
+            last_votes, last_up = votes[-self.window :], up[-self.window :]
+            if last_votes.sum() >= (self.keep if i in self._voted else self.least):
+                out[n] = _median_and_spread(last_up[last_votes > 0])
+                voted.add(int(i))
+            elif len(up) >= self.median_window and median_above(elevation[-self.median_window :]):
+                out[n] = _median_and_spread(up[-self.median_window :])
                 voted.add(int(i))
         self._voted = voted
         return out[:, 0], out[:, 1]
+
+
+def median_above(
+    elevation_rad: np.ndarray, k: float = MEDIAN_ABOVE_K, floor_rad: float = MEDIAN_ABOVE_FLOOR_RAD
+) -> bool:
+    """Whether a track's measured elevations (rad, above the own-ship's horizontal) put it above.
+
+    One reading in the ground's band counts only far above the horizontal (:func:`elevation_trusted`:
+    8.6 deg): readings through the nulls scatter by degrees and their tail reaches that high. Their
+    median does not: it moves by ``1.2533 * spread / sqrt(n)`` (``spread`` 1.4826 median absolute
+    deviation), and the ground pulls it down, never up. So an aircraft 300 m above at 3 km (5.7 deg,
+    readings scattered by 3.5 deg) is above when the median of twenty readings is ``k`` of those
+    errors above the horizontal (3.7: one window in ten thousand of a level aircraft's, by chance)
+    and above ``floor_rad``, the bias the readings share (the AHRS pitch and roll errors and the
+    antenna's mounting), long before a single reading passes 8.6 deg.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> median_above(np.radians(5.7 + 3.5 * rng.standard_normal(20)))
+    True
+    >>> co_altitude = np.radians(np.r_[3.5 * rng.standard_normal(17), 20.0, 25.0, 30.0])  # a burst up
+    >>> median_above(co_altitude)
+    False
+    """
+    el = np.asarray(elevation_rad, float)
+    el = el[np.isfinite(el)]
+    if el.size < 3:
+        return False
+    median, spread = _median_and_spread(el)
+    return bool(median > max(k * 1.2533 * spread / np.sqrt(el.size), floor_rad))
 
 
 def _median_and_spread(up_m: np.ndarray) -> tuple[float, float]:
@@ -341,7 +394,9 @@ def place_elevations(
     trusted = elevation_trusted(elevation, sigma_rad, measured, band)
     in_band = np.asarray(measured, bool) & band
     sigma, held = np.asarray(sigma_rad, float), np.zeros(len(d), bool)
-    trusted, track_up, spread = _voted(votes, ids, trusted, band, in_band, range_m * np.sin(elevation))
+    trusted, track_up, spread = _voted(
+        votes, ids, trusted, band, in_band, range_m * np.sin(elevation), range_m
+    )
     spread = np.where(np.isfinite(track_up), np.fmax(spread, BAND_ELEVATION_SIGMA_RAD * range_m), np.nan)
     if below is not None and clearance_m is not None:
         held = _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids)
@@ -351,11 +406,12 @@ def place_elevations(
     return *_placed(*placed), trusted, track_up, spread
 
 
-def _voted(votes, ids, trusted, band, in_band, up_m) -> tuple:
+def _voted(votes, ids, trusted, band, in_band, up_m, range_m) -> tuple:
     """Trust in the band only while the track is voted above; the tracks' agreed heights and spreads."""
     if votes is None:
         return trusted, *np.full((2, len(trusted)), np.nan)
-    track_up, spread = votes.update(ids, trusted & band, in_band, up_m)
+    elevation = np.arcsin(np.clip(up_m / np.maximum(range_m, 1e-9), -1.0, 1.0))
+    track_up, spread = votes.update(ids, trusted & band, in_band, up_m, elevation)
     return trusted & (~band | np.isfinite(track_up)), track_up, spread
 
 

@@ -173,7 +173,7 @@ def navigated_own_state(ds: xr.Dataset, source: str = "frames") -> OwnShipStates
     """Own-ship state per frame as the aircraft knows it: the navigation solution, never the truth.
 
     :meth:`skyradar.io.ownship_states.OwnShipStates.from_frames` reads ``nav_*`` (``own_*`` only
-    for stores written before navigation existed); None without position and velocity.
+    for a store without a navigation solution); None without position and velocity.
     """
     return OwnShipStates.from_frames(ds, source)
 

@@ -80,39 +80,40 @@ def test_a_run_processed_after_another_gives_the_same_rows(run, whole):
     for name in ("own_height_agl_m", "nav_height_agl_m"):
         if name in higher:
             higher[name] = higher[name] * 1.03
-    assert (
-        navigated_own_state(higher)["own_height_agl_m"][0] != navigated_own_state(run)["own_height_agl_m"][0]
-    )
+    assert navigated_own_state(higher).height_agl_m[0] != navigated_own_state(run).height_agl_m[0]
     clutter_frames._CACHE.clear()
     process_frames(higher, suppression="auto")
     pd.testing.assert_frame_equal(process_frames(run, suppression="auto"), whole)
 
 
 def test_the_velocity_mean_is_the_last_five_frames_and_a_gap_spoils_only_those():
+    from dataclasses import replace
+
     from skyradar.geo import rotation_matrix
+    from skyradar.io.ownship_states import OwnShipStates
     from skyradar.process.clutter_anchors import frame_geometries
 
     rng = np.random.default_rng(1)
     n = 12
-    own = {
-        "own_vn_mps": 50 + rng.normal(0, 0.2, n),
-        "own_ve_mps": rng.normal(0, 0.2, n),
-        "own_vd_mps": rng.normal(0, 0.2, n),
-        "own_yaw_rad": rng.uniform(-3, 3, n),
-        "own_pitch_rad": np.zeros(n),
-        "own_roll_rad": np.zeros(n),
-        "own_height_agl_m": np.full(n, 400.0),
-        "has_geo": np.array(False),
-    }
+    own = OwnShipStates.from_columns(
+        {
+            "time_s": np.arange(n) / 9.4,
+            "own_north_m": np.zeros(n),
+            "own_east_m": np.zeros(n),
+            "own_down_m": np.full(n, -400.0),
+            "own_vn_mps": 50 + rng.normal(0, 0.2, n),
+            "own_ve_mps": rng.normal(0, 0.2, n),
+            "own_vd_mps": rng.normal(0, 0.2, n),
+            "own_yaw_rad": rng.uniform(-3, 3, n),
+            "own_height_agl_m": np.full(n, 400.0),
+        }
+    )
     got = frame_geometries(own)
     for i in range(n):  # peer: each frame's velocity rotated into its heading-free frame, then averaged
         rows = range(max(i - 4, 0), i + 1)
-        v = [
-            rotation_matrix(own["own_yaw_rad"][j], 0.0, 0.0).T
-            @ [own[k][j] for k in ("own_vn_mps", "own_ve_mps", "own_vd_mps")]
-            for j in rows
-        ]
+        v = [rotation_matrix(own.yaw_rad[j], 0.0, 0.0).T @ own.velocity_ned_mps[j] for j in rows]
         np.testing.assert_allclose(got[i, :3], np.mean(v, axis=0), atol=1e-12)
-    own["own_vn_mps"][3] = np.nan  # a navigation gap
-    spoiled = ~np.isfinite(frame_geometries(own)).all(axis=1)
+    gap = own.vn_mps.copy()
+    gap[3] = np.nan  # a navigation gap
+    spoiled = ~np.isfinite(frame_geometries(replace(own, vn_mps=gap))).all(axis=1)
     assert spoiled.tolist() == [i in range(3, 8) for i in range(n)]

@@ -166,17 +166,22 @@ def test_two_pair_solver_agrees_with_numpy_eigh_on_ring_covariances_warm_started
 
 @pytest.fixture(scope="module")
 def flat_prediction():
+    from skyradar.io.ownship_states import OwnShipStates
+
     one = np.ones(1)
-    own = {
-        "own_vn_mps": 50 * one,
-        "own_ve_mps": 0 * one,
-        "own_vd_mps": 0 * one,
-        "own_yaw_rad": 0 * one,
-        "own_pitch_rad": 0 * one,
-        "own_roll_rad": 0 * one,
-        "own_height_agl_m": 1000 * one,
-        "has_geo": np.array(False),
-    }
+    own = OwnShipStates.from_columns(
+        {
+            "time_s": 0 * one,
+            "own_north_m": 0 * one,
+            "own_east_m": 0 * one,
+            "own_down_m": -1000 * one,
+            "own_vn_mps": 50 * one,
+            "own_ve_mps": 0 * one,
+            "own_vd_mps": 0 * one,
+            "own_yaw_rad": 0 * one,
+            "own_height_agl_m": 1000 * one,
+        }
+    )
     return frame_subspace(own, 0, CFG)
 
 

@@ -7,11 +7,13 @@ Checked against the straightforward computation (every tap's outer product summe
 from __future__ import annotations
 
 from collections import OrderedDict
+from dataclasses import replace
 
 import numpy as np
 
 from skyradar.config import RadarConfig
 from skyradar.geo import rotation_matrix
+from skyradar.io.ownship_states import OwnShipStates
 from skyradar.process import clutter_frames
 from skyradar.process.clutter import clutter_subspace, hermitian_eigh
 from skyradar.process.doa import steering_vector
@@ -114,7 +116,7 @@ def test_jacobi_eigen_pairs_of_small_hermitian_matrices():
         np.testing.assert_allclose(v.conj().T @ v, np.eye(n), atol=1e-12)
 
 
-def _turning_own(n: int, bank_deg: float, noise_mps: float) -> dict:
+def _turning_own(n: int, bank_deg: float, noise_mps: float) -> OwnShipStates:
     """Own-ship frames at 9.4 Hz, 60 m/s, in a coordinated turn at ``bank_deg`` (0: straight)."""
     rng = np.random.default_rng(0)
     t = np.arange(n) / 9.4
@@ -129,14 +131,15 @@ def _turning_own(n: int, bank_deg: float, noise_mps: float) -> dict:
         "own_roll_rad": np.full(n, np.radians(bank_deg)),
     }
     own["own_vn_mps"] = own["own_vn_mps"] + noise_mps * rng.standard_normal(n)
-    return own | {"own_height_agl_m": np.full(n, 600.0), "has_geo": np.array(False)}
+    position = {"own_north_m": np.zeros(n), "own_east_m": np.zeros(n), "own_down_m": np.full(n, -600.0)}
+    return OwnShipStates.from_columns(own | position | {"time_s": t, "own_height_agl_m": np.full(n, 600.0)})
 
 
-def _predictions(own: dict, monkeypatch) -> list:
+def _predictions(own: OwnShipStates, monkeypatch) -> list:
     calls = []
     monkeypatch.setattr(clutter_frames, "clutter_subspace", lambda *a, **k: calls.append(a) or object())
     monkeypatch.setattr(clutter_frames, "_CACHE", OrderedDict())
-    for i in range(own["own_yaw_rad"].size):
+    for i in range(len(own)):
         clutter_frames.frame_subspace(own, i, CFG)
     return calls
 
@@ -148,8 +151,7 @@ def test_navigation_noise_and_a_banked_turn_do_not_force_new_predictions(monkeyp
     assert len(_predictions(_turning_own(100, 0.0, 0.2), monkeypatch)) <= 2
     assert len(_predictions(_turning_own(100, 35.0, 0.2), monkeypatch)) <= 2
     # A real change is followed within the 5 frames: a climb of 1 m/s from frame 50 on.
-    own = _turning_own(100, 0.0, 0.0)
-    own["own_vd_mps"] = np.where(np.arange(100) >= 50, -1.0, 0.0)
+    own = replace(_turning_own(100, 0.0, 0.0), vd_mps=np.where(np.arange(100) >= 50, -1.0, 0.0))
     calls = _predictions(own, monkeypatch)
     assert 2 <= len(calls) <= 3 and calls[-1][1][2] == -1.0
 

@@ -236,8 +236,6 @@ def test_radar_height_replaces_the_gnss_height_where_the_estimator_was_trusted()
     gnss = ds["nav_height_agl_m"].values
     np.testing.assert_array_equal(out["nav_height_agl_m"].values, [590.0, 591.0, gnss[2], 603.0])
     np.testing.assert_array_equal(out["own_height_agl_m"].values, ds["own_height_agl_m"].values)
-    np.testing.assert_array_equal(
-        navigated_own_state(out)["own_height_agl_m"], [590.0, 591.0, gnss[2], 603.0]
-    )
+    np.testing.assert_array_equal(navigated_own_state(out).height_agl_m, [590.0, 591.0, gnss[2], 603.0])
     with pytest.raises(InputError, match="h_m"):
         with_radar_height(ds, state.drop(columns="h_m"))

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from skyradar.config import RadarConfig
+from skyradar.io.ownship_states import OwnShipStates
 from skyradar.process import clutter_anchors, clutter_frames
 from skyradar.process.cfar import cfar_2d_floor
 from skyradar.process.clutter_doa import (
@@ -114,16 +115,20 @@ def test_frame_subspace_is_reused_within_the_tolerance_and_recomputed_beyond(mon
     height = np.array([1000.0, 1000.0, 1008.0, 993.0, 1040.0, 1070.0, 1000.0, 1003.0])
     pitch = np.radians([0.0, 0.0, 0.3, -0.4, 0.0, 0.0, 0.0, 0.0])
     n = vd.size
-    own = {
-        "own_vn_mps": np.full(n, 50.0),
-        "own_ve_mps": np.zeros(n),
-        "own_vd_mps": vd,
-        "own_yaw_rad": np.full(n, 0.3),
-        "own_pitch_rad": pitch,
-        "own_roll_rad": np.zeros(n),
-        "own_height_agl_m": height,
-        "has_geo": np.array(False),
-    }
+    own = OwnShipStates.from_columns(
+        {
+            "time_s": np.arange(n) / 9.4,
+            "own_north_m": np.zeros(n),
+            "own_east_m": np.zeros(n),
+            "own_down_m": -height,
+            "own_vn_mps": np.full(n, 50.0),
+            "own_ve_mps": np.zeros(n),
+            "own_vd_mps": vd,
+            "own_yaw_rad": np.full(n, 0.3),
+            "own_pitch_rad": pitch,
+            "own_height_agl_m": height,
+        }
+    )
     monkeypatch.setattr(clutter_anchors, "_SMOOTH_FRAMES", 1)
     got = [clutter_frames.frame_subspace(own, i, CFG) for i in range(n)]
     assert all(g is got[0] for g in got[:5]) and len(calls) == 3  # 4 % higher too

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -49,6 +49,7 @@ from skyradar.daa.alerting import AlertConfig
 from skyradar.daa.pipeline import AlertStream
 from skyradar.daa.run_tables import ownship_from_frames
 from skyradar.io.frames import frames_dataset
+from skyradar.io.ownship_states import OwnShipStates
 from skyradar.io.tables import appended
 from skyradar.process.clutter_anchors import AnchorWalk, frame_geometries
 from skyradar.process.detect_run import merge_head_tables
@@ -194,7 +195,7 @@ class StreamingChain:
         self._alerter = AlertStream(alert_config, with_advice=with_advice, source=built.name)
         self._next = 0
         self._own_truth: dict[str, list[float]] = {}
-        self._navigated: list[dict[str, np.ndarray]] = []  # the last frames' navigated own-ship states
+        self._navigated: list[OwnShipStates] = []  # the last frames' navigated own-ship states
         self._n_detections = 0
         self._own_so_far: pd.DataFrame | None = None  # the own-ship table's rows so far
         self._skipped = 0  # confirmed track rows without a state to alert on, so far
@@ -329,8 +330,12 @@ class StreamingChain:
             return None
         if name == self.heads[0].name:  # one own-ship: its recent states serve every head
             self._navigated = [*self._navigated, state][-_SMOOTH_FRAMES:]
-        recent = {k: np.concatenate([s[k] for s in self._navigated]) for k in state if np.ndim(state[k])}
-        recent |= {k: v for k, v in state.items() if not np.ndim(v)}
+        # The recent frames' arrays with this head's flags (every head flies the one own-ship).
+        recent = replace(
+            OwnShipStates.concatenate(self._navigated),
+            has_geo=state.has_geo,
+            navigation_source=state.navigation_source,
+        )
         geometry = frame_geometries(recent, self.built.terrain)[-1]
         return self._walks[name].next(geometry)[None, :]
 

@@ -159,7 +159,7 @@ def _stream(tracks: pd.DataFrame, own: pd.DataFrame, n_frames: int) -> pd.DataFr
 def _miss_inputs(tracks: pd.DataFrame, own: pd.DataFrame) -> tuple:
     t = tracks["time_s"].to_numpy(float)
     at = interp_ownship(own, t, "bench")
-    own_v = np.column_stack([at["own_vn_mps"], at["own_ve_mps"], at["own_vd_mps"]])
+    own_v = at.velocity_ned_mps
     return (
         tracks["track_id"].to_numpy(),
         t,

@@ -51,6 +51,7 @@ from skyradar.daa.tables import (
     covariances,
     interp_ownship,
 )
+from skyradar.io.ownship_states import OwnShipStates
 from skyradar.io.tables import appended
 
 __all__ = [
@@ -311,7 +312,7 @@ class _AlertRows:
 
     df: pd.DataFrame  # the clean tracks rows and the lost tracks' predictions, in time order
     t: np.ndarray
-    own: dict[str, np.ndarray]  # the own-ship interpolated to the rows' times
+    own: OwnShipStates  # the own-ship interpolated to the rows' times
     own_vel: np.ndarray
     s: np.ndarray  # relative position (intruder minus own-ship), m
     v: np.ndarray  # relative velocity, m/s
@@ -330,7 +331,7 @@ class _AlertRows:
         return _AlertRows(
             df,
             self.t[keep],
-            {name: values[keep] for name, values in self.own.items()},
+            self.own.select(keep),
             self.own_vel[keep],
             self.s[keep],
             self.v[keep],
@@ -356,8 +357,7 @@ def _alert_rows(
     predicted = df["extrapolated"].to_numpy(bool)
     t = df["time_s"].to_numpy(float)
     own = interp_ownship(ownship, t, source)
-    own_pos = np.stack([own["own_north_m"], own["own_east_m"], own["own_down_m"]], -1)
-    own_vel = np.stack([own["own_vn_mps"], own["own_ve_mps"], own["own_vd_mps"]], -1)
+    own_pos, own_vel = own.position_ned_m, own.velocity_ned_mps
     v_int = df[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(float)
     s, v = df[["north_m", "east_m", "down_m"]].to_numpy(float) - own_pos, v_int - own_vel
     located = np.isfinite(s).all(axis=1) & np.isfinite(v).all(axis=1)  # else a range-only row
@@ -385,12 +385,12 @@ def _alerts_out(rows: _AlertRows, config: AlertConfig, with_advice: bool) -> pd.
     range_m = np.where(
         located, np.linalg.norm(s, axis=-1), np.where(np.isnan(measured_r), fitted_r, measured_r)
     )
-    out = _alerts_table(df, t, level, raw, s, v_int, own["own_yaw_rad"], located, range_m)
+    out = _alerts_table(df, t, level, raw, s, v_int, own.yaw_rad, located, range_m)
     out["extrapolated"] = rows.predicted
     out["geometry"] = np.where(located, "3-d", "range-only")
     if with_advice:
         corrective = config.levels[min(1, len(config.levels) - 1)]
-        height = own.get("own_height_agl_m")
+        height = own.height_agl_m  # NaN where unknown: no terrain band, as without the column
         dthr, zthr = raw["dthr_m"], raw["zthr_m"]
         volume, alerting_time_s = corrective.volume, corrective.alerting_time_s
         advice_columns(out, s, v_int, own_vel, height, dthr, zthr, volume, alerting_time_s, located)

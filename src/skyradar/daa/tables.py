@@ -21,6 +21,8 @@ import numpy as np
 import pandas as pd
 
 from skyradar.errors import InputError
+from skyradar.io.navigation import NAVIGATION_SOURCES
+from skyradar.io.ownship_states import OwnShipStates
 from skyradar.io.tables import check_within, finite_column
 from skyradar.track.track_table import OWNSHIP_COLUMNS as TRACKER_OWNSHIP_COLUMNS
 
@@ -111,8 +113,33 @@ def _flag(flag: pd.Series, name: str, source: str) -> np.ndarray:
     return flag.astype(bool).to_numpy()
 
 
-def interp_ownship(own: pd.DataFrame, times: np.ndarray, source: str) -> dict[str, np.ndarray]:
-    """Own-ship state at ``times`` (linear; heading unwrapped; else the ground track)."""
+def interp_ownship(own: pd.DataFrame, times: np.ndarray, source: str) -> OwnShipStates:
+    """Own-ship state at ``times`` (linear; heading unwrapped; else the ground track).
+
+    Parameters
+    ----------
+    own : pandas.DataFrame
+        Own-ship table (see the module docstring); ``attrs["navigation_source"]`` is kept when set.
+    times : ndarray
+        Times to interpolate to, s (at most 1 s outside the table's).
+    source : str
+        Name of the tracks, for errors.
+
+    Returns
+    -------
+    OwnShipStates
+        The state at ``times``: no attitude but the heading, no geodetic fix, and a NaN height above
+        ground when the table has none.
+
+    Examples
+    --------
+    >>> own = pd.DataFrame({"time_s": [0.0, 2.0], "own_north_m": [0.0, 100.0], "own_east_m": 0.0,
+    ...     "own_down_m": -500.0, "own_vn_mps": 50.0, "own_ve_mps": 0.0, "own_vd_mps": 0.0})
+    >>> at = interp_ownship(own, np.array([1.0]), "tracks")
+    >>> float(at.north_m[0]), float(at.yaw_rad[0]), at.has_geo
+    (50.0, 0.0, False)
+    """
+    kind = own.attrs.get("navigation_source")
     own = own.sort_values("time_s")
     t = own["time_s"].to_numpy(float)
     if times.size and (times.min() < t[0] - 1.0 or times.max() > t[-1] + 1.0):
@@ -127,7 +154,9 @@ def interp_ownship(own: pd.DataFrame, times: np.ndarray, source: str) -> dict[st
         out[c] = np.interp(times, t, values)
     if "own_yaw_rad" not in out:
         out["own_yaw_rad"] = np.arctan2(out["own_ve_mps"], out["own_vn_mps"])
-    return out
+    out["time_s"] = np.asarray(times, float)
+    known = isinstance(kind, str) and kind in NAVIGATION_SOURCES
+    return OwnShipStates.from_columns(out, kind if known else None)
 
 
 def covariances(df: pd.DataFrame) -> tuple[np.ndarray | None, np.ndarray | None]:

@@ -9,11 +9,13 @@ The names users call, importable from here (each is imported from its module on 
 - :func:`~.recordings.read_recording`, :func:`~.recording_writer.write_recording` and
   :func:`~.recording_writer.write_sigmf_recording`: raw ADC recordings (a sidecar beside the
   samples, or SigMF); :func:`~.sigmf_io.read_iq_recording`: a passive receiver's IQ;
-- :func:`~.outputs.check_output`: the check every writing command makes before any work.
+- :func:`~.outputs.check_output`: the check every writing command makes before any work;
+- :class:`~.ownship_states.OwnShipStates`: the own-ship's navigated state per frame, the typed
+  object process, clutter suppression and alerting take.
 
 Modules: frames (:mod:`.frames`, :mod:`.frames_model`, :mod:`.frames_heads`, :mod:`.cint16`,
-:mod:`.checks`, :mod:`.store_size`, :mod:`.navigation`, :mod:`.run_origin`, :mod:`.run_export`,
-:mod:`.ownship_input`); tables (:mod:`.tables`, :mod:`.table_columns`); recordings
+:mod:`.checks`, :mod:`.store_size`, :mod:`.navigation`, :mod:`.ownship_states`, :mod:`.run_origin`,
+:mod:`.run_export`, :mod:`.ownship_input`); tables (:mod:`.tables`, :mod:`.table_columns`); recordings
 (:mod:`.recordings`, :mod:`.recording_sigmf`, :mod:`.recording_writer`, :mod:`.sigmf_io`,
 :mod:`.iq_raw`, :mod:`.iq_recording`); writing safely (:mod:`.outputs`, :mod:`.atomic`,
 :mod:`.locks`) and reading safely (:mod:`.safe_yaml`).
@@ -31,5 +33,6 @@ _EXPORTS = {
     "recording_writer": ("write_recording", "write_sigmf_recording"),
     "sigmf_io": ("read_iq_recording",),
     "outputs": ("check_output",),
+    "ownship_states": ("OwnShipStates",),
 }
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)

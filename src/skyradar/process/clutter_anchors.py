@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from skyradar.io.ownship_states import OwnShipStates
 from skyradar.process.ground import height_above_ground_m
 
 __all__ = [
@@ -54,27 +55,27 @@ RECENT_ANCHORS = 8  # anchors the walk keeps (clutter_frames caches as many pred
 _SMOOTH_FRAMES = 5  # velocity mean over this frame and the 4 before it (GNSS velocity noise is white)
 
 
-def frame_geometries(own: dict[str, np.ndarray], terrain: Any = None, stop: int | None = None) -> np.ndarray:
+def frame_geometries(own: OwnShipStates, terrain: Any = None, stop: int | None = None) -> np.ndarray:
     """Velocity in a heading-free frame (m/s, forward, right, down; the mean over each frame and the
     4 before it), pitch, roll (rad) and height above the ground below (m) of frames ``0:stop``.
 
-    ``own`` is the own-ship dict of :mod:`skyradar.process.pipeline`. The height is the navigated
-    one, else the terrain's under the own-ship (``terrain.height_at(lat, lon)`` or a callable) when
-    the run is geodetic; a DEM without ground there reads as no ground (1e9 m). Rows without a
-    height, or not above the ground, are NaN.
+    ``own`` is the run's navigated :class:`~skyradar.io.ownship_states.OwnShipStates`. The height
+    is the navigated one, else the terrain's under the own-ship (``terrain.height_at(lat, lon)`` or
+    a callable) when the run is geodetic; a DEM without ground there reads as no ground (1e9 m).
+    Rows without a height, or not above the ground, are NaN.
 
     Examples
     --------
-    >>> one = np.ones(2)
-    >>> own = {"own_vn_mps": 0 * one, "own_ve_mps": 50 * one, "own_vd_mps": 0 * one,
-    ...        "own_yaw_rad": np.radians(90) * one, "own_pitch_rad": 0 * one, "own_roll_rad": 0 * one,
-    ...        "own_height_agl_m": np.array([500.0, -1.0]), "has_geo": np.array(False)}
+    >>> one, zero = np.ones(2), np.zeros(2)
+    >>> own = OwnShipStates.from_columns({"time_s": [0.0, 0.1], "own_north_m": zero, "own_east_m": zero,
+    ...     "own_down_m": zero, "own_vn_mps": zero, "own_ve_mps": 50 * one, "own_vd_mps": zero,
+    ...     "own_yaw_rad": np.radians(90) * one, "own_height_agl_m": np.array([500.0, -1.0])})
     >>> frame_geometries(own).round(6).tolist()
     [[50.0, 0.0, 0.0, 0.0, 0.0, 500.0], [nan, nan, nan, nan, nan, nan]]
     """
-    n = own["own_yaw_rad"].size if stop is None else int(stop)
-    yaw = np.asarray(own["own_yaw_rad"][:n], float)
-    vn, ve, vd = (np.asarray(own[k][:n], float) for k in ("own_vn_mps", "own_ve_mps", "own_vd_mps"))
+    n = own.yaw_rad.size if stop is None else int(stop)
+    yaw = own.yaw_rad[:n]
+    vn, ve, vd = own.vn_mps[:n], own.ve_mps[:n], own.vd_mps[:n]
     # Flat ground is the same in every direction: each frame's velocity in its own heading-free frame
     # (constant through a coordinated turn), averaged against the GNSS velocity noise.
     free = np.column_stack([np.cos(yaw) * vn + np.sin(yaw) * ve, np.cos(yaw) * ve - np.sin(yaw) * vn, vd])
@@ -82,18 +83,18 @@ def frame_geometries(own: dict[str, np.ndarray], terrain: Any = None, stop: int 
     padded = np.vstack([np.zeros((_SMOOTH_FRAMES - 1, 3)), free])
     windows = np.lib.stride_tricks.sliding_window_view(padded, _SMOOTH_FRAMES, axis=0)
     mean = windows.sum(axis=-1) / np.minimum(np.arange(1, n + 1), _SMOOTH_FRAMES)[:, None]
-    height = np.array(own["own_height_agl_m"][:n], float)
+    height = np.array(own.height_agl_m[:n], float)
     unknown = ~np.isfinite(height)
-    if unknown.any() and bool(own["has_geo"]) and terrain is not None:
+    if unknown.any() and own.has_geo and terrain is not None:
         height[unknown] = _height_over_terrain(own, terrain, np.flatnonzero(unknown))
-    out = np.column_stack([mean, own["own_pitch_rad"][:n], own["own_roll_rad"][:n], height])
+    out = np.column_stack([mean, own.pitch_rad[:n], own.roll_rad[:n], height])
     out[~(height > 0)] = np.nan
     return out
 
 
-def _height_over_terrain(own: dict[str, np.ndarray], terrain: Any, rows: np.ndarray) -> np.ndarray:
+def _height_over_terrain(own: OwnShipStates, terrain: Any, rows: np.ndarray) -> np.ndarray:
     """Own-ship altitude less the terrain height under it at ``rows``, m (1e9 outside the DEM)."""
-    lat, lon, alt = (np.asarray(own[k], float)[rows] for k in ("own_lat_deg", "own_lon_deg", "own_alt_m"))
+    lat, lon, alt = own.lat_deg[rows], own.lon_deg[rows], own.alt_m[rows]
     agl = height_above_ground_m(lat, lon, alt, terrain)
     return np.where(np.isfinite(agl), agl, 1e9)
 
@@ -121,9 +122,7 @@ def _within_tolerance(state: np.ndarray, at: np.ndarray) -> bool:
     )
 
 
-def prediction_anchors(
-    own: dict[str, np.ndarray], terrain: Any = None, stop: int | None = None
-) -> np.ndarray:
+def prediction_anchors(own: OwnShipStates, terrain: Any = None, stop: int | None = None) -> np.ndarray:
     """The geometry (:func:`frame_geometries`' columns, quantised) each of frames ``0:stop`` is
     predicted at; NaN rows where there is no height above the ground.
 
@@ -134,10 +133,10 @@ def prediction_anchors(
     Examples
     --------
     >>> n = 4
-    >>> own = {"own_vn_mps": np.full(n, 50.0), "own_ve_mps": np.zeros(n),
-    ...        "own_vd_mps": np.array([0.0, 0.3, 0.0, 0.0]), "own_yaw_rad": np.zeros(n),
-    ...        "own_pitch_rad": np.zeros(n), "own_roll_rad": np.zeros(n),
-    ...        "own_height_agl_m": np.array([1000.0, 1030.0, 1200.0, 1000.0]), "has_geo": np.array(False)}
+    >>> own = OwnShipStates.from_columns({"time_s": np.arange(n) * 0.1, "own_north_m": np.zeros(n),
+    ...     "own_east_m": np.zeros(n), "own_down_m": np.zeros(n), "own_vn_mps": np.full(n, 50.0),
+    ...     "own_ve_mps": np.zeros(n), "own_vd_mps": np.array([0.0, 0.3, 0.0, 0.0]),
+    ...     "own_height_agl_m": np.array([1000.0, 1030.0, 1200.0, 1000.0])})
     >>> a = prediction_anchors(own)
     >>> a[:, 5].round(1).tolist()  # 3 % higher: the first anchor; 20 % higher: a new one; back: the first
     [999.7, 999.7, 1199.9, 999.7]

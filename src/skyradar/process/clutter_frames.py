@@ -1,9 +1,9 @@
 """Clutter suppression inside the frames pipeline: per-frame geometry (cached) and DoA after projection.
 
-:func:`frame_subspace` turns one frame's navigation state (the own-ship dict of
-:mod:`skyradar.process.pipeline`: velocity, attitude, height above ground) into the predicted
-clutter subspace over flat ground at the own-ship's height above the ground below it (from the
-navigation, else from the terrain under the own-ship). It depends on the velocity in a
+:func:`frame_subspace` turns one frame's navigation state (the run's
+:class:`~skyradar.io.ownship_states.OwnShipStates`: velocity, attitude, height above ground)
+into the predicted clutter subspace over flat ground at the own-ship's height above the ground
+below it (from the navigation, else from the terrain under the own-ship). It depends on the velocity in a
 heading-free frame, pitch, roll and height only, so it is computed at the frame's anchor
 (:mod:`skyradar.process.clutter_anchors`: reused while the navigated geometry stays within a
 stated tolerance, the same anchor however the run is chunked) and cached: a straight flight computes
@@ -28,6 +28,7 @@ import numpy as np
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.geo import rotation_matrix
+from skyradar.io.ownship_states import OwnShipStates
 from skyradar.process.clutter import ClutterSubspace, clutter_subspace
 from skyradar.process.clutter_adaptive import ring_whitening
 from skyradar.process.clutter_anchors import RECENT_ANCHORS, anchor_key, prediction_anchors
@@ -54,7 +55,7 @@ _CACHE_SIZE = RECENT_ANCHORS
 
 
 def frame_subspace(
-    own: dict[str, np.ndarray],
+    own: OwnShipStates,
     i: int,
     config: RadarConfig,
     terrain: Any = None,
@@ -240,7 +241,7 @@ def _fit(proj: np.ndarray, z: np.ndarray, y: np.ndarray, s: np.ndarray, whitened
 
 def frame_clutter(
     suppression: str,
-    own: dict | None,
+    own: OwnShipStates | None,
     i: int,
     config: RadarConfig,
     terrain: Any = None,

@@ -42,7 +42,7 @@ from skyradar.geo import ned_rotation_to, ned_to_geodetic, rotation_matrix
 from skyradar.io.checks import check_finite_frames
 from skyradar.io.frames import radar_config_of
 from skyradar.io.frames_model import frame_times_s
-from skyradar.io.navigation import navigation_state
+from skyradar.io.ownship_states import OwnShipStates
 from skyradar.io.run_origin import scenario_origin  # re-exported: the origin of a processed run
 from skyradar.process.clutter_anchors import prediction_anchors
 from skyradar.process.clutter_frames import detect_suppressed, frame_clutter
@@ -102,9 +102,6 @@ DETECTION_COLUMNS = [c for c in DETECTION_TABLE_COLUMNS if c != "radar"]
 # against the primary 2e-8 this threshold is about 2.4 dB lower (Gamma(2) noise), and a confirmed
 # track's gate of a few cells sees one of its false alarms in thousands of frames.
 PFA_SECONDARY = 1e-4
-_OWN = ("own_north_m", "own_east_m", "own_down_m", "own_vn_mps", "own_ve_mps", "own_vd_mps")
-_ATT = ("own_yaw_rad", "own_pitch_rad", "own_roll_rad", "own_height_agl_m")
-_GEO = ("own_lat_deg", "own_lon_deg", "own_alt_m")
 
 
 def process_cube(
@@ -172,39 +169,35 @@ def process_cube(
     }
 
 
-def navigated_own_state(ds: xr.Dataset, source: str = "frames") -> dict[str, np.ndarray] | None:
+def navigated_own_state(ds: xr.Dataset, source: str = "frames") -> OwnShipStates | None:
     """Own-ship state per frame as the aircraft knows it: the navigation solution, never the truth.
 
-    :func:`skyradar.io.navigation.navigation_state` reads ``nav_*`` (``own_*`` only for stores
-    written before navigation existed); keys keep the own-ship table's ``own_*`` names.
+    :meth:`skyradar.io.ownship_states.OwnShipStates.from_frames` reads ``nav_*`` (``own_*`` only
+    for a store without a navigation solution); None without position and velocity.
     """
-    nav = navigation_state(ds, source)
-    if nav is None or not all(name in nav for name in _OWN):
-        return None
-    state = {name: nav[name].to_numpy(float) for name in _OWN}
-    for name in _ATT + _GEO:
-        missing = np.nan if name == "own_height_agl_m" else 0.0  # unknown height stays unknown
-        state[name] = nav[name].to_numpy(float) if name in nav else np.full(len(nav), missing)
-    state["has_geo"] = np.array(all(name in nav for name in _GEO))
-    state["navigation_source"] = nav.attrs["navigation_source"]
-    return state
+    return OwnShipStates.from_frames(ds, source)
 
 
-def _body_to_ned(own: dict[str, np.ndarray], i: int, origin: tuple | None) -> np.ndarray:
+def _position(own: OwnShipStates, i: int) -> np.ndarray:
+    """NED position of frame ``i``, m."""
+    return np.array([own.north_m[i], own.east_m[i], own.down_m[i]])
+
+
+def _body_to_ned(own: OwnShipStates, i: int, origin: tuple | None) -> np.ndarray:
     """Rotation of frame ``i`` from the body frame to the scenario NED frame."""
-    body_to_ned = rotation_matrix(own["own_yaw_rad"][i], own["own_pitch_rad"][i], own["own_roll_rad"][i])
-    if origin is not None and bool(own["has_geo"]):
+    body_to_ned = rotation_matrix(own.yaw_rad[i], own.pitch_rad[i], own.roll_rad[i])
+    if origin is not None and own.has_geo:
         # Attitude is relative to the local vertical at the aircraft (as in the simulator).
-        lat, lon = own["own_lat_deg"][i], own["own_lon_deg"][i]
+        lat, lon = own.lat_deg[i], own.lon_deg[i]
         body_to_ned = ned_rotation_to(origin[0], origin[1], lat, lon).T @ body_to_ned
     return body_to_ned
 
 
 def _to_world(
-    out: dict[str, np.ndarray], own: dict[str, np.ndarray], i: int, config: RadarConfig, origin: tuple | None
+    out: dict[str, np.ndarray], own: OwnShipStates, i: int, config: RadarConfig, origin: tuple | None
 ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray]:
     """NED position, geodetic position and NED unit direction of one frame's detections."""
-    pos = np.array([own["own_north_m"][i], own["own_east_m"][i], own["own_down_m"][i]])
+    pos = _position(own, i)
     body_to_ned = _body_to_ned(own, i, origin)
     body = np.stack([out["x_body_m"], out["y_body_m"], out["z_body_m"]], axis=1)
     ned = pos + body @ body_to_ned.T
@@ -217,21 +210,21 @@ def _to_world(
     return ned, geo, u_ned
 
 
-def _geodetic_fn(own: dict[str, np.ndarray], i: int, origin: tuple | None) -> GeodeticFn | None:
+def _geodetic_fn(own: OwnShipStates, i: int, origin: tuple | None) -> GeodeticFn | None:
     """NED points -> (lat, lon, alt) for frame ``i``: from the scenario origin, else relative to the
     own-ship's geodetic fix (about 2 m off at 5 km); None with neither."""
     if origin is not None:
         return lambda points: ned_to_geodetic(points, *origin)
-    if not bool(own["has_geo"]):
+    if not own.has_geo:
         return None
-    pos = np.array([own["own_north_m"][i], own["own_east_m"][i], own["own_down_m"][i]])
-    fix = (float(own["own_lat_deg"][i]), float(own["own_lon_deg"][i]), float(own["own_alt_m"][i]))
+    pos = _position(own, i)
+    fix = (float(own.lat_deg[i]), float(own.lon_deg[i]), float(own.alt_m[i]))
     return lambda points: ned_to_geodetic(points - pos, *fix)
 
 
 def _ground_flags(
     out: dict[str, np.ndarray],
-    own: dict | None,
+    own: OwnShipStates | None,
     i: int,
     u_ned: np.ndarray | None,
     config: RadarConfig,
@@ -248,8 +241,8 @@ def _ground_flags(
     if own is None or n == 0:
         return np.zeros(n, bool)
     assert u_ned is not None  # found with own (_to_world)
-    own_agl = float(own["own_height_agl_m"][i])
-    pos = np.array([own["own_north_m"][i], own["own_east_m"][i], own["own_down_m"][i]])
+    own_agl = float(own.height_agl_m[i])
+    pos = _position(own, i)
     geodetic = _geodetic_fn(own, i, origin)
     located = geodetic is not None
     if terrain is not None and geodetic is not None and not np.isfinite(own_agl):
@@ -257,7 +250,7 @@ def _ground_flags(
     if not np.isfinite(own_agl):
         return np.zeros(n, bool)  # no terrain, no own-ship height: Doppler alone cannot decide
     height_fn = surface_height_fn(pos[2] + own_agl, terrain if located else None, geodetic)
-    vel = np.array([own[k][i] for k in _OWN[3:]])
+    vel = np.array([own.vn_mps[i], own.ve_mps[i], own.vd_mps[i]])
     ant_to_ned = _body_to_ned(own, i, origin) @ config.mount.rotation
     return flag_ground(out, u_ned, vel, ant_to_ned, height_fn, own_agl, config)
 
@@ -327,7 +320,9 @@ def _checked_config(ds: xr.Dataset, config: RadarConfig | None, spur_map, source
     return config
 
 
-def _located(out: dict, time_s: float, i: int, own, origin, config: RadarConfig, terrain) -> dict:
+def _located(
+    out: dict, time_s: float, i: int, own: OwnShipStates | None, origin, config: RadarConfig, terrain
+) -> dict:
     """One frame's detections with time, frame, world position (NaN without own-ship) and ground flag."""
     n = len(out["range_m"])
     out["time_s"] = np.full(n, time_s)
@@ -421,5 +416,5 @@ def process_frames(
         if progress is not None:
             progress(min(start + batch_frames, stop) - first)
     table = pd.DataFrame({c: np.concatenate([r[c] for r in rows]) for c in DETECTION_COLUMNS})
-    table.attrs["navigation_source"] = None if own is None else str(own["navigation_source"])
+    table.attrs["navigation_source"] = None if own is None else own.navigation_source
     return table

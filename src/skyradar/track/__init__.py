@@ -11,14 +11,15 @@ The names users call, importable from here (each is imported from its module on 
   :class:`~.components.Associator`, :class:`~.components.Updater`, :class:`~.components.Initiator`,
   :class:`~.components.Deleter` and :class:`~.components.Reacquirer`; the live tracks it holds,
   :class:`~.types.TrackArrays`, and what a frame returns, :class:`~.types.FrameTracks`;
+  :class:`~.range_walk.RangeWalks`, which confirms a fast closure by its range history;
   :class:`~.tracker3d.Tracker3D`, the 3-D filter on direction-of-arrival positions;
 - :func:`~.io.read_detections` and :func:`~.simulated_detections.synthetic_detections`, detections
   from a file or from truth;
 - :func:`~.evaluate.evaluate_run` (``skyradar evaluate``) and :func:`~.metrics.track_metrics`.
 
 Modules: the tracker (:mod:`.tracker`, :mod:`.types`, :mod:`.components`, :mod:`.models`,
-:mod:`.kalman`, :mod:`.association`, :mod:`.initiation`, :mod:`.deletion`, :mod:`.dealias`,
-:mod:`.reacquisition`, :mod:`.reacquired_ids`); 3-D tracks (:mod:`.tracker3d`, :mod:`.measure3d`,
+:mod:`.kalman`, :mod:`.association`, :mod:`.initiation`, :mod:`.range_walk`, :mod:`.deletion`,
+:mod:`.dealias`, :mod:`.reacquisition`, :mod:`.reacquired_ids`); 3-D tracks (:mod:`.tracker3d`, :mod:`.measure3d`,
 :mod:`.doa_feed`, :mod:`.elevation_trust`); several heads (:mod:`.fusion`); the ground
 (:mod:`.ground_tracks`, :mod:`.ground_doa`, :mod:`.static_point`); tables in and out
 (:mod:`.track_table`, :mod:`.io`, :mod:`.frame_grid`, :mod:`.simulated_detections`); scoring
@@ -33,6 +34,7 @@ from skyradar.lazy_exports import lazy_exports
 _EXPORTS = {
     "track_table": ("track_detections", "track_air_detections"),
     "tracker": ("RangeDopplerTracker", "TrackerConfig"),
+    "range_walk": ("RangeWalks", "RangeWalkRule"),
     "models": ("radar_model", "traditional_model"),
     "components": ("Predictor", "Associator", "Updater", "Initiator", "Deleter", "Reacquirer"),
     "types": ("TrackArrays", "FrameTracks"),

@@ -118,6 +118,7 @@ class ImageSimulator:
         swerling: int = 0,
         adaptive_facets: bool | None = None,
     ) -> None:
+        config.require_one_transmitter("the image-domain simulator")  # frames per receive channel
         self.config = config
         self.terrain = terrain
         lat0, lon0, alt0 = origin

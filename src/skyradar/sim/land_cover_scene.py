@@ -125,6 +125,7 @@ class LandCoverSimulator:
         shadow: bool = True,
         speckle: bool = True,
     ) -> None:
+        config.require_one_transmitter("the land-cover simulator")  # frames per receive channel
         code = np.asarray(class_code)
         height = np.asarray(height_m, np.float32)
         if code.shape != grid.shape or height.shape != grid.shape:

@@ -60,7 +60,7 @@ def test_each_transmitter_slow_time_halves_the_unambiguous_doppler():
 
 
 def test_mimo_config_round_trips_through_dict_and_recording(tmp_path):
-    from skyradar.io.recording_writer import write_recording
+    from skyradar.io.recording_writer import write_recording, write_sigmf_recording
     from skyradar.io.recordings import read_recording
 
     back = RadarConfig.from_dict(MIMO.to_dict())
@@ -73,6 +73,9 @@ def test_mimo_config_round_trips_through_dict_and_recording(tmp_path):
     assert read == cfg and read.n_tx == 2
     split = mimo.split_chirps(np.asarray(frames[0]), read)
     assert np.all(split[:4] == 0) and np.all(split[4:] == 1)
+    sigmf_frames, sigmf_read = read_recording(write_sigmf_recording(tmp_path / "rec", adc, cfg, "cf32_le"))
+    assert sigmf_read == cfg and sigmf_read.n_tx == 2
+    np.testing.assert_array_equal(np.asarray(sigmf_frames[0]), adc[0])
 
 
 @pytest.mark.parametrize(
@@ -297,6 +300,20 @@ def test_an_aliased_target_keeps_a_residual_bias_with_the_aliased_compensation_a
     az, el = np.degrees(angles_from_direction(estimate_directions(out.pixels, MIMO)))
     assert az[0] == pytest.approx(AZ_DEG, abs=0.2) and el[0] == pytest.approx(EL_DEG, abs=0.2)
     assert out.residue.tolist() == [1] and out.peak_ratio[0] > 1.0
+
+
+@pytest.mark.parametrize(("el_deg", "resolved"), [(-10.0, True), (10.0, True), (-20.0, False), (25.0, False)])
+def test_the_ambiguity_is_resolved_where_the_alias_leaves_the_field_of_view(el_deg, resolved):
+    # mimo-2x4's wrong residue mimics the down direction cosine shifted by 1: outside the prototype's
+    # 49.5 deg cone within 13.9 deg of the horizontal plane (rx_layouts docstring), inside beyond.
+    v = -25.0
+    z = steering_vector(direction_from_angles(0.0, np.radians(el_deg)), MIMO) * mimo.slot_phase(v, MIMO)
+    out = mimo.virtual_pixels(z[None], MIMO.doppler_bin(v), MIMO)
+    if resolved:
+        assert out.residue.tolist() == [1] and out.peak_ratio[0] > 1.01
+        assert out.radial_velocity_mps[0] == pytest.approx(v, abs=MIMO.doppler_resolution_mps)
+    else:  # both residues have a plane wave inside the cone that fits: the ratio says so
+        assert out.peak_ratio[0] < 1.005
 
 
 def test_virtual_array_bound_is_the_closed_form_2x4_ura():

@@ -24,7 +24,12 @@ from inside the antenna's field of view (the cone within 6 dB of peak gain,
 ``lambda m / (n_tx d)`` in direction cosine along a transmitter spacing ``d``; it loses where that
 direction lies outside the cone (for ``mimo-2x4`` see :mod:`skyradar.rx_layouts`). The chosen
 residue also extends the unambiguous velocity to ``[-n_tx VLim, n_tx VLim)``, the
-one-transmitter ``PRF * lambda / 4``.
+one-transmitter ``PRF * lambda / 4``. The margin is small for arrays with a short transmitter
+baseline: a wrong residue's best direction sits on the cone's edge, inside the broad beam of two
+rows, so for ``mimo-2x4`` the winning peak beats the other by 1.5-18 % (``peak_ratio``
+1.015-1.18 at 5-10 deg above or below the horizontal, azimuth within 20 deg); noise of comparable
+size, a low SNR or a direction near the cone's edge makes the choice unreliable, and a ratio within
+0.5 % of 1 means both residues fit. The track's range rate over several frames is then the other witness.
 """
 
 from __future__ import annotations

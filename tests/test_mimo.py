@@ -179,6 +179,17 @@ def test_bad_transmitters_are_one_line_through_the_cli(tmp_path, radar, needles)
     assert not (tmp_path / "r.zarr").exists()
 
 
+def test_the_image_domain_simulators_refuse_several_transmitters():
+    from skyradar.sim.image import ImageSimulator
+    from skyradar.sim.land_cover_scene import LandCoverSimulator
+
+    with pytest.raises(InputError, match="radar.tx_positions_m: the image-domain simulator models one"):
+        ImageSimulator(MIMO)
+    with pytest.raises(InputError, match="radar.tx_positions_m: the land-cover simulator models one"):
+        LandCoverSimulator(MIMO, np.zeros((2, 2)), np.zeros((2, 2)), None)  # refused before the grid is read
+    ImageSimulator(PROTO)  # one transmitter: built
+
+
 def test_scenario_names_the_mimo_array():
     from skyradar.scene.scenario import Scenario
 
@@ -197,6 +208,23 @@ def test_split_chirps_sorts_chirp_n_to_transmitter_n_mod_n_tx():
     assert split[:, :, 0].tolist() == [
         [100 * r + t + 2 * j for j in range(3)] for t in range(2) for r in range(4)
     ]
+
+
+def test_the_plain_range_doppler_transform_refuses_interleaved_chirps():
+    adc = np.zeros((4, MIMO.n_doppler, MIMO.samples_per_chirp), np.complex64)
+    with pytest.raises(InputError, match=r"radar.tx_positions_m: the range-Doppler .*virtual_range_doppler"):
+        range_doppler(adc, MIMO)
+
+
+def test_a_mimo_recording_is_refused_by_skyradar_rd_in_one_line(tmp_path):
+    from skyradar.io.recording_writer import write_recording
+
+    cfg = MIMO.replace(n_doppler=8)
+    adc = np.zeros((1, 4, 8, cfg.samples_per_chirp), np.complex64)
+    write_recording(tmp_path / "rec.bin", adc, cfg, dtype="complex64")
+    result = skyradar("rd", "rec.json", "-o", "rd.zarr", cwd=tmp_path)
+    assert_one_line_error(result, "radar.tx_positions_m", "got 2", "virtual_range_doppler")
+    assert not (tmp_path / "rd.zarr").exists()
 
 
 def test_one_transmitter_virtual_cube_is_the_range_doppler_cube():

@@ -393,12 +393,14 @@ class RadarConfig:
         v.setflags(write=False)
         return v
 
-    def require_one_transmitter(self, what: str) -> None:
-        """InputError naming ``radar.tx_positions_m`` when ``what``, a one-transmitter model, gets several."""
+    def require_one_transmitter(self, what: str, instead: str) -> None:
+        """InputError naming ``radar.tx_positions_m`` when ``what``, a one-transmitter model, gets several.
+
+        ``instead`` says what handles a time-division MIMO radar.
+        """
         if self.n_tx > 1:
             raise InputError(
-                f"radar.tx_positions_m: {what} models one transmitter, got {self.n_tx}; simulate a "
-                "time-division MIMO radar at the chirp level (skyradar.sim.raw.simulate_adc)"
+                f"radar.tx_positions_m: {what} models one transmitter, got {self.n_tx}; {instead}"
             )
 
     @property

@@ -344,6 +344,23 @@ def test_the_ambiguity_is_resolved_where_the_alias_leaves_the_field_of_view(el_d
         assert out.peak_ratio[0] < 1.005
 
 
+@pytest.mark.parametrize("radial_mps", [-5.0, 20.0, -30.0, 35.0])
+def test_three_transmitters_resolve_every_residue(radial_mps):
+    # A row of 4 receivers at lambda/2, transmitters at 0 and 2 lambda across and one lambda/2 up:
+    # per-transmitter limit 13.0 m/s, so the velocities here alias by m = 0, 1, 2 and 1.
+    rx = [[0, (2 * i - 3) * LAM / 4, 0] for i in range(4)]
+    tx = [[0, 0, 0], [0, 2 * LAM, 0], [0, LAM, LAM / 2]]
+    cfg = RadarConfig.prototype_2022(rx_positions_m=rx, tx_positions_m=tx, n_doppler=249)
+    for az_deg, el_deg in ((10.0, -5.0), (-15.0, 3.0)):
+        u = direction_from_angles(np.radians(az_deg), np.radians(el_deg))
+        z = steering_vector(u, cfg) * mimo.slot_phase(radial_mps, cfg)
+        out = mimo.virtual_pixels(z[None], cfg.doppler_bin(radial_mps), cfg)
+        assert out.radial_velocity_mps[0] == pytest.approx(radial_mps, abs=cfg.doppler_resolution_mps)
+        az, el = np.degrees(angles_from_direction(estimate_directions(out.pixels, cfg)))
+        # The compensation uses the bin's centre: up to half a bin of velocity is left as phase.
+        assert az[0] == pytest.approx(az_deg, abs=0.5) and el[0] == pytest.approx(el_deg, abs=0.5)
+
+
 def test_virtual_array_bound_is_the_closed_form_2x4_ura():
     # 2 rows x 4 columns at d = lambda/2 (k d = pi): sum y^2 = 10 d^2, sum z^2 = 2 d^2 about the
     # centre, so at boresight sd = 1 / (pi sqrt(2 SNR sum / d^2)).

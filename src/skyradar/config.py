@@ -11,6 +11,17 @@ positive for a receding target; a velocity outside ``[-VLim, VLim)`` wraps aroun
 
 Frames: antenna frame has boresight +x, y right, z down. The :class:`Mount` rotates it into
 the aircraft body frame (forward, right, down).
+
+Time-division MIMO. A radar may have 1 to :data:`MAX_TX` transmitters (``tx_positions_m``) that
+take turns chirp by chirp: chirp ``n`` of a frame is sent by transmitter ``n mod n_tx``. Each
+transmitter's chirps are then spaced ``n_tx / PRF`` apart, so its slow time has ``nV / n_tx``
+samples, the unambiguous radial velocity shrinks to ``PRF * lambda / (4 n_tx)`` and the Doppler
+axis (``doppler_axis_mps``, ``doppler_bin``) has ``nV / n_tx`` bins of the unchanged width
+``PRF * lambda / (2 nV)``. Every transmitter-receiver pair is a virtual channel at
+``tx + rx`` (``virtual_positions_m``): the far-field two-way phase is
+``-(2 pi / lambda) u . (tx + rx)`` plus a common term, which is the one-way receive phase of
+:mod:`skyradar.process.doa` for an antenna at ``tx + rx``. A single-transmitter radar is the case
+``n_tx = 1``; its fields, serialisation and hash are those of a radar without ``tx_positions_m``.
 """
 
 from __future__ import annotations
@@ -25,7 +36,7 @@ from numpy.typing import ArrayLike
 
 from skyradar.antenna import AntennaPattern, GainCut
 from skyradar.errors import InputError
-from skyradar.rx_layouts import MAX_RX, rx_layout_m
+from skyradar.rx_layouts import MAX_RX, MAX_TX, MIMO_LAYOUTS, mimo_layout_m, rx_layout_m
 from skyradar.units import centred_bin, centred_bin_value, nearest_bin
 
 __all__ = ["SPEED_OF_LIGHT", "BOLTZMANN", "Mount", "RadarConfig"]
@@ -128,9 +139,12 @@ class RadarConfig:
         Receive antenna phase centres in the antenna frame, m, or a layout name of
         :func:`skyradar.rx_layouts.rx_layout_m` (``"square"``, ``"kite"``, ``"ura-2x3"``,
         ``"ura-2x4"``); 1 to 32 distinct positions. Default: the 2x2
-        square, half-wavelength spacing.
+        square, half-wavelength spacing. A MIMO layout name of
+        :func:`skyradar.rx_layouts.mimo_layout_m` (``"mimo-2x4"``) sets the receive antennas and,
+        unless ``tx_positions_m`` is given, the transmitters.
     tx_position_m : ndarray, shape (3,)
-        Transmit antenna phase centre in the antenna frame, m.
+        Transmit antenna phase centre in the antenna frame, m; set to the first row of
+        ``tx_positions_m`` when that is given.
     noise_figure_db : float
         Receiver noise figure, dB.
     temperature_k : float
@@ -141,6 +155,11 @@ class RadarConfig:
         Antenna placement on the aircraft.
     rx_calibration : ndarray, shape (n_rx,), complex
         Per-channel complex gain the measured signal is divided by (1 = uncalibrated).
+    tx_positions_m : ndarray, shape (n_tx, 3), optional
+        Transmit antenna phase centres, m, for a time-division MIMO radar (1 to :data:`MAX_TX`
+        distinct positions, ``n_tx * n_rx`` at most :data:`MAX_RX` virtual channels, ``n_doppler``
+        a multiple of ``n_tx``; module docstring). None for one transmitter at ``tx_position_m``;
+        a single row is that case too and is stored as None.
 
     Examples
     --------
@@ -166,6 +185,7 @@ class RadarConfig:
     antenna: AntennaPattern = field(default_factory=AntennaPattern.default)
     mount: Mount = field(default_factory=Mount)
     rx_calibration: np.ndarray = _SET_BY_POST_INIT
+    tx_positions_m: np.ndarray | None = None
 
     if TYPE_CHECKING:
 
@@ -185,6 +205,7 @@ class RadarConfig:
             antenna: AntennaPattern = ...,
             mount: Mount = ...,
             rx_calibration: ArrayLike | None = ...,
+            tx_positions_m: ArrayLike | None = ...,
         ) -> None: ...
 
     def __post_init__(self) -> None:
@@ -201,6 +222,10 @@ class RadarConfig:
         if self.prf_hz >= self.fs_hz:
             raise InputError(f"radar.prf_hz ({self.prf_hz}) must be below fs_hz ({self.fs_hz})")
         rx = "square" if self.rx_positions_m is None else self.rx_positions_m
+        tx_many = self.tx_positions_m
+        if isinstance(rx, str) and rx in MIMO_LAYOUTS:
+            layout_tx, rx = mimo_layout_m(rx, self.wavelength_m)
+            tx_many = layout_tx if tx_many is None else tx_many
         rx = rx_layout_m(rx, self.wavelength_m) if isinstance(rx, str) else np.array(rx, dtype=float)
         if rx.size == 0:  # [] from a scenario, or (0, 3)
             rx = rx.reshape(0, 3)
@@ -231,7 +256,15 @@ class RadarConfig:
                 f"radar.rx_positions_m: the receive antennas span {span_m:.4g} m, more than one radar's "
                 f"{_MAX_APERTURE_M:g} m (positions are metres in the antenna frame)"
             )
-        tx = np.zeros(3) if self.tx_position_m is None else np.array(self.tx_position_m, dtype=float)
+        # Given transmitters set tx_position_m to their first row (a copy with only tx_positions_m
+        # changed carries the old tx_position_m along, so it cannot count as a second opinion).
+        tx_many = None if tx_many is None else self._checked_transmitters(tx_many, rx.shape[0])
+        if tx_many is not None and tx_many.shape[0] == 1:  # one transmitter: the plain radar
+            tx, tx_many = tx_many[0].copy(), None
+        elif tx_many is not None:
+            tx = tx_many[0].copy()
+        else:
+            tx = np.zeros(3) if self.tx_position_m is None else np.array(self.tx_position_m, dtype=float)
         if tx.shape != (3,) or not np.all(np.isfinite(tx)):
             raise InputError(f"radar.tx_position_m must be 3 finite metres, got {self.tx_position_m!r}")
         if np.abs(tx).max() > _MAX_APERTURE_M:
@@ -246,11 +279,20 @@ class RadarConfig:
         )
         if cal.shape != (rx.shape[0],) or not np.all(np.isfinite(cal)) or np.any(cal == 0):
             raise InputError(f"radar.rx_calibration must be {rx.shape[0]} finite non-zero complex gains")
+        n_tx = 1 if tx_many is None else tx_many.shape[0]
+        if self.n_doppler % n_tx or self.n_doppler // n_tx < 2:
+            raise InputError(
+                f"radar.n_doppler {self.n_doppler} must be a multiple of the {n_tx} transmitters "
+                "with at least 2 chirps per transmitter"
+            )
         rx.setflags(write=False)
         tx.setflags(write=False)
         cal.setflags(write=False)
+        if tx_many is not None:
+            tx_many.setflags(write=False)
         object.__setattr__(self, "rx_positions_m", rx)
         object.__setattr__(self, "tx_position_m", tx)
+        object.__setattr__(self, "tx_positions_m", tx_many)
         object.__setattr__(self, "rx_calibration", cal)
         object.__setattr__(self, "n_doppler", int(self.n_doppler))
         if self.range_limit_m > self.rmax_m:
@@ -262,6 +304,45 @@ class RadarConfig:
                 f"radar.range_limit_m {self.range_limit_m} gives {self.n_range} range bins of "
                 f"{self.range_resolution_m:.2f} m; needs at least 2"
             )
+
+    @staticmethod
+    def _checked_transmitters(value: Any, n_rx: int) -> np.ndarray:
+        """``tx_positions_m`` as an (n_tx, 3) float array, or one InputError line naming the field."""
+        try:
+            tx = np.array(value, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError(
+                f"radar.tx_positions_m must be an (n_tx, 3) array of metres, got {value!r}"
+            ) from None
+        if tx.ndim != 2 or tx.shape[1] != 3 or tx.shape[0] == 0:
+            raise InputError(
+                f"radar.tx_positions_m must be an (n_tx, 3) array of metres, got shape {tx.shape}"
+            )
+        if tx.shape[0] > MAX_TX:
+            raise InputError(
+                f"radar.tx_positions_m: {tx.shape[0]} transmitters; a time-division MIMO radar has "
+                f"1 to {MAX_TX}"
+            )
+        if not np.all(np.isfinite(tx)):
+            bad = int(np.flatnonzero(~np.all(np.isfinite(tx), axis=1))[0])
+            raise InputError(
+                f"radar.tx_positions_m: transmitter {bad} is not finite metres: {tx[bad].tolist()}"
+            )
+        if np.abs(tx).max() > _MAX_APERTURE_M:
+            raise InputError(
+                f"radar.tx_positions_m: {np.abs(tx).max():.4g} m from the antenna frame's origin, more "
+                f"than one radar's {_MAX_APERTURE_M:g} m"
+            )
+        gap = np.linalg.norm(tx[:, None, :] - tx[None, :, :], axis=2) + np.eye(tx.shape[0])
+        if np.any(gap < 1e-6):  # two transmitters in one place: their virtual channels coincide
+            i, j = sorted(int(v) for v in np.argwhere(gap < 1e-6)[0])
+            raise InputError(f"radar.tx_positions_m: transmitters {i} and {j} coincide at {tx[i].tolist()} m")
+        if tx.shape[0] * n_rx > MAX_RX:
+            raise InputError(
+                f"radar.tx_positions_m: {tx.shape[0]} transmitters x {n_rx} receivers are "
+                f"{tx.shape[0] * n_rx} virtual channels; a radar has at most {MAX_RX}"
+            )
+        return tx
 
     @classmethod
     def prototype_2022(cls, **changes: Any) -> RadarConfig:
@@ -283,6 +364,51 @@ class RadarConfig:
         return int(self.rx_positions_m.shape[0])
 
     @property
+    def n_tx(self) -> int:
+        """Transmitters taking turns chirp by chirp (1 without ``tx_positions_m``)."""
+        return 1 if self.tx_positions_m is None else int(self.tx_positions_m.shape[0])
+
+    @property
+    def transmitters_m(self) -> np.ndarray:
+        """Transmit phase centres (n_tx, 3), m: ``tx_positions_m``, or ``tx_position_m`` as one row."""
+        return self.tx_position_m[None, :] if self.tx_positions_m is None else self.tx_positions_m
+
+    @property
+    def n_virtual(self) -> int:
+        """Virtual channels, ``n_tx * n_rx``."""
+        return self.n_tx * self.n_rx
+
+    @cached_property
+    def virtual_positions_m(self) -> np.ndarray:
+        """Virtual channel positions (n_tx * n_rx, 3), m: ``tx + rx``, transmitter-major.
+
+        Channel ``t * n_rx + r`` is transmitter ``t`` with receiver ``r``; its far-field phase is
+        ``-(2 pi / lambda) u . (tx_t + rx_r)`` plus a common term (module docstring).
+
+        >>> cfg = RadarConfig.prototype_2022(rx_positions_m="mimo-2x4")
+        >>> cfg.n_tx, cfg.n_rx, cfg.virtual_positions_m.shape
+        (2, 4, (8, 3))
+        """
+        v = (self.transmitters_m[:, None, :] + self.rx_positions_m[None, :, :]).reshape(-1, 3)
+        v.setflags(write=False)
+        return v
+
+    def require_one_transmitter(self, what: str, instead: str) -> None:
+        """InputError naming ``radar.tx_positions_m`` when ``what``, a one-transmitter model, gets several.
+
+        ``instead`` says what handles a time-division MIMO radar.
+        """
+        if self.n_tx > 1:
+            raise InputError(
+                f"radar.tx_positions_m: {what} models one transmitter, got {self.n_tx}; {instead}"
+            )
+
+    @property
+    def n_doppler_per_tx(self) -> int:
+        """Chirps of one transmitter per frame, ``n_doppler / n_tx``: the Doppler bins of a frame."""
+        return self.n_doppler // self.n_tx
+
+    @property
     def rmax_m(self) -> float:
         """Unambiguous range c*Fs / (2*B*PRF), m."""
         return SPEED_OF_LIGHT * self.fs_hz / (2.0 * self.bandwidth_hz * self.prf_hz)
@@ -294,13 +420,13 @@ class RadarConfig:
 
     @property
     def v_lim_mps(self) -> float:
-        """Nyquist radial velocity PRF * lambda / 4, m/s."""
-        return self.prf_hz * self.wavelength_m / 4.0
+        """Nyquist radial velocity PRF * lambda / (4 n_tx), m/s (each transmitter chirps every n_tx / PRF)."""
+        return self.prf_hz * self.wavelength_m / (4.0 * self.n_tx)
 
     @property
     def doppler_resolution_mps(self) -> float:
-        """dV = 2 VLim / nV, m/s."""
-        return 2.0 * self.v_lim_mps / self.n_doppler
+        """dV = 2 VLim / (nV / n_tx), m/s."""
+        return 2.0 * self.v_lim_mps / self.n_doppler_per_tx
 
     @property
     def samples_per_chirp(self) -> int:
@@ -337,8 +463,9 @@ class RadarConfig:
 
     @cached_property
     def doppler_axis_mps(self) -> np.ndarray:
-        """Doppler bin centres (j - nV/2) * dV, m/s (FFT-shifted order)."""
-        return centred_bin_value(np.arange(self.n_doppler), self.doppler_resolution_mps, self.n_doppler)
+        """Doppler bin centres (j - nD/2) * dV, m/s (FFT-shifted order), ``nD = n_doppler_per_tx``."""
+        n = self.n_doppler_per_tx
+        return centred_bin_value(np.arange(n), self.doppler_resolution_mps, n)
 
     # ---- bin <-> physical units (skyradar.units: ties round up, Doppler wraps) -------------
     def range_bin(self, range_m: ArrayLike, radial_velocity_mps: ArrayLike = 0.0) -> np.ndarray:
@@ -354,13 +481,13 @@ class RadarConfig:
         return nearest_bin(np.asarray(range_m, float) + shift_m, self.range_resolution_m)
 
     def doppler_bin(self, radial_velocity_mps: ArrayLike) -> np.ndarray:
-        """Doppler bin (FFT-shifted) of a radial velocity, wrapped into ``[0, n_doppler)`` (int64).
+        """Doppler bin (FFT-shifted) of a radial velocity, wrapped into ``[0, n_doppler_per_tx)`` (int64).
 
         >>> cfg = RadarConfig.prototype_2022()
         >>> cfg.doppler_bin([0.0, -cfg.v_lim_mps, cfg.v_lim_mps]).tolist()
         [125, 0, 0]
         """
-        return centred_bin(radial_velocity_mps, self.doppler_resolution_mps, self.n_doppler)
+        return centred_bin(radial_velocity_mps, self.doppler_resolution_mps, self.n_doppler_per_tx)
 
     def range_at_bin_m(self, range_bin: ArrayLike) -> np.ndarray:
         """Range ``k * dR`` of a (possibly fractional) range bin, m."""
@@ -372,7 +499,7 @@ class RadarConfig:
         >>> float(RadarConfig.prototype_2022().radial_velocity_at_bin_mps(125.5)) > 0
         True
         """
-        return centred_bin_value(doppler_bin, self.doppler_resolution_mps, self.n_doppler)
+        return centred_bin_value(doppler_bin, self.doppler_resolution_mps, self.n_doppler_per_tx)
 
     @property
     def pe_w(self) -> float:
@@ -392,7 +519,7 @@ class RadarConfig:
     def to_dict(self) -> dict[str, Any]:
         """JSON-able description, round-trips through :meth:`from_dict`."""
         ant = self.antenna
-        return {
+        out: dict[str, Any] = {
             "fc_hz": self.fc_hz,
             "fs_hz": self.fs_hz,
             "prf_hz": self.prf_hz,
@@ -413,6 +540,9 @@ class RadarConfig:
             | {k: getattr(self.mount, k) for k in ("yaw_deg", "pitch_deg", "roll_deg")},
             "rx_calibration": [[c.real, c.imag] for c in self.rx_calibration],
         }
+        if self.tx_positions_m is not None:  # only MIMO radars carry the key: one-TX hashes stay put
+            out["tx_positions_m"] = self.tx_positions_m.tolist()
+        return out
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> RadarConfig:

@@ -30,6 +30,22 @@ array, limits the usable field of view (:func:`skyradar.process.doa.array_geomet
 
 Any other array is given by its positions (``radar.rx_positions_m``, 1 to :data:`MAX_RX` rows).
 
+Time-division MIMO layouts name transmitters and receivers together (:func:`mimo_layout_m`);
+the transmitters take turns chirp by chirp and every transmitter-receiver pair is a virtual
+channel at ``tx + rx`` (:mod:`skyradar.config`). ``mimo-2x4`` is four receivers in a row across
+at half-wavelength spacing and two transmitters on the vertical axis half a wavelength apart: its
+virtual array is the uniform 2x4 at half-wavelength spacing (``ura-2x4``'s positions, in the same
+row-major order), from six antennas instead of eight. With half-wavelength pairs spanning its
+plane, the virtual array is free of grating lobes over the whole forward half-space, azimuth and
+elevation -90..90 deg. Its transmitters' slots widen one ambiguity: a radial velocity aliased
+beyond the per-transmitter limit shifts the second row's phase by pi, which mimics a direction
+whose ``down`` direction cosine differs by 1. :func:`skyradar.process.mimo.virtual_pixels` tells
+the two apart by the antenna's field of view (the cone within 6 dB of peak gain, half-angle
+``alpha``): unique where the alias direction falls outside it, which holds everywhere for
+``alpha < 30 deg`` and otherwise for ``|sin(el)| < 1 - sin(alpha)`` (within 13.9 deg of the
+horizontal plane for the prototype's 49.5 deg); closer to the cone's top and bottom both
+hypotheses fit and the velocity stays ambiguous by a factor of two.
+
 Examples
 --------
 >>> rx_layout_m("square", 0.04).round(3).tolist()[0]
@@ -46,11 +62,28 @@ import numpy as np
 
 from skyradar.errors import InputError
 
-__all__ = ["MAX_RX", "RX_LAYOUTS", "RxLayout", "check_rx_layout", "rx_layout_m", "square_m", "ura_m"]
+__all__ = [
+    "ArrayLayout",
+    "MAX_RX",
+    "MAX_TX",
+    "MIMO_LAYOUTS",
+    "MimoLayout",
+    "RX_LAYOUTS",
+    "RxLayout",
+    "check_rx_layout",
+    "mimo_layout_m",
+    "rx_layout_m",
+    "square_m",
+    "ura_m",
+]
 
 RxLayout = Literal["square", "kite", "ura-2x3", "ura-2x4"]  # the layouts' names
 RX_LAYOUTS: tuple[str, ...] = get_args(RxLayout)
 MAX_RX = 32  # receive channels a radar may have (CFAR and noise-floor tables are built up to it)
+MimoLayout = Literal["mimo-2x4"]  # named transmitter + receiver layouts (time-division MIMO)
+MIMO_LAYOUTS: tuple[str, ...] = get_args(MimoLayout)
+ArrayLayout = Literal[RxLayout, MimoLayout]  # every named array: receive-only or MIMO
+MAX_TX = 4  # transmitters of a time-division MIMO radar (each costs a factor in unambiguous Doppler)
 
 
 def rx_layout_m(name: str, wavelength_m: float) -> np.ndarray:
@@ -129,3 +162,36 @@ def check_rx_layout(name: str, label: str) -> str:
     if name not in RX_LAYOUTS:
         raise InputError(f"{label} must be one of {', '.join(RX_LAYOUTS)}, got {name!r}")
     return name
+
+
+def mimo_layout_m(name: str, wavelength_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """Transmit and receive positions, m, of a named time-division MIMO layout.
+
+    Parameters
+    ----------
+    name : str
+        ``"mimo-2x4"`` (module docstring).
+    wavelength_m : float
+        Carrier wavelength, m.
+
+    Returns
+    -------
+    tx_m : ndarray, shape (n_tx, 3)
+        Transmit phase centres (0, right, down), m; the top one first.
+    rx_m : ndarray, shape (n_rx, 3)
+        Receive phase centres (0, right, down), m, from left to right.
+
+    Examples
+    --------
+    >>> tx, rx = mimo_layout_m("mimo-2x4", 0.04)
+    >>> tx[:, 2].round(3).tolist(), rx[:, 1].round(3).tolist()
+    ([-0.01, 0.01], [-0.03, -0.01, 0.01, 0.03])
+    """
+    if name not in MIMO_LAYOUTS:
+        raise InputError(
+            f"radar.rx_positions_m: MIMO layout must be one of {', '.join(MIMO_LAYOUTS)}, got {name!r}"
+        )
+    half = float(wavelength_m) / 2.0
+    rx = ura_m(1, 4, half)
+    tx = ura_m(2, 1, half)
+    return tx, rx

@@ -28,6 +28,9 @@ A recording is two files with the same stem: the samples (``NAME.bin``, or the f
 ``chirp`` becomes the Doppler axis (``n_doppler`` = its length), ``sample`` must not exceed
 ``Fs / PRF`` samples (shorter chirps are zero-padded by the range FFT). A recording with ``rx``
 other than 4 needs ``radar.rx_positions_m``. A 3-D recording without a ``frame`` axis is one frame.
+A time-division MIMO recording gives ``radar.tx_positions_m``: its chirps are in transmit order,
+chirp ``n`` from transmitter ``n mod n_tx`` (:mod:`skyradar.process.mimo` sorts them);
+:func:`skyradar.io.recording_writer.write_recording` records the transmitters of its config.
 
 ``.npy`` files carry dtype and shape themselves; a sidecar with the same stem is optional and
 supplies the radar fields and ``axes`` (default ``frame, rx, chirp, sample``); without one the

@@ -15,7 +15,8 @@ The names users call, importable from here (each is imported from its module on 
 
 Modules: range-Doppler (:mod:`.rangedoppler`, :mod:`.windows`, :mod:`.rd_store`); detection
 (:mod:`.power`, :mod:`.cfar`, :mod:`.detect`, :mod:`.spurs`, :mod:`.pipeline`, :mod:`.detect_run`,
-:mod:`.realtime`); direction of arrival (:mod:`.doa`, :mod:`.calibration`, :mod:`.smoothing`);
+:mod:`.realtime`); direction of arrival (:mod:`.doa`, :mod:`.calibration`, :mod:`.smoothing`,
+:mod:`.mimo` for time-division MIMO's virtual channels);
 the ground (:mod:`.ground`, :mod:`.ground_elevation`, :mod:`.terrain_rise`); clutter suppression
 (:mod:`.clutter`, :mod:`.clutter_suppress`, :mod:`.clutter_adaptive`, :mod:`.clutter_anchors`,
 :mod:`.clutter_frames`, :mod:`.clutter_doa`, :mod:`.small_hermitian`, :mod:`.top_eigen`).

@@ -24,6 +24,14 @@ to the value the coarse direction predicts and the least-squares fit is redone o
 A square of side d > lambda/2 is unique only within ``asin(lambda / (2 d))`` of boresight on
 either axis (56.4 deg at 0.6 lambda); beyond that a direction is reported at its grating lobe.
 
+Time-division MIMO (``config.n_tx > 1``): the channels are the virtual channels
+``t * n_rx + r`` at ``tx_t + rx_r`` (:attr:`skyradar.config.RadarConfig.virtual_positions_m`), whose
+far-field phase is the receive phase above for an antenna at ``tx_t + rx_r``; every function here
+then takes pixels of ``n_virtual`` channels, after the transmitter slots' Doppler phase is removed
+(:mod:`skyradar.process.mimo`). Calibration is per receiver, the same for every transmitter. A
+one-transmitter radar uses ``rx_positions_m``: its ``tx + rx`` differ from them by a common shift,
+which changes only the common phase.
+
 Cramer-Rao bound: for ``x_k = A exp(i theta_k) + n_k``, ``n_k ~ CN(0, sigma^2)`` and the unknowns
 (A, phi, az, el), the Fisher information of (az, el) after eliminating the nuisance phase is
 ``J = 2 SNR sum_k (g_k - mean(g)) (g_k - mean(g))^T`` with ``g_k = -(2 pi / lambda) (du/daz . r_k,
@@ -60,6 +68,7 @@ __all__ = [
     "estimate_directions",
     "direction_coherence",
     "doa_crlb",
+    "field_of_view_rad",
     "antenna_to_body",
 ]
 
@@ -179,11 +188,22 @@ def _geometry(
     return ArrayGeometry(basis, normal, design, solve, pairs, pair_solve, grid, match)
 
 
+def _channel_positions(config: RadarConfig) -> np.ndarray:
+    """Positions (n_channels, 3), m, of the channels DoA works on: receivers, or virtual channels for MIMO."""
+    return config.rx_positions_m if config.n_tx == 1 else config.virtual_positions_m
+
+
+def _channel_calibration(config: RadarConfig) -> np.ndarray:
+    """Complex gain per channel: ``rx_calibration``, repeated for every transmitter slot for MIMO."""
+    return config.rx_calibration if config.n_tx == 1 else np.tile(config.rx_calibration, config.n_tx)
+
+
 def array_geometry(
     config: RadarConfig, facing: tuple[float, float, float] = (1.0, 0.0, 0.0)
 ) -> ArrayGeometry:
-    """Least-squares operators of ``config``'s receive array (cached); InputError for unusable layouts."""
-    rx = np.ascontiguousarray(config.rx_positions_m, dtype=float)
+    """Least-squares operators of ``config``'s receive (or MIMO virtual) array (cached); InputError for
+    unusable layouts."""
+    rx = np.ascontiguousarray(_channel_positions(config), dtype=float)
     fx, fy, fz = (float(f) for f in np.asarray(facing, float) / np.linalg.norm(facing))
     return _geometry(
         rx.tobytes(), rx.shape[0], float(config.wavelength_m), (fx, fy, fz), _fov_half_angle(config)
@@ -191,6 +211,12 @@ def array_geometry(
 
 
 _FOV_CACHE: dict[int, tuple[object, float]] = {}
+
+
+def field_of_view_rad(config: RadarConfig) -> float:
+    """Half-angle of the field of view, rad: the widest off-boresight angle at which either principal
+    cut of ``config.antenna`` is within 6 dB of its peak (the cone the coarse DoA search covers)."""
+    return _fov_half_angle(config)
 
 
 def _fov_half_angle(config: RadarConfig, max_loss_db: float = 6.0) -> float:
@@ -234,9 +260,9 @@ def angles_from_direction(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def steering_vector(u: np.ndarray, config: RadarConfig) -> np.ndarray:
-    """Far-field receive phases ``exp(-i (2 pi / lambda) u . r_k)``, shape (..., n_rx)."""
+    """Far-field receive phases ``exp(-i (2 pi / lambda) u . r_k)``, shape (..., n_rx) (MIMO: n_virtual)."""
     return np.exp(
-        -1j * (2.0 * np.pi / config.wavelength_m) * (np.asarray(u, float) @ config.rx_positions_m.T)
+        -1j * (2.0 * np.pi / config.wavelength_m) * (np.asarray(u, float) @ _channel_positions(config).T)
     )
 
 
@@ -284,7 +310,8 @@ def estimate_directions(
     Parameters
     ----------
     pixels : ndarray, shape (n, n_rx), complex
-        Peak pixel of each detection, one column per receive antenna.
+        Peak pixel of each detection, one column per receive antenna (per virtual channel,
+        ``n_virtual`` columns, for a MIMO radar).
     config : RadarConfig
         Antenna positions, wavelength and ``rx_calibration`` (divided out unless ``calibrated``).
     calibrated : bool
@@ -300,12 +327,12 @@ def estimate_directions(
         tracker follows them in range and range rate only).
     """
     z = np.atleast_2d(np.asarray(pixels))
-    if z.ndim != 2 or z.shape[1] != config.n_rx:
-        raise InputError(f"doa: field 'rx' has {z.shape[-1]} channels, radar_config has {config.n_rx}")
-    if config.n_rx == 1:
+    if z.ndim != 2 or z.shape[1] != config.n_virtual:
+        raise InputError(f"doa: field 'rx' has {z.shape[-1]} channels, radar_config has {config.n_virtual}")
+    if config.n_virtual == 1:
         return np.full((z.shape[0], 3), np.nan)
     if not calibrated:
-        z = z / config.rx_calibration
+        z = z / _channel_calibration(config)
     geo = array_geometry(config, facing)
     if z.shape[0] == 0:
         return np.zeros((0, 3))
@@ -335,10 +362,10 @@ def direction_coherence(
     """
     z = np.atleast_2d(np.asarray(pixels))
     if not calibrated:
-        z = z / config.rx_calibration
+        z = z / _channel_calibration(config)
     steer = steering_vector(u, config)
     num = np.abs(np.sum(z * np.conj(steer), axis=1)) ** 2
-    den = config.n_rx * np.maximum(np.sum(np.abs(z) ** 2, axis=1), 1e-300)
+    den = config.n_virtual * np.maximum(np.sum(np.abs(z) ** 2, axis=1), 1e-300)
     return num / den
 
 
@@ -357,7 +384,7 @@ def doa_crlb(
     azimuth_rad, elevation_rad : array_like
         True direction in the antenna frame.
     config : RadarConfig
-        Antenna positions and wavelength.
+        Antenna positions (the virtual array for MIMO) and wavelength.
 
     Returns
     -------
@@ -374,7 +401,8 @@ def doa_crlb(
     snr = 10.0 ** (np.asarray(snr_db, float) / 10.0)
     az, el = np.broadcast_arrays(np.asarray(azimuth_rad, float), np.asarray(elevation_rad, float))
     k = 2.0 * np.pi / config.wavelength_m
-    q = config.rx_positions_m - config.rx_positions_m.mean(axis=0)
+    positions = _channel_positions(config)
+    q = positions - positions.mean(axis=0)
     du_daz = np.stack([-np.cos(el) * np.sin(az), np.cos(el) * np.cos(az), np.zeros_like(az)], axis=-1)
     du_del = np.stack([-np.sin(el) * np.cos(az), -np.sin(el) * np.sin(az), -np.cos(el)], axis=-1)
     g = -k * np.stack([du_daz @ q.T, du_del @ q.T], axis=-1)  # (..., n_rx, 2), centred by q

@@ -97,6 +97,10 @@ class RangeDopplerProcessor:
         workers: int = 2,
         n_samples: int | None = None,
     ) -> None:
+        # Interleaved transmitters are one slow time each, not one of n_doppler chirps.
+        config.require_one_transmitter(
+            "the range-Doppler transform", "sort its chirps with skyradar.process.mimo.virtual_range_doppler"
+        )
         self.config = config
         self.n_fft = config.samples_per_chirp
         self.n_samples = self.n_fft if n_samples is None else int(n_samples)

@@ -50,7 +50,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
-from skyradar.rx_layouts import RxLayout
+from skyradar.rx_layouts import ArrayLayout
 from skyradar.scene.impairment_config import ImpairmentConfig
 from skyradar.scene.navigation_config import NavigationConfig, with_preset
 
@@ -183,13 +183,21 @@ class RadarModel(_Model):
         description="Receive antenna phase centres in the antenna frame (x boresight, y right, z down), "
         "one ``[x, y, z]`` per antenna, m; or ``rx_layout``.",
     )
-    rx_layout: RxLayout | None = Field(
+    rx_layout: ArrayLayout | None = Field(
         None,
         description="A named receive array (:mod:`skyradar.rx_layouts`): ``square`` is the prototype's "
-        "2x2 at half-wavelength spacing; or ``rx_positions_m``.",
+        "2x2 at half-wavelength spacing; or ``rx_positions_m``. ``mimo-2x4`` names a time-division "
+        "MIMO array, its two transmitters included (unless ``tx_positions_m`` is given).",
     )
     tx_position_m: Vector3 | None = Field(
         None, description="Transmit antenna phase centre in the antenna frame, m; unset: ``[0, 0, 0]``."
+    )
+    tx_positions_m: list[Vector3] | None = Field(
+        None,
+        description="Time-division MIMO: 1 to 4 transmit phase centres in the antenna frame, m, taking "
+        "turns chirp by chirp (chirp n from transmitter n mod n_tx); transmitters x receivers at most "
+        "32 virtual channels, ``n_doppler`` a multiple of their number. Unset: one transmitter at "
+        "``tx_position_m``.",
     )
     noise_figure_db: Finite | None = Field(None, description="Receiver noise figure, dB.")
     temperature_k: Positive | None = Field(None, description="Reference noise temperature, K.")
@@ -203,6 +211,8 @@ class RadarModel(_Model):
     def _one_array(self) -> RadarModel:
         if self.rx_positions_m is not None and self.rx_layout is not None:
             raise ValueError("give rx_positions_m or rx_layout, not both")
+        if self.tx_position_m is not None and self.tx_positions_m is not None:
+            raise ValueError("give tx_position_m or tx_positions_m, not both")
         return self
 
     def overrides(self) -> dict[str, Any]:

@@ -118,6 +118,10 @@ class ImageSimulator:
         swerling: int = 0,
         adaptive_facets: bool | None = None,
     ) -> None:
+        config.require_one_transmitter(  # frames per receive channel
+            "the image-domain simulator",
+            "simulate a time-division MIMO radar at the chirp level (skyradar.sim.raw.simulate_adc)",
+        )
         self.config = config
         self.terrain = terrain
         lat0, lon0, alt0 = origin

@@ -125,6 +125,10 @@ class LandCoverSimulator:
         shadow: bool = True,
         speckle: bool = True,
     ) -> None:
+        config.require_one_transmitter(  # frames per receive channel
+            "the land-cover simulator",
+            "simulate a time-division MIMO radar at the chirp level (skyradar.sim.raw.simulate_adc)",
+        )
         code = np.asarray(class_code)
         height = np.asarray(height_m, np.float32)
         if code.shape != grid.shape or height.shape != grid.shape:

@@ -13,6 +13,12 @@ aliasing), the intra-chirp Doppler that shifts the beat frequency by ``2v/lambda
 coupling, 0.19 m per m/s for the prototype), range migration within the frame and the per-antenna
 phase all follow from the delays.
 
+Time-division MIMO. With ``config.n_tx`` transmitters, chirp ``n`` is sent by transmitter
+``n mod n_tx``: its delays use that transmitter's position at that chirp's sample times. The
+scatterers keep moving between the slots, so a moving target's phase advances by
+``2 pi (2 v / lambda) / PRF`` from one transmitter's chirp to the next one's on top of the
+transmitters' geometric phase difference; :mod:`skyradar.process.mimo` removes that advance.
+
 Units. ``|a_i|^2`` is the received power in W from the radar equation with the two-way gain of
 ``config.antenna`` (the image-domain simulator's equation), so after
 :func:`skyradar.process.rangedoppler.range_doppler` an on-bin target has the image-domain pixel
@@ -40,8 +46,9 @@ def received_power_w(config: RadarConfig, positions_m: np.ndarray, rcs_m2: np.nd
     """Received power of point scatterers from the radar equation, W.
 
     ``Pr = Pe * G(az, el)^2 * sigma * lambda^2 / ((4 pi)^3 R^4)`` with ``R`` half the mean two-way
-    path over the receivers and ``G`` the one-way gain of ``config.antenna``; zero for scatterers
-    on or behind the antenna plane (x <= 0 in the antenna frame).
+    path over the receivers (and the transmitters, for MIMO) and ``G`` the one-way gain of
+    ``config.antenna``; zero for scatterers on or behind the antenna plane (x <= 0 in the antenna
+    frame).
 
     Parameters
     ----------
@@ -60,7 +67,10 @@ def received_power_w(config: RadarConfig, positions_m: np.ndarray, rcs_m2: np.nd
     """
     p = np.asarray(positions_m, float).reshape(-1, 3)
     rcs = np.broadcast_to(np.asarray(rcs_m2, float), p.shape[:1])
-    r_tx = np.linalg.norm(p - config.tx_position_m, axis=1)
+    if config.n_tx == 1:
+        r_tx = np.linalg.norm(p - config.tx_position_m, axis=1)
+    else:
+        r_tx = np.linalg.norm(p[:, None, :] - config.transmitters_m[None], axis=2).mean(axis=1)
     r_rx = np.linalg.norm(p[:, None, :] - config.rx_positions_m[None], axis=2).mean(axis=1)
     r = (r_tx + r_rx) / 2.0
     _, az, el = direction_angles(p)
@@ -94,14 +104,17 @@ def _beat_kernel(out, pos, vel, amp, tx, rx, fc, slope, fs, prf, t_ref, c):  # p
     n_rx, n_chirp, n_s = out.shape
     n_scat = pos.shape[0]
     two_pi = 2.0 * np.pi
+    n_tx = tx.shape[0]
     for n in numba.prange(n_chirp):
         t_n = n / prf - t_ref
+        slot = n % n_tx  # time-division MIMO: chirp n is sent by transmitter n mod n_tx
+        tx0, tx1, tx2 = tx[slot, 0], tx[slot, 1], tx[slot, 2]
         for i in range(n_scat):
             vx, vy, vz = vel[i, 0], vel[i, 1], vel[i, 2]
             px, py, pz = pos[i, 0] + vx * t_n, pos[i, 1] + vy * t_n, pos[i, 2] + vz * t_n
             v2 = vx * vx + vy * vy + vz * vz
             # |p(t) - a|^2 = d.d + 2 d.v t + v.v t^2 for constant velocity: exact per sample.
-            dx, dy, dz = px - tx[0], py - tx[1], pz - tx[2]
+            dx, dy, dz = px - tx0, py - tx1, pz - tx2
             a_tx, b_tx = dx * dx + dy * dy + dz * dz, 2.0 * (dx * vx + dy * vy + dz * vz)
             for k in range(n_rx):
                 ex, ey, ez = px - rx[k, 0], py - rx[k, 1], pz - rx[k, 2]
@@ -138,7 +151,7 @@ def _beat_signal(config: RadarConfig, pos, vel, power, t_ref: float, chunk: int)
             np.ascontiguousarray(pos[sel]),
             np.ascontiguousarray(vel[sel]),
             amp[sel],
-            config.tx_position_m,
+            np.ascontiguousarray(config.transmitters_m),
             config.rx_positions_m,
             config.fc_hz,
             config.chirp_slope_hz_per_s,
@@ -163,6 +176,10 @@ def simulate_adc(
     chunk: int = 256,
 ) -> np.ndarray:
     """ADC cube of one frame, (n_rx, n_doppler, samples_per_chirp) complex64.
+
+    For a time-division MIMO radar chirp ``n`` comes from transmitter ``n mod n_tx`` (module
+    docstring); :func:`skyradar.process.mimo.virtual_range_doppler` sorts the chirps into virtual
+    channels.
 
     Parameters
     ----------

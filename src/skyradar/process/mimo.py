@@ -1,0 +1,284 @@
+"""Time-division MIMO: the ADC cube's interleaved chirps to virtual channels, and their slot phase.
+
+A radar with ``n_tx`` transmitters sends chirp ``n`` of a frame from transmitter ``t = n mod n_tx``
+(:mod:`skyradar.config`). Sorting the chirps by transmitter gives each transmitter a slow time of
+``nD = n_doppler / n_tx`` chirps spaced ``T = n_tx / PRF``; the range-Doppler transform of each,
+channel by receiver, gives the virtual cube ``(n_range, nD, n_tx * n_rx)`` whose channel
+``t * n_rx + r`` is the pair (transmitter ``t``, receiver ``r``) at ``tx_t + rx_r``
+(:attr:`~skyradar.config.RadarConfig.virtual_positions_m`). Its axes are the MIMO config's
+``range_axis_m`` and ``doppler_axis_mps`` (``nD`` bins of ``PRF * lambda / (2 n_doppler)``).
+
+Slot phase. Transmitter ``t`` chirps ``t / PRF`` after transmitter 0, so a target of radial
+velocity ``v`` has advanced its two-way phase by ``2 pi f_d t / PRF`` (``f_d = 2 v / lambda``) in
+transmitter ``t``'s channels besides the direction's phase. Left in, it reads as a direction
+shift along the transmitters' baseline (an angle bias that grows with ``|v|``). It is removed with
+the Doppler bin's velocity ``v_hat`` (:func:`compensate_slot_phase`).
+
+Ambiguity. The Doppler axis only spans ``[-VLim, VLim)`` with ``VLim = PRF * lambda / (4 n_tx)``:
+the true velocity is ``v_hat + 2 m VLim`` for an integer ``m``, and the compensation then leaves
+the phase ``2 pi m t / n_tx`` on slot ``t``, the same for every ``m`` of one residue mod ``n_tx``.
+:func:`virtual_pixels` tries the ``n_tx`` residues and keeps the one whose pixels one plane wave
+from inside the antenna's field of view (the cone within 6 dB of peak gain,
+:func:`skyradar.process.doa.field_of_view_rad`) explains best: the beamformer peak
+``max_u |z . conj(s(u))|^2`` over that cone. A wrong residue mimics a direction shifted by
+``lambda m / (n_tx d)`` in direction cosine along a transmitter spacing ``d``; it loses where that
+direction lies outside the cone (for ``mimo-2x4`` see :mod:`skyradar.rx_layouts`). The chosen
+residue also extends the unambiguous velocity to ``[-n_tx VLim, n_tx VLim)``, the
+one-transmitter ``PRF * lambda / 4``. The margin is small for arrays with a short transmitter
+baseline: a wrong residue's best direction sits on the cone's edge, inside the broad beam of two
+rows, so for ``mimo-2x4`` the winning peak beats the other by 1.5-18 % (``peak_ratio``
+1.015-1.18 at 5-10 deg above or below the horizontal, azimuth within 20 deg); noise of comparable
+size, a low SNR or a direction near the cone's edge makes the choice unreliable, and a ratio within
+0.5 % of 1 means both residues fit. The track's range rate over several frames is then the other witness.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from skyradar.config import RadarConfig
+from skyradar.errors import InputError
+from skyradar.process.doa import field_of_view_rad
+from skyradar.process.rangedoppler import range_doppler
+from skyradar.process.windows import WindowSpec
+
+__all__ = [
+    "VirtualPixels",
+    "split_chirps",
+    "virtual_range_doppler",
+    "slot_phase",
+    "compensate_slot_phase",
+    "virtual_pixels",
+]
+
+
+def _check_adc(adc: np.ndarray, config: RadarConfig) -> None:
+    if np.ndim(adc) != 3 or np.shape(adc)[:2] != (config.n_rx, config.n_doppler):
+        raise InputError(
+            f"adc: expected a (rx, chirp, sample) cube of {config.n_rx} receivers and {config.n_doppler} "
+            f"chirps, got shape {np.shape(adc)}"
+        )
+
+
+def split_chirps(adc: np.ndarray, config: RadarConfig) -> np.ndarray:
+    """Interleaved ADC cube to one slow time per transmitter.
+
+    Parameters
+    ----------
+    adc : ndarray, shape (n_rx, n_doppler, n_samples)
+        One frame, chirp ``n`` from transmitter ``n mod n_tx``.
+    config : RadarConfig
+        The MIMO radar.
+
+    Returns
+    -------
+    ndarray, shape (n_tx * n_rx, n_doppler_per_tx, n_samples)
+        Channel ``t * n_rx + r``, slow index ``j`` = chirp ``t + j * n_tx`` of receiver ``r`` (a view
+        when the input is contiguous).
+
+    Examples
+    --------
+    >>> cfg = RadarConfig.prototype_2022(rx_positions_m="mimo-2x4", n_doppler=4)
+    >>> adc = np.arange(4)[None, :, None] * np.ones((4, 4, 1))
+    >>> split_chirps(adc, cfg)[[0, 4], :, 0].tolist()  # receiver 0 with transmitter 0, then 1
+    [[0.0, 2.0], [1.0, 3.0]]
+    """
+    _check_adc(adc, config)
+    a = np.asarray(adc)
+    n_tx, n_rx, n_s = config.n_tx, config.n_rx, a.shape[2]
+    per_tx = a.reshape(n_rx, config.n_doppler_per_tx, n_tx, n_s).transpose(2, 0, 1, 3)
+    return per_tx.reshape(n_tx * n_rx, config.n_doppler_per_tx, n_s)
+
+
+@lru_cache(maxsize=8)
+def _slot_config(config: RadarConfig) -> RadarConfig:
+    """One transmitter's radar: the receivers, calibration and range axis of ``config``, its slow time."""
+    return config.replace(tx_positions_m=None, n_doppler=config.n_doppler_per_tx)
+
+
+def virtual_range_doppler(
+    adc: np.ndarray,
+    config: RadarConfig,
+    range_window: WindowSpec = "hann",
+    doppler_window: WindowSpec = "hann",
+    remove_dc: bool = False,
+    workers: int = 2,
+) -> np.ndarray:
+    """Virtual range-Doppler cube of one interleaved ADC cube (slot phase still in).
+
+    Parameters
+    ----------
+    adc : ndarray, shape (n_rx, n_doppler, n_samples)
+        One frame, chirp ``n`` from transmitter ``n mod n_tx``.
+    config : RadarConfig
+        The MIMO radar (one transmitter gives :func:`skyradar.process.rangedoppler.range_doppler`'s cube).
+    range_window, doppler_window, remove_dc, workers
+        As :func:`skyradar.process.rangedoppler.range_doppler`; the Doppler window spans one
+        transmitter's ``n_doppler_per_tx`` chirps.
+
+    Returns
+    -------
+    ndarray, shape (n_range, n_doppler_per_tx, n_tx * n_rx), complex64
+        Channel ``t * n_rx + r``, each divided by receiver ``r``'s calibration gain; axes
+        ``config.range_axis_m`` and ``config.doppler_axis_mps``.
+    """
+    _check_adc(adc, config)
+    if config.n_tx == 1:
+        return range_doppler(adc, config, range_window, doppler_window, remove_dc, workers=workers)
+    slot_cfg = _slot_config(config)
+    n_tx, n_rx = config.n_tx, config.n_rx
+    out = np.empty((config.n_range, config.n_doppler_per_tx, n_tx * n_rx), np.complex64)
+    a = np.asarray(adc)
+    for t in range(n_tx):
+        out[..., t * n_rx : (t + 1) * n_rx] = range_doppler(
+            a[:, t::n_tx, :], slot_cfg, range_window, doppler_window, remove_dc, workers=workers
+        )
+    return out
+
+
+def slot_phase(radial_velocity_mps: np.ndarray | float, config: RadarConfig) -> np.ndarray:
+    """Phase factor ``exp(i 2 pi (2 v / lambda) t / PRF)`` of each virtual channel, shape (..., n_virtual).
+
+    Channel ``t * n_rx + r`` gets transmitter ``t``'s factor: the two-way phase a target of radial
+    velocity ``v`` (m/s, positive receding) gains over the ``t / PRF`` s between transmitter 0's
+    chirp and transmitter ``t``'s.
+
+    Examples
+    --------
+    >>> cfg = RadarConfig.prototype_2022(rx_positions_m="mimo-2x4")
+    >>> ph = slot_phase(cfg.v_lim_mps, cfg)  # at the limit: pi per transmitter chirp, pi / 2 per slot
+    >>> np.round(np.angle(ph[[0, 4]]) / np.pi, 6).tolist()
+    [0.0, 0.5]
+    """
+    v = np.asarray(radial_velocity_mps, float)[..., None]
+    slots = np.repeat(np.arange(config.n_tx), config.n_rx)
+    return np.exp(2j * np.pi * (2.0 * v / config.wavelength_m) * slots / config.prf_hz)
+
+
+def compensate_slot_phase(rd: np.ndarray, config: RadarConfig) -> np.ndarray:
+    """Virtual cube with each Doppler bin's slot phase removed (the bin's aliased velocity), complex64.
+
+    Parameters
+    ----------
+    rd : ndarray, shape (n_range, n_doppler_per_tx, n_virtual)
+        From :func:`virtual_range_doppler`.
+    config : RadarConfig
+        The MIMO radar.
+
+    Returns
+    -------
+    ndarray, same shape
+        ``rd * conj(slot_phase(doppler_axis_mps))``; exact for velocities on the axis
+        ``[-VLim, VLim)``, the residue ``2 pi m t / n_tx`` beyond (module docstring).
+    """
+    if np.shape(rd)[1:] != (config.n_doppler_per_tx, config.n_virtual):
+        raise InputError(
+            f"rd: expected (range, {config.n_doppler_per_tx} Doppler bins, {config.n_virtual} virtual "
+            f"channels), got shape {np.shape(rd)}"
+        )
+    factor = np.conj(slot_phase(config.doppler_axis_mps, config)).astype(np.complex64)
+    return (np.asarray(rd) * factor[None]).astype(np.complex64, copy=False)
+
+
+@dataclass(frozen=True)
+class VirtualPixels:
+    """Pixels with the slot phase removed and the residue of the velocity ambiguity chosen.
+
+    Attributes
+    ----------
+    pixels : ndarray, shape (n, n_virtual), complex
+        Ready for :func:`skyradar.process.doa.estimate_directions` with the MIMO config.
+    residue : ndarray, shape (n,), int
+        The chosen ``m mod n_tx`` (0: the Doppler axis' velocity is the true one).
+    radial_velocity_mps : ndarray, shape (n,)
+        The velocity of the chosen residue within ``[-n_tx VLim, n_tx VLim)``, m/s.
+    peak_ratio : ndarray, shape (n,)
+        Beamformer peak of the chosen residue over the best other one (>= 1; inf for one
+        transmitter): how clearly the field of view tells the residues apart.
+    """
+
+    pixels: np.ndarray
+    residue: np.ndarray
+    radial_velocity_mps: np.ndarray
+    peak_ratio: np.ndarray
+
+
+@lru_cache(maxsize=8)
+def _fov_match(config: RadarConfig, facing: tuple[float, float, float]) -> np.ndarray:
+    """Conjugate virtual steering vectors (n_virtual, n_grid) of directions inside the field of view."""
+    positions = config.virtual_positions_m - config.virtual_positions_m.mean(axis=0)
+    aperture = max(float(np.linalg.norm(positions, axis=1).max()), 1e-12)
+    # Step: the phase across the aperture moves by at most pi/8 between neighbours.
+    step = min(0.05, config.wavelength_m / (16.0 * aperture))
+    n = int(4.0 * np.pi / step**2)
+    i = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * i / n  # Fibonacci sphere: near-uniform directions
+    phi = np.pi * (1.0 + 5**0.5) * i
+    u = np.stack([np.sqrt(1 - z * z) * np.cos(phi), np.sqrt(1 - z * z) * np.sin(phi), z], axis=1)
+    u = u[u @ np.asarray(facing) >= np.cos(field_of_view_rad(config))]
+    return np.ascontiguousarray(np.exp(1j * (2.0 * np.pi / config.wavelength_m) * (u @ positions.T)).T)
+
+
+def virtual_pixels(
+    pixels: np.ndarray,
+    doppler_bin: np.ndarray | int,
+    config: RadarConfig,
+    facing: tuple[float, float, float] = (1.0, 0.0, 0.0),
+) -> VirtualPixels:
+    """Slot phase removed and velocity ambiguity resolved for detections of the virtual cube.
+
+    Parameters
+    ----------
+    pixels : ndarray, shape (n, n_virtual), complex
+        Detections' pixels of :func:`virtual_range_doppler` (calibrated, slot phase still in).
+    doppler_bin : int or ndarray, shape (n,)
+        Their Doppler bins (``config.doppler_axis_mps``; fractional bins are allowed).
+    config : RadarConfig
+        The MIMO radar.
+    facing : (float, float, float)
+        Centre of the field of view in the antenna frame (the boresight by default).
+
+    Returns
+    -------
+    VirtualPixels
+        Compensated pixels, residue, unambiguous velocity (m/s) and peak ratio (module docstring).
+
+    Examples
+    --------
+    >>> from skyradar.process.doa import direction_from_angles, steering_vector
+    >>> cfg = RadarConfig.prototype_2022(rx_positions_m="mimo-2x4")
+    >>> v = 1.5 * cfg.v_lim_mps  # aliased onto -0.5 VLim
+    >>> z = steering_vector(direction_from_angles(0.2, -0.1), cfg) * slot_phase(v, cfg)
+    >>> out = virtual_pixels(z[None], cfg.doppler_bin(v), cfg)
+    >>> out.residue.tolist(), round(float(out.radial_velocity_mps[0] / cfg.v_lim_mps), 3)
+    ([1], 1.5)
+    """
+    z = np.atleast_2d(np.asarray(pixels))
+    if z.ndim != 2 or z.shape[1] != config.n_virtual:
+        raise InputError(
+            f"mimo: pixels have {z.shape[-1]} channels, the radar has {config.n_virtual} virtual"
+        )
+    bins = np.broadcast_to(np.asarray(doppler_bin, float), z.shape[:1])
+    v_hat = np.asarray(config.radial_velocity_at_bin_mps(bins), float)
+    z = z * np.conj(slot_phase(v_hat, config))
+    n_tx = config.n_tx
+    if n_tx == 1:
+        inf = np.full(z.shape[0], np.inf)
+        return VirtualPixels(z, np.zeros(z.shape[0], int), v_hat, inf)
+    fx, fy, fz = (float(f) for f in np.asarray(facing, float) / np.linalg.norm(facing))
+    match = _fov_match(config, (fx, fy, fz))
+    slots = np.repeat(np.arange(n_tx), config.n_rx)
+    residues = np.exp(-2j * np.pi * np.outer(np.arange(n_tx), slots) / n_tx)  # (n_tx, n_virtual)
+    candidates = z[:, None, :] * residues[None]  # (n, n_tx, n_virtual)
+    peak = np.abs(candidates @ match).max(axis=2) ** 2 if match.shape[1] else np.zeros(candidates.shape[:2])
+    best = np.argmax(peak, axis=1)
+    ordered = np.sort(peak, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = ordered[:, -1] / ordered[:, -2]
+    span = 2.0 * n_tx * config.v_lim_mps  # the one-transmitter Doppler span, 4 * VLim_1 / 2
+    v = v_hat + best * 2.0 * config.v_lim_mps
+    v = (v + span / 2.0) % span - span / 2.0
+    return VirtualPixels(candidates[np.arange(z.shape[0]), best], best, v, ratio)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cli_helpers import assert_one_line_error, skyradar
+from cli_helpers import assert_one_line_error, skyradar, small_scenario
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.process import mimo
@@ -135,20 +135,7 @@ def test_given_transmitters_set_the_transmitter_position():
 
 
 def _scenario(radar: dict) -> dict:
-    return {
-        "name": "mimo",
-        "origin": {"lat_deg": 47.0, "lon_deg": 8.0, "alt_m": 0.0},
-        "radar": radar,
-        "ownship": {
-            "type": "straight",
-            "start_ned_m": [0, 0, -1000],
-            "heading_deg": 0,
-            "speed_mps": 50,
-            "duration_s": 2,
-        },
-        "frame_rate_hz": 2,
-        "duration_s": 1,
-    }
+    return small_scenario("layout", duration_s=1.0, frame_rate_hz=2.0, radar=radar)
 
 
 @pytest.mark.parametrize(

@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cli_helpers import assert_one_line_error, skyradar
+from cli_helpers import assert_one_line_error, skyradar, small_scenario
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.process.doa import direction_from_angles, estimate_directions, steering_vector
@@ -54,20 +54,7 @@ def test_kite_directions_are_exact_without_noise_across_the_beam(az_deg, el_deg)
 
 
 def _spec(radar: dict) -> dict:
-    return {
-        "name": "layout",
-        "origin": {"lat_deg": 47.0, "lon_deg": 8.0, "alt_m": 0.0},
-        "radar": radar,
-        "ownship": {
-            "type": "straight",
-            "start_ned_m": [0, 0, -1000],
-            "heading_deg": 0,
-            "speed_mps": 50,
-            "duration_s": 2,
-        },
-        "frame_rate_hz": 2,
-        "duration_s": 1,
-    }
+    return small_scenario("layout", duration_s=1.0, frame_rate_hz=2.0, radar=radar)
 
 
 def test_scenario_rx_layout_names_the_array():

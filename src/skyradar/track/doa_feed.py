@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from skyradar.io.ownship_states import REQUIRED_COLUMNS
 from skyradar.track.elevation_trust import AboveVotes, BelowConsensus, place_elevations
 from skyradar.track.ground_doa import elevation_measured_flags
 from skyradar.track.io import validate_ownship
@@ -21,15 +22,7 @@ from skyradar.units import wrap
 __all__ = ["Measure3D", "OWNSHIP_COLUMNS"]
 
 _NED = ("north_m", "east_m", "down_m")
-OWNSHIP_COLUMNS = (
-    "time_s",
-    "own_north_m",
-    "own_east_m",
-    "own_down_m",
-    "own_vn_mps",
-    "own_ve_mps",
-    "own_vd_mps",
-)
+OWNSHIP_COLUMNS = REQUIRED_COLUMNS  # the own-ship rows the 3-D feed reads: time, NED position, velocity
 
 
 class Measure3D:

@@ -34,8 +34,8 @@ def ownship_from_frames(ds: xr.Dataset, source: str = "frames") -> pd.DataFrame:
     """Own-ship state of a frames run as a table (:mod:`skyradar.daa.tables`): what the aircraft knows.
 
     The values are the run's navigation solution (``nav_*``, GNSS/AHRS with errors) read by
-    :func:`skyradar.io.navigation.navigation_state`; only a store written before navigation
-    existed gives its ``own_*`` truth (``attrs["navigation_source"] == "truth"``).
+    :func:`skyradar.io.navigation.navigation_state`; only a store without ``nav_*`` variables
+    gives its ``own_*`` truth (``attrs["navigation_source"] == "truth"``).
     """
     state = navigation_state(ds, source)
     missing = [c for c in OWNSHIP_COLUMNS[1:] if state is None or c not in state]

@@ -5,7 +5,7 @@ navigation solution an aircraft would have (``nav_*``: GNSS and AHRS with errors
 :mod:`skyradar.sim.navigation`). :func:`navigation_state` is the one reader process, track and
 alert use: it returns the ``nav_*`` values under the own-ship table's column names
 (:data:`STATE_COLUMNS`, named ``own_*`` because the table is "what the own-ship knows"). Stores
-written before navigation existed have only ``own_*``: they are used with a logged note and
+without ``nav_*`` variables hold only ``own_*``: they are used with a logged note and
 ``attrs["navigation_source"] == "truth"`` so a result can say so.
 
 Examples
@@ -78,7 +78,7 @@ def navigation_state(ds: xr.Dataset, source: str = "frames") -> pd.DataFrame | N
     -------
     pandas.DataFrame or None
         ``time_s`` and the :data:`STATE_COLUMNS` the run has, from ``nav_*``, else from ``own_*``
-        (stores written before navigation); ``attrs["navigation_source"]`` says which.
+        (stores without ``nav_*``); ``attrs["navigation_source"]`` says which.
     """
     kind = navigation_source(ds)
     if kind is None:

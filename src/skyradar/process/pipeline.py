@@ -6,7 +6,7 @@ apparent range of the peak (bin ``k`` at ``k * dR``): the sawtooth range-Doppler
 (``v * fc / (B PRF)``, 0.19 m per m/s) is left in because the measured radial velocity may be
 aliased. World coordinates need the own-ship navigation state in the
 Dataset (``nav_*`` variables, GNSS/AHRS with errors, via :func:`skyradar.io.navigation.navigation_state`;
-``own_*`` truth only in stores written before navigation existed, with a logged note and
+``own_*`` truth only in stores without ``nav_*`` variables, with a logged note and
 ``table.attrs["navigation_source"] == "truth"``); the scenario's geodetic origin is read from the attributes
 ``origin_lat_deg``, ``origin_lon_deg``, ``origin_alt_m`` (or ``origin`` as a list) when present,
 otherwise latitude/longitude/altitude are taken relative to the own-ship position (about 2 m off

@@ -107,7 +107,7 @@ def dem_for_run(path: str | Path, ds: Any, range_limit_m: float, source: str) ->
     """Read the DEM ``path`` for a frames run ``ds``: the window its own-ship can see, checked to cover it.
 
     The own-ship positions come from the run's navigation (``nav_lat_deg``/``nav_lon_deg``, or
-    its NED track and stored origin; ``own_*`` in runs written before navigation). A run without
+    its NED track and stored origin; ``own_*`` in runs without ``nav_*``). A run without
     either cannot place a DEM: :class:`InputError` naming ``source``.
     """
     from skyradar.scene.dem_readers import read_dem

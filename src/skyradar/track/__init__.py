@@ -19,8 +19,8 @@ The names users call, importable from here (each is imported from its module on 
 
 Modules: the tracker (:mod:`.tracker`, :mod:`.types`, :mod:`.components`, :mod:`.models`,
 :mod:`.kalman`, :mod:`.association`, :mod:`.initiation`, :mod:`.range_walk`, :mod:`.deletion`,
-:mod:`.dealias`, :mod:`.reacquisition`, :mod:`.reacquired_ids`); 3-D tracks (:mod:`.tracker3d`, :mod:`.measure3d`,
-:mod:`.doa_feed`, :mod:`.elevation_trust`); several heads (:mod:`.fusion`); the ground
+:mod:`.dealias`, :mod:`.reacquisition`, :mod:`.reacquired_ids`); 3-D tracks (:mod:`.tracker3d`,
+:mod:`.measure3d`, :mod:`.doa_feed`, :mod:`.elevation_trust`); several heads (:mod:`.fusion`); the ground
 (:mod:`.ground_tracks`, :mod:`.ground_doa`, :mod:`.static_point`); tables in and out
 (:mod:`.track_table`, :mod:`.io`, :mod:`.frame_grid`, :mod:`.simulated_detections`); scoring
 (:mod:`.evaluate`, :mod:`.detectable`, :mod:`.metrics`).

@@ -125,3 +125,37 @@ def test_one_clutter_hit_in_a_tracks_doppler_history_is_not_a_patch():
     twice = spiked.copy()
     twice[7] -= 1.0  # two: scatterers taking turns
     assert not doppler_smooth(t, twice, WIDTH_MPS)
+
+
+def test_a_walk_on_a_lost_tracks_aircraft_takes_its_id_back():
+    """Confirmed by M-of-N, lost for three seconds, then seen in a third of its frames: the walk
+    confirms it again and the tracks table carries the lost track's id (rows stay sorted by id)."""
+    import pandas as pd
+
+    from skyradar.track.track_table import track_detections
+
+    rng = np.random.default_rng(5)
+    t = np.arange(0.0, 14.0, FRAME_S)
+    seen = (t < 2.0) | ((t > 5.0) & (rng.random(t.size) < 0.33))
+    closing = -113.0
+    det = pd.DataFrame(
+        {
+            "time_s": t[seen],
+            "range_m": 4200.0 + closing * t[seen] + rng.normal(0, 3.0, seen.sum()),
+            "radial_velocity_mps": _wrap(closing) + rng.normal(0, 0.05, seen.sum()),
+        }
+    )
+    other = pd.DataFrame(  # a second aircraft, so the lost track is not the only one
+        {"time_s": t, "range_m": 2500.0 - 20.0 * t, "radial_velocity_mps": np.full(t.size, -20.0)}
+    )
+    det = pd.concat([det, other]).sort_values("time_s", kind="stable").reset_index(drop=True)
+    own = pd.DataFrame(
+        {"time_s": t, "own_north_m": OWN_SPEED_MPS * t, "own_east_m": 0.0, "own_down_m": -1000.0}
+        | {"own_vn_mps": OWN_SPEED_MPS, "own_ve_mps": 0.0, "own_vd_mps": 0.0}
+    )
+    tracks = track_detections(det, frame_times_s=t, ownship=own, ground_test=False)
+    fast = tracks[tracks.confirmed & (tracks.radial_velocity_mps < -100.0)]
+    early, late = fast[fast.time_s < 2.5], fast[fast.time_s > 6.0]
+    assert len(early) and len(late)
+    assert set(late.track_id) == set(early.track_id)  # the same id after the gap
+    assert late.time_s.min() < 10.0  # confirmed again by its walk, not by 4 hits in 5 frames

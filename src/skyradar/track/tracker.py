@@ -111,6 +111,7 @@ class RangeDopplerTracker:
             range_walks = RangeWalks(model.doppler_width_mps) if model.wrap_doppler else False
         self.range_walks: RangeWalks | None = range_walks if isinstance(range_walks, RangeWalks) else None
         self._walked: set[int] = set()  # ids of the tracks a range walk confirmed
+        self._walk_pending: set[int] = set()  # ... in the last frame, not yet offered a lost track's id
         self.time_s: float | None = None  # the last frame's time; None before the first
         self._now = 0.0  # the frame being processed, for the stages of step
         self._next_id = 0
@@ -227,10 +228,10 @@ class RangeDopplerTracker:
         tr.x[track_rows, 2] = tr.x[track_rows, 1]
         tr.confirmed[track_rows] = True
         tr.set_anchor(track_rows, self._now)
-        reacquired = self._reacquired
-        self._reacquire(fresh[~tr.was_confirmed[fresh]])
-        self._reacquired = np.concatenate([reacquired, self._reacquired])
-        tr.was_confirmed[track_rows] = True
+        # Newly confirmed: the next frame's management gives them a lost track's id if one matches
+        # (ids change there, where the rows are sorted by id again).
+        fresh_ids = tr.ids[fresh[~tr.was_confirmed[fresh]]]
+        self._walk_pending.update(int(i) for i in fresh_ids)
         self._walked.update(int(i) for i in tr.ids[track_rows])
         return alive_det
 
@@ -410,7 +411,12 @@ class RangeDopplerTracker:
             tr.resolved[back] = tr.anchor_resolved[back]
         # Closed tracks that were ever confirmed are kept as lost, at their last solid update.
         self.reacquirer.add_anchored(tr, dead & tr.was_confirmed)
-        self._reacquire(np.flatnonzero(tentative & tr.confirmed & ~tr.was_confirmed & ~dead))
+        walked = np.isin(tr.ids, list(self._walk_pending))
+        self._walk_pending = set()
+        self._reacquire(np.flatnonzero((tentative | walked) & tr.confirmed & ~tr.was_confirmed & ~dead))
+        for new_id, lost_id in self._reacquired.tolist():  # a walk's standing follows its track's id
+            if new_id in self._walked:
+                self._walked.add(int(lost_id))
         tr.was_confirmed |= tr.confirmed
         alive = np.flatnonzero(~dead)
         # A reacquired track has an older id: keep the rows sorted by id, as callers look ids up.

@@ -17,22 +17,14 @@ from typing import Any, Literal
 import numpy as np
 import xarray as xr
 
-from skyradar.io.navigation import NAVIGATION_SOURCES, navigation_state
+from skyradar.io.navigation import NAVIGATION_SOURCES, STATE_COLUMNS, navigation_state
 
 __all__ = ["OwnShipStates", "NavigationSource", "REQUIRED_COLUMNS"]
 
 NavigationSource = Literal["navigation", "truth"]  # skyradar.io.navigation.NAVIGATION_SOURCES
 
 # The own-ship table's columns every state needs: time, NED position and velocity.
-REQUIRED_COLUMNS = (
-    "time_s",
-    "own_north_m",
-    "own_east_m",
-    "own_down_m",
-    "own_vn_mps",
-    "own_ve_mps",
-    "own_vd_mps",
-)
+REQUIRED_COLUMNS = ("time_s", *STATE_COLUMNS[:6])  # north, east, down; vn, ve, vd
 _ATTITUDE = ("own_yaw_rad", "own_pitch_rad", "own_roll_rad")
 _GEO = ("own_lat_deg", "own_lon_deg", "own_alt_m")
 # An unknown height above the ground stays unknown (NaN); an unknown attitude or geodetic fix reads

@@ -11,7 +11,8 @@ The names users call, importable from here (each is imported from its module on 
   :class:`~.components.Associator`, :class:`~.components.Updater`, :class:`~.components.Initiator`,
   :class:`~.components.Deleter` and :class:`~.components.Reacquirer`; the live tracks it holds,
   :class:`~.types.TrackArrays`, and what a frame returns, :class:`~.types.FrameTracks`;
-  :class:`~.range_walk.RangeWalks`, which confirms a fast closure by its range history;
+  :class:`~.range_walk.RangeWalks` with its :class:`~.range_walk.RangeWalkRule`, which confirms a
+  fast closure by its range history;
   :class:`~.tracker3d.Tracker3D`, the 3-D filter on direction-of-arrival positions;
 - :func:`~.io.read_detections` and :func:`~.simulated_detections.synthetic_detections`, detections
   from a file or from truth;

@@ -395,7 +395,7 @@ def place_elevations(
     in_band = np.asarray(measured, bool) & band
     sigma, held = np.asarray(sigma_rad, float), np.zeros(len(d), bool)
     trusted, track_up, spread = _voted(
-        votes, ids, trusted, band, in_band, range_m * np.sin(elevation), range_m
+        votes, ids, trusted, band, in_band, range_m * np.sin(elevation), elevation
     )
     spread = np.where(np.isfinite(track_up), np.fmax(spread, BAND_ELEVATION_SIGMA_RAD * range_m), np.nan)
     if below is not None and clearance_m is not None:
@@ -406,11 +406,10 @@ def place_elevations(
     return *_placed(*placed), trusted, track_up, spread
 
 
-def _voted(votes, ids, trusted, band, in_band, up_m, range_m) -> tuple:
+def _voted(votes, ids, trusted, band, in_band, up_m, elevation) -> tuple:
     """Trust in the band only while the track is voted above; the tracks' agreed heights and spreads."""
     if votes is None:
         return trusted, *np.full((2, len(trusted)), np.nan)
-    elevation = np.arcsin(np.clip(up_m / np.maximum(range_m, 1e-9), -1.0, 1.0))
     track_up, spread = votes.update(ids, trusted & band, in_band, up_m, elevation)
     return trusted & (~band | np.isfinite(track_up)), track_up, spread
 

@@ -357,6 +357,35 @@ def test_a_track_confirmed_8_s_before_the_loss_warns_within_a_second(closure_mps
     assert first_warning <= 1.0
 
 
+def test_rows_the_velocity_gate_silences_are_no_evidence_against_the_conflict():
+    # A fast closure confirmed over clutter 1.5 km away: its directions scatter, so its horizontal
+    # velocity sigma starts near 30 m/s and converges below the gate's bound over about 2.5 s. The
+    # gated rows say nothing about the conflict; counted as "no conflict" they would fill the
+    # 2-of-4-seconds window with zeros and the warning would wait until its converged rows were half
+    # of it (1.3-1.7 s at this closure). Taken as no evidence, it is issued on the second converged row.
+    dt = 1.0 / 9.4
+    own, tracks = _head_on(start_m=D_NC + 10.0 * 115.0, closure_mps=115.0, duration_s=8.0, dt=dt)
+    t = tracks["time_s"].to_numpy()
+    sigma = np.where(t < 2.5, 30.0, 2.0)  # per horizontal axis: gated (x ~12 s to CPA > 150 m), then not
+    cov = {f"cov_vv_{i}{j}": (sigma**2 if i == j else np.zeros_like(t)) for i in range(3) for j in range(3)}
+    cfg = AlertConfig(
+        period_s=1.0, max_velocity_sigma_mps=6.0, min_track_age_s=0.0, min_track_age_floor_s=0.0
+    )
+    out = alerts_from_tracks(tracks.assign(**cov), own, cfg, with_advice=False)
+    first_converged = t[np.argmax(t >= 2.5)]
+    gated_rows = out["time_s"].to_numpy() < 2.5
+    assert (out["raw_level"].to_numpy()[gated_rows] == 0).all()
+    first_warning = out["time_s"].to_numpy()[np.argmax(out["level"].to_numpy() == 3)]
+    assert first_warning == pytest.approx(first_converged + dt)
+    # The same converged rows after a window of frames that measured no conflict wait for their half.
+    clear = tracks.assign(**cov, east_m=np.where(t < 2.5, 3000.0, 0.0), ve_mps=0.0)
+    measured = alerts_from_tracks(
+        clear.assign(**{"cov_vv_00": 4.0, "cov_vv_11": 4.0}), own, cfg, with_advice=False
+    )
+    later = measured["time_s"].to_numpy()[np.argmax(measured["level"].to_numpy() == 3)]
+    assert later > first_converged + 0.5
+
+
 def test_a_track_far_from_its_loss_of_well_clear_waits_the_full_age():
     # 20 s and more from the loss, a fresh track keeps the full minimum age: there is time to converge.
     dt = 1.0 / 9.4

@@ -81,7 +81,11 @@ def _gate_unconverged(
     do, so that row's horizontal conflict holds whatever its velocity error. (A fast closure at
     2 km over clutter can keep a horizontal velocity sigma near 10 m/s from scattered directions
     while its range path gives the miss to about 10 m.)
+
+    A silenced row is marked ``raw["gated"]``: its velocity says nothing about the conflict, so the
+    M-of-N filter takes it as no evidence (:func:`_filter_inputs`), not as a frame without one.
     """
+    raw["gated"] = np.zeros(len(raw["level"]), bool)
     if config.max_velocity_sigma_mps is not None and cov_v is not None:
         sigma_hv = np.sqrt(np.nan_to_num(cov_v[:, 0, 0] + cov_v[:, 1, 1], nan=np.inf))
         radius_m = config.levels[-1].volume.dthr_m
@@ -90,6 +94,7 @@ def _gate_unconverged(
         raw["level"][unconverged] = 0
         raw["hold_level"][unconverged] = 0
         raw["flarm_level"][unconverged] = 0
+        raw["gated"] = unconverged
 
 
 def _required_age(s: np.ndarray, v: np.ndarray, config: AlertConfig, located: np.ndarray) -> np.ndarray:
@@ -101,10 +106,16 @@ def _required_age(s: np.ndarray, v: np.ndarray, config: AlertConfig, located: np
 
 
 def _filter_inputs(raw: dict, rows: np.ndarray, predicted: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The M-of-N filter's evidence and hold levels of ``rows``: a prediction, and a range-only row
-    whose fit refused, are no evidence of a conflict (-1)."""
+    """The M-of-N filter's evidence and hold levels of ``rows``: a prediction, a range-only row
+    whose fit refused and a row the velocity gate silenced are no evidence of a conflict (-1).
+
+    A gated row's velocity is too uncertain to say whether the track conflicts, so it neither
+    raises a level nor counts as a frame without a conflict: counted as level 0, the gated rows
+    of a fast closure's first seconds after confirmation would fill the filter's window with
+    zeros, and its first converged rows would wait until they were half of that window. Its hold
+    level stays the gate's 0: an issued alert is held by the frames that measure it."""
     unknown = ~raw["known"][rows]
-    evidence = np.where(predicted[rows] | unknown, -1, raw["level"][rows])
+    evidence = np.where(predicted[rows] | unknown | raw["gated"][rows], -1, raw["level"][rows])
     return evidence, np.where(unknown, -1, raw["hold_level"][rows])
 
 

@@ -54,3 +54,4 @@ def test_bench_track_reports_ours_baseline_and_ratio():
     for key in ("frames_per_s", "cpu_frames_per_s", "baseline_frames_per_s", "speedup_same_frames"):
         assert r[key] > 0
     assert 30 <= r["detections_per_frame"] <= 50
+    assert r["own_speed_mps"] == 50.0  # the range walks run, as in the chain

@@ -110,6 +110,21 @@ def test_bad_recordings_are_one_line_naming_file_field_and_value(tmp_path):
 
 
 @pytest.mark.parametrize(
+    ("field", "value", "match"),
+    [
+        ("rx_positions_m", [[0, 0, 0], [0, 0, 0]], r"'skyradar:radar.rx_positions_m': all receive antennas"),
+        ("tx_positions_m", [[0, 0, 0], [0, 0, 0]], r"'skyradar:radar.tx_positions_m': transmitters 0 and 1"),
+    ],
+)
+def test_a_bad_radar_field_is_named_by_its_sigmf_key(tmp_path, field, value, match):
+    meta = write_sigmf_recording(tmp_path / "a", frames(2), CFG)
+    radar = json.loads(meta.read_text())["global"]["skyradar:radar"]
+    _edit(meta, **{"skyradar:radar": radar | {field: value}})
+    with pytest.raises(InputError, match=match):
+        read_recording(meta)
+
+
+@pytest.mark.parametrize(
     ("changes", "match"),
     [
         ({"core:sample_rate": None}, r"field 'core:sample_rate' \(the ADC rate, Hz\) is missing"),

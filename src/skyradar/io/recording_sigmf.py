@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import warnings
 from pathlib import Path
 from typing import Any
@@ -69,12 +70,13 @@ SIGMF_DTYPES: dict[str, tuple[str, str]] = {
 }
 _BYTES_PER_SAMPLE = {"complex_int16": 4, "complex64": 8, "int16": 2, "float32": 4}
 # Field names of the skyradar-adc/1 description -> the SigMF key they come from (for messages).
+# Every field of the radar's configuration (``radar.<field>``) comes from ``skyradar:radar``.
 _RENAMED = {
     "frame_times_s": "skyradar:frame_times_s",
     "frame_period_s": "skyradar:frame_period_s",
     "radar": "skyradar:radar",
-    "radar.rx_positions_m": "skyradar:radar.rx_positions_m",
 }
+_RADAR_FIELD = re.compile(r"(?<![\w:.])'?radar\.([A-Za-z_][\w.]*)'?")
 
 
 def _load(meta_path: Path, data_path: Path, named: Path) -> dict[str, Any]:
@@ -251,6 +253,7 @@ def read_sigmf_recording(path: str | Path) -> tuple[AdcFrames, RadarConfig]:
         return open_described(meta_path, description)
     except InputError as exc:  # name the SigMF key a translated field came from
         message = str(exc)
+        message = _RADAR_FIELD.sub(lambda m: f"'skyradar:radar.{m.group(1)}'", message)
         for field, key in _RENAMED.items():
             message = message.replace(f"'{field}'", f"'{key}'")
         raise InputError(message) from None

@@ -336,6 +336,33 @@ def test_a_range_path_inside_the_volume_lifts_the_velocity_gate():
     assert early == {"inside": 3, "outside": 0, "no range": 0}
 
 
+def test_the_rows_before_confirmation_extend_the_range_path_that_lifts_the_gate():
+    # The same closure first held by the ground test for 3 s (over clutter its first detections
+    # are judged young, rough or on the ground), then confirmed. Its range and range rate were
+    # measured all along, so its path spans the fit's 4 s one second after confirmation, not four.
+    # Held rows can only lift the gate: a path passing 1 km away stays silent with them.
+    cfg = AlertConfig(max_velocity_sigma_mps=6.0, min_track_age_s=0.0)
+    first_inside = {}
+    for name, offset, keep_held in (
+        ("with held rows", 320.0, True),
+        ("confirmed rows only", 320.0, False),
+        ("outside, with held rows", 1000.0, True),
+    ):
+        own, tracks = _crossing_ahead(offset)
+        tracks = tracks.assign(confirmed=tracks["time_s"] >= 3.0)
+        if not keep_held:
+            tracks = tracks[tracks["confirmed"]]
+        out = alerts_from_tracks(tracks, own, cfg, with_advice=False)
+        gated = out["tcpa_s"].to_numpy() > 16.0  # the plain gate silences these rows (10 m/s x 16 s > 150 m)
+        raised = (out["raw_level"].to_numpy() == 3) & gated
+        first_inside[name] = (
+            round(float(out["time_s"].to_numpy()[np.argmax(raised)]), 1) if raised.any() else None
+        )
+    assert first_inside["with held rows"] <= 4.1
+    assert first_inside["confirmed rows only"] >= 6.9
+    assert first_inside["outside, with held rows"] is None
+
+
 def _converged(tracks: pd.DataFrame, sigma_mps: float = 2.0) -> pd.DataFrame:
     """A track with a converged velocity (``sigma_mps`` per horizontal axis, 20 m of position)."""
     cov = {f"cov_vv_{i}{j}": (sigma_mps**2 if i == j else 0.0) for i in range(3) for j in range(3)}

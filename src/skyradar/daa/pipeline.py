@@ -50,6 +50,7 @@ from skyradar.daa.tables import (
     clean_tracks,
     covariances,
     interp_ownship,
+    range_history,
 )
 from skyradar.io.ownship_states import OwnShipStates
 from skyradar.io.tables import appended
@@ -68,7 +69,12 @@ __all__ = [
 
 
 def _gate_unconverged(
-    raw: dict, cov_v, config: AlertConfig, located: np.ndarray, range_miss: np.ndarray
+    raw: dict,
+    cov_v,
+    config: AlertConfig,
+    located: np.ndarray,
+    range_miss: np.ndarray,
+    track_miss: np.ndarray | None = None,
 ) -> None:
     """Silences (in ``raw``) the rows whose horizontal velocity is not known well enough to alert on.
 
@@ -80,7 +86,12 @@ def _gate_unconverged(
     is at most the 3-D miss, and range and Doppler are measured to a pixel whatever the directions
     do, so that row's horizontal conflict holds whatever its velocity error. (A fast closure at
     2 km over clutter can keep a horizontal velocity sigma near 10 m/s from scattered directions
-    while its range path gives the miss to about 10 m.)
+    while its range path gives the miss to about 10 m.) ``track_miss`` is the same path fitted over
+    every row of the track up to the row, confirmed or not (:func:`_whole_track_range_miss`): a
+    closure confirmed 2.5 km away has measured its range and range rate since its first detection,
+    and its path is known seconds before its confirmed rows span the fit's window. Either path
+    inside lifts the gate; it never silences a row the gate would let through, so the rows held
+    before confirmation can only bring a warning earlier, never clear one.
 
     A silenced row is marked ``raw["gated"]``: its velocity says nothing about the conflict, so the
     M-of-N filter takes it as no evidence (:func:`_filter_inputs`), not as a frame without one.
@@ -90,6 +101,8 @@ def _gate_unconverged(
         sigma_hv = np.sqrt(np.nan_to_num(cov_v[:, 0, 0] + cov_v[:, 1, 1], nan=np.inf))
         radius_m = config.levels[-1].volume.dthr_m
         inside = range_miss[0] + K_SIGMA * range_miss[1] < radius_m  # False where NaN
+        if track_miss is not None:
+            inside |= track_miss[0] + K_SIGMA * track_miss[1] < radius_m
         unconverged = velocity_unconverged(sigma_hv, raw["tcpa_s"], config) & located & ~inside
         raw["level"][unconverged] = 0
         raw["hold_level"][unconverged] = 0
@@ -249,6 +262,35 @@ def _range_fit(df: pd.DataFrame, t: np.ndarray, own_vel: np.ndarray, predicted: 
     return fit
 
 
+def _whole_track_range_miss(
+    df: pd.DataFrame,
+    t: np.ndarray,
+    predicted: np.ndarray,
+    ranges: pd.DataFrame | None,
+    ownship: pd.DataFrame,
+    source: str,
+) -> np.ndarray:
+    """Miss distance and sigma (m, shape (2, n)) of each measured row's range path fitted over every
+    row of its track up to it, confirmed or not (``ranges``: :func:`~skyradar.daa.tables.range_history`);
+    NaN on predictions and where the fit refuses."""
+    out = np.full((2, len(df)), np.nan)
+    if ranges is None or len(ranges) == 0 or len(df) == 0:
+        return out
+    ids = df["track_id"].to_numpy()
+    mine = ranges[ranges["track_id"].isin(np.unique(ids[~predicted]))]
+    if len(mine) == 0:
+        return out
+    rt = mine["time_s"].to_numpy(float)
+    own_v = interp_ownship(ownship, rt, source).velocity_ned_mps
+    r, rdot = (mine[c].to_numpy(float) for c in RANGE_COLUMNS)
+    miss, sigma, _, _ = range_only_fit(mine["track_id"].to_numpy(), rt, r, rdot, own_v)
+    index = pd.MultiIndex.from_arrays([mine["track_id"].to_numpy(), rt])
+    at = index.get_indexer(pd.MultiIndex.from_arrays([ids, t]))
+    found = (at >= 0) & ~predicted
+    out[0, found], out[1, found] = miss[at[found]], sigma[at[found]]
+    return out
+
+
 def _merged_levels(
     s: np.ndarray,
     v: np.ndarray,
@@ -357,10 +399,18 @@ class _AlertRows:
 
 
 def _alert_rows(
-    tracks: pd.DataFrame, ownship: pd.DataFrame, config: AlertConfig, source: str, cleaned: bool = False
+    tracks: pd.DataFrame,
+    ownship: pd.DataFrame,
+    config: AlertConfig,
+    source: str,
+    cleaned: bool = False,
+    ranges: pd.DataFrame | None = None,
 ) -> _AlertRows:
     """The state, geometry and raw levels of every row (:func:`alerts_from_tracks` up to its filter).
-    ``cleaned``: ``tracks`` are :func:`~skyradar.daa.tables.clean_tracks`' rows already."""
+    ``cleaned``: ``tracks`` are :func:`~skyradar.daa.tables.clean_tracks`' rows already, and
+    ``ranges`` every track's :func:`~skyradar.daa.tables.range_history` (else read from ``tracks``)."""
+    if not cleaned and ranges is None:
+        ranges = range_history(tracks, source)
     df = tracks.reset_index(drop=True) if cleaned else clean_tracks(tracks, source)
     if cleaned:
         df.attrs["rows_skipped_no_state"] = 0
@@ -381,7 +431,8 @@ def _alert_rows(
     raw = _merged_levels(s, v, t, config, cov_p, cov_v, fit, located)
     raw["level"][predicted] = 0  # a prediction holds a track's level, never raises it
     raw["flarm_level"][predicted] = 0
-    _gate_unconverged(raw, cov_v, config, located, path[:2])
+    track_miss = _whole_track_range_miss(df, t, predicted, ranges, ownship, source)
+    _gate_unconverged(raw, cov_v, config, located, path[:2], track_miss)
     required_age = _required_age(s, v, config, located)
     level = np.zeros(len(df), int)
     return _AlertRows(df, t, own, own_vel, s, v, v_int, located, predicted, fit, raw, required_age, level)
@@ -493,6 +544,7 @@ class AlertStream:
         self.with_advice, self.source = with_advice, source
         self._window_s = RANGE_FIT_WINDOW_S + self.config.lost_track_hold_s + 1.0
         self._tracks: pd.DataFrame | None = None  # the confirmed rows of the window
+        self._ranges: pd.DataFrame | None = None  # every track's measured ranges in the window
         self._own: pd.DataFrame | None = None  # the own-ship rows of the window
         self._last_confirmed_s: dict[int, float] = {}
         self._filters: dict[int, AlertFilter] = {}
@@ -512,6 +564,9 @@ class AlertStream:
         clean = clean_tracks(tracks, self.source)  # each row is checked once, as it comes
         self._own = appended(_since(self._own, time_s - self._window_s), ownship)
         self._tracks = appended(_since(self._tracks, time_s - self._window_s), clean)
+        self._ranges = appended(
+            _since(self._ranges, time_s - self._window_s), range_history(tracks, self.source)
+        )
         self._last_confirmed_s.update(
             dict.fromkeys(tracks["track_id"].to_numpy()[confirmed].tolist(), time_s)
         )
@@ -520,7 +575,7 @@ class AlertStream:
         alive_since = time_s - self.config.lost_track_hold_s - 1e-9
         alive = [i for i, t in self._last_confirmed_s.items() if t >= alive_since]
         history = self._tracks[self._tracks["track_id"].isin(alive)]
-        rows = _alert_rows(history, own, self.config, self.source, cleaned=True)
+        rows = _alert_rows(history, own, self.config, self.source, cleaned=True, ranges=self._ranges)
         rows = rows.select(rows.t == time_s)
         self._issue(rows)
         out = _alerts_out(rows, self.config, self.with_advice)

@@ -7,7 +7,9 @@ them, the position covariance ``cov_pp_00 .. cov_pp_22`` (m^2) and velocity cova
 Rows with NaN position or velocity (no direction of arrival) are skipped, except the range-only
 rows: no position (NaN ``north_m`` or ``east_m``) but a range ``range_m`` (m) and range rate
 ``range_rate_mps`` (m/s), which are alerted on the range-only geometry
-(:mod:`skyradar.daa.range_only`). With a ``confirmed`` column only confirmed rows are used.
+(:mod:`skyradar.daa.range_only`). With a ``confirmed`` column only confirmed rows are alerted on;
+the range path that lifts the velocity gate also reads the rows before confirmation
+(:func:`range_history`).
 ``AlertConfig.max_velocity_sigma_mps`` silences rows of tracks whose velocity has not converged.
 
 Own-ship table: ``time_s, own_north_m, own_east_m, own_down_m, own_vn_mps, own_ve_mps, own_vd_mps``
@@ -33,6 +35,7 @@ __all__ = [
     "STATE_LIMITS",
     "RANGE_COLUMNS",
     "clean_tracks",
+    "range_history",
     "range_only_rows",
     "interp_ownship",
     "covariances",
@@ -86,6 +89,39 @@ def clean_tracks(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
     clean = df[ok].sort_values(["time_s", "track_id"], kind="stable").reset_index(drop=True)
     clean.attrs["rows_skipped_no_state"] = int((~ok).sum())
     return clean
+
+
+def range_history(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
+    """Every row of every track, confirmed or not, that measured a range and a range rate.
+
+    A track's range and range rate come from its range-Doppler detections whatever its ground test
+    or its confirmation said, so the rows before it was confirmed extend its range path
+    (:func:`skyradar.daa.range_miss.range_only_fit`) back to its first detections. Columns
+    ``track_id`` (int), ``time_s`` (s), ``range_m`` (m) and ``range_rate_mps`` (m/s), in time
+    order; empty without the range columns. Values are checked as :func:`clean_tracks` checks them.
+
+    Examples
+    --------
+    >>> t = pd.DataFrame({"time_s": [0.0, 0.1, 0.1], "track_id": [1, 1, 2], "confirmed": [False, True, True],
+    ...                   "range_m": [900.0, 890.0, np.nan], "range_rate_mps": [-100.0, -100.0, 5.0]})
+    >>> range_history(t, "t").to_numpy().tolist()
+    [[1.0, 0.0, 900.0, -100.0], [1.0, 0.1, 890.0, -100.0]]
+    """
+    columns = ["track_id", "time_s", *RANGE_COLUMNS]
+    if not set(RANGE_COLUMNS) <= set(tracks) or len(tracks) == 0:
+        return pd.DataFrame(
+            {name: np.zeros(0, np.int64 if name == "track_id" else float) for name in columns}
+        )
+    df = tracks.reset_index(drop=True)
+    cols = {name: finite_column(df, name, source) for name in ("time_s", "track_id")}
+    for name in RANGE_COLUMNS:
+        cols[name] = finite_column(df, name, source, allow_nan=True)
+        limit, unit = STATE_LIMITS[name[-1]]
+        check_within(cols[name], limit, unit, source, name, "not a range or range rate of an aircraft")
+    measured = np.isfinite(cols["range_m"]) & np.isfinite(cols["range_rate_mps"])
+    out = pd.DataFrame({name: cols[name][measured] for name in columns})
+    out["track_id"] = out["track_id"].astype(np.int64)
+    return out.sort_values(["time_s", "track_id"], kind="stable").reset_index(drop=True)
 
 
 def range_only_rows(tracks: pd.DataFrame) -> np.ndarray:

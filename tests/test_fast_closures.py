@@ -106,26 +106,6 @@ def test_an_aliased_closure_clears_the_ground_hold_within_five_detections(closin
         assert confirmed[4:].all(), trial
 
 
-@pytest.mark.parametrize("spike_at", [2, 3, 4])
-def test_one_clutter_hit_early_in_an_aliased_closure_does_not_restart_its_history(spike_at):
-    # Over clutter the track's gate takes a ground cell's detection a Doppler bin off the intruder's
-    # (1.3 m/s) among its first five. Five detections cannot tell one such hit from a patch's
-    # scatterers taking turns, so the track is held ("rough"), but its history is kept: from the sixth
-    # detection the Doppler test leaves the one hit out, and the range walk releases the track there.
-    # Started afresh after the hit, it would need five more detections of its new history.
-    rng = np.random.default_rng(spike_at)
-    det, own = _closure_detections(106.7, 120.0, rng, 12)
-    det.loc[spike_at, "radial_velocity_mps"] += 1.3
-    tracks = pd.DataFrame(
-        {"time_s": det["time_s"], "track_id": 1, "detection_row": np.arange(12), "confirmed": True}
-    )
-    out = hold_ground_tracks(tracks, det, own, WIDTH, C, flat_surface(AGL_M))
-    confirmed = out["confirmed"].to_numpy()
-    assert int(np.argmax(confirmed)) == 5  # the sixth detection
-    assert confirmed[5:].all()
-    assert set(out["held_by"].to_numpy()[:5]) <= {"young", "rough", "direction"}
-
-
 def test_a_patch_whose_doppler_hops_in_every_detection_stays_held():
     # Residual clutter whose two scatterers take turns: its Doppler hops by a bin at every detection,
     # though its ranges walk as fast as a closure's. Leaving one detection out does not smooth it.

@@ -407,10 +407,7 @@ def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test
     time already, so a later verdict could not undo its count; the fits cost time). A Doppler
     that is not one smooth curve starts the history again after its largest step: the detections
     before it came from another scatterer, more than the static fit's trim leaves out, and the
-    new history needs ``ground_min_detections``. A history too short for the Doppler test to
-    leave out one detection (:data:`_SPIKE_MIN_DETECTIONS`) is held but not started again: one
-    clutter hit among a closure's first detections would otherwise cost it a whole new history.
-    Once a static ground point has fitted it, a
+    new history needs ``ground_min_detections``. Once a static ground point has fitted it, a
     track is released only when the judgements running over ``release_span_detections``
     detections say otherwise, and not before ``ground_min_detections``: the surface model and a
     patch's scatterers make a fit fail now and then, and each was a confirmed ground row.
@@ -518,10 +515,7 @@ class _HistoryWalk:
             sl = slice(max(start, k + 1 - test.max_history), k + 1)
             args = (h.own_p, h.own_v, surface_down, width, coupling, test, h.doa)
             reason = _judge(sl, t, h.rng, h.vel, *args)
-            if reason == "rough" and sl.stop - sl.start >= _SPIKE_MIN_DETECTIONS:
-                # a fresh history, as long as the Doppler test's window. A shorter history is held
-                # but kept: it cannot yet tell one clutter hit the gate took (which the Doppler test
-                # leaves out from _SPIKE_MIN_DETECTIONS on) from a patch's scatterers taking turns.
+            if reason == "rough":  # a fresh history, as long as the Doppler test's window
                 self.start = max(start, _largest_step(h.vel, width, sl))
                 self.least = test.ground_min_detections
             if reason == "ground":  # ground once: as long a history as the Doppler test's to clear it

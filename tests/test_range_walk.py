@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.stats import poisson
 
 from skyradar.track.ground_tracks import doppler_smooth
 from skyradar.track.models import radar_model
@@ -159,3 +160,162 @@ def test_a_walk_on_a_lost_tracks_aircraft_takes_its_id_back():
     assert len(early) and len(late)
     assert set(late.track_id) == set(early.track_id)  # the same id after the gap
     assert late.time_s.min() < 10.0  # confirmed again by its walk, not by 4 hits in 5 frames
+
+
+# The plain search the compiled one must reproduce: each candidate's Doppler neighbours found by
+# scanning every kept detection, each ambiguity's line judged in its own pass.
+_MIN_EXTENT_M = 300.0
+
+
+class _ReferenceWalks:
+    """The range-walk search written plainly, one candidate and one ambiguity at a time."""
+
+    def __init__(self, doppler_width_mps: float, rule: RangeWalkRule | None = None) -> None:
+        self.width = float(doppler_width_mps)
+        self.rule = rule or RangeWalkRule()
+        self._frame = 0
+        self._t = np.zeros(0)
+        self._f = np.zeros(0, np.int64)
+        self._r = np.zeros(0)
+        self._v = np.zeros(0)
+
+    def step(
+        self, time_s: float, z: np.ndarray, candidate: np.ndarray, static_speed_mps: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """One frame: which of its detections complete a closing walk, and at which true radial velocity.
+
+        Parameters
+        ----------
+        time_s : float
+            The frame's time, s (not decreasing between calls).
+        z : ndarray, shape (n, 2)
+            The frame's detections: range (m) and the cell's radial velocity (m/s, aliased).
+        candidate : ndarray of bool, shape (n,)
+            Detections free to start or support a walk (not taken by a confirmed track).
+        static_speed_mps : float
+            The fastest a static point's range can change this frame (the own-ship's speed), m/s.
+            NaN: unknown, and no walk starts (the detections are still kept as support).
+
+        Returns
+        -------
+        rows : ndarray of int
+            Rows of ``z`` that complete a walk, at most one per walk.
+        velocity_mps : ndarray
+            Their true radial velocity (``v + k W``), m/s.
+        """
+        rule = self.rule
+        z = np.asarray(z, float).reshape(-1, 2)
+        keep = self._t >= time_s - rule.window_s
+        self._t, self._f, self._r, self._v = self._t[keep], self._f[keep], self._r[keep], self._v[keep]
+        rows: list[int] = []
+        velocity: list[float] = []
+        cand = np.flatnonzero(np.asarray(candidate, bool))
+        if np.isfinite(static_speed_mps) and self._t.size:
+            limit = float(static_speed_mps) + rule.margin_mps
+            taken = np.zeros(self._t.size, bool)
+            for i in cand:
+                found = self._walk(float(time_s), z[i], limit, taken)
+                if found is None:
+                    continue
+                v_true, support = found
+                taken[support] = True
+                rows.append(int(i))
+                velocity.append(v_true)
+            if taken.any():  # a walk's support belongs to its track now
+                left = ~taken
+                self._t, self._f, self._r, self._v = (
+                    self._t[left],
+                    self._f[left],
+                    self._r[left],
+                    self._v[left],
+                )
+        new = np.setdiff1d(cand, np.array(rows, int))
+        self._t = np.concatenate([self._t, np.full(new.size, float(time_s))])
+        self._f = np.concatenate([self._f, np.full(new.size, self._frame, np.int64)])
+        self._r = np.concatenate([self._r, z[new, 0]])
+        self._v = np.concatenate([self._v, z[new, 1]])
+        self._frame += 1
+        return np.array(rows, int), np.array(velocity, float)
+
+    def _walk(
+        self, time_s: float, zi: np.ndarray, limit_mps: float, taken: np.ndarray
+    ) -> tuple[float, np.ndarray] | None:
+        """The closing walk through detection ``zi`` with the most support, if it passes the rule."""
+        rule, width = self.rule, self.width
+        dv = (self._v - zi[1] + width / 2.0) % width - width / 2.0
+        near = np.flatnonzero((np.abs(dv) <= rule.doppler_gate_mps) & ~taken)
+        if near.size < rule.least_frames - 1:
+            return None
+        dt = self._t[near] - time_s  # <= 0
+        mean_v = zi[1] + 0.5 * dv[near]  # the two detections' mean Doppler, in zi's alias
+
+        def support(k: int) -> np.ndarray:
+            residual = self._r[near] - (zi[0] + (mean_v + k * width) * dt)
+            return near[np.abs(residual) <= rule.range_gate_m]
+
+        def frames(rows: np.ndarray) -> int:
+            return int(np.unique(self._f[rows]).size) + 1  # the new detection's frame too
+
+        k_max = int(np.ceil((rule.max_closing_mps + abs(zi[1])) / width)) + 1
+        ks = np.arange(-k_max, k_max + 1)
+        speeds = zi[1] + ks * width
+        static = max((frames(support(int(k))) for k in ks[np.abs(speeds) <= limit_mps]), default=1)
+        # Chance support: the Doppler's other detections in the window, spread over the ranges they cover.
+        extent_m = max(float(np.ptp(self._r[near])), _MIN_EXTENT_M) + 2.0 * rule.range_gate_m
+        per_detection = 2.0 * rule.range_gate_m / extent_m
+        best: tuple[float, np.ndarray] | None = None
+        best_n = 0
+        for k in ks[(speeds < -limit_mps) & (speeds >= -rule.max_closing_mps)]:
+            rows = support(int(k))
+            n = frames(rows)
+            if n < rule.least_frames or n < rule.static_ratio * static or n <= best_n:
+                continue
+            if time_s - self._t[rows].min() < rule.min_span_s:
+                continue
+            chance = (near.size - rows.size) * per_detection
+            if poisson.sf(n - 2, chance) > rule.false_walk_probability:  # P(at least n - 1 supports)
+                continue
+            best, best_n = (float(zi[1] + k * width), rows), n
+        return best
+
+
+def _dense_scene(rng: np.random.Generator, n_frames: int) -> list[np.ndarray]:
+    """About 150 detections a frame spread over the image, static clutter at a few Dopplers, and
+    closures at -100 to -117 m/s seen in a third to a half of their frames."""
+    frames = []
+    closures = [(3200.0, -100.0, 3), (2800.0, -113.0, 2), (3600.0, -117.0, 3)]
+    patch = rng.uniform(800.0, 4000.0, 80)
+    for k in range(n_frames):
+        t = k * FRAME_S
+        uniform = np.column_stack(
+            [rng.uniform(200.0, 4500.0, 100), rng.uniform(-WIDTH_MPS / 2, WIDTH_MPS / 2, 100)]
+        )
+        pick = rng.choice(patch.size, 40, replace=False)
+        ground = np.column_stack(
+            [patch[pick] - 30.0 * t + rng.normal(0, 4, 40), -30.0 + rng.normal(0, 0.15, 40)]
+        )
+        rows = [uniform, ground]
+        for r0, v, every in closures:
+            if k % every == 0:
+                rows.append(
+                    np.array([[r0 + v * t + rng.normal(0, 3.0), float(_wrap(v + rng.normal(0, 0.05)))]])
+                )
+        z = np.concatenate(rows)
+        frames.append(z[rng.permutation(len(z))])
+    return frames
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_compiled_search_finds_the_walks_the_plain_one_finds(seed):
+    rng = np.random.default_rng(seed)
+    frames = _dense_scene(rng, 60)
+    fast, plain = RangeWalks(WIDTH_MPS), _ReferenceWalks(WIDTH_MPS)
+    started = 0
+    for k, z in enumerate(frames):
+        free = rng.random(len(z)) < 0.9  # some detections are taken by confirmed tracks
+        rows, velocity = fast.step(k * FRAME_S, z, free, OWN_SPEED_MPS)
+        rows_ref, velocity_ref = plain.step(k * FRAME_S, z, free, OWN_SPEED_MPS)
+        np.testing.assert_array_equal(rows, rows_ref)
+        np.testing.assert_allclose(velocity, velocity_ref, rtol=0, atol=1e-9)
+        started += rows.size
+    assert started >= 3, started  # the closures start walks: the comparison covers found walks, not only none

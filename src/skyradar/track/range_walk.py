@@ -48,10 +48,11 @@ own-ship flies at 50 m/s:
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
-from scipy.stats import poisson
 
 __all__ = ["RangeWalkRule", "RangeWalks"]
 
@@ -111,6 +112,10 @@ class RangeWalks:
 
     Keeps the recent detections not taken by a confirmed track (times, frames, range, Doppler);
     :meth:`step` searches each new candidate's lines against them, then adds the frame's candidates.
+    The search is compiled (numba): a candidate's Doppler neighbours come from binary searches on the
+    kept detections sorted by Doppler, and every ambiguity's line is judged in one pass over them, so
+    a candidate costs in proportion to its Doppler neighbours, not to every kept detection
+    (``skyradar bench track`` measures it).
 
     Parameters
     ----------
@@ -157,20 +162,40 @@ class RangeWalks:
         z = np.asarray(z, float).reshape(-1, 2)
         keep = self._t >= time_s - rule.window_s
         self._t, self._f, self._r, self._v = self._t[keep], self._f[keep], self._r[keep], self._v[keep]
-        rows: list[int] = []
-        velocity: list[float] = []
+        rows = np.zeros(0, int)
+        velocity = np.zeros(0)
         cand = np.flatnonzero(np.asarray(candidate, bool))
-        if np.isfinite(static_speed_mps) and self._t.size:
-            limit = float(static_speed_mps) + rule.margin_mps
-            taken = np.zeros(self._t.size, bool)
-            for i in cand:
-                found = self._walk(float(time_s), z[i], limit, taken)
-                if found is None:
-                    continue
-                v_true, support = found
-                taken[support] = True
-                rows.append(int(i))
-                velocity.append(v_true)
+        if np.isfinite(static_speed_mps) and self._t.size and cand.size:
+            by_doppler = np.argsort(self._v, kind="stable")
+            settings = np.array(
+                [
+                    self.width,
+                    float(static_speed_mps) + rule.margin_mps,
+                    rule.doppler_gate_mps,
+                    rule.range_gate_m,
+                    rule.least_frames,
+                    rule.min_span_s,
+                    rule.static_ratio,
+                    rule.max_closing_mps,
+                    rule.false_walk_probability,
+                    _MIN_EXTENT_M,
+                ]
+            )
+            found, taken = _search_walks(
+                float(time_s),
+                z[cand, 0].copy(),
+                z[cand, 1].copy(),
+                self._t,
+                self._f,
+                self._r,
+                self._v,
+                by_doppler,
+                self._v[by_doppler],
+                self._frame,
+                settings,
+            )
+            walked = np.isfinite(found)
+            rows, velocity = cand[walked], found[walked]
             if taken.any():  # a walk's support belongs to its track now
                 left = ~taken
                 self._t, self._f, self._r, self._v = (
@@ -179,51 +204,122 @@ class RangeWalks:
                     self._r[left],
                     self._v[left],
                 )
-        new = np.setdiff1d(cand, np.array(rows, int))
+        new = np.setdiff1d(cand, rows)
         self._t = np.concatenate([self._t, np.full(new.size, float(time_s))])
         self._f = np.concatenate([self._f, np.full(new.size, self._frame, np.int64)])
         self._r = np.concatenate([self._r, z[new, 0]])
         self._v = np.concatenate([self._v, z[new, 1]])
         self._frame += 1
-        return np.array(rows, int), np.array(velocity, float)
+        return rows.astype(int), velocity.astype(float)
 
-    def _walk(
-        self, time_s: float, zi: np.ndarray, limit_mps: float, taken: np.ndarray
-    ) -> tuple[float, np.ndarray] | None:
-        """The closing walk through detection ``zi`` with the most support, if it passes the rule."""
-        rule, width = self.rule, self.width
-        dv = (self._v - zi[1] + width / 2.0) % width - width / 2.0
-        near = np.flatnonzero((np.abs(dv) <= rule.doppler_gate_mps) & ~taken)
-        if near.size < rule.least_frames - 1:
-            return None
-        dt = self._t[near] - time_s  # <= 0
-        mean_v = zi[1] + 0.5 * dv[near]  # the two detections' mean Doppler, in zi's alias
 
-        def support(k: int) -> np.ndarray:
-            residual = self._r[near] - (zi[0] + (mean_v + k * width) * dt)
-            return near[np.abs(residual) <= rule.range_gate_m]
+@numba.njit(cache=True)
+def _poisson_tail(n: int, mean: float) -> float:  # pragma: no cover - numba
+    """P(X >= n) for X ~ Poisson(mean): the sum of the tail's terms from n up."""
+    if n <= 0:
+        return 1.0
+    if mean <= 0.0:
+        return 0.0
+    term = math.exp(-mean + n * math.log(mean) - math.lgamma(n + 1.0))
+    total = 0.0
+    j = n
+    while term > 1e-300 and (term > 1e-17 * total or j < mean):
+        total += term
+        j += 1
+        term *= mean / j
+    return min(total, 1.0)
 
-        def frames(rows: np.ndarray) -> int:
-            return int(np.unique(self._f[rows]).size) + 1  # the new detection's frame too
 
-        k_max = int(np.ceil((rule.max_closing_mps + abs(zi[1])) / width)) + 1
-        ks = np.arange(-k_max, k_max + 1)
-        speeds = zi[1] + ks * width
-        static = max((frames(support(int(k))) for k in ks[np.abs(speeds) <= limit_mps]), default=1)
+@numba.njit(cache=True)
+def _search_walks(
+    time_s, cand_r, cand_v, t, f, r, v, by_doppler, sorted_v, frame_now, settings
+):  # pragma: no cover
+    """Each candidate's closing walk (its true radial velocity, NaN: none) through the kept
+    detections (times ``t``, frames ``f``, ranges ``r``, Doppler ``v``; ``by_doppler`` sorts them by
+    Doppler into ``sorted_v``), in the candidates' order; a walk's support is taken from the later
+    candidates. Returns the velocities and the taken mask. ``settings``: image width, the static
+    limit, then :class:`RangeWalkRule`'s gates and tests (see :meth:`RangeWalks.step`)."""
+    width, limit, gate_v, gate_r = settings[0], settings[1], settings[2], settings[3]
+    least, min_span, static_ratio = int(settings[4]), settings[5], settings[6]
+    max_closing, p_false, min_extent = settings[7], settings[8], settings[9]
+    n_kept = t.size
+    taken = np.zeros(n_kept, np.bool_)
+    found = np.full(cand_r.size, np.nan)
+    near = np.empty(n_kept, np.int64)
+    dv = np.empty(n_kept)
+    oldest = frame_now
+    for q in range(n_kept):
+        oldest = min(oldest, f[q])
+    n_ages = frame_now - oldest + 1
+    for c in range(cand_r.size):
+        ri, vi = cand_r[c], cand_v[c]
+        # The kept detections within the Doppler gate, modulo the image width (binary searches on
+        # the gate and its images one width either side).
+        m = 0
+        for shift in (-width, 0.0, width):
+            lo = np.searchsorted(sorted_v, vi + shift - gate_v - 1e-9)
+            hi = np.searchsorted(sorted_v, vi + shift + gate_v + 1e-9, side="right")
+            for q in range(lo, hi):
+                idx = by_doppler[q]
+                if taken[idx]:
+                    continue
+                d = (v[idx] - vi + width / 2.0) % width - width / 2.0
+                if abs(d) <= gate_v:
+                    near[m] = idx
+                    dv[m] = d
+                    m += 1
+        if m < least - 1:
+            continue
+        k_max = int(math.ceil((max_closing + abs(vi)) / width)) + 1
+        # Frames holding support of each ambiguity's line r0 + (mean Doppler + k W)(t - t0).
+        n_frames = np.ones(2 * k_max + 1, np.int64)  # the new detection's frame
+        seen = np.zeros(n_ages, np.bool_)
+        for kk in range(2 * k_max + 1):
+            k = kk - k_max
+            if not -max_closing <= vi + k * width <= limit:
+                continue  # neither a static point's line nor a closing one: never judged
+            seen[:] = False
+            for a in range(m):
+                idx = near[a]
+                residual = r[idx] - (ri + (vi + 0.5 * dv[a] + k * width) * (t[idx] - time_s))
+                if abs(residual) <= gate_r and not seen[frame_now - f[idx]]:
+                    seen[frame_now - f[idx]] = True
+                    n_frames[kk] += 1
+        static = 1
+        for kk in range(2 * k_max + 1):
+            if abs(vi + (kk - k_max) * width) <= limit:
+                static = max(static, n_frames[kk])
         # Chance support: the Doppler's other detections in the window, spread over the ranges they cover.
-        extent_m = max(float(np.ptp(self._r[near])), _MIN_EXTENT_M) + 2.0 * rule.range_gate_m
-        per_detection = 2.0 * rule.range_gate_m / extent_m
-        best: tuple[float, np.ndarray] | None = None
-        best_n = 0
-        for k in ks[(speeds < -limit_mps) & (speeds >= -rule.max_closing_mps)]:
-            rows = support(int(k))
-            n = frames(rows)
-            if n < rule.least_frames or n < rule.static_ratio * static or n <= best_n:
+        r_low, r_high = np.inf, -np.inf
+        for a in range(m):
+            r_low, r_high = min(r_low, r[near[a]]), max(r_high, r[near[a]])
+        per_detection = 2.0 * gate_r / (max(r_high - r_low, min_extent) + 2.0 * gate_r)
+        best_k, best_n = -1, 0
+        for kk in range(2 * k_max + 1):
+            speed = vi + (kk - k_max) * width
+            n = n_frames[kk]
+            if not (speed < -limit and speed >= -max_closing):
                 continue
-            if time_s - self._t[rows].min() < rule.min_span_s:
+            if n < least or n < static_ratio * static or n <= best_n:
                 continue
-            chance = (near.size - rows.size) * per_detection
-            if poisson.sf(n - 2, chance) > rule.false_walk_probability:  # P(at least n - 1 supports)
+            support, first_t = 0, time_s
+            for a in range(m):
+                idx = near[a]
+                residual = r[idx] - (ri + (vi + 0.5 * dv[a] + (kk - k_max) * width) * (t[idx] - time_s))
+                if abs(residual) <= gate_r:
+                    support += 1
+                    first_t = min(first_t, t[idx])
+            if time_s - first_t < min_span:
                 continue
-            best, best_n = (float(zi[1] + k * width), rows), n
-        return best
+            if _poisson_tail(n - 1, (m - support) * per_detection) > p_false:  # at least n - 1 supports
+                continue
+            best_k, best_n = kk, n
+        if best_k < 0:
+            continue
+        found[c] = vi + (best_k - k_max) * width
+        for a in range(m):
+            idx = near[a]
+            residual = r[idx] - (ri + (vi + 0.5 * dv[a] + (best_k - k_max) * width) * (t[idx] - time_s))
+            if abs(residual) <= gate_r:
+                taken[idx] = True
+    return found, taken

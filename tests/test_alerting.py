@@ -363,6 +363,17 @@ def test_the_rows_before_confirmation_extend_the_range_path_that_lifts_the_gate(
     assert first_inside["outside, with held rows"] is None
 
 
+def test_a_tracks_table_with_repeated_rows_is_alerted_as_without_them():
+    # A table that lists some of a track's rows twice (concatenated exports) describes the same
+    # track: its alerts are those of the table without the repeats.
+    cfg = AlertConfig(max_velocity_sigma_mps=6.0, min_track_age_s=0.0)
+    own, tracks = _crossing_ahead(320.0)
+    repeated = pd.concat([tracks, tracks.iloc[:5]]).sort_values("time_s", kind="stable")
+    once = alerts_from_tracks(tracks, own, cfg, with_advice=False)
+    twice = alerts_from_tracks(repeated, own, cfg, with_advice=False).drop_duplicates(["time_s", "track_id"])
+    assert twice["level"].tolist() == once["level"].tolist()
+
+
 def _converged(tracks: pd.DataFrame, sigma_mps: float = 2.0) -> pd.DataFrame:
     """A track with a converged velocity (``sigma_mps`` per horizontal axis, 20 m of position)."""
     cov = {f"cov_vv_{i}{j}": (sigma_mps**2 if i == j else 0.0) for i in range(3) for j in range(3)}

@@ -278,6 +278,7 @@ def _whole_track_range_miss(
         return out
     ids = df["track_id"].to_numpy()
     mine = ranges[ranges["track_id"].isin(np.unique(ids[~predicted]))]
+    mine = mine.drop_duplicates(["track_id", "time_s"], keep="last")  # a track has one state a time
     if len(mine) == 0:
         return out
     rt = mine["time_s"].to_numpy(float)

@@ -115,6 +115,41 @@ def test_label_tracks_matches_a_prior_height_track_by_range_and_bearing():
     assert label_tracks(aside, truth) == {5: "clutter"}
 
 
+def test_label_tracks_matches_a_track_by_range_and_range_rate_when_its_bearing_is_off():
+    # Over relief a closure's directions come through clutter nulls and scatter by tens of degrees:
+    # its co-altitude track sits 60 deg off the intruder's bearing (500-700 m across), but its
+    # range and range rate are the intruder's to a pixel. A ground track at the same ranges whose
+    # range rate is a static point's (-50 m/s, the own-ship's speed) is not the intruder's.
+    t = np.arange(0.0, 5.0, 0.5)
+    north = 700.0 - 100.0 * t  # closing head-on at 100 m/s, own-ship at the origin
+    dims = ("time", "target")
+    data = {
+        "tgt_north_m": (dims, north[:, None]),
+        "tgt_east_m": (dims, np.zeros((t.size, 1))),
+        "tgt_down_m": (dims, np.zeros((t.size, 1))),
+        "tgt_range_m": (dims, north[:, None]),
+        "tgt_radial_velocity_mps": (dims, np.full((t.size, 1), -100.0)),
+    }
+    data |= {f"own_{axis}_m": ("time", np.zeros(t.size)) for axis in ("north", "east", "down")}
+    truth = xr.Dataset(data, coords={"time": t, "target": ["a"]})
+    off = np.radians(60.0)
+    track = pd.DataFrame(
+        {
+            "time_s": t,
+            "track_id": 5,
+            "north_m": north * np.cos(off),
+            "east_m": north * np.sin(off),
+            "down_m": 0.0,
+            "range_m": north + 3.0,
+            "range_rate_mps": -100.2,
+            "altitude_measured": False,
+        }
+    )
+    assert label_tracks(track, truth) == {5: "a"}
+    assert label_tracks(track.drop(columns=["range_m", "range_rate_mps"]), truth) == {5: "clutter"}
+    assert label_tracks(track.assign(range_rate_mps=-50.0), truth) == {5: "clutter"}
+
+
 def test_alert_timeline_lists_each_level_change():
     alerts = pd.DataFrame(
         {

@@ -56,6 +56,8 @@ __all__ = [
 ]
 
 _MATCH_M = 300.0  # a track is an intruder's if its median distance to that truth is below this
+# ... or if its range and range rate follow that truth's, medians within these (m, m/s)
+_MATCH_RANGE_M, _MATCH_RATE_MPS = 50.0, 2.0
 
 
 def _truth_dataset(built, simulator) -> xr.Dataset:
@@ -238,7 +240,12 @@ def label_tracks(tracks: pd.DataFrame, truth: xr.Dataset, max_distance_m: float 
 
     On rows whose height is the co-altitude prior (``altitude_measured`` False) the distance is
     taken in what the radar measured, slant range and bearing from the own-ship (``own_*`` in
-    ``truth``): such a track is its intruder's even when it flies 300 m above.
+    ``truth``): such a track is its intruder's even when it flies 300 m above. A track whose
+    bearings are off too (directions through clutter nulls over relief scatter by tens of degrees)
+    is still its intruder's when its range and range rate follow the intruder's truth
+    (``tgt_range_m``, ``tgt_radial_velocity_mps``; medians within 50 m and 2 m/s): those are measured
+    to a pixel whatever the directions do, and a ground point's range rate parts from an
+    aircraft's within seconds, so a track that follows both over its life is that aircraft.
 
     Examples
     --------
@@ -266,8 +273,27 @@ def label_tracks(tracks: pd.DataFrame, truth: xr.Dataset, max_distance_m: float 
                 dist[prior] = _range_bearing_distance_m(pos[prior], truth_pos[idx[prior]], own[idx[prior]])
             med = np.array([np.nanmedian(d) if np.isfinite(d).any() else np.inf for d in dist.T])
         best = int(np.argmin(med)) if med.size else -1
-        labels[int(tid)] = names[best] if best >= 0 and med[best] < max_distance_m else "clutter"
+        if not (best >= 0 and med[best] < max_distance_m):
+            best = _range_rate_match(g, truth, idx)
+        labels[int(tid)] = names[best] if best >= 0 else "clutter"
     return labels
+
+
+def _range_rate_match(rows: pd.DataFrame, truth: xr.Dataset, idx: np.ndarray) -> int:
+    """The target whose range and range rate a track's ``rows`` (at truth frames ``idx``) follow,
+    medians within ``_MATCH_RANGE_M`` and ``_MATCH_RATE_MPS``; -1: none (or no such columns)."""
+    columns = ("range_m", "range_rate_mps")
+    if not set(columns) <= set(rows) or not {"tgt_range_m", "tgt_radial_velocity_mps"} <= set(truth):
+        return -1
+    with np.errstate(all="ignore"):
+        d_range = np.abs(rows["range_m"].to_numpy(float)[:, None] - truth["tgt_range_m"].values[idx])
+        d_rate = np.abs(
+            rows["range_rate_mps"].to_numpy(float)[:, None] - truth["tgt_radial_velocity_mps"].values[idx]
+        )
+        med_range = np.array([np.nanmedian(d) if np.isfinite(d).any() else np.inf for d in d_range.T])
+        med_rate = np.array([np.nanmedian(d) if np.isfinite(d).any() else np.inf for d in d_rate.T])
+    follows = (med_range < _MATCH_RANGE_M) & (med_rate < _MATCH_RATE_MPS)
+    return int(np.argmin(np.where(follows, med_range, np.inf))) if follows.any() else -1
 
 
 def confirmed_rows(tracks: pd.DataFrame) -> pd.DataFrame:

@@ -374,6 +374,12 @@ def test_a_tracks_table_with_repeated_rows_is_alerted_as_without_them():
     assert twice["level"].tolist() == once["level"].tolist()
 
 
+def test_a_tracks_table_without_times_is_one_error_naming_the_columns():
+    own, tracks = _crossing_ahead(320.0)
+    with pytest.raises(InputError, match=r"t.parquet: missing column\(s\) \['time_s'\]"):
+        alerts_from_tracks(tracks.drop(columns="time_s"), own, with_advice=False, source="t.parquet")
+
+
 def _converged(tracks: pd.DataFrame, sigma_mps: float = 2.0) -> pd.DataFrame:
     """A track with a converged velocity (``sigma_mps`` per horizontal axis, 20 m of position)."""
     cov = {f"cov_vv_{i}{j}": (sigma_mps**2 if i == j else 0.0) for i in range(3) for j in range(3)}

@@ -410,9 +410,9 @@ def _alert_rows(
     """The state, geometry and raw levels of every row (:func:`alerts_from_tracks` up to its filter).
     ``cleaned``: ``tracks`` are :func:`~skyradar.daa.tables.clean_tracks`' rows already, and
     ``ranges`` every track's :func:`~skyradar.daa.tables.range_history` (else read from ``tracks``)."""
-    if not cleaned and ranges is None:
-        ranges = range_history(tracks, source)
     df = tracks.reset_index(drop=True) if cleaned else clean_tracks(tracks, source)
+    if not cleaned and ranges is None:
+        ranges = range_history(tracks, source)  # after clean_tracks named any missing column
     if cleaned:
         df.attrs["rows_skipped_no_state"] = 0
     df = lost_track_rows(df, ownship["time_s"].to_numpy(float), config.lost_track_hold_s)

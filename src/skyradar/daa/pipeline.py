@@ -74,7 +74,7 @@ def _gate_unconverged(
     config: AlertConfig,
     located: np.ndarray,
     range_miss: np.ndarray,
-    track_miss: np.ndarray | None = None,
+    track_miss: np.ndarray,
 ) -> None:
     """Silences (in ``raw``) the rows whose horizontal velocity is not known well enough to alert on.
 
@@ -100,9 +100,9 @@ def _gate_unconverged(
     if config.max_velocity_sigma_mps is not None and cov_v is not None:
         sigma_hv = np.sqrt(np.nan_to_num(cov_v[:, 0, 0] + cov_v[:, 1, 1], nan=np.inf))
         radius_m = config.levels[-1].volume.dthr_m
-        inside = range_miss[0] + K_SIGMA * range_miss[1] < radius_m  # False where NaN
-        if track_miss is not None:
-            inside |= track_miss[0] + K_SIGMA * track_miss[1] < radius_m
+        inside = (range_miss[0] + K_SIGMA * range_miss[1] < radius_m) | (  # False where NaN
+            track_miss[0] + K_SIGMA * track_miss[1] < radius_m
+        )
         unconverged = velocity_unconverged(sigma_hv, raw["tcpa_s"], config) & located & ~inside
         raw["level"][unconverged] = 0
         raw["hold_level"][unconverged] = 0

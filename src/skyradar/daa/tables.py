@@ -74,11 +74,7 @@ def clean_tracks(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
         bad = int(np.flatnonzero(ids != np.round(ids))[0])
         raise InputError(f"{source}: field 'track_id' is not a whole number at row {bad} ({ids[bad]!r})")
     # Track ids stay integers in the alerts, as the tracker wrote them.
-    for name in RANGE_COLUMNS:
-        if name in df:
-            cols[name] = finite_column(df, name, source, allow_nan=True)
-            limit, unit = STATE_LIMITS[name[-1]]
-            check_within(cols[name], limit, unit, source, name, "not a range or range rate of an aircraft")
+    cols |= _range_columns(df, source)
     df = df.assign(**cols | {"track_id": ids.astype(np.int64)})
     for name in ("confirmed", "altitude_measured"):
         if name in df:
@@ -114,14 +110,23 @@ def range_history(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
         )
     df = tracks.reset_index(drop=True)
     cols = {name: finite_column(df, name, source) for name in ("time_s", "track_id")}
-    for name in RANGE_COLUMNS:
-        cols[name] = finite_column(df, name, source, allow_nan=True)
-        limit, unit = STATE_LIMITS[name[-1]]
-        check_within(cols[name], limit, unit, source, name, "not a range or range rate of an aircraft")
+    cols |= _range_columns(df, source)
     measured = np.isfinite(cols["range_m"]) & np.isfinite(cols["range_rate_mps"])
     out = pd.DataFrame({name: cols[name][measured] for name in columns})
     out["track_id"] = out["track_id"].astype(np.int64)
     return out.sort_values(["time_s", "track_id"], kind="stable").reset_index(drop=True)
+
+
+def _range_columns(df: pd.DataFrame, source: str) -> dict[str, np.ndarray]:
+    """``df``'s range and range rate columns (those it has) as floats, NaN allowed; a non-number,
+    an infinity or a value no aircraft's range or range rate has is refused naming the row."""
+    cols = {}
+    for name in RANGE_COLUMNS:
+        if name in df:
+            cols[name] = finite_column(df, name, source, allow_nan=True)
+            limit, unit = STATE_LIMITS[name[-1]]
+            check_within(cols[name], limit, unit, source, name, "not a range or range rate of an aircraft")
+    return cols
 
 
 def range_only_rows(tracks: pd.DataFrame) -> np.ndarray:

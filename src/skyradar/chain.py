@@ -271,7 +271,7 @@ def label_tracks(tracks: pd.DataFrame, truth: xr.Dataset, max_distance_m: float 
             if own is not None and "altitude_measured" in g:
                 prior = ~g["altitude_measured"].to_numpy(bool)
                 dist[prior] = _range_bearing_distance_m(pos[prior], truth_pos[idx[prior]], own[idx[prior]])
-            med = np.array([np.nanmedian(d) if np.isfinite(d).any() else np.inf for d in dist.T])
+            med = _median_per_target(dist)
         best = int(np.argmin(med)) if med.size else -1
         if not (best >= 0 and med[best] < max_distance_m):
             best = _range_rate_match(g, truth, idx)
@@ -290,10 +290,16 @@ def _range_rate_match(rows: pd.DataFrame, truth: xr.Dataset, idx: np.ndarray) ->
         d_rate = np.abs(
             rows["range_rate_mps"].to_numpy(float)[:, None] - truth["tgt_radial_velocity_mps"].values[idx]
         )
-        med_range = np.array([np.nanmedian(d) if np.isfinite(d).any() else np.inf for d in d_range.T])
-        med_rate = np.array([np.nanmedian(d) if np.isfinite(d).any() else np.inf for d in d_rate.T])
+        med_range, med_rate = _median_per_target(d_range), _median_per_target(d_rate)
     follows = (med_range < _MATCH_RANGE_M) & (med_rate < _MATCH_RATE_MPS)
     return int(np.argmin(np.where(follows, med_range, np.inf))) if follows.any() else -1
+
+
+def _median_per_target(distance: np.ndarray) -> np.ndarray:
+    """Median over a track's rows of each target's column of ``distance`` (rows, targets), NaN rows
+    left out; infinite for a target with no finite row."""
+    with np.errstate(all="ignore"):
+        return np.array([np.nanmedian(d) if np.isfinite(d).any() else np.inf for d in distance.T])
 
 
 def confirmed_rows(tracks: pd.DataFrame) -> pd.DataFrame:

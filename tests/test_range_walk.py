@@ -167,75 +167,19 @@ def test_a_walk_on_a_lost_tracks_aircraft_takes_its_id_back():
 _MIN_EXTENT_M = 300.0
 
 
-class _ReferenceWalks:
-    """The range-walk search written plainly, one candidate and one ambiguity at a time."""
+class _ReferenceWalks(RangeWalks):
+    """:class:`RangeWalks` with the search written plainly, one candidate and one ambiguity at a time."""
 
-    def __init__(self, doppler_width_mps: float, rule: RangeWalkRule | None = None) -> None:
-        self.width = float(doppler_width_mps)
-        self.rule = rule or RangeWalkRule()
-        self._frame = 0
-        self._t = np.zeros(0)
-        self._f = np.zeros(0, np.int64)
-        self._r = np.zeros(0)
-        self._v = np.zeros(0)
-
-    def step(
-        self, time_s: float, z: np.ndarray, candidate: np.ndarray, static_speed_mps: float
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """One frame: which of its detections complete a closing walk, and at which true radial velocity.
-
-        Parameters
-        ----------
-        time_s : float
-            The frame's time, s (not decreasing between calls).
-        z : ndarray, shape (n, 2)
-            The frame's detections: range (m) and the cell's radial velocity (m/s, aliased).
-        candidate : ndarray of bool, shape (n,)
-            Detections free to start or support a walk (not taken by a confirmed track).
-        static_speed_mps : float
-            The fastest a static point's range can change this frame (the own-ship's speed), m/s.
-            NaN: unknown, and no walk starts (the detections are still kept as support).
-
-        Returns
-        -------
-        rows : ndarray of int
-            Rows of ``z`` that complete a walk, at most one per walk.
-        velocity_mps : ndarray
-            Their true radial velocity (``v + k W``), m/s.
-        """
-        rule = self.rule
-        z = np.asarray(z, float).reshape(-1, 2)
-        keep = self._t >= time_s - rule.window_s
-        self._t, self._f, self._r, self._v = self._t[keep], self._f[keep], self._r[keep], self._v[keep]
-        rows: list[int] = []
-        velocity: list[float] = []
-        cand = np.flatnonzero(np.asarray(candidate, bool))
-        if np.isfinite(static_speed_mps) and self._t.size:
-            limit = float(static_speed_mps) + rule.margin_mps
-            taken = np.zeros(self._t.size, bool)
-            for i in cand:
-                found = self._walk(float(time_s), z[i], limit, taken)
-                if found is None:
-                    continue
-                v_true, support = found
-                taken[support] = True
-                rows.append(int(i))
-                velocity.append(v_true)
-            if taken.any():  # a walk's support belongs to its track now
-                left = ~taken
-                self._t, self._f, self._r, self._v = (
-                    self._t[left],
-                    self._f[left],
-                    self._r[left],
-                    self._v[left],
-                )
-        new = np.setdiff1d(cand, np.array(rows, int))
-        self._t = np.concatenate([self._t, np.full(new.size, float(time_s))])
-        self._f = np.concatenate([self._f, np.full(new.size, self._frame, np.int64)])
-        self._r = np.concatenate([self._r, z[new, 0]])
-        self._v = np.concatenate([self._v, z[new, 1]])
-        self._frame += 1
-        return np.array(rows, int), np.array(velocity, float)
+    def _search(self, time_s: float, z: np.ndarray, limit_mps: float) -> tuple[np.ndarray, np.ndarray]:
+        taken = np.zeros(self._t.size, bool)
+        found = np.full(len(z), np.nan)
+        for i in range(len(z)):
+            walk = self._walk(time_s, z[i], limit_mps, taken)
+            if walk is None:
+                continue
+            found[i], support = walk
+            taken[support] = True
+        return found, taken
 
     def _walk(
         self, time_s: float, zi: np.ndarray, limit_mps: float, taken: np.ndarray

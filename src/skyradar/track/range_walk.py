@@ -166,34 +166,7 @@ class RangeWalks:
         velocity = np.zeros(0)
         cand = np.flatnonzero(np.asarray(candidate, bool))
         if np.isfinite(static_speed_mps) and self._t.size and cand.size:
-            by_doppler = np.argsort(self._v, kind="stable")
-            settings = np.array(
-                [
-                    self.width,
-                    float(static_speed_mps) + rule.margin_mps,
-                    rule.doppler_gate_mps,
-                    rule.range_gate_m,
-                    rule.least_frames,
-                    rule.min_span_s,
-                    rule.static_ratio,
-                    rule.max_closing_mps,
-                    rule.false_walk_probability,
-                    _MIN_EXTENT_M,
-                ]
-            )
-            found, taken = _search_walks(
-                float(time_s),
-                z[cand, 0].copy(),
-                z[cand, 1].copy(),
-                self._t,
-                self._f,
-                self._r,
-                self._v,
-                by_doppler,
-                self._v[by_doppler],
-                self._frame,
-                settings,
-            )
+            found, taken = self._search(float(time_s), z[cand], float(static_speed_mps) + rule.margin_mps)
             walked = np.isfinite(found)
             rows, velocity = cand[walked], found[walked]
             if taken.any():  # a walk's support belongs to its track now
@@ -211,6 +184,48 @@ class RangeWalks:
         self._v = np.concatenate([self._v, z[new, 1]])
         self._frame += 1
         return rows.astype(int), velocity.astype(float)
+
+    def _search(self, time_s: float, z: np.ndarray, limit_mps: float) -> tuple[np.ndarray, np.ndarray]:
+        """The closing walk of each candidate detection ``z`` (rows: range, aliased Doppler), in
+        order, against the kept detections: its true radial velocity (NaN: none), and which kept
+        detections the walks took. ``limit_mps``: the fastest a static point's range changes, plus
+        the rule's margin."""
+        rule = self.rule
+        by_doppler = np.argsort(self._v, kind="stable")
+        settings = np.array(
+            [
+                self.width,
+                limit_mps,
+                rule.doppler_gate_mps,
+                rule.range_gate_m,
+                rule.least_frames,
+                rule.min_span_s,
+                rule.static_ratio,
+                rule.max_closing_mps,
+                rule.false_walk_probability,
+                _MIN_EXTENT_M,
+            ]
+        )
+        return _search_walks(
+            time_s,
+            np.ascontiguousarray(z[:, 0]),
+            np.ascontiguousarray(z[:, 1]),
+            self._t,
+            self._f,
+            self._r,
+            self._v,
+            by_doppler,
+            self._v[by_doppler],
+            self._frame,
+            settings,
+        )
+
+
+@numba.njit(cache=True)
+def _off_line(r_kept, t_kept, ri, v_line, time_s):  # pragma: no cover - numba
+    """Range of a kept detection (``r_kept`` m at ``t_kept`` s) off the line through the new
+    detection (``ri`` m at ``time_s`` s) at ``v_line`` m/s."""
+    return r_kept - (ri + v_line * (t_kept - time_s))
 
 
 @numba.njit(cache=True)
@@ -281,7 +296,7 @@ def _search_walks(
             seen[:] = False
             for a in range(m):
                 idx = near[a]
-                residual = r[idx] - (ri + (vi + 0.5 * dv[a] + k * width) * (t[idx] - time_s))
+                residual = _off_line(r[idx], t[idx], ri, vi + 0.5 * dv[a] + k * width, time_s)
                 if abs(residual) <= gate_r and not seen[frame_now - f[idx]]:
                     seen[frame_now - f[idx]] = True
                     n_frames[kk] += 1
@@ -305,7 +320,7 @@ def _search_walks(
             support, first_t = 0, time_s
             for a in range(m):
                 idx = near[a]
-                residual = r[idx] - (ri + (vi + 0.5 * dv[a] + (kk - k_max) * width) * (t[idx] - time_s))
+                residual = _off_line(r[idx], t[idx], ri, vi + 0.5 * dv[a] + (kk - k_max) * width, time_s)
                 if abs(residual) <= gate_r:
                     support += 1
                     first_t = min(first_t, t[idx])
@@ -319,7 +334,7 @@ def _search_walks(
         found[c] = vi + (best_k - k_max) * width
         for a in range(m):
             idx = near[a]
-            residual = r[idx] - (ri + (vi + 0.5 * dv[a] + (best_k - k_max) * width) * (t[idx] - time_s))
+            residual = _off_line(r[idx], t[idx], ri, vi + 0.5 * dv[a] + (best_k - k_max) * width, time_s)
             if abs(residual) <= gate_r:
                 taken[idx] = True
     return found, taken

@@ -363,6 +363,39 @@ def test_the_rows_before_confirmation_extend_the_range_path_that_lifts_the_gate(
     assert first_inside["outside, with held rows"] is None
 
 
+def test_a_range_path_inside_the_volume_raises_a_co_altitude_track_its_velocity_would_clear():
+    # A fast closure whose elevation the clutter nulls took (its height is the co-altitude prior)
+    # and whose horizontal velocity drifted 25 m/s east on scattered directions: the track predicts
+    # a horizontal miss near 900 m, outside the 670 m warning radius. Its range and range rate put
+    # the 3-D miss at 320 m, and the horizontal miss is at most that: the warning is raised on the
+    # path once it enters within the alerting time. A measured height is the 3-D track's to judge,
+    # and a track whose height is outside the volume when the path enters is not raised by it.
+    cfg = AlertConfig(min_track_age_s=0.0)
+    entering = {}
+    for name, offset_m, measured, above_m in (
+        ("prior, path inside", 320.0, False, 0.0),
+        ("prior, path outside", 1000.0, False, 0.0),
+        ("measured height", 320.0, True, 0.0),
+        ("prior, 300 m above", 320.0, False, 300.0),
+    ):
+        own, tracks = _crossing_ahead(offset_m)
+        drifted = {"east_m": 300.0 + 25.0 * tracks["time_s"], "ve_mps": 25.0, "down_m": -1000.0 - above_m}
+        tracks = _converged(tracks).assign(**drifted, altitude_measured=measured)
+        out = alerts_from_tracks(tracks, own, cfg, with_advice=False)
+        assert (out["hmd_m"] > 800.0).all()  # the velocity alone clears every row
+        warned = out["raw_level"].to_numpy() == 3
+        entering[name] = round(float(out["time_s"].to_numpy()[np.argmax(warned)]), 1) if warned.any() else None
+    # Own-ship and intruder close at 115 m/s from 2.8 km: the path is within 670 m of the own-ship
+    # from 24.3 - 5.0 = 19.3 s with its miss 3 sigmas high, inside the 25 s alerting time as soon
+    # as the fit spans its 4 s.
+    assert entering["prior, path inside"] == pytest.approx(4.0, abs=0.2)
+    assert entering == {"prior, path inside": entering["prior, path inside"]} | {
+        "prior, path outside": None,
+        "measured height": None,
+        "prior, 300 m above": None,
+    }
+
+
 def test_a_tracks_table_with_repeated_rows_is_alerted_as_without_them():
     # A table that lists some of a track's rows twice (concatenated exports) describes the same
     # track: its alerts are those of the table without the repeats.

@@ -25,7 +25,7 @@ from skyradar.daa.conflict import (
     loss_of_well_clear_interval,
     widened_thresholds,
 )
-from skyradar.daa.range_miss import cannot_enter
+from skyradar.daa.range_miss import cannot_enter, surely_inside_s
 
 __all__ = [
     "LEVEL_NAMES",
@@ -334,7 +334,9 @@ def _volume_levels(s, v, tcpa, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2, m
     """Highest level whose (widened) volume is lost within its alerting time, its entry time,
     the widened thresholds ``{level: (dthr_m, zthr_m)}`` of every level, and the highest level
     lost within its hold time (:meth:`AlertLevel.hold_time_s`). ``miss`` (miss distance and sigma,
-    m) clears the levels whose plain cylinder it passes outside."""
+    m) clears the levels whose plain cylinder it passes outside; with the path's relative speed
+    squared and time to its closest approach it also raises those its path surely enters while the
+    track's height is inside (:func:`raw_alert_levels`)."""
     level = np.zeros(len(s), int)
     hold = np.zeros(len(s), int)
     t_in_out = np.full(len(s), np.nan)
@@ -348,8 +350,13 @@ def _volume_levels(s, v, tcpa, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2, m
         t_in, _ = loss_of_well_clear_interval(s, v, lv.volume, held_s, dthr, zthr)
         possible = np.ones(len(s), bool)
         if miss is not None and lv.volume.tthr_s == 0.0 and lv.volume.tcoa_s == 0.0:
-            miss_m, sigma_m = miss
-            possible = ~cannot_enter(miss_m, sigma_m, lv.volume.dthr_m, lv.volume.zthr_m)
+            possible = ~cannot_enter(miss[0], miss[1], lv.volume.dthr_m, lv.volume.zthr_m)
+            if len(miss) == 4:
+                sure_s = surely_inside_s(*miss, lv.volume.dthr_m)
+                with np.errstate(invalid="ignore"):
+                    height_in = np.abs(s[:, 2] + v[:, 2] * sure_s) < zthr  # False where NaN
+                sure_s = np.where(height_in, sure_s, np.nan)
+                t_in = np.fmin(t_in, np.where(sure_s <= held_s, sure_s, np.nan))
         hit = possible & (t_in <= lv.alerting_time_s)
         level = np.where(hit, k, level)
         hold = np.where(possible & np.isfinite(t_in), k, hold)
@@ -374,10 +381,16 @@ def raw_alert_levels(
     config : AlertConfig, optional
     cov_pos_m2, cov_vel_m2ps2 : ndarray, shape (n, 3, 3), optional
         Relative position / velocity covariance; widens the volumes.
-    miss : (ndarray, ndarray), optional
+    miss : tuple of ndarray, optional
         3-D miss distance and its sigma per row, m (:func:`skyradar.daa.range_miss.range_miss_distance`,
         NaN: unknown): a level whose volume (a cylinder without tau) the miss passes outside by 3
-        sigmas is not raised, whatever ``s`` and ``v`` predict.
+        sigmas is not raised, whatever ``s`` and ``v`` predict. With two more arrays, the path's
+        relative speed squared (m^2/s^2) and time to its 3-D closest approach from the row (s),
+        as :func:`skyradar.daa.range_miss.range_only_fit` gives them: a level is also lost where
+        the path, its miss 3 sigmas high, is inside the cylinder's radius within the lookahead
+        (:func:`skyradar.daa.range_miss.surely_inside_s`, a bound on the horizontal distance
+        whatever ``v`` predicts) and the height ``s`` and ``v`` predict then is inside the
+        cylinder's (widened) half-height.
 
     Returns
     -------

@@ -303,8 +303,9 @@ def _merged_levels(
     located: np.ndarray,
 ) -> dict[str, np.ndarray]:
     """Raw levels and geometry of every row: the 3-D geometry on rows with a position
-    (:func:`~skyradar.daa.alerting.raw_alert_levels`, the range fit's miss clearing levels of rows
-    whose height is the co-altitude prior), the range-only one on the others
+    (:func:`~skyradar.daa.alerting.raw_alert_levels`; on rows whose height is the co-altitude
+    prior the range fit's path clears the levels it passes outside of and raises those it surely
+    enters, whatever the track's velocity predicts), the range-only one on the others
     (:func:`~skyradar.daa.range_only.range_only_levels`)."""
     n = len(t)
     raw: dict[str, np.ndarray] = {
@@ -317,7 +318,7 @@ def _merged_levels(
     raw["known"] = located.copy()
     if located.any():
         cp, cv = (None if c is None else c[located] for c in (cov_p, cov_v))
-        miss = (fit[0, located], fit[1, located])
+        miss = (fit[0, located], fit[1, located], fit[2, located], fit[3, located] - t[located])
         for name, values in raw_alert_levels(s[located], v[located], config, cp, cv, miss).items():
             raw[name][located] = values
     if (~located).any():

@@ -383,8 +383,8 @@ def test_a_range_path_inside_the_volume_raises_a_co_altitude_track_its_velocity_
         tracks = _converged(tracks).assign(**drifted, altitude_measured=measured)
         out = alerts_from_tracks(tracks, own, cfg, with_advice=False)
         assert (out["hmd_m"] > 800.0).all()  # the velocity alone clears every row
-        warned = out["raw_level"].to_numpy() == 3
-        entering[name] = round(float(out["time_s"].to_numpy()[np.argmax(warned)]), 1) if warned.any() else None
+        warned = out["time_s"].to_numpy()[out["raw_level"].to_numpy() == 3]
+        entering[name] = round(float(warned[0]), 1) if warned.size else None
     # Own-ship and intruder close at 115 m/s from 2.8 km: the path is within 670 m of the own-ship
     # from 24.3 - 5.0 = 19.3 s with its miss 3 sigmas high, inside the 25 s alerting time as soon
     # as the fit spans its 4 s.

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+import scipy.stats
 
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG
 from skyradar.daa.pipeline import AlertStream, alerts_from_tracks
@@ -92,8 +93,10 @@ def range_miss_baseline(
     own_accel_tol_mps: float = 1.0,
 ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`skyradar.daa.range_miss.range_miss_distance` the straightforward way: per row, select
-    the track's window and fit ``r rdot`` against time with :func:`numpy.polyfit` (the miss from
-    the fitted slope: :func:`skyradar.daa.range_miss.miss_of_window`, as ours).
+    the track's window, set aside its rows off a Theil-Sen line as ours does
+    (:func:`skyradar.daa.range_miss.line_fit`), and fit the others' ``r rdot`` against time with
+    :func:`scipy.stats.linregress` (the miss from the fitted slope and its standard error:
+    :func:`skyradar.daa.range_miss.miss_of_window`, as ours).
 
     Examples
     --------
@@ -118,11 +121,29 @@ def range_miss_baseline(
                 continue
             if np.abs(own_v[w] - own_v[j]).max() > own_accel_tol_mps or not np.isfinite(y[w]).all():
                 continue
-            u2 = np.polyfit(t[w] - t[w].mean(), y[w], 1)[0]
-            if not u2 > 0.0:
+            kept = _off_line_rows_dropped(t[w], y[w])
+            if kept.sum() < 3:
                 continue
-            miss[j], sigma[j] = miss_of_window(r[w], y[w], u2)
+            fit = scipy.stats.linregress(t[w][kept], y[w][kept])
+            if not fit.slope > 0.0:
+                continue
+            miss[j], sigma[j] = miss_of_window(r[w][kept], y[w][kept], fit.slope, fit.stderr)
     return miss, sigma
+
+
+def _off_line_rows_dropped(t: np.ndarray, y: np.ndarray, k: float = 3.5) -> np.ndarray:
+    """Which rows lie within ``k`` spreads of the Theil-Sen line between the window's halves (numpy)."""
+    half = t.size // 2
+    stride = max(half // 16, 1)
+    first, second = np.arange(0, half, stride), np.arange(half, t.size, stride)
+    dt = t[None, second] - t[first, None]
+    slopes = (y[None, second] - y[first, None])[dt > 0] / dt[dt > 0]
+    if slopes.size == 0:
+        return np.zeros(t.size, bool)
+    residual = y - np.median(slopes) * t
+    residual -= np.median(residual)
+    spread = 1.4826 * np.median(np.abs(residual))
+    return np.abs(residual) <= k * spread + 1e-9 * (np.abs(y).max() + 1.0)
 
 
 def _frames(tracks: pd.DataFrame, own: pd.DataFrame, n_frames: int):

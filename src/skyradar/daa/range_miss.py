@@ -41,7 +41,7 @@ cylinder's corner (:mod:`skyradar.daa.range_only`, from :func:`range_only_fit`).
 The fit is per track over a sliding window; it refuses (NaN) where it has too few rows, where the
 own-ship's velocity changed in the window (a turn bends the relative path), or where the rows do
 not agree on one miss distance (a manoeuvring intruder, a range-rate alias): the spread of the
-per-row miss distances is the fit's uncertainty.
+per-row miss distances and the fitted slope's error are the fit's uncertainty (:func:`miss_of_window`).
 """
 
 from __future__ import annotations
@@ -56,6 +56,7 @@ __all__ = [
     "miss_of_window",
     "cannot_enter",
     "surely_inside_s",
+    "line_fit",
 ]
 
 RANGE_FIT_WINDOW_S = 10.0  # the trailing window of a row's range fit, s
@@ -90,8 +91,9 @@ def range_miss_distance(
     Returns
     -------
     miss_m, sigma_m : ndarray, shape (n,)
-        Miss distance, m, and its standard deviation (spread of the rows' values), m; NaN where
-        the fit refuses or the rows' squared misses centre on zero or below.
+        Miss distance, m, and its standard deviation (the rows' spread and the slope's error,
+        :func:`miss_of_window`), m; NaN where the fit refuses or the rows' squared misses centre
+        on zero or below.
 
     Examples
     --------
@@ -200,37 +202,106 @@ def _fit_track(t, r, y, own_v, window_s, min_span_s, min_rows, own_tol):  # prag
         tw, yw = t[i0 : j + 1], y[i0 : j + 1]
         if np.abs(own_v[i0 : j + 1] - own_v[j]).max() > own_tol or not np.isfinite(yw).all():
             continue  # the own-ship's velocity changed (a turn), or a row has no range rate
-        tc = tw - tw.mean()
-        u2 = (tc * (yw - yw.mean())).sum() / (tc * tc).sum()
+        u2, u2_sigma, t_mean, y_mean, inlier = line_fit(tw, yw)
         if not u2 > 0.0:
             continue
-        m, s = miss_of_window(r[i0 : j + 1], yw, u2)
+        rw, yw = r[i0 : j + 1][inlier], yw[inlier]
+        m, s = miss_of_window(rw, yw, u2, u2_sigma)
         if m != m:  # NaN: the rows' squared misses centre on zero or below, a collision course
-            m2 = r[i0 : j + 1] ** 2 - yw**2 / u2
-            m, s = 0.0, np.sqrt(1.4826 * np.median(np.abs(m2 - np.median(m2))))
+            m2 = rw**2 - yw**2 / u2
+            spread_m2 = 1.4826 * np.median(np.abs(m2 - np.median(m2)))
+            m, s = 0.0, np.sqrt(np.hypot(spread_m2, np.median(yw**2) / u2**2 * u2_sigma))
         out[0, j], out[1, j], out[2, j] = m, s, u2
-        out[3, j] = tw.mean() - yw.mean() / u2
+        out[3, j] = t_mean - y_mean / u2
     return out
 
 
 @numba.njit(cache=True)
-def miss_of_window(r: np.ndarray, y: np.ndarray, u2: float) -> tuple[float, float]:  # pragma: no cover
+def line_fit(t: np.ndarray, y: np.ndarray, k: float = 3.5) -> tuple:  # pragma: no cover - numba
+    """The straight line ``y = y_mean + slope (t - t_mean)`` through a window's rows, robust to rows
+    off it: a range rate of the ground's taken into a track's window (a clutter hit) puts its
+    ``r rdot`` far off the line, and a least-squares slope follows it.
+
+    The first line is Theil-Sen's (the median of the slopes between the rows of the window's first
+    half and those of its second, every ``half // 16``-th of each, and the median intercept),
+    which a quarter of the rows off the line does not move far. The rows more than ``k`` spreads
+    (1.4826 median absolute deviation of the residuals) off it are set aside, and the kept rows
+    are fitted by least squares, whose slope's standard error they give. Returns the slope, its
+    standard error, ``t_mean`` and ``y_mean`` of the kept rows and which rows are kept (NaN slope
+    where fewer than 3 are).
+
+    Examples
+    --------
+    >>> t = np.arange(20.0)
+    >>> y = 3.0 * t - 5.0
+    >>> y[[4, 9, 15]] = 500.0  # three rows off the line
+    >>> slope, sd, t_mean, y_mean, kept = line_fit(t, y)
+    >>> round(float(slope), 6), round(float(sd), 6), int(kept.sum())
+    (3.0, 0.0, 17)
+    """
+    n = t.size
+    half = n // 2
+    keep = np.zeros(n, np.bool_)
+    if half < 2:
+        return np.nan, np.nan, np.nan, np.nan, keep
+    stride = max(half // 16, 1)  # at most about 16 x 16 pairs: the median needs no more
+    slopes = np.empty(half * (n - half))
+    m = 0
+    for i in range(0, half, stride):
+        for j in range(half, n, stride):
+            if t[j] > t[i]:
+                slopes[m] = (y[j] - y[i]) / (t[j] - t[i])
+                m += 1
+    if m == 0:
+        return np.nan, np.nan, np.nan, np.nan, keep
+    slope = np.median(slopes[:m])
+    residual = y - slope * t
+    residual -= np.median(residual)
+    spread = 1.4826 * np.median(np.abs(residual))
+    keep = np.abs(residual) <= k * spread + 1e-9 * (np.abs(y).max() + 1.0)
+    tk, yk = t[keep], y[keep]
+    if tk.size < 3:
+        return np.nan, np.nan, np.nan, np.nan, keep
+    t_mean, y_mean = tk.mean(), yk.mean()
+    tc = tk - t_mean
+    slope = (tc * (yk - y_mean)).sum() / (tc * tc).sum()
+    fit_residual = yk - y_mean - slope * tc
+    sd = np.sqrt((fit_residual * fit_residual).sum() / (tk.size - 2) / (tc * tc).sum())
+    return slope, sd, t_mean, y_mean, keep
+
+
+@numba.njit(cache=True)
+def miss_of_window(
+    r: np.ndarray, y: np.ndarray, u2: float, u2_sigma: float = 0.0
+) -> tuple[float, float]:  # pragma: no cover
     """Miss distance and its sigma, m, from one window's ranges ``r`` (m), ``y = r rdot`` (m^2/s)
-    and the relative speed squared ``u2`` (m^2/s^2) fitted to them: the median of the rows'
-    ``r^2 - y^2 / u2`` and its spread (1.4826 median absolute deviation); NaN where it is not positive.
+    and the relative speed squared ``u2`` (m^2/s^2) fitted to them, with that slope's standard
+    error ``u2_sigma`` (m^2/s^2); NaN where the miss squared is not positive.
+
+    The miss is the square root of the median of the rows' ``r^2 - y^2 / u2``. Its sigma has two
+    parts: the rows' spread (1.4826 median absolute deviation), and the slope's error, which moves
+    every row's ``r^2 - y^2 / u2`` the same way, by ``y^2 / u2^2`` per unit of ``u2``, so no spread
+    shows it. A window whose ``r rdot`` carries a few clutter hits (a range rate of the ground at the
+    target's range) can fit a slope far off with rows that still agree on a miss: the slope's
+    error then says so. The second part is taken on the miss squared and converted with
+    ``sqrt(m^2 + e) - m``, which stays finite near a collision course.
 
     Examples
     --------
     >>> r = np.array([500.0, 1000.0])
     >>> [round(float(x), 3) for x in miss_of_window(r, -60.0 * np.sqrt(r**2 - 400.0**2), 3600.0)]
     [400.0, 0.0]
+    >>> [round(float(x), 1) for x in miss_of_window(r, -60.0 * np.sqrt(r**2 - 400.0**2), 3600.0, 36.0)]
+    [400.0, 5.8]
     """
     m2 = r**2 - y**2 / u2
     centre = np.median(m2)
     if not centre > 0.0:
         return np.nan, np.nan
     miss = np.sqrt(centre)
-    return miss, 1.4826 * np.median(np.abs(m2 - centre)) / (2.0 * miss)
+    spread = 1.4826 * np.median(np.abs(m2 - centre)) / (2.0 * miss)
+    slope = np.sqrt(centre + np.median(y**2) / u2**2 * u2_sigma) - miss
+    return miss, np.hypot(spread, slope)
 
 
 def cannot_enter(

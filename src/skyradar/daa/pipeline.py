@@ -239,26 +239,33 @@ def _altitude_measured(df: pd.DataFrame) -> np.ndarray:
     return df["altitude_measured"].to_numpy(bool)  # checked by clean_tracks
 
 
-def _range_fit(df: pd.DataFrame, t: np.ndarray, own_vel: np.ndarray, predicted: np.ndarray) -> np.ndarray:
+def _range_fit(
+    df: pd.DataFrame, t: np.ndarray, own_vel: np.ndarray, predicted: np.ndarray, wanted: np.ndarray
+) -> np.ndarray:
     """The range-only path (:func:`~skyradar.daa.range_miss.range_only_fit`: miss, sigma, relative
-    speed squared, time of closest approach; shape (4, n)) of every measured row, over its track's
-    measured rows. A lost track's prediction has no range measured: it carries the path of its
-    track's last measured row, which straight motion keeps (the four are constants of it)."""
+    speed squared, time of closest approach; shape (4, n)) of every ``wanted`` measured row, over
+    its track's measured rows. A lost track's prediction has no range measured: it carries the path
+    of its track's last measured row, which straight motion keeps (the four are constants of it)."""
     fit = np.full((4, len(df)), np.nan)
     if not set(RANGE_COLUMNS) <= set(df):
         return fit
     ids = df["track_id"].to_numpy()
-    rows = ~predicted
-    r, rdot = (df[c].to_numpy(float)[rows] for c in RANGE_COLUMNS)
-    fit[:, rows] = range_only_fit(ids[rows], t[rows], r, rdot, own_vel[rows])
-    if predicted.any():
+    need = wanted & ~predicted
+    src = np.array([], float)
+    if (predicted & wanted).any():
         # Rows are in time order: each prediction takes the last measured row of its track.
         source = pd.Series(np.where(predicted, np.nan, np.arange(len(df)))).groupby(ids).ffill()
-        src = source.to_numpy()[predicted]
+        src = source.to_numpy()[predicted & wanted]
+        need[src[np.isfinite(src)].astype(int)] = True
+    rows = ~predicted
+    r, rdot = (df[c].to_numpy(float)[rows] for c in RANGE_COLUMNS)
+    fit[:, rows] = range_only_fit(ids[rows], t[rows], r, rdot, own_vel[rows], wanted=need[rows])
+    if src.size:
         values = np.full((4, src.size), np.nan)
         ok = np.isfinite(src)
         values[:, ok] = fit[:, src[ok].astype(int)]
-        fit[:, predicted] = values
+        fit[:, predicted & wanted] = values
+    fit[:, ~wanted] = np.nan
     return fit
 
 
@@ -269,25 +276,28 @@ def _whole_track_range_miss(
     ranges: pd.DataFrame | None,
     ownship: pd.DataFrame,
     source: str,
+    wanted: np.ndarray,
 ) -> np.ndarray:
-    """Miss distance and sigma (m, shape (2, n)) of each measured row's range path fitted over every
-    row of its track up to it, confirmed or not (``ranges``: :func:`~skyradar.daa.tables.range_history`);
-    NaN on predictions and where the fit refuses."""
+    """Miss distance and sigma (m, shape (2, n)) of each ``wanted`` measured row's range path fitted
+    over every row of its track up to it, confirmed or not (``ranges``:
+    :func:`~skyradar.daa.tables.range_history`); NaN on predictions and where the fit refuses."""
     out = np.full((2, len(df)), np.nan)
     if ranges is None or len(ranges) == 0 or len(df) == 0:
         return out
     ids = df["track_id"].to_numpy()
-    mine = ranges[ranges["track_id"].isin(np.unique(ids[~predicted]))]
+    mine = ranges[ranges["track_id"].isin(np.unique(ids[~predicted & wanted]))]
     mine = mine.drop_duplicates(["track_id", "time_s"], keep="last")  # a track has one state a time
     if len(mine) == 0:
         return out
     rt = mine["time_s"].to_numpy(float)
-    own_v = interp_ownship(ownship, rt, source).velocity_ned_mps
-    r, rdot = (mine[c].to_numpy(float) for c in RANGE_COLUMNS)
-    miss, sigma, _, _ = range_only_fit(mine["track_id"].to_numpy(), rt, r, rdot, own_v)
     index = pd.MultiIndex.from_arrays([mine["track_id"].to_numpy(), rt])
     at = index.get_indexer(pd.MultiIndex.from_arrays([ids, t]))
-    found = (at >= 0) & ~predicted
+    found = (at >= 0) & ~predicted & wanted
+    need = np.zeros(len(mine), bool)
+    need[at[found]] = True
+    own_v = interp_ownship(ownship, rt, source).velocity_ned_mps
+    r, rdot = (mine[c].to_numpy(float) for c in RANGE_COLUMNS)
+    miss, sigma, _, _ = range_only_fit(mine["track_id"].to_numpy(), rt, r, rdot, own_v, wanted=need)
     out[0, found], out[1, found] = miss[at[found]], sigma[at[found]]
     return out
 
@@ -407,10 +417,12 @@ def _alert_rows(
     source: str,
     cleaned: bool = False,
     ranges: pd.DataFrame | None = None,
+    at_time_s: float | None = None,
 ) -> _AlertRows:
     """The state, geometry and raw levels of every row (:func:`alerts_from_tracks` up to its filter).
     ``cleaned``: ``tracks`` are :func:`~skyradar.daa.tables.clean_tracks`' rows already, and
-    ``ranges`` every track's :func:`~skyradar.daa.tables.range_history` (else read from ``tracks``)."""
+    ``ranges`` every track's :func:`~skyradar.daa.tables.range_history` (else read from ``tracks``).
+    ``at_time_s``: only the rows at that time (s) are returned, the earlier ones feeding their fits."""
     df = tracks.reset_index(drop=True) if cleaned else clean_tracks(tracks, source)
     if not cleaned and ranges is None:
         ranges = range_history(tracks, source)  # after clean_tracks named any missing column
@@ -419,13 +431,20 @@ def _alert_rows(
     df = lost_track_rows(df, ownship["time_s"].to_numpy(float), config.lost_track_hold_s)
     predicted = df["extrapolated"].to_numpy(bool)
     t = df["time_s"].to_numpy(float)
+    wanted = np.ones(len(df), bool) if at_time_s is None else t == at_time_s
+    path = _range_fit(df, t, interp_ownship(ownship, t, source).velocity_ned_mps, predicted, wanted)
+    track_miss = _whole_track_range_miss(df, t, predicted, ranges, ownship, source, wanted)
+    if at_time_s is not None:
+        attrs = dict(df.attrs)
+        df, t, predicted = df[wanted].reset_index(drop=True), t[wanted], predicted[wanted]
+        df.attrs = attrs
+        path, track_miss = path[:, wanted], track_miss[:, wanted]
     own = interp_ownship(ownship, t, source)
     own_pos, own_vel = own.position_ned_m, own.velocity_ned_mps
     v_int = df[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(float)
     s, v = df[["north_m", "east_m", "down_m"]].to_numpy(float) - own_pos, v_int - own_vel
     located = np.isfinite(s).all(axis=1) & np.isfinite(v).all(axis=1)  # else a range-only row
     cov_p, cov_v = covariances(df)
-    path = _range_fit(df, t, own_vel, predicted)
     # The range path judges the levels of rows whose height is the co-altitude prior or that have
     # no position (a measured height is the 3-D track's to judge), and a 3-D prediction carries none.
     judged = (~_altitude_measured(df) | ~located) & ~(predicted & located)
@@ -433,7 +452,6 @@ def _alert_rows(
     raw = _merged_levels(s, v, t, config, cov_p, cov_v, fit, located)
     raw["level"][predicted] = 0  # a prediction holds a track's level, never raises it
     raw["flarm_level"][predicted] = 0
-    track_miss = _whole_track_range_miss(df, t, predicted, ranges, ownship, source)
     _gate_unconverged(raw, cov_v, config, located, path[:2], track_miss)
     required_age = _required_age(s, v, config, located)
     level = np.zeros(len(df), int)
@@ -577,8 +595,9 @@ class AlertStream:
         alive_since = time_s - self.config.lost_track_hold_s - 1e-9
         alive = [i for i, t in self._last_confirmed_s.items() if t >= alive_since]
         history = self._tracks[self._tracks["track_id"].isin(alive)]
-        rows = _alert_rows(history, own, self.config, self.source, cleaned=True, ranges=self._ranges)
-        rows = rows.select(rows.t == time_s)
+        rows = _alert_rows(
+            history, own, self.config, self.source, cleaned=True, ranges=self._ranges, at_time_s=time_s
+        )
         self._issue(rows)
         out = _alerts_out(rows, self.config, self.with_advice)
         # The frame's own count: its confirmed rows without a state (the history's are counted on theirs).

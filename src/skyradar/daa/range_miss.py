@@ -130,6 +130,7 @@ def range_only_fit(
     min_span_s: float = 4.0,
     min_rows: int = 20,
     own_accel_tol_mps: float = 1.0,
+    wanted: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The straight relative path each row's window of range and range rate fits: its 3-D miss
     distance and uncertainty (:func:`range_miss_distance`), relative speed squared and time of the
@@ -138,7 +139,9 @@ def range_only_fit(
     The fitted line ``r rdot = |u|^2 (t - t_c)`` gives ``|u|^2`` (its slope) and ``t_c`` (its zero);
     with the miss ``m`` the range follows at any time, ``r(t)^2 = m^2 + |u|^2 (t - t_c)^2``. All
     four are constants of straight relative motion, so a row's values also describe the path after
-    it. Parameters as :func:`range_miss_distance`.
+    it. Parameters as :func:`range_miss_distance`; ``wanted`` (bool per row, default all): the rows
+    whose window is fitted, the others only feed those windows and are NaN (a stream fits the rows
+    of its latest frame).
 
     Returns
     -------
@@ -170,14 +173,18 @@ def range_only_fit(
     t = np.asarray(time_s, float)
     r, rdot = np.asarray(range_m, float), np.asarray(range_rate_mps, float)
     own_v = np.asarray(own_velocity_mps, float).reshape(n, 3)
+    want = np.ones(n, bool) if wanted is None else np.asarray(wanted, bool).reshape(n)
     order = np.argsort(ids, kind="stable")
     bounds = np.flatnonzero(np.diff(ids[order])) + 1
     for rows in np.split(order, bounds):
+        if not want[rows].any():
+            continue
         out[:, rows] = _fit_track(
             t[rows],
             r[rows],
             r[rows] * rdot[rows],
             own_v[rows],
+            want[rows],
             window_s,
             min_span_s,
             min_rows,
@@ -187,15 +194,18 @@ def range_only_fit(
 
 
 @numba.njit(cache=True)
-def _fit_track(t, r, y, own_v, window_s, min_span_s, min_rows, own_tol):  # pragma: no cover - numba
+def _fit_track(t, r, y, own_v, want, window_s, min_span_s, min_rows, own_tol):  # pragma: no cover
     # y = r * rdot, a straight line in time of slope |u|^2 and zero at the closest approach
-    # (module docstring). Rows: miss, sigma, |u|^2, time of the closest approach.
+    # (module docstring). Rows: miss, sigma, |u|^2, time of the closest approach; only the
+    # ``want`` rows are fitted.
     n = t.size
     out = np.full((4, n), np.nan)
     i0 = 0
     for j in range(n):
         while t[i0] <= t[j] - window_s:
             i0 += 1
+        if not want[j]:
+            continue
         k = j + 1 - i0
         if k < min_rows or t[j] - t[i0] < min_span_s:
             continue

@@ -352,7 +352,7 @@ def _volume_levels(s, v, tcpa, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2, m
         if miss is not None and lv.volume.tthr_s == 0.0 and lv.volume.tcoa_s == 0.0:
             possible = ~cannot_enter(miss[0], miss[1], lv.volume.dthr_m, lv.volume.zthr_m)
             if len(miss) == 4:
-                sure_s = surely_inside_s(*miss, lv.volume.dthr_m)
+                sure_s = surely_inside_s(miss[0], miss[1], miss[2], miss[3], lv.volume.dthr_m)
                 with np.errstate(invalid="ignore"):
                     height_in = np.abs(s[:, 2] + v[:, 2] * sure_s) < zthr  # False where NaN
                 sure_s = np.where(height_in, sure_s, np.nan)
@@ -370,7 +370,7 @@ def raw_alert_levels(
     config: AlertConfig | None = None,
     cov_pos_m2: np.ndarray | None = None,
     cov_vel_m2ps2: np.ndarray | None = None,
-    miss: tuple[np.ndarray, np.ndarray] | None = None,
+    miss: tuple[np.ndarray, ...] | None = None,
 ) -> dict[str, np.ndarray]:
     """Per-encounter raw alert level and conflict geometry (no persistence).
 

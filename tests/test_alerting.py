@@ -396,6 +396,23 @@ def test_a_range_path_inside_the_volume_raises_a_co_altitude_track_its_velocity_
     }
 
 
+def test_a_range_path_holds_a_warning_whose_track_height_the_ground_pulled_down():
+    # A closure 79 m below passing 343 m aside, over hills: inside the ground's band its elevations
+    # are mixtures pulled towards the ground that agree on 300 m below, so the track predicts a
+    # vertical miss of 300 m and no loss of well clear. Its range and range rate measure a 3-D miss
+    # of 352 m, which leaves sqrt(352^2 - 340^2) = 91 m of vertical miss beside the predicted
+    # horizontal 340 m: the issued warning holds. It is not raised on that (a predicted horizontal
+    # miss that is off leaves a vertical that is off too), and a path whose 3-D miss agrees with
+    # the track's (450 m) holds nothing.
+    s = np.array([[1500.0, 340.0, 300.0]])  # NED: 1.5 km ahead, 340 m right, 300 m below
+    v = np.array([[-110.0, 0.0, 0.0]])
+    speed2, tcpa = np.array([110.0**2]), np.array([1500.0 / 110.0])
+    for miss_m, held in ((352.0, 3), (450.0, 0)):
+        path = (np.array([miss_m]), np.array([3.0]), speed2, tcpa)
+        out = raw_alert_levels(s, v, AlertConfig(), miss=path)
+        assert (int(out["level"][0]), int(out["hold_level"][0])) == (0, held), miss_m
+
+
 def test_a_tracks_table_with_repeated_rows_is_alerted_as_without_them():
     # A table that lists some of a track's rows twice (concatenated exports) describes the same
     # track: its alerts are those of the table without the repeats.

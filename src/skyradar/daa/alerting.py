@@ -330,13 +330,14 @@ def alerting_rows(times_s: np.ndarray, required_age_s: np.ndarray) -> np.ndarray
     return np.cumsum(ready) > 0
 
 
-def _volume_levels(s, v, tcpa, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2, miss=None):
+def _volume_levels(s, v, tcpa, hmd, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2, miss=None):
     """Highest level whose (widened) volume is lost within its alerting time, its entry time,
     the widened thresholds ``{level: (dthr_m, zthr_m)}`` of every level, and the highest level
     lost within its hold time (:meth:`AlertLevel.hold_time_s`). ``miss`` (miss distance and sigma,
     m) clears the levels whose plain cylinder it passes outside; with the path's relative speed
     squared and time to its closest approach it also raises those its path surely enters while the
-    track's height is inside (:func:`raw_alert_levels`)."""
+    track's height is inside, and holds them while the vertical miss the path leaves beside the
+    track's horizontal miss ``hmd`` (m) is inside (:func:`raw_alert_levels`)."""
     level = np.zeros(len(s), int)
     hold = np.zeros(len(s), int)
     t_in_out = np.full(len(s), np.nan)
@@ -349,17 +350,20 @@ def _volume_levels(s, v, tcpa, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2, m
         held_s = lv.hold_time_s(config.hold_time_factor)
         t_in, _ = loss_of_well_clear_interval(s, v, lv.volume, held_s, dthr, zthr)
         possible = np.ones(len(s), bool)
+        path_holds = np.zeros(len(s), bool)
         if miss is not None and lv.volume.tthr_s == 0.0 and lv.volume.tcoa_s == 0.0:
             possible = ~cannot_enter(miss[0], miss[1], lv.volume.dthr_m, lv.volume.zthr_m)
             if len(miss) == 4:
                 sure_s = surely_inside_s(miss[0], miss[1], miss[2], miss[3], lv.volume.dthr_m)
+                sure_s = np.where(sure_s <= held_s, sure_s, np.nan)
                 with np.errstate(invalid="ignore"):
                     height_in = np.abs(s[:, 2] + v[:, 2] * sure_s) < zthr  # False where NaN
-                sure_s = np.where(height_in, sure_s, np.nan)
-                t_in = np.fmin(t_in, np.where(sure_s <= held_s, sure_s, np.nan))
+                    left_vertical_m = np.sqrt(np.maximum(miss[0] ** 2 - hmd**2, 0.0))
+                t_in = np.fmin(t_in, np.where(height_in, sure_s, np.nan))
+                path_holds = np.isfinite(sure_s) & (left_vertical_m < zthr)
         hit = possible & (t_in <= lv.alerting_time_s)
         level = np.where(hit, k, level)
-        hold = np.where(possible & np.isfinite(t_in), k, hold)
+        hold = np.where(possible & (np.isfinite(t_in) | path_holds), k, hold)
         t_in_out = np.where(hit, t_in, t_in_out)
     return level, t_in_out, widened, hold
 
@@ -390,7 +394,13 @@ def raw_alert_levels(
         the path, its miss 3 sigmas high, is inside the cylinder's radius within the lookahead
         (:func:`skyradar.daa.range_miss.surely_inside_s`, a bound on the horizontal distance
         whatever ``v`` predicts) and the height ``s`` and ``v`` predict then is inside the
-        cylinder's (widened) half-height.
+        cylinder's (widened) half-height. An issued level is also held while the path surely
+        enters within the hold time and the vertical miss it leaves beside the predicted
+        horizontal one, ``sqrt(miss^2 - hmd^2)``, is inside the half-height: range and range rate
+        are measured to a pixel where the ground's band pulls a track's elevations towards the
+        ground, so a height that makes the predicted 3-D miss larger than the measured one is
+        the estimate to doubt. It holds and never raises: where the predicted horizontal miss
+        is itself off, the vertical it leaves is too.
 
     Returns
     -------
@@ -411,7 +421,7 @@ def raw_alert_levels(
     s = np.atleast_2d(np.asarray(s, float))
     v = np.atleast_2d(np.asarray(v, float))
     tcpa, hmd, vmd = cpa(s, v)
-    level, t_in_out, widened, hold = _volume_levels(s, v, tcpa, config, cov_pos_m2, cov_vel_m2ps2, miss)
+    level, t_in_out, widened, hold = _volume_levels(s, v, tcpa, hmd, config, cov_pos_m2, cov_vel_m2ps2, miss)
     t_imp, _ = loss_of_well_clear_interval(s, v, config.collision_volume, config.flarm_thresholds_s[0])
     corrective = widened[min(2, len(config.levels))]
     return {

@@ -105,20 +105,20 @@ def _detect(built, heads, keep_frames, block_frames, timings, options) -> tuple[
     for start in range(0, n, block_frames):
         rows = np.arange(start, min(start + block_frames, n))
         for name, simulator in simulators.items():
-            t0 = time.perf_counter()
+            t0 = time.process_time()
             iq = simulate_frames(built, rows, simulator)
-            timings["simulate"] += time.perf_counter() - t0
+            timings["simulate"] += time.process_time() - t0
             for f in set(keep_frames).intersection(rows.tolist()) if name == heads[0].name else ():
                 rd[f] = iq[f - start].copy()  # the first head's range-Doppler cube
             truth = truths[name]
             ds = truth.isel(time=slice(start, start + rows.size)).assign(iq=(truth["iq"].dims, iq))
-            t0 = time.perf_counter()
+            t0 = time.process_time()
             run_anchors = anchors[name]
             block = None if run_anchors is None else run_anchors[start : start + rows.size]
             det = process_frames(ds, terrain=built.terrain, source=built.name, anchors=block, **options)
             det["frame"] += start
             detections[name].append(det)
-            timings["process"] += time.perf_counter() - t0
+            timings["process"] += time.process_time() - t0
     merged = merge_head_tables({name: pd.concat(d, ignore_index=True) for name, d in detections.items()})
     return merged, {name: t.drop_vars("iq") for name, t in truths.items()}, rd
 
@@ -157,7 +157,9 @@ def run_chain(
         ``truth`` (the first head's frames Dataset without ``iq``), ``truth_by_head`` ({head:
         Dataset}: intruder angles, SNR and visibility as each head sees them), ``detections`` (with
         the ``radar`` column), ``tracks``, ``alerts``, ``ownship`` (tables), ``rd_frames`` ({frame:
-        (n_range, n_doppler, n_rx) complex64} of the first head) and ``timings_s`` per stage.
+        (n_range, n_doppler, n_rx) complex64} of the first head) and ``timings_s``: the CPU
+        seconds of each stage (:func:`time.process_time`, which other jobs sharing the machine do
+        not inflate).
     """
     chosen = select_heads(built.heads, heads, "run_chain")
     timings = {"simulate": 0.0, "process": 0.0}
@@ -191,7 +193,7 @@ def track_and_alert(
     gives them (spurs out, ground-flagged rows only inside a confirmed track's gate, without their
     direction); ``detection_row`` of the tracks indexes the returned ``detections`` (the chosen
     heads' rows). Returns ``tracks``, ``alerts``, ``ownship``, ``detections`` and ``timings_s``
-    (track, alert).
+    (CPU seconds of track and alert, :func:`time.process_time`).
     """
     chosen = tracked_heads(built, heads, "track_and_alert")
     truth = truth if truth is not None else _truth_dataset(built, make_simulator(built)).drop_vars("iq")
@@ -200,7 +202,7 @@ def track_and_alert(
     if heads is not None and "radar" in detections.columns:
         mine = detections["radar"].isin([h.name for h in chosen]).to_numpy(bool)
     air, used = tracker_detections(detections[mine])
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     tracks = track_detections(
         air,
         "radar",
@@ -211,10 +213,10 @@ def track_and_alert(
         ground_test=GroundTrackTest(surface_down=scenario_surface(built, own)),
     )
     tracks = restore_detection_rows(tracks, used)  # detection_row indexes the chosen heads' rows
-    timings = {"track": time.perf_counter() - t0}
-    t0 = time.perf_counter()
+    timings = {"track": time.process_time() - t0}
+    t0 = time.process_time()
     alerts = alerts_from_tracks(tracks, own, alert_config, with_advice=with_advice, source=built.name)
-    timings["alert"] = time.perf_counter() - t0
+    timings["alert"] = time.process_time() - t0
     mine_table = detections[mine].reset_index(drop=True)
     out = {"tracks": tracks, "alerts": alerts, "ownship": own, "detections": mine_table}
     return out | {"timings_s": timings}

@@ -6,7 +6,7 @@ the whole chain of the encounter experiment
 (:func:`skyradar.experiments.encounter_chain.run_encounter`: simulate with the point-spread and
 speckle, process with clutter suppression, track, alert; single head) once over each terrain, in
 this process, and reports the process CPU seconds it took (every thread of the simulator's kernels
-counted) beside the wall time of each stage. The baseline is the cost a 200-encounter set can
+counted) and each stage's share of them. The baseline is the cost a 200-encounter set can
 afford: ``encounter_target_cpu_s`` (9 CPU-s per encounter runs a 200-encounter set in 15 minutes
 on 2 cores).
 
@@ -30,10 +30,11 @@ _STAGES = ("simulate", "process", "track", "alert")
 
 
 def run_encounter_bench(terrains: tuple[str, ...] = BENCH_TERRAINS, seed: int = 0) -> dict:
-    """CPU seconds of one encounter over each terrain, and each stage's wall seconds.
+    """CPU seconds of one encounter over each terrain, and each stage's CPU seconds.
 
     Keys per terrain ``T``: ``encounter_T_cpu_s``, ``encounter_T_wall_s``, ``encounter_T_frames``,
-    ``encounter_T_<stage>_s`` (stage wall time, s); then the largest CPU cost over the terrains and
+    ``encounter_T_<stage>_s`` (the stage's CPU time, s, :func:`skyradar.chain.run_chain`'s
+    ``timings_s``); then the largest CPU cost over the terrains and
     whether it meets :data:`TARGET_CPU_S`.
     """
     params = make_encounters(1, seed).iloc[0]

@@ -92,7 +92,7 @@ def lead_against_clear_sky(terrain: pd.DataFrame, clear: pd.DataFrame) -> dict[s
 
 
 def cost_ms_per_frame(res: pd.DataFrame) -> dict[str, float]:
-    """Mean wall time per frame of each stage, ms (simulate and process: every head of the run,
+    """Mean CPU time per frame of each stage, ms (simulate and process: every head of the run,
     counted once per encounter; track and alert: per layout, named ``track_<layout>``).
 
     Examples

@@ -7,7 +7,6 @@ import pandas as pd
 import pytest
 import xarray as xr
 
-from cli_helpers import assert_one_line_error, skyradar
 from skyradar.daa.pipeline import alert_summary, alerts_for_run, alerts_from_tracks
 from skyradar.daa.provenance import ownship_signature
 from skyradar.daa.run_tables import has_ownship, ownship_from_frames, truth_tracks
@@ -49,8 +48,3 @@ def test_a_run_without_ownship_state_has_no_ownship_table():
     assert not has_ownship(ds)
     with pytest.raises(InputError, match=r"^b\.zarr: no own-ship state .*own_vd_mps"):
         alerts_for_run(ds, run_name="b.zarr")
-
-
-def test_bench_chain_does_not_run_the_flight_benchmark(tmp_path):
-    result = skyradar("bench", "chain", "--flight-frames", "5", cwd=tmp_path)
-    assert_one_line_error(result, "--flight-frames 5", "skyradar bench flight --frames 5")

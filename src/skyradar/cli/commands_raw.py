@@ -67,7 +67,6 @@ def rd(
     windows' coherent gain. Written chunk by chunk; an interrupted run resumes. The recording is
     fully checked first: a bad recording leaves no output.
     """
-    from skyradar.errors import InputError
     from skyradar.process.rd_store import recording_to_frames
     from skyradar.process.windows import get_window
 
@@ -97,16 +96,6 @@ def rd(
     emit_result(result, as_json, "range-Doppler frames")
 
 
-def _no_flight_frames(value: int) -> int:
-    # `bench chain` used to run the flight benchmark too; one benchmark per command now.
-    if value:
-        raise InputError(
-            f"--flight-frames {value}: bench chain no longer runs the flight benchmark; "
-            f"use `skyradar bench flight --frames {value}`"
-        )
-    return value
-
-
 @bench_app.command("chain")
 def bench_chain(
     frames: Annotated[
@@ -117,10 +106,6 @@ def bench_chain(
     ] = 20,
     workers: Annotated[int, typer.Option("--workers", callback=WORKERS, help="FFT threads.")] = 2,
     as_json: JsonOption = False,
-    flight_frames: Annotated[
-        int,
-        typer.Option(hidden=True, callback=_no_flight_frames, help="Deprecated: see `bench flight`."),
-    ] = 0,
 ) -> None:
     """ADC cube -> range-Doppler cube throughput against a per-channel numpy.fft loop.
 

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from skyradar.daa.pipeline import alerts_from_tracks
-from skyradar.daa.range_miss import cannot_enter, range_miss_distance
+from skyradar.daa.range_miss import cannot_enter, range_miss_distance, range_only_fit
 
 T = np.arange(0.0, 12.0, 1 / 9.4)
 OWN_V = np.array([50.0, 0.0, 0.0])
@@ -75,6 +75,21 @@ def test_clutter_hits_in_the_window_widen_the_sigma_to_cover_the_miss():
             assert ok.sum() > 50 and sigma[-1] < 30.0 and abs(got[-1] - 233.0) < 60.0, (seed, share)
             z.extend(np.abs(got[ok] - 233.0) / sigma[ok])
     assert np.mean(np.array(z) < 3.0) > 0.99 and max(z) < 4.0
+
+
+def test_the_wanted_rows_get_the_whole_fit_and_the_others_feed_it():
+    # A stream fits only its latest frame's rows; their windows still hold the earlier rows.
+    u = np.array([-90.0, 0.0, 0.0])
+    rel = np.array([0.0, 300.0, 150.0]) + np.outer(T - 30.0, u)
+    r, rdot = _range_rows(rel, np.tile(u, (T.size, 1)))
+    rdot = rdot + np.random.default_rng(2).normal(0, 0.1, T.size)
+    ids = np.repeat([4, 9], T.size)
+    args = (ids, np.tile(T, 2), np.tile(r, 2), np.tile(rdot, 2), np.tile(OWN_V, (2 * T.size, 1)))
+    wanted = np.zeros(ids.size, bool)
+    wanted[[T.size - 1, 2 * T.size - 40]] = True
+    full, some = np.array(range_only_fit(*args)), np.array(range_only_fit(*args, wanted=wanted))
+    np.testing.assert_array_equal(some[:, wanted], full[:, wanted])
+    assert np.isfinite(some[:, wanted]).all() and np.isnan(some[:, ~wanted]).all()
 
 
 def test_an_own_ship_turn_or_a_short_track_refuses():

@@ -222,10 +222,10 @@ def test_real_server_survives_abrupt_disconnects(run):
     with serve_in_thread(create_app(run, speed=100.0)) as url:
         ws_url = url.replace("http", "ws") + "/ws"
         for _ in range(3):
-            ws = connect(ws_url, open_timeout=10)
-            json.loads(ws.recv(timeout=10))
-            json.loads(ws.recv(timeout=10))
-            ws.socket.close()  # drop the TCP connection without a close handshake
+            with connect(ws_url, open_timeout=10) as ws:
+                json.loads(ws.recv(timeout=10))
+                json.loads(ws.recv(timeout=10))
+                ws.socket.close()  # drop the TCP connection without a close handshake
         with connect(ws_url, open_timeout=10) as ws:
             assert json.loads(ws.recv(timeout=10))["type"] == "info"
             assert json.loads(ws.recv(timeout=10))["index"] == 0

@@ -126,7 +126,10 @@ def serve(
     # On loopback, refuse requests addressed to other names (DNS rebinding from a web page).
     asgi = LoopbackHostOnly(web_app) if local else web_app
     server = uvicorn.Server(uvicorn.Config(asgi, host=host, port=port, log_level="warning"))
-    server.run(sockets=[sock])
+    try:
+        server.run(sockets=[sock])
+    finally:
+        sock.close()  # uvicorn closes it on shutdown; not when it fails to start
 
 
 @bench_app.command("alert")

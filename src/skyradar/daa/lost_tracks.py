@@ -48,7 +48,9 @@ def _grown_covariances(rows: pd.DataFrame, dt: np.ndarray) -> dict[str, np.ndarr
     return {c: grown[k].reshape(-1, 9)[:, n] for k in names for n, c in enumerate(names[k])}
 
 
-def lost_track_rows(tracks: pd.DataFrame, frame_times_s: np.ndarray, hold_s: float) -> pd.DataFrame:
+def lost_track_rows(
+    tracks: pd.DataFrame, frame_times_s: np.ndarray, hold_s: float, only_at_s: float | None = None
+) -> pd.DataFrame:
     """The tracks table with a predicted row on every frame a track has no row, up to ``hold_s`` s after
     its last row (and never before its first).
 
@@ -62,6 +64,8 @@ def lost_track_rows(tracks: pd.DataFrame, frame_times_s: np.ndarray, hold_s: flo
         The frame times, s (the own-ship table's).
     hold_s : float
         Longest prediction, s (0: no rows added).
+    only_at_s : float, optional
+        Add predicted rows on the frame at this time only, s (a stream's latest frame).
 
     Returns
     -------
@@ -79,6 +83,8 @@ def lost_track_rows(tracks: pd.DataFrame, frame_times_s: np.ndarray, hold_s: flo
     for _, rows in tracks.groupby("track_id", sort=False):
         t = rows["time_s"].to_numpy(float)
         window = frames[(frames > t[0]) & (frames <= t[-1] + hold_s)]
+        if only_at_s is not None:
+            window = window[window == only_at_s]
         last = np.searchsorted(t, window, side="right") - 1  # the row at or before each frame
         after = np.minimum(last + 1, t.size - 1)
         nearest = np.minimum(window - t[last], np.abs(t[after] - window))

@@ -428,7 +428,7 @@ def _alert_rows(
         ranges = range_history(tracks, source)  # after clean_tracks named any missing column
     if cleaned:
         df.attrs["rows_skipped_no_state"] = 0
-    df = lost_track_rows(df, ownship["time_s"].to_numpy(float), config.lost_track_hold_s)
+    df = lost_track_rows(df, ownship["time_s"].to_numpy(float), config.lost_track_hold_s, at_time_s)
     predicted = df["extrapolated"].to_numpy(bool)
     t = df["time_s"].to_numpy(float)
     wanted = np.ones(len(df), bool) if at_time_s is None else t == at_time_s

@@ -431,7 +431,7 @@ def test_a_negative_range_is_one_error_through_the_cli(tmp_path):
     tracks.assign(range_m=-tracks["range_m"]).to_csv(tmp_path / "tracks.csv", index=False)
     own.to_csv(tmp_path / "own.csv", index=False)
     result = skyradar("alert", "tracks.csv", "--ownship", "own.csv", "-o", "alerts.parquet", cwd=tmp_path)
-    assert_one_line_error(result, "tracks.csv", "'range_m'", "row 0", "never negative")
+    assert_one_line_error(result, "tracks.csv", "'range_m'", "never negative")
     assert not (tmp_path / "alerts.parquet").exists()
 
 

@@ -133,7 +133,7 @@ def _range_columns(df: pd.DataFrame, source: str) -> dict[str, np.ndarray]:
         if negative.size:
             i = int(negative[0])
             value = cols["range_m"][i]
-            raise InputError(f"{source}: field 'range_m' is {value:.6g} m at row {i}: never negative")
+            raise InputError(f"{source}: field 'range_m' is {value:.6g} m at row {i}: a range is never negative")
     return cols
 
 

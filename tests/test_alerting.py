@@ -424,17 +424,6 @@ def test_a_tracks_table_with_repeated_rows_is_alerted_as_without_them():
     assert twice["level"].tolist() == once["level"].tolist()
 
 
-def test_a_negative_range_is_one_error_through_the_cli(tmp_path):
-    from cli_helpers import assert_one_line_error, skyradar
-
-    own, tracks = _crossing_ahead(320.0)
-    tracks.assign(range_m=-tracks["range_m"]).to_csv(tmp_path / "tracks.csv", index=False)
-    own.to_csv(tmp_path / "own.csv", index=False)
-    result = skyradar("alert", "tracks.csv", "--ownship", "own.csv", "-o", "alerts.parquet", cwd=tmp_path)
-    assert_one_line_error(result, "tracks.csv", "'range_m'", "never negative")
-    assert not (tmp_path / "alerts.parquet").exists()
-
-
 def test_a_tracks_table_without_times_is_one_error_naming_the_columns():
     own, tracks = _crossing_ahead(320.0)
     with pytest.raises(InputError, match=r"t.parquet: missing column\(s\) \['time_s'\]"):

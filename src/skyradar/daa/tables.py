@@ -119,21 +119,13 @@ def range_history(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
 
 def _range_columns(df: pd.DataFrame, source: str) -> dict[str, np.ndarray]:
     """``df``'s range and range rate columns (those it has) as floats, NaN allowed; a non-number,
-    an infinity, a negative range or a value no aircraft's range or range rate has is refused
-    naming the row."""
+    an infinity or a value no aircraft's range or range rate has is refused naming the row."""
     cols = {}
     for name in RANGE_COLUMNS:
         if name in df:
             cols[name] = finite_column(df, name, source, allow_nan=True)
             limit, unit = STATE_LIMITS[name[-1]]
             check_within(cols[name], limit, unit, source, name, "not a range or range rate of an aircraft")
-    if "range_m" in cols:
-        with np.errstate(invalid="ignore"):
-            negative = np.flatnonzero(cols["range_m"] < 0.0)
-        if negative.size:
-            i = int(negative[0])
-            value = cols["range_m"][i]
-            raise InputError(f"{source}: field 'range_m' is {value:.6g} m at row {i}: a range is never negative")
     return cols
 
 

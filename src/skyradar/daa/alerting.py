@@ -343,6 +343,9 @@ def _volume_levels(s, v, tcpa, hmd, config: AlertConfig, cov_pos_m2, cov_vel_m2p
     t_in_out = np.full(len(s), np.nan)
     widened = {}
     z = (config.z_h_pos, config.z_h_vel, config.z_v_pos, config.z_v_vel)
+    if miss is not None and len(miss) == 4:
+        with np.errstate(invalid="ignore"):  # the vertical miss the path leaves beside hmd
+            left_vertical_m = np.sqrt(np.maximum(miss[0] ** 2 - hmd**2, 0.0))
     for k, lv in enumerate(config.levels, start=1):
         t_ref = np.clip(tcpa, 0.0, lv.alerting_time_s)
         dthr, zthr = widened_thresholds(lv.volume, cov_pos_m2, cov_vel_m2ps2, t_ref, *z)
@@ -358,7 +361,6 @@ def _volume_levels(s, v, tcpa, hmd, config: AlertConfig, cov_pos_m2, cov_vel_m2p
                 sure_s = np.where(sure_s <= held_s, sure_s, np.nan)
                 with np.errstate(invalid="ignore"):
                     height_in = np.abs(s[:, 2] + v[:, 2] * sure_s) < zthr  # False where NaN
-                    left_vertical_m = np.sqrt(np.maximum(miss[0] ** 2 - hmd**2, 0.0))
                 t_in = np.fmin(t_in, np.where(height_in, sure_s, np.nan))
                 path_holds = np.isfinite(sure_s) & (left_vertical_m < zthr)
         hit = possible & (t_in <= lv.alerting_time_s)

@@ -432,14 +432,14 @@ def _alert_rows(
     predicted = df["extrapolated"].to_numpy(bool)
     t = df["time_s"].to_numpy(float)
     wanted = np.ones(len(df), bool) if at_time_s is None else t == at_time_s
-    path = _range_fit(df, t, interp_ownship(ownship, t, source).velocity_ned_mps, predicted, wanted)
+    own = interp_ownship(ownship, t, source)
+    path = _range_fit(df, t, own.velocity_ned_mps, predicted, wanted)
     track_miss = _whole_track_range_miss(df, t, predicted, ranges, ownship, source, wanted)
     if at_time_s is not None:
         attrs = dict(df.attrs)
         df, t, predicted = df[wanted].reset_index(drop=True), t[wanted], predicted[wanted]
         df.attrs = attrs
-        path, track_miss = path[:, wanted], track_miss[:, wanted]
-    own = interp_ownship(ownship, t, source)
+        path, track_miss, own = path[:, wanted], track_miss[:, wanted], own.select(wanted)
     own_pos, own_vel = own.position_ned_m, own.velocity_ned_mps
     v_int = df[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(float)
     s, v = df[["north_m", "east_m", "down_m"]].to_numpy(float) - own_pos, v_int - own_vel

@@ -220,7 +220,7 @@ def _fit_track(t, r, y, own_v, want, window_s, min_span_s, min_rows, own_tol):  
         if m != m:  # NaN: the rows' squared misses centre on zero or below, a collision course
             m2 = rw**2 - yw**2 / u2
             spread_m2 = 1.4826 * np.median(np.abs(m2 - np.median(m2)))
-            m, s = 0.0, np.sqrt(np.hypot(spread_m2, np.median(yw**2) / u2**2 * u2_sigma))
+            m, s = 0.0, np.sqrt(np.hypot(spread_m2, _slope_error_m2(yw, u2, u2_sigma)))
         out[0, j], out[1, j], out[2, j] = m, s, u2
         out[3, j] = t_mean - y_mean / u2
     return out
@@ -255,7 +255,7 @@ def line_fit(t: np.ndarray, y: np.ndarray, k: float = 3.5) -> tuple:  # pragma: 
     if half < 2:
         return np.nan, np.nan, np.nan, np.nan, keep
     stride = max(half // 16, 1)  # at most about 16 x 16 pairs: the median needs no more
-    slopes = np.empty(half * (n - half))
+    slopes = np.empty(((half + stride - 1) // stride) * ((n - half + stride - 1) // stride))
     m = 0
     for i in range(0, half, stride):
         for j in range(half, n, stride):
@@ -310,8 +310,14 @@ def miss_of_window(
         return np.nan, np.nan
     miss = np.sqrt(centre)
     spread = 1.4826 * np.median(np.abs(m2 - centre)) / (2.0 * miss)
-    slope = np.sqrt(centre + np.median(y**2) / u2**2 * u2_sigma) - miss
+    slope = np.sqrt(centre + _slope_error_m2(y, u2, u2_sigma)) - miss
     return miss, np.hypot(spread, slope)
+
+
+@numba.njit(cache=True)
+def _slope_error_m2(y: np.ndarray, u2: float, u2_sigma: float) -> float:  # pragma: no cover - numba
+    # How far the slope's error moves the rows' r^2 - y^2 / u2 together: y^2 / u2^2 per unit of u2.
+    return np.median(y**2) / u2**2 * u2_sigma
 
 
 def cannot_enter(

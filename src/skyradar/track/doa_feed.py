@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from skyradar.io.ownship_states import REQUIRED_COLUMNS
-from skyradar.track.elevation_trust import AboveVotes, BelowConsensus, agreed_closely, place_elevations
+from skyradar.track.elevation_trust import AboveVotes, BelowConsensus, place_elevations
 from skyradar.track.ground_doa import elevation_measured_flags
 from skyradar.track.io import validate_ownship
 from skyradar.track.measure3d import angle_sigma_rad, position_covariance
@@ -39,7 +39,7 @@ class Measure3D:
         self.measured, self.trusted = np.empty(0, bool), np.empty(0, bool)
         self.own, self.agl = None, np.full(len(grid), np.nan)
         self.votes, self.below, self.surface_down = AboveVotes(), BelowConsensus(), surface_down
-        self.agreed_up: dict[int, float] = {}  # the height each track's readings last agreed on closely
+        self.agreed_up: dict[int, float] = {}  # the height each track's in-band readings last agreed on
         self.agreed_ids: set[int] = set()  # tracks whose in-band readings agreed on a height last frame
         self.add_detections(det)
         if ownship is not None:
@@ -107,8 +107,8 @@ class Measure3D:
         # so the along-sight error is never taken below the across-sight one.
         across = np.linalg.norm(pos - own_p, axis=1) * sigma
         # Elevations the ground may have pulled, or the nulls left unmeasured, sit at the height the
-        # track's readings agree on, else at the one they last agreed on closely, else at the
-        # co-altitude prior, with a loose vertical sigma (skyradar.track.elevation_trust).
+        # track's readings last agreed on, else at the co-altitude prior, with a loose vertical sigma
+        # (skyradar.track.elevation_trust).
         measured = np.zeros(det.size, bool)
         measured[has] = self.measured[idx]
         speed = float(np.linalg.norm(own_v))
@@ -127,7 +127,7 @@ class Measure3D:
             np.array([self.agreed_up.get(int(i), np.nan) for i in out.alive_ids], float),
         )
         self.trusted[idx] = trusted[has]
-        self._restart_heights(out.alive_ids, self.own[k], track_up, spread, rng[:, 0])
+        self._restart_heights(out.alive_ids, self.own[k], track_up, spread)
         cov = np.full((det.size, 3, 3), np.nan)
         use = has & np.isfinite(sigma)
         cov[use] = position_covariance(
@@ -136,25 +136,20 @@ class Measure3D:
         radial = RadialObservation(own_p, own_v, v_unaliased, self.motion.sigma_velocity_mps)
         return self.t3.step(float(out.time_s), out.alive_ids, pos, cov, radial)
 
-    def _restart_heights(self, ids, own_state, track_up, spread, range_m) -> None:
+    def _restart_heights(self, ids, own_state, track_up, spread) -> None:
         """Restart the 3-D height of each track whose readings now agree on one and did not last frame.
 
         Its height so far is the co-altitude prior (or a first scattered reading): a gradual pull
         from there takes seconds the alert does not have (over flat ground 300 m below, an aircraft
-        overtaken 339 m above is first seen 780 m away, already inside the horizontal volume).
-        A track that agreed before restarts only on readings that agree closely
-        (:func:`~skyradar.track.elevation_trust.agreed_closely`), and keeps that height for its
-        free readings: a median the ground's pull scatters and lowers moves neither."""
-        ids = np.asarray(ids)
-        alive = {int(i) for i in ids}
-        self.agreed_up = {i: u for i, u in self.agreed_up.items() if i in alive}
+        overtaken 339 m above is first seen 780 m away, already inside the horizontal volume)."""
         agreed = np.isfinite(track_up)
-        kept = agreed & (~np.isin(ids, list(self.agreed_up)) | agreed_closely(spread, range_m))
-        new = kept & ~np.isin(ids, list(self.agreed_ids))
-        self.agreed_ids = {int(i) for i in ids[agreed]}
-        self.agreed_up.update(zip(ids[kept].tolist(), track_up[kept].tolist(), strict=True))
+        new = agreed & ~np.isin(ids, list(self.agreed_ids))
+        self.agreed_ids = {int(i) for i in np.asarray(ids)[agreed]}
+        alive = {int(i) for i in np.asarray(ids)}
+        self.agreed_up = {i: u for i, u in self.agreed_up.items() if i in alive}
+        self.agreed_up.update(zip(np.asarray(ids)[agreed].tolist(), track_up[agreed].tolist(), strict=True))
         if np.any(new):
-            self.t3.reset_height(ids[new], own_state, track_up[new], spread[new])
+            self.t3.reset_height(np.asarray(ids)[new], own_state, track_up[new], spread[new])
 
     def _clearance(self, pos: np.ndarray, flat_down_m: float) -> np.ndarray:
         """Height of each point above the terrain (``surface_down``), else above a level ground at

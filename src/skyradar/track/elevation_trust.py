@@ -51,7 +51,6 @@ __all__ = [
     "MEDIAN_ABOVE_FLOOR_RAD",
     "MEDIAN_ABOVE_K",
     "BelowConsensus",
-    "agreed_closely",
 ]
 
 FREE_ELEVATION_SIGMA_RAD = 0.35  # vertical-angle sigma of a free detection, at the co-altitude prior
@@ -323,29 +322,6 @@ class BelowConsensus:
         return (median, spread) if agree else (np.nan, np.nan)
 
 
-def agreed_closely(spread_m: np.ndarray, range_m: np.ndarray) -> np.ndarray:
-    """Whether the readings a track's height rests on scatter no more than one reading does (bool).
-
-    ``spread_m`` is the spread (1.4826 median absolute deviation) of the heights a track's readings
-    agree on (:class:`AboveVotes`), m; ``range_m`` the track's range, m. Readings of one aircraft
-    through the nulls scatter by :data:`BAND_ELEVATION_SIGMA_RAD`; readings that scatter wider
-    are a mixture of the aircraft's and the ground's pull, and the pull only lowers them: their
-    median sinks while the aircraft holds its height (over hills, the median of the readings of an
-    aircraft level 338 m above drifts to 127 m in 5 s, scattered by 145-180 m at 1.3-1.6 km,
-    twice a reading's scatter). Such a median is an agreement on *whether* the track is above,
-    not on its height; the height a track keeps once its vote lapses (``Measure3D``) is the last
-    one its readings agreed on closely, or the first they agreed on. NaN: False.
-
-    Examples
-    --------
-    >>> agreed_closely(np.array([60.0, 160.0, np.nan]), np.array([1500.0, 1500.0, 1500.0])).tolist()
-    [True, False, False]
-    """
-    limit = BAND_ELEVATION_SIGMA_RAD * np.asarray(range_m, float) * (1.0 + 1e-9)
-    with np.errstate(invalid="ignore"):
-        return np.asarray(spread_m, float) <= limit
-
-
 def at_elevation(
     positions_m: np.ndarray, own_position_m: np.ndarray, elevation_rad: np.ndarray
 ) -> np.ndarray:
@@ -396,9 +372,7 @@ def place_elevations(
         The tracks' consensus below (updated here) and each point's height above the terrain, m; in
         the band, readings below count only within 3 bounds of it (sigma at least 0.05 rad).
     last_up_m : ndarray, shape (k,), optional
-        Height above the own-ship each row's track last agreed on closely (:func:`agreed_closely`),
-        m (NaN: never). Where given, it places the track's readings in place of a median whose
-        readings scatter wider than one reading does, and while its vote lapses.
+        Height above the own-ship each row's track last agreed on, m (NaN: never).
 
     Returns
     -------
@@ -428,11 +402,7 @@ def place_elevations(
         held = _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids)
     trusted, sigma = trusted | held, np.where(held, np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD), sigma)
     agreed, window = trusted & band & ~held & np.isfinite(track_up), votes.window if votes is not None else 1
-    placed_up = track_up
-    if last_up_m is not None:  # a scattered median says the track is above, not at which height
-        scattered = np.isfinite(track_up) & np.isfinite(last_up_m) & ~agreed_closely(spread, range_m)
-        placed_up = np.where(scattered, last_up_m, track_up)
-    placed = (positions_m, own, range_m, sigma, trusted, agreed, placed_up, spread, last_up_m, window)
+    placed = (positions_m, own, range_m, sigma, trusted, agreed, track_up, spread, last_up_m, window)
     return *_placed(*placed), trusted, track_up, spread
 
 

@@ -69,6 +69,7 @@ __all__ = [
     "direction_coherence",
     "doa_crlb",
     "field_of_view_rad",
+    "FIELD_OF_VIEW_LOSS_DB",
     "antenna_to_body",
 ]
 
@@ -211,15 +212,17 @@ def array_geometry(
 
 
 _FOV_CACHE: dict[int, tuple[object, float]] = {}
+FIELD_OF_VIEW_LOSS_DB = 6.0  # one-way loss from the pattern's peak at the field of view's edge, dB
 
 
 def field_of_view_rad(config: RadarConfig) -> float:
     """Half-angle of the field of view, rad: the widest off-boresight angle at which either principal
-    cut of ``config.antenna`` is within 6 dB of its peak (the cone the coarse DoA search covers)."""
+    cut of ``config.antenna`` is within :data:`FIELD_OF_VIEW_LOSS_DB` of its peak (the cone the coarse
+    DoA search covers)."""
     return _fov_half_angle(config)
 
 
-def _fov_half_angle(config: RadarConfig, max_loss_db: float = 6.0) -> float:
+def _fov_half_angle(config: RadarConfig, max_loss_db: float = FIELD_OF_VIEW_LOSS_DB) -> float:
     """Widest off-boresight angle (rad) at which either principal cut is within ``max_loss_db`` of peak."""
     ant = config.antenna
     cached = _FOV_CACHE.get(id(ant))

@@ -20,6 +20,16 @@ most ``doppler_gate_bins`` Doppler resolutions, and, with DoA positions, their p
 most ``position_gate`` times the range (angle errors of a 2x2 array at low SNR are tenths of a
 radian). Two aircraft that agree in all three in one frame are merged for that frame, which
 costs the weaker one an update (a miss), not its track.
+
+The position gate holds only while the weaker detection's direction means something. Each
+head's field of view ends where its pattern is :data:`~skyradar.process.doa.FIELD_OF_VIEW_LOSS_DB`
+(6 dB) below its peak one-way, and its DoA search covers no more. A target inside both heads'
+fields gives SNRs at most twice that apart (12 dB, two-way: the same target, range and
+fluctuation in both). A weaker detection further below is the target seen from outside the weaker
+head's field, through its pattern's skirts, where its direction search cannot point at it (a wing
+head sees an aircraft ahead of the nose 30 dB below the nose head, its azimuths scattered over
++-90 deg): it is a duplicate whatever its position says. The cost is the same as above: a second
+aircraft at the same range and radial velocity, that much weaker, loses that frame's update.
 """
 
 from __future__ import annotations
@@ -28,12 +38,15 @@ import numpy as np
 import pandas as pd
 
 from skyradar.config import RadarConfig
+from skyradar.process.doa import FIELD_OF_VIEW_LOSS_DB
 
 __all__ = ["fuse_heads", "restore_detection_rows", "HEAD_COLUMN"]
 
 HEAD_COLUMN = "radar"  # the detections column naming the radar head (skyradar.process.detect_run)
 _BODY = ("x_body_m", "y_body_m", "z_body_m")
 _NED = ("north_m", "east_m", "down_m")
+# SNR gap beyond which the weaker of two heads sees a target from outside its field of view, dB
+OUTSIDE_FIELD_GAP_DB = 2.0 * FIELD_OF_VIEW_LOSS_DB
 
 
 def _duplicates(r, v, pos, heads, snr, width: float, gates: tuple[float, float, float]) -> np.ndarray:
@@ -49,7 +62,8 @@ def _duplicates(r, v, pos, heads, snr, width: float, gates: tuple[float, float, 
             dv = v[i] - v[j]
             if abs(dv - width * np.round(dv / width)) > gate_v:
                 continue
-            if pos is not None and np.linalg.norm(pos[i] - pos[j]) > gate_p * max(r[i], 1.0):
+            apart = pos is not None and np.linalg.norm(pos[i] - pos[j]) > gate_p * max(r[i], 1.0)
+            if apart and snr[j] - snr[i] <= OUTSIDE_FIELD_GAP_DB:
                 continue
             dup[i] = True
             break

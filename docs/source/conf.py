@@ -24,10 +24,16 @@ extensions = [
     "numpydoc",
     "myst_parser",
     "sphinx_gallery.gen_gallery",
+    "matplotlib.sphinxext.plot_directive",
     "skyradar_docs",
 ]
 # The examples gallery: examples/*.py at the repository's root, run at every build (a script is run
 # again only when it changed); its pages are generated into gallery/, which git ignores.
+# Figures of the how-it-works pages, drawn by the library at every build; the code stays in the source.
+plot_include_source = False
+plot_html_show_source_link = False
+plot_html_show_formats = False
+plot_formats = [("png", 110)]
 sphinx_gallery_conf = {
     "examples_dirs": "../../examples",
     "gallery_dirs": "gallery",

@@ -164,3 +164,22 @@ def test_a_local_cluster_starts_quietly_when_the_default_dashboard_port_is_taken
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "3"
     assert "8787" not in done.stderr and "Traceback" not in done.stderr, done.stderr
+
+
+def test_a_cluster_that_times_out_on_close_is_logged_not_raised(caplog):
+    from skyradar.parallel import close
+
+    class Slow:
+        closed = False
+
+        def close(self) -> None:
+            raise TimeoutError("workers did not stop within 30 s")
+
+    class Client:
+        cluster = Slow()
+
+        def close(self) -> None:
+            pass
+
+    close(Client(), owns_cluster=True)  # no exception over the written result
+    assert "did not shut down cleanly" in caplog.text

@@ -155,11 +155,19 @@ def _interrupts_held() -> Iterator[list[int]]:
 
 
 def close(client, owns_cluster: bool) -> None:
-    """Close a client from :func:`connect`, and its local cluster when we started it."""
+    """Close a client from :func:`connect`, and its local cluster when we started it.
+
+    Called once the work is written (or while an error propagates): a cluster that does not shut
+    down in time on a loaded machine loses nothing, and its worker processes end with this one, so
+    a timeout here is logged in one line instead of raised over the result or the error.
+    """
     cluster = getattr(client, "cluster", None)
-    client.close()
-    if owns_cluster and cluster is not None:
-        cluster.close()
+    try:
+        client.close()
+        if owns_cluster and cluster is not None:
+            cluster.close()
+    except (TimeoutError, OSError) as exc:
+        logging.getLogger(__name__).warning("the Dask cluster did not shut down cleanly: %r", exc)
 
 
 def map_chunks(

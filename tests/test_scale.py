@@ -170,8 +170,6 @@ def test_a_cluster_that_times_out_on_close_is_logged_not_raised(caplog):
     from skyradar.parallel import close
 
     class Slow:
-        closed = False
-
         def close(self) -> None:
             raise TimeoutError("workers did not stop within 30 s")
 

@@ -105,3 +105,31 @@ def test_predictions_count_neither_for_nor_against_raising_a_level():
     # Half the measured rows of the last 4 s: the four before the gap say no, the fourth after it tips it.
     assert first["p"] == 3.75
     assert first["e"] > first["p"]
+
+
+def test_one_frames_predictions_are_those_of_the_whole_run_on_that_frame():
+    # A stream adds the predicted rows of its latest frame only (``only_at_s``): the same rows the
+    # whole run's call adds on that frame, for tracks that start late, fade, end and come back.
+    rng = np.random.default_rng(3)
+    frames = np.round(np.arange(0.0, 20.0, FRAME_S), 9)
+    rows = []
+    for track_id in range(1, 9):
+        seen = frames[(frames >= rng.uniform(0, 4)) & (frames <= rng.uniform(14, 20))]
+        seen = seen[rng.random(seen.size) > rng.uniform(0.0, 0.6)]  # fades of a frame or two
+        fade = rng.uniform(2, 5)  # and one of up to 12 s: longer than the hold on some tracks
+        seen = seen[(seen < fade) | (seen > fade + rng.uniform(0, 12))]
+        for t in seen:
+            rows.append((t, track_id, *rng.normal(0.0, 1000.0, 3), *rng.normal(0.0, 50.0, 3)))
+    cols = ["time_s", "track_id", "north_m", "east_m", "down_m", "vn_mps", "ve_mps", "vd_mps"]
+    tracks = pd.DataFrame(rows, columns=cols).sort_values(["time_s", "track_id"], kind="stable")
+    tracks = tracks.reset_index(drop=True).assign(range_m=1000.0)
+    for name in [f"cov_{k}_{i}{j}" for k in ("pp", "vv", "pv") for i in range(3) for j in range(3)]:
+        tracks[name] = rng.random(len(tracks))
+    whole = lost_track_rows(tracks, frames, hold_s=8.0)
+    checked = 0
+    for at_s in frames[::3]:
+        one = lost_track_rows(tracks, frames, hold_s=8.0, only_at_s=at_s)
+        expected = whole[~whole["extrapolated"] | (whole["time_s"] == at_s)].reset_index(drop=True)
+        pd.testing.assert_frame_equal(one, expected)
+        checked += int(one["extrapolated"].sum())
+    assert checked > 20  # the frames checked hold predictions

@@ -79,12 +79,61 @@ def lost_track_rows(
     if hold_s <= 0.0 or len(tracks) == 0 or frames.size < 2:
         return out
     half_frame = 0.5 * float(np.median(np.diff(frames)))
+    if only_at_s is not None:
+        added = _lost_at(tracks, float(only_at_s), frames, hold_s, half_frame)
+    else:
+        added = _lost_on_frames(tracks, frames, hold_s, half_frame)
+    if not added:
+        return out
+    merged = pd.concat([out, *added], ignore_index=True)
+    merged.attrs = dict(tracks.attrs)
+    return merged.sort_values(["time_s", "track_id"], kind="stable").reset_index(drop=True)
+
+
+def _predicted(start: pd.DataFrame, at_s: np.ndarray, dt: np.ndarray) -> pd.DataFrame:
+    """The rows ``start`` predicted ``dt`` s on to the times ``at_s`` (constant velocity), flagged."""
+    moved = {
+        p: start[p].to_numpy(float) + start[v].to_numpy(float) * dt for p, v in zip(_POS, _VEL, strict=True)
+    }
+    unmeasured = {c: np.nan for c in ("range_m", "range_rate_mps") if c in start}
+    return start.assign(time_s=at_s, extrapolated=True, **moved, **unmeasured).assign(
+        **_grown_covariances(start, dt)
+    )
+
+
+def _lost_at(
+    tracks: pd.DataFrame, at_s: float, frames: np.ndarray, hold_s: float, half_frame: float
+) -> list[pd.DataFrame]:
+    """The predicted rows of the frame at ``at_s`` alone, every track at once (a stream's step):
+    the rule of :func:`_lost_on_frames` on one frame."""
+    if not np.any(frames == at_s):
+        return []
+    ids = tracks["track_id"].to_numpy()
+    order = np.argsort(ids, kind="stable")  # each track's rows in their table order, as groupby keeps them
+    t = tracks["time_s"].to_numpy(float)[order]
+    first = np.flatnonzero(np.r_[True, ids[order][1:] != ids[order][:-1]])
+    end = np.r_[first[1:], t.size] - 1  # each track's last row
+    inside = (t[first] < at_s) & (at_s <= t[end] + hold_s)
+    last = first + np.add.reduceat(t <= at_s, first) - 1  # the row at or before the frame
+    after = np.minimum(last + 1, end)
+    nearest = np.minimum(at_s - t[last], np.abs(t[after] - at_s))
+    dt = at_s - t[last]
+    gap = inside & (nearest > half_frame) & (dt <= hold_s)
+    if not gap.any():
+        return []
+    start = tracks.iloc[order[last[gap]]].reset_index(drop=True)
+    return [_predicted(start, np.full(int(gap.sum()), at_s), dt[gap])]
+
+
+def _lost_on_frames(
+    tracks: pd.DataFrame, frames: np.ndarray, hold_s: float, half_frame: float
+) -> list[pd.DataFrame]:
+    """Each track's predicted rows on the frames it has no row within half a frame of, after its
+    first row and up to ``hold_s`` after the row before."""
     added = []
     for _, rows in tracks.groupby("track_id", sort=False):
         t = rows["time_s"].to_numpy(float)
         window = frames[(frames > t[0]) & (frames <= t[-1] + hold_s)]
-        if only_at_s is not None:
-            window = window[window == only_at_s]
         last = np.searchsorted(t, window, side="right") - 1  # the row at or before each frame
         after = np.minimum(last + 1, t.size - 1)
         nearest = np.minimum(window - t[last], np.abs(t[after] - window))
@@ -96,19 +145,5 @@ def lost_track_rows(
         if not keep.any():
             continue
         start = rows.iloc[last[keep]].reset_index(drop=True)
-        dt = dt[keep]
-        moved = {
-            p: start[p].to_numpy(float) + start[v].to_numpy(float) * dt
-            for p, v in zip(_POS, _VEL, strict=True)
-        }
-        unmeasured = {c: np.nan for c in ("range_m", "range_rate_mps") if c in start}
-        added.append(
-            start.assign(time_s=gap_frames[keep], extrapolated=True, **moved, **unmeasured).assign(
-                **_grown_covariances(start, dt)
-            )
-        )
-    if not added:
-        return out
-    merged = pd.concat([out, *added], ignore_index=True)
-    merged.attrs = dict(tracks.attrs)
-    return merged.sort_values(["time_s", "track_id"], kind="stable").reset_index(drop=True)
+        added.append(_predicted(start, gap_frames[keep], dt[keep]))
+    return added

@@ -142,6 +142,9 @@ def test_gallery_runs_every_example(site):
 def test_pages_of_every_stage_are_built(site):
     for page in ("getting-started", "user-guide/simulate", "how-it-works/alerting", "api/track", "changelog"):
         assert (site / f"{page}.html").is_file(), page
+    for page in ("clutter-suppression", "elevation-trust"):  # drawn by the library at the build
+        assert (site / "how-it-works" / f"{page}.html").is_file(), page
+        assert (site / "_images" / f"{page}-1.png").is_file(), page
     assert "Unreleased" in _text(site / "changelog.html")  # CHANGELOG.md is included
 
 

@@ -118,3 +118,20 @@ def test_range_rate_fit_exact_on_ring_buffer():
         push_history(buf_r, np.array([0]), np.array([500.0 - 60.0 * t]), np.array([count]))
     assert range_rate_fit(buf_t, buf_r, np.array([7]))[0] == pytest.approx(-60.0)
     assert np.isnan(range_rate_fit(np.array([[0.0, np.nan]]), np.array([[1.0, np.nan]]), np.array([1])))[0]
+
+
+def test_a_collision_course_track_never_reports_a_negative_range():
+    # Head-on at 100 m/s (aliased), detected down to 5 m: the frame after, the filter's prediction
+    # is 8.5 m past zero; the table reports the range projected onto range >= 0.
+    import pandas as pd
+
+    from skyradar.config import RadarConfig
+    from skyradar.track.track_table import track_detections
+
+    cfg = RadarConfig.prototype_2022()
+    t = np.arange(60) / 9.4
+    r = 600.0 - 100.0 * t
+    alias = (-100.0 + cfg.v_lim_mps) % (2 * cfg.v_lim_mps) - cfg.v_lim_mps
+    det = pd.DataFrame({"time_s": t[r > 5.0], "range_m": r[r > 5.0], "radial_velocity_mps": alias})
+    out = track_detections(det, frame_times_s=t)
+    assert out["range_m"].min() == 0.0 and out["range_rate_mps"].iloc[-1] < -90.0

@@ -422,7 +422,10 @@ def _assemble(
         "time_s": cat("time_s"),
         "frame": cat("frame"),
         "track_id": cat("track_id"),
-        "range_m": state[:, 0],
+        # A range is never negative: the estimate is projected onto range >= 0, as a Kalman filter
+        # with an inequality constraint does (Simon, "Kalman filtering with state constraints",
+        # IET Control Theory & Applications 4(8), 2010); a collision course passes through zero.
+        "range_m": np.maximum(state[:, 0], 0.0),
         "radial_velocity_mps": state[:, 1],
         "range_rate_mps": state[:, 2],
         "radial_accel_mps2": state[:, 3],

@@ -110,8 +110,8 @@ def _lost_at(
         return []
     ids = tracks["track_id"].to_numpy()
     order = np.argsort(ids, kind="stable")  # each track's rows in their table order, as groupby keeps them
-    t = tracks["time_s"].to_numpy(float)[order]
-    first = np.flatnonzero(np.r_[True, ids[order][1:] != ids[order][:-1]])
+    t, ids = tracks["time_s"].to_numpy(float)[order], ids[order]
+    first = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])
     end = np.r_[first[1:], t.size] - 1  # each track's last row
     inside = (t[first] < at_s) & (at_s <= t[end] + hold_s)
     last = first + np.add.reduceat(t <= at_s, first) - 1  # the row at or before the frame

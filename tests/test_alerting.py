@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -526,3 +528,45 @@ def test_an_issued_warning_is_held_while_its_loss_is_predicted_within_the_hold_t
     assert (np.diff(chattering[first:]) != 0).sum() >= 4
     with pytest.raises(ValueError, match="hold_time_factor"):
         AlertConfig(hold_time_factor=0.5)
+
+
+def _level_below(height_below_m: float, climb_mps: float, sigma_vz_mps: float) -> tuple:
+    """A head-on intruder closing at 100 m/s from 4 km, ``height_below_m`` below own-ship at first and
+    climbing at ``climb_mps``; its track's horizontal velocity converged (2 m/s), its height known to
+    10 m and its vertical speed to ``sigma_vz_mps`` (at 3 m/s: the tracker's level-flight prior)."""
+    dt = 1.0 / 9.4
+    own, tracks = _head_on(start_m=4000.0, closure_mps=100.0, duration_s=45.0, dt=dt)
+    t = tracks["time_s"].to_numpy()
+    tracks = _converged(tracks).assign(
+        down_m=-1000.0 + height_below_m - climb_mps * t,
+        vd_mps=-climb_mps,
+        cov_pp_22=100.0,
+        cov_vv_22=sigma_vz_mps**2,
+    )
+    return own, tracks
+
+
+def test_a_level_intruder_outside_the_may_alert_zone_is_not_warned_for_its_prior_vertical_speed():
+    # 212 m below and level: outside 1.5 times ZTHR (206 m), where a near miss must not be warned.
+    # The track's vertical-speed sigma is the level-flight prior, not a measurement; widened by it,
+    # ZTHR (137 m, plus 7.5 m for the height's sigma) would grow by 3 m/s x 25 s to 220 m, and the
+    # intruder would be warned however well its height is measured. The radar settings widen by the
+    # measured height's sigma only.
+    own, tracks = _level_below(212.0, climb_mps=0.0, sigma_vz_mps=3.0)
+    radar = alerts_from_tracks(tracks, own, RADAR_ALERT_CONFIG, with_advice=False)
+    assert radar["level"].max() < 3
+    widened_by_prior = replace(RADAR_ALERT_CONFIG, z_v_vel=1.0)
+    assert alerts_from_tracks(tracks, own, widened_by_prior, with_advice=False)["level"].max() == 3
+
+
+def test_an_intruder_climbing_into_the_volume_is_warned_before_the_loss():
+    # The same intruder climbing at 3 m/s, its vertical speed measured (0.5 m/s): the prediction
+    # carries it into the volume (220 - 3 x 40 = 100 m below at the closest approach).
+    own, tracks = _level_below(220.0, climb_mps=3.0, sigma_vz_mps=0.5)
+    out = alerts_from_tracks(tracks, own, RADAR_ALERT_CONFIG, with_advice=False)
+    t = out["time_s"].to_numpy()
+    rel = np.abs(tracks["down_m"].to_numpy() + 1000.0)
+    horizontal = np.abs(tracks["north_m"].to_numpy() - own["own_north_m"].to_numpy())
+    t_lowc = t[np.argmax((rel <= 137.16) & (horizontal <= D_NC))]
+    t_warn = t[np.argmax(out["level"].to_numpy() == 3)]
+    assert out["level"].max() == 3 and t_warn < t_lowc - 12.5

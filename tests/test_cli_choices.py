@@ -86,7 +86,6 @@ def test_a_missing_value_is_still_a_usage_error(monkeypatch, capsys):
 
 
 def test_each_enum_holds_the_names_the_library_takes():
-    from skyradar.daa.alert_config import ALERT_CONFIGS
     from skyradar.experiments.encounter_terrain import TERRAINS
     from skyradar.experiments.encounters import FAMILIES
     from skyradar.io.frames import COMPRESSORS, PRECISIONS
@@ -108,7 +107,6 @@ def test_each_enum_holds_the_names_the_library_takes():
     assert _names(choices.RxLayout) == RX_LAYOUTS
     assert _names(choices.Navigation) == NAVIGATION_MODELS
     assert _names(choices.AircraftClass) == tuple(AIRCRAFT_CLASSES)
-    assert set(_names(choices.AlertSettings)) <= set(ALERT_CONFIGS)
     assert set(_names(choices.StateMethod)) == {*STATE_METHODS, "terrain"}  # terrain: estimate_run's own
     assert _names(choices.Detector) == typing.get_args(typing.get_type_hints(detect)["method"])
     assert _names(choices.Side) == typing.get_args(typing.get_type_hints(encounter_from_tracks)["side"])

@@ -8,7 +8,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from cli_helpers import assert_one_line_error, skyradar
 from skyradar.code_version import code_version
+from skyradar.daa.alert_config import config_digest
+from skyradar.daa.alerting import RADAR_ALERT_CONFIG
 from skyradar.daa.conflict import FT
 from skyradar.errors import InputError
 from skyradar.experiments.encounter_set import (
@@ -255,6 +258,7 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
         "family": "synthetic",
         "split": "development",
         "alert_config": "radar",
+        "alert_config_digest": config_digest(RADAR_ALERT_CONFIG),
     }
     key = {**settings, "version": code_version()}
     _, save = E.partial_store(tmp_path, key)
@@ -298,12 +302,35 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
     table = pd.read_parquet(tmp_path / "encounters.parquet")
     assert table.loc[0, "frames"] == 7 and table.loc[1, "frames"] > 50  # row 0 kept, row 1 computed
     assert not list(tmp_path.glob("*.partial*"))
+    # Alerted with other settings (a file of fields), the same set resumes nothing of a radar run.
+    save({("none", 0): [fake]})
+    settings_file = tmp_path.parent / "three-of-five.yaml"
+    settings_file.write_text("base: radar\nm: 3\nn: 5\n")
+    s = E.run(
+        tmp_path,
+        n_encounters=2,
+        seed=5,
+        workers=1,
+        frame_rate_hz=4.7,
+        layouts=("single",),
+        simulation=LIGHT,
+        alert_settings=str(settings_file),
+    )
+    assert s["resumed_encounters"] == 0 and s["alert_config"] == str(settings_file)
+    assert s["alert_config_digest"] != config_digest(RADAR_ALERT_CONFIG)
     # Different settings never reuse another run's rows.
     save({("none", 0): [fake]})
     assert E.partial_store(tmp_path, {**key, "seed": 6})[0] == {}
     assert E.partial_store(tmp_path, {**key, "navigation": "perfect"})[0] == {}
     assert E.partial_store(tmp_path, {**key, "rx_layout": "kite"})[0] == {}
     assert E.partial_store(tmp_path, {**key, "family": "real-flights"})[0] == {}
+
+
+def test_bad_alert_settings_file_gives_one_line(tmp_path):
+    (tmp_path / "mine.yaml").write_text("base: radar\nm: 5\nn: 4\n")
+    r = skyradar("experiment", "encounters", "--alert-config", "mine.yaml", "--output", "o", cwd=tmp_path)
+    assert_one_line_error(r, "mine.yaml", "m=5")
+    assert not (tmp_path / "o").exists()
 
 
 def test_flat_terrain_variant_puts_ground_under_the_whole_window():

@@ -39,7 +39,6 @@ __all__ = [
     "RxLayout",
     "Family",
     "Split",
-    "AlertSettings",
     "EncounterTerrain",
 ]
 
@@ -224,13 +223,6 @@ class Split(StrEnum):
 
     development = "development"
     evaluation = "evaluation"
-
-
-class AlertSettings(StrEnum):
-    """``experiment encounters --alert-config``: the alerting settings the chain warns with."""
-
-    radar = "radar"
-    do365b = "do365b"
 
 
 class EncounterTerrain(StrEnum):

@@ -18,7 +18,7 @@ from skyradar.cli.app import (
     experiment_app,
     number_in,
 )
-from skyradar.cli.choices import AlertSettings, EncounterTerrain, Family, Layout, Navigation, RxLayout, Split
+from skyradar.cli.choices import EncounterTerrain, Family, Layout, Navigation, RxLayout, Split
 from skyradar.io.outputs import OVERWRITE_HELP
 
 __all__ = [
@@ -162,13 +162,14 @@ def experiment_encounters(
     ] = Family.synthetic,
     split: SplitOption = None,
     alert_settings: Annotated[
-        AlertSettings,
+        str,
         typer.Option(
             "--alert-config",
-            help="Alerting settings the chain warns with: radar (the default, every result of the docs) "
-            "or do365b (DAIDALUS' DO-365B non-cooperative alerter).",
+            help="Alerting settings the chain warns with: radar (the default, every result of the docs), "
+            "do365b (DAIDALUS' DO-365B non-cooperative alerter), default (AlertConfig's own defaults) "
+            "or FILE.yaml (fields of skyradar.daa.alert_config, as for 'skyradar alert --config').",
         ),
-    ] = AlertSettings.radar,
+    ] = "radar",
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     as_json: JsonOption = False,
 ) -> None:
@@ -178,6 +179,7 @@ def experiment_encounters(
     missed, late and false warnings, clutter and ground tracks, track fragments, warning lead.
     """
     from skyradar.cli.commands_sim import frame_progress
+    from skyradar.daa.alert_config import alert_config
     from skyradar.experiments.encounter_terrain import parse_terrains
     from skyradar.experiments.encounters import DEFAULT_ENCOUNTERS, DEFAULT_TERRAIN_ENCOUNTERS, run
     from skyradar.io.outputs import check_output, mark_folder
@@ -185,6 +187,7 @@ def experiment_encounters(
 
     check_workers(workers)
     check_split(seed, split)
+    alert_config(alert_settings, option="--alert-config")  # a bad setting is named before any output
     if family is Family.real_flights:
         from skyradar.scene.sample_flights import sample_flights
 
@@ -213,7 +216,7 @@ def experiment_encounters(
             family=family.value,
             command="skyradar " + " ".join(sys.argv[1:]),
             scheduler=scheduler,
-            alert_settings=alert_settings.value,
+            alert_settings=alert_settings,
         )
     emit_result(result, as_json, "encounters")
 

@@ -14,10 +14,13 @@ changes from ``do365b``, and why:
 - an issued level holds while lost within 1.5 times its alerting time (37.5 s for the warning),
   not within DAIDALUS' early alerting time (90 s): a radar track's prediction after a manoeuvre is
   trusted less far ahead; and it is lowered only after its M-of-N stayed below for 5 s;
-- tracks wait before alerting (a share of the time left, at most 2 s), a track whose horizontal
-  velocity is known worse than 6 m/s (scaled by the time to CPA) raises nothing, and the vertical
-  speed's z-score is 1 (the tracker's level-flight prior): a fresh radar track's velocity is
-  noise, which DAIDALUS, fed by ADS-B-quality tracks, does not expect;
+- tracks wait before alerting (a share of the time left, at most 2 s) and a track whose horizontal
+  velocity is known worse than 6 m/s (scaled by the time to CPA) raises nothing: a fresh radar
+  track's velocity is noise, which DAIDALUS, fed by ADS-B-quality tracks, does not expect;
+- the volumes are not widened by the vertical speed's sigma (``z_v_vel`` 0): at the ranges where a
+  warning is decided the radar does not measure a vertical speed, and that sigma is the tracker's
+  level-flight prior; widened by it, every level intruder up to 212 m above or below would be
+  inside the warning volume whatever the radar measures (the measured height's sigma still widens);
 - a lost track's prediction holds its level for 8 s (radar tracks drop out in clutter and nulls).
 
 A file holds :class:`AlertConfig` fields, starting from ``base`` (``radar`` unless given)::
@@ -57,7 +60,7 @@ from skyradar.daa.alerting import DO365B_ALERT_CONFIG, RADAR_ALERT_CONFIG, Alert
 from skyradar.daa.conflict import WellClearVolume
 from skyradar.errors import InputError
 
-__all__ = ["ALERT_CONFIGS", "WARNING_LEVEL", "alert_config", "check_warns_head_on"]
+__all__ = ["ALERT_CONFIGS", "WARNING_LEVEL", "alert_config", "check_warns_head_on", "config_digest"]
 
 ALERT_CONFIGS = {"radar": RADAR_ALERT_CONFIG, "default": AlertConfig(), "do365b": DO365B_ALERT_CONFIG}
 WARNING_LEVEL = 3  # preventive 1, corrective 2, warning 3: the level every DAA score counts
@@ -148,8 +151,10 @@ def _fields(label: str, data: dict) -> dict:
     return changes
 
 
-def alert_config(value: str | Path) -> AlertConfig:
+def alert_config(value: str | Path, option: str = "--config") -> AlertConfig:
     """The alerting settings ``value`` names: ``radar``, ``default``, ``do365b``, or a YAML file of fields.
+
+    ``option`` names the command-line option in the message that refuses a value.
 
     Examples
     --------
@@ -164,7 +169,7 @@ def alert_config(value: str | Path) -> AlertConfig:
         return ALERT_CONFIGS[str(value)]
     path = Path(value)
     if path.suffix.lower() not in (".yaml", ".yml") or not path.is_file():
-        raise InputError(f"--config {value}: not radar, default, do365b or an existing .yaml file")
+        raise InputError(f"{option} {value}: not radar, default, do365b or an existing .yaml file")
     from skyradar.io.safe_yaml import load_yaml
 
     try:
@@ -184,6 +189,24 @@ def alert_config(value: str | Path) -> AlertConfig:
         raise InputError(f"{path}: {exc}") from None
     check_warns_head_on(config, str(path))
     return config
+
+
+def config_digest(config: AlertConfig) -> str:
+    """A short digest of every field of ``config``: two runs alerted with the same settings have the
+    same digest, whatever name or file gave them (a resumed run must use the same settings).
+
+    Examples
+    --------
+    >>> config_digest(alert_config("radar")) == config_digest(dataclasses.replace(RADAR_ALERT_CONFIG))
+    True
+    >>> config_digest(RADAR_ALERT_CONFIG) == config_digest(DO365B_ALERT_CONFIG)
+    False
+    """
+    import hashlib
+    import json
+
+    fields = json.dumps(dataclasses.asdict(config), sort_keys=True, default=repr)
+    return hashlib.sha256(fields.encode()).hexdigest()[:16]
 
 
 def check_warns_head_on(config: AlertConfig, label: str) -> None:

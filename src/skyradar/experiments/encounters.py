@@ -27,7 +27,7 @@ from typing import Any
 import pandas as pd
 
 from skyradar.code_version import code_version, provenance
-from skyradar.daa.alert_config import ALERT_CONFIGS
+from skyradar.daa.alert_config import alert_config, config_digest
 from skyradar.errors import InputError
 from skyradar.experiments.encounter_chain import FRAME_RATE_HZ, LAYOUTS, SUPPRESSION, run_encounter
 from skyradar.experiments.encounter_report import write_report
@@ -223,15 +223,15 @@ def run(
     Finished encounters are kept in ``encounters.partial.parquet`` while the run goes on; a run that
     was interrupted resumes from them when started again with the same settings. ``scheduler`` and
     ``workers``: where the encounters run (:func:`run_encounters`). ``alert_settings`` names the
-    alerting settings (:data:`skyradar.daa.alert_config.ALERT_CONFIGS`: ``radar``, ``do365b``).
+    alerting settings (:func:`skyradar.daa.alert_config.alert_config`: ``radar``, ``do365b``,
+    ``default`` or a YAML file of fields); the summary records the name and a digest of every field
+    (:func:`~skyradar.daa.alert_config.config_digest`), and a run resumes only with the same settings.
     """
     terrains, layouts = tuple(terrains), tuple(x for x in LAYOUTS if x in layouts)
     check_encounter_set(n_encounters, terrains, tuple(layouts) or ("",))
     check_rx_layout(rx_layout, "--rx-layout:")
     t0 = time.perf_counter()
-    cfg = ALERT_CONFIGS.get(alert_settings)
-    if cfg is None:
-        raise InputError(f"--alert-config: must be one of {', '.join(ALERT_CONFIGS)}, got {alert_settings!r}")
+    cfg = alert_config(alert_settings, option="--alert-config")
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     if not uncertainty:
@@ -257,7 +257,8 @@ def run(
         "navigation": navigation,
         "suppression": SUPPRESSION,
         "late_lead_s": late_lead_s,
-        "alert_config": alert_settings,
+        "alert_config": str(alert_settings),
+        "alert_config_digest": config_digest(cfg),
         "simulation": simulation or {},
         "rx_layout": rx_layout,
         "family": family,

@@ -66,6 +66,8 @@ def test_results_page_holds_the_measured_numbers(site):
         columns = ("terrain", "layout", "encounters", "conflicts", "observable_conflicts", "missed_warnings")
         columns += ("false_warnings", "false_warning_rate", "false_warning_rate_ci95")
         columns += ("median_warning_lead_s",)
+        if "lead_against_clear_sky" in row:  # a run that flew clear sky too: the paired change of lead
+            columns += ("lead_change_against_clear_sky_s",)
         cells = [format_value(k, row[k]) for k in columns]
         assert " ".join(cells) in text, f"{path.name}: first row {cells} not on the results page"
     benchmarks = sorted((RESULTS / "benchmarks").glob("*.json"))
@@ -73,6 +75,20 @@ def test_results_page_holds_the_measured_numbers(site):
     for path in benchmarks:
         result = json.loads(path.read_text())
         assert path.name in text and result["date_utc"] in text and result["command"] in text
+
+
+def test_a_run_with_clear_sky_shows_its_paired_change_of_lead():
+    # A run over a terrain and clear sky (`--terrain hills,none`) records, per terrain row, its lead
+    # against clear sky on the same encounters; the results page shows the median change.
+    sys.path.insert(0, str(SOURCE / "_ext"))
+    try:
+        from skyradar_docs import _with_intervals, format_value
+    finally:
+        sys.path.remove(str(SOURCE / "_ext"))
+    paired = {"encounters": 51, "median_lead_s": 24.0, "median_difference_s": -2.56}
+    row = _with_intervals({"terrain": "hills", "lead_against_clear_sky": paired})
+    assert format_value("lead_change_against_clear_sky_s", row["lead_change_against_clear_sky_s"]) == "-2.6"
+    assert "lead_change_against_clear_sky_s" not in _with_intervals({"terrain": "none"})
 
 
 def test_results_page_holds_the_clutter_experiments_numbers(site):

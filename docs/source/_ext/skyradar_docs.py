@@ -71,6 +71,7 @@ ROW_FIELDS = (
     "false_warning_rate",
     "false_warning_rate_ci95",
     "median_warning_lead_s",
+    "lead_change_against_clear_sky_s",
     "warnings_not_held",
     "alert_flickers",
 )
@@ -105,7 +106,12 @@ CLUTTER_PLOTS = {
 }
 
 # Decimals of the fractional numbers; the rest are counts.
-DECIMALS = {"false_warning_rate": 3, "median_warning_lead_s": 1, "load_average_1min": 2} | {
+DECIMALS = {
+    "false_warning_rate": 3,
+    "median_warning_lead_s": 1,
+    "lead_change_against_clear_sky_s": 1,
+    "load_average_1min": 2,
+} | {
     key: decimals for key, _, decimals in CLUTTER_FIGURES if decimals is not None
 }
 
@@ -137,10 +143,15 @@ RATE_COUNTS = {"false_warning_rate": ("false_warnings", "must_not_alert_encounte
 
 
 def _with_intervals(row: dict) -> dict:
-    """``row`` with each rate's ``_ci95`` interval, from its counts where the summary lacks it."""
+    """``row`` with each rate's ``_ci95`` interval, from its counts where the summary lacks it, and
+    the median change of warning lead against clear sky on the same encounters where the run flew
+    clear sky too (``lead_change_against_clear_sky_s``, s)."""
     from skyradar.experiments.encounter_set import rate_interval
 
     row = dict(row)
+    paired = row.get("lead_against_clear_sky")
+    if isinstance(paired, dict):
+        row["lead_change_against_clear_sky_s"] = paired.get("median_difference_s")
     for rate, (count, trials) in RATE_COUNTS.items():
         if f"{rate}_ci95" not in row and count in row and trials in row:
             row[f"{rate}_ci95"] = rate_interval(int(row[count]), int(row[trials]))
@@ -243,7 +254,7 @@ class ResultsDirective(SphinxDirective):
         keys = [k for k in (*SUMMARY_FIELDS, *PROVENANCE_FIELDS) if k in summary or k not in optional]
         section += _field_list({k: summary.get(k) for k in keys})
         rows = [_with_intervals(r) for r in summary.get("rows") or [summary]]
-        optional = ("warnings_not_held", "alert_flickers")  # shown where the summary has them
+        optional = ("lead_change_against_clear_sky_s", "warnings_not_held", "alert_flickers")  # where present
         shown = [f for f in ROW_FIELDS if f not in optional or any(f in r for r in rows)]
         section += _table(
             # A zero-width space after each underscore lets the long column names wrap.

@@ -50,7 +50,7 @@ def site(tmp_path_factory) -> Path:
 def test_results_page_holds_the_measured_numbers(site):
     sys.path.insert(0, str(SOURCE / "_ext"))
     try:
-        from skyradar_docs import _with_intervals, format_value
+        from skyradar_docs import _row_as_shown, format_value
     finally:
         sys.path.remove(str(SOURCE / "_ext"))
     text = _text(site / "results.html")
@@ -58,7 +58,7 @@ def test_results_page_holds_the_measured_numbers(site):
     assert files, "no measured summaries in docs/results"
     for path in files:
         summary = json.loads(path.read_text())
-        row = _with_intervals(summary["rows"][0])  # the interval from the counts where not recorded
+        row = _row_as_shown(summary["rows"][0])  # the interval from the counts where not recorded
         assert path.name in text
         assert summary["date_utc"] in text
         assert summary["command"] in text
@@ -82,13 +82,13 @@ def test_a_run_with_clear_sky_shows_its_paired_change_of_lead():
     # against clear sky on the same encounters; the results page shows the median change.
     sys.path.insert(0, str(SOURCE / "_ext"))
     try:
-        from skyradar_docs import _with_intervals, format_value
+        from skyradar_docs import _row_as_shown, format_value
     finally:
         sys.path.remove(str(SOURCE / "_ext"))
     paired = {"encounters": 51, "median_lead_s": 24.0, "median_difference_s": -2.56}
-    row = _with_intervals({"terrain": "hills", "lead_against_clear_sky": paired})
+    row = _row_as_shown({"terrain": "hills", "lead_against_clear_sky": paired})
     assert format_value("lead_change_against_clear_sky_s", row["lead_change_against_clear_sky_s"]) == "-2.6"
-    assert "lead_change_against_clear_sky_s" not in _with_intervals({"terrain": "none"})
+    assert "lead_change_against_clear_sky_s" not in _row_as_shown({"terrain": "none"})
 
 
 def test_results_page_holds_the_clutter_experiments_numbers(site):

@@ -142,10 +142,10 @@ def format_value(name: str, value: object) -> str:
 RATE_COUNTS = {"false_warning_rate": ("false_warnings", "must_not_alert_encounters")}
 
 
-def _with_intervals(row: dict) -> dict:
-    """``row`` with each rate's ``_ci95`` interval, from its counts where the summary lacks it, and
-    the median change of warning lead against clear sky on the same encounters where the run flew
-    clear sky too (``lead_change_against_clear_sky_s``, s)."""
+def _row_as_shown(row: dict) -> dict:
+    """A summary row as the results page shows it: with each rate's ``_ci95`` interval, from its
+    counts where the summary lacks it, and the median change of warning lead against clear sky on
+    the same encounters where the run flew clear sky too (``lead_change_against_clear_sky_s``, s)."""
     from skyradar.experiments.encounter_set import rate_interval
 
     row = dict(row)
@@ -253,7 +253,7 @@ class ResultsDirective(SphinxDirective):
         optional = ("split", "alert_config", "load_average_1min")
         keys = [k for k in (*SUMMARY_FIELDS, *PROVENANCE_FIELDS) if k in summary or k not in optional]
         section += _field_list({k: summary.get(k) for k in keys})
-        rows = [_with_intervals(r) for r in summary.get("rows") or [summary]]
+        rows = [_row_as_shown(r) for r in summary.get("rows") or [summary]]
         optional = ("lead_change_against_clear_sky_s", "warnings_not_held", "alert_flickers")  # where present
         shown = [f for f in ROW_FIELDS if f not in optional or any(f in r for r in rows)]
         section += _table(

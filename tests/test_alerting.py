@@ -530,6 +530,32 @@ def test_an_issued_warning_is_held_while_its_loss_is_predicted_within_the_hold_t
         AlertConfig(hold_time_factor=0.5)
 
 
+def test_an_issued_warning_is_held_while_the_miss_stays_inside_the_enlarged_volume():
+    # Threshold hysteresis in space: a head-on intruder whose track height scatters about the 450 ft
+    # threshold (130-170 m above, the 30-35 m a radar's height scatters by at 2-3 km) after it was
+    # warned 110 m above. Without the spatial hold its warning drops and comes back; with the
+    # volume enlarged 1.5 times (206 m) it holds.
+    own, tracks = _head_on(start_m=4000.0, duration_s=34.0)
+    t = tracks["time_s"].to_numpy()
+    wobble = 150.0 + 20.0 * np.sign(np.sin(2.0 * np.pi * t / 14.0))  # 170 m for 7 s, then 130 m for 7 s
+    up = np.where(t < 14.0, 110.0, wobble)
+    tracks = tracks.assign(down_m=-1000.0 - up)
+    plain = replace(RADAR_ALERT_CONFIG, z_v_pos=0.0, hold_volume_factor=1.0)  # no covariance: no widening
+    held = replace(plain, hold_volume_factor=1.5)
+    lvl_plain = alerts_from_tracks(tracks, own, plain, with_advice=False)["level"].to_numpy()
+    lvl_held = alerts_from_tracks(tracks, own, held, with_advice=False)["level"].to_numpy()
+    first = int(np.argmax(lvl_held == 3))
+    assert first > 0 and t[first] < 14.0 and int(np.argmax(lvl_plain == 3)) == first  # raised alike
+    assert (lvl_held[first:] == 3).all()
+    assert (np.diff((lvl_plain[first:] == 3).astype(int)) != 0).sum() >= 2  # dropped and raised again
+    # Beyond the enlarged volume nothing holds it: 250 m above, the warning is lowered.
+    away = tracks.assign(down_m=-1000.0 - np.where(t < 14.0, 110.0, 250.0))
+    lvl_away = alerts_from_tracks(away, own, held, with_advice=False)["level"].to_numpy()
+    assert lvl_away[-1] < 3
+    with pytest.raises(ValueError, match="hold_volume_factor"):
+        AlertConfig(hold_volume_factor=0.9)
+
+
 def _level_below(height_below_m: float, climb_mps: float, sigma_vz_mps: float) -> tuple:
     """A head-on intruder closing at 100 m/s from 4 km, ``height_below_m`` below own-ship at first and
     climbing at ``climb_mps``; its track's horizontal velocity converged (2 m/s), its height known to

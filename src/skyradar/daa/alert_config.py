@@ -13,7 +13,9 @@ changes from ``do365b``, and why:
   the corrective volume;
 - an issued level holds while lost within 1.5 times its alerting time (37.5 s for the warning),
   not within DAIDALUS' early alerting time (90 s): a radar track's prediction after a manoeuvre is
-  trusted less far ahead; and it is lowered only after its M-of-N stayed below for 5 s;
+  trusted less far ahead; it holds too while its volume enlarged 1.5 times is lost (a track's
+  predicted miss scatters, and near the volume's edge it would cross the edge back and forth); and
+  it is lowered only after its M-of-N stayed below for 5 s;
 - tracks wait before alerting (a share of the time left, at most 2 s) and a track whose horizontal
   velocity is known worse than 6 m/s (scaled by the time to CPA) raises nothing: a fresh radar
   track's velocity is noise, which DAIDALUS, fed by ADS-B-quality tracks, does not expect;
@@ -37,6 +39,7 @@ A file holds :class:`AlertConfig` fields, starting from ``base`` (``radar`` unle
     age_fraction_of_time_left: 0.1   # a fresh track waits at most this share of the time left
     min_track_age_floor_s: 0.5
     hold_time_factor: 1.5            # an issued level holds while lost within 1.5x its alerting time
+    hold_volume_factor: 1.5          # ... or while its volume enlarged 1.5x is
     lost_track_hold_s: 8.0           # a lost track's prediction holds its alert this long
     max_velocity_sigma_mps: 6.0  # null: no gate
     flarm_thresholds_s: [18, 13, 8]
@@ -76,6 +79,7 @@ _FLOATS = (
     "age_fraction_of_time_left",
     "min_track_age_floor_s",
     "hold_time_factor",
+    "hold_volume_factor",
     "lost_track_hold_s",
 )
 _OPTIONAL = ("period_s", "max_velocity_sigma_mps", "gap_reset_s")

@@ -6,7 +6,9 @@ level ``k`` is issued when at least ``M`` of the last ``N`` raw levels reach ``k
 issued, is held at least ``persistence_s``, and it is lowered only after the M-of-N level has stayed
 below it for ``hysteresis_s``. The threshold has hysteresis too: an issued level counts as still
 reached while its volume is predicted lost within ``hold_time_factor`` times its alerting time, so a
-prediction that sits near the edge of the alerting time does not make the alert chatter. The
+prediction that sits near the edge of the alerting time does not make the alert chatter; and, with
+``hold_volume_factor`` above 1, while that volume enlarged by the factor is, so a prediction whose
+miss sits near the volume's edge does not either. The
 defaults follow DAIDALUS' DO-365B configuration (``alerting_m = 2``, ``alerting_n = 4``,
 ``persistence_time = 4 s``, ``hysteresis_time = 5 s``).
 """
@@ -148,6 +150,14 @@ class AlertConfig:
         of its alerting time (threshold hysteresis, >= 1): a raw level that hovers at the edge of
         the alerting time, as a track's prediction does when the widened volume's edge crosses
         the alerting time, raises the alert once and does not drop and raise it again.
+    hold_volume_factor : float
+        An issued level is also held while its (widened) volume, its horizontal and vertical
+        thresholds multiplied by this factor (>= 1), is predicted lost within its hold time
+        (threshold hysteresis in space). A track's predicted miss scatters from frame to frame by
+        its position and velocity errors (a radar's height by 30-35 m at 2-3 km, a quarter of
+        the 450 ft threshold); where the true miss lies near the volume's edge the prediction
+        crosses it back and forth, and the alert would drop and come back. 1: no spatial hold
+        (DAIDALUS').
     lost_track_hold_s : float
         A confirmed track that has no row on a frame is predicted there from its last row for this
         long, s (the tracker's reacquisition memory), and the prediction may hold the level the
@@ -182,6 +192,7 @@ class AlertConfig:
     age_fraction_of_time_left: float = 0.1
     min_track_age_floor_s: float = 0.5
     hold_time_factor: float = 1.5
+    hold_volume_factor: float = 1.0
     lost_track_hold_s: float = 8.0
     max_velocity_sigma_mps: float | None = None
 
@@ -192,6 +203,8 @@ class AlertConfig:
             raise ValueError(f"alert config: period_s must be > 0, got {self.period_s}")
         if not self.hold_time_factor >= 1.0:
             raise ValueError(f"alert config: hold_time_factor must be >= 1, got {self.hold_time_factor}")
+        if not self.hold_volume_factor >= 1.0:
+            raise ValueError(f"alert config: hold_volume_factor must be >= 1, got {self.hold_volume_factor}")
         if self.gap_reset_s is not None and not self.gap_reset_s > 0:
             raise ValueError(f"alert config: gap_reset_s must be > 0, got {self.gap_reset_s}")
         if not self.lost_track_hold_s >= 0.0:
@@ -220,7 +233,14 @@ class AlertConfig:
 # every level intruder reaches ZTHR + 3 m/s x 25 s = 212 m whatever the radar measures: past 1.5
 # times ZTHR (206 m), where a near miss must not be warned. The vertical speed the tracker estimates
 # still moves the prediction, and the measured height's sigma still widens ZTHR.
-RADAR_ALERT_CONFIG = AlertConfig(period_s=1.0, max_velocity_sigma_mps=6.0, z_v_vel=0.0)
+# An issued level also holds while its volume enlarged 1.5 times is predicted lost: a radar track's
+# predicted miss scatters from frame to frame (its height by 30-35 m at 2-3 km), so where the true miss
+# lies near the volume's edge the prediction crosses it back and forth; inside 1.5 times the volume an
+# encounter may be warned (a sensor cannot tell it from a conflict), and a warning there is held
+# rather than dropped and raised again.
+RADAR_ALERT_CONFIG = AlertConfig(
+    period_s=1.0, max_velocity_sigma_mps=6.0, z_v_vel=0.0, hold_volume_factor=1.5
+)
 
 
 # DAIDALUS' DO-365B non-cooperative alerting as its DO_365B_no_SUM configuration sets it: the
@@ -336,7 +356,8 @@ def alerting_rows(times_s: np.ndarray, required_age_s: np.ndarray) -> np.ndarray
 def _volume_levels(s, v, tcpa, hmd, config: AlertConfig, cov_pos_m2, cov_vel_m2ps2, miss=None):
     """Highest level whose (widened) volume is lost within its alerting time, its entry time,
     the widened thresholds ``{level: (dthr_m, zthr_m)}`` of every level, and the highest level
-    lost within its hold time (:meth:`AlertLevel.hold_time_s`). ``miss`` (miss distance and sigma,
+    lost within its hold time (:meth:`AlertLevel.hold_time_s`), or whose volume enlarged by
+    ``hold_volume_factor`` is. ``miss`` (miss distance and sigma,
     m) clears the levels whose plain cylinder it passes outside; with the path's relative speed
     squared and time to its closest approach it also raises those its path surely enters while the
     track's height is inside, and holds them while the vertical miss the path leaves beside the
@@ -355,6 +376,10 @@ def _volume_levels(s, v, tcpa, hmd, config: AlertConfig, cov_pos_m2, cov_vel_m2p
         widened[k] = (dthr, zthr)
         held_s = lv.hold_time_s(config.hold_time_factor)
         t_in, _ = loss_of_well_clear_interval(s, v, lv.volume, held_s, dthr, zthr)
+        t_hold = t_in
+        if config.hold_volume_factor > 1.0:
+            f = config.hold_volume_factor
+            t_hold, _ = loss_of_well_clear_interval(s, v, lv.volume, held_s, f * dthr, f * zthr)
         possible = np.ones(len(s), bool)
         path_holds = np.zeros(len(s), bool)
         if miss is not None and lv.volume.tthr_s == 0.0 and lv.volume.tcoa_s == 0.0:
@@ -368,7 +393,7 @@ def _volume_levels(s, v, tcpa, hmd, config: AlertConfig, cov_pos_m2, cov_vel_m2p
                 path_holds = np.isfinite(sure_s) & (left_vertical_m < zthr)
         hit = possible & (t_in <= lv.alerting_time_s)
         level = np.where(hit, k, level)
-        hold = np.where(possible & (np.isfinite(t_in) | path_holds), k, hold)
+        hold = np.where(possible & (np.isfinite(t_in) | np.isfinite(t_hold) | path_holds), k, hold)
         t_in_out = np.where(hit, t_in, t_in_out)
     return level, t_in_out, widened, hold
 

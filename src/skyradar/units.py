@@ -79,7 +79,11 @@ def wrap(values: ArrayLike, width: float | np.ndarray) -> np.ndarray:
     """
     values, width = np.asarray(values, float), np.asarray(width, float)
     # floor is faster than np.mod and gives the same result for finite inputs.
-    return values - width * np.floor((values + width / 2.0) / width)
+    out = values - width * np.floor((values + width / 2.0) / width)
+    # Rounding can leave a value an ulp outside the interval (e.g. -0.6000000000000014 for W = 1.2):
+    # it is moved by one width, and a value rounded onto W/2 is -W/2, so the interval stays half-open.
+    out = np.where(out < -width / 2.0, out + width, out)
+    return np.where(out >= width / 2.0, out - width, out)
 
 
 def wrap_angle(angle_rad: ArrayLike) -> np.ndarray:

@@ -33,6 +33,16 @@ def _text(page: Path) -> str:
     return re.sub(r"\s+", " ", html.unescape(re.sub(r"<[^>]+>", " ", page.read_text())))
 
 
+def _from_docs_extension(*names: str) -> tuple:
+    """The named objects of the docs' Sphinx extension (``docs/source/_ext/skyradar_docs.py``)."""
+    sys.path.insert(0, str(SOURCE / "_ext"))
+    try:
+        import skyradar_docs
+    finally:
+        sys.path.remove(str(SOURCE / "_ext"))
+    return tuple(getattr(skyradar_docs, name) for name in names)
+
+
 @pytest.fixture(scope="module")
 def site(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("docs")
@@ -48,11 +58,7 @@ def site(tmp_path_factory) -> Path:
 
 
 def test_results_page_holds_the_measured_numbers(site):
-    sys.path.insert(0, str(SOURCE / "_ext"))
-    try:
-        from skyradar_docs import _row_as_shown, format_value
-    finally:
-        sys.path.remove(str(SOURCE / "_ext"))
+    _row_as_shown, format_value = _from_docs_extension("_row_as_shown", "format_value")
     text = _text(site / "results.html")
     files = sorted(RESULTS.glob("*.json"))
     assert files, "no measured summaries in docs/results"
@@ -80,11 +86,7 @@ def test_results_page_holds_the_measured_numbers(site):
 def test_a_run_with_clear_sky_shows_its_paired_change_of_lead():
     # A run over a terrain and clear sky (`--terrain hills,none`) records, per terrain row, its lead
     # against clear sky on the same encounters; the results page shows the median change.
-    sys.path.insert(0, str(SOURCE / "_ext"))
-    try:
-        from skyradar_docs import _row_as_shown, format_value
-    finally:
-        sys.path.remove(str(SOURCE / "_ext"))
+    _row_as_shown, format_value = _from_docs_extension("_row_as_shown", "format_value")
     paired = {"encounters": 51, "median_lead_s": 24.0, "median_difference_s": -2.56}
     row = _row_as_shown({"terrain": "hills", "lead_against_clear_sky": paired})
     assert format_value("lead_change_against_clear_sky_s", row["lead_change_against_clear_sky_s"]) == "-2.6"
@@ -94,11 +96,7 @@ def test_a_run_with_clear_sky_shows_its_paired_change_of_lead():
 def test_results_page_holds_the_clutter_experiments_numbers(site):
     """Each saved ``experiment clutter`` summary (``skyradar-clutter``): its provenance, a row per
     figure of merit with one value per terrain, and the figures kept beside it."""
-    sys.path.insert(0, str(SOURCE / "_ext"))
-    try:
-        from skyradar_docs import CLUTTER_FIGURES, format_value
-    finally:
-        sys.path.remove(str(SOURCE / "_ext"))
+    CLUTTER_FIGURES, format_value = _from_docs_extension("CLUTTER_FIGURES", "format_value")
     page = (site / "results.html").read_text()
     text = _text(site / "results.html").replace("\u2019", "'")  # smart quotes back to plain
     files = sorted((RESULTS / "clutter").glob("*.json"))

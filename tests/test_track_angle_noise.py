@@ -34,11 +34,12 @@ def _velocity_rms(noise_memory: float, seed: int, true_sd_rad: float, stated_sd_
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_scattered_directions_do_not_drive_the_velocity(seed):
     # Directions 15 times worse than their stated bound (0.15 vs 0.01 rad): trusting the bound, the
-    # velocity is 26-32 m/s off (measured, seeds 0-5); matching the noise to the innovations, 14-19.
+    # velocity is 32-65 m/s off (measured, seeds 0-7); matching the noise to the innovations, 3-13
+    # on six of them and 21-32 on two whose first position is 3 sigma off.
     trusting = _velocity_rms(0.0, seed, 0.15, 0.01)
     matched = _velocity_rms(0.1, seed, 0.15, 0.01)
-    assert trusting > 22.0
-    assert matched < 20.0 and matched < 0.75 * trusting
+    assert trusting > 30.0
+    assert matched < 10.0 and matched < 0.25 * trusting
 
 
 def test_honest_noise_is_left_alone():

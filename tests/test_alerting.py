@@ -482,6 +482,26 @@ def test_rows_the_velocity_gate_silences_are_no_evidence_against_the_conflict():
     assert later > first_converged + 0.5
 
 
+def test_an_issued_warning_is_held_while_the_velocity_gate_silences_the_rows():
+    # A head-on warned on converged rows, whose velocity then scatters for 9 s (an own-ship turn,
+    # directions over clutter): the gate keeps those rows from raising, and they say nothing that
+    # the conflict is gone. Counted as frames without a conflict they would drop the warning after
+    # the 5-s hysteresis and raise it again when the velocity converges; held by their geometry
+    # (the volume widened by the velocity's sigma still lost), the warning stays on.
+    dt = 1.0 / 9.4
+    own, tracks = _head_on(start_m=D_NC + 20.0 * 100.0, closure_mps=100.0, duration_s=15.0, dt=dt)
+    t = tracks["time_s"].to_numpy()
+    gated = (t >= 3.0) & (t < 12.0)
+    sigma = np.where(gated, 9.0, 2.0)  # per horizontal axis: 12.7 m/s x 15-24 s to CPA > 150 m
+    cov = {f"cov_vv_{i}{j}": (sigma**2 if i == j else np.zeros_like(t)) for i in range(3) for j in range(3)}
+    cfg = replace(RADAR_ALERT_CONFIG, min_track_age_s=0.0, min_track_age_floor_s=0.0)
+    out = alerts_from_tracks(tracks.assign(**cov), own, cfg, with_advice=False)
+    level, raw = out["level"].to_numpy(), out["raw_level"].to_numpy()
+    assert (raw[gated] == 0).all()  # the gate silences them
+    first = int(np.argmax(level == 3))
+    assert t[first] < 3.0 and (level[first:] == 3).all()
+
+
 def test_a_track_far_from_its_loss_of_well_clear_waits_the_full_age():
     # 20 s and more from the loss, a fresh track keeps the full minimum age: there is time to converge.
     dt = 1.0 / 9.4

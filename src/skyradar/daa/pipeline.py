@@ -94,7 +94,10 @@ def _gate_unconverged(
     before confirmation can only bring a warning earlier, never clear one.
 
     A silenced row is marked ``raw["gated"]``: its velocity says nothing about the conflict, so the
-    M-of-N filter takes it as no evidence (:func:`_filter_inputs`), not as a frame without one.
+    M-of-N filter takes it as no evidence to raise (:func:`_filter_inputs`), not as a frame without
+    one. Its hold level is left as its geometry gives it: the gate keeps an uncertain velocity from
+    raising an alert, and an alert that converged frames raised is held as DO-365B holds it, while
+    the volume widened by that uncertainty is predicted lost within the level's hold time.
     """
     raw["gated"] = np.zeros(len(raw["level"]), bool)
     if config.max_velocity_sigma_mps is not None and cov_v is not None:
@@ -105,7 +108,6 @@ def _gate_unconverged(
         )
         unconverged = velocity_unconverged(sigma_hv, raw["tcpa_s"], config) & located & ~inside
         raw["level"][unconverged] = 0
-        raw["hold_level"][unconverged] = 0
         raw["flarm_level"][unconverged] = 0
         raw["gated"] = unconverged
 
@@ -126,7 +128,9 @@ def _filter_inputs(raw: dict, rows: np.ndarray, predicted: np.ndarray) -> tuple[
     raises a level nor counts as a frame without a conflict: counted as level 0, the gated rows
     of a fast closure's first seconds after confirmation would fill the filter's window with
     zeros, and its first converged rows would wait until they were half of that window. Its hold
-    level stays the gate's 0: an issued alert is held by the frames that measure it."""
+    level is its geometry's (:func:`_gate_unconverged`): a warning raised on a closure's range path
+    is not dropped while the velocity converges (an own-ship in a turn keeps it uncertain for
+    seconds longer than the 5-s hysteresis)."""
     unknown = ~raw["known"][rows]
     evidence = np.where(predicted[rows] | unknown | raw["gated"][rows], -1, raw["level"][rows])
     return evidence, np.where(unknown, -1, raw["hold_level"][rows])

@@ -93,10 +93,11 @@ def test_radial_velocity_update_beats_positions_alone():
     assert errs[1] < 0.5 * errs[0]
 
 
-def test_a_range_rate_moves_only_the_velocity_along_the_line_of_sight():
-    # The range rate says nothing about the position or the velocity across the line of sight: with
-    # position-velocity and cross-velocity correlations in P, the update still changes the velocity
-    # along u alone, by u' P_vv u / S of the innovation.
+def test_a_range_rate_moves_the_horizontal_velocity_only_along_the_line_of_sight():
+    # The range rate says nothing about the position or the horizontal velocity across the line of
+    # sight: with position-velocity and cross-velocity correlations in P, the update leaves the
+    # position alone and changes the horizontal velocity along the horizontal line of sight only.
+    # The vertical speed takes the optimal gain (P h / S), small under its tight level-flight prior.
     rng = np.random.default_rng(3)
     A = rng.normal(size=(6, 6))
     P = (A @ A.T + 6.0 * np.eye(6))[None] * 25.0
@@ -104,11 +105,39 @@ def test_a_range_rate_moves_only_the_velocity_along_the_line_of_sight():
     obs = RadialObservation(np.zeros(3), np.array([50.0, 0.0, 0.0]), np.array([-99.0]), 0.2)
     x1, P1 = range_rate_update(x, P, obs.radial_velocity_mps, obs)
     u = x[0, :3] / np.linalg.norm(x[0, :3])
+    u_h = u[:2] / np.linalg.norm(u[:2])
     dv = x1[0, 3:] - x[0, 3:]
     assert np.array_equal(x1[0, :3], x[0, :3])
-    assert np.allclose(dv - (dv @ u) * u, 0.0, atol=1e-9)
-    assert np.isclose(u @ (x1[0, 3:] - obs.own_velocity_mps), -99.0, atol=2.0)  # the innovation is taken
+    assert abs(dv[0] * u_h[1] - dv[1] * u_h[0]) < 1e-9  # nothing across the horizontal line of sight
+    Ph = P[0] @ np.concatenate([np.zeros(3), u])  # the optimal gain's direction, times S
+    assert dv[2] / (dv[:2] @ u_h) == pytest.approx(Ph[5] / (Ph[3:5] @ u_h))
     assert np.all(np.linalg.eigvalsh(P1[0]) > 0.0) and np.allclose(P1[0], P1[0].T)
+
+
+def test_range_rates_do_not_send_a_level_intruder_down_the_line_of_sight_vertically():
+    # A level intruder 250 m above, 3.5 km ahead: the line of sight climbs at 4 deg, so a gain along
+    # the 3-D line of sight would put 7 % of the first range rate's 50 m/s correction into the
+    # vertical speed (3.5 m/s of descent towards the own-ship at 2 s, a false vertical conflict).
+    # The vertical speed's own gain, under its 3 m/s prior, keeps it level.
+    rng = np.random.default_rng(11)
+    own_v, int_v = np.array([50.0, 0.0, 0.0]), np.array([-50.0, 0.0, 0.0])
+    rel0, runs = np.array([3500.0, 100.0, -250.0]), 300
+    t3, ids = Tracker3D(), np.arange(runs)
+    for k in range(int(6.0 / DT) + 1):
+        t = k * DT
+        own = own_v * t
+        rel = rel0 + (int_v - own_v) * t
+        r = np.linalg.norm(rel)
+        u = rel / r
+        across = rng.normal(0.0, 0.02, (runs, 3))
+        across -= (across @ u)[:, None] * u
+        seen = (u + across) / np.linalg.norm(u + across, axis=1)[:, None]
+        pos = own + (r + rng.normal(0.0, 5.0, (runs, 1))) * seen
+        cov = position_covariance(pos, own, np.full(runs, 0.02), np.full(runs, r * 0.02))
+        rr = u @ (int_v - own_v) + rng.normal(0.0, 0.2, runs)
+        x, _ = t3.step(t, ids, pos, cov, RadialObservation(own, own_v, rr, 0.2))
+        if k in (int(2.0 / DT), int(6.0 / DT)):
+            assert abs(float(np.mean(x[:, 5]))) < 0.5, t
 
 
 def test_confirmed_false_while_coasting_and_true_again_after():

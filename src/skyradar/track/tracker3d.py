@@ -11,9 +11,10 @@ SNR, :mod:`skyradar.track.measure3d`). When the own-ship state is known, the de-
 velocity, the radar's most accurate measurement, updates the velocity too: ``h(x) = u . (v - v_own)``
 with ``u`` the unit line of sight of the prediction (:func:`range_rate_update`). Without it the
 radial velocity comes from differencing positions that are tens of metres apart. The range rate
-measures the velocity along the line of sight and nothing else, so its gain acts along the line of
-sight only; the velocity across it comes from the positions. Positions that fall outside a
-chi-square gate of the prediction (DoA outliers at low SNR) are not used.
+measures the velocity along the line of sight and nothing else, so in the horizontal plane its gain
+acts along the line of sight only; the horizontal velocity across it comes from the positions.
+Positions that fall outside a chi-square gate of the prediction (DoA outliers at low SNR) are not
+used.
 
 The stated angle error is the bound at the detection's SNR; after clutter suppression a 2 x 2 array's
 directions scatter far more (tens of degrees over terrain), and a filter that trusts the bound takes
@@ -76,17 +77,19 @@ def range_rate_update(
     ``|w_perp|^2 * var(angle)``, ``w = v - v_own``, the angle variance from the predicted position
     covariance across the line of sight.
 
-    The gain is confined to the line of sight: it changes the velocity along ``u`` by
-    ``u' P_vv u / S`` of the innovation and leaves the position and the velocity across ``u``
-    alone. The optimal gain ``P h / S`` also acts across ``u`` through ``P_vv``, and there it reads
-    the error of the filter's own line of sight as information: ``u`` is off by the angle error
-    ``a`` of the prediction, the gain then carries ``P_vv a / S`` across the line of sight, and the
-    innovation carries ``-a . w``. Their product pulls the velocity across the line of sight
-    towards zero on every update, by ``P_vv var(a) w_perp / S``, which with a cross-range
-    velocity sigma of tens of m/s and a range-rate sigma of 0.2 m/s exceeds the velocity itself:
-    a track first seen at 3.5 km is held on a collision course for seconds, and a
-    conflict-free aircraft 1 km abeam is warned. Joseph form keeps the covariance right for
-    this gain.
+    The gain leaves the position alone and, in the horizontal plane, acts along the horizontal
+    line of sight only; the vertical speed takes the optimal gain ``(P h / S)_vd``. The optimal
+    gain ``P h / S`` also acts across ``u`` through ``P_vv``, and there it reads the error of the
+    filter's own line of sight as information: ``u`` is off by the angle error ``a`` of the
+    prediction, the gain then carries ``P_vv a / S`` across the line of sight, and the innovation
+    carries ``-a . w``. Their product pulls the velocity across the line of sight towards zero on
+    every update, by ``P_vv var(a) w_perp / S``, which with a horizontal velocity sigma of tens of
+    m/s and a range-rate sigma of 0.2 m/s exceeds the velocity itself: a track first seen at 3.5 km
+    is held on a collision course for seconds, and a conflict-free aircraft 1 km abeam is warned.
+    The vertical speed's sigma is a few m/s (its level-flight prior), so its optimal gain stays
+    small; confined to the 3-D line of sight instead, the gain would put ``u_z`` of each horizontal
+    correction into it (3.5 m/s of descent on a level aircraft 250 m above at 3.5 km, a false
+    vertical conflict). Joseph form keeps the covariance right for this gain.
 
     Examples
     --------
@@ -108,8 +111,10 @@ def range_rate_update(
     h = np.concatenate([np.zeros_like(u), u], axis=1)  # (n, 6)
     Ph = np.einsum("nij,nj->ni", P, h)
     S = np.einsum("ni,ni->n", h, Ph) + noise
-    along = np.einsum("ni,ni->n", u, Ph[:, 3:]) / S  # u' P_vv u / S
-    K = np.concatenate([np.zeros_like(u), along[:, None] * u], axis=1)
+    K = Ph / S[:, None]
+    K[:, :3] = 0.0
+    along_h = u[:, :2] / np.linalg.norm(u[:, :2], axis=1)[:, None]  # horizontal line of sight
+    K[:, 3:5] = np.sum(K[:, 3:5] * along_h, axis=1)[:, None] * along_h
     x_new = x + K * (rr_mps - uw)[:, None]
     I_KH = np.eye(6) - K[:, :, None] * h[:, None, :]
     P_new = I_KH @ P @ np.swapaxes(I_KH, -1, -2) + noise[:, None, None] * K[:, :, None] * K[:, None, :]

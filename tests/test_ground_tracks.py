@@ -173,12 +173,9 @@ def test_history_starts_again_after_a_reacquisition_gap():
         assert (~out.loc[after_gap, "confirmed"]).all() == held_after, gap_s
 
 
-def test_converging_aircraft_fits_a_static_point_but_its_direction_keeps_it():
-    # Over flat ground 300 m below, an aircraft converging at 60 deg (42 m/s, 550 m miss, co-altitude)
-    # has |w| = 46.5 m/s against the own-ship's 50 m/s, so its range and Doppler fit a static point
-    # for seconds (its miss distance reaches the ground 300 m below). Held until they do not, it would
-    # be warned 0.5 s after its loss of well clear. A direction of arrival that puts it in the air,
-    # consistently, keeps it confirmed; without one it is held.
+def _converging_over_300_m():
+    """An aircraft converging at 60 deg (42 m/s, 550 m miss, co-altitude) over flat ground 300 m below:
+    the own-ship table, its detections with azimuths measured to 0.02 rad, and the ground test."""
     from skyradar.track.ground_tracks import GroundTrackTest
 
     agl = 300.0
@@ -192,7 +189,16 @@ def test_converging_aircraft_fits_a_static_point_but_its_direction_keeps_it():
     rng = np.random.default_rng(5)
     det["azimuth_rad"] = np.arctan2(rel[:, 1], rel[:, 0]) + rng.normal(0, 0.02, T.size)
     det["elevation_rad"] = rng.normal(0, 0.02, T.size)
-    test = GroundTrackTest(surface_down=flat_surface(agl))
+    return own, det, GroundTrackTest(surface_down=flat_surface(agl))
+
+
+def test_converging_aircraft_fits_a_static_point_but_its_direction_keeps_it():
+    # Over flat ground 300 m below, an aircraft converging at 60 deg (42 m/s, 550 m miss, co-altitude)
+    # has |w| = 46.5 m/s against the own-ship's 50 m/s, so its range and Doppler fit a static point
+    # for seconds (its miss distance reaches the ground 300 m below). Held until they do not, it would
+    # be warned 0.5 s after its loss of well clear. A direction of arrival that puts it in the air,
+    # consistently, keeps it confirmed; without one it is held.
+    own, det, test = _converging_over_300_m()
     with_doa = track_detections(det, ownship=own, ground_test=test)
     no_doa = det.drop(columns=["azimuth_rad", "elevation_rad"])
     without = track_detections(no_doa, ownship=own, ground_test=test)
@@ -318,20 +324,8 @@ def test_an_azimuth_that_no_fitting_static_point_has_releases_the_track():
     # lie at azimuths of +-25 deg (8-10 deg below the horizon); it is measured at 35-38 deg, ten
     # times the azimuth's 1-deg error, on every detection. No static point it could be sits where
     # it is seen: it is an object within 2 s, as a measured elevation would make it.
-    from skyradar.track.ground_tracks import GroundTrackTest
-
-    agl = 300.0
-    own = _own().assign(own_height_agl_m=agl)
-    w = -46.5 * np.array([np.cos(np.radians(20.0)), np.sin(np.radians(20.0)), 0.0])
-    across = np.cross(w, [0.0, 0.0, 1.0])
-    rel = -2000.0 * w / np.linalg.norm(w) + 550.0 * across / np.linalg.norm(across) + w * T[:, None]
-    target = rel + own[["own_north_m", "own_east_m", "own_down_m"]].to_numpy()
-    det = _detections(target, seed=4)
-    rng = np.random.default_rng(5)
-    det["azimuth_rad"] = np.arctan2(rel[:, 1], rel[:, 0]) + rng.normal(0, 0.02, T.size)
-    det["elevation_rad"] = 0.0
-    det["elevation_measured"] = False
-    test = GroundTrackTest(surface_down=flat_surface(agl))
+    own, det, test = _converging_over_300_m()
+    det = det.assign(elevation_rad=0.0, elevation_measured=False)
     assert _confirmed_from(track_detections(det, ownship=own, ground_test=test)) < 2.0
 
 

@@ -114,6 +114,16 @@ def test_a_range_rate_moves_the_horizontal_velocity_only_along_the_line_of_sight
     assert np.all(np.linalg.eigvalsh(P1[0]) > 0.0) and np.allclose(P1[0], P1[0].T)
 
 
+def test_a_range_rate_straight_above_moves_only_the_vertical_speed():
+    # Straight above the own-ship the line of sight has no horizontal part: the range rate measures
+    # the vertical closure alone, and the horizontal velocity and the covariance stay finite.
+    obs = RadialObservation(np.zeros(3), np.array([50.0, 0.0, 0.0]), np.array([-3.0]), 0.2)
+    x = np.array([[0.0, 0.0, -300.0, 0.0, 0.0, 0.0]])
+    x1, P1 = range_rate_update(x, np.eye(6)[None] * 100.0, obs.radial_velocity_mps, obs)
+    assert np.all(np.isfinite(x1)) and np.all(np.isfinite(P1))
+    assert np.array_equal(x1[0, :5], x[0, :5]) and x1[0, 5] > 2.5  # closing from above: descending
+
+
 def test_range_rates_do_not_send_a_level_intruder_down_the_line_of_sight_vertically():
     # A level intruder 250 m above, 3.5 km ahead: the line of sight climbs at 4 deg, so a gain along
     # the 3-D line of sight would put 7 % of the first range rate's 50 m/s correction into the

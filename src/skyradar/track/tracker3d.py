@@ -113,7 +113,10 @@ def range_rate_update(
     S = np.einsum("ni,ni->n", h, Ph) + noise
     K = Ph / S[:, None]
     K[:, :3] = 0.0
-    along_h = u[:, :2] / np.linalg.norm(u[:, :2], axis=1)[:, None]  # horizontal line of sight
+    # The horizontal line of sight; straight above or below there is none, and the range rate says
+    # nothing of the horizontal velocity (its gain there is 0, not NaN).
+    horizontal = np.linalg.norm(u[:, :2], axis=1, keepdims=True)
+    along_h = np.divide(u[:, :2], horizontal, out=np.zeros_like(u[:, :2]), where=horizontal > 0.0)
     K[:, 3:5] = np.sum(K[:, 3:5] * along_h, axis=1)[:, None] * along_h
     x_new = x + K * (rr_mps - uw)[:, None]
     I_KH = np.eye(6) - K[:, :, None] * h[:, None, :]

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-import pytest
 
 from skyradar.config import RadarConfig
 from skyradar.track.ground_tracks import (
@@ -66,6 +65,10 @@ def _detections(target_ned: np.ndarray, seed: int = 0, t: np.ndarray = T, up_m: 
             "east_m": target_ned[:, 1],
             "down_m": target_ned[:, 2] - up_m,
             "snr_db": 20.0 + 0 * t,
+            # a forward radar on the own-ship flying north, level: its right axis points east
+            "right_axis_north": 0 * t,
+            "right_axis_east": 1 + 0 * t,
+            "right_axis_down": 0 * t,
         }
     )
 
@@ -311,12 +314,6 @@ def test_track_without_a_measured_direction_needs_more_detections():
         assert earliest / 9.4 <= _confirmed_from(out) <= latest / 9.4 + 1e-9, velocity_mps
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the ground hold reads measured elevations only: an aircraft whose range-Doppler history is "
-    "a static ground point's and whose elevation clutter suppression left unobservable is held, "
-    "however clearly its azimuth differs from that point's",
-)
 def test_an_azimuth_that_no_fitting_static_point_has_releases_the_track():
     # The converging aircraft above (|w| = 46.5 m/s, 550 m miss, co-altitude over ground 300 m
     # below), inside the ground's band, its elevation left unobservable by the nulls of its cell
@@ -327,6 +324,25 @@ def test_an_azimuth_that_no_fitting_static_point_has_releases_the_track():
     own, det, test = _converging_over_300_m()
     det = det.assign(elevation_rad=0.0, elevation_measured=False)
     assert _confirmed_from(track_detections(det, ownship=own, ground_test=test)) < 2.0
+
+
+def test_a_ground_cell_read_between_its_static_points_stays_held():
+    # Residual clutter of a cell holding ground left and right of the own-ship's track (points at
+    # +-20 deg, 2.3 km away over flat ground 500 m below): after the nulls its direction reads in
+    # between, a steady 0-3 deg, elevation unmeasured. That direction is a mix of the two points,
+    # not a direction no static point could give: the track stays held, as does one read at the
+    # point itself. Read at 35 deg, beyond both, the same history is released as an object.
+    from skyradar.track.ground_tracks import GroundTrackTest
+
+    az = np.radians(20.0)
+    ground_r = np.sqrt(2300.0**2 - AGL_M**2)
+    ground = np.tile([ground_r * np.cos(az), ground_r * np.sin(az), AGL_M], (T.size, 1))
+    rng = np.random.default_rng(12)
+    base = _detections(ground, seed=13).assign(elevation_rad=0.0, down_m=0.0, elevation_measured=False)
+    test = GroundTrackTest(surface_down=flat_surface(AGL_M))
+    for read_deg, kept in ((1.5, False), (20.0, False), (35.0, True)):
+        det = base.assign(azimuth_rad=np.radians(read_deg) + rng.normal(0, 0.02, T.size))
+        assert (len(track_detections(det, ownship=_own(), ground_test=test)) > 0) == kept, read_deg
 
 
 def test_prior_elevations_do_not_overrule_the_static_ground_fit():
@@ -454,3 +470,26 @@ def test_a_ground_track_is_released_only_by_verdicts_on_new_directions(monkeypat
     held = held_with(["ground"] * 10 + [""] * 13)
     released = test.min_detections - 1 + 10 + test.release_span_detections
     assert held[:released].all() and not held[released:].any()
+
+
+def test_the_azimuth_rule_reads_the_antenna_frame_of_a_banked_own_ship():
+    # A ground point 2 km ahead, 300 m below, left of the track, seen from an own-ship banked 35 deg
+    # right: the antenna's right axis dips 35 deg, so the point's direction cosine along it is
+    # -0.26 (azimuth -14.8 deg with the elevation prior), not the level -0.42 (-24.7 deg). Read in
+    # the antenna frame the measured azimuth is the point's: held. Read in a level frame, the same
+    # azimuth would lie 10 deg (5 sd) off the point and release it.
+    from skyradar.track.ground_doa import azimuth_off_static_points
+
+    rng = np.random.default_rng(3)
+    own = np.zeros((10, 3))
+    point = np.array([[1780.0, -830.0, 300.0]])
+    roll = np.radians(35.0)
+    banked = np.tile([0.0, np.cos(roll), np.sin(roll)], (10, 1))
+    cosine = (point[0] @ banked[0]) / np.linalg.norm(point[0])
+    assert abs(np.degrees(np.arcsin(cosine)) + 14.8) < 0.1
+    seen = np.arcsin(cosine) + rng.normal(0, 0.01, 10)
+    assert not azimuth_off_static_points(seen, np.zeros(10), banked, own, point)
+    assert azimuth_off_static_points(seen, np.zeros(10), np.tile([0.0, 1.0, 0.0], (10, 1)), own, point)
+    # Residual clutter scattered over the beam is no direction: held whatever the points.
+    scattered = rng.uniform(-0.6, 0.6, 10)
+    assert not azimuth_off_static_points(scattered, np.zeros(10), banked, own, point)

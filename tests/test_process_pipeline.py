@@ -86,6 +86,16 @@ def test_world_positions_match_truth_and_ground_is_flagged():
         lat, lon, alt = ned_to_geodetic(ned, *ORIGIN)
         np.testing.assert_allclose(rows.lat_deg, lat, atol=1e-9)
         np.testing.assert_allclose(rows.alt_m, alt, atol=1e-3)
+        # The right axis is the one the azimuth is measured about: the direction cosine along it of
+        # each true point, seen from the antenna, is sin(azimuth) cos(elevation).
+        right = rows[["right_axis_north", "right_axis_east", "right_axis_down"]].to_numpy()
+        np.testing.assert_allclose(np.linalg.norm(right, axis=1), 1.0, atol=1e-12)
+        for point in (aircraft, ground):
+            k = int(np.argmin(np.linalg.norm(ned - point, axis=1)))
+            own = np.array([ds[f"own_{a}_m"].values[frame] for a in ("north", "east", "down")])
+            sight = (point - own) / np.linalg.norm(point - own)
+            az, el = rows.azimuth_rad.iloc[k], rows.elevation_rad.iloc[k]
+            assert abs(sight @ right[k] - np.sin(az) * np.cos(el)) < 0.01
 
 
 def test_body_frame_without_ownship_and_nan_world():

@@ -86,6 +86,10 @@ DETECTION_TABLE_COLUMNS: dict[str, str] = {
     "north_m": "m; position north in the scenario NED frame, from the navigation solution (NaN without it)",
     "east_m": "m; position east in the scenario NED frame (NaN without own-ship navigation)",
     "down_m": "m; position down in the scenario NED frame (NaN without own-ship navigation)",
+    "right_axis_north": "-; north component of the antenna's right axis in the scenario NED frame: "
+    "sin(azimuth_rad) cos(elevation_rad) is the direction cosine along it (NaN without own-ship navigation)",
+    "right_axis_east": "-; east component of the antenna's right axis (NaN without own-ship navigation)",
+    "right_axis_down": "-; down component of the antenna's right axis (NaN without own-ship navigation)",
     "lat_deg": "deg; WGS84 latitude (NaN without own-ship navigation)",
     "lon_deg": "deg; WGS84 longitude (NaN without own-ship navigation)",
     "alt_m": "m; height above the WGS84 ellipsoid (NaN without own-ship navigation)",
@@ -195,19 +199,21 @@ def _body_to_ned(own: OwnShipStates, i: int, origin: tuple | None) -> np.ndarray
 
 def _to_world(
     out: dict[str, np.ndarray], own: OwnShipStates, i: int, config: RadarConfig, origin: tuple | None
-) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray]:
-    """NED position, geodetic position and NED unit direction of one frame's detections."""
+) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray, np.ndarray]:
+    """NED position, geodetic position and NED unit direction of one frame's detections, and the
+    antenna's right axis in NED (3,)."""
     pos = _position(own, i)
     body_to_ned = _body_to_ned(own, i, origin)
     body = np.stack([out["x_body_m"], out["y_body_m"], out["z_body_m"]], axis=1)
     ned = pos + body @ body_to_ned.T
-    u_ned = out["u_ant"] @ (body_to_ned @ config.mount.rotation).T
+    ant_to_ned = body_to_ned @ config.mount.rotation
+    u_ned = out["u_ant"] @ ant_to_ned.T
     geodetic = _geodetic_fn(own, i, origin)
     if geodetic is not None:
         geo = geodetic(ned)
     else:
         geo = (np.full(len(ned), np.nan), np.full(len(ned), np.nan), np.full(len(ned), np.nan))
-    return ned, geo, u_ned
+    return ned, geo, u_ned, ant_to_ned[:, 1]
 
 
 def _geodetic_fn(own: OwnShipStates, i: int, origin: tuple | None) -> GeodeticFn | None:
@@ -328,10 +334,12 @@ def _located(
     out["time_s"] = np.full(n, time_s)
     out["frame"] = np.full(n, i, np.int64)
     nan = np.full(n, np.nan)
-    ned, geo, u_ned = (np.full((n, 3), np.nan), (nan, nan, nan), None)
+    ned, geo, u_ned, right = (np.full((n, 3), np.nan), (nan, nan, nan), None, np.full(3, np.nan))
     if own is not None:
-        ned, geo, u_ned = _to_world(out, own, i, config, origin)
+        ned, geo, u_ned, right = _to_world(out, own, i, config, origin)
     out.update(north_m=ned[:, 0], east_m=ned[:, 1], down_m=ned[:, 2])
+    out.update(right_axis_north=np.full(n, right[0]), right_axis_east=np.full(n, right[1]))
+    out["right_axis_down"] = np.full(n, right[2])
     out.update(lat_deg=np.asarray(geo[0]), lon_deg=np.asarray(geo[1]), alt_m=np.asarray(geo[2]))
     out["is_ground"] = _ground_flags(out, own, i, u_ned, config, terrain, origin)
     return out

@@ -14,6 +14,8 @@ import numpy as np
 import pandas as pd
 
 DOA_COLUMNS = ("azimuth_rad", "elevation_rad", "north_m", "east_m", "down_m", "elevation_measured")
+# The antenna's right axis in NED: the azimuth is measured about it (``process.pipeline``).
+AXIS_COLUMNS = ("right_axis_north", "right_axis_east", "right_axis_down")
 DOA_SIGMA_RAD = float(np.radians(2.0))  # CRLB at 13-20 dB plus attitude errors
 DOA_FIELD_RAD = float(np.radians(45.0))  # half-angle of boresight inside which that holds
 # A direction (and the track's height) counts as measured when this many of its last detections had
@@ -22,7 +24,9 @@ MEASURED_LEAST, MEASURED_WINDOW = 3, 10
 
 __all__ = [
     "DOA_COLUMNS",
+    "AXIS_COLUMNS",
     "doa_height_sd",
+    "azimuth_off_static_points",
     "doa_in_the_air",
     "direction_measured",
     "doa_on_the_ground",
@@ -33,25 +37,111 @@ __all__ = [
 
 def doa_height_sd(det: np.ndarray, surface_down, sigma_rad: float = DOA_SIGMA_RAD) -> list[np.ndarray]:
     """Azimuth and elevation (antenna frame) of each detection, its DoA position's height above
-    the surface in standard deviations (range x ``sigma_rad``, 10 m for the surface) and
-    whether its elevation was measured (:func:`elevation_measured_flags` says how the column is read).
+    the surface in standard deviations (range x ``sigma_rad``, 10 m for the surface), whether its
+    elevation was measured (:func:`elevation_measured_flags` says how the column is read) and the
+    antenna's right axis in NED (k, 3; NaN where ``det`` does not have it).
 
-    ``det`` columns: time, range, radial velocity, then :data:`DOA_COLUMNS`; ``surface_down`` maps
-    NE points (k, 2) to the ground's ``down``, m.
+    ``det`` columns: time, range, radial velocity, then :data:`DOA_COLUMNS`, optionally
+    :data:`AXIS_COLUMNS`; ``surface_down`` maps NE points (k, 2) to the ground's ``down``, m.
 
     Examples
     --------
     >>> det = np.array([[0.0, 1000.0, 5.0, 0.1, -0.5, 800.0, 0.0, 480.0, 1.0]])
-    >>> az, el, z, measured = doa_height_sd(det, lambda ne: np.full(len(ne), 500.0))
+    >>> az, el, z, measured, right = doa_height_sd(det, lambda ne: np.full(len(ne), 500.0))
     >>> round(float(z[0]), 2), bool(measured[0])  # 20 m above ground, sd hypot(35, 10) m
     (0.55, True)
     """
     az, el, measured = det[:, 3], det[:, 4], det[:, 8] == 1.0
+    right = det[:, 9:12] if det.shape[1] >= 12 else np.full((len(det), 3), np.nan)
     if surface_down is None or not np.isfinite(det[:, 5:8]).any():
-        return [az, el, np.full(az.size, np.nan), measured]
+        return [az, el, np.full(az.size, np.nan), measured, right]
     with np.errstate(invalid="ignore"):
         height = surface_down(np.nan_to_num(det[:, 5:7])) - det[:, 7]
-        return [az, el, height / np.hypot(det[:, 1] * sigma_rad, 10.0), measured]
+        return [az, el, height / np.hypot(det[:, 1] * sigma_rad, 10.0), measured, right]
+
+
+def azimuth_off_static_points(
+    azimuth_rad,
+    elevation_rad,
+    right_axis,
+    own_position_m,
+    points_ned,
+    sigma_rad: float = DOA_SIGMA_RAD,
+    field_rad: float = DOA_FIELD_RAD,
+    n: int = 10,
+    min_sd: float = 4.0,
+) -> bool:
+    """Whether a track's recent azimuths say, reliably, that it is none of the static ground points
+    that explain its range and Doppler.
+
+    The array measures the direction cosine along the antenna's right axis,
+    ``sin(azimuth) cos(elevation)``, even where clutter suppression left the elevation unobservable
+    (``process.clutter_doa`` searches the cone of that cosine). A static point ``P`` seen from
+    ``o`` has the cosine ``(P - o) / |P - o| . right``. Of the last ``n`` detections at least half
+    and five must lie inside the field (``field_rad`` of boresight) with a known right axis; their
+    cosines must agree (robust spread within 3 sd, the sd being ``sigma_rad cos(azimuth)``: one
+    direction, not residual clutter scattered over the beam), and their median must lie ``min_sd``
+    sd or more beyond every point's on one side. Between two points is not enough: a cell holding
+    ground left and right of the own-ship's track reads, after its nulls, a direction in between.
+    Beyond them no static point the history allows, nor a mix of them, sits where the track is
+    seen: it is an object. An aircraft whose speed relative to the own-ship equals the
+    own-ship's has a static point's range-Doppler history, and the nulls of its ground cell may
+    leave its elevation unmeasured; its azimuth still tells it from that point's.
+
+    Parameters
+    ----------
+    azimuth_rad, elevation_rad : array_like, shape (k,)
+        Directions of arrival in the antenna frame, rad (elevation 0 where it was not measured).
+    right_axis : array_like, shape (k, 3)
+        The antenna's right axis in NED at each detection.
+    own_position_m : array_like, shape (k, 3)
+        Own-ship NED position at each detection, m.
+    points_ned : array_like, shape (m, 3)
+        Static points that explain the history (:func:`skyradar.track.static_point.static_ground_points`).
+    sigma_rad, field_rad : float
+        Azimuth error and the half-angle of boresight inside which it holds, rad.
+    n : int
+        Detections read, the newest.
+    min_sd : float
+        Least distance from every point's cosine, in sd.
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    Ground 300 m below, 2 km ahead at +-25 deg fits the history; the track is seen at 36 deg, then
+    at 24.6 deg (where the point on the right is), then at 0 deg (between the two):
+
+    >>> rng = np.random.default_rng(0)
+    >>> own, right = np.zeros((10, 3)), np.tile([0.0, 1.0, 0.0], (10, 1))
+    >>> points = np.array([[1780.0, 830.0, 300.0], [1780.0, -830.0, 300.0]])
+    >>> seen = np.radians(36.0) + rng.normal(0, 0.02, 10)
+    >>> azimuth_off_static_points(seen, np.zeros(10), right, own, points)
+    True
+    >>> on_the_point = seen - np.radians(36.0 - 24.6)
+    >>> azimuth_off_static_points(on_the_point, np.zeros(10), right, own, points)
+    False
+    >>> azimuth_off_static_points(seen - np.radians(36.0), np.zeros(10), right, own, points)
+    False
+    """
+    az, el = (np.asarray(a, float)[-n:] for a in (azimuth_rad, elevation_rad))
+    right = np.asarray(right_axis, float).reshape(-1, 3)[-n:]
+    own = np.asarray(own_position_m, float).reshape(-1, 3)[-n:]
+    points = np.asarray(points_ned, float).reshape(-1, 3)
+    with np.errstate(invalid="ignore"):
+        inside = (np.abs(az) <= field_rad) & (np.abs(el) <= field_rad) & np.isfinite(right).all(axis=1)
+    if points.size == 0 or inside.sum() < max(5, az.size // 2):
+        return False
+    cosine = (np.sin(az) * np.cos(el))[inside]
+    sd = sigma_rad * float(np.median(np.cos(az[inside])))
+    if 1.4826 * np.median(np.abs(cosine - np.median(cosine))) > 3.0 * sd:
+        return False
+    sight = points[:, None, :] - own[inside][None]  # (m, k, 3)
+    point_cosine = np.sum(sight * right[inside][None], axis=2) / np.linalg.norm(sight, axis=2)
+    off = np.median(cosine[None] - point_cosine, axis=1)  # each point's, signed
+    return bool(np.all(off >= min_sd * sd) or np.all(off <= -min_sd * sd))
 
 
 def doa_in_the_air(

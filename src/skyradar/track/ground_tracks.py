@@ -41,7 +41,9 @@ consistently, that the track flies above the ground overrules the static fit
 stays a track. An elevation that clutter suppression left unobservable (``process.clutter_doa``
 places it co-altitude) is no evidence either way: it neither overrules the static fit (its prior
 elevation 0 with a steady azimuth looks like "one direction in the air" and would release ground
-patches over hills) nor holds a track by itself.
+patches over hills) nor holds a track by itself. Its azimuth is: the array measures the direction
+cosine along the antenna's right axis whatever the elevation, and a track seen, consistently, where
+none of the static points that fit its history is (:func:`azimuth_off_static_points`) is an object.
 
 :func:`hold_ground_tracks` applies both tests causally (a row uses only the detections up to it)
 to a tracks table: rows of a track while the ground explains it, or while it is not an object,
@@ -59,9 +61,11 @@ import pandas as pd
 from scipy.stats import chi2, norm
 
 from skyradar.track.ground_doa import (
+    AXIS_COLUMNS,
     DOA_COLUMNS,
     DOA_FIELD_RAD,
     DOA_SIGMA_RAD,
+    azimuth_off_static_points,
     direction_measured,
     doa_height_sd,
     doa_in_the_air,
@@ -71,6 +75,7 @@ from skyradar.track.ground_doa import (
 from skyradar.track.static_point import (
     fits_static_ground,
     flat_surface,
+    static_ground_points,
     static_point_measurements,
     terrain_surface,
     trimmed_sum,
@@ -88,7 +93,7 @@ HOLD_REASONS: dict[str, str] = {
     "range": "its ranges contradict its Doppler (not one scatterer)",
     "rough": "its Doppler is not one smooth curve (scatterers of a patch taking turns)",
     "direction": "its measured elevations put it on the surface, or none is measured",
-    "ground": "one static point on the surface explains its range-Doppler history",
+    "ground": "a static point on the surface explains its range-Doppler history and is where it is seen",
     "ground-release": "a static ground point fitted it; judged an object for too short a span yet",
 }
 
@@ -104,6 +109,8 @@ __all__ = [
     "flat_surface",
     "terrain_surface",
     "doa_in_the_air",
+    "azimuth_off_static_points",
+    "static_ground_points",
     "doppler_smooth",
     "doa_on_the_ground",
     "direction_measured",
@@ -386,14 +393,20 @@ def _judge(sl, t, rng, vel, own_p, own_v, surface_down, width, coupling, test, d
         measured = doa[3][sl]
         if not direction_measured(measured) or doa_on_the_ground(measured, doa[2][sl]):
             return "direction"
-    azimuth, elevation, height_sd, measured = (a[sl] for a in doa)
+    azimuth, elevation, height_sd, measured, right = (a[sl] for a in doa)
     if surface_down is None or doa_in_the_air(
         azimuth, elevation, height_sd, measured, test.doa_sigma_rad, test.doa_field_rad
     ):
         return ""
     fit = (test.sigma_range_m, test.sigma_velocity_mps, test.tail, test.trim)
-    ground = fits_static_ground(rng[sl], vel[sl], own_p[sl], own_v[sl], surface_down, width, coupling, *fit)
-    return "ground" if ground else ""
+    points = static_ground_points(rng[sl], vel[sl], own_p[sl], own_v[sl], surface_down, width, coupling, *fit)
+    if len(points) == 0:
+        return ""
+    if not doa_on_the_ground(measured, height_sd) and azimuth_off_static_points(
+        azimuth, elevation, right, own_p[sl], points, test.doa_sigma_rad, test.doa_field_rad
+    ):
+        return ""  # seen where none of the static points that fit it is
+    return "ground"
 
 
 def _history_held(t, rng, vel, own_p, own_v, surface_down, width, coupling, test, doa) -> np.ndarray:
@@ -566,7 +579,8 @@ class TrackHoldWalk:
 
     def why(self, det: np.ndarray, ownship, surface_down, width: float, coupling: float) -> np.ndarray:
         """Why each detection of ``det`` (rows: time, range, radial velocity, then
-        :data:`DOA_COLUMNS`; every detection of the track so far) holds the track.
+        :data:`DOA_COLUMNS`, optionally :data:`AXIS_COLUMNS`; every detection of the track so far)
+        holds the track.
 
         A call with no new detection gives the last call's answer: every judgement depends on the
         detections and on the walk over those before the newest, and neither has changed."""
@@ -669,6 +683,7 @@ def hold_ground_tracks(
     det = np.column_stack(
         [held_detections[c].to_numpy(float) if c in held_detections else nan for c in names]
         + [elevation_measured_flags(held_detections).astype(float)]
+        + [held_detections[c].to_numpy(float) if c in held_detections else nan for c in AXIS_COLUMNS]
     )
     why = np.full(len(tracks), "young", dtype=object)
     kept: dict[int, tuple[np.ndarray, TrackHoldWalk]] = {}

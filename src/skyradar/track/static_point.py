@@ -15,7 +15,13 @@ from scipy.stats import chi2
 
 from skyradar.units import wrap
 
-__all__ = ["static_point_measurements", "fits_static_ground", "flat_surface", "terrain_surface"]
+__all__ = [
+    "static_point_measurements",
+    "fits_static_ground",
+    "static_ground_points",
+    "flat_surface",
+    "terrain_surface",
+]
 
 _EARTH_RADIUS_M = 6_371_000.0
 
@@ -110,11 +116,10 @@ def fits_static_ground(
 
     ``range_m`` (apparent) and ``radial_velocity_mps`` (aliased, modulo ``width_mps``) of the
     detections, the own-ship's NED position and velocity (k, 3) at their times, and the
-    surface's ``down`` at NE points (:func:`flat_surface`). The point starts where the newest,
-    the middle and the oldest detection's ring meets the surface (:func:`_ring_candidates`) and
-    moves on the surface by Gauss-Newton steps. ``sigma_*``: one detection's errors; ``tail``:
-    the chi-square test's false-rejection probability; ``trim``: fraction of worst-fitting
-    detections left out (another scatterer of the patch, a noise hit in the gate).
+    surface's ``down`` at NE points (:func:`flat_surface`); :func:`static_ground_points` finds the
+    points. ``sigma_*``: one detection's errors; ``tail``: the chi-square test's false-rejection
+    probability; ``trim``: fraction of worst-fitting detections left out (another scatterer of the
+    same clutter patch, a noise hit in the gate).
 
     Examples
     --------
@@ -127,6 +132,52 @@ def fits_static_ground(
     >>> fits_static_ground(rho - 2.0 * t * 10, v, own, vel, flat_surface(500.0), 78.3, 0.19)  # 20 m/s off
     False
     """
+    points = static_ground_points(
+        range_m,
+        radial_velocity_mps,
+        own_position_m,
+        own_velocity_mps,
+        surface_down,
+        width_mps,
+        coupling_s,
+        sigma_range_m,
+        sigma_velocity_mps,
+        tail,
+        trim,
+    )
+    return len(points) > 0
+
+
+def static_ground_points(
+    range_m: np.ndarray,
+    radial_velocity_mps: np.ndarray,
+    own_position_m: np.ndarray,
+    own_velocity_mps: np.ndarray,
+    surface_down: Callable[[np.ndarray], np.ndarray],
+    width_mps: float,
+    coupling_s: float,
+    sigma_range_m: float = 8.0,
+    sigma_velocity_mps: float = 0.25,
+    tail: float = 1e-3,
+    trim: float = 0.1,
+) -> np.ndarray:
+    """The static points on the surface that explain a detection history, NED (m, 3), m.
+
+    Arguments as :func:`fits_static_ground`. The points start where the newest, the middle and the
+    oldest detection's ring meets the surface (:func:`_ring_candidates`) and move on the surface by
+    Gauss-Newton steps; those whose trimmed chi-square passes the test are returned (several: the
+    rings meet the surface left and right of the own-ship's track, and one minimum may be reached
+    from several starts). None: no static point explains the history.
+
+    Examples
+    --------
+    >>> t = np.arange(30) * 0.1
+    >>> own = np.column_stack([50.0 * t, 0 * t, 0 * t]); vel = np.tile([50.0, 0, 0], (30, 1))
+    >>> rho, v = static_point_measurements(np.array([2000.0, 800.0, 500.0]), own, vel, 0.19)
+    >>> points = static_ground_points(rho, v, own, vel, flat_surface(500.0), 78.3, 0.19)
+    >>> np.unique(points.round(), axis=0).tolist()  # in level flight its mirror has its history too
+    [[2000.0, -800.0, 500.0], [2000.0, 800.0, 500.0]]
+    """
     rng, vel = np.asarray(range_m, float), np.asarray(radial_velocity_mps, float)
     own_p, own_v = np.asarray(own_position_m, float), np.asarray(own_velocity_mps, float)
     n = rng.size
@@ -136,7 +187,7 @@ def fits_static_ground(
     ]
     candidates = np.concatenate(starts) if starts else np.zeros((0, 2))
     if candidates.size == 0:
-        return False
+        return np.zeros((0, 3))
     sig = np.array([sigma_range_m, sigma_velocity_mps])
 
     def residuals(ne: np.ndarray) -> np.ndarray:  # (m, 2) candidates -> (m, 2n) normalised residuals
@@ -144,8 +195,9 @@ def fits_static_ground(
         rho, v = static_point_measurements(points[:, None, :], own_p, own_v, coupling_s)
         return np.concatenate([(rng - rho) / sig[0], wrap(vel - v, width_mps) / sig[1]], axis=1)
 
-    cost, keep = _gauss_newton(residuals, candidates, n, trim)
-    return bool(np.any(cost <= chi2.isf(tail, 2 * keep - 2)))
+    ne, cost, keep = _gauss_newton(residuals, candidates, n, trim)
+    fit = ne[cost <= chi2.isf(tail, 2 * keep - 2)]
+    return np.column_stack([fit, surface_down(fit)]) if len(fit) else np.zeros((0, 3))
 
 
 def _kept_rows(z2: np.ndarray, trim: float) -> np.ndarray:
@@ -163,7 +215,8 @@ def _gauss_newton(residuals: Callable, ne: np.ndarray, n: int, trim: float, step
     damping grows. Plain Gauss-Newton steps overshoot along the fit's long valley (the point
     slides along the iso-range, iso-Doppler line with little change) and over a DEM's kinks,
     and miss minima well inside the test's limit.
-    Returns each start's trimmed chi-square (m,) and the number of detections kept.
+    Returns the points reached (m, 2), each one's trimmed chi-square (m,) and the number of
+    detections kept.
     """
     ne = np.asarray(ne, float).copy()
     keep = n - int(np.floor(trim * n))
@@ -182,7 +235,7 @@ def _gauss_newton(residuals: Callable, ne: np.ndarray, n: int, trim: float, step
         better = trial_cost < cost
         ne[better], e[better], cost[better] = trial[better], trial_e[better], trial_cost[better]
         damping = np.where(better, damping / 3.0, damping * 4.0)
-    return cost, keep
+    return ne, cost, keep
 
 
 def _trimmed_cost(e: np.ndarray, n: int, keep: int) -> tuple[np.ndarray, np.ndarray]:

@@ -226,3 +226,39 @@ def test_directory_as_table_and_sweep_suffix(tmp_path):
     )
     _assert_one_line_error(result, "x.txt", ".csv or .parquet")
     assert not (tmp_path / "x.txt").exists()
+
+
+@pytest.mark.parametrize(
+    ("column", "value", "needles"),
+    [
+        ("right_axis_north", "abc", ["'right_axis_north'", "not a number", "row 2", "'abc'"]),
+        ("azimuth_rad", 7.0, ["'azimuth_rad'", "is 7 at row 2", "rad"]),
+        ("right_axis_east", 1e308, ["'right_axis_east'", "row 2"]),
+    ],
+)
+def test_track_refuses_directions_that_are_not_directions(tmp_path, column, value, needles):
+    # The ground hold reads each detection's direction and the antenna's right axis: text or an
+    # impossible value there is one line naming the file, field and row; NaN (not known) is taken.
+    import pandas as pd
+
+    t = np.arange(20) * 0.1
+    detections = pd.DataFrame(
+        {
+            "time_s": t,
+            "range_m": 1000.0 - 40.0 * t,
+            "radial_velocity_mps": -40.0,
+            "azimuth_rad": 0.1,
+            "elevation_rad": np.nan,
+            "right_axis_north": 0.0,
+            "right_axis_east": 1.0,
+            "right_axis_down": 0.0,
+        }
+    ).astype({column: object})
+    detections.loc[2, column] = value
+    detections.to_csv(tmp_path / "det.csv", index=False)
+    result = _skyradar("track", "det.csv", "-o", "tracks.parquet", cwd=tmp_path)
+    _assert_one_line_error(result, "det.csv", *needles)
+    assert not (tmp_path / "tracks.parquet").exists()
+    detections.loc[2, column] = np.nan
+    detections.to_csv(tmp_path / "det.csv", index=False)
+    assert _skyradar("track", "det.csv", "-o", "tracks.parquet", cwd=tmp_path).returncode == 0

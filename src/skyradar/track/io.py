@@ -34,6 +34,15 @@ _DETECTION_LIMITS = {
     "down_m": (1.0e7, "m"),
 }
 _OWNSHIP_LIMITS = {"m": (1.0e7, "m"), "mps": (1.0e4, "m/s")}  # by the unit ending the column's name
+# Directions a detection may hold, each within its bound or NaN (not known): angles in radians, and
+# the components of the antenna's right axis, a unit vector.
+_DIRECTION_LIMITS = {
+    "azimuth_rad": (np.pi, "rad"),
+    "elevation_rad": (np.pi / 2, "rad"),
+    "right_axis_north": (1.0 + 1e-6, ""),
+    "right_axis_east": (1.0 + 1e-6, ""),
+    "right_axis_down": (1.0 + 1e-6, ""),
+}
 
 
 def validate_detections(df: pd.DataFrame, source: str = "detections") -> pd.DataFrame:
@@ -63,6 +72,22 @@ def validate_detections(df: pd.DataFrame, source: str = "detections") -> pd.Data
         if col in df.columns:
             values = pd.to_numeric(df[col], errors="coerce").to_numpy(float)
             check_within(values, limit, unit, source, col, "not a radar measurement")
+    for col, (limit, unit) in _DIRECTION_LIMITS.items():  # NaN: not known; text or 1e308: refused
+        if col in df.columns:
+            values = pd.to_numeric(df[col], errors="coerce")
+            bad = np.flatnonzero(values.isna().to_numpy() & df[col].notna().to_numpy())
+            if bad.size:
+                raise InputError(
+                    f"{source}: field '{col}' is not a number at row {bad[0]} ({df[col].iloc[bad[0]]!r})"
+                )
+            outside = np.flatnonzero(np.abs(values.to_numpy(float)) > limit)
+            if outside.size:
+                i = int(outside[0])
+                raise InputError(
+                    f"{source}: field '{col}' is {values.iloc[i]:g} at row {i}, outside "
+                    f"[-{limit:.4g}, {limit:.4g}]{' ' + unit if unit else ''}"
+                )
+            df = df.assign(**{col: values.to_numpy(float)})
     t = df["time_s"].to_numpy(float)
     back = np.flatnonzero(t[1:] < t[:-1])
     if back.size:

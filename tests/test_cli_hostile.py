@@ -232,7 +232,7 @@ def test_directory_as_table_and_sweep_suffix(tmp_path):
     ("column", "value", "needles"),
     [
         ("right_axis_north", "abc", ["'right_axis_north'", "not a number", "row 2", "'abc'"]),
-        ("azimuth_rad", 7.0, ["'azimuth_rad'", "is 7 at row 2", "rad"]),
+        ("azimuth_rad", 7.0, ["'azimuth_rad'", "is 7 rad at row 2", "not a direction"]),
         ("right_axis_east", 1e308, ["'right_axis_east'", "row 2"]),
     ],
 )

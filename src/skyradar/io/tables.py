@@ -130,6 +130,8 @@ def check_within(
 ) -> None:
     """Refuse the first of ``values`` (column ``col``) beyond +-``limit``, naming the row; NaN passes.
 
+    ``unit`` follows each number as written ("" for a dimensionless column).
+
     1e308 is a finite number, but no measurement or state ``what`` describes holds it.
 
     Examples
@@ -143,8 +145,10 @@ def check_within(
         beyond = np.flatnonzero(np.abs(values) > limit)
     if beyond.size:
         i = int(beyond[0])
+        spaced = f" {unit}" if unit else ""
         raise InputError(
-            f"{source}: field '{col}' is {values[i]:.6g} {unit} at row {i}, beyond +-{limit:g} {unit}: {what}"
+            f"{source}: field '{col}' is {values[i]:.6g}{spaced} at row {i}, "
+            f"beyond +-{limit:g}{spaced}: {what}"
         )
 
 

@@ -338,8 +338,8 @@ def _located(
     if own is not None:
         ned, geo, u_ned, right = _to_world(out, own, i, config, origin)
     out.update(north_m=ned[:, 0], east_m=ned[:, 1], down_m=ned[:, 2])
-    out.update(right_axis_north=np.full(n, right[0]), right_axis_east=np.full(n, right[1]))
-    out["right_axis_down"] = np.full(n, right[2])
+    for axis, component in zip(("north", "east", "down"), right, strict=True):
+        out[f"right_axis_{axis}"] = np.full(n, component)
     out.update(lat_deg=np.asarray(geo[0]), lon_deg=np.asarray(geo[1]), alt_m=np.asarray(geo[2]))
     out["is_ground"] = _ground_flags(out, own, i, u_ned, config, terrain, origin)
     return out

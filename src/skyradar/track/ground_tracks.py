@@ -674,16 +674,19 @@ def hold_ground_tracks(
         return tracks
     if surface_down is None and ownship is not None and np.isfinite(median_ground_down_m(ownship)):
         surface_down = flat_surface(median_ground_down_m(ownship))
-    names = ["time_s", "range_m", "radial_velocity_mps", *DOA_COLUMNS[:-1]]
     rows = tracks["detection_row"].to_numpy()
     # Only the detections the tracks hold are read (a stream's table holds every frame's).
     used = np.unique(rows[rows >= 0])
     held_detections = detections.iloc[used]
     nan = np.full(used.size, np.nan)
+
+    def floats(names) -> list[np.ndarray]:
+        return [held_detections[c].to_numpy(float) if c in held_detections else nan for c in names]
+
     det = np.column_stack(
-        [held_detections[c].to_numpy(float) if c in held_detections else nan for c in names]
+        floats(["time_s", "range_m", "radial_velocity_mps", *DOA_COLUMNS[:-1]])
         + [elevation_measured_flags(held_detections).astype(float)]
-        + [held_detections[c].to_numpy(float) if c in held_detections else nan for c in AXIS_COLUMNS]
+        + floats(AXIS_COLUMNS)
     )
     why = np.full(len(tracks), "young", dtype=object)
     kept: dict[int, tuple[np.ndarray, TrackHoldWalk]] = {}

@@ -80,13 +80,7 @@ def validate_detections(df: pd.DataFrame, source: str = "detections") -> pd.Data
                 raise InputError(
                     f"{source}: field '{col}' is not a number at row {bad[0]} ({df[col].iloc[bad[0]]!r})"
                 )
-            outside = np.flatnonzero(np.abs(values.to_numpy(float)) > limit)
-            if outside.size:
-                i = int(outside[0])
-                raise InputError(
-                    f"{source}: field '{col}' is {values.iloc[i]:g} at row {i}, outside "
-                    f"[-{limit:.4g}, {limit:.4g}]{' ' + unit if unit else ''}"
-                )
+            check_within(values.to_numpy(float), limit, unit, source, col, "not a direction")
             df = df.assign(**{col: values.to_numpy(float)})
     t = df["time_s"].to_numpy(float)
     back = np.flatnonzero(t[1:] < t[:-1])

@@ -7,6 +7,7 @@ import json
 import numpy as np
 import pandas as pd
 import pytest
+import xarray as xr
 
 from cli_helpers import assert_one_line_error, skyradar
 from skyradar.code_version import code_version
@@ -14,6 +15,7 @@ from skyradar.daa.alert_config import config_digest
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG
 from skyradar.daa.conflict import FT
 from skyradar.errors import InputError
+from skyradar.experiments.encounter_chain import truth_warning_time
 from skyradar.experiments.encounter_set import (
     OWN_SPEED_MPS,
     T_CPA_S,
@@ -389,3 +391,64 @@ def test_run_encounter_builds_its_scenario_with_the_simulation_and_array_asked_f
     built, _, _ = build_encounter(_row(), 0, 4.7, 40.0, None, ("single",), None, LIGHT, "kite")
     assert {k: built.sim_options[k] for k in LIGHT} == LIGHT
     assert built.heads[0].config.rx_positions_m[3, 2] > 0.02  # the kite's tail, m below the centre
+
+
+def _truth_frames(turn_at_s: float | None, intruder_east_m: float = 0.0) -> xr.Dataset:
+    """Frames truth of an own-ship flying north at 50 m/s and an intruder 3 km ahead flying south at
+    50 m/s, ``intruder_east_m`` to the side, turning east (50 m/s) at ``turn_at_s`` (None: never)."""
+    t = np.arange(0.0, 40.0, 0.1)
+    own_n = 50.0 * t
+    after = np.zeros_like(t) if turn_at_s is None else np.clip(t - turn_at_s, 0.0, None)
+    before = t - after
+    tgt_n, tgt_e = 3000.0 - 50.0 * before, intruder_east_m + 50.0 * after
+    tgt_vn = np.where(after > 0, 0.0, -50.0)
+    tgt_ve = np.where(after > 0, 50.0, 0.0)
+    zeros = np.zeros_like(t)
+    own = {"north_m": own_n, "east_m": zeros, "down_m": zeros - 1000.0, "vn_mps": zeros + 50.0}
+    own |= {"ve_mps": zeros, "vd_mps": zeros, "yaw_rad": zeros, "pitch_rad": zeros, "roll_rad": zeros}
+    tgt = {"north_m": tgt_n, "east_m": tgt_e, "down_m": zeros - 1000.0, "vn_mps": tgt_vn}
+    tgt |= {"ve_mps": tgt_ve, "vd_mps": zeros}
+    data = {f"own_{k}": ("time", v) for k, v in own.items()}
+    data |= {f"tgt_{k}": (("time", "target"), v[:, None]) for k, v in tgt.items()}
+    return xr.Dataset(data, coords={"time": t})
+
+
+def test_perfect_surveillance_warns_an_intruder_that_heads_at_the_ownship_before_it_turns_away():
+    # Closing at 100 m/s from 3 km, the intruder is 23 s from the loss of well clear at the start:
+    # the alerter warns on its true state within seconds. It turns east at 15 s, 1.5 km away, and
+    # passes 1.06 km clear (1500 m / sqrt 2): outside 1.5 times the well-clear radius, so a
+    # must-not-alert encounter that perfect surveillance warns all the same.
+    turning = _truth_frames(turn_at_s=15.0)
+    t_warn = truth_warning_time(turning, RADAR_ALERT_CONFIG)
+    assert 2.0 <= t_warn < 15.0
+    # Flying parallel 2 km to the side, it is never predicted inside the volume.
+    assert np.isnan(truth_warning_time(_truth_frames(None, intruder_east_m=2000.0), RADAR_ALERT_CONFIG))
+
+
+def test_perfect_surveillance_reads_the_true_ownship_not_its_navigation_solution():
+    truth = _truth_frames(turn_at_s=15.0)
+    far_off = truth.assign(
+        {f"nav_{v[4:]}": truth[v] for v in truth.data_vars if str(v).startswith("own_")}
+    ).assign(nav_east_m=truth["own_east_m"] + 2000.0)
+    assert truth_warning_time(far_off, RADAR_ALERT_CONFIG) == truth_warning_time(truth, RADAR_ALERT_CONFIG)
+
+
+def test_false_warnings_split_by_what_perfect_surveillance_warns():
+    res = pd.DataFrame(
+        {
+            "conflict": [False, False, False, False],
+            "may_alert": [False, False, False, True],
+            "observable": [False, False, False, False],
+            "t_lowc_s": [np.nan] * 4,
+            "t_warning_s": [90.0, 70.0, np.nan, 80.0],
+            "t_truth_warning_s": [85.0, np.nan, 60.0, 80.0],
+        }
+    )
+    s = summarise(res, late_lead_s=12.5)
+    assert (s["must_not_alert_encounters"], s["false_warnings"]) == (3, 2)
+    assert (s["false_warnings_alerter"], s["false_warnings_sensor"], s["must_not_alert_truth_warned"]) == (
+        1,
+        1,
+        2,
+    )
+    assert np.isnan(summarise(res.drop(columns="t_truth_warning_s"), 12.5)["false_warnings_sensor"])

@@ -61,8 +61,8 @@ from sphinx.util.nodes import nested_parse_with_titles
 # Settings of one summary, in the order shown; `split` and `load_average_1min` are shown when present.
 SUMMARY_FIELDS = ("family", "terrains", "layouts", "encounters", "seed", "split", "alert_config")
 PROVENANCE_FIELDS = ("command", "version", "date_utc", "load_average_1min")
-# Headline numbers of one row (a terrain and a layout); `warnings_not_held` and `alert_flickers` only
-# when present.
+# Headline numbers of one row (a terrain and a layout); `false_warnings_sensor` (the false warnings
+# perfect surveillance does not give), `warnings_not_held` and `alert_flickers` only when present.
 ROW_FIELDS = (
     "conflicts",
     "observable_conflicts",
@@ -70,6 +70,7 @@ ROW_FIELDS = (
     "false_warnings",
     "false_warning_rate",
     "false_warning_rate_ci95",
+    "false_warnings_sensor",
     "median_warning_lead_s",
     "lead_change_against_clear_sky_s",
     "warnings_not_held",
@@ -254,7 +255,12 @@ class ResultsDirective(SphinxDirective):
         keys = [k for k in (*SUMMARY_FIELDS, *PROVENANCE_FIELDS) if k in summary or k not in optional]
         section += _field_list({k: summary.get(k) for k in keys})
         rows = [_row_as_shown(r) for r in summary.get("rows") or [summary]]
-        optional = ("lead_change_against_clear_sky_s", "warnings_not_held", "alert_flickers")  # where present
+        optional = (  # where present
+            "lead_change_against_clear_sky_s",
+            "warnings_not_held",
+            "alert_flickers",
+            "false_warnings_sensor",
+        )
         shown = [f for f in ROW_FIELDS if f not in optional or any(f in r for r in rows)]
         section += _table(
             # A zero-width space after each underscore lets the long column names wrap.

@@ -16,9 +16,12 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+import xarray as xr
 
 from skyradar.chain import confirmed_rows, label_tracks, run_chain
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig
+from skyradar.daa.pipeline import alerts_from_tracks
+from skyradar.daa.run_tables import ownship_from_frames, truth_tracks
 from skyradar.experiments.encounter_score import frame_status, track_counts, unwarned_cause
 from skyradar.experiments.encounter_set import (
     encounter_scenario,
@@ -35,6 +38,7 @@ __all__ = [
     "chain_rows",
     "run_encounter",
     "score_layout",
+    "truth_warning_time",
     "layout_heads",
     "warning_held",
     "warning_flickers",
@@ -138,8 +142,38 @@ def warning_flickers(warn_times_s: np.ndarray, frame_s: float, t_cpa_s: float) -
     return int(np.sum(np.diff(warn) > 1.5 * frame_s + 1e-9)) if warn.size > 1 else 0
 
 
+def truth_warning_time(truth: xr.Dataset, config: AlertConfig) -> float:
+    """First warning (level 3) the alerter gives on the true states of intruder and own-ship, s.
+
+    The same alerting settings as the chain, fed with perfect surveillance: the intruder's true
+    position and velocity on every frame (in the field of view or not) and the own-ship's true
+    state instead of its navigation solution. A recorded intruder that turns away after heading
+    at the own-ship is predicted into a loss of well clear by any alerter that projects straight
+    lines; a warning perfect surveillance gives too is the alerter's, not the sensor's. NaN: no
+    warning.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> truth_warning_time(xr.Dataset(), RADAR_ALERT_CONFIG)
+    nan
+    """
+    if "tgt_north_m" not in truth or "own_north_m" not in truth:
+        return float("nan")
+    own = ownship_from_frames(truth.drop_vars([v for v in truth.data_vars if str(v).startswith("nav_")]))
+    tracks = truth_tracks(truth, visible_only=False)
+    alerts = alerts_from_tracks(tracks, own, config, with_advice=False, source="truth")
+    warn = alerts["time_s"].to_numpy(float)[alerts["level"].to_numpy(int) >= 3] if len(alerts) else []
+    return float(np.min(warn)) if len(warn) else float("nan")
+
+
 def score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[str, Any]:
-    """One layout's result row from its tracks and alerts (``chain``) and its heads' truth."""
+    """One layout's result row from its tracks and alerts (``chain``) and its heads' truth.
+
+    ``opts`` holds the scoring options (``fov_deg``, ``min_snr_db``, ``observe_window_s``,
+    ``buffer``) and, optionally, the ``alert_config`` whose warning on perfect surveillance is
+    written as ``t_truth_warning_s`` (:func:`truth_warning_time`).
+    """
     tracks, alerts = chain["tracks"], chain["alerts"]
     labels = label_tracks(tracks, truths[0])
     warn = alerts[alerts["level"] >= 3] if len(alerts) else alerts
@@ -164,6 +198,8 @@ def score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[s
         tracks=int(tracks["track_id"].nunique()),
         own_agl_m=own_agl,
     )
+    if opts.get("alert_config") is not None:
+        row["t_truth_warning_s"] = truth_warning_time(truths[0], opts["alert_config"])
     return row
 
 
@@ -271,6 +307,7 @@ def chain_rows(
     ``t`` and ``rel`` are the dense relative truth the encounter is scored on."""
     from skyradar.chain import track_and_alert
 
+    opts = opts | {"alert_config": cfg}
     chain = run_chain(built, cfg, with_advice=False, process_options={"suppression": SUPPRESSION})
     shared = shared | {
         f"{k}_s": float(v) for k, v in chain["timings_s"].items() if k in ("simulate", "process")

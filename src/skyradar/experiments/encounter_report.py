@@ -157,9 +157,18 @@ def _row_sentence(r: dict[str, Any]) -> str:
         f"({_percent(r['warned_before_lowc_fraction'])}, 95 % interval {_percent(lo)} to {_percent(hi)})"
         + (f", the median warning {lead:.1f} s before it" if np.isfinite(lead) else "")
         + f"; unwarned: {', '.join(causes) or 'none'}. A warning came in {r['false_warnings']} of the "
-        f"{r['must_not_alert_encounters']} encounters that must not alert, and {clutter} clutter "
-        f"track{'' if clutter == 1 else 's'} reached a warning."
+        f"{r['must_not_alert_encounters']} encounters that must not alert"
+        + _alerter_share(r)
+        + f", and {clutter} clutter track{'' if clutter == 1 else 's'} reached a warning."
     )
+
+
+def _alerter_share(r: dict[str, Any]) -> str:
+    """How many false warnings perfect surveillance gives too (empty without the count)."""
+    alerter = r.get("false_warnings_alerter", float("nan"))
+    if not isinstance(alerter, int) or not r["false_warnings"]:
+        return ""
+    return f" ({alerter} of them warned on the true states too: the alerter's, not the sensor's)"
 
 
 def summary_markdown(rows: list[dict[str, Any]], settings: dict[str, Any]) -> str:

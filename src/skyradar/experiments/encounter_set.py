@@ -330,13 +330,29 @@ def rate_interval(count: int, trials: int) -> list[float]:
 
 def summarise(res: pd.DataFrame, late_lead_s: float) -> dict[str, Any]:
     """Counts and rates of the encounter table (see ``skyradar experiment encounters --help``);
-    each rate with its 95 % interval (:func:`rate_interval`, key ``RATE_ci95``)."""
+    each rate with its 95 % interval (:func:`rate_interval`, key ``RATE_ci95``).
+
+    The false warnings (warnings in must-not-alert encounters) are split by whether the same
+    alerter warns on perfect surveillance too (column ``t_truth_warning_s``): an intruder that
+    heads at the own-ship and turns away is warned by any alerter that projects straight lines
+    (``false_warnings_alerter``); the rest are the sensor's (``false_warnings_sensor``). Without
+    the column these counts are NaN.
+    """
     lead = res["t_lowc_s"] - res["t_warning_s"]
     in_time = res["t_warning_s"] < res["t_lowc_s"]
     obs, conflict = res["observable"], res["conflict"]
     must_not = ~conflict & ~res["may_alert"]
     warned = res["t_warning_s"].notna()
     good = obs & in_time
+    keys = ("false_warnings_alerter", "false_warnings_sensor", "must_not_alert_truth_warned")
+    split: dict[str, Any] = dict.fromkeys(keys, float("nan"))
+    if "t_truth_warning_s" in res:
+        truth_warned = res["t_truth_warning_s"].notna()
+        split = {
+            "false_warnings_alerter": int((must_not & warned & truth_warned).sum()),
+            "false_warnings_sensor": int((must_not & warned & ~truth_warned).sum()),
+            "must_not_alert_truth_warned": int((must_not & truth_warned).sum()),
+        }
     return {
         "encounters": int(len(res)),
         "conflicts": int(conflict.sum()),
@@ -351,6 +367,7 @@ def summarise(res: pd.DataFrame, late_lead_s: float) -> dict[str, Any]:
         "false_warnings": int((must_not & warned).sum()),
         "false_warning_rate": float((must_not & warned).sum() / max(int(must_not.sum()), 1)),
         "false_warning_rate_ci95": rate_interval(int((must_not & warned).sum()), int(must_not.sum())),
+        **split,
         "missed_warning_rate": float((obs & ~in_time).sum() / max(int(obs.sum()), 1)),
         "missed_warning_rate_ci95": rate_interval(int((obs & ~in_time).sum()), int(obs.sum())),
         "median_warning_lead_s": float(np.median(lead[good])) if good.any() else float("nan"),

@@ -70,3 +70,22 @@ def test_the_pattern_finds_each_kind_of_history():
 def test_no_comment_docstring_or_document_tells_history():
     told = [f"{where}:{n}: {line}" for path in _searched() for where, n, line in _hits(path)]
     assert not told, "history in comments, docstrings, test names or documents:\n" + "\n".join(told)
+
+
+def test_the_records_of_runs_name_their_code_only_as_provenance():
+    # docs/results/ records which commit measured each result ("code at commit abc1234"): that is
+    # provenance a reader can check out, not history. Sessions, issues, encounter ids, a hash
+    # followed by a remark in parentheses and the brief are forbidden there as everywhere.
+    told_here = re.compile(
+        r"session [0-9]|issue [0-9]|encounter [0-9]+|\b[0-9a-f]{7}\b \(|seed-brief", flags=re.IGNORECASE
+    )
+    assert told_here.search("code at commit 0983e4b (load average 4)")
+    records = sorted(p for p in (ROOT / "docs" / "results").rglob("*.md"))
+    assert records
+    told = [
+        f"{path.name}:{n}: {line}"
+        for path in records
+        for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
+        if told_here.search(line)
+    ]
+    assert not told, "history in the records of runs:\n" + "\n".join(told)

@@ -234,11 +234,14 @@ def test_directory_as_table_and_sweep_suffix(tmp_path):
         ("right_axis_north", "abc", ["'right_axis_north'", "not a number", "row 2", "'abc'"]),
         ("azimuth_rad", 7.0, ["'azimuth_rad'", "is 7 rad at row 2", "not a direction"]),
         ("right_axis_east", 1e308, ["'right_axis_east'", "row 2"]),
+        ("north_m", "abc", ["'north_m'", "not a number", "row 2", "'abc'"]),
+        ("down_m", 1e308, ["'down_m'", "row 2", "not a radar measurement"]),
     ],
 )
 def test_track_refuses_directions_that_are_not_directions(tmp_path, column, value, needles):
-    # The ground hold reads each detection's direction and the antenna's right axis: text or an
-    # impossible value there is one line naming the file, field and row; NaN (not known) is taken.
+    # The ground hold reads each detection's direction and the antenna's right axis, the 3-D filter
+    # its position: text or an impossible value there is one line naming the file, field and row
+    # (text is never read as NaN, a table silently without positions); NaN (not known) is taken.
     import pandas as pd
 
     t = np.arange(20) * 0.1
@@ -252,6 +255,9 @@ def test_track_refuses_directions_that_are_not_directions(tmp_path, column, valu
             "right_axis_north": 0.0,
             "right_axis_east": 1.0,
             "right_axis_down": 0.0,
+            "north_m": 1000.0 - 40.0 * t,
+            "east_m": 100.0,
+            "down_m": 0.0,
         }
     ).astype({column: object})
     detections.loc[2, column] = value
@@ -262,3 +268,13 @@ def test_track_refuses_directions_that_are_not_directions(tmp_path, column, valu
     detections.loc[2, column] = np.nan
     detections.to_csv(tmp_path / "det.csv", index=False)
     assert _skyradar("track", "det.csv", "-o", "tracks.parquet", cwd=tmp_path).returncode == 0
+
+
+@pytest.mark.parametrize("given", ["/dev/null", "empty.csv"])
+def test_track_refuses_a_table_that_is_no_file_or_empty(tmp_path, given):
+    # A device (pyarrow reports /dev/null as missing) and an empty file are named for what they are.
+    (tmp_path / "empty.csv").write_text("")
+    result = _skyradar("track", given, "-o", "tracks.parquet", cwd=tmp_path)
+    reason = "is not a regular file" if given == "/dev/null" else "is empty"
+    _assert_one_line_error(result, given, reason)
+    assert not (tmp_path / "tracks.parquet").exists()

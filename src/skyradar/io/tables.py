@@ -75,6 +75,10 @@ def read_table(
         raise InputError(f"{path}: no such file")
     if path.is_dir():
         raise InputError(f"{path}: is a directory, not a table (Parquet or CSV file)")
+    if not path.is_file():  # a device, pipe or socket: pyarrow reports it as missing
+        raise InputError(f"{path}: is not a regular file, not a table (Parquet or CSV file)")
+    if path.stat().st_size == 0:
+        raise InputError(f"{path}: is empty, not a table (Parquet or CSV file)")
     try:
         df = pd.read_csv(path) if path.suffix.lower() == ".csv" else pd.read_parquet(path)
     except Exception as exc:  # noqa: BLE001 - reader failure becomes one clear line

@@ -68,11 +68,12 @@ def validate_detections(df: pd.DataFrame, source: str = "detections") -> pd.Data
     if (rng < 0).any():  # a range is a distance: a negated column would be tracked behind the radar
         i = int(np.flatnonzero(rng < 0)[0])
         raise InputError(f"{source}: field 'range_m' is negative at row {i} ({rng[i]:g} m); a range is >= 0")
-    for col, (limit, unit) in _DETECTION_LIMITS.items():  # 1e308 is finite, but no radar measures it
-        if col in df.columns:
-            values = pd.to_numeric(df[col], errors="coerce").to_numpy(float)
-            check_within(values, limit, unit, source, col, "not a radar measurement")
-    for col, (limit, unit) in _DIRECTION_LIMITS.items():  # NaN: not known; text or 1e308: refused
+    # Every numeric field within what a radar measures (1e308 is finite, but no radar measures it).
+    # The optional ones (a position, a direction) may be NaN, not known; text is refused, never read
+    # as NaN: a position column of words would silently become a table without positions.
+    limits = {col: (*bound, "not a radar measurement") for col, bound in _DETECTION_LIMITS.items()}
+    limits |= {col: (*bound, "not a direction") for col, bound in _DIRECTION_LIMITS.items()}
+    for col, (limit, unit, meaning) in limits.items():
         if col in df.columns:
             values = pd.to_numeric(df[col], errors="coerce")
             bad = np.flatnonzero(values.isna().to_numpy() & df[col].notna().to_numpy())
@@ -80,8 +81,9 @@ def validate_detections(df: pd.DataFrame, source: str = "detections") -> pd.Data
                 raise InputError(
                     f"{source}: field '{col}' is not a number at row {bad[0]} ({df[col].iloc[bad[0]]!r})"
                 )
-            check_within(values.to_numpy(float), limit, unit, source, col, "not a direction")
-            df = df.assign(**{col: values.to_numpy(float)})
+            check_within(values.to_numpy(float), limit, unit, source, col, meaning)
+            if col not in REQUIRED_DETECTION_COLUMNS:
+                df = df.assign(**{col: values.to_numpy(float)})
     t = df["time_s"].to_numpy(float)
     back = np.flatnonzero(t[1:] < t[:-1])
     if back.size:

@@ -314,7 +314,7 @@ class StreamingChain:
                 self._out["ownship"].append(own_row)
         merged = merge_head_tables(tables)
         self._out["detections"].append(merged)
-        return merged, own_row  # type: ignore[return-value]
+        return merged, own_row
 
     def _navigation(self, own: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         """The frame's navigation solution from the own-ship truth of the frames so far."""

@@ -29,7 +29,8 @@ ch2``; none is imported with the package):
 - :mod:`.bluesky_compare` (BlueSky's perfect-state conflict detection against the radar's, through
   the plugin of :mod:`skyradar.integrations.bluesky`).
 
-:mod:`.ground_scenes` scores the ground filter on named scenes over flat ground, hills and Jacksboro.
+:mod:`.ground_scenes` scores the ground filter on named scenes over flat ground, hills and Jacksboro;
+:mod:`.readme_results` writes the README's results table from the measured JSON in docs/results/.
 """
 
 __all__ = [

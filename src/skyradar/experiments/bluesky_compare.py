@@ -250,7 +250,7 @@ def run(
             if progress is not None:
                 progress(name, time_s)
 
-        runs[name] = run_scenario(scenario, name, end_s=end_s, log_path=log_path, progress=report)  # type: ignore[arg-type]
+        runs[name] = run_scenario(scenario, name, end_s=end_s, log_path=log_path, progress=report)
     radar_run = runs["radar"]
     detections = detection_table(radar_run.detections)
     rpz, hpz = _zones(scenario)

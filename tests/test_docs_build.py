@@ -276,6 +276,23 @@ def test_shipped_scenarios_use_only_keys_on_the_page(site):
         assert not _keys_on_page(page, yaml.safe_load(path.read_text())), path.name
 
 
+def test_the_readme_scenario_uses_only_keys_on_the_page(site):
+    # The README's example (run through its commands by tests/test_readme.py) is written from the
+    # generated reference: every key of it is listed there, at its path and for its variant.
+    import yaml
+
+    page = _scenario_page(site)
+    readme = (ROOT / "README.md").read_text()
+    (block,) = re.findall(r"```yaml\n(.*?)```", readme, flags=re.DOTALL)
+    scenario = yaml.safe_load(block)
+    assert {"origin", "ownship", "intruders"} <= set(scenario)
+    assert _keys_on_page(page, scenario) == []
+    # A key the page does not list is found, at the top and inside a list's items.
+    assert _keys_on_page(page, scenario | {"not_a_key": 1}) == ["not_a_key"]
+    glider = scenario["intruders"][0] | {"not_a_key": 0}
+    assert _keys_on_page(page, scenario | {"intruders": [glider]}) == ["intruders[].not_a_key"]
+
+
 def test_a_scenario_written_from_the_page_loads(site, tmp_path):
     """A scenario whose keys all come from the page, optional ones at the defaults the page shows,
     validates to the same scenario as one that leaves them out, and builds."""

@@ -35,7 +35,7 @@ README_RESULTS: tuple[str, ...] = (
     "encounters-synthetic-none-seed7212-n200.json",
     "encounters-synthetic-flat300-seed7214-n200.json",
     "encounters-synthetic-jacksboro-seed7215-n200.json",
-    "encounters-synthetic-hills-seed7212-n200.json",
+    "encounters-synthetic-hills-seed7216-n200.json",
     "encounters-fast-closures-hills-none-seed7208-n200.json",
     "encounters-fast-closures-jacksboro-seed7207-n200.json",
     "encounters-real-flights-none-seed7216-n100.json",

@@ -272,9 +272,10 @@ def test_track_refuses_directions_that_are_not_directions(tmp_path, column, valu
 
 @pytest.mark.parametrize("given", ["/dev/null", "empty.csv"])
 def test_track_refuses_a_table_that_is_no_file_or_empty(tmp_path, given):
-    # A device (pyarrow reports /dev/null as missing) and an empty file are named for what they are.
+    # A device (pyarrow reports /dev/null as missing) and an empty file are named for what they are;
+    # a named pipe stays a table streamed in (tests/test_exclusive_writer.py reads one).
     (tmp_path / "empty.csv").write_text("")
     result = _skyradar("track", given, "-o", "tracks.parquet", cwd=tmp_path)
-    reason = "is not a regular file" if given == "/dev/null" else "is empty"
+    reason = "is a device" if given == "/dev/null" else "is empty"
     _assert_one_line_error(result, given, reason)
     assert not (tmp_path / "tracks.parquet").exists()

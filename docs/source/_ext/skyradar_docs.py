@@ -70,11 +70,11 @@ ROW_FIELDS = (
     "false_warnings",
     "false_warning_rate",
     "false_warning_rate_ci95",
-    "false_warnings_sensor",
     "median_warning_lead_s",
     "lead_change_against_clear_sky_s",
     "warnings_not_held",
     "alert_flickers",
+    "false_warnings_sensor",
 )
 # Figures of merit of one terrain case of the clutter experiment (its summary's ``terrains``), in the
 # order shown: key, meaning (with its unit), decimals (None: a count).

@@ -75,9 +75,11 @@ def read_table(
         raise InputError(f"{path}: no such file")
     if path.is_dir():
         raise InputError(f"{path}: is a directory, not a table (Parquet or CSV file)")
-    if not path.is_file():  # a device, pipe or socket: pyarrow reports it as missing
-        raise InputError(f"{path}: is not a regular file, not a table (Parquet or CSV file)")
-    if path.stat().st_size == 0:
+    # A device or a socket is no table (pyarrow reports /dev/null as missing); a named pipe is read
+    # as it streams (a shell's process substitution gives one).
+    if path.is_char_device() or path.is_block_device() or path.is_socket():
+        raise InputError(f"{path}: is a device, not a table (Parquet or CSV file)")
+    if path.is_file() and path.stat().st_size == 0:
         raise InputError(f"{path}: is empty, not a table (Parquet or CSV file)")
     try:
         df = pd.read_csv(path) if path.suffix.lower() == ".csv" else pd.read_parquet(path)

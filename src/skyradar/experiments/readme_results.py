@@ -34,6 +34,7 @@ __all__ = [
 README_RESULTS: tuple[str, ...] = (
     "encounters-synthetic-none-seed7212-n200.json",
     "encounters-synthetic-flat300-seed7214-n200.json",
+    "encounters-synthetic-flat1000-seed7217-n200.json",
     "encounters-synthetic-jacksboro-seed7215-n200.json",
     "encounters-synthetic-hills-seed7216-n200.json",
     "encounters-fast-closures-hills-none-seed7208-n200.json",

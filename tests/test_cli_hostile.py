@@ -231,10 +231,10 @@ def test_directory_as_table_and_sweep_suffix(tmp_path):
 @pytest.mark.parametrize(
     ("column", "value", "needles"),
     [
-        ("right_axis_north", "abc", ["'right_axis_north'", "not a number", "row 2", "'abc'"]),
+        ("right_axis_north", "abc", ["'right_axis_north'", "not a finite number", "row 2", "'abc'"]),
         ("azimuth_rad", 7.0, ["'azimuth_rad'", "is 7 rad at row 2", "not a direction"]),
         ("right_axis_east", 1e308, ["'right_axis_east'", "row 2"]),
-        ("north_m", "abc", ["'north_m'", "not a number", "row 2", "'abc'"]),
+        ("north_m", "abc", ["'north_m'", "not a finite number", "row 2", "'abc'"]),
         ("down_m", 1e308, ["'down_m'", "row 2", "not a radar measurement"]),
     ],
 )

@@ -16,6 +16,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from skyradar.experiments.encounters import EVALUATION_SEEDS_FROM
 from skyradar.io.atomic import write_text_atomic
 
 __all__ = [
@@ -57,10 +58,6 @@ HEADER: tuple[str, ...] = (
     "measured",
 )
 
-# Seeds from this value up are evaluation seeds: a summary written before it recorded its split
-# is read by its seed.
-EVALUATION_SEED_MIN = 7000
-
 
 def is_evaluation(summary: Mapping[str, Any]) -> bool:
     """Whether an encounter summary is a run on the evaluation split.
@@ -85,7 +82,7 @@ def is_evaluation(summary: Mapping[str, Any]) -> bool:
     """
     if "split" in summary and summary["split"] is not None:
         return bool(summary["split"] == "evaluation")
-    return int(summary["seed"]) >= EVALUATION_SEED_MIN
+    return int(summary["seed"]) >= EVALUATION_SEEDS_FROM  # a summary without a split key
 
 
 def _short_version(version: str) -> str:
@@ -240,9 +237,9 @@ def replace_readme_table(readme_text: str, table: str) -> str:
     if readme_text.count(START) != 1 or readme_text.count(END) != 1:
         raise ValueError(f"the README needs {START} and {END} once each")
     before, _, rest = readme_text.partition(START)
-    inside, _, after = rest.partition(END)
-    if END in before or START in after:
+    if END in before:
         raise ValueError(f"{END} comes before {START}")
+    after = rest.partition(END)[2]
     return f"{before}{START}\n{table.strip()}\n{END}{after}"
 
 

@@ -57,14 +57,8 @@ def validate_detections(df: pd.DataFrame, source: str = "detections") -> pd.Data
     missing = [c for c in REQUIRED_DETECTION_COLUMNS if c not in df.columns]
     if missing:
         raise InputError(f"{source}: missing column(s) {missing} (have {list(df.columns)})")
-    for col in REQUIRED_DETECTION_COLUMNS:
-        values = pd.to_numeric(df[col], errors="coerce").to_numpy(float)
-        bad = np.flatnonzero(~np.isfinite(values))
-        if bad.size:
-            raise InputError(
-                f"{source}: field '{col}' is not a finite number at row {bad[0]} ({df[col].iloc[bad[0]]!r})"
-            )
-    rng = pd.to_numeric(df["range_m"]).to_numpy(float)
+    required = {col: finite_column(df, col, source) for col in REQUIRED_DETECTION_COLUMNS}
+    rng = required["range_m"]
     if (rng < 0).any():  # a range is a distance: a negated column would be tracked behind the radar
         i = int(np.flatnonzero(rng < 0)[0])
         raise InputError(f"{source}: field 'range_m' is negative at row {i} ({rng[i]:g} m); a range is >= 0")
@@ -74,16 +68,12 @@ def validate_detections(df: pd.DataFrame, source: str = "detections") -> pd.Data
     limits = {col: (*bound, "not a radar measurement") for col, bound in _DETECTION_LIMITS.items()}
     limits |= {col: (*bound, "not a direction") for col, bound in _DIRECTION_LIMITS.items()}
     for col, (limit, unit, meaning) in limits.items():
-        if col in df.columns:
-            values = pd.to_numeric(df[col], errors="coerce")
-            bad = np.flatnonzero(values.isna().to_numpy() & df[col].notna().to_numpy())
-            if bad.size:
-                raise InputError(
-                    f"{source}: field '{col}' is not a number at row {bad[0]} ({df[col].iloc[bad[0]]!r})"
-                )
-            check_within(values.to_numpy(float), limit, unit, source, col, meaning)
-            if col not in REQUIRED_DETECTION_COLUMNS:
-                df = df.assign(**{col: values.to_numpy(float)})
+        if col in required:
+            check_within(required[col], limit, unit, source, col, meaning)
+        elif col in df.columns:
+            values = finite_column(df, col, source, allow_nan=True)
+            check_within(values, limit, unit, source, col, meaning)
+            df = df.assign(**{col: values})
     t = df["time_s"].to_numpy(float)
     back = np.flatnonzero(t[1:] < t[:-1])
     if back.size:

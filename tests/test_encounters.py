@@ -183,6 +183,7 @@ def test_full_chain_warns_head_on_collision_and_stays_quiet_when_far():
     # Warned well ahead of the loss of well clear, by a track that follows the intruder.
     assert 12.5 <= hit["t_lowc_s"] - hit["t_warning_s"] <= 30.0
     assert hit["tracks"] >= 1 and hit["frames"] > 150
+    assert not hit["warned_on_altitude_prior"]  # clear sky: no clutter nulls, the elevation is measured
     (far,) = run_encounter(_row(h=2.5 * D_NC), seed=1, frame_rate_hz=4.7, simulation=LIGHT)
     assert not far["conflict"] and not far["may_alert"]
     assert np.isnan(far["t_warning_s"]) and np.isnan(far["t_other_warning_s"])
@@ -452,3 +453,21 @@ def test_false_warnings_split_by_what_perfect_surveillance_warns():
         2,
     )
     assert np.isnan(summarise(res.drop(columns="t_truth_warning_s"), 12.5)["false_warnings_sensor"])
+
+
+def test_false_warnings_on_a_co_altitude_prior_are_counted_apart():
+    # Only a must-not-alert encounter's warning counts: the third is not warned, the fourth may alert.
+    res = pd.DataFrame(
+        {
+            "conflict": [False, False, False, False],
+            "may_alert": [False, False, False, True],
+            "observable": [False] * 4,
+            "t_lowc_s": [np.nan] * 4,
+            "t_warning_s": [90.0, 70.0, np.nan, 80.0],
+            "warned_on_altitude_prior": [True, False, False, True],
+        }
+    )
+    assert summarise(res, 12.5)["false_warnings_altitude_prior"] == 1
+    assert np.isnan(
+        summarise(res.drop(columns="warned_on_altitude_prior"), 12.5)["false_warnings_altitude_prior"]
+    )

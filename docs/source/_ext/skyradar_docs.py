@@ -62,7 +62,8 @@ from sphinx.util.nodes import nested_parse_with_titles
 SUMMARY_FIELDS = ("family", "terrains", "layouts", "encounters", "seed", "split", "alert_config")
 PROVENANCE_FIELDS = ("command", "version", "date_utc", "load_average_1min")
 # Headline numbers of one row (a terrain and a layout); `false_warnings_sensor` (the false warnings
-# perfect surveillance does not give), `warnings_not_held` and `alert_flickers` only when present.
+# perfect surveillance does not give), `false_warnings_altitude_prior` (those first warned on a co-altitude
+# prior), `warnings_not_held` and `alert_flickers` only when present.
 ROW_FIELDS = (
     "conflicts",
     "observable_conflicts",
@@ -75,6 +76,7 @@ ROW_FIELDS = (
     "warnings_not_held",
     "alert_flickers",
     "false_warnings_sensor",
+    "false_warnings_altitude_prior",
 )
 # Figures of merit of one terrain case of the clutter experiment (its summary's ``terrains``), in the
 # order shown: key, meaning (with its unit), decimals (None: a count).
@@ -112,9 +114,7 @@ DECIMALS = {
     "median_warning_lead_s": 1,
     "lead_change_against_clear_sky_s": 1,
     "load_average_1min": 2,
-} | {
-    key: decimals for key, _, decimals in CLUTTER_FIGURES if decimals is not None
-}
+} | {key: decimals for key, _, decimals in CLUTTER_FIGURES if decimals is not None}
 
 
 def format_value(name: str, value: object) -> str:
@@ -260,6 +260,7 @@ class ResultsDirective(SphinxDirective):
             "warnings_not_held",
             "alert_flickers",
             "false_warnings_sensor",
+            "false_warnings_altitude_prior",
         )
         shown = [f for f in ROW_FIELDS if f not in optional or any(f in r for r in rows)]
         section += _table(

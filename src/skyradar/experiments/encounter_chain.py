@@ -42,6 +42,7 @@ __all__ = [
     "layout_heads",
     "warning_held",
     "warning_flickers",
+    "warned_on_altitude_prior",
     "FRAME_RATE_HZ",
     "LAYOUTS",
     "SUPPRESSION",
@@ -167,6 +168,26 @@ def truth_warning_time(truth: xr.Dataset, config: AlertConfig) -> float:
     return float(np.min(warn)) if len(warn) else float("nan")
 
 
+def warned_on_altitude_prior(warnings: pd.DataFrame) -> bool:
+    """Whether the first of these warning rows (an alerts table's) rests on a co-altitude prior.
+
+    A track none of whose elevations was measured flies at the own-ship's height (over the ground
+    two clutter nulls at one elevation take the 2x2 array's whole elevation dimension): an intruder
+    passing above or below then looks level, and its warning cannot be cleared by a vertical miss.
+    False without warnings.
+
+    Examples
+    --------
+    >>> rows = pd.DataFrame({"time_s": [12.0, 10.0], "altitude_measured": [True, False]})
+    >>> [warned_on_altitude_prior(r) for r in (rows, rows.iloc[:1], rows.iloc[:0])]
+    [True, False, False]
+    """
+    if not len(warnings):
+        return False
+    first = warnings["altitude_measured"].to_numpy(bool)[np.argmin(warnings["time_s"].to_numpy(float))]
+    return not bool(first)
+
+
 def score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[str, Any]:
     """One layout's result row from its tracks and alerts (``chain``) and its heads' truth.
 
@@ -194,6 +215,7 @@ def score_layout(chain: dict, truths: list, built, t, rel, opts: dict) -> dict[s
     row.update(track_counts(confirmed_rows(tracks), warned, labels, built.terrain, own_agl))
     row.update(intruder_track_figures(tracks, labels, truths[0]))
     row.update(
+        warned_on_altitude_prior=warned_on_altitude_prior(warn[mine]),
         t_other_warning_s=float(other.min()) if other.size else float("nan"),
         tracks=int(tracks["track_id"].nunique()),
         own_agl_m=own_agl,

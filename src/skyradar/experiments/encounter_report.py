@@ -164,11 +164,14 @@ def _row_sentence(r: dict[str, Any]) -> str:
 
 
 def _alerter_share(r: dict[str, Any]) -> str:
-    """How many false warnings perfect surveillance gives too (empty without the count)."""
+    """How many false warnings perfect surveillance gives too, and how many were first warned on a
+    co-altitude prior (empty without the counts)."""
     alerter = r.get("false_warnings_alerter", float("nan"))
     if not isinstance(alerter, int) or not r["false_warnings"]:
         return ""
-    return f" ({alerter} of them warned on the true states too: the alerter's, not the sensor's)"
+    prior = r.get("false_warnings_altitude_prior", float("nan"))
+    on_prior = f", {prior} first warned on a co-altitude prior" if isinstance(prior, int) and prior else ""
+    return f" ({alerter} of them warned on the true states too: the alerter's, not the sensor's{on_prior})"
 
 
 def summary_markdown(rows: list[dict[str, Any]], settings: dict[str, Any]) -> str:

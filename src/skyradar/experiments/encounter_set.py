@@ -336,7 +336,10 @@ def summarise(res: pd.DataFrame, late_lead_s: float) -> dict[str, Any]:
     alerter warns on perfect surveillance too (column ``t_truth_warning_s``): an intruder that
     heads at the own-ship and turns away is warned by any alerter that projects straight lines
     (``false_warnings_alerter``); the rest are the sensor's (``false_warnings_sensor``). Without
-    the column these counts are NaN.
+    the column these counts are NaN. ``false_warnings_altitude_prior`` counts the false warnings
+    whose first warning rests on a co-altitude prior (column ``warned_on_altitude_prior``): the
+    track's elevation was never measured, so an intruder that passes above or below looks level and
+    must be warned (NaN without the column).
     """
     lead = res["t_lowc_s"] - res["t_warning_s"]
     in_time = res["t_warning_s"] < res["t_lowc_s"]
@@ -353,6 +356,9 @@ def summarise(res: pd.DataFrame, late_lead_s: float) -> dict[str, Any]:
             "false_warnings_sensor": int((must_not & warned & ~truth_warned).sum()),
             "must_not_alert_truth_warned": int((must_not & truth_warned).sum()),
         }
+    prior = float("nan")
+    if "warned_on_altitude_prior" in res:
+        prior = int((must_not & warned & res["warned_on_altitude_prior"].fillna(False).astype(bool)).sum())
     return {
         "encounters": int(len(res)),
         "conflicts": int(conflict.sum()),
@@ -368,6 +374,7 @@ def summarise(res: pd.DataFrame, late_lead_s: float) -> dict[str, Any]:
         "false_warning_rate": float((must_not & warned).sum() / max(int(must_not.sum()), 1)),
         "false_warning_rate_ci95": rate_interval(int((must_not & warned).sum()), int(must_not.sum())),
         **split,
+        "false_warnings_altitude_prior": prior,
         "missed_warning_rate": float((obs & ~in_time).sum() / max(int(obs.sum()), 1)),
         "missed_warning_rate_ci95": rate_interval(int((obs & ~in_time).sum()), int(obs.sum())),
         "median_warning_lead_s": float(np.median(lead[good])) if good.any() else float("nan"),

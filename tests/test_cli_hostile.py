@@ -279,3 +279,35 @@ def test_track_refuses_a_table_that_is_no_file_or_empty(tmp_path, given):
     reason = "is a device" if given == "/dev/null" else "is empty"
     _assert_one_line_error(result, given, reason)
     assert not (tmp_path / "tracks.parquet").exists()
+
+
+@pytest.mark.parametrize("content", ["csv", "parquet"])
+def test_track_reads_a_table_from_a_pipe_or_a_file_without_suffix_by_its_content(tmp_path, content):
+    # A shell's process substitution hands the command a pipe named /dev/fd/N: no suffix says the
+    # format, so the content does (Parquet's magic bytes); the tracks are those of the named file.
+    import subprocess
+    import sys
+
+    import pandas as pd
+
+    t = np.arange(30) * 0.1
+    detections = pd.DataFrame(
+        {"time_s": t, "range_m": 1000.0 - 40.0 * t, "radial_velocity_mps": -40.0, "azimuth_rad": 0.1}
+    )
+    named = tmp_path / f"det.{content}"
+    detections.to_csv(named, index=False) if content == "csv" else detections.to_parquet(named)
+    (tmp_path / "det_no_suffix").write_bytes(named.read_bytes())
+    assert _skyradar("track", named.name, "-o", "named.parquet", cwd=tmp_path).returncode == 0
+    assert _skyradar("track", "det_no_suffix", "-o", "bare.parquet", cwd=tmp_path).returncode == 0
+    piped = subprocess.run(
+        ["bash", "-c", f'"{sys.executable}" -m skyradar track <(cat {named.name}) -o piped.parquet'],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert piped.returncode == 0, piped.stderr
+    expected = pd.read_parquet(tmp_path / "named.parquet")
+    assert len(expected) > 0
+    for other in ("bare.parquet", "piped.parquet"):
+        pd.testing.assert_frame_equal(pd.read_parquet(tmp_path / other), expected)

@@ -7,6 +7,7 @@ Readers check required columns and say which are missing.
 
 from __future__ import annotations
 
+import io
 import json
 import math
 from collections.abc import Iterable
@@ -82,7 +83,7 @@ def read_table(
     if path.is_file() and path.stat().st_size == 0:
         raise InputError(f"{path}: is empty, not a table (Parquet or CSV file)")
     try:
-        df = pd.read_csv(path) if path.suffix.lower() == ".csv" else pd.read_parquet(path)
+        df = _read_by_format(path)
     except Exception as exc:  # noqa: BLE001 - reader failure becomes one clear line
         raise InputError(f"{path}: cannot read table ({type(exc).__name__}: {exc})") from exc
     missing = [c for c in required if c not in df.columns]
@@ -99,6 +100,24 @@ def read_table(
                 f"{path}: field '{sort_by}' goes backwards at row {i} ({values[i - 1]} -> {values[i]})"
             )
     return df
+
+
+def _read_by_format(path: Path) -> pd.DataFrame:
+    """The table at ``path``: CSV by its ``.csv`` suffix, Parquet by ``.parquet``; without either the
+    content decides (Parquet opens with the magic bytes ``PAR1``, anything else is read as CSV), so a
+    shell's process substitution (``<(cat det.csv)``, a pipe named ``/dev/fd/63``) reads as what it
+    holds. A pipe cannot be read twice: its bytes are read once and parsed from memory."""
+    suffix = path.suffix.lower()
+    if suffix == ".csv":
+        return pd.read_csv(path)
+    if suffix == ".parquet":
+        return pd.read_parquet(path)
+    if path.is_fifo():
+        data = path.read_bytes()
+        return pd.read_parquet(io.BytesIO(data)) if data[:4] == b"PAR1" else pd.read_csv(io.BytesIO(data))
+    with path.open("rb") as f:
+        magic = f.read(4)
+    return pd.read_parquet(path) if magic == b"PAR1" else pd.read_csv(path)
 
 
 def finite_column(df: pd.DataFrame, col: str, source: str | Path, allow_nan: bool = False) -> np.ndarray:

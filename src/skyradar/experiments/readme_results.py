@@ -40,7 +40,7 @@ README_RESULTS: tuple[str, ...] = (
     "encounters-synthetic-hills-seed7216-n200.json",
     "encounters-fast-closures-hills-none-seed7208-n200.json",
     "encounters-fast-closures-jacksboro-seed7207-n200.json",
-    "encounters-real-flights-none-seed7216-n100.json",
+    "encounters-real-flights-none-seed7218-n100.json",
 )
 
 START = "<!-- results-table:start -->"

@@ -70,7 +70,27 @@ def _truth_dataset(built, simulator) -> xr.Dataset:
 
 
 def run_attrs(built) -> dict[str, Any]:
-    """The attributes the chain's frames Datasets carry: scenario name, origin, start time."""
+    """The attributes the chain's frames Datasets carry: scenario name, origin, start time.
+
+    Parameters
+    ----------
+    built : BuiltScenario
+        From :meth:`skyradar.scene.scenario.Scenario.build` (its ``name``, ``origin`` as (lat deg,
+        lon deg, alt m) and ``start_time``, when it has one).
+
+    Returns
+    -------
+    dict
+        ``scenario``, ``origin_lat_deg``, ``origin_lon_deg``, ``origin_alt_m`` (m) and ``start_time``
+        (None when the scenario has none).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> run_attrs(SimpleNamespace(name="head-on", origin=(52.0, 4.0, 10.0)))
+    {'scenario': 'head-on', 'origin_lat_deg': 52.0, 'origin_lon_deg': 4.0, 'origin_alt_m': 10.0,
+     'start_time': None}
+    """
     return {
         "scenario": built.name,
         "origin_lat_deg": built.origin[0],
@@ -82,7 +102,41 @@ def run_attrs(built) -> dict[str, Any]:
 
 def tracked_heads(built, heads: list[str] | None, caller: str) -> list:
     """The heads ``heads`` of ``built`` (all by default) that one tracker follows; InputError naming
-    ``caller`` when they differ in Doppler width or range resolution (one tracker's pixel grid)."""
+    ``caller`` when they differ in Doppler width or range resolution (one tracker's pixel grid).
+
+    Parameters
+    ----------
+    built : BuiltScenario
+        From :meth:`skyradar.scene.scenario.Scenario.build` (only ``built.heads`` is read).
+    heads : list of str or None
+        Names of the heads to track; None: all.
+    caller : str
+        Name of the calling command or function in error messages.
+
+    Returns
+    -------
+    list of RadarHead
+        The chosen heads, in the scenario's order.
+
+    Examples
+    --------
+    A head with half the bandwidth has twice the range bin (m), so no tracker follows it with the
+    others:
+
+    >>> import dataclasses
+    >>> from types import SimpleNamespace
+    >>> from skyradar.config import RadarConfig
+    >>> from skyradar.scene.radar_heads import RadarHead
+    >>> c = RadarConfig()
+    >>> coarse = dataclasses.replace(c, bandwidth_hz=c.bandwidth_hz / 2)
+    >>> built = SimpleNamespace(heads=[RadarHead("nose", c), RadarHead("left", c), RadarHead("tail", coarse)])
+    >>> [h.name for h in tracked_heads(built, ["nose", "left"], "track")]
+    ['nose', 'left']
+    >>> tracked_heads(built, None, "track")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: track: heads ['nose', 'left', 'tail'] differ in Doppler width or range ...
+    """
     chosen = select_heads(built.heads, heads, caller)
     if len({(h.config.v_lim_mps, h.config.range_resolution_m) for h in chosen}) > 1:
         names = [h.name for h in chosen]
@@ -225,8 +279,37 @@ def track_and_alert(
 def scenario_surface(built, own: pd.DataFrame):
     """The scenario's ground for the track-level ground test (None: the own-ship's height above ground).
 
-    ``own`` is the own-ship table (its median ground under the own-ship is the level ground beyond
-    the DEM)."""
+    Parameters
+    ----------
+    built : BuiltScenario
+        From :meth:`skyradar.scene.scenario.Scenario.build` (its ``terrain`` DEM and ``origin`` as
+        (lat deg, lon deg, alt m)).
+    own : DataFrame
+        The own-ship table (``own_down_m`` and ``own_height_agl_m``, m): its median ground under the
+        own-ship is the level ground beyond the DEM.
+
+    Returns
+    -------
+    callable or None
+        NE points (k, 2) in m -> ``down`` of the ground, m (:func:`terrain_surface`); None without a
+        DEM.
+
+    Examples
+    --------
+    A DEM 200 m high up to 52.01 deg north under an origin at 1000 m; beyond it the ground under the
+    own-ship (``-500 + 1400`` m down):
+
+    >>> from types import SimpleNamespace
+    >>> class Dem:
+    ...     def height_at(self, lat, lon):
+    ...         return np.where(np.asarray(lat) < 52.01, 200.0, np.nan)
+    >>> own = pd.DataFrame({"own_down_m": [-500.0], "own_height_agl_m": [1400.0]})
+    >>> surface = scenario_surface(SimpleNamespace(terrain=Dem(), origin=(52.0, 4.0, 1000.0)), own)
+    >>> surface(np.array([[0.0, 0.0], [5000.0, 0.0]])).tolist()
+    [800.0, 900.0]
+    >>> scenario_surface(SimpleNamespace(terrain=None), own) is None
+    True
+    """
     if built.terrain is None or not hasattr(built.terrain, "height_at"):
         return None
     return terrain_surface(built.terrain, built.origin, median_ground_down_m(own))

@@ -139,7 +139,39 @@ def ecef_to_geodetic_point(x: float, y: float, z: float) -> tuple[float, float, 
 def ned_to_geodetic(
     ned_m: np.ndarray, lat0_deg: float, lon0_deg: float, alt0_m: float = 0.0, flat_earth: bool = False
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Local NED (metres, shape (..., 3)) back to geodetic (lat_deg, lon_deg, alt_m)."""
+    """Local NED (metres, shape (..., 3)) back to geodetic (lat_deg, lon_deg, alt_m).
+
+    Parameters
+    ----------
+    ned_m : ndarray, shape (..., 3)
+        North, east, down of the points from the origin, m.
+    lat0_deg, lon0_deg : float
+        Geodetic latitude and longitude of the origin, deg.
+    alt0_m : float
+        Altitude of the origin above the WGS84 ellipsoid, m.
+    flat_earth : bool
+        Use a spherical flat-earth approximation (degrees per metre at the origin) instead of the
+        WGS84 ellipsoid.
+
+    Returns
+    -------
+    lat_deg, lon_deg, alt_m : ndarray
+        Geodetic latitude (deg), longitude (deg) and altitude (m), of shape ``ned_m.shape[:-1]``.
+
+    Examples
+    --------
+    A round trip with :func:`geodetic_to_ned`:
+
+    >>> ned = geodetic_to_ned(52.01, 4.0, 100.0, 52.0, 4.0)
+    >>> [round(float(x), 6) for x in ned_to_geodetic(ned, 52.0, 4.0)]
+    [52.01, 4.0, 100.0]
+
+    On the flat earth 1 km north is ``1000 / R`` rad of latitude:
+
+    >>> lat, lon, alt = ned_to_geodetic(np.array([[1000.0, 0.0, -50.0]]), 0.0, 0.0, flat_earth=True)
+    >>> bool(np.isclose(lat[0], np.degrees(1000.0 / EARTH_RADIUS_M))), float(alt[0])
+    (True, 50.0)
+    """
     ned = np.asarray(ned_m, dtype=float)
     if ned.shape == (3,) and not flat_earth:
         ecef = _geodetic_to_ecef(lat0_deg, lon0_deg, alt0_m) + _ecef_from_ned(lat0_deg, lon0_deg) @ ned
@@ -164,6 +196,27 @@ def ned_rotation_to(lat0_deg: float, lon0_deg: float, lat_deg: float, lon_deg: f
 
     Attitude angles are relative to the local vertical at the aircraft; this accounts for the
     Earth's curvature between the scenario origin and the aircraft.
+
+    Parameters
+    ----------
+    lat0_deg, lon0_deg : float
+        Geodetic latitude and longitude of the origin, deg.
+    lat_deg, lon_deg : float
+        Geodetic latitude and longitude of the local frame, deg.
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+        Rotation matrix ``R`` with ``v_local = R @ v_origin``.
+
+    Examples
+    --------
+    One degree of latitude further north the local vertical is tilted by one degree about east:
+    the origin's ``down`` has a north component of ``sin(1 deg)`` there.
+
+    >>> R = ned_rotation_to(0.0, 0.0, 1.0, 0.0)
+    >>> round(float(np.degrees(np.arcsin(R[0, 2]))), 6), np.round(R[:, 1], 6).tolist()
+    (1.0, [0.0, 1.0, 0.0])
     """
     return _ecef_from_ned(lat_deg, lon_deg).T @ _ecef_from_ned(lat0_deg, lon0_deg)
 
@@ -171,7 +224,22 @@ def ned_rotation_to(lat0_deg: float, lon0_deg: float, lat_deg: float, lon_deg: f
 def direction_angles(vectors: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Range, azimuth and elevation of vectors in a forward-right-down frame.
 
-    Azimuth is positive to the right of +x, elevation positive above the x-y plane (radians).
+    Parameters
+    ----------
+    vectors : ndarray, shape (..., 3)
+        Vectors in a forward-right-down frame, m.
+
+    Returns
+    -------
+    range_m, azimuth_rad, elevation_rad : ndarray, shape (...)
+        Length (m); azimuth, positive to the right of +x (rad); elevation, positive above the x-y
+        plane (rad).
+
+    Examples
+    --------
+    >>> rng, az, el = direction_angles(np.array([[0.0, 100.0, -100.0], [0.0, 0.0, -50.0]]))
+    >>> rng.round(3).tolist(), np.degrees(az).round(3).tolist(), np.degrees(el).round(3).tolist()
+    ([141.421, 50.0], [90.0, 0.0], [45.0, 90.0])
     """
     v = np.asarray(vectors, dtype=float)
     rng = np.linalg.norm(v, axis=-1)

@@ -31,7 +31,29 @@ def predict(x: np.ndarray, P: np.ndarray, F: np.ndarray, Q: np.ndarray) -> tuple
 
 
 def innovation_covariance(P: np.ndarray, H: np.ndarray, R: np.ndarray) -> np.ndarray:
-    """``S = H P H^T + R`` for one covariance or a stack."""
+    """``S = H P H^T + R`` for one covariance or a stack.
+
+    Parameters
+    ----------
+    P : ndarray, shape (d, d) or (n, d, d)
+        State covariance, in the squared units of the state (m^2, m^2/s^2, ...).
+    H : ndarray, shape (k, d)
+        Measurement matrix.
+    R : ndarray, shape (k, k)
+        Measurement noise covariance, in the squared units of the measurement.
+
+    Returns
+    -------
+    ndarray, shape (k, k) or (n, k, k)
+        Innovation covariance.
+
+    Examples
+    --------
+    Measuring the sum of two independent states with variances 4 and 1 m^2, noise 0.5 m^2:
+
+    >>> innovation_covariance(np.diag([4.0, 1.0]), np.array([[1.0, 1.0]]), np.array([[0.5]])).tolist()
+    [[5.5]]
+    """
     return H @ P @ H.T + R
 
 

@@ -352,6 +352,52 @@ def advice_columns(
     range-only track, :mod:`skyradar.daa.range_only`) has no bearing: it takes no part in the
     advice, and a frame where such a row alerts gets none (empty bands, NaN preferences), since a
     band or manoeuvre computed without it could lead into it.
+
+    Parameters
+    ----------
+    alerts : DataFrame
+        Alerts table sorted by ``time_s`` (s), with a ``level`` column; the columns are added to it.
+    s : ndarray, shape (n, 3)
+        Intruder position relative to the own-ship per row, NED, m.
+    v_int : ndarray, shape (n, 3)
+        Intruder velocity per row, NED, m/s.
+    own_vel : ndarray, shape (n, 3)
+        Own-ship velocity per row, NED, m/s.
+    height_agl_m : ndarray, shape (n,), or None
+        Own-ship height above ground per row, m (None: no terrain bands).
+    dthr_m, zthr_m : ndarray, shape (n,)
+        Horizontal and vertical thresholds per row (widened by the track's uncertainty), m.
+    volume : WellClearVolume
+        The well-clear volume of the advice (thresholds in m and s).
+    alerting_time_s : float
+        Lookahead of the bands, s.
+    located : ndarray of bool, shape (n,), optional
+        Rows with a position (default all).
+
+    Returns
+    -------
+    None
+        ``alerts`` gains ``heading_bands_deg`` (deg), ``vs_bands_mps``, ``terrain_vs_bands_mps``
+        (m/s; each a flat list of band bounds per row), ``preferred_heading_deg`` (deg) and
+        ``preferred_vs_mps`` (m/s).
+
+    Examples
+    --------
+    Two intruders in the frame at 0 s, one of them alerting, and a frame at 1 s without an alert:
+    both rows of the first frame carry that frame's :func:`resolution_advice`.
+
+    >>> import pandas as pd
+    >>> alerts = pd.DataFrame({"time_s": [0.0, 0.0, 1.0], "level": [3, 0, 0]})
+    >>> s = np.array([[3000.0, 100.0, 0.0], [0.0, 5000.0, 0.0], [2900.0, 100.0, 0.0]])
+    >>> v = np.array([[-50.0, 0.0, 0.0], [0.0, 0.0, 0.0], [-50.0, 0.0, 0.0]])
+    >>> own, vol = np.tile([50.0, 0.0, 0.0], (3, 1)), WellClearVolume(500.0, 100.0)
+    >>> advice_columns(alerts, s, v, own, None, np.full(3, 500.0), np.full(3, 100.0), vol, 60.0)
+    >>> adv = resolution_advice(own[0], s[:2], v[:2], vol, 60.0, dthr_m=np.full(2, 500.0),
+    ...                         zthr_m=np.full(2, 100.0))
+    >>> adv["heading_bands_deg"], adv["preferred_heading_deg"]
+    ([[344.5, 382.5]], 344.0)
+    >>> alerts["heading_bands_deg"].tolist(), alerts["preferred_heading_deg"].tolist()
+    ([[344.5, 382.5], [344.5, 382.5], []], [344.0, 344.0, nan])
     """
     n = len(alerts)
     names = ("heading_bands_deg", "vs_bands_mps", "terrain_vs_bands_mps")

@@ -51,9 +51,26 @@ LEVEL_NAMES = ("none", "preventive", "corrective", "warning")
 class AlertLevel:
     """One alert level: its volume, alerting time (s) and early alerting time (s).
 
-    ``early_alerting_time_s`` (DAIDALUS' ``early_alerting_time``, at least the alerting time): once
-    the level is issued, it stays reached while its volume is predicted lost within this time.
-    None: :attr:`AlertConfig.hold_time_factor` times the alerting time.
+    Parameters
+    ----------
+    name : str
+        Name of the level (``'preventive'``, ``'corrective'``, ``'warning'``).
+    volume : WellClearVolume
+        The well-clear volume whose predicted loss raises the level (thresholds in m and s).
+    alerting_time_s : float
+        The level is reached when its volume is predicted lost within this time, s.
+    early_alerting_time_s : float, optional
+        DAIDALUS' ``early_alerting_time``, s (at least the alerting time): once the level is
+        issued, it stays reached while its volume is predicted lost within this time. None:
+        :attr:`AlertConfig.hold_time_factor` times the alerting time.
+
+    Examples
+    --------
+    >>> warning = AlertLevel("warning", WellClearVolume(670.56, 137.16), 25.0)
+    >>> warning.hold_time_s(1.5)
+    37.5
+    >>> AlertLevel("warning", WellClearVolume(670.56, 137.16), 25.0, 90.0).hold_time_s(1.5)
+    90.0
     """
 
     name: str

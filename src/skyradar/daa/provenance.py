@@ -125,6 +125,39 @@ def check_tracks_match_run(
     command was given ``run`` (``""`` for an argument), named in the message. Without a signature
     anywhere along its ``source`` chain, or without own-ship state in ``ds``, nothing can be
     compared and nothing is raised (the time-span check of the alerting still applies).
+
+    Parameters
+    ----------
+    tracks_attrs : dict
+        The tracks table's metadata (``ownship_signature``, or a ``source`` to follow).
+    tracks_path : str
+        Name of the tracks table in the message.
+    ds : xr.Dataset
+        The frames run, with the own-ship NED position ``own_north_m, own_east_m, own_down_m`` (m).
+    run : str
+        Name of the run in the message.
+    option : str
+        How the command was given ``run`` (``""`` for an argument).
+
+    Returns
+    -------
+    None
+        Raises :class:`InputError` on a mismatch (origin, time span, or own-ship positions more than
+        1 m apart).
+
+    Examples
+    --------
+    >>> t = np.arange(4.0)
+    >>> pos = {n: ("time", v) for n, v in zip(_POS, (10 * t, 0 * t, -500 + 0 * t))}
+    >>> ds = xr.Dataset(pos, coords={"time": t})
+    >>> attrs = {"ownship_signature": ownship_signature(ds, "a.zarr")}
+    >>> check_tracks_match_run(attrs, "tracks.parquet", ds, "a.zarr") is None
+    True
+    >>> check_tracks_match_run(attrs, "tracks.parquet", ds.assign(own_east_m=ds.own_east_m + 50.0), "b.zarr")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: tracks.parquet: tracks come from run a.zarr (0..3 s) but --ownship b.zarr is \
+another run (0..3 s): the own-ship positions differ by 50 m at t = 0 s; give the run the tracks were made from
     """
     from skyradar.io.run_origin import scenario_origin
 

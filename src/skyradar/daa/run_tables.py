@@ -36,6 +36,35 @@ def ownship_from_frames(ds: xr.Dataset, source: str = "frames") -> pd.DataFrame:
     The values are the run's navigation solution (``nav_*``, GNSS/AHRS with errors) read by
     :func:`skyradar.io.navigation.navigation_state`; only a store without ``nav_*`` variables
     gives its ``own_*`` truth (``attrs["navigation_source"] == "truth"``).
+
+    Parameters
+    ----------
+    ds : xr.Dataset
+        Frames Dataset with the own-ship NED position (m) and velocity (m/s), as ``nav_*`` or
+        ``own_*`` variables.
+    source : str
+        Name of the run in error messages.
+
+    Returns
+    -------
+    DataFrame
+        ``time_s`` (s), the own-ship columns of :data:`OWNSHIP_COLUMNS` (m, m/s) and those of
+        :data:`OPTIONAL_OWNSHIP_COLUMNS` the run has; InputError when a state variable is missing or
+        not a finite state.
+
+    Examples
+    --------
+    >>> t = np.arange(3.0)
+    >>> state = {"own_north_m": 50.0 * t, "own_east_m": 0 * t, "own_down_m": -500 + 0 * t,
+    ...          "own_vn_mps": 50 + 0 * t, "own_ve_mps": 0 * t, "own_vd_mps": 0 * t}
+    >>> ds = xr.Dataset({k: ("time", v) for k, v in state.items()}, coords={"time": t})
+    >>> own = ownship_from_frames(ds, "run.zarr")
+    >>> own["own_north_m"].tolist(), own.attrs["navigation_source"]
+    ([0.0, 50.0, 100.0], 'truth')
+    >>> ownship_from_frames(ds.drop_vars("own_vd_mps"), "run.zarr")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: run.zarr: no own-ship state (missing variable(s) ['own_vd_mps'])
     """
     state = navigation_state(ds, source)
     missing = [c for c in OWNSHIP_COLUMNS[1:] if state is None or c not in state]

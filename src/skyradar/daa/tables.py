@@ -60,6 +60,31 @@ def clean_tracks(tracks: pd.DataFrame, source: str) -> pd.DataFrame:
     position at all (NaN ``north_m`` or ``east_m``) and a finite ``range_m`` and ``range_rate_mps``
     (:func:`range_only_rows`); anything else that is not a finite number (a string, an infinity, a
     NaN time or id) is refused naming the row.
+
+    Parameters
+    ----------
+    tracks : DataFrame
+        Tracks table: ``time_s`` (s), ``track_id``, NED ``north_m, east_m, down_m`` (m) and
+        ``vn_mps, ve_mps, vd_mps`` (m/s); optionally ``confirmed``, ``altitude_measured`` and the
+        range columns ``range_m`` (m) and ``range_rate_mps`` (m/s).
+    source : str
+        Name of the table in error messages.
+
+    Returns
+    -------
+    DataFrame
+        The kept rows sorted by time and track, with integer ``track_id``.
+
+    Examples
+    --------
+    A row without a direction is skipped and an unconfirmed row dropped:
+
+    >>> t = pd.DataFrame({"time_s": [0.0, 0.0, 1.0], "track_id": [1.0, 2.0, 1.0],
+    ...     "north_m": [1000.0, np.nan, 900.0], "east_m": 0.0, "down_m": 0.0, "vn_mps": -100.0,
+    ...     "ve_mps": 0.0, "vd_mps": 0.0, "confirmed": [True, True, False]})
+    >>> clean = clean_tracks(t, "tracks")
+    >>> clean["track_id"].tolist(), clean["north_m"].tolist(), clean.attrs["rows_skipped_no_state"]
+    ([1], [1000.0], 1)
     """
     missing = [c for c in TRACK_COLUMNS if c not in tracks]
     if missing:
@@ -201,7 +226,26 @@ def interp_ownship(own: pd.DataFrame, times: np.ndarray, source: str) -> OwnShip
 
 
 def covariances(df: pd.DataFrame) -> tuple[np.ndarray | None, np.ndarray | None]:
-    """Position and velocity covariances (n, 3, 3) of the rows, or None without the columns."""
+    """Position and velocity covariances (n, 3, 3) of the rows, or None without the columns.
+
+    Parameters
+    ----------
+    df : DataFrame
+        Rows with the columns ``cov_pp_ij`` (m^2) and ``cov_vv_ij`` (m^2/s^2), ``i, j`` in 0..2.
+
+    Returns
+    -------
+    cov_p, cov_v : ndarray, shape (n, 3, 3), or None
+        Position (m^2) and velocity (m^2/s^2) covariances; None where the table lacks any of the
+        nine columns.
+
+    Examples
+    --------
+    >>> df = pd.DataFrame({f"cov_pp_{i}{j}": [4.0 * (i == j)] for i in range(3) for j in range(3)})
+    >>> cov_p, cov_v = covariances(df)
+    >>> cov_p.shape, cov_p[0].diagonal().tolist(), cov_v
+    ((1, 3, 3), [4.0, 4.0, 4.0], None)
+    """
     cov_p = df[_COV_P].to_numpy(float).reshape(-1, 3, 3) if all(c in df for c in _COV_P) else None
     cov_v = df[_COV_V].to_numpy(float).reshape(-1, 3, 3) if all(c in df for c in _COV_V) else None
     return cov_p, cov_v

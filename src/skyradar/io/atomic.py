@@ -72,7 +72,29 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
 
 
 def write_with(path: str | Path, writer: Callable[[Path], Any]) -> Path:
-    """Call ``writer(tmp)`` inside :func:`atomic_path` and return ``path``."""
+    """Call ``writer(tmp)`` inside :func:`atomic_path` and return ``path``.
+
+    Parameters
+    ----------
+    path : path
+        The final file name.
+    writer : callable
+        Called once with the temporary path; it writes the whole file there. If it raises, the
+        temporary file is removed and ``path`` is untouched.
+
+    Returns
+    -------
+    Path
+        ``path``, holding what ``writer`` wrote.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = write_with(Path(d) / "n.bin", lambda tmp: tmp.write_bytes(bytes(range(4))))
+    ...     p.read_bytes(), [q.name for q in Path(d).iterdir()]
+    (b'\\x00\\x01\\x02\\x03', ['n.bin'])
+    """
     with atomic_path(path) as tmp:
         writer(tmp)
     return Path(path)

@@ -140,7 +140,32 @@ def decode(ds: xr.Dataset) -> xr.Dataset:
 
 
 def encode_template(template: xr.Dataset, chunk_frames: int) -> tuple[xr.Dataset, dict[str, Any]]:
-    """The template with lazy ``iq_int16``/``iq_scale`` in place of ``iq``, and their chunk encoding."""
+    """The template with lazy ``iq_int16``/``iq_scale`` in place of ``iq``, and their chunk encoding.
+
+    Parameters
+    ----------
+    template : xarray.Dataset
+        A frames template with complex ``iq`` of dims ``(time, range, doppler, rx)``.
+    chunk_frames : int
+        Frames per chunk along ``time``.
+
+    Returns
+    -------
+    template : xarray.Dataset
+        ``template`` without ``iq``, with zero-filled lazy ``iq_int16`` (int16) and ``iq_scale``
+        (float32, W^0.5 per code step).
+    chunks : dict
+        Per variable, its ``chunks`` shape and ``dtype`` for the store's encoding.
+
+    Examples
+    --------
+    >>> iq = np.zeros((5, 3, 4, 2), np.complex64)
+    >>> out, chunks = encode_template(xr.Dataset({"iq": (_IQ_DIMS, iq)}), chunk_frames=2)
+    >>> sorted(out.data_vars), out.iq_int16.shape, out.iq_scale.dims
+    (['iq_int16', 'iq_scale'], (5, 3, 4, 2, 2), ('time', 'range', 'rx'))
+    >>> chunks["iq_int16"]["chunks"], chunks["iq_scale"]
+    ((2, 3, 4, 2, 2), {'chunks': (2, 3, 2), 'dtype': 'float32'})
+    """
     import dask.array as da
 
     n, n_range, n_doppler, n_rx = template["iq"].shape

@@ -145,7 +145,35 @@ def _open_zarr(path: Path) -> xr.Dataset:
 
 
 def radar_config_of(ds: xr.Dataset, source: str = "frames") -> RadarConfig:
-    """The RadarConfig stored with a frames Dataset."""
+    """The RadarConfig stored with a frames Dataset.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A frames Dataset (its ``radar_config`` attribute holds the configuration as JSON).
+    source : str
+        Names the store in error messages.
+
+    Returns
+    -------
+    RadarConfig
+
+    Raises
+    ------
+    InputError
+        When the attribute is missing or does not describe a valid RadarConfig.
+
+    Examples
+    --------
+    >>> cfg = RadarConfig.prototype_2022(n_doppler=4, range_limit_m=100.0)
+    >>> ds = frames_dataset(np.zeros((1, cfg.n_range, 4, cfg.n_rx), np.complex64), np.zeros(1), cfg)
+    >>> radar_config_of(ds) == cfg, radar_config_of(ds).n_doppler
+    (True, 4)
+    >>> radar_config_of(xr.Dataset(), "run.zarr")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: run.zarr: no 'radar_config' attribute; not a skyradar frames store
+    """
     text = ds.attrs.get("radar_config")
     if text is None:
         raise InputError(f"{source}: no 'radar_config' attribute; not a skyradar frames store")
@@ -159,11 +187,44 @@ def open_frames(path: str | Path, head: int | str | None = None) -> xr.Dataset:
     """Open a frames store (a Zarr directory) and check it is usable.
 
     A store of several radar heads (:mod:`skyradar.io.frames_heads`) opens as the single-head
-    Dataset of ``head`` (name or index; default the first head).
+    Dataset of ``head`` (name or index; default the first head). Stores written before absolute
+    time (float ``time``, no ``start_time``) still open; :func:`frame_times_s` reads their elapsed
+    seconds.
 
-    Raises :class:`InputError` naming the file when it is missing, not a directory, unfinished, empty
-    or inconsistent with its own RadarConfig. Stores written before absolute time (float ``time``,
-    no ``start_time``) still open; :func:`frame_times_s` reads their elapsed seconds.
+    Parameters
+    ----------
+    path : path
+        The store (a Zarr directory); a ``.partial`` name is refused.
+    head : int or str, optional
+        Radar head to open in a store of several heads.
+
+    Returns
+    -------
+    xarray.Dataset
+        Lazy frames Dataset with complex64 ``iq`` (cint16 stores are decoded).
+
+    Raises
+    ------
+    InputError
+        Naming the file when it is missing, not a directory, unfinished, empty or inconsistent with
+        its own RadarConfig.
+
+    Examples
+    --------
+    >>> import tempfile, dask.array as da
+    >>> cfg = RadarConfig.prototype_2022(n_doppler=4, range_limit_m=100.0)
+    >>> iq = np.full((2, cfg.n_range, 4, cfg.n_rx), 1 - 2j, np.complex64)
+    >>> template = frames_dataset(da.zeros(iq.shape, dtype=np.complex64), np.array([0.0, 0.1]), cfg)
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     writer = FrameStoreWriter(Path(d) / "run.zarr", template, 2, "demo")
+    ...     writer.write_chunk(0, iq)
+    ...     ds = open_frames(writer.close())
+    ...     ds.iq.shape, bool((ds.iq.values == iq).all()), frame_times_s(ds).tolist()
+    ((2, 6, 4, 4), True, [0.0, 0.1])
+    >>> open_frames("missing.zarr")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: missing.zarr: no such run
     """
     path = Path(path)
     if path.name.endswith(".partial"):
@@ -228,6 +289,23 @@ class FrameStoreWriter:
         Lossless codec for ``iq`` (see :data:`COMPRESSORS`).
     precision : {"complex64", "cint16"}
         Pixel format (see :data:`PRECISIONS`); readers see complex64 ``iq`` either way.
+
+    Examples
+    --------
+    Three frames in chunks of two: the store appears under its final name only at :meth:`close`.
+
+    >>> import tempfile, dask.array as da
+    >>> cfg = RadarConfig.prototype_2022(n_doppler=4, range_limit_m=100.0)
+    >>> iq = (1 - 2j) * np.arange(3 * cfg.n_range * 4 * cfg.n_rx).reshape(3, cfg.n_range, 4, cfg.n_rx)
+    >>> template = frames_dataset(da.zeros(iq.shape, dtype=np.complex64), np.array([0.0, 0.1, 0.2]), cfg)
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     writer = FrameStoreWriter(Path(d) / "run.zarr", template, 2, "demo")
+    ...     for index in writer.pending_chunks():
+    ...         writer.write_chunk(index, iq[writer.chunk_slice(index)])
+    ...     names_before = sorted(p.name for p in Path(d).iterdir())
+    ...     ds = open_frames(writer.close())
+    ...     names_before, [p.name for p in Path(d).iterdir()], bool((ds.iq.values == iq).all())
+    (['run.zarr.partial', 'run.zarr.partial.done'], ['run.zarr'], True)
     """
 
     def __init__(

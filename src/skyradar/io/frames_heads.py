@@ -46,14 +46,53 @@ def head_templates(template: xr.Dataset | Mapping[str, xr.Dataset]) -> tuple[lis
 
 
 def write_heads_root(partial: Path, attrs: dict, groups: list) -> None:
-    """Create the store's root: the head names and the job's attributes (several heads only)."""
+    """Create the store's root: the head names and the job's attributes (several heads only).
+
+    Parameters
+    ----------
+    partial : Path
+        The store being written.
+    attrs : dict
+        The job's root attributes (fingerprint, precision).
+    groups : list
+        Head names from :func:`head_templates`; ``[None]`` (one head at the root) writes nothing.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     write_heads_root(Path(d) / "one.zarr", {}, [None])
+    ...     write_heads_root(Path(d) / "two.zarr", {"skyradar_fingerprint": "f"}, ["left", "right"])
+    ...     [p.name for p in Path(d).iterdir()], store_heads(Path(d) / "two.zarr")
+    (['two.zarr'], ['left', 'right'])
+    """
     if groups != [None]:
         root = xr.Dataset(attrs=dict(attrs) | {HEADS_ATTR: json.dumps(groups)})
         root.to_zarr(partial, mode="w", consolidated=False)
 
 
 def store_heads(path: str | Path) -> list[str] | None:
-    """Head names of a multi-head store (None for a single-head store)."""
+    """Head names of a multi-head store (None for a single-head store).
+
+    Parameters
+    ----------
+    path : path
+        A frames store; anything that is not a readable Zarr group counts as single-head.
+
+    Returns
+    -------
+    list of str or None
+        The head names in the scenario's order.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     _ = xr.Dataset({"a": ("x", [1])}).to_zarr(Path(d) / "one.zarr", consolidated=False)
+    ...     write_heads_root(Path(d) / "two.zarr", {}, ["left", "right"])
+    ...     store_heads(Path(d) / "one.zarr"), store_heads(Path(d) / "two.zarr"), store_heads(d + "/none")
+    (None, ['left', 'right'], None)
+    """
     import zarr
 
     try:
@@ -75,8 +114,43 @@ def mark_heads_complete(partial: Path, groups: list) -> None:
 def open_head(path: Path, root: xr.Dataset, head: int | str | None) -> xr.Dataset:
     """The single-head Dataset of ``head`` (name or index; None: the first) of the store at ``path``.
 
-    ``root`` is the store opened at its root; a single-head store is returned as it is (``head``
-    may then be None, 0 or the name of the one head it holds, ``radar``).
+    Parameters
+    ----------
+    path : Path
+        The store.
+    root : xarray.Dataset
+        The store opened at its root; a single-head store is returned as it is (``head`` may then
+        be None, 0 or the name of the one head it holds, ``radar``).
+    head : int or str or None
+        Head name or index (negative counts from the end).
+
+    Returns
+    -------
+    xarray.Dataset
+        The head's Dataset with the job's marks from the root and the attributes ``radar_head``
+        (its name) and ``radar_heads`` (JSON list of all names).
+
+    Raises
+    ------
+    InputError
+        For an unknown head name or an index out of range.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     path = Path(d) / "run.zarr"
+    ...     write_heads_root(path, {"skyradar_complete": True}, ["left", "right"])
+    ...     for i, name in enumerate(["left", "right"]):
+    ...         _ = xr.Dataset({"a": ("x", [i])}).to_zarr(path, group=name, mode="w", consolidated=False)
+    ...     root = xr.open_zarr(path, consolidated=False)
+    ...     ds = open_head(path, root, -1)
+    ...     ds.attrs["radar_head"], int(ds["a"][0]), ds.attrs["skyradar_complete"]
+    ('right', 1, True)
+    >>> open_head(Path("run.zarr"), xr.Dataset(), "left")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: run.zarr: field 'head': 'left' unknown; this run has one radar head ('radar')
     """
     text = root.attrs.get(HEADS_ATTR)
     if text is None:

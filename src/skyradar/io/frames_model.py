@@ -159,7 +159,26 @@ def parse_start_time(value: Any, source: str = "scenario", field: str = "start_t
 
 
 def format_start_time(when: np.datetime64) -> str:
-    """``datetime64`` as ISO 8601 UTC with a ``Z`` (whole seconds shown without a fraction)."""
+    """``datetime64`` as ISO 8601 UTC with a ``Z`` (whole seconds shown without a fraction).
+
+    Parameters
+    ----------
+    when : numpy.datetime64
+        A UTC instant.
+
+    Returns
+    -------
+    str
+        The instant with trailing zeros of the fraction dropped; :func:`parse_start_time` reads it back.
+
+    Examples
+    --------
+    >>> when = np.datetime64("2026-05-01T10:00:00.250")
+    >>> format_start_time(when), format_start_time(np.datetime64("2026-05-01"))
+    ('2026-05-01T10:00:00.25Z', '2026-05-01T00:00:00Z')
+    >>> parse_start_time(format_start_time(when)) == when
+    np.True_
+    """
     text = str(np.datetime64(when, "ns"))  # type: ignore[call-overload]  # numpy's stub: no (datetime64, unit)
     head, _, frac = text.partition(".")
     frac = frac.rstrip("0")
@@ -169,7 +188,26 @@ def format_start_time(when: np.datetime64) -> str:
 def time_coordinate(times_s: Any, start_time: Any = None) -> dict[str, Any]:
     """The ``time`` (UTC datetime64[ns]) and ``time_s`` (elapsed s) coordinates of frames at ``times_s``.
 
-    ``time = start_time + round(time_s * 1e9) ns``; ``time_s`` keeps the float seconds exactly.
+    Parameters
+    ----------
+    times_s : array_like
+        Frame times, s since ``start_time``.
+    start_time : str or datetime64, optional
+        ISO 8601 instant of elapsed time 0 s; default :data:`DEFAULT_START_TIME`.
+
+    Returns
+    -------
+    dict
+        ``{"time": (dim, values, attrs), "time_s": (dim, values, attrs)}`` for an xarray constructor:
+        ``time = start_time + round(time_s * 1e9) ns``; ``time_s`` keeps the float seconds exactly.
+
+    Examples
+    --------
+    >>> c = time_coordinate([0.0, 1.5, 2e-9], "2026-05-01T12:00:00+02:00")
+    >>> [str(t) for t in c["time"][1]]
+    ['2026-05-01T10:00:00.000000000', '2026-05-01T10:00:01.500000000', '2026-05-01T10:00:00.000000002']
+    >>> c["time_s"][1].tolist(), c["time_s"][2]["units"]
+    ([0.0, 1.5, 2e-09], 's')
     """
     t = np.asarray(times_s, float)
     epoch = parse_start_time(DEFAULT_START_TIME if start_time is None else start_time)
@@ -183,7 +221,34 @@ def time_coordinate(times_s: Any, start_time: Any = None) -> dict[str, Any]:
 
 
 def axis_coordinates(config: RadarConfig, times_s: Any, start_time: Any = None) -> dict[str, Any]:
-    """Coordinates of a (time, range, doppler, rx) frames Dataset, with CF attributes."""
+    """Coordinates of a (time, range, doppler, rx) frames Dataset, with CF attributes.
+
+    Parameters
+    ----------
+    config : RadarConfig
+        Gives the range axis (m), Doppler axis (m/s) and antenna count.
+    times_s : array_like
+        Frame times, s since ``start_time``.
+    start_time : str or datetime64, optional
+        ISO 8601 instant of elapsed time 0 s (see :func:`time_coordinate`).
+
+    Returns
+    -------
+    dict
+        ``time``, ``time_s``, ``range``, ``doppler`` and ``rx``, each ``(dim, values, attrs)``.
+
+    Examples
+    --------
+    Range bins are c / (2 B) = 14.99 m apart for a 10 MHz sweep; four Doppler bins span
+    [-v_lim, v_lim) in steps of v_lim / 2.
+
+    >>> cfg = RadarConfig.prototype_2022(n_doppler=4, range_limit_m=100.0)
+    >>> c = axis_coordinates(cfg, [0.0, 0.1])
+    >>> sorted(c), np.round(c["range"][1][:3], 2).tolist(), c["range"][2]["units"]
+    (['doppler', 'range', 'rx', 'time', 'time_s'], [0.0, 14.99, 29.98], 'm')
+    >>> np.round(c["doppler"][1] / cfg.v_lim_mps, 6).tolist(), c["rx"][1].tolist()
+    ([-1.0, -0.5, 0.0, 0.5], [0, 1, 2, 3])
+    """
     coords = time_coordinate(times_s, start_time)
     coords["range"] = ("range", config.range_axis_m, _cf("range", "m", "range bin centre"))
     coords["doppler"] = (
@@ -196,7 +261,28 @@ def axis_coordinates(config: RadarConfig, times_s: Any, start_time: Any = None) 
 
 
 def variable_attrs(name: str, units: str, long_name: str) -> dict[str, str]:
-    """``units``, ``long_name`` and, when CF has one, ``standard_name`` of variable ``name``."""
+    """``units``, ``long_name`` and, when CF has one, ``standard_name`` of variable ``name``.
+
+    Parameters
+    ----------
+    name : str
+        The variable name, looked up in :data:`STANDARD_NAMES`.
+    units : str
+        Its units, e.g. "m", "m/s", "rad".
+    long_name : str
+        A description.
+
+    Returns
+    -------
+    dict of str to str
+
+    Examples
+    --------
+    >>> variable_attrs("own_lat_deg", "degree", "own-ship WGS84 latitude")["standard_name"]
+    'latitude'
+    >>> variable_attrs("tgt_rcs_m2", "m^2", "radar cross-section")
+    {'units': 'm^2', 'long_name': 'radar cross-section'}
+    """
     return _cf(name, units, long_name)
 
 
@@ -232,7 +318,25 @@ def frame_times_s(ds: xr.Dataset) -> np.ndarray:
 
 
 def start_time_of(ds: xr.Dataset) -> np.datetime64:
-    """UTC instant of elapsed time 0 s (the ``start_time`` attribute, or :data:`DEFAULT_START_TIME`)."""
+    """UTC instant of elapsed time 0 s (the ``start_time`` attribute, or :data:`DEFAULT_START_TIME`).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A frames Dataset.
+
+    Returns
+    -------
+    numpy.datetime64
+        In ns, UTC (an offset in the attribute is applied).
+
+    Examples
+    --------
+    >>> str(start_time_of(xr.Dataset(attrs={"start_time": "2026-05-01T12:00:00+02:00"})))
+    '2026-05-01T10:00:00.000000000'
+    >>> str(start_time_of(xr.Dataset()))
+    '1970-01-01T00:00:00.000000000'
+    """
     return parse_start_time(ds.attrs.get("start_time", DEFAULT_START_TIME), "frames", "start_time")
 
 

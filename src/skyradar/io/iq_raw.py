@@ -30,7 +30,43 @@ RAW_SUFFIXES = {".cf32": "cf32_le", ".ci16": "ci16_le", ".cs16": "ci16_le"}
 
 
 def read_raw_iq(data_path: str | Path, require_illuminator: bool = True) -> IqRecording:
-    """Open ``NAME.cf32``/``NAME.ci16`` with its sidecar ``NAME.json``/``.yaml``/``.yml``."""
+    """Open ``NAME.cf32``/``NAME.ci16`` with its sidecar ``NAME.json``/``.yaml``/``.yml``.
+
+    Parameters
+    ----------
+    data_path : path
+        The sample file; its suffix (``.cf32``, ``.ci16`` or ``.cs16``) sets the datatype.
+    require_illuminator : bool
+        Refuse a sidecar without the illuminator's position (lat, lon in degrees, alt in m).
+
+    Returns
+    -------
+    IqRecording
+        The samples stay on disk until read.
+
+    Raises
+    ------
+    InputError
+        When the file or its sidecar is missing or unreadable, or a required field is missing or invalid.
+
+    Examples
+    --------
+    A YAML sidecar; the ``ci16`` codes are divided by 32768 on reading.
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     data = Path(d) / "r.ci16"
+    ...     _ = data.write_bytes(np.array([16384, -8192, 0, 32767], "<i2").tobytes())
+    ...     _ = data.with_suffix(".yaml").write_text("{sample_rate_hz: 2000000, center_frequency_hz: 1.0e+9, "
+    ...         "receiver: {latitude: 52.0, longitude: 5.0, altitude: 10.0}}")
+    ...     rec = read_raw_iq(data, require_illuminator=False)
+    ...     rec.n_samples, rec.duration_s, rec.read(0, 2).tolist()
+    (2, 1e-06, [(0.5-0.25j), 0.999969482421875j])
+    >>> read_raw_iq("missing.cf32")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: missing.cf32: no such file
+    """
     data_path = Path(data_path)
     if not data_path.exists():
         raise InputError(f"{data_path}: no such file")

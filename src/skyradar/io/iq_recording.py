@@ -53,6 +53,39 @@ class IqRecording:
         (lat_deg, lon_deg, alt_m), WGS84.
     illuminator, receiver : dict
         The ``skyradar:illuminator`` and ``skyradar:receiver`` objects.
+
+    Parameters
+    ----------
+    path, data_path : Path
+        The metadata (or sidecar) file and the sample file.
+    datatype : str
+        A key of :data:`DATATYPES`.
+    offset_bytes : int
+        Header bytes before the first sample in ``data_path``.
+    info : dict
+        ``sample_rate_hz`` (Hz), ``center_frequency_hz`` (Hz), ``receiver_geodetic``,
+        ``illuminator``, ``illuminator_geodetic``, and optionally ``start_time``, ``receiver`` and
+        ``n_samples`` (the data file must hold at least that many).
+
+    Raises
+    ------
+    InputError
+        When the data file is shorter than its header or than ``n_samples``, ends inside a sample, or
+        holds float32 values declared as ``ci16_le``.
+
+    Examples
+    --------
+    Five cf32 samples after an 8-byte header, read in chunks of two with one sample of overlap.
+
+    >>> import tempfile
+    >>> info = {"sample_rate_hz": 1e6, "center_frequency_hz": 1e9, "receiver_geodetic": (52.0, 5.0, 10.0),
+    ...         "illuminator": {}, "illuminator_geodetic": None}
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     data = Path(d) / "r.cf32"
+    ...     _ = data.write_bytes(bytes(8) + (np.arange(5) * 1j).astype("<c8").tobytes())
+    ...     rec = IqRecording(data.with_suffix(".json"), data, "cf32_le", 8, info)
+    ...     rec.n_samples, [(start, block.imag.tolist()) for start, block in rec.chunks(2, overlap=1)]
+    (5, [(0, [0.0, 1.0, 2.0]), (2, [2.0, 3.0, 4.0]), (4, [4.0])])
     """
 
     def __init__(self, path: Path, data_path: Path, datatype: str, offset_bytes: int, info: dict) -> None:

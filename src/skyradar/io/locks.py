@@ -178,9 +178,35 @@ def command_outputs() -> Iterator[None]:
 
 
 def hold_output(path: str | Path, option: str = "--output") -> bool:
-    """Lock output ``path`` until the running command ends (:func:`command_outputs`); False, and no
-    lock, outside a command or in a worker process forked from one. :class:`InputError` when another
-    process is writing ``path``."""
+    """Lock output ``path`` until the running command ends (:func:`command_outputs`).
+
+    Parameters
+    ----------
+    path : path
+        The output to lock (its lock file is :func:`lock_path`).
+    option : str
+        The command-line option that names ``path``, for the error message.
+
+    Returns
+    -------
+    bool
+        True when locked; False, and no lock, outside a command or in a worker process forked from one.
+
+    Raises
+    ------
+    InputError
+        When another process is writing ``path``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     out = Path(d) / "tracks.parquet"
+    ...     with command_outputs():
+    ...         locked = hold_output(out), hold_output(out), lock_path(out).exists()
+    ...     locked, lock_path(out).exists(), hold_output(out)
+    ((True, True, True), False, False)
+    """
     if _SCOPE is None or _SCOPE[0] != os.getpid():
         return False
     _SCOPE[1].enter_context(exclusive_output(path, option))

@@ -78,7 +78,20 @@ def navigation_state(ds: xr.Dataset, source: str = "frames") -> pd.DataFrame | N
     -------
     pandas.DataFrame or None
         ``time_s`` and the :data:`STATE_COLUMNS` the run has, from ``nav_*``, else from ``own_*``
-        (stores without ``nav_*``); ``attrs["navigation_source"]`` says which.
+        (stores without ``nav_*``); ``attrs["navigation_source"]`` says which. Units as in the
+        column names: m, m/s, rad, degree; ``time_s`` in s.
+
+    Examples
+    --------
+    A store with only the truth: its values are used, and the source says so.
+
+    >>> ds = xr.Dataset({"own_yaw_rad": ("time", [0.0, np.pi / 2]), "own_alt_m": ("time", [100.0, 110.0])},
+    ...                 coords={"time": [0.0, 0.5]})
+    >>> state = navigation_state(ds)
+    >>> list(state.columns), state["own_alt_m"].tolist(), state.attrs["navigation_source"]
+    (['time_s', 'own_yaw_rad', 'own_alt_m'], [100.0, 110.0], 'truth')
+    >>> navigation_state(xr.Dataset()) is None
+    True
     """
     kind = navigation_source(ds)
     if kind is None:

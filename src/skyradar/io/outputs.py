@@ -52,7 +52,22 @@ _MARGIN_BYTES = 64 * 2**20
 
 
 def notify(message: str) -> None:
-    """One line to stderr (progress notes that are not errors)."""
+    """One line to stderr (progress notes that are not errors).
+
+    Parameters
+    ----------
+    message : str
+        The note, printed with a newline and flushed at once.
+
+    Examples
+    --------
+    >>> import contextlib, io
+    >>> err = io.StringIO()
+    >>> with contextlib.redirect_stderr(err):
+    ...     notify("run.zarr: resuming at chunk 3")
+    >>> err.getvalue()
+    'run.zarr: resuming at chunk 3\\n'
+    """
     print(message, file=sys.stderr, flush=True)
 
 
@@ -248,7 +263,26 @@ def _check_replaceable(path: Path, label: str, kind: str, overwrite: bool) -> No
 
 
 def mark_folder(path: str | Path) -> Path:
-    """Create folder ``path`` (if needed) with the marker that says skyradar wrote it; return it."""
+    """Create folder ``path`` (if needed) with the marker that says skyradar wrote it; return it.
+
+    Parameters
+    ----------
+    path : path
+        The output folder; missing parents are created, an existing marker is kept as it is.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     out = mark_folder(Path(d) / "report" / "figures")
+    ...     [p.name for p in out.iterdir()], is_ours(out, "folder"), is_ours(out.parent, "folder")
+    (['.skyradar-output'], True, False)
+    """
     path = Path(path)
     path.mkdir(parents=True, exist_ok=True)
     marker = path / FOLDER_MARKER

@@ -81,6 +81,38 @@ def open_ownship(path: str | Path, option: str = "--ownship") -> xr.Dataset:
 
     Read its navigation with :func:`skyradar.io.navigation.navigation_state` and its origin with
     :func:`skyradar.io.run_origin.scenario_origin`.
+
+    Parameters
+    ----------
+    path : path
+        A frames store, or a ``.parquet``/``.pq``/``.csv`` table with ``time_s`` (s) and own-ship
+        columns (``own_*``/``nav_*``, units in their names: m, m/s, rad, degree).
+    option : str
+        The command-line option that names ``path``, for error messages.
+
+    Returns
+    -------
+    xarray.Dataset
+        On ``time``; a table's numeric columns become variables and ``time_s`` a coordinate.
+
+    Raises
+    ------
+    InputError
+        When ``path`` is missing, of another kind, or not a valid run or table.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     csv = Path(d) / "own.csv"
+    ...     _ = csv.write_text("time_s,nav_north_m,nav_vn_mps\\n0.0,0.0,40.0\\n0.5,20.0,40.0\\n")
+    ...     ds = open_ownship(csv)
+    ...     sorted(ds.data_vars), ds["nav_north_m"].values.tolist(), ds["time_s"].values.tolist()
+    (['nav_north_m', 'nav_vn_mps'], [0.0, 20.0], [0.0, 0.5])
+    >>> open_ownship("missing.csv")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: --ownship missing.csv: no such run or table
     """
     from skyradar.io.frames import open_frames
     from skyradar.io.tables import read_table

@@ -85,7 +85,28 @@ def write_recording(
 
     Returns
     -------
-    Path of the sidecar.
+    Path
+        The sidecar.
+
+    Examples
+    --------
+    The default scale maps the largest magnitude, ``|3 - 6j| = sqrt(45)``, to 30000 counts; reading
+    back is exact to half a count.
+
+    >>> import tempfile
+    >>> from skyradar.io.recordings import read_recording
+    >>> cfg = RadarConfig.prototype_2022(n_doppler=4)
+    >>> adc = np.zeros((2, 4, 4, 16), np.complex64)
+    >>> adc[1, 2, 3, 5] = 3 - 6j
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     side = write_recording(Path(d) / "rec.bin", adc, cfg)
+    ...     meta = json.loads(side.read_text())
+    ...     frames, config = read_recording(side)
+    ...     back = frames[1]
+    ...     side.name, sorted(p.name for p in Path(d).iterdir()), meta["dtype"], meta["shape"]
+    ('rec.json', ['rec.bin', 'rec.json'], 'complex_int16', [2, 4, 4, 16])
+    >>> round(meta["scale"] * 30000 / 45**0.5, 6), bool(abs(back - adc[1]).max() <= meta["scale"])
+    (1.0, True)
     """
     path = Path(path)
     frames = np.asarray(frames)

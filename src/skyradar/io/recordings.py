@@ -85,6 +85,30 @@ class AdcFrames:
     times_s : ndarray
         Frame times, s.
     is_complex : bool
+
+    Parameters
+    ----------
+    raw : ndarray
+        The data in file order; with ``complex_pairs``, a last axis of length 2 holds I and Q.
+    axes : list of str
+        The names of ``raw``'s first four axes, any order of :data:`AXES`.
+    complex_pairs : bool
+        ``raw`` holds I/Q pairs (``complex_int16``, ``complex64`` on disk).
+    scale : float
+        Sample value times ``scale`` is sqrt(W) at the ADC.
+    times_s : ndarray
+        Frame times, s.
+
+    Examples
+    --------
+    int16 I/Q pairs stored (frame, chirp, sample, rx), read as (rx, chirp, sample) frames:
+
+    >>> raw = np.arange(2 * 3 * 4 * 2 * 2, dtype=np.int16).reshape(2, 3, 4, 2, 2)
+    >>> frames = AdcFrames(raw, ["frame", "chirp", "sample", "rx"], True, 0.5, np.array([0.0, 0.1]))
+    >>> frames.shape, len(frames), frames[1].dtype
+    ((2, 2, 3, 4), 2, dtype('complex64'))
+    >>> raw[1, 2, 3, 1].tolist(), complex(frames[1][1, 2, 3])
+    ([94, 95], (47+47.5j))
     """
 
     def __init__(
@@ -371,6 +395,24 @@ def open_described(sidecar: Path, meta: dict[str, Any]) -> tuple[AdcFrames, Rada
     -------
     frames : AdcFrames
     config : RadarConfig
+
+    Raises
+    ------
+    InputError
+        Naming ``sidecar``, the field and the value for any inconsistency.
+
+    Examples
+    --------
+    Real float32 samples, two frames of 4 rx x 2 chirps x 8 samples, 0.25 s apart:
+
+    >>> import tempfile
+    >>> meta = {"dtype": "float32", "shape": [2, 4, 2, 8], "axes": list(AXES), "sample_rate_hz": 10e6,
+    ...         "fc_hz": 9.425e9, "bandwidth_hz": 10e6, "prf_hz": 4921.0, "frame_period_s": 0.25}
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     _ = (Path(d) / "rec.bin").write_bytes(np.arange(128, dtype="<f4").tobytes())
+    ...     frames, config = open_described(Path(d) / "rec.json", meta)
+    ...     frames.shape, frames[1][0, 1].tolist(), frames.times_s.tolist(), config.n_doppler
+    ((2, 4, 2, 8), [72.0, 73.0, 74.0, 75.0, 76.0, 77.0, 78.0, 79.0], [0.0, 0.25], 2)
     """
     raw, pairs, _ = _open_binary(sidecar, meta)
     return _frames_of(sidecar, meta, raw, pairs)

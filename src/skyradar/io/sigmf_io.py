@@ -206,6 +206,7 @@ class SigmfWriter:
     path : str or Path
         ``NAME.sigmf-meta`` (or ``NAME``); the data goes to ``NAME.sigmf-data``.
     sample_rate_hz, center_frequency_hz : float
+        Complex sample rate and centre frequency, Hz.
     receiver : dict
         ``latitude``, ``longitude``, ``altitude`` of the receiving antenna (WGS84 deg, deg, m).
     illuminator : dict
@@ -215,8 +216,34 @@ class SigmfWriter:
     start_time : datetime or str, optional
         UTC time of the first sample (default now).
     description : str
+        ``core:description``; default "passive radar receiver recording".
     overwrite : bool
         Replace existing files (otherwise an existing one raises :class:`InputError`).
+
+    Examples
+    --------
+    Two chunks appended; the metadata counts and hashes all of them, and an exception inside the
+    block leaves no file.
+
+    >>> import tempfile
+    >>> rx = {"latitude": 52.0, "longitude": 5.0, "altitude": 40.0}
+    >>> tx = {"latitude": 52.1, "longitude": 5.0, "altitude": 20.0}
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     with SigmfWriter(Path(d) / "rec", 2e6, 1e9, rx, tx, start_time="2026-05-01T10:00:00Z") as w:
+    ...         w.write(np.arange(3) * 1j)
+    ...         w.write(np.ones(2))
+    ...     meta = json.loads((Path(d) / "rec.sigmf-meta").read_text())
+    ...     data = np.fromfile(Path(d) / "rec.sigmf-data", "<c8")
+    ...     try:
+    ...         with SigmfWriter(Path(d) / "bad", 2e6, 1e9, rx, tx) as w:
+    ...             raise ValueError("receiver stopped")
+    ...     except ValueError:
+    ...         pass
+    ...     names = sorted(p.name for p in Path(d).iterdir())
+    >>> meta["global"]["skyradar:sample_count"], meta["global"]["core:geolocation"]["coordinates"]
+    (5, [5.0, 52.0, 40.0])
+    >>> data.tolist(), names
+    ([0j, 1j, 2j, (1+0j), (1+0j)], ['rec.sigmf-data', 'rec.sigmf-meta'])
     """
 
     def __init__(

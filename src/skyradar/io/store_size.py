@@ -56,7 +56,43 @@ def check_store_space(
     compressor: str = "none",
     precision: str = "complex64",
 ) -> None:
-    """Refuse to start when the store's unwritten chunks do not fit on the disk of ``path``."""
+    """Refuse to start when the store's unwritten chunks do not fit on the disk of ``path``.
+
+    Chunks already marked done in ``NAME.partial.done`` (a run being resumed) are not counted; each
+    unwritten chunk counts whole, ``chunk_frames`` frames.
+
+    Parameters
+    ----------
+    path : path
+        The store's final name.
+    config : RadarConfig
+        Sets the pixels per frame.
+    n_frames : int
+        Frames in the run.
+    chunk_frames : int
+        Frames per chunk along time.
+    compressor : {"none", "zstd", "blosc"}
+    precision : {"complex64", "cint16"}
+        See :func:`store_bytes`.
+
+    Raises
+    ------
+    InputError
+        When the estimate (plus a margin) exceeds the free space.
+
+    Examples
+    --------
+    Ten prototype frames (27 MB) fit; 10^12 frames (2.66e9 GB) do not.
+
+    >>> import tempfile
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     check_store_space(Path(d) / "run.zarr", cfg, 10, 4)
+    ...     check_store_space(Path(d) / "run.zarr", cfg, 10**12, 16)
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: .../run.zarr: a 1000000000000-frame complex64 store needs about 2.66e+09 GB...
+    """
     path = Path(path)
     chunk_frames = max(1, min(int(chunk_frames), int(n_frames)))  # a chunk is at most the whole run
     n_chunks = max(1, -(-int(n_frames) // chunk_frames))

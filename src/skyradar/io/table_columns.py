@@ -30,7 +30,23 @@ _TEXT = re.compile(r"(?P<unit>[^;]+); (?P<meaning>.+?)(?:; optional: (?P<optiona
 
 
 class ColumnDoc(NamedTuple):
-    """One column's unit, meaning and, for a column not always written, when it is written."""
+    """One column's unit, meaning and, for a column not always written, when it is written.
+
+    Parameters
+    ----------
+    unit : str
+        The column's unit ("m", "m/s", "s", "rad", ...), ``-`` for flags, counts, identifiers and text.
+    meaning : str
+        What the column holds.
+    optional : str or None
+        When the column is written; None for a column every run writes.
+
+    Examples
+    --------
+    >>> doc = ColumnDoc("m/s", "radial velocity", None)
+    >>> doc.unit, doc == column_doc("m/s; radial velocity")
+    ('m/s', True)
+    """
 
     unit: str
     meaning: str
@@ -38,7 +54,32 @@ class ColumnDoc(NamedTuple):
 
 
 def column_doc(text: str) -> ColumnDoc:
-    """The parts of a column's ``"unit; meaning[; optional: when]"`` text; ValueError on any other."""
+    """The parts of a column's ``"unit; meaning[; optional: when]"`` text.
+
+    Parameters
+    ----------
+    text : str
+        ``"UNIT; MEANING"``, optionally followed by ``"; optional: WHEN"``.
+
+    Returns
+    -------
+    ColumnDoc
+        Unit and meaning stripped of surrounding spaces.
+
+    Raises
+    ------
+    ValueError
+        For text of any other form.
+
+    Examples
+    --------
+    >>> column_doc("rad; azimuth; optional: a run with --angles")
+    ColumnDoc(unit='rad', meaning='azimuth', optional='a run with --angles')
+    >>> column_doc("azimuth")
+    Traceback (most recent call last):
+    ...
+    ValueError: a column's text is 'unit; meaning[; optional: when]', got 'azimuth'
+    """
     match = _TEXT.fullmatch(text)
     if match is None:
         raise ValueError(f"a column's text is 'unit; meaning[; optional: when]', got {text!r}")
@@ -46,5 +87,22 @@ def column_doc(text: str) -> ColumnDoc:
 
 
 def always_written(columns: dict[str, str]) -> list[str]:
-    """The columns of a table's mapping that every run writes (not marked optional)."""
+    """The columns of a table's mapping that every run writes (not marked optional).
+
+    Parameters
+    ----------
+    columns : dict of str to str
+        Column name to ``"unit; meaning[; optional: when]"`` text, in the table's column order.
+
+    Returns
+    -------
+    list of str
+        The names, in the mapping's order.
+
+    Examples
+    --------
+    >>> always_written({"time_s": "s; frame time", "head": "-; radar head; optional: several heads",
+    ...                 "range_m": "m; range"})
+    ['time_s', 'range_m']
+    """
     return [name for name, text in columns.items() if column_doc(text).optional is None]

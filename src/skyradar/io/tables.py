@@ -54,8 +54,29 @@ def appended(table: pd.DataFrame | None, rows: pd.DataFrame) -> pd.DataFrame:
 def write_table(df: pd.DataFrame, path: str | Path, metadata: dict[str, Any] | None = None) -> Path:
     """Write ``df`` to Parquet atomically; ``metadata`` goes into ``df.attrs`` (kept by pyarrow).
 
-    ``skyradar_format`` in the metadata marks the file as ours (:mod:`skyradar.io.outputs` then
-    lets a later run replace it without ``--overwrite``).
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        The table; its index is not written. ``df`` itself is left unchanged.
+    path : path
+        The Parquet file.
+    metadata : dict, optional
+        Extra table attributes. ``skyradar_format`` (default ``"table/1"``) marks the file as ours
+        (:mod:`skyradar.io.outputs` then lets a later run replace it without ``--overwrite``).
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> df = pd.DataFrame({"time_s": [0.0, 0.1], "range_m": [120.0, 118.5]})
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     back = read_table(write_table(df, Path(d) / "det.parquet", {"origin_lla": [52.0, 5.0, 0.0]}))
+    >>> back.equals(df), back.attrs["skyradar_format"], back.attrs["origin_lla"], df.attrs
+    (True, 'table/1', [52.0, 5.0, 0.0], {})
     """
     df = df.copy(deep=False)
     df.attrs.update({"skyradar_format": "table/1", **(metadata or {})})
@@ -67,9 +88,41 @@ def read_table(
 ) -> pd.DataFrame:
     """Read a Parquet (or CSV) table and check that ``required`` columns are present.
 
-    Columns in ``finite`` must hold finite numbers: a string, NaN or inf names its row. With
-    ``sort_by`` the column must be non-decreasing; a clear error names the first row where it
-    goes backwards.
+    Parameters
+    ----------
+    path : path
+        A ``.parquet`` or ``.csv`` file; without either suffix the content decides (Parquet starts
+        with ``PAR1``), so a named pipe reads as what it holds.
+    required : iterable of str
+        Columns that must be present.
+    sort_by : str, optional
+        A column that must be non-decreasing.
+    finite : iterable of str
+        Columns that must hold finite numbers.
+
+    Returns
+    -------
+    pandas.DataFrame
+
+    Raises
+    ------
+    InputError
+        Naming the file when it is missing, unreadable or lacks a required column; naming the first
+        bad row when a ``finite`` column holds a string, NaN or inf, or ``sort_by`` goes backwards.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     csv = Path(d) / "tracks.csv"
+    ...     _ = csv.write_text("time_s,range_m\\n0.0,100.0\\n0.1,98.0\\n0.05,97.0\\n")
+    ...     df = read_table(csv, required=["time_s", "range_m"], finite=["range_m"])
+    ...     try:
+    ...         read_table(csv, sort_by="time_s")
+    ...     except InputError as err:
+    ...         message = str(err).replace(d, "DIR")
+    >>> df["range_m"].tolist(), message
+    ([100.0, 98.0, 97.0], "DIR/tracks.csv: field 'time_s' goes backwards at row 2 (0.1 -> 0.05)")
     """
     path = Path(path)
     if not path.exists():
@@ -202,5 +255,26 @@ def jsonable(value: Any) -> Any:
 
 
 def write_json_atomic(path: str | Path, payload: Any) -> Path:
-    """Write JSON to ``path`` through a temporary name and rename (NaN and inf become null)."""
+    """Write JSON to ``path`` through a temporary name and rename (NaN and inf become null).
+
+    Parameters
+    ----------
+    path : path
+        The JSON file; missing parent folders are created.
+    payload : object
+        Anything :func:`jsonable` makes plain (dicts, lists, numpy scalars and arrays).
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = write_json_atomic(Path(d) / "out" / "s.json", {"rmse_m": np.float64(1.5), "ok": [np.nan]})
+    ...     json.loads(p.read_text())
+    {'rmse_m': 1.5, 'ok': [None]}
+    """
     return write_text_atomic(path, json.dumps(jsonable(payload), indent=2, default=float, allow_nan=False))

@@ -79,7 +79,33 @@ STATE_TABLE_COLUMNS: dict[str, str] = {
 
 @dataclass(frozen=True)
 class FrameEstimate:
-    """One frame: the fit (antenna height), its ridge, quality and the low-quality flag."""
+    """One frame: the fit (antenna height), its ridge, quality and the low-quality flag.
+
+    Attributes
+    ----------
+    fit : StateFit
+        V_X (m/s), V_Z (m/s, positive down) and H (m, of the antenna); NaN on a low-quality frame.
+    ridge : Ridge
+        The ground-ridge pairs the fit used.
+    quality : float
+        ``inlier_fraction * min(1, n_inliers / 50)``, 0..1.
+    low_quality : bool
+        Too few inliers or too low a quality; the filter skips the frame.
+
+    Examples
+    --------
+    Ridge pairs of flat ground 500 m below, flying at 60 m/s and climbing at 3 m/s:
+
+    >>> from skyradar.nav.inversion import ridge_velocity
+    >>> r = np.linspace(520.0, 4000.0, 80)
+    >>> z = np.zeros(80, int)
+    >>> ridge = Ridge(r, ridge_velocity(r, 60.0, -3.0, 500.0), z, z, np.full(80, 20.0), 1e-12, 80)
+    >>> est = estimate_frame(None, RadarConfig.prototype_2022(), ridge=ridge)
+    >>> est.quality, est.low_quality, est.n_inliers
+    (1.0, False, 80)
+    >>> round(est.fit.vx_mps, 2), round(est.fit.vz_mps, 2), round(est.fit.h_m, 1)
+    (60.0, -3.0, 500.0)
+    """
 
     fit: StateFit
     ridge: Ridge
@@ -168,7 +194,31 @@ def filter_table(
 ) -> pd.DataFrame:
     """Add filtered columns (``vx_mps, vz_mps, h_m`` and their ``*_sd``) and ``used_by_filter``.
 
-    ``table`` holds per-frame ``time_s`` and raw ``vx_raw_mps, vz_raw_mps, h_raw_m`` with SDs.
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        Per-frame ``time_s`` (s) and raw ``vx_raw_mps, vz_raw_mps`` (m/s), ``h_raw_m`` (m) with their
+        SDs ``vx_raw_sd_mps, vz_raw_sd_mps, h_raw_sd_m``; NaN rows are not measurements.
+    settings : KalmanSettings, optional
+        Filter tuning (default :class:`KalmanSettings`).
+    reference_h_m : ndarray, optional
+        Reference height per frame, m, for the thesis' GPS gate (``settings.gps_gate_m``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        A copy of ``table`` with the filtered columns (NaN until the first measurement).
+
+    Examples
+    --------
+    A constant state with one frame 400 m off in height: the innovation gate drops that frame.
+
+    >>> table = pd.DataFrame({"time_s": np.arange(6.0), "vx_raw_mps": 50.0, "vz_raw_mps": 0.0,
+    ...                       "h_raw_m": [np.nan, 300.0, 300.0, 300.0, 700.0, 300.0],
+    ...                       "vx_raw_sd_mps": 1.0, "vz_raw_sd_mps": 1.0, "h_raw_sd_m": 5.0})
+    >>> out = filter_table(table)
+    >>> out["h_m"].round(1).tolist(), out["used_by_filter"].tolist()
+    ([nan, 300.0, 300.0, 300.0, 300.0, 300.0], [False, True, True, True, False, True])
     """
     raw = table[["vx_raw_mps", "vz_raw_mps", "h_raw_m"]].to_numpy().astype(float)
     raw_sd = table[["vx_raw_sd_mps", "vz_raw_sd_mps", "h_raw_sd_m"]].to_numpy().astype(float)
@@ -249,14 +299,46 @@ def estimate_run(
 ) -> pd.DataFrame:
     """Per-frame raw and filtered flight state of a frames Dataset (``source`` names it in errors).
 
-    ``method`` is ``thesis``, ``robust`` or ``terrain`` (:mod:`skyradar.nav.terrain_aware`,
-    which takes the attitude from the run's ``own_yaw_rad/own_pitch_rad/own_roll_rad``, i.e. an
-    AHRS; level flight heading north when absent). Returns a DataFrame with ``time_s, frame,
-    vx_raw_mps, vz_raw_mps, h_raw_m`` (+ ``_sd``), filtered ``vx_mps, vz_mps, h_m`` (+ ``_sd``),
-    ``quality, low_quality, n_ridge, n_inliers, used_by_filter``. With ``gps_gate`` the
-    thesis' 150 m gate against ``own_height_agl_m`` (comparison only). With ``ahrs``
-    (:class:`skyradar.sim.navigation.AhrsModel`) the run's attitude, the simulator's truth, reaches the
-    estimators only through that model's seeded (``ahrs_seed``) errors.
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A frames Dataset (its ``iq``, ``radar_config`` and own-ship navigation are read).
+    method : {"thesis", "robust", "terrain"}
+        ``terrain`` is :mod:`skyradar.nav.terrain_aware`, which takes the attitude (rad) from the
+        run's navigation ``own_yaw_rad/own_pitch_rad/own_roll_rad``, i.e. an AHRS; level flight
+        heading north when absent.
+    settings : KalmanSettings, optional
+        Filter tuning; default :class:`KalmanSettings` (``terrain_psd=400`` m^2/s for ``terrain``).
+    gps_gate : bool
+        The thesis' 150 m gate against the navigation's ``own_height_agl_m`` (comparison only).
+    progress : callable, optional
+        Called as ``progress(done, total)`` after each frame.
+    source : str
+        Names the run in errors.
+    ahrs : AhrsModel, optional
+        With a :class:`skyradar.sim.navigation.AhrsModel` the run's attitude, the simulator's truth,
+        reaches the estimators only through that model's errors, seeded by ``ahrs_seed``.
+    ahrs_seed : int
+
+    Returns
+    -------
+    pandas.DataFrame
+        The columns of :data:`STATE_TABLE_COLUMNS`: ``time_s`` (s), ``frame``, raw
+        ``vx_raw_mps, vz_raw_mps`` (m/s), ``h_raw_m`` (m) with ``_sd``, filtered ``vx_mps, vz_mps,
+        h_m`` with ``_sd``, ``quality, low_quality, n_ridge, n_inliers, used_by_filter``.
+
+    Examples
+    --------
+    Frames that see only sky (no ground returns) are flagged and give no state:
+
+    >>> from skyradar.io.frames import frames_dataset
+    >>> cfg = RadarConfig.prototype_2022(range_limit_m=1000.0)
+    >>> cube = np.zeros((3, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
+    >>> table = estimate_run(frames_dataset(cube, np.array([0.0, 0.1, 0.2]), cfg))
+    >>> list(table.columns) == list(STATE_TABLE_COLUMNS)
+    True
+    >>> table["low_quality"].tolist(), table["h_m"].isna().all(), table["used_by_filter"].any()
+    ([True, True, True], np.True_, np.False_)
     """
     from skyradar.io.frames import radar_config_of
 

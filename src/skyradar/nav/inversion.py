@@ -55,6 +55,15 @@ class StateFit:
         Which input pairs the fit kept.
     rms_mps : float
         RMS radial-velocity residual of the kept pairs, m/s.
+
+    Examples
+    --------
+    >>> r = np.linspace(600.0, 4000.0, 40)
+    >>> fit = fit_robust(r, ridge_velocity(r, 50.0, 1.0, 400.0))
+    >>> fit.ok, int(fit.inliers.sum()), round(fit.h_m, 1), fit.rms_mps < 1e-6
+    (True, 40, 400.0, True)
+    >>> StateFit.failed(3).ok, StateFit.failed(3).inliers.tolist()
+    (False, [False, False, False])
     """
 
     vx_mps: float

@@ -41,7 +41,21 @@ class KalmanSettings:
     meas_sd_floor : tuple of float
         Lower bounds of the measurement SDs (V_X m/s, V_Z m/s, H m).
     gps_gate_m : float or None
-        Thesis mode: reject measurements farther than this from the reference height.
+        Thesis mode: reject measurements farther than this from the reference height, m.
+
+    Examples
+    --------
+    A height jump of 400 m: the default gate rejects it; with ``max_rejections=1`` the filter
+    restarts from it at once.
+
+    >>> t = np.arange(6.0)
+    >>> z = np.column_stack([np.full(6, 50.0), np.zeros(6), [300.0, 300.0, 300.0, 300.0, 700.0, 700.0]])
+    >>> sd = np.tile([1.0, 1.0, 5.0], (6, 1))
+    >>> filter_states(t, z, sd).accepted.tolist()
+    [True, True, True, True, False, False]
+    >>> out = filter_states(t, z, sd, KalmanSettings(max_rejections=1))
+    >>> out.accepted.tolist(), out.state[4, 2]
+    ([True, True, True, True, True, True], np.float64(700.0))
     """
 
     accel_psd: float = 0.5
@@ -54,7 +68,26 @@ class KalmanSettings:
 
 @dataclass(frozen=True)
 class FilterOutput:
-    """Filtered states (n, 3) in the order (V_X, V_Z, H), their SDs, and which frames were used."""
+    """Filtered states (n, 3) in the order (V_X, V_Z, H), their SDs, and which frames were used.
+
+    Attributes
+    ----------
+    state : ndarray, shape (n, 3)
+        V_X (m/s), V_Z (m/s, positive down), H (m); NaN rows before the first usable measurement.
+    sd : ndarray, shape (n, 3)
+        One-sigma uncertainties, same units.
+    accepted : ndarray of bool, shape (n,)
+        Frames whose measurement the filter took.
+
+    Examples
+    --------
+    Descending at 2 m/s: between measurements the height follows H' = -V_Z.
+
+    >>> z = np.array([[50.0, 2.0, 600.0], [np.nan] * 3, [50.0, 2.0, 596.0]])
+    >>> out = filter_states(np.array([0.0, 1.0, 2.0]), z, np.tile([1.0, 1.0, 5.0], (3, 1)))
+    >>> np.round(out.state[:, 2], 6).tolist(), out.accepted.tolist(), out.sd[0].tolist()
+    ([600.0, 598.0, 596.0], [True, False, True], [1.0, 1.0, 5.0])
+    """
 
     state: np.ndarray
     sd: np.ndarray

@@ -48,6 +48,28 @@ def with_radar_height(ds: xr.Dataset, state: pd.DataFrame, source: str = "state"
     xr.Dataset
         A shallow copy with the new ``nav_height_agl_m`` and ``attrs["nav_height_source"]``
         (``"radar"``); the ``own_*`` truth is untouched.
+
+    Raises
+    ------
+    InputError
+        When ``ds`` has no ``nav_height_agl_m`` or ``state`` lacks ``time_s`` or ``h_m``.
+
+    Examples
+    --------
+    Frames 0.5 s apart: each takes the nearest trusted estimate within 0.25 s (half a frame). The
+    frame at 0.5 s is 0.3 s from both trusted ones and keeps its GNSS height; the frame at 1.0 s
+    takes the estimate at 0.8 s, as the filter does not use the one at 1.0 s.
+
+    >>> ds = xr.Dataset({"nav_height_agl_m": ("time", [500.0, 500.0, 500.0]),
+    ...                  "own_height_agl_m": ("time", [480.0, 481.0, 482.0])},
+    ...                 coords={"time": [0.0, 0.5, 1.0]})
+    >>> state = pd.DataFrame({"time_s": [0.2, 0.8, 1.0], "h_m": [478.0, 479.0, 470.0],
+    ...                       "used_by_filter": [True, True, False]})
+    >>> out = with_radar_height(ds, state)
+    >>> out["nav_height_agl_m"].values.tolist(), out.attrs["nav_height_source"]
+    ([478.0, 500.0, 479.0], 'radar')
+    >>> out["own_height_agl_m"].values.tolist() == ds["own_height_agl_m"].values.tolist()
+    True
     """
     if "nav_height_agl_m" not in ds:
         raise InputError(f"{source}: the run has no navigation height (nav_height_agl_m) to replace")

@@ -69,6 +69,16 @@ class Ridge:
         Noise floor of the summed power image, W per pixel.
     n_occupied : int
         Pixels above the gate in the whole image.
+
+    Examples
+    --------
+    >>> ridge = Ridge(np.array([600.0, 615.0]), np.array([-20.0, -21.5]), np.array([40, 41]),
+    ...               np.array([60, 58]), np.array([18.0, 17.5]), 1e-13, 35)
+    >>> len(ridge), len(Ridge.empty()), ridge.radial_velocity_mps.min()
+    (2, 0, np.float64(-21.5))
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> len(extract_ridge(np.zeros((cfg.n_range, cfg.n_doppler)), cfg))  # only sky: no ridge
+    0
     """
 
     range_m: np.ndarray

@@ -40,12 +40,54 @@ __all__ = [
 
 
 def reflector_position(range_m: float, azimuth_rad: float, elevation_rad: float) -> np.ndarray:
-    """Antenna-frame position (3,) of a point at range, azimuth (right +) and elevation (up +)."""
+    """Antenna-frame position (3,) of a point at range, azimuth (right +) and elevation (up +).
+
+    Parameters
+    ----------
+    range_m : float
+        Distance from the antenna, m.
+    azimuth_rad : float
+        Azimuth, rad, positive to the right.
+    elevation_rad : float
+        Elevation, rad, positive up.
+
+    Returns
+    -------
+    ndarray, shape (3,)
+        Position (x boresight, y right, z down), m.
+
+    Examples
+    --------
+    >>> reflector_position(100.0, 0.0, np.radians(30.0)).round(3).tolist()  # 30 deg up: z is negative
+    [86.603, 0.0, -50.0]
+    """
     return float(range_m) * direction_from_angles(azimuth_rad, elevation_rad)
 
 
 def expected_pixels(position_m: np.ndarray, config: RadarConfig) -> np.ndarray:
-    """Unit-amplitude pixels ``exp(i 2 pi (|p - tx| + |p - rx_k|) / lambda)`` per receiver, (n_rx,)."""
+    """Unit-amplitude pixels ``exp(i 2 pi (|p - tx| + |p - rx_k|) / lambda)`` per receiver, (n_rx,).
+
+    Parameters
+    ----------
+    position_m : ndarray, shape (3,)
+        Scatterer position in the antenna frame, m.
+    config : RadarConfig
+        Transmit and receive antenna positions (m) and wavelength (m).
+
+    Returns
+    -------
+    ndarray, shape (n_rx,), complex
+        Predicted pixel of every receiver for an ideal (uncalibrated gain 1) radar.
+
+    Examples
+    --------
+    On the boresight of the symmetric 2x2 square every receiver sees the same path:
+
+    >>> from skyradar.config import RadarConfig
+    >>> z = expected_pixels(np.array([100.0, 0.0, 0.0]), RadarConfig.prototype_2022())
+    >>> np.round(np.abs(z), 6).tolist(), bool(np.allclose(z, z[0]))
+    ([1.0, 1.0, 1.0, 1.0], True)
+    """
     p = np.asarray(position_m, float)
     path = np.linalg.norm(p - config.tx_position_m) + np.linalg.norm(p - config.rx_positions_m, axis=1)
     return np.exp(1j * 2.0 * np.pi * np.mod(path / config.wavelength_m, 1.0))
@@ -57,7 +99,30 @@ def in_field_of_view(
     config: RadarConfig,
     max_loss_db: float = 6.0,
 ) -> np.ndarray:
-    """True where the one-way antenna gain is within ``max_loss_db`` of its peak (and in front)."""
+    """True where the one-way antenna gain is within ``max_loss_db`` of its peak (and in front).
+
+    Parameters
+    ----------
+    azimuth_rad, elevation_rad : array_like
+        Direction in the antenna frame, rad (azimuth right +, elevation up +).
+    config : RadarConfig
+        Its ``antenna`` pattern gives the gain.
+    max_loss_db : float
+        Largest one-way loss from the peak gain still inside the field of view, dB.
+
+    Returns
+    -------
+    ndarray of bool
+        Broadcast shape of the two angles.
+
+    Examples
+    --------
+    The prototype's field of view reaches 49.5 deg off boresight:
+
+    >>> from skyradar.config import RadarConfig
+    >>> in_field_of_view(np.radians([0.0, 30.0, 60.0]), 0.0, RadarConfig.prototype_2022()).tolist()
+    [True, True, False]
+    """
     az, el = np.asarray(azimuth_rad, float), np.asarray(elevation_rad, float)
     loss = config.antenna.peak_db - config.antenna.gain_db(az, el)
     return (np.abs(az) < np.pi / 2) & (np.abs(el) < np.pi / 2) & (loss <= max_loss_db)
@@ -89,14 +154,27 @@ def estimate_rx_calibration(
     position_m : ndarray, shape (3,)
         Reflector position in the antenna frame, m.
     config : RadarConfig
-        Antenna positions and wavelength.
+        Antenna positions (m), wavelength (m) and antenna pattern (the reflector must be in the field
+        of view).
     gain : bool
         Estimate amplitudes too; False gives unit-magnitude (phase-only) factors.
+    max_loss_db : float
+        Largest one-way antenna loss from peak, dB, at the reflector direction; beyond it InputError.
 
     Returns
     -------
     ndarray, shape (n_rx,), complex
-        Value for ``config.replace(rx_calibration=...)``.
+        Value for ``config.replace(rx_calibration=...)``: ``c_0`` real, RMS of ``|c_k|`` one.
+
+    Examples
+    --------
+    >>> from skyradar.config import RadarConfig
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> p = reflector_position(438.0, np.radians(5.0), np.radians(-1.0))
+    >>> offsets = np.array([1.0, 2.0j, -1.0, 1.0])  # gains 1, 2, 1, 1 and phases 0, 90, 180, 0 deg
+    >>> cal = estimate_rx_calibration(expected_pixels(p, cfg) * offsets, p, cfg)
+    >>> np.round(cal * np.sqrt(7.0 / 4.0), 6).tolist()  # offsets scaled to unit RMS magnitude
+    [(1+0j), 2j, (-1+0j), (1+0j)]
     """
     x = np.atleast_2d(np.asarray(pixels, complex))
     if x.shape[1] != config.n_rx:
@@ -131,6 +209,33 @@ def calibrate_from_frames(
         Raw frames.
     position_m : ndarray, shape (3,)
         Reflector position in the antenna frame, m.
+    config : RadarConfig
+        Radar the frames come from; its axes give the predicted bin.
+    radial_velocity_mps : float
+        Reflector radial velocity, m/s (positive receding); 0 for a fixed reflector.
+    search_bins : (int, int)
+        Half-width of the search window in (range, Doppler) bins.
+    gain : bool
+        Estimate amplitudes too; False gives unit-magnitude (phase-only) factors.
+
+    Returns
+    -------
+    RadarConfig
+        ``config`` with ``rx_calibration`` from :func:`estimate_rx_calibration`.
+
+    Examples
+    --------
+    One frame with the reflector in its predicted pixel and per-channel phase offsets:
+
+    >>> from skyradar.config import RadarConfig
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> p = reflector_position(438.0, np.radians(5.0), np.radians(-1.0))
+    >>> offsets = np.exp(1j * np.radians([0.0, 40.0, -70.0, 120.0]))
+    >>> frame = np.zeros((cfg.n_range, cfg.n_doppler, cfg.n_rx), complex)
+    >>> frame[cfg.range_bin(438.0), cfg.doppler_bin(0.0)] = 10.0 * expected_pixels(p, cfg) * offsets
+    >>> calibrated = calibrate_from_frames(frame, p, cfg)
+    >>> np.round(np.degrees(np.angle(calibrated.rx_calibration)), 3).tolist()
+    [0.0, 40.0, -70.0, 120.0]
     """
     cube = np.asarray(frames)
     cube = cube[None] if cube.ndim == 3 else cube
@@ -161,7 +266,27 @@ def calibrate_from_frames(
 
 
 def calibration_phase_error_deg(estimated: np.ndarray, true: np.ndarray) -> float:
-    """RMS phase error over channels between two calibrations after removing their common phase, deg."""
+    """RMS phase error over channels between two calibrations after removing their common phase, deg.
+
+    Parameters
+    ----------
+    estimated, true : ndarray, shape (n_rx,), complex
+        The two calibrations; their magnitudes do not matter.
+
+    Returns
+    -------
+    float
+        RMS phase difference, deg, after the best common phase rotation.
+
+    Examples
+    --------
+    Phase errors of 0, 10, 0 and -10 deg give ``sqrt(200 / 4)``; a common phase is free:
+
+    >>> round(calibration_phase_error_deg(np.exp(1j * np.radians([0.0, 10.0, 0.0, -10.0])), np.ones(4)), 4)
+    7.0711
+    >>> round(calibration_phase_error_deg(np.full(4, 1j), np.ones(4)), 6)
+    0.0
+    """
     diff = np.asarray(estimated, complex) * np.conj(np.asarray(true, complex))
     common = np.angle(np.sum(diff / np.abs(diff)))
     return float(np.degrees(np.sqrt(np.mean(np.angle(diff * np.exp(-1j * common)) ** 2))))

@@ -36,7 +36,25 @@ __all__ = ["cfar_factor", "cfar_2d", "cfar_2d_floor", "training_cells"]
 
 
 def training_cells(guard: tuple[int, int], train: tuple[int, int]) -> int:
-    """Training cells of a 2-D CA-CFAR window, the window less its guard block (guard 2x2, train 4x8: 248)."""
+    """Training cells of a 2-D CA-CFAR window, the window less its guard block (guard 2x2, train 4x8: 248).
+
+    Parameters
+    ----------
+    guard : (int, int)
+        Guard cells on each side of the cell under test (range, Doppler), bins.
+    train : (int, int)
+        Training cells beyond the guard cells on each side (range, Doppler), bins.
+
+    Returns
+    -------
+    int
+        ``(2 (gr + tr) + 1) (2 (gd + td) + 1) - (2 gr + 1) (2 gd + 1)``.
+
+    Examples
+    --------
+    >>> training_cells((2, 2), (4, 8)), training_cells((0, 0), (1, 1))  # 13 x 21 - 5 x 5; 3 x 3 - 1
+    (248, 8)
+    """
     (gr, gd), (tr, td) = guard, train
     return (2 * (gr + tr) + 1) * (2 * (gd + td) + 1) - (2 * gr + 1) * (2 * gd + 1)
 
@@ -203,6 +221,8 @@ def cfar_2d(
         and is about 100 times slower than CA (a few hundred ms per prototype frame).
     n_integrated : int
         Channels averaged non-coherently into each pixel.
+    rank : int, optional
+        Order statistic of the ring for ``kind="os"`` (1 is the smallest); default 3/4 of the ring.
     exclude : ndarray of bool, optional
         Pixels (e.g. a spur map) kept out of the training cells and out of the hits.
 
@@ -212,6 +232,19 @@ def cfar_2d(
         Pixels above ``alpha * noise``.
     noise : ndarray of float32
         Noise estimate per pixel, W.
+
+    Examples
+    --------
+    One bright pixel on a flat unit background is the only hit; its training ring holds the
+    background, so its noise estimate is exactly 1:
+
+    >>> power = np.ones((64, 64), np.float32)
+    >>> power[20, 30] = 1000.0
+    >>> hits, noise = cfar_2d(power, pfa=1e-6)
+    >>> np.argwhere(hits).tolist(), float(noise[20, 30])
+    ([[20, 30]], 1.0)
+    >>> int(cfar_2d(power, pfa=1e-6, exclude=power > 10.0)[0].sum())  # an excluded pixel is never a hit
+    0
     """
     power = np.asarray(power, dtype=np.float32)
     gr, gd, tr, td, hr, hd, n_train = _window(power.shape, guard, train)

@@ -100,7 +100,25 @@ def _height_over_terrain(own: OwnShipStates, terrain: Any, rows: np.ndarray) -> 
 
 
 def anchor_key(anchor: np.ndarray) -> tuple:
-    """Integer key of an anchor (quantised velocity, pitch, roll, height), for caches."""
+    """Integer key of an anchor (quantised velocity, pitch, roll, height), for caches.
+
+    Parameters
+    ----------
+    anchor : ndarray, shape (6,)
+        Heading-free velocity (forward, right, down), m/s, pitch and roll, rad, and height above
+        the ground, m (a row of :func:`prediction_anchors`).
+
+    Returns
+    -------
+    tuple
+        Velocity in steps of 0.25 m/s and pitch and roll in steps of 1 deg (ints), then the height
+        in m rounded to 1 mm.
+
+    Examples
+    --------
+    >>> anchor_key(np.array([60.0, 0.0, 0.5, np.radians(2.0), np.radians(-1.0), 1000.0]))
+    (240, 0, 2, 2, -1, 1000.0)
+    """
     v = np.round(np.asarray(anchor[:3], float) / _V_STEP).astype(int)
     angles = np.round(np.degrees(anchor[3:5]) / _ANGLE_STEP_DEG).astype(int)
     return (*v.tolist(), *angles.tolist(), round(float(anchor[5]), 3))

@@ -67,6 +67,37 @@ def frame_subspace(
     over the run's frames up to ``i`` by
     :func:`~skyradar.process.clutter_anchors.prediction_anchors`) and kept for the next frames
     that share it (the last 8 predictions, about 20 MB each).
+
+    Parameters
+    ----------
+    own : OwnShipStates
+        The run's navigated own-ship state (velocity m/s, attitude rad, height above ground m).
+    i : int
+        Frame.
+    config : RadarConfig
+        The radar (its mount turns the antenna frame into the body frame).
+    terrain : Terrain or callable(lat, lon), optional
+        Ground height, m, for frames without a navigated height above ground.
+    anchors : ndarray (n_frames, 6), optional
+        The run's :func:`~skyradar.process.clutter_anchors.prediction_anchors`.
+
+    Returns
+    -------
+    ClutterSubspace or None
+
+    Examples
+    --------
+    Flying level north at 50 m/s, 500 m above flat ground: the ground starts at range bin 33
+    (500 m); the second frame, at the same geometry, shares the prediction:
+
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> one, zero = np.ones(2), np.zeros(2)
+    >>> own = OwnShipStates.from_columns({"time_s": [0.0, 0.1], "own_north_m": zero, "own_east_m": zero,
+    ...     "own_down_m": zero, "own_vn_mps": 50 * one, "own_ve_mps": zero, "own_vd_mps": zero,
+    ...     "own_yaw_rad": zero, "own_height_agl_m": np.array([500.0, 500.0])})
+    >>> sub = frame_subspace(own, 0, cfg)
+    >>> int(np.nonzero(sub.predicted)[0].min()), int(cfg.range_bin(500.0)), frame_subspace(own, 1, cfg) is sub
+    (33, 33, True)
     """
     if anchors is None:
         anchors = prediction_anchors(own, terrain, stop=i + 1)
@@ -253,6 +284,42 @@ def frame_clutter(
     state (velocity, attitude and height above ground, or a terrain under a geodetic position).
     ``"auto"``: knowledge-aided where that state exists, none elsewhere. ``anchors``: the run's
     :func:`~skyradar.process.clutter_anchors.prediction_anchors` (computed here when not given).
+
+    Parameters
+    ----------
+    suppression : {"none", "knowledge-aided", "auto"}
+        The rule above.
+    own : OwnShipStates or None
+        The run's navigated own-ship state (velocity m/s, attitude rad, height above ground m).
+    i : int
+        Frame.
+    config : RadarConfig
+        The radar.
+    terrain : Terrain or callable(lat, lon), optional
+        Ground height, m, for frames without a navigated height above ground.
+    anchors : ndarray (n_frames, 6), optional
+        As above.
+
+    Returns
+    -------
+    ClutterSubspace or None
+        :func:`frame_subspace`'s prediction, or None where the frame is not suppressed.
+
+    Examples
+    --------
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> one, zero = np.ones(2), np.zeros(2)
+    >>> own = OwnShipStates.from_columns({"time_s": [0.0, 0.1], "own_north_m": zero, "own_east_m": zero,
+    ...     "own_down_m": zero, "own_vn_mps": 50 * one, "own_ve_mps": zero, "own_vd_mps": zero,
+    ...     "own_yaw_rad": zero, "own_height_agl_m": np.array([500.0, 500.0])})
+    >>> frame_clutter("none", own, 0, cfg) is None, frame_clutter("auto", None, 0, cfg) is None
+    (True, True)
+    >>> frame_clutter("knowledge-aided", own, 0, cfg) is frame_subspace(own, 0, cfg)
+    True
+    >>> frame_clutter("knowledge-aided", None, 0, cfg)
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: suppression 'knowledge-aided' needs the own-ship state ...
     """
     if suppression not in SUPPRESSIONS:
         raise InputError(f"field 'suppression' must be one of {', '.join(SUPPRESSIONS)}, got {suppression!r}")

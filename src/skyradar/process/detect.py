@@ -70,6 +70,21 @@ class Detections:
     secondary : ndarray of bool
         True where the blob passed only the secondary threshold of a nulled cell (see
         :func:`detect`'s ``pfa_secondary``); all False by default.
+
+    Examples
+    --------
+    One 30 dB pixel in range bin 100 (100 x 14.99 m) and Doppler bin 40 (85 bins of 0.313 m/s
+    below zero Doppler, bin 125):
+
+    >>> from skyradar.config import RadarConfig
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> power = np.full((cfg.n_range, cfg.n_doppler), cfg.noise_power_w, np.float32)
+    >>> power[100, 40] = 1001 * cfg.noise_power_w
+    >>> det = detect(power, cfg)
+    >>> len(det), det.snr_db.round(3).tolist(), det.range_m(cfg).round(2).tolist()
+    (1, [30.0], [1498.96])
+    >>> det.radial_velocity_mps(cfg).round(2).tolist(), len(det.select(det.snr_db > 40.0))
+    ([-26.61], 0)
     """
 
     range_index: np.ndarray
@@ -115,8 +130,30 @@ def shi_tomasi(
 ) -> np.ndarray:
     """Shi-Tomasi corners of a dB image (OpenCV ``goodFeaturesToTrack``), Doppler wrapping.
 
-    Returns an (n, 2) int array of (range_index, doppler_index), strongest corner first.
-    ``quality`` is relative to the strongest corner's minimum eigenvalue, as in OpenCV.
+    Parameters
+    ----------
+    power_db : ndarray (n_range, n_doppler)
+        Power image, dB.
+    max_corners : int
+        Most corners returned.
+    quality : float
+        Relative to the strongest corner's minimum eigenvalue, as in OpenCV.
+    min_distance : int
+        Least distance between two corners, bins.
+    block_size : int
+        Side of the window the gradient covariance is summed over, bins.
+
+    Returns
+    -------
+    ndarray (n, 2) of int
+        (range_index, doppler_index), strongest corner first.
+
+    Examples
+    --------
+    >>> img = np.zeros((20, 30))
+    >>> img[5, 10], img[12, 20] = 30.0, 20.0
+    >>> shi_tomasi(img).tolist()
+    [[5, 10], [12, 20]]
     """
     image = np.asarray(power_db, dtype=np.float32)
     pad = block_size + min_distance
@@ -193,8 +230,32 @@ def blob_peaks(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Brightest pixel of each 8-connected blob of ``mask`` (blobs join across the Doppler edge).
 
-    With ``seeds`` (a boolean image) only blobs containing a seed pixel are kept.
-    Returns (range_index, doppler_index), strongest blob first.
+    Parameters
+    ----------
+    mask : ndarray of bool (n_range, n_doppler)
+        Pixels that passed the threshold.
+    power : ndarray (n_range, n_doppler)
+        Power image, W: the brightest pixel of each blob is its peak.
+    seeds : ndarray of bool (n_range, n_doppler), optional
+        Only blobs containing a seed pixel are kept.
+
+    Returns
+    -------
+    (range_index, doppler_index) : tuple of ndarray of int
+        Peak pixel of each blob, strongest blob first.
+
+    Examples
+    --------
+    Pixels (1, 0) and (1, 7) touch across the Doppler edge and form one blob:
+
+    >>> mask = np.zeros((5, 8), bool)
+    >>> mask[1, [0, 7]] = mask[3, 3] = True
+    >>> power = np.zeros((5, 8))
+    >>> power[1, 0], power[1, 7], power[3, 3] = 2.0, 5.0, 3.0
+    >>> [x.tolist() for x in blob_peaks(mask, power)]
+    [[1, 3], [7, 3]]
+    >>> [x.tolist() for x in blob_peaks(mask, power, seeds=power == 2.0)]
+    [[1], [7]]
     """
     mask = np.ascontiguousarray(mask, dtype=np.bool_)
     use_seeds = seeds is not None
@@ -212,6 +273,27 @@ def refine_peaks(power: np.ndarray, r: np.ndarray, d: np.ndarray) -> tuple[np.nd
 
     Exact for a Gaussian-shaped peak; for a Hann-windowed sinc the bias stays below about 0.05 bin.
     Range edges get no offset; Doppler neighbours wrap.
+
+    Parameters
+    ----------
+    power : ndarray (n_range, n_doppler)
+        Power image, W.
+    r, d : ndarray of int
+        Peak pixels.
+
+    Returns
+    -------
+    (range_bin, doppler_bin) : tuple of ndarray of float
+        Sub-pixel positions, bins (offsets at most half a bin; Doppler wrapped into [0, n_doppler)).
+
+    Examples
+    --------
+    A Gaussian peak centred at range bin 10.3, Doppler bin 4:
+
+    >>> rr, dd = np.meshgrid(np.arange(20.0), np.arange(16.0), indexing="ij")
+    >>> power = np.exp(-((rr - 10.3) ** 2) / 2.0 - (dd - 4.0) ** 2 / 8.0)
+    >>> [x.round(6).tolist() for x in refine_peaks(power, np.array([10]), np.array([4]))]
+    [[10.3], [4.0]]
     """
     n_r, n_d = power.shape
     floor = _TINY32
@@ -314,6 +396,10 @@ def detect(
         against ``config.noise_power_w`` reaches ``min_snr_db`` (the thesis' detector).
     pfa : float
         CFAR false-alarm probability per pixel (2e-8: about 0.002 false alarms per prototype frame).
+    guard, train : (int, int)
+        CFAR guard and training cells on each side (range, Doppler), bins.
+    min_snr_db : float
+        SNR a Shi-Tomasi corner needs, dB.
     use_cfar_noise : bool
         SNR against the CFAR noise estimate (True) or against ``config.noise_power_w``.
     exclude : ndarray of bool, optional
@@ -327,6 +413,27 @@ def detect(
         false-alarm probability but not at ``pfa``. The nulls cost a target in a ground cell several dB of
         SNR; a tracker that already follows it needs only the few cells its gate predicts, where
         this threshold's false alarms are rare, and may update it from them (never start a track).
+
+    Returns
+    -------
+    Detections
+        One per blob, strongest first (``secondary`` ones after the others).
+
+    Examples
+    --------
+    A single pixel 1000 times over a flat noise floor: one detection at 30 dB SNR, in its pixel
+    (its neighbours are equal, so no sub-pixel offset):
+
+    >>> from skyradar.config import RadarConfig
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> power = np.full((cfg.n_range, cfg.n_doppler), cfg.noise_power_w, np.float32)
+    >>> power[100, 40] = 1001 * cfg.noise_power_w
+    >>> det = detect(power, cfg)
+    >>> det.range_bin.tolist(), det.doppler_bin.tolist(), det.snr_db.round(3).tolist()
+    ([100.0], [40.0], [30.0])
+    >>> det = detect(power, cfg, method="shi-tomasi")
+    >>> det.range_index.tolist(), det.doppler_index.tolist()
+    ([100], [40])
     """
     power = np.asarray(power, dtype=np.float32)
     if power.shape != (config.n_range, config.n_doppler):

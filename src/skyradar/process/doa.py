@@ -97,6 +97,15 @@ class ArrayGeometry:
     grid_match : ndarray, shape (n_rx, n_grid), complex, or None
         Conjugate steering vectors of the grid points (precomputed: the complex exponentials
         cost more than the beamforming product itself).
+
+    Examples
+    --------
+    >>> from skyradar.config import RadarConfig
+    >>> geo = array_geometry(RadarConfig.prototype_2022())  # the 2x2 square in the y-z plane
+    >>> geo.dims, geo.normal.round(6).tolist(), geo.pairs.tolist()
+    (2, [1.0, 0.0, 0.0], [[0, 1], [0, 2], [1, 3], [2, 3]])
+    >>> bool(np.allclose(geo.solve.sum(axis=1), 0.0))  # a common phase drops out
+    True
     """
 
     basis: np.ndarray
@@ -203,7 +212,30 @@ def array_geometry(
     config: RadarConfig, facing: tuple[float, float, float] = (1.0, 0.0, 0.0)
 ) -> ArrayGeometry:
     """Least-squares operators of ``config``'s receive (or MIMO virtual) array (cached); InputError for
-    unusable layouts."""
+    unusable layouts.
+
+    Parameters
+    ----------
+    config : RadarConfig
+        Antenna positions (m) and wavelength (m); the field of view bounds the coarse search grid.
+    facing : (float, float, float)
+        Side a coplanar array looks at (antenna frame, any length); the default is the boresight.
+
+    Returns
+    -------
+    ArrayGeometry
+        The same object for the same layout, wavelength and facing side.
+
+    Examples
+    --------
+    >>> from skyradar.config import RadarConfig
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> geo = array_geometry(cfg)
+    >>> geo.design.shape, geo.grid is None  # 4 receivers, 2 in-plane unknowns, unambiguous pairs
+    ((4, 2), True)
+    >>> array_geometry(cfg) is geo
+    True
+    """
     rx = np.ascontiguousarray(_channel_positions(config), dtype=float)
     fx, fy, fz = (float(f) for f in np.asarray(facing, float) / np.linalg.norm(facing))
     return _geometry(
@@ -218,7 +250,24 @@ FIELD_OF_VIEW_LOSS_DB = 6.0  # one-way loss from the pattern's peak at the field
 def field_of_view_rad(config: RadarConfig) -> float:
     """Half-angle of the field of view, rad: the widest off-boresight angle at which either principal
     cut of ``config.antenna`` is within :data:`FIELD_OF_VIEW_LOSS_DB` of its peak (the cone the coarse
-    DoA search covers)."""
+    DoA search covers).
+
+    Parameters
+    ----------
+    config : RadarConfig
+        Its ``antenna`` pattern sets the angle (searched on a 0.5 deg grid).
+
+    Returns
+    -------
+    float
+        Half-angle, rad, in [0, pi / 2].
+
+    Examples
+    --------
+    >>> from skyradar.config import RadarConfig
+    >>> round(float(np.degrees(field_of_view_rad(RadarConfig.prototype_2022()))), 3)
+    49.5
+    """
     return _fov_half_angle(config)
 
 
@@ -250,20 +299,79 @@ def _fov_of_pattern(ant, max_loss_db: float) -> float:
 
 
 def direction_from_angles(azimuth_rad: np.ndarray | float, elevation_rad: np.ndarray | float) -> np.ndarray:
-    """Unit vectors (..., 3) in the antenna frame (x boresight, y right, z down)."""
+    """Unit vectors (..., 3) in the antenna frame (x boresight, y right, z down).
+
+    Parameters
+    ----------
+    azimuth_rad : array_like
+        Azimuth, rad, positive to the right.
+    elevation_rad : array_like
+        Elevation, rad, positive up; broadcast against ``azimuth_rad``.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        ``(cos el cos az, cos el sin az, -sin el)``.
+
+    Examples
+    --------
+    >>> direction_from_angles(0.0, np.radians(30.0)).round(6).tolist()  # 30 deg up: z is negative
+    [0.866025, 0.0, -0.5]
+    """
     az, el = np.broadcast_arrays(np.asarray(azimuth_rad, float), np.asarray(elevation_rad, float))
     return np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)], axis=-1)
 
 
 def angles_from_direction(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Azimuth (positive right) and elevation (positive up) of vectors (..., 3), radians."""
+    """Azimuth (positive right) and elevation (positive up) of vectors (..., 3), radians.
+
+    Parameters
+    ----------
+    u : ndarray, shape (..., 3)
+        Vectors in the antenna frame (x boresight, y right, z down), any length (e.g. positions in m).
+
+    Returns
+    -------
+    (azimuth_rad, elevation_rad) : tuple of ndarray
+        Each of shape (...), rad; the inverse of :func:`direction_from_angles`.
+
+    Examples
+    --------
+    >>> az, el = angles_from_direction(np.array([1.0, 1.0, -np.sqrt(2.0)]))
+    >>> np.round(np.degrees([az, el]), 6).tolist()  # 45 deg right, 45 deg up
+    [45.0, 45.0]
+    """
     u = np.asarray(u, float)
     norm = np.maximum(np.linalg.norm(u, axis=-1), 1e-300)
     return np.arctan2(u[..., 1], u[..., 0]), np.arcsin(np.clip(-u[..., 2] / norm, -1.0, 1.0))
 
 
 def steering_vector(u: np.ndarray, config: RadarConfig) -> np.ndarray:
-    """Far-field receive phases ``exp(-i (2 pi / lambda) u . r_k)``, shape (..., n_rx) (MIMO: n_virtual)."""
+    """Far-field receive phases ``exp(-i (2 pi / lambda) u . r_k)``, shape (..., n_rx) (MIMO: n_virtual).
+
+    Parameters
+    ----------
+    u : ndarray, shape (..., 3)
+        Unit directions in the antenna frame.
+    config : RadarConfig
+        Wavelength (m) and channel positions ``r_k`` (m): the receivers, or the virtual channels for MIMO.
+
+    Returns
+    -------
+    ndarray, shape (..., n_rx), complex
+        Unit-modulus phasors, one per channel.
+
+    Examples
+    --------
+    With half-wavelength spacing along y, receivers 0 and 1 differ by ``-pi sin(az)`` in phase:
+
+    >>> from skyradar.config import RadarConfig
+    >>> s = steering_vector(direction_from_angles(np.radians(20.0), 0.0), RadarConfig.prototype_2022())
+    >>> s.shape, round(float(np.angle(s[1] * np.conj(s[0]))), 4)
+    ((4,), -1.0745)
+    >>> round(-np.pi * float(np.sin(np.radians(20.0))), 4)
+    -1.0745
+    """
     return np.exp(
         -1j * (2.0 * np.pi / config.wavelength_m) * (np.asarray(u, float) @ _channel_positions(config).T)
     )
@@ -328,6 +436,17 @@ def estimate_directions(
         Unit vectors; multiply by the measured range for positions. A one-channel radar has no
         direction: every row is NaN (its detections carry NaN angles and positions, and the
         tracker follows them in range and range rate only).
+
+    Examples
+    --------
+    Raw pixels carry each channel's complex gain; ``rx_calibration`` divides it out:
+
+    >>> cal = np.exp(1j * np.radians([0.0, 40.0, -70.0, 120.0]))
+    >>> cfg = RadarConfig.prototype_2022(rx_calibration=cal)
+    >>> u = direction_from_angles(np.radians([-25.0, 5.0]), np.radians([10.0, -20.0]))
+    >>> raw = steering_vector(u, cfg) * cal
+    >>> np.degrees(angles_from_direction(estimate_directions(raw, cfg))).round(6).tolist()
+    [[-25.0, 5.0], [10.0, -20.0]]
     """
     z = np.atleast_2d(np.asarray(pixels))
     if z.ndim != 2 or z.shape[1] != config.n_virtual:
@@ -362,6 +481,33 @@ def direction_coherence(
     About ``SNR / (SNR + 1)`` for a single scatterer; clearly lower when a pixel sums returns
     from several directions (e.g. ground to the left and right at the same range and Doppler),
     where the estimated direction means nothing.
+
+    Parameters
+    ----------
+    pixels : ndarray, shape (n, n_rx), complex
+        Pixels of all channels (``n_virtual`` for MIMO), one row per detection.
+    u : ndarray, shape (n, 3) or (3,)
+        Unit directions in the antenna frame to test.
+    config : RadarConfig
+        Channel positions (m), wavelength (m) and ``rx_calibration`` (divided out unless ``calibrated``).
+    calibrated : bool
+        True when ``pixels`` already had the calibration divided out.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Coherence in [0, 1]; 1 for a noise-free plane wave from ``u``.
+
+    Examples
+    --------
+    >>> from skyradar.config import RadarConfig
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> right, left = direction_from_angles(np.radians([20.0, -20.0]), 0.0)
+    >>> pixels = steering_vector(right, cfg)[None, :]
+    >>> np.round(direction_coherence(pixels, right, cfg), 6).tolist()
+    [1.0]
+    >>> np.round(direction_coherence(pixels, left, cfg), 3).tolist()  # the mirrored direction fits badly
+    [0.227]
     """
     z = np.atleast_2d(np.asarray(pixels))
     if not calibrated:
@@ -418,7 +564,30 @@ def doa_crlb(
 
 
 def antenna_to_body(points_m: np.ndarray, config: RadarConfig) -> np.ndarray:
-    """Antenna-frame points (..., 3) to the body frame (forward, right, down) via ``config.mount``."""
+    """Antenna-frame points (..., 3) to the body frame (forward, right, down) via ``config.mount``.
+
+    Parameters
+    ----------
+    points_m : ndarray, shape (..., 3)
+        Points in the antenna frame (x boresight, y right, z down), m.
+    config : RadarConfig
+        Its ``mount`` gives the rotation and the lever arm (m).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        Points in the body frame, m: rotated, then shifted by ``mount.position_m``.
+
+    Examples
+    --------
+    A radar pitched 30 deg down, 2 m forward and 0.3 m below the reference point, sees a point
+    100 m along its boresight 86.6 m ahead and 50 m below:
+
+    >>> from skyradar.config import Mount, RadarConfig
+    >>> cfg = RadarConfig.prototype_2022(mount=Mount.preset("forward-down"))
+    >>> antenna_to_body(np.array([100.0, 0.0, 0.0]), cfg).round(3).tolist()
+    [88.603, 0.0, 50.3]
+    """
     mount = config.mount
     rotation = _mount_rotation(mount.yaw_deg, mount.pitch_deg, mount.roll_deg)
     return np.asarray(points_m, float) @ rotation.T + np.asarray(mount.position_m)

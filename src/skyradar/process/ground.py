@@ -71,7 +71,29 @@ _ALTITUDE_LEAK_BINS = 2.0  # range bins the altitude return leaks (window sidelo
 
 
 def static_radial_velocity_mps(direction_ned: np.ndarray, own_velocity_ned_mps: np.ndarray) -> np.ndarray:
-    """Radial velocity of a static point seen along unit vectors ``direction_ned`` (n, 3), m/s."""
+    """Radial velocity of a static point seen along unit vectors ``direction_ned`` (n, 3), m/s.
+
+    Parameters
+    ----------
+    direction_ned : ndarray (..., 3)
+        Unit vectors from the radar, NED (any frame, the same as the velocity's).
+    own_velocity_ned_mps : ndarray (3,)
+        Radar velocity over the ground, m/s.
+
+    Returns
+    -------
+    ndarray (...)
+        ``-v . u``, m/s, positive receding (not aliased).
+
+    Examples
+    --------
+    Flying north at 50 m/s: a point ahead closes at 50 m/s, one 60 deg to the right at
+    ``50 cos 60 deg``, the point straight below not at all:
+
+    >>> u = np.array([[1.0, 0.0, 0.0], [0.5, np.sqrt(3.0) / 2.0, 0.0], [0.0, 0.0, 1.0]])
+    >>> (static_radial_velocity_mps(u, np.array([50.0, 0.0, 0.0])) + 0.0).round(6).tolist()
+    [-50.0, -25.0, 0.0]
+    """
     u = np.asarray(direction_ned, float)
     return -np.einsum("...i,...i->...", u, np.broadcast_to(np.asarray(own_velocity_ned_mps, float), u.shape))
 
@@ -82,7 +104,31 @@ def doppler_matches_static(
     config: RadarConfig,
     tolerance_mps: np.ndarray | float,
 ) -> np.ndarray:
-    """True where measured and expected radial velocity agree within the tolerance, modulo ``2 VLim``."""
+    """True where measured and expected radial velocity agree within the tolerance, modulo ``2 VLim``.
+
+    Parameters
+    ----------
+    radial_velocity_mps : ndarray
+        Measured (aliased) radial velocity, m/s.
+    expected_mps : ndarray
+        Expected radial velocity of a static point, m/s (any alias).
+    config : RadarConfig
+        Its ``v_lim_mps`` sets the alias period ``2 VLim``, m/s.
+    tolerance_mps : float or ndarray
+        Largest difference still agreeing, m/s.
+
+    Returns
+    -------
+    ndarray of bool
+
+    Examples
+    --------
+    The prototype's velocities alias with a period of 78.26 m/s, so -50 m/s shows at 28.26 m/s:
+
+    >>> from skyradar.config import RadarConfig
+    >>> doppler_matches_static(np.array([28.26, 0.0]), -50.0, RadarConfig.prototype_2022(), 0.5).tolist()
+    [True, False]
+    """
     width = 2.0 * config.v_lim_mps
     diff = np.asarray(radial_velocity_mps, float) - np.asarray(expected_mps, float)
     return np.abs((diff + width / 2.0) % width - width / 2.0) <= tolerance_mps
@@ -102,9 +148,41 @@ def in_ground_band(
     Needs no direction: ground ``h`` below the radar is seen at range R along unit vectors with
     down component ``u_d = h / R``, whose static radial velocities fill
     ``-v_d u_d +- |v_horizontal| sqrt(1 - u_d^2)`` (the clutter region of the range-Doppler
-    image, bounded by R = h and V = -speed). ``terrain_margin_m`` allows for ground up to that
-    much higher than the ground directly below (it widens the band). Used for pixels whose
-    direction is unreliable (a pixel summing ground to the left and right of the track).
+    image, bounded by R = h and V = -speed). Used for pixels whose direction is unreliable (a
+    pixel summing ground to the left and right of the track).
+
+    Parameters
+    ----------
+    range_m : ndarray
+        Slant ranges, m.
+    radial_velocity_mps : ndarray
+        Measured (aliased) radial velocities, m/s.
+    own_velocity_ned_mps : ndarray (3,)
+        Radar velocity over the ground, NED, m/s.
+    own_height_agl_m : float
+        Height above the ground directly below, m.
+    config : RadarConfig
+        Alias period (``2 v_lim_mps``), Doppler and range resolution.
+    tolerance_mps : float, optional
+        Doppler slack, m/s; default 1.5 Doppler bins.
+    terrain_margin_m : float or ndarray
+        Allows for ground up to that much higher than the ground directly below, m (it widens the band).
+
+    Returns
+    -------
+    ndarray of bool
+
+    Examples
+    --------
+    Flying level at 20 m/s, 500 m up: at 1000 m the ground is 30 deg down or less, so its static
+    radial velocity is within ``20 cos 30 deg = 17.3`` m/s (plus the slack); nearer than the
+    height less the margin there is no ground:
+
+    >>> from skyradar.config import RadarConfig
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> rng, v_r = np.array([1000.0, 1000.0, 300.0]), np.array([10.0, 30.0, 0.0])
+    >>> in_ground_band(rng, v_r, np.array([20.0, 0.0, 0.0]), 500.0, cfg).tolist()
+    [True, False, False]
     """
     rng = np.maximum(np.asarray(range_m, float), 1e-9)
     v = np.asarray(own_velocity_ned_mps, float)
@@ -126,7 +204,34 @@ def height_above_ground_m(
     terrain: Any = None,
     ground_alt_m: float | None = None,
 ) -> np.ndarray:
-    """Altitude above the terrain (``terrain.height_at`` or a callable) or a flat ground, m (NaN: unknown)."""
+    """Altitude above the terrain (``terrain.height_at`` or a callable) or a flat ground, m (NaN: unknown).
+
+    Parameters
+    ----------
+    lat_deg, lon_deg : ndarray
+        Geodetic position, deg.
+    alt_m : ndarray
+        Altitude, m (the terrain's datum).
+    terrain : Terrain or callable(lat, lon), optional
+        Ground height, m, at each position; first choice.
+    ground_alt_m : float, optional
+        Altitude of a flat ground, m, without ``terrain``.
+
+    Returns
+    -------
+    ndarray
+        Height above the ground, m; NaN without ``terrain`` and ``ground_alt_m``.
+
+    Examples
+    --------
+    >>> hills = lambda lat, lon: np.full(np.shape(lat), 100.0)  # ground at 100 m
+    >>> height_above_ground_m(np.array([52.0]), np.array([4.0]), np.array([600.0]), hills).tolist()
+    [500.0]
+    >>> float(height_above_ground_m(52.0, 4.0, 600.0, ground_alt_m=50.0))
+    550.0
+    >>> float(height_above_ground_m(52.0, 4.0, 600.0))  # neither: unknown
+    nan
+    """
     alt = np.asarray(alt_m, float)
     if terrain is not None:
         height_at: Callable = terrain.height_at if hasattr(terrain, "height_at") else terrain
@@ -320,6 +425,50 @@ def flag_ground(
     tested too: the phase step is near +-pi there, and the ground straight below (the altitude
     return) is otherwise read as a direction above the aircraft; read so, it is ground when its
     range and Doppler are the ground's within the DoA's cone around the nadir.
+
+    Parameters
+    ----------
+    out : dict of ndarray
+        The frame's detection columns: ``range_m`` (m), ``snr_db`` (dB), ``azimuth_rad`` and
+        ``elevation_rad`` (antenna frame, rad), ``north_m``, ``east_m``, ``down_m`` (NED
+        position, m), ``radial_velocity_mps`` (aliased, m/s), ``u_ant`` (n, 3), ``coherence`` and
+        optionally ``elevation_measured`` (bool).
+    u_ned : ndarray (n, 3)
+        The detections' unit directions, NED.
+    own_velocity_ned_mps : ndarray (3,)
+        Radar velocity over the ground, m/s.
+    ant_to_ned : ndarray (3, 3)
+        Rotation of antenna-frame vectors into NED.
+    height_fn : callable
+        Height above the surface of NED points (..., 3), m (:func:`surface_height_fn`).
+    own_height_agl_m : float
+        Height above the ground directly below, m.
+    config : RadarConfig
+        Antenna positions and pattern (DoA bound, field of view), Doppler and range axes.
+
+    Returns
+    -------
+    ndarray of bool (n,)
+        ``is_ground``.
+
+    Examples
+    --------
+    Flying north at 50 m/s, level, 500 m over flat ground (antenna frame = NED): a detection at
+    1000 m, 30 deg down, lies on the ground, and with the static Doppler there,
+    ``-50 cos 30 deg = -43.3`` m/s, it is ground; one level 10 deg right, closing at 20 m/s, is not:
+
+    >>> from skyradar.config import RadarConfig
+    >>> from skyradar.process.doa import direction_from_angles
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> az, el, rng = np.radians([0.0, 10.0]), np.radians([-30.0, 0.0]), np.array([1000.0, 1000.0])
+    >>> u = direction_from_angles(az, el)
+    >>> north, east, down = (rng[:, None] * u).T
+    >>> out = {"range_m": rng, "snr_db": np.full(2, 25.0), "azimuth_rad": az, "elevation_rad": el,
+    ...        "north_m": north, "east_m": east, "down_m": down, "u_ant": u, "coherence": np.ones(2),
+    ...        "radial_velocity_mps": np.array([-43.3, -20.0])}
+    >>> surface = surface_height_fn(500.0, None, None)
+    >>> flag_ground(out, u, np.array([50.0, 0.0, 0.0]), np.eye(3), surface, 500.0, cfg)
+    array([ True, False])
     """
     from skyradar.process.calibration import in_field_of_view
     from skyradar.process.doa import doa_crlb

@@ -29,6 +29,28 @@ def recording_files(recording: str | Path, frames: Any = None) -> list[Path]:
 
     Every existing NAME.{json,yaml,yml,bin,dat,npy,sigmf-meta,sigmf-data} beside it, and the
     memory-mapped data file.
+
+    Parameters
+    ----------
+    recording : str or Path
+        The recording as named by the user (a sidecar, a data file or a bare SigMF stem).
+    frames : object, optional
+        The frames as :func:`~skyradar.io.recordings.read_recording` returns them; when their
+        ``raw`` attribute is a memory map, its file is added.
+
+    Returns
+    -------
+    list of Path
+        The existing files, each once, the named one first.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     for name in ("run.json", "run.bin", "other.bin"):
+    ...         _ = (Path(tmp) / name).write_bytes(b"")
+    ...     print([f.name for f in recording_files(Path(tmp) / "run.json")])
+    ['run.json', 'run.bin']
     """
     path = Path(recording)
     suffixes = (".json", ".yaml", ".yml", ".bin", ".dat", ".npy", ".sigmf-meta", ".sigmf-data")

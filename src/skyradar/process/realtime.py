@@ -67,6 +67,18 @@ def frame_latencies(frames: pd.DataFrame) -> pd.DataFrame:
     DataFrame
         The rows in arrival order with ``latency_s`` and ``deadline_s`` (the head's median frame
         interval) and ``kept_up`` (``latency_s <= deadline_s``) added.
+
+    Examples
+    --------
+    One head at 10 Hz: the first frame takes 0.15 s, longer than the 0.1 s until the next, which
+    then waits 0.05 s:
+
+    >>> frames = pd.DataFrame(
+    ...     {"radar": "nose", "time_s": [0.2, 0.0, 0.1], "processing_s": [0.01, 0.15, 0.05]}
+    ... )
+    >>> timed = frame_latencies(frames)
+    >>> timed["time_s"].tolist(), timed["latency_s"].round(3).tolist(), timed["kept_up"].tolist()
+    ([0.0, 0.1, 0.2], [0.15, 0.1, 0.01], [False, True, True])
     """
     timed = frames.sort_values("time_s", kind="stable", ignore_index=True)
     timed["latency_s"] = paced_latencies(timed["time_s"].to_numpy(), timed["processing_s"].to_numpy())

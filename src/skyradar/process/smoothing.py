@@ -24,7 +24,23 @@ __all__ = ["hann_window", "hann_smooth"]
 
 
 def hann_window(length: int) -> np.ndarray:
-    """Hann window of ``length`` non-zero taps summing to one."""
+    """Hann window of ``length`` non-zero taps summing to one.
+
+    Parameters
+    ----------
+    length : int
+        Taps, at least 1 (frames when used along a track).
+
+    Returns
+    -------
+    ndarray (length,)
+        The Hann window of ``length + 2`` points without its zero end taps, normalised.
+
+    Examples
+    --------
+    >>> hann_window(3).tolist(), hann_window(1).tolist()
+    ([0.25, 0.5, 0.25], [1.0])
+    """
     if int(length) != length or length < 1:
         raise InputError(f"smoothing: field 'window' must be a positive integer, got {length!r}")
     w = hann(int(length) + 2)[1:-1]  # drop the zero end taps
@@ -47,6 +63,14 @@ def hann_smooth(values: np.ndarray, window: int, axis: int = 0) -> np.ndarray:
     -------
     ndarray
         Same shape; NaN only where the window covers no valid sample.
+
+    Examples
+    --------
+    A ramp keeps its inner samples (the window is symmetric); its ends lag towards the inside,
+    the renormalised window seeing only one side of them:
+
+    >>> hann_smooth(np.arange(7.0), 5).round(3).tolist()
+    [0.625, 1.182, 2.0, 3.0, 4.0, 4.818, 5.375]
     """
     x = np.asarray(values, float)
     w = hann_window(window)

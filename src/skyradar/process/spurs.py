@@ -60,6 +60,34 @@ def detection_pixels(
     above the thermal noise floor at false-alarm probability ``pfa`` (default 1e-5), the floor
     estimated from the image median, so extended interference (zero-Doppler line, near-range
     leakage with its range gradient) is learned whole, not only where a CFAR window would fire.
+
+    Parameters
+    ----------
+    power : ndarray (n_range, n_doppler)
+        Channel-integrated frame, W.
+    config : RadarConfig
+        Image shape, channel count and noise power for the detector.
+    pixels : {"peaks", "hits"}
+        Detector points or every pixel above the floor.
+    **detect_kwargs
+        Passed to :func:`skyradar.process.detect.detect` (``pfa`` also sets the ``"hits"`` threshold).
+
+    Returns
+    -------
+    ndarray of bool (n_range, n_doppler)
+
+    Examples
+    --------
+    >>> from skyradar.config import RadarConfig
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> def frame(target_range):  # flat noise, a spur at (50, 0) and a target at (target_range, 100)
+    ...     p = np.full((cfg.n_range, cfg.n_doppler), cfg.noise_power_w, np.float32)
+    ...     p[50, 0] = p[target_range, 100] = 1000 * cfg.noise_power_w
+    ...     return p
+    >>> np.argwhere(detection_pixels(frame(100), cfg)).tolist()
+    [[50, 0], [100, 100]]
+    >>> np.argwhere(detection_pixels(frame(100), cfg, "hits")).tolist()
+    [[50, 0], [100, 100]]
     """
     if pixels == "hits":
         law = stats.gamma(config.n_rx, scale=1.0 / config.n_rx)
@@ -85,6 +113,18 @@ class SpurMap:
         Pixels with ``frequency > threshold`` are spurs.
     n_frames : int
         Frames the map was learned from.
+
+    Examples
+    --------
+    Positions are rounded to the nearest pixel, Doppler wrapping (bin 2.0 of 2 is bin 0):
+
+    >>> spur_map = SpurMap(np.array([[0.0, 0.3], [0.1, 0.02]]), threshold=0.05)
+    >>> spur_map.mask.tolist()
+    [[False, True], [True, False]]
+    >>> spur_map.contains(np.array([0.2, 1.4, 0.0]), np.array([1.3, 2.0, 0.4])).tolist()
+    [True, True, False]
+    >>> int(spur_map.with_threshold(0.2).mask.sum())
+    1
     """
 
     frequency: np.ndarray
@@ -169,12 +209,36 @@ def learn_spur_map(
     ----------
     powers : iterable of ndarray (n_range, n_doppler)
         Frames from :func:`skyradar.process.detect.integrate_channels`.
+    config : RadarConfig
+        Image shape, channel count and noise power for the detector.
     threshold : float
         Hit frequency above which a pixel is a spur.
     pixels : {"peaks", "hits"}
         Learn detector points (thesis) or every CFAR hit pixel (:func:`detection_pixels`).
     **detect_kwargs
         Passed to :func:`skyradar.process.detect.detect`; default Shi-Tomasi corners as in the thesis.
+
+    Returns
+    -------
+    SpurMap
+        Hit frequency of every pixel over the frames (detections dilated by one pixel).
+
+    Examples
+    --------
+    Over four frames the spur stays put and the target moves 10 range bins a frame: only the
+    spur and its 8 neighbours are hit in more than half of them:
+
+    >>> from skyradar.config import RadarConfig
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> def frame(target_range):  # flat noise, a spur at (50, 0) and a target at (target_range, 100)
+    ...     p = np.full((cfg.n_range, cfg.n_doppler), cfg.noise_power_w, np.float32)
+    ...     p[50, 0] = p[target_range, 100] = 1000 * cfg.noise_power_w
+    ...     return p
+    >>> spur_map = learn_spur_map((frame(100 + 10 * i) for i in range(4)), cfg, threshold=0.5)
+    >>> spur_map.n_frames, int(spur_map.mask.sum())
+    (4, 9)
+    >>> spur_map.contains(np.array([50.0, 100.0]), np.array([249.0, 100.0])).tolist()  # spur, target
+    [True, False]
     """
     detect_kwargs.setdefault("method", "shi-tomasi")
     counts = None
@@ -202,6 +266,21 @@ class OnlineSpurMap:
         Frequency above which a pixel is a spur.
     min_frames : int
         Frames to see before anything is called a spur.
+
+    Examples
+    --------
+    A spur on the Doppler edge in every frame, an object moving two Doppler bins a frame: after
+    ``min_frames`` only the spur's dilated 3 x 3 block (wrapping to the last column) stays lit:
+
+    >>> online = OnlineSpurMap((6, 8), time_constant_frames=5, min_frames=3)
+    >>> for i in range(4):
+    ...     hits = np.zeros((6, 8), bool)
+    ...     hits[1, 0] = hits[4, 2 * i] = True
+    ...     mask = online.update(hits)
+    >>> np.argwhere(mask).tolist()
+    [[0, 0], [0, 1], [0, 7], [1, 0], [1, 1], [1, 7], [2, 0], [2, 1], [2, 7]]
+    >>> online.snapshot().n_frames
+    4
     """
 
     def __init__(

@@ -72,7 +72,31 @@ def rise_points(
     antenna_ned_m: np.ndarray, range_m: np.ndarray, n_radii: int = 16, n_azimuth: int = 24
 ) -> tuple[np.ndarray, np.ndarray]:
     """The rings :func:`terrain_rise_m` samples: their radii (n_radii,), m, and their NED points
-    (n_radii, n_azimuth, 3), m, at the radar's depth, out to the largest of ``range_m`` (not empty)."""
+    (n_radii, n_azimuth, 3), m, at the radar's depth, out to the largest of ``range_m`` (not empty).
+
+    Parameters
+    ----------
+    antenna_ned_m : ndarray (3,)
+        The radar's position, NED, m.
+    range_m : ndarray
+        Slant ranges, m; the rings reach the largest.
+    n_radii, n_azimuth : int
+        Rings, equally spaced from ``max(range_m) / n_radii`` out, and points per ring (from north,
+        clockwise, equally spaced).
+
+    Returns
+    -------
+    radii : ndarray (n_radii,)
+        Ring radii, m.
+    points : ndarray (n_radii, n_azimuth, 3)
+        NED points, m.
+
+    Examples
+    --------
+    >>> radii, points = rise_points(np.array([0.0, 0.0, -100.0]), np.array([300.0, 1000.0]), 4, 4)
+    >>> radii.tolist(), points.shape, points[0, 1].round(1).tolist()  # first ring, due east
+    ([250.0, 500.0, 750.0, 1000.0], (4, 4, 3), [0.0, 250.0, -100.0])
+    """
     antenna = np.asarray(antenna_ned_m, float)
     radii = np.linspace(0.0, float(np.max(range_m)), n_radii + 1)[1:]
     az = np.linspace(0.0, 2.0 * np.pi, n_azimuth, endpoint=False)

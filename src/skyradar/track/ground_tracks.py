@@ -126,7 +126,8 @@ class GroundTrackTest:
     ----------
     sigma_range_m, sigma_velocity_mps : float
         Errors of one detection's range (half a 15 m bin: straddle, window sidelobes, own-ship
-        position) and radial velocity (half a Doppler bin and the own-ship's velocity error).
+        position), m, and radial velocity (half a Doppler bin and the own-ship's velocity error),
+        m/s.
     tail : float
         False-rejection probability of each chi-square test.
     trim : float
@@ -157,14 +158,14 @@ class GroundTrackTest:
         A gap between two detections of a track longer than this (the tracker's coasting time)
         starts its history again: across it the track was reacquired on a prediction, and the
         detections before may come from another scatterer (residual clutter joined to residual
-        clutter made one "object" receding at 110 m/s over hills).
+        clutter made one "object" receding at 110 m/s over hills), s.
     doa_sigma_rad, doa_field_rad : float
         A direction of arrival this accurate (CRLB at 13-20 dB plus attitude errors) inside this
-        half-angle of boresight may overrule the static-ground fit (:func:`doa_in_the_air`).
+        half-angle of boresight may overrule the static-ground fit (:func:`doa_in_the_air`), rad.
     point_sigma_velocity_mps : float or None
         Doppler error of one point target's detections about a smooth curve (the radial velocity
-        as measured, without the own-ship's velocity error): a track whose Doppler scatters more
-        is not one object (:func:`doppler_smooth`); None: that test is off.
+        as measured, without the own-ship's velocity error), m/s: a track whose Doppler scatters
+        more is not one object (:func:`doppler_smooth`); None: that test is off.
     ground_min_detections : int
         Detections a track needs, instead of ``min_detections``, while its measured directions put
         it on the surface (:func:`doa_on_the_ground`) or while it has no measured direction (fewer
@@ -181,6 +182,21 @@ class GroundTrackTest:
         Over five detections at 9.4 frames/s the slope is known to 12 m/s, a sixth of the image
         width between two aliases; over three or four, ranges of residual clutter hopping between
         cells fit a steep line.
+
+    Examples
+    --------
+    A track closing at 50 m/s, its ranges following its Doppler, with no own-ship state (only the
+    range-Doppler test applies): held while young, released at ``release_detections``; an earlier
+    release with a looser test.
+
+    >>> k = np.arange(8)
+    >>> det = pd.DataFrame({"time_s": 0.1 * k, "range_m": 1000.0 - 5.0 * k, "radial_velocity_mps": -50.0})
+    >>> tracks = pd.DataFrame({"time_s": 0.1 * k, "track_id": 1, "detection_row": k, "confirmed": True})
+    >>> hold_ground_tracks(tracks, det, None, 78.3, 0.0)["held_by"].tolist()
+    ['young', 'young', 'young', 'young', '', '', '', '']
+    >>> test = GroundTrackTest(min_detections=2, release_detections=3)
+    >>> hold_ground_tracks(tracks, det, None, 78.3, 0.0, test=test)["held_by"].tolist()[:4]
+    ['young', 'direction', '', '']
     """
 
     sigma_range_m: float = 8.0
@@ -567,6 +583,26 @@ class TrackHoldWalk:
     it (the last of a history before a gap as its last); the newest is judged on a copy of the walk,
     as the last of the history so far. The columns of a detection (own-ship state, DoA height) are
     computed when it arrives, with the ``ownship`` and ``surface_down`` of that call.
+
+    Parameters
+    ----------
+    test : GroundTrackTest
+        Settings of the ground test.
+
+    Examples
+    --------
+    A stream's track closing at 50 m/s (no direction of arrival, no own-ship state), judged as its
+    detections arrive (rows: time (s), range (m), radial velocity (m/s), the direction columns,
+    the measured-elevation flag, the antenna axis):
+
+    >>> k = np.arange(8.0)
+    >>> rd = np.column_stack([0.1 * k, 1000.0 - 5.0 * k, np.full(8, -50.0)])
+    >>> det = np.column_stack([rd, np.full((8, 5), np.nan), np.ones(8), np.full((8, 3), np.nan)])
+    >>> walk = TrackHoldWalk(GroundTrackTest())
+    >>> walk.why(det[:4], None, None, 78.3, 0.0).tolist()
+    ['young', 'young', 'young', 'young']
+    >>> walk.why(det, None, None, 78.3, 0.0).tolist()
+    ['young', 'young', 'young', 'young', '', '', '', '']
     """
 
     def __init__(self, test: GroundTrackTest) -> None:
@@ -668,6 +704,49 @@ def hold_ground_tracks(
     each track's judgements between calls on a growing table (a stream's): a track whose detection
     rows extend those of the last call is judged on its new detections only. Only the tracks of
     this call are kept.
+
+    Parameters
+    ----------
+    tracks : DataFrame
+        Tracks table: ``time_s`` (s), ``track_id``, ``detection_row`` (-1: coasting), ``confirmed``
+        and optionally ``held_by``.
+    detections : DataFrame
+        Detections: ``time_s`` (s), ``range_m`` (m), ``radial_velocity_mps`` (m/s), optionally the
+        direction columns.
+    ownship : DataFrame or None
+        Own-ship table (``time_s`` in s, ``own_*`` NED position in m and velocity in m/s).
+    width_mps : float
+        Width of the Doppler image, m/s.
+    coupling_s : float
+        Range-Doppler coupling, s (m of apparent range per m/s).
+    surface_down : callable, optional
+        NE points (k, 2) in m -> ``down`` of the ground, m.
+    test : GroundTrackTest, optional
+        Settings of the test (default :class:`GroundTrackTest`).
+    walks : dict, optional
+        Judgements kept between calls, updated in place.
+
+    Returns
+    -------
+    DataFrame
+        ``tracks`` with ``confirmed`` False on held rows and the reason in ``held_by`` (``""`` on
+        confirmed rows), without the tracks that have no confirmed row left.
+
+    Examples
+    --------
+    Without own-ship state: a track closing at 50 m/s whose ranges follow its Doppler is released
+    at its fifth detection; one whose range jumps 30 m back and forth every frame at a constant
+    Doppler (no single object) is held by the range-Doppler test on most rows:
+
+    >>> k = np.arange(8)
+    >>> ranges = np.r_[1000.0 - 5.0 * k, 2000.0 + 30.0 * (k % 2)]
+    >>> det = pd.DataFrame({"time_s": 0.1 * np.r_[k, k], "range_m": ranges, "radial_velocity_mps": -50.0})
+    >>> tracks = pd.DataFrame({"time_s": 0.1 * np.r_[k, k], "track_id": np.repeat([1, 2], 8),
+    ...                        "detection_row": np.r_[k, k + 8], "confirmed": True})
+    >>> out = hold_ground_tracks(tracks, det, None, 78.3, 0.0)
+    >>> out.groupby("track_id")["held_by"].agg(list).to_dict()
+    {1: ['young', 'young', 'young', 'young', '', '', '', ''],
+     2: ['young', 'young', 'young', 'young', 'range', '', 'range', 'range']}
     """
     test = test or GroundTrackTest()
     if len(tracks) == 0:

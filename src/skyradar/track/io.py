@@ -105,7 +105,35 @@ def validate_ownship(df: pd.DataFrame, columns: tuple[str, ...], source: str = "
 
 
 def read_detections(path: str | Path) -> pd.DataFrame:
-    """Read and validate a detections table (Parquet or CSV)."""
+    """Read and validate a detections table (Parquet or CSV).
+
+    Parameters
+    ----------
+    path : str or Path
+        The table, with at least ``time_s`` (s), ``range_m`` (m) and ``radial_velocity_mps`` (m/s).
+
+    Returns
+    -------
+    DataFrame
+        The checked table; InputError naming ``path`` when a column is missing or a value is not a
+        finite number within bounds.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> det = pd.DataFrame({"time_s": [0.0, 0.1], "range_m": [1000.0, 995.0], "radial_velocity_mps": -50.0})
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = os.path.join(tmp, "det.csv")
+    ...     det.to_csv(path, index=False)
+    ...     back = read_detections(path)
+    ...     det.drop(columns="range_m").to_csv(path, index=False)
+    ...     read_detections(path)
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: .../det.csv: missing column(s) ['range_m'] (have ...)
+    >>> back.equals(det)
+    True
+    """
     df = read_table(path, required=REQUIRED_DETECTION_COLUMNS)
     return validate_detections(df, str(path))
 
@@ -132,6 +160,29 @@ class Truth:
     names : list of str
     snr_db : ndarray, shape (n_time, n_target), or None
         Expected SNR (radar equation, no noise), when the run has it.
+
+    Parameters
+    ----------
+    time_s : ndarray, shape (n_time,)
+        Frame times, s.
+    range_m : ndarray, shape (n_time, n_target)
+        Target ranges, m.
+    radial_velocity_mps : ndarray, shape (n_time, n_target)
+        Target radial velocities, not aliased, m/s.
+    visible : ndarray of bool, shape (n_time, n_target)
+        Whether each target is in the beam.
+    names : list of str, optional
+        Target names (default ``T0, T1, ...``).
+    snr_db : ndarray, shape (n_time, n_target), optional
+        Expected SNR, dB.
+
+    Examples
+    --------
+    >>> t = np.arange(4.0)
+    >>> truth = Truth(t, np.column_stack([1000.0 - 50.0 * t, 3000.0 + 0 * t]), np.tile([-50.0, 0.0], (4, 1)),
+    ...               np.ones((4, 2), bool))
+    >>> truth.names, truth.range_m[-1].tolist(), truth.snr_db is None
+    (['T0', 'T1'], [850.0, 3000.0], True)
     """
 
     def __init__(

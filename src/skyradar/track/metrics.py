@@ -199,9 +199,36 @@ def detected_truth(
     :func:`truth_segments` it gives the number of aircraft visits a tracker could follow.
     ``coupling_s`` adds the range-Doppler coupling to the truth range before comparing.
 
+    Parameters
+    ----------
+    truth : Truth
+        Intruder truth on the frame grid.
+    detections : DataFrame
+        ``time_s`` (s), ``range_m`` (m) and ``radial_velocity_mps`` (m/s).
+    pixel_size : (float, float)
+        Range bin (m) and Doppler bin (m/s) of one pixel.
+    doppler_width_mps : float or None
+        Width of the Doppler image, m/s: the Doppler difference is wrapped into it (None: not).
+    threshold_px : float
+        Largest distance of a detection from the truth, pixels.
+    coupling_s : float
+        Range-Doppler coupling, s (m of apparent range per m/s).
+
     Returns
     -------
     ndarray of bool, shape (n_time, n_target)
+
+    Examples
+    --------
+    A target closing at 50 m/s: at 1 s the detection is 2 pixels of range off, at 3 s its Doppler
+    has aliased by the image width of 78.3 m/s:
+
+    >>> t = np.arange(4.0)
+    >>> truth = Truth(t, (1000.0 - 50.0 * t)[:, None], np.full((4, 1), -50.0), np.ones((4, 1), bool))
+    >>> det = pd.DataFrame({"time_s": [0.0, 1.0, 3.0], "range_m": [1001.0, 980.0, 850.0],
+    ...                     "radial_velocity_mps": [-50.0, -50.0, -50.0 + 78.3]})
+    >>> detected_truth(truth, det, (15.0, 0.3), 78.3)[:, 0].tolist()
+    [True, False, False, True]
     """
     n_time, n_tgt = truth.visible.shape
     out = np.zeros((n_time, n_tgt), bool)
@@ -230,6 +257,40 @@ def match_tracks(
     """Per truth frame: matched track id per target (-1 when none) and the GOSPA distance.
 
     Tracks are taken at the truth frame nearest in time (within half a frame interval).
+
+    Parameters
+    ----------
+    tracks : DataFrame
+        ``time_s`` (s), ``track_id``, ``range_m`` (m) and ``radial_velocity_mps`` (m/s).
+    truth : Truth
+        Intruder truth on the frame grid.
+    pixel_size : (float, float)
+        Range bin (m) and Doppler bin (m/s) of one pixel.
+    doppler_width_mps : float or None
+        Width of the Doppler image, m/s (None: the Doppler difference is not wrapped).
+    threshold_px : float
+        Largest track-to-truth distance of a match, pixels.
+    gospa_c_px : float
+        GOSPA cut-off distance, pixels.
+
+    Returns
+    -------
+    matched : ndarray of int, shape (n_time, n_target)
+        Matched track id, -1 when none.
+    gospa : ndarray, shape (n_time,)
+        GOSPA distance per frame, pixels.
+
+    Examples
+    --------
+    One track on the target and one far from it: the far one costs ``sqrt(c^2 / 2)`` of GOSPA.
+
+    >>> t = np.arange(3.0)
+    >>> truth = Truth(t, (1000.0 - 50.0 * t)[:, None], np.full((3, 1), -50.0), np.ones((3, 1), bool))
+    >>> tracks = pd.DataFrame({"time_s": np.r_[t, t], "track_id": np.repeat([7, 8], 3),
+    ...     "range_m": np.r_[1000.0 - 50.0 * t, 3000.0 + 0 * t], "radial_velocity_mps": -50.0})
+    >>> matched, d = match_tracks(tracks, truth, (15.0, 0.3), 78.3)
+    >>> matched[:, 0].tolist(), bool(np.allclose(d, np.sqrt(10.0**2 / 2)))
+    ([7, 7, 7], True)
     """
     n_time, n_tgt = truth.visible.shape
     matched = np.full((n_time, n_tgt), -1, np.int64)
@@ -357,6 +418,48 @@ def track_metrics(
     predictions included: the track exists there, as in Stone Soup's SIAP completeness), not only
     on ``confirmed`` rows (``completeness_confirmed``). ``tracks_per_target``: distinct tracks
     matched to each target over the run.
+
+    Parameters
+    ----------
+    tracks : DataFrame
+        ``time_s`` (s), ``track_id``, ``range_m`` (m), ``radial_velocity_mps`` (m/s),
+        ``innovation_range_m`` (m), ``innovation_radial_velocity_mps`` (m/s) and ``confirmed``.
+    truth : Truth
+        Intruder truth on the frame grid.
+    pixel_size : (float, float)
+        Range bin (m) and Doppler bin (m/s) of one pixel.
+    doppler_width_mps : float or None
+        Width of the Doppler image, m/s (None: the Doppler difference is not wrapped).
+    threshold_px, gospa_c_px : float
+        Largest distance of a match and GOSPA cut-off, pixels.
+    gap_s, min_duration_s : float
+        Truth gaps bridged and shortest truth segment counted, s.
+    confirm : (int, int)
+        M-of-N visible frames that start a truth segment.
+    counted : ndarray of bool, optional
+        Frames of the counted truth segments (default ``truth.visible``).
+    coasting : bool
+        Match a track's rows from its first confirmed one on.
+
+    Returns
+    -------
+    dict
+        Counts (``truth_tracks``, ``tracks``, ``false_tracks``, ``fragmentation``, ``id_switches``,
+        ``missed_truth_tracks``), ``completeness`` fractions, ``gospa_mean`` (pixels) and the
+        innovation statistics of :func:`innovation_stats`.
+
+    Examples
+    --------
+    One track following the target over the run and one false track:
+
+    >>> t = np.arange(4.0)
+    >>> truth = Truth(t, (1000.0 - 50.0 * t)[:, None], np.full((4, 1), -50.0), np.ones((4, 1), bool))
+    >>> tracks = pd.DataFrame({"time_s": np.r_[t, t], "track_id": np.repeat([7, 8], 4),
+    ...     "range_m": np.r_[1000.0 - 50.0 * t, 3000.0 + 0 * t], "radial_velocity_mps": -50.0,
+    ...     "innovation_range_m": 0.0, "innovation_radial_velocity_mps": 0.0, "confirmed": True})
+    >>> m = track_metrics(tracks, truth, (15.0, 0.3), 78.3, min_duration_s=1.0)
+    >>> m["truth_tracks"], m["false_tracks"], m["completeness"], round(m["gospa_mean"] ** 2, 9)
+    (1, 1, 1.0, 50.0)
     """
     if counted is None:
         counted = truth.visible

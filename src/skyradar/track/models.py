@@ -53,11 +53,22 @@ class MotionModel:
     q_velocity_mps3 : float
         White-jerk noise driving the radial acceleration, m/s^3 (both models).
     init_sigma_rate_mps, init_sigma_accel_mps2 : float
-        Prior standard deviations of ``dR/dt`` and ``dV_R/dt`` for a new track.
+        Prior standard deviations of ``dR/dt`` (m/s) and ``dV_R/dt`` (m/s^2) for a new track.
     coupling_s : float
         Range-Doppler coupling of a sawtooth chirp, s (m of apparent range per m/s): the observed
         range is ``R + coupling_s * V_R``. The radar model knows it (so ``R`` is the true range once
         ``V_R`` is de-aliased); the image model does not (0).
+
+    Examples
+    --------
+    The state is (range [m], radial velocity [m/s], range rate [m/s], radial acceleration [m/s^2]);
+    in the coupled model range follows the radial velocity:
+
+    >>> m = MotionModel("radar", coupled=True, wrap_doppler=True, dealias=True, doppler_width_mps=78.3)
+    >>> (m.transition(0.1) @ [1000.0, -50.0, -50.0, 2.0]).round(3).tolist()
+    [995.0, -49.8, -50.0, 2.0]
+    >>> m.measurement_noise.diagonal().round(3).tolist()
+    [20.25, 0.04]
     """
 
     name: str

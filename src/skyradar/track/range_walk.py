@@ -88,6 +88,25 @@ class RangeWalkRule:
     false_walk_probability : float
         Largest chance that the detections of the walk's Doppler in the window put its support on
         one line by coincidence (Poisson, see the module docstring).
+
+    Examples
+    --------
+    A closure at -113 m/s (aliased into a 78.3 m/s image) detected every 0.2 s: the default rule
+    starts the walk after ``min_span_s = 2`` s, a rule of 4 frames over 1 s after 1 s.
+
+    >>> def first_walk(rule):
+    ...     walks = RangeWalks(78.3, rule)
+    ...     for k in range(30):
+    ...         z = np.array([[3000.0 - 113.0 * 0.2 * k, -113.0 + 78.3]])
+    ...         rows, velocity = walks.step(0.2 * k, z, np.ones(1, bool), static_speed_mps=50.0)
+    ...         if rows.size:
+    ...             return round(0.2 * k, 1), round(float(velocity[0]), 1)
+    >>> first_walk(RangeWalkRule()), first_walk(RangeWalkRule(window_s=2.0, least_frames=4, min_span_s=1.0))
+    ((2.0, -113.0), (1.0, -113.0))
+    >>> RangeWalkRule(least_frames=2)
+    Traceback (most recent call last):
+    ...
+    ValueError: least_frames must be at least 3, got 2
     """
 
     window_s: float = 4.0
@@ -123,6 +142,19 @@ class RangeWalks:
         Width ``W`` of the Doppler image (``2 V_lim``), m/s.
     rule : RangeWalkRule, optional
         Thresholds (default :class:`RangeWalkRule`).
+
+    Examples
+    --------
+    A closure at -113 m/s seen in the cell of -34.7 m/s every 0.2 s, the own-ship at 50 m/s: the
+    frame that completes 2 s of support gives the detection and its true radial velocity.
+
+    >>> walks = RangeWalks(doppler_width_mps=78.3)
+    >>> for k in range(11):
+    ...     z = np.array([[3000.0 - 113.0 * 0.2 * k, -113.0 + 78.3]])
+    ...     rows, velocity = walks.step(0.2 * k, z, np.ones(1, bool), static_speed_mps=50.0)
+    ...     if rows.size:
+    ...         print(k, rows.tolist(), velocity.round(1).tolist())
+    10 [0] [-113.0]
     """
 
     def __init__(self, doppler_width_mps: float, rule: RangeWalkRule | None = None) -> None:

@@ -251,6 +251,34 @@ def terrain_surface(terrain, origin: tuple[float, float, float], flat_down_m: fl
     The fit calls it thousands of times with a few points, so the NED-to-geodetic conversion is
     linearised at the origin (degrees per metre north and east, and the Earth's curvature dropping
     the surface by ``(n^2 + e^2) / 2R``): under 0.1 m off at 15 km.
+
+    Parameters
+    ----------
+    terrain : object
+        A DEM with ``height_at(lat_deg, lon_deg)`` giving the height above the ellipsoid, m (NaN
+        outside it).
+    origin : (float, float, float)
+        Latitude (deg), longitude (deg) and altitude (m) of the NED origin.
+    flat_down_m : float
+        ``down`` of the level ground beyond the DEM, m.
+
+    Returns
+    -------
+    callable
+        NE points (k, 2) in m -> ``down`` of the surface, m, shape (k,).
+
+    Examples
+    --------
+    A DEM 200 m high up to 52.01 deg north under an origin at 1000 m: 800 m down under the origin,
+    the level ground beyond the DEM's edge, and the curvature's ``(10 km)^2 / 2R = 7.85`` m drop at 10 km
+    east:
+
+    >>> class Dem:
+    ...     def height_at(self, lat, lon):
+    ...         return np.where(np.asarray(lat) < 52.01, 200.0, np.nan)
+    >>> surface = terrain_surface(Dem(), (52.0, 4.0, 1000.0), 900.0)
+    >>> surface(np.array([[0.0, 0.0], [5000.0, 0.0], [0.0, 10000.0]])).round(2).tolist()
+    [800.0, 900.0, 807.85]
     """
     from skyradar.geo import ned_to_geodetic
 

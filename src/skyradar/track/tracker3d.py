@@ -56,6 +56,17 @@ class RadialObservation:
         De-aliased radial velocity (positive receding) per track; NaN where none.
     sigma_mps : float
         Its standard deviation, m/s.
+
+    Examples
+    --------
+    A filter 1 km east of an own-ship flying east at 50 m/s, its velocity unknown (400 m^2/s^2):
+    a range rate of -80 m/s puts the intruder's east velocity at ``50 - 80`` m/s.
+
+    >>> obs = RadialObservation(np.zeros(3), np.array([0.0, 50.0, 0.0]), np.array([-80.0]))
+    >>> x = np.array([[0.0, 1000.0, 0.0, 0.0, 0.0, 0.0]])
+    >>> x1, _ = range_rate_update(x, np.eye(6)[None] * 400.0, obs.radial_velocity_mps, obs)
+    >>> x1.round(1).tolist()
+    [[0.0, 1000.0, 0.0, 0.0, -30.0, 0.0]]
     """
 
     own_position_m: np.ndarray

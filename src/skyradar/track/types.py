@@ -47,6 +47,21 @@ class TrackerConfig:
         this long after (:mod:`skyradar.track.reacquisition`), s; 0 turns reacquisition off.
     reacquire_jerk_mps3 : float
         White jerk of a lost track's prediction across the gap, m/s^3.
+
+    Examples
+    --------
+    A target seen in every frame is confirmed at the fourth frame by the default 4-of-5 rule, at
+    the second by a 2-of-3 rule:
+
+    >>> from skyradar.track.models import radar_model
+    >>> from skyradar.track.tracker import RangeDopplerTracker
+    >>> def confirmed_at(config):
+    ...     trk = RangeDopplerTracker(radar_model(78.3), config)
+    ...     for k in range(5):
+    ...         if trk.step(0.1 * k, np.array([[1000.0 - 5.0 * k, -50.0]])).track_id.size:
+    ...             return k + 1
+    >>> confirmed_at(TrackerConfig()), confirmed_at(TrackerConfig(confirm_m=2, confirm_n=3))
+    (4, 2)
     """
 
     gate: float = 16.0
@@ -223,6 +238,21 @@ class FrameTracks:
         Whether each reported track is confirmed (all True unless ``report_tentative``).
     reacquired : ndarray of int, shape (r, 2)
         (id at birth, lost id it took) of the tracks that reacquired a lost track in this frame.
+
+    Examples
+    --------
+    What :meth:`~skyradar.track.tracker.RangeDopplerTracker.step` returns: the tentative track is
+    live but not reported until the fourth frame confirms it.
+
+    >>> from skyradar.track.models import radar_model
+    >>> from skyradar.track.tracker import RangeDopplerTracker
+    >>> trk = RangeDopplerTracker(radar_model(78.3))
+    >>> frames = [trk.step(0.1 * k, np.array([[1000.0 - 5.0 * k, -50.0]])) for k in range(4)]
+    >>> frames[2].track_id.tolist(), frames[2].alive_ids.tolist()
+    ([], [0])
+    >>> out = frames[3]
+    >>> out.track_id.tolist(), out.n_updates.tolist(), out.detection_index.tolist(), out.state.shape
+    ([0], [4], [0], (1, 4))
     """
 
     time_s: float

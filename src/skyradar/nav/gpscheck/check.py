@@ -80,7 +80,30 @@ def radar_side(config: RadarConfig, source: str = "run") -> str:
 
 
 def pose_grid_for(config: RadarConfig, pixel_m: float = PIXEL_M, source: str = "run") -> PoseGrid:
-    """The body-aligned ground grid of the radar's side, out to its processed range."""
+    """The body-aligned ground grid of the radar's side, out to its processed range.
+
+    Parameters
+    ----------
+    config : RadarConfig
+        A side-looking radar (:func:`radar_side`); its ``range_limit_m`` (m) sets the extent.
+    pixel_m : float
+        Pixel size, m.
+    source : str
+        Names the run in errors.
+
+    Returns
+    -------
+    PoseGrid
+        Forward ``-range..range``, sideways ``0..range`` on the radar's side.
+
+    Examples
+    --------
+    >>> from skyradar.config import Mount
+    >>> cfg = RadarConfig.prototype_2022(mount=Mount.preset("side-left"), range_limit_m=500.0)
+    >>> body = pose_grid_for(cfg)
+    >>> body.shape, float(body.forward_m[0]), float(body.right_m[0]), float(body.right_m[-1])
+    ((250, 125), -498.0, -498.0, -2.0)
+    """
     return PoseGrid.side_looking(config.range_limit_m, pixel_m, radar_side(config, source))
 
 
@@ -88,6 +111,30 @@ def building_height_m(layers) -> float:
     """The map's representative building height: the footprint-area-weighted mean (0 without buildings).
 
     Large buildings dominate what a radar sees, hence the area weights.
+
+    Parameters
+    ----------
+    layers : MapLayers
+        Its ``buildings`` GeoDataFrame has ``height_m`` (m) and polygon footprints (m^2 by ``.area``).
+
+    Returns
+    -------
+    float
+        Height, m.
+
+    Examples
+    --------
+    A 300 m^2 building 10 m high and a 100 m^2 one 30 m high: (300 * 10 + 100 * 30) / 400 = 15 m.
+
+    >>> import geopandas as gpd
+    >>> from shapely.geometry import box
+    >>> from skyradar.scene.map_render import MapLayers
+    >>> empty = gpd.GeoDataFrame(geometry=[])
+    >>> footprints = [box(0, 0, 30, 10), box(0, 20, 10, 30)]
+    >>> houses = gpd.GeoDataFrame({"height_m": [10.0, 30.0]}, geometry=footprints)
+    >>> layers = MapLayers(houses, empty, empty, empty, empty, empty, empty, 60.0, 25.0)
+    >>> round(building_height_m(layers), 6)
+    15.0
     """
     buildings = layers.buildings
     if not len(buildings):
@@ -129,7 +176,37 @@ def correct_layover(
 
 
 def render_map(layers, grid: GroundGrid) -> np.ndarray:
-    """The reference map on ``grid``, drawn at half the pixel size and averaged (no lost thin roads)."""
+    """The reference map on ``grid``, drawn at half the pixel size and averaged (no lost thin roads).
+
+    Parameters
+    ----------
+    layers : MapLayers
+        The map (needs the ``geo`` extra).
+    grid : GroundGrid
+        Where to draw it; pixel size in m.
+
+    Returns
+    -------
+    ndarray of float32, shape ``grid.shape``
+        Grey levels 0..1: roads light, buildings dark.
+
+    Examples
+    --------
+    A primary road along east at north 0 on a 2 m grid:
+
+    >>> import geopandas as gpd
+    >>> from shapely.geometry import LineString
+    >>> from skyradar.scene.map_render import MapLayers
+    >>> empty = gpd.GeoDataFrame(geometry=[])
+    >>> road = gpd.GeoDataFrame({"road_class": ["primary"], "width_m": [12.0]},
+    ...                         geometry=[LineString([(-50, 0), (50, 0)])])
+    >>> layers = MapLayers(gpd.GeoDataFrame({"height_m": []}, geometry=[]), road, empty, empty, empty,
+    ...                    empty, empty, 60.0, 25.0)
+    >>> grid = GroundGrid.from_extent(-20.0, 20.0, -20.0, 20.0, pixel_m=2.0)
+    >>> image = render_map(layers, grid)
+    >>> image.shape, image.dtype, [round(float(v), 2) for v in image[[10, 0], 10]]  # road, background
+    ((20, 20), dtype('float32'), [1.0, 0.93])
+    """
     from skyradar.scene.map_render import render_reference_map  # geo extra: imported when used
 
     half = GroundGrid(
@@ -142,14 +219,55 @@ def render_map(layers, grid: GroundGrid) -> np.ndarray:
 
 
 def prepare_map(map_image: np.ndarray, methods: Sequence[str]) -> dict[str, np.ndarray]:
-    """The map pre-processed by each method (NaN, no data, is masked)."""
+    """The map pre-processed by each method (NaN, no data, is masked).
+
+    Parameters
+    ----------
+    map_image : 2-D array
+        The rendered or raster map (:func:`render_map`); NaN where it has no data.
+    methods : sequence of str
+        Methods of :data:`skyradar.nav.gpscheck.preprocess.METHODS`.
+
+    Returns
+    -------
+    dict of str to ndarray
+        Per method a float32 image in 0..1 (the map inverted, :data:`MAP_OPTIONS`), 0 where the map
+        has no data.
+
+    Examples
+    --------
+    >>> world = np.random.default_rng(0).random((50, 60))
+    >>> world[:5] = np.nan
+    >>> out = prepare_map(world, ["gamma"])
+    >>> gamma = out["gamma"]
+    >>> list(out), gamma.shape, gamma.dtype, float(gamma[:5].max()), float(gamma.max())
+    (['gamma'], (50, 60), dtype('float32'), 0.0, 1.0)
+    """
     valid = np.isfinite(map_image)
     return {method: preprocess(map_image, method, valid, **MAP_OPTIONS) for method in methods}
 
 
 @dataclass(frozen=True)
 class FrameCheck:
-    """One frame's GPS check."""
+    """One frame's GPS check.
+
+    Attributes
+    ----------
+    ground_fraction : float
+        Share of the beam's two-way energy on the ground within range, 0..1.
+    gps_ssim : float
+        SSIM of the radar ground image and the map at the GPS pose (NaN when not searched).
+    offset : PoseOffset or None
+        The correction the search found; None on a wing-up frame (not searched).
+    verdict : str
+        One of :data:`skyradar.nav.gpscheck.monitor.VERDICTS`.
+
+    Examples
+    --------
+    >>> body = PoseGrid.side_looking(range_m=40.0, pixel_m=4.0)
+    >>> check_frame(np.ones(body.shape), 0.2, np.zeros(3), None, None, body)
+    FrameCheck(ground_fraction=0.2, gps_ssim=nan, offset=None, verdict='no decision: wing up')
+    """
 
     ground_fraction: float
     gps_ssim: float
@@ -172,9 +290,51 @@ def check_frame(
 ) -> FrameCheck:
     """Score the GPS pose (SSIM), search for the correction and give the verdict for one frame.
 
-    ``radar_image`` is the frame's ground image (linear power, NaN where unseen) on ``pose_grid``.
-    A wing-up frame (``ground_fraction`` below the setting) is not searched. ``height_agl_m`` and
-    ``building_m`` (the map's building height) set the layover correction (:func:`correct_layover`).
+    Parameters
+    ----------
+    radar_image : 2-D array
+        The frame's ground image on ``pose_grid``: linear power, W, NaN where unseen.
+    ground_fraction : float
+        Share of the beam on the ground, 0..1; below ``settings.min_ground_fraction`` the frame is
+        wing up and not searched.
+    gps_pose : (3,) array
+        ``(north_m, east_m, heading_rad)`` the GPS reports.
+    map_processed : 2-D array
+        The map on ``grid``, pre-processed with ``method`` (:func:`prepare_map`).
+    grid : GroundGrid
+    pose_grid : PoseGrid
+    method : str
+        Pre-processing method for the radar image, the one the map is processed with.
+    settings : MonitorSettings
+    height_agl_m, building_m : float
+        Height above ground and the map's building height, m: the layover correction
+        (:func:`correct_layover`).
+    **search_options
+        Passed to :func:`skyradar.nav.gpscheck.search.search_offset` (``margin_m``, ...).
+
+    Returns
+    -------
+    FrameCheck
+
+    Examples
+    --------
+    A map of dark blocks (buildings) on light ground; the radar sees the buildings bright (30 dB
+    above the ground). A GPS pose 20 m north and 12 m west of the true one is corrected and found
+    inconsistent; the true pose is consistent.
+
+    >>> blocks = np.random.default_rng(0).random((40, 40)) < 0.3
+    >>> world = np.where(np.kron(blocks, np.ones((6, 6))), 0.2, 0.9)
+    >>> grid, body = GroundGrid(0.0, 0.0, 4.0, world.shape), PoseGrid.side_looking(160.0, 4.0)
+    >>> truth = np.array([480.0, 400.0, 0.3])
+    >>> radar = 10.0 ** (3.0 * (1.0 - sample_at_pose(world, grid, body, *truth)))
+    >>> mapped = prepare_map(world, ["gamma"])["gamma"]
+    >>> options = {"method": "gamma", "margin_m": 40.0, "max_heading_deg": 3.0}
+    >>> wrong = check_frame(radar, 0.9, truth + [20.0, -12.0, 0.0], mapped, grid, body, **options)
+    >>> wrong.verdict, round(wrong.offset.d_north_m), round(wrong.offset.d_east_m)
+    ('inconsistent', -20, 12)
+    >>> right = check_frame(radar, 0.9, truth, mapped, grid, body, **options)
+    >>> right.verdict, round(right.offset.distance_m), right.gps_ssim > 0.9
+    ('consistent', 0, True)
     """
     radar_image = correct_layover(radar_image, pose_grid, height_agl_m, building_m)
     mask = np.isfinite(radar_image)
@@ -266,11 +426,51 @@ def check_coverage(
     """One-line error naming the map when a frame's ground footprint at the GPS pose is off the map.
 
     The footprint is geometric (where the beam meets the ground within range), so no frame is read.
-    ``map_extent`` is :class:`MapLayers` or a :class:`GroundGrid`. With ``map_image`` (a raster map on
-    that grid, NaN where the file has no data) the footprint must also lie on the map's data: at least
-    ``min_data_fraction`` of it in every frame. A map with data elsewhere but none under the flight
-    would otherwise give every frame "no decision: too little structure", which reads like a verdict
-    on the radar image, not on the map.
+    A map with data elsewhere but none under the flight would otherwise give every frame "no
+    decision: too little structure", which reads like a verdict on the radar image, not on the map.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A frames Dataset with the own-ship state (``own_north_m``, ..., m, m/s, rad).
+    config : RadarConfig
+        A side-looking radar.
+    map_extent : MapLayers or GroundGrid
+    frames : sequence of int, optional
+        Frames to check (default all); wing-up frames are skipped.
+    gps_offset : (3,) float
+        ``(north_m, east_m, heading_deg)`` added to the run's pose, as in :func:`check_run`.
+    pixel_m : float
+        Pixel size of the footprint grid, m.
+    source, map_source : str
+        Names of the run and the map, for errors.
+    min_ground_fraction : float
+        Frames with less of the beam on the ground are wing up.
+    map_image : 2-D array, optional
+        A raster map on ``map_extent`` (a GroundGrid), NaN where the file has no data: at least
+        ``min_data_fraction`` of every frame's footprint must then lie on data.
+    min_data_fraction : float
+
+    Raises
+    ------
+    InputError
+        Naming the map when a footprint is off it or off its data.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> from skyradar.config import Mount
+    >>> cfg = RadarConfig.prototype_2022(mount=Mount.preset("side-right"), range_limit_m=500.0)
+    >>> state = {"own_north_m": 0.0, "own_east_m": 0.0, "own_yaw_rad": 0.0, "own_pitch_rad": 0.0,
+    ...          "own_roll_rad": 0.0, "own_vn_mps": 50.0, "own_ve_mps": 0.0, "own_vd_mps": 0.0,
+    ...          "own_height_agl_m": 100.0}
+    >>> ds = xr.Dataset({name: ("time", [value]) for name, value in state.items()})
+    >>> grid = GroundGrid.from_extent(-1000.0, 1000.0, -1000.0, 1000.0, pixel_m=4.0)
+    >>> check_coverage(ds, cfg, grid)
+    >>> check_coverage(ds, cfg, grid, gps_offset=(0.0, 1500.0, 0.0), map_source="city.osm.pbf")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: city.osm.pbf: the map (north -1000..1000 m, east -1000..1000 m) does not ...
     """
     from skyradar.scene.map_render import check_map_covers  # geo extra: imported when used
 
@@ -356,10 +556,56 @@ def check_run(
 ) -> pd.DataFrame:
     """The GPS check of the chosen frames of a frames dataset; one row per frame.
 
-    ``gps_offset`` ``(north_m, east_m, heading_deg)`` is added to the run's own-ship pose: a biased or
-    spoofed GPS (run :func:`check_coverage` first: the footprints must lie on the map). ``building_m`` is
-    the map's building height for the layover correction (:func:`building_height_m`). Columns:
-    :data:`GPSCHECK_COLUMNS`.
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A frames Dataset with ``iq`` and the own-ship state (``own_north_m``, ..., m, m/s, rad).
+    config : RadarConfig
+        A side-looking radar.
+    map_processed : 2-D array
+        The map on ``grid`` pre-processed with ``method`` (:func:`prepare_map`).
+    grid : GroundGrid
+    frames : sequence of int, optional
+        Frames to check (default all).
+    method : str
+        Pre-processing method.
+    gps_offset : (3,) float
+        ``(north_m, east_m, heading_deg)`` added to the run's own-ship pose: a biased or spoofed GPS
+        (run :func:`check_coverage` first: the footprints must lie on the map).
+    settings : MonitorSettings
+    pixel_m : float
+        Pixel size of the ground image, m.
+    source : str
+        Names the run in errors.
+    building_m : float
+        The map's building height for the layover correction (:func:`building_height_m`), m.
+    progress : callable, optional
+        Called with no argument after each frame.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`GPSCHECK_COLUMNS`.
+
+    Examples
+    --------
+    Frames without any return: the level one sees a featureless footprint (no decision), the one
+    rolled 0.6 rad away from the radar's side sees too little ground (wing up).
+
+    >>> from skyradar.config import Mount
+    >>> from skyradar.io.frames import frames_dataset
+    >>> cfg = RadarConfig.prototype_2022(mount=Mount.preset("side-right"), range_limit_m=500.0, n_doppler=16)
+    >>> own = {"own_north_m": [0.0, 5.0], "own_east_m": [0.0, 0.0], "own_down_m": [-100.0, -100.0],
+    ...        "own_yaw_rad": [0.0, 0.0], "own_pitch_rad": [0.0, 0.0], "own_roll_rad": [0.0, -0.6],
+    ...        "own_vn_mps": [50.0, 50.0], "own_ve_mps": [0.0, 0.0], "own_vd_mps": [0.0, 0.0],
+    ...        "own_height_agl_m": [100.0, 100.0]}
+    >>> cube = np.zeros((2, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
+    >>> ds = frames_dataset(cube, np.array([0.0, 0.1]), cfg, ownship={k: np.array(v) for k, v in own.items()})
+    >>> grid = GroundGrid.from_extent(-1000.0, 1000.0, -1000.0, 1000.0, pixel_m=8.0)
+    >>> mapped = prepare_map(np.random.default_rng(0).random(grid.shape), ["gamma"])["gamma"]
+    >>> table = check_run(ds, cfg, mapped, grid, method="gamma", pixel_m=8.0)
+    >>> list(table.columns) == list(GPSCHECK_COLUMNS), table["verdict"].tolist(), table["alert"].any()
+    (True, ['no decision: too little structure', 'no decision: wing up'], np.False_)
     """
     pose_grid = pose_grid_for(config, pixel_m, source)
     _check_state(ds, source)

@@ -225,9 +225,36 @@ def score_poses(
 ) -> np.ndarray:
     """SSIM of the pre-processed radar image against the pre-processed map sampled at each pose.
 
-    ``map_world`` lies on ``grid``; ``radar`` and ``radar_mask`` on ``pose_grid``; outside the map reads 0.
-    ``map_pose_grid`` (default ``pose_grid``) is where the map is sampled: ``pose_grid`` moved by the
-    expected layover (:func:`skyradar.nav.gpscheck.check.layover_grid`).
+    Parameters
+    ----------
+    radar, radar_mask : 2-D arrays on ``pose_grid``
+        The pre-processed radar image and its footprint.
+    map_world : 2-D array on ``grid``
+        The pre-processed map; outside it reads 0.
+    grid : GroundGrid
+    pose_grid : PoseGrid
+    poses : ndarray, shape (n, 3) or (3,)
+        ``(north_m, east_m, heading_rad)`` per candidate.
+    map_pose_grid : PoseGrid, optional
+        Where the map is sampled (default ``pose_grid``): ``pose_grid`` moved by the expected layover
+        (:func:`skyradar.nav.gpscheck.check.layover_grid`).
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        SSIM per pose; 1 for a map identical to the radar image.
+
+    Examples
+    --------
+    >>> grid = GroundGrid(0.0, 0.0, 2.0, (200, 200))
+    >>> world = np.random.default_rng(0).random(grid.shape).astype(np.float32)
+    >>> body = PoseGrid.side_looking(range_m=60.0, pixel_m=2.0)
+    >>> truth = np.array([200.0, 200.0, 0.3])
+    >>> radar = sample_at_poses(world, grid, body, truth)
+    >>> poses = truth + np.array([[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [0.0, 0.0, np.radians(5.0)]])
+    >>> scores = score_poses(radar, np.ones(body.shape, bool), world, grid, body, poses)
+    >>> round(float(scores[0]), 6), bool(scores[1:].max() < 0.1)
+    (1.0, True)
     """
     where = pose_grid if map_pose_grid is None else map_pose_grid
     radar, radar_mask, where = crop_to_mask(radar, np.asarray(radar_mask, bool), where)
@@ -239,7 +266,25 @@ def score_poses(
 
 @dataclass(frozen=True)
 class DecoyResult:
-    """One frame of the decoy test: the picked pose's errors and the false-positive share."""
+    """One frame of the decoy test: the picked pose's errors and the false-positive share.
+
+    Attributes
+    ----------
+    heading_error_deg : float
+        Heading error of the picked pose, deg.
+    position_error_m : float
+        Position error of the picked pose, m.
+    false_positive_fraction : float
+        Share of the decoys scoring above the true pose, 0..1.
+    true_score, best_score : float
+        SSIM of the true pose and of the picked one.
+
+    Examples
+    --------
+    >>> result = DecoyResult(1.5, 12.0, 0.02, 0.61, 0.64)
+    >>> result.correct(), result.correct(max_position_m=10.0)
+    (True, False)
+    """
 
     heading_error_deg: float
     position_error_m: float

@@ -44,7 +44,35 @@ VERDICTS = (CONSISTENT, INCONSISTENT, WING_UP, LOW_STRUCTURE)
 
 @dataclass(frozen=True)
 class MonitorSettings:
-    """Thresholds of the monitor (defaults: the acceptance bounds and ch6's calibration)."""
+    """Thresholds of the monitor (defaults: the acceptance bounds and ch6's calibration).
+
+    Attributes
+    ----------
+    min_ground_fraction : float
+        Share of the beam on the ground (0..1) below which a frame is wing up.
+    min_psr : float
+        Peak-to-sidelobe ratio below which the alignment is not distinct (too little structure).
+    max_position_m : float
+        Largest correction still consistent, m.
+    max_heading_deg : float
+        Largest heading correction still consistent, deg.
+    alert_frames : int
+        Decided frames in a row that must be inconsistent for the alert.
+
+    Examples
+    --------
+    A 5 m, 0.5 deg correction found with PSR 7: consistent by default, not with tighter settings.
+
+    >>> offset = PoseOffset(3.0, 4.0, 0.5, 0.8, 0.3, 7.0)
+    >>> frame_verdict(0.9, offset), frame_verdict(0.9, offset, MonitorSettings(max_position_m=4.0))
+    ('consistent', 'inconsistent')
+    >>> frame_verdict(0.9, offset, MonitorSettings(min_psr=8.0))
+    'no decision: too little structure'
+    >>> MonitorSettings(alert_frames=0)
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: MonitorSettings: alert_frames must be at least 1, got 0
+    """
 
     min_ground_fraction: float = 0.5
     # ch6 seeds 6-8: every unspoofed frame with PSR >= 4.5 was within 8 m; at 4.0 a turn frame was 45 m off.

@@ -37,7 +37,20 @@ THESIS_METHOD_NUMBER = {"threshold_entropy": 5, "clahe_ridge": 8, "clahe_entropy
 
 
 class PreprocessOptions(TypedDict, total=False):
-    """Keyword options of :func:`preprocess`, kept as a set (the map's, the radar's)."""
+    """Keyword options of :func:`preprocess`, kept as a set (the map's, the radar's).
+
+    Any subset of the keys may be given; each has the meaning and default of the keyword of the
+    same name of :func:`preprocess` (sizes in pixels).
+
+    Examples
+    --------
+    Power 1, 10 and 100 W is 0, 10 and 20 dB, scaled to 0, 0.5 and 1; the gamma of 0.5 gives 0.707
+    in the middle. NaN is outside the mask: 0.
+
+    >>> options = PreprocessOptions(log_power=True)
+    >>> preprocess(np.array([[1.0, 10.0, 100.0, np.nan]]), "gamma", **options).round(4).tolist()
+    [[0.0, 0.7071, 1.0, 0.0]]
+    """
 
     log_power: bool
     invert: bool

@@ -47,9 +47,20 @@ __all__ = ["FacetRule", "facet_rule", "cell_counts"]
 class FacetRule(NamedTuple):
     """Sub-facet counts per cell axis (rows, columns) for the terrain kernel.
 
-    ``n_min``: the uniform counts, or the adaptive minimum; ``n_max``: the largest count
-    (equal to ``n_min`` for the uniform rule); ``adapt``: (range target m, radial-velocity
-    target m/s, 0, 0), or all 0 for the uniform rule.
+    Parameters
+    ----------
+    n_min : (int, int)
+        The uniform counts, or the adaptive minimum.
+    n_max : (int, int)
+        The largest counts (equal to ``n_min`` for the uniform rule).
+    adapt : (float, float, float, float)
+        (range target, m; radial-velocity target, m/s; 0; 0), or all 0 for the uniform rule.
+
+    Examples
+    --------
+    >>> rule = FacetRule((2, 2), (8, 12), (7.5, 0.157, 0.0, 0.0))
+    >>> rule.counts, rule.per_cell_max  # 8 x 12 sub-facets at most
+    ((2, 2, 8, 12), 96)
     """
 
     n_min: tuple[int, int]

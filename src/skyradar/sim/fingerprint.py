@@ -18,7 +18,35 @@ def referenced_files(built) -> list[Path]:
     """Every file the scenario file of ``built`` refers to (trajectories, DEMs, antenna cuts).
 
     Read from the scenario's own fields named ``path`` or ``*_csv``, resolved as the scenario
-    resolves them (relative to its folder). Empty when the scenario has no source file.
+    resolves them (relative to its folder). The files need not exist.
+
+    Parameters
+    ----------
+    built : BuiltScenario
+        Any object with a ``source`` attribute (the scenario file's path, or None).
+
+    Returns
+    -------
+    list of Path
+        The referenced files; empty when the scenario has no source file.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from types import SimpleNamespace
+    >>> tmp = tempfile.TemporaryDirectory()
+    >>> folder = Path(tmp.name)
+    >>> _ = (folder / "s.yaml").write_text(
+    ...     "{origin: {lat_deg: 52.0, lon_deg: 4.0}, duration_s: 1, "
+    ...     "ownship: {type: straight, speed_mps: 50, start_ned_m: [0, 0, -500]}, "
+    ...     "intruders: [{name: B, type: file, path: tracks/adsb.csv}]}"
+    ... )
+    >>> built = SimpleNamespace(source=folder / "s.yaml")
+    >>> [p.relative_to(folder).as_posix() for p in referenced_files(built)]
+    ['tracks/adsb.csv']
+    >>> referenced_files(SimpleNamespace(source=None))
+    []
+    >>> tmp.cleanup()
     """
     source = getattr(built, "source", None)
     if not source or not Path(source).is_file():
@@ -55,6 +83,30 @@ def fingerprint(built) -> str:
 
     The scenario text, every file it refers to (contents), radar, times, options and the package
     version. (:class:`~skyradar.io.frames.FrameStoreWriter` adds the chunk layout and codec.)
+
+    Parameters
+    ----------
+    built : BuiltScenario
+        Read: ``name``, ``origin``, ``radar``, ``times_s`` (s), ``sim_options`` and, when present,
+        ``source`` and ``start_time``.
+
+    Returns
+    -------
+    str
+        16 hexadecimal digits of the SHA-256 of those inputs.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from types import SimpleNamespace
+    >>> from skyradar.config import RadarConfig
+    >>> built = SimpleNamespace(name="demo", origin=(52.0, 4.0, 0.0), radar=RadarConfig.prototype_2022(),
+    ...                         times_s=np.arange(10) * 0.1, sim_options={"seed": 0})
+    >>> key = fingerprint(built)
+    >>> len(key), key == fingerprint(built)  # the same inputs, the same key
+    (16, True)
+    >>> fingerprint(SimpleNamespace(**{**vars(built), "sim_options": {"seed": 1}})) != key
+    True
     """
     from skyradar import __version__
 

@@ -21,7 +21,32 @@ LEVEL_CLEAR_M = 50.0  # antenna height above level terrain from which nothing in
 
 
 class HorizonGrid(NamedTuple):
-    """Bins of the polar horizon of one simulator (radar and DEM spacing fix them)."""
+    """Bins of the polar horizon of one simulator (radar and DEM spacing fix them).
+
+    Parameters
+    ----------
+    nsub : (int, int)
+        Horizon samples per DEM cell, per axis.
+    r_lim_m : float
+        Samples beyond this horizontal distance are left out, m.
+    az_bin_rad : float
+        Azimuth bin width, rad.
+    h_bin_m : float
+        Horizontal-distance bin width, m.
+    n_az, n_h : int
+        Azimuth and horizontal-distance bins.
+    sample_m : float
+        The patch one sample stands for, m (see ``horizon_map``).
+
+    Examples
+    --------
+    >>> from skyradar.config import RadarConfig
+    >>> g = horizon_grid(RadarConfig.prototype_2022(range_limit_m=300.0), (10.0, 10.0), (4, 4), 7.5)
+    >>> g.nsub, g.h_bin_m, g.n_az, g.n_h, g.sample_m  # n_az: ceil(pi r_lim / h_bin)
+    ((2, 2), 7.5, 132, 43, 5.0)
+    >>> round(g.az_bin_rad * g.n_az, 6) == round(2 * np.pi, 6)
+    True
+    """
 
     nsub: tuple[int, int]  # horizon samples per DEM cell, per axis
     r_lim_m: float  # samples beyond this horizontal distance are left out
@@ -63,6 +88,32 @@ def needs_horizon(grid: HorizonGrid, p_ned: np.ndarray, level: bool, occlusion: 
     geometric horizon, sqrt(2 R_earth h), 25 km at h = 50 m. With the antenna more than
     ``LEVEL_CLEAR_M`` above every point of the crop (a lower bound of its height) and the range
     limit below that, the horizon is skipped: the same frames, without its cost.
+
+    Parameters
+    ----------
+    grid : HorizonGrid
+        The simulator's horizon bins.
+    p_ned : ndarray, shape (..., 3)
+        The terrain crop relative to the antenna, NED, m.
+    level : bool
+        The terrain has one height everywhere.
+    occlusion : bool
+        The simulator's occlusion option.
+
+    Returns
+    -------
+    bool
+        True when the frame needs the horizon map.
+
+    Examples
+    --------
+    >>> from skyradar.config import RadarConfig
+    >>> grid = horizon_grid(RadarConfig.prototype_2022(), (30.0, 30.0), (2, 2), 7.5)
+    >>> below_60 = np.array([[[0.0, 0.0, 60.0], [30.0, 0.0, 60.0]]])  # level ground 60 m down
+    >>> needs_horizon(grid, below_60, True, True), needs_horizon(grid, below_60 - [0, 0, 20], True, True)
+    (False, True)
+    >>> needs_horizon(grid, below_60, False, True), needs_horizon(grid, below_60, False, False)
+    (True, False)
     """
     clear = level and grid.r_lim_m < 20e3 and float(p_ned[..., 2].min()) > LEVEL_CLEAR_M
     return bool(occlusion) and not clear
@@ -71,7 +122,41 @@ def needs_horizon(grid: HorizonGrid, p_ned: np.ndarray, level: bool, occlusion: 
 def terrain_horizon(
     grid: HorizonGrid, p_ned: np.ndarray, rot_ned_to_ant: np.ndarray, n_blocks: int
 ) -> np.ndarray:
-    """The whole (n_az, n_h) horizon map of the crop ``p_ned`` (NED, relative to the antenna)."""
+    """The whole (n_az, n_h) horizon map of the crop ``p_ned`` (NED, relative to the antenna).
+
+    Parameters
+    ----------
+    grid : HorizonGrid
+        The horizon bins.
+    p_ned : ndarray, shape (rows, cols, 3)
+        DEM grid points relative to the antenna, NED, m.
+    rot_ned_to_ant : ndarray, shape (3, 3)
+        NED to antenna-frame rotation.
+    n_blocks : int
+        Parallel blocks of the map's computation.
+
+    Returns
+    -------
+    ndarray, shape (n_az, n_h)
+        Per bin, the steepest slope (-down / horizontal distance) of the terrain strictly closer
+        along its azimuth; -inf where nothing is closer.
+
+    Examples
+    --------
+    Beyond a ridge whose top is 10 m below the antenna, 100 to 110 m north, a point must be above
+    the ridge's slope, about -10 m over 100 m:
+
+    >>> from skyradar.config import RadarConfig
+    >>> grid = horizon_grid(RadarConfig.prototype_2022(range_limit_m=300.0), (10.0, 10.0), (2, 2), 7.5)
+    >>> n, e = np.meshgrid(np.arange(-300.0, 301.0, 10.0), np.arange(-300.0, 301.0, 10.0), indexing="ij")
+    >>> down = np.where((n >= 100) & (n <= 110), 10.0, 50.0)  # ground 50 m below, a ridge 100 m north
+    >>> p_ned = np.stack([n, e, down], -1)
+    >>> horizon = terrain_horizon(grid, p_ned, np.eye(3), 1)
+    >>> bins = (grid.az_bin_rad, grid.h_bin_m, grid.n_az, grid.n_h)
+    >>> a, k, _ = target_bins(np.array([[200.0, 0.0, 0.0]]), *bins)  # 200 m north
+    >>> horizon.shape, round(float(horizon[a[0], k[0]]), 3)
+    ((132, 43), -0.093)
+    """
     return horizon_map(
         p_ned,
         rot_ned_to_ant,
@@ -89,7 +174,31 @@ def terrain_horizon(
 def target_bins(
     rel_ned: np.ndarray, az_bin_rad: float, h_bin_m: float, n_az: int, n_h: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Azimuth bin, horizontal-range bin and slope of points ``rel_ned`` (m, relative to the antenna)."""
+    """Azimuth bin, horizontal-range bin and slope of points ``rel_ned`` (m, relative to the antenna).
+
+    Parameters
+    ----------
+    rel_ned : ndarray, shape (n, 3)
+        Points relative to the antenna, NED, m.
+    az_bin_rad : float
+        Azimuth bin width, rad; bin 0 starts at -pi (south).
+    h_bin_m : float
+        Horizontal-distance bin width, m.
+    n_az, n_h : int
+        Azimuth and horizontal-distance bins (the last distance bin takes everything beyond).
+
+    Returns
+    -------
+    (ndarray, ndarray, ndarray)
+        Azimuth bins, distance bins and slopes (-down / horizontal distance) of the points.
+
+    Examples
+    --------
+    >>> rel = np.array([[100.0, 0.0, 50.0], [0.0, 100.0, -10.0], [0.0, 900.0, 0.0]])
+    >>> a, k, slope = target_bins(rel, np.pi / 2, 30.0, 4, 10)
+    >>> a.tolist(), k.tolist(), slope.tolist()  # north, east; 100 m is bin 3; 900 m the last bin
+    ([2, 3, 3], [3, 3, 9], [-0.5, 0.1, -0.0])
+    """
     h = np.hypot(rel_ned[:, 0], rel_ned[:, 1])
     a = ((np.arctan2(rel_ned[:, 1], rel_ned[:, 0]) + np.pi) / az_bin_rad).astype(int) % n_az
     k = np.minimum((h / h_bin_m).astype(int), n_h - 1)
@@ -99,7 +208,38 @@ def target_bins(
 def target_clear(
     grid: HorizonGrid, p_ned: np.ndarray, rot_ned_to_ant: np.ndarray, rel_ned: np.ndarray
 ) -> np.ndarray:
-    """True for points ``rel_ned`` not hidden by the crop ``p_ned``: the frame's test, without its map."""
+    """True for points ``rel_ned`` not hidden by the crop ``p_ned``: the frame's test, without its map.
+
+    Parameters
+    ----------
+    grid : HorizonGrid
+        The horizon bins.
+    p_ned : ndarray, shape (rows, cols, 3)
+        DEM grid points relative to the antenna, NED, m.
+    rot_ned_to_ant : ndarray, shape (3, 3)
+        NED to antenna-frame rotation.
+    rel_ned : ndarray, shape (n, 3)
+        Points relative to the antenna, NED, m.
+
+    Returns
+    -------
+    ndarray of bool, shape (n,)
+        Equal to testing the points against :func:`terrain_horizon`'s map.
+
+    Examples
+    --------
+    A ridge 10 m below the antenna, 100 m north, hides a point 200 m north and 40 m below the
+    antenna (slope -0.2), not one 20 m above it; nothing hides a point to the south:
+
+    >>> from skyradar.config import RadarConfig
+    >>> grid = horizon_grid(RadarConfig.prototype_2022(range_limit_m=300.0), (10.0, 10.0), (2, 2), 7.5)
+    >>> n, e = np.meshgrid(np.arange(-300.0, 301.0, 10.0), np.arange(-300.0, 301.0, 10.0), indexing="ij")
+    >>> down = np.where((n >= 100) & (n <= 110), 10.0, 50.0)  # ground 50 m below, a ridge 100 m north
+    >>> p_ned = np.stack([n, e, down], -1)
+    >>> rel = np.array([[200.0, 0.0, 40.0], [200.0, 0.0, -20.0], [-200.0, 0.0, 40.0]])
+    >>> target_clear(grid, p_ned, np.eye(3), rel).tolist()
+    [False, True, True]
+    """
     a, k, slope = target_bins(rel_ned, grid.az_bin_rad, grid.h_bin_m, grid.n_az, grid.n_h)
     entries = horizon_at(
         p_ned,

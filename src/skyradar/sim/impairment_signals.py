@@ -26,7 +26,23 @@ __all__ = [
 
 
 def dbm_to_w(power_dbm: float | np.ndarray) -> float | np.ndarray:
-    """Power in dBm to W."""
+    """Power in dBm to W.
+
+    Parameters
+    ----------
+    power_dbm : float or ndarray
+        Power, dBm.
+
+    Returns
+    -------
+    float or ndarray
+        Power, W: ``10 ** ((P_dBm - 30) / 10)``.
+
+    Examples
+    --------
+    >>> dbm_to_w(30.0), dbm_to_w(np.array([0.0, -120.0])).tolist()
+    (np.float64(1.0), [0.001, 1e-15])
+    """
     return 10.0 ** ((np.asarray(power_dbm, float) - 30.0) / 10.0)
 
 
@@ -111,7 +127,33 @@ def spur_adc(config: RadarConfig, spurs: list[tuple[float, float, float]], seed:
 
     Each spur is a tone on its pixel's beat and Doppler frequency with amplitude sqrt(P): after
     :func:`~skyradar.process.rangedoppler.range_doppler` its pixel power is ``P`` times the windows'
-    coherent gain, like a target's. Phases as in :func:`spur_cube` with the same seed.
+    coherent gain, like a target's.
+
+    Parameters
+    ----------
+    config : RadarConfig
+    spurs : list of (range_m, velocity_mps, power_dbm)
+        Spur positions (m, m/s; nearest pixel, velocity wraps) and pixel powers (dBm).
+    seed : int
+        Fixes each spur's phase per channel, as in :func:`spur_cube` with the same seed.
+
+    Returns
+    -------
+    ndarray, shape (n_rx, n_doppler, samples_per_chirp), complex64
+
+    Examples
+    --------
+    A -120 dBm spur at 600 m and 10 m/s: every sample has amplitude sqrt(1e-15 W); the fast-time
+    FFT peaks at the range bin (600 m / 15 m = 40) and the shifted slow-time FFT at the Doppler bin:
+
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> adc = spur_adc(cfg, [(600.0, 10.0, -120.0)])
+    >>> adc.shape, bool(np.allclose(np.abs(adc), np.sqrt(1e-15)))
+    ((4, 250, 2032), True)
+    >>> k = int(np.abs(np.fft.fft(adc[0, 0])).argmax())
+    >>> j = int(np.abs(np.fft.fftshift(np.fft.fft(adc[0, :, 0]))).argmax())
+    >>> k, j == int(cfg.doppler_bin(10.0))
+    (40, True)
     """
     rows, cols, power = _spur_pixels(config, spurs, None, 0.0)
     values = np.sqrt(power)[:, None] * _phasors(np.random.default_rng([seed, 1]), (rows.size, config.n_rx))
@@ -136,8 +178,35 @@ def zero_doppler_line(
 ) -> np.ndarray:
     """Bright line at V = 0 over all ranges, power falling with range; fixed (n_range, n_doppler, n_rx).
 
-    Pixel power ``P(R) = P_100 - falloff * log10(max(R, dR) / 100 m)`` dB on the zero-Doppler bin;
-    ``width_bins`` > 1 spreads it over that many bins (each neighbour 6 dB down per bin).
+    Pixel power ``P(R) = P_100 - falloff * log10(max(R, dR) / 100 m)`` dB on the zero-Doppler bin.
+
+    Parameters
+    ----------
+    config : RadarConfig
+    power_dbm_at_100m : float
+        ``P_100``, the pixel power at 100 m, dBm.
+    falloff_db_per_decade : float
+        ``falloff``, dB per decade of range.
+    width_bins : int
+        Above 1, the line spreads over that many Doppler bins (each neighbour 6 dB down per bin).
+    seed : int
+        Fixes the pixels' phases.
+
+    Returns
+    -------
+    ndarray, shape (n_range, n_doppler, n_rx), complex64
+
+    Examples
+    --------
+    Bins 7 and 67 are 104.9 m and 1004.3 m out: -115 - 20 log10(R / 100 m) dBm.
+
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> line = zero_doppler_line(cfg)
+    >>> j0 = int(cfg.doppler_bin(0.0))
+    >>> np.round(10 * np.log10(np.abs(line[[7, 67], j0, 0]) ** 2) + 30, 1).tolist()
+    [-115.4, -135.0]
+    >>> int(np.count_nonzero(np.abs(line).sum(axis=(0, 2))))  # one Doppler bin
+    1
     """
     cube = np.zeros((config.n_range, config.n_doppler, config.n_rx), np.complex64)
     r = np.maximum(config.range_axis_m, config.range_resolution_m)
@@ -159,9 +228,32 @@ def near_range_leakage(
 ) -> np.ndarray:
     """Returns at all velocities near the radar: (n_range, n_doppler, n_rx) complex64, new each frame.
 
-    Complex Gaussian pixels of mean power ``power_dbm`` at zero range, falling linearly in dB to
-    30 dB down at ``range_m`` and absent beyond; one random pattern per frame, coupled into every
-    channel with a fixed phase (a single leakage source).
+    One random pattern per frame, coupled into every channel with a fixed phase (a single
+    leakage source).
+
+    Parameters
+    ----------
+    config : RadarConfig
+    power_dbm : float
+        Mean pixel power at zero range, dBm; complex Gaussian pixels, falling linearly in dB to
+        30 dB down at ``range_m``.
+    range_m : float
+        Range of the leakage, m; absent beyond.
+    rng : numpy.random.Generator, optional
+        The frame's random stream (default: a fresh, unseeded one).
+
+    Returns
+    -------
+    ndarray, shape (n_range, n_doppler, n_rx), complex64
+
+    Examples
+    --------
+    >>> cfg = RadarConfig.prototype_2022()  # 15 m range bins
+    >>> cube = near_range_leakage(cfg, -110.0, 100.0, np.random.default_rng(0))
+    >>> np.flatnonzero(np.abs(cube).sum(axis=(1, 2))).tolist()  # bins 0..6: up to 90 m
+    [0, 1, 2, 3, 4, 5, 6]
+    >>> round(float(10 * np.log10(np.mean(np.abs(cube[0]) ** 2)) + 30))  # mean power at 0 m, dBm
+    -110
     """
     rng = rng or np.random.default_rng()
     r = config.range_axis_m
@@ -214,7 +306,32 @@ def channel_errors(
 
 
 def apply_channel_errors(data: np.ndarray, errors: np.ndarray, layout: str = "rd") -> np.ndarray:
-    """Multiply each channel by its error: rx is the last axis (``'rd'``) or axis -3 (``'adc'``)."""
+    """Multiply each channel by its error: rx is the last axis (``'rd'``) or axis -3 (``'adc'``).
+
+    Parameters
+    ----------
+    data : ndarray
+        Range-Doppler (..., n_range, n_doppler, n_rx) or ADC (..., n_rx, n_chirp, n_sample) cube.
+    errors : ndarray, shape (n_rx,)
+        Complex gain per channel (:func:`channel_errors`).
+    layout : {"rd", "adc"}
+        Where the channel axis is.
+
+    Returns
+    -------
+    ndarray
+        The cube times the errors (a new array).
+
+    Examples
+    --------
+    >>> e = channel_errors(4, gain_db=[0, 6, 0, 0], phase_deg=[0, 0, 90, 0])
+    >>> rd = apply_channel_errors(np.ones((2, 3, 4), np.complex64), e)
+    >>> np.round(np.abs(rd[0, 0]), 3).tolist(), np.round(np.degrees(np.angle(rd[0, 0]))).tolist()
+    ([1.0, 1.995, 1.0, 1.0], [0.0, 0.0, 90.0, 0.0])
+    >>> adc = apply_channel_errors(np.ones((4, 3, 5), np.complex64), e, layout="adc")
+    >>> np.round(np.abs(adc[:, 0, 0]), 3).tolist()
+    [1.0, 1.995, 1.0, 1.0]
+    """
     e = np.asarray(errors, np.complex64)
     return data * (e if layout == "rd" else e[:, None, None])
 
@@ -222,7 +339,31 @@ def apply_channel_errors(data: np.ndarray, errors: np.ndarray, layout: str = "rd
 def receiver_noise(
     config: RadarConfig, noise_figure_db: float | None = None, rng: np.random.Generator | None = None
 ) -> np.ndarray:
-    """Thermal receiver noise per range-Doppler pixel, k T (PRF/nV) F; (n_range, n_doppler, n_rx)."""
+    """Thermal receiver noise per range-Doppler pixel, k T (PRF/nV) F; (n_range, n_doppler, n_rx).
+
+    Parameters
+    ----------
+    config : RadarConfig
+    noise_figure_db : float, optional
+        Receiver noise figure F, dB (default: the radar's).
+    rng : numpy.random.Generator, optional
+        The frame's random stream (default: a fresh, unseeded one).
+
+    Returns
+    -------
+    ndarray, shape (n_range, n_doppler, n_rx), complex64
+        Circular complex Gaussian noise of mean power ``k T (PRF/nV) F`` per pixel, W.
+
+    Examples
+    --------
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> noise = receiver_noise(cfg, rng=np.random.default_rng(0))
+    >>> noise.shape, round(float(np.mean(np.abs(noise) ** 2) / cfg.noise_power_w), 2)
+    ((333, 250, 4), 1.0)
+    >>> louder = receiver_noise(cfg, cfg.noise_figure_db + 3.0, np.random.default_rng(0))
+    >>> round(float(np.mean(np.abs(louder) ** 2) / np.mean(np.abs(noise) ** 2)), 2)  # 3 dB more
+    2.0
+    """
     nf = config.noise_figure_db if noise_figure_db is None else noise_figure_db
     power = BOLTZMANN * config.temperature_k * config.noise_bandwidth_hz * 10 ** (nf / 10.0)
     rng = rng or np.random.default_rng()

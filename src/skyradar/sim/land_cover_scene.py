@@ -311,8 +311,44 @@ def simulate_land_cover_run(
 ) -> xr.Dataset:
     """Frames of a flight over the map as the standard frames Dataset (``iq`` plus own-ship truth).
 
-    ``position_ned_m``, ``velocity_ned_mps`` and ``attitude_rad`` are (n, 3) per frame time; the
-    own-ship height above ground is ``-down`` (the map is flat).
+    Parameters
+    ----------
+    simulator : LandCoverSimulator
+        The radar and the map.
+    times_s : ndarray, shape (n,)
+        Frame times, s.
+    position_ned_m : ndarray, shape (n, 3)
+        Own-ship position per frame, NED, m; the own-ship height above ground is ``-down`` (the
+        map is flat).
+    velocity_ned_mps : ndarray, shape (n, 3)
+        Own-ship velocity per frame, NED, m/s.
+    attitude_rad : ndarray, shape (n, 3)
+        Own-ship yaw, pitch and roll per frame, rad.
+    attrs : dict, optional
+        Dataset attributes, added to (and replacing) the run's defaults.
+    progress : callable, optional
+        Called with 1 after each frame.
+
+    Returns
+    -------
+    xarray.Dataset
+        The frames dataset of :func:`skyradar.io.frames.frames_dataset`.
+
+    Examples
+    --------
+    From 200 m above flat ground, the nearest ground return is 200 m out (bin 67, 201 m):
+
+    >>> cfg = ch6_radar_config()
+    >>> grid = GroundGrid.from_extent(-100.0, 100.0, 0.0, 500.0, pixel_m=2.0)
+    >>> sim = LandCoverSimulator(cfg, np.zeros(grid.shape, np.int8), np.zeros(grid.shape), grid, noise=False)
+    >>> pos = np.array([[0.0, 0.0, -200.0], [5.0, 0.0, -200.0]])
+    >>> vel = np.tile([50.0, 0.0, 0.0], (2, 1))
+    >>> ds = simulate_land_cover_run(sim, [0.0, 0.1], pos, vel, np.zeros((2, 3)))
+    >>> dict(ds.sizes)["time"], ds.iq.shape, ds.own_height_agl_m.values.tolist()
+    (2, (2, 166, 256, 4), [200.0, 200.0])
+    >>> power = (np.abs(ds.iq.values[0]) ** 2).sum(axis=(1, 2))
+    >>> round(float(cfg.range_axis_m[np.flatnonzero(power)[0]]))
+    201
     """
     cfg = simulator.config
     times_s = np.asarray(times_s, float)

@@ -266,8 +266,35 @@ def navigation_solution(
 def navigation_variables(built, ownship_truth: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
     """The ``nav_*`` variables of a built scenario's own-ship truth (``scenario_truth``'s own_* dict).
 
-    The model is ``built.navigation`` (None: perfect); the seed is its ``seed`` or else the
-    scenario's ``simulation.seed``; the terrain database is the scenario's terrain.
+    Parameters
+    ----------
+    built : BuiltScenario
+        Read: ``navigation`` (the error model; None: perfect), ``sim_options["seed"]`` (the seed
+        when the model sets none), ``terrain`` (the terrain database, optional), ``times_s`` (s)
+        and ``origin``.
+    ownship_truth : mapping
+        The ``own_*`` arrays, as in :func:`navigation_solution`.
+
+    Returns
+    -------
+    dict of ndarray
+        The ``nav_*`` arrays of :func:`navigation_solution`.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> t = np.arange(5) * 0.1
+    >>> names = [f"{a}_m" for a in _XYZ] + [f"{a}_mps" for a in _VXYZ] + [f"{a}_rad" for a in _ATT]
+    >>> truth = {f"own_{k}": np.zeros(t.size) for k in names}
+    >>> built = SimpleNamespace(navigation="ga-typical", sim_options={"seed": 3}, terrain=None,
+    ...                         times_s=t, origin=(52.0, 4.0, 0.0))
+    >>> nav = navigation_variables(built, truth)
+    >>> same = navigation_solution(truth, t, "ga-typical", 3, (52.0, 4.0, 0.0))  # the scenario's seed
+    >>> bool(np.array_equal(nav["nav_north_m"], same["nav_north_m"]))
+    True
+    >>> built.navigation = None  # perfect: the truth
+    >>> bool(np.all(navigation_variables(built, truth)["nav_north_m"] == 0.0))
+    True
     """
     cfg = navigation_config(getattr(built, "navigation", None) or "perfect")
     seed = cfg.seed if cfg.seed is not None else int(built.sim_options.get("seed") or 0)

@@ -328,7 +328,21 @@ def target_psf_taps(
 
 
 class PSFKernels(NamedTuple):
-    """The sub-bin averaged range and Doppler kernels of one radar's frames (float32, odd lengths)."""
+    """The sub-bin averaged range and Doppler kernels of one radar's frames (float32, odd lengths).
+
+    Parameters
+    ----------
+    h_range, h_doppler : ndarray of float32
+        Range and Doppler kernels (:func:`binned_kernel`), odd lengths.
+    oversample : int
+        Sub-bins per bin the kernels are sampled at.
+
+    Examples
+    --------
+    >>> k = PSFKernels(binned_kernel("hann", 64, 2), binned_kernel("hann", 64, 2), 2)
+    >>> len(k.h_range), k.reach  # 27 half-bin taps: 6 whole bins either side
+    (27, (6, 6))
+    """
 
     h_range: np.ndarray
     h_doppler: np.ndarray
@@ -371,12 +385,56 @@ def enbw(kernels: PSFKernels | None) -> float:
 
 
 def frame_options(psf, speckle, swerling) -> tuple[bool, bool, int]:
-    """Checked ``psf``, ``speckle`` and ``swerling`` simulation options."""
+    """Checked ``psf``, ``speckle`` and ``swerling`` simulation options.
+
+    Parameters
+    ----------
+    psf, speckle : bool-like
+        Window point-spread and terrain speckle on or off.
+    swerling : int
+        Target fluctuation model: 0 (constant) or 1 (Swerling 1); a bool is refused.
+
+    Returns
+    -------
+    (bool, bool, int)
+
+    Raises
+    ------
+    InputError
+        For any other ``swerling``.
+
+    Examples
+    --------
+    >>> frame_options(1, 0, 1)
+    (True, False, 1)
+    >>> frame_options(True, False, 2)
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: simulation.swerling must be 0 or 1, got 2
+    """
     if swerling not in (0, 1) or isinstance(swerling, bool):
         raise InputError(f"simulation.swerling must be 0 or 1, got {swerling!r}")
     return bool(psf), bool(speckle), int(swerling)
 
 
 def speckle_key(noise_key: np.uint64) -> np.uint64:
-    """The frame's speckle stream key, derived from its noise key (never 0: 0 means no speckle)."""
+    """The frame's speckle stream key, derived from its noise key (never 0: 0 means no speckle).
+
+    Parameters
+    ----------
+    noise_key : numpy.uint64
+        The frame's noise key.
+
+    Returns
+    -------
+    numpy.uint64
+        ``noise_key`` XOR a fixed stream constant, or 1 where that is 0.
+
+    Examples
+    --------
+    >>> hex(int(speckle_key(np.uint64(0))))  # the stream constant itself
+    '0x5d5ec1e5a1b2c3d4'
+    >>> speckle_key(np.uint64(0x5D5EC1E5A1B2C3D4))
+    np.uint64(1)
+    """
     return np.uint64(int(noise_key) ^ _SPECKLE_STREAM) or np.uint64(1)

@@ -53,7 +53,32 @@ _SIM_KEYS = (
 
 def make_simulator(built, head: int | str = 0) -> Simulator:
     """An :class:`ImageSimulator` of one radar head (index or name) of a BuiltScenario, with its
-    ``sim_options`` and impairments; frames and truth of that head come from it."""
+    ``sim_options`` and impairments; frames and truth of that head come from it.
+
+    Parameters
+    ----------
+    built : BuiltScenario
+    head : int or str
+        The radar head's index or name.
+
+    Returns
+    -------
+    ImageSimulator or LandCoverSimulator
+        The land-cover simulator when the scenario's ground is a map's land cover.
+
+    Examples
+    --------
+    >>> from skyradar.scene.scenario import Scenario
+    >>> spec = {"name": "pair", "origin": {"lat_deg": 52.0, "lon_deg": 4.36, "alt_m": 0.0},
+    ...     "radar": {"range_limit_m": 1500}, "simulation": {"noise": False},
+    ...     "ownship": {"type": "straight", "start_ned_m": [0, 0, -2000], "speed_mps": 30},
+    ...     "intruders": [{"name": "A", "type": "straight", "start_ned_m": [900, 0, -2000], "speed_mps": 30}],
+    ...     "frame_rate_hz": 10, "duration_s": 0.2}
+    >>> built = Scenario.from_dict(spec).build()  # two frames; A flies 900 m ahead at the same velocity
+    >>> sim = make_simulator(built)
+    >>> type(sim).__name__, sim.config.n_range, sim.noise  # 1500 m / 15 m range bins
+    ('ImageSimulator', 100, False)
+    """
     radar = head_of(built.heads, head, "make_simulator").config
     options = {k: v for k, v in built.sim_options.items() if k in _SIM_KEYS and v is not None}
     impairments = getattr(built, "impairments", None)
@@ -103,8 +128,44 @@ def simulate_frames(
 ) -> np.ndarray:
     """Frames ``indices`` of the simulator's head as an (n, range, doppler, rx) complex64 array.
 
-    ``ownship`` (one state per frame of ``indices``) replaces the scenario's own-ship trajectory
-    sampled at those frames.
+    Parameters
+    ----------
+    built : BuiltScenario
+    indices : ndarray of int
+        Frame indices in the run.
+    simulator : ImageSimulator, optional
+        Default: :func:`make_simulator` of the first head.
+    ownship : TrajectorySample, optional
+        One state per frame of ``indices``; replaces the scenario's own-ship trajectory sampled
+        at those frames.
+
+    Returns
+    -------
+    ndarray, shape (n, n_range, n_doppler, n_rx), complex64
+        Pixel units: ``|pixel|^2`` in W.
+
+    Examples
+    --------
+    The intruder (1 m^2) 900 m ahead on boresight at zero radial velocity is one pixel of the
+    radar equation's power ``Pe G^2 lambda^2 sigma / ((4 pi)^3 R^4)``:
+
+    >>> from skyradar.scene.scenario import Scenario
+    >>> spec = {"name": "pair", "origin": {"lat_deg": 52.0, "lon_deg": 4.36, "alt_m": 0.0},
+    ...     "radar": {"range_limit_m": 1500}, "simulation": {"noise": False},
+    ...     "ownship": {"type": "straight", "start_ned_m": [0, 0, -2000], "speed_mps": 30},
+    ...     "intruders": [{"name": "A", "type": "straight", "start_ned_m": [900, 0, -2000], "speed_mps": 30}],
+    ...     "frame_rate_hz": 10, "duration_s": 0.2}
+    >>> built = Scenario.from_dict(spec).build()  # two frames; A flies 900 m ahead at the same velocity
+    >>> frames = simulate_frames(built, np.arange(2))
+    >>> k, j, _ = np.unravel_index(np.abs(frames[1]).argmax(), frames[1].shape)
+    >>> cfg = built.radar
+    >>> frames.shape, round(float(cfg.range_axis_m[k]), 1), float(cfg.doppler_axis_mps[j])
+    ((2, 100, 250, 4), 899.4, 0.0)
+    >>> gain = 10 ** (float(cfg.antenna.gain_db(0.0, 0.0)) / 10)
+    >>> expected = cfg.pe_w * gain**2 * cfg.wavelength_m**2 / ((4 * np.pi) ** 3 * 900.0**4)
+    >>> power = np.abs(frames[1, k, j]) ** 2
+    >>> f"{expected:.2e}", bool(np.allclose(power, expected, rtol=1e-5))
+    ('5.51e-16', True)
     """
     simulator = simulator or make_simulator(built)
     indices = np.asarray(indices)
@@ -178,7 +239,38 @@ def frames_truth(
 ) -> tuple[dict, dict, list[str]]:
     """Own-ship truth (``own_*``, no navigation solution) and intruder truth of frames ``indices``.
 
-    ``ownship`` replaces the scenario's own-ship sample at those frames, as in :func:`simulate_frames`.
+    Parameters
+    ----------
+    built : BuiltScenario
+    indices : ndarray of int
+        Frame indices in the run.
+    simulator : ImageSimulator, optional
+        Default: :func:`make_simulator` of the first head.
+    ownship : TrajectorySample, optional
+        Replaces the scenario's own-ship sample at those frames, as in :func:`simulate_frames`.
+
+    Returns
+    -------
+    (dict, dict, list of str)
+        Own-ship arrays on time, intruder arrays on (time, target) (``tgt_*``, NaN where an
+        intruder is absent) and the intruders' names.
+
+    Examples
+    --------
+    >>> from skyradar.scene.scenario import Scenario
+    >>> spec = {"name": "pair", "origin": {"lat_deg": 52.0, "lon_deg": 4.36, "alt_m": 0.0},
+    ...     "radar": {"range_limit_m": 1500}, "simulation": {"noise": False},
+    ...     "ownship": {"type": "straight", "start_ned_m": [0, 0, -2000], "speed_mps": 30},
+    ...     "intruders": [{"name": "A", "type": "straight", "start_ned_m": [900, 0, -2000], "speed_mps": 30}],
+    ...     "frame_rate_hz": 10, "duration_s": 0.2}
+    >>> built = Scenario.from_dict(spec).build()  # two frames; A flies 900 m ahead at the same velocity
+    >>> own, targets, names = frames_truth(built, np.array([1]))
+    >>> names, own["own_north_m"].tolist()  # 30 m/s x 0.1 s
+    (['A'], [3.0])
+    >>> round(float(targets["tgt_range_m"][0, 0]), 3), float(targets["tgt_radial_velocity_mps"][0, 0])
+    (900.0, 0.0)
+    >>> bool(targets["tgt_visible"][0, 0])
+    True
     """
     simulator = simulator or make_simulator(built)
     own, intruders = _states(built, np.asarray(indices), ownship)
@@ -187,7 +279,35 @@ def frames_truth(
 
 
 def scenario_truth(built, simulator: Simulator | None = None) -> tuple[dict, dict, list[str]]:
-    """Own-ship truth on time and intruder truth on (time, target), named as in ``skyradar.io.frames``."""
+    """Own-ship truth on time and intruder truth on (time, target), named as in ``skyradar.io.frames``.
+
+    The own-ship dict also holds the navigation solution (``nav_*``,
+    :func:`~skyradar.sim.navigation.navigation_variables`) beside the truth (``own_*``).
+
+    Parameters
+    ----------
+    built : BuiltScenario
+    simulator : ImageSimulator, optional
+        Default: :func:`make_simulator` of the first head.
+
+    Returns
+    -------
+    (dict, dict, list of str)
+        As :func:`frames_truth` over every frame, plus the ``nav_*`` arrays.
+
+    Examples
+    --------
+    >>> from skyradar.scene.scenario import Scenario
+    >>> spec = {"name": "pair", "origin": {"lat_deg": 52.0, "lon_deg": 4.36, "alt_m": 0.0},
+    ...     "radar": {"range_limit_m": 1500}, "simulation": {"noise": False},
+    ...     "ownship": {"type": "straight", "start_ned_m": [0, 0, -2000], "speed_mps": 30},
+    ...     "intruders": [{"name": "A", "type": "straight", "start_ned_m": [900, 0, -2000], "speed_mps": 30}],
+    ...     "frame_rate_hz": 10, "duration_s": 0.2}
+    >>> built = Scenario.from_dict(spec).build()  # two frames; A flies 900 m ahead at the same velocity
+    >>> own, targets, names = scenario_truth(built)
+    >>> own["own_north_m"].tolist(), targets["tgt_range_m"].shape, "nav_north_m" in own
+    ([0.0, 3.0], (2, 1), True)
+    """
     ownship, targets, names = frames_truth(built, np.arange(built.times_s.size), simulator)
     # The navigation solution (nav_*) beside the truth: the chain reads only nav_*, as an aircraft
     # knows only its navigation solution.
@@ -195,7 +315,37 @@ def scenario_truth(built, simulator: Simulator | None = None) -> tuple[dict, dic
 
 
 def simulate(built, progress: Callable[[int], None] | None = None, head: int | str = 0) -> xr.Dataset:
-    """Whole scenario in memory (small runs, tests), one radar head."""
+    """Whole scenario in memory (small runs, tests), one radar head.
+
+    Parameters
+    ----------
+    built : BuiltScenario
+    progress : callable, optional
+        Called with 1 after each frame.
+    head : int or str
+        The radar head's index or name.
+
+    Returns
+    -------
+    xarray.Dataset
+        The frames dataset (:func:`skyradar.io.frames.frames_dataset`): ``iq``, truth and
+        :func:`frames_attrs`.
+
+    Examples
+    --------
+    >>> from skyradar.scene.scenario import Scenario
+    >>> spec = {"name": "pair", "origin": {"lat_deg": 52.0, "lon_deg": 4.36, "alt_m": 0.0},
+    ...     "radar": {"range_limit_m": 1500}, "simulation": {"noise": False},
+    ...     "ownship": {"type": "straight", "start_ned_m": [0, 0, -2000], "speed_mps": 30},
+    ...     "intruders": [{"name": "A", "type": "straight", "start_ned_m": [900, 0, -2000], "speed_mps": 30}],
+    ...     "frame_rate_hz": 10, "duration_s": 0.2}
+    >>> built = Scenario.from_dict(spec).build()  # two frames; A flies 900 m ahead at the same velocity
+    >>> ds = simulate(built)
+    >>> dict(ds.sizes)
+    {'time': 2, 'range': 100, 'doppler': 250, 'rx': 4, 'target': 1}
+    >>> ds.attrs["scenario"], bool(np.array_equal(ds.iq.values, simulate_frames(built, np.arange(2))))
+    ('pair', True)
+    """
     simulator = make_simulator(built, head)
     n, cfg = built.times_s.size, simulator.config
     iq = np.empty((n, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
@@ -208,7 +358,32 @@ def simulate(built, progress: Callable[[int], None] | None = None, head: int | s
 
 
 def frames_attrs(built) -> dict[str, Any]:
-    """The scenario attributes a frames dataset carries (name, origin, simulator options, start time)."""
+    """The scenario attributes a frames dataset carries (name, origin, simulator options, start time).
+
+    Parameters
+    ----------
+    built : BuiltScenario
+
+    Returns
+    -------
+    dict
+        ``scenario``, ``origin_lat_deg``, ``origin_lon_deg``, ``origin_alt_m`` (m), ``sim_options``
+        (JSON of the options as strings) and, when the scenario has them, ``terrain`` and
+        ``start_time``.
+
+    Examples
+    --------
+    >>> from skyradar.scene.scenario import Scenario
+    >>> spec = {"name": "pair", "origin": {"lat_deg": 52.0, "lon_deg": 4.36, "alt_m": 0.0},
+    ...     "radar": {"range_limit_m": 1500}, "simulation": {"noise": False},
+    ...     "ownship": {"type": "straight", "start_ned_m": [0, 0, -2000], "speed_mps": 30},
+    ...     "intruders": [{"name": "A", "type": "straight", "start_ned_m": [900, 0, -2000], "speed_mps": 30}],
+    ...     "frame_rate_hz": 10, "duration_s": 0.2}
+    >>> built = Scenario.from_dict(spec).build()  # two frames; A flies 900 m ahead at the same velocity
+    >>> attrs = frames_attrs(built)
+    >>> attrs["scenario"], attrs["origin_lat_deg"], json.loads(attrs["sim_options"])["noise"]
+    ('pair', 52.0, 'False')
+    """
     attrs = {
         "scenario": built.name,
         "origin_lat_deg": built.origin[0],

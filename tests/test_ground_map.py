@@ -345,3 +345,27 @@ def test_pose_sampling_keeps_nan_map_pixels_and_refuses_nan_poses():
     assert np.all(got[~np.isnan(got)] == 1.0)
     with pytest.raises(InputError, match="finite"):
         sample_at_poses(image, grid, PoseGrid(0.0, 0.0, 1.0, (2, 2)), np.array([np.nan, 0.0, 0.0]))
+
+
+def test_a_highway_drawn_as_an_area_is_no_road():
+    # Roads are lines drawn at their class's width: a pedestrian square tagged highway (a polygon) is
+    # left out, as a polygon tagged railway is; a tunnel is left out too (not seen from the air).
+    import geopandas as gpd
+    from shapely.geometry import LineString, Polygon
+
+    from skyradar.scene.osm_map import _geodetic_layers
+
+    roads = gpd.GeoDataFrame(
+        {
+            "id": [1, 2, 3],
+            "highway": ["residential", "residential", "residential"],
+            "tunnel": [None, None, "yes"],
+        },
+        geometry=[
+            LineString([(24.9, 60.1), (24.91, 60.1)]),
+            Polygon([(24.9, 60.1), (24.91, 60.1), (24.91, 60.11)]),
+            LineString([(24.9, 60.12), (24.91, 60.12)]),
+        ],
+    )
+    raw = {"buildings": None, "roads": roads, "railways": None, "areas": None, "trees": None}
+    assert _geodetic_layers(raw)["roads"]["osm_id"].tolist() == [1]

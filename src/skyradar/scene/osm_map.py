@@ -111,6 +111,25 @@ class MapLayers:
     Every layer has ``osm_id``, the OSM way/relation/node id it came from.
     origin_lat_deg, origin_lon_deg : the geodetic origin of the local frame (WGS84).
     source : where the map came from (a path), for error messages.
+
+    Examples
+    --------
+    Two houses and a road; the map's extent is that of all its features:
+
+    >>> import geopandas as gpd
+    >>> from shapely.geometry import LineString, box
+    >>> empty = gpd.GeoDataFrame(geometry=[])
+    >>> houses = gpd.GeoDataFrame({"height_m": [9.0, 12.0]},
+    ...                           geometry=[box(0, 0, 10, 10), box(40, 20, 50, 30)])
+    >>> road = gpd.GeoDataFrame({"road_class": ["primary"], "width_m": [12.0]},
+    ...                         geometry=[LineString([(-20, -5), (60, -5)])])
+    >>> layers = MapLayers(houses, road, empty, empty, empty, empty, empty, 60.0, 25.0)
+    >>> layers.counts()
+    {'open_land': 0, 'grass': 0, 'forest': 0, 'water': 0, 'railways': 0, 'roads': 1, 'buildings': 2}
+    >>> [float(v) for v in layers.bounds_m]  # north_min, north_max, east_min, east_max
+    [-5.0, 30.0, -20.0, 60.0]
+    >>> [float(v) for v in layers.grid(pixel_m=5.0, margin_m=10.0).extent_m]  # 10 m wider on every side
+    [-30.0, 70.0, -15.0, 40.0]
     """
 
     buildings: gpd.GeoDataFrame
@@ -265,7 +284,9 @@ def _geodetic_layers(raw: dict) -> dict[str, gpd.GeoDataFrame]:
     if _present(roads):
         cls = np.array([_HIGHWAY_CLASS.get(h) for h in _tag(roads, "highway")], dtype=object)
         # An object array compares with None elementwise; numpy's stub admits no None operand.
-        keep = np.not_equal(cls, None) & _not_tunnel(roads)  # type: ignore[call-overload]  # numpy stub & _kind(roads, ("LineString", "MultiLineString"))
+        classified = np.not_equal(cls, None)  # type: ignore[call-overload]
+        # A highway drawn as an area (a square, a rest area) is no road line to draw at a width.
+        keep = classified & _not_tunnel(roads) & _kind(roads, ("LineString", "MultiLineString"))
         widths = np.array([ROAD_WIDTH_M[c] for c in cls[keep]], dtype=float)
         layers["roads"] = _pick(roads, keep, road_class=cls[keep].astype(str), width_m=widths)
     rail = raw["railways"]

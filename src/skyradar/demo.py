@@ -51,7 +51,19 @@ LEVEL_NAMES = {0: "none", 1: "preventive", 2: "corrective", 3: "WARNING"}
 
 
 def demo_scenario_path() -> Path:
-    """Path of the embedded demo scenario (package data)."""
+    """Path of the embedded demo scenario (package data).
+
+    Returns
+    -------
+    Path
+        ``scenarios/demo_circuit.yaml`` inside the installed package.
+
+    Examples
+    --------
+    >>> path = demo_scenario_path()
+    >>> path.name, [i.name for i in load_scenario(path).model.intruders]
+    ('demo_circuit.yaml', ['collision', 'fast-jet', 'glider'])
+    """
     return Path(str(files("skyradar") / "data" / "scenarios" / DEMO_SCENARIO))
 
 
@@ -66,6 +78,29 @@ def alert_timeline(alerts: pd.DataFrame, labels: dict[int, str]) -> pd.DataFrame
     Columns ``time_s, track_id, intruder, level, level_name, range_m, bearing_deg, rel_alt_m,
     time_to_impact_s, preferred_heading_deg, preferred_vs_mps, altitude_measured`` (those the alerts
     have).
+
+    Parameters
+    ----------
+    alerts : DataFrame
+        The alerts table: one row per track per frame, with ``time_s`` (s), ``track_id``, ``level``,
+        ``range_m`` (m), ``bearing_deg``, ``rel_alt_m`` (m) and ``time_to_impact_s`` (s).
+    labels : dict of int to str
+        Intruder name per track id (:func:`skyradar.chain.label_tracks`); other tracks are ``clutter``.
+
+    Returns
+    -------
+    DataFrame
+        The level changes in time order; a track that never alerts has no rows.
+
+    Examples
+    --------
+    Track 1 rises from none to preventive to warning and stays; track 2 never alerts:
+
+    >>> alerts = pd.DataFrame({"time_s": [0.0, 1.0, 2.0, 3.0, 1.0, 2.0], "track_id": [1, 1, 1, 1, 2, 2],
+    ...     "level": [0, 1, 3, 3, 0, 0], "range_m": 900.0, "bearing_deg": 0.0, "rel_alt_m": 0.0,
+    ...     "time_to_impact_s": 20.0})
+    >>> alert_timeline(alerts, {1: "collision"})[["time_s", "intruder", "level_name"]].values.tolist()
+    [[1.0, 'collision', 'preventive'], [2.0, 'collision', 'WARNING']]
     """
     cols = ["time_s", "track_id", "level", "range_m", "bearing_deg", "rel_alt_m", "time_to_impact_s"]
     cols += [c for c in ("preferred_heading_deg", "preferred_vs_mps", "altitude_measured") if c in alerts]

@@ -11,4 +11,15 @@ __all__ = ["InputError"]
 
 
 class InputError(ValueError):
-    """Bad user input: the message names the file, field and value."""
+    """Bad user input: the message names the file, field and value.
+
+    A :class:`ValueError`, so code that catches those catches it too.
+
+    Examples
+    --------
+    >>> try:
+    ...     raise InputError("scene.yaml: field 'duration_s' must be > 0, got -1")
+    ... except ValueError as exc:
+    ...     print(type(exc).__name__, exc)
+    InputError scene.yaml: field 'duration_s' must be > 0, got -1
+    """

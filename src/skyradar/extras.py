@@ -29,7 +29,18 @@ EXTRAS: dict[str, tuple[str, ...]] = {
 
 
 class MissingExtraError(InputError):
-    """A command needs an optional extra that is not installed."""
+    """A command needs an optional extra that is not installed.
+
+    An :class:`~skyradar.errors.InputError`, so the CLI reports it in one line with exit code 2.
+
+    Examples
+    --------
+    >>> try:
+    ...     import_extra("no_such_module_xyz", "geo", "reading dem.tif")
+    ... except InputError as exc:
+    ...     print(type(exc).__name__, exc)
+    MissingExtraError reading dem.tif needs the optional 'geo' extra: pip install 'skyradar[geo]'
+    """
 
 
 def _message(what: str, extra: str) -> str:

@@ -36,6 +36,20 @@ def lazy_exports(
     -------
     names, getattr, dir
         The names in order, and the two module-level functions of PEP 562.
+
+    Examples
+    --------
+    The name resolves to the module's object; an unknown name is an :class:`AttributeError`, as for
+    any module (here on the standard library's ``json``, which already holds the name):
+
+    >>> import json
+    >>> names, getattr_, dir_ = lazy_exports("json", {"decoder": ("JSONDecodeError",)})
+    >>> getattr_("JSONDecodeError") is json.decoder.JSONDecodeError, "JSONDecodeError" in dir_()
+    (True, True)
+    >>> getattr_("no_such_name")
+    Traceback (most recent call last):
+    ...
+    AttributeError: module 'json' has no attribute 'no_such_name'
     """
     names = [name for module_names in exports.values() for name in module_names]
     home = {name: module for module, module_names in exports.items() for name in module_names}

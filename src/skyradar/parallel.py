@@ -160,6 +160,35 @@ def close(client, owns_cluster: bool) -> None:
     Called once the work is written (or while an error propagates): a cluster that does not shut
     down in time on a loaded machine loses nothing, and its worker processes end with this one, so
     a timeout here is logged in one line instead of raised over the result or the error.
+
+    Parameters
+    ----------
+    client : distributed.Client
+        The client (anything with ``close()`` and, for a local cluster, ``cluster.close()``).
+    owns_cluster : bool
+        Close the client's cluster too (it was started by :func:`connect`).
+
+    Examples
+    --------
+    With stand-ins for a client and its cluster (no Dask needed); a timeout is logged, not raised:
+
+    >>> class Part:
+    ...     def __init__(self, name, fail=False):
+    ...         self.name, self.fail = name, fail
+    ...     def close(self):
+    ...         print("closed", self.name)
+    ...         if self.fail:
+    ...             raise TimeoutError("slow shutdown")
+    >>> client = Part("client"); client.cluster = Part("cluster")
+    >>> close(client, owns_cluster=True)
+    closed client
+    closed cluster
+    >>> close(client, owns_cluster=False)
+    closed client
+    >>> client.cluster = Part("cluster", fail=True)
+    >>> close(client, owns_cluster=True)
+    closed client
+    closed cluster
     """
     cluster = getattr(client, "cluster", None)
     try:
@@ -210,6 +239,43 @@ def map_frame_chunks(
 
     Workers open the run themselves from ``path`` (a shared filesystem), so only the chunk bounds
     travel to them and only each chunk's (small) result travels back.
+
+    Parameters
+    ----------
+    job : callable
+        ``job(path, start, stop, *args)``: the result of frames ``start`` to ``stop`` (exclusive).
+        On Dask it must be importable by the workers (a module-level function).
+    path : str
+        The run, opened by ``job`` itself.
+    n_frames : int
+        Frames in the run.
+    chunk_frames : int
+        Frames per chunk (the last may be shorter).
+    *args
+        Further arguments of ``job``.
+    scheduler : str, optional
+        A Dask scheduler address (``tcp://HOST:PORT``).
+    workers : int, optional
+        Processes of a local Dask cluster; without ``scheduler`` and ``workers`` the chunks run here,
+        one after the other.
+    progress : callable, optional
+        ``progress(frames)`` after each chunk, with its number of frames.
+
+    Returns
+    -------
+    list
+        The chunks' results in frame order.
+
+    Examples
+    --------
+    Without a scheduler or workers, in a plain loop:
+
+    >>> done = []
+    >>> map_frame_chunks(lambda path, start, stop, k: (start, stop * k), "run.zarr", 10, 4, 10,
+    ...                  progress=done.append)
+    [(0, 40), (4, 80), (8, 100)]
+    >>> done
+    [4, 4, 2]
     """
     bounds = [(s, min(s + chunk_frames, n_frames)) for s in range(0, n_frames, chunk_frames)]
     if scheduler is None and not workers:

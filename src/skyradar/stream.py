@@ -89,6 +89,16 @@ class Advice:
         The preferred conflict-free heading, deg (NaN: none).
     preferred_vs_mps : float
         The preferred conflict-free vertical speed, m/s, positive up (NaN: none).
+
+    Examples
+    --------
+    The advice columns of an alerting frame's rows (:func:`frame_advice`):
+
+    >>> alerts = pd.DataFrame({"level": [3], "heading_bands_deg": [[350.0, 20.0]], "vs_bands_mps": [[]],
+    ...     "terrain_vs_bands_mps": [[]], "preferred_heading_deg": [80.0], "preferred_vs_mps": [np.nan]})
+    >>> advice = frame_advice(alerts)
+    >>> advice.heading_bands_deg, advice.preferred_heading_deg, advice.vs_bands_mps
+    ([350.0, 20.0], 80.0, [])
     """
 
     heading_bands_deg: list[float]
@@ -117,6 +127,21 @@ class FrameResult:
         The frame's alerts rows (:data:`~skyradar.daa.pipeline.ALERT_COLUMNS`).
     advice : Advice or None
         The frame's advice when an alert is issued on it and advice is on; else None.
+
+    Examples
+    --------
+    The first frame of a head-on encounter (as :class:`StreamingChain`'s example):
+
+    >>> from skyradar.scene.scenario import Scenario
+    >>> spec = {"name": "head-on", "origin": {"lat_deg": 52.0, "lon_deg": 4.36, "alt_m": 0.0},
+    ...     "radar": {"range_limit_m": 1500},
+    ...     "ownship": {"type": "straight", "start_ned_m": [0, 0, -2000], "speed_mps": 50},
+    ...     "intruders": [{"name": "A", "type": "straight", "start_ned_m": [900, -40, -2000],
+    ...                    "heading_deg": 180, "speed_mps": 40}],
+    ...     "frame_rate_hz": 9.4, "duration_s": 1.0}
+    >>> result = StreamingChain(Scenario.from_dict(spec).build(), with_advice=False).step()
+    >>> result.frame, result.time_s, len(result.detections), len(result.tracks), result.advice
+    (0, 0.0, 1, 0, None)
     """
 
     frame: int

@@ -48,9 +48,33 @@ def ca_cfar_noise(
 ) -> tuple[np.ndarray, int]:
     """Mean power of the training cells around each cell and their number.
 
-    ``guard`` and ``train`` are half-widths per axis: the outer box spans ``guard + train`` cells on
-    each side, the excluded inner box ``guard``. Edges are mirrored (``mode="reflect"``; per axis,
-    ``"wrap"`` for a circular axis such as Doppler).
+    Parameters
+    ----------
+    power : ndarray
+        Power map (linear), any number of dimensions.
+    guard, train : int or tuple of int
+        Half-widths in cells, one for every axis or one per axis: the outer box spans
+        ``guard + train`` cells on each side, the excluded inner box ``guard``.
+    mode : str or tuple of str
+        Edge handling (:func:`scipy.ndimage.uniform_filter`): mirrored by default (``"reflect"``);
+        per axis, ``"wrap"`` for a circular axis such as Doppler.
+
+    Returns
+    -------
+    noise : ndarray
+        Mean training-cell power at each cell (the shape of ``power``).
+    n_train : int
+        Number of training cells per cell.
+
+    Examples
+    --------
+    Guard 1 and train 2: 7 cells in the box, 3 left out, 4 training cells. A spike inside the guard
+    box is left out; two cells away it is a training cell and raises the estimate to (3 + 101) / 4.
+
+    >>> p = np.ones(11); p[5] = 101.0
+    >>> noise, n_train = ca_cfar_noise(p, 1, 2)
+    >>> n_train, noise[[5, 7]].tolist()
+    (4, [1.0, 26.0])
     """
     power = np.asarray(power, dtype=float)
     g = _box(guard, power.ndim)

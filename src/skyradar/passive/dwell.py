@@ -27,7 +27,33 @@ __all__ = ["DwellSettings", "detect_dwell", "detect_dwells"]
 
 @dataclass(frozen=True)
 class DwellSettings:
-    """CFAR and cancellation settings (lags and Doppler bins are cells)."""
+    """CFAR and cancellation settings (lags and Doppler bins are cells).
+
+    Attributes
+    ----------
+    min_lag : int
+        First lag searched (shorter lags hold the direct path's residue).
+    pfa_static, pfa_moving : float
+        CFAR false-alarm probability per cell of the static and the moving channel.
+    guard_lags, train_lags : int
+        CFAR guard and training half-widths along the lags.
+    lags_per_independent : float
+        Lags per independent noise sample (``cells_per_independent`` of
+        :func:`~skyradar.passive.cfar.ca_cfar`).
+    cancel : str
+        Static-return canceller of the moving channel (``"mti2"``, ``"mti3"``, ``"mti4"``, or another
+        method of :func:`~skyradar.passive.mti.cancel_static`).
+    doppler_oversample : int
+        Doppler grid points per pulse of the dwell.
+    zero_doppler_guard_hz : float
+        Moving-channel cells within this Doppler shift of 0 are not detections, Hz.
+
+    Examples
+    --------
+    >>> s = DwellSettings(zero_doppler_guard_hz=100.0)
+    >>> s.cancel, s.train_lags, s.zero_doppler_guard_hz
+    ('mti3', 40, 100.0)
+    """
 
     min_lag: int = 4
     pfa_static: float = 1e-6
@@ -77,6 +103,37 @@ def detect_dwells(
 
     One vectorised pass over all dwells of a chunk (the per-dwell work is small, so Python overhead
     would otherwise dominate).
+
+    Parameters
+    ----------
+    profiles : ndarray
+        Complex pulse profiles, (dwells, pulses, lags).
+    times_s : ndarray
+        Time of each pulse, s, (dwells, pulses).
+    prf_hz : float
+        Mean pulse repetition frequency, Hz (sets the Doppler grid's span).
+    settings : DwellSettings
+        CFAR and cancellation settings.
+
+    Returns
+    -------
+    list of dict
+        The candidates of every dwell, as :func:`detect_dwell`'s; ``time_s`` is the mean pulse time of
+        the candidate's dwell, s (moving candidates also carry ``static_db``, the zero-Doppler power
+        at their lag).
+
+    Examples
+    --------
+    Two dwells of 16 pulses; a mover at lag 120 and 300 Hz in the second only:
+
+    >>> rng = np.random.default_rng(1)
+    >>> t = np.arange(16) * 1e-3
+    >>> p = (rng.normal(size=(2, 16, 200)) + 1j * rng.normal(size=(2, 16, 200))) / np.sqrt(2)
+    >>> p[1, :, 120] += 3.0 * np.exp(2j * np.pi * 300.0 * t)
+    >>> found = detect_dwells(p, np.stack([t, t + 0.1]), 1000.0, DwellSettings(zero_doppler_guard_hz=100.0))
+    >>> (c,) = found
+    >>> c["channel"], round(c["lag"]), round(c["doppler_hz"], -2), round(float(c["time_s"]), 4)
+    ('moving', 120, 300.0, 0.1075)
     """
     s = settings
     lo = s.min_lag

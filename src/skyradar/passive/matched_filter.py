@@ -53,7 +53,27 @@ def thesis_test_pulse(sample_rate_hz: float = 20e6) -> tuple[np.ndarray, np.ndar
 
 
 def filter_taps(pulse: np.ndarray, window: str | None = None) -> np.ndarray:
-    """Impulse response ``h[m] = w[m] conj(p[N-1-m])``; ``window`` None or ``"hann"`` (sin^2(pi m/N))."""
+    """Impulse response ``h[m] = w[m] conj(p[N-1-m])``; ``window`` None or ``"hann"`` (sin^2(pi m/N)).
+
+    Parameters
+    ----------
+    pulse : ndarray
+        The transmitted pulse's samples (1-D, complex).
+    window : str, optional
+        ``None`` (or ``"none"``) for no taper, ``"hann"`` for ``w[m] = sin^2(pi m / N)``.
+
+    Returns
+    -------
+    ndarray
+        The ``N`` filter taps (complex128).
+
+    Examples
+    --------
+    >>> np.round(filter_taps(np.array([1, 2j, 3])), 3).tolist()
+    [(3-0j), -2j, (1-0j)]
+    >>> np.round(filter_taps(np.array([1, 2j, 3]), "hann"), 3).tolist()  # w = [0, 0.75, 0.75]
+    [0j, -1.5j, (0.75+0j)]
+    """
     pulse = np.asarray(pulse)
     if pulse.ndim != 1 or pulse.size == 0:
         raise InputError(f"matched filter: pulse must be a non-empty 1-D array, got shape {pulse.shape}")

@@ -60,7 +60,44 @@ COLUMNS = list(PASSIVE_TABLE_COLUMNS)
 @dataclass(frozen=True)
 class PassiveSettings:
     """Processing choices. ``pulse``: ``"metadata"`` (the illuminator's long pulse as the operator
-    gives it) or ``"recording"`` (the strongest direct-path pulse of the first rotation)."""
+    gives it) or ``"recording"`` (the strongest direct-path pulse of the first rotation).
+
+    Attributes
+    ----------
+    max_bistatic_range_m : float
+        Longest bistatic range searched, m: sets the lags per profile.
+    pulse : str
+        Matched-filter template: ``"metadata"`` or ``"recording"``.
+    window : str or None
+        Matched-filter taper (``"hann"`` or None).
+    chunk_samples : int
+        Samples read and filtered per chunk.
+    hop_fraction : float
+        Hop between dwells as a fraction of a dwell.
+    blind_half_width_deg : float
+        Half-width of the blind zone around the receiver's bearing from the illuminator, deg.
+    min_bistatic_range_m : float or None
+        Shortest bistatic range kept, m; None: three range resolutions of the long pulse.
+    sidelobe_margin_db, static_sidelobe_margin_db : float
+        Margin below a stronger detection at the same range and Doppler under which a detection of the
+        moving (static) channel counts as a sidelobe look, dB.
+    merge_time_dwells : float
+        Time tolerance of merging candidates of overlapping dwells, in dwells.
+    max_clutter_to_signal_db : float
+        A moving candidate near zero Doppler this much weaker than the static return at its lag is
+        that return's cancellation residue, dB.
+    dwell : DwellSettings
+        CFAR and cancellation settings of each dwell.
+
+    Examples
+    --------
+    A profile covers the bistatic ranges up to ``max_bistatic_range_m``: 45 km at 5 MS/s is
+    ``ceil(45 km / c * fs) + 1`` = 752 lags.
+
+    >>> s = PassiveSettings(window=None)
+    >>> s.pulse, s.window, int(np.ceil(s.max_bistatic_range_m / C_MPS * 5e6)) + 1
+    ('metadata', None, 752)
+    """
 
     max_bistatic_range_m: float = 45_000.0
     pulse: str = "metadata"
@@ -78,6 +115,26 @@ class PassiveSettings:
 
 @dataclass
 class PassiveResult:
+    """What :func:`process_recording` gives.
+
+    Attributes
+    ----------
+    detections : DataFrame
+        The detections table: :data:`COLUMNS`, units in :data:`PASSIVE_TABLE_COLUMNS`.
+    n_pulses : int
+        Direct-path pulses found.
+    n_dwells : int
+        Dwells searched.
+    scan_period_s : float
+        The illuminator's rotation period found from the direct path, s.
+    crossings_s : ndarray
+        Times the main beam swept the receiver, s from the first sample.
+    masked : int
+        Detections dropped in the blind zone.
+    pulse_source : str
+        Where the matched-filter template came from (``metadata`` or ``recording``).
+    """
+
     detections: pd.DataFrame
     n_pulses: int
     n_dwells: int
@@ -128,7 +185,22 @@ def _template(recording, ill: Illuminator, settings: PassiveSettings) -> np.ndar
 def process_recording(
     recording, settings: PassiveSettings | None = None, progress: Callable[[int, int], None] | None = None
 ) -> PassiveResult:
-    """Detections of a passive recording (an :class:`skyradar.io.sigmf_io.IqRecording`)."""
+    """Detections of a passive recording (an :class:`skyradar.io.sigmf_io.IqRecording`).
+
+    Parameters
+    ----------
+    recording : IqRecording
+        The recording, with its illuminator's metadata.
+    settings : PassiveSettings, optional
+        Processing choices (default :class:`PassiveSettings`).
+    progress : callable, optional
+        ``progress(samples_done, total)`` after each chunk.
+
+    Returns
+    -------
+    PassiveResult
+        The detections and what the processing found of the scan.
+    """
     from threadpoolctl import threadpool_limits
 
     # The dwell products are small (tens x hundreds): threaded BLAS only spins on them.

@@ -91,9 +91,24 @@ def estimate_pulse(x: np.ndarray, width_samples: int) -> np.ndarray:
 class ScanPhase:
     """Beam azimuth over time from the main-beam crossings of the receiver.
 
-    ``crossings_s``: times the main beam points at the receiver (on the recording's clock, as seen by
-    the direct path); ``period_s``: rotation period; ``bearing_rad``: azimuth of the receiver from the
-    illuminator (clockwise from north); ``direction``: +1 clockwise, -1 counter-clockwise.
+    Attributes
+    ----------
+    crossings_s : ndarray
+        Times the main beam points at the receiver (on the recording's clock, as seen by the direct
+        path), s, increasing.
+    period_s : float
+        Rotation period, s.
+    bearing_rad : float
+        Azimuth of the receiver from the illuminator (clockwise from north), rad.
+    direction : int
+        +1 clockwise, -1 counter-clockwise.
+
+    Examples
+    --------
+    Crossings at 1 s and 5 s: sweep 0 runs to 3 s, sweep 1 to 7 s.
+
+    >>> ScanPhase(np.array([1.0, 5.0]), 4.0, 0.0).sweep([0.0, 2.9, 3.1, 7.1]).tolist()
+    [0, 0, 1, 2]
     """
 
     crossings_s: np.ndarray
@@ -145,6 +160,38 @@ def scan_phase(
     rotation (at least 10 dB above the median), refined by a parabola through the dB values (exact
     for a Gaussian main lobe). With two or more crossings the period is their median spacing,
     otherwise ``period_hint_s`` (the illuminator's nominal rotation).
+
+    Parameters
+    ----------
+    times_s : ndarray
+        Arrival time of each direct-path pulse, s (at least 3).
+    amplitudes : ndarray
+        Direct-path amplitude (or complex value) of each pulse.
+    period_hint_s : float
+        Nominal rotation period, s: spaces the search for maxima, and is the period with one crossing.
+    bearing_rad : float
+        Azimuth of the receiver from the illuminator (clockwise from north), rad.
+    direction : int
+        +1 clockwise, -1 counter-clockwise.
+    source : str
+        What the pulses come from, named in errors.
+
+    Returns
+    -------
+    ScanPhase
+        The crossings, period, bearing and direction.
+
+    Examples
+    --------
+    A 4 s rotation whose 1.4 deg Gaussian beam sweeps the receiver at 2 s and 6 s, 1 kHz pulses:
+
+    >>> from skyradar.units import wrap_angle
+    >>> t = np.arange(0.0, 10.0, 1e-3)
+    >>> off = wrap_angle(2 * np.pi * (t - 2.0) / 4.0)
+    >>> amp = 0.01 + np.exp(-4 * np.log(2) * (off / np.radians(1.4)) ** 2)
+    >>> sp = scan_phase(t, amp, 4.5, np.radians(250.0))
+    >>> np.round(sp.crossings_s, 3).tolist(), round(sp.period_s, 3)
+    ([2.0, 6.0], 4.0)
     """
     times_s = np.asarray(times_s, dtype=float)
     db = 20 * np.log10(np.abs(np.asarray(amplitudes)) + 1e-30)

@@ -48,7 +48,29 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Receiver:
-    """The receiving antenna's site (WGS84: deg, deg, m above the ellipsoid) and front end."""
+    """The receiving antenna's site (WGS84: deg, deg, m above the ellipsoid) and front end.
+
+    Attributes
+    ----------
+    latitude, longitude : float
+        Geodetic position, deg.
+    altitude : float
+        Height of the antenna above the WGS84 ellipsoid, m.
+    noise_figure_db : float
+        Front-end noise figure, dB.
+    antenna_gain_dbi : float
+        Antenna gain, dBi.
+    height_above_ground_m : float
+        Height of the antenna above the ground, m.
+
+    Examples
+    --------
+    Thermal noise in 1 MHz: -174 dBm/Hz + 60 dB + 5 dB noise figure.
+
+    >>> rx = Receiver(52.0, 5.0, 40.0)
+    >>> round(float(10 * np.log10(rx.noise_power_w(1e6) / 1e-3)), 1), rx.geodetic
+    (-109.0, (52.0, 5.0, 40.0))
+    """
 
     latitude: float
     longitude: float
@@ -78,7 +100,30 @@ class Receiver:
 
 @dataclass(frozen=True)
 class Reflectors:
-    """Static point scatterers: NED positions (n, 3) m, RCS (n,) m^2, kind and group name per point."""
+    """Static point scatterers: NED positions (n, 3) m, RCS (n,) m^2, kind and group name per point.
+
+    Attributes
+    ----------
+    position_ned_m : ndarray
+        Positions in the receiver's NED frame, (n, 3), m.
+    rcs_m2 : ndarray
+        Radar cross-section of each point, (n,), m^2 (finite, >= 0).
+    kind : ndarray
+        Kind of each point (``"building"``, ``"clutter"``), (n,); one value is broadcast to all.
+    group : ndarray
+        Group name of each point (the cluster's), (n,); one value is broadcast to all.
+
+    Examples
+    --------
+    >>> town = Reflectors([[100.0, 0.0, 20.0], [120.0, 5.0, 20.0]], [10.0, 30.0], "building", "town")
+    >>> both = Reflectors.concat([town, Reflectors([0.0, 900.0, 40.0], 0.5, "clutter", "ground")])
+    >>> len(both), both.position_ned_m.shape, both.kind.tolist()
+    (3, (3, 3), ['building', 'building', 'clutter'])
+    >>> Reflectors([[0.0, 0.0, 0.0]], [-1.0], "building", "x")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: reflectors: need finite positions (n, 3) and rcs_m2 >= 0 (n,), got 1, (1,)
+    """
 
     position_ned_m: np.ndarray
     rcs_m2: np.ndarray
@@ -126,6 +171,26 @@ class Aircraft:
 
     Recording time ``t`` is trajectory time ``t + time_offset_s``; outside the trajectory's span the
     aircraft is absent.
+
+    Attributes
+    ----------
+    trajectory : Trajectory
+        The flight, positions in the receiver's NED frame (m).
+    rcs_m2 : float
+        Radar cross-section, m^2.
+    time_offset_s : float
+        Trajectory time at recording time 0, s.
+
+    Examples
+    --------
+    North at 50 m/s over trajectory times 0-10 s, seen from recording time 0 at trajectory time 4 s:
+
+    >>> from skyradar.scene.trajectories import Trajectory
+    >>> traj = Trajectory.from_states([0.0, 10.0], [[0, 0, -500], [500, 0, -500]], [[50, 0, 0]] * 2,
+    ...                               origin=(52.0, 5.0, 40.0), name="GA1")
+    >>> present, pos, vel = Aircraft(traj, rcs_m2=2.0, time_offset_s=4.0).states(np.array([0.0, 2.0, 8.0]))
+    >>> present.tolist(), pos[:, 0].round(3).tolist()
+    ([True, True, False], [200.0, 300.0, nan])
     """
 
     trajectory: Trajectory
@@ -206,6 +271,40 @@ def building_cluster(
 
     A median of 1000 m^2 per point (walls and roofs facing both sites, corner reflections) puts a town
     15-20 dB above the rural clutter points around it, as the towns stood out in the thesis' recording.
+
+    Parameters
+    ----------
+    name : str
+        The cluster's group name.
+    bearing_deg : float
+        Bearing of the cluster's centre from the receiver, clockwise from north, deg.
+    distance_m : float
+        Horizontal distance of the centre from the receiver, m.
+    rng : numpy.random.Generator
+        Source of the point positions and RCS.
+    n_points : int
+        Number of points.
+    radius_m : float
+        Twice the standard deviation of the points' horizontal scatter around the centre, m.
+    rcs_median_m2 : float
+        Median RCS per point, m^2.
+    height_below_antenna_m : float
+        Height of the ground below the antenna at the receiver, m (the Earth's curvature is added).
+
+    Returns
+    -------
+    Reflectors
+        ``n_points`` points of kind ``"building"`` and group ``name``.
+
+    Examples
+    --------
+    A town 10 km due east: the points' down coordinate is 25 m plus the curvature drop
+    ``(10 km)^2 / (2 R)``, about 7.8 m.
+
+    >>> c = building_cluster("town", 90.0, 10_000.0, np.random.default_rng(0), n_points=200, radius_m=100.0)
+    >>> east, down = c.position_ned_m[:, 1].mean(), c.position_ned_m[:, 2].mean()
+    >>> len(c), set(c.group), round(float(east), -2), round(float(down))
+    (200, {'town'}, 10000.0, 33)
     """
     centre = distance_m * np.array([np.cos(np.radians(bearing_deg)), np.sin(np.radians(bearing_deg))])
     ne = centre + rng.normal(0.0, radius_m / 2.0, size=(n_points, 2))
@@ -228,6 +327,38 @@ def ground_clutter(
     Points nearer the transmitter than ``exclusion_m`` are dropped: a PSR's elevation pattern and site
     screening keep its own surroundings out of the beam. ``sigma0_db`` about -50 dB: low-grazing rural
     land at S band, most of it shadowed.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Source of the point positions.
+    tx_ned_m : ndarray
+        The transmitter's position in the receiver's NED frame, m.
+    n_points : int
+        Number of points drawn over the disc (before the exclusion).
+    max_distance_m : float
+        Radius of the disc, m.
+    sigma0_db : float
+        Clutter reflectivity (RCS per unit ground area), dB m^2/m^2.
+    exclusion_m : float
+        Points within this horizontal distance of the transmitter are dropped, m.
+    height_below_antenna_m : float
+        Height of the ground below the antenna at the receiver, m (the Earth's curvature is added).
+
+    Returns
+    -------
+    Reflectors
+        The kept points, kind ``"clutter"``, group ``"ground"``.
+
+    Examples
+    --------
+    Each point carries 1e-5 * pi * (22 km)^2 / 800 = 19.0 m^2:
+
+    >>> tx = np.array([0.0, -12000.0, 0.0])
+    >>> g = ground_clutter(np.random.default_rng(0), tx)
+    >>> from_tx = np.hypot(*(g.position_ned_m[:, :2] - tx[:2]).T)
+    >>> round(float(g.rcs_m2[0]), 1), len(g) < 800, bool(from_tx.min() > 1500)
+    (19.0, True, True)
     """
     r = max_distance_m * np.sqrt(rng.uniform(0.0, 1.0, n_points))
     phi = rng.uniform(0.0, 2 * np.pi, n_points)
@@ -245,6 +376,45 @@ class PassiveScene:
 
     ``azimuth_at_t0_rad`` is the beam azimuth at the first sample and ``first_pulse_s`` the emission
     time of PRI 0 on the recording's clock: the processor must find both from the direct path.
+
+    Attributes
+    ----------
+    receiver : Receiver
+        The receiving site; the scene's NED frame is centred on it.
+    illuminator : Illuminator
+        The transmitting radar.
+    reflectors : Reflectors
+        Static point scatterers.
+    aircraft : tuple of Aircraft
+        Moving reflectors.
+    duration_s : float
+        Length of the recording, s.
+    azimuth_at_t0_rad : float
+        Beam azimuth at the first sample, clockwise from north, rad.
+    first_pulse_s : float
+        Emission time of PRI 0, s from the first sample.
+    start_time : datetime
+        Wall-clock time of the first sample.
+    seed : int
+        Seed of the receiver noise.
+    description : str
+        The recording's description.
+
+    Examples
+    --------
+    The illuminator 12 km due west: the beam, starting north and turning at 13.5 rpm (4.44 s a turn),
+    points east at the receiver after a quarter turn and then once per turn.
+
+    >>> from skyradar.geo import ned_to_geodetic
+    >>> from skyradar.passive.illuminator import Illuminator
+    >>> rx = Receiver(52.0, 5.0, 40.0)
+    >>> ill = Illuminator(*map(float, ned_to_geodetic(np.array([0.0, -12000.0, 0.0]), *rx.geodetic)))
+    >>> mast = Reflectors([[0.0, 4000.0, 0.0]], [10.0], "building", "mast")
+    >>> scene = PassiveScene(rx, ill, mast, duration_s=8.0)
+    >>> round(scene.baseline_m, 3), np.degrees(scene.azimuth_from_tx_rad([[0.0, 0.0, 0.0]])).round(6).tolist()
+    (12000.0, [90.0])
+    >>> scene.receiver_crossing_times_s.round(3).tolist()
+    [1.111, 5.556]
     """
 
     receiver: Receiver
@@ -299,6 +469,38 @@ def aircraft_from_adsb(
     With ``start_time`` and absolute timestamps in the file, recording time 0 is ``start_time``;
     otherwise it is the file's first timestamp. An ATC radar's traffic is of every type: each
     aircraft's path is built within the ``any`` class's limits (:mod:`skyradar.scene.flyable`).
+
+    Parameters
+    ----------
+    path : str or Path
+        The track file (one aircraft per ``icao24``).
+    receiver : Receiver
+        The receiver, whose NED frame the trajectories are expressed in.
+    start_time : datetime, optional
+        Wall-clock time of recording time 0.
+    rcs_m2 : float
+        Radar cross-section given to every aircraft, m^2.
+
+    Returns
+    -------
+    list of Aircraft
+        One per aircraft of the file, named by its ``icao24``.
+
+    Examples
+    --------
+    An aircraft 500 m above the receiver flying north, 0.001 deg (111 m) every 10 s:
+
+    >>> import tempfile, pathlib
+    >>> rows = "0,abc123,52.0,5.0,540\\n10,abc123,52.001,5.0,540\\n20,abc123,52.002,5.0,540\\n"
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     f = pathlib.Path(d) / "traffic.csv"
+    ...     _ = f.write_text("time_s,icao24,latitude,longitude,alt_m\\n" + rows)
+    ...     planes = aircraft_from_adsb(f, Receiver(52.0, 5.0, 40.0), rcs_m2=3.0)
+    >>> [(p.name, p.rcs_m2) for p in planes]
+    [('abc123', 3.0)]
+    >>> _, pos, _ = planes[0].states(np.array([0.0, 10.0]))
+    >>> pos[:, [0, 2]].round(1).tolist()
+    [[0.0, -500.0], [111.3, -500.0]]
     """
     from skyradar.scene.adsb import read_trajectories
 

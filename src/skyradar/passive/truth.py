@@ -31,7 +31,23 @@ __all__ = ["truth_paths", "truth_table", "truth_summary", "write_truth"]
 
 
 def truth_paths(meta_path: str | Path) -> tuple[Path, Path]:
-    """(table, json) truth paths beside a recording ``NAME.sigmf-meta``."""
+    """(table, json) truth paths beside a recording ``NAME.sigmf-meta``.
+
+    Parameters
+    ----------
+    meta_path : str or Path
+        The recording: ``NAME.sigmf-meta``, ``NAME.sigmf-data`` or the bare ``NAME``.
+
+    Returns
+    -------
+    (Path, Path)
+        ``NAME.truth.parquet`` and ``NAME.truth.json`` in the recording's folder.
+
+    Examples
+    --------
+    >>> [p.name for p in truth_paths("runs/rec.sigmf-data")]
+    ['rec.truth.parquet', 'rec.truth.json']
+    """
     meta, _ = sigmf_paths(meta_path)
     stem = meta.name.removesuffix(".sigmf-meta")
     return meta.with_name(stem + ".truth.parquet"), meta.with_name(stem + ".truth.json")
@@ -87,7 +103,35 @@ def _aircraft_rows(scene: PassiveScene) -> pd.DataFrame:
 
 
 def truth_table(scene: PassiveScene) -> pd.DataFrame:
-    """One row per reflector per sweep (see the module docstring), sorted by time."""
+    """One row per reflector per sweep (see the module docstring), sorted by time.
+
+    Parameters
+    ----------
+    scene : PassiveScene
+        The simulated scene.
+
+    Returns
+    -------
+    DataFrame
+        The truth table: the columns of the module docstring, one row per reflector per main-beam
+        crossing within the recording.
+
+    Examples
+    --------
+    The illuminator 12 km due west, a mast 4 km due east: on the baseline's extension, so
+    ``r_tx = 16 km``, ``r_rx = 4 km`` and the bistatic range 16 + 4 - 12 = 8 km; the beam (starting
+    north, 4.44 s a turn) crosses it a quarter turn in, and once per turn after.
+
+    >>> from skyradar.geo import ned_to_geodetic
+    >>> from skyradar.passive.illuminator import Illuminator
+    >>> from skyradar.passive.scene import PassiveScene, Receiver, Reflectors
+    >>> rx = Receiver(52.0, 5.0, 40.0)
+    >>> ill = Illuminator(*map(float, ned_to_geodetic(np.array([0.0, -12000.0, 0.0]), *rx.geodetic)))
+    >>> mast = Reflectors([[0.0, 4000.0, 0.0]], [10.0], "building", "mast")
+    >>> t = truth_table(PassiveScene(rx, ill, mast, duration_s=8.0))
+    >>> t[["time_s", "sweep", "bistatic_range_m", "r_rx_m"]].round(3).values.tolist()
+    [[1.111, 0.0, 8000.0, 4000.0], [5.556, 1.0, 8000.0, 4000.0]]
+    """
     parts = [df for df in (_static_rows(scene), _aircraft_rows(scene)) if len(df)]
     df = pd.concat(parts, ignore_index=True) if parts else _aircraft_rows(scene)
     ill, rx = scene.illuminator, scene.receiver
@@ -126,7 +170,36 @@ def truth_table(scene: PassiveScene) -> pd.DataFrame:
 
 
 def truth_summary(scene: PassiveScene, sample_rate_hz: float) -> dict:
-    """The scan, timing and cluster summary written to ``NAME.truth.json``."""
+    """The scan, timing and cluster summary written to ``NAME.truth.json``.
+
+    Parameters
+    ----------
+    scene : PassiveScene
+        The simulated scene.
+    sample_rate_hz : float
+        The recording's sample rate, Hz.
+
+    Returns
+    -------
+    dict
+        JSON-ready: the frame, sample rate (Hz), duration (s), illuminator position (NED, m), baseline
+        (m), beam azimuth at sample 0 (deg), rotation period (s), emission time of PRI 0 (s), main-beam
+        crossings of the receiver (s), the building clusters' centres, the aircraft and the seed.
+
+    Examples
+    --------
+    >>> from skyradar.geo import ned_to_geodetic
+    >>> from skyradar.passive.illuminator import Illuminator
+    >>> from skyradar.passive.scene import PassiveScene, Receiver, Reflectors
+    >>> rx = Receiver(52.0, 5.0, 40.0)
+    >>> ill = Illuminator(*map(float, ned_to_geodetic(np.array([0.0, -12000.0, 0.0]), *rx.geodetic)))
+    >>> mast = Reflectors([[0.0, 4000.0, 0.0]], [10.0], "building", "mast")
+    >>> summary = truth_summary(PassiveScene(rx, ill, mast, duration_s=8.0), 5e6)
+    >>> round(summary["baseline_m"], 3), [round(t, 3) for t in summary["receiver_crossing_times_s"]]
+    (12000.0, [1.111, 5.556])
+    >>> summary["clusters"][0]["name"], summary["clusters"][0]["r_rx_m"]
+    ('mast', 4000.0)
+    """
     refl = scene.reflectors
     clusters = []
     for name in dict.fromkeys(refl.group[refl.kind == "building"]):
@@ -158,7 +231,38 @@ def truth_summary(scene: PassiveScene, sample_rate_hz: float) -> dict:
 
 
 def write_truth(scene: PassiveScene, meta_path: str | Path, sample_rate_hz: float) -> tuple[Path, Path]:
-    """Write ``NAME.truth.parquet`` and ``NAME.truth.json`` beside the recording."""
+    """Write ``NAME.truth.parquet`` and ``NAME.truth.json`` beside the recording.
+
+    Parameters
+    ----------
+    scene : PassiveScene
+        The simulated scene.
+    meta_path : str or Path
+        The recording (see :func:`truth_paths`).
+    sample_rate_hz : float
+        The recording's sample rate, Hz.
+
+    Returns
+    -------
+    (Path, Path)
+        The table and the JSON summary written.
+
+    Examples
+    --------
+    >>> import json, tempfile, pathlib
+    >>> from skyradar.geo import ned_to_geodetic
+    >>> from skyradar.passive.illuminator import Illuminator
+    >>> from skyradar.passive.scene import PassiveScene, Receiver, Reflectors
+    >>> rx = Receiver(52.0, 5.0, 40.0)
+    >>> ill = Illuminator(*map(float, ned_to_geodetic(np.array([0.0, -12000.0, 0.0]), *rx.geodetic)))
+    >>> mast = Reflectors([[0.0, 4000.0, 0.0]], [10.0], "building", "mast")
+    >>> scene = PassiveScene(rx, ill, mast, duration_s=8.0)
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     table, summary = write_truth(scene, pathlib.Path(d) / "rec", 5e6)
+    ...     rows, info = len(pd.read_parquet(table)), json.loads(summary.read_text())
+    >>> table.name, rows, info["sample_rate_hz"]
+    ('rec.truth.parquet', 2, 5000000.0)
+    """
     table, summary = truth_paths(meta_path)
     write_table(truth_table(scene), table, metadata={"skyradar_format": "passive-truth/1"})
     write_json_atomic(summary, truth_summary(scene, sample_rate_hz))

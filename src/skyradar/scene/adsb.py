@@ -75,7 +75,30 @@ MAX_INFLATED_BYTES = 256 << 20
 
 
 def read_track_table(path: str | Path) -> pd.DataFrame:
-    """Load a CSV, Parquet or JSON (records or JSON lines) file as a DataFrame, unchanged."""
+    """Load a CSV, Parquet or JSON (records or JSON lines) file as a DataFrame, unchanged.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.csv``/``.txt``, ``.parquet``/``.pq``, ``.json``, or ``.jsonl``/``.ndjson`` for JSON lines;
+        optionally compressed (``.gz``, ``.bz2``, ``.xz``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        The file's rows and columns as stored: no unit conversion, no repair. ``icao24`` and
+        ``callsign`` of a CSV stay text, so leading zeros survive.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     f = pathlib.Path(d) / "track.csv"
+    ...     _ = f.write_text("timestamp,icao24,latitude\\n0,008123,52.0\\n10,008123,52.001\\n")
+    ...     table = read_track_table(f)
+    >>> table.shape, table["icao24"].tolist(), table["latitude"].tolist()
+    ((2, 3), ['008123', '008123'], [52.0, 52.001])
+    """
     path = Path(path)
     if not path.exists():
         raise InputError(f"{path}: no such file")
@@ -273,6 +296,21 @@ class FlightFit:
     limits : KinematicLimits
     notes : list of str
         Every repair, as the one line logged for the file says.
+
+    Examples
+    --------
+    Three fixes 0.001 deg (111.3 m) apart in latitude every 10 s: nothing to repair, every fix kept.
+
+    >>> import tempfile, pathlib
+    >>> rows = "0,52,4,300\\n10,52.001,4,300\\n20,52.002,4,300\\n"
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     f = pathlib.Path(d) / "track.csv"
+    ...     _ = f.write_text("time_s,latitude,longitude,alt_m\\n" + rows)
+    ...     fit = fit_flight(f)
+    >>> fit.fix_time_s.tolist(), np.round(fit.fix_position_ned_m[:, 0], 1).tolist()
+    ([0.0, 10.0, 20.0], [0.0, 111.3, 222.5])
+    >>> fit.path.kept.tolist(), fit.fix_velocity_ned_mps is None, fit.limits.name, fit.notes
+    ([True, True, True], True, 'ga', [])
     """
 
     trajectory: Any
@@ -400,9 +438,11 @@ def read_trajectory(
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> f = pathlib.Path(tempfile.mkdtemp()) / "track.csv"
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> f = pathlib.Path(folder.name) / "track.csv"
     >>> _ = f.write_text("timestamp,latitude,longitude,altitude\\n0,52,4,1000\\n10,52.001,4,1000\\n")
     >>> traj = read_trajectory(f)
+    >>> folder.cleanup()
     >>> round(float(traj.sample([10.0]).position_ned_m[0, 0]), 1), round(float(traj.origin[2]), 1)
     (111.3, 304.8)
     """
@@ -442,6 +482,22 @@ def fit_flight(
     Returns
     -------
     FlightFit
+        The trajectory, the fixes it was built from and the repairs.
+
+    Examples
+    --------
+    Two aircraft in one file; ``icao24`` picks one. Its own first fix is the origin and time zero:
+
+    >>> import tempfile, pathlib
+    >>> rows = "0,abc123,52,4,300\\n10,abc123,52.001,4,300\\n5,def456,52,4.01,600\\n15,def456,52,4.011,600\\n"
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     f = pathlib.Path(d) / "two.csv"
+    ...     _ = f.write_text("time_s,icao24,latitude,longitude,alt_m\\n" + rows)
+    ...     fit = fit_flight(f, icao24="def456")
+    >>> fit.trajectory.name, fit.trajectory.origin, fit.fix_time_s.tolist()
+    ('def456', (52.0, 4.01, 600.0), [0.0, 10.0])
+    >>> round(float(fit.trajectory.sample([10.0]).position_ned_m[0, 1]), 1)  # 0.001 deg east at 52 N
+    68.7
     """
     path = Path(path)
     limits = _limits(aircraft_class)
@@ -495,9 +551,39 @@ def read_trajectories(
     so all trajectories stay in step. Without an ``icao24`` column the file is one aircraft,
     keyed by its file stem. Repairs are reported in one line for the file.
 
+    Parameters
+    ----------
+    path : str or Path
+        As :func:`read_trajectory` reads.
+    origin : (lat_deg, lon_deg, alt_m), optional
+        Shared NED frame origin (deg, deg, m); defaults to the first row with a full position.
+    time_zero_s : float, optional
+        Timestamp (unix s, or ``time_s`` value) that becomes ``time_s == 0`` for every aircraft, s;
+        default the earliest in the file.
+    aircraft_class : str
+        A key of :data:`skyradar.scene.flyable.AIRCRAFT_CLASSES`: the limits every built path keeps to.
+
     Returns
     -------
     dict of str to Trajectory
+        One trajectory per ``icao24``, all in the same frame and on the same clock.
+
+    Examples
+    --------
+    ``def456`` starts 5 s after ``abc123`` and 0.01 deg east of it; both keep those offsets:
+
+    >>> import tempfile, pathlib
+    >>> rows = "0,abc123,52,4,300\\n10,abc123,52.001,4,300\\n5,def456,52,4.01,600\\n15,def456,52,4.011,600\\n"
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     f = pathlib.Path(d) / "two.csv"
+    ...     _ = f.write_text("time_s,icao24,latitude,longitude,alt_m\\n" + rows)
+    ...     tracks = read_trajectories(f)
+    >>> sorted(tracks), tracks["def456"].origin, float(tracks["def456"].start_s)
+    (['abc123', 'def456'], (52.0, 4.0, 300.0), 5.0)
+    >>> np.round(tracks["abc123"].sample([10.0]).position_ned_m[0], 1).tolist()
+    [111.3, 0.0, 0.0]
+    >>> round(float(tracks["def456"].sample([5.0]).position_ned_m[0, 1]), 1)  # 0.01 deg east at 52 N
+    686.8
     """
     path = Path(path)
     limits = _limits(aircraft_class)

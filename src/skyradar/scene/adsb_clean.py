@@ -49,12 +49,12 @@ __all__ = [
 _EPOCH_BAND_S = (631_152_000.0, 4_102_444_800.0)
 EPOCH_UNITS = (("s", 1.0), ("ms", 1e-3), ("us", 1e-6), ("ns", 1e-9))
 _SAME_TIME_MAX_SPREAD_M = 1000.0  # two fixes of one aircraft at one (1 s rounded) time are closer
-_M_PER_DEG = 111_320.0
+_M_PER_DEG = 111_320.0  # metres per degree of latitude (rounded; used only for the 1 km check above)
 # A fix may sit this far from where the previous one allows (ADS-B position quantisation, GNSS noise, m).
 POSITION_NOISE_M = 50.0
 # At most this share of a track's fixes may be dropped as glitches (implausible position or altitude);
 # a track with more is refused: something other than an occasional bad message is wrong with it.
-GLITCH_BUDGET = 0.05  # metres per degree of latitude (rounded; used only for the 1 km check above)
+GLITCH_BUDGET = 0.05
 
 
 def _numeric_unit(path: Path, col: str, values: np.ndarray) -> tuple[str, float]:
@@ -190,8 +190,49 @@ def clean_rows(
 ) -> tuple[pd.DataFrame, str, np.ndarray, np.ndarray, str, list[str]]:
     """Repair one aircraft's rows: ``(rows, time column, seconds, altitude m, altitude field, notes)``.
 
-    The rows come back sorted by time, one per time, each with a finite latitude, longitude and
-    altitude; the index keeps the file's row numbers for later messages.
+    Parameters
+    ----------
+    path : Path
+        The file the rows come from, named in errors.
+    df : pandas.DataFrame
+        One aircraft's rows as read (:func:`skyradar.scene.adsb.read_track_table`).
+    impala : bool
+        OpenSky Impala state vectors: the barometric altitude is ``baroaltitude`` in m, not
+        ``altitude`` in ft.
+    label : str
+        Appended to error messages (the aircraft, for a file of several).
+
+    Returns
+    -------
+    rows : pandas.DataFrame
+        The rows sorted by time, one per time, each with a finite latitude, longitude and
+        altitude; the index keeps the file's row numbers for later messages.
+    time_column : str
+        ``time_s`` or ``timestamp``.
+    time_s : ndarray
+        The rows' times, unix or relative s.
+    alt_m : ndarray
+        The rows' altitudes, m.
+    alt_field : str
+        The column the altitudes come from, for messages.
+    notes : list of str
+        One phrase per repair.
+
+    Examples
+    --------
+    A row out of order, a velocity-only row sharing a timestamp, and a row without a position:
+
+    >>> df = pd.DataFrame({"timestamp": [20.0, 0.0, 10.0, 10.0, 30.0],
+    ...                    "latitude": [52.002, 52.0, 52.001, None, None],
+    ...                    "longitude": [4.0, 4.0, 4.0, None, 4.0], "alt_m": [300.0] * 5})
+    >>> rows, col, t, alt, field, notes = clean_rows(Path("f.csv"), df)
+    >>> rows.index.tolist(), col, t.tolist(), alt.tolist(), field
+    ([1, 2, 0], 'timestamp', [0.0, 10.0, 20.0], [300.0, 300.0, 300.0], 'alt_m')
+    >>> for note in notes:
+    ...     print(note)
+    sorted by time (1 step(s) back)
+    merged 1 row(s) sharing a timestamp
+    dropped 1 row(s) without a position
     """
     col, t, unit_note = time_seconds(path, df)
     notes = [unit_note] if unit_note else []

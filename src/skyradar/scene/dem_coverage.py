@@ -24,7 +24,27 @@ _MARGIN_M = 1000.0
 
 
 class DemCoverageError(InputError):
-    """The DEM does not cover the area a flight needs."""
+    """The DEM does not cover the area a flight needs.
+
+    An :class:`~skyradar.errors.InputError`, so the command line reports it in one line; callers
+    catch it alone to add where the flight is.
+
+    Examples
+    --------
+    A tile at 52 N, 4 E read for a flight near 10 N, 10 E:
+
+    >>> import tempfile, pathlib
+    >>> from skyradar.scene.dem_readers import read_hgt
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = pathlib.Path(d) / "N52E004.hgt"
+    ...     np.full((1201, 1201), 7, ">i2").tofile(p)
+    ...     try:
+    ...         read_hgt(p, bounds=Bounds(10.0, 10.0, 10.1, 10.1))
+    ...     except DemCoverageError as exc:
+    ...         print(isinstance(exc, InputError), exc)
+    True N52E004.hgt: the DEM covers lat 52..53, lon 4..5, outside the area the flight needs (lat 10..10.1, \
+lon 10..10.1)
+    """
 
 
 def footprint_bounds(lat_deg: np.ndarray, lon_deg: np.ndarray, margin_m: float) -> Bounds:
@@ -109,6 +129,43 @@ def dem_for_run(path: str | Path, ds: Any, range_limit_m: float, source: str) ->
     The own-ship positions come from the run's navigation (``nav_lat_deg``/``nav_lon_deg``, or
     its NED track and stored origin; ``own_*`` in runs without ``nav_*``). A run without
     either cannot place a DEM: :class:`InputError` naming ``source``.
+
+    Parameters
+    ----------
+    path : str or Path
+        DEM file (SRTM ``.hgt``, GeoTIFF or ``.npz``).
+    ds : xarray.Dataset
+        The frames run (only its navigation variables, ``time`` and origin attributes are read).
+    range_limit_m : float
+        The radar's range limit, m; the window reaches this plus 1 km beyond every position.
+    source : str
+        Name of the run, for messages.
+
+    Returns
+    -------
+    Terrain
+        The window of the DEM under the run.
+
+    Raises
+    ------
+    DemCoverageError
+        When the DEM does not lie under every own-ship position.
+
+    Examples
+    --------
+    A run over 52.5 N, 4.5 E with a 2 km range limit reads the tile's samples within 3 km of the
+    track (range limit plus 1 km), not the whole tile:
+
+    >>> import tempfile, pathlib
+    >>> import xarray as xr
+    >>> ds = xr.Dataset({"nav_lat_deg": ("time", [52.5, 52.51]), "nav_lon_deg": ("time", [4.5, 4.5])},
+    ...                 coords={"time": [0.0, 1.0]})
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = pathlib.Path(d) / "N52E004.hgt"
+    ...     np.full((1201, 1201), 7, ">i2").tofile(p)
+    ...     terrain = dem_for_run(p, ds, 2000.0, "run.zarr")
+    >>> terrain.shape, float(terrain.height_at(52.5, 4.5))
+    ((81, 111), 7.0)
     """
     from skyradar.scene.dem_readers import read_dem
 

@@ -139,10 +139,12 @@ def read_hgt(path: str | Path, max_void_fraction: float = 0.01, bounds: Bounds |
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> p = pathlib.Path(tempfile.mkdtemp()) / "N52E004.hgt"
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> p = pathlib.Path(folder.name) / "N52E004.hgt"
     >>> np.full((1201, 1201), 7, ">i2").tofile(p)
     >>> read_hgt(p).bounds
     Bounds(south_deg=52.0, west_deg=4.0, north_deg=53.0, east_deg=5.0)
+    >>> folder.cleanup()
     """
     path = Path(path)
     match = _HGT_NAME.match(path.name)
@@ -205,6 +207,39 @@ def read_geotiff(path: str | Path, max_void_fraction: float = 0.01, bounds: Boun
     at pixel [0, 0] (its centre transformed to WGS84 lat/lon), with the spacing scaled to ground
     metres and the grid's rotation from true north (meridian convergence) measured at the anchor.
     The nodata value and NaN are voids.
+
+    Parameters
+    ----------
+    path : str or Path
+        The GeoTIFF (needs the ``geo`` extra, rasterio).
+    max_void_fraction : float
+        Largest share of void samples that is filled; more raise :class:`InputError`.
+    bounds : Bounds, optional
+        (south, west, north, east), deg: read only the window covering them.
+
+    Returns
+    -------
+    Terrain
+        Row 0 north and column 0 west, whichever way the file stores them.
+
+    Examples
+    --------
+    A 3 x 4 grid of 0.01 deg pixels whose north-west pixel centre is at 52.025 N, 4.005 E:
+
+    >>> import tempfile, pathlib
+    >>> import rasterio
+    >>> z = np.arange(12.0, dtype="float32").reshape(3, 4)
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = pathlib.Path(d) / "dem.tif"
+    ...     profile = {"driver": "GTiff", "height": 3, "width": 4, "count": 1, "dtype": "float32"}
+    ...     transform = rasterio.Affine(0.01, 0.0, 4.0, 0.0, -0.01, 52.03)  # pixel edges
+    ...     with rasterio.open(p, "w", crs="EPSG:4326", transform=transform, **profile) as dst:
+    ...         dst.write(z, 1)
+    ...     t = read_geotiff(p)
+    >>> t.kind, [round(v, 6) for v in t.bounds]
+    ('geographic', [52.005, 4.005, 52.025, 4.035])
+    >>> float(t.height_at(52.025, 4.005)), float(t.height_at(52.005, 4.035))  # z[0, 0], z[2, 3]
+    (0.0, 11.0)
     """
     path = Path(path)
     # The later rasterio imports of this module run only after this one succeeded.
@@ -352,6 +387,36 @@ def read_npz(path: str | Path, max_void_fraction: float = 0.01, bounds: Bounds |
     ``dx_m, dy_m, lat0_deg, lon0_deg`` (+ optional ``rotation_deg``) for a projected grid
     anchored at sample [0, 0]. Optional ``nodata``. With ``bounds`` only the window covering them is
     kept (and void-filled), as :func:`read_hgt` and :func:`read_geotiff` read theirs.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.npz`` file (no pickled objects).
+    max_void_fraction : float
+        Largest share of void samples that is filled; more raise :class:`InputError`.
+    bounds : Bounds, optional
+        (south, west, north, east), deg: keep only the window covering them.
+
+    Returns
+    -------
+    Terrain
+
+    Examples
+    --------
+    Sample centres 0.01 deg apart from 52.02 N, 4.0 E (north-west) to 52.0 N, 4.03 E (south-east);
+    between samples the height is bilinear:
+
+    >>> import tempfile, pathlib
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = pathlib.Path(d) / "dem.npz"
+    ...     np.savez(p, elevation=np.arange(12.0).reshape(3, 4), dx=0.01, dy=0.01, xmin=4.0, ymax=52.02)
+    ...     t = read_npz(p)
+    >>> t.bounds
+    Bounds(south_deg=52.0, west_deg=4.0, north_deg=52.02, east_deg=4.03)
+    >>> float(t.height_at(52.02, 4.0)), float(t.height_at(52.0, 4.03))  # corner samples
+    (0.0, 11.0)
+    >>> round(float(t.height_at(52.01, 4.015)), 6)  # halfway between z[1, 1] and z[1, 2]
+    5.5
     """
     path = Path(path)
     try:
@@ -400,10 +465,12 @@ def read_dem(
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> p = pathlib.Path(tempfile.mkdtemp()) / "N52E005.hgt"
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> p = pathlib.Path(folder.name) / "N52E005.hgt"
     >>> np.full((1201, 1201), 10, ">i2").tofile(p)
     >>> float(read_dem(p, height_offset_m=45.0).height_at(52.5, 5.5))
     55.0
+    >>> folder.cleanup()
     """
     path = Path(path)
     if not path.is_file():

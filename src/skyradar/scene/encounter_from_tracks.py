@@ -255,8 +255,46 @@ def encounter_scenario(
     """The scenario (as a dict for YAML) flying ``own_file`` and ``intruder_file`` around ``t_cpa_s``.
 
     The window is ``before_s`` before to ``after_s`` after the closest approach, cut to the time
-    both fly. The origin is the own ship's position at the closest approach; ``start_time`` is
+    both fly. The origin is the own-ship track's own (its ``origin``, where its local frame starts:
+    the same frame the intruder is placed in); ``start_time`` is
     the UTC of t = 0 s when the own-ship track had absolute timestamps.
+
+    Parameters
+    ----------
+    own, intruder : Trajectory
+        The two tracks, on one clock.
+    own_file, intruder_file : str
+        The files the scenario's flights read (paths as the scenario file will hold them).
+    t_cpa_s : float
+        Time of the closest approach on the tracks' clock, s.
+    before_s, after_s : float
+        Length of the window before and after the closest approach, s.
+    name : str
+        The scenario's name.
+
+    Returns
+    -------
+    dict
+        The scenario's sections (``name``, ``origin``, ``ownship``, ``intruders``, ``start_s``,
+        ``duration_s`` and, with absolute timestamps, ``start_time``), ready for YAML.
+
+    Raises
+    ------
+    InputError
+        When the two tracks do not fly at the same time within the window.
+
+    Examples
+    --------
+    Both fly 0..120 s and pass 200 m apart at 30 s; the window is cut to 0..50 s:
+
+    >>> from skyradar.scene.flights import straight
+    >>> own = straight([-1500, 0, 0], 0.0, 50.0, 120.0, origin=(47.0, 11.0, 1000.0), name="own")
+    >>> intr = straight([1500, 200, 0], 180.0, 50.0, 120.0, origin=(47.0, 11.0, 1000.0), name="B")
+    >>> s = encounter_scenario(own, intr, "own.csv", "b.csv", 30.0)
+    >>> s["origin"], s["start_s"], s["duration_s"]
+    ({'lat_deg': 47.0, 'lon_deg': 11.0, 'alt_m': 1000.0}, 0.0, 50.0)
+    >>> s["ownship"], s["intruders"][0]["name"], "start_time" in s
+    ({'type': 'file', 'path': 'own.csv', 'time_zero_s': 0.0}, 'B', False)
     """
     start = max(own.start_s, intruder.start_s, t_cpa_s - before_s)
     end = min(own.end_s, intruder.end_s, t_cpa_s + after_s)

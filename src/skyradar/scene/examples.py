@@ -36,7 +36,28 @@ def list_example_scenarios() -> list[str]:
 
 
 def example_scenario(name: str) -> Path:
-    """Path of a shipped example scenario (see :func:`list_example_scenarios`)."""
+    """Path of a shipped example scenario (see :func:`list_example_scenarios`).
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`list_example_scenarios`, with or without ``.yaml``.
+
+    Returns
+    -------
+    Path
+        The scenario file inside the installed package.
+
+    Raises
+    ------
+    InputError
+        For a name not shipped, listing the names that are.
+
+    Examples
+    --------
+    >>> example_scenario("ch2_flat_forward").name, example_scenario("ch2_flat_forward.yaml").is_file()
+    ('ch2_flat_forward.yaml', True)
+    """
     stem = name[: -len(".yaml")] if name.endswith(".yaml") else name
     path = _scenario_dir() / f"{stem}.yaml"
     if not path.is_file():

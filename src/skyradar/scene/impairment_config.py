@@ -27,7 +27,19 @@ class _Section(BaseModel):
 
 
 class Spur(BaseModel):
-    """One fixed spur: a bright pixel in every frame (nearest pixel; the velocity wraps)."""
+    """One fixed spur: a bright pixel in every frame (nearest pixel; the velocity wraps).
+
+    Examples
+    --------
+    >>> spur = Spur(range_m=300.0, velocity_mps=12.5, power_dbm=-125.0)
+    >>> spur.range_m, spur.velocity_mps, spur.power_dbm
+    (300.0, 12.5, -125.0)
+    >>> Spur(range_m=-1.0, velocity_mps=0.0, power_dbm=-125.0)  # a range is never negative
+    Traceback (most recent call last):
+    ...
+    pydantic_core._pydantic_core.ValidationError: 1 validation error for Spur
+    ...
+    """
 
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
     range_m: float = Field(ge=0.0, description="Range of the spur's pixel, m.")
@@ -37,7 +49,15 @@ class Spur(BaseModel):
 
 class SpursConfig(_Section):
     """Fixed spurs (self-interference), the same in every frame; each spur's phase per channel is fixed by
-    the impairments' ``seed``."""
+    the impairments' ``seed``.
+
+    Examples
+    --------
+    >>> spur = {"range_m": 750, "velocity_mps": -20, "power_dbm": -128}
+    >>> cfg = SpursConfig.model_validate({"spurs": [spur]})
+    >>> cfg.spurs[0].range_m, cfg.enabled, cfg.leakage, cfg.map_file, cfg.map_power_dbm
+    (750.0, True, True, None, -130.0)
+    """
 
     spurs: list[Spur] = Field(default_factory=list, description="The spurs, one entry each.")
     map_file: str | None = Field(
@@ -54,7 +74,16 @@ class SpursConfig(_Section):
 
 
 class ZeroDopplerConfig(_Section):
-    """A bright line on the zero-Doppler bin over all ranges."""
+    """A bright line on the zero-Doppler bin over all ranges.
+
+    Examples
+    --------
+    >>> cfg = ZeroDopplerConfig(power_dbm_at_100m=-110.0, falloff_db_per_decade=15.0)
+    >>> cfg.power_dbm_at_100m - 2 * cfg.falloff_db_per_decade  # pixel power at 10 km, dBm
+    -140.0
+    >>> cfg.width_bins, ZeroDopplerConfig(enabled=False).enabled
+    (1, False)
+    """
 
     power_dbm_at_100m: float = Field(-115.0, description="Pixel power at 100 m, dBm.")
     falloff_db_per_decade: float = Field(
@@ -66,7 +95,14 @@ class ZeroDopplerConfig(_Section):
 
 
 class NearRangeConfig(_Section):
-    """Returns at all velocities near the radar: a new random pattern every frame."""
+    """Returns at all velocities near the radar: a new random pattern every frame.
+
+    Examples
+    --------
+    >>> cfg = NearRangeConfig(range_m=50.0)
+    >>> cfg.power_dbm, cfg.range_m, cfg.power_dbm - 30.0  # mean pixel power at 0 m and at range_m, dBm
+    (-110.0, 50.0, -140.0)
+    """
 
     power_dbm: float = Field(-110.0, description="Mean pixel power at zero range, dBm.")
     range_m: float = Field(
@@ -77,7 +113,18 @@ class NearRangeConfig(_Section):
 
 
 class ChannelErrorsConfig(_Section):
-    """Per-antenna gain and phase errors; channel 0 is the reference."""
+    """Per-antenna gain and phase errors; channel 0 is the reference.
+
+    Examples
+    --------
+    Given errors per channel, or standard deviations to draw them with:
+
+    >>> given = ChannelErrorsConfig(gain_db=[0.0, 0.5, -0.3, 0.2], phase_deg=[0.0, 10.0, -5.0, 3.0])
+    >>> given.gain_db[1], given.phase_deg[1], given.gain_sd_db
+    (0.5, 10.0, 0.0)
+    >>> ChannelErrorsConfig(gain_sd_db=0.5, phase_sd_deg=10.0).gain_db is None
+    True
+    """
 
     gain_db: list[float] | None = Field(
         None, description="Gain error of each receive channel, dB; unset: drawn with ``gain_sd_db``."
@@ -92,7 +139,13 @@ class ChannelErrorsConfig(_Section):
 
 
 class NoiseConfig(_Section):
-    """Thermal receiver noise added with the impairments."""
+    """Thermal receiver noise added with the impairments.
+
+    Examples
+    --------
+    >>> NoiseConfig().noise_figure_db is None, NoiseConfig(noise_figure_db=8.0).noise_figure_db
+    (True, 8.0)
+    """
 
     noise_figure_db: float | None = Field(None, description="Receiver noise figure, dB; unset: the radar's.")
 
@@ -165,6 +218,27 @@ def thesis_flight_look(seed: int = 0) -> ImpairmentConfig:
     every frame; returns at all velocities within 100 m; a bright zero-Doppler line (45 dB above
     noise at 100 m, 30 dB at 1 km, 20 dB at 5 km); 0.5 dB / 10 deg channel errors. Thermal noise is left
     to the simulator.
+
+    Parameters
+    ----------
+    seed : int
+        Seed of the fixed patterns (spur phases, zero-Doppler line, channel errors).
+
+    Returns
+    -------
+    ImpairmentConfig
+
+    Examples
+    --------
+    The zero-Doppler line falls 15 dB per decade of range, 15 dB from 100 m to 1 km:
+
+    >>> imp = thesis_flight_look(seed=3)
+    >>> [s.range_m for s in imp.spurs.spurs]
+    [300.0, 750.0, 1200.0, 1950.0, 2700.0, 3600.0]
+    >>> imp.zero_doppler.power_dbm_at_100m - imp.zero_doppler.falloff_db_per_decade, imp.seed
+    (-125.0, 3)
+    >>> imp.ground_reflectivity_db, imp.channel_errors.phase_sd_deg, imp.noise is None
+    (-10.0, 10.0, True)
     """
     spurs = [
         (300.0, 12.5, -125.0),

@@ -30,7 +30,27 @@ __all__ = ["MapRaster", "local_crs", "read_map_raster"]
 
 @dataclass(frozen=True)
 class MapRaster:
-    """A reference image on a ground grid: ``image`` (float32, NaN where the file has no data)."""
+    """A reference image on a ground grid: ``image`` (float32, NaN where the file has no data).
+
+    Attributes
+    ----------
+    image : ndarray of float32, shape ``grid.shape``
+        The band's values on the grid's pixels.
+    grid : GroundGrid
+        The north/east pixel grid in the local frame of the origin.
+    origin_lat_deg, origin_lon_deg : float
+        Geodetic origin of the local frame, deg (WGS84).
+    source : str
+        The file, for messages.
+
+    Examples
+    --------
+    >>> from skyradar.scene.ground_grid import GroundGrid
+    >>> grid = GroundGrid.from_extent(-20.0, 20.0, -20.0, 20.0, pixel_m=10.0)
+    >>> m = MapRaster(np.zeros(grid.shape, np.float32), grid, 52.0, 4.0, "map.tif")
+    >>> m.image.shape == m.grid.shape, m.source
+    (True, 'map.tif')
+    """
 
     image: np.ndarray
     grid: GroundGrid
@@ -40,7 +60,27 @@ class MapRaster:
 
 
 def local_crs(origin_lat_deg: float, origin_lon_deg: float) -> CRS:
-    """The CRS whose (x, y) in metres is the local (east, north) about a WGS84 origin."""
+    """The CRS whose (x, y) in metres is the local (east, north) about a WGS84 origin.
+
+    Parameters
+    ----------
+    origin_lat_deg, origin_lon_deg : float
+        The origin, deg (WGS84).
+
+    Returns
+    -------
+    rasterio.crs.CRS
+        An azimuthal equidistant projection centred on the origin, in metres.
+
+    Examples
+    --------
+    The origin is (0, 0), and 1000 m north is 1000 m of meridian arc, 0.008987 deg at 52 N:
+
+    >>> from rasterio.warp import transform
+    >>> lon, lat = transform(local_crs(52.0, 4.0), "EPSG:4326", [0.0, 0.0], [0.0, 1000.0])
+    >>> [round(v, 6) for v in lon], [round(v, 6) for v in lat]
+    ([4.0, 4.0], [52.0, 52.008987])
+    """
     crs = import_extra("rasterio.crs", "geo", "reading a raster map")
     return crs.CRS.from_proj4(
         f"+proj=aeqd +lat_0={origin_lat_deg!r} +lon_0={origin_lon_deg!r} +datum=WGS84 +units=m"
@@ -68,16 +108,44 @@ def read_map_raster(
 
     Parameters
     ----------
-    path : GeoTIFF (or any raster GDAL reads) with a CRS and a geotransform.
-    grid : the destination grid in the local frame; default the raster's extent at its native resolution.
-    origin_lat_deg, origin_lon_deg : geodetic origin of the local frame; default the raster's centre.
-    band : 1-based band number.
+    path : str or Path
+        GeoTIFF (or any raster GDAL reads) with a CRS and a geotransform.
+    grid : GroundGrid, optional
+        The destination grid in the local frame; default the raster's extent at its native resolution.
+    origin_lat_deg, origin_lon_deg : float, optional
+        Geodetic origin of the local frame, deg; default the raster's centre.
+    band : int
+        1-based band number.
+
+    Returns
+    -------
+    MapRaster
+        The band on ``grid``, NaN where the raster has no data.
 
     Raises
     ------
     InputError
         One line naming the file: missing, unreadable, no georeference, no such band, or a band
         without one finite value.
+
+    Examples
+    --------
+    A 3 x 4 raster of 0.01 deg pixels; at the origin, the centre of pixel [1, 1], the band's value
+    comes back:
+
+    >>> import tempfile, pathlib
+    >>> import rasterio
+    >>> z = np.arange(12.0, dtype="float32").reshape(3, 4)
+    >>> grid = GroundGrid.from_extent(-150.0, 150.0, -150.0, 150.0, pixel_m=100.0)  # [1, 1] at (0, 0)
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = pathlib.Path(d) / "map.tif"
+    ...     profile = {"driver": "GTiff", "height": 3, "width": 4, "count": 1, "dtype": "float32"}
+    ...     transform = rasterio.Affine(0.01, 0.0, 4.0, 0.0, -0.01, 52.03)  # pixel edges
+    ...     with rasterio.open(p, "w", crs="EPSG:4326", transform=transform, **profile) as dst:
+    ...         dst.write(z, 1)
+    ...     m = read_map_raster(p, grid, origin_lat_deg=52.015, origin_lon_deg=4.015)
+    >>> m.image.shape, round(float(m.image[1, 1]), 3), (m.origin_lat_deg, m.origin_lon_deg)
+    ((3, 3), 5.0, (52.015, 4.015))
     """
     path = Path(path)
     rasterio = import_extra("rasterio", "geo", f"reading {path}")

@@ -30,7 +30,27 @@ __all__ = ["MAP_STYLE", "MapStyle", "render_reference_map", "outdated_map", "che
 
 @dataclass(frozen=True)
 class MapStyle:
-    """Grey levels (0 black .. 1 white) and line widths of the cartographic rendering."""
+    """Grey levels (0 black .. 1 white) and line widths of the cartographic rendering.
+
+    Widths (``*_m``) are in m on the ground; every other field is a grey level.
+
+    Examples
+    --------
+    A darker road fill and a 3 m casing either side of a 12 m road; 8 m off its centre line the
+    casing shows, 10 m off the background:
+
+    >>> import geopandas as gpd
+    >>> from shapely.geometry import LineString
+    >>> empty = gpd.GeoDataFrame(geometry=[])
+    >>> road = gpd.GeoDataFrame({"road_class": ["primary"], "width_m": [12.0]},
+    ...                         geometry=[LineString([(-50, 0), (50, 0)])])
+    >>> layers = MapLayers(gpd.GeoDataFrame({"height_m": []}, geometry=[]), road, empty, empty, empty,
+    ...                    empty, empty, 60.0, 25.0)
+    >>> style = MapStyle(road_fill=0.8, road_casing_m=3.0)
+    >>> image = render_reference_map(layers, GroundGrid.from_extent(-20, 20, -20, 20, pixel_m=1.0), style)
+    >>> [round(float(v), 2) for v in image[[20, 28, 30], 20]]  # north 0.5, 8.5 and 10.5 m
+    [0.8, 0.55, 0.93]
+    """
 
     background: float = 0.93
     open_land: float = 0.88

@@ -113,6 +113,27 @@ def with_preset(value: Any) -> Any:
 
     ``None`` is ``ga-typical``; a name is ``{model: name}``; anything that is not a known model
     passes through unchanged for the model's own validation to refuse.
+
+    Parameters
+    ----------
+    value : None, str or dict
+        The scenario's ``navigation`` section as written.
+
+    Returns
+    -------
+    dict or Any
+        Every field of the named model, the keys given in ``value`` replacing its values; ``value``
+        itself when it names no known model.
+
+    Examples
+    --------
+    >>> heading = with_preset("only-heading")
+    >>> heading["model"], heading["heading_bias_deg"], heading["gnss_latency_s"], heading["heading_tau_s"]
+    ('only-heading', 1.5, 0.0, 300.0)
+    >>> with_preset({"model": "perfect", "gnss_latency_s": 0.1})["gnss_latency_s"]
+    0.1
+    >>> with_preset({"model": "unknown"})
+    {'model': 'unknown'}
     """
     if value is None or isinstance(value, str):
         value = {"model": "ga-typical" if value is None else value}
@@ -138,6 +159,16 @@ class NavigationConfig(BaseModel):
     standard deviation ``*_bias_*`` and correlation time ``*_tau_s``). A plain string is a model
     name (``navigation: only-heading``); keys given beside ``model`` override its values. The
     values of ``ga-typical`` and their sources: :mod:`skyradar.scene.navigation_config`.
+
+    Examples
+    --------
+    Validated from a section with its model's values filled in (:func:`with_preset`):
+
+    >>> latency = NavigationConfig.model_validate(with_preset("only-latency"))
+    >>> latency.gnss_latency_s, latency.ahrs_latency_s, latency.heading_bias_deg, latency.is_perfect
+    (0.2, 0.02, 0.0, False)
+    >>> NavigationConfig.model_validate(with_preset("perfect")).is_perfect
+    True
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)

@@ -35,7 +35,22 @@ SINGLE_HEAD_NAME = "radar"  # the head of a scenario without a radars: list
 
 @dataclass(frozen=True)
 class RadarHead:
-    """One radar head: its name (the detections' ``radar`` column) and its hardware and mount."""
+    """One radar head: its name (the detections' ``radar`` column) and its hardware and mount.
+
+    Attributes
+    ----------
+    name : str
+        The head's name; its frames are the store's group of that name.
+    config : RadarConfig
+        The head's radar, its mount (``config.mount``) inside.
+
+    Examples
+    --------
+    >>> from skyradar.config import Mount
+    >>> head = RadarHead("right", RadarConfig(mount=Mount.preset("right-wingtip")))
+    >>> head.name, head.config.mount.yaw_deg
+    ('right', 75.0)
+    """
 
     name: str
     config: RadarConfig
@@ -46,6 +61,32 @@ def scenario_heads(scenario: Any) -> list[RadarHead]:
 
     Raises :class:`InputError` naming the scenario and the field on a duplicate name, an unknown
     mount or a bad override, and when both ``mount`` and ``radars`` are given.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The validated scenario.
+
+    Returns
+    -------
+    list of RadarHead
+        In the order of ``radars:``; one head named ``"radar"`` without it.
+
+    Examples
+    --------
+    A head's ``radar`` keys override the top-level ones for that head only:
+
+    >>> from skyradar.scene.scenario import Scenario
+    >>> data = {"origin": {"lat_deg": 52.0, "lon_deg": 4.0}, "duration_s": 1, "radar": {"pe_dbm": 30},
+    ...         "ownship": {"type": "straight", "speed_mps": 50, "start_ned_m": [0, 0, -500]},
+    ...         "radars": [{"name": "nose", "mount": "nose"},
+    ...                    {"name": "tail", "mount": "tail", "radar": {"pe_dbm": 40}}]}
+    >>> heads = scenario_heads(Scenario.from_dict(data))
+    >>> [(h.name, h.config.pe_dbm, h.config.mount.yaw_deg) for h in heads]
+    [('nose', 30.0, 0.0), ('tail', 40.0, 180.0)]
+    >>> del data["radars"]
+    >>> [(h.name, h.config.pe_dbm) for h in scenario_heads(Scenario.from_dict(data))]
+    [('radar', 30.0)]
     """
     m = scenario.model
     if m.radars is None:

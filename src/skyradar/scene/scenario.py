@@ -68,7 +68,24 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Intruder:
-    """Another aircraft: its trajectory (scenario NED frame) and radar cross-section (m^2)."""
+    """Another aircraft: its trajectory (scenario NED frame) and radar cross-section (m^2).
+
+    Attributes
+    ----------
+    name : str
+        The frames' ``target`` name.
+    trajectory : Trajectory
+        Its flight in the scenario's NED frame.
+    rcs_m2 : float
+        Radar cross-section, m^2.
+
+    Examples
+    --------
+    >>> from skyradar.scene.flights import straight
+    >>> b = Intruder("B", straight([2000, 0, -500], 180.0, 40.0, 60.0, origin=(52.0, 4.0, 0.0)), rcs_m2=2.0)
+    >>> b.name, b.rcs_m2, np.round(b.trajectory.sample([10.0]).position_ned_m, 6).tolist()
+    ('B', 2.0, [[1600.0, 0.0, -500.0]])
+    """
 
     name: str
     trajectory: Trajectory
@@ -82,6 +99,26 @@ class BuiltScenario:
     ``times_s`` are the frame times (s). Intruders exist only inside their trajectories' spans
     (``intruder.trajectory.covers(times_s)``); own-ship covers every frame. ``sim_options`` keys:
     facet_size_m, reflectivity, occlusion, noise, flat_earth, range_doppler_coupling, seed.
+
+    Examples
+    --------
+    Built by :meth:`Scenario.build`; a 50 m/s own-ship flying north is 500 m north after 10 s and
+    the intruder, 2 km ahead at 40 m/s head-on, 400 m closer:
+
+    >>> data = {"origin": {"lat_deg": 52.0, "lon_deg": 4.0}, "duration_s": 10, "frame_rate_hz": 2,
+    ...         "ownship": {"type": "straight", "speed_mps": 50, "start_ned_m": [0, 0, -500]},
+    ...         "intruders": [{"name": "B", "type": "straight", "heading_deg": 180, "speed_mps": 40,
+    ...                        "start_ned_m": [2000, 0, -500], "rcs_m2": 2}]}
+    >>> built = Scenario.from_dict(data).build()
+    >>> len(built.times_s), float(built.times_s[-1]), built.origin, built.terrain is None
+    (20, 9.5, (52.0, 4.0, 0.0), True)
+    >>> np.round(built.ownship.sample([10.0]).position_ned_m, 6).tolist()
+    [[500.0, 0.0, -500.0]]
+    >>> b = built.intruders[0]
+    >>> b.name, b.rcs_m2, np.round(b.trajectory.sample([10.0]).position_ned_m, 6).tolist()
+    ('B', 2.0, [[1600.0, 0.0, -500.0]])
+    >>> [h.name for h in built.heads]
+    ['radar']
     """
 
     name: str
@@ -109,6 +146,36 @@ def load_scenario(path: str | Path) -> Scenario:
     """Read and validate a scenario YAML file.
 
     Raises :class:`InputError` (one line naming the file and the field) on any problem.
+
+    Parameters
+    ----------
+    path : str or Path
+        The YAML file; paths inside it are relative to its folder.
+
+    Returns
+    -------
+    Scenario
+        Validated, not yet built (:meth:`Scenario.build`).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> text = ("origin: {lat_deg: 52.0, lon_deg: 4.0}\\nduration_s: 5\\nframe_rate_hz: 2\\n"
+    ...         "ownship: {type: straight, heading_deg: 90, speed_mps: 40, start_ned_m: [0, 0, -300]}\\n")
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     f = pathlib.Path(d) / "east.yaml"
+    ...     _ = f.write_text(text)
+    ...     scenario = load_scenario(f)
+    ...     _ = f.write_text(text.replace("frame_rate_hz: 2", "frame_rate_hz: -5"))
+    ...     try:
+    ...         load_scenario(f)
+    ...     except InputError as exc:
+    ...         print(str(exc).replace(d, "DIR"))
+    DIR/east.yaml: field 'frame_rate_hz': must be > 0 (got -5)
+    >>> scenario.frame_times().tolist()
+    [0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5]
+    >>> np.round(scenario.build().ownship.sample([5.0]).position_ned_m, 6).tolist()  # 40 m/s east for 5 s
+    [[0.0, 200.0, -300.0]]
     """
     path = Path(path)
     if not path.is_file():
@@ -126,7 +193,29 @@ def load_scenario(path: str | Path) -> Scenario:
 
 
 class Scenario:
-    """A validated scenario file; :meth:`build` makes the trajectories, terrain and radar."""
+    """A validated scenario file; :meth:`build` makes the trajectories, terrain and radar.
+
+    Parameters
+    ----------
+    model : ScenarioModel
+        The validated file (:meth:`from_dict` validates a mapping).
+    source : Path, optional
+        The scenario file: relative paths in it are relative to its folder, and messages name it.
+
+    Examples
+    --------
+    A 50 m/s own-ship circling at 500 m radius is opposite its start after half a turn,
+    pi 500 / 50 s, and back after a whole one:
+
+    >>> data = {"origin": {"lat_deg": 52.0, "lon_deg": 4.0}, "duration_s": 63, "frame_rate_hz": 1,
+    ...         "ownship": {"type": "circle", "center_ned_m": [0, 0, -500], "radius_m": 500, "speed_mps": 50}}
+    >>> scenario = Scenario.from_dict(data)
+    >>> scenario.name, len(scenario.frame_times())
+    ('scenario', 63)
+    >>> own = scenario.build().ownship
+    >>> np.round(own.sample([0.0, 10 * np.pi, 20 * np.pi]).position_ned_m, 3).tolist()
+    [[500.0, 0.0, -500.0], [-500.0, 0.0, -500.0], [500.0, 0.0, -500.0]]
+    """
 
     def __init__(self, model: ScenarioModel, source: Path | None = None) -> None:
         self.model = model

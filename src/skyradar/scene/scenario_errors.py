@@ -20,7 +20,28 @@ def _describe(value: Any) -> str:
 
 
 def validation_error_line(source: str, err: Mapping[str, Any]) -> str:
-    """One line from a pydantic error: file, dotted field, what is wrong, the value."""
+    """One line from a pydantic error: file, dotted field, what is wrong, the value.
+
+    Parameters
+    ----------
+    source : str
+        The scenario file (or a label), first on the line.
+    err : Mapping
+        One entry of pydantic's ``ValidationError.errors()``; union tags leave the dotted field.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> err = {"type": "greater_than", "loc": ("frame_rate_hz",), "ctx": {"gt": 0.0}, "input": -5}
+    >>> validation_error_line("s.yaml", err)
+    "s.yaml: field 'frame_rate_hz': must be > 0 (got -5)"
+    >>> err = {"type": "extra_forbidden", "loc": ("ownship", "straight", "sped_mps")}  # "straight": a tag
+    >>> validation_error_line("s.yaml", err)
+    "s.yaml: unknown key 'ownship.sped_mps'"
+    """
     loc = [
         str(p) for p in err["loc"] if not (isinstance(p, str) and (p in TAGS or p.startswith("function-")))
     ]

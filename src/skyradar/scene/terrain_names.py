@@ -34,7 +34,27 @@ _OPTION = "option '--terrain'"
 
 
 def terrain_spec_attr(model: Any) -> str | None:
-    """JSON of a scenario's terrain model for the run's ``terrain`` attribute; None for a file DEM."""
+    """JSON of a scenario's terrain model for the run's ``terrain`` attribute; None for a file DEM.
+
+    Parameters
+    ----------
+    model : terrain model or None
+        A scenario's ``terrain`` section (:mod:`skyradar.scene.scenario_models`).
+
+    Returns
+    -------
+    str or None
+        The section as JSON for ``flat``, ``fractal`` and ``jacksboro``; None for a file DEM or no
+        terrain.
+
+    Examples
+    --------
+    >>> from skyradar.scene.scenario_models import FileTerrainModel, FlatTerrainModel
+    >>> terrain_spec_attr(FlatTerrainModel(type="flat", height_m=12.0, size_m=3000.0))
+    '{"height_m": 12.0, "size_m": 3000.0, "spacing_m": 30.0, "type": "flat"}'
+    >>> terrain_spec_attr(FileTerrainModel(type="file", path="N52E004.hgt")) is None
+    True
+    """
     if model is None or getattr(model, "type", None) not in BUILTIN_TERRAINS:
         return None
     return json.dumps(model.model_dump(mode="json"))
@@ -65,7 +85,32 @@ def _origin(ds: Any, source: str) -> tuple[float, float, float]:
 
 
 def recorded_terrain(ds: Any, source: str = "frames") -> Terrain | None:
-    """The scenario terrain a run records (attribute ``terrain``), rebuilt; None when it records none."""
+    """The scenario terrain a run records (attribute ``terrain``), rebuilt; None when it records none.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The frames run (its attributes ``terrain`` and origin are read).
+    source : str
+        Name of the run, for messages.
+
+    Returns
+    -------
+    Terrain or None
+
+    Examples
+    --------
+    A run that records a flat terrain 12 m above the ellipsoid, 3 km square, about its origin:
+
+    >>> import xarray as xr
+    >>> spec = '{"type": "flat", "height_m": 12.0, "size_m": 3000.0, "spacing_m": 30.0}'
+    >>> ds = xr.Dataset(attrs={"terrain": spec, "origin_lat_deg": 52.0, "origin_lon_deg": 4.0})
+    >>> t = recorded_terrain(ds)
+    >>> t.shape, [round(v, 6) for v in t.center_latlon], float(t.height_at(52.0, 4.0))
+    ((101, 101), [52.0, 4.0], 12.0)
+    >>> recorded_terrain(xr.Dataset()) is None
+    True
+    """
     spec = _spec(ds)
     if spec is None:
         return None
@@ -113,6 +158,38 @@ def terrain_for_run(value: str, ds: Any, range_limit_m: float, source: str) -> T
 
     Raises :class:`InputError` (one line) for an unknown name, a file that is not a DEM, a DEM or
     built-in terrain that does not lie under the own-ship, or a run without own-ship position.
+
+    Parameters
+    ----------
+    value : str
+        ``flat``, ``fractal``, ``jacksboro`` (any case) or a DEM file path.
+    ds : xarray.Dataset
+        The frames run (navigation variables, ``time`` and attributes are read).
+    range_limit_m : float
+        The radar's range limit, m: how far around the own-ship a DEM is read.
+    source : str
+        Name of the run, for messages.
+
+    Returns
+    -------
+    Terrain
+
+    Examples
+    --------
+    ``flat`` rebuilds the flat terrain the run records:
+
+    >>> import xarray as xr
+    >>> spec = '{"type": "flat", "height_m": 12.0, "size_m": 3000.0}'
+    >>> ds = xr.Dataset({"nav_lat_deg": ("time", [52.0, 52.001]), "nav_lon_deg": ("time", [4.0, 4.0])},
+    ...                 coords={"time": [0.0, 1.0]},
+    ...                 attrs={"terrain": spec, "origin_lat_deg": 52.0, "origin_lon_deg": 4.0})
+    >>> float(terrain_for_run("Flat", ds, 1000.0, "run.zarr").height_at(52.0, 4.0))
+    12.0
+    >>> terrain_for_run("hills", ds, 1000.0, "run.zarr")
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: option '--terrain': 'hills' is neither a DEM file nor a built-in terrain \
+(flat, fractal, jacksboro)
     """
     from skyradar.io.frames_model import frame_times_s
     from skyradar.scene.dem_coverage import check_dem_covers, dem_for_run, run_track

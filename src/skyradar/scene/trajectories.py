@@ -43,7 +43,40 @@ MIN_TRACK_SPEED_MPS = 0.5  # below this the track angle is noise; heading is hel
 
 @dataclass(frozen=True)
 class TrajectorySample:
-    """States of a trajectory at requested times (arrays of length n; vectors (n, 3))."""
+    """States of a trajectory at requested times (arrays of length n; vectors (n, 3)).
+
+    Attributes
+    ----------
+    time_s : ndarray, shape (n,)
+        The requested times, s.
+    position_ned_m : ndarray, shape (n, 3)
+        Positions (north, east, down) in the trajectory's NED frame, m.
+    velocity_ned_mps : ndarray, shape (n, 3)
+        Velocities in the same frame, m/s.
+    attitude_rad : ndarray, shape (n, 3)
+        (yaw, pitch, roll), rad.
+    lat_deg, lon_deg : ndarray, shape (n,)
+        Geodetic positions, deg.
+    alt_m : ndarray, shape (n,)
+        Heights above the WGS84 ellipsoid, m.
+
+    Examples
+    --------
+    Made by :meth:`Trajectory.sample`; 30 m/s east from the origin is 300 m east after 10 s:
+
+    >>> positions = [[0, 0, -1000], [0, 600, -1000]]
+    >>> traj = Trajectory.from_states([0.0, 20.0], positions, origin=(52.0, 4.0, 0.0))
+    >>> s = traj.sample([10.0, 20.0])
+    >>> len(s), s.position_ned_m[0].tolist(), s.velocity_ned_mps[0].tolist()
+    (2, [0.0, 300.0, -1000.0], [0.0, 30.0, 0.0])
+
+    Heading east (yaw 90 deg), and 300 m east is 0.0044 deg of longitude at 52 N:
+
+    >>> round(float(np.degrees(s.attitude_rad[0, 0])), 2)
+    90.0
+    >>> round(float(s.lat_deg[0]), 4), round(float(s.lon_deg[0]), 4), round(float(s.alt_m[0]), 1)
+    (52.0, 4.0044, 1000.0)
+    """
 
     time_s: np.ndarray
     position_ned_m: np.ndarray

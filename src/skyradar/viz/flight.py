@@ -39,6 +39,22 @@ def flight_fit_figure(fit: FlightFit, path: str | Path, window_s: tuple[float, f
     -------
     Path
         ``path``.
+
+    Examples
+    --------
+    Four fixes of a flight north at 11 m/s; the SVG, with its text kept as text, names what each
+    panel shows:
+
+    >>> import re, tempfile
+    >>> from skyradar.scene.adsb import fit_flight
+    >>> rows = "0,52,4,300\\n10,52.001,4,300\\n20,52.002,4,300\\n30,52.003,4,300\\n"
+    >>> with tempfile.TemporaryDirectory() as d, plt.rc_context({"svg.fonttype": "none"}):
+    ...     f = Path(d) / "ga.csv"
+    ...     _ = f.write_text("time_s,latitude,longitude,alt_m\\n" + rows)
+    ...     svg = flight_fit_figure(fit_flight(f), Path(d) / "ga.svg").read_text()
+    >>> texts = re.findall(r"<text[^>]*>([^<]*)</text>", svg)
+    >>> [t for t in ("ga: map", "fixes used (4)", "speed", "ga horizontal limit") if t in texts]
+    ['ga: map', 'fixes used (4)', 'speed', 'ga horizontal limit']
     """
     traj = fit.trajectory
     start, end = window_s if window_s is not None else (traj.start_s, traj.end_s)

@@ -44,7 +44,43 @@ def _save(fig, path: Path) -> Path:
 
 
 def plot_range_doppler(frame, config, detections: pd.DataFrame, title: str, path: Path) -> Path:
-    """Strength image of one frame with its detections (ground: white dots, others: red circles)."""
+    """Strength image of one frame with its detections (ground: white dots, others: red circles).
+
+    Parameters
+    ----------
+    frame : ndarray
+        One frame, (range, doppler, rx), complex.
+    config : RadarConfig
+        The radar (axes and noise power).
+    detections : DataFrame
+        The frame's detections: ``range_m`` (m), ``radial_velocity_mps`` (m/s), ``is_ground``, ``spur``.
+    title : str
+        The figure's title.
+    path : Path
+        The image to write (format by its suffix).
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Examples
+    --------
+    One detection on the ground, one spur, one kept; the SVG (text kept as text) counts them in
+    the legend:
+
+    >>> import re, tempfile
+    >>> from skyradar.config import RadarConfig
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> frame = np.full((cfg.n_range, cfg.n_doppler, cfg.n_rx), np.sqrt(cfg.noise_power_w), complex)
+    >>> det = pd.DataFrame({"range_m": [300.0, 900.0, 1200.0], "radial_velocity_mps": [0.0, -5.0, 10.0],
+    ...                     "is_ground": [True, False, False], "spur": [False, False, True]})
+    >>> with tempfile.TemporaryDirectory() as d, plt.rc_context({"svg.fonttype": "none"}):
+    ...     svg = plot_range_doppler(frame, cfg, det, "frame 7", Path(d) / "rd.svg").read_text()
+    >>> texts = lambda svg: re.findall(r"<text[^>]*>([^<]*)</text>", svg)
+    >>> [t for t in texts(svg) if "(" in t or "frame" in t]
+    ['frame 7', 'ground/spur (2)', 'kept for tracking (1)']
+    """
     fig, ax = plt.subplots(figsize=(7, 5))
     plot_strength(frame, config, ax=ax)
     ground = detections["is_ground"].to_numpy(bool) | detections["spur"].to_numpy(bool)
@@ -74,7 +110,43 @@ def plot_range_doppler(frame, config, detections: pd.DataFrame, title: str, path
 def plot_plan_view(
     truth, tracks: pd.DataFrame, labels: dict[int, str], alerts: pd.DataFrame, path: Path
 ) -> Path:
-    """North/east plan view: own-ship and intruder truth, confirmed 3-D tracks, warning points."""
+    """North/east plan view: own-ship and intruder truth, confirmed 3-D tracks, warning points.
+
+    Parameters
+    ----------
+    truth : xarray.Dataset
+        A run's truth: ``own_north_m``, ``own_east_m`` (time), ``tgt_north_m``, ``tgt_east_m``
+        (time, target), m, and the frame times.
+    tracks : DataFrame
+        Tracks table: ``track_id``, ``confirmed``, ``north_m``, ``east_m`` (m).
+    labels : dict of int to str
+        Intruder name per track id; others are drawn grey as clutter.
+    alerts : DataFrame
+        Alerts table: ``time_s`` (s), ``level``, ``rel_north_m``, ``rel_east_m`` (m, from the own-ship).
+    path : Path
+        The image to write (format by its suffix).
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Examples
+    --------
+    The sample encounter of :mod:`skyradar.web.sample`, one confirmed track on ``head-on``:
+
+    >>> import re, tempfile
+    >>> from skyradar.web.sample import sample_run_dataset
+    >>> truth = sample_run_dataset(n_frames=3)
+    >>> tracks = pd.DataFrame({"track_id": [1, 1], "confirmed": True, "east_m": 0.0,
+    ...                        "north_m": [6400.0, 6300.0]})
+    >>> alerts = pd.DataFrame({"time_s": [1.0], "level": [3], "rel_east_m": [0.0], "rel_north_m": [6300.0]})
+    >>> with tempfile.TemporaryDirectory() as d, plt.rc_context({"svg.fonttype": "none"}):
+    ...     svg = plot_plan_view(truth, tracks, {1: "head-on"}, alerts, Path(d) / "plan.svg").read_text()
+    >>> texts = lambda svg: re.findall(r"<text[^>]*>([^<]*)</text>", svg)
+    >>> [t for t in texts(svg) if t in ("T1", "own-ship", "head-on truth", "crossing truth", "north [m]")]
+    ['north [m]', 'T1', 'own-ship', 'head-on truth', 'crossing truth']
+    """
     fig, ax = plt.subplots(figsize=(7, 7))
     ax.plot(truth["own_east_m"], truth["own_north_m"], "k-", lw=2, label="own-ship")
     ax.plot(truth["own_east_m"][0], truth["own_north_m"][0], "k>", ms=8)
@@ -109,7 +181,37 @@ def plot_plan_view(
 
 
 def plot_alert_timeline(alerts: pd.DataFrame, labels: dict[int, str], t_span_s, path: Path) -> Path:
-    """Issued alert level of every alerting-capable track over time, one row per track."""
+    """Issued alert level of every alerting-capable track over time, one row per track.
+
+    Parameters
+    ----------
+    alerts : DataFrame
+        Alerts table: ``time_s`` (s), ``track_id``, ``level`` (0-3).
+    labels : dict of int to str
+        Intruder name per track id; other tracks are labelled ``clutter``.
+    t_span_s : (float, float)
+        The time axis' span, s.
+    path : Path
+        The image to write (format by its suffix).
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Examples
+    --------
+    Two tracks, one row each, labelled by their intruder:
+
+    >>> import re, tempfile
+    >>> alerts = pd.DataFrame({"time_s": [0.0, 1.0, 1.0, 2.0], "track_id": [1, 1, 4, 4],
+    ...                        "level": [1, 3, 0, 0]})
+    >>> with tempfile.TemporaryDirectory() as d, plt.rc_context({"svg.fonttype": "none"}):
+    ...     svg = plot_alert_timeline(alerts, {1: "collision"}, (0.0, 3.0), Path(d) / "t.svg").read_text()
+    >>> texts = lambda svg: re.findall(r"<text[^>]*>([^<]*)</text>", svg)
+    >>> [t for t in texts(svg) if t.startswith("T")]
+    ['T1 (collision)', 'T4 (clutter)']
+    """
     ids = sorted(alerts["track_id"].unique()) if len(alerts) else []
     fig, ax = plt.subplots(figsize=(8, 0.5 * max(len(ids), 2) + 1.5))
     for row, tid in enumerate(ids):

@@ -151,6 +151,31 @@ class LoopbackHostOnly:
     A server bound to 127.0.0.1 is still reachable from a web page through DNS rebinding (a name
     that first resolves to the attacker, then to 127.0.0.1); such requests carry the attacker's
     name in ``Host``, so refusing other names closes that door.
+
+    Parameters
+    ----------
+    app : ASGI application
+        The application requests with a loopback ``Host`` pass on to.
+
+    Examples
+    --------
+    Driven directly with ASGI messages (no server): a loopback ``Host`` reaches the app, another name
+    gets 403 over HTTP and close code 1008 over a WebSocket.
+
+    >>> import asyncio
+    >>> async def app(scope, receive, send):
+    ...     await send({"type": "http.response.start", "status": 200, "headers": []})
+    >>> sent = []
+    >>> async def send(message):
+    ...     sent.append(message)
+    >>> async def receive():
+    ...     return {}
+    >>> guard = LoopbackHostOnly(app)
+    >>> requests = [("http", b"127.0.0.1:8765"), ("http", b"evil.example"), ("websocket", b"evil.example")]
+    >>> for kind, host in requests:
+    ...     asyncio.run(guard({"type": kind, "headers": [(b"host", host)]}, receive, send))
+    >>> [m.get("status", m.get("code")) for m in sent if m["type"] != "http.response.body"]
+    [200, 403, 1008]
     """
 
     def __init__(self, app: Any):

@@ -91,7 +91,36 @@ def sample_run_dataset(
 
 
 def write_sample_run(path: str | Path, n_frames: int = 60, dt_s: float = 1.0, chunk_frames: int = 10) -> Path:
-    """Write the sample run as a Zarr frames store at ``path`` (atomically, via ``.partial``)."""
+    """Write the sample run as a Zarr frames store at ``path`` (atomically, via ``.partial``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The store to write (``RUN.zarr``).
+    n_frames : int
+        Number of frames.
+    dt_s : float
+        Time between frames, s.
+    chunk_frames : int
+        Frames per stored chunk.
+
+    Returns
+    -------
+    Path
+        The finished store.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from skyradar.io.frames import open_frames
+    >>> from skyradar.io.frames_model import frame_times_s
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     run = write_sample_run(Path(d) / "run.zarr", n_frames=4, chunk_frames=2)
+    ...     names = sorted(p.name for p in Path(d).iterdir())
+    ...     times = frame_times_s(open_frames(run)).tolist()
+    >>> names, times
+    (['run.zarr'], [0.0, 1.0, 2.0, 3.0])
+    """
     ds = sample_run_dataset(n_frames, dt_s)
     template = ds.assign(iq=ds["iq"].chunk({"time": chunk_frames}))
     writer = FrameStoreWriter(path, template, chunk_frames, fingerprint="skyradar-sample-run")

@@ -74,6 +74,22 @@ class RunSource:
         Final name of the frames store (``RUN.zarr``); ``RUN.zarr.partial`` is used while it exists.
     tracks_path, alerts_path : path, optional
         Tracks / alerts Parquet tables.
+
+    Examples
+    --------
+    The sample run (:mod:`skyradar.web.sample`), alerted from its truth. At t = 1 s only ``crossing`` is
+    within the 5 km range limit: 1470 m north, 2960 m east and 400 m below the own-ship, 3329 m away.
+
+    >>> import tempfile
+    >>> from skyradar.web.sample import write_sample_run
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     source = RunSource(write_sample_run(Path(d) / "run.zarr", n_frames=4, chunk_frames=2))
+    ...     info, frame = source.info(), source.frame(1, with_image=False)
+    >>> info["n_ready"], info["growing"], info["traffic_source"]
+    (4, False, 'truth')
+    >>> own = frame["ownship"]
+    >>> own["north_m"], own["gs_mps"], [round(t["range_m"]) for t in frame["traffic"]]
+    (50.0, 50.0, [3329])
     """
 
     def __init__(

@@ -61,6 +61,22 @@ class TrafficPicture:
         Ground velocity north and east, m/s.
     tracked : ndarray of bool
         Aircraft the own-ship's radar has a confirmed track on now (the own-ship itself: False).
+
+    Examples
+    --------
+    ``B``'s track was lost at 10 s: its last estimate (south at 55 m/s), flown on to 20 s, stands in
+    for it, 550 m further south, and it does not count as tracked.
+
+    >>> from types import SimpleNamespace
+    >>> from skyradar.geo import geodetic_to_ned
+    >>> traf = SimpleNamespace(id=["A", "B"], lat=[52.0, 52.1], lon=[4.0, 4.0], alt=[900.0, 900.0],
+    ...     vs=[0.0, 0.0], gsnorth=[60.0, -60.0], gseast=[0.0, 0.0])
+    >>> last = TrackEstimate(7, 10.0, 52.09, 4.0, 900.0, -55.0, 0.0, 0.0, acid="B")
+    >>> picture = TrafficPicture.of(traf, "A", {}, 20.0, lost={"B": last})
+    >>> picture.tracked.tolist(), float(picture.gs[1]), float(picture.trk[1])
+    ([False, False], 55.0, 180.0)
+    >>> round(float(geodetic_to_ned(picture.lat[1], picture.lon[1], 900.0, 52.09, 4.0, 900.0)[0]), 1)
+    -550.0
     """
 
     id: list[str]
@@ -119,6 +135,17 @@ class DetectionResult:
     qdr, dist, dcpa, tcpa, tLOS : ndarray
         Per conflict pair: bearing (deg), distance (m), distance at closest approach (m), time to
         closest approach (s) and time to loss of separation (s).
+
+    Examples
+    --------
+    ``detect``'s tuple by name and back (per-pair scalars become arrays):
+
+    >>> returned = ([("A", "B")], [], [True, False], [30.0, 0.0], 90.0, 5000.0, 100.0, 30.0, 25.0)
+    >>> result = DetectionResult.of(returned)
+    >>> result.confpairs, result.inconf.tolist(), result.dist.tolist(), result.tcpa.tolist()
+    ([('A', 'B')], [True, False], [5000.0], [30.0])
+    >>> len(result.astuple())
+    9
     """
 
     confpairs: list[tuple[str, str]]

@@ -93,6 +93,15 @@ class DetectionRecord:
         Per radar-equipped aircraft: the aircraft it had a confirmed track on.
     false_conflicts : tuple of tuple
         (own-ship, track id) of the conflicts with false tracks (no aircraft near the track).
+
+    Examples
+    --------
+    ``A``'s radar had no track on ``B`` yet: the resolution did not act on the true conflict (A, B).
+
+    >>> record = DetectionRecord(12.0, frozenset({("A", "B"), ("B", "A")}), frozenset({("B", "A")}),
+    ...     frozenset(), ("A",), {"A": ()})
+    >>> sorted(record.truth_pairs - record.used_pairs)
+    [('A', 'B')]
     """
 
     time_s: float
@@ -128,6 +137,23 @@ class SkyradarPlugin:
         Every error line so far.
     log : list of DetectionRecord
         One record per conflict-detection step.
+
+    Examples
+    --------
+    The settings commands need no simulation; an error is answered and kept, ``reset`` restores the
+    defaults (2 frames/s, clear sky):
+
+    >>> p = SkyradarPlugin()
+    >>> p.command_config("RATE", "4"), p.command_terrain("FLAT", "300")
+    ((True, 'SKYRADARCFG: RATE 4'), (True, 'SKYRADARTERRAIN: flat'))
+    >>> p.frame_rate_hz, p.terrain.kind, p.terrain.height_m
+    (4.0, 'flat', 300.0)
+    >>> p.command_config("RANGE", "-1")
+    (False, 'SKYRADARCFG RANGE -1: must be a finite number > 0')
+    >>> p.errors
+    ['SKYRADARCFG RANGE -1: must be a finite number > 0']
+    >>> p.reset(); p.frame_rate_hz, p.terrain.kind, p.errors
+    (2.0, 'none', [])
     """
 
     frame_rate_hz: float = DEFAULT_FRAME_RATE_HZ
@@ -431,7 +457,31 @@ class _Conflicts:
 
 class DetectionGate:
     """Stands for BlueSky's conflict detection (``bs.traf.cd``): :meth:`update` goes through the plugin,
-    everything else to the detection object itself."""
+    everything else to the detection object itself.
+
+    Parameters
+    ----------
+    cd : ConflictDetection
+        BlueSky's detection object.
+    owner : SkyradarPlugin
+        The plugin whose ``detect`` runs each step.
+
+    Examples
+    --------
+    With stand-ins for BlueSky's detection and the plugin:
+
+    >>> from types import SimpleNamespace
+    >>> calls = []
+    >>> owner = SimpleNamespace(detect=lambda *args: calls.append(args))
+    >>> cd = SimpleNamespace(rpz=9260.0)
+    >>> gate = DetectionGate(cd, owner)
+    >>> gate.update("own", "intruders")
+    >>> calls == [(cd, "own", "intruders")]
+    True
+    >>> gate.rpz = 5000.0  # settings go to the detection object
+    >>> cd.rpz, gate.rpz
+    (5000.0, 5000.0)
+    """
 
     def __init__(self, cd: Any, owner: SkyradarPlugin) -> None:
         object.__setattr__(self, "_cd", cd)
@@ -450,7 +500,31 @@ class DetectionGate:
 
 class ResolutionGate:
     """Stands for BlueSky's conflict resolution (``bs.traf.cr``): :meth:`update` goes through the plugin,
-    everything else to the resolution object itself."""
+    everything else to the resolution object itself.
+
+    Parameters
+    ----------
+    cr : ConflictResolution
+        BlueSky's resolution object.
+    owner : SkyradarPlugin
+        The plugin whose ``resolve`` runs each step.
+
+    Examples
+    --------
+    With stand-ins for BlueSky's resolution and the plugin:
+
+    >>> from types import SimpleNamespace
+    >>> calls = []
+    >>> owner = SimpleNamespace(resolve=lambda *args: calls.append(args))
+    >>> cr = SimpleNamespace(active=False)
+    >>> gate = ResolutionGate(cr, owner)
+    >>> gate.update("conf", "own", "intruders")
+    >>> calls == [(cr, "conf", "own", "intruders")]
+    True
+    >>> gate.active = True  # settings go to the resolution object
+    >>> cr.active
+    True
+    """
 
     def __init__(self, cr: Any, owner: SkyradarPlugin) -> None:
         object.__setattr__(self, "_cr", cr)

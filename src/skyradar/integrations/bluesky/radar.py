@@ -160,6 +160,14 @@ class TerrainSpec:
         The DEM file (``file``).
     seed : int
         Seed of the fractal hills.
+
+    Examples
+    --------
+    >>> flat = TerrainSpec("flat", height_m=300.0).build(52.0, 4.36)
+    >>> float(np.asarray(flat.height_at(np.array([52.01]), np.array([4.37])))[0])
+    300.0
+    >>> TerrainSpec().build(52.0, 4.36) is None  # clear sky
+    True
     """
 
     kind: Literal["none", "flat", "fractal", "jacksboro", "file"] = "none"
@@ -264,6 +272,17 @@ class TrafficState:
         Vertical speed, m/s, positive up.
     heading_deg : ndarray
         Heading, deg clockwise from north.
+
+    Examples
+    --------
+    East at 100 m/s, descending at 5 m/s, flown on 10 s: 1000 m east, 50 m lower.
+
+    >>> from skyradar.geo import geodetic_to_ned
+    >>> lat, lon, alt, vn, ve, vs, hdg = ([v] for v in (52.0, 4.0, 1000.0, 0.0, 100.0, -5.0, 90.0))
+    >>> later = TrafficState(0.0, ("A",), *map(np.array, (lat, lon, alt, vn, ve, vs, hdg))).moved(10.0)
+    >>> ned = geodetic_to_ned(later.lat_deg, later.lon_deg, later.alt_m, 52.0, 4.0, 1000.0)
+    >>> later.time_s, (np.round(ned, 3) + 0.0).tolist()
+    (10.0, [[0.0, 1000.0, 50.0]])
     """
 
     time_s: float
@@ -326,6 +345,17 @@ class TrackEstimate:
         (a false track).
     error_m : float
         3-D distance from the track to that aircraft at the frame, m (NaN when ``acid`` is empty).
+
+    Examples
+    --------
+    South at 55 m/s, climbing at 2 m/s; 10 s later the prediction is 550 m south and 20 m higher:
+
+    >>> from skyradar.geo import geodetic_to_ned
+    >>> estimate = TrackEstimate(7, 10.0, 52.0, 4.0, 1000.0, -55.0, 0.0, 2.0, acid="B")
+    >>> later = estimate.at(20.0)
+    >>> ned = geodetic_to_ned(later.lat_deg, later.lon_deg, later.alt_m, 52.0, 4.0, 1000.0)
+    >>> later.time_s, later.acid, (np.round(ned, 3) + 0.0).tolist()
+    (20.0, 'B', [-550.0, 0.0, -20.0])
     """
 
     track_id: int
@@ -387,6 +417,19 @@ class AirborneRadar:
         Frames simulated so far.
     false_tracks : int
         Confirmed track rows with no aircraft near them, so far.
+
+    Examples
+    --------
+    The module's example flies one through a head-on encounter. Switched on at 30 s, its first frame
+    is due then; settings the prototype cannot fly are refused:
+
+    >>> radar = AirborneRadar("OWN", origin=(52.0, 4.36), frame_rate_hz=2.0, start_s=30.0)
+    >>> radar.next_frame_s, radar.n_frames, radar.estimates
+    (30.0, 0, [])
+    >>> AirborneRadar("OWN", mounts=("forward", "forward"))
+    Traceback (most recent call last):
+    ...
+    skyradar.errors.InputError: SKYRADAR OWN: a head is given twice: forward forward
     """
 
     acid: str

@@ -42,7 +42,15 @@ _started: dict[str, Any] = {}  # the BlueSky simulation of this process, once st
 
 
 def require_bluesky() -> None:
-    """Raise :class:`InputError` naming the ``bluesky`` extra when BlueSky is not installed."""
+    """Raise :class:`InputError` naming the ``bluesky`` extra when BlueSky is not installed.
+
+    Examples
+    --------
+    With the extra installed it returns quietly; without it, the error reads ``the BlueSky plugin needs
+    the optional 'bluesky' extra: pip install 'skyradar[bluesky]'``.
+
+    >>> require_bluesky()
+    """
     from skyradar.extras import require_extra
 
     require_extra("bluesky", "the BlueSky plugin")

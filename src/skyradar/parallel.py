@@ -159,7 +159,8 @@ def close(client, owns_cluster: bool) -> None:
 
     Called once the work is written (or while an error propagates): a cluster that does not shut
     down in time on a loaded machine loses nothing, and its worker processes end with this one, so
-    a timeout here is logged in one line instead of raised over the result or the error.
+    a timeout here is logged in one line instead of raised over the result or the error. A client
+    that times out closing still has its local cluster closed: the workers are stopped either way.
 
     Parameters
     ----------
@@ -189,14 +190,18 @@ def close(client, owns_cluster: bool) -> None:
     >>> close(client, owns_cluster=True)
     closed client
     closed cluster
+    >>> slow = Part("client", fail=True); slow.cluster = Part("cluster")
+    >>> close(slow, owns_cluster=True)
+    closed client
+    closed cluster
     """
     cluster = getattr(client, "cluster", None)
-    try:
-        client.close()
-        if owns_cluster and cluster is not None:
-            cluster.close()
-    except (TimeoutError, OSError) as exc:
-        logging.getLogger(__name__).warning("the Dask cluster did not shut down cleanly: %r", exc)
+    parts = [client] + ([cluster] if owns_cluster and cluster is not None else [])
+    for part in parts:
+        try:
+            part.close()
+        except (TimeoutError, OSError) as exc:
+            logging.getLogger(__name__).warning("the Dask cluster did not shut down cleanly: %r", exc)
 
 
 def map_chunks(

@@ -415,6 +415,12 @@ class PassiveScene:
     (12000.0, [90.0])
     >>> scene.receiver_crossing_times_s.round(3).tolist()
     [1.111, 5.556]
+
+    A crossing due exactly at the end of a 10 s recording is after its last sample:
+
+    >>> from dataclasses import replace
+    >>> replace(scene, duration_s=10.0).receiver_crossing_times_s.round(3).tolist()
+    [1.111, 5.556]
     """
 
     receiver: Receiver
@@ -458,7 +464,11 @@ class PassiveScene:
     def _crossings(self, azimuth_rad: float) -> np.ndarray:
         w = self.illuminator.rotation_rate_rad_s
         t0 = np.mod(azimuth_rad - self.azimuth_at_t0_rad, 2 * np.pi) / w
-        return np.arange(t0, self.duration_s, 2 * np.pi / w)
+        period = 2 * np.pi / w
+        # Crossings strictly before the end: one due at the end (to rounding) falls after the last
+        # sample, and np.arange's float steps can land it a hair inside.
+        count = max(int(np.ceil((self.duration_s - t0) / period - 1e-9)), 0)
+        return t0 + period * np.arange(count)
 
 
 def aircraft_from_adsb(

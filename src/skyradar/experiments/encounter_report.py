@@ -170,7 +170,7 @@ def _alerter_share(r: dict[str, Any]) -> str:
     if not isinstance(alerter, int) or not r["false_warnings"]:
         return ""
     prior = r.get("false_warnings_altitude_prior", float("nan"))
-    on_prior = f", {prior} first warned on a co-altitude prior" if isinstance(prior, int) and prior else ""
+    on_prior = f"; {prior} first warned on a co-altitude prior" if isinstance(prior, int) and prior else ""
     return f" ({alerter} of them warned on the true states too: the alerter's, not the sensor's{on_prior})"
 
 

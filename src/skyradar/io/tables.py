@@ -165,12 +165,14 @@ def _read_by_format(path: Path) -> pd.DataFrame:
         return pd.read_csv(path)
     if suffix == ".parquet":
         return pd.read_parquet(path)
+    source: Path | io.BytesIO = path
     if path.is_fifo():
         data = path.read_bytes()
-        return pd.read_parquet(io.BytesIO(data)) if data[:4] == b"PAR1" else pd.read_csv(io.BytesIO(data))
-    with path.open("rb") as f:
-        magic = f.read(4)
-    return pd.read_parquet(path) if magic == b"PAR1" else pd.read_csv(path)
+        source, magic = io.BytesIO(data), data[:4]
+    else:
+        with path.open("rb") as f:
+            magic = f.read(4)
+    return pd.read_parquet(source) if magic == b"PAR1" else pd.read_csv(source)
 
 
 def finite_column(df: pd.DataFrame, col: str, source: str | Path, allow_nan: bool = False) -> np.ndarray:

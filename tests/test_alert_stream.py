@@ -1,7 +1,7 @@
 """AlertStream, one frame at a time, gives the batch alerts of a run longer than its window.
 
 The stream keeps a trailing window of rows and each track's filter state; the batch sees the whole
-run. A run of 50 s (two windows) with a head-on conflict whose track drops out for 4 s (lost-track
+run. A run of 80 s (two windows) with a head-on conflict whose track drops out for 4 s (lost-track
 predictions, then the same id again), a crossing track with covariances (the velocity gate and
 the widened volumes), a range-only track (the range fit), a track that dies and comes back after
 the hold with the same id must give the same table, advice included.
@@ -17,7 +17,7 @@ from skyradar.daa.alerting import RADAR_ALERT_CONFIG
 from skyradar.daa.pipeline import AlertStream, alerts_from_tracks
 
 FRAME_S = 0.2
-TIMES = np.round(np.arange(0.0, 50.0, FRAME_S), 6)
+TIMES = np.round(np.arange(0.0, 80.0, FRAME_S), 6)
 
 
 def _own() -> pd.DataFrame:
@@ -89,7 +89,7 @@ def tracks_and_ownship() -> tuple[pd.DataFrame, pd.DataFrame]:
     crossing = _straight(2, crossing_t, [2400.0, -2000.0, -1010.0], [0.0, 55.0, 0.0], rng, sigma_v=20.0)
     ranged_t = TIMES[(TIMES >= 1.0) & (TIMES < 40.0)]
     ranged = _range_only(3, ranged_t, [3000.0, 200.0, 0.0], [-40.0, 0.0, 0.0])
-    comeback_t = TIMES[((TIMES >= 3.0) & (TIMES < 12.0)) | (TIMES >= 30.0)]  # gone longer than the hold
+    comeback_t = TIMES[((TIMES >= 3.0) & (TIMES < 12.0)) | (TIMES >= 45.0)]  # gone longer than the hold
     comeback = _straight(4, comeback_t, [3000.0, 900.0, -1000.0], [-20.0, -10.0, 0.0], rng)
     tracks = pd.concat([head_on, crossing, ranged, comeback], ignore_index=True)
     tracks = tracks.sort_values(["time_s", "track_id"], kind="stable").reset_index(drop=True)

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
+import pytest
 
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG
 from skyradar.daa.conflict import WellClearVolume
-from skyradar.daa.lost_tracks import lost_track_rows
+from skyradar.daa.lost_tracks import lost_track_hold, lost_track_rows
 from skyradar.daa.pipeline import alerts_from_tracks
 
 FRAME_S = 1.0 / 9.4
@@ -107,7 +110,51 @@ def test_predictions_count_neither_for_nor_against_raising_a_level():
     assert first["e"] > first["p"]
 
 
-def test_one_frames_predictions_are_those_of_the_whole_run_on_that_frame():
+def test_a_closing_track_is_held_until_its_closest_approach():
+    # Closed form: a crossing at 100 m/s relative with a 300 m miss, 2 km before the closest point,
+    # reaches it in 20 s; its range rate (-98.9 m/s) would say 20.2 s, an upper bound.
+    s = np.array([[2000.0, 300.0, -50.0], [2000.0, 300.0, -50.0], [5000.0, 0.0, 0.0], [1500.0, 0.0, 0.0]])
+    v = np.array([[-100.0, 0.0, 0.0], [100.0, 0.0, 0.0], [-100.0, 0.0, 0.0], [-100.0, 0.0, 0.0]])
+    holds = lost_track_hold(s, v, hold_s=8.0, closing_hold_s=25.0)
+    np.testing.assert_allclose(holds, [20.0, 8.0, 25.0, 15.0])  # closing, receding, capped, closing
+    # A CPA sooner than the hold, a state without velocity, and a closing hold below the hold: the hold.
+    odd = lost_track_hold(
+        np.array([[300.0, 0.0, 0.0], [2000.0, 0.0, 0.0], [2000.0, 0.0, 0.0]]),
+        np.array([[-100.0, 0.0, 0.0], [np.nan, 0.0, 0.0], [0.0, 0.0, 0.0]]),
+        hold_s=8.0,
+        closing_hold_s=25.0,
+    )
+    assert odd.tolist() == [8.0, 8.0, 8.0]
+    assert lost_track_hold(s, v, hold_s=8.0, closing_hold_s=0.0).tolist() == [8.0] * 4
+
+
+def test_a_warning_is_held_through_a_fade_longer_than_the_hold_until_the_closest_approach():
+    # A head-on closure warned before it fades behind a clutter ridge for 12 s, longer than the 8-s
+    # hold of any lost track: closing, it is predicted until its closest approach, and the warning
+    # stays on every frame of the fade; held only 8 s, it drops 4 s before the track is seen again.
+    own, tracks = _head_on(seconds_to_lowc=15.0, duration_s=19.0)
+    faded = tracks[(tracks["time_s"] < 5.0) | (tracks["time_s"] > 17.0)]
+    gap = (own["time_s"] > 5.0) & (own["time_s"] < 17.0)
+    held = alerts_from_tracks(faded, own, RADAR_ALERT_CONFIG, with_advice=False)
+    assert RADAR_ALERT_CONFIG.closing_track_hold_s > 12.0 > RADAR_ALERT_CONFIG.lost_track_hold_s
+    assert len(held) == len(own)
+    during = held[held["time_s"].between(5.0, 17.0, inclusive="neither")]
+    assert len(during) == int(gap.sum()) and during["extrapolated"].all() and (during["level"] == 3).all()
+    short = replace(RADAR_ALERT_CONFIG, closing_track_hold_s=0.0)
+    dropped = alerts_from_tracks(faded, own, short, with_advice=False)
+    assert dropped["time_s"].between(13.1, 17.0, inclusive="neither").sum() == 0
+
+
+def test_a_receding_track_is_held_only_the_hold():
+    own, tracks = _head_on(seconds_to_lowc=15.0, duration_s=30.0)
+    receding = tracks.assign(vn_mps=100.0, north_m=tracks["north_m"].iloc[0] + 100.0 * tracks["time_s"])
+    seen = receding[receding["time_s"] < 2.0]
+    alerts = alerts_from_tracks(seen, own, RADAR_ALERT_CONFIG, with_advice=False)
+    assert alerts["time_s"].max() <= seen["time_s"].max() + RADAR_ALERT_CONFIG.lost_track_hold_s + 1e-9
+
+
+@pytest.mark.parametrize("per_row_hold", [False, True])
+def test_one_frames_predictions_are_those_of_the_whole_run_on_that_frame(per_row_hold):
     # A stream adds the predicted rows of its latest frame only (``only_at_s``): the same rows the
     # whole run's call adds on that frame, for tracks that start late, fade, end and come back.
     rng = np.random.default_rng(3)
@@ -125,10 +172,12 @@ def test_one_frames_predictions_are_those_of_the_whole_run_on_that_frame():
     tracks = tracks.reset_index(drop=True).assign(range_m=1000.0)
     for name in [f"cov_{k}_{i}{j}" for k in ("pp", "vv", "pv") for i in range(3) for j in range(3)]:
         tracks[name] = rng.random(len(tracks))
-    whole = lost_track_rows(tracks, frames, hold_s=8.0)
+    # Each row's own hold (a closing track's is longer) or one for all.
+    hold = rng.uniform(2.0, 20.0, len(tracks)) if per_row_hold else 8.0
+    whole = lost_track_rows(tracks, frames, hold_s=hold)
     checked = 0
     for at_s in frames[::3]:
-        one = lost_track_rows(tracks, frames, hold_s=8.0, only_at_s=at_s)
+        one = lost_track_rows(tracks, frames, hold_s=hold, only_at_s=at_s)
         expected = whole[~whole["extrapolated"] | (whole["time_s"] == at_s)].reset_index(drop=True)
         pd.testing.assert_frame_equal(one, expected)
         checked += int(one["extrapolated"].sum())

@@ -62,12 +62,48 @@ def test_detection_gap_keeps_the_track_id(gap_s):
 
 
 def test_gap_longer_than_reacquisition_is_a_new_track():
-    """An aircraft that stays away longer than ``reacquire_s`` is a new track, as without reacquisition."""
-    t, _, _, det = _straight((6.0, 15.0), -30.0)
+    """An aircraft not closing that stays away longer than ``reacquire_s`` is a new track, as without
+    reacquisition."""
+    t, _, _, det = _straight((6.0, 15.0), 30.0)
     tracks = track_detections(
         det, "radar", CFG, tracker_config=TrackerConfig(reacquire_s=8.0), frame_times_s=t
     )
     assert _ids_on(tracks, det, 0).size == 2
+
+
+def test_a_closing_aircraft_keeps_its_id_through_a_gap_longer_than_reacquisition():
+    """A closure hidden for 9 s (a clutter ridge) is still the same aircraft: closing at 30 m/s from
+    2.8 km it cannot have passed for 90 s, so its lost track waits (up to ``reacquire_closing_s``)."""
+    t, _, _, det = _straight((6.0, 15.0), -30.0)
+    config = TrackerConfig(reacquire_s=8.0, reacquire_closing_s=25.0)
+    tracks = track_detections(det, "radar", CFG, tracker_config=config, frame_times_s=t)
+    assert _ids_on(tracks, det, 0).size == 1
+    no_longer = TrackerConfig(reacquire_s=8.0, reacquire_closing_s=0.0)
+    tracks = track_detections(det, "radar", CFG, tracker_config=no_longer, frame_times_s=t)
+    assert _ids_on(tracks, det, 0).size == 2
+
+
+def test_a_lost_closing_track_is_kept_until_it_could_have_passed():
+    """The memory of a closing track is its range over its closing speed (the latest its closest
+    approach can come), between ``max_age_s`` and ``closing_max_age_s``: the rate the range follows
+    is the radial velocity once the alias is resolved, the range-rate state before."""
+    lost = LostTracks(radar_model(WIDTH), max_age_s=8.0, closing_max_age_s=25.0)
+    x = np.array(
+        [
+            [1500.0, -100.0, -100.0, 0.0],  # 15 s to pass
+            [1500.0, 10.0, -100.0, 0.0],  # unresolved: aliased +10, range falling at 100 m/s
+            [4000.0, -100.0, -100.0, 0.0],  # 40 s: the cap
+            [500.0, -100.0, -100.0, 0.0],  # 5 s: the plain memory
+            [1500.0, 40.0, 40.0, 0.0],  # receding
+        ]
+    )
+    resolved = np.array([True, False, True, True, True])
+    np.testing.assert_allclose(lost.memory_of(x, resolved), [15.0, 15.0, 25.0, 8.0, 8.0])
+    lost.add(np.arange(5), x, np.repeat(np.diag([16.0, 0.04, 1.0, 0.25])[None], 5, axis=0), resolved, 0.0)
+    lost.expire(14.0)
+    assert lost.ids.tolist() == [0, 1, 2]
+    lost.expire(20.0)
+    assert lost.ids.tolist() == [2]
 
 
 def test_fast_intruder_reacquired_with_its_alias():

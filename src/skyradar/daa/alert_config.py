@@ -41,6 +41,7 @@ A file holds :class:`AlertConfig` fields, starting from ``base`` (``radar`` unle
     hold_time_factor: 1.5            # an issued level holds while lost within 1.5x its alerting time
     hold_volume_factor: 1.5          # ... or while its volume enlarged 1.5x is
     lost_track_hold_s: 8.0           # a lost track's prediction holds its alert this long
+    closing_track_hold_s: 25.0       # ... a closing one's up to its closest approach, at most this
     max_velocity_sigma_mps: 6.0  # null: no gate
     flarm_thresholds_s: [18, 13, 8]
     levels:                      # preventive, corrective, warning
@@ -81,6 +82,7 @@ _FLOATS = (
     "hold_time_factor",
     "hold_volume_factor",
     "lost_track_hold_s",
+    "closing_track_hold_s",
 )
 _OPTIONAL = ("period_s", "max_velocity_sigma_mps", "gap_reset_s")
 _VOLUME_KEYS = ("dthr_m", "zthr_m", "tthr_s", "tcoa_s")

@@ -179,6 +179,13 @@ class AlertConfig:
         A confirmed track that has no row on a frame is predicted there from its last row for this
         long, s (the tracker's reacquisition memory), and the prediction may hold the level the
         track reached, never raise it (:mod:`skyradar.daa.lost_tracks`); 0 turns it off.
+    closing_track_hold_s : float
+        A lost track that was closing on the own-ship is predicted up to its time of closest
+        approach instead, at most this long, s (:func:`~skyradar.daa.lost_tracks.lost_track_hold`;
+        at most ``lost_track_hold_s``: held as the others). A closing aircraft stays a
+        threat until it has passed, however long the radar takes to see it again. 25 s is the
+        warning's alerting time: beyond it a prediction says nothing the warning needs, and a
+        constant-velocity prediction has grown by hundreds of metres.
     max_velocity_sigma_mps : float, optional
         Track-quality gate: a track row whose horizontal velocity standard deviation
         ``sqrt(cov_vv_00 + cov_vv_11)`` exceeds this raises no alert, m/s (default off), while its
@@ -211,6 +218,7 @@ class AlertConfig:
     hold_time_factor: float = 1.5
     hold_volume_factor: float = 1.0
     lost_track_hold_s: float = 8.0
+    closing_track_hold_s: float = 25.0
     max_velocity_sigma_mps: float | None = None
 
     def __post_init__(self) -> None:
@@ -226,6 +234,10 @@ class AlertConfig:
             raise ValueError(f"alert config: gap_reset_s must be > 0, got {self.gap_reset_s}")
         if not self.lost_track_hold_s >= 0.0:
             raise ValueError(f"alert config: lost_track_hold_s must be >= 0, got {self.lost_track_hold_s}")
+        if not self.closing_track_hold_s >= 0.0:
+            raise ValueError(
+                f"alert config: closing_track_hold_s must be >= 0, got {self.closing_track_hold_s}"
+            )
         if not self.min_track_age_floor_s >= 0.0:
             raise ValueError(
                 f"alert config: min_track_age_floor_s must be >= 0, got {self.min_track_age_floor_s}"
@@ -233,6 +245,11 @@ class AlertConfig:
         if not 0.0 <= self.age_fraction_of_time_left <= 1.0:
             fraction = self.age_fraction_of_time_left
             raise ValueError(f"alert config: age_fraction_of_time_left must be in [0, 1], got {fraction}")
+
+    @property
+    def longest_lost_track_hold_s(self) -> float:
+        """The longest a lost track's prediction is held, s."""
+        return max(self.lost_track_hold_s, self.closing_track_hold_s)
 
     @property
     def lookahead_s(self) -> float:
@@ -281,6 +298,7 @@ DO365B_ALERT_CONFIG = AlertConfig(
     min_track_age_s=0.0,
     min_track_age_floor_s=0.0,
     lost_track_hold_s=0.0,
+    closing_track_hold_s=0.0,
 )
 
 

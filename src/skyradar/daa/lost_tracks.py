@@ -10,6 +10,14 @@ its last one, :func:`lost_track_rows` adds the track's constant-velocity predict
 its covariance grown by the white acceleration of the gap. The alerter lets such a row hold the
 level the track has reached, never raise it: a prediction is no evidence of a new conflict.
 
+A track that was closing on the own-ship when it was lost is held longer: up to its predicted time
+of closest approach, at most ``closing_hold_s`` (:func:`lost_track_hold`). The threat of a closing
+aircraft lasts until it has passed, whatever the time the radar needs to see it again; and the
+fast closures that hide longest are those a terrain's clutter ridge covers for seconds on end, at
+the ranges where a warning matters most. The prediction's own geometry still decides: it holds a
+level only while it predicts that level's loss of well clear, so the hold ends once the predicted
+closest approach is passed or the prediction no longer conflicts.
+
 Examples
 --------
 >>> tracks = pd.DataFrame({"time_s": [0.0, 0.5, 2.0], "track_id": 1, "north_m": [3000.0, 2950.0, 2800.0],
@@ -24,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-__all__ = ["lost_track_rows", "SIGMA_ACCEL_MPS2"]
+__all__ = ["lost_track_hold", "lost_track_rows", "SIGMA_ACCEL_MPS2"]
 
 # White acceleration of a prediction across a gap, m/s^2 per axis: the tracker's 3-D filter's.
 SIGMA_ACCEL_MPS2 = 2.0
@@ -48,8 +56,53 @@ def _grown_covariances(rows: pd.DataFrame, dt: np.ndarray) -> dict[str, np.ndarr
     return {c: grown[k].reshape(-1, 9)[:, n] for k in names for n, c in enumerate(names[k])}
 
 
+def lost_track_hold(
+    relative_position_m: np.ndarray, relative_velocity_mps: np.ndarray, hold_s: float, closing_hold_s: float
+) -> np.ndarray:
+    """How long a prediction from each track row may stand in for the track once it is lost, s.
+
+    ``hold_s`` for every row, and for a row closing on the own-ship (relative position and velocity
+    with a negative dot product) its time to the closest approach, ``-s.v / |v|^2``, when that is
+    longer, at most ``closing_hold_s``.
+
+    Parameters
+    ----------
+    relative_position_m, relative_velocity_mps : ndarray, shape (n, 3)
+        The intruder's position (m) and velocity (m/s) relative to the own-ship, NED.
+    hold_s : float
+        The hold of every lost track, s.
+    closing_hold_s : float
+        The longest hold of a closing track, s (at most ``hold_s``: closing tracks are held as the
+        others are).
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        The hold from each row, s (``hold_s`` where the state is not finite).
+
+    Examples
+    --------
+    Head-on at 2 km closing at 100 m/s (closest approach in 20 s), and the same aircraft receding:
+
+    >>> s = np.array([[2000.0, 0.0, 0.0], [2000.0, 0.0, 0.0]])
+    >>> v = np.array([[-100.0, 0.0, 0.0], [100.0, 0.0, 0.0]])
+    >>> lost_track_hold(s, v, hold_s=8.0, closing_hold_s=25.0).tolist()
+    [20.0, 8.0]
+    """
+    s, v = np.asarray(relative_position_m, float), np.asarray(relative_velocity_mps, float)
+    closing_rate = -np.einsum("ij,ij->i", s, v)  # -s.v, m^2/s
+    speed_sq = np.einsum("ij,ij->i", v, v)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tcpa = np.where(closing_rate > 0.0, closing_rate / speed_sq, 0.0)
+    tcpa = np.where(np.isfinite(tcpa), tcpa, 0.0)
+    return np.maximum(float(hold_s), np.minimum(tcpa, float(closing_hold_s)))
+
+
 def lost_track_rows(
-    tracks: pd.DataFrame, frame_times_s: np.ndarray, hold_s: float, only_at_s: float | None = None
+    tracks: pd.DataFrame,
+    frame_times_s: np.ndarray,
+    hold_s: float | np.ndarray,
+    only_at_s: float | None = None,
 ) -> pd.DataFrame:
     """The tracks table with a predicted row on every frame a track has no row, up to ``hold_s`` s after
     its last row (and never before its first).
@@ -62,8 +115,9 @@ def lost_track_rows(
         present).
     frame_times_s : ndarray
         The frame times, s (the own-ship table's).
-    hold_s : float
-        Longest prediction, s (0: no rows added).
+    hold_s : float or ndarray
+        Longest prediction, s (0: no rows added); per row of ``tracks`` (:func:`lost_track_hold`),
+        the hold of a gap is that of the row before it.
     only_at_s : float, optional
         Add predicted rows on the frame at this time only, s (a stream's latest frame).
 
@@ -86,13 +140,14 @@ def lost_track_rows(
     """
     out = tracks.assign(extrapolated=False)
     frames = np.unique(np.asarray(frame_times_s, float))
-    if hold_s <= 0.0 or len(tracks) == 0 or frames.size < 2:
+    holds = np.broadcast_to(np.asarray(hold_s, float), (len(tracks),))
+    if len(tracks) == 0 or not (holds > 0.0).any() or frames.size < 2:
         return out
     half_frame = 0.5 * float(np.median(np.diff(frames)))
     if only_at_s is not None:
-        added = _lost_at(tracks, float(only_at_s), frames, hold_s, half_frame)
+        added = _lost_at(tracks, float(only_at_s), frames, holds, half_frame)
     else:
-        added = _lost_on_frames(tracks, frames, hold_s, half_frame)
+        added = _lost_on_frames(tracks, frames, holds, half_frame)
     if not added:
         return out
     merged = pd.concat([out, *added], ignore_index=True)
@@ -112,7 +167,7 @@ def _predicted(start: pd.DataFrame, at_s: np.ndarray, dt: np.ndarray) -> pd.Data
 
 
 def _lost_at(
-    tracks: pd.DataFrame, at_s: float, frames: np.ndarray, hold_s: float, half_frame: float
+    tracks: pd.DataFrame, at_s: float, frames: np.ndarray, holds: np.ndarray, half_frame: float
 ) -> list[pd.DataFrame]:
     """The predicted rows of the frame at ``at_s`` alone, every track at once (a stream's step):
     the rule of :func:`_lost_on_frames` on one frame."""
@@ -120,15 +175,14 @@ def _lost_at(
         return []
     ids = tracks["track_id"].to_numpy()
     order = np.argsort(ids, kind="stable")  # each track's rows in their table order, as groupby keeps them
-    t, ids = tracks["time_s"].to_numpy(float)[order], ids[order]
+    t, ids, holds = tracks["time_s"].to_numpy(float)[order], ids[order], holds[order]
     first = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])
     end = np.r_[first[1:], t.size] - 1  # each track's last row
-    inside = (t[first] < at_s) & (at_s <= t[end] + hold_s)
     last = first + np.add.reduceat(t <= at_s, first) - 1  # the row at or before the frame
     after = np.minimum(last + 1, end)
     nearest = np.minimum(at_s - t[last], np.abs(t[after] - at_s))
     dt = at_s - t[last]
-    gap = inside & (nearest > half_frame) & (dt <= hold_s)
+    gap = (t[first] < at_s) & (nearest > half_frame) & (dt <= holds[last])
     if not gap.any():
         return []
     start = tracks.iloc[order[last[gap]]].reset_index(drop=True)
@@ -136,14 +190,15 @@ def _lost_at(
 
 
 def _lost_on_frames(
-    tracks: pd.DataFrame, frames: np.ndarray, hold_s: float, half_frame: float
+    tracks: pd.DataFrame, frames: np.ndarray, holds: np.ndarray, half_frame: float
 ) -> list[pd.DataFrame]:
     """Each track's predicted rows on the frames it has no row within half a frame of, after its
-    first row and up to ``hold_s`` after the row before."""
+    first row and up to the hold of the row before (``holds``, per row) after it."""
     added = []
-    for _, rows in tracks.groupby("track_id", sort=False):
+    for _, index in tracks.groupby("track_id", sort=False).indices.items():
+        rows, hold = tracks.iloc[index], holds[index]
         t = rows["time_s"].to_numpy(float)
-        window = frames[(frames > t[0]) & (frames <= t[-1] + hold_s)]
+        window = frames[(frames > t[0]) & (frames <= t[-1] + hold.max())]
         last = np.searchsorted(t, window, side="right") - 1  # the row at or before each frame
         after = np.minimum(last + 1, t.size - 1)
         nearest = np.minimum(window - t[last], np.abs(t[after] - window))
@@ -151,7 +206,7 @@ def _lost_on_frames(
         if gap_frames.size == 0:
             continue
         dt = gap_frames - t[last]
-        keep = dt <= hold_s
+        keep = dt <= hold[last]
         if not keep.any():
             continue
         start = rows.iloc[last[keep]].reset_index(drop=True)

@@ -38,7 +38,7 @@ from skyradar.daa.alerting import (
     velocity_unconverged,
 )
 from skyradar.daa.conflict import traffic_indication
-from skyradar.daa.lost_tracks import lost_track_rows
+from skyradar.daa.lost_tracks import lost_track_hold, lost_track_rows
 from skyradar.daa.provenance import check_tracks_match_run
 from skyradar.daa.range_miss import RANGE_FIT_WINDOW_S, range_only_fit
 from skyradar.daa.range_only import K_SIGMA, range_only_levels
@@ -447,7 +447,16 @@ def _alert_rows(
         ranges = range_history(tracks, source)  # after clean_tracks named any missing column
     if cleaned:
         df.attrs["rows_skipped_no_state"] = 0
-    df = lost_track_rows(df, ownship["time_s"].to_numpy(float), config.lost_track_hold_s, at_time_s)
+    holds: float | np.ndarray = config.lost_track_hold_s
+    if config.closing_track_hold_s > config.lost_track_hold_s and len(df):
+        seen = interp_ownship(ownship, df["time_s"].to_numpy(float), source)
+        holds = lost_track_hold(
+            df[["north_m", "east_m", "down_m"]].to_numpy(float) - seen.position_ned_m,
+            df[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(float) - seen.velocity_ned_mps,
+            config.lost_track_hold_s,
+            config.closing_track_hold_s,
+        )
+    df = lost_track_rows(df, ownship["time_s"].to_numpy(float), holds, at_time_s)
     predicted = df["extrapolated"].to_numpy(bool)
     t = df["time_s"].to_numpy(float)
     wanted = np.ones(len(df), bool) if at_time_s is None else t == at_time_s
@@ -590,11 +599,11 @@ class AlertStream:
     run: each track's M-of-N filter (:class:`~skyradar.daa.alerting.AlertFilter`), fed one row per
     frame, its first time and whether it is old enough to alert; and the tracks and own-ship rows
     of a trailing window, of the tracks that can have a row on the frame (a confirmed row within
-    ``lost_track_hold_s``). The window is ``lost_track_hold_s`` plus the range fit's
-    :data:`~skyradar.daa.range_miss.RANGE_FIT_WINDOW_S` plus a second: a lost track's prediction
-    carries the range path of its last measured row, up to ``lost_track_hold_s`` old, fitted over
-    the window before that row. A prediction spaces its rows by the median frame interval of the
-    window (the batch: of the whole run).
+    the longest hold, :attr:`~skyradar.daa.alerting.AlertConfig.longest_lost_track_hold_s`). The
+    window is that hold plus the range fit's :data:`~skyradar.daa.range_miss.RANGE_FIT_WINDOW_S`
+    plus a second: a lost track's prediction carries the range path of its last measured row, up to
+    that hold old, fitted over the window before that row. A prediction spaces its rows by the
+    median frame interval of the window (the batch: of the whole run).
 
     Parameters
     ----------
@@ -616,7 +625,7 @@ class AlertStream:
     def __init__(self, config: AlertConfig | None = None, with_advice: bool = True, source: str = "tracks"):
         self.config = config or AlertConfig()
         self.with_advice, self.source = with_advice, source
-        self._window_s = RANGE_FIT_WINDOW_S + self.config.lost_track_hold_s + 1.0
+        self._window_s = RANGE_FIT_WINDOW_S + self.config.longest_lost_track_hold_s + 1.0
         self._tracks: pd.DataFrame | None = None  # the confirmed rows of the window
         self._ranges: pd.DataFrame | None = None  # every track's measured ranges in the window
         self._own: pd.DataFrame | None = None  # the own-ship rows of the window
@@ -646,7 +655,7 @@ class AlertStream:
         )
         own = self._own  # a new frame each step: its attrs are this frame's own-ship's
         own.attrs = dict(ownship.attrs)
-        alive_since = time_s - self.config.lost_track_hold_s - 1e-9
+        alive_since = time_s - self.config.longest_lost_track_hold_s - 1e-9
         alive = [i for i, t in self._last_confirmed_s.items() if t >= alive_since]
         history = self._tracks[self._tracks["track_id"].isin(alive)]
         rows = _alert_rows(

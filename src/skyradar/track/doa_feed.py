@@ -28,11 +28,14 @@ OWNSHIP_COLUMNS = REQUIRED_COLUMNS  # the own-ship rows the 3-D feed reads: time
 class Measure3D:
     """Feeds the 3-D tracker: DoA position, its covariance and the de-aliased radial velocity."""
 
-    def __init__(self, det, config, motion, sigma_rad, ownship, grid, surface_down=None) -> None:
+    def __init__(
+        self, det, config, motion, sigma_rad, ownship, grid, surface_down=None, lost_memory_s: float = 8.0
+    ) -> None:
         self.active = all(c in det.columns for c in _NED)
         if not self.active:
             return
-        self.t3 = Tracker3D()
+        # A lost filter is kept as long as the range-Doppler tracker may give its id back.
+        self.t3 = Tracker3D(lost_memory_s=lost_memory_s)
         self.config, self.sigma_rad = config, sigma_rad
         self.motion, self.width = motion, motion.doppler_width_mps
         self.ned, self.z, self.sigma = np.empty((0, 3)), np.empty((0, 2)), np.empty(0)

@@ -5,7 +5,11 @@ coasting time (2 s): coasting longer would let the track's gate, which grows wit
 jerk, take any detection within a large part of the image. An aircraft that fades for a few seconds
 (beam edge, SNR dip, a turn) then comes back as a new track, a fragment. This role keeps the closed
 confirmed tracks for ``max_age_s`` seconds instead of forgetting them, without reporting or gating
-them. When a new track is confirmed (M-of-N, so never on one clutter point), it is compared with
+them. A track that was closing on the own-ship when it was lost is kept longer, up to the time its
+range would take to reach zero at its range rate, at most ``closing_max_age_s``: that time bounds
+its closest approach from above (a crossing's range falls slower than its relative speed), and a
+closing aircraft is a threat until it has passed, however long a clutter ridge hides it. When a
+new track is confirmed (M-of-N, so never on one clutter point), it is compared with
 every lost track predicted to the same time with a gentler process noise (``q_jerk_mps3``, the
 jerk an aircraft sustains over seconds rather than the frame-to-frame one); a pair within the
 chi-square gate gives the new track the lost track's id (Hungarian assignment on the Mahalanobis
@@ -41,6 +45,9 @@ class LostTracks:
         The tracker's motion model (prediction, measurement matrix and noise).
     max_age_s : float
         A lost track is forgotten this long after it was closed, s (0 disables reacquisition).
+    closing_max_age_s : float
+        A lost track closing on the own-ship is forgotten at its range over its closing speed after
+        it was closed, at most this long and never before ``max_age_s``, s (0: as the others).
     q_jerk_mps3 : float
         White jerk of the prediction across the gap, m/s^3.
     gate : float
@@ -75,11 +82,14 @@ class LostTracks:
         resolve_sd_mps: float = 13.0,
         tau_s: float = 2.0,
         sigma_accel_mps2: float = 4.0,
+        closing_max_age_s: float = 0.0,
     ) -> None:
-        if max_age_s < 0 or not q_jerk_mps3 > 0 or not gate > 0:
+        if max_age_s < 0 or not q_jerk_mps3 > 0 or not gate > 0 or not closing_max_age_s >= 0:
             raise ValueError(
-                f"need max_age_s >= 0, q_jerk_mps3 > 0, gate > 0; got {max_age_s}, {q_jerk_mps3}, {gate}"
+                "need max_age_s >= 0, q_jerk_mps3 > 0, gate > 0, closing_max_age_s >= 0; got "
+                f"{max_age_s}, {q_jerk_mps3}, {gate}, {closing_max_age_s}"
             )
+        self.closing_max_age_s = float(closing_max_age_s)
         self.model = model
         self.tau_s, self.sigma_accel_mps2 = float(tau_s), float(sigma_accel_mps2)
         self._gentle = replace(model, q_velocity_mps3=float(q_jerk_mps3), q_range_mps2=float(q_jerk_mps3))
@@ -89,6 +99,7 @@ class LostTracks:
         self.P = np.zeros((0, 4, 4))
         self.resolved = np.zeros(0, bool)
         self.time_s = np.zeros(0)
+        self.memory_s = np.zeros(0)
 
     def __len__(self) -> int:
         return int(self.ids.size)
@@ -99,11 +110,36 @@ class LostTracks:
         """Keep closed tracks: states ``x`` (k, 4) and covariances ``P`` (k, 4, 4) at ``time_s``."""
         if self.max_age_s == 0 or len(ids) == 0:
             return
+        resolved = np.asarray(resolved, bool)
         self.ids = np.concatenate([self.ids, np.asarray(ids, np.int64)])
         self.x = np.concatenate([self.x, x])
         self.P = np.concatenate([self.P, P])
-        self.resolved = np.concatenate([self.resolved, np.asarray(resolved, bool)])
+        self.resolved = np.concatenate([self.resolved, resolved])
         self.time_s = np.concatenate([self.time_s, np.broadcast_to(np.asarray(time_s, float), (len(ids),))])
+        self.memory_s = np.concatenate([self.memory_s, self.memory_of(x, resolved)])
+
+    def memory_of(self, x: np.ndarray, resolved: np.ndarray) -> np.ndarray:
+        """How long lost tracks of states ``x`` (k, 4) are kept, s: ``max_age_s``, or for a closing
+        track its range over its closing speed when longer, at most ``closing_max_age_s``.
+
+        The closing speed is the rate the range follows: the radial velocity once the alias is
+        resolved (radar model), the range-rate state before it.
+
+        Examples
+        --------
+        >>> from skyradar.track.models import radar_model
+        >>> lost = LostTracks(radar_model(78.3), closing_max_age_s=25.0)
+        >>> x = np.array([[2000.0, -100.0, -100.0, 0.0], [2000.0, 60.0, 60.0, 0.0]])
+        >>> lost.memory_of(x, np.array([True, True])).tolist()  # closing, receding
+        [20.0, 8.0]
+        """
+        x = np.asarray(x, float)
+        follows_radial = (np.asarray(resolved, bool) | (not self.model.dealias)) & self.model.coupled
+        rate = np.where(follows_radial, x[:, 1], x[:, 2])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            to_zero = np.where(rate < 0.0, x[:, 0] / -rate, 0.0)
+        to_zero = np.where(np.isfinite(to_zero), to_zero, 0.0)
+        return np.maximum(self.max_age_s, np.minimum(to_zero, self.closing_max_age_s))
 
     def add_anchored(self, tracks: TrackArrays, mask: np.ndarray) -> None:
         """Keep the tracker's tracks ``mask`` at their anchors
@@ -117,8 +153,8 @@ class LostTracks:
         )
 
     def expire(self, time_s: float) -> None:
-        """Forget lost tracks closed more than ``max_age_s`` before ``time_s``."""
-        keep = time_s - self.time_s <= self.max_age_s
+        """Forget lost tracks closed longer before ``time_s`` than their memory (:meth:`memory_of`)."""
+        keep = time_s - self.time_s <= self.memory_s
         if not keep.all():
             self._take(keep)
 
@@ -206,6 +242,7 @@ class LostTracks:
     def _take(self, keep: np.ndarray) -> None:
         self.ids, self.x, self.P = self.ids[keep], self.x[keep], self.P[keep]
         self.resolved, self.time_s = self.resolved[keep], self.time_s[keep]
+        self.memory_s = self.memory_s[keep]
 
 
 def manoeuvre_transition(

@@ -195,7 +195,16 @@ def track_detections(
     detections, head_rows = fuse_heads(validate_detections(detections), config)  # heads -> one stream
     motion, tracker = _make_tracker(model, config, tracker_config)
     grid, lo, hi = _frame_slices(detections["time_s"].to_numpy(float), frame_times_s)
-    m3 = Measure3D(detections, config, motion, position_sigma_rad, ownship, grid, _surface(ground_test))
+    m3 = Measure3D(
+        detections,
+        config,
+        motion,
+        position_sigma_rad,
+        ownship,
+        grid,
+        _surface(ground_test),
+        _reacquisition_memory_s(tracker),
+    )
     chunks = _run_tracker(tracker, m3, detections, grid, lo, hi, own_speeds_mps(ownship, grid))
     t = _table(chunks, origin, m3, detections, ownship, config, ground_test)
     return restore_detection_rows(t, head_rows)
@@ -245,6 +254,11 @@ def _make_tracker(model, config: RadarConfig, tracker_config) -> tuple[MotionMod
     motion = make_model(model, config) if isinstance(model, str) else model
     pixel = (config.range_resolution_m, config.doppler_resolution_mps)
     return motion, RangeDopplerTracker(motion, tracker_config, pixel, report_tentative=True)
+
+
+def _reacquisition_memory_s(tracker: RangeDopplerTracker) -> float:
+    """The longest a lost track's id can be given back, s (its closing tracks' memory)."""
+    return max(tracker.config.reacquire_s, tracker.config.reacquire_closing_s)
 
 
 def _held(tracks, detections, ownship, config: RadarConfig, ground_test, walks=None) -> pd.DataFrame:
@@ -561,7 +575,10 @@ class TrackTableStream:
         rows = np.arange(len(fused)) if rows is None else rows
         if self._m3 is None:
             surface = _surface(self.ground_test)
-            self._m3 = Measure3D(fused, self.config, self.motion, self.position_sigma_rad, None, [], surface)
+            memory_s = _reacquisition_memory_s(self.tracker)
+            self._m3 = Measure3D(
+                fused, self.config, self.motion, self.position_sigma_rad, None, [], surface, memory_s
+            )
         elif self._m3.active:
             self._m3.add_detections(fused)
         if ownship is not None:

@@ -104,7 +104,12 @@ class RangeDopplerTracker:
         self.deleter = deleter or MissDeleter(self.config.max_misses, self.config.max_coast_s)
         c = self.config
         self.reacquirer = reacquirer or LostTracks(
-            model, c.reacquire_s, c.reacquire_jerk_mps3, c.gate, c.resolve_fraction * model.doppler_width_mps
+            model,
+            c.reacquire_s,
+            c.reacquire_jerk_mps3,
+            c.gate,
+            c.resolve_fraction * model.doppler_width_mps,
+            closing_max_age_s=c.reacquire_closing_s,
         )
         self._reacquired = np.zeros((0, 2), np.int64)
         if range_walks is None:

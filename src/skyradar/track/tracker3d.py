@@ -202,7 +202,8 @@ class Tracker3D:
         adds to the average.
     lost_memory_s : float
         A filter whose track is no longer alive is kept this long for a reacquisition, s (the
-        range-Doppler tracker's ``reacquire_s``); 0 forgets it at once.
+        longest the range-Doppler tracker keeps a lost track: ``reacquire_closing_s``); 0 forgets
+        it at once.
     fusion_gate : float
         Chi-square (6 degrees of freedom) gate on the difference of a lost filter, predicted
         across the gap, and the reacquiring one; beyond it they are not one aircraft's, and the

@@ -45,6 +45,10 @@ class TrackerConfig:
     reacquire_s : float
         A closed confirmed track can be taken up again, with its id, by a track confirmed up to
         this long after (:mod:`skyradar.track.reacquisition`), s; 0 turns reacquisition off.
+    reacquire_closing_s : float
+        A lost track closing on the own-ship can be taken up until its range over its closing speed
+        (a bound on the time to its closest approach), at most this long, s (never less than
+        ``reacquire_s``): 25 s, the time a warning looks ahead.
     reacquire_jerk_mps3 : float
         White jerk of a lost track's prediction across the gap, m/s^3.
 
@@ -76,6 +80,7 @@ class TrackerConfig:
     dealias: str = "confident"
     resolve_fraction: float = 1.0 / 6.0
     reacquire_s: float = 8.0
+    reacquire_closing_s: float = 25.0
     reacquire_jerk_mps3: float = 1.5
 
 

@@ -429,6 +429,22 @@ class _AlertRows:
         )
 
 
+def _lost_track_holds(
+    df: pd.DataFrame, ownship: pd.DataFrame, config: AlertConfig, source: str
+) -> np.ndarray:
+    """How long each row's prediction may stand in for its lost track, s
+    (:func:`~skyradar.daa.lost_tracks.lost_track_hold`, from the own-ship at the row's time)."""
+    if not config.closing_track_hold_s > config.lost_track_hold_s or len(df) == 0:
+        return np.full(len(df), config.lost_track_hold_s)
+    seen = interp_ownship(ownship, df["time_s"].to_numpy(float), source)
+    return lost_track_hold(
+        df[["north_m", "east_m", "down_m"]].to_numpy(float) - seen.position_ned_m,
+        df[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(float) - seen.velocity_ned_mps,
+        config.lost_track_hold_s,
+        config.closing_track_hold_s,
+    )
+
+
 def _alert_rows(
     tracks: pd.DataFrame,
     ownship: pd.DataFrame,
@@ -447,15 +463,7 @@ def _alert_rows(
         ranges = range_history(tracks, source)  # after clean_tracks named any missing column
     if cleaned:
         df.attrs["rows_skipped_no_state"] = 0
-    holds: float | np.ndarray = config.lost_track_hold_s
-    if config.closing_track_hold_s > config.lost_track_hold_s and len(df):
-        seen = interp_ownship(ownship, df["time_s"].to_numpy(float), source)
-        holds = lost_track_hold(
-            df[["north_m", "east_m", "down_m"]].to_numpy(float) - seen.position_ned_m,
-            df[["vn_mps", "ve_mps", "vd_mps"]].to_numpy(float) - seen.velocity_ned_mps,
-            config.lost_track_hold_s,
-            config.closing_track_hold_s,
-        )
+    holds = _lost_track_holds(df, ownship, config, source)
     df = lost_track_rows(df, ownship["time_s"].to_numpy(float), holds, at_time_s)
     predicted = df["extrapolated"].to_numpy(bool)
     t = df["time_s"].to_numpy(float)
@@ -629,7 +637,7 @@ class AlertStream:
         self._tracks: pd.DataFrame | None = None  # the confirmed rows of the window
         self._ranges: pd.DataFrame | None = None  # every track's measured ranges in the window
         self._own: pd.DataFrame | None = None  # the own-ship rows of the window
-        self._last_confirmed_s: dict[int, float] = {}
+        self._held_until_s: dict[int, float] = {}  # the last frame a track's prediction can reach
         self._filters: dict[int, AlertFilter] = {}
         self._first_s: dict[int, float] = {}
         self._ready: set[int] = set()
@@ -650,13 +658,17 @@ class AlertStream:
         self._ranges = appended(
             _since(self._ranges, time_s - self._window_s), range_history(tracks, self.source)
         )
-        self._last_confirmed_s.update(
-            dict.fromkeys(tracks["track_id"].to_numpy()[confirmed].tolist(), time_s)
-        )
         own = self._own  # a new frame each step: its attrs are this frame's own-ship's
         own.attrs = dict(ownship.attrs)
-        alive_since = time_s - self.config.longest_lost_track_hold_s - 1e-9
-        alive = [i for i, t in self._last_confirmed_s.items() if t >= alive_since]
+        # A track can have a row on this frame while a prediction from one of its rows reaches it
+        # (the latest such frame of any of its rows: a superset of the batch's).
+        holds = _lost_track_holds(clean, own, self.config, self.source)
+        plain_s = time_s + self.config.lost_track_hold_s
+        reach = [(i, plain_s) for i in tracks["track_id"].to_numpy()[confirmed].tolist()]
+        reach += zip(clean["track_id"].tolist(), (time_s + holds).tolist(), strict=True)
+        for track, until in reach:
+            self._held_until_s[track] = max(self._held_until_s.get(track, until), until)
+        alive = [i for i, until in self._held_until_s.items() if until >= time_s - 1e-9]
         history = self._tracks[self._tracks["track_id"].isin(alive)]
         rows = _alert_rows(
             history, own, self.config, self.source, cleaned=True, ranges=self._ranges, at_time_s=time_s

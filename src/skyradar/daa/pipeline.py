@@ -606,11 +606,12 @@ class AlertStream:
     stream keeps what the stages need, and no more, so a frame costs the same at any point of a
     run: each track's M-of-N filter (:class:`~skyradar.daa.alerting.AlertFilter`), fed one row per
     frame, its first time and whether it is old enough to alert; and the tracks and own-ship rows
-    of a trailing window, of the tracks that can have a row on the frame (a confirmed row within
-    the longest hold, :attr:`~skyradar.daa.alerting.AlertConfig.longest_lost_track_hold_s`). The
-    window is that hold plus the range fit's :data:`~skyradar.daa.range_miss.RANGE_FIT_WINDOW_S`
-    plus a second: a lost track's prediction carries the range path of its last measured row, up to
-    that hold old, fitted over the window before that row. A prediction spaces its rows by the
+    of a trailing window, of the tracks that can have a row on the frame (a confirmed row, or a
+    prediction from one of their rows within its hold). The window is the longest hold
+    (:attr:`~skyradar.daa.alerting.AlertConfig.longest_lost_track_hold_s`) plus the range fit's
+    :data:`~skyradar.daa.range_miss.RANGE_FIT_WINDOW_S` plus a second: a lost track's prediction
+    carries the range path of its last measured row, up to that hold old, fitted over the window
+    before that row. A prediction spaces its rows by the
     median frame interval of the window (the batch: of the whole run).
 
     Parameters

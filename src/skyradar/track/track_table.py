@@ -257,8 +257,10 @@ def _make_tracker(model, config: RadarConfig, tracker_config) -> tuple[MotionMod
 
 
 def _reacquisition_memory_s(tracker: RangeDopplerTracker) -> float:
-    """The longest a lost track's id can be given back, s (its closing tracks' memory)."""
-    return max(tracker.config.reacquire_s, tracker.config.reacquire_closing_s)
+    """The longest a lost track's id can be given back, s (its closing tracks' memory; 0 with
+    reacquisition off)."""
+    c = tracker.config
+    return max(c.reacquire_s, c.reacquire_closing_s) if c.reacquire_s > 0 else 0.0
 
 
 def _held(tracks, detections, ownship, config: RadarConfig, ground_test, walks=None) -> pd.DataFrame:

@@ -18,7 +18,7 @@ from skyradar.scene.scenario import Scenario
 LAM = RadarConfig.prototype_2022().wavelength_m
 
 
-@pytest.mark.parametrize(("name", "rows", "cols"), [("ura-2x3", 2, 3), ("ura-2x4", 2, 4)])
+@pytest.mark.parametrize(("name", "rows", "cols"), [("ura-2x3", 2, 3), ("ura-2x4", 2, 4), ("ura-4x2", 4, 2)])
 def test_ura_layouts_are_centred_half_wavelength_grids(name, rows, cols):
     assert name in RX_LAYOUTS
     rx = rx_layout_m(name, LAM)
@@ -28,6 +28,32 @@ def test_ura_layouts_are_centred_half_wavelength_grids(name, rows, cols):
     np.testing.assert_allclose(np.diff(np.unique(rx[:, 1].round(12))), LAM / 2)
     np.testing.assert_allclose(np.diff(np.unique(rx[:, 2].round(12))), LAM / 2)
     assert RadarConfig.prototype_2022(rx_positions_m=name).n_rx == rows * cols
+
+
+def test_upright_ura_measures_elevation_the_square_cannot():
+    """Four rows of two: the rows' second moment is 5 times the square's and the channels twice as
+    many, so the elevation bound is sqrt(10) times smaller in a clear cell; through two nulls at one
+    elevation (ground left and right at one range and Doppler) the square has no elevation left,
+    the upright array keeps one."""
+    from skyradar.process.clutter_doa import angle_sigmas_rad
+    from skyradar.process.doa import direction_from_angles, steering_vector
+
+    square, tall = (RadarConfig.prototype_2022(rx_positions_m=n) for n in ("square", "ura-4x2"))
+    for snr_db in (10.0, 20.0):
+        sq_az, sq_el = doa_crlb(snr_db, 0.0, 0.0, square)
+        tall_az, tall_el = doa_crlb(snr_db, 0.0, 0.0, tall)
+        np.testing.assert_allclose(sq_el / tall_el, np.sqrt(10.0), rtol=1e-9)
+        np.testing.assert_allclose(sq_az / tall_az, np.sqrt(2.0), rtol=1e-9)
+    target = direction_from_angles(np.radians([8.0]), np.radians([5.0]))  # 5 deg above boresight
+    ground = direction_from_angles(np.radians([-35.0, 35.0]), np.radians(-12.0))  # one depression
+    sigmas = {}
+    for name, cfg in (("square", square), ("ura-4x2", tall)):
+        z = 10.0 * steering_vector(target, cfg) * np.sqrt(cfg.noise_power_w)  # 20 dB per channel
+        e, _ = np.linalg.qr(steering_vector(ground, cfg).T)
+        proj = (np.eye(cfg.n_rx) - e @ e.conj().T)[None]
+        sigmas[name] = np.degrees(angle_sigmas_rad(target, z, proj, cfg, cfg.noise_power_w)[0][0])
+    assert np.isinf(sigmas["square"])
+    assert sigmas["ura-4x2"] < 1.0
 
 
 def _bad_arrays() -> list:

@@ -138,7 +138,7 @@ class RadarConfig:
     rx_positions_m : ndarray, shape (n_rx, 3), or str
         Receive antenna phase centres in the antenna frame, m, or a layout name of
         :func:`skyradar.rx_layouts.rx_layout_m` (``"square"``, ``"kite"``, ``"ura-2x3"``,
-        ``"ura-2x4"``); 1 to 32 distinct positions. Default: the 2x2
+        ``"ura-2x4"``, ``"ura-4x2"``); 1 to 32 distinct positions. Default: the 2x2
         square, half-wavelength spacing. A MIMO layout name of
         :func:`skyradar.rx_layouts.mimo_layout_m` (``"mimo-2x4"``) sets the receive antennas and,
         unless ``tx_positions_m`` is given, the transmitters.

@@ -21,7 +21,14 @@ Its vertical aperture of one wavelength is unambiguous through the two half-wave
 ``ura-2x3`` and ``ura-2x4`` are uniform rectangular arrays at the prototype's half-wavelength
 element spacing: two rows (one above the other) of three or four columns across, centred on the
 boresight axis. More channels buy angle accuracy (the Cramer-Rao bound falls with the aperture's
-second moments, :func:`skyradar.process.doa.doa_crlb`) and more clutter nulls.
+second moments, :func:`skyradar.process.doa.doa_crlb`) and more clutter nulls. ``ura-4x2`` stands
+the same eight channels upright: four rows of two columns. Its vertical aperture (1.5 wavelengths)
+gives an elevation bound 3.2 times smaller than the square's at the same per-channel SNR (the
+rows' second moment is 5 times the square's, the channel count twice): 1.3 deg against 4.1 deg
+at 10 dB per channel (:func:`~skyradar.process.doa.doa_crlb`). An aircraft 250 m above the
+own-ship 3 km ahead is 4.8 deg up, a little over one of the square's sigmas from co-altitude.
+Its azimuth keeps the square's half-wavelength horizontal baseline, its bound 1.4 times smaller
+from the channel count.
 
 Unambiguous field of view: every layout here has half-wavelength pairs spanning the array plane
 (the kite's one-wavelength baseline is unwrapped from them), so each is free of grating lobes
@@ -77,7 +84,7 @@ __all__ = [
     "ura_m",
 ]
 
-RxLayout = Literal["square", "kite", "ura-2x3", "ura-2x4"]  # the layouts' names
+RxLayout = Literal["square", "kite", "ura-2x3", "ura-2x4", "ura-4x2"]  # the layouts' names
 RX_LAYOUTS: tuple[str, ...] = get_args(RxLayout)
 MAX_RX = 32  # receive channels a radar may have (CFAR and noise-floor tables are built up to it)
 MimoLayout = Literal["mimo-2x4"]  # named transmitter + receiver layouts (time-division MIMO)
@@ -92,8 +99,8 @@ def rx_layout_m(name: str, wavelength_m: float) -> np.ndarray:
     Parameters
     ----------
     name : str
-        ``"square"`` (2x2, half-wavelength sides), ``"kite"``, ``"ura-2x3"`` or ``"ura-2x4"`` (see
-        the module docstring).
+        ``"square"`` (2x2, half-wavelength sides), ``"kite"``, ``"ura-2x3"``, ``"ura-2x4"`` or
+        ``"ura-4x2"`` (rows x columns; see the module docstring).
     wavelength_m : float
         Carrier wavelength, m.
 

@@ -192,6 +192,7 @@ class RxLayout(StrEnum):
     kite = "kite"
     ura_2x3 = "ura-2x3"
     ura_2x4 = "ura-2x4"
+    ura_4x2 = "ura-4x2"
 
 
 class Family(StrEnum):

@@ -129,7 +129,7 @@ _RX_LAYOUT = Annotated[
         "--rx-layout",
         help="Receive array of every head (scenario 'radar.rx_layout:'): square (the prototype's 2x2) "
         "kite (no centre of symmetry: keeps the elevation of targets in flat-ground clutter), or the "
-        "uniform rectangular arrays ura-2x3 and ura-2x4 (half-wavelength spacing).",
+        "uniform rectangular arrays ura-2x3, ura-2x4 and ura-4x2 (rows x columns, half-wavelength spacing).",
     ),
 ]
 

@@ -247,6 +247,7 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
 
     settings = {
         "n": 2,
+        "only": None,
         "seed": 5,
         "frame_rate_hz": 4.7,
         "buffer": 1.5,
@@ -327,6 +328,31 @@ def test_interrupted_run_resumes_from_its_partial_table(tmp_path):
     assert E.partial_store(tmp_path, {**key, "navigation": "perfect"})[0] == {}
     assert E.partial_store(tmp_path, {**key, "rx_layout": "kite"})[0] == {}
     assert E.partial_store(tmp_path, {**key, "family": "real-flights"})[0] == {}
+
+
+def test_only_reruns_an_encounter_of_the_set_as_the_whole_set_runs_it(tmp_path):
+    from skyradar.experiments import encounters as E
+
+    common = {"seed": 5, "workers": 1, "frame_rate_hz": 4.7, "layouts": ("single",), "simulation": LIGHT}
+    E.run(tmp_path / "all", n_encounters=2, **common)
+    s = E.run(tmp_path / "one", n_encounters=2, only=(1,), **common)
+    whole, alone = (pd.read_parquet(tmp_path / d / "encounters.parquet") for d in ("all", "one"))
+    assert s["encounters"] == 1 and s["only"] == [1] and alone["encounter"].tolist() == [1]
+    timings = ["simulate_s", "process_s", "track_s", "alert_s"]
+    same_row = whole[whole["encounter"] == 1].drop(columns=timings).reset_index(drop=True)
+    pd.testing.assert_frame_equal(alone.drop(columns=timings), same_row)
+    # A selection is its own run: it never resumes the whole set's rows, nor they its.
+    key = {"n": 2, "seed": 5}
+    _, save = E.partial_store(tmp_path / "p", {**key, "only": [1]})
+    save({("none", 1): [{"frames": 7}]})
+    assert E.partial_store(tmp_path / "p", {**key, "only": None})[0] == {}
+
+
+@pytest.mark.parametrize(("only", "named"), [("2", "got 2"), ("1,x", "'1,x'"), ("-1", "'-1'")])
+def test_bad_only_gives_one_line(tmp_path, only, named):
+    r = skyradar("experiment", "encounters", "--n", "2", "--only", only, "--output", "o", cwd=tmp_path)
+    assert_one_line_error(r, "--only", named)
+    assert not (tmp_path / "o").exists()
 
 
 def test_bad_alert_settings_file_gives_one_line(tmp_path):

@@ -29,6 +29,7 @@ __all__ = [
     "EncounterSchedulerOption",
     "SplitOption",
     "check_split",
+    "parse_only",
 ]
 
 # The layouts each --layout scores.
@@ -81,6 +82,35 @@ _NAVIGATION = Annotated[
         "typical errors of X alone); scoring always uses the truth."
     ),
 ]
+
+_ONLY = Annotated[
+    str | None,
+    typer.Option(
+        "--only",
+        help="Comma-separated encounter numbers (0 to --n - 1) to run alone, each exactly as the whole "
+        "set of --n encounters runs it (the set's parameters depend on --n and --seed).",
+    ),
+]
+
+
+def parse_only(text: str | None) -> tuple[int, ...] | None:
+    """``--only``'s encounter numbers (None: every encounter); InputError naming ``--only`` unless
+    the text is comma-separated non-negative integers.
+
+    Examples
+    --------
+    >>> parse_only("7, 3,7"), parse_only(None)
+    ((7, 3, 7), None)
+    """
+    from skyradar.errors import InputError
+
+    if text is None:
+        return None
+    parts = [part.strip() for part in text.split(",")]
+    if not all(part.isdigit() for part in parts):
+        raise InputError(f"--only: must be comma-separated encounter numbers (0, 1, ...), got {text!r}")
+    return tuple(int(part) for part in parts)
+
 
 EncounterWorkersOption = Annotated[
     int | None,
@@ -161,6 +191,7 @@ def experiment_encounters(
         ),
     ] = Family.synthetic,
     split: SplitOption = None,
+    only: _ONLY = None,
     alert_settings: Annotated[
         str,
         typer.Option(
@@ -187,6 +218,7 @@ def experiment_encounters(
 
     check_workers(workers)
     check_split(seed, split)
+    selected = parse_only(only)
     alert_config(alert_settings, option="--alert-config")  # a bad setting is named before any output
     if family is Family.real_flights:
         from skyradar.scene.sample_flights import sample_flights
@@ -195,9 +227,15 @@ def experiment_encounters(
     terrains, layouts = parse_terrains(terrain), LAYOUTS_SCORED[layout]
     if n is None:  # over terrain an encounter costs minutes: the default keeps a run within 5 minutes
         n = DEFAULT_ENCOUNTERS if terrains == ["none"] else DEFAULT_TERRAIN_ENCOUNTERS
+    if selected is not None:  # a bad number is named before any output
+        import pandas as pd
+
+        from skyradar.experiments.encounters import select_encounters
+
+        select_encounters(pd.DataFrame(index=range(n)), selected)
     check_output(out, (), overwrite, kind="folder", option="--output")
     mark_folder(out)
-    total = n * len(terrains)
+    total = (n if selected is None else len(set(selected))) * len(terrains)
     with frame_progress(total, "encounters") as bar:
         task = bar.add_task("encounters", total=total)
         result = run(
@@ -217,6 +255,7 @@ def experiment_encounters(
             command="skyradar " + " ".join(sys.argv[1:]),
             scheduler=scheduler,
             alert_settings=alert_settings,
+            only=selected,
         )
     emit_result(result, as_json, "encounters")
 

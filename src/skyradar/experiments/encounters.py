@@ -48,6 +48,7 @@ __all__ = [
     "EVALUATION_SEEDS_FROM",
     "partial_store",
     "check_encounter_set",
+    "select_encounters",
 ]
 
 MAX_ENCOUNTERS = 100_000  # 200 times the thesis-sized set; more is a typo, not a plan
@@ -100,7 +101,8 @@ def run_encounters(
     With ``scheduler`` (a Dask scheduler's address) the encounters run on that cluster; else with
     ``workers`` > 1 (default: up to 2, one per core) on a local Dask cluster of that many worker
     processes; with ``workers=1`` in this process. The rows do not depend on where they ran (each
-    encounter's seed is ``seed`` plus its index).
+    encounter's seed is ``seed`` plus its index, the row's label in ``params``: a selection of a
+    set's rows runs each as the whole set runs it).
 
     Returns one row per terrain, encounter and layout (columns ``terrain``, ``encounter``,
     ``layout``, the encounter's parameters and its result). ``progress`` is called with the number
@@ -114,8 +116,8 @@ def run_encounters(
     """
     workers = check_workers(workers) or min(2, os.cpu_count() or 1)  # 10**20 spawned until memory ran out
     results: dict[tuple[str, int], list[dict]] = dict(done or {})
-    records = params.to_dict("records")
-    todo = [(tr, i, p) for tr in terrains for i, p in enumerate(records) if (tr, i) not in results]
+    records = list(zip(params.index.tolist(), params.to_dict("records"), strict=True))
+    todo = [(tr, int(i), p) for tr in terrains for i, p in records if (tr, i) not in results]
     kw = {"seed": seed, "options": options, "family": family, "loop": loop}
 
     def finished(rows: list[tuple[str, int, list[dict]]]) -> None:
@@ -148,8 +150,8 @@ def run_encounters(
 def _long_table(params: pd.DataFrame, results: dict, terrains) -> pd.DataFrame:
     rows = []
     for tr in terrains:
-        for i, p in enumerate(params.to_dict("records")):
-            rows += [{"terrain": tr, "encounter": i, **p, **r} for r in results[(tr, i)]]
+        for i, p in zip(params.index.tolist(), params.to_dict("records"), strict=True):
+            rows += [{"terrain": tr, "encounter": int(i), **p, **r} for r in results[(tr, i)]]
     return pd.DataFrame(rows)
 
 
@@ -169,6 +171,31 @@ def partial_store(out_dir: Path, key: dict, name: str = _PARTIAL) -> tuple[dict,
         write_table(pd.DataFrame(rows), path)
 
     return done, save
+
+
+def select_encounters(params: pd.DataFrame, only: tuple[int, ...] | None) -> pd.DataFrame:
+    """The rows of an encounter set whose index is in ``only`` (None: all), labels kept, in order.
+
+    An encounter's parameters and seed follow from the set's size and seed and its index, so a
+    selection reruns exactly those encounters of the whole set (``--only``). InputError naming
+    ``--only`` for an index outside the set.
+
+    Examples
+    --------
+    >>> enc = make_fast_closures(5, seed=3)
+    >>> picked = select_encounters(enc, (4, 1))
+    >>> picked.index.tolist(), bool(picked.loc[4].equals(enc.loc[4]))
+    ([1, 4], True)
+    """
+    if only is None:
+        return params
+    outside = sorted({int(i) for i in only} - set(range(len(params))))
+    if outside or not only:
+        got = outside[0] if outside else "nothing"
+        raise InputError(
+            f"--only: encounters are numbered 0 to {len(params) - 1} (--n {len(params)}), got {got}"
+        )
+    return params.loc[sorted({int(i) for i in only})]
 
 
 def check_encounter_set(n_encounters: int, terrains: tuple[str, ...], layouts: tuple[str, ...]) -> None:
@@ -200,6 +227,7 @@ def run(
     command: str | None = None,
     scheduler: str | None = None,
     alert_settings: str = "radar",
+    only: tuple[int, ...] | None = None,
 ) -> dict:
     """Run the encounter set; write ``encounters.parquet``/``.csv`` (one row per terrain, encounter
     and layout), ``summary.json``, ``summary_rows.csv`` and the figures into ``out_dir``; return the
@@ -226,6 +254,8 @@ def run(
     alerting settings (:func:`skyradar.daa.alert_config.alert_config`: ``radar``, ``do365b``,
     ``default`` or a YAML file of fields); the summary records the name and a digest of every field
     (:func:`~skyradar.daa.alert_config.config_digest`), and a run resumes only with the same settings.
+    ``only`` runs those encounters of the set alone (:func:`select_encounters`: each as the whole
+    set runs it); the summary counts them alone and records the selection.
     """
     terrains, layouts = tuple(terrains), tuple(x for x in LAYOUTS if x in layouts)
     check_encounter_set(n_encounters, terrains, tuple(layouts) or ("",))
@@ -246,8 +276,10 @@ def run(
         enc = make_fast_closures(n_encounters, seed)
     else:
         enc = make_encounters(n_encounters, seed)
+    enc = select_encounters(enc, only)
     settings = {
         "n": n_encounters,
+        "only": None if only is None else enc.index.tolist(),
         "seed": seed,
         "frame_rate_hz": frame_rate_hz,
         "buffer": buffer,

@@ -19,6 +19,8 @@ from skyradar.track.elevation_trust import (
     FREE_ELEVATION_SIGMA_RAD,
     AboveVotes,
     BelowConsensus,
+    band_elevation_sigma_rad,
+    elevation_trusted,
     place_elevations,
 )
 from skyradar.track.track_table import track_detections
@@ -364,3 +366,24 @@ def test_an_aircraft_above_is_voted_above_by_its_median_before_any_single_readin
     assert np.mean([median_above(window) for window in level]) <= 1e-3
     biased = np.radians(1.0) + level
     assert np.mean([median_above(window) for window in biased]) <= 0.01
+
+
+def test_a_taller_array_trusts_in_band_readings_its_aperture_resolves():
+    """An aircraft 250 m above the own-ship 3 km ahead is 4.8 deg up. Through ``ura-4x2`` (an
+    elevation bound of 1.3 deg at 10 dB per channel) most of its in-band readings clear three of
+    that array's floors, none clear three of the square's; a level aircraft's readings, at the
+    same scatter, clear neither."""
+    from skyradar.process.doa import channel_positions_m, doa_crlb
+
+    tall = RadarConfig.prototype_2022(rx_positions_m="ura-4x2")
+    floor = band_elevation_sigma_rad(channel_positions_m(tall), tall.wavelength_m)
+    assert floor < 0.5 * band_elevation_sigma_rad(channel_positions_m(CFG), CFG.wavelength_m)
+    sigma = float(doa_crlb(10.0, 0.0, 0.0, tall)[1])
+    rng = np.random.default_rng(4)
+    above = np.arcsin(250.0 / 3000.0) + sigma * rng.standard_normal(2000)
+    level = sigma * rng.standard_normal(2000)
+    measured, band, sig = np.ones(2000, bool), np.ones(2000, bool), np.full(2000, sigma)
+    trusted_tall = elevation_trusted(above, sig, measured, band, band_sigma_rad=floor)
+    trusted_square = elevation_trusted(above, sig, measured, band)
+    assert trusted_tall.mean() > 0.7 and trusted_square.mean() < 0.01
+    assert elevation_trusted(level, sig, measured, band, band_sigma_rad=floor).mean() < 0.01

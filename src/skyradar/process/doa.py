@@ -71,6 +71,7 @@ __all__ = [
     "field_of_view_rad",
     "FIELD_OF_VIEW_LOSS_DB",
     "antenna_to_body",
+    "channel_positions_m",
 ]
 
 
@@ -198,8 +199,14 @@ def _geometry(
     return ArrayGeometry(basis, normal, design, solve, pairs, pair_solve, grid, match)
 
 
-def _channel_positions(config: RadarConfig) -> np.ndarray:
-    """Positions (n_channels, 3), m, of the channels DoA works on: receivers, or virtual channels for MIMO."""
+def channel_positions_m(config: RadarConfig) -> np.ndarray:
+    """Positions (n_channels, 3), m, of the channels DoA works on: receivers, or virtual channels for MIMO.
+
+    Examples
+    --------
+    >>> channel_positions_m(RadarConfig.prototype_2022()).shape
+    (4, 3)
+    """
     return config.rx_positions_m if config.n_tx == 1 else config.virtual_positions_m
 
 
@@ -236,7 +243,7 @@ def array_geometry(
     >>> array_geometry(cfg) is geo
     True
     """
-    rx = np.ascontiguousarray(_channel_positions(config), dtype=float)
+    rx = np.ascontiguousarray(channel_positions_m(config), dtype=float)
     fx, fy, fz = (float(f) for f in np.asarray(facing, float) / np.linalg.norm(facing))
     return _geometry(
         rx.tobytes(), rx.shape[0], float(config.wavelength_m), (fx, fy, fz), _fov_half_angle(config)
@@ -373,7 +380,7 @@ def steering_vector(u: np.ndarray, config: RadarConfig) -> np.ndarray:
     -1.0745
     """
     return np.exp(
-        -1j * (2.0 * np.pi / config.wavelength_m) * (np.asarray(u, float) @ _channel_positions(config).T)
+        -1j * (2.0 * np.pi / config.wavelength_m) * (np.asarray(u, float) @ channel_positions_m(config).T)
     )
 
 
@@ -550,7 +557,7 @@ def doa_crlb(
     snr = 10.0 ** (np.asarray(snr_db, float) / 10.0)
     az, el = np.broadcast_arrays(np.asarray(azimuth_rad, float), np.asarray(elevation_rad, float))
     k = 2.0 * np.pi / config.wavelength_m
-    positions = _channel_positions(config)
+    positions = channel_positions_m(config)
     q = positions - positions.mean(axis=0)
     du_daz = np.stack([-np.cos(el) * np.sin(az), np.cos(el) * np.cos(az), np.zeros_like(az)], axis=-1)
     du_del = np.stack([-np.sin(el) * np.cos(az), -np.sin(el) * np.sin(az), -np.cos(el)], axis=-1)

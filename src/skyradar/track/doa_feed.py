@@ -12,7 +12,14 @@ from __future__ import annotations
 import numpy as np
 
 from skyradar.io.ownship_states import REQUIRED_COLUMNS
-from skyradar.track.elevation_trust import AboveVotes, BelowConsensus, place_elevations
+from skyradar.process.doa import channel_positions_m
+from skyradar.track.elevation_trust import (
+    BAND_ELEVATION_SIGMA_RAD,
+    AboveVotes,
+    BelowConsensus,
+    band_elevation_sigma_rad,
+    place_elevations,
+)
 from skyradar.track.ground_doa import elevation_measured_flags
 from skyradar.track.io import validate_ownship
 from skyradar.track.measure3d import angle_sigma_rad, position_covariance
@@ -37,6 +44,12 @@ class Measure3D:
         # A lost filter is kept as long as the range-Doppler tracker may give its id back.
         self.t3 = Tracker3D(lost_memory_s=lost_memory_s)
         self.config, self.sigma_rad = config, sigma_rad
+        # The array's least elevation scatter in the ground's band (a taller array's is smaller).
+        self.band_sigma_rad = (
+            BAND_ELEVATION_SIGMA_RAD
+            if config is None
+            else band_elevation_sigma_rad(channel_positions_m(config), config.wavelength_m)
+        )
         self.motion, self.width = motion, motion.doppler_width_mps
         self.ned, self.z, self.sigma = np.empty((0, 3)), np.empty((0, 2)), np.empty(0)
         self.measured, self.trusted = np.empty(0, bool), np.empty(0, bool)
@@ -128,6 +141,7 @@ class Measure3D:
             self.below,
             self._clearance(pos, own_p[2] + self.agl[k]),
             np.array([self.agreed_up.get(int(i), np.nan) for i in out.alive_ids], float),
+            self.band_sigma_rad,
         )
         self.trusted[idx] = trusted[has]
         self._restart_heights(out.alive_ids, self.own[k], track_up, spread)

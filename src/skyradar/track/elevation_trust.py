@@ -11,9 +11,10 @@ intruder over Jacksboro). Both errors pull *towards the ground*, so they are bel
 true elevation; none can put a reading above the own-ship's horizontal when the ground is below
 it. Hence the asymmetric rule (:func:`elevation_trusted`): inside the ground's range-Doppler band
 (:func:`in_ground_band`) an elevation counts only when it is measured and more than ``k``
-standard deviations above the own-ship's horizontal; outside the band every measured elevation
-counts. The rest are *free*: the tracker places them at the co-altitude prior (elevation 0 above
-the own-ship's horizontal, :func:`at_elevation`) with a vertical-angle sigma of
+standard deviations above the own-ship's horizontal (the deviation at least a floor that scales
+with the array's beamwidth in elevation, :func:`band_elevation_sigma_rad`); outside the band every
+measured elevation counts. The rest are *free*: the tracker places them at the co-altitude prior
+(elevation 0 above the own-ship's horizontal, :func:`at_elevation`) with a vertical-angle sigma of
 :data:`FREE_ELEVATION_SIGMA_RAD`, while range and azimuth count in full. A track with no trusted
 elevation then stays co-altitude; one with trusted elevations follows them (a free reading weighs
 1/300 of a trusted one at 0.02 rad). Free readings are not placed at the track's *predicted*
@@ -42,6 +43,7 @@ import numpy as np
 __all__ = [
     "FREE_ELEVATION_SIGMA_RAD",
     "BAND_ELEVATION_SIGMA_RAD",
+    "band_elevation_sigma_rad",
     "in_ground_band",
     "elevation_trusted",
     "at_elevation",
@@ -55,8 +57,9 @@ __all__ = [
 
 FREE_ELEVATION_SIGMA_RAD = 0.35  # vertical-angle sigma of a free detection, at the co-altitude prior
 # Least elevation scatter assumed inside the ground's band when a reading is judged above the horizontal
-# (3 of it: 8.6 deg): readings through the nulls scatter by degrees past their bound, with a heavy upper
-# tail (over hills, an aircraft 39 m below has 1.7 % of its measured elevations above 8.6 deg).
+# (3 of it: 8.6 deg), for the prototype's square: readings through the nulls scatter by degrees past their
+# bound, with a heavy upper tail (over hills, an aircraft 39 m below has 1.7 % of its measured elevations
+# above 8.6 deg). Other arrays scale it by their vertical aperture (band_elevation_sigma_rad).
 BAND_ELEVATION_SIGMA_RAD = 0.05
 # Elevation bias a track's readings share, rad (3 deg): three times the 1-deg dynamic pitch and roll
 # error of a GA MEMS AHRS (the ``ga-typical`` navigation's datasheet class) with the mount's alignment.
@@ -99,18 +102,51 @@ def in_ground_band(
     return near & (np.abs(np.asarray(radial_velocity_mps, float)) <= own_speed_mps + margin_mps)
 
 
+def band_elevation_sigma_rad(channel_positions_m: np.ndarray, wavelength_m: float) -> float:
+    """Least elevation scatter assumed in the ground's band for an array, rad.
+
+    :data:`BAND_ELEVATION_SIGMA_RAD` was measured on the prototype's square, whose rows sit a
+    quarter wavelength above and below its centre. The scatter past the bound comes from the
+    ground the nulls leave in the cell (relief puts it at more than the two nulled directions),
+    and the angle a residual interferer pulls an estimate by scales with the beamwidth, which
+    scales inversely with the array's vertical extent. So the floor is the square's times the
+    ratio of the RMS vertical offsets of the channels (``down`` about their mean), the square's
+    (``wavelength_m / 4``) over the array's (``channel_positions_m``, m: the receivers, or a MIMO
+    radar's virtual channels). An array no taller than the square keeps the square's floor, and
+    ``ura-4x2`` (rows at a quarter and three quarters of a wavelength from its centre) has 0.45 of
+    it; an array with no vertical extent has no elevation to trust (infinity).
+
+    Examples
+    --------
+    >>> from skyradar.rx_layouts import rx_layout_m
+    >>> lam = 0.0123
+    >>> [round(band_elevation_sigma_rad(rx_layout_m(n, lam), lam), 4) for n in ("square", "ura-2x4", "kite")]
+    [0.05, 0.05, 0.0302]
+    >>> round(band_elevation_sigma_rad(rx_layout_m("ura-4x2", lam), lam), 4)
+    0.0224
+    """
+    down = np.asarray(channel_positions_m, float)[:, 2]
+    rms_m = float(np.sqrt(np.mean((down - down.mean()) ** 2)))
+    if rms_m <= 0.0:
+        return float("inf")
+    return BAND_ELEVATION_SIGMA_RAD * round(float(wavelength_m) / 4.0 / rms_m, 6)
+
+
 def elevation_trusted(
     elevation_rad: np.ndarray,
     sigma_rad: np.ndarray,
     measured: np.ndarray,
     band: np.ndarray,
     k: float = 3.0,
+    band_sigma_rad: float = BAND_ELEVATION_SIGMA_RAD,
 ) -> np.ndarray:
     """Whether each detection's elevation may move its track's height (bool per detection).
 
     ``elevation_rad`` is the DoA point's elevation above the own-ship's horizontal (NED), rad;
-    ``sigma_rad`` its standard deviation (taken at least :data:`BAND_ELEVATION_SIGMA_RAD` in the
-    band); ``measured`` the detection's ``elevation_measured``; ``band`` :func:`in_ground_band`.
+    ``sigma_rad`` its standard deviation (taken at least ``band_sigma_rad`` in the band: the
+    array's :func:`band_elevation_sigma_rad`, by default the square's
+    :data:`BAND_ELEVATION_SIGMA_RAD`); ``measured`` the detection's ``elevation_measured``;
+    ``band`` :func:`in_ground_band`.
     The track's vote (:class:`AboveVotes`) is applied by :func:`place_elevations`. See the module
     docstring for the rule.
 
@@ -121,7 +157,7 @@ def elevation_trusted(
     ...                   np.array([True, True, True, False])).tolist()
     [False, True, False, False]
     """
-    floor = np.where(band, BAND_ELEVATION_SIGMA_RAD, 0.0)
+    floor = np.where(band, band_sigma_rad, 0.0)
     above = np.asarray(elevation_rad, float) > k * np.maximum(np.asarray(sigma_rad, float), floor)
     return np.asarray(measured, bool) & (~np.asarray(band, bool) | above)
 
@@ -355,6 +391,7 @@ def place_elevations(
     below: BelowConsensus | None = None,
     clearance_m: np.ndarray | None = None,
     last_up_m: np.ndarray | None = None,
+    band_sigma_rad: float = BAND_ELEVATION_SIGMA_RAD,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """DoA positions with free elevations at their track's height, elevation sigma, trust, and height.
 
@@ -373,12 +410,15 @@ def place_elevations(
         the band, readings below count only within 3 bounds of it (sigma at least 0.05 rad).
     last_up_m : ndarray, shape (k,), optional
         Height above the own-ship each row's track last agreed on, m (NaN: never).
+    band_sigma_rad : float
+        Least elevation scatter in the ground's band, rad (:func:`band_elevation_sigma_rad` of the
+        array; default the square's).
 
     Returns
     -------
     positions_m, elevation_sigma_rad, trusted, track_up_m, track_spread_m : ndarray
         See :func:`_placed`; the height above the own-ship each row's track agrees on
-        (:class:`AboveVotes`) and its spread (at least :data:`BAND_ELEVATION_SIGMA_RAD` at its range), m.
+        (:class:`AboveVotes`) and its spread (at least ``band_sigma_rad`` at its range), m.
 
     Examples
     --------
@@ -391,16 +431,16 @@ def place_elevations(
     d = np.asarray(positions_m, float) - own
     elevation, range_m = np.arctan2(-d[:, 2], np.hypot(d[:, 0], d[:, 1])), np.linalg.norm(d, axis=1)
     band = in_ground_band(range_m, radial_velocity_mps, own_speed_mps, height_agl_m)
-    trusted = elevation_trusted(elevation, sigma_rad, measured, band)
+    trusted = elevation_trusted(elevation, sigma_rad, measured, band, band_sigma_rad=band_sigma_rad)
     in_band = np.asarray(measured, bool) & band
     sigma, held = np.asarray(sigma_rad, float), np.zeros(len(d), bool)
     trusted, track_up, spread = _voted(
         votes, ids, trusted, band, in_band, range_m * np.sin(elevation), elevation
     )
-    spread = np.where(np.isfinite(track_up), np.fmax(spread, BAND_ELEVATION_SIGMA_RAD * range_m), np.nan)
+    spread = np.where(np.isfinite(track_up), np.fmax(spread, band_sigma_rad * range_m), np.nan)
     if below is not None and clearance_m is not None:
-        held = _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids)
-    trusted, sigma = trusted | held, np.where(held, np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD), sigma)
+        held = _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids, band_sigma_rad)
+    trusted, sigma = trusted | held, np.where(held, np.maximum(sigma, band_sigma_rad), sigma)
     agreed, window = trusted & band & ~held & np.isfinite(track_up), votes.window if votes is not None else 1
     placed = (positions_m, own, range_m, sigma, trusted, agreed, track_up, spread, last_up_m, window)
     return *_placed(*placed), trusted, track_up, spread
@@ -436,14 +476,16 @@ def _placed(positions_m, own, range_m, sigma, trusted, agreed, track_up, spread,
     return out, np.where(trusted, sigma, FREE_ELEVATION_SIGMA_RAD)
 
 
-def _held_below(elevation, range_m, sigma, in_band, clearance_m, below, ids, k: float = 3.0) -> np.ndarray:
+def _held_below(
+    elevation, range_m, sigma, in_band, clearance_m, below, ids, band_sigma_rad: float, k: float = 3.0
+) -> np.ndarray:
     """In-band readings below the horizontal that agree with their track's :class:`BelowConsensus`.
 
     A consensus below only trusts its readings; it neither places free ones nor restarts the
     track's height: readings a mixture pulls can agree too (over flat ground 1000 m below, an
     aircraft 103 m below has readings agreeing 700 m below; held there, its track would never be
     warned). Above the horizontal the ground pulls none."""
-    wide = k * np.maximum(sigma, BAND_ELEVATION_SIGMA_RAD)
+    wide = k * np.maximum(sigma, band_sigma_rad)
     up, loose, is_below = range_m * np.sin(elevation), range_m * wide, elevation < -wide
     clear = np.asarray(clearance_m) - loose
     consensus, _ = below.update(ids, up, range_m * sigma, is_below, in_band, clear)

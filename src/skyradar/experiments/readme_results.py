@@ -39,7 +39,7 @@ README_RESULTS: tuple[str, ...] = (
     "encounters-synthetic-jacksboro-seed7215-n200.json",
     "encounters-synthetic-hills-seed7216-n200.json",
     "encounters-fast-closures-hills-none-seed7219-n200.json",
-    "encounters-fast-closures-jacksboro-seed7218-n200.json",
+    "encounters-fast-closures-jacksboro-none-seed7220-n200.json",
     "encounters-real-flights-none-seed7218-n100.json",
 )
 

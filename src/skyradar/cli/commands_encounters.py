@@ -228,14 +228,12 @@ def experiment_encounters(
     if n is None:  # over terrain an encounter costs minutes: the default keeps a run within 5 minutes
         n = DEFAULT_ENCOUNTERS if terrains == ["none"] else DEFAULT_TERRAIN_ENCOUNTERS
     if selected is not None:  # a bad number is named before any output
-        import pandas as pd
+        from skyradar.experiments.encounters import check_only
 
-        from skyradar.experiments.encounters import select_encounters
-
-        select_encounters(pd.DataFrame(index=range(n)), selected)
+        selected = tuple(check_only(selected, n))
     check_output(out, (), overwrite, kind="folder", option="--output")
     mark_folder(out)
-    total = (n if selected is None else len(set(selected))) * len(terrains)
+    total = (n if selected is None else len(selected)) * len(terrains)
     with frame_progress(total, "encounters") as bar:
         task = bar.add_task("encounters", total=total)
         result = run(

@@ -49,6 +49,7 @@ __all__ = [
     "partial_store",
     "check_encounter_set",
     "select_encounters",
+    "check_only",
 ]
 
 MAX_ENCOUNTERS = 100_000  # 200 times the thesis-sized set; more is a typo, not a plan
@@ -173,12 +174,31 @@ def partial_store(out_dir: Path, key: dict, name: str = _PARTIAL) -> tuple[dict,
     return done, save
 
 
+def check_only(only: tuple[int, ...], n_encounters: int) -> list[int]:
+    """The encounter numbers ``only`` of a set of ``n_encounters``, sorted, each once; InputError
+    naming ``--only`` for a number outside the set (or none at all).
+
+    Examples
+    --------
+    >>> check_only((4, 1, 4), 5)
+    [1, 4]
+    """
+    picked = sorted({int(i) for i in only})
+    outside = [i for i in picked if not 0 <= i < n_encounters]
+    if outside or not picked:
+        got = outside[0] if outside else "nothing"
+        raise InputError(
+            f"--only: encounters are numbered 0 to {n_encounters - 1} (--n {n_encounters}), got {got}"
+        )
+    return picked
+
+
 def select_encounters(params: pd.DataFrame, only: tuple[int, ...] | None) -> pd.DataFrame:
     """The rows of an encounter set whose index is in ``only`` (None: all), labels kept, in order.
 
     An encounter's parameters and seed follow from the set's size and seed and its index, so a
-    selection reruns exactly those encounters of the whole set (``--only``). InputError naming
-    ``--only`` for an index outside the set.
+    selection reruns exactly those encounters of the whole set (``--only``); :func:`check_only`
+    refuses a number outside the set.
 
     Examples
     --------
@@ -187,15 +207,7 @@ def select_encounters(params: pd.DataFrame, only: tuple[int, ...] | None) -> pd.
     >>> picked.index.tolist(), bool(picked.loc[4].equals(enc.loc[4]))
     ([1, 4], True)
     """
-    if only is None:
-        return params
-    outside = sorted({int(i) for i in only} - set(range(len(params))))
-    if outside or not only:
-        got = outside[0] if outside else "nothing"
-        raise InputError(
-            f"--only: encounters are numbered 0 to {len(params) - 1} (--n {len(params)}), got {got}"
-        )
-    return params.loc[sorted({int(i) for i in only})]
+    return params if only is None else params.loc[check_only(only, len(params))]
 
 
 def check_encounter_set(n_encounters: int, terrains: tuple[str, ...], layouts: tuple[str, ...]) -> None:

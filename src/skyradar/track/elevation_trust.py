@@ -407,7 +407,7 @@ def place_elevations(
         The tracks' votes (updated here) and track ids; without: all voted, each reading on its own.
     below, clearance_m : BelowConsensus and ndarray, shape (k,), optional
         The tracks' consensus below (updated here) and each point's height above the terrain, m; in
-        the band, readings below count only within 3 bounds of it (sigma at least 0.05 rad).
+        the band, readings below count only within 3 bounds of it (sigma at least ``band_sigma_rad``).
     last_up_m : ndarray, shape (k,), optional
         Height above the own-ship each row's track last agreed on, m (NaN: never).
     band_sigma_rad : float

@@ -197,3 +197,46 @@ def test_bench_reports_frames_per_second_of_1_6_and_8_channels():
     out = run_arrays(n_cubes=1, n_targets=2, min_time_s=0.05)
     for n_rx in (1, 6, 8):
         assert out[f"rx{n_rx}_frames_per_s"] > 0 and out[f"rx{n_rx}_cpu_frames_per_s"] > 0
+
+
+def test_larger_arrays_null_the_clutter_relief_leaves_and_keep_the_intruder():
+    """Over hills, two nulls per cell leave an eight-channel array's cells full of the clutter its
+    aperture resolves; with the ceiling of its channel count (six) it detects as few cells as the
+    square does with two, and the head-on intruder (3 km to 1.8 km, aliased into the ground's
+    band) is detected in every frame either way. The square keeps its two nulls."""
+    import functools
+
+    import skyradar.process.clutter_frames as clutter_frames
+    from skyradar.benchmarks.process_adaptive import SPEED_MPS, relief_cubes
+    from skyradar.process.clutter import clutter_subspace
+    from skyradar.process.clutter_suppress import default_max_nulls, suppress_clutter
+
+    assert default_max_nulls(4) == 2 and default_max_nulls(8) == 6
+
+    def detections(layout: str, max_nulls: int | None) -> tuple[list[int], list[bool]]:
+        config = RadarConfig.prototype_2022(rx_positions_m=layout)
+        cubes, agl = relief_cubes(config, 3, 0)
+        velocity = np.array([SPEED_MPS, 0.0, 0.0])
+        sub = clutter_subspace(config, velocity, config.mount.rotation, agl, n_azimuth=720)
+        v_lim = config.v_lim_mps
+        aliased = (-2.0 * SPEED_MPS + v_lim) % (2.0 * v_lim) - v_lim  # the closing speed, aliased
+        counts, seen = [], []
+        original = clutter_frames.suppress_clutter
+        try:
+            clutter_frames.suppress_clutter = functools.partial(suppress_clutter, max_nulls=max_nulls)
+            for range_m, cube in zip(np.linspace(3000.0, 1800.0, 3), cubes, strict=True):
+                det = clutter_frames.detect_suppressed(cube, config, sub)[0]
+                near = np.abs(det.range_m(config) - range_m) < 20.0
+                near &= np.abs(det.radial_velocity_mps(config) - aliased) < 1.0
+                counts.append(len(det.range_index))
+                seen.append(bool(near.any()))
+        finally:
+            clutter_frames.suppress_clutter = original
+        return counts, seen
+
+    two, two_seen = detections("ura-4x2", 2)
+    ceiling, ceiling_seen = detections("ura-4x2", None)
+    square, _ = detections("square", None)
+    assert all(two_seen) and all(ceiling_seen)
+    assert np.mean(ceiling) < 0.6 * np.mean(two)
+    assert np.mean(ceiling) < 1.2 * np.mean(square)

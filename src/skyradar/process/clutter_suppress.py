@@ -54,6 +54,7 @@ from skyradar.process.power import power_image
 from skyradar.rx_layouts import MAX_RX
 
 __all__ = [
+    "default_max_nulls",
     "Suppressed",
     "suppress_clutter",
     "null_count",
@@ -225,6 +226,42 @@ def _project_power(z, vectors, nulls, out):  # pragma: no cover - compiled
     return out
 
 
+def default_max_nulls(n_rx: int) -> int:
+    """Most clutter directions one cell may null on an array of ``n_rx`` channels.
+
+    Over flat ground a range-Doppler cell holds clutter from two directions, left and right of
+    the ground track at one depression angle: two nulls. Over relief the circle of one range and
+    one Doppler meets the terrain in more places, and what the point spread leaks in from the
+    neighbouring cells comes from nearby directions that a larger aperture resolves: on the frames
+    over hills of ``skyradar bench process`` an eight-channel array with two nulls per cell
+    detects about 2.5 times the cells the square does, and as many with six. So an array nulls as
+    many directions as its channels allow while two are left: after ``m`` nulls a target's
+    snapshot spans ``n_rx - m`` dimensions; with one left the projected matched filter
+    ``|s^H P z|^2 / s^H P s`` is the same for every direction
+    (:mod:`skyradar.process.clutter_doa`), with two their ratio measures it. Up to four channels
+    that is two nulls (one on two channels, none on one); six channels take four, eight take six.
+    It is a ceiling: nulls are placed only where the clutter needs them (the predicted pass's
+    residual, the adaptive pass's eigenvalue edge).
+
+    Parameters
+    ----------
+    n_rx : int
+        Receive (or virtual) channels of the array.
+
+    Returns
+    -------
+    int
+        The ceiling on nulls per cell.
+
+    Examples
+    --------
+    >>> [default_max_nulls(n) for n in (1, 2, 3, 4, 6, 8)]
+    [0, 1, 2, 2, 4, 6]
+    """
+    n = int(n_rx)
+    return max(min(2, n - 1), n - 2, 0)
+
+
 def suppress_clutter(
     cube: np.ndarray,
     subspace: ClutterSubspace,
@@ -244,8 +281,8 @@ def suppress_clutter(
     config : RadarConfig
         Channel count, calibration and nominal noise power ``noise_power_w`` (W).
     max_nulls : int, optional
-        Most directions nulled in one cell; default 2 (keeps two channels' worth of noise averaging
-        on the 2x2), at most ``n_rx - 1`` (none on a one-channel radar).
+        Most directions nulled in one cell; default :func:`default_max_nulls` of the array's
+        channel count, at most ``n_rx - 1`` (none on a one-channel radar).
     gate : float
         A direction is nulled when the measured clutter-to-noise ratio times its eigenvalue
         fraction exceeds this.
@@ -286,7 +323,7 @@ def suppress_clutter(
     if cube.shape != subspace.predicted.shape + (config.n_rx,):
         raise InputError(f"suppression: frame shape {cube.shape} does not fit the clutter prediction")
     if max_nulls is None:
-        max_nulls = min(2, config.n_rx - 1)
+        max_nulls = default_max_nulls(config.n_rx)
     if not 0 <= max_nulls < config.n_rx:
         raise InputError(f"suppression: field 'max_nulls' must be in [0, {config.n_rx - 1}], got {max_nulls}")
     raw = power_image(cube, config.rx_calibration)

@@ -63,7 +63,8 @@ SUMMARY_FIELDS = ("family", "terrains", "layouts", "encounters", "seed", "split"
 PROVENANCE_FIELDS = ("command", "version", "date_utc", "load_average_1min")
 # Headline numbers of one row (a terrain and a layout); `false_warnings_sensor` (the false warnings
 # perfect surveillance does not give), `false_warnings_altitude_prior` (those first warned on a co-altitude
-# prior), `warnings_not_held` and `alert_flickers` only when present.
+# prior), `false_warnings_any_track` (must-not-alert encounters warned on any track), `warnings_not_held`
+# and `alert_flickers` only when present.
 ROW_FIELDS = (
     "conflicts",
     "observable_conflicts",
@@ -77,6 +78,7 @@ ROW_FIELDS = (
     "alert_flickers",
     "false_warnings_sensor",
     "false_warnings_altitude_prior",
+    "false_warnings_any_track",
 )
 # Figures of merit of one terrain case of the clutter experiment (its summary's ``terrains``), in the
 # order shown: key, meaning (with its unit), decimals (None: a count).
@@ -261,6 +263,7 @@ class ResultsDirective(SphinxDirective):
             "alert_flickers",
             "false_warnings_sensor",
             "false_warnings_altitude_prior",
+            "false_warnings_any_track",
         )
         shown = [f for f in ROW_FIELDS if f not in optional or any(f in r for r in rows)]
         section += _table(

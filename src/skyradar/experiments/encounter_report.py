@@ -159,8 +159,18 @@ def _row_sentence(r: dict[str, Any]) -> str:
         + f"; unwarned: {', '.join(causes) or 'none'}. A warning came in {r['false_warnings']} of the "
         f"{r['must_not_alert_encounters']} encounters that must not alert"
         + _alerter_share(r)
-        + f", and {clutter} clutter track{'' if clutter == 1 else 's'} reached a warning."
+        + f", and {clutter} clutter track{'' if clutter == 1 else 's'} reached a warning"
+        + _heard(r)
+        + "."
     )
+
+
+def _heard(r: dict[str, Any]) -> str:
+    """How many must-not-alert encounters heard a warning on any track (empty without the count)."""
+    heard = r.get("false_warnings_any_track", float("nan"))
+    if not isinstance(heard, int):
+        return ""
+    return f" ({heard} of the encounters that must not alert heard a warning on some track)"
 
 
 def _alerter_share(r: dict[str, Any]) -> str:

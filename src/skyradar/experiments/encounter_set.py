@@ -339,7 +339,21 @@ def summarise(res: pd.DataFrame, late_lead_s: float) -> dict[str, Any]:
     the column these counts are NaN. ``false_warnings_altitude_prior`` counts the false warnings
     whose first warning rests on a co-altitude prior (column ``warned_on_altitude_prior``): the
     track's elevation was never measured, so an intruder that passes above or below looks level and
-    must be warned (NaN without the column).
+    must be warned (NaN without the column). A pilot hears a warning whatever track raised it:
+    ``false_warnings_any_track`` counts the must-not-alert encounters warned on the intruder's track
+    or on any other (clutter, ground; column ``t_other_warning_s``), with its rate and interval
+    (NaN without the column).
+
+    Examples
+    --------
+    Two must-not-alert encounters, one warned on a clutter track only, and a conflict warned in time:
+
+    >>> res = pd.DataFrame({"observable": [False, False, True], "conflict": [False, False, True],
+    ...                     "may_alert": False, "t_lowc_s": [np.nan, np.nan, 30.0],
+    ...                     "t_warning_s": [np.nan, np.nan, 5.0], "t_other_warning_s": [np.nan, 9.0, np.nan]})
+    >>> s = summarise(res, 12.5)
+    >>> s["false_warnings"], s["false_warnings_any_track"], s["median_warning_lead_s"]
+    (0, 1, 25.0)
     """
     lead = res["t_lowc_s"] - res["t_warning_s"]
     in_time = res["t_warning_s"] < res["t_lowc_s"]
@@ -355,6 +369,18 @@ def summarise(res: pd.DataFrame, late_lead_s: float) -> dict[str, Any]:
             "false_warnings_alerter": int((must_not & warned & truth_warned).sum()),
             "false_warnings_sensor": int((must_not & warned & ~truth_warned).sum()),
             "must_not_alert_truth_warned": int((must_not & truth_warned).sum()),
+        }
+    any_track: dict[str, Any] = {
+        "false_warnings_any_track": np.nan,
+        "false_warning_rate_any_track": np.nan,
+        "false_warning_rate_any_track_ci95": [np.nan, np.nan],
+    }
+    if "t_other_warning_s" in res:
+        heard = int((must_not & (warned | res["t_other_warning_s"].notna())).sum())
+        any_track = {
+            "false_warnings_any_track": heard,
+            "false_warning_rate_any_track": float(heard / max(int(must_not.sum()), 1)),
+            "false_warning_rate_any_track_ci95": rate_interval(heard, int(must_not.sum())),
         }
     prior = float("nan")
     if "warned_on_altitude_prior" in res:
@@ -375,6 +401,7 @@ def summarise(res: pd.DataFrame, late_lead_s: float) -> dict[str, Any]:
         "false_warning_rate_ci95": rate_interval(int((must_not & warned).sum()), int(must_not.sum())),
         **split,
         "false_warnings_altitude_prior": prior,
+        **any_track,
         "missed_warning_rate": float((obs & ~in_time).sum() / max(int(obs.sum()), 1)),
         "missed_warning_rate_ci95": rate_interval(int((obs & ~in_time).sum()), int(obs.sum())),
         "median_warning_lead_s": float(np.median(lead[good])) if good.any() else float("nan"),

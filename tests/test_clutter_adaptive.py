@@ -301,6 +301,6 @@ def test_relief_benchmark_agrees_with_its_numpy_baseline():
     result = run_adaptive(n_cubes=1)
     assert result["relief_adaptive_cells_per_frame"] > 1000  # the flat prediction misses the hills
     assert result["relief_adaptive_same_nulls"] > 0.999
-    for n_rx in (6, 8):  # up to four and six nulls, the general subspace iteration against eigh
+    for n_rx in (6, 8):  # the compiled step on six and eight channels against eigh
         assert result[f"relief_rx{n_rx}_adaptive_cells_per_frame"] > 1000
         assert result[f"relief_rx{n_rx}_adaptive_same_nulls"] > 0.999

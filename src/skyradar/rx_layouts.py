@@ -21,15 +21,19 @@ Its vertical aperture of one wavelength is unambiguous through the two half-wave
 ``ura-2x3`` and ``ura-2x4`` are uniform rectangular arrays at the prototype's half-wavelength
 element spacing: two rows (one above the other) of three or four columns across, centred on the
 boresight axis. More channels buy angle accuracy (the Cramer-Rao bound falls with the aperture's
-second moments, :func:`skyradar.process.doa.doa_crlb`) and more clutter nulls. ``ura-4x2`` stands
+second moments, :func:`skyradar.process.doa.doa_crlb`) and more clutter nulls
+(:func:`skyradar.process.clutter_suppress.default_max_nulls`: four on six channels, six on
+eight). ``ura-4x2`` stands
 the same eight channels upright: four rows of two columns. Its vertical aperture (1.5 wavelengths)
 gives an elevation bound 3.2 times smaller than the square's at the same per-channel SNR (the
 rows' second moment is 5 times the square's, the channel count twice): 1.3 deg against 4.1 deg
 at 10 dB per channel (:func:`~skyradar.process.doa.doa_crlb`). An aircraft 250 m above the
 own-ship 3 km ahead is 4.8 deg up, a little over one of the square's sigmas from co-altitude.
 Its azimuth keeps the square's half-wavelength horizontal baseline, its bound 1.4 times smaller
-from the channel count. Over relief it confirms ground tracks many times as often as the square
-(two nulls per cell and the square's ground tests): the arrays guide says so with the measured set.
+from the channel count. Over relief it confirms ground tracks many times as often as the square:
+the return of the ground below the aircraft, which the square's ground tests recognise at the
+end-fire of its vertical baseline, reaches four rows as no plane wave; the arrays guide says so
+with the measured set.
 
 Unambiguous field of view: every layout here has half-wavelength pairs spanning the array plane
 (the kite's one-wavelength baseline is unwrapped from them), so each is free of grating lobes

@@ -13,8 +13,8 @@ candidate cells' ring covariances, explicit projectors). ``relief_adaptive_same_
 fraction of cells where both chose the same null count, ``relief_adaptive_same_detections`` whether
 CFAR finds the same cells on both images in every frame. The chain's CPU time per frame splits
 into the predicted nulls, the adaptive step, and detection with the direction searches. The same
-figures for the six- and eight-channel arrays (``relief_rx6_*``, ``relief_rx8_*``), whose cells
-take up to four and six nulls: what a larger array's suppression costs over relief. Both
+figures for the six- and eight-channel arrays (``relief_rx6_*``, ``relief_rx8_*``): what a larger
+array's suppression costs over relief, at its default ceiling of nulls per cell. Both
 versions stop at a tolerance (the compiled subspace iteration's residual, the baseline's exact
 ``eigh``), so a cell whose eigenvalue lies within it of the edge, or whose power lies that close to
 its CFAR threshold, can take another null count or detection: the ``same_*`` figures say how often.
@@ -110,7 +110,7 @@ def run_adaptive(n_cubes: int = 4, seed: int = 0) -> dict:
     """CPU ms per frame of the adaptive step, ours and the numpy baseline; the whole chain's frames/s.
 
     The prototype's square under ``relief_*``; the six- and eight-channel arrays of
-    ``skyradar bench process`` (``ura-2x3``, ``ura-2x4``, with their own ceilings on nulls,
+    ``skyradar bench process`` (``ura-2x3``, ``ura-2x4``, at their default ceiling on nulls,
     :func:`skyradar.process.clutter_suppress.default_max_nulls`) on fewer frames of the same hills
     under ``relief_rx6_*`` and ``relief_rx8_*``.
     """

@@ -21,9 +21,8 @@ Its vertical aperture of one wavelength is unambiguous through the two half-wave
 ``ura-2x3`` and ``ura-2x4`` are uniform rectangular arrays at the prototype's half-wavelength
 element spacing: two rows (one above the other) of three or four columns across, centred on the
 boresight axis. More channels buy angle accuracy (the Cramer-Rao bound falls with the aperture's
-second moments, :func:`skyradar.process.doa.doa_crlb`) and more clutter nulls
-(:func:`skyradar.process.clutter_suppress.default_max_nulls`: four on six channels, six on
-eight). ``ura-4x2`` stands
+second moments, :func:`skyradar.process.doa.doa_crlb`) and room for more clutter nulls, which
+cost the target too (:func:`skyradar.process.clutter_suppress.default_max_nulls`). ``ura-4x2`` stands
 the same eight channels upright: four rows of two columns. Its vertical aperture (1.5 wavelengths)
 gives an elevation bound 3.2 times smaller than the square's at the same per-channel SNR (the
 rows' second moment is 5 times the square's, the channel count twice): 1.3 deg against 4.1 deg

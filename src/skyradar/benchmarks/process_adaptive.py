@@ -29,7 +29,7 @@ import numpy as np
 from skyradar.config import RadarConfig
 from skyradar.process.clutter import clutter_subspace
 from skyradar.process.clutter_adaptive import ADAPTIVE_GATE, ADAPTIVE_WINDOW, EIGEN_EDGE, RING_CLIP
-from skyradar.process.clutter_suppress import default_max_nulls, suppress_clutter
+from skyradar.process.clutter_suppress import Suppressed, default_max_nulls, suppress_clutter
 from skyradar.process.detect import detect
 from skyradar.process.pipeline import process_cube
 from skyradar.scene.synthetic_terrain import fractal_terrain
@@ -128,10 +128,12 @@ def _adaptive_figures(config: RadarConfig, n_cubes: int, seed: int, prefix: str)
     inv_gain = (1.0 / np.asarray(config.rx_calibration)).astype(np.complex64)
     max_nulls = default_max_nulls(config.n_rx)
 
-    def baseline(cube: np.ndarray) -> np.ndarray:
+    def baseline(cube: np.ndarray) -> Suppressed:
+        """The predicted pass, its cells rewritten in place by the numpy adaptive step."""
         s = suppress_clutter(cube, sub, config, adaptive=False)
         args = (s.clutter_to_noise, s.noise_floor_w, s.power, s.nulls, s.unsuppressed)
-        return baseline_adaptive(cube, inv_gain, *args, max_nulls=max_nulls)
+        baseline_adaptive(cube, inv_gain, *args, max_nulls=max_nulls)
+        return s
 
     predicted = _cpu_per_frame(lambda c: suppress_clutter(c, sub, config, adaptive=False), cubes)
     ours = _cpu_per_frame(lambda c: suppress_clutter(c, sub, config), cubes) - predicted
@@ -139,18 +141,7 @@ def _adaptive_figures(config: RadarConfig, n_cubes: int, seed: int, prefix: str)
     chain = _cpu_per_frame(lambda c: process_cube(c, config, clutter=sub), cubes)
     same, same_hits, cells = [], [], []
     for cube in cubes:
-        s = suppress_clutter(cube, sub, config)
-        b = suppress_clutter(cube, sub, config, adaptive=False)
-        baseline_adaptive(
-            cube,
-            inv_gain,
-            b.clutter_to_noise,
-            b.noise_floor_w,
-            b.power,
-            b.nulls,
-            b.unsuppressed,
-            max_nulls=max_nulls,
-        )
+        s, b = suppress_clutter(cube, sub, config), baseline(cube)
         same.append(float(np.mean(s.nulls == b.nulls)))
         same_hits.append(_hit_cells(s, config) == _hit_cells(b, config))
         assert s.adaptive is not None  # suppress_clutter's adaptive pass (its default) sets it

@@ -409,6 +409,20 @@ class RadarConfig:
         return self.n_doppler // self.n_tx
 
     @property
+    def frame_shape(self) -> tuple[int, int, int]:
+        """Shape of one range-Doppler frame: ``(n_range, n_doppler_per_tx, n_virtual)``.
+
+        One channel per receiver, or per virtual channel (transmitter-major) for a time-division
+        MIMO radar, whose frame has one transmitter's ``nV / n_tx`` Doppler bins.
+
+        >>> RadarConfig.prototype_2022().frame_shape
+        (333, 250, 4)
+        >>> RadarConfig.prototype_2022(rx_positions_m="mimo-2x4").frame_shape
+        (333, 125, 8)
+        """
+        return self.n_range, self.n_doppler_per_tx, self.n_virtual
+
+    @property
     def rmax_m(self) -> float:
         """Unambiguous range c*Fs / (2*B*PRF), m."""
         return SPEED_OF_LIGHT * self.fs_hz / (2.0 * self.bandwidth_hz * self.prf_hz)
@@ -507,8 +521,9 @@ class RadarConfig:
 
     @property
     def noise_bandwidth_hz(self) -> float:
-        """Noise bandwidth of one range-Doppler pixel after coherent integration: PRF / nV."""
-        return self.prf_hz / self.n_doppler
+        """Noise bandwidth of one range-Doppler pixel after coherent integration over one
+        transmitter's chirps: ``PRF / (nV / n_tx)``, Hz (``PRF / nV`` for one transmitter)."""
+        return self.prf_hz / self.n_doppler_per_tx
 
     @property
     def noise_power_w(self) -> float:

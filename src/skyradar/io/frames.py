@@ -99,8 +99,9 @@ def frames_dataset(
 
     Parameters
     ----------
-    iq : array_like, shape (n_time, n_range, n_doppler, n_rx)
-        Complex pixels (numpy or dask).
+    iq : array_like, shape (n_time, *config.frame_shape)
+        Complex pixels (numpy or dask); for a time-division MIMO radar the ``rx`` axis holds the
+        virtual channels and ``doppler`` one transmitter's bins.
     times_s : ndarray, shape (n_time,)
         Frame times, s.
     config : RadarConfig
@@ -121,7 +122,7 @@ def frames_dataset(
     >>> frames_dataset(cube, np.array([0.0, 0.1]), cfg).iq.dims
     ('time', 'range', 'doppler', 'rx')
     """
-    expected = (len(times_s), config.n_range, config.n_doppler, config.n_rx)
+    expected = (len(times_s), *config.frame_shape)
     if tuple(iq.shape) != expected:
         raise InputError(
             f"frames: iq has shape {tuple(iq.shape)}, expected (time, range, doppler, rx) = {expected}"
@@ -256,11 +257,11 @@ def open_frames(path: str | Path, head: int | str | None = None) -> xr.Dataset:
     if ds.sizes.get("time", 0) == 0:
         raise InputError(f"{path}: empty run (0 frames)")
     check_frame_times(frame_times_s(ds), path)
-    if ds.sizes.get("rx") != config.n_rx:
+    if ds.sizes.get("rx") != config.n_virtual:
         raise InputError(
-            f"{path}: field 'rx' has {ds.sizes.get('rx')} antennas, radar_config has {config.n_rx}"
+            f"{path}: field 'rx' has {ds.sizes.get('rx')} channels, radar_config has {config.n_virtual}"
         )
-    for dim, n in (("range", config.n_range), ("doppler", config.n_doppler)):
+    for dim, n in (("range", config.n_range), ("doppler", config.n_doppler_per_tx)):
         if ds.sizes.get(dim) != n:
             raise InputError(f"{path}: dimension '{dim}' is {ds.sizes.get(dim)}, radar_config needs {n}")
     return ds

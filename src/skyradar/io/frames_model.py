@@ -256,7 +256,10 @@ def axis_coordinates(config: RadarConfig, times_s: Any, start_time: Any = None) 
         config.doppler_axis_mps,
         _cf("doppler", "m/s", "radial velocity bin centre, positive receding"),
     )
-    coords["rx"] = ("rx", np.arange(config.n_rx), {"units": "1", "long_name": "receive antenna index"})
+    long_name = "receive antenna index"
+    if config.n_tx > 1:
+        long_name = "virtual channel index, transmitter * n_rx + receiver (time-division MIMO)"
+    coords["rx"] = ("rx", np.arange(config.n_virtual), {"units": "1", "long_name": long_name})
     return coords
 
 

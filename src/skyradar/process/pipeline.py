@@ -170,6 +170,7 @@ def process_cube(
     >>> np.degrees(out["azimuth_rad"]).round().tolist(), np.degrees(out["elevation_rad"]).round().tolist()
     ([10.0], [-5.0])
     """
+    _require_one_transmitter(config)
     if cube.ndim != 3 or cube.shape[2] != config.n_rx:
         raise InputError(f"frame: field 'rx' has {cube.shape[-1]} channels, radar_config has {config.n_rx}")
     if spur_mode not in ("mask", "flag"):
@@ -345,6 +346,15 @@ def process_chunk(
     )
 
 
+def _require_one_transmitter(config: RadarConfig) -> None:
+    # A MIMO frame's virtual channels carry each target's slot phase, which DoA and the clutter
+    # nulls' steering do not model yet.
+    config.require_one_transmitter(
+        "frame processing (clutter suppression, detection, DoA)",
+        "the virtual channels' slot phase is removed per detection by skyradar.process.mimo.virtual_pixels",
+    )
+
+
 def _checked_config(ds: xr.Dataset, config: RadarConfig | None, spur_map, source: str) -> RadarConfig:
     """The radar config to process ``ds`` with (the stored one unless given), checked against the frames."""
     stored = radar_config_of(ds, source)
@@ -357,10 +367,11 @@ def _checked_config(ds: xr.Dataset, config: RadarConfig | None, spur_map, source
             )
     if ds.sizes.get("time", 0) == 0:
         raise InputError(f"{source}: empty run (0 frames)")
-    if ds.sizes.get("rx") != config.n_rx:
+    if ds.sizes.get("rx") != config.n_virtual:
         raise InputError(
-            f"{source}: field 'rx' has {ds.sizes.get('rx')} antennas, radar_config has {config.n_rx}"
+            f"{source}: field 'rx' has {ds.sizes.get('rx')} channels, radar_config has {config.n_virtual}"
         )
+    _require_one_transmitter(config)
     if spur_map is not None and spur_map.frequency.shape != (config.n_range, config.n_doppler):
         raise InputError(f"{source}: spur map shape {spur_map.frequency.shape} does not fit the frames")
     return config

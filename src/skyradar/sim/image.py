@@ -43,6 +43,7 @@ __all__ = [
     "AntennaGeometry",
     "TerrainView",
     "ImageSimulator",
+    "terrain_channel_positions_m",
     "REFLECTIVITY_MODELS",
     "two_way_gain_table",
 ]
@@ -118,10 +119,6 @@ class ImageSimulator:
         swerling: int = 0,
         adaptive_facets: bool | None = None,
     ) -> None:
-        config.require_one_transmitter(  # frames per receive channel
-            "the image-domain simulator",
-            "simulate a time-division MIMO radar at the chirp level (skyradar.sim.raw.simulate_adc)",
-        )
         self.config = config
         self.terrain = terrain
         lat0, lon0, alt0 = origin
@@ -189,7 +186,8 @@ class ImageSimulator:
         frame_index: int = 0,
         out: np.ndarray | None = None,
     ) -> np.ndarray:
-        """Simulate one frame; returns (n_range, n_doppler, n_rx) complex64.
+        """Simulate one frame; returns ``config.frame_shape`` complex64: (n_range, n_doppler, n_rx), or
+        (n_range, n_doppler / n_tx, n_tx * n_rx) virtual channels for a time-division MIMO radar.
 
         ``out``, if given, is a C-contiguous complex64 array of that shape that receives the
         frame (and is returned): a caller filling a preallocated stack of frames skips a fresh
@@ -211,7 +209,7 @@ class ImageSimulator:
             sparse = self._sparse_buffers(view, self._scratch)
             self._accumulate_terrain(geom, view, self._no_blocks(), sparse, self._scratch, speckle)
             finalize_frame(self._no_blocks(), 0.0 if psf else sigma, key, grid)
-            add_sparse(grid.reshape(-1, cfg.n_rx), *sparse)
+            add_sparse(grid.reshape(-1, cfg.n_virtual), *sparse)
         else:
             blocks = self._accumulation_blocks()
             self._accumulate_terrain(geom, view, blocks, _NO_SPARSE, self._scratch, speckle)
@@ -240,16 +238,17 @@ class ImageSimulator:
     def _grid_shape(self) -> tuple[int, int, int]:
         # Accumulation grid: the frame's bins, or sub-bins with the point-spread.
         n = 1 if self._psf is None else self._psf.oversample
-        return n * self.config.n_range, n * self.config.n_doppler, self.config.n_rx
+        n_range, n_doppler, n_channels = self.config.frame_shape
+        return n * n_range, n * n_doppler, n_channels
 
     @property
     def noise_per_pixel_w(self) -> float:
-        """Thermal noise power per pixel of the frames, W (times the windows' ENBW with ``psf``)."""
+        """Thermal noise power per pixel of the frames, W (times the windows' ENBW with ``psf``); a MIMO
+        radar's pixel integrates one transmitter's chirps (``config.noise_power_w``)."""
         return self.config.noise_power_w * enbw(self._psf)
 
     def _output(self, out: np.ndarray | None) -> np.ndarray:
-        cfg = self.config
-        shape = (cfg.n_range, cfg.n_doppler, cfg.n_rx)
+        shape = self.config.frame_shape
         if out is None:
             return np.empty(shape, np.complex64)
         if out.shape != shape or out.dtype != np.complex64 or not out.flags.c_contiguous:
@@ -288,8 +287,7 @@ class ImageSimulator:
         return relative_points(self._grid_ned, rows.start, rows.stop, cols.start, cols.stop, origin, p_ned)
 
     def terrain_cube(self, geom: AntennaGeometry, view: TerrainView | None = None) -> np.ndarray:
-        """Terrain returns only, (n_range, n_doppler, n_rx) complex64, without noise."""
-        cfg = self.config
+        """Terrain returns only, ``config.frame_shape`` complex64, without noise."""
         blocks = self._accumulation_blocks()
         view = view if view is not None else self.terrain_view(geom)
         if view is not None:
@@ -298,7 +296,7 @@ class ImageSimulator:
         finalize_frame(blocks, 0.0, np.uint64(0), out)
         if self._psf is None:
             return out
-        frame = np.empty((cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
+        frame = np.empty(self.config.frame_shape, np.complex64)
         self._spread(out, frame, 0.0, np.uint64(0))
         return frame
 
@@ -316,7 +314,8 @@ class ImageSimulator:
     def _sparse_suits(self, view: TerrainView) -> bool:
         # Few facets (DEM spacing): a list of contributions beats clearing per-thread cubes.
         ny, nx = view.p_ned.shape[:2]
-        return (ny - 1) * (nx - 1) * self._facets.per_cell_max <= self.config.n_range * self.config.n_doppler
+        n_range, n_doppler, _ = self.config.frame_shape
+        return (ny - 1) * (nx - 1) * self._facets.per_cell_max <= n_range * n_doppler
 
     def _sparse_buffers(
         self, view: TerrainView, scratch: dict | None = None
@@ -326,7 +325,7 @@ class ImageSimulator:
         cap = -(-(ny - 1) // n_blocks) * (nx - 1) * self._facets.per_cell_max
         return (
             _array(scratch, "sparse_idx", (n_blocks, cap), np.int64),
-            _array(scratch, "sparse_val", (n_blocks, cap, self.config.n_rx), np.complex64),
+            _array(scratch, "sparse_val", (n_blocks, cap, self.config.n_virtual), np.complex64),
             np.zeros(n_blocks, np.int64),
         )
 
@@ -345,13 +344,14 @@ class ImageSimulator:
         p_ant = rotate_points(view.p_ned, rot, _array(scratch, "p_ant", view.p_ned.shape, np.float64))
         power_const = cfg.pe_w * cfg.wavelength_m**2 / (4 * np.pi) ** 3 * self.ground_gain
         v_ground = rot @ (-geom.velocity_ned_mps)
+        channels = terrain_channel_positions_m(cfg, v_ground)
         if self._kernel_mode == 1 and sparse[0].shape[1] == 0:  # dense: threads own range bands
             banded_returns(
                 view.p_ned,
                 p_ant,
                 -rot[:, 2],
-                cfg.tx_position_m,
-                cfg.rx_positions_m,
+                cfg.transmitters_m[0],
+                channels,
                 v_ground,
                 self._facets,
                 cfg.wavelength_m,
@@ -372,8 +372,8 @@ class ImageSimulator:
             view.p_ned,
             p_ant,
             -rot[:, 2],
-            cfg.tx_position_m,
-            cfg.rx_positions_m,
+            cfg.transmitters_m[0],
+            channels,
             v_ground,
             self._facets.counts,
             self._facets.adapt,
@@ -420,6 +420,49 @@ class ImageSimulator:
             return np.ones(len(targets), bool)
         rel = np.array([t.position_ned_m for t in targets], float).reshape(-1, 3) - geom.origin_ned_m
         return target_clear(self._horizon_grid, p_ned, geom.rot_ned_to_ant, rel)
+
+
+def terrain_channel_positions_m(config: RadarConfig, ground_velocity_mps: np.ndarray) -> np.ndarray:
+    """Where each channel of a frame sees static terrain from, in the antenna frame, m (n_virtual, 3).
+
+    One transmitter: the receivers. Time-division MIMO: channel ``t * n_rx + r`` is transmitter
+    ``t`` with receiver ``r``, its two-way path ``|P - tx_t| + |P - rx_r|`` plus the slot's Doppler
+    path ``2 v_r t / PRF`` (transmitter ``t`` chirps ``t / PRF`` after transmitter 0, and each
+    transmitter's slow time starts at its first chirp). In the far field
+    ``|P - tx_t| = |P - tx_0| - u . (tx_t - tx_0)``, and a static point's radial velocity is
+    ``v_r = u . w`` for the terrain's velocity ``w`` relative to the antenna, so the path is that of
+    transmitter 0 with a receiver at ``rx_r + (tx_t - tx_0) - 2 w t / PRF``: the terrain kernels,
+    which take one transmitter and any receivers, simulate the virtual channels exactly to first
+    order in the antenna's size over the range (moving targets get their own slot phase,
+    :func:`skyradar.sim.targets.target_geometry`).
+
+    Parameters
+    ----------
+    config : RadarConfig
+    ground_velocity_mps : ndarray, shape (3,)
+        Velocity of static terrain relative to the antenna, in the antenna frame (minus the
+        antenna's own velocity), m/s.
+
+    Returns
+    -------
+    ndarray, shape (n_virtual, 3)
+
+    Examples
+    --------
+    >>> cfg = RadarConfig.prototype_2022(rx_positions_m="mimo-2x4")
+    >>> p = terrain_channel_positions_m(cfg, np.array([-50.0, 0.0, 0.0]))
+    >>> p.shape, bool(np.allclose(p[:4], cfg.rx_positions_m))
+    ((8, 3), True)
+    >>> shift = p[4:] - cfg.rx_positions_m - (cfg.transmitters_m[1] - cfg.transmitters_m[0])
+    >>> np.round(shift[0] * 1e3, 2).tolist()  # 2 * 50 m/s / PRF along boresight, mm
+    [20.32, 0.0, 0.0]
+    """
+    if config.n_tx == 1:
+        return config.rx_positions_m
+    slot_s = np.arange(config.n_tx) / config.prf_hz
+    tx = config.transmitters_m
+    offset = (tx - tx[0])[:, None, :] - 2.0 * slot_s[:, None, None] * np.asarray(ground_velocity_mps, float)
+    return (offset + config.rx_positions_m[None]).reshape(-1, 3)
 
 
 def _array(scratch: dict | None, name: str, shape: tuple[int, ...], dtype) -> np.ndarray:

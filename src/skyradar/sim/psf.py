@@ -355,7 +355,8 @@ class PSFKernels(NamedTuple):
 
 
 def psf_kernels(config, window: str = PSF_WINDOW, oversample: int = OVERSAMPLE) -> PSFKernels:
-    """Kernels for ``config``: range over ``samples_per_chirp``, Doppler over ``n_doppler``.
+    """Kernels for ``config``: range over ``samples_per_chirp``, Doppler over one transmitter's chirps
+    (``n_doppler_per_tx``).
 
     Examples
     --------
@@ -365,7 +366,7 @@ def psf_kernels(config, window: str = PSF_WINDOW, oversample: int = OVERSAMPLE) 
     """
     return PSFKernels(
         binned_kernel(window, config.samples_per_chirp, oversample),
-        binned_kernel(window, config.n_doppler, oversample),
+        binned_kernel(window, config.n_doppler_per_tx, oversample),
         oversample,
     )
 

@@ -82,8 +82,9 @@ def received_power_w(config: RadarConfig, positions_m: np.ndarray, rcs_m2: np.nd
 def adc_noise(config: RadarConfig, seed: int | np.random.SeedSequence | None = None) -> np.ndarray:
     """Receiver noise at the ADC, (n_rx, n_doppler, samples_per_chirp) complex64.
 
-    Power per sample ``noise_power_w * Ns * nV`` (``k T F`` times ``Ns * PRF``), so an unwindowed
-    range-Doppler pixel carries ``config.noise_power_w``.
+    Power per sample ``noise_power_w * Ns * nV / n_tx`` (``k T F`` times ``Ns * PRF``), so an
+    unwindowed range-Doppler pixel (of one transmitter's ``nV / n_tx`` chirps) carries
+    ``config.noise_power_w``.
 
     Examples
     --------
@@ -93,7 +94,7 @@ def adc_noise(config: RadarConfig, seed: int | np.random.SeedSequence | None = N
     ((4, 250, 2032), True)
     """
     shape = (config.n_rx, config.n_doppler, config.samples_per_chirp)
-    sigma = np.sqrt(config.noise_power_w * shape[1] * shape[2] / 2.0)
+    sigma = np.sqrt(config.noise_power_w * config.n_doppler_per_tx * shape[2] / 2.0)
     rng = np.random.default_rng(seed)
     pair = rng.standard_normal((*shape, 2), dtype=np.float32) * np.float32(sigma)
     return pair.view(np.complex64)[..., 0]

@@ -141,7 +141,7 @@ def simulate_frames(
 
     Returns
     -------
-    ndarray, shape (n, n_range, n_doppler, n_rx), complex64
+    ndarray, shape (n, *config.frame_shape), complex64
         Pixel units: ``|pixel|^2`` in W.
 
     Examples
@@ -171,7 +171,7 @@ def simulate_frames(
     indices = np.asarray(indices)
     own, intruders = _states(built, indices, ownship)
     cfg = simulator.config
-    out = np.empty((indices.size, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
+    out = np.empty((indices.size, *cfg.frame_shape), np.complex64)
     impairments = getattr(built, "impairments", None)
     for i, frame_index in enumerate(indices):
         platform, targets, _ = _frame_inputs(own, intruders, i)
@@ -348,7 +348,7 @@ def simulate(built, progress: Callable[[int], None] | None = None, head: int | s
     """
     simulator = make_simulator(built, head)
     n, cfg = built.times_s.size, simulator.config
-    iq = np.empty((n, cfg.n_range, cfg.n_doppler, cfg.n_rx), np.complex64)
+    iq = np.empty((n, *cfg.frame_shape), np.complex64)
     for i in range(n):
         iq[i] = simulate_frames(built, np.array([i]), simulator)[0]
         if progress:

@@ -28,7 +28,7 @@ def _template(built, chunk_frames: int, simulator: ImageSimulator) -> xr.Dataset
     import dask.array as da
 
     cfg = simulator.config
-    shape = (built.times_s.size, cfg.n_range, cfg.n_doppler, cfg.n_rx)
+    shape = (built.times_s.size, *cfg.frame_shape)
     iq = da.zeros(shape, dtype=np.complex64, chunks=(chunk_frames, -1, -1, -1))
     ownship, targets, names = scenario_truth(built, simulator)
     return frames_dataset(iq, built.times_s, cfg, ownship, targets, names, frames_attrs(built))

@@ -100,8 +100,10 @@ def target_geometry(
         Per target: ``range_m`` (half the mean two-way path), ``radial_velocity_mps``,
         ``azimuth_rad``, ``elevation_rad``, ``power_w`` (the radar equation), ``snr_db``,
         ``range_position_bins``, ``range_bin``, ``doppler_bin``, ``visible`` (ahead of the
-        antenna, inside the range bins and clear) and ``path_m`` (two-way path per receive
-        antenna).
+        antenna, inside the range bins and clear) and ``path_m`` (two-way path per channel of a
+        frame, m: per receive antenna, or per virtual channel ``t * n_rx + r`` of a time-division
+        MIMO radar, ``|P - tx_t| + |P - rx_r| + 2 v_r t / PRF``: transmitter ``t`` chirps ``t / PRF``
+        after transmitter 0, and the target's range moves ``v_r t / PRF`` meanwhile).
 
     Examples
     --------
@@ -127,13 +129,14 @@ def target_geometry(
     rcs = np.array([t.rcs_m2 for t in targets], float)
     p_ant = (pos - geom.origin_ned_m) @ geom.rot_ned_to_ant.T
     v_ant = (vel - geom.velocity_ned_mps) @ geom.rot_ned_to_ant.T
-    r_tx = np.linalg.norm(p_ant - cfg.tx_position_m, axis=1)
+    r_tx = np.linalg.norm(p_ant[:, None, :] - cfg.transmitters_m[None], axis=2)  # (n_targets, n_tx)
     r_rx = np.linalg.norm(p_ant[:, None, :] - cfg.rx_positions_m[None], axis=2)
-    path = r_tx[:, None] + r_rx
     rng, az, el = direction_angles(p_ant)
     u = p_ant / np.maximum(rng, 1e-9)[:, None]
     v_r = np.einsum("ij,ij->i", v_ant, u)
-    half_path = path.mean(axis=1) / 2.0
+    half_path = (r_tx[:, :1] + r_rx).mean(axis=1) / 2.0
+    slot_m = 2.0 * v_r[:, None] * np.arange(cfg.n_tx) / cfg.prf_hz  # (n_targets, n_tx); 0 for one transmitter
+    path = ((r_tx + slot_m)[:, :, None] + r_rx[:, None, :]).reshape(len(p_ant), cfg.n_virtual)
     gain_db = cfg.antenna.gain_db(az, el)
     power_w = cfg.pe_w * 10 ** (gain_db / 5.0) * cfg.wavelength_m**2 * rcs / ((4 * np.pi) ** 3 * half_path**4)
     k = nearest_bin(half_path + coupling_s * v_r, cfg.range_resolution_m)  # coupling_s may differ from cfg's
@@ -168,7 +171,7 @@ def add_targets(
 
     Parameters
     ----------
-    cube : ndarray, shape (n_range, n_doppler, n_rx), complex
+    cube : ndarray, shape ``cfg.frame_shape``, complex
         The frame, changed in place; pixel units ``|pixel|^2`` in W.
     cfg : RadarConfig
     geom : AntennaGeometry
@@ -209,7 +212,7 @@ def add_targets(
     if psf_reach is not None:
         _add_spread(cube, cfg, g, keep, values, psf_reach)
         return
-    for q in range(cfg.n_rx):
+    for q in range(cfg.n_virtual):
         np.add.at(
             cube[..., q], (g["range_bin"][keep], g["doppler_bin"][keep]), values[:, q].astype(cube.dtype)
         )
@@ -218,9 +221,10 @@ def add_targets(
 def _add_spread(cube, cfg: RadarConfig, g, keep, values, reach: tuple[int, int]) -> None:
     # Range position as the bins' own (with the coupling shift), Doppler as doppler_bin's.
     x_range = g["range_position_bins"][keep]
-    x_doppler = g["radial_velocity_mps"][keep] / cfg.doppler_resolution_mps + cfg.n_doppler // 2
+    n_doppler = cfg.n_doppler_per_tx
+    x_doppler = g["radial_velocity_mps"][keep] / cfg.doppler_resolution_mps + n_doppler // 2
     for t in range(values.shape[0]):
         kr, wr = target_psf_taps(PSF_WINDOW, cfg.samples_per_chirp, x_range[t], reach[0], cfg.n_range, False)
-        kd, wd = target_psf_taps(PSF_WINDOW, cfg.n_doppler, x_doppler[t], reach[1], cfg.n_doppler, True)
+        kd, wd = target_psf_taps(PSF_WINDOW, n_doppler, x_doppler[t], reach[1], n_doppler, True)
         spread = np.multiply.outer(np.multiply.outer(wr, wd), values[t])
         cube[np.ix_(kr, kd)] += spread.astype(cube.dtype)

@@ -210,3 +210,69 @@ def test_a_closure_lost_for_seconds_keeps_its_identity_and_its_warning():
     assert (alerts.loc[alerts["time_s"] >= before["time_s"].max(), "level"] == 3).all()  # through the fade
     assert alerts.loc[alerts["extrapolated"], "time_s"].between(5.5, 9.0).all()  # until reconfirmed
     assert (measured["raw_level"].iloc[:5] == 3).all()
+
+
+def _confirmed(det: pd.DataFrame, own: pd.DataFrame) -> np.ndarray:
+    tracks = pd.DataFrame(
+        {"time_s": det["time_s"], "track_id": 1, "detection_row": np.arange(len(det)), "confirmed": True}
+    )
+    out = hold_ground_tracks(tracks, det, own, WIDTH, C, flat_surface(AGL_M))
+    return out["confirmed"].to_numpy(bool) if len(out) else np.zeros(len(det), bool)
+
+
+def _read_on_the_surface(det: pd.DataFrame, own: pd.DataFrame, azimuth_rad: np.ndarray) -> pd.DataFrame:
+    """``det`` read at the ground's depression at its range, from ``azimuth_rad``: its elevations
+    measured and its DoA points on the surface."""
+    own_p, _ = _state(own)
+    r = det["range_m"].to_numpy()
+    depression = np.arcsin(AGL_M / r)
+    ground_range = r * np.cos(depression)
+    return det.assign(
+        azimuth_rad=azimuth_rad,
+        elevation_rad=-depression,
+        elevation_measured=True,
+        north_m=own_p[:, 0] + ground_range * np.cos(azimuth_rad),
+        east_m=own_p[:, 1] + ground_range * np.sin(azimuth_rad),
+        down_m=AGL_M,
+    )
+
+
+def test_a_ground_patch_strung_along_a_closing_alias_is_not_released_by_its_range_rate():
+    # A ground patch fills one Doppler bin over many ranges; the tracker can string its scatterers,
+    # left and right of the own-ship's track, along a line as steep as a closure's. The line alone
+    # passes the range-rate test, but the directions read the surface and scatter across the beam:
+    # the patch keeps the slower tests (ten detections before the direction test may let go).
+    rng = np.random.default_rng(11)
+    for trial in range(10):
+        det, own = _closure_detections(106.7, 90.0 + 20.0 * trial, rng, 12)
+        scattered = rng.choice(np.radians([-48.0, -30.0, 40.0, 64.0]), len(det))
+        patch = _read_on_the_surface(det, own, scattered)
+        assert not _confirmed(patch, own)[:9].any(), trial
+
+
+def test_an_aliased_closure_read_at_the_grounds_elevation_from_one_azimuth_is_released():
+    # An aircraft whose cell's mixture pulls its measured elevation onto the surface keeps one
+    # azimuth: the range-rate release stands, at its fifth detection.
+    rng = np.random.default_rng(12)
+    for trial in range(10):
+        det, own = _closure_detections(106.7, 90.0 + 20.0 * trial, rng, 12)
+        one_azimuth = np.radians(25.0) + rng.normal(0.0, 0.01, len(det))
+        confirmed = _confirmed(_read_on_the_surface(det, own, one_azimuth), own)
+        assert confirmed.any() and int(np.argmax(confirmed)) <= 4, trial
+
+
+def test_a_history_receding_faster_than_the_ground_waits_for_the_slower_tests():
+    # Receding at 107 m/s (its Doppler aliased to +28.4 m/s) is faster than any static point, but it
+    # is no closure: the early release is not for it, and its unmeasured direction holds it for ten.
+    rng = np.random.default_rng(13)
+    det, own = _closure_detections(106.7, 120.0, rng, 12)
+    t = det["time_s"].to_numpy()
+    det = det.assign(
+        range_m=1800.0 + 106.7 * t + rng.normal(0.0, 2.5, t.size),
+        radial_velocity_mps=(106.7 + rng.normal(0.0, 0.05, t.size) + WIDTH / 2) % WIDTH - WIDTH / 2,
+    )
+    speed = np.full(t.size, 50.0)
+    args = (t[:5], det["range_m"].to_numpy()[:5], det["radial_velocity_mps"].to_numpy()[:5], speed[:5])
+    assert faster_than_ground(*args, WIDTH, C)
+    assert not faster_than_ground(*args, WIDTH, C, closing=True)
+    assert not _confirmed(det, own)[:9].any()

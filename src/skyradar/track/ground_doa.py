@@ -30,6 +30,7 @@ __all__ = [
     "doa_in_the_air",
     "direction_measured",
     "doa_on_the_ground",
+    "doa_of_a_ground_patch",
     "altitude_measured",
     "elevation_measured_flags",
 ]
@@ -222,6 +223,67 @@ def doa_on_the_ground(elevation_measured, height_sd, n: int = 10, max_sd: float 
     z = np.asarray(height_sd, float)[-n:]
     measured = np.asarray(elevation_measured, bool)[-n:] & np.isfinite(z)
     return bool(measured.sum() >= 3 and np.median(z[measured]) < max_sd)
+
+
+def doa_of_a_ground_patch(
+    azimuth_rad,
+    elevation_rad,
+    elevation_measured,
+    height_sd,
+    sigma_rad: float = DOA_SIGMA_RAD,
+    n: int = 10,
+) -> bool:
+    """Whether a track's recent directions of arrival are those of a ground patch's scatterers.
+
+    Of its last ``n`` detections, the measured elevations put it on the surface
+    (:func:`doa_on_the_ground`) and the direction cosines along the antenna's right axis,
+    ``sin(azimuth) cos(elevation)``, scatter beyond one direction: their rms about the median, the
+    worst fifth left out (an aircraft's odd reading through a sidelobe), exceeds 3 sd, the sd being
+    ``sigma_rad cos(azimuth)`` at the median azimuth. A patch's scatterers cluster (two or three
+    readings from near one azimuth, then others far off), so a median absolute deviation, which
+    ignores half the readings, can miss it.
+    Each half alone is no proof: an aircraft in a ground cell can read the ground's elevation (the
+    cell's mixture pulls it down) but it keeps one azimuth, which the array measures whatever the
+    elevation; an aircraft read through the nulls over relief scatters in azimuth but reads above
+    the surface. Residual clutter of a patch, its scatterers taking turns left and right of the
+    own-ship's track, reads the surface and scatters across the beam: both at once.
+
+    Parameters
+    ----------
+    azimuth_rad, elevation_rad : array_like, shape (k,)
+        Directions of arrival in the antenna frame, rad.
+    elevation_measured : array_like of bool, shape (k,)
+        Whether each elevation was measured (not ``process.clutter_doa``'s prior).
+    height_sd : array_like, shape (k,)
+        Each DoA position's height above the surface in sd (:func:`doa_height_sd`).
+    sigma_rad : float
+        Direction error of one point target's detections, rad.
+    n : int
+        Detections read, the newest.
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    Ground 300 m below, 2 km away (8.6 deg down): readings at that elevation, first from one
+    azimuth, then from scatterers 30 deg left and 60 deg right taking turns:
+
+    >>> el, on = np.full(6, np.radians(-8.6)), np.full(6, True)
+    >>> steady = np.radians([20.0, 20.5, 19.6, 20.2, 19.9, 20.1])
+    >>> doa_of_a_ground_patch(steady, el, on, np.zeros(6))
+    False
+    >>> doa_of_a_ground_patch(np.radians([-30.0, -29.0, -48.0, -33.0, 64.0, 64.5]), el, on, np.zeros(6))
+    True
+    """
+    az, el = (np.asarray(a, float)[-n:] for a in (azimuth_rad, elevation_rad))
+    if not doa_on_the_ground(np.asarray(elevation_measured, bool)[-n:], np.asarray(height_sd, float)[-n:]):
+        return False
+    cosine = np.sin(az) * np.cos(el)
+    sd = sigma_rad * float(np.median(np.cos(az)))
+    z2 = np.sort(((cosine - np.median(cosine)) / sd) ** 2)
+    return bool(np.mean(z2[: z2.size - z2.size // 5]) > 9.0)
 
 
 def altitude_measured(

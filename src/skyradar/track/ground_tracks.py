@@ -18,14 +18,21 @@ elevations put it on the surface (:func:`doa_on_the_ground`) needs ten detection
 before these tests may release it: some alias fits three hopping ranges, and the Doppler test
 needs its full window.
 
-A track whose range moves faster than any static point's can is an object, whatever its aliased
-Doppler or direction say (:func:`faster_than_ground`): a static point's range rate is bounded by
+A track whose range closes faster than any static point's can is an object, whatever its aliased
+Doppler says (:func:`faster_than_ground`): a static point's range rate is bounded by
 the own-ship's speed, ``|dr/dt| <= |v|``, and the range history tells which alias of the measured
 Doppler is the true radial velocity. A head-on closure at 107 m/s aliases into the band the ground
 ahead fills, but its range falls by a whole image width (78 m/s) faster than the ground's of the
 same Doppler: over five detections at 9.4 frames/s that is 33 m, six times the slope's error. Such
 a track is judged an object at its fifth detection, the most urgent geometry there is released
 first; a track whose radial velocity lies inside the ground's band keeps the slower tests below.
+The release has two limits, both because a ground patch fills one Doppler bin over many ranges
+and the tracker can string its scatterers along a line of almost any slope, one that some alias
+then fits. It is for closures: a history receding faster than the ground is no threat and waits
+for the slower tests. And it does not overrule directions that are a patch's
+(:func:`doa_of_a_ground_patch`): measured elevations on the surface while the azimuths scatter
+across the beam; an aircraft keeps one azimuth even when its cell's mixture pulls its elevation
+down, and reads above the surface when the nulls scatter its azimuth.
 
 Why aircraft are kept: in straight flight the history of a point moving at relative velocity
 ``w`` has ``d(r dr/dt)/dt = |w|^2``, a static point's ``|v|^2``; so an aircraft fits a static
@@ -69,6 +76,7 @@ from skyradar.track.ground_doa import (
     direction_measured,
     doa_height_sd,
     doa_in_the_air,
+    doa_of_a_ground_patch,
     doa_on_the_ground,
     elevation_measured_flags,
 )
@@ -273,6 +281,7 @@ def faster_than_ground(
     coupling_s: float,
     test: GroundTrackTest | None = None,
     max_alias: int = 2,
+    closing: bool = False,
 ) -> bool:
     """Whether a detection history is one scatterer whose range moves faster than any static point's.
 
@@ -299,6 +308,8 @@ def faster_than_ground(
     test : GroundTrackTest, optional
     max_alias : int
         Largest alias ``|k|`` considered.
+    closing : bool
+        Only a history that closes (its de-aliased radial velocity negative at every detection).
 
     Returns
     -------
@@ -307,13 +318,17 @@ def faster_than_ground(
     Examples
     --------
     A head-on closure at 107 m/s, its Doppler aliased to -28.4 m/s, against own-ship at 50 m/s,
-    five detections at 9.4 frames/s; then a ground point with the same Doppler:
+    five detections at 9.4 frames/s; then a ground point with the same Doppler; then a history
+    receding at 107 m/s, faster than the ground but not closing:
 
     >>> t = np.arange(5) / 9.4
     >>> closure = 1500.0 - 106.7 * t
     >>> faster_than_ground(t, closure, np.full(5, -28.4), np.full(5, 50.0), 78.3, 0.19)
     True
     >>> faster_than_ground(t, 1500.0 - 28.4 * t, np.full(5, -28.4), np.full(5, 50.0), 78.3, 0.19)
+    False
+    >>> receding = 1500.0 + 106.7 * t
+    >>> faster_than_ground(t, receding, np.full(5, 28.4), np.full(5, 50.0), 78.3, 0.19, closing=True)
     False
     """
     test = test or GroundTrackTest()
@@ -337,6 +352,8 @@ def faster_than_ground(
     k = int(aliases[allowed][0])
     if np.all(np.abs(v + k * width_mps) <= bound):
         return False  # the allowed alias is a radial velocity some static point has
+    if closing and not np.all(v + k * width_mps < 0.0):
+        return False
     res = excess - k * width_mps * (t - t[0])
     z2 = ((res - res.mean()) / test.sigma_range_jitter_m) ** 2
     keep = t.size - int(np.floor(test.trim * t.size))
@@ -529,12 +546,22 @@ class _HistoryWalk:
             h.own_speed is not None
             and k + 1 - start >= max(test.min_detections, test.fast_min_detections)
             and faster_than_ground(
-                t[recent], h.rng[recent], h.vel[recent], h.own_speed[recent], width, coupling, test
+                t[recent],
+                h.rng[recent],
+                h.vel[recent],
+                h.own_speed[recent],
+                width,
+                coupling,
+                test,
+                closing=True,
             )
             and (
                 test.point_sigma_velocity_mps is None or doppler_smooth(t[recent], h.vel[recent], width, test)
             )
-        ):  # one point, and no static point moves so fast: an object, however its Doppler aliases
+            and not doa_of_a_ground_patch(
+                h.doa[0][recent], h.doa[1][recent], h.doa[3][recent], h.doa[2][recent], test.doa_sigma_rad
+            )
+        ):  # one point closing faster than any static point can: an object, however its Doppler aliases
             self.ground_seen, self.least = False, test.min_detections
             self.object_since = min(self.object_since, k)
             self.last = "young" if k + 1 - start < test.release_detections else ""

@@ -469,13 +469,47 @@ def test_doa_takes_virtual_channels_and_refuses_receiver_counts():
         estimate_directions(np.ones((1, 4), complex), MIMO)
 
 
-def test_processing_mimo_frames_is_one_clear_line_through_the_cli(tmp_path):
-    # The frames are written; processing them needs the slot phase removed per detection, which the
-    # frame pipeline does not do: one line naming the field, exit code 2, nothing written.
+def test_a_mimo_run_is_processed_without_suppression_and_refused_with_it(tmp_path):
+    # A head-on intruder closing at 55 m/s in clear sky: its Doppler aliases once past the 19.6 m/s
+    # limit of two transmitters, so the residue must be resolved too; left in, the phase step
+    # between its slots would read 36 deg off in elevation. Simulate, then process without clutter
+    # suppression: each frame's strongest detection has the intruder's direction within four times
+    # its bound. With suppression: one line.
+    import xarray as xr
     import yaml
 
-    (tmp_path / "s.yaml").write_text(yaml.safe_dump(_scenario({"rx_layout": "mimo-2x4"})))
+    intruder = {
+        "name": "head-on",
+        "type": "encounter",
+        "kind": "head-on",
+        "t_cpa_s": 25.0,
+        "intruder_speed_mps": 5,
+        "rcs_m2": 1.0,
+    }
+    scenario = _scenario({"rx_layout": "mimo-2x4"}) | {"intruders": [intruder], "frame_rate_hz": 5.0}
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(scenario))
     assert skyradar("simulate", "s.yaml", "--output", "r.zarr", cwd=tmp_path).returncode == 0
-    result = skyradar("process", "r.zarr", "--output", "d.parquet", cwd=tmp_path)
-    assert_one_line_error(result, "radar.tx_positions_m", "frame processing", "got 2")
-    assert not (tmp_path / "d.parquet").exists()
+    result = skyradar("process", "r.zarr", "--output", "d.parquet", "--suppression", "none", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    import pandas as pd
+
+    det = pd.read_parquet(tmp_path / "d.parquet")
+    truth = xr.open_zarr(tmp_path / "r.zarr", consolidated=False)
+    best = det.loc[det.groupby("frame")["snr_db"].idxmax()]
+    assert len(best) == truth.sizes["time"]
+    frames = best["frame"].to_numpy()
+    az, el = (truth[f"tgt_{a}_rad"].isel(target=0).values[frames] for a in ("azimuth", "elevation"))
+    bound = doa_crlb(best["snr_db"].to_numpy(), az, el, MIMO)
+    for got, expected, sd in zip((best["azimuth_rad"], best["elevation_rad"]), (az, el), bound, strict=True):
+        assert np.all(np.abs(got.to_numpy() - expected) <= 4.0 * sd)
+    expected_v = truth["tgt_radial_velocity_mps"].isel(target=0).values[best["frame"].to_numpy()]
+    aliased = (expected_v + MIMO.v_lim_mps) % (2 * MIMO.v_lim_mps) - MIMO.v_lim_mps
+    np.testing.assert_allclose(
+        best["radial_velocity_mps"].to_numpy(), aliased, atol=MIMO.doppler_resolution_mps
+    )
+
+    result = skyradar(
+        "process", "r.zarr", "--output", "e.parquet", "--suppression", "knowledge-aided", cwd=tmp_path
+    )
+    assert_one_line_error(result, "radar.tx_positions_m", "clutter suppression", "got 2")
+    assert not (tmp_path / "e.parquet").exists()

@@ -436,10 +436,9 @@ def detect(
     ([100], [40])
     """
     power = np.asarray(power, dtype=np.float32)
-    if power.shape != (config.n_range, config.n_doppler):
+    if power.shape != config.frame_shape[:2]:
         raise InputError(
-            f"frame: power image shape {power.shape} does not match radar_config "
-            f"{(config.n_range, config.n_doppler)}"
+            f"frame: power image shape {power.shape} does not match radar_config {config.frame_shape[:2]}"
         )
     if channels is not None and method == "cfar":
         floor = config.noise_power_w if noise_floor_w is None else noise_floor_w

@@ -72,6 +72,7 @@ __all__ = [
     "FIELD_OF_VIEW_LOSS_DB",
     "antenna_to_body",
     "channel_positions_m",
+    "channel_calibration",
 ]
 
 
@@ -210,8 +211,15 @@ def channel_positions_m(config: RadarConfig) -> np.ndarray:
     return config.rx_positions_m if config.n_tx == 1 else config.virtual_positions_m
 
 
-def _channel_calibration(config: RadarConfig) -> np.ndarray:
-    """Complex gain per channel: ``rx_calibration``, repeated for every transmitter slot for MIMO."""
+def channel_calibration(config: RadarConfig) -> np.ndarray:
+    """Complex gain per channel: ``rx_calibration``, repeated for every transmitter slot for MIMO
+    (calibration is per receiver, the same through every transmitter).
+
+    Examples
+    --------
+    >>> channel_calibration(RadarConfig.prototype_2022(rx_positions_m="mimo-2x4")).shape
+    (8,)
+    """
     return config.rx_calibration if config.n_tx == 1 else np.tile(config.rx_calibration, config.n_tx)
 
 
@@ -461,7 +469,7 @@ def estimate_directions(
     if config.n_virtual == 1:
         return np.full((z.shape[0], 3), np.nan)
     if not calibrated:
-        z = z / _channel_calibration(config)
+        z = z / channel_calibration(config)
     geo = array_geometry(config, facing)
     if z.shape[0] == 0:
         return np.zeros((0, 3))
@@ -518,7 +526,7 @@ def direction_coherence(
     """
     z = np.atleast_2d(np.asarray(pixels))
     if not calibrated:
-        z = z / _channel_calibration(config)
+        z = z / channel_calibration(config)
     steer = steering_vector(u, config)
     num = np.abs(np.sum(z * np.conj(steer), axis=1)) ** 2
     den = config.n_virtual * np.maximum(np.sum(np.abs(z) ** 2, axis=1), 1e-300)

@@ -50,10 +50,12 @@ from skyradar.process.detect import detect, integrate_channels
 from skyradar.process.doa import (
     angles_from_direction,
     antenna_to_body,
+    channel_calibration,
     direction_coherence,
     estimate_directions,
 )
 from skyradar.process.ground import GeodeticFn, flag_ground, height_above_ground_m, surface_height_fn
+from skyradar.process.mimo import virtual_pixels
 from skyradar.process.spurs import SpurMap
 
 __all__ = [
@@ -170,9 +172,12 @@ def process_cube(
     >>> np.degrees(out["azimuth_rad"]).round().tolist(), np.degrees(out["elevation_rad"]).round().tolist()
     ([10.0], [-5.0])
     """
-    _require_one_transmitter(config)
-    if cube.ndim != 3 or cube.shape[2] != config.n_rx:
-        raise InputError(f"frame: field 'rx' has {cube.shape[-1]} channels, radar_config has {config.n_rx}")
+    if cube.ndim != 3 or cube.shape[2] != config.n_virtual:
+        raise InputError(
+            f"frame: field 'rx' has {cube.shape[-1]} channels, radar_config has {config.n_virtual}"
+        )
+    if clutter is not None:
+        _require_one_transmitter_to_suppress(config)
     if spur_mode not in ("mask", "flag"):
         raise InputError(f"process: field 'spur_mode' must be 'mask' or 'flag', got {spur_mode!r}")
     exclude = spur_map.mask if spur_map is not None and spur_mode == "mask" else None
@@ -181,10 +186,14 @@ def process_cube(
             cube, config, clutter, exclude, method, pfa_secondary=pfa_secondary, **detect_kwargs
         )
     else:
-        power = integrate_channels(cube, config.rx_calibration)
+        calibration = channel_calibration(config)
+        power = integrate_channels(cube, calibration)
         det = detect(power, config, method=method, exclude=exclude, **detect_kwargs)
-        u = estimate_directions(cube[det.range_index, det.doppler_index], config)
-        coherence = direction_coherence(cube[det.range_index, det.doppler_index], u, config)
+        pixels = cube[det.range_index, det.doppler_index] / calibration
+        if config.n_tx > 1:  # each transmitter slot's Doppler phase out, its ambiguity resolved
+            pixels = virtual_pixels(pixels, det.doppler_bin, config).pixels
+        u = estimate_directions(pixels, config, calibrated=True)
+        coherence = direction_coherence(pixels, u, config, calibrated=True)
         elevation_measured = np.ones(len(det), bool)
     range_m = det.range_m(config)
     body = antenna_to_body(range_m[:, None] * u, config)
@@ -346,12 +355,12 @@ def process_chunk(
     )
 
 
-def _require_one_transmitter(config: RadarConfig) -> None:
-    # A MIMO frame's virtual channels carry each target's slot phase, which DoA and the clutter
-    # nulls' steering do not model yet.
+def _require_one_transmitter_to_suppress(config: RadarConfig) -> None:
+    # Ground clutter in a MIMO frame's cell comes from several aliases of its Doppler, each with its
+    # own slot phase, and the nulls' steering models one transmitter.
     config.require_one_transmitter(
-        "frame processing (clutter suppression, detection, DoA)",
-        "the virtual channels' slot phase is removed per detection by skyradar.process.mimo.virtual_pixels",
+        "clutter suppression",
+        "process a time-division MIMO radar's frames with suppression 'none'",
     )
 
 
@@ -371,8 +380,7 @@ def _checked_config(ds: xr.Dataset, config: RadarConfig | None, spur_map, source
         raise InputError(
             f"{source}: field 'rx' has {ds.sizes.get('rx')} channels, radar_config has {config.n_virtual}"
         )
-    _require_one_transmitter(config)
-    if spur_map is not None and spur_map.frequency.shape != (config.n_range, config.n_doppler):
+    if spur_map is not None and spur_map.frequency.shape != config.frame_shape[:2]:
         raise InputError(f"{source}: spur map shape {spur_map.frequency.shape} does not fit the frames")
     return config
 
@@ -443,6 +451,8 @@ def process_frames(
         uses only inside a confirmed track's gate); None, or not above ``pfa``: none.
     """
     config = _checked_config(ds, config, spur_map, source)
+    if suppression != "none":
+        _require_one_transmitter_to_suppress(config)
     first, stop, _ = (frames or slice(None)).indices(ds.sizes["time"])
     own, origin = navigated_own_state(ds, source), scenario_origin(ds)
     times = frame_times_s(ds)

@@ -188,10 +188,10 @@ class SpurMap:
                 spur_map = cls(data["frequency"], float(data["threshold"]), int(data["n_frames"]))
         except (OSError, KeyError, ValueError) as exc:
             raise InputError(f"{path}: not a spur map ({type(exc).__name__}: {exc})") from exc
-        if config is not None and spur_map.frequency.shape != (config.n_range, config.n_doppler):
+        if config is not None and spur_map.frequency.shape != config.frame_shape[:2]:
             raise InputError(
                 f"{path}: field 'frequency' has shape {spur_map.frequency.shape}, radar_config needs "
-                f"{(config.n_range, config.n_doppler)}"
+                f"{config.frame_shape[:2]}"
             )
         return spur_map
 

@@ -18,9 +18,17 @@ from skyradar.sim.image import ImageSimulator, PlatformState
 ORIGIN = (52.0, 4.36, 100.0)
 
 
-@pytest.mark.parametrize("mount", ["forward", "forward-down"])
-def test_ours_and_both_baselines_give_the_same_cube(mount):
-    config = RadarConfig.prototype_2022(range_limit_m=1500.0, mount=Mount.preset(mount))
+@pytest.mark.parametrize(
+    ("mount", "rx"),
+    [
+        ("forward", "square"),
+        ("forward-down", "square"),
+        ("forward", [[0.0, 0.0, 0.0]]),
+        ("forward", "ura-2x3"),
+    ],
+)
+def test_ours_and_both_baselines_give_the_same_cube(mount, rx):
+    config = RadarConfig.prototype_2022(range_limit_m=1500.0, mount=Mount.preset(mount), rx_positions_m=rx)
     terrain = fractal_terrain(52.0, 4.36, 30.0, size_m=5000.0, spacing_m=50.0, seed=3, mean_height_m=100.0)
     ours = ImageSimulator(
         config, terrain, ORIGIN, facet_size_m=float("inf"), occlusion=False, flat_earth=True, noise=False
@@ -73,6 +81,10 @@ def test_bench_sim_json_names_synthetic_terrain_and_both_ratios(tmp_path):
     fps = data["frames_per_s"]
     assert data["speedup_vs_numpy_baseline"] == pytest.approx(fps / data["numpy_baseline_frames_per_s"])
     assert data["speedup_vs_thesis_baseline"] == pytest.approx(fps / data["thesis_baseline_frames_per_s"])
+    for name in ("rx1", "rx6", "rx8"):  # the other receive arrays, each against its own baseline
+        ratio = data[f"{name}_frames_per_s"] / data[f"{name}_numpy_baseline_frames_per_s"]
+        assert data[f"{name}_speedup_vs_numpy_baseline"] == pytest.approx(ratio)
+    assert data["mimo_2x4_vs_rx8"] == pytest.approx(data["mimo_2x4_frames_per_s"] / data["rx8_frames_per_s"])
     one = data["fine_psf_one_thread_cpu_ms_per_frame"]
     assert data["fine_psf_thread_cpu_overhead"] == pytest.approx(data["fine_psf_cpu_ms_per_frame"] / one)
     wide = {**os.environ, "COLUMNS": "200"}  # the help text unwrapped

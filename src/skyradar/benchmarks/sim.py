@@ -24,7 +24,11 @@ coupling, and thermal noise.
 Ours is also timed with its full physics (exact geodesy, occlusion), at DEM spacing and at
 facets of at most dR/2, and at dR/2 with the windows' point-spread and speckle
 (``frames_per_s_fine_psf``, its ratio to the same run's fine figure, and its multiple of the
-9.4 Hz field rate); no baseline does that work, so those have no baseline ratio.
+9.4 Hz field rate); no baseline does that work, so those have no baseline ratio. The
+``frames_per_s`` physics is timed again with one receive channel, the 2x3 and the 2x4 URA
+(``rx1_*``, ``rx6_*``, ``rx8_*``, each against the numpy baseline of that array), and with the
+``mimo-2x4`` radar (``mimo_2x4_*``: eight virtual channels over half the Doppler bins, against
+``rx8``; the baselines model one transmitter).
 """
 
 from __future__ import annotations
@@ -273,11 +277,48 @@ def _baseline_fps(config, terrain, origin, geometry, n_frames, baseline_frames, 
         baseline_frames,
         min_seconds,
     )
+    return fps_thesis, _numpy_baseline_fps(config, terrain, origin, geometry, n_frames, min_seconds)
+
+
+def _numpy_baseline_fps(config, terrain, origin, geometry, n_frames: int, min_seconds: float) -> float:
+    """Frames/s of the numpy baseline on the tile and geometry ours is timed on."""
+    physics, rng = FacetPhysics(config), np.random.default_rng(1)
     grid = terrain.points_ned(*origin, flat_earth=True)
-    fps_numpy = _time_frames(
+    return _time_frames(
         lambda i: numpy_baseline_frame(terrain, grid, geometry(i), physics, rng), n_frames, min_seconds
     )
-    return fps_thesis, fps_numpy
+
+
+# Receive arrays timed besides the prototype's four channels: one channel, 2x3 and 2x4 URAs.
+_OTHER_ARRAYS = {"rx1": [[0.0, 0.0, 0.0]], "rx6": "ura-2x3", "rx8": "ura-2x4"}
+
+
+def _array_keys(terrain, origin, platform, n_frames: int, baseline_frames: int, min_seconds: float) -> dict:
+    """Frames/s of the same-physics frames (DEM-cell facets, flat earth, no occlusion) for 1, 6 and 8
+    receive channels, each with the numpy baseline of the same array in this run, and of the
+    ``mimo-2x4`` radar (8 virtual channels over half the Doppler bins), against ``rx8``'s."""
+    out: dict[str, Any] = {}
+    layouts: dict[str, Any] = {**_OTHER_ARRAYS, "mimo_2x4": "mimo-2x4"}
+    for name, rx in layouts.items():
+        config = RadarConfig.prototype_2022(rx_positions_m=rx)
+        sim = ImageSimulator(
+            config, terrain, origin, facet_size_m=float("inf"), occlusion=False, flat_earth=True
+        )
+        buffer = np.empty(config.frame_shape, np.complex64)
+        fps = _time_frames(
+            lambda i, sim=sim, out=buffer: sim.frame(platform(i), frame_index=i, out=out),
+            n_frames,
+            min_seconds,
+        )
+        out[f"{name}_frames_per_s"] = fps
+        if config.n_tx > 1:  # the baselines model one transmitter
+            out[f"{name}_vs_rx8"] = fps / out["rx8_frames_per_s"]
+            continue
+        geometry = (config, terrain, origin, lambda i, sim=sim: sim.geometry(platform(i)))
+        fps_numpy = _numpy_baseline_fps(*geometry, min(n_frames, 3 * baseline_frames), min_seconds)
+        out[f"{name}_numpy_baseline_frames_per_s"] = fps_numpy
+        out[f"{name}_speedup_vs_numpy_baseline"] = fps / fps_numpy
+    return out
 
 
 def _sub_facets(sim: ImageSimulator, platform: PlatformState) -> int:
@@ -348,7 +389,7 @@ def run(n_frames: int = 40, baseline_frames: int = 6, min_seconds: float = 2.0) 
         )
 
     # Into one preallocated frame, as simulate_frames writes into its stack of frames.
-    buffer = np.empty((config.n_range, config.n_doppler, config.n_rx), np.complex64)
+    buffer = np.empty(config.frame_shape, np.complex64)
 
     def ours_cpu(sim: ImageSimulator, n: int) -> tuple[float, float]:
         return _time_frames_cpu(lambda i: sim.frame(platform(i), frame_index=i, out=buffer), n, min_seconds)
@@ -364,6 +405,7 @@ def run(n_frames: int = 40, baseline_frames: int = 6, min_seconds: float = 2.0) 
 
     ours_geometry = (config, terrain, origin, lambda i: same.geometry(platform(i)))
     fps_thesis, fps_numpy = _baseline_fps(*ours_geometry, n_frames, baseline_frames, min_seconds)
+    arrays = _array_keys(terrain, origin, platform, n_frames, baseline_frames, min_seconds)
     ny, nx = terrain.shape
     return {
         "terrain": f"{ny}x{nx} {TERRAIN_NOTE}",
@@ -379,6 +421,10 @@ def run(n_frames: int = 40, baseline_frames: int = 6, min_seconds: float = 2.0) 
         "frames_per_s_fine": fps_fine,
         **psf_keys,
         "full_physics": "exact WGS84 geodesy and occlusion (ours only; no baseline ratio)",
+        **arrays,
+        "arrays": "rx1, rx6 (ura-2x3), rx8 (ura-2x4): the frames_per_s physics with that receive array, "
+        "each against its numpy baseline; mimo_2x4: 8 virtual channels over half the Doppler bins, "
+        "against rx8",
         "thesis_code_frames_per_s": THESIS_FRAMES_PER_S,
         "speedup_vs_thesis_code": fps / THESIS_FRAMES_PER_S,
         "timing": f"median frame time after one warm-up frame, at least {min_seconds:g} s per implementation",

@@ -99,9 +99,9 @@ def frames_dataset(
 
     Parameters
     ----------
-    iq : array_like, shape (n_time, *config.frame_shape)
-        Complex pixels (numpy or dask); for a time-division MIMO radar the ``rx`` axis holds the
-        virtual channels and ``doppler`` one transmitter's bins.
+    iq : array_like, shape (n_time, n_range, n_doppler, n_channels)
+        Complex pixels (numpy or dask), each frame ``config.frame_shape``; for a time-division MIMO
+        radar the ``rx`` axis holds the virtual channels and ``doppler`` one transmitter's bins.
     times_s : ndarray, shape (n_time,)
         Frame times, s.
     config : RadarConfig

@@ -141,8 +141,8 @@ def simulate_frames(
 
     Returns
     -------
-    ndarray, shape (n, *config.frame_shape), complex64
-        Pixel units: ``|pixel|^2`` in W.
+    ndarray, shape (n, n_range, n_doppler, n_channels), complex64
+        Each frame ``config.frame_shape``; pixel units: ``|pixel|^2`` in W.
 
     Examples
     --------

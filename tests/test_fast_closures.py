@@ -212,11 +212,14 @@ def test_a_closure_lost_for_seconds_keeps_its_identity_and_its_warning():
     assert (measured["raw_level"].iloc[:5] == 3).all()
 
 
-def _confirmed(det: pd.DataFrame, own: pd.DataFrame) -> np.ndarray:
+PATCH_TEST = GroundTrackTest(patch_directions=True)  # an array whose directions can tell a patch
+
+
+def _confirmed(det: pd.DataFrame, own: pd.DataFrame, test: GroundTrackTest = PATCH_TEST) -> np.ndarray:
     tracks = pd.DataFrame(
         {"time_s": det["time_s"], "track_id": 1, "detection_row": np.arange(len(det)), "confirmed": True}
     )
-    out = hold_ground_tracks(tracks, det, own, WIDTH, C, flat_surface(AGL_M))
+    out = hold_ground_tracks(tracks, det, own, WIDTH, C, flat_surface(AGL_M), test=test)
     return out["confirmed"].to_numpy(bool) if len(out) else np.zeros(len(det), bool)
 
 
@@ -248,6 +251,20 @@ def test_a_ground_patch_strung_along_a_closing_alias_is_not_released_by_its_rang
         scattered = rng.choice(np.radians([-48.0, -30.0, 40.0, 64.0]), len(det))
         patch = _read_on_the_surface(det, own, scattered)
         assert not _confirmed(patch, own)[:9].any(), trial
+
+
+def test_the_squares_directions_do_not_hold_back_a_closure_that_reads_like_a_patch():
+    # The 2x2 square keeps two channels after its two nulls: an aircraft in a ground cell over relief
+    # can read the surface and scatter in azimuth at once, so its default test releases on the range
+    # rate alone, at the fifth detection.
+    from skyradar.track.ground_tracks import default_ground_test
+
+    square = default_ground_test(RadarConfig.prototype_2022(), flat_surface(AGL_M))
+    rng = np.random.default_rng(14)
+    det, own = _closure_detections(106.7, 120.0, rng, 12)
+    scattered = rng.choice(np.radians([-48.0, -30.0, 40.0, 64.0]), len(det))
+    confirmed = _confirmed(_read_on_the_surface(det, own, scattered), own, square)
+    assert confirmed.any() and int(np.argmax(confirmed)) <= 4
 
 
 def test_an_aliased_closure_read_at_the_grounds_elevation_from_one_azimuth_is_released():

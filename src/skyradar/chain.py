@@ -41,7 +41,7 @@ from skyradar.process.pipeline import clutter_anchors, process_frames
 from skyradar.scene.radar_heads import select_heads
 from skyradar.sim.scenario_frames import make_simulator, scenario_truth, simulate_frames
 from skyradar.track.fusion import restore_detection_rows
-from skyradar.track.ground_tracks import GroundTrackTest, median_ground_down_m, terrain_surface
+from skyradar.track.ground_tracks import default_ground_test, median_ground_down_m, terrain_surface
 from skyradar.track.track_table import track_detections, tracker_detections
 from skyradar.units import wrap
 
@@ -264,7 +264,7 @@ def track_and_alert(
         frame_times_s=built.times_s,
         origin=built.origin,
         ownship=own,
-        ground_test=GroundTrackTest(surface_down=scenario_surface(built, own)),
+        ground_test=default_ground_test(chosen[0].config, scenario_surface(built, own)),
     )
     tracks = restore_detection_rows(tracks, used)  # detection_row indexes the chosen heads' rows
     timings = {"track": time.process_time() - t0}

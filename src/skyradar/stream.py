@@ -58,7 +58,7 @@ from skyradar.scene.trajectories import TrajectorySample
 from skyradar.sim.navigation import navigation_at_frame
 from skyradar.sim.scenario_frames import frames_truth, make_simulator, simulate_frames
 from skyradar.track.fusion import restore_detection_rows
-from skyradar.track.ground_tracks import GroundTrackTest
+from skyradar.track.ground_tracks import default_ground_test
 from skyradar.track.track_table import TrackTableStream, empty_tracks, tracker_detections
 
 __all__ = ["Advice", "FrameResult", "StreamingChain", "frame_advice"]
@@ -214,7 +214,7 @@ class StreamingChain:
             "radar",
             self.heads[0].config,
             origin=built.origin,
-            ground_test=GroundTrackTest(),
+            ground_test=default_ground_test(self.heads[0].config),
             several_heads=len(self.heads) > 1,
         )
         self._alerter = AlertStream(alert_config, with_advice=with_advice, source=built.name)

@@ -109,7 +109,7 @@ def _ground_test(terrain: str | None, run, ownship: Path | None, own, origin_lla
     """The track-level ground test over ``--terrain`` (default: the terrain the run records)."""
     from skyradar.cli.commands_process import terrain_window
     from skyradar.errors import InputError
-    from skyradar.track.ground_tracks import GroundTrackTest, median_ground_down_m, terrain_surface
+    from skyradar.track.ground_tracks import default_ground_test, median_ground_down_m, terrain_surface
 
     if run is None:
         if terrain is not None and terrain.strip().lower() != "none":
@@ -119,7 +119,7 @@ def _ground_test(terrain: str | None, run, ownship: Path | None, own, origin_lla
     dem = terrain_window(terrain, run, config, ownship)
     if dem is None or not hasattr(dem, "height_at") or origin_lla is None:
         return True  # level ground at the own-ship's height above ground, where it has one
-    return GroundTrackTest(surface_down=terrain_surface(dem, origin_lla, median_ground_down_m(own)))
+    return default_ground_test(config, terrain_surface(dem, origin_lla, median_ground_down_m(own)))
 
 
 @app.command()

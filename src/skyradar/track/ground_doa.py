@@ -13,6 +13,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from skyradar.config import RadarConfig
+from skyradar.process.clutter_suppress import default_max_nulls
+
 DOA_COLUMNS = ("azimuth_rad", "elevation_rad", "north_m", "east_m", "down_m", "elevation_measured")
 # The antenna's right axis in NED: the azimuth is measured about it (``process.pipeline``).
 AXIS_COLUMNS = ("right_axis_north", "right_axis_east", "right_axis_down")
@@ -31,6 +34,7 @@ __all__ = [
     "direction_measured",
     "doa_on_the_ground",
     "doa_of_a_ground_patch",
+    "directions_tell_patches",
     "altitude_measured",
     "elevation_measured_flags",
 ]
@@ -284,6 +288,35 @@ def doa_of_a_ground_patch(
     sd = sigma_rad * float(np.median(np.cos(az)))
     z2 = np.sort(((cosine - np.median(cosine)) / sd) ** 2)
     return bool(np.mean(z2[: z2.size - z2.size // 5]) > 9.0)
+
+
+def directions_tell_patches(config: RadarConfig) -> bool:
+    """Whether an array's directions in a ground cell can tell a patch's scatterers from an aircraft.
+
+    True when three or more channels are left after the cell's clutter nulls
+    (:func:`skyradar.process.clutter_suppress.default_max_nulls`): two to measure a direction, one
+    more to see that one plane wave explains the pixel. With two left (the 2x2 square, the kite)
+    the residual ground of a cell over relief pulls an aircraft's measured elevation onto the
+    surface and scatters its azimuth at once: a co-altitude closure over hills, five detections in,
+    read -3 to -19 deg and direction cosines from +0.38 to -0.48. There
+    :func:`doa_of_a_ground_patch` is no evidence.
+
+    Parameters
+    ----------
+    config : RadarConfig
+        The radar (its receive, or MIMO virtual, channels).
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> [directions_tell_patches(RadarConfig.prototype_2022(rx_positions_m=a)) for a in ("square", "ura-2x3")]
+    [False, True]
+    """
+    n = config.n_virtual
+    return n - default_max_nulls(n) >= 3
 
 
 def altitude_measured(

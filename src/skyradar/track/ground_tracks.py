@@ -74,6 +74,7 @@ from skyradar.track.ground_doa import (
     DOA_SIGMA_RAD,
     azimuth_off_static_points,
     direction_measured,
+    directions_tell_patches,
     doa_height_sd,
     doa_in_the_air,
     doa_of_a_ground_patch,
@@ -108,6 +109,7 @@ HOLD_REASONS: dict[str, str] = {
 __all__ = [
     "HOLD_REASONS",
     "GroundTrackTest",
+    "default_ground_test",
     "static_point_measurements",
     "fits_static_ground",
     "range_doppler_consistent",
@@ -185,6 +187,11 @@ class GroundTrackTest:
         interpolation and straddle at 13 dB and more), m; the own-ship's position error, common
         to those detections, is not in it. The range-rate test (:func:`faster_than_ground`)
         uses it.
+    patch_directions : bool
+        Directions a ground patch's scatterers give (:func:`doa_of_a_ground_patch`) keep a track
+        from the early release of a closure faster than the ground; only for arrays whose
+        directions in a ground cell can tell a patch from an aircraft
+        (:func:`~skyradar.track.ground_doa.directions_tell_patches`).
     fast_min_detections : int
         Detections a history needs before its range rate may judge it faster than the ground.
         Over five detections at 9.4 frames/s the slope is known to 12 m/s, a sixth of the image
@@ -223,6 +230,25 @@ class GroundTrackTest:
     ground_min_detections: int = 10
     sigma_range_jitter_m: float = 4.0
     fast_min_detections: int = 5
+    patch_directions: bool = False
+
+
+def default_ground_test(
+    config, surface_down: Callable[[np.ndarray], np.ndarray] | None = None
+) -> GroundTrackTest:
+    """The ground test for a radar: :class:`GroundTrackTest`'s settings, ``surface_down`` (default a
+    level ground at the own-ship's height above it) and the patch-direction rule where the array's
+    directions can tell a patch (:func:`~skyradar.track.ground_doa.directions_tell_patches`).
+
+    Examples
+    --------
+    >>> from skyradar.config import RadarConfig
+    >>> default_ground_test(RadarConfig.prototype_2022()).patch_directions
+    False
+    >>> default_ground_test(RadarConfig.prototype_2022(rx_positions_m="ura-2x3")).patch_directions
+    True
+    """
+    return GroundTrackTest(surface_down=surface_down, patch_directions=directions_tell_patches(config))
 
 
 def _doppler_path(
@@ -558,8 +584,11 @@ class _HistoryWalk:
             and (
                 test.point_sigma_velocity_mps is None or doppler_smooth(t[recent], h.vel[recent], width, test)
             )
-            and not doa_of_a_ground_patch(
-                h.doa[0][recent], h.doa[1][recent], h.doa[3][recent], h.doa[2][recent], test.doa_sigma_rad
+            and not (
+                test.patch_directions
+                and doa_of_a_ground_patch(
+                    h.doa[0][recent], h.doa[1][recent], h.doa[3][recent], h.doa[2][recent], test.doa_sigma_rad
+                )
             )
         ):  # one point closing faster than any static point can: an object, however its Doppler aliases
             self.ground_seen, self.least = False, test.min_detections

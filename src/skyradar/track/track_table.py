@@ -14,7 +14,12 @@ from skyradar.track.doa_feed import OWNSHIP_COLUMNS, Measure3D
 from skyradar.track.frame_grid import frame_grid, frame_numbers
 from skyradar.track.fusion import fuse_heads, restore_detection_rows
 from skyradar.track.ground_doa import altitude_measured
-from skyradar.track.ground_tracks import HOLD_REASONS, GroundTrackTest, hold_ground_tracks
+from skyradar.track.ground_tracks import (
+    HOLD_REASONS,
+    GroundTrackTest,
+    default_ground_test,
+    hold_ground_tracks,
+)
 from skyradar.track.io import validate_detections
 from skyradar.track.models import MotionModel, radar_model, traditional_model
 from skyradar.track.reacquired_ids import relabel_reacquired
@@ -271,7 +276,7 @@ def _held(tracks, detections, ownship, config: RadarConfig, ground_test, walks=N
     tracks = tracks.assign(held_by=np.where(tracks["confirmed"].to_numpy(bool), "", tracker_why))
     if ground_test is False:
         return tracks
-    test = ground_test if isinstance(ground_test, GroundTrackTest) else GroundTrackTest()
+    test = ground_test if isinstance(ground_test, GroundTrackTest) else default_ground_test(config)
     width, coupling = 2.0 * config.v_lim_mps, config.range_doppler_coupling_s
     return hold_ground_tracks(tracks, detections, ownship, width, coupling, test.surface_down, test, walks)
 
@@ -557,7 +562,11 @@ class TrackTableStream:
 
     def set_surface(self, surface_down: Callable | None) -> None:
         """The terrain (NE -> down, m) of the ground test and the 3-D feed from this frame on."""
-        test = self.ground_test if isinstance(self.ground_test, GroundTrackTest) else GroundTrackTest()
+        test = (
+            self.ground_test
+            if isinstance(self.ground_test, GroundTrackTest)
+            else default_ground_test(self.config)
+        )
         if self.ground_test is not False:
             self.ground_test = replace(test, surface_down=surface_down)
         if self._m3 is not None and self._m3.active:

@@ -55,7 +55,7 @@ from skyradar.scene.scenario import BuiltScenario, Intruder
 from skyradar.scene.trajectories import GRAVITY_MPS2, Trajectory, TrajectorySample
 from skyradar.sim.navigation import navigation_variables
 from skyradar.sim.scenario_frames import frames_truth, make_simulator, simulate_frames
-from skyradar.track.ground_tracks import GroundTrackTest
+from skyradar.track.ground_tracks import default_ground_test
 from skyradar.track.track_table import TrackTableStream, tracker_detections
 from skyradar.units import wrap_angle
 
@@ -490,7 +490,7 @@ class AirborneRadar:
             "radar",
             heads[0].config,
             origin=origin,
-            ground_test=GroundTrackTest(),
+            ground_test=default_ground_test(heads[0].config),
             several_heads=len(heads) > 1,
         )
         self._own_rows: list[pd.DataFrame] = []

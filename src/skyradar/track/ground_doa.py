@@ -246,6 +246,7 @@ def doa_of_a_ground_patch(
     ``sigma_rad cos(azimuth)`` at the median azimuth. A patch's scatterers cluster (two or three
     readings from near one azimuth, then others far off), so a median absolute deviation, which
     ignores half the readings, can miss it.
+
     Each half alone is no proof: an aircraft in a ground cell can read the ground's elevation (the
     cell's mixture pulls it down) but it keeps one azimuth, which the array measures whatever the
     elevation; an aircraft read through the nulls over relief scatters in azimuth but reads above

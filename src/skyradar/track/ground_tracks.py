@@ -29,10 +29,12 @@ first; a track whose radial velocity lies inside the ground's band keeps the slo
 The release has two limits, both because a ground patch fills one Doppler bin over many ranges
 and the tracker can string its scatterers along a line of almost any slope, one that some alias
 then fits. It is for closures: a history receding faster than the ground is no threat and waits
-for the slower tests. And it does not overrule directions that are a patch's
-(:func:`doa_of_a_ground_patch`): measured elevations on the surface while the azimuths scatter
-across the beam; an aircraft keeps one azimuth even when its cell's mixture pulls its elevation
-down, and reads above the surface when the nulls scatter its azimuth.
+for the slower tests. And, on an array with three or more channels left after the clutter nulls
+(:func:`~skyradar.track.ground_doa.directions_tell_patches`, ``GroundTrackTest.patch_directions``),
+it does not overrule directions that are a patch's (:func:`doa_of_a_ground_patch`): measured
+elevations on the surface while the azimuths scatter across the beam; there an aircraft keeps one
+azimuth even when its cell's mixture pulls its elevation down. With two channels left (the 2x2
+square) an aircraft over relief can read both ways at once, so the range rate alone decides.
 
 Why aircraft are kept: in straight flight the history of a point moving at relative velocity
 ``w`` has ``d(r dr/dt)/dt = |w|^2``, a static point's ``|v|^2``; so an aircraft fits a static
@@ -67,6 +69,7 @@ import numpy as np
 import pandas as pd
 from scipy.stats import chi2, norm
 
+from skyradar.config import RadarConfig
 from skyradar.track.ground_doa import (
     AXIS_COLUMNS,
     DOA_COLUMNS,
@@ -234,7 +237,7 @@ class GroundTrackTest:
 
 
 def default_ground_test(
-    config, surface_down: Callable[[np.ndarray], np.ndarray] | None = None
+    config: RadarConfig, surface_down: Callable[[np.ndarray], np.ndarray] | None = None
 ) -> GroundTrackTest:
     """The ground test for a radar: :class:`GroundTrackTest`'s settings, ``surface_down`` (default a
     level ground at the own-ship's height above it) and the patch-direction rule where the array's
@@ -242,7 +245,6 @@ def default_ground_test(
 
     Examples
     --------
-    >>> from skyradar.config import RadarConfig
     >>> default_ground_test(RadarConfig.prototype_2022()).patch_directions
     False
     >>> default_ground_test(RadarConfig.prototype_2022(rx_positions_m="ura-2x3")).patch_directions

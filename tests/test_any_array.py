@@ -207,7 +207,6 @@ def test_larger_arrays_can_null_the_clutter_relief_leaves_and_keep_the_intruder(
     from skyradar.benchmarks.process_adaptive import SPEED_MPS, relief_cubes
     from skyradar.process.clutter import clutter_subspace
     from skyradar.process.clutter_suppress import default_max_nulls, suppress_clutter
-    from skyradar.process.detect import detect
 
     assert default_max_nulls(4) == 2 and default_max_nulls(8) == 2
 
@@ -222,14 +221,7 @@ def test_larger_arrays_can_null_the_clutter_relief_leaves_and_keep_the_intruder(
         aliased = (-2.0 * SPEED_MPS + v_lim) % (2.0 * v_lim) - v_lim  # the closing speed, aliased
         counts, seen = [], []
         for range_m, cube in zip(np.linspace(3000.0, 1800.0, 3), cubes, strict=True):
-            sup = suppress_clutter(cube, sub, config, max_nulls=max_nulls)
-            det = detect(
-                sup.power,
-                config,
-                channels=sup.channels,
-                train_exclude=sup.unsuppressed,
-                noise_floor_w=sup.noise_floor_w,
-            )
+            det = suppress_clutter(cube, sub, config, max_nulls=max_nulls).detections(config)
             near = np.abs(det.range_m(config) - range_m) < 20.0
             near &= np.abs(det.radial_velocity_mps(config) - aliased) < 1.0
             counts.append(len(det.range_index))

@@ -16,7 +16,6 @@ from skyradar.process.clutter_adaptive import (
 )
 from skyradar.process.clutter_frames import detect_suppressed, frame_subspace
 from skyradar.process.clutter_suppress import suppress_clutter
-from skyradar.process.detect import detect
 from skyradar.process.doa import direction_from_angles, steering_vector
 from skyradar.process.top_eigen import top_eigenpairs, top_two_eigenpairs
 
@@ -187,9 +186,7 @@ def flat_prediction():
 
 def _hits(cube, sub, adaptive, pixel):
     out = suppress_clutter(cube, sub, CFG, adaptive=adaptive)
-    det = detect(
-        out.power, CFG, channels=out.channels, train_exclude=out.unsuppressed, noise_floor_w=out.noise_floor_w
-    )
+    det = out.detections(CFG)
     found = np.any((det.range_index == pixel[0]) & (det.doppler_index == pixel[1]))
     return out, bool(found), len(det)
 

@@ -30,7 +30,6 @@ from skyradar.config import RadarConfig
 from skyradar.process.clutter import clutter_subspace
 from skyradar.process.clutter_adaptive import ADAPTIVE_GATE, ADAPTIVE_WINDOW, EIGEN_EDGE, RING_CLIP
 from skyradar.process.clutter_suppress import Suppressed, default_max_nulls, suppress_clutter
-from skyradar.process.detect import detect
 from skyradar.process.pipeline import process_cube
 from skyradar.scene.synthetic_terrain import fractal_terrain
 from skyradar.sim.image import ImageSimulator, PlatformState, PointTarget
@@ -162,14 +161,7 @@ def _adaptive_figures(config: RadarConfig, n_cubes: int, seed: int, prefix: str)
 
 
 def _hit_cells(suppressed, config: RadarConfig) -> set[tuple[int, int]]:
-    """The (range, Doppler) cells CFAR detects on a suppressed image (channels from its null counts:
-    the baseline rewrites those in place)."""
-    channels = (config.n_rx - suppressed.nulls).astype(np.int8)
-    det = detect(
-        suppressed.power,
-        config,
-        channels=channels,
-        train_exclude=suppressed.unsuppressed,
-        noise_floor_w=suppressed.noise_floor_w,
-    )
+    """The (range, Doppler) cells CFAR detects on a suppressed image (the baseline rewrites its null
+    counts in place; :meth:`~skyradar.process.clutter_suppress.Suppressed.detections` reads them)."""
+    det = suppressed.detections(config)
     return set(zip(det.range_index.tolist(), det.doppler_index.tolist(), strict=True))

@@ -34,7 +34,7 @@ from skyradar.process.clutter_adaptive import ring_whitening
 from skyradar.process.clutter_anchors import RECENT_ANCHORS, anchor_key, prediction_anchors
 from skyradar.process.clutter_doa import directions_after_projection, projected_directions
 from skyradar.process.clutter_suppress import projected_snapshots, suppress_clutter
-from skyradar.process.detect import Detections, detect
+from skyradar.process.detect import Detections
 from skyradar.process.doa import direction_coherence, estimate_directions, steering_vector
 from skyradar.process.ground import static_radial_velocity_mps
 from skyradar.units import wrap
@@ -220,16 +220,7 @@ def detect_suppressed(
     the median azimuth error at the intruder (4.2 to 1.9 deg over 25 frames).
     """
     sup = suppress_clutter(cube, clutter, config)
-    det = detect(
-        sup.power,
-        config,
-        method=method,
-        exclude=exclude,
-        channels=sup.channels,
-        train_exclude=sup.unsuppressed,
-        noise_floor_w=sup.noise_floor_w,
-        **detect_kwargs,
-    )
+    det = sup.detections(config, method=method, exclude=exclude, **detect_kwargs)
     pixels = cube[det.range_index, det.doppler_index]
     u = estimate_directions(pixels, config)
     coherence = direction_coherence(pixels, u, config)

@@ -50,6 +50,7 @@ from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.process.clutter import ClutterSubspace, cell_scratch, decompose_cell
 from skyradar.process.clutter_adaptive import adaptive_nulls
+from skyradar.process.detect import Detections, detect
 from skyradar.process.power import power_image
 from skyradar.rx_layouts import MAX_RX
 
@@ -120,6 +121,22 @@ class Suppressed:
             own = self.adaptive[range_index, doppler_index]
             vectors[own] = self.adaptive_vectors[range_index[own], doppler_index[own]]
         return vectors
+
+    def detections(self, config: RadarConfig, **detect_kwargs) -> Detections:
+        """CFAR on the suppressed image as the chain runs it (:func:`skyradar.process.detect.detect`):
+        each pixel's channel count from its nulls (``n_rx - nulls``, so a pass that rewrote
+        ``nulls`` in place is read as it now is), training outside unsuppressed clutter, against the
+        frame's measured floor; ``detect_kwargs`` as ``detect`` takes them (``method``,
+        ``exclude``, ...)."""
+        channels = (config.n_rx - self.nulls).astype(np.int8)
+        return detect(
+            self.power,
+            config,
+            channels=channels,
+            train_exclude=self.unsuppressed,
+            noise_floor_w=self.noise_floor_w,
+            **detect_kwargs,
+        )
 
     def applied_vectors(self, subspace: ClutterSubspace) -> np.ndarray:
         """:meth:`cell_vectors` of every cell (n_range, n_doppler, n_rx, n_rx)."""

@@ -59,10 +59,12 @@ def _state(own: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
     )
 
 
-def _closure_detections(closing_mps: float, miss_m: float, rng: np.random.Generator, n: int) -> tuple:
+def _closure_detections(
+    closing_mps: float, miss_m: float, rng: np.random.Generator, n: int, width_mps: float = WIDTH
+) -> tuple:
     """Detections of a co-altitude intruder closing head-on at ``closing_mps`` with a lateral miss,
-    range noise 2.5 m (13-20 dB), Doppler noise 0.05 m/s; its direction of arrival unmeasured
-    (elevation 0, the chain's co-altitude prior)."""
+    range noise 2.5 m (13-20 dB), Doppler noise 0.05 m/s, aliased into an image ``width_mps`` wide;
+    its direction of arrival unmeasured (elevation 0, the chain's co-altitude prior)."""
     t = np.arange(n) * FRAME_S
     own = _own(t)
     own_p, _ = _state(own)
@@ -75,7 +77,7 @@ def _closure_detections(closing_mps: float, miss_m: float, rng: np.random.Genera
         {
             "time_s": t,
             "range_m": r + C * v + rng.normal(0.0, 2.5, n),
-            "radial_velocity_mps": (measured_v + WIDTH / 2) % WIDTH - WIDTH / 2,
+            "radial_velocity_mps": (measured_v + width_mps / 2) % width_mps - width_mps / 2,
             "azimuth_rad": rng.choice([-0.9, 0.9], n),
             "elevation_rad": 0.0 * t,
             "elevation_measured": False,
@@ -215,11 +217,13 @@ def test_a_closure_lost_for_seconds_keeps_its_identity_and_its_warning():
 PATCH_TEST = GroundTrackTest(patch_directions=True)  # an array whose directions can tell a patch
 
 
-def _confirmed(det: pd.DataFrame, own: pd.DataFrame, test: GroundTrackTest = PATCH_TEST) -> np.ndarray:
+def _confirmed(
+    det: pd.DataFrame, own: pd.DataFrame, test: GroundTrackTest = PATCH_TEST, width_mps: float = WIDTH
+) -> np.ndarray:
     tracks = pd.DataFrame(
         {"time_s": det["time_s"], "track_id": 1, "detection_row": np.arange(len(det)), "confirmed": True}
     )
-    out = hold_ground_tracks(tracks, det, own, WIDTH, C, flat_surface(AGL_M), test=test)
+    out = hold_ground_tracks(tracks, det, own, width_mps, C, flat_surface(AGL_M), test=test)
     return out["confirmed"].to_numpy(bool) if len(out) else np.zeros(len(det), bool)
 
 
@@ -240,17 +244,34 @@ def _read_on_the_surface(det: pd.DataFrame, own: pd.DataFrame, azimuth_rad: np.n
     )
 
 
+def _taking_turns(rng: np.random.Generator, n: int) -> np.ndarray:
+    """Azimuths (rad) of four scatterers of a patch, left and right of the track, taking turns in
+    a random order within every four detections."""
+    scatterers = np.radians([-48.0, -30.0, 40.0, 64.0])
+    return np.concatenate([rng.permutation(scatterers) for _ in range(-(-n // 4))])[:n]
+
+
 def test_a_ground_patch_strung_along_a_closing_alias_is_not_released_by_its_range_rate():
     # A ground patch fills one Doppler bin over many ranges; the tracker can string its scatterers,
     # left and right of the own-ship's track, along a line as steep as a closure's. The line alone
     # passes the range-rate test, but the directions read the surface and scatter across the beam:
-    # the patch keeps the slower tests (ten detections before the direction test may let go).
+    # the patch is held, and stays held once its history outgrows the first ten detections and no
+    # single static point fits the line.
     rng = np.random.default_rng(11)
     for trial in range(10):
-        det, own = _closure_detections(106.7, 90.0 + 20.0 * trial, rng, 12)
-        scattered = rng.choice(np.radians([-48.0, -30.0, 40.0, 64.0]), len(det))
-        patch = _read_on_the_surface(det, own, scattered)
-        assert not _confirmed(patch, own)[:9].any(), trial
+        det, own = _closure_detections(106.7, 90.0 + 20.0 * trial, rng, 40)
+        patch = _read_on_the_surface(det, own, _taking_turns(rng, len(det)))
+        assert not _confirmed(patch, own).any(), trial
+
+
+def test_an_aircraft_read_on_the_surface_from_one_azimuth_is_not_held_as_a_patch():
+    # Inside the ground's band (a 30 m/s converging closure, no early release), read at the ground's
+    # elevation by its cell's mixture but from one azimuth: the patch rule does not hold it.
+    rng = np.random.default_rng(15)
+    det, own = _closure_detections(80.0, 400.0, rng, 40)
+    one_azimuth = np.radians(-25.0) + rng.normal(0.0, 0.01, len(det))
+    on_surface = _read_on_the_surface(det, own, one_azimuth)
+    assert _confirmed(on_surface, own).any()
 
 
 def test_the_squares_directions_do_not_hold_back_a_closure_that_reads_like_a_patch():
@@ -262,7 +283,7 @@ def test_the_squares_directions_do_not_hold_back_a_closure_that_reads_like_a_pat
     square = default_ground_test(RadarConfig.prototype_2022(), flat_surface(AGL_M))
     rng = np.random.default_rng(14)
     det, own = _closure_detections(106.7, 120.0, rng, 12)
-    scattered = rng.choice(np.radians([-48.0, -30.0, 40.0, 64.0]), len(det))
+    scattered = _taking_turns(rng, len(det))
     confirmed = _confirmed(_read_on_the_surface(det, own, scattered), own, square)
     assert confirmed.any() and int(np.argmax(confirmed)) <= 4
 
@@ -293,3 +314,4 @@ def test_a_history_receding_faster_than_the_ground_waits_for_the_slower_tests():
     assert faster_than_ground(*args, WIDTH, C)
     assert not faster_than_ground(*args, WIDTH, C, closing=True)
     assert not _confirmed(det, own)[:9].any()
+

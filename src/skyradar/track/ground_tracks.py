@@ -33,8 +33,11 @@ for the slower tests. And, on an array with three or more channels left after th
 (:func:`~skyradar.track.ground_doa.directions_tell_patches`, ``GroundTrackTest.patch_directions``),
 it does not overrule directions that are a patch's (:func:`doa_of_a_ground_patch`): measured
 elevations on the surface while the azimuths scatter across the beam; there an aircraft keeps one
-azimuth even when its cell's mixture pulls its elevation down. With two channels left (the 2x2
-square) an aircraft over relief can read both ways at once, so the range rate alone decides.
+azimuth even when its cell's mixture pulls its elevation down. On such arrays those directions
+hold a track at any age, in the slower tests too: a patch strung along a steep line is fitted by
+no single static point once its history outgrows the first detections, and the scatterers taking
+turns are what its directions show. With two channels left (the 2x2 square) an aircraft over
+relief can read both ways at once, so the range rate and the static fit alone decide.
 
 Why aircraft are kept: in straight flight the history of a point moving at relative velocity
 ``w`` has ``d(r dr/dt)/dt = |w|^2``, a static point's ``|v|^2``; so an aircraft fits a static
@@ -104,7 +107,8 @@ HOLD_REASONS: dict[str, str] = {
     "young": "too few detections for the ground test to judge it",
     "range": "its ranges contradict its Doppler (not one scatterer)",
     "rough": "its Doppler is not one smooth curve (scatterers of a patch taking turns)",
-    "direction": "its measured elevations put it on the surface, or none is measured",
+    "direction": "its measured elevations put it on the surface, or none is measured, or its directions "
+    "are a ground patch's",
     "ground": "a static point on the surface explains its range-Doppler history and is where it is seen",
     "ground-release": "a static ground point fitted it; judged an object for too short a span yet",
 }
@@ -191,9 +195,9 @@ class GroundTrackTest:
         to those detections, is not in it. The range-rate test (:func:`faster_than_ground`)
         uses it.
     patch_directions : bool
-        Directions a ground patch's scatterers give (:func:`doa_of_a_ground_patch`) keep a track
-        from the early release of a closure faster than the ground; only for arrays whose
-        directions in a ground cell can tell a patch from an aircraft
+        Directions a ground patch's scatterers give (:func:`doa_of_a_ground_patch`) hold a track,
+        at any age and against the early release of a closure faster than the ground; only for
+        arrays whose directions in a ground cell can tell a patch from an aircraft
         (:func:`~skyradar.track.ground_doa.directions_tell_patches`).
     fast_min_detections : int
         Detections a history needs before its range rate may judge it faster than the ground.
@@ -455,6 +459,10 @@ def _judge(sl, t, rng, vel, own_p, own_v, surface_down, width, coupling, test, d
         if not direction_measured(measured) or doa_on_the_ground(measured, doa[2][sl]):
             return "direction"
     azimuth, elevation, height_sd, measured, right = (a[sl] for a in doa)
+    if test.patch_directions and doa_of_a_ground_patch(
+        azimuth, elevation, measured, height_sd, test.doa_sigma_rad
+    ):  # a patch's directions at any age: no static point need fit scatterers taking turns
+        return "direction"
     if surface_down is None or doa_in_the_air(
         azimuth, elevation, height_sd, measured, test.doa_sigma_rad, test.doa_field_rad
     ):

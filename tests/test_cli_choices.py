@@ -92,7 +92,7 @@ def test_each_enum_holds_the_names_the_library_takes():
     from skyradar.nav.flight_state import METHODS as STATE_METHODS
     from skyradar.nav.gpscheck.preprocess import METHODS as GPSCHECK_METHODS
     from skyradar.process.detect import detect
-    from skyradar.rx_layouts import RX_LAYOUTS
+    from skyradar.rx_layouts import MIMO_LAYOUTS, RX_LAYOUTS
     from skyradar.scene.encounter_from_tracks import encounter_from_tracks
     from skyradar.scene.flyable import AIRCRAFT_CLASSES
     from skyradar.scene.navigation_config import NAVIGATION_MODELS
@@ -104,7 +104,7 @@ def test_each_enum_holds_the_names_the_library_takes():
     assert _names(choices.Precision) == PRECISIONS
     assert _names(choices.GpsCheckMethod) == GPSCHECK_METHODS
     assert _names(choices.TruthMode) == TRUTH_MODES
-    assert _names(choices.RxLayout) == RX_LAYOUTS
+    assert _names(choices.RxLayout) == RX_LAYOUTS + MIMO_LAYOUTS
     assert _names(choices.Navigation) == NAVIGATION_MODELS
     assert _names(choices.AircraftClass) == tuple(AIRCRAFT_CLASSES)
     assert set(_names(choices.StateMethod)) == {*STATE_METHODS, "terrain"}  # terrain: estimate_run's own

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -174,6 +176,19 @@ def test_a_mimo_scenario_simulates_virtual_channel_frames_through_the_cli(tmp_pa
     iq = xr.open_zarr(tmp_path / "r.zarr", consolidated=False).iq
     assert iq.sizes["doppler"] == MIMO.n_doppler_per_tx and iq.sizes["rx"] == MIMO.n_virtual
     assert "virtual channel" in iq["rx"].attrs["long_name"]
+
+
+def test_a_mimo_array_runs_the_encounter_experiment_in_clear_sky_through_the_cli(tmp_path):
+    # Simulate -> process (no suppression: nothing to suppress, and the nulls model one transmitter)
+    # -> track -> alert -> score, the run's settings saying so.
+    result = skyradar(
+        "experiment", "encounters", "--rx-layout", "mimo-2x4", "--n", "2", "--layout", "single",
+        "--workers", "1", "--output", "enc", "--json", cwd=tmp_path,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout.strip().splitlines()[-1])
+    assert (summary["rx_layout"], summary["suppression"], summary["encounters"]) == ("mimo-2x4", "none", 2)
+    assert summary["terrains"] == ["none"]
 
 
 def test_the_land_cover_simulator_refuses_several_transmitters():

@@ -58,6 +58,35 @@ def test_aliased_track_is_dealiased_to_true_radial_velocity(mode):
     assert last.range_rate_mps == pytest.approx(-95.0, abs=10.0)
 
 
+@pytest.mark.parametrize("mode", ["confident", "thesis"])
+def test_a_150_mps_closure_through_a_mimo_image_is_dealiased(mode):
+    # Two transmitters halve the image (39.15 m/s at the prototype's PRF): a 150 m/s head-on closure
+    # is four widths from its measured Doppler; its range history de-aliases it to one track.
+    mimo = RadarConfig.prototype_2022(rx_positions_m="mimo-2x4")
+    width = 2.0 * mimo.v_lim_mps
+    assert width == pytest.approx(W / 2.0) and abs(round(-150.0 / width)) == 4
+    t = np.arange(0.0, 5.0, DT)
+    V = np.full_like(t, -150.0)
+    R = 3000.0 + V * t
+    det = synthetic_detections(t, R[:, None], V[:, None], config=mimo, seed=5)
+    assert det["radial_velocity_mps"].abs().max() <= width / 2.0
+    tracks = track_detections(det, "radar", mimo, TrackerConfig(dealias=mode), frame_times_s=t)
+    assert tracks.track_id.nunique() == 1
+    assert tracks.iloc[-1].radial_velocity_mps == pytest.approx(-150.0, abs=1.0)
+
+
+def test_the_alias_bound_covers_the_same_radial_speeds_in_every_image():
+    from skyradar.track.dealias import MAX_RADIAL_SPEED_MPS, alias_count
+
+    for width in (W, W / 2.0, W / 3.0, W / 4.0, 20.0, 200.0, 500.0):
+        k = alias_count(width)
+        assert (k + 0.5) * width >= MAX_RADIAL_SPEED_MPS  # every speed up to the bound is some alias
+        assert k == 0 or (k - 0.5) * width <= MAX_RADIAL_SPEED_MPS  # the largest alias is needed
+    assert alias_count(W) == 2  # the prototype's bound
+    with pytest.raises(ValueError, match="width_mps"):
+        alias_count(0.0)
+
+
 @pytest.mark.parametrize("seed", [0, 1, 2, 3])
 def test_two_intruders_crossing_at_close_range_keep_identities(seed):
     t = np.arange(0.0, 12.0, DT)

@@ -64,7 +64,7 @@ def _truth_dataset(built, simulator) -> xr.Dataset:
     """Frames Dataset of the whole run with a zero-stride placeholder ``iq`` (no memory)."""
     own, tgt, names = scenario_truth(built, simulator)
     cfg = simulator.config
-    shape = (built.times_s.size, cfg.n_range, cfg.n_doppler, cfg.n_rx)
+    shape = (built.times_s.size, *cfg.frame_shape)
     iq = np.broadcast_to(np.zeros((), np.complex64), shape)
     return frames_dataset(iq, built.times_s, cfg, own, tgt, names, run_attrs(built))
 

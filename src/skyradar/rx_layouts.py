@@ -162,16 +162,20 @@ def ura_m(rows: int, cols: int, spacing_m: float) -> np.ndarray:
     return np.column_stack([np.zeros(rows * cols), right.ravel(), down.ravel()])
 
 
-def check_rx_layout(name: str, label: str) -> str:
-    """``name`` if it is a layout of :data:`RX_LAYOUTS`, else InputError ``"{label} must be ..."``.
+def check_rx_layout(name: str, label: str, mimo: bool = False) -> str:
+    """``name`` if it is a layout of :data:`RX_LAYOUTS` (or, with ``mimo``, of :data:`MIMO_LAYOUTS`),
+    else InputError ``"{label} must be ..."``.
 
     Examples
     --------
     >>> check_rx_layout("kite", "--rx-layout")
     'kite'
+    >>> check_rx_layout("mimo-2x4", "--rx-layout", mimo=True)
+    'mimo-2x4'
     """
-    if name not in RX_LAYOUTS:
-        raise InputError(f"{label} must be one of {', '.join(RX_LAYOUTS)}, got {name!r}")
+    names = RX_LAYOUTS + MIMO_LAYOUTS if mimo else RX_LAYOUTS
+    if name not in names:
+        raise InputError(f"{label} must be one of {', '.join(names)}, got {name!r}")
     return name
 
 

@@ -185,14 +185,15 @@ class Navigation(StrEnum):
 
 
 class RxLayout(StrEnum):
-    """``experiment encounters --rx-layout``: every head's receive array
-    (``skyradar.rx_layouts.RX_LAYOUTS``)."""
+    """``experiment encounters --rx-layout``: every head's array (``skyradar.rx_layouts.RX_LAYOUTS``,
+    then ``MIMO_LAYOUTS``)."""
 
     square = "square"
     kite = "kite"
     ura_2x3 = "ura-2x3"
     ura_2x4 = "ura-2x4"
     ura_4x2 = "ura-4x2"
+    mimo_2x4 = "mimo-2x4"
 
 
 class Family(StrEnum):

@@ -9,13 +9,51 @@ With 15 m range bins and about 10 frames/s the slope of two observations is too 
 the alias reliably (about 60 m/s standard deviation against ``W/2 = 39`` m/s), so the slope here
 is a least-squares fit over the last few observations; the rule is applied at every update and
 settles as the history grows.
+
+How many aliases a track may be off by follows from the fastest radial speed a light aircraft's
+radar sees, not from one radar's image: two light aircraft head-on at 190 kt each close at
+195 m/s (:data:`MAX_RADIAL_SPEED_MPS`). :func:`alias_count` turns that into the alias bound of
+an image of any width, so a time-division MIMO radar, whose image is narrower by its number of
+transmitters, keeps the same span of radial speeds.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["dealias_velocity", "range_rate_fit", "push_history"]
+__all__ = ["MAX_RADIAL_SPEED_MPS", "alias_count", "dealias_velocity", "range_rate_fit", "push_history"]
+
+MAX_RADIAL_SPEED_MPS = 195.0  # two light aircraft head-on at 190 kt each, m/s
+
+
+def alias_count(width_mps: float, max_radial_speed_mps: float = MAX_RADIAL_SPEED_MPS) -> int:
+    """Largest alias ``|k|`` of a radial velocity up to ``max_radial_speed_mps`` in an image ``W`` wide.
+
+    A measured velocity lies within ``W/2`` of zero, so the true one, ``v + k W``, can reach the
+    speed only for ``|k| W - W/2 <= max_radial_speed_mps``: ``|k| <= floor(v_max / W + 1/2)``.
+
+    Parameters
+    ----------
+    width_mps : float
+        Doppler image width ``2 VLim``, m/s.
+    max_radial_speed_mps : float
+        Fastest radial speed to cover, m/s.
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    The prototype's 78.3 m/s image needs two aliases either side for +-195 m/s; a 2 TX x 4 RX
+    time-division MIMO radar at the same PRF (39.15 m/s image) needs five:
+
+    >>> alias_count(78.3), alias_count(39.15)
+    (2, 5)
+    """
+    if not (np.isfinite(width_mps) and width_mps > 0.0):
+        raise ValueError(f"width_mps must be a positive number of m/s, got {width_mps!r}")
+    return int(np.floor(max_radial_speed_mps / width_mps + 0.5))
 
 
 def dealias_velocity(velocity_mps: np.ndarray, range_rate_mps: np.ndarray, width_mps: float) -> np.ndarray:

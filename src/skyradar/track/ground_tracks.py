@@ -73,6 +73,7 @@ import pandas as pd
 from scipy.stats import chi2, norm
 
 from skyradar.config import RadarConfig
+from skyradar.track.dealias import alias_count
 from skyradar.track.ground_doa import (
     AXIS_COLUMNS,
     DOA_COLUMNS,
@@ -274,13 +275,14 @@ def range_doppler_consistent(
     width_mps: float,
     coupling_s: float,
     test: GroundTrackTest | None = None,
-    max_alias: int = 2,
+    max_alias: int | None = None,
 ) -> bool:
     """Whether a detection history's ranges follow its Doppler: ``dr/dt`` is the de-aliased radial velocity.
 
     The radial velocities are unwrapped by continuity, integrated over time, and shifted by a
-    whole number of image widths (the alias, ``|k| <= max_alias``); the apparent ranges must follow
-    within the range error (trimmed chi-square).
+    whole number of image widths (the alias, ``|k| <= max_alias``, by default the image's
+    :func:`~skyradar.track.dealias.alias_count`); the apparent ranges must follow within the range
+    error (trimmed chi-square).
 
     Examples
     --------
@@ -296,6 +298,7 @@ def range_doppler_consistent(
     rng = np.asarray(range_m, float)
     _, moved = _doppler_path(t, radial_velocity_mps, width_mps, coupling_s)
     limit = chi2.isf(test.tail, max(rng.size - int(np.floor(test.trim * rng.size)) - 1, 1))
+    max_alias = alias_count(width_mps) if max_alias is None else max_alias
     for k in range(-max_alias, max_alias + 1):
         res = rng - moved - k * width_mps * (t - t[0])
         z2 = ((res - np.median(res)) / test.sigma_range_m) ** 2
@@ -312,7 +315,7 @@ def faster_than_ground(
     width_mps: float,
     coupling_s: float,
     test: GroundTrackTest | None = None,
-    max_alias: int = 2,
+    max_alias: int | None = None,
     closing: bool = False,
 ) -> bool:
     """Whether a detection history is one scatterer whose range moves faster than any static point's.
@@ -338,8 +341,9 @@ def faster_than_ground(
     coupling_s : float
         Range-Doppler coupling, s (apparent range = range + coupling * radial velocity).
     test : GroundTrackTest, optional
-    max_alias : int
-        Largest alias ``|k|`` considered.
+    max_alias : int, optional
+        Largest alias ``|k|`` considered; by default the image's
+        :func:`~skyradar.track.dealias.alias_count` (radial speeds up to 195 m/s).
     closing : bool
         Only a history that closes (its de-aliased radial velocity negative at every detection).
 
@@ -376,6 +380,7 @@ def faster_than_ground(
         return False
     slope = float(np.sum(tc * (excess - excess.mean())) / sxx)
     z = float(norm.isf(test.tail))
+    max_alias = alias_count(width_mps) if max_alias is None else max_alias
     aliases = np.arange(-max_alias, max_alias + 1)
     allowed = np.abs(slope - aliases * width_mps) <= z * test.sigma_range_jitter_m / np.sqrt(sxx)
     if np.count_nonzero(allowed) != 1:

@@ -19,7 +19,7 @@ import numpy as np
 
 from skyradar.track.association import Association, associate
 from skyradar.track.components import Associator, Deleter, Initiator, Predictor, Reacquirer, Updater
-from skyradar.track.dealias import dealias_velocity, push_history, range_rate_fit
+from skyradar.track.dealias import alias_count, dealias_velocity, push_history, range_rate_fit
 from skyradar.track.deletion import MissDeleter
 from skyradar.track.initiation import MOfN, push_hit
 from skyradar.track.kalman import predict, update
@@ -112,6 +112,7 @@ class RangeDopplerTracker:
             closing_max_age_s=c.reacquire_closing_s,
         )
         self._reacquired = np.zeros((0, 2), np.int64)
+        self.max_alias = alias_count(model.doppler_width_mps) if c.max_alias is None else c.max_alias
         if range_walks is None:
             range_walks = RangeWalks(model.doppler_width_mps) if model.wrap_doppler else False
         self.range_walks: RangeWalks | None = range_walks if isinstance(range_walks, RangeWalks) else None
@@ -296,7 +297,7 @@ class RangeDopplerTracker:
                 None if range_wrap is None else range_wrap[rows],
                 self.config.metric,
                 self.pixel_size,
-                self.config.max_alias,
+                self.max_alias,
             )
             parts.append(Association(rows[a.track_index], dets[a.detection_index], a.innovation, a.cost))
             free[dets[a.detection_index]] = False

@@ -27,8 +27,9 @@ class TrackerConfig:
         Time without an update before a track is closed, s.
     history : int
         Range observations kept per track for the range-rate fit used to de-alias.
-    max_alias : int
-        Largest alias (in image widths) a single-observation track may be off by.
+    max_alias : int or None
+        Largest alias (in image widths) a single-observation track may be off by; None: the
+        image's :func:`~skyradar.track.dealias.alias_count` (radial speeds up to 195 m/s).
     confirmed_first : bool
         Assign detections to confirmed tracks before tentative ones.
     dealias : {'confident', 'thesis'}
@@ -75,7 +76,7 @@ class TrackerConfig:
     max_misses: int = 20
     max_coast_s: float = 2.0
     history: int = 16
-    max_alias: int = 2
+    max_alias: int | None = None
     confirmed_first: bool = True
     dealias: str = "confident"
     resolve_fraction: float = 1.0 / 6.0

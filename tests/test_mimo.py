@@ -245,8 +245,6 @@ def test_terrain_channel_positions_give_each_virtual_channels_path_and_slot_phas
     # 50 m/s with some climb: the path through the shifted receiver equals the virtual channel's
     # exact two-way path plus 2 v_r t / PRF to within the far field's second-order term
     # |tx_t - tx_0|^2 / (2 R): 0.03 wavelengths for a 4-wavelength baseline at 300 m.
-    from skyradar.sim.image import terrain_channel_positions_m
-
     if layout == "three-tx":
         tx = [[0.0, 0.0, 0.0], [0.0, 2 * LAM, 0.0], [0.0, 4 * LAM, -0.5 * LAM]]
         config = RadarConfig.prototype_2022(tx_positions_m=tx, n_doppler=252)
@@ -257,7 +255,7 @@ def test_terrain_channel_positions_give_each_virtual_channels_path_and_slot_phas
     n = 500
     u = direction_from_angles(rng.uniform(-1.2, 1.2, n), rng.uniform(-1.0, 0.3, n))
     p = rng.uniform(300.0, 4900.0, n)[:, None] * u
-    q = terrain_channel_positions_m(config, w)
+    q = config.terrain_channel_positions_m(w)
     got = np.linalg.norm(p - config.transmitters_m[0], axis=1)[:, None] + np.linalg.norm(
         p[:, None, :] - q[None], axis=2
     )
@@ -291,6 +289,37 @@ def test_terrain_of_a_mimo_radar_fills_the_virtual_frame():
     assert (power[beyond].sum(axis=(1, 2)) > 0).all()
     per_channel_db = 10 * np.log10(power.sum(axis=(0, 1))).reshape(MIMO.n_tx, MIMO.n_rx)
     assert np.all(np.abs(per_channel_db[1] - per_channel_db[0]) < 0.2)
+
+
+def _cell_residual(frame: np.ndarray, config: RadarConfig, height_m: float, nulls: int) -> float:
+    """Median over the strongest half of the predicted clutter cells of the part of a cell's power
+    left after projecting out the ``nulls`` dominant eigenvectors of its predicted covariance."""
+    from skyradar.process.clutter import clutter_subspace
+
+    sub = clutter_subspace(config, np.array([50.0, 0.0, 0.0]), config.mount.rotation, height_m, n_azimuth=720)
+    power = np.sum(np.abs(frame) ** 2, axis=-1)
+    rr, dd = np.nonzero(sub.predicted & (power > np.median(power[sub.predicted])))
+    vectors, z = sub.cell_vectors(rr, dd)[:, :, :nulls], frame[rr, dd]
+    kept = np.sum(np.abs(np.einsum("nkm,nk->nm", vectors.conj(), z)) ** 2, axis=1)
+    return float(np.median(1.0 - kept / power[rr, dd]))
+
+
+def test_the_predicted_clutter_of_a_mimo_frame_holds_its_simulated_ground(monkeypatch):
+    # Flat ground 300 m below an antenna flying north at 50 m/s, noise off. Every static point of a
+    # frame sees the virtual channels from the same moved receivers, so the prediction over those
+    # positions (its Doppler folded into the 125-bin image) spans the simulated ground: two
+    # eigenvectors take all but 1e-3 of a cell's power, as with one transmitter. A model of the
+    # virtual positions without the slots' Doppler path misses most of it.
+    from skyradar.scene.terrain import Terrain
+    from skyradar.sim.image import ImageSimulator, PlatformState
+
+    terrain = Terrain.projected(np.zeros((400, 400)), 52.0, 4.0, 30.0, 30.0)
+    lat, lon = terrain.center_latlon
+    sim = ImageSimulator(MIMO, terrain, origin=(lat, lon, 300.0), noise=False)
+    frame = np.asarray(sim.frame(PlatformState(np.zeros(3), np.array([50.0, 0.0, 0.0]), np.zeros(3))))
+    assert _cell_residual(frame, MIMO, 300.0, nulls=2) < 1e-3
+    monkeypatch.setattr(RadarConfig, "terrain_channel_positions_m", lambda self, w: self.virtual_positions_m)
+    assert _cell_residual(frame, MIMO, 300.0, nulls=2) > 0.5
 
 
 def test_scenario_names_the_mimo_array():

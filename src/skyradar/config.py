@@ -393,6 +393,50 @@ class RadarConfig:
         v.setflags(write=False)
         return v
 
+    def terrain_channel_positions_m(self, ground_velocity_mps: ArrayLike) -> np.ndarray:
+        """Where each channel of a frame sees static terrain from, in the antenna frame, m (n_virtual, 3).
+
+        One transmitter: the receivers. Time-division MIMO: channel ``t * n_rx + r`` is transmitter
+        ``t`` with receiver ``r``, its two-way path ``|P - tx_t| + |P - rx_r|`` plus the slot's
+        Doppler path ``2 v_r t / PRF`` (transmitter ``t`` chirps ``t / PRF`` after transmitter 0,
+        and each transmitter's slow time starts at its first chirp). In the far field
+        ``|P - tx_t| = |P - tx_0| - u . (tx_t - tx_0)``, and a static point's radial velocity is
+        ``v_r = u . w`` for the terrain's velocity ``w`` relative to the antenna, so the path is
+        that of transmitter 0 with a receiver at ``rx_r + (tx_t - tx_0) - 2 w t / PRF``. Every
+        static point of a frame shares these positions (``w`` is one vector), so whatever takes
+        one transmitter and any receivers treats the virtual channels exactly to first order in
+        the antenna's size over the range: the simulator's terrain kernels, and the predicted
+        clutter covariance (:func:`skyradar.process.clutter.clutter_subspace`). Moving targets
+        have their own slot phase (:func:`skyradar.sim.targets.target_geometry`).
+
+        Parameters
+        ----------
+        ground_velocity_mps : array_like, shape (3,)
+            Velocity of static terrain relative to the antenna, in the antenna frame (minus the
+            antenna's own velocity), m/s.
+
+        Returns
+        -------
+        ndarray, shape (n_virtual, 3)
+
+        Examples
+        --------
+        >>> cfg = RadarConfig.prototype_2022(rx_positions_m="mimo-2x4")
+        >>> p = cfg.terrain_channel_positions_m([-50.0, 0.0, 0.0])
+        >>> p.shape, bool(np.allclose(p[:4], cfg.rx_positions_m))
+        ((8, 3), True)
+        >>> shift = p[4:] - cfg.rx_positions_m - (cfg.transmitters_m[1] - cfg.transmitters_m[0])
+        >>> np.round(shift[0] * 1e3, 2).tolist()  # 2 * 50 m/s / PRF along boresight, mm
+        [20.32, 0.0, 0.0]
+        """
+        if self.n_tx == 1:
+            return self.rx_positions_m
+        slot_s = np.arange(self.n_tx) / self.prf_hz
+        tx = self.transmitters_m
+        w = np.asarray(ground_velocity_mps, float)
+        offset = (tx - tx[0])[:, None, :] - 2.0 * slot_s[:, None, None] * w
+        return (offset + self.rx_positions_m[None]).reshape(-1, 3)
+
     def require_one_transmitter(self, what: str, instead: str) -> None:
         """InputError naming ``radar.tx_positions_m`` when ``what``, a one-transmitter model, gets several.
 

@@ -323,6 +323,12 @@ def clutter_subspace(
 ) -> ClutterSubspace:
     """Predicted clutter covariance eigen-decomposition of every range-Doppler cell.
 
+    The covariance is that of the frame's channels (:attr:`~skyradar.config.RadarConfig.frame_shape`):
+    for a time-division MIMO radar the virtual channels, which every static point of the frame sees
+    from the same moved receivers (:meth:`~skyradar.config.RadarConfig.terrain_channel_positions_m`),
+    its Doppler folded into the ``nV / n_tx``-bin image, so a cell adds the covariances of every
+    alias of its Doppler.
+
     Parameters
     ----------
     config : RadarConfig
@@ -360,11 +366,13 @@ def clutter_subspace(
     rot = np.ascontiguousarray(ant_to_ned, float)  # u_ant = rot^T u for each NED vector u
     v = np.ascontiguousarray(velocity_ned_mps, float)
     geometry = (config.range_doppler_coupling_s, config.range_resolution_m, config.doppler_resolution_mps)
-    u_ant, az, el, r_pos, d_pos, grazing = _ring_samples(
-        rng, phi, depth, v, rot, *geometry, float(config.n_doppler // 2)
-    )
+    n_r, n_d, n_k = config.frame_shape
+    u_ant, az, el, r_pos, d_pos, grazing = _ring_samples(rng, phi, depth, v, rot, *geometry, float(n_d // 2))
     weight = 10.0 ** (2.0 * config.antenna.gain_db(az, el) / 10.0) * grazing
-    rx, wavenumber = np.ascontiguousarray(config.rx_positions_m, float), 2.0 * np.pi / config.wavelength_m
-    n_r, n_d, n_k = config.n_range, config.n_doppler, config.n_rx
+    # Every static point sees the channels from the same places (the receivers; for a MIMO radar
+    # also moved by each transmitter's offset and its slot's Doppler path), and its Doppler folds
+    # into the frame's image: the aliases of one cell add their covariances.
+    rx = np.ascontiguousarray(config.terrain_channel_positions_m(-(rot.T @ v)), float)
+    wavenumber = 2.0 * np.pi / config.wavelength_m
     acc = _accumulate(r_pos, d_pos, u_ant, rx, wavenumber, weight, n_r, n_d, np.zeros((n_r, n_d, n_k * n_k)))
     return ClutterSubspace(acc, n_k, rot.T @ v, rot[2].copy(), float(height_agl_m))

@@ -43,7 +43,6 @@ __all__ = [
     "AntennaGeometry",
     "TerrainView",
     "ImageSimulator",
-    "terrain_channel_positions_m",
     "REFLECTIVITY_MODELS",
     "two_way_gain_table",
 ]
@@ -344,7 +343,7 @@ class ImageSimulator:
         p_ant = rotate_points(view.p_ned, rot, _array(scratch, "p_ant", view.p_ned.shape, np.float64))
         power_const = cfg.pe_w * cfg.wavelength_m**2 / (4 * np.pi) ** 3 * self.ground_gain
         v_ground = rot @ (-geom.velocity_ned_mps)
-        channels = terrain_channel_positions_m(cfg, v_ground)
+        channels = cfg.terrain_channel_positions_m(v_ground)
         if self._kernel_mode == 1 and sparse[0].shape[1] == 0:  # dense: threads own range bands
             banded_returns(
                 view.p_ned,
@@ -420,49 +419,6 @@ class ImageSimulator:
             return np.ones(len(targets), bool)
         rel = np.array([t.position_ned_m for t in targets], float).reshape(-1, 3) - geom.origin_ned_m
         return target_clear(self._horizon_grid, p_ned, geom.rot_ned_to_ant, rel)
-
-
-def terrain_channel_positions_m(config: RadarConfig, ground_velocity_mps: np.ndarray) -> np.ndarray:
-    """Where each channel of a frame sees static terrain from, in the antenna frame, m (n_virtual, 3).
-
-    One transmitter: the receivers. Time-division MIMO: channel ``t * n_rx + r`` is transmitter
-    ``t`` with receiver ``r``, its two-way path ``|P - tx_t| + |P - rx_r|`` plus the slot's Doppler
-    path ``2 v_r t / PRF`` (transmitter ``t`` chirps ``t / PRF`` after transmitter 0, and each
-    transmitter's slow time starts at its first chirp). In the far field
-    ``|P - tx_t| = |P - tx_0| - u . (tx_t - tx_0)``, and a static point's radial velocity is
-    ``v_r = u . w`` for the terrain's velocity ``w`` relative to the antenna, so the path is that of
-    transmitter 0 with a receiver at ``rx_r + (tx_t - tx_0) - 2 w t / PRF``: the terrain kernels,
-    which take one transmitter and any receivers, simulate the virtual channels exactly to first
-    order in the antenna's size over the range (moving targets get their own slot phase,
-    :func:`skyradar.sim.targets.target_geometry`).
-
-    Parameters
-    ----------
-    config : RadarConfig
-    ground_velocity_mps : ndarray, shape (3,)
-        Velocity of static terrain relative to the antenna, in the antenna frame (minus the
-        antenna's own velocity), m/s.
-
-    Returns
-    -------
-    ndarray, shape (n_virtual, 3)
-
-    Examples
-    --------
-    >>> cfg = RadarConfig.prototype_2022(rx_positions_m="mimo-2x4")
-    >>> p = terrain_channel_positions_m(cfg, np.array([-50.0, 0.0, 0.0]))
-    >>> p.shape, bool(np.allclose(p[:4], cfg.rx_positions_m))
-    ((8, 3), True)
-    >>> shift = p[4:] - cfg.rx_positions_m - (cfg.transmitters_m[1] - cfg.transmitters_m[0])
-    >>> np.round(shift[0] * 1e3, 2).tolist()  # 2 * 50 m/s / PRF along boresight, mm
-    [20.32, 0.0, 0.0]
-    """
-    if config.n_tx == 1:
-        return config.rx_positions_m
-    slot_s = np.arange(config.n_tx) / config.prf_hz
-    tx = config.transmitters_m
-    offset = (tx - tx[0])[:, None, :] - 2.0 * slot_s[:, None, None] * np.asarray(ground_velocity_mps, float)
-    return (offset + config.rx_positions_m[None]).reshape(-1, 3)
 
 
 def _array(scratch: dict | None, name: str, shape: tuple[int, ...], dtype) -> np.ndarray:

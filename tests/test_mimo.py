@@ -557,3 +557,81 @@ def test_a_mimo_run_is_processed_without_suppression_and_refused_with_it(tmp_pat
     )
     assert_one_line_error(result, "radar.tx_positions_m", "clutter suppression", "got 2")
     assert not (tmp_path / "e.parquet").exists()
+
+
+def test_the_runner_up_residue_is_the_mirror_direction_along_the_transmitters():
+    # A target 50 deg right and 30 deg up, not moving: both residues fit inside the antenna's field
+    # of view's reach (its down direction cosine is more than 1 - sin 49.5 deg from zero), and the
+    # runner-up's pixels read the direction whose down cosine differs by lambda / (2 d) = 1.
+    u = direction_from_angles(np.radians(50.0), np.radians(30.0))
+    z = steering_vector(u, MIMO)
+    out = mimo.virtual_pixels(z[None], MIMO.doppler_bin(0.0), MIMO)
+    chosen = estimate_directions(out.pixels, MIMO, calibrated=True)[0]
+    other = estimate_directions(out.other_pixels, MIMO, calibrated=True)[0]
+    assert {int(out.residue[0]), int(out.other_residue[0])} == {0, 1}
+    assert out.peak_ratio[0] < 1.2  # the field of view barely tells them apart
+    truth, mirror = (chosen, other) if out.residue[0] == 0 else (other, chosen)
+    np.testing.assert_allclose(truth, u, atol=1e-6)
+    assert mirror[1] == pytest.approx(u[1], abs=1e-6) and mirror[2] - u[2] == pytest.approx(1.0, abs=1e-6)
+
+
+def _overtaken_above(flip_from_s: float, with_other: bool):
+    """Detections of an aircraft overtaken 230 m above and 300 m right (radial velocity about
+    -10 m/s, unaliased through mimo-2x4's 39.15 m/s image) by an own-ship flying north at 50 m/s,
+    level; from ``flip_from_s`` every frame chose the wrong residue: its position is the mirror
+    (down direction cosine + 1) and the truth is the runner-up's."""
+    import pandas as pd
+
+    rng = np.random.default_rng(21)
+    t = np.arange(0.0, 8.0, 1.0 / 9.4)
+    own = np.column_stack([50.0 * t, 0 * t, 0 * t])
+    rel = np.column_stack([500.0 - 15.0 * t, 300.0 + 0 * t, -230.0 + 0 * t])
+    r = np.linalg.norm(rel, axis=1)
+    v = np.sum(rel * [-15.0, 0.0, 0.0], axis=1) / r
+    u = rel / r[:, None]
+    mirror = np.column_stack([np.zeros_like(r), u[:, 1], u[:, 2] + 1.0])
+    mirror[:, 0] = np.sqrt(1.0 - mirror[:, 1] ** 2 - mirror[:, 2] ** 2)
+    flipped = t >= flip_from_s
+    seen = np.where(flipped[:, None], mirror, u) * r[:, None] + own + rng.normal(0.0, 3.0, (t.size, 3))
+    other = np.where(flipped[:, None], u, mirror) * r[:, None] + own
+    det = pd.DataFrame(
+        {
+            "time_s": t,
+            "range_m": r + MIMO.range_doppler_coupling_s * v + rng.normal(0.0, 2.0, t.size),
+            "radial_velocity_mps": v + rng.normal(0.0, 0.05, t.size),
+            "snr_db": 25.0,
+            "north_m": seen[:, 0],
+            "east_m": seen[:, 1],
+            "down_m": seen[:, 2],
+        }
+    )
+    if with_other:
+        det = det.assign(
+            residue=flipped.astype(int),
+            other_residue=(~flipped).astype(int),
+            other_north_m=other[:, 0],
+            other_east_m=other[:, 1],
+            other_down_m=other[:, 2],
+        )
+    ownship = pd.DataFrame(
+        {"time_s": t, "own_north_m": own[:, 0], "own_east_m": 0 * t, "own_down_m": 0 * t}
+        | {"own_vn_mps": 50.0 + 0 * t, "own_ve_mps": 0 * t, "own_vd_mps": 0 * t}
+    )
+    return det, ownship, t
+
+
+def test_a_tracks_range_rate_chooses_each_detections_residue():
+    # Where the field of view cannot choose the residue, the frames read the aircraft 230 m above
+    # as the mirror below. Once the track's range rate has resolved its radial velocity, the
+    # residue it implies, round((v - v_hat) / 2 VLim) mod n_tx, picks each detection's position:
+    # the track's height stays the aircraft's. Without the runner-up's position it is pulled down.
+    from skyradar.track.track_table import track_detections
+
+    heights = {}
+    for with_other in (True, False):
+        det, ownship, t = _overtaken_above(2.0, with_other)
+        tracks = track_detections(det, "radar", MIMO, frame_times_s=t, ownship=ownship, ground_test=False)
+        last = tracks[tracks["confirmed"] & (tracks["time_s"] > 6.0)]
+        heights[with_other] = -last["down_m"].to_numpy()
+    assert np.all(np.abs(heights[True] - 230.0) < 30.0)
+    assert np.median(np.abs(heights[False] - 230.0)) > 60.0

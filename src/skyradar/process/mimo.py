@@ -29,7 +29,11 @@ baseline: a wrong residue's best direction sits on the cone's edge, inside the b
 rows, so for ``mimo-2x4`` the winning peak beats the other by 1.5-18 % (``peak_ratio``
 1.015-1.18 at 5-10 deg above or below the horizontal, azimuth within 20 deg); noise of comparable
 size, a low SNR or a direction near the cone's edge makes the choice unreliable, and a ratio within
-0.5 % of 1 means both residues fit. The track's range rate over several frames is then the other witness.
+0.5 % of 1 means both residues fit. The track's range rate over several frames is then the other
+witness: the runner-up residue's pixels are kept (``VirtualPixels.other_pixels``), the detections
+table carries the position their direction gives (``other_*_m``), and the 3-D tracker takes it
+where the track's de-aliased radial velocity ``v`` says that residue,
+``round((v - v_hat) / 2 VLim) mod n_tx`` (:class:`skyradar.track.doa_feed.Measure3D`).
 """
 
 from __future__ import annotations
@@ -224,6 +228,11 @@ class VirtualPixels:
     peak_ratio : ndarray, shape (n,)
         Beamformer peak of the chosen residue over the best other one (>= 1; inf for one
         transmitter): how clearly the field of view tells the residues apart.
+    other_pixels : ndarray, shape (n, n_virtual), complex
+        The pixels of that best other residue (the chosen ones again for one transmitter): where
+        both fit, a track's range rate tells which was right.
+    other_residue : ndarray, shape (n,), int
+        Its residue (-1 for one transmitter).
 
     Examples
     --------
@@ -245,6 +254,8 @@ class VirtualPixels:
     residue: np.ndarray
     radial_velocity_mps: np.ndarray
     peak_ratio: np.ndarray
+    other_pixels: np.ndarray
+    other_residue: np.ndarray
 
 
 @lru_cache(maxsize=8)
@@ -307,19 +318,20 @@ def virtual_pixels(
     z = z * np.conj(slot_phase(v_hat, config))
     n_tx = config.n_tx
     if n_tx == 1:
-        inf = np.full(z.shape[0], np.inf)
-        return VirtualPixels(z, np.zeros(z.shape[0], int), v_hat, inf)
+        n = z.shape[0]
+        return VirtualPixels(z, np.zeros(n, int), v_hat, np.full(n, np.inf), z, np.full(n, -1))
     fx, fy, fz = (float(f) for f in np.asarray(facing, float) / np.linalg.norm(facing))
     match = _fov_match(config, (fx, fy, fz))
     slots = np.repeat(np.arange(n_tx), config.n_rx)
     residues = np.exp(-2j * np.pi * np.outer(np.arange(n_tx), slots) / n_tx)  # (n_tx, n_virtual)
     candidates = z[:, None, :] * residues[None]  # (n, n_tx, n_virtual)
     peak = np.abs(candidates @ match).max(axis=2) ** 2 if match.shape[1] else np.zeros(candidates.shape[:2])
+    rows = np.arange(z.shape[0])
     best = np.argmax(peak, axis=1)
-    ordered = np.sort(peak, axis=1)
+    other = np.argmax(np.where(np.arange(n_tx) == best[:, None], -np.inf, peak), axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = ordered[:, -1] / ordered[:, -2]
+        ratio = peak[rows, best] / peak[rows, other]
     span = 2.0 * n_tx * config.v_lim_mps  # the one-transmitter Doppler span, 4 * VLim_1 / 2
     v = v_hat + best * 2.0 * config.v_lim_mps
     v = (v + span / 2.0) % span - span / 2.0
-    return VirtualPixels(candidates[np.arange(z.shape[0]), best], best, v, ratio)
+    return VirtualPixels(candidates[rows, best], best, v, ratio, candidates[rows, other], other)

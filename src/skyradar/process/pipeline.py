@@ -99,6 +99,15 @@ DETECTION_TABLE_COLUMNS: dict[str, str] = {
     "spur": "-; True: the peak lies in the spur map (--spur-mode flag; masked spurs are not detected)",
     "secondary": "-; True: the peak passed only the secondary threshold of a nulled cell: it may update "
     "a track, never start one",
+    "residue": "-; time-division MIMO: the transmit-slot residue m mod n_tx the frame chose for the "
+    "peak (its true radial velocity is radial_velocity_mps + m 2 VLim, modulo n_tx 2 VLim); 0 with one "
+    "transmitter",
+    "other_residue": "-; time-division MIMO: the runner-up residue, where the field of view chose less "
+    "clearly (-1 with one transmitter)",
+    "other_north_m": "m; time-division MIMO: position north from the runner-up residue's direction; a "
+    "track whose range rate says that residue takes it (NaN with one transmitter or without navigation)",
+    "other_east_m": "m; time-division MIMO: position east from the runner-up residue's direction",
+    "other_down_m": "m; time-division MIMO: position down from the runner-up residue's direction",
     "radar": "-; name of the radar head that detected it (`radar` for a run of one head)",
 }
 # The columns of one head's frames (process_frames); `radar` is added when the heads' tables merge
@@ -153,7 +162,11 @@ def process_cube(
     dict of ndarray
         Equal-length arrays: the detection columns up to ``z_body_m`` (ranges and body positions in
         m, angles in rad, radial velocity in m/s, SNR in dB) plus ``spur``, ``u_ant`` (n, 3) unit
-        vectors and ``coherence`` (:func:`.direction_coherence`).
+        vectors, ``coherence`` (:func:`.direction_coherence`), ``residue`` and ``other_residue``
+        (a time-division MIMO radar's chosen and runner-up residue of the velocity ambiguity,
+        :func:`skyradar.process.mimo.virtual_pixels`; 0 and -1 with one transmitter) and
+        ``other_body_m`` (n, 3), the body position the runner-up's direction gives (NaN with one
+        transmitter), m.
 
     Examples
     --------
@@ -181,6 +194,7 @@ def process_cube(
     if spur_mode not in ("mask", "flag"):
         raise InputError(f"process: field 'spur_mode' must be 'mask' or 'flag', got {spur_mode!r}")
     exclude = spur_map.mask if spur_map is not None and spur_mode == "mask" else None
+    other = None  # a time-division MIMO radar's runner-up residue of each detection
     if clutter is not None:  # a ClutterSubspace: knowledge-aided suppression before detection
         det, u, coherence, elevation_measured = detect_suppressed(
             cube, config, clutter, exclude, method, pfa_secondary=pfa_secondary, **detect_kwargs
@@ -191,12 +205,20 @@ def process_cube(
         det = detect(power, config, method=method, exclude=exclude, **detect_kwargs)
         pixels = cube[det.range_index, det.doppler_index] / calibration
         if config.n_tx > 1:  # each transmitter slot's Doppler phase out, its ambiguity resolved
-            pixels = virtual_pixels(pixels, det.doppler_bin, config).pixels
+            other = virtual_pixels(pixels, det.doppler_bin, config)
+            pixels = other.pixels
         u = estimate_directions(pixels, config, calibrated=True)
         coherence = direction_coherence(pixels, u, config, calibrated=True)
         elevation_measured = np.ones(len(det), bool)
     range_m = det.range_m(config)
     body = antenna_to_body(range_m[:, None] * u, config)
+    n = len(det)
+    residue, other_residue = np.zeros(n, np.int64), np.full(n, -1, np.int64)
+    body_other = np.full((n, 3), np.nan)
+    if other is not None:  # the direction the runner-up residue gives, for a track's range rate to choose
+        u_other = estimate_directions(other.other_pixels, config, calibrated=True)
+        residue, other_residue = other.residue.astype(np.int64), other.other_residue.astype(np.int64)
+        body_other = antenna_to_body(range_m[:, None] * u_other, config)
     az, el = angles_from_direction(u)
     spur = (
         spur_map.contains(det.range_bin, det.doppler_bin)
@@ -220,6 +242,9 @@ def process_cube(
         "secondary": det.secondary,
         "u_ant": u,
         "coherence": coherence,
+        "residue": residue,
+        "other_residue": other_residue,
+        "other_body_m": body_other,
     }
 
 
@@ -252,10 +277,9 @@ def _to_world(
 ) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray, np.ndarray]:
     """NED position, geodetic position and NED unit direction of one frame's detections, and the
     antenna's right axis in NED (3,)."""
-    pos = _position(own, i)
     body_to_ned = _body_to_ned(own, i, origin)
     body = np.stack([out["x_body_m"], out["y_body_m"], out["z_body_m"]], axis=1)
-    ned = pos + body @ body_to_ned.T
+    ned = _body_to_world(body, own, i, origin)
     ant_to_ned = body_to_ned @ config.mount.rotation
     u_ned = out["u_ant"] @ ant_to_ned.T
     geodetic = _geodetic_fn(own, i, origin)
@@ -264,6 +288,11 @@ def _to_world(
     else:
         geo = (np.full(len(ned), np.nan), np.full(len(ned), np.nan), np.full(len(ned), np.nan))
     return ned, geo, u_ned, ant_to_ned[:, 1]
+
+
+def _body_to_world(body: np.ndarray, own: OwnShipStates, i: int, origin: tuple | None) -> np.ndarray:
+    """Body-frame positions (n, 3) of frame ``i`` in the scenario's NED frame, m."""
+    return _position(own, i) + body @ _body_to_ned(own, i, origin).T
 
 
 def _geodetic_fn(own: OwnShipStates, i: int, origin: tuple | None) -> GeodeticFn | None:
@@ -397,6 +426,9 @@ def _located(
     if own is not None:
         ned, geo, u_ned, right = _to_world(out, own, i, config, origin)
     out.update(north_m=ned[:, 0], east_m=ned[:, 1], down_m=ned[:, 2])
+    other = out.pop("other_body_m")
+    other_ned = np.full((n, 3), np.nan) if own is None else _body_to_world(other, own, i, origin)
+    out.update(other_north_m=other_ned[:, 0], other_east_m=other_ned[:, 1], other_down_m=other_ned[:, 2])
     for axis, component in zip(("north", "east", "down"), right, strict=True):
         out[f"right_axis_{axis}"] = np.full(n, component)
     out.update(lat_deg=np.asarray(geo[0]), lon_deg=np.asarray(geo[1]), alt_m=np.asarray(geo[2]))

@@ -5,6 +5,14 @@ the 3-D tracker's (:class:`~skyradar.track.tracker3d.Tracker3D`) update: the DoA
 from the apparent range ``R + c V_R`` to the true one, its covariance
 (:func:`~skyradar.track.measure3d.position_covariance`), the elevations it may trust
 (:mod:`skyradar.track.elevation_trust`) and the de-aliased radial velocity.
+
+A time-division MIMO radar's frame chooses each detection's residue of the velocity ambiguity by
+the antenna's field of view (:func:`skyradar.process.mimo.virtual_pixels`); far above or below the
+horizontal both residues fit and the frame may read the mirror direction. Once a track's range
+rate has resolved its radial velocity ``v``, the residue is ``round((v - v_hat) / 2 VLim) mod
+n_tx`` for the detection's aliased ``v_hat``: where that is the runner-up's, the detection's
+position is the runner-up's (``other_north_m``, ...), so a track's height follows the aircraft, not
+a mirror that flips with the frames.
 """
 
 from __future__ import annotations
@@ -29,6 +37,7 @@ from skyradar.units import wrap
 __all__ = ["Measure3D", "OWNSHIP_COLUMNS"]
 
 _NED = ("north_m", "east_m", "down_m")
+_OTHER = ("other_residue", "other_north_m", "other_east_m", "other_down_m")
 OWNSHIP_COLUMNS = REQUIRED_COLUMNS  # the own-ship rows the 3-D feed reads: time, NED position, velocity
 
 
@@ -52,6 +61,9 @@ class Measure3D:
         )
         self.motion, self.width = motion, motion.doppler_width_mps
         self.ned, self.z, self.sigma = np.empty((0, 3)), np.empty((0, 2)), np.empty(0)
+        # A time-division MIMO radar's detections carry the runner-up residue's position too.
+        self.n_tx = 1 if config is None else config.n_tx
+        self.other_residue, self.other_ned = np.empty(0, np.int64), np.empty((0, 3))
         self.measured, self.trusted = np.empty(0, bool), np.empty(0, bool)
         self.own, self.agl = None, np.full(len(grid), np.nan)
         self.votes, self.below, self.surface_down = AboveVotes(), BelowConsensus(), surface_down
@@ -74,6 +86,12 @@ class Measure3D:
         else:
             sigma = np.full(len(det), 0.04 if self.sigma_rad is None else float(self.sigma_rad))
         self.ned, self.z = np.concatenate([self.ned, ned]), np.concatenate([self.z, z])
+        other_residue, other_ned = np.full(len(det), -1, np.int64), np.full((len(det), 3), np.nan)
+        if all(c in det.columns for c in _OTHER):
+            other_residue = det["other_residue"].to_numpy(np.int64)
+            other_ned = det[list(_OTHER[1:])].to_numpy(float)
+        self.other_residue = np.concatenate([self.other_residue, other_residue])
+        self.other_ned = np.concatenate([self.other_ned, other_ned])
         self.sigma = np.concatenate([self.sigma, sigma])
         self.measured = np.concatenate([self.measured, elevation_measured_flags(det)])
         self.trusted = np.concatenate([self.trusted, np.zeros(len(det), bool)])
@@ -101,8 +119,13 @@ class Measure3D:
         v_meas = np.full(det.size, np.nan)
         v_meas[has] = self.z[idx, 1]
         # The detection's radial velocity moved to the track's (de-aliased) alias.
-        v_track = v_meas + self.width * np.round((state[:, 1] - v_meas) / self.width)
+        alias = np.round((state[:, 1] - v_meas) / self.width)
+        v_track = v_meas + self.width * alias
         v_unaliased = np.where(resolved, v_track, np.nan)
+        if self.n_tx > 1:  # the residue the track's range rate says, where the frame chose the other
+            take = np.zeros(det.size, bool)
+            take[has] = resolved[has] & (np.mod(alias[has], self.n_tx) == self.other_residue[idx])
+            pos[take] = self.other_ned[det[take] + a]
         sigma = np.full(det.size, 0.04)
         sigma[has] = self.sigma[idx]
         c, sr = self.motion.coupling_s, self.motion.sigma_range_m

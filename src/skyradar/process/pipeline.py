@@ -194,7 +194,7 @@ def process_cube(
     if spur_mode not in ("mask", "flag"):
         raise InputError(f"process: field 'spur_mode' must be 'mask' or 'flag', got {spur_mode!r}")
     exclude = spur_map.mask if spur_map is not None and spur_mode == "mask" else None
-    other = None  # a time-division MIMO radar's runner-up residue of each detection
+    virtual = None  # a time-division MIMO radar's pixels, residues chosen (and runners-up)
     if clutter is not None:  # a ClutterSubspace: knowledge-aided suppression before detection
         det, u, coherence, elevation_measured = detect_suppressed(
             cube, config, clutter, exclude, method, pfa_secondary=pfa_secondary, **detect_kwargs
@@ -205,8 +205,8 @@ def process_cube(
         det = detect(power, config, method=method, exclude=exclude, **detect_kwargs)
         pixels = cube[det.range_index, det.doppler_index] / calibration
         if config.n_tx > 1:  # each transmitter slot's Doppler phase out, its ambiguity resolved
-            other = virtual_pixels(pixels, det.doppler_bin, config)
-            pixels = other.pixels
+            virtual = virtual_pixels(pixels, det.doppler_bin, config)
+            pixels = virtual.pixels
         u = estimate_directions(pixels, config, calibrated=True)
         coherence = direction_coherence(pixels, u, config, calibrated=True)
         elevation_measured = np.ones(len(det), bool)
@@ -215,9 +215,9 @@ def process_cube(
     n = len(det)
     residue, other_residue = np.zeros(n, np.int64), np.full(n, -1, np.int64)
     body_other = np.full((n, 3), np.nan)
-    if other is not None:  # the direction the runner-up residue gives, for a track's range rate to choose
-        u_other = estimate_directions(other.other_pixels, config, calibrated=True)
-        residue, other_residue = other.residue.astype(np.int64), other.other_residue.astype(np.int64)
+    if virtual is not None:  # the direction the runner-up residue gives, for a track's range rate to choose
+        u_other = estimate_directions(virtual.other_pixels, config, calibrated=True)
+        residue, other_residue = virtual.residue.astype(np.int64), virtual.other_residue.astype(np.int64)
         body_other = antenna_to_body(range_m[:, None] * u_other, config)
     az, el = angles_from_direction(u)
     spur = (

@@ -241,6 +241,9 @@ def test_directory_as_table_and_sweep_suffix(tmp_path):
         ("right_axis_east", 1e308, ["'right_axis_east'", "row 2"]),
         ("north_m", "abc", ["'north_m'", "not a finite number", "row 2", "'abc'"]),
         ("down_m", 1e308, ["'down_m'", "row 2", "not a radar measurement"]),
+        ("other_north_m", "abc", ["'other_north_m'", "not a finite number", "row 2", "'abc'"]),
+        ("other_residue", 7, ["'other_residue'", "is 7 at row 2", "whole number"]),
+        ("other_residue", "abc", ["'other_residue'", "not a finite number", "row 2"]),
     ],
 )
 def test_track_refuses_directions_that_are_not_directions(tmp_path, column, value, needles):
@@ -263,6 +266,10 @@ def test_track_refuses_directions_that_are_not_directions(tmp_path, column, valu
             "north_m": 1000.0 - 40.0 * t,
             "east_m": 100.0,
             "down_m": 0.0,
+            "other_residue": -1,
+            "other_north_m": np.nan,
+            "other_east_m": np.nan,
+            "other_down_m": np.nan,
         }
     ).astype({column: object})
     detections.loc[2, column] = value

@@ -183,7 +183,7 @@ def test_a_mimo_array_runs_the_encounter_experiment_in_clear_sky_through_the_cli
     # -> track -> alert -> score, the run's settings saying so.
     result = skyradar(
         "experiment", "encounters", "--rx-layout", "mimo-2x4", "--n", "2", "--layout", "single",
-        "--workers", "1", "--output", "enc", "--json", cwd=tmp_path,
+        "--frame-rate-hz", "4.7", "--workers", "1", "--output", "enc", "--json", cwd=tmp_path,
     )  # fmt: skip
     assert result.returncode == 0, result.stderr
     summary = json.loads(result.stdout.strip().splitlines()[-1])

@@ -12,6 +12,7 @@ from skyradar.errors import InputError
 from skyradar.io.checks import MAX_TIME_S, check_frame_times
 from skyradar.io.frames_model import frame_times_s
 from skyradar.io.tables import check_within, finite_column, read_table
+from skyradar.rx_layouts import MAX_TX
 
 __all__ = [
     "REQUIRED_DETECTION_COLUMNS",
@@ -32,6 +33,9 @@ _DETECTION_LIMITS = {
     "north_m": (1.0e7, "m"),
     "east_m": (1.0e7, "m"),
     "down_m": (1.0e7, "m"),
+    "other_north_m": (1.0e7, "m"),
+    "other_east_m": (1.0e7, "m"),
+    "other_down_m": (1.0e7, "m"),
 }
 _OWNSHIP_LIMITS = {"m": (1.0e7, "m"), "mps": (1.0e4, "m/s")}  # by the unit ending the column's name
 # Directions a detection may hold, each within its bound or NaN (not known): angles in radians, and
@@ -74,6 +78,16 @@ def validate_detections(df: pd.DataFrame, source: str = "detections") -> pd.Data
             values = finite_column(df, col, source, allow_nan=True)
             check_within(values, limit, unit, source, col, meaning)
             df = df.assign(**{col: values})
+    if "other_residue" in df.columns:  # a MIMO radar's runner-up residue: -1 or NaN (none) to MAX_TX - 1
+        residue = np.nan_to_num(finite_column(df, "other_residue", source, allow_nan=True), nan=-1.0)
+        bad = np.flatnonzero((residue != np.round(residue)) | (residue < -1) | (residue > MAX_TX - 1))
+        if bad.size:
+            i = int(bad[0])
+            raise InputError(
+                f"{source}: field 'other_residue' is {residue[i]:g} at row {i}: a residue is a whole "
+                f"number from 0 to {MAX_TX - 1} (-1: none)"
+            )
+        df = df.assign(other_residue=residue.astype(np.int64))
     t = df["time_s"].to_numpy(float)
     back = np.flatnonzero(t[1:] < t[:-1])
     if back.size:

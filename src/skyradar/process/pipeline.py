@@ -274,12 +274,14 @@ def _body_to_ned(own: OwnShipStates, i: int, origin: tuple | None) -> np.ndarray
 
 def _to_world(
     out: dict[str, np.ndarray], own: OwnShipStates, i: int, config: RadarConfig, origin: tuple | None
-) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray, np.ndarray]:
-    """NED position, geodetic position and NED unit direction of one frame's detections, and the
-    antenna's right axis in NED (3,)."""
-    body_to_ned = _body_to_ned(own, i, origin)
+) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray, np.ndarray, np.ndarray]:
+    """NED position, geodetic position and NED unit direction of one frame's detections, the
+    antenna's right axis in NED (3,), and the NED position of ``other_body_m`` (the runner-up
+    residue's, NaN with one transmitter)."""
+    pos, body_to_ned = _position(own, i), _body_to_ned(own, i, origin)
     body = np.stack([out["x_body_m"], out["y_body_m"], out["z_body_m"]], axis=1)
-    ned = _body_to_world(body, own, i, origin)
+    ned = pos + body @ body_to_ned.T
+    other_ned = pos + out["other_body_m"] @ body_to_ned.T
     ant_to_ned = body_to_ned @ config.mount.rotation
     u_ned = out["u_ant"] @ ant_to_ned.T
     geodetic = _geodetic_fn(own, i, origin)
@@ -287,12 +289,7 @@ def _to_world(
         geo = geodetic(ned)
     else:
         geo = (np.full(len(ned), np.nan), np.full(len(ned), np.nan), np.full(len(ned), np.nan))
-    return ned, geo, u_ned, ant_to_ned[:, 1]
-
-
-def _body_to_world(body: np.ndarray, own: OwnShipStates, i: int, origin: tuple | None) -> np.ndarray:
-    """Body-frame positions (n, 3) of frame ``i`` in the scenario's NED frame, m."""
-    return _position(own, i) + body @ _body_to_ned(own, i, origin).T
+    return ned, geo, u_ned, ant_to_ned[:, 1], other_ned
 
 
 def _geodetic_fn(own: OwnShipStates, i: int, origin: tuple | None) -> GeodeticFn | None:
@@ -423,11 +420,11 @@ def _located(
     out["frame"] = np.full(n, i, np.int64)
     nan = np.full(n, np.nan)
     ned, geo, u_ned, right = (np.full((n, 3), np.nan), (nan, nan, nan), None, np.full(3, np.nan))
+    other_ned = np.full((n, 3), np.nan)
     if own is not None:
-        ned, geo, u_ned, right = _to_world(out, own, i, config, origin)
+        ned, geo, u_ned, right, other_ned = _to_world(out, own, i, config, origin)
+    del out["other_body_m"]
     out.update(north_m=ned[:, 0], east_m=ned[:, 1], down_m=ned[:, 2])
-    other = out.pop("other_body_m")
-    other_ned = np.full((n, 3), np.nan) if own is None else _body_to_world(other, own, i, origin)
     out.update(other_north_m=other_ned[:, 0], other_east_m=other_ned[:, 1], other_down_m=other_ned[:, 2])
     for axis, component in zip(("north", "east", "down"), right, strict=True):
         out[f"right_axis_{axis}"] = np.full(n, component)

@@ -68,6 +68,7 @@ __all__ = [
     "estimate_directions",
     "direction_coherence",
     "doa_crlb",
+    "direction_covariance",
     "field_of_view_rad",
     "FIELD_OF_VIEW_LOSS_DB",
     "antenna_to_body",
@@ -533,6 +534,65 @@ def direction_coherence(
     return num / den
 
 
+def direction_covariance(
+    snr_db: np.ndarray | float,
+    azimuth_rad: np.ndarray | float,
+    elevation_rad: np.ndarray | float,
+    config: RadarConfig,
+) -> np.ndarray:
+    """Cramer-Rao bound on the error of a direction across the line of sight, rad^2, shape (..., 2, 2).
+
+    The inverse Fisher information (module docstring) of the direction's angular displacement along
+    its two tangent axes in the antenna frame: rightward (increasing azimuth, ``cos(el) d az``) and
+    upward (increasing elevation). A position at range ``R`` is off across the line of sight by
+    ``R`` times that displacement, so ``R^2`` times this matrix is its covariance there, with the
+    correlation of the two axes that an array's geometry gives off boresight. An array wider than
+    it is tall measures the first axis better than the second (``ura-2x4``: 2.2 times at boresight).
+
+    Parameters
+    ----------
+    snr_db : array_like
+        Per-channel, per-pixel SNR ``A^2 / sigma^2`` of the pixel the direction is taken from, dB.
+    azimuth_rad, elevation_rad : array_like
+        True direction in the antenna frame.
+    config : RadarConfig
+        Antenna positions (the virtual array for MIMO) and wavelength.
+
+    Returns
+    -------
+    ndarray, shape (..., 2, 2)
+        Covariance of the (rightward, upward) angular displacement, rad^2; NaN where the array
+        does not measure both (one channel, or a line of channels).
+
+    Examples
+    --------
+    The square's two axes are alike at boresight; a row of four over two is not.
+
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> C = direction_covariance(20.0, 0.0, 0.0, cfg)
+    >>> bool(np.isclose(C[0, 0], C[1, 1])), float(C[0, 1])
+    (True, 0.0)
+    >>> C = direction_covariance(20.0, 0.0, 0.0, RadarConfig.prototype_2022(rx_positions_m="ura-2x4"))
+    >>> round(float(np.sqrt(C[1, 1] / C[0, 0])), 2)
+    2.24
+    """
+    snr = 10.0 ** (np.asarray(snr_db, float) / 10.0)
+    az, el = np.broadcast_arrays(np.asarray(azimuth_rad, float), np.asarray(elevation_rad, float))
+    k = 2.0 * np.pi / config.wavelength_m
+    positions = channel_positions_m(config)
+    q = positions - positions.mean(axis=0)
+    right = np.stack([-np.sin(az), np.cos(az), np.zeros_like(az)], axis=-1)  # du/daz / cos(el)
+    up = np.stack([-np.sin(el) * np.cos(az), -np.sin(el) * np.sin(az), -np.cos(el)], axis=-1)  # du/del
+    g = -k * np.stack([right @ q.T, up @ q.T], axis=-1)  # (..., n, 2), centred by q
+    info = np.einsum("...ki,...kj->...ij", g, g) * (2.0 * snr)[..., None, None]
+    det = info[..., 0, 0] * info[..., 1, 1] - info[..., 0, 1] ** 2
+    cov = np.stack([info[..., 1, 1], -info[..., 0, 1], -info[..., 1, 0], info[..., 0, 0]], axis=-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cov = cov / det[..., None]
+    cov[~(det > 0.0)] = np.nan
+    return cov.reshape(*det.shape, 2, 2)
+
+
 def doa_crlb(
     snr_db: np.ndarray | float,
     azimuth_rad: np.ndarray | float,
@@ -553,7 +613,8 @@ def doa_crlb(
     Returns
     -------
     (sd_az_rad, sd_el_rad) : tuple of ndarray
-        Square roots of the diagonal of the inverse Fisher information (module docstring).
+        Square roots of the diagonal of the inverse Fisher information (module docstring); the
+        azimuth's is that of :func:`direction_covariance`'s rightward axis over ``cos(el)``.
 
     Examples
     --------
@@ -562,20 +623,10 @@ def doa_crlb(
     >>> round(float(np.degrees(sd_az)), 3) == round(float(np.degrees(sd_el)), 3)  # square array
     True
     """
-    snr = 10.0 ** (np.asarray(snr_db, float) / 10.0)
-    az, el = np.broadcast_arrays(np.asarray(azimuth_rad, float), np.asarray(elevation_rad, float))
-    k = 2.0 * np.pi / config.wavelength_m
-    positions = channel_positions_m(config)
-    q = positions - positions.mean(axis=0)
-    du_daz = np.stack([-np.cos(el) * np.sin(az), np.cos(el) * np.cos(az), np.zeros_like(az)], axis=-1)
-    du_del = np.stack([-np.sin(el) * np.cos(az), -np.sin(el) * np.sin(az), -np.cos(el)], axis=-1)
-    g = -k * np.stack([du_daz @ q.T, du_del @ q.T], axis=-1)  # (..., n_rx, 2), centred by q
-    info = np.einsum("...ki,...kj->...ij", g, g)
-    det = info[..., 0, 0] * info[..., 1, 1] - info[..., 0, 1] ** 2
+    cov = direction_covariance(snr_db, azimuth_rad, elevation_rad, config)
+    el = np.broadcast_to(np.asarray(elevation_rad, float), cov.shape[:-2])
     with np.errstate(divide="ignore", invalid="ignore"):
-        var_az = info[..., 1, 1] / det / (2.0 * snr)
-        var_el = info[..., 0, 0] / det / (2.0 * snr)
-    return np.sqrt(var_az), np.sqrt(var_el)
+        return np.sqrt(cov[..., 0, 0]) / np.cos(el), np.sqrt(cov[..., 1, 1])
 
 
 def antenna_to_body(points_m: np.ndarray, config: RadarConfig) -> np.ndarray:

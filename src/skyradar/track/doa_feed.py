@@ -30,7 +30,7 @@ from skyradar.track.elevation_trust import (
 )
 from skyradar.track.ground_doa import elevation_measured_flags
 from skyradar.track.io import validate_ownship
-from skyradar.track.measure3d import angle_sigma_rad, position_covariance
+from skyradar.track.measure3d import angle_covariance_rad2, angle_sigma_rad, position_covariance
 from skyradar.track.tracker3d import RadialObservation, Tracker3D
 from skyradar.units import wrap
 
@@ -38,6 +38,7 @@ __all__ = ["Measure3D", "OWNSHIP_COLUMNS"]
 
 _NED = ("north_m", "east_m", "down_m")
 _OTHER = ("other_residue", "other_north_m", "other_east_m", "other_down_m")
+_RIGHT = ("right_axis_north", "right_axis_east", "right_axis_down")
 OWNSHIP_COLUMNS = REQUIRED_COLUMNS  # the own-ship rows the 3-D feed reads: time, NED position, velocity
 
 
@@ -61,6 +62,8 @@ class Measure3D:
         )
         self.motion, self.width = motion, motion.doppler_width_mps
         self.ned, self.z, self.sigma = np.empty((0, 3)), np.empty((0, 2)), np.empty(0)
+        # Each detection's angle error on the array's axes and the array's right axis in NED.
+        self.angle_cov, self.right = np.empty((0, 2, 2)), np.empty((0, 3))
         # A time-division MIMO radar's detections carry the runner-up residue's position too.
         self.n_tx = 1 if config is None else config.n_tx
         self.other_residue, self.other_ned = np.empty(0, np.int64), np.empty((0, 3))
@@ -80,11 +83,20 @@ class Measure3D:
         z = det[["range_m", "radial_velocity_mps"]].to_numpy(float)
         if self.sigma_rad is None and "snr_db" in det.columns:
             azimuth, elevation = (
-                det[c].to_numpy(float) if c in det.columns else None for c in ("azimuth_rad", "elevation_rad")
+                det[c].to_numpy(float) if c in det.columns else np.zeros(len(det))
+                for c in ("azimuth_rad", "elevation_rad")
             )
-            sigma = angle_sigma_rad(det["snr_db"].to_numpy(float), self.config, azimuth, elevation)
+            snr_db = det["snr_db"].to_numpy(float)
+            sigma = angle_sigma_rad(snr_db, self.config, azimuth, elevation)
+            angle_cov = angle_covariance_rad2(snr_db, self.config, azimuth, elevation)
         else:
             sigma = np.full(len(det), 0.04 if self.sigma_rad is None else float(self.sigma_rad))
+            angle_cov = sigma[:, None, None] ** 2 * np.eye(2)
+        right = np.full((len(det), 3), np.nan)
+        if all(c in det.columns for c in _RIGHT):
+            right = det[list(_RIGHT)].to_numpy(float)
+        self.angle_cov = np.concatenate([self.angle_cov, angle_cov])
+        self.right = np.concatenate([self.right, right])
         self.ned, self.z = np.concatenate([self.ned, ned]), np.concatenate([self.z, z])
         other_residue, other_ned = np.full(len(det), -1, np.int64), np.full((len(det), 3), np.nan)
         if all(c in det.columns for c in _OTHER):
@@ -170,8 +182,17 @@ class Measure3D:
         self._restart_heights(out.alive_ids, self.own[k], track_up, spread)
         cov = np.full((det.size, 3, 3), np.nan)
         use = has & np.isfinite(sigma)
+        # The angle error on the array's axes (a wide array's elevation is its worse axis), the
+        # elevation loosened where the placement rules loosened it.
+        loosened = np.where(el_sigma != sigma, el_sigma, np.nan)
+        rows = det[use] + a
         cov[use] = position_covariance(
-            pos[use], own_p, sigma[use], np.maximum(range_sigma, across)[use], el_sigma[use]
+            pos[use],
+            own_p,
+            self.angle_cov[rows],
+            np.maximum(range_sigma, across)[use],
+            loosened[use],
+            self.right[rows],
         )
         radial = RadialObservation(own_p, own_v, v_unaliased, self.motion.sigma_velocity_mps)
         return self.t3.step(float(out.time_s), out.alive_ids, pos, cov, radial)

@@ -154,11 +154,6 @@ def test_huge_worker_count_is_refused_before_any_process_starts(tiny_run, comman
         (["experiment", "ch5", "--duration", "1e308"], ["--duration", "1e+308"]),
         (["experiment", "encounters", "--n", str(10**20)], ["--n", str(10**20)]),
         (["experiment", "encounters", "--rx-layout", "ring"], ["--rx-layout", "'ring'"]),
-        # A MIMO frame's ground cells hold several aliases with their own slot phases: no suppression.
-        (
-            ["experiment", "encounters", "--rx-layout", "mimo-2x4", "--terrain", "none,flat-300"],
-            ["--rx-layout mimo-2x4", "clear sky", "none,flat-300"],
-        ),
     ],
 )
 def test_experiment_sizes_are_bounded_before_the_output_folder(tmp_path, args, needles):

@@ -179,15 +179,15 @@ def test_a_mimo_scenario_simulates_virtual_channel_frames_through_the_cli(tmp_pa
 
 
 def test_a_mimo_array_runs_the_encounter_experiment_in_clear_sky_through_the_cli(tmp_path):
-    # Simulate -> process (no suppression: nothing to suppress, and the nulls model one transmitter)
-    # -> track -> alert -> score, the run's settings saying so.
+    # Simulate -> process -> track -> alert -> score; in clear sky the frames have no height above
+    # ground, so "auto" suppression leaves them as they are.
     result = skyradar(
         "experiment", "encounters", "--rx-layout", "mimo-2x4", "--n", "2", "--layout", "single",
         "--frame-rate-hz", "4.7", "--workers", "1", "--output", "enc", "--json", cwd=tmp_path,
     )  # fmt: skip
     assert result.returncode == 0, result.stderr
     summary = json.loads(result.stdout.strip().splitlines()[-1])
-    assert (summary["rx_layout"], summary["suppression"], summary["encounters"]) == ("mimo-2x4", "none", 2)
+    assert (summary["rx_layout"], summary["suppression"], summary["encounters"]) == ("mimo-2x4", "auto", 2)
     assert summary["terrains"] == ["none"]
 
 
@@ -513,12 +513,12 @@ def test_doa_takes_virtual_channels_and_refuses_receiver_counts():
         estimate_directions(np.ones((1, 4), complex), MIMO)
 
 
-def test_a_mimo_run_is_processed_without_suppression_and_refused_with_it(tmp_path):
+def test_a_mimo_run_is_processed_without_suppression(tmp_path):
     # A head-on intruder closing at 55 m/s in clear sky: its Doppler aliases once past the 19.6 m/s
     # limit of two transmitters, so the residue must be resolved too; left in, the phase step
     # between its slots would read 36 deg off in elevation. Simulate, then process without clutter
     # suppression: each frame's strongest detection has the intruder's direction within four times
-    # its bound. With suppression: one line.
+    # its bound.
     import xarray as xr
     import yaml
 
@@ -551,12 +551,6 @@ def test_a_mimo_run_is_processed_without_suppression_and_refused_with_it(tmp_pat
     np.testing.assert_allclose(
         best["radial_velocity_mps"].to_numpy(), aliased, atol=MIMO.doppler_resolution_mps
     )
-
-    result = skyradar(
-        "process", "r.zarr", "--output", "e.parquet", "--suppression", "knowledge-aided", cwd=tmp_path
-    )
-    assert_one_line_error(result, "radar.tx_positions_m", "clutter suppression", "got 2")
-    assert not (tmp_path / "e.parquet").exists()
 
 
 def test_the_runner_up_residue_is_the_mirror_direction_along_the_transmitters():

@@ -22,7 +22,6 @@ from skyradar.chain import confirmed_rows, label_tracks, run_chain
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG, AlertConfig
 from skyradar.daa.pipeline import alerts_from_tracks
 from skyradar.daa.run_tables import ownship_from_frames, truth_tracks
-from skyradar.errors import InputError
 from skyradar.experiments.encounter_score import frame_status, track_counts, unwarned_cause
 from skyradar.experiments.encounter_set import (
     encounter_scenario,
@@ -37,7 +36,6 @@ from skyradar.scene.scenario import Scenario
 __all__ = [
     "build_encounter",
     "chain_rows",
-    "encounter_suppression",
     "run_encounter",
     "score_layout",
     "truth_warning_time",
@@ -317,30 +315,6 @@ def run_encounter(
     return chain_rows(built, truth["t"], truth["rel"], shared, layouts, cfg, opts)
 
 
-def encounter_suppression(built) -> str:
-    """The clutter suppression an encounter's frames get: :data:`SUPPRESSION`, except with a
-    time-division MIMO radar in clear sky, ``"none"``: its frames hold no ground, and the nulls'
-    steering models one transmitter. A MIMO radar over terrain is refused (InputError).
-
-    Examples
-    --------
-    >>> data = {"origin": {"lat_deg": 52.0, "lon_deg": 4.0}, "duration_s": 1, "frame_rate_hz": 2,
-    ...         "ownship": {"type": "straight", "speed_mps": 50, "start_ned_m": [0, 0, -500]}}
-    >>> encounter_suppression(Scenario.from_dict(data).build())
-    'auto'
-    >>> encounter_suppression(Scenario.from_dict(data | {"radar": {"rx_layout": "mimo-2x4"}}).build())
-    'none'
-    """
-    if all(head.config.n_tx == 1 for head in built.heads):
-        return SUPPRESSION
-    if built.terrain is not None:
-        raise InputError(
-            f"{built.name}: a time-division MIMO radar's encounters run in clear sky only: "
-            "clutter suppression models one transmitter"
-        )
-    return "none"
-
-
 def chain_rows(
     built,
     t: np.ndarray,
@@ -356,8 +330,7 @@ def chain_rows(
     from skyradar.chain import track_and_alert
 
     opts = opts | {"alert_config": cfg}
-    suppression = encounter_suppression(built)
-    chain = run_chain(built, cfg, with_advice=False, process_options={"suppression": suppression})
+    chain = run_chain(built, cfg, with_advice=False, process_options={"suppression": SUPPRESSION})
     shared = shared | {
         f"{k}_s": float(v) for k, v in chain["timings_s"].items() if k in ("simulate", "process")
     }

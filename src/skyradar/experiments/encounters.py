@@ -35,13 +35,12 @@ from skyradar.experiments.encounter_set import make_encounters, make_fast_closur
 from skyradar.experiments.encounter_terrain import TERRAINS
 from skyradar.io.tables import write_json_atomic, write_table
 from skyradar.parallel import check_workers, close, connect
-from skyradar.rx_layouts import MIMO_LAYOUTS, check_rx_layout
+from skyradar.rx_layouts import check_rx_layout
 
 __all__ = [
     "run_encounter",
     "run_encounters",
     "run",
-    "check_encounter_array",
     "MAX_ENCOUNTERS",
     "DEFAULT_ENCOUNTERS",
     "DEFAULT_TERRAIN_ENCOUNTERS",
@@ -221,32 +220,6 @@ def check_encounter_set(n_encounters: int, terrains: tuple[str, ...], layouts: t
         raise InputError(f"--layout: must be among {', '.join(LAYOUTS)}, got {','.join(layouts)!r}")
 
 
-def check_encounter_array(rx_layout: str, terrains: tuple[str, ...]) -> str:
-    """``rx_layout`` if the encounter set can run it over ``terrains``, else one InputError line.
-
-    Every receive array of :data:`~skyradar.rx_layouts.RX_LAYOUTS` runs over every terrain; a
-    time-division MIMO array (:data:`~skyradar.rx_layouts.MIMO_LAYOUTS`) in clear sky only, since
-    clutter suppression models one transmitter.
-
-    Examples
-    --------
-    >>> check_encounter_array("mimo-2x4", ("none",))
-    'mimo-2x4'
-    >>> try:
-    ...     check_encounter_array("mimo-2x4", ("none", "hills"))
-    ... except InputError as exc:
-    ...     print(str(exc)[:60])
-    --rx-layout mimo-2x4: a time-division MIMO array runs in cle
-    """
-    check_rx_layout(rx_layout, "--rx-layout:", mimo=True)
-    if rx_layout in MIMO_LAYOUTS and tuple(terrains) != ("none",):
-        raise InputError(
-            f"--rx-layout {rx_layout}: a time-division MIMO array runs in clear sky only (--terrain none, "
-            f"got {','.join(terrains)}): clutter suppression models one transmitter"
-        )
-    return rx_layout
-
-
 def run(
     out_dir: Path,
     n_encounters: int = DEFAULT_ENCOUNTERS,
@@ -298,7 +271,7 @@ def run(
     """
     terrains, layouts = tuple(terrains), tuple(x for x in LAYOUTS if x in layouts)
     check_encounter_set(n_encounters, terrains, tuple(layouts) or ("",))
-    check_encounter_array(rx_layout, terrains)
+    check_rx_layout(rx_layout, "--rx-layout:", mimo=True)
     t0 = time.perf_counter()
     cfg = alert_config(alert_settings, option="--alert-config")
     out_dir = Path(out_dir)
@@ -326,7 +299,7 @@ def run(
         "terrains": list(terrains),
         "layouts": list(layouts),
         "navigation": navigation,
-        "suppression": "none" if rx_layout in MIMO_LAYOUTS else SUPPRESSION,
+        "suppression": SUPPRESSION,
         "late_lead_s": late_lead_s,
         "alert_config": str(alert_settings),
         "alert_config_digest": config_digest(cfg),

@@ -45,7 +45,7 @@ from numba import njit
 
 from skyradar.config import RadarConfig
 from skyradar.process.clutter import steering_into
-from skyradar.process.doa import direction_from_angles, steering_vector
+from skyradar.process.doa import channel_positions_m, direction_from_angles, steering_vector
 
 __all__ = [
     "directions_after_projection",
@@ -311,7 +311,7 @@ def _direction_fisher(
     du_del = np.stack([-np.sin(el) * np.cos(az), -np.sin(el) * np.sin(az), -np.cos(el)], -1)
     du_daz = np.stack([-np.cos(el) * np.sin(az), np.cos(el) * np.cos(az), np.zeros_like(az)], -1)
     s = steering_vector(u, config)
-    rx = np.asarray(config.rx_positions_m, float)
+    rx = np.asarray(channel_positions_m(config), float)
     d = np.stack([-1j * k * (g @ rx.T) * s for g in (du_del, du_daz)], -1)  # (n, n_rx, 2)
     ws, wd = np.einsum("nkl,nl->nk", proj, s), np.einsum("nkl,nlj->nkj", proj, d)
     sws = np.einsum("nk,nk->n", s.conj(), ws).real
@@ -351,7 +351,7 @@ def projected_directions(
     ([True, False], [-5.0, 0.0])
     """
     basis = _coarse(config)
-    rx = np.ascontiguousarray(config.rx_positions_m, float)
+    rx = np.ascontiguousarray(channel_positions_m(config), float)
     wavenumber = 2.0 * np.pi / config.wavelength_m
     half = int(round(_FINE_HALF_DEG / _FINE_STEP_DEG))
     rule = (np.radians(_COARSE_DEG), rx, wavenumber, np.radians(_FINE_STEP_DEG), half)

@@ -51,6 +51,7 @@ from skyradar.errors import InputError
 from skyradar.process.clutter import ClutterSubspace, cell_scratch, decompose_cell
 from skyradar.process.clutter_adaptive import adaptive_nulls
 from skyradar.process.detect import Detections, detect
+from skyradar.process.doa import channel_calibration
 from skyradar.process.power import power_image
 from skyradar.rx_layouts import MAX_RX
 
@@ -128,7 +129,7 @@ class Suppressed:
         ``nulls`` in place is read as it now is), training outside unsuppressed clutter, against the
         frame's measured floor; ``detect_kwargs`` as ``detect`` takes them (``method``,
         ``exclude``, ...)."""
-        channels = (config.n_rx - self.nulls).astype(np.int8)
+        channels = (config.n_virtual - self.nulls).astype(np.int8)
         return detect(
             self.power,
             config,
@@ -288,19 +289,21 @@ def suppress_clutter(
     gate: float = 3.0,
     adaptive: bool = True,
 ) -> Suppressed:
-    """Project every cell of a (n_range, n_doppler, n_rx) frame off its predicted clutter directions.
+    """Project every cell of a (n_range, n_doppler, n_channels) frame off its predicted clutter directions.
 
     Parameters
     ----------
     cube : ndarray, complex
-        One frame, uncalibrated channels (``config.rx_calibration`` is divided out here).
+        One frame, uncalibrated channels (:func:`~skyradar.process.doa.channel_calibration` is
+        divided out here): the receivers, or a time-division MIMO radar's virtual channels with
+        their transmit-slot phase still in, which the prediction models (:mod:`skyradar.process.clutter`).
     subspace : ClutterSubspace
         The frame geometry's predicted clutter.
     config : RadarConfig
         Channel count, calibration and nominal noise power ``noise_power_w`` (W).
     max_nulls : int, optional
         Most directions nulled in one cell; default :func:`default_max_nulls` of the array's
-        channel count, at most ``n_rx - 1`` (none on a one-channel radar).
+        channel count, at most ``n_channels - 1`` (none on a one-channel radar).
     gate : float
         A direction is nulled when the measured clutter-to-noise ratio times its eigenvalue
         fraction exceeds this.
@@ -338,17 +341,22 @@ def suppress_clutter(
     (40, [1], 1.0)
     """
     cube = np.asarray(cube)
-    if cube.shape != subspace.predicted.shape + (config.n_rx,):
+    if cube.shape != subspace.predicted.shape + (config.n_virtual,):
         raise InputError(f"suppression: frame shape {cube.shape} does not fit the clutter prediction")
     if max_nulls is None:
-        max_nulls = default_max_nulls(config.n_rx)
-    if not 0 <= max_nulls < config.n_rx:
-        raise InputError(f"suppression: field 'max_nulls' must be in [0, {config.n_rx - 1}], got {max_nulls}")
-    raw = power_image(cube, config.rx_calibration)
-    floor = measured_floor(raw, subspace.predicted, config.noise_power_w, config.n_rx, subspace.free_cells)
+        max_nulls = default_max_nulls(config.n_virtual)
+    if not 0 <= max_nulls < config.n_virtual:
+        raise InputError(
+            f"suppression: field 'max_nulls' must be in [0, {config.n_virtual - 1}], got {max_nulls}"
+        )
+    calibration = channel_calibration(config)
+    raw = power_image(cube, calibration)
+    floor = measured_floor(
+        raw, subspace.predicted, config.noise_power_w, config.n_virtual, subspace.free_cells
+    )
     power, nulls = np.empty(raw.shape, np.float32), np.empty(raw.shape, np.int8)
     unsuppressed, cnr = np.empty(raw.shape, np.bool_), np.empty(raw.shape, np.float32)
-    inv_gain = (1.0 / np.asarray(config.rx_calibration)).astype(np.complex64)
+    inv_gain = (1.0 / calibration).astype(np.complex64)
     z = np.ascontiguousarray(cube, np.complex64)
     rule = (np.float32(1.0 / floor), np.int64(max_nulls), np.float32(gate), np.float32(_RESIDUAL))
     cells = (subspace.covariance, subspace.predicted, subspace.done, subspace._vectors, subspace._fractions)
@@ -357,7 +365,7 @@ def suppress_clutter(
     trained: tuple[np.ndarray, np.ndarray] | tuple[None, None] = (None, None)
     if adaptive:
         trained = adaptive_nulls(z, inv_gain, cnr, floor, power, nulls, unsuppressed, max_nulls, gate)
-    channels = (config.n_rx - nulls).astype(np.int8)
+    channels = (config.n_virtual - nulls).astype(np.int8)
     return Suppressed(power, channels, unsuppressed, nulls, cnr, floor, *trained)
 
 

@@ -56,6 +56,7 @@ __all__ = [
     "slot_phase",
     "compensate_slot_phase",
     "virtual_pixels",
+    "compensate_projector",
 ]
 
 
@@ -233,6 +234,10 @@ class VirtualPixels:
         both fit, a track's range rate tells which was right.
     other_residue : ndarray, shape (n,), int
         Its residue (-1 for one transmitter).
+    phasors, other_phasors : ndarray, shape (n, n_virtual), complex
+        The unit phasors each residue multiplies the input pixels by (``pixels = phasors * z``):
+        what turns a projector of the input pixels into one of the compensated pixels
+        (:func:`compensate_projector`).
 
     Examples
     --------
@@ -256,6 +261,8 @@ class VirtualPixels:
     peak_ratio: np.ndarray
     other_pixels: np.ndarray
     other_residue: np.ndarray
+    phasors: np.ndarray
+    other_phasors: np.ndarray
 
 
 @lru_cache(maxsize=8)
@@ -274,11 +281,32 @@ def _fov_match(config: RadarConfig, facing: tuple[float, float, float]) -> np.nd
     return np.ascontiguousarray(np.exp(1j * (2.0 * np.pi / config.wavelength_m) * (u @ positions.T)).T)
 
 
+def _projected_peaks(z: np.ndarray, proj: np.ndarray, phasors: np.ndarray, match: np.ndarray) -> np.ndarray:
+    """Peak over the field of view of the projected matched filter ``|s^H P_m z_m|^2 / (s^H P_m s)``
+    per detection and residue (n, n_tx), ``z_m = d_m * z`` and ``P_m = D_m P D_m^H`` with ``D_m =
+    diag(d_m)``: ``s^H P_m z_m = (d_m * P z) . conj(s)`` and ``s^H P_m s = a^H P a`` with
+    ``a = conj(d_m) * s``. A direction the projector took (``a^H P a`` below 1e-9 of ``|a|^2``)
+    scores 0; elsewhere the score is at most ``|P z|^2`` (Cauchy-Schwarz)."""
+    peaks = np.zeros(phasors.shape[:2])
+    if not match.shape[1]:
+        return peaks
+    n_channels = match.shape[0]
+    for i in range(len(z)):
+        b = phasors[i][:, :, None] * match[None]  # (n_tx, n_virtual, n_grid): conj(a) per residue
+        y = proj[i] @ z[i]
+        num = np.abs(np.einsum("tkg,k->tg", b, y)) ** 2
+        den = np.einsum("tkg,tkg->tg", b, np.einsum("kl,tlg->tkg", proj[i], np.conj(b))).real
+        seen = den > 1e-9 * n_channels
+        peaks[i] = np.where(seen, num / np.where(seen, den, 1.0), 0.0).max(axis=1)
+    return peaks
+
+
 def virtual_pixels(
     pixels: np.ndarray,
     doppler_bin: np.ndarray | int,
     config: RadarConfig,
     facing: tuple[float, float, float] = (1.0, 0.0, 0.0),
+    proj: np.ndarray | None = None,
 ) -> VirtualPixels:
     """Slot phase removed and velocity ambiguity resolved for detections of the virtual cube.
 
@@ -292,6 +320,11 @@ def virtual_pixels(
         The MIMO radar.
     facing : (float, float, float)
         Centre of the field of view in the antenna frame (the boresight by default).
+    proj : ndarray, shape (n, n_virtual, n_virtual), complex, optional
+        Each pixel's clutter projector or whitening (Hermitian, of the input pixels, slot phase
+        in; :func:`skyradar.process.clutter_frames.detect_suppressed`): the residues are then
+        told apart by the projected matched filter's peak in the field of view instead of the
+        beamformer's, so that the clutter a cell's nulls take out does not choose for the target.
 
     Returns
     -------
@@ -307,25 +340,40 @@ def virtual_pixels(
     >>> out = virtual_pixels(z[None], cfg.doppler_bin(v), cfg)
     >>> out.residue.tolist(), round(float(out.radial_velocity_mps[0] / cfg.v_lim_mps), 3)
     ([1], 1.5)
+
+    Through a projector that leaves the channels alone the choice is the same:
+
+    >>> virtual_pixels(z[None], cfg.doppler_bin(v), cfg, proj=np.eye(8)[None]).residue.tolist()
+    [1]
     """
     z = np.atleast_2d(np.asarray(pixels))
     if z.ndim != 2 or z.shape[1] != config.n_virtual:
         raise InputError(
             f"mimo: pixels have {z.shape[-1]} channels, the radar has {config.n_virtual} virtual"
         )
+    if proj is not None and np.shape(proj) != (z.shape[0], config.n_virtual, config.n_virtual):
+        raise InputError(f"mimo: proj has shape {np.shape(proj)}, expected one square matrix per pixel")
     bins = np.broadcast_to(np.asarray(doppler_bin, float), z.shape[:1])
     v_hat = np.asarray(config.radial_velocity_at_bin_mps(bins), float)
-    z = z * np.conj(slot_phase(v_hat, config))
+    base = np.conj(slot_phase(v_hat, config))
     n_tx = config.n_tx
     if n_tx == 1:
         n = z.shape[0]
-        return VirtualPixels(z, np.zeros(n, int), v_hat, np.full(n, np.inf), z, np.full(n, -1))
+        return VirtualPixels(
+            base * z, np.zeros(n, int), v_hat, np.full(n, np.inf), base * z, np.full(n, -1), base, base
+        )
     fx, fy, fz = (float(f) for f in np.asarray(facing, float) / np.linalg.norm(facing))
     match = _fov_match(config, (fx, fy, fz))
     slots = np.repeat(np.arange(n_tx), config.n_rx)
     residues = np.exp(-2j * np.pi * np.outer(np.arange(n_tx), slots) / n_tx)  # (n_tx, n_virtual)
-    candidates = z[:, None, :] * residues[None]  # (n, n_tx, n_virtual)
-    peak = np.abs(candidates @ match).max(axis=2) ** 2 if match.shape[1] else np.zeros(candidates.shape[:2])
+    phasors = base[:, None, :] * residues[None]  # (n, n_tx, n_virtual)
+    candidates = z[:, None, :] * phasors
+    if proj is not None:
+        peak = _projected_peaks(z, np.asarray(proj), phasors, match)
+    elif match.shape[1]:
+        peak = np.abs(candidates @ match).max(axis=2) ** 2
+    else:
+        peak = np.zeros(candidates.shape[:2])
     rows = np.arange(z.shape[0])
     best = np.argmax(peak, axis=1)
     other = np.argmax(np.where(np.arange(n_tx) == best[:, None], -np.inf, peak), axis=1)
@@ -334,4 +382,40 @@ def virtual_pixels(
     span = 2.0 * n_tx * config.v_lim_mps  # the one-transmitter Doppler span, 4 * VLim_1 / 2
     v = v_hat + best * 2.0 * config.v_lim_mps
     v = (v + span / 2.0) % span - span / 2.0
-    return VirtualPixels(candidates[rows, best], best, v, ratio, candidates[rows, other], other)
+    return VirtualPixels(
+        candidates[rows, best],
+        best,
+        v,
+        ratio,
+        candidates[rows, other],
+        other,
+        phasors[rows, best],
+        phasors[rows, other],
+    )
+
+
+def compensate_projector(proj: np.ndarray, phasors: np.ndarray) -> np.ndarray:
+    """A projector (or whitening) of pixels ``z`` as one of the compensated pixels ``d * z``.
+
+    ``D P D^H`` with ``D = diag(d)`` (``d`` unit phasors, :attr:`VirtualPixels.phasors`): the
+    compensated pixel's projection is the compensated projection, ``(D P D^H)(D z) = D (P z)``.
+
+    Parameters
+    ----------
+    proj : ndarray, shape (n, k, k), complex
+    phasors : ndarray, shape (n, k), complex
+
+    Returns
+    -------
+    ndarray, shape (n, k, k), complex
+
+    Examples
+    --------
+    >>> d = np.exp(1j * np.array([[0.0, 0.5]]))
+    >>> p = np.array([[[0.5, 0.5], [0.5, 0.5]]], complex)
+    >>> z = np.array([[1.0, 2.0]], complex)
+    >>> bool(np.allclose(compensate_projector(p, d)[0] @ (d[0] * z[0]), d[0] * (p[0] @ z[0])))
+    True
+    """
+    d = np.asarray(phasors)
+    return np.asarray(proj) * d[:, :, None] * np.conj(d)[:, None, :]

@@ -189,36 +189,43 @@ def process_cube(
         raise InputError(
             f"frame: field 'rx' has {cube.shape[-1]} channels, radar_config has {config.n_virtual}"
         )
-    if clutter is not None:
-        _require_one_transmitter_to_suppress(config)
     if spur_mode not in ("mask", "flag"):
         raise InputError(f"process: field 'spur_mode' must be 'mask' or 'flag', got {spur_mode!r}")
     exclude = spur_map.mask if spur_map is not None and spur_mode == "mask" else None
-    virtual = None  # a time-division MIMO radar's pixels, residues chosen (and runners-up)
     if clutter is not None:  # a ClutterSubspace: knowledge-aided suppression before detection
-        det, u, coherence, elevation_measured = detect_suppressed(
+        found = detect_suppressed(
             cube, config, clutter, exclude, method, pfa_secondary=pfa_secondary, **detect_kwargs
         )
+        det, u, coherence, elevation_measured = (
+            found.detections,
+            found.u_ant,
+            found.coherence,
+            found.elevation_measured,
+        )
+        residue, other_residue, u_other = found.residue, found.other_residue, found.other_u_ant
     else:
         calibration = channel_calibration(config)
         power = integrate_channels(cube, calibration)
         det = detect(power, config, method=method, exclude=exclude, **detect_kwargs)
         pixels = cube[det.range_index, det.doppler_index] / calibration
+        n = len(det)
+        residue, other_residue, u_other = (
+            np.zeros(n, np.int64),
+            np.full(n, -1, np.int64),
+            np.full((n, 3), np.nan),
+        )
         if config.n_tx > 1:  # each transmitter slot's Doppler phase out, its ambiguity resolved
             virtual = virtual_pixels(pixels, det.doppler_bin, config)
             pixels = virtual.pixels
+            # the direction the runner-up residue gives, for a track's range rate to choose
+            u_other = estimate_directions(virtual.other_pixels, config, calibrated=True)
+            residue, other_residue = virtual.residue.astype(np.int64), virtual.other_residue.astype(np.int64)
         u = estimate_directions(pixels, config, calibrated=True)
         coherence = direction_coherence(pixels, u, config, calibrated=True)
-        elevation_measured = np.ones(len(det), bool)
+        elevation_measured = np.ones(n, bool)
     range_m = det.range_m(config)
     body = antenna_to_body(range_m[:, None] * u, config)
-    n = len(det)
-    residue, other_residue = np.zeros(n, np.int64), np.full(n, -1, np.int64)
-    body_other = np.full((n, 3), np.nan)
-    if virtual is not None:  # the direction the runner-up residue gives, for a track's range rate to choose
-        u_other = estimate_directions(virtual.other_pixels, config, calibrated=True)
-        residue, other_residue = virtual.residue.astype(np.int64), virtual.other_residue.astype(np.int64)
-        body_other = antenna_to_body(range_m[:, None] * u_other, config)
+    body_other = antenna_to_body(range_m[:, None] * u_other, config)
     az, el = angles_from_direction(u)
     spur = (
         spur_map.contains(det.range_bin, det.doppler_bin)
@@ -381,15 +388,6 @@ def process_chunk(
     )
 
 
-def _require_one_transmitter_to_suppress(config: RadarConfig) -> None:
-    # Ground clutter in a MIMO frame's cell comes from several aliases of its Doppler, each with its
-    # own slot phase, and the nulls' steering models one transmitter.
-    config.require_one_transmitter(
-        "clutter suppression",
-        "process a time-division MIMO radar's frames with suppression 'none'",
-    )
-
-
 def _checked_config(ds: xr.Dataset, config: RadarConfig | None, spur_map, source: str) -> RadarConfig:
     """The radar config to process ``ds`` with (the stored one unless given), checked against the frames."""
     stored = radar_config_of(ds, source)
@@ -480,8 +478,6 @@ def process_frames(
         uses only inside a confirmed track's gate); None, or not above ``pfa``: none.
     """
     config = _checked_config(ds, config, spur_map, source)
-    if suppression != "none":
-        _require_one_transmitter_to_suppress(config)
     first, stop, _ = (frames or slice(None)).indices(ds.sizes["time"])
     own, origin = navigated_own_state(ds, source), scenario_origin(ds)
     times = frame_times_s(ds)

@@ -301,3 +301,45 @@ def test_a_lost_filter_of_another_aircraft_is_not_fused():
     before = t3.P.copy()
     t3.rename(np.array([2]), np.array([1]))
     np.testing.assert_array_equal(t3.P, before)
+
+
+def _mirror_then_truth(restart: bool) -> tuple[np.ndarray, np.ndarray]:
+    """A filter fed an aircraft 310 m above (down -1310 m) as each frame reads it: until 1 s the
+    frames alternate between it and its mirror 860 m lower (a MIMO radar's two velocity residues,
+    where the field of view cannot choose), then every position is the aircraft's (the track's range
+    rate now chooses). The first frame and two of every three read the mirror; the stated noise
+    varies with the SNR frame by frame. Returns the filter's down position and vertical speed per
+    frame after 1 s."""
+    t3 = Tracker3D()
+    ids = np.array([0])
+    rng = np.random.default_rng(3)
+    downs, climbs = [], []
+    for k, t in enumerate(np.arange(0.0, 4.0, DT)):
+        cov = np.diag([1.0, 0.7, 1.2]) ** 2 * rng.uniform(8.0, 18.0) ** 2  # stated noise, SNR by SNR, m^2
+        truth = np.array([1000.0 - 15.0 * t, 300.0, -1310.0])
+        mirror = truth + [0.0, 0.0, 860.0]
+        seen = mirror if (t < 1.0 and k % 3 != 2) else truth
+        first_truth_frame = restart and t >= 1.0 and t - DT < 1.0
+        x, _ = t3.step(
+            t, ids, (seen + rng.normal(0.0, 10.0, 3))[None], cov[None],
+            restart_ids=ids if first_truth_frame else None,
+        )  # fmt: skip
+        if t >= 1.0:
+            downs.append(x[0, 2])
+            climbs.append(-x[0, 5])
+    return np.array(downs), np.array(climbs)
+
+
+def test_a_filter_fed_two_hypotheses_restarts_when_told_which_is_right():
+    # Fed mostly the mirror and now and then the aircraft, the filter learns a noise scale of
+    # hundreds and sits at the mirror; once the positions are all the aircraft's, a filter told so restarts on the
+    # first one that misses its gate at the stated noise and holds the aircraft's height, level.
+    # Left to its gate, the aircraft's positions straddle it with that noise scale (the stated noise
+    # varies), so the five rejections in a row its restart waits for do not come: it accepts one now
+    # and then and slides towards the aircraft: 3 s later it is still hundreds of metres off and
+    # climbing, a vertical speed a level aircraft never had.
+    downs, climbs = _mirror_then_truth(restart=True)
+    assert np.all(np.abs(downs + 1310.0) < 30.0)
+    assert np.all(np.abs(climbs) < 5.0)
+    downs, climbs = _mirror_then_truth(restart=False)
+    assert np.min(np.abs(downs + 1310.0)) > 500.0 and climbs[-1] > 3.0

@@ -28,7 +28,8 @@ def experiment_arrays(
         typer.Option(
             "--arrays",
             help="Comma-separated receive arrays, each simulated with its own channels: square (the "
-            "prototype's 2x2), kite, ura-2x3, ura-2x4, ura-4x2.",
+            "prototype's 2x2), kite, ura-2x3, ura-2x4, ura-4x2, or mimo-2x4 (2 transmitters x 4 receivers "
+            "taking turns).",
         ),
     ] = "square,ura-2x3",
     terrain: Annotated[

@@ -1,6 +1,7 @@
 """Receive-array trade study: what each array buys a pilot over each terrain, and what it costs.
 
-Every array of the study (a name of :data:`skyradar.rx_layouts.RX_LAYOUTS`; a further array is one
+Every array of the study (a name of :data:`skyradar.rx_layouts.RX_LAYOUTS`, or of
+:data:`~skyradar.rx_layouts.MIMO_LAYOUTS` for transmitters taking turns; a further array is one
 more name there) flies the same encounter set (same seed, same geometry,
 :func:`skyradar.experiments.encounter_set.make_encounters`) over every terrain asked for, each
 simulated with its own receive channels, through the whole chain of ``skyradar experiment
@@ -30,7 +31,10 @@ Minimum detectable velocity and usable Doppler fraction (:func:`doppler_notch`)
     fastest), so that MDV is set on the clutter-free side and is the same for every array;
     ``mdv_into_ground_band_mps`` is the separation on the other side, into the band of sidelobe
     ground, where the arrays differ: more channels keep more of a target whose direction is near
-    the nulled ground directions, so the notch narrows and the usable fraction grows.
+    the nulled ground directions, so the notch narrows and the usable fraction grows. A
+    time-division MIMO array's target pixels carry the slot phase of the bin's velocity and of the
+    alias residue, which the nulls do not know: its gain is averaged over the ``n_tx`` residues,
+    and its fraction is of its own image, ``n_tx`` times narrower than one transmitter's.
 DoA error against its Cramer-Rao bound (:func:`doa_against_bound`)
     A Monte-Carlo of the array's estimator (:func:`skyradar.process.doa.estimate_directions`) on a
     point target at a known direction (:data:`DOA_DIRECTION_DEG`), one pixel per trial with
@@ -71,7 +75,7 @@ from skyradar.experiments.encounters import EVALUATION_SEEDS_FROM, MAX_ENCOUNTER
 from skyradar.experiments.summary_md import write_summary
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.tables import write_json_atomic, write_table
-from skyradar.rx_layouts import RX_LAYOUTS, check_rx_layout
+from skyradar.rx_layouts import MIMO_LAYOUTS, RX_LAYOUTS, check_rx_layout
 
 __all__ = [
     "run",
@@ -108,7 +112,8 @@ _SUBFOLDER = "encounters_{}"
 
 def parse_arrays(value: str | Sequence[str], option: str = "--arrays") -> list[str]:
     """Array names from a comma-separated list (or a sequence), each a layout of
-    :data:`~skyradar.rx_layouts.RX_LAYOUTS`, in the given order, each once.
+    :data:`~skyradar.rx_layouts.RX_LAYOUTS` or :data:`~skyradar.rx_layouts.MIMO_LAYOUTS`, in the
+    given order, each once.
 
     Examples
     --------
@@ -120,17 +125,18 @@ def parse_arrays(value: str | Sequence[str], option: str = "--arrays") -> list[s
     skyradar.errors.InputError: --arrays: must be a comma-separated list of square, kite, ..., got 'ring'
     """
     names = [v.strip() for v in (value.split(",") if isinstance(value, str) else value)]
-    if not names or any(n not in RX_LAYOUTS for n in names):
+    known = RX_LAYOUTS + MIMO_LAYOUTS
+    if not names or any(n not in known for n in names):
         shown = value if isinstance(value, str) else ",".join(value)
-        raise InputError(
-            f"{option}: must be a comma-separated list of {', '.join(RX_LAYOUTS)}, got {shown!r}"
-        )
+        raise InputError(f"{option}: must be a comma-separated list of {', '.join(known)}, got {shown!r}")
     return list(dict.fromkeys(names))
 
 
 def array_config(array: str) -> RadarConfig:
-    """The prototype radar with the receive array ``array`` (:data:`~skyradar.rx_layouts.RX_LAYOUTS`)."""
-    check_rx_layout(array, "--arrays:")
+    """The prototype radar with the receive array ``array`` (:data:`~skyradar.rx_layouts.RX_LAYOUTS`),
+    or the transmitters and receivers of a time-division MIMO one
+    (:data:`~skyradar.rx_layouts.MIMO_LAYOUTS`)."""
+    check_rx_layout(array, "--arrays:", mimo=True)
     return RadarConfig.prototype_2022(rx_positions_m=array)
 
 
@@ -180,7 +186,8 @@ def doa_against_bound(
     for snr_db in snrs_db:
         phase = np.exp(1j * rng.uniform(0.0, 2.0 * np.pi, trials))
         noise = (
-            rng.standard_normal((trials, config.n_rx)) + 1j * rng.standard_normal((trials, config.n_rx))
+            rng.standard_normal((trials, config.n_virtual))
+            + 1j * rng.standard_normal((trials, config.n_virtual))
         ) / np.sqrt(2.0)
         pixels = 10.0 ** (snr_db / 20.0) * phase[:, None] * steer[None, :] + noise
         est_az, est_el = angles_from_direction(estimate_directions(pixels, config, calibrated=True))
@@ -232,12 +239,13 @@ def doppler_notch(
     from skyradar.process.clutter_anchors import prediction_anchors
     from skyradar.process.clutter_frames import frame_subspace
     from skyradar.process.clutter_suppress import projected_power, suppress_clutter
-    from skyradar.process.doa import steering_vector
+    from skyradar.process.doa import channel_calibration, steering_vector
+    from skyradar.process.mimo import slot_phase
     from skyradar.process.pipeline import navigated_own_state
     from skyradar.process.power import power_image
     from skyradar.units import wrap
 
-    check_rx_layout(array, "--arrays:")
+    check_rx_layout(array, "--arrays:", mimo=True)
     far, near = _NOTCH_RANGE_M[1], _NOTCH_RANGE_M[0]
     common: dict[str, Any] = dict(
         n_frames=n_frames,
@@ -261,16 +269,26 @@ def doppler_notch(
     anchors = prediction_anchors(own)
     rows = (config.range_axis_m >= near) & (config.range_axis_m <= far)
     cubes = np.asarray(full["iq"])
-    boresight = np.broadcast_to(steering_vector(np.array([1.0, 0.0, 0.0]), config), cubes[0].shape)
-    c_in, c_out, gain = (np.zeros(config.n_doppler) for _ in range(3))
+    calibration = channel_calibration(config)
+    n_bins = config.frame_shape[1]
+    # A boresight target in each Doppler bin, as its pixels arrive: a MIMO radar's carry the slot
+    # phase of the bin's velocity and of its alias residue, which the nulls do not know; the gain
+    # is averaged over the n_tx residues (the aliases a bin holds, equally likely).
+    steer = steering_vector(np.array([1.0, 0.0, 0.0]), config)
+    slots = np.repeat(np.arange(config.n_tx), config.n_rx)
+    residues = np.exp(2j * np.pi * np.outer(np.arange(config.n_tx), slots) / config.n_tx)
+    slot = slot_phase(np.asarray(config.doppler_axis_mps, float), config)  # (n_bins, channels)
+    c_in, c_out, gain = (np.zeros(n_bins) for _ in range(3))
     for i in range(n_frames):
         sub = frame_subspace(own, i, config, None, anchors)
         assert sub is not None  # flat ground: the height above it is known
         sup = suppress_clutter(cubes[i], sub, config)
         vectors = sup.applied_vectors(sub)
-        c_in += power_image(clutter[i], config.rx_calibration)[rows].mean(axis=0)
-        c_out += projected_power(clutter[i] / config.rx_calibration, vectors, sup.nulls)[rows].mean(axis=0)
-        gain += projected_power(boresight, vectors, sup.nulls)[rows].mean(axis=0)
+        c_in += power_image(clutter[i], calibration)[rows].mean(axis=0)
+        c_out += projected_power(clutter[i] / calibration, vectors, sup.nulls)[rows].mean(axis=0)
+        for residue in residues:
+            target = np.broadcast_to(steer * slot * residue, cubes[0].shape)
+            gain += projected_power(target, vectors, sup.nulls)[rows].mean(axis=0) / config.n_tx
     c_in, c_out, gain = (x / n_frames for x in (c_in, c_out, gain))
     noise = config.noise_power_w
     loss_none = 10.0 * np.log10(noise / (c_in + noise))
@@ -324,14 +342,15 @@ def processing_rate(array: str, seconds: float = 0.5, n_cubes: int = 3, seed: in
     dict
         ``frames_per_s`` (wall clock) and ``cpu_frames_per_s`` (per process-CPU second), measured.
     """
-    from skyradar.process.doa import direction_from_angles, steering_vector
+    from skyradar.process.doa import channel_calibration, direction_from_angles, steering_vector
     from skyradar.process.pipeline import process_cube
 
     if not 0.0 < seconds < float("inf"):
         raise InputError(f"arrays: timing seconds must be finite and > 0, got {seconds}")
     config = array_config(array)
     rng = np.random.default_rng(seed)
-    shape = (config.n_range, config.n_doppler, config.n_rx)
+    shape, calibration = config.frame_shape, channel_calibration(config)
+    speed_mps = min(35.0, 0.9 * config.v_lim_mps)  # radial speeds inside the Doppler image
     sigma = np.sqrt(config.noise_power_w / 2.0)
     cubes = []
     for _ in range(n_cubes):
@@ -339,9 +358,9 @@ def processing_rate(array: str, seconds: float = 0.5, n_cubes: int = 3, seed: in
         for _ in range(5):
             u = direction_from_angles(rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5))
             k = int(config.range_bin(rng.uniform(300.0, 4500.0)))
-            j = int(config.doppler_bin(rng.uniform(-35.0, 35.0)))
+            j = int(config.doppler_bin(rng.uniform(-speed_mps, speed_mps)))
             amp = np.sqrt(config.noise_power_w * 10**2.5) * np.exp(1j * rng.uniform(0.0, 2.0 * np.pi))
-            cube[k, j] += (amp * steering_vector(u, config) * config.rx_calibration).astype(np.complex64)
+            cube[k, j] += (amp * steering_vector(u, config) * calibration).astype(np.complex64)
         cubes.append(cube)
     process_cube(cubes[0], config)  # warm-up: compiled kernels, caches
     n, t0, c0 = 0, time.perf_counter(), time.process_time()
@@ -351,6 +370,13 @@ def processing_rate(array: str, seconds: float = 0.5, n_cubes: int = 3, seed: in
         wall = time.perf_counter() - t0
         if wall >= seconds and n >= n_cubes:
             return {"frames_per_s": n / wall, "cpu_frames_per_s": n / max(time.process_time() - c0, 1e-9)}
+
+
+def _channels(array: str) -> dict[str, int]:
+    """Receivers ``n_rx``, transmitters ``n_tx`` and the ``channels`` the processing works on (the
+    receivers, or a MIMO array's virtual channels)."""
+    config = array_config(array)
+    return {"n_rx": config.n_rx, "n_tx": config.n_tx, "channels": config.n_virtual}
 
 
 def _encounter_digest(table: pd.DataFrame, terrain: str, columns: list[str]) -> str:
@@ -373,7 +399,7 @@ def array_rows(array: str, summary: dict[str, Any], table: pd.DataFrame, columns
         out.append(
             {
                 "array": array,
-                "n_rx": array_config(array).n_rx,
+                **_channels(array),
                 "terrain": r["terrain"],
                 "encounters": int(r["encounters"]),
                 "encounter_set": _encounter_digest(table, r["terrain"], columns),
@@ -536,7 +562,7 @@ def run(
         per_array.append(
             {
                 "array": array,
-                "n_rx": array_config(array).n_rx,
+                **_channels(array),
                 **notch,
                 "doa": doa,
                 **rate,

@@ -100,7 +100,7 @@ def summary_markdown(result: dict[str, Any], out_dir: Path | None = None) -> str
         [
             [
                 a["array"],
-                a["n_rx"],
+                a["channels"],
                 number(a["mdv_mps"], 2),
                 number(a["mdv_into_ground_band_mps"], 1),
                 number(a["usable_doppler_fraction"], 2),
@@ -204,7 +204,7 @@ def plot_frames_per_s(per_array: list[dict], path: Path) -> None:
     x = np.arange(len(per_array))
     ax.bar(x - 0.2, [a["frames_per_s"] for a in per_array], 0.4, label="wall clock")
     ax.bar(x + 0.2, [a["cpu_frames_per_s"] for a in per_array], 0.4, label="per CPU second")
-    ax.set_xticks(x, [f"{a['array']}\n{a['n_rx']} ch" for a in per_array], fontsize=8)
+    ax.set_xticks(x, [f"{a['array']}\n{a['channels']} ch" for a in per_array], fontsize=8)
     ax.set(ylabel="frames/s")
     ax.set_title("detection + DoA, one head (measured)", fontsize=9)
     ax.legend(fontsize=8)

@@ -108,6 +108,9 @@ DETECTION_TABLE_COLUMNS: dict[str, str] = {
     "track whose range rate says that residue takes it (NaN with one transmitter or without navigation)",
     "other_east_m": "m; time-division MIMO: position east from the runner-up residue's direction",
     "other_down_m": "m; time-division MIMO: position down from the runner-up residue's direction",
+    "other_azimuth_rad": "rad; time-division MIMO: the runner-up residue's azimuth in the antenna frame (NaN "
+    "with one transmitter): its angle error, where a track takes its position",
+    "other_elevation_rad": "rad; time-division MIMO: the runner-up residue's elevation in the antenna frame",
     "radar": "-; name of the radar head that detected it (`radar` for a run of one head)",
 }
 # The columns of one head's frames (process_frames); `radar` is added when the heads' tables merge
@@ -164,9 +167,9 @@ def process_cube(
         m, angles in rad, radial velocity in m/s, SNR in dB) plus ``spur``, ``u_ant`` (n, 3) unit
         vectors, ``coherence`` (:func:`.direction_coherence`), ``residue`` and ``other_residue``
         (a time-division MIMO radar's chosen and runner-up residue of the velocity ambiguity,
-        :func:`skyradar.process.mimo.virtual_pixels`; 0 and -1 with one transmitter) and
-        ``other_body_m`` (n, 3), the body position the runner-up's direction gives (NaN with one
-        transmitter), m.
+        :func:`skyradar.process.mimo.virtual_pixels`; 0 and -1 with one transmitter),
+        ``other_azimuth_rad`` and ``other_elevation_rad``, the runner-up's direction (rad), and
+        ``other_body_m`` (n, 3), the body position it gives (NaN with one transmitter), m.
 
     Examples
     --------
@@ -227,6 +230,7 @@ def process_cube(
     body = antenna_to_body(range_m[:, None] * u, config)
     body_other = antenna_to_body(range_m[:, None] * u_other, config)
     az, el = angles_from_direction(u)
+    other_az, other_el = angles_from_direction(u_other)
     spur = (
         spur_map.contains(det.range_bin, det.doppler_bin)
         if spur_map is not None
@@ -251,6 +255,8 @@ def process_cube(
         "coherence": coherence,
         "residue": residue,
         "other_residue": other_residue,
+        "other_azimuth_rad": other_az,
+        "other_elevation_rad": other_el,
         "other_body_m": body_other,
     }
 

@@ -43,6 +43,8 @@ _OWNSHIP_LIMITS = {"m": (1.0e7, "m"), "mps": (1.0e4, "m/s")}  # by the unit endi
 _DIRECTION_LIMITS = {
     "azimuth_rad": (np.pi, "rad"),
     "elevation_rad": (np.pi / 2, "rad"),
+    "other_azimuth_rad": (np.pi, "rad"),
+    "other_elevation_rad": (np.pi / 2, "rad"),
     "right_axis_north": (1.0 + 1e-6, ""),
     "right_axis_east": (1.0 + 1e-6, ""),
     "right_axis_down": (1.0 + 1e-6, ""),

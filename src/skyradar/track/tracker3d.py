@@ -257,6 +257,7 @@ class Tracker3D:
         positions_m: np.ndarray,
         variances_m2: np.ndarray,
         radial: RadialObservation | None = None,
+        restart_ids: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
         """Move every filter to ``time_s`` and update those whose track has a 3-D position.
 
@@ -272,6 +273,11 @@ class Tracker3D:
             Per-axis variance of each position, or its full covariance, m^2.
         radial : RadialObservation, optional
             Own-ship state and de-aliased radial velocity per track, for a range-rate update.
+        restart_ids : ndarray of int, optional
+            Tracks whose earlier positions the caller knows to be of mixed hypotheses (a MIMO
+            radar's two velocity residues): a position of theirs that fails the gate at its stated
+            noise restarts the filter at once, with the stated noise again, instead of being
+            weighed with the noise scale those positions taught it.
 
         Returns
         -------
@@ -295,7 +301,8 @@ class Tracker3D:
         # A position without a finite covariance (e.g. no SNR for its angle error) is not used.
         has = np.all(np.isfinite(positions_m), axis=1) & np.all(np.isfinite(cov), axis=(1, 2))
         pos, known = _lookup(self.ids, ids)
-        self._update_positions(np.flatnonzero(has & known), pos, positions_m, cov)
+        fresh = np.isin(ids, np.asarray([] if restart_ids is None else restart_ids, np.int64))
+        self._update_positions(np.flatnonzero(has & known), pos, positions_m, cov, fresh)
         new = has & ~known
         if np.any(new):
             self._add(ids[new], positions_m[new], cov[new])
@@ -420,9 +427,11 @@ class Tracker3D:
         self.P[rows, 2, 2] = np.asarray(sigma_m, float)[found] ** 2
 
     def _update_positions(
-        self, sel: np.ndarray, pos: np.ndarray, positions_m: np.ndarray, cov: np.ndarray
+        self, sel: np.ndarray, pos: np.ndarray, positions_m: np.ndarray, cov: np.ndarray, fresh: np.ndarray
     ) -> None:
-        """Gated linear update of the filters ``pos[sel]`` with ``positions_m[sel]``."""
+        """Gated linear update of the filters ``pos[sel]`` with ``positions_m[sel]``; a position of
+        a ``fresh`` (mask over all rows) track outside the gate at its stated noise restarts its
+        filter and forgets the noise scale."""
         if sel.size == 0:
             return
         rows = pos[sel]
@@ -430,21 +439,24 @@ class Tracker3D:
         stated = cov[sel]
         cov_sel = stated * self.noise_scale[rows, None, None]  # the noise this filter's innovations showed
         S = self.P[rows, :3, :3] + cov_sel
-        nis = _nis(y, S)
-        self._match_noise(rows, y, self.P[rows, :3, :3] + stated)
+        nis, nis_stated = _nis(y, S), _nis(y, self.P[rows, :3, :3] + stated)
+        self._match_noise(rows, nis_stated)
         ok = nis < self.gate
-        restart = ~ok & (self.rejects[rows] >= self.max_rejects)
+        renew = fresh[sel] & (nis_stated >= self.gate)
+        restart = (~ok & (self.rejects[rows] >= self.max_rejects)) | renew
         self.rejects[rows] = np.where(ok, 0, self.rejects[rows] + 1)
         up = rows[ok]
         self.x[up], self.P[up] = update(self.x[up], self.P[up], y[ok], _H3, cov_sel[ok])
         if np.any(restart):
+            self.noise_scale[rows[renew]], self.noise_samples[rows[renew]] = 1.0, 0
+            cov_sel[renew] = stated[renew]
             x0, P0 = self._initial(positions_m[sel][restart], cov_sel[restart])
             r = rows[restart]
             self.x[r], self.P[r], self.rejects[r] = x0, P0, 0
 
-    def _match_noise(self, rows: np.ndarray, y: np.ndarray, S_stated: np.ndarray) -> None:
-        """Average ``NIS / 3`` of the filters ``rows`` against the stated noise into their noise scale."""
-        nis = _nis(y, S_stated)
+    def _match_noise(self, rows: np.ndarray, nis: np.ndarray) -> None:
+        """Average ``NIS / 3`` of the filters ``rows`` (``nis`` against the stated noise) into their
+        noise scale."""
         top = self.max_noise_scale
         seen = np.minimum(np.nan_to_num(nis, nan=3.0 * top), 3.0 * top) / 3.0
         # A running mean until 1 / noise_memory innovations are in, then the exponential average:

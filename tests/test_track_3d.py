@@ -332,8 +332,9 @@ def _mirror_then_truth(restart: bool) -> tuple[np.ndarray, np.ndarray]:
 
 def test_a_filter_fed_two_hypotheses_restarts_when_told_which_is_right():
     # Fed mostly the mirror and now and then the aircraft, the filter learns a noise scale of
-    # hundreds and sits at the mirror; once the positions are all the aircraft's, a filter told so restarts on the
-    # first one that misses its gate at the stated noise and holds the aircraft's height, level.
+    # hundreds and sits at the mirror; once the positions are all the aircraft's, a filter told so
+    # restarts on the first one that misses its gate at the stated noise and holds the aircraft's
+    # height, level.
     # Left to its gate, the aircraft's positions straddle it with that noise scale (the stated noise
     # varies), so the five rejections in a row its restart waits for do not come: it accepts one now
     # and then and slides towards the aircraft: 3 s later it is still hundreds of metres off and

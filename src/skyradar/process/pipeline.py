@@ -52,6 +52,7 @@ from skyradar.process.doa import (
     antenna_to_body,
     channel_calibration,
     direction_coherence,
+    direction_from_angles,
     estimate_directions,
 )
 from skyradar.process.ground import GeodeticFn, flag_ground, height_above_ground_m, surface_height_fn
@@ -330,7 +331,12 @@ def _ground_flags(
 
     The surface is the terrain (DEM) under each detection, else (and beyond the DEM) a flat
     ground at the terrain height under the own-ship, from its navigated height above ground or
-    the DEM; with neither, nothing is ground.
+    the DEM; with neither, nothing is ground. A time-division MIMO radar's detection is ground too
+    where its runner-up residue's direction is: the ground below the field of view (the altitude
+    return, 30-80 deg down within 1.4 heights of range) is strong enough to be detected there, and
+    the field of view, which chooses the residue, prefers the mirror near the horizontal: read so,
+    it sits a few tens of metres above the own-ship with every Doppler of the folded image, and
+    started tracks near co-altitude that only the runner-up's direction explains.
     """
     n = len(out["range_m"])
     if own is None or n == 0:
@@ -347,7 +353,22 @@ def _ground_flags(
     height_fn = surface_height_fn(pos[2] + own_agl, terrain if located else None, geodetic)
     vel = np.array([own.vn_mps[i], own.ve_mps[i], own.vd_mps[i]])
     ant_to_ned = _body_to_ned(own, i, origin) @ config.mount.rotation
-    return flag_ground(out, u_ned, vel, ant_to_ned, height_fn, own_agl, config)
+    flags = flag_ground(out, u_ned, vel, ant_to_ned, height_fn, own_agl, config)
+    other = np.isfinite(out["other_azimuth_rad"]) & np.isfinite(out["other_elevation_rad"])
+    other &= np.isfinite(out["other_down_m"]) & ~flags
+    if other.any():
+        mirror = {k: np.asarray(v)[other] for k, v in out.items() if np.ndim(v) >= 1 and len(v) == n}
+        mirror |= {
+            "azimuth_rad": mirror["other_azimuth_rad"],
+            "elevation_rad": mirror["other_elevation_rad"],
+            "north_m": mirror["other_north_m"],
+            "east_m": mirror["other_east_m"],
+            "down_m": mirror["other_down_m"],
+            "u_ant": direction_from_angles(mirror["other_azimuth_rad"], mirror["other_elevation_rad"]),
+        }
+        u_mirror = mirror["u_ant"] @ ant_to_ned.T
+        flags[other] = flag_ground(mirror, u_mirror, vel, ant_to_ned, height_fn, own_agl, config)
+    return flags
 
 
 def clutter_anchors(ds: xr.Dataset, terrain: Any = None, source: str = "frames") -> np.ndarray | None:

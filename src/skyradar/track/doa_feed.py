@@ -16,10 +16,11 @@ position is the runner-up's (``other_north_m``, ...) with its own direction's an
 a mirror that flips with the frames. The positions a track was fed before its radial velocity
 resolved came from each frame's own choice, some of them the mirror hundreds of metres away, and
 the filter built on them has learnt a noise scale that large (:class:`~skyradar.track.tracker3d.Tracker3D`).
-At the frame it resolves, a position of the residue its range rate says that fails the filter's
-gate restarts the filter (``restart_ids``) instead of pulling it over in small steps: on a
-development set an aircraft overtaken 310 m above drifted down at 34 m/s for 10 s that way, with
-its NIS straddling the gate so that the five rejections in a row a restart waits for never came.
+At the frame it resolves, a position of the residue its range rate says that misses the filter's
+gate at its stated noise restarts the filter (``restart_ids``) instead of pulling it over in small
+steps: left to the gate, the aircraft's positions straddle it with that noise scale, the five
+rejections in a row a restart waits for do not come, and the track of an aircraft overtaken a few
+hundred metres above slides towards it at tens of m/s for seconds, a vertical speed that warns.
 """
 
 from __future__ import annotations

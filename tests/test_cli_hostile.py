@@ -239,6 +239,8 @@ def test_directory_as_table_and_sweep_suffix(tmp_path):
         ("other_north_m", "abc", ["'other_north_m'", "not a finite number", "row 2", "'abc'"]),
         ("other_residue", 7, ["'other_residue'", "is 7 at row 2", "whole number"]),
         ("other_residue", "abc", ["'other_residue'", "not a finite number", "row 2"]),
+        ("other_elevation_rad", 2.0, ["'other_elevation_rad'", "is 2 rad at row 2", "not a direction"]),
+        ("other_azimuth_rad", "abc", ["'other_azimuth_rad'", "not a finite number", "row 2", "'abc'"]),
     ],
 )
 def test_track_refuses_directions_that_are_not_directions(tmp_path, column, value, needles):
@@ -265,6 +267,8 @@ def test_track_refuses_directions_that_are_not_directions(tmp_path, column, valu
             "other_north_m": np.nan,
             "other_east_m": np.nan,
             "other_down_m": np.nan,
+            "other_azimuth_rad": np.nan,
+            "other_elevation_rad": np.nan,
         }
     ).astype({column: object})
     detections.loc[2, column] = value

@@ -38,12 +38,10 @@ from skyradar.process.clutter_suppress import projected_snapshots, suppress_clut
 from skyradar.process.detect import Detections
 from skyradar.process.doa import (
     channel_calibration,
-    direction_coherence,
-    estimate_directions,
     steering_vector,
 )
 from skyradar.process.ground import static_radial_velocity_mps
-from skyradar.process.mimo import compensate_projector, virtual_pixels
+from skyradar.process.mimo import compensate_projector, plain_directions, virtual_pixels
 from skyradar.units import wrap
 
 __all__ = [
@@ -304,18 +302,10 @@ def detect_suppressed(
     sup = suppress_clutter(cube, clutter, config)
     det = sup.detections(config, method=method, exclude=exclude, **detect_kwargs)
     n = len(det)
-    pixels = cube[det.range_index, det.doppler_index]
-    z = pixels / channel_calibration(config)
-    residue, other_residue, u_other = np.zeros(n, np.int64), np.full(n, -1, np.int64), np.full((n, 3), np.nan)
-    if config.n_tx > 1:  # each transmitter slot's Doppler phase out, its ambiguity resolved
-        virtual = virtual_pixels(z, det.doppler_bin, config)
-        u = estimate_directions(virtual.pixels, config, calibrated=True)
-        coherence = direction_coherence(virtual.pixels, u, config, calibrated=True)
-        u_other = estimate_directions(virtual.other_pixels, config, calibrated=True)
-        residue, other_residue = virtual.residue.astype(np.int64), virtual.other_residue.astype(np.int64)
-    else:
-        u = estimate_directions(pixels, config)
-        coherence = direction_coherence(pixels, u, config)
+    z = cube[det.range_index, det.doppler_index] / channel_calibration(config)
+    plain = plain_directions(z, det.doppler_bin, config)
+    u, coherence, u_other = plain.u_ant, plain.coherence, plain.other_u_ant
+    residue, other_residue = plain.residue, plain.other_residue
     elevation_measured = np.ones(n, bool)
     nulls = sup.nulls[det.range_index, det.doppler_index]
     projected = (nulls > 0) & (coherence < _PLANE_WAVE)  # one plane wave explains it: the target dominates

@@ -45,7 +45,7 @@ import numpy as np
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
-from skyradar.process.doa import field_of_view_rad
+from skyradar.process.doa import direction_coherence, estimate_directions, field_of_view_rad
 from skyradar.process.rangedoppler import range_doppler
 from skyradar.process.windows import WindowSpec
 
@@ -57,6 +57,8 @@ __all__ = [
     "compensate_slot_phase",
     "virtual_pixels",
     "compensate_projector",
+    "PlainDirections",
+    "plain_directions",
 ]
 
 
@@ -419,3 +421,76 @@ def compensate_projector(proj: np.ndarray, phasors: np.ndarray) -> np.ndarray:
     """
     d = np.asarray(phasors)
     return np.asarray(proj) * d[:, :, None] * np.conj(d)[:, None, :]
+
+
+@dataclass(frozen=True)
+class PlainDirections:
+    """Directions of detections read from their pixels as they are (no clutter projection).
+
+    Attributes
+    ----------
+    u_ant : ndarray, shape (n, 3)
+        Antenna-frame unit vectors (:func:`skyradar.process.doa.estimate_directions`).
+    coherence : ndarray, shape (n,)
+        One plane wave's fit to each pixel (:func:`skyradar.process.doa.direction_coherence`).
+    residue, other_residue : ndarray, shape (n,), int
+        A time-division MIMO radar's chosen and runner-up residue (:func:`virtual_pixels`); 0 and
+        -1 with one transmitter.
+    other_u_ant : ndarray, shape (n, 3)
+        The runner-up residue's direction (NaN with one transmitter).
+
+    Examples
+    --------
+    >>> cfg = RadarConfig.prototype_2022()
+    >>> plain_directions(np.ones((1, 4), complex), 0, cfg).u_ant.round(6).tolist()
+    [[1.0, 0.0, 0.0]]
+    """
+
+    u_ant: np.ndarray
+    coherence: np.ndarray
+    residue: np.ndarray
+    other_residue: np.ndarray
+    other_u_ant: np.ndarray
+
+
+def plain_directions(
+    pixels: np.ndarray, doppler_bin: np.ndarray | int, config: RadarConfig
+) -> PlainDirections:
+    """Directions of calibrated detection pixels: a MIMO radar's after :func:`virtual_pixels` (slot
+    phase out, residue chosen by the field of view), with the runner-up residue's direction too.
+
+    Parameters
+    ----------
+    pixels : ndarray, shape (n, n_virtual), complex
+        Calibrated pixels (slot phase still in for a MIMO radar).
+    doppler_bin : int or ndarray, shape (n,)
+        Their Doppler bins.
+    config : RadarConfig
+        The radar.
+
+    Returns
+    -------
+    PlainDirections
+
+    Examples
+    --------
+    >>> from skyradar.process.doa import angles_from_direction, direction_from_angles, steering_vector
+    >>> cfg = RadarConfig.prototype_2022(rx_positions_m="mimo-2x4")
+    >>> v = 1.5 * cfg.v_lim_mps
+    >>> z = steering_vector(direction_from_angles(0.2, -0.1), cfg) * slot_phase(v, cfg)
+    >>> out = plain_directions(z[None], cfg.doppler_bin(v), cfg)
+    >>> out.residue.tolist(), np.round(angles_from_direction(out.u_ant), 3).ravel().tolist()
+    ([1], [0.2, -0.1])
+    """
+    z = np.atleast_2d(np.asarray(pixels))
+    n = z.shape[0]
+    residue, other_residue, u_other = np.zeros(n, np.int64), np.full(n, -1, np.int64), np.full((n, 3), np.nan)
+    if config.n_tx > 1:  # each transmitter slot's Doppler phase out, its ambiguity resolved
+        virtual = virtual_pixels(z, doppler_bin, config)
+        z = virtual.pixels
+        u_other = estimate_directions(virtual.other_pixels, config, calibrated=True)
+        residue, other_residue = virtual.residue.astype(np.int64), virtual.other_residue.astype(np.int64)
+    u = estimate_directions(z, config, calibrated=True)
+    return PlainDirections(
+        u, direction_coherence(z, u, config, calibrated=True), residue, other_residue, u_other
+    )

@@ -51,12 +51,10 @@ from skyradar.process.doa import (
     angles_from_direction,
     antenna_to_body,
     channel_calibration,
-    direction_coherence,
     direction_from_angles,
-    estimate_directions,
 )
 from skyradar.process.ground import GeodeticFn, flag_ground, height_above_ground_m, surface_height_fn
-from skyradar.process.mimo import virtual_pixels
+from skyradar.process.mimo import plain_directions
 from skyradar.process.spurs import SpurMap
 
 __all__ = [
@@ -211,22 +209,12 @@ def process_cube(
         calibration = channel_calibration(config)
         power = integrate_channels(cube, calibration)
         det = detect(power, config, method=method, exclude=exclude, **detect_kwargs)
-        pixels = cube[det.range_index, det.doppler_index] / calibration
-        n = len(det)
-        residue, other_residue, u_other = (
-            np.zeros(n, np.int64),
-            np.full(n, -1, np.int64),
-            np.full((n, 3), np.nan),
+        plain = plain_directions(
+            cube[det.range_index, det.doppler_index] / calibration, det.doppler_bin, config
         )
-        if config.n_tx > 1:  # each transmitter slot's Doppler phase out, its ambiguity resolved
-            virtual = virtual_pixels(pixels, det.doppler_bin, config)
-            pixels = virtual.pixels
-            # the direction the runner-up residue gives, for a track's range rate to choose
-            u_other = estimate_directions(virtual.other_pixels, config, calibrated=True)
-            residue, other_residue = virtual.residue.astype(np.int64), virtual.other_residue.astype(np.int64)
-        u = estimate_directions(pixels, config, calibrated=True)
-        coherence = direction_coherence(pixels, u, config, calibrated=True)
-        elevation_measured = np.ones(n, bool)
+        u, coherence, u_other = plain.u_ant, plain.coherence, plain.other_u_ant
+        residue, other_residue = plain.residue, plain.other_residue
+        elevation_measured = np.ones(len(det), bool)
     range_m = det.range_m(config)
     body = antenna_to_body(range_m[:, None] * u, config)
     body_other = antenna_to_body(range_m[:, None] * u_other, config)

@@ -217,9 +217,12 @@ def process_cube(
         elevation_measured = np.ones(len(det), bool)
     range_m = det.range_m(config)
     body = antenna_to_body(range_m[:, None] * u, config)
-    body_other = antenna_to_body(range_m[:, None] * u_other, config)
     az, el = angles_from_direction(u)
-    other_az, other_el = angles_from_direction(u_other)
+    n = len(det)
+    body_other, other_az, other_el = np.full((n, 3), np.nan), np.full(n, np.nan), np.full(n, np.nan)
+    if config.n_tx > 1:  # the runner-up residue's direction and position
+        body_other = antenna_to_body(range_m[:, None] * u_other, config)
+        other_az, other_el = angles_from_direction(u_other)
     spur = (
         spur_map.contains(det.range_bin, det.doppler_bin)
         if spur_map is not None

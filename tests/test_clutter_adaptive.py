@@ -214,7 +214,7 @@ def test_target_in_clutter_the_prediction_misses_is_found_only_with_adaptive_nul
     # its direction through the ring's whitening: the target's (25 dB, 2 of 4 dimensions nulled), not
     # the clutter's (25-30 deg away)
     found = detect_suppressed(cube, CFG, flat_prediction)
-    det, u, coherence = found.detections, found.u_ant, found.coherence
+    det, u, coherence = found.detections, found.directions.u_ant, found.directions.coherence
     k = np.flatnonzero((det.range_index == pixel[0]) & (det.doppler_index == pixel[1]))[0]
     assert np.degrees(np.arccos(u[k] @ direction_from_angles(0.0, 0.0))) < 10.0 and coherence[k] > 0.9
 
@@ -231,7 +231,7 @@ def test_one_unpredicted_clutter_plane_wave_is_not_taken_for_the_target(flat_pre
     pixel = (160, 190)
     cube[pixel] += np.sqrt(10**2.5 * noise_w) * _steer(5, 0) * np.exp(1j * rng.uniform(0, 6.3))  # 25 dB
     found = detect_suppressed(cube.astype(np.complex64), CFG, flat_prediction)
-    det, u = found.detections, found.u_ant
+    det, u = found.detections, found.directions.u_ant
     k = np.flatnonzero((det.range_index == pixel[0]) & (det.doppler_index == pixel[1]))[0]
     assert np.degrees(np.arccos(u[k] @ direction_from_angles(np.radians(5.0), 0.0))) < 10.0
 

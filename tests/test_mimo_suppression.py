@@ -66,11 +66,11 @@ def test_an_intruder_in_the_folded_ground_band_is_read_through_the_nulls(
         )
         assert hit.any(), seed
         k = np.flatnonzero(hit)[np.argmax(det.snr_db[hit])]
-        got = np.degrees(angles_from_direction(found.u_ant[k : k + 1])).ravel()
+        got = np.degrees(angles_from_direction(found.directions.u_ant[k : k + 1])).ravel()
         assert np.all(np.abs(got - truth) < 2.0), (seed, got)
-        assert found.residue[k] == residue and found.other_residue[k] == 1 - residue
+        assert found.directions.residue[k] == residue and found.directions.other_residue[k] == 1 - residue
         # the runner-up residue's direction is the mirror along the transmitters: far from the truth
-        other = np.degrees(angles_from_direction(found.other_u_ant[k : k + 1])).ravel()
+        other = np.degrees(angles_from_direction(found.directions.other_u_ant[k : k + 1])).ravel()
         assert np.abs(other[1] - el_deg) > 20.0
 
 
@@ -81,8 +81,8 @@ def test_one_transmitter_has_no_runner_up_residue():
     shape = cfg.frame_shape
     cube = (rng.standard_normal(shape) + 1j * rng.standard_normal(shape)) * np.sqrt(cfg.noise_power_w / 2)
     found = detect_suppressed(cube.astype(np.complex64), cfg, sub)
-    assert np.all(found.residue == 0) and np.all(found.other_residue == -1)
-    assert np.isnan(found.other_u_ant).all()
+    assert np.all(found.directions.residue == 0) and np.all(found.directions.other_residue == -1)
+    assert np.isnan(found.directions.other_u_ant).all()
     out = process_cube(cube.astype(np.complex64), cfg, clutter=sub)
     assert np.isnan(out["other_body_m"]).all()
 

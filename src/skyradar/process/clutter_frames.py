@@ -41,7 +41,7 @@ from skyradar.process.doa import (
     steering_vector,
 )
 from skyradar.process.ground import static_radial_velocity_mps
-from skyradar.process.mimo import compensate_projector, plain_directions, virtual_pixels
+from skyradar.process.mimo import DetectionDirections, compensate_projector, plain_directions, virtual_pixels
 from skyradar.units import wrap
 
 __all__ = [
@@ -208,17 +208,9 @@ class SuppressedDetections:
     ----------
     detections : Detections
         CFAR on the suppressed image.
-    u_ant : ndarray, shape (n, 3)
-        Antenna-frame unit vectors.
-    coherence : ndarray, shape (n,)
-        One plane wave's fit to each snapshot (through the cell's nulls where it was searched there).
-    elevation_measured : ndarray, shape (n,), bool
-        False where the nulls left the elevation unobservable and ``u_ant`` holds elevation 0 (a prior).
-    residue, other_residue : ndarray, shape (n,), int
-        A time-division MIMO radar's chosen and runner-up residue of the velocity ambiguity
-        (:func:`skyradar.process.mimo.virtual_pixels`); 0 and -1 with one transmitter.
-    other_u_ant : ndarray, shape (n, 3)
-        The direction the runner-up residue gives (NaN with one transmitter).
+    directions : DetectionDirections
+        Their directions (:class:`skyradar.process.mimo.DetectionDirections`), searched through the
+        cell's nulls where the plain one does not stand.
 
     Examples
     --------
@@ -231,17 +223,14 @@ class SuppressedDetections:
     >>> noise = rng.standard_normal(cfg.frame_shape) + 1j * rng.standard_normal(cfg.frame_shape)
     >>> cube = noise * np.sqrt(cfg.noise_power_w / 2)
     >>> found = detect_suppressed(cube.astype(np.complex64), cfg, sub)
-    >>> found.u_ant.shape == (len(found.detections), 3), bool(np.all(found.other_residue == -1))
-    (True, True)
+    >>> found.directions.u_ant.shape == (len(found.detections), 3)
+    True
+    >>> bool(np.all(found.directions.other_residue == -1))
+    True
     """
 
     detections: Detections
-    u_ant: np.ndarray
-    coherence: np.ndarray
-    elevation_measured: np.ndarray
-    residue: np.ndarray
-    other_residue: np.ndarray
-    other_u_ant: np.ndarray
+    directions: DetectionDirections
 
 
 def detect_suppressed(
@@ -296,17 +285,14 @@ def detect_suppressed(
     >>> cube[100, 40] += 10.0 * np.sqrt(cfg.noise_power_w) * steering_vector(u, cfg)
     >>> found = detect_suppressed(cube.astype(np.complex64), cfg, sub)
     >>> hit = (found.detections.range_index == 100) & (found.detections.doppler_index == 40)
-    >>> np.degrees(angles_from_direction(found.u_ant[hit])).ravel().round().tolist()
+    >>> np.degrees(angles_from_direction(found.directions.u_ant[hit])).ravel().round().tolist()
     [20.0, 0.0]
     """
     sup = suppress_clutter(cube, clutter, config)
     det = sup.detections(config, method=method, exclude=exclude, **detect_kwargs)
-    n = len(det)
     z = cube[det.range_index, det.doppler_index] / channel_calibration(config)
-    plain = plain_directions(z, det.doppler_bin, config)
-    u, coherence, u_other = plain.u_ant, plain.coherence, plain.other_u_ant
-    residue, other_residue = plain.residue, plain.other_residue
-    elevation_measured = np.ones(n, bool)
+    directions = plain_directions(z, det.doppler_bin, config)
+    u, coherence, elevation_measured = directions.u_ant, directions.coherence, directions.elevation_measured
     nulls = sup.nulls[det.range_index, det.doppler_index]
     projected = (nulls > 0) & (coherence < _PLANE_WAVE)  # one plane wave explains it: the target dominates
     maybe = (nulls > 0) & ~projected  # ... or the clutter does, and a target hides under it
@@ -323,10 +309,10 @@ def detect_suppressed(
             proj[own] = ring_whitening(cube, inv_gain, r[own], d[own], sup.noise_floor_w)
         if config.n_tx > 1:  # the pixels and their projector turned by the residue chosen through it
             turned = virtual_pixels(zp, det.doppler_bin[projected], config, proj=proj)
-            residue[projected] = turned.residue
-            other_residue[projected] = turned.other_residue
+            directions.residue[projected] = turned.residue
+            directions.other_residue[projected] = turned.other_residue
             other_proj = compensate_projector(proj, turned.other_phasors)
-            u_other[projected] = projected_directions(
+            directions.other_u_ant[projected] = projected_directions(
                 turned.other_pixels, other_proj, config, sup.noise_floor_w
             )[0]
             zp, y, proj = turned.pixels, turned.phasors * y, compensate_projector(proj, turned.phasors)
@@ -334,7 +320,7 @@ def detect_suppressed(
             zp, proj, config, sup.noise_floor_w
         )
         coherence[projected] = _fit(proj, zp, y, steering_vector(u[projected], config), own)
-    return SuppressedDetections(det, u, coherence, elevation_measured, residue, other_residue, u_other)
+    return SuppressedDetections(det, directions)
 
 
 def _fit(proj: np.ndarray, z: np.ndarray, y: np.ndarray, s: np.ndarray, whitened: np.ndarray) -> np.ndarray:

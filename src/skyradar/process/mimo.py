@@ -57,7 +57,7 @@ __all__ = [
     "compensate_slot_phase",
     "virtual_pixels",
     "compensate_projector",
-    "PlainDirections",
+    "DetectionDirections",
     "plain_directions",
 ]
 
@@ -424,15 +424,19 @@ def compensate_projector(proj: np.ndarray, phasors: np.ndarray) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class PlainDirections:
-    """Directions of detections read from their pixels as they are (no clutter projection).
+class DetectionDirections:
+    """Directions of one frame's detections, as the pipeline reads them from their pixels.
 
     Attributes
     ----------
     u_ant : ndarray, shape (n, 3)
-        Antenna-frame unit vectors (:func:`skyradar.process.doa.estimate_directions`).
+        Antenna-frame unit vectors (:func:`skyradar.process.doa.estimate_directions`, or through a
+        cell's clutter nulls).
     coherence : ndarray, shape (n,)
-        One plane wave's fit to each pixel (:func:`skyradar.process.doa.direction_coherence`).
+        One plane wave's fit to each pixel (:func:`skyradar.process.doa.direction_coherence`; through
+        the nulls where the direction was searched there).
+    elevation_measured : ndarray, shape (n,), bool
+        False where the nulls left the elevation unobservable and ``u_ant`` holds elevation 0 (a prior).
     residue, other_residue : ndarray, shape (n,), int
         A time-division MIMO radar's chosen and runner-up residue (:func:`virtual_pixels`); 0 and
         -1 with one transmitter.
@@ -448,6 +452,7 @@ class PlainDirections:
 
     u_ant: np.ndarray
     coherence: np.ndarray
+    elevation_measured: np.ndarray
     residue: np.ndarray
     other_residue: np.ndarray
     other_u_ant: np.ndarray
@@ -455,9 +460,10 @@ class PlainDirections:
 
 def plain_directions(
     pixels: np.ndarray, doppler_bin: np.ndarray | int, config: RadarConfig
-) -> PlainDirections:
-    """Directions of calibrated detection pixels: a MIMO radar's after :func:`virtual_pixels` (slot
-    phase out, residue chosen by the field of view), with the runner-up residue's direction too.
+) -> DetectionDirections:
+    """Directions of calibrated detection pixels read as they are (no clutter nulls; every elevation
+    measured): a MIMO radar's after :func:`virtual_pixels` (slot phase out, residue chosen by the
+    field of view), with the runner-up residue's direction too.
 
     Parameters
     ----------
@@ -470,7 +476,7 @@ def plain_directions(
 
     Returns
     -------
-    PlainDirections
+    DetectionDirections
 
     Examples
     --------
@@ -491,6 +497,5 @@ def plain_directions(
         u_other = estimate_directions(virtual.other_pixels, config, calibrated=True)
         residue, other_residue = virtual.residue.astype(np.int64), virtual.other_residue.astype(np.int64)
     u = estimate_directions(z, config, calibrated=True)
-    return PlainDirections(
-        u, direction_coherence(z, u, config, calibrated=True), residue, other_residue, u_other
-    )
+    coherence = direction_coherence(z, u, config, calibrated=True)
+    return DetectionDirections(u, coherence, np.ones(n, bool), residue, other_residue, u_other)

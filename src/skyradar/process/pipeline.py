@@ -51,7 +51,6 @@ from skyradar.process.doa import (
     angles_from_direction,
     antenna_to_body,
     channel_calibration,
-    direction_from_angles,
 )
 from skyradar.process.ground import GeodeticFn, flag_ground, height_above_ground_m, surface_height_fn
 from skyradar.process.mimo import plain_directions
@@ -167,8 +166,9 @@ def process_cube(
         vectors, ``coherence`` (:func:`.direction_coherence`), ``residue`` and ``other_residue``
         (a time-division MIMO radar's chosen and runner-up residue of the velocity ambiguity,
         :func:`skyradar.process.mimo.virtual_pixels`; 0 and -1 with one transmitter),
-        ``other_azimuth_rad`` and ``other_elevation_rad``, the runner-up's direction (rad), and
-        ``other_body_m`` (n, 3), the body position it gives (NaN with one transmitter), m.
+        ``other_azimuth_rad``, ``other_elevation_rad`` and ``other_u_ant`` (n, 3), the runner-up's
+        direction (rad; unit vectors), and ``other_body_m`` (n, 3), the body position it gives (NaN
+        with one transmitter), m.
 
     Examples
     --------
@@ -198,23 +198,14 @@ def process_cube(
         found = detect_suppressed(
             cube, config, clutter, exclude, method, pfa_secondary=pfa_secondary, **detect_kwargs
         )
-        det, u, coherence, elevation_measured = (
-            found.detections,
-            found.u_ant,
-            found.coherence,
-            found.elevation_measured,
-        )
-        residue, other_residue, u_other = found.residue, found.other_residue, found.other_u_ant
+        det, directions = found.detections, found.directions
     else:
         calibration = channel_calibration(config)
         power = integrate_channels(cube, calibration)
         det = detect(power, config, method=method, exclude=exclude, **detect_kwargs)
-        plain = plain_directions(
-            cube[det.range_index, det.doppler_index] / calibration, det.doppler_bin, config
-        )
-        u, coherence, u_other = plain.u_ant, plain.coherence, plain.other_u_ant
-        residue, other_residue = plain.residue, plain.other_residue
-        elevation_measured = np.ones(len(det), bool)
+        pixels = cube[det.range_index, det.doppler_index] / calibration
+        directions = plain_directions(pixels, det.doppler_bin, config)
+    u, u_other = directions.u_ant, directions.other_u_ant
     range_m = det.range_m(config)
     body = antenna_to_body(range_m[:, None] * u, config)
     az, el = angles_from_direction(u)
@@ -237,16 +228,17 @@ def process_cube(
         "power_db": 10.0 * np.log10(np.maximum(det.power_w, 1e-300)),
         "azimuth_rad": az,
         "elevation_rad": el,
-        "elevation_measured": elevation_measured,
+        "elevation_measured": directions.elevation_measured,
         "x_body_m": body[:, 0],
         "y_body_m": body[:, 1],
         "z_body_m": body[:, 2],
         "spur": spur,
         "secondary": det.secondary,
         "u_ant": u,
-        "coherence": coherence,
-        "residue": residue,
-        "other_residue": other_residue,
+        "coherence": directions.coherence,
+        "residue": directions.residue,
+        "other_residue": directions.other_residue,
+        "other_u_ant": u_other,
         "other_azimuth_rad": other_az,
         "other_elevation_rad": other_el,
         "other_body_m": body_other,
@@ -327,7 +319,7 @@ def _ground_flags(
     return, 30-80 deg down within 1.4 heights of range) is strong enough to be detected there, and
     the field of view, which chooses the residue, prefers the mirror near the horizontal: read so,
     it sits a few tens of metres above the own-ship with every Doppler of the folded image, and
-    started tracks near co-altitude that only the runner-up's direction explains.
+    would start tracks near co-altitude that only the runner-up's direction explains.
     """
     n = len(out["range_m"])
     if own is None or n == 0:
@@ -345,8 +337,7 @@ def _ground_flags(
     vel = np.array([own.vn_mps[i], own.ve_mps[i], own.vd_mps[i]])
     ant_to_ned = _body_to_ned(own, i, origin) @ config.mount.rotation
     flags = flag_ground(out, u_ned, vel, ant_to_ned, height_fn, own_agl, config)
-    other = np.isfinite(out["other_azimuth_rad"]) & np.isfinite(out["other_elevation_rad"])
-    other &= np.isfinite(out["other_down_m"]) & ~flags
+    other = np.isfinite(out["other_u_ant"]).all(axis=1) & np.isfinite(out["other_down_m"]) & ~flags
     if other.any():
         mirror = {k: np.asarray(v)[other] for k, v in out.items() if np.ndim(v) >= 1 and len(v) == n}
         mirror |= {
@@ -355,7 +346,7 @@ def _ground_flags(
             "north_m": mirror["other_north_m"],
             "east_m": mirror["other_east_m"],
             "down_m": mirror["other_down_m"],
-            "u_ant": direction_from_angles(mirror["other_azimuth_rad"], mirror["other_elevation_rad"]),
+            "u_ant": mirror["other_u_ant"],
         }
         u_mirror = mirror["u_ant"] @ ant_to_ned.T
         flags[other] = flag_ground(mirror, u_mirror, vel, ant_to_ned, height_fn, own_agl, config)

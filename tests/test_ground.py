@@ -180,3 +180,43 @@ def test_altitude_return_read_straight_up_is_ground():
 
     flags = flag_ground(frame, u, np.array([50.0, 0.0, 0.0]), np.eye(3), height_fn, 300.0, CFG)
     assert flags.tolist() == [True, False, False]
+
+
+def test_altitude_return_read_through_the_other_residue_is_ground():
+    # A time-division MIMO radar with two transmitters half a wavelength apart in height reads a
+    # wrong residue as a vertical direction cosine shifted by one: the ground 10 deg ahead of the
+    # nadir, 300 m below, reads a little above the boresight. Through that shift it is the ground,
+    # at its range and static Doppler; a level aircraft read the same way farther out, or closing
+    # faster than any ground at that range, is not, and an array without transmitter slots
+    # (the prototype's) has no such reading of the ground.
+    from skyradar.process.ground import flag_ground
+
+    mimo = RadarConfig.prototype_2022(rx_positions_m="mimo-2x4")
+    ring = np.radians(10.0)
+    truth = np.array([np.sin(ring), 0.0, np.cos(ring)])  # forward, right, down
+    read = truth + np.array([0.0, 0.0, -1.0])
+    read[0] = np.sqrt(1.0 - read[2] ** 2)
+    u = np.repeat(read[None], 3, axis=0)
+    rng = np.array([300.0 / np.cos(ring), 1000.0, 300.0 / np.cos(ring)])
+    v_ground = -50.0 * np.sin(ring)
+    el = np.arcsin(-u[:, 2])
+    p = rng[:, None] * u
+    frame = {
+        "range_m": rng,
+        "snr_db": np.full(3, 15.0),
+        "azimuth_rad": np.zeros(3),
+        "elevation_rad": el,
+        "north_m": p[:, 0],
+        "east_m": p[:, 1],
+        "down_m": p[:, 2],
+        "radial_velocity_mps": np.array([v_ground, v_ground, -25.0]),
+        "u_ant": u,
+        "coherence": np.full(3, 0.95),
+    }
+
+    def height_fn(points):
+        return 300.0 - np.asarray(points, float)[..., 2]
+
+    args = (np.array([50.0, 0.0, 0.0]), np.eye(3), height_fn, 300.0)
+    assert flag_ground(frame, u, *args, mimo).tolist() == [True, False, False]
+    assert flag_ground(frame, u, *args, CFG).tolist() == [False, False, False]

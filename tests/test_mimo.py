@@ -629,3 +629,30 @@ def test_a_tracks_range_rate_chooses_each_detections_residue():
         heights[with_other] = -last["down_m"].to_numpy()
     assert np.all(np.abs(heights[True] - 230.0) < 30.0)
     assert np.median(np.abs(heights[False] - 230.0)) > 60.0
+
+
+@pytest.mark.parametrize(
+    "tx_down_m",
+    [[-0.25, 0.25], [-0.5, 0.0, 0.5]],  # in wavelengths: two and three transmitters on one line
+)
+def test_a_wrong_residue_reads_as_the_shifted_direction(tx_down_m):
+    # Closed form: the compensation off by residue m leaves exp(-i 2 pi m t / n_tx) on transmitter
+    # t's channels, the same phases (up to one common factor) as a plane wave from u + d.
+    lam = MIMO.wavelength_m
+    tx = np.array([[0.0, 0.0, z * lam] for z in tx_down_m])
+    cfg = RadarConfig.prototype_2022(rx_positions_m=MIMO.rx_positions_m, tx_positions_m=tx, n_doppler=252)
+    shifts = mimo.residue_shifts(cfg)
+    assert len(shifts) == 2 * (cfg.n_tx - 1)
+    u = direction_from_angles(np.radians(12.0), np.radians(-7.0))
+    slots = np.repeat(np.arange(cfg.n_tx), cfg.n_rx)
+    for m in range(1, cfg.n_tx):
+        read = steering_vector(u, cfg) * np.exp(-2j * np.pi * m * slots / cfg.n_tx)
+        fits = [np.abs(np.vdot(steering_vector(u + d, cfg), read)) / cfg.n_virtual for d in shifts]
+        assert max(fits) == pytest.approx(1.0, abs=1e-9)
+
+
+def test_transmitters_off_one_uniform_line_have_no_residue_shift():
+    lam = MIMO.wavelength_m
+    tx = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.5 * lam], [0.0, 0.0, 1.7 * lam]])
+    cfg = RadarConfig.prototype_2022(rx_positions_m=MIMO.rx_positions_m, tx_positions_m=tx, n_doppler=252)
+    assert mimo.residue_shifts(cfg).shape == (0, 3)

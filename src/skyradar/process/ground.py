@@ -330,6 +330,7 @@ def classify_ground(
     height_sd: np.ndarray | None = None,
     leakage_bins: float = 2.0,
     doppler_sd: np.ndarray | None = None,
+    below_is_ground: np.ndarray | bool = True,
 ) -> np.ndarray:
     """True for ground returns: on the surface, or in a ground direction at ground Doppler.
 
@@ -341,6 +342,9 @@ def classify_ground(
     standard deviations of the height and of the static radial velocity; ``height_margin_m`` is
     the 3-sd height below which the position alone proves ground; ``leakage_bins`` the range
     bins a ground return leaks (window sidelobes, straddle). No height: nothing is ground.
+    ``below_is_ground`` (bool or (n,)): a position more than 3 sd below the surface is ground (a
+    measured direction: nothing flies there); False where the direction is a hypothesis that
+    holds only at the surface (an alias: along it the ground lies nearer than the range).
 
     Examples
     --------
@@ -370,11 +374,12 @@ def classify_ground(
         leak = leakage_bins * config.range_resolution_m * np.abs(np.nan_to_num(u[:, 2]))
         # Position and Doppler tested jointly: both within 3 sd together (chi-square, 2 dof, 99.73 %),
         # the position allowed to fall short of the surface by the range leakage.
-        z_h = np.maximum(h - leak, 0.0) / sd
+        # Only a measured direction may fall below the surface: along an alias the ground is nearer.
+        z_h = np.maximum(h - leak, np.where(below_is_ground, 0.0, np.maximum(-h, 0.0))) / sd
         joint = z_h**2 + z_v**2 <= _CHI2_2DOF_3SD
-        conclusive = (h <= 3.0 * sd) & (3.0 * sd <= height_margin_m)
+        conclusive = (h <= 3.0 * sd) & (3.0 * sd <= height_margin_m) & (below_is_ground | (h >= -3.0 * sd))
         below = h < -3.0 * sd
-    return np.isfinite(h) & (joint | conclusive | below)
+    return np.isfinite(h) & (joint | conclusive | (below & below_is_ground))
 
 
 def surface_height_fn(
@@ -424,7 +429,10 @@ def flag_ground(
     Near the end-fire of a baseline (direction cosine above sin 45 deg) the mirrored direction is
     tested too: the phase step is near +-pi there, and the ground straight below (the altitude
     return) is otherwise read as a direction above the aircraft; read so, it is ground when its
-    range and Doppler are the ground's within the DoA's cone around the nadir.
+    range and Doppler are the ground's within the DoA's cone around the nadir. A time-division
+    MIMO radar's direction is tested too as each wrong residue would have shifted it
+    (:func:`skyradar.process.mimo.residue_shifts`): for ``mimo-2x4`` the other residue reads the
+    altitude return near the boresight, a level target a few hundred metres ahead.
 
     Parameters
     ----------
@@ -486,7 +494,9 @@ def flag_ground(
     # Every surface height this frame asks for, in one call of height_fn: over a DEM each call
     # converts its points to geodetic and looks them up, a fixed cost larger than the points'.
     el = np.asarray(out["elevation_rad"], float)[unreliable]
-    heights = _Prefetched(height_fn, _surface_queries(u_ant, rng, unreliable, el, antenna, ant_to_ned))
+    aliases = _alias_directions(u_ant, config)
+    queries = _surface_queries(u_ant, rng, unreliable, el, antenna, ant_to_ned, aliases)
+    heights = _Prefetched(height_fn, queries)
     args = (antenna, ant_to_ned, heights, own_velocity_ned_mps, config)
     ground = _ground_along(u_ant, rng, v_r, sd_az, sd_el, *args)
     # Over relief, ground beside the track can be nearer than the ground below: widen the band by
@@ -495,7 +505,7 @@ def flag_ground(
     if unreliable.any():
         margin_m[unreliable] += terrain_rise_m(heights, antenna, rng[unreliable])
     band = in_ground_band(rng, v_r, own_velocity_ned_mps, own_height_agl_m, config, terrain_margin_m=margin_m)
-    mirrored = _mirrored_ground(u_ant, rng, v_r, sd_az, sd_el, band, own_height_agl_m, args)
+    mirrored = _mirrored_ground(aliases, rng, v_r, sd_az, sd_el, band, own_height_agl_m, args)
     ground |= mirrored
     sel = unreliable & band
     hit = sel & mirrored
@@ -511,35 +521,61 @@ def flag_ground(
     return np.where(measured, np.where(unreliable, hit, ground), mirrored)
 
 
-def _mirrored_ground(u_ant, rng, v_r, sd_az, sd_el, band, own_agl_m, args) -> np.ndarray:
-    """Ground read through the mirrored direction of detections near the end-fire of a baseline.
+def _mirrored_ground(aliases, rng, v_r, sd_az, sd_el, band, own_agl_m, args) -> np.ndarray:
+    """Ground read through the other directions the array reads as the detections' (aliases).
 
-    The phase step is close to +-pi there and noise flips its sign, so the mirrored direction is
-    as plausible: the ground straight below read as straight above. The return of the ground below
-    (the altitude return, the strongest of all: normal incidence at the shortest range) is ground
-    when its range and Doppler are in the ground band and its range is one that ground within the
-    DoA's 3-sd cone around that direction can have: at the pole the linearised Doppler error of
-    :func:`classify_ground` vanishes, though every direction of that cone is as likely.
+    Near the end-fire of a baseline the phase step is close to +-pi and noise flips its sign, so
+    the mirrored direction is as plausible: the ground straight below read as straight above; a
+    time-division MIMO radar's wrong residue reads the ground below near the boresight. The return
+    of the ground below (the altitude return, the strongest of all: normal incidence at the shortest
+    range) is ground when its range and Doppler are in the ground band and its range is one that
+    ground within the DoA's 3-sd cone around that direction can have: at the pole the linearised
+    Doppler error of :func:`classify_ground` vanishes, though every direction of that cone is as
+    likely.
     """
     antenna, ant_to_ned, _, _, config = args
-    mirror, amb = _mirrors(u_ant)
+    u_alias, row, measured_below = aliases
     mirrored = np.zeros(rng.shape, bool)
-    if not amb.any():
+    if not row.size:
         return mirrored
-    mirrored[amb] = _ground_along(mirror[amb], rng[amb], v_r[amb], sd_az[amb], sd_el[amb], *args)
-    cone_cos = np.cos(3.0 * np.maximum(sd_az, sd_el))
+    r, sa, se = rng[row], sd_az[row], sd_el[row]
+    hit = _ground_along(u_alias, r, v_r[row], sa, se, *args, below=measured_below)
+    cone_cos = np.cos(3.0 * np.maximum(sa, se))
     leak = _ALTITUDE_LEAK_BINS * config.range_resolution_m
-    down = (mirror @ np.asarray(ant_to_ned, float).T)[:, 2]
+    down = (u_alias @ np.asarray(ant_to_ned, float).T)[:, 2]
     with np.errstate(invalid="ignore"):
-        altitude = amb & band & (down >= cone_cos) & (rng * cone_cos <= own_agl_m + leak)
-    return mirrored | altitude
+        hit |= band[row] & (down >= cone_cos) & (r * cone_cos <= own_agl_m + leak)
+    np.logical_or.at(mirrored, row, hit)
+    return mirrored
 
 
-def _mirrors(u_ant: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Directions with the end-fire direction cosines mirrored (beyond sin 45 deg), and which changed."""
+def _alias_directions(u_ant: np.ndarray, config: RadarConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The other directions (m, 3) the array reads as detections' directions ``u_ant``, the
+    detection row (m,) of each, and whether a position below the surface along it is ground (m,).
+
+    The end-fire mirror: direction cosines beyond sin 45 deg with their sign flipped (a phase
+    step near +-pi). A time-division MIMO radar's residue shifts
+    (:func:`skyradar.process.mimo.residue_shifts`): the direction cosines across the array moved
+    by each shift, where they stay inside the unit circle, the forward component's sign kept; a
+    residue's direction is ground only at the surface (below it, the ground along that direction
+    is nearer than the detection, which the other residue then does not explain).
+    """
+    from skyradar.process.mimo import residue_shifts
+
     mirror = u_ant.copy()
     mirror[:, 1:] *= np.where(np.abs(u_ant[:, 1:]) > _ENDFIRE_COSINE, -1.0, 1.0)
-    return mirror, np.any(mirror != u_ant, axis=1)
+    changed = np.flatnonzero(np.any(mirror != u_ant, axis=1))
+    directions, rows = [mirror[changed]], [changed]
+    for shift in residue_shifts(config):
+        across = u_ant[:, 1:] + shift[1:]
+        rest = 1.0 - np.sum(across**2, axis=1)
+        with np.errstate(invalid="ignore"):
+            inside = np.flatnonzero(rest >= 0.0)
+        forward = np.where(u_ant[inside, 0] < 0.0, -1.0, 1.0) * np.sqrt(rest[inside])
+        directions.append(np.column_stack([forward, across[inside]]))
+        rows.append(inside)
+    below = np.concatenate([np.full(len(r), k == 0) for k, r in enumerate(rows)])
+    return np.concatenate(directions), np.concatenate(rows), below
 
 
 def _along_points(
@@ -549,12 +585,12 @@ def _along_points(
     return antenna + rng[:, None] * (u_ant @ np.asarray(ant_to_ned, float).T)
 
 
-def _surface_queries(u_ant, rng, unreliable, el, antenna, ant_to_ned) -> list[np.ndarray]:
+def _surface_queries(u_ant, rng, unreliable, el, antenna, ant_to_ned, aliases) -> list[np.ndarray]:
     """The point sets :func:`flag_ground` asks the surface height of, built as its steps build them."""
-    mirror, amb = _mirrors(u_ant)
+    u_alias, row, _ = aliases
     queries = [_along_points(u_ant, rng, antenna, ant_to_ned)]
-    if amb.any():
-        queries.append(_along_points(mirror[amb], rng[amb], antenna, ant_to_ned))
+    if row.size:
+        queries.append(_along_points(u_alias, rng[row], antenna, ant_to_ned))
     if unreliable.any():
         queries.append(antenna[None])
         queries.append(rise_points(antenna, rng[unreliable])[1])
@@ -589,11 +625,15 @@ class _Prefetched:
         return self._fn(points)
 
 
-def _ground_along(u_ant, rng, v_r, sd_az, sd_el, antenna, ant_to_ned, height_fn, vel, config) -> np.ndarray:
+def _ground_along(
+    u_ant, rng, v_r, sd_az, sd_el, antenna, ant_to_ned, height_fn, vel, config, below=True
+) -> np.ndarray:
     """:func:`classify_ground` of detections at ``rng`` along antenna-frame directions ``u_ant``."""
     u_ned = u_ant @ np.asarray(ant_to_ned, float).T
     h = height_fn(antenna + rng[:, None] * u_ned)
     sd_h = height_sd_m(rng, sd_az, sd_el, u_ant, ant_to_ned, config, SURFACE_SD_M)
     sd_v = static_doppler_sd_mps(u_ant, sd_az, sd_el, ant_to_ned, vel)
     sigma = np.maximum(sd_az, sd_el)
-    return classify_ground(rng, v_r, u_ned, config, vel, h, sigma, height_sd=sd_h, doppler_sd=sd_v)
+    return classify_ground(
+        rng, v_r, u_ned, config, vel, h, sigma, height_sd=sd_h, doppler_sd=sd_v, below_is_ground=below
+    )

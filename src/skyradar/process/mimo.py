@@ -57,6 +57,7 @@ __all__ = [
     "compensate_slot_phase",
     "virtual_pixels",
     "compensate_projector",
+    "residue_shifts",
     "DetectionDirections",
     "plain_directions",
 ]
@@ -421,6 +422,56 @@ def compensate_projector(proj: np.ndarray, phasors: np.ndarray) -> np.ndarray:
     """
     d = np.asarray(phasors)
     return np.asarray(proj) * d[:, :, None] * np.conj(d)[:, None, :]
+
+
+def residue_shifts(config: RadarConfig) -> np.ndarray:
+    """Direction-cosine shifts (n, 3) in the antenna frame that a wrong residue mimics, both signs.
+
+    Compensating a target's slot phase with residue ``m`` off the true one leaves the phase
+    ``2 pi m t / n_tx`` on transmitter ``t``'s channels (module docstring): the pixels of a plane
+    wave from ``u + d`` with ``(tx_t - tx_0) . d = -m t lambda / n_tx`` on every transmitter.
+    Where that shift leaves every receiver's phase unchanged (``(rx_r - rx_0) . d`` a whole number
+    of wavelengths) the wrong residue reads the direction ``u`` as ``u + d`` exactly, whatever
+    ``u``: the ground straight below, read through the other residue, sits near the boresight.
+    Shifts without that exact form (transmitters off one uniform line) are left out: no single
+    direction mimics them. Each ``d`` is given with ``-d`` (the residues ``m`` and ``n_tx - m``).
+
+    Parameters
+    ----------
+    config : RadarConfig
+        The radar; one transmitter has no shifts.
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+        Shifts ``d`` of the unit direction's components (forward, right, down), dimensionless.
+
+    Examples
+    --------
+    Two transmitters half a wavelength apart in height: the other residue moves the vertical
+    direction cosine by one, so the nadir (``0, 0, 1``) reads as the boresight:
+
+    >>> residue_shifts(RadarConfig.prototype_2022(rx_positions_m="mimo-2x4")).round(6).tolist()
+    [[0.0, 0.0, -1.0], [-0.0, -0.0, 1.0]]
+    >>> residue_shifts(RadarConfig.prototype_2022()).shape
+    (0, 3)
+    """
+    n_tx = config.n_tx
+    if n_tx == 1:
+        return np.zeros((0, 3))
+    tx = np.asarray(config.transmitters_m, float)
+    rx = np.asarray(config.rx_positions_m, float)
+    lam = config.wavelength_m
+    shifts = []
+    for m in range(1, n_tx):
+        target = -m * np.arange(n_tx) * lam / n_tx
+        d_yz = np.linalg.lstsq((tx - tx[0])[:, 1:], target, rcond=None)[0]
+        d = np.array([0.0, *d_yz])
+        tx_err = ((tx - tx[0]) @ d - target) / lam
+        rx_cycles = (rx - rx[0]) @ d / lam
+        if np.allclose(tx_err, 0.0, atol=1e-6) and np.allclose(rx_cycles, np.round(rx_cycles), atol=1e-6):
+            shifts += [d, -d]
+    return np.array(shifts).reshape(-1, 3)
 
 
 @dataclass(frozen=True)

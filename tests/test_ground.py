@@ -220,3 +220,37 @@ def test_altitude_return_read_through_the_other_residue_is_ground():
     args = (np.array([50.0, 0.0, 0.0]), np.eye(3), height_fn, 300.0)
     assert flag_ground(frame, u, *args, mimo).tolist() == [True, False, False]
     assert flag_ground(frame, u, *args, CFG).tolist() == [False, False, False]
+
+
+def test_unmeasured_elevation_in_the_altitude_ring_is_ground_where_its_cone_meets_the_ring():
+    # Over flat ground 300 m below, flying north at 50 m/s: at 310 m the ground forms a ring
+    # 14.6 deg around the nadir; the point of it behind, with a horizontal direction cosine of
+    # -0.1, recedes at 50 * 0.2305 = 11.5 m/s. A detection whose elevation the nulls left
+    # unmeasured (the level prior) on that cone, at that range cell and Doppler, is that ground;
+    # at a Doppler no point of the ring on its cone has, or beyond the ring, it is left to its track.
+    from skyradar.process.ground import flag_ground
+
+    across = -0.1
+    u = np.repeat([[np.sqrt(1.0 - across**2), across, 0.0]], 3, axis=0)
+    behind = np.sqrt(1.0 - across**2 - (300.0 / 310.0) ** 2)
+    rng = np.array([307.0, 307.0, 600.0])
+    p = rng[:, None] * u
+    frame = {
+        "range_m": rng,
+        "snr_db": np.full(3, 15.0),
+        "azimuth_rad": np.full(3, np.arcsin(across)),
+        "elevation_rad": np.zeros(3),
+        "north_m": p[:, 0],
+        "east_m": p[:, 1],
+        "down_m": p[:, 2],
+        "radial_velocity_mps": np.array([50.0 * behind, -40.0, 50.0 * behind]),
+        "u_ant": u,
+        "coherence": np.full(3, 0.95),
+        "elevation_measured": np.zeros(3, bool),
+    }
+
+    def height_fn(points):
+        return 300.0 - np.asarray(points, float)[..., 2]
+
+    flags = flag_ground(frame, u, np.array([50.0, 0.0, 0.0]), np.eye(3), height_fn, 300.0, CFG)
+    assert flags.tolist() == [True, False, False]

@@ -516,9 +516,74 @@ def flag_ground(
         tested = ground_in_elevation(rng[unreliable], el, heights, antenna, ant_to_ned, margin)
         hit[sel] |= tested[sel[unreliable]]
     # An elevation the nulls left unobservable is a prior (elevation 0), not a measurement: such a
-    # detection is ground here only by the mirror rule; its track's history decides the rest.
+    # detection is ground here by the mirror rule, or when it lies in the altitude ring and its
+    # azimuth cone meets that ring where the ground has its Doppler; its track's history decides
+    # the rest.
     measured = np.asarray(out.get("elevation_measured", np.ones(rng.size, bool)), bool)
-    return np.where(measured, np.where(unreliable, hit, ground), mirrored)
+    ring = np.zeros(rng.shape, bool)
+    if not measured.all():
+        free = ~measured
+        ring[free] = _ring_ground(u_ant[free], rng[free], v_r[free], sd_az[free], own_height_agl_m, args)
+    return np.where(measured, np.where(unreliable, hit, ground), mirrored | ring)
+
+
+def _ring_ground(u_ant, rng, v_r, sd_az, own_agl_m, args) -> np.ndarray:
+    """Detections of unmeasured elevation that the altitude ring explains.
+
+    The ground nearest the radar lies straight below; at a range ``R`` just beyond the height
+    ``h`` it forms a ring at the angle ``acos(h / R)`` around the nadir, seen at near-normal
+    incidence (the strongest ground of the frame) through the sidelobes at every azimuth and
+    either side of the array's plane. A detection whose elevation the nulls left unmeasured lies
+    somewhere on the cone of its measured horizontal direction cosine ``c``. On that cone,
+    ``u = (sqrt(1 - c^2) cos t, c, sqrt(1 - c^2) sin t)`` (antenna frame), a static point's radial
+    velocity ``-v . u`` equals the detection's (any alias) at two angles ``t`` in closed form; the
+    flat ground ``h`` below lies along each at the range ``h / (u . down)``. Within the altitude
+    return's leak plus one range cell of the height, the detection is ground when one of those
+    ranges is its own within the leak and half a cell and the surface is there
+    (:func:`classify_ground` at that point, which also allows the cone's azimuth uncertainty).
+    Farther out a detection's unmeasured elevation is left to its track: there an aircraft in a
+    ground cell is as likely.
+    """
+    antenna, ant_to_ned, _, vel, config = args
+    cell = config.range_resolution_m
+    reach_m = _ALTITUDE_LEAK_BINS * cell + 0.5 * cell
+    ground = np.zeros(rng.shape, bool)
+    near = np.flatnonzero(rng <= own_agl_m + reach_m + 0.5 * cell)
+    if not near.size or not np.isfinite(own_agl_m) or own_agl_m <= 0.0 or not np.all(np.isfinite(vel)):
+        return ground
+    rotation = np.asarray(ant_to_ned, float)
+    down_axis = rotation[2]  # the NED down axis in the antenna frame
+    v_ant = rotation.T @ np.asarray(vel, float)
+    across = np.clip(u_ant[near, 1], -1.0, 1.0)
+    radius = np.sqrt(1.0 - across**2)
+    a, b = v_ant[0] * radius, v_ant[2] * radius
+    amplitude = np.maximum(np.hypot(a, b), 1e-12)
+    width = 2.0 * config.v_lim_mps
+    n_alias = int(np.ceil(np.linalg.norm(vel) / width)) + 1
+    directions, rows, ranges = [], [], []
+    for k in range(-n_alias, n_alias + 1):
+        needed = -(v_r[near] + k * width) - v_ant[1] * across  # = a cos t + b sin t
+        ratio = needed / amplitude
+        meets = np.abs(ratio) <= 1.0
+        spread = np.arccos(np.clip(ratio, -1.0, 1.0))
+        for side in (-1.0, 1.0):
+            t = np.arctan2(b, a) + side * spread
+            u = np.column_stack([radius * np.cos(t), across, radius * np.sin(t)])
+            down = u @ down_axis
+            with np.errstate(divide="ignore", invalid="ignore"):
+                r_ground = own_agl_m / down
+            ok = meets & (down > 0.0) & (np.abs(r_ground - rng[near]) <= reach_m)
+            directions.append(u[ok])
+            rows.append(near[ok])
+            ranges.append(r_ground[ok])
+    row = np.concatenate(rows)
+    if not row.size:
+        return ground
+    sd = sd_az[row]  # the cone's; the ring sets the rest of the direction
+    u_ring, r_ring = np.concatenate(directions), np.concatenate(ranges)
+    hit = _ground_along(u_ring, r_ring, v_r[row], sd, sd, *args, below=False)
+    np.logical_or.at(ground, row, hit)
+    return ground
 
 
 def _mirrored_ground(aliases, rng, v_r, sd_az, sd_el, band, own_agl_m, args) -> np.ndarray:

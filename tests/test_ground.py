@@ -254,3 +254,35 @@ def test_unmeasured_elevation_in_the_altitude_ring_is_ground_where_its_cone_meet
 
     flags = flag_ground(frame, u, np.array([50.0, 0.0, 0.0]), np.eye(3), height_fn, 300.0, CFG)
     assert flags.tolist() == [True, False, False]
+
+
+def test_altitude_return_read_just_below_the_boresight_through_the_other_residue_is_ground():
+    # The nadir itself, read through the other residue, is the boresight; DoA noise of a degree
+    # puts it just below, where the residue's shift lands beyond the unit circle. Within 3 sd of
+    # it the shifted direction is the nadir, and the return one range cell short of the height
+    # (its leak) at a few m/s is the altitude return. An aircraft read there at 600 m is not.
+    from skyradar.process.ground import flag_ground
+
+    mimo = RadarConfig.prototype_2022(rx_positions_m="mimo-2x4")
+    read = np.array([np.cos(np.radians(0.6)), 0.0, np.sin(np.radians(0.6))])
+    u = np.repeat(read[None], 2, axis=0)
+    rng = np.array([285.0, 600.0])
+    p = rng[:, None] * u
+    frame = {
+        "range_m": rng,
+        "snr_db": np.full(2, 12.0),
+        "azimuth_rad": np.zeros(2),
+        "elevation_rad": np.full(2, -np.radians(0.6)),
+        "north_m": p[:, 0],
+        "east_m": p[:, 1],
+        "down_m": p[:, 2],
+        "radial_velocity_mps": np.array([-3.0, -3.0]),
+        "u_ant": u,
+        "coherence": np.full(2, 0.95),
+    }
+
+    def height_fn(points):
+        return 300.0 - np.asarray(points, float)[..., 2]
+
+    flags = flag_ground(frame, u, np.array([50.0, 0.0, 0.0]), np.eye(3), height_fn, 300.0, mimo)
+    assert flags.tolist() == [True, False]

@@ -494,7 +494,7 @@ def flag_ground(
     # Every surface height this frame asks for, in one call of height_fn: over a DEM each call
     # converts its points to geodetic and looks them up, a fixed cost larger than the points'.
     el = np.asarray(out["elevation_rad"], float)[unreliable]
-    aliases = _alias_directions(u_ant, config)
+    aliases = _alias_directions(u_ant, config, np.maximum(sd_az, sd_el))
     queries = _surface_queries(u_ant, rng, unreliable, el, antenna, ant_to_ned, aliases)
     heights = _Prefetched(height_fn, queries)
     args = (antenna, ant_to_ned, heights, own_velocity_ned_mps, config)
@@ -614,14 +614,18 @@ def _mirrored_ground(aliases, rng, v_r, sd_az, sd_el, band, own_agl_m, args) -> 
     return mirrored
 
 
-def _alias_directions(u_ant: np.ndarray, config: RadarConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _alias_directions(
+    u_ant: np.ndarray, config: RadarConfig, sd_rad: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The other directions (m, 3) the array reads as detections' directions ``u_ant``, the
     detection row (m,) of each, and whether a position below the surface along it is ground (m,).
 
     The end-fire mirror: direction cosines beyond sin 45 deg with their sign flipped (a phase
     step near +-pi). A time-division MIMO radar's residue shifts
     (:func:`skyradar.process.mimo.residue_shifts`): the direction cosines across the array moved
-    by each shift, where they stay inside the unit circle, the forward component's sign kept; a
+    by each shift, where they stay inside the unit circle within 3 DoA sd (``sd_rad``, rad; the
+    ground below read slightly beyond it is brought back onto it), the forward component's sign
+    kept; a
     residue's direction is ground only at the surface (below it, the ground along that direction
     is nearer than the detection, which the other residue then does not explain).
     """
@@ -633,11 +637,13 @@ def _alias_directions(u_ant: np.ndarray, config: RadarConfig) -> tuple[np.ndarra
     directions, rows = [mirror[changed]], [changed]
     for shift in residue_shifts(config):
         across = u_ant[:, 1:] + shift[1:]
-        rest = 1.0 - np.sum(across**2, axis=1)
+        norm = np.linalg.norm(across, axis=1)
         with np.errstate(invalid="ignore"):
-            inside = np.flatnonzero(rest >= 0.0)
-        forward = np.where(u_ant[inside, 0] < 0.0, -1.0, 1.0) * np.sqrt(rest[inside])
-        directions.append(np.column_stack([forward, across[inside]]))
+            inside = np.flatnonzero(norm <= 1.0 + 3.0 * sd_rad)
+        across = across[inside] / np.maximum(norm[inside], 1.0)[:, None]
+        rest = np.maximum(1.0 - np.sum(across**2, axis=1), 0.0)
+        forward = np.where(u_ant[inside, 0] < 0.0, -1.0, 1.0) * np.sqrt(rest)
+        directions.append(np.column_stack([forward, across]))
         rows.append(inside)
     below = np.concatenate([np.full(len(r), k == 0) for k, r in enumerate(rows)])
     return np.concatenate(directions), np.concatenate(rows), below

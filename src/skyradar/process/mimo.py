@@ -451,8 +451,8 @@ def residue_shifts(config: RadarConfig) -> np.ndarray:
     Two transmitters half a wavelength apart in height: the other residue moves the vertical
     direction cosine by one, so the nadir (``0, 0, 1``) reads as the boresight:
 
-    >>> residue_shifts(RadarConfig.prototype_2022(rx_positions_m="mimo-2x4")).round(6).tolist()
-    [[0.0, 0.0, -1.0], [-0.0, -0.0, 1.0]]
+    >>> (residue_shifts(RadarConfig.prototype_2022(rx_positions_m="mimo-2x4")).round(6) + 0.0).tolist()
+    [[0.0, 0.0, -1.0], [0.0, 0.0, 1.0]]
     >>> residue_shifts(RadarConfig.prototype_2022()).shape
     (0, 3)
     """

@@ -544,7 +544,7 @@ def _ring_ground(u_ant, rng, v_r, sd_az, own_agl_m, args) -> np.ndarray:
     Farther out a detection's unmeasured elevation is left to its track: there an aircraft in a
     ground cell is as likely.
     """
-    antenna, ant_to_ned, _, vel, config = args
+    antenna, ant_to_ned, heights, vel, config = args
     cell = config.range_resolution_m
     reach_m = _ALTITUDE_LEAK_BINS * cell + 0.5 * cell
     ground = np.zeros(rng.shape, bool)
@@ -581,7 +581,9 @@ def _ring_ground(u_ant, rng, v_r, sd_az, own_agl_m, args) -> np.ndarray:
         return ground
     sd = sd_az[row]  # the cone's; the ring sets the rest of the direction
     u_ring, r_ring = np.concatenate(directions), np.concatenate(ranges)
-    hit = _ground_along(u_ring, r_ring, v_r[row], sd, sd, *args, below=False)
+    hit = _ground_along(
+        u_ring, r_ring, v_r[row], sd, sd, antenna, ant_to_ned, heights, vel, config, below=False
+    )
     np.logical_or.at(ground, row, hit)
     return ground
 
@@ -598,13 +600,15 @@ def _mirrored_ground(aliases, rng, v_r, sd_az, sd_el, band, own_agl_m, args) -> 
     Doppler error of :func:`classify_ground` vanishes, though every direction of that cone is as
     likely.
     """
-    antenna, ant_to_ned, _, _, config = args
+    antenna, ant_to_ned, heights, vel, config = args
     u_alias, row, measured_below = aliases
     mirrored = np.zeros(rng.shape, bool)
     if not row.size:
         return mirrored
     r, sa, se = rng[row], sd_az[row], sd_el[row]
-    hit = _ground_along(u_alias, r, v_r[row], sa, se, *args, below=measured_below)
+    hit = _ground_along(
+        u_alias, r, v_r[row], sa, se, antenna, ant_to_ned, heights, vel, config, measured_below
+    )
     cone_cos = np.cos(3.0 * np.maximum(sa, se))
     leak = _ALTITUDE_LEAK_BINS * config.range_resolution_m
     down = (u_alias @ np.asarray(ant_to_ned, float).T)[:, 2]

@@ -629,9 +629,8 @@ def _alias_directions(
     (:func:`skyradar.process.mimo.residue_shifts`): the direction cosines across the array moved
     by each shift, where they stay inside the unit circle within 3 DoA sd (``sd_rad``, rad; the
     ground below read slightly beyond it is brought back onto it), the forward component's sign
-    kept; a
-    residue's direction is ground only at the surface (below it, the ground along that direction
-    is nearer than the detection, which the other residue then does not explain).
+    kept; a residue's direction is ground only at the surface (below it, the ground along that
+    direction is nearer than the detection, which the other residue then does not explain).
     """
     from skyradar.process.mimo import residue_shifts
 

@@ -150,6 +150,29 @@ def test_ridge_beside_the_track_nearer_than_the_ground_below_is_ground():
     assert flag_ground(above, above["u_ant"], *args).tolist() == [False]
 
 
+def _level_frame(u: np.ndarray, rng: np.ndarray, v_r: np.ndarray, snr_db: float, coherence: float) -> dict:
+    """One frame's detection columns at ``rng`` along antenna-frame directions ``u`` of a radar
+    whose antenna frame is NED (level, facing north, at the origin)."""
+    p = rng[:, None] * u
+    return {
+        "range_m": rng,
+        "snr_db": np.full(len(rng), snr_db),
+        "azimuth_rad": np.arctan2(u[:, 1], u[:, 0]),
+        "elevation_rad": np.arcsin(-u[:, 2]),
+        "north_m": p[:, 0],
+        "east_m": p[:, 1],
+        "down_m": p[:, 2],
+        "radial_velocity_mps": np.asarray(v_r, float),
+        "u_ant": u,
+        "coherence": np.full(len(rng), coherence),
+    }
+
+
+def _flat_300(points):
+    """Height above flat ground 300 m below the origin, m."""
+    return 300.0 - np.asarray(points, float)[..., 2]
+
+
 def test_altitude_return_read_straight_up_is_ground():
     # Over flat ground 300 m below, the ground just ahead of the nadir leaks into the range bin one
     # short of the height (window sidelobes, straddle) at a few m/s of closing Doppler; the DoA of
@@ -161,24 +184,9 @@ def test_altitude_return_read_straight_up_is_ground():
     el, az = np.radians(88.0), np.radians(90.0)
     u = np.array([[np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)]] * 3)
     rng = np.array([286.0, 200.0, 286.0])  # altitude return; nearer than the ground; closing fast
-    p = rng[:, None] * u
-    frame = {
-        "range_m": rng,
-        "snr_db": np.full(3, 13.0),
-        "azimuth_rad": np.full(3, az),
-        "elevation_rad": np.full(3, el),
-        "north_m": p[:, 0],
-        "east_m": p[:, 1],
-        "down_m": p[:, 2],
-        "radial_velocity_mps": np.array([-4.4, -4.4, -30.0]),
-        "u_ant": u,
-        "coherence": np.full(3, 0.9),
-    }
+    frame = _level_frame(u, rng, np.array([-4.4, -4.4, -30.0]), snr_db=13.0, coherence=0.9)
 
-    def height_fn(points):
-        return 300.0 - np.asarray(points, float)[..., 2]
-
-    flags = flag_ground(frame, u, np.array([50.0, 0.0, 0.0]), np.eye(3), height_fn, 300.0, CFG)
+    flags = flag_ground(frame, u, np.array([50.0, 0.0, 0.0]), np.eye(3), _flat_300, 300.0, CFG)
     assert flags.tolist() == [True, False, False]
 
 
@@ -199,25 +207,9 @@ def test_altitude_return_read_through_the_other_residue_is_ground():
     u = np.repeat(read[None], 3, axis=0)
     rng = np.array([300.0 / np.cos(ring), 1000.0, 300.0 / np.cos(ring)])
     v_ground = -50.0 * np.sin(ring)
-    el = np.arcsin(-u[:, 2])
-    p = rng[:, None] * u
-    frame = {
-        "range_m": rng,
-        "snr_db": np.full(3, 15.0),
-        "azimuth_rad": np.zeros(3),
-        "elevation_rad": el,
-        "north_m": p[:, 0],
-        "east_m": p[:, 1],
-        "down_m": p[:, 2],
-        "radial_velocity_mps": np.array([v_ground, v_ground, -25.0]),
-        "u_ant": u,
-        "coherence": np.full(3, 0.95),
-    }
+    frame = _level_frame(u, rng, np.array([v_ground, v_ground, -25.0]), snr_db=15.0, coherence=0.95)
 
-    def height_fn(points):
-        return 300.0 - np.asarray(points, float)[..., 2]
-
-    args = (np.array([50.0, 0.0, 0.0]), np.eye(3), height_fn, 300.0)
+    args = (np.array([50.0, 0.0, 0.0]), np.eye(3), _flat_300, 300.0)
     assert flag_ground(frame, u, *args, mimo).tolist() == [True, False, False]
     assert flag_ground(frame, u, *args, CFG).tolist() == [False, False, False]
 
@@ -234,25 +226,10 @@ def test_unmeasured_elevation_in_the_altitude_ring_is_ground_where_its_cone_meet
     u = np.repeat([[np.sqrt(1.0 - across**2), across, 0.0]], 3, axis=0)
     behind = np.sqrt(1.0 - across**2 - (300.0 / 310.0) ** 2)
     rng = np.array([307.0, 307.0, 600.0])
-    p = rng[:, None] * u
-    frame = {
-        "range_m": rng,
-        "snr_db": np.full(3, 15.0),
-        "azimuth_rad": np.full(3, np.arcsin(across)),
-        "elevation_rad": np.zeros(3),
-        "north_m": p[:, 0],
-        "east_m": p[:, 1],
-        "down_m": p[:, 2],
-        "radial_velocity_mps": np.array([50.0 * behind, -40.0, 50.0 * behind]),
-        "u_ant": u,
-        "coherence": np.full(3, 0.95),
-        "elevation_measured": np.zeros(3, bool),
-    }
+    frame = _level_frame(u, rng, np.array([50.0 * behind, -40.0, 50.0 * behind]), snr_db=15.0, coherence=0.95)
+    frame["elevation_measured"] = np.zeros(len(rng), bool)
 
-    def height_fn(points):
-        return 300.0 - np.asarray(points, float)[..., 2]
-
-    flags = flag_ground(frame, u, np.array([50.0, 0.0, 0.0]), np.eye(3), height_fn, 300.0, CFG)
+    flags = flag_ground(frame, u, np.array([50.0, 0.0, 0.0]), np.eye(3), _flat_300, 300.0, CFG)
     assert flags.tolist() == [True, False, False]
 
 
@@ -267,22 +244,7 @@ def test_altitude_return_read_just_below_the_boresight_through_the_other_residue
     read = np.array([np.cos(np.radians(0.6)), 0.0, np.sin(np.radians(0.6))])
     u = np.repeat(read[None], 2, axis=0)
     rng = np.array([285.0, 600.0])
-    p = rng[:, None] * u
-    frame = {
-        "range_m": rng,
-        "snr_db": np.full(2, 12.0),
-        "azimuth_rad": np.zeros(2),
-        "elevation_rad": np.full(2, -np.radians(0.6)),
-        "north_m": p[:, 0],
-        "east_m": p[:, 1],
-        "down_m": p[:, 2],
-        "radial_velocity_mps": np.array([-3.0, -3.0]),
-        "u_ant": u,
-        "coherence": np.full(2, 0.95),
-    }
+    frame = _level_frame(u, rng, np.array([-3.0, -3.0]), snr_db=12.0, coherence=0.95)
 
-    def height_fn(points):
-        return 300.0 - np.asarray(points, float)[..., 2]
-
-    flags = flag_ground(frame, u, np.array([50.0, 0.0, 0.0]), np.eye(3), height_fn, 300.0, mimo)
+    flags = flag_ground(frame, u, np.array([50.0, 0.0, 0.0]), np.eye(3), _flat_300, 300.0, mimo)
     assert flags.tolist() == [True, False]

@@ -248,3 +248,20 @@ def test_altitude_return_read_just_below_the_boresight_through_the_other_residue
 
     flags = flag_ground(frame, u, np.array([50.0, 0.0, 0.0]), np.eye(3), _flat_300, 300.0, mimo)
     assert flags.tolist() == [True, False]
+
+
+def test_a_runner_up_direction_is_ground_only_at_the_surface():
+    # A MIMO aircraft 2 km ahead, 4.6 deg below the boresight, closing faster than the ground:
+    # its runner-up residue reads the vertical cosine one lower, 67 deg up, whose end-fire mirror
+    # points 67 deg down, 1.8 km under flat ground 300 m below. Read as a measurement, a position
+    # below the surface is ground; read as the hypothesis it is, the ground along it is nearer
+    # and explains nothing.
+    from skyradar.process.ground import flag_ground
+
+    mimo = RadarConfig.prototype_2022(rx_positions_m="mimo-2x4")
+    down = np.sin(np.radians(4.6)) - 1.0
+    u = np.array([[np.sqrt(1.0 - down**2), 0.0, down]])
+    frame = _level_frame(u, np.array([2000.0]), np.array([-19.0]), snr_db=15.0, coherence=0.95)
+    args = (u, np.array([50.0, 0.0, 0.0]), np.eye(3), _flat_300, 300.0, mimo)
+    assert flag_ground(frame, *args).tolist() == [True]
+    assert flag_ground(frame, *args, hypothesis=True).tolist() == [False]

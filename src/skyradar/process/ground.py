@@ -416,6 +416,7 @@ def flag_ground(
     height_fn: Callable[[np.ndarray], np.ndarray],
     own_height_agl_m: float,
     config: RadarConfig,
+    hypothesis: bool = False,
 ) -> np.ndarray:
     """``is_ground`` of one frame's detections (dict of columns as built by the pipeline).
 
@@ -453,6 +454,10 @@ def flag_ground(
         Height above the ground directly below, m.
     config : RadarConfig
         Antenna positions and pattern (DoA bound, field of view), Doppler and range axes.
+    hypothesis : bool
+        The directions are hypotheses, not measurements (a MIMO detection's runner-up residue):
+        a position below the surface along them, or along their aliases, is not ground, because
+        the ground along such a direction lies nearer than the detection.
 
     Returns
     -------
@@ -494,11 +499,12 @@ def flag_ground(
     # Every surface height this frame asks for, in one call of height_fn: over a DEM each call
     # converts its points to geodetic and looks them up, a fixed cost larger than the points'.
     el = np.asarray(out["elevation_rad"], float)[unreliable]
-    aliases = _alias_directions(u_ant, config, np.maximum(sd_az, sd_el))
+    u_alias, alias_row, alias_below = _alias_directions(u_ant, config, np.maximum(sd_az, sd_el))
+    aliases = (u_alias, alias_row, alias_below & (not hypothesis))
     queries = _surface_queries(u_ant, rng, unreliable, el, antenna, ant_to_ned, aliases)
     heights = _Prefetched(height_fn, queries)
     args = (antenna, ant_to_ned, heights, own_velocity_ned_mps, config)
-    ground = _ground_along(u_ant, rng, v_r, sd_az, sd_el, *args)
+    ground = _ground_along(u_ant, rng, v_r, sd_az, sd_el, *args, not hypothesis)
     # Over relief, ground beside the track can be nearer than the ground below: widen the band by
     # the terrain's rise around the radar (zero over flat ground, where the fixed margin stays).
     margin_m = np.full(rng.shape, TERRAIN_MARGIN_M)

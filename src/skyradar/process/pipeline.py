@@ -349,7 +349,9 @@ def _ground_flags(
             "u_ant": mirror["other_u_ant"],
         }
         u_mirror = mirror["u_ant"] @ ant_to_ned.T
-        flags[other] = flag_ground(mirror, u_mirror, vel, ant_to_ned, height_fn, own_agl, config)
+        # The runner-up is a hypothesis: along it, as along its aliases, only the surface is ground.
+        runner_up = (mirror, u_mirror, vel, ant_to_ned, height_fn, own_agl, config)
+        flags[other] = flag_ground(*runner_up, hypothesis=True)
     return flags
 
 

@@ -244,12 +244,21 @@ def _project_power(z, vectors, nulls, out):  # pragma: no cover - compiled
     return out
 
 
-def default_max_nulls(n_rx: int) -> int:
+def default_max_nulls(n_rx: int, n_tx: int = 1) -> int:
     """Most clutter directions one cell nulls by default on an array of ``n_rx`` channels.
 
     Over flat ground a range-Doppler cell holds clutter from two directions, left and right of
     the ground track at one depression angle: two nulls, on any array of three channels or more
-    (one on two channels, none on one). A larger array could take more: after ``m`` nulls a
+    (one on two channels, none on one). A time-division MIMO frame of ``n_tx`` transmitters folds
+    ``n_tx`` aliases of each Doppler into one cell (:mod:`skyradar.process.clutter`), each alias a
+    left and right pair of its own: ``2 n_tx`` directions, nulled up to ``n_rx - 2`` so that two
+    dimensions stay to measure a target's direction. With two transmitters the ground that shares
+    an intruder's aliased Doppler at its azimuth lies one alias away from the pair the antenna's
+    sidelobes see far off the nose; two nulls leave that pair 20-30 dB over the noise in the
+    cells of an intruder whose own speed along the line of sight is near ``2 v_lim``
+    (``tests/test_clutter_suppression.py``).
+
+    A larger array could take more: after ``m`` nulls a
     target's snapshot spans ``n_rx - m`` dimensions, and two are enough for its direction to be
     estimable. Over relief more directions hold clutter, and ``suppress_clutter(...,
     max_nulls=n_rx - 2)`` nulls them: on the frames over hills of ``skyradar bench process`` an
@@ -267,6 +276,8 @@ def default_max_nulls(n_rx: int) -> int:
     ----------
     n_rx : int
         Receive (or virtual) channels of the array.
+    n_tx : int
+        Transmitters taking turns (time-division MIMO; 1 otherwise).
 
     Returns
     -------
@@ -277,8 +288,11 @@ def default_max_nulls(n_rx: int) -> int:
     --------
     >>> [default_max_nulls(n) for n in (1, 2, 3, 4, 6, 8)]
     [0, 1, 2, 2, 2, 2]
+    >>> default_max_nulls(8, n_tx=2)  # the 2 TX x 4 RX MIMO array's eight virtual channels
+    4
     """
-    return max(min(2, int(n_rx) - 1), 0)
+    keep = 2 if n_rx >= 4 else 1  # channels left to measure a direction (none to spare below four)
+    return max(min(2 * max(int(n_tx), 1), int(n_rx) - keep), 0)
 
 
 def suppress_clutter(
@@ -344,7 +358,7 @@ def suppress_clutter(
     if cube.shape != subspace.predicted.shape + (config.n_virtual,):
         raise InputError(f"suppression: frame shape {cube.shape} does not fit the clutter prediction")
     if max_nulls is None:
-        max_nulls = default_max_nulls(config.n_virtual)
+        max_nulls = default_max_nulls(config.n_virtual, config.n_tx)
     if not 0 <= max_nulls < config.n_virtual:
         raise InputError(
             f"suppression: field 'max_nulls' must be in [0, {config.n_virtual - 1}], got {max_nulls}"

@@ -317,7 +317,7 @@ def directions_tell_patches(config: RadarConfig) -> bool:
     [False, True]
     """
     n = config.n_virtual
-    return n - default_max_nulls(n) >= 3
+    return n - default_max_nulls(n, config.n_tx) >= 3
 
 
 def altitude_measured(

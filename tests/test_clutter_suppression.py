@@ -221,8 +221,8 @@ def test_intruder_mixed_with_sidelobe_clutter_keeps_its_detections_and_elevation
 
 def _mimo_intruder_at_twice_the_velocity_limit(nulls_for_mimo: int | None, monkeypatch) -> tuple:
     """Detections of three frames of the 2 TX x 4 RX MIMO radar 300 m over flat ground, an
-    intruder 1000 m out, 15 deg right and 3 deg up, flying at the radar at ``2 v_lim``; and the
-    intruder's aliased radial velocity, m/s."""
+    intruder 1000 m out, 15 deg right and 3 deg up, flying at the radar at ``2 v_lim``: the whole
+    table, the intruder's detections not flagged ground, and its (bearing, elevation), rad."""
     from skyradar.process import clutter_suppress
 
     if nulls_for_mimo is not None:

@@ -258,19 +258,19 @@ def default_max_nulls(n_rx: int, n_tx: int = 1) -> int:
     cells of an intruder whose own speed along the line of sight is near ``2 v_lim``
     (``tests/test_clutter_suppression.py``).
 
-    A larger array could take more: after ``m`` nulls a
-    target's snapshot spans ``n_rx - m`` dimensions, and two are enough for its direction to be
-    estimable. Over relief more directions hold clutter, and ``suppress_clutter(...,
-    max_nulls=n_rx - 2)`` nulls them: on the frames over hills of ``skyradar bench process`` an
-    eight-channel array then detects as few cells as the square with two nulls, instead of 2.5
-    times as many. It is not the default because the target pays for it. Each null takes with it
-    the part of the target's steering vector along it, and with two dimensions left its direction
-    is estimable but poorly: on the development fast-closure sets over the hills (the results page,
-    ``...-ura-2x3-ceiling`` against ``...-ura-2x3-two-nulls``, ``...-ura-4x2-ceiling`` against
-    ``...-ura-4x2``), the eight-channel upright array's track of a climbing intruder had its
-    horizontal miss at 1.1-2.8 km for 8 s (386 m true) and was warned 8.3 s later (about when perfect
-    surveillance warns), the six-channel array warned one more must-not-alert encounter, and
-    the tracks on the ground stayed about as many, for twice the processing time a frame.
+    A larger array could take more: after ``m`` nulls a target's snapshot spans ``n_rx - m``
+    dimensions, and two are enough for its direction to be estimable. Over relief more directions
+    hold clutter, and ``suppress_clutter(..., max_nulls=n_rx - 2)`` nulls them: on the frames over
+    hills of ``skyradar bench process`` an eight-channel array then detects as few cells as the
+    square with two nulls, instead of 2.5 times as many. It is not the default because the target
+    pays for it. Each null takes with it the part of the target's steering vector along it, and with
+    two dimensions left its direction is estimable but poorly: on the development fast-closure sets
+    over the hills (the results page, ``...-ura-2x3-ceiling`` against ``...-ura-2x3-two-nulls``,
+    ``...-ura-4x2-ceiling`` against ``...-ura-4x2``), the eight-channel upright array's track of a
+    climbing intruder had its horizontal miss at 1.1-2.8 km for 8 s (386 m true) and was warned 8.3
+    s later (about when perfect surveillance warns), the six-channel array warned one more
+    must-not-alert encounter, and the tracks on the ground stayed about as many, for twice the
+    processing time a frame.
 
     Parameters
     ----------
@@ -291,7 +291,7 @@ def default_max_nulls(n_rx: int, n_tx: int = 1) -> int:
     >>> default_max_nulls(8, n_tx=2)  # the 2 TX x 4 RX MIMO array's eight virtual channels
     4
     """
-    keep = 2 if n_rx >= 4 else 1  # channels left to measure a direction (none to spare below four)
+    keep = 2 if n_rx >= 4 else 1  # two channels stay to measure a direction; one on smaller arrays
     return max(min(2 * max(int(n_tx), 1), int(n_rx) - keep), 0)
 
 

@@ -20,9 +20,10 @@ from matplotlib.figure import Figure  # noqa: E402
 from skyradar.config import RadarConfig  # noqa: E402
 from skyradar.errors import InputError  # noqa: E402
 from skyradar.io import recording_writer, recordings  # noqa: E402
+from skyradar.io.json_results import write_json_atomic
 from skyradar.io.recording_writer import write_recording  # noqa: E402
 from skyradar.io.recordings import read_recording  # noqa: E402
-from skyradar.io.tables import read_table, write_json_atomic, write_table  # noqa: E402
+from skyradar.io.tables import read_table, write_table  # noqa: E402
 
 SRC = Path(__file__).resolve().parents[1] / "src" / "skyradar"
 

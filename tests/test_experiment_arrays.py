@@ -17,7 +17,7 @@ from cli_helpers import assert_one_line_error, skyradar
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.experiments import arrays
-from skyradar.io.tables import jsonable
+from skyradar.io.json_results import jsonable
 
 
 def _ura_bound_deg(rows: int, cols: int, snr_db: float) -> tuple[float, float]:

@@ -36,7 +36,7 @@ PATTERNS = {
 ALLOWED = {
     ("benchmarks/flight_state.py", "power image"): "the thesis' plain loop, timed as the benchmark baseline",
 }
-JSON_HOME = "io/tables.py"
+JSON_HOME = "io/json_results.py"
 
 
 def _json_sanitisers(tree: ast.AST) -> list[int]:
@@ -67,7 +67,7 @@ def find_pastes(root: Path) -> list[str]:
                 out.append(f"{rel}:{text.count(chr(10), 0, m.start()) + 1}: {key}")
         if rel != JSON_HOME:
             out += [
-                f"{rel}:{line}: JSON sanitiser: use skyradar.io.tables.jsonable"
+                f"{rel}:{line}: JSON sanitiser: use skyradar.io.json_results.jsonable"
                 for line in _json_sanitisers(ast.parse(text))
             ]
     return out

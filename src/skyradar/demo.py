@@ -28,7 +28,8 @@ from skyradar.chain import run_chain as _run_chain
 from skyradar.daa.alerting import RADAR_ALERT_CONFIG
 from skyradar.errors import InputError
 from skyradar.io.atomic import write_csv_atomic
-from skyradar.io.tables import write_json_atomic, write_table
+from skyradar.io.json_results import write_json_atomic
+from skyradar.io.tables import write_table
 from skyradar.scene.scenario import load_scenario
 
 __all__ = [

@@ -15,7 +15,7 @@ from rich.console import Console
 from rich.table import Table
 
 from skyradar.errors import InputError
-from skyradar.io.tables import jsonable
+from skyradar.io.json_results import jsonable
 
 __all__ = [
     "app",

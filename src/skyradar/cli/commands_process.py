@@ -265,8 +265,8 @@ def calibrate(
     from skyradar.errors import InputError
     from skyradar.io.checks import check_finite_frames
     from skyradar.io.frames import radar_config_of
+    from skyradar.io.json_results import write_json_atomic
     from skyradar.io.outputs import check_output
-    from skyradar.io.tables import write_json_atomic
     from skyradar.process.calibration import calibrate_from_frames, reflector_position
 
     check_output(output, [run], overwrite, kind="file")

@@ -74,7 +74,8 @@ from skyradar.experiments.encounter_terrain import TERRAINS
 from skyradar.experiments.encounters import EVALUATION_SEEDS_FROM, MAX_ENCOUNTERS
 from skyradar.experiments.summary_md import write_summary
 from skyradar.io.atomic import write_csv_atomic
-from skyradar.io.tables import write_json_atomic, write_table
+from skyradar.io.json_results import write_json_atomic
+from skyradar.io.tables import write_table
 from skyradar.rx_layouts import MIMO_LAYOUTS, RX_LAYOUTS, check_rx_layout
 
 __all__ = [

@@ -36,7 +36,7 @@ import pandas as pd
 from skyradar.code_version import code_version, provenance
 from skyradar.geo import geodetic_to_ned
 from skyradar.io.atomic import savefig_atomic, write_csv_atomic, write_text_atomic
-from skyradar.io.tables import write_json_atomic
+from skyradar.io.json_results import write_json_atomic
 
 __all__ = ["demo_scenario", "detection_table", "separation_table", "run", "plot"]
 

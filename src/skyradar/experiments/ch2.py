@@ -24,7 +24,7 @@ from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.experiments.summary_md import number, page, write_summary
 from skyradar.io.atomic import write_csv_atomic
-from skyradar.io.tables import write_json_atomic
+from skyradar.io.json_results import write_json_atomic
 from skyradar.scene.scenario import Scenario, example_scenario
 from skyradar.sim.scenario_frames import make_simulator, scenario_truth, simulate_frames
 from skyradar.viz.rangedoppler import save_frame_figure, strength_db

@@ -64,7 +64,8 @@ from skyradar.experiments.ch3_scene import (
 )
 from skyradar.experiments.summary_md import number, page, write_summary
 from skyradar.io.atomic import write_csv_atomic
-from skyradar.io.tables import write_json_atomic, write_table
+from skyradar.io.json_results import write_json_atomic
+from skyradar.io.tables import write_table
 from skyradar.process.calibration import calibrate_from_frames, calibration_phase_error_deg
 from skyradar.process.detect import integrate_channels
 from skyradar.process.doa import doa_crlb

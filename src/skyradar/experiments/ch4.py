@@ -41,7 +41,8 @@ from skyradar.config import RadarConfig
 from skyradar.experiments.ch4_flights import EPBC, SCENARIOS, Traffic, build_traffic
 from skyradar.experiments.summary_md import beside, counted, number, page, write_summary
 from skyradar.io.atomic import write_csv_atomic
-from skyradar.io.tables import write_json_atomic, write_table
+from skyradar.io.json_results import write_json_atomic
+from skyradar.io.tables import write_table
 from skyradar.parallel import check_workers, close, connect
 from skyradar.track.detectable import detection_threshold_snr_db
 from skyradar.track.io import Truth

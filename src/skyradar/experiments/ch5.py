@@ -39,7 +39,8 @@ from skyradar.config import Mount, RadarConfig
 from skyradar.errors import InputError
 from skyradar.experiments.ch5_flight import Flight, terrain_following_flight
 from skyradar.io.atomic import write_csv_atomic
-from skyradar.io.tables import write_json_atomic, write_table
+from skyradar.io.json_results import write_json_atomic
+from skyradar.io.tables import write_table
 from skyradar.nav.flight_state import estimate_frame, filter_table, mount_height_offset_m
 from skyradar.nav.kalman_state import KalmanSettings
 from skyradar.nav.ridge import extract_ridge

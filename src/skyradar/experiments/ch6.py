@@ -30,7 +30,8 @@ import numpy as np
 import pandas as pd
 
 from skyradar.experiments.ch6_flight import Leg, fly
-from skyradar.io.tables import write_json_atomic, write_table
+from skyradar.io.json_results import write_json_atomic
+from skyradar.io.tables import write_table
 from skyradar.nav.gpscheck.check import (
     DEFAULT_METHOD,
     PIXEL_M,

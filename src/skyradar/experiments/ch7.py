@@ -24,7 +24,8 @@ import pandas as pd
 
 from skyradar.experiments.summary_md import number, page, write_summary
 from skyradar.io.atomic import write_csv_atomic
-from skyradar.io.tables import write_json_atomic, write_table
+from skyradar.io.json_results import write_json_atomic
+from skyradar.io.tables import write_table
 
 __all__ = ["run", "THESIS", "summary_markdown"]
 

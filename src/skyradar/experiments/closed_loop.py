@@ -48,7 +48,8 @@ from skyradar.experiments.encounter_chain import (
 from skyradar.experiments.encounter_set import T_CPA_S, make_encounters, make_fast_closures, rate_interval
 from skyradar.experiments.summary_md import markdown_table, number
 from skyradar.io.atomic import savefig_atomic, write_csv_atomic, write_text_atomic
-from skyradar.io.tables import write_json_atomic, write_table
+from skyradar.io.json_results import write_json_atomic
+from skyradar.io.tables import write_table
 from skyradar.pilot import PilotConfig
 
 __all__ = [

@@ -84,7 +84,7 @@ from skyradar.experiments.encounter_set import FAST_CLOSURE_AGL_M
 from skyradar.experiments.summary_md import write_summary
 from skyradar.io.atomic import write_csv_atomic
 from skyradar.io.frames import radar_config_of
-from skyradar.io.tables import write_json_atomic
+from skyradar.io.json_results import write_json_atomic
 from skyradar.process.clutter_anchors import prediction_anchors
 from skyradar.process.clutter_frames import frame_subspace
 from skyradar.process.clutter_suppress import projected_power, suppress_clutter

@@ -33,7 +33,8 @@ from skyradar.experiments.encounter_chain import FRAME_RATE_HZ, LAYOUTS, SUPPRES
 from skyradar.experiments.encounter_report import write_report
 from skyradar.experiments.encounter_set import make_encounters, make_fast_closures
 from skyradar.experiments.encounter_terrain import TERRAINS
-from skyradar.io.tables import write_json_atomic, write_table
+from skyradar.io.json_results import write_json_atomic
+from skyradar.io.tables import write_table
 from skyradar.parallel import check_workers, close, connect
 from skyradar.rx_layouts import check_rx_layout
 

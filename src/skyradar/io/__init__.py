@@ -15,10 +15,10 @@ The names users call, importable from here (each is imported from its module on 
 
 Modules: frames (:mod:`.frames`, :mod:`.frames_model`, :mod:`.frames_heads`, :mod:`.cint16`,
 :mod:`.checks`, :mod:`.store_size`, :mod:`.navigation`, :mod:`.ownship_states`, :mod:`.run_origin`,
-:mod:`.run_export`, :mod:`.ownship_input`); tables (:mod:`.tables`, :mod:`.table_columns`); recordings
-(:mod:`.recordings`, :mod:`.recording_sigmf`, :mod:`.recording_writer`, :mod:`.sigmf_io`,
-:mod:`.iq_raw`, :mod:`.iq_recording`); writing safely (:mod:`.outputs`, :mod:`.atomic`,
-:mod:`.locks`) and reading safely (:mod:`.safe_yaml`).
+:mod:`.run_export`, :mod:`.ownship_input`); tables (:mod:`.tables`, :mod:`.table_columns`); JSON
+results (:mod:`.json_results`); recordings (:mod:`.recordings`, :mod:`.recording_sigmf`,
+:mod:`.recording_writer`, :mod:`.sigmf_io`, :mod:`.iq_raw`, :mod:`.iq_recording`); writing safely
+(:mod:`.outputs`, :mod:`.atomic`, :mod:`.locks`) and reading safely (:mod:`.safe_yaml`).
 """
 
 from __future__ import annotations

@@ -8,8 +8,6 @@ Readers check required columns and say which are missing.
 from __future__ import annotations
 
 import io
-import json
-import math
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
@@ -18,15 +16,13 @@ import numpy as np
 import pandas as pd
 
 from skyradar.errors import InputError
-from skyradar.io.atomic import write_text_atomic, write_with
+from skyradar.io.atomic import write_with
 
 __all__ = [
     "finite_column",
     "check_within",
     "write_table",
     "read_table",
-    "write_json_atomic",
-    "jsonable",
     "appended",
 ]
 
@@ -230,53 +226,3 @@ def check_within(
             f"{source}: field '{col}' is {values[i]:.6g}{spaced} at row {i}, "
             f"beyond +-{limit:g}{spaced}: {what}"
         )
-
-
-def jsonable(value: Any) -> Any:
-    """``value`` with numpy scalars and arrays made plain and NaN/inf made None (JSON has no NaN).
-
-    The one JSON sanitiser: results printed with ``--json``, written by :func:`write_json_atomic` and sent
-    by the live display all go through it.
-
-    Examples
-    --------
-    >>> jsonable({"a": np.float32(1.5), "b": np.array([1.0, np.nan]), 3: (np.int64(2), float("inf"))})
-    {'a': 1.5, 'b': [1.0, None], '3': [2, None]}
-    """
-    if isinstance(value, dict):
-        return {str(k): jsonable(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [jsonable(v) for v in value]
-    if isinstance(value, np.ndarray) and value.ndim > 0:
-        return [jsonable(v) for v in value.tolist()]
-    if hasattr(value, "item") and callable(value.item) and getattr(value, "ndim", 0) == 0:
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
-def write_json_atomic(path: str | Path, payload: Any) -> Path:
-    """Write JSON to ``path`` through a temporary name and rename (NaN and inf become null).
-
-    Parameters
-    ----------
-    path : path
-        The JSON file; missing parent folders are created.
-    payload : object
-        Anything :func:`jsonable` makes plain (dicts, lists, numpy scalars and arrays).
-
-    Returns
-    -------
-    Path
-        ``path``.
-
-    Examples
-    --------
-    >>> import tempfile
-    >>> with tempfile.TemporaryDirectory() as d:
-    ...     p = write_json_atomic(Path(d) / "out" / "s.json", {"rmse_m": np.float64(1.5), "ok": [np.nan]})
-    ...     json.loads(p.read_text())
-    {'rmse_m': 1.5, 'ok': [None]}
-    """
-    return write_text_atomic(path, json.dumps(jsonable(payload), indent=2, default=float, allow_nan=False))

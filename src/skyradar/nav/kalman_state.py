@@ -15,9 +15,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
 
 from skyradar.kalman import innovation_covariance, update
+from skyradar.quantiles import chi2_quantile
 
 __all__ = ["KalmanSettings", "FilterOutput", "filter_states"]
 
@@ -160,7 +160,7 @@ def filter_states(
     n = t.size
     out_x, out_sd = np.full((n, 3), np.nan), np.full((n, 3), np.nan)
     accepted = np.zeros(n, bool)
-    gate = float(stats.chi2.ppf(s.gate_probability, 3))
+    gate = chi2_quantile(s.gate_probability, 3)
     x = p = None
     t_prev, rejections = None, 0
     for i in range(n):

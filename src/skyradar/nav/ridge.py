@@ -39,12 +39,12 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from scipy import stats
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.nav._flight_state_kernels import ridge_rows
 from skyradar.process.power import power_image
+from skyradar.quantiles import gamma_quantile
 
 __all__ = ["Ridge", "summed_power_image", "noise_floor_w", "band_start", "extract_ridge"]
 
@@ -143,8 +143,8 @@ def noise_floor_w(
 
 @lru_cache(maxsize=64)
 def _gamma_quantile(quantile: float, n_rx: int) -> float:
-    # scipy.stats' machinery costs about a millisecond a call; every frame asks the same question.
-    return float(stats.gamma.ppf(quantile, n_rx))
+    # Every frame asks the same question; the cache answers it once.
+    return gamma_quantile(quantile, n_rx)
 
 
 def band_start(occupied: np.ndarray) -> np.ndarray | int | None:

@@ -22,8 +22,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from skyradar.io.json_results import write_json_atomic
 from skyradar.io.sigmf_io import sigmf_paths
-from skyradar.io.tables import write_json_atomic, write_table
+from skyradar.io.tables import write_table
 from skyradar.passive.budget import db, echo_power_w, matched_filter_snr
 from skyradar.passive.scene import PassiveScene, bistatic_geometry
 

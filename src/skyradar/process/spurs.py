@@ -32,11 +32,12 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from scipy import ndimage, stats
+from scipy import ndimage
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.process.detect import detect
+from skyradar.quantiles import gamma_quantile, gamma_upper_quantile
 
 __all__ = ["THESIS_THRESHOLDS", "SpurMap", "detection_pixels", "learn_spur_map", "OnlineSpurMap"]
 
@@ -90,9 +91,10 @@ def detection_pixels(
     [[50, 0], [100, 100]]
     """
     if pixels == "hits":
-        law = stats.gamma(config.n_rx, scale=1.0 / config.n_rx)
-        floor = np.median(power) / law.median()
-        return power > np.float32(law.isf(detect_kwargs.get("pfa", 1e-5)) * floor)
+        # Mean of n_rx unit exponential powers: gamma of shape n_rx and scale 1 / n_rx.
+        floor = np.median(power) / (gamma_quantile(0.5, config.n_rx) / config.n_rx)
+        threshold = gamma_upper_quantile(detect_kwargs.get("pfa", 1e-5), config.n_rx) / config.n_rx
+        return power > np.float32(threshold * floor)
     if pixels != "peaks":
         raise InputError(f"spur map: field 'pixels' must be 'peaks' or 'hits', got {pixels!r}")
     det = detect(power, config, **detect_kwargs)

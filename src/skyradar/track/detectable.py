@@ -5,8 +5,8 @@ inside the range limit, in line of sight: the run's ``tgt_visible``) and its exp
 equation with the two-way antenna gain, no noise: ``tgt_snr_db``) reaches the detection threshold,
 the SNR at which the CA-CFAR of :func:`skyradar.process.detect.detect` detects with 50 %
 probability. Detections play no part: a frame in the beam but far below the threshold is not one
-a tracker could have followed, and scoring it as missed (as ``skyradar evaluate`` did) made every
-beam-edge frame a loss of completeness.
+a tracker could have followed, and scoring it as missed would make every beam-edge frame a loss of
+completeness.
 """
 
 from __future__ import annotations
@@ -14,7 +14,6 @@ from __future__ import annotations
 import inspect
 
 import numpy as np
-from scipy import optimize, stats
 
 from skyradar.config import RadarConfig
 
@@ -35,6 +34,8 @@ def detection_threshold_snr_db(config: RadarConfig, probability: float = 0.5) ->
     >>> round(detection_threshold_snr_db(RadarConfig.prototype_2022()), 1)
     7.5
     """
+    from scipy import optimize, stats  # noncentral F; imported here, scipy.stats alone takes ~0.5 s
+
     from skyradar.process.cfar import cfar_factor, training_cells
     from skyradar.process.detect import detect
 

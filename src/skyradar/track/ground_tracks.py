@@ -70,9 +70,9 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from scipy.stats import chi2, norm
 
 from skyradar.config import RadarConfig
+from skyradar.quantiles import chi2_upper_quantile, normal_upper_quantile
 from skyradar.track.dealias import alias_count
 from skyradar.track.ground_doa import (
     AXIS_COLUMNS,
@@ -297,7 +297,7 @@ def range_doppler_consistent(
     t = np.asarray(time_s, float)
     rng = np.asarray(range_m, float)
     _, moved = _doppler_path(t, radial_velocity_mps, width_mps, coupling_s)
-    limit = chi2.isf(test.tail, max(rng.size - int(np.floor(test.trim * rng.size)) - 1, 1))
+    limit = chi2_upper_quantile(test.tail, max(rng.size - int(np.floor(test.trim * rng.size)) - 1, 1))
     max_alias = alias_count(width_mps) if max_alias is None else max_alias
     for k in range(-max_alias, max_alias + 1):
         res = rng - moved - k * width_mps * (t - t[0])
@@ -379,7 +379,7 @@ def faster_than_ground(
     if not sxx > 0.0:
         return False
     slope = float(np.sum(tc * (excess - excess.mean())) / sxx)
-    z = float(norm.isf(test.tail))
+    z = normal_upper_quantile(test.tail)
     max_alias = alias_count(width_mps) if max_alias is None else max_alias
     aliases = np.arange(-max_alias, max_alias + 1)
     allowed = np.abs(slope - aliases * width_mps) <= z * test.sigma_range_jitter_m / np.sqrt(sxx)
@@ -394,7 +394,7 @@ def faster_than_ground(
     res = excess - k * width_mps * (t - t[0])
     z2 = ((res - res.mean()) / test.sigma_range_jitter_m) ** 2
     keep = t.size - int(np.floor(test.trim * t.size))
-    return bool(trimmed_sum(z2, test.trim)[0] <= chi2.isf(test.tail, max(keep - 2, 1)))
+    return bool(trimmed_sum(z2, test.trim)[0] <= chi2_upper_quantile(test.tail, max(keep - 2, 1)))
 
 
 def _own_state(ownship: pd.DataFrame, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -450,7 +450,7 @@ def _smooth_curve(t: np.ndarray, v: np.ndarray, test: GroundTrackTest) -> bool:
     res = v - np.polyval(np.polyfit(t - t[0], v, degree), t - t[0])
     z2 = (res / test.point_sigma_velocity_mps) ** 2
     keep = t.size - int(np.floor(test.trim * t.size))
-    return bool(trimmed_sum(z2, test.trim)[0] <= chi2.isf(test.tail, max(keep - degree - 1, 1)))
+    return bool(trimmed_sum(z2, test.trim)[0] <= chi2_upper_quantile(test.tail, max(keep - degree - 1, 1)))
 
 
 def _judge(sl, t, rng, vel, own_p, own_v, surface_down, width, coupling, test, doa) -> str:

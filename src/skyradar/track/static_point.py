@@ -11,8 +11,8 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from scipy.stats import chi2
 
+from skyradar.quantiles import chi2_upper_quantile
 from skyradar.units import wrap
 
 __all__ = [
@@ -196,7 +196,7 @@ def static_ground_points(
         return np.concatenate([(rng - rho) / sig[0], wrap(vel - v, width_mps) / sig[1]], axis=1)
 
     ne, cost, keep = _gauss_newton(residuals, candidates, n, trim)
-    fit = ne[cost <= chi2.isf(tail, 2 * keep - 2)]
+    fit = ne[cost <= chi2_upper_quantile(tail, 2 * keep - 2)]
     return np.column_stack([fit, surface_down(fit)]) if len(fit) else np.zeros((0, 3))
 
 

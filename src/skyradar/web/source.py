@@ -28,8 +28,9 @@ from skyradar.errors import InputError
 from skyradar.io import cint16
 from skyradar.io.frames import FrameStoreWriter, open_frames, radar_config_of
 from skyradar.io.frames_model import frame_times_s
+from skyradar.io.json_results import jsonable
 from skyradar.io.navigation import navigation_state
-from skyradar.io.tables import jsonable, read_table
+from skyradar.io.tables import read_table
 from skyradar.process.power import power_image
 
 __all__ = ["RunSource", "range_doppler_png"]

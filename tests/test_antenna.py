@@ -118,9 +118,9 @@ def test_simulate_stores_the_measured_cuts(tmp_path):
     ],
     ids=["nan-gain", "non-monotonic", "missing-column", "short-coverage"],
 )
-def test_simulate_refuses_a_bad_cut_in_one_line(tmp_path, az, needles):
+def test_simulate_refuses_a_bad_cut_in_one_line(tmp_path, az, needles, cli):
     path = _scenario_with_cuts(tmp_path, az=az)
-    result = _skyradar("simulate", str(path), "-o", "run.zarr", cwd=tmp_path)
+    result = cli("simulate", str(path), "-o", "run.zarr", cwd=tmp_path)
     _assert_one_line_error(result, *needles)
     assert not (tmp_path / "run.zarr").exists()
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import yaml
 
-from cli_helpers import assert_one_line_error, skyradar, small_scenario
+from cli_helpers import assert_one_line_error, small_scenario
 from skyradar.chain import run_chain
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
@@ -73,9 +73,9 @@ def test_bad_arrays_are_refused_naming_the_field(rx, needle):
 
 
 @pytest.mark.parametrize(("rx", "needle"), _bad_arrays())
-def test_bad_arrays_are_one_line_through_the_cli(tmp_path, rx, needle):
+def test_bad_arrays_are_one_line_through_the_cli(tmp_path, rx, needle, cli):
     (tmp_path / "s.yaml").write_text(yaml.safe_dump(small_scenario("bad", radar={"rx_positions_m": rx})))
-    result = skyradar("simulate", "s.yaml", "--output", "r.zarr", cwd=tmp_path)
+    result = cli("simulate", "s.yaml", "--output", "r.zarr", cwd=tmp_path)
     assert_one_line_error(result, "s.yaml", "rx_positions_m", needle)
     assert not (tmp_path / "r.zarr").exists()
 

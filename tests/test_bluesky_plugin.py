@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cli_helpers import assert_one_line_error, skyradar
+from cli_helpers import assert_one_line_error
 from skyradar.integrations.bluesky.runner import run_scenario
 
 _SETUP = """00:00:00.00>ASAS ON
@@ -108,10 +108,10 @@ _BAD = {
 
 
 @pytest.mark.parametrize("case", sorted(_BAD))
-def test_bad_input_is_one_line_through_the_command(tmp_path, case):
+def test_bad_input_is_one_line_through_the_command(tmp_path, case, cli):
     text, needles = _BAD[case]
     path = _scenario(tmp_path, case, text)
-    result = skyradar(
+    result = cli(
         "experiment",
         "bluesky",
         "--scenario",

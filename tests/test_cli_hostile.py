@@ -93,9 +93,9 @@ def _add_flag(column: str, first_value):
         ),
     ],
 )
-def test_alert_refuses_corrupt_track_values(tiny_run, name, change, needles):
+def test_alert_refuses_corrupt_track_values(tiny_run, name, change, needles, cli):
     _tracks_variant(tiny_run, name, change)
-    result = _skyradar("alert", name, "--ownship", "run.zarr", "-o", f"alerts_{name}", cwd=tiny_run)
+    result = cli("alert", name, "--ownship", "run.zarr", "-o", f"alerts_{name}", cwd=tiny_run)
     _assert_one_line_error(result, *needles)
     assert not (tiny_run / f"alerts_{name}").exists()
 
@@ -128,19 +128,19 @@ def test_parquet_named_csv_is_one_line(tiny_run):
         ({"start_s": 1e308}, ["'start_s'", "1e+308"]),
     ],
 )
-def test_scenario_wrong_types_are_refused(tmp_path, change, needles):
+def test_scenario_wrong_types_are_refused(tmp_path, change, needles, cli):
     (tmp_path / "s.yaml").write_text(yaml.safe_dump({**BASE, **change}))
-    result = _skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
+    result = cli("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
     _assert_one_line_error(result, "s.yaml", *needles)
     assert not any(tmp_path.glob("run.zarr*"))
 
 
 @pytest.mark.parametrize("command", ["simulate", "process"])
-def test_huge_worker_count_is_refused_before_any_process_starts(tiny_run, command):
+def test_huge_worker_count_is_refused_before_any_process_starts(tiny_run, command, cli):
     # --workers 10**20 started a local cluster and the machine ran out of memory (exit 137).
     source = "s.yaml" if command == "simulate" else "run.zarr"
     output = "w.zarr" if command == "simulate" else "w.parquet"
-    result = _skyradar(command, source, "-o", output, "--workers", str(10**20), cwd=tiny_run)
+    result = cli(command, source, "-o", output, "--workers", str(10**20), cwd=tiny_run)
     _assert_one_line_error(result, "--workers", str(10**20))
     assert not any(tiny_run.glob("w.*"))
 
@@ -156,8 +156,8 @@ def test_huge_worker_count_is_refused_before_any_process_starts(tiny_run, comman
         (["experiment", "encounters", "--rx-layout", "ring"], ["--rx-layout", "'ring'"]),
     ],
 )
-def test_experiment_sizes_are_bounded_before_the_output_folder(tmp_path, args, needles):
-    result = _skyradar(*args, "--output", "out", cwd=tmp_path)
+def test_experiment_sizes_are_bounded_before_the_output_folder(tmp_path, args, needles, cli):
+    result = cli(*args, "--output", "out", cwd=tmp_path)
     _assert_one_line_error(result, *needles)
     assert not (tmp_path / "out").exists()  # refused before the folder is made
 
@@ -184,8 +184,8 @@ def test_evaluate_refuses_nan_radial_velocity(tiny_run):
         (["bench", "flight", "--frames", str(10**20)], ["--frames", str(10**20)]),
     ],
 )
-def test_bench_sizes_are_bounded(tmp_path, args, needles):
-    _assert_one_line_error(_skyradar(*args, cwd=tmp_path), *needles)
+def test_bench_sizes_are_bounded(tmp_path, args, needles, cli):
+    _assert_one_line_error(cli(*args, cwd=tmp_path), *needles)
 
 
 def test_duplicate_yaml_key_is_refused(tmp_path):
@@ -243,7 +243,7 @@ def test_directory_as_table_and_sweep_suffix(tmp_path):
         ("other_azimuth_rad", "abc", ["'other_azimuth_rad'", "not a finite number", "row 2", "'abc'"]),
     ],
 )
-def test_track_refuses_directions_that_are_not_directions(tmp_path, column, value, needles):
+def test_track_refuses_directions_that_are_not_directions(tmp_path, column, value, needles, cli):
     # The ground hold reads each detection's direction and the antenna's right axis, the 3-D filter
     # its position: text or an impossible value there is one line naming the file, field and row
     # (text is never read as NaN, a table silently without positions); NaN (not known) is taken.
@@ -273,20 +273,20 @@ def test_track_refuses_directions_that_are_not_directions(tmp_path, column, valu
     ).astype({column: object})
     detections.loc[2, column] = value
     detections.to_csv(tmp_path / "det.csv", index=False)
-    result = _skyradar("track", "det.csv", "-o", "tracks.parquet", cwd=tmp_path)
+    result = cli("track", "det.csv", "-o", "tracks.parquet", cwd=tmp_path)
     _assert_one_line_error(result, "det.csv", *needles)
     assert not (tmp_path / "tracks.parquet").exists()
     detections.loc[2, column] = np.nan
     detections.to_csv(tmp_path / "det.csv", index=False)
-    assert _skyradar("track", "det.csv", "-o", "tracks.parquet", cwd=tmp_path).returncode == 0
+    assert cli("track", "det.csv", "-o", "tracks.parquet", cwd=tmp_path).returncode == 0
 
 
 @pytest.mark.parametrize("given", ["/dev/null", "empty.csv"])
-def test_track_refuses_a_table_that_is_no_file_or_empty(tmp_path, given):
+def test_track_refuses_a_table_that_is_no_file_or_empty(tmp_path, given, cli):
     # A device (pyarrow reports /dev/null as missing) and an empty file are named for what they are;
     # a named pipe stays a table streamed in (tests/test_exclusive_writer.py reads one).
     (tmp_path / "empty.csv").write_text("")
-    result = _skyradar("track", given, "-o", "tracks.parquet", cwd=tmp_path)
+    result = cli("track", given, "-o", "tracks.parquet", cwd=tmp_path)
     reason = "is a device" if given == "/dev/null" else "is empty"
     _assert_one_line_error(result, given, reason)
     assert not (tmp_path / "tracks.parquet").exists()

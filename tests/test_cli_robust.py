@@ -20,8 +20,8 @@ from cli_helpers import skyradar as _skyradar
 
 
 @pytest.mark.parametrize("args", [(), ("experiment",), ("bench",)])
-def test_bare_command_prints_help_and_exits_0(tmp_path, args):
-    result = _skyradar(*args, cwd=tmp_path)
+def test_bare_command_prints_help_and_exits_0(tmp_path, args, cli):
+    result = cli(*args, cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert "Usage" in result.stdout
     assert "Traceback" not in result.stderr
@@ -36,8 +36,8 @@ def test_bare_command_prints_help_and_exits_0(tmp_path, args):
         (("simulate", "a.yaml", "-o", "b.zarr", "--chunk-frames", "1.5"), "--chunk-frames"),
     ],
 )
-def test_usage_error_is_short_with_exit_2(tmp_path, args, needle):
-    result = _skyradar(*args, cwd=tmp_path)
+def test_usage_error_is_short_with_exit_2(tmp_path, args, needle, cli):
+    result = cli(*args, cwd=tmp_path)
     assert result.returncode == 2, result.stderr
     assert "Traceback" not in result.stderr
     assert len(result.stderr.strip().splitlines()) <= 4, result.stderr
@@ -65,11 +65,11 @@ def _detections(path: Path, n: int, ground: bool) -> Path:
 
 
 @pytest.mark.parametrize(("n", "ground", "model"), [(0, False, "radar"), (12, True, "traditional")])
-def test_track_without_air_detections_writes_empty_table(tmp_path, n, ground, model):
+def test_track_without_air_detections_writes_empty_table(tmp_path, n, ground, model, cli):
     from skyradar.track.track_table import TRACK_COLUMNS
 
     source = _detections(tmp_path / "det.parquet", n, ground)
-    result = _skyradar("track", str(source), "-o", "trk.parquet", "--model", model, cwd=tmp_path)
+    result = cli("track", str(source), "-o", "trk.parquet", "--model", model, cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert "no tracks" in result.stderr
     tracks = pd.read_parquet(tmp_path / "trk.parquet")
@@ -123,9 +123,9 @@ def test_track_without_air_detections_writes_empty_table(tmp_path, n, ground, mo
         (("evaluate", "r.zarr", "t.parquet", "--gospa-c", "nan"), ["--gospa-c", "nan"]),
     ],
 )
-def test_bad_option_values_give_one_line(tmp_path, args, needles):
+def test_bad_option_values_give_one_line(tmp_path, args, needles, cli):
     _detections(tmp_path / "d.parquet", 3, False)
-    result = _skyradar(*args, cwd=tmp_path, timeout=60)
+    result = cli(*args, cwd=tmp_path, timeout=60)
     _assert_one_line_error(result, *needles)
     assert not (tmp_path / "out").exists()  # refused before any work
 
@@ -225,9 +225,9 @@ def _store(path: Path, *, nan_frame: int | None = None, times: list[float] | Non
         ("calibrate", "-o", "out.parquet", "--range-m", "300", "--azimuth-deg", "0", "--elevation-deg", "0"),
     ],
 )
-def test_nan_frame_is_refused_naming_file_and_frame(tmp_path, command):
+def test_nan_frame_is_refused_naming_file_and_frame(tmp_path, command, cli):
     run = _store(tmp_path / "run.zarr", nan_frame=4)
-    result = _skyradar(command[0], str(run), *command[1:], cwd=tmp_path)
+    result = cli(command[0], str(run), *command[1:], cwd=tmp_path)
     _assert_one_line_error(result, "run.zarr", "'iq'", "frame 4", "nan")
     assert not (tmp_path / "out.parquet").exists()
 
@@ -236,9 +236,9 @@ def test_nan_frame_is_refused_naming_file_and_frame(tmp_path, command):
     ("command", "times"),
     [("process", [0, 0.1, 0.2, 0.2, 0.3, 0.4]), ("state", [0, 0.1, 0.2, 0.15, 0.3, 0.4])],
 )
-def test_repeated_or_backward_frame_times_are_refused(tmp_path, command, times):
+def test_repeated_or_backward_frame_times_are_refused(tmp_path, command, times, cli):
     run = _store(tmp_path / "run.zarr", times=times)
-    result = _skyradar(command, str(run), "-o", "out.parquet", cwd=tmp_path)
+    result = cli(command, str(run), "-o", "out.parquet", cwd=tmp_path)
     _assert_one_line_error(result, "run.zarr", "'time'", "frame 3")
 
 
@@ -326,7 +326,7 @@ _OWN = {"type": "straight", "start_ned_m": [0, 0, -500], "heading_deg": 0, "spee
         ({"radar": {"noise_figure_db": 1e11}}, ["noise_figure_db", "+-300"]),
     ],
 )
-def test_nonsense_scenario_is_refused(tmp_path, change, needles):
+def test_nonsense_scenario_is_refused(tmp_path, change, needles, cli):
     import yaml
 
     scenario = {
@@ -339,7 +339,7 @@ def test_nonsense_scenario_is_refused(tmp_path, change, needles):
         "duration_s": 1.0,
     }
     (tmp_path / "s.yaml").write_text(yaml.safe_dump({**scenario, **change}))
-    result = _skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
+    result = cli("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
     _assert_one_line_error(result, "s.yaml", *needles)
     assert not any(tmp_path.glob("run.zarr*"))
 
@@ -353,7 +353,7 @@ def test_nonsense_scenario_is_refused(tmp_path, change, needles):
         (["0,52,4,1000", "10,52.001,4,-100000"], ["track.csv", "row 1", "'altitude'", "-30480 m"]),
     ],
 )
-def test_implausible_trajectory_file_is_refused(tmp_path, rows, needles):
+def test_implausible_trajectory_file_is_refused(tmp_path, rows, needles, cli):
     import yaml
 
     (tmp_path / "track.csv").write_text("\n".join(["timestamp,latitude,longitude,altitude", *rows]) + "\n")
@@ -366,7 +366,7 @@ def test_implausible_trajectory_file_is_refused(tmp_path, rows, needles):
         "duration_s": 1.0,
     }
     (tmp_path / "s.yaml").write_text(yaml.safe_dump(scenario))
-    result = _skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
+    result = cli("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
     _assert_one_line_error(result, *needles)
     assert not any(tmp_path.glob("run.zarr*"))
 
@@ -396,9 +396,9 @@ def test_implausible_trajectory_file_is_refused(tmp_path, rows, needles):
         (("experiment", "ch3", "--path", "bogus"), ["--path", "bogus"]),
     ],
 )
-def test_options_are_named_in_their_errors(tmp_path, args, needles):
+def test_options_are_named_in_their_errors(tmp_path, args, needles, cli):
     _store(tmp_path / "run.zarr")
-    _assert_one_line_error(_skyradar(*args, cwd=tmp_path), *needles)
+    _assert_one_line_error(cli(*args, cwd=tmp_path), *needles)
 
 
 def test_rd_names_the_window_option(tmp_path):
@@ -411,11 +411,11 @@ def test_rd_names_the_window_option(tmp_path):
     ("rows", "needles"),
     [([], ["own.csv", "no rows"]), (["0,0,0,nan,0,0,0", "1,0,0,0,0,0,0"], ["own.csv", "own_down_m", "nan"])],
 )
-def test_track_refuses_empty_or_nan_ownship(tmp_path, rows, needles):
+def test_track_refuses_empty_or_nan_ownship(tmp_path, rows, needles, cli):
     source = _detections(tmp_path / "det.parquet", 3, False)
     header = "time_s,own_north_m,own_east_m,own_down_m,own_vn_mps,own_ve_mps,own_vd_mps"
     (tmp_path / "own.csv").write_text("\n".join([header, *rows]) + "\n")
-    result = _skyradar("track", str(source), "-o", "t.parquet", "--ownship", "own.csv", cwd=tmp_path)
+    result = cli("track", str(source), "-o", "t.parquet", "--ownship", "own.csv", cwd=tmp_path)
     _assert_one_line_error(result, *needles)
     assert not (tmp_path / "t.parquet").exists()
 

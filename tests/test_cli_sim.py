@@ -69,9 +69,9 @@ def test_resume_skips_finished_chunks(tmp_path):
         ({"radar": {"rx_positions_m": [[0, 0, 0]] * 4}}, ["scenario.yaml", "rx_positions_m"]),
     ],
 )
-def test_bad_scenario_gives_one_line(tmp_path, change, needles):
+def test_bad_scenario_gives_one_line(tmp_path, change, needles, cli):
     scenario = _write(tmp_path, {**BASE, **change})
-    result = _skyradar("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path)
+    result = cli("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path)
     _assert_one_line_error(result, *needles)
     assert not any(tmp_path.glob("run.zarr*"))
 
@@ -118,10 +118,10 @@ def test_wrong_hgt_size(tmp_path):
         ("timestamp,longitude,altitude\n0,4.36,1000\n1,4.36,1000\n", ["track.csv", "latitude"]),
     ],
 )
-def test_bad_trajectory_file(tmp_path, csv, needles):
+def test_bad_trajectory_file(tmp_path, csv, needles, cli):
     (tmp_path / "track.csv").write_text(csv)
     scenario = _write(tmp_path, {**BASE, "ownship": "track.csv"})
-    _assert_one_line_error(_skyradar("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path), *needles)
+    _assert_one_line_error(cli("simulate", str(scenario), "-o", "run.zarr", cwd=tmp_path), *needles)
 
 
 def test_help_on_every_command(tmp_path):

@@ -349,8 +349,8 @@ def test_only_reruns_an_encounter_of_the_set_as_the_whole_set_runs_it(tmp_path):
 
 
 @pytest.mark.parametrize(("only", "named"), [("2", "got 2"), ("1,x", "'1,x'"), ("-1", "'-1'")])
-def test_bad_only_gives_one_line(tmp_path, only, named):
-    r = skyradar("experiment", "encounters", "--n", "2", "--only", only, "--output", "o", cwd=tmp_path)
+def test_bad_only_gives_one_line(tmp_path, only, named, cli):
+    r = cli("experiment", "encounters", "--n", "2", "--only", only, "--output", "o", cwd=tmp_path)
     assert_one_line_error(r, "--only", named)
     assert not (tmp_path / "o").exists()
 

@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cli_helpers import assert_one_line_error, skyradar
+from cli_helpers import assert_one_line_error
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.experiments import arrays
@@ -160,8 +160,8 @@ def test_parse_arrays_keeps_order_and_refuses_unknown_names():
         (["--terrain", "moon"], ["--terrain", "moon"]),
     ],
 )
-def test_bad_input_is_one_line_and_exit_2_through_the_cli(tmp_path, args, needles):
-    result = skyradar("experiment", "arrays", "-o", str(tmp_path / "out"), *args, cwd=tmp_path)
+def test_bad_input_is_one_line_and_exit_2_through_the_cli(tmp_path, args, needles, cli):
+    result = cli("experiment", "arrays", "-o", str(tmp_path / "out"), *args, cwd=tmp_path)
     assert_one_line_error(result, *needles)
     assert not (tmp_path / "out").exists()  # refused before anything was written
 

@@ -157,11 +157,11 @@ def _scenario(radar: dict) -> dict:
         ),
     ],
 )
-def test_bad_transmitters_are_one_line_through_the_cli(tmp_path, radar, needles):
+def test_bad_transmitters_are_one_line_through_the_cli(tmp_path, radar, needles, cli):
     import yaml
 
     (tmp_path / "s.yaml").write_text(yaml.safe_dump(_scenario(radar)))
-    result = skyradar("simulate", "s.yaml", "--output", "r.zarr", cwd=tmp_path)
+    result = cli("simulate", "s.yaml", "--output", "r.zarr", cwd=tmp_path)
     assert_one_line_error(result, *needles)
     assert not (tmp_path / "r.zarr").exists()
 

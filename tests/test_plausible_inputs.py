@@ -42,9 +42,9 @@ REFUSED = [
 
 
 @pytest.mark.parametrize(("change", "field", "bound"), REFUSED)
-def test_implausible_physical_inputs_are_refused(tmp_path, change, field, bound):
+def test_implausible_physical_inputs_are_refused(tmp_path, change, field, bound, cli):
     (tmp_path / "s.yaml").write_text(yaml.safe_dump({**BASE, **change}))
-    result = skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
+    result = cli("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
     assert_one_line_error(result, "s.yaml", field, bound)
     assert not (tmp_path / "run.zarr").exists()
 
@@ -175,9 +175,9 @@ def test_an_alert_config_that_warns_is_accepted(tmp_path):
 
 
 @pytest.mark.parametrize("address", ["garbage address", "tcp://::::bad"])
-def test_a_malformed_scheduler_address_is_one_line(tmp_path, address):
+def test_a_malformed_scheduler_address_is_one_line(tmp_path, address, cli):
     (tmp_path / "s.yaml").write_text(yaml.safe_dump(BASE))
-    result = skyradar("simulate", "s.yaml", "-o", "run.zarr", "--scheduler", address, cwd=tmp_path)
+    result = cli("simulate", "s.yaml", "-o", "run.zarr", "--scheduler", address, cwd=tmp_path)
     assert_one_line_error(result, "--scheduler", "not a Dask scheduler address")
     assert not list(tmp_path.glob("run.zarr*"))
 
@@ -195,9 +195,9 @@ def test_a_scheduler_address_without_a_valid_port_is_refused_before_the_output_f
     "command",
     [("simulate-passive", "-o", "rec.sigmf-meta"), ("passive", "rec.sigmf-meta", "-o", "d.parquet")],
 )
-def test_a_tiny_iq_chunk_is_refused(tmp_path, command):
+def test_a_tiny_iq_chunk_is_refused(tmp_path, command, cli):
     """One-sample chunks made a 1-s recording take hours: the option is bounded below."""
-    result = skyradar(*command, "--chunk-samples", "1", cwd=tmp_path)
+    result = cli(*command, "--chunk-samples", "1", cwd=tmp_path)
     assert result.returncode == 2 and "--chunk-samples" in result.stderr and ">= 4096" in result.stderr
     assert "Traceback" not in result.stderr
 
@@ -343,11 +343,11 @@ def test_a_range_of_1e308_is_refused_by_track(tmp_path):
         ("10,52.001,4.36,FL350,100,0,0", ["'altitude'", "row 1", "'FL350'"]),  # was dropped as empty
     ],
 )
-def test_a_flight_file_with_a_corrupt_number_is_one_line(tmp_path, row, needles):
+def test_a_flight_file_with_a_corrupt_number_is_one_line(tmp_path, row, needles, cli):
     rows = ["0,52,4.36,1000,100,0,0", row, "20,52.002,4.36,1000,100,0,0", "30,52.003,4.36,1000,100,0,0"]
     head = "timestamp,latitude,longitude,altitude,groundspeed,track,vertical_rate"
     (tmp_path / "f.csv").write_text("\n".join([head, *rows]) + "\n")
-    assert_one_line_error(skyradar("flight", "f.csv", "-o", "p.csv", cwd=tmp_path), "f.csv", *needles)
+    assert_one_line_error(cli("flight", "f.csv", "-o", "p.csv", cwd=tmp_path), "f.csv", *needles)
     assert not (tmp_path / "p.csv").exists()
 
 
@@ -361,12 +361,12 @@ def test_a_refused_intruder_file_is_the_one_line_after_a_good_own_ship_file(tmp_
 
 
 @pytest.mark.parametrize("name", ["../x", ".", "zarr.json", ".zattrs", "a/b", "nose head"])
-def test_a_radar_head_name_that_is_not_a_plain_name_is_refused(tmp_path, name):
+def test_a_radar_head_name_that_is_not_a_plain_name_is_refused(tmp_path, name, cli):
     # A head's frames are a group named after it: a path or a Zarr metadata key would write outside it
     # (and crashed half-way, leaving a .partial store).
     heads = [{"name": name, "mount": "nose"}, {"name": "left", "mount": "left-wingtip"}]
     (tmp_path / "s.yaml").write_text(yaml.safe_dump({**BASE, "duration_s": 0.4, "radars": heads}))
-    done = skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
+    done = cli("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
     assert_one_line_error(done, "radars.0.name")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.yaml"]
 
@@ -379,9 +379,9 @@ def test_a_radar_head_name_that_is_not_a_plain_name_is_refused(tmp_path, name):
         {"tx_position_m": [0.0, 500.0, 0.0]},
     ],
 )
-def test_an_antenna_array_larger_than_one_aircraft_is_refused(tmp_path, radar):
+def test_an_antenna_array_larger_than_one_aircraft_is_refused(tmp_path, radar, cli):
     # One radar's antennas sit on one aircraft, within 2 m of each other; farther is a unit mistake.
     (tmp_path / "s.yaml").write_text(yaml.safe_dump({**BASE, "duration_s": 0.4, "radar": radar}))
-    done = skyradar("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
+    done = cli("simulate", "s.yaml", "-o", "run.zarr", cwd=tmp_path)
     assert_one_line_error(done, "radar.", "2 m")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.yaml"]

@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cli_helpers import assert_one_line_error, skyradar, small_scenario
+from cli_helpers import assert_one_line_error, small_scenario
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
 from skyradar.process.doa import direction_from_angles, estimate_directions, steering_vector
@@ -83,11 +83,11 @@ def test_a_head_overrides_the_top_level_layout():
         ),
     ],
 )
-def test_bad_layout_is_one_line(tmp_path, radar, needles):
+def test_bad_layout_is_one_line(tmp_path, radar, needles, cli):
     import yaml
 
     (tmp_path / "s.yaml").write_text(yaml.safe_dump(_spec(radar)))
-    result = skyradar("simulate", "s.yaml", "--output", "r.zarr", cwd=tmp_path)
+    result = cli("simulate", "s.yaml", "--output", "r.zarr", cwd=tmp_path)
     assert_one_line_error(result, "s.yaml", *needles)
     assert not (tmp_path / "r.zarr").exists()
 

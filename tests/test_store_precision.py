@@ -169,9 +169,9 @@ def test_store_bytes_and_disk_check_account_for_precision(tmp_path, monkeypatch)
 
 
 @pytest.mark.parametrize("command", ["simulate", "rd"])
-def test_bad_precision_is_one_line(tmp_path, command):
+def test_bad_precision_is_one_line(tmp_path, command, cli):
     source = _write(tmp_path, BASE) if command == "simulate" else tmp_path / "rec.npy"
-    result = _skyradar(command, str(source), "-o", "out.zarr", "--precision", "int8", cwd=tmp_path)
+    result = cli(command, str(source), "-o", "out.zarr", "--precision", "int8", cwd=tmp_path)
     _assert_one_line_error(result, "--precision", "int8")
     assert not (tmp_path / "out.zarr").exists()
 

@@ -125,7 +125,7 @@ def _adaptive_figures(config: RadarConfig, n_cubes: int, seed: int, prefix: str)
     cubes, agl = relief_cubes(config, n_cubes, seed)
     sub = clutter_subspace(config, np.array([SPEED_MPS, 0.0, 0.0]), config.mount.rotation, agl, n_azimuth=720)
     inv_gain = (1.0 / np.asarray(config.rx_calibration)).astype(np.complex64)
-    max_nulls = default_max_nulls(config.n_rx)
+    max_nulls = default_max_nulls(config.n_virtual, config.n_tx)  # as suppress_clutter takes it
 
     def baseline(cube: np.ndarray) -> Suppressed:
         """The predicted pass, its cells rewritten in place by the numpy adaptive step."""

@@ -8,6 +8,7 @@ from __future__ import annotations
 import html
 import importlib.util
 import json
+import os
 import re
 import subprocess
 import sys
@@ -48,10 +49,15 @@ def site(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("docs")
     html_dir, doctrees = out / "html", out / "doctrees"
     cmd = [sys.executable, "-m", "sphinx", "-b", "html", "-W", "--keep-going", "-q", "-d", str(doctrees)]
+    # The gallery's examples write their outputs into temporary folders: under this test's own
+    # (TMPDIR), which pytest removes, so a test run leaves nothing in the system's.
+    scratch = out / "examples-tmp"
+    scratch.mkdir()
+    env = {**os.environ, "TMPDIR": str(scratch)}
     # The timeout guards against a hung build, not its speed: the gallery runs every example, and a
     # loaded 2-core machine takes several minutes.
     proc = subprocess.run(
-        [*cmd, str(SOURCE), str(html_dir)], capture_output=True, text=True, timeout=480, cwd=ROOT
+        [*cmd, str(SOURCE), str(html_dir)], capture_output=True, text=True, timeout=480, cwd=ROOT, env=env
     )
     assert proc.returncode == 0, f"sphinx build failed:\n{proc.stdout}\n{proc.stderr}"
     return html_dir

@@ -387,3 +387,43 @@ def test_a_taller_array_trusts_in_band_readings_its_aperture_resolves():
     trusted_square = elevation_trusted(above, sig, measured, band)
     assert trusted_tall.mean() > 0.7 and trusted_square.mean() < 0.01
     assert elevation_trusted(level, sig, measured, band, band_sigma_rad=floor).mean() < 0.01
+
+
+def _with_gap(det: pd.DataFrame, start_s: float, end_s: float, unmeasured_after_s: float) -> pd.DataFrame:
+    """``det`` without its detections from ``start_s`` to ``end_s`` (the track is deleted and a new
+    one reacquires its id) and unmeasured for ``unmeasured_after_s`` after the gap."""
+    t = det["time_s"].to_numpy(float)
+    kept = det[(t < start_s) | (t >= end_s)].copy()
+    first = (kept["time_s"] >= end_s) & (kept["time_s"] < end_s + unmeasured_after_s)
+    kept.loc[first, "elevation_measured"] = False
+    return kept.reset_index(drop=True)
+
+
+def test_a_track_below_that_reacquires_its_id_resumes_its_height():
+    # Jacksboro: an aircraft 250 m below, tracked at its height for 20 s, lost for 2 s and picked up
+    # again by a new track whose readings are too few to agree: without the lost track's evidence it
+    # sits at the co-altitude prior, tens of metres off horizontally too, misses the lost filter's
+    # fusion gate, and is warned at once. Here 300 m below, 3 s without detections, then unmeasured
+    # readings for half a second before measured ones again.
+    det = _with_gap(
+        _aircraft(-300.0, 30.0, np.full(N, "true"), ahead_m=700.0, noise_rad=0.013), 8.0, 11.0, 0.5
+    )
+    tracks = track_detections(det, ownship=_own(), ground_test=False)
+    confirmed = tracks.query("confirmed")
+    assert confirmed.track_id.nunique() == 1  # the new track took the lost one's id
+    after_gap = confirmed[confirmed.time_s >= 11.0]
+    assert len(after_gap) > 50 and np.all(np.abs(-after_gap["down_m"] + 300.0) < 60.0)
+
+
+def test_a_reacquired_track_whose_readings_contradict_the_lost_height_does_not_inherit_it():
+    # The reacquisition matches range and range rate, not height: a track whose own in-band readings
+    # lie at the surface is not held at the height above the lost track's readings agreed on (a
+    # co-altitude aircraft held 300 m above would go unwarned). Its readings start a vote of their own.
+    t = np.arange(N) / 9.4
+    reading = np.where(t < 8.0, "true", "ground")
+    det = _with_gap(_aircraft(300.0, 30.0, reading, ahead_m=700.0, noise_rad=0.013), 8.0, 11.0, 0.0)
+    confirmed = track_detections(det, ownship=_own(), ground_test=False).query("confirmed")
+    before, after_gap = confirmed[confirmed.time_s < 8.0], confirmed[confirmed.time_s >= 12.0]
+    assert np.all(np.abs(-before["down_m"].iloc[-20:] - 300.0) < 60.0)
+    assert len(after_gap) > 50 and np.all(np.abs(after_gap["down_m"]) < 100.0)
+    assert not after_gap["altitude_measured"].any()

@@ -25,6 +25,8 @@ hundred metres above slides towards it at tens of m/s for seconds, a vertical sp
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from skyradar.io.ownship_states import REQUIRED_COLUMNS
@@ -49,6 +51,21 @@ _OTHER = ("other_residue", "other_north_m", "other_east_m", "other_down_m")
 _OTHER_ANGLES = ("other_azimuth_rad", "other_elevation_rad")
 _RIGHT = ("right_axis_north", "right_axis_east", "right_axis_down")
 OWNSHIP_COLUMNS = REQUIRED_COLUMNS  # the own-ship rows the 3-D feed reads: time, NED position, velocity
+
+
+@dataclass(frozen=True)
+class _LostEvidence:
+    """What a lost track's elevations said when it was lost at ``time_s`` (s): its in-band readings
+    (:meth:`AboveVotes.recent`, :meth:`BelowConsensus.recent`), its vote above, the height its
+    readings last agreed on (m above the own-ship, NaN: none) and whether they agreed on a height
+    (voted above, or a consensus below) when it was lost."""
+
+    time_s: float
+    above: list
+    voted: bool
+    below: list
+    agreed_up: float
+    agreed: bool
 
 
 class Measure3D:
@@ -83,6 +100,10 @@ class Measure3D:
         self.agreed_up: dict[int, float] = {}  # the height each track's in-band readings last agreed on
         self.agreed_ids: set[int] = set()  # tracks whose in-band readings agreed on a height last frame
         self.resolved_ids: set[int] = set()  # MIMO tracks whose range rate chose their residue last frame
+        # The elevation evidence of tracks the range-Doppler tracker may still give back (reacquire).
+        self.lost_memory_s = float(lost_memory_s)
+        self._alive_ids = np.empty(0, np.int64)
+        self._lost: dict[int, _LostEvidence] = {}
         self.add_detections(det)
         if ownship is not None:
             self.own, self.agl = np.empty((0, len(OWNSHIP_COLUMNS) - 1)), np.empty(0)
@@ -147,8 +168,94 @@ class Measure3D:
         self.own = own if self.own is None else np.concatenate([self.own, own])
         self.agl = np.concatenate([self.agl, agl])
 
+    def reacquire(self, new_ids: np.ndarray, lost_ids: np.ndarray, k: int) -> None:
+        """Give the tracks ``new_ids`` the ids ``lost_ids`` they reacquired (before :meth:`step`
+        of frame ``k``): their 3-D filters (:meth:`Tracker3D.rename`) and their elevation evidence.
+
+        In the ground's band a track's height rests on its readings agreeing over the last ten
+        frames (:mod:`skyradar.track.elevation_trust`); a track that reacquires a lost id has only
+        its few readings since it started, too few to agree, so they sit at the co-altitude prior.
+        For an aircraft 250 m below at 600 m, the prior puts its position 26 deg off its measured
+        direction, tens of metres off horizontally as well, and the new filter misses the lost
+        one's fusion gate: the track is warned at once, at the own-ship's altitude. So when the
+        lost track's readings agreed on a height (voted above, or a consensus below) and the new
+        track's in-band
+        readings do not contradict it (their median within three bounds of the lost filter's
+        height, predicted across the gap), the track resumes: its readings follow the lost
+        track's in the votes and the consensus below, and its filter is moved on its range
+        sphere to the lost filter's height (with its own vertical sigma, so the height is not
+        counted twice) before the two are fused. Otherwise it starts with its own readings only.
+        A ground track handed an intruder's id reads the surface, which contradicts a height
+        above; inheriting one below only takes it further from a warning.
+        """
+        new_ids, lost_ids = np.asarray(new_ids, np.int64), np.asarray(lost_ids, np.int64)
+        if not self.active or new_ids.size == 0:
+            return
+        resumed: dict[int, float] = {}
+        for new, lost in zip(new_ids.tolist(), lost_ids.tolist(), strict=True):
+            evidence = self._lost.pop(lost, None)
+            above, voted = self.votes.recent(new)
+            below = self.below.recent(new)
+            height = self._lost_height(evidence, lost, above, k)
+            if evidence is not None and height is not None:
+                above, voted = evidence.above + above, evidence.voted
+                below = evidence.below + below
+                if np.isfinite(evidence.agreed_up):
+                    self.agreed_up[lost] = evidence.agreed_up
+                resumed[new] = height
+            self.votes.resume(lost, above, voted)
+            self.below.resume(lost, below)
+            for held in (self.agreed_ids, self.resolved_ids):
+                if new in held:
+                    held.discard(new)
+                    held.add(lost)
+        if resumed and self.own is not None:
+            ids, heights = np.array(list(resumed), np.int64), np.array(list(resumed.values()), float)
+            self.t3.reset_height(ids, self.own[k - 1], heights, np.full(ids.size, np.nan))
+        self._alive_ids = np.where(np.isin(self._alive_ids, new_ids), -1, self._alive_ids)
+        self.t3.rename(new_ids, lost_ids)
+
+    def _lost_height(self, evidence, lost_id: int, above: list, k: int) -> float | None:
+        """The height above the own-ship (m) a reacquired track resumes at, or None: the lost
+        filter's, predicted to the last frame, where the lost track's readings agreed on a height
+        and the new track's in-band readings ``above`` (:meth:`AboveVotes.recent`) do not
+        contradict it."""
+        if evidence is None or not evidence.agreed or self.own is None or k < 1:
+            return None
+        lost = self.t3.lost_prediction(lost_id)
+        if lost is None or not np.all(np.isfinite(lost[0])):
+            return None
+        x, P = lost
+        own = self.own[k - 1]
+        up = float(own[2] - x[2])
+        readings = np.array(above, float).reshape(-1, 3)
+        if len(readings) >= 3:
+            range_m = float(np.linalg.norm(x[:3] - own[:3]))
+            bound = 3.0 * max(float(np.sqrt(P[2, 2])), self.band_sigma_rad * range_m)
+            if abs(float(np.median(readings[:, 1])) - up) > bound:
+                return None
+        return up
+
+    def _remember_lost(self, alive_ids: np.ndarray, time_s: float) -> None:
+        """Keep the elevation evidence of the tracks gone since the last frame for a reacquisition;
+        forget what is older than the memory."""
+        gone = self._alive_ids[(self._alive_ids >= 0) & ~np.isin(self._alive_ids, alive_ids)]
+        for i in gone.tolist():
+            above, voted = self.votes.recent(i)
+            self._lost[i] = _LostEvidence(
+                time_s=time_s,
+                above=above,
+                voted=voted,
+                below=self.below.recent(i),
+                agreed_up=self.agreed_up.get(i, np.nan),
+                agreed=voted or bool(np.isfinite(self.below.consensus(self.below.recent(i))[0])),
+            )
+        self._lost = {i: e for i, e in self._lost.items() if time_s - e.time_s <= self.lost_memory_s}
+        self._alive_ids = np.asarray(alive_ids, np.int64).copy()
+
     def step(self, tracker, out, k: int, a: int, b: int) -> tuple[np.ndarray, np.ndarray]:
         det = out.alive_detection
+        self._remember_lost(np.asarray(out.alive_ids, np.int64), float(out.time_s))
         has = det >= 0
         idx = det[has] + a
         pos = np.full((det.size, 3), np.nan)

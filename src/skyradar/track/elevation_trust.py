@@ -232,6 +232,20 @@ class AboveVotes:
         self._voted = voted
         return out[:, 0], out[:, 1]
 
+    def recent(self, track_id: int) -> tuple[list, bool]:
+        """Track ``track_id``'s last readings (rows of vote, height m, elevation rad; oldest
+        first) and whether it was voted above at its last update."""
+        return self._recent.of(track_id), int(track_id) in self._voted
+
+    def resume(self, track_id: int, readings: list, voted: bool) -> None:
+        """Hold ``readings`` (as :meth:`recent` gives them) and the vote ``voted`` as track
+        ``track_id``'s, e.g. a lost track's before its gap followed by those of the track that
+        reacquired its id after it."""
+        self._recent.set(track_id, readings)
+        self._voted.discard(int(track_id))
+        if voted:
+            self._voted.add(int(track_id))
+
 
 def median_above(
     elevation_rad: np.ndarray, k: float = MEDIAN_ABOVE_K, floor_rad: float = MEDIAN_ABOVE_FLOOR_RAD
@@ -291,6 +305,14 @@ class _RecentReadings:
             out.append(recent)
         return out
 
+    def of(self, track_id: int) -> list:
+        """A copy of track ``track_id``'s readings, oldest first (empty if none)."""
+        return list(self._by_track.get(int(track_id), []))
+
+    def set(self, track_id: int, readings: list) -> None:
+        """Hold ``readings`` (oldest first, the last ``window`` kept) as track ``track_id``'s."""
+        self._by_track[int(track_id)] = list(readings)[-self.window :]
+
 
 class BelowConsensus:
     """Per track, the height below the own-ship its recent in-band elevations agree on, if any.
@@ -345,12 +367,23 @@ class BelowConsensus:
             np.asarray(clear_m, float),
         )
         recent = self._recent.push(ids, np.column_stack(columns).tolist(), counts)
-        out = np.array([self._consensus(np.array(r, float).reshape(-1, 4)) for r in recent], float)
+        out = np.array([self.consensus(r) for r in recent], float)
         out = out.reshape(-1, 2)
         return out[:, 0], out[:, 1]
 
-    def _consensus(self, readings: np.ndarray) -> tuple[float, float]:
-        up, bound, below, clear = readings.T
+    def recent(self, track_id: int) -> list:
+        """Track ``track_id``'s last readings (rows of height m, bound m, below, clearance m;
+        oldest first)."""
+        return self._recent.of(track_id)
+
+    def resume(self, track_id: int, readings: list) -> None:
+        """Hold ``readings`` (as :meth:`recent` gives them) as track ``track_id``'s."""
+        self._recent.set(track_id, readings)
+
+    def consensus(self, readings: list) -> tuple[float, float]:
+        """The height (m) and spread (m) the ``readings`` (as :meth:`recent` gives them) agree on
+        below the own-ship; NaN, NaN where they do not."""
+        up, bound, below, clear = np.array(readings, float).reshape(-1, 4).T
         if len(up) < self.window or below.sum() < self.least:
             return np.nan, np.nan
         median, spread = _median_and_spread(up)

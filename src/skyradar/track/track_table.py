@@ -339,7 +339,7 @@ def _step_frame(
     row["reacquired"] = out.reacquired
     row["reacquired_t"] = np.full(len(out.reacquired), float(time_s))
     if m3.active:
-        m3.t3.rename(out.reacquired[:, 0], out.reacquired[:, 1])
+        m3.reacquire(out.reacquired[:, 0], out.reacquired[:, 1], k)
         x, P = m3.step(tracker, out, k, a, a + len(z))
         rows = np.searchsorted(out.alive_ids, out.track_id)
         row["x3"], row["P3"] = x[rows], P[rows]

@@ -360,18 +360,13 @@ class Tracker3D:
         independent but for the process noise across the gap, which the prediction adds to the
         lost one: ``P = (P_lost^-1 + P_live^-1)^-1``, ``x = P (P_lost^-1 x_lost + P_live^-1 x_live)``.
         """
-        lost = self._lost.pop(track_id, None)
+        lost = self.lost_prediction(track_id)
+        self._lost.pop(track_id, None)
         pos, found = _lookup(self.ids, np.array([track_id], np.int64))
-        if lost is None or not found[0] or self.time_s is None:
+        if lost is None or not found[0]:
             return
-        t_lost, x_lost, P_lost = lost
+        x_lost, P_lost = lost
         row = int(pos[0])
-        dt = self.time_s - t_lost
-        if dt > 0.0:
-            x_lost, P_lost = predict(
-                x_lost[None], P_lost[None], cv3d_transition(dt), cv3d_process_noise(dt, self._accel_sigmas())
-            )
-            x_lost, P_lost = x_lost[0], P_lost[0]
         x_live, P_live = self.x[row], self.P[row]
         if not (np.all(np.isfinite(x_lost)) and np.all(np.isfinite(x_live))):
             return
@@ -383,10 +378,37 @@ class Tracker3D:
         self.x[row] = P @ (info_lost @ x_lost + info_live @ x_live)
         self.P[row] = 0.5 * (P + P.T)
 
+    def lost_prediction(self, track_id: int) -> tuple[np.ndarray, np.ndarray] | None:
+        """The filter of the lost track ``track_id`` predicted to the last step's time: state (6,)
+        and covariance (6, 6); None when no such filter is kept.
+
+        Examples
+        --------
+        >>> t3 = Tracker3D()
+        >>> _ = t3.step(0.0, np.array([4]), np.array([[1000.0, 0.0, -300.0]]), np.array([400.0]))
+        >>> t3.x[0, 3] = -50.0  # closing at 50 m/s
+        >>> _ = t3.step(1.0, np.array([], np.int64), np.empty((0, 3)), np.empty(0))
+        >>> x, P = t3.lost_prediction(4)
+        >>> x[:3].round(1).tolist(), t3.lost_prediction(5)
+        ([950.0, 0.0, -300.0], None)
+        """
+        lost = self._lost.get(int(track_id))
+        if lost is None or self.time_s is None:
+            return None
+        t_lost, x_lost, P_lost = lost
+        dt = self.time_s - t_lost
+        if dt > 0.0:
+            x, P = predict(
+                x_lost[None], P_lost[None], cv3d_transition(dt), cv3d_process_noise(dt, self._accel_sigmas())
+            )
+            return x[0], P[0]
+        return x_lost.copy(), P_lost.copy()
+
     def reset_height(
         self, ids: np.ndarray, own_state: np.ndarray, up_m: np.ndarray, sigma_m: np.ndarray
     ) -> None:
-        """Restart the filters ``ids`` at ``up_m`` above the own-ship (m) with ``sigma_m`` (m).
+        """Restart the filters ``ids`` at ``up_m`` above the own-ship (m) with ``sigma_m`` (m; NaN
+        keeps the filter's own vertical sigma).
 
         For a height learnt at once rather than reading by reading (a track whose elevations
         first agree, :mod:`skyradar.track.elevation_trust`): updated one scattered reading at a
@@ -423,8 +445,10 @@ class Tracker3D:
         self.x[rows, :2] = own[:2] + along * horizontal[:, None]
         self.x[rows, 2] = own[2] - up
         self.x[rows, 3:5] = own[3:5] + v_h
+        sigma = np.asarray(sigma_m, float)[found]
+        variance = np.where(np.isfinite(sigma), sigma**2, self.P[rows, 2, 2])
         self.P[rows, 2, :], self.P[rows, :, 2] = 0.0, 0.0
-        self.P[rows, 2, 2] = np.asarray(sigma_m, float)[found] ** 2
+        self.P[rows, 2, 2] = variance
 
     def _update_positions(
         self, sel: np.ndarray, pos: np.ndarray, positions_m: np.ndarray, cov: np.ndarray, fresh: np.ndarray

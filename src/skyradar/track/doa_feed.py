@@ -179,12 +179,11 @@ class Measure3D:
         direction, tens of metres off horizontally as well, and the new filter misses the lost
         one's fusion gate: the track is warned at once, at the own-ship's altitude. So when the
         lost track's readings agreed on a height (voted above, or a consensus below) and the new
-        track's in-band
-        readings do not contradict it (their median within three bounds of the lost filter's
-        height, predicted across the gap), the track resumes: its readings follow the lost
-        track's in the votes and the consensus below, and its filter is moved on its range
-        sphere to the lost filter's height (with its own vertical sigma, so the height is not
-        counted twice) before the two are fused. Otherwise it starts with its own readings only.
+        track's in-band readings do not contradict it (their median within three bounds of the
+        lost filter's height, predicted across the gap), the track resumes: its readings follow
+        the lost track's in the votes and the consensus below, and its filter is moved on its
+        range sphere to the lost filter's height (with its own vertical sigma, so the height is
+        not counted twice) before the two are fused. Otherwise it starts with its own readings only.
         A ground track handed an intruder's id reads the surface, which contradicts a height
         above; inheriting one below only takes it further from a warning.
         """
@@ -242,13 +241,14 @@ class Measure3D:
         gone = self._alive_ids[(self._alive_ids >= 0) & ~np.isin(self._alive_ids, alive_ids)]
         for i in gone.tolist():
             above, voted = self.votes.recent(i)
+            below = self.below.recent(i)
             self._lost[i] = _LostEvidence(
                 time_s=time_s,
                 above=above,
                 voted=voted,
-                below=self.below.recent(i),
+                below=below,
                 agreed_up=self.agreed_up.get(i, np.nan),
-                agreed=voted or bool(np.isfinite(self.below.consensus(self.below.recent(i))[0])),
+                agreed=voted or bool(np.isfinite(self.below.consensus(below)[0])),
             )
         self._lost = {i: e for i, e in self._lost.items() if time_s - e.time_s <= self.lost_memory_s}
         self._alive_ids = np.asarray(alive_ids, np.int64).copy()

@@ -96,7 +96,8 @@ class Measure3D:
         self.other_sigma, self.other_angle_cov = np.empty(0), np.empty((0, 2, 2))
         self.measured, self.trusted = np.empty(0, bool), np.empty(0, bool)
         self.own, self.agl = None, np.full(len(grid), np.nan)
-        self.votes, self.below, self.surface_down = AboveVotes(), BelowConsensus(), surface_down
+        self.votes = AboveVotes(spread_floor_rad=self.band_sigma_rad)
+        self.below, self.surface_down = BelowConsensus(), surface_down
         self.agreed_up: dict[int, float] = {}  # the height each track's in-band readings last agreed on
         self.agreed_ids: set[int] = set()  # tracks whose in-band readings agreed on a height last frame
         self.resolved_ids: set[int] = set()  # MIMO tracks whose range rate chose their residue last frame

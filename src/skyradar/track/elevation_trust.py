@@ -184,6 +184,14 @@ class AboveVotes:
     above reads 14-43 deg for a true 27-32 deg, on 30 % of its detections) set the track's height
     from the first one accepted and the gate keeps out the rest; the track stays 170 m up.
 
+    A track whose readings stay mostly under the threshold is voted above too when the median of
+    its last ``median_window`` readings is (:func:`median_above`), tested from its
+    ``median_least``-th reading on: a track born close to the own-ship (reacquired, or first seen
+    late) with 40 % of its frames measured gathers twenty readings in about five seconds, during
+    which it sits at the co-altitude prior, and an aircraft 300 m above may be warned as if level.
+    Ten readings let the median vote in half that time, at the same chance per window that a level
+    aircraft's readings pass (their scatter held at least ``spread_floor_rad``).
+
     Examples
     --------
     >>> votes = AboveVotes(window=4, least=2)
@@ -194,9 +202,18 @@ class AboveVotes:
     [310.0, nan]
     """
 
-    def __init__(self, window: int = 10, least: int = 7, keep: int = 4, median_window: int = 20) -> None:
+    def __init__(
+        self,
+        window: int = 10,
+        least: int = 7,
+        keep: int = 4,
+        median_window: int = 20,
+        median_least: int = 10,
+        spread_floor_rad: float = BAND_ELEVATION_SIGMA_RAD,
+    ) -> None:
         self.window, self.least, self.keep = int(window), int(least), int(keep)
-        self.median_window = int(median_window)
+        self.median_window, self.median_least = int(median_window), int(median_least)
+        self.spread_floor_rad = float(spread_floor_rad)
         self._recent = _RecentReadings(max(self.window, self.median_window))
         self._voted: set[int] = set()
 
@@ -211,9 +228,10 @@ class AboveVotes:
         """Add this frame's vote ``above`` and height ``up_m`` (m above the own-ship) of each track
         ``ids`` where ``counts``; returns each track's height and its spread while voted above, m
         (NaN: not voted). Tracks not listed are forgotten. With the readings' ``elevation_rad``
-        (above the own-ship's horizontal), ``median_window`` readings whose median elevation is
-        above the horizontal (:func:`median_above`) vote the track above too, at the median of
-        those readings' heights."""
+        (above the own-ship's horizontal), the last ``median_window`` readings (from
+        ``median_least`` on) whose median elevation is above the horizontal (:func:`median_above`,
+        their scatter taken as at least ``spread_floor_rad``) vote the track above too, at the
+        median of those readings' heights."""
         el = np.full(len(np.atleast_1d(up_m)), np.nan) if elevation_rad is None else elevation_rad
         columns = (np.asarray(above, float), np.asarray(up_m, float), np.asarray(el, float))
         readings = np.column_stack(columns).tolist()
@@ -226,7 +244,11 @@ class AboveVotes:
             if last_votes.sum() >= (self.keep if i in self._voted else self.least):
                 out[n] = _median_and_spread(last_up[last_votes > 0])
                 voted.add(int(i))
-            elif len(up) >= self.median_window and median_above(elevation[-self.median_window :]):
+            elif median_above(
+                elevation[-self.median_window :],
+                least=self.median_least,
+                spread_floor_rad=self.spread_floor_rad,
+            ):
                 out[n] = _median_and_spread(up[-self.median_window :])
                 voted.add(int(i))
         self._voted = voted
@@ -248,7 +270,11 @@ class AboveVotes:
 
 
 def median_above(
-    elevation_rad: np.ndarray, k: float = MEDIAN_ABOVE_K, floor_rad: float = MEDIAN_ABOVE_FLOOR_RAD
+    elevation_rad: np.ndarray,
+    k: float = MEDIAN_ABOVE_K,
+    floor_rad: float = MEDIAN_ABOVE_FLOOR_RAD,
+    least: int = 3,
+    spread_floor_rad: float = 0.0,
 ) -> bool:
     """Whether a track's measured elevations (rad, above the own-ship's horizontal) put it above.
 
@@ -256,10 +282,33 @@ def median_above(
     8.6 deg): readings through the nulls scatter by degrees and their tail reaches that high. Their
     median does not: it moves by ``1.2533 * spread / sqrt(n)`` (``spread`` 1.4826 median absolute
     deviation), and the ground pulls it down, never up. So an aircraft 300 m above at 3 km (5.7 deg,
-    readings scattered by 3.5 deg) is above when the median of twenty readings is ``k`` of those
-    errors above the horizontal (3.7: one window in ten thousand of a level aircraft's, by chance)
-    and above ``floor_rad``, the bias the readings share (the AHRS pitch and roll errors and the
-    antenna's mounting), long before a single reading passes 8.6 deg.
+    readings scattered by 3.5 deg) is above when the median of its ``n`` readings (at least
+    ``least``) is ``k`` of those errors above the horizontal and above ``floor_rad``, the bias the
+    readings share (the AHRS pitch and roll errors and the antenna's mounting), long before a single
+    reading passes 8.6 deg. ``spread`` is taken as at least ``spread_floor_rad``, the least scatter
+    the array gives readings in the ground's band (:func:`band_elevation_sigma_rad`): a few readings
+    can agree by chance, but not more closely than the array resolves. Estimated from ten readings,
+    the spread alone falls far enough below the truth often enough that a level aircraft's median
+    would pass in about one window in four hundred; with the floor it passes in about one in three
+    thousand, as twenty readings do (3.7: one-sided 1e-4 for a known spread).
+
+    Parameters
+    ----------
+    elevation_rad : ndarray
+        The track's measured in-band elevations above the own-ship's horizontal, rad (NaN ignored).
+    k : float
+        Standard errors of the median it must lie above the horizontal.
+    floor_rad : float
+        Least median elevation, rad: the bias the readings may share.
+    least : int
+        Fewest finite readings the test is made on (never under three).
+    spread_floor_rad : float
+        Least spread of the readings, rad.
+
+    Returns
+    -------
+    bool
+        Whether the median elevation is above both bounds.
 
     Examples
     --------
@@ -269,12 +318,15 @@ def median_above(
     >>> co_altitude = np.radians(np.r_[3.5 * rng.standard_normal(17), 20.0, 25.0, 30.0])  # a burst up
     >>> median_above(co_altitude)
     False
+    >>> median_above(np.radians([6.0, 6.2, 5.9]), least=10)  # too few readings
+    False
     """
     el = np.asarray(elevation_rad, float)
     el = el[np.isfinite(el)]
-    if el.size < 3:
+    if el.size < max(int(least), 3):
         return False
     median, spread = _median_and_spread(el)
+    spread = max(spread, float(spread_floor_rad))
     return bool(median > max(k * 1.2533 * spread / np.sqrt(el.size), floor_rad))
 
 

@@ -289,7 +289,7 @@ def median_above(
     the array gives readings in the ground's band (:func:`band_elevation_sigma_rad`): a few readings
     can agree by chance, but not more closely than the array resolves. Estimated from ten readings,
     the spread alone falls far enough below the truth often enough that a level aircraft's median
-    would pass in about one window in four hundred; with the floor it passes in about one in three
+    would pass in about one window in 350; with the floor it passes in about one in three
     thousand, as twenty readings do (3.7: one-sided 1e-4 for a known spread).
 
     Parameters

@@ -362,3 +362,53 @@ def test_an_output_under_a_file_is_refused_before_any_work(tmp_path):
         result = skyradar(*args, cwd=tmp_path)
         assert_one_line_error(result, "afile", "is a file, not a folder")
     assert (tmp_path / "afile").read_text() == "not a folder"
+
+
+def _textbook_rts(t, z_pos, r_pos, z_vel, r_vel, q):
+    """The same filter and smoother in matrix form (numpy, LAPACK's inverse): the peer."""
+    n = t.size
+    first = int(np.argmax(np.isfinite(z_pos)))
+    x, p = np.array([z_pos[first], 0.0]), np.diag([1e8, 1e6])
+    xf, pf, xp, pp, total = np.zeros((n, 2)), np.zeros((n, 2, 2)), np.zeros((n, 2)), np.zeros((n, 2, 2)), 0.0
+    for k in range(n):
+        if k > 0:
+            dt = t[k] - t[k - 1]
+            f = np.array([[1.0, dt], [0.0, 1.0]])
+            x = f @ x
+            p = f @ p @ f.T + q * np.array([[dt**3 / 3, dt**2 / 2], [dt**2 / 2, dt]])
+        xp[k], pp[k] = x, p
+        for j, (z, r) in enumerate(((z_pos[k], r_pos[k]), (z_vel[k], r_vel[k]))):
+            if np.isfinite(z):
+                s = p[j, j] + r
+                if k > first:
+                    total -= 0.5 * (np.log(2 * np.pi * s) + (z - x[j]) ** 2 / s)
+                gain = p[:, j] / s
+                x = x + gain * (z - x[j])
+                p = p - np.outer(gain, p[j])
+        xf[k], pf[k] = x, p
+    xs = xf.copy()
+    for k in range(n - 2, -1, -1):
+        f = np.array([[1.0, t[k + 1] - t[k]], [0.0, 1.0]])
+        c = pf[k] @ f.T @ np.linalg.inv(pp[k + 1])
+        xs[k] = xf[k] + c @ (xs[k + 1] - xp[k + 1])
+    return xs, total
+
+
+def test_the_compiled_smoother_is_the_textbook_kalman_rts_pair():
+    """The scalar-algebra filter and RTS smoother equal the matrix form on uneven, gappy fixes."""
+    from skyradar.scene.flyable import _forward, _rts_axis
+
+    rng = np.random.default_rng(3)
+    t = np.cumsum(rng.uniform(0.2, 1.5, 200))
+    truth = 60.0 * t + 40.0 * np.sin(t / 9.0)
+    z_pos = truth + rng.normal(0.0, 25.0, t.size)
+    z_vel = 60.0 + (40.0 / 9.0) * np.cos(t / 9.0) + rng.normal(0.0, 1.5, t.size)
+    z_pos[:3] = np.nan  # the filter starts at the first finite position
+    z_pos[rng.random(t.size) < 0.2] = np.nan
+    z_vel[rng.random(t.size) < 0.3] = np.nan
+    r_pos, r_vel = np.full(t.size, 25.0**2), np.full(t.size, 1.5**2)
+    expected, expected_total = _textbook_rts(t, z_pos, r_pos, z_vel, r_vel, 0.5)
+    np.testing.assert_allclose(_rts_axis(t, z_pos, r_pos, z_vel, r_vel, 0.5), expected, rtol=1e-9, atol=1e-7)
+    assert _forward(t, z_pos, r_pos, z_vel, r_vel, 0.5)[4] == pytest.approx(expected_total, rel=1e-10)
+    # The smoother is closer to the truth than the fixes (the point of smoothing them).
+    assert np.nanmean(np.abs(expected[:, 0] - truth)) < 0.5 * np.nanmean(np.abs(z_pos - truth))

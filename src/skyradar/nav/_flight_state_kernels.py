@@ -92,21 +92,29 @@ def smallest_three(keys: np.ndarray) -> np.ndarray:
     n_rows, n = keys.shape
     out = np.empty((n_rows, 3), np.int64)
     for i in range(n_rows):
-        best = np.array([np.inf, np.inf, np.inf])
-        at = np.array([-1, -1, -1])
+        b0, b1, b2 = np.inf, np.inf, np.inf
+        a0, a1, a2 = -1, -1, -1
         for j in range(n):
             k = keys[i, j]
-            if k < best[2]:
-                if k < best[1]:
-                    best[2], at[2] = best[1], at[1]
-                    if k < best[0]:
-                        best[1], at[1] = best[0], at[0]
-                        best[0], at[0] = k, j
+            if k < b2:
+                if k < b1:
+                    b2, a2 = b1, a1
+                    if k < b0:
+                        b1, a1 = b0, a0
+                        b0, a0 = k, j
                     else:
-                        best[1], at[1] = k, j
+                        b1, a1 = k, j
                 else:
-                    best[2], at[2] = k, j
-        out[i] = np.sort(at)
+                    b2, a2 = k, j
+        # The three indices ascending: a sorting network in scalars (np.sort would compile a
+        # general sort for three numbers).
+        if a0 > a1:
+            a0, a1 = a1, a0
+        if a1 > a2:
+            a1, a2 = a2, a1
+        if a0 > a1:
+            a0, a1 = a1, a0
+        out[i, 0], out[i, 1], out[i, 2] = a0, a1, a2
     return out
 
 

@@ -267,7 +267,7 @@ def _band_pass(
         us, ws = np.empty(n_cell_max), np.empty(n_cell_max)
         scratch = np.zeros((CELL_FIELDS, cap))
         r_rx_sub, cos_sin = np.empty((rx.shape[0], cap)), np.empty((2, rx.shape[0], cap), np.float32)
-        k = 0
+        k = np.int64(0)
         for i in range(ny - 1):
             for j in range(nx - 1):
                 if _cell_behind(p_ant, i, j):
@@ -310,7 +310,7 @@ def _band_pass(
                         lo,
                         hi,
                     )
-                    k = 0
+                    k = np.int64(0)
                 _sub_centres(us, ws, nu, nw)
                 _corner_terms(p_ant, i, j, ta)
                 if use_horizon:

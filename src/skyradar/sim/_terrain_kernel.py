@@ -332,7 +332,7 @@ def terrain_returns(
         us, ws = np.empty(n_cell_max), np.empty(n_cell_max)
         scratch = np.zeros((CELL_FIELDS, cap))
         r_rx_sub, cos_sin = np.empty((rx.shape[0], cap)), np.empty((2, rx.shape[0], cap), np.float32)
-        k = 0  # items in the batch
+        k = np.int64(0)  # items in the batch (typed int64, not the literal 0: one compile of the callees)
         for i in range(blk, ny - 1, n_blocks):  # interleaved rows: blocks share the work evenly
             for j in range(nx - 1):
                 if _cell_behind(p_ant, i, j) or _cell_beyond(p_ant, i, j, r_max):
@@ -401,7 +401,7 @@ def terrain_returns(
                         blk,
                         speckle_key,
                     )
-                    k = 0
+                    k = np.int64(0)
                 # The cell's own geometry loops pay off from 16 sub-facets; below, their set-up per
                 # row costs more (30 m hill grids, ~13 a cell: 18.7 -> 10.9 ms a frame with 16, not 8).
                 if n_sub >= 16:
@@ -498,7 +498,7 @@ def _flush(
     scatter_items(out, sparse, blk, scratch, cos_sin, k)
 
 
-@njit(inline="always")
+@njit(fastmath=True, error_model="numpy")
 def _reference_cell(
     ta,
     tn,

@@ -149,9 +149,6 @@ def process(
     from skyradar.io.navigation import navigation_source
     from skyradar.io.outputs import check_output
     from skyradar.io.tables import write_table
-    from skyradar.process.detect_run import detect_run_heads, detection_summary
-    from skyradar.process.realtime import frame_latencies, realtime_summary
-    from skyradar.process.spurs import SpurMap
 
     if realtime and (scheduler is not None or workers):
         raise InputError("--realtime times frames on one processor: leave out --scheduler and --workers")
@@ -159,6 +156,11 @@ def process(
     check_output(output, [run, spur_map, dem_path, radar_config], overwrite, kind="table")
     ds = open_frames(run)
     config = _read_config(radar_config) if radar_config is not None else radar_config_of(ds, str(run))
+    # The pipeline's imports (about 1.5 s) come after the run is read: a bad run fails fast.
+    from skyradar.process.detect_run import detect_run_heads, detection_summary
+    from skyradar.process.realtime import frame_latencies, realtime_summary
+    from skyradar.process.spurs import SpurMap
+
     spurs = SpurMap.load(spur_map, config) if spur_map is not None else None
     dem = terrain_window(terrain, ds, config, run)
     bar, task = _progress(ds.sizes["time"] * len(store_heads(run) or [run]), "frames")

@@ -8,7 +8,6 @@ power and the noise per pixel change with the windows (see :mod:`skyradar.proces
 from __future__ import annotations
 
 import numpy as np
-import scipy.signal
 
 from skyradar.config import RadarConfig
 from skyradar.errors import InputError
@@ -72,6 +71,10 @@ def get_window(spec: WindowSpec, n: int) -> np.ndarray:
     >>> round(float(get_window('hann', 8).mean()), 3)
     0.5
     """
+    # Imported here: scipy.signal takes about half a second to import, which a command that stops
+    # on its input (or never makes a window) should not pay.
+    import scipy.signal
+
     name, param = _window_key(spec)
     return scipy.signal.get_window(name if param is None else (name, param), int(n), fftbins=True)
 

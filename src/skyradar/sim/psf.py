@@ -36,7 +36,6 @@ from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
-import scipy.signal
 from numba import njit, prange
 
 from skyradar.errors import InputError
@@ -63,6 +62,8 @@ _SPECKLE_STREAM = 0x5D5EC1E5A1B2C3D4  # XORed into the frame's noise key: speckl
 
 @lru_cache(maxsize=16)
 def _window(name: str, n: int) -> np.ndarray:
+    import scipy.signal  # here, not at import: see skyradar.process.windows.get_window
+
     try:
         return scipy.signal.get_window(name, int(n), fftbins=True).astype(float)
     except ValueError:

@@ -267,7 +267,7 @@ def _band_pass(
         us, ws = np.empty(n_cell_max), np.empty(n_cell_max)
         scratch = np.zeros((CELL_FIELDS, cap))
         r_rx_sub, cos_sin = np.empty((rx.shape[0], cap)), np.empty((2, rx.shape[0], cap), np.float32)
-        k = np.int64(0)
+        k = np.int64(0)  # typed int64, not the literal 0, as in terrain_returns
         for i in range(ny - 1):
             for j in range(nx - 1):
                 if _cell_behind(p_ant, i, j):
